@@ -1,0 +1,20 @@
+"""spectrinsic: spectral rendering of synthetic intrinsic-image datasets.
+
+Subpackages, in data-flow order: :mod:`spectrinsic.spectra` (measured spectra and colour maths),
+:mod:`spectrinsic.scenes` (scenes as plain data), :mod:`spectrinsic.render` (Mitsuba 3
+backends), :mod:`spectrinsic.gt_export` (ground-truth layers, writers, loader) and
+:mod:`spectrinsic.decompose` (decomposers, metrics, evaluation).
+"""
+
+from __future__ import annotations
+
+from importlib.metadata import PackageNotFoundError, version
+
+from spectrinsic.errors import SpectrinsicError, SpectrinsicWarning
+
+try:
+    __version__ = version("spectrinsic")
+except PackageNotFoundError:  # pragma: no cover - running from a source tree
+    __version__ = "0+unknown"
+
+__all__ = ["__version__", "SpectrinsicError", "SpectrinsicWarning"]

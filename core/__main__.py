@@ -1,0 +1,5 @@
+import sys
+
+from spectrinsic.cli import main
+
+sys.exit(main())

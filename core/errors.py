@@ -1,0 +1,87 @@
+"""Exceptions and warnings raised by spectrinsic.
+
+Every error raised for bad user input is a :class:`SpectrinsicError` whose message is one line
+that names the input and what was expected. Suspicious but valid input gives a
+:class:`SpectrinsicWarning`.
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Iterable
+
+__all__ = [
+    "SpectrinsicError",
+    "SpectrumNotFoundError",
+    "DataDirectoryError",
+    "SpectralDataError",
+    "SceneError",
+    "RenderError",
+    "DatasetError",
+    "MissingDependencyError",
+    "SpectrinsicWarning",
+    "validate_choice",
+    "did_you_mean",
+]
+
+
+class SpectrinsicError(Exception):
+    """Base class of every error spectrinsic raises for bad input or missing resources."""
+
+
+class SpectrumNotFoundError(SpectrinsicError, KeyError):
+    """A spectrum, sensor set or illuminant name that no registry knows."""
+
+    def __str__(self) -> str:  # KeyError would quote the message
+        return str(self.args[0]) if self.args else ""
+
+
+class DataDirectoryError(SpectrinsicError, FileNotFoundError):
+    """A spectral data directory is not configured or lacks an expected file."""
+
+
+class SpectralDataError(SpectrinsicError, ValueError):
+    """Spectral values or wavelengths that are malformed (empty, non-increasing, negative...)."""
+
+
+class SceneError(SpectrinsicError, ValueError):
+    """A scene description that is malformed or physically meaningless."""
+
+
+class RenderError(SpectrinsicError, RuntimeError):
+    """Rendering could not be carried out (no usable Mitsuba variant, failed pass...)."""
+
+
+class DatasetError(SpectrinsicError, RuntimeError):
+    """A dataset folder that is incomplete, corrupt or inconsistent with its manifest."""
+
+
+class MissingDependencyError(SpectrinsicError, ImportError):
+    """An optional dependency needed by the requested feature is not installed."""
+
+
+class SpectrinsicWarning(UserWarning):
+    """Suspicious but valid input, or a degraded mode (e.g. scalar Mitsuba variants)."""
+
+
+def did_you_mean(value: str, choices: Iterable[str], n: int = 3) -> str:
+    """Return ``" (did you mean 'a', 'b'?)"`` for close matches of *value*, or ``""``."""
+    close = difflib.get_close_matches(value, list(choices), n=n, cutoff=0.6)
+    if not close:
+        return ""
+    return " (did you mean " + ", ".join(repr(c) for c in close) + "?)"
+
+
+def validate_choice(value: str, choices: Iterable[str], what: str) -> str:
+    """Return *value* if it is one of *choices*, else raise a one-line ``ValueError``.
+
+    >>> validate_choice("rgb3", ["rgb3", "rgb6"], "render mode")
+    'rgb3'
+    """
+    choices = list(choices)
+    if value in choices:
+        return value
+    raise SpectrinsicError(
+        f"unknown {what} {value!r}; expected one of {', '.join(map(repr, choices))}"
+        + did_you_mean(value, choices)
+    )

@@ -1,0 +1,1 @@
+"""spectrinsic.gt_export"""

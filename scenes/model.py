@@ -1,0 +1,184 @@
+"""The scene model: a scene is plain data.
+
+Geometry is arrays; materials, lights and the camera are frozen records that *name* spectra
+(``"munsell:5R 4/14"``, ``"planck:2800K"``) from :mod:`spectrinsic.spectra` rather than hold
+colours, so any layer of ground truth can be recomputed from the spectra. A scene can be
+compared, hashed (:func:`scene_hash`) and written as JSON (:func:`scene_to_dict`) next to every
+rendered sample. Only :mod:`spectrinsic.render` translates a scene into a Mitsuba dict.
+
+Units: lengths in scene units (metres by convention), angles in degrees, wavelengths in nm.
+All materials are Lambertian (as in the thesis dataset).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass, field, fields, is_dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+__all__ = [
+    "Material",
+    "Mesh",
+    "Light",
+    "Camera",
+    "Scene",
+    "LightKind",
+    "scene_to_dict",
+    "scene_hash",
+]
+
+LightKind = Literal["point", "spot", "area", "directional"]
+
+
+@dataclass(frozen=True)
+class Material:
+    """A Lambertian material whose reflectance is the spectrum called *spectrum*.
+
+    Attributes
+    ----------
+    name
+        Human-readable name (``"wall"``, ``"stripe 2"``).
+    spectrum
+        Registry name of a reflectance spectrum, e.g. ``"munsell:5R 4/14"``.
+    """
+
+    name: str
+    spectrum: str
+
+
+@dataclass(frozen=True, eq=False)
+class Mesh:
+    """A triangle mesh in world space with one material index per face.
+
+    Attributes
+    ----------
+    name
+        Object name, unique in its scene.
+    vertices
+        ``(V, 3)`` float64 world-space positions.
+    faces
+        ``(F, 3)`` int64 vertex indices, counter-clockwise seen from outside.
+    face_materials
+        ``(F,)`` int64 indices into :attr:`Scene.materials`; lets one object carry several
+        exact spectra (painted stripes, patches).
+    object_id
+        Non-negative id written to the object-id ground-truth map.
+    """
+
+    name: str
+    vertices: np.ndarray
+    faces: np.ndarray
+    face_materials: np.ndarray
+    object_id: int
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Mesh):
+            return NotImplemented
+        return (
+            self.name == other.name
+            and self.object_id == other.object_id
+            and np.array_equal(self.vertices, other.vertices)
+            and np.array_equal(self.faces, other.faces)
+            and np.array_equal(self.face_materials, other.face_materials)
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+@dataclass(frozen=True)
+class Light:
+    """A light source with the relative spectral power distribution called *spectrum*.
+
+    Attributes
+    ----------
+    kind
+        ``"point"``, ``"spot"``, ``"area"`` (a rectangle) or ``"directional"``.
+    spectrum
+        Registry name of an illuminant, e.g. ``"planck:2800K"``. The registry normalises every
+        illuminant to unit luminance-weighted mean, so *power* alone sets brightness.
+    power
+        Scale on the normalised SPD: radiant intensity for point and spot lights, radiance for
+        area lights, irradiance for directional lights (relative units). Must be > 0.
+    position
+        World position (point, spot, area centre); unused for directional lights.
+    direction
+        Direction the light travels (spot, area normal, directional); unused for point lights.
+    size
+        ``(width, height)`` of an area light in scene units.
+    cutoff_deg
+        Spot cone half-angle in degrees.
+    """
+
+    kind: LightKind
+    spectrum: str
+    power: float
+    position: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    direction: tuple[float, float, float] = (0.0, 0.0, -1.0)
+    size: tuple[float, float] = (1.0, 1.0)
+    cutoff_deg: float = 30.0
+    name: str = "light"
+
+
+@dataclass(frozen=True)
+class Camera:
+    """A pinhole camera.
+
+    Attributes
+    ----------
+    origin, target, up
+        World-space eye position, look-at point and up vector.
+    fov_deg
+        Horizontal field of view in degrees.
+    width, height
+        Image size in pixels.
+    """
+
+    origin: tuple[float, float, float]
+    target: tuple[float, float, float]
+    up: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    fov_deg: float = 40.0
+    width: int = 128
+    height: int = 128
+    name: str = "view0"
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A complete renderable scene: geometry, materials, lights and one camera."""
+
+    name: str
+    meshes: tuple[Mesh, ...]
+    materials: tuple[Material, ...]
+    lights: tuple[Light, ...]
+    camera: Camera
+    metadata: dict[str, Any] = field(default_factory=dict, compare=False, hash=False)
+
+
+def _plain(value: Any) -> Any:
+    if is_dataclass(value) and not isinstance(value, type):
+        return {f.name: _plain(getattr(value, f.name)) for f in fields(value)}
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, (tuple, list)):
+        return [_plain(v) for v in value]
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def scene_to_dict(scene: Scene) -> dict[str, Any]:
+    """Return *scene* as JSON-serialisable plain data (arrays become nested lists)."""
+    return _plain(scene)
+
+
+def scene_hash(scene: Scene) -> str:
+    """SHA-256 of the scene's canonical JSON (metadata excluded): equal scenes, equal hashes."""
+    data = scene_to_dict(scene)
+    data.pop("metadata", None)
+    blob = json.dumps(data, sort_keys=True, separators=(",", ":")).encode()
+    return hashlib.sha256(blob).hexdigest()
