@@ -1,1 +1,58 @@
-"""spectrinsic.spectra"""
+"""spectrinsic.spectra: measured spectra, sensor sets and the colour maths of thesis chapters 4–5.
+
+Pure functions on arrays and small frozen records; numpy and colour-science only. Only
+:mod:`spectrinsic.spectra.io` reads files.
+"""
+
+from spectrinsic.spectra.colorimetry import (
+    LINEAR_SRGB_TO_XYZ,
+    XYZ_TO_LINEAR_SRGB,
+    absolute_reflectance,
+    diagonal_values,
+    linear_srgb_to_xyz,
+    responses,
+    xyz_to_linear_srgb,
+    xyz_to_xy,
+)
+from spectrinsic.spectra.grid import (
+    COLORIMETRIC_WAVELENGTHS,
+    DEFAULT_WAVELENGTHS,
+    resample,
+    validate_wavelengths,
+    wavelength_grid,
+)
+from spectrinsic.spectra.illuminants import ILLUMINANT_SETS, illuminant_set, planck_law
+from spectrinsic.spectra.photometric import angular_error, fit_matrix, fit_projection, sharpening_transform
+from spectrinsic.spectra.records import SensorSet, Spectrum
+from spectrinsic.spectra.registry import get_sensors, get_spectrum, list_spectra
+from spectrinsic.spectra.sensors import box_bands, gaussian_sensors
+
+__all__ = [
+    "COLORIMETRIC_WAVELENGTHS",
+    "DEFAULT_WAVELENGTHS",
+    "ILLUMINANT_SETS",
+    "LINEAR_SRGB_TO_XYZ",
+    "XYZ_TO_LINEAR_SRGB",
+    "SensorSet",
+    "Spectrum",
+    "absolute_reflectance",
+    "angular_error",
+    "box_bands",
+    "diagonal_values",
+    "fit_matrix",
+    "fit_projection",
+    "gaussian_sensors",
+    "get_sensors",
+    "get_spectrum",
+    "illuminant_set",
+    "linear_srgb_to_xyz",
+    "list_spectra",
+    "planck_law",
+    "resample",
+    "responses",
+    "sharpening_transform",
+    "validate_wavelengths",
+    "wavelength_grid",
+    "xyz_to_linear_srgb",
+    "xyz_to_xy",
+]

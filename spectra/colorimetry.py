@@ -1,0 +1,134 @@
+"""Integration of spectra against sensors, and colour-space conversions.
+
+Conventions: a *response* is ``p_k = ∫ x(λ) S_k(λ) dλ`` in nm units (the rectangle rule on the
+grid, as colour-science's ``"Integration"`` method), where ``x`` is a spectral radiance or a
+product ``f(λ) L(λ)`` (thesis Eq. 4.9). Linear sRGB is never gamma-encoded here.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from spectrinsic.errors import SpectralDataError
+from spectrinsic.spectra.grid import COLORIMETRIC_WAVELENGTHS, integration_weights
+from spectrinsic.spectra.records import Spectrum
+from spectrinsic.typing import Responses, SensorCurves, SpectralValues, Wavelengths
+
+__all__ = [
+    "XYZ_TO_LINEAR_SRGB",
+    "LINEAR_SRGB_TO_XYZ",
+    "responses",
+    "diagonal_values",
+    "xyz_to_linear_srgb",
+    "linear_srgb_to_xyz",
+    "xyz_to_xy",
+    "absolute_reflectance",
+]
+
+
+def _srgb_matrices() -> tuple[np.ndarray, np.ndarray]:
+    import colour
+
+    cs = colour.RGB_COLOURSPACES["sRGB"]
+    return np.asarray(cs.matrix_XYZ_to_RGB, float), np.asarray(cs.matrix_RGB_to_XYZ, float)
+
+
+#: IEC 61966-2-1 sRGB matrices (D65 white), from colour-science.
+XYZ_TO_LINEAR_SRGB, LINEAR_SRGB_TO_XYZ = _srgb_matrices()
+
+
+def _check(values: np.ndarray, curves: np.ndarray, wavelengths: np.ndarray) -> None:
+    if values.shape[-1] != wavelengths.size or curves.shape[-1] != wavelengths.size:
+        raise SpectralDataError(
+            f"spectra {values.shape} and sensors {curves.shape} must both end in the "
+            f"{wavelengths.size} samples of the wavelength grid"
+        )
+
+
+def responses(spectra: SpectralValues, curves: SensorCurves, wavelengths: Wavelengths) -> Responses:
+    """Sensor responses ``p_k = Σ_λ x(λ) S_k(λ) Δλ`` (thesis Eq. 4.9 / 5.5).
+
+    Parameters
+    ----------
+    spectra
+        ``(..., W)`` spectral values on *wavelengths*.
+    curves
+        ``(K, W)`` sensor sensitivities on *wavelengths*.
+    wavelengths
+        ``(W,)`` nm.
+
+    Returns
+    -------
+    ``(..., K)`` float64.
+
+    >>> wl = np.array([500.0, 505.0]); responses(np.ones(2), np.ones((1, 2)), wl)
+    array([10.])
+    """
+    x = np.asarray(spectra, float)
+    s = np.asarray(curves, float)
+    wl = np.asarray(wavelengths, float)
+    _check(x, s, wl)
+    return (x * integration_weights(wl)) @ s.T
+
+
+def diagonal_values(spectra: SpectralValues, curves: SensorCurves, wavelengths: Wavelengths) -> Responses:
+    """Channel values of a K-channel diagonal render: ``∫ f S_k dλ / ∫ S_k dλ`` (Eq. 5.4, normalised).
+
+    With material values from this function and light values ``∫ L S_k dλ`` (:func:`responses`),
+    their product approximates ``∫ f L S_k dλ`` (Eq. 5.2) whatever the scale of each sensor.
+    """
+    s = np.asarray(curves, float)
+    area = responses(np.ones(s.shape[-1]), s, wavelengths)
+    if np.any(area == 0):
+        raise SpectralDataError("a sensor has zero area on the wavelength grid")
+    return responses(spectra, s, wavelengths) / area
+
+
+def xyz_to_linear_srgb(xyz: np.ndarray) -> np.ndarray:
+    """CIE XYZ (..., 3) to linear sRGB (..., 3) with the IEC 61966-2-1 matrix; no gamma."""
+    return np.asarray(xyz, float) @ XYZ_TO_LINEAR_SRGB.T
+
+
+def linear_srgb_to_xyz(rgb: np.ndarray) -> np.ndarray:
+    """Linear sRGB (..., 3) to CIE XYZ (..., 3)."""
+    return np.asarray(rgb, float) @ LINEAR_SRGB_TO_XYZ.T
+
+
+def xyz_to_xy(xyz: np.ndarray) -> np.ndarray:
+    """CIE 1931 xy chromaticity of XYZ (..., 3); black maps to (0, 0)."""
+    xyz = np.asarray(xyz, float)
+    s = xyz.sum(axis=-1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        xy = np.where(s > 0, xyz[..., :2] / np.where(s == 0, 1, s), 0.0)
+    return xy
+
+
+def absolute_reflectance(
+    reflectances: Spectrum | str | Sequence[Spectrum | str],
+    *,
+    data_dir: str | None = None,
+) -> np.ndarray:
+    """Absolute reflectance: linear sRGB of reflectances under D65 with sRGB sensors.
+
+    The thesis' canonical conditions (section 4.2, ``p^{s,c}``): ``XYZ = Σ ρ E_D65 x̄ Δλ /
+    Σ E_D65 ȳ Δλ`` on the 1 nm CIE grid (360–830 nm), then the sRGB matrix, so the perfect white
+    is ``(1, 1, 1)``.
+
+    Returns
+    -------
+    ``(3,)`` for one spectrum, ``(N, 3)`` for a sequence; float64, linear sRGB.
+    """
+    from spectrinsic.spectra.registry import get_sensors, get_spectrum
+
+    single = isinstance(reflectances, (Spectrum, str))
+    items = [reflectances] if single else list(reflectances)  # type: ignore[list-item]
+    spectra = [get_spectrum(s, data_dir=data_dir) if isinstance(s, str) else s for s in items]
+    wl = COLORIMETRIC_WAVELENGTHS
+    cmf = get_sensors("cie1931").on(wl)
+    d65 = get_spectrum("cie:D65").on(wl)
+    rho = np.stack([s.on(wl) for s in spectra]) if spectra else np.zeros((0, wl.size))
+    xyz = responses(rho * d65, cmf, wl) / responses(d65, cmf[1:2], wl)
+    rgb = xyz_to_linear_srgb(xyz)
+    return rgb[0] if single else rgb

@@ -1,0 +1,148 @@
+"""Illuminant spectral power distributions.
+
+Every illuminant is normalised to unit luminance-weighted mean, ``Σ L(λ) ȳ(λ) = Σ ȳ(λ)`` on
+its own grid, so that a perfect white under any light has luminance Y = 1 and a light's
+brightness is set only by its ``power``.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from spectrinsic.errors import SpectralDataError, SpectrumNotFoundError, did_you_mean, validate_choice
+from spectrinsic.spectra import io
+from spectrinsic.spectra.grid import wavelength_grid
+from spectrinsic.spectra.records import Spectrum
+
+__all__ = [
+    "planck_law",
+    "planckian",
+    "daylight",
+    "cie_illuminant",
+    "light_source",
+    "sfu_illuminant",
+    "normalise_illuminant",
+    "illuminant_set",
+    "ILLUMINANT_SETS",
+]
+
+#: Named sets of 5 like thesis Appendix B, drawn from what the dependencies ship. Planckian:
+#: a wide range of common colour temperatures. Non-Planckian: fluorescent (broadband, narrow
+#: tri-band), an RGB LED, a high-pressure sodium and a phosphor LED.
+ILLUMINANT_SETS: dict[str, tuple[str, ...]] = {
+    "planckian": ("planck:2000K", "planck:2800K", "planck:4000K", "planck:6500K", "planck:10000K"),
+    "non-planckian": ("cie:FL2", "cie:FL11", "cie:LED-RGB1", "cie:HP1", "cie:LED-B3"),
+}
+
+
+def illuminant_set(name: str) -> tuple[str, ...]:
+    """The 5 spectrum names of set ``"planckian"`` or ``"non-planckian"``."""
+    return ILLUMINANT_SETS[validate_choice(name, ILLUMINANT_SETS, "illuminant set")]
+
+
+@functools.lru_cache(maxsize=1)
+def _ybar() -> tuple[np.ndarray, np.ndarray]:
+    import colour
+
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+    return np.asarray(cmfs.wavelengths, float), np.asarray(cmfs.values[:, 1], float)
+
+
+def normalise_illuminant(wavelengths: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Scale *values* so that ``Σ L ȳ = Σ ȳ`` over *wavelengths* (ȳ: CIE 1931 2°)."""
+    wl_y, y = _ybar()
+    ybar = np.interp(wavelengths, wl_y, y, left=0.0, right=0.0)
+    lum = float(np.sum(values * ybar))
+    if not lum > 0:
+        raise SpectralDataError("illuminant has no power where the eye is sensitive (380-780 nm)")
+    return values * (float(np.sum(ybar)) / lum)
+
+
+def _illuminant(name: str, wl: np.ndarray, values: np.ndarray, source: str) -> Spectrum:
+    wl = np.asarray(wl, float)
+    return Spectrum(name, "illuminant", wl, normalise_illuminant(wl, np.asarray(values, float)), source)
+
+
+def planck_law(wavelengths_nm: np.ndarray, temperature: float) -> np.ndarray:
+    """Spectral radiance of a black body, W·sr⁻¹·m⁻²·m⁻¹, at wavelengths in nm (thesis Eq. B.1).
+
+    ``R(λ, T) = c1 λ⁻⁵ / (exp(c2 / (λ T)) − 1)`` with c1 = 2hc² (radiance; the exitance form's
+    2πhc² divided by π) and c2 = 1.4388e-2 m·K (CIE 015:2018), evaluated by colour-science's ``planck_law`` on λ in
+    metres. Only the shape matters downstream: illuminants are normalised.
+    """
+    import colour
+
+    if not temperature > 0:
+        raise SpectralDataError(f"Planckian temperature {temperature!r} K: expected T > 0")
+    wl = np.asarray(wavelengths_nm, float)
+    values = colour.colorimetry.planck_law(wl.ravel() * 1e-9, float(temperature))
+    return np.asarray(values, float).reshape(wl.shape)
+
+
+def _kelvin(key: str, what: str) -> float:
+    text = key.strip().upper().removesuffix("K").strip()
+    try:
+        t = float(text)
+    except ValueError:
+        raise SpectrumNotFoundError(f"{what} {key!r}: expected a temperature like '2800K'") from None
+    if not t > 0:
+        raise SpectralDataError(f"{what} {key!r}: temperature must be > 0 K")
+    return t
+
+
+def planckian(key: str) -> Spectrum:
+    """A black body at a temperature, e.g. ``"2800K"`` (360–830 nm at 1 nm)."""
+    t = _kelvin(key, "Planckian temperature")
+    wl = wavelength_grid(360.0, 830.0, 1.0)
+    return _illuminant(f"planck:{t:g}K", wl, planck_law(wl, t), "Planck's law (thesis Eq. B.1)")
+
+
+def daylight(key: str) -> Spectrum:
+    """CIE daylight (D-series) at a correlated colour temperature, e.g. ``"6500K"`` (4000–25000 K)."""
+    import colour
+
+    t = _kelvin(key, "daylight CCT")
+    if not 4000 <= t <= 25000:
+        raise SpectralDataError(f"daylight CCT {key!r}: CIE daylight is defined for 4000-25000 K")
+    xy = colour.temperature.CCT_to_xy_CIE_D(t)
+    sd = colour.sd_CIE_illuminant_D_series(xy)
+    return _illuminant(f"daylight:{t:g}K", sd.wavelengths, sd.values, "CIE 015:2018 daylight")
+
+
+def cie_illuminant(key: str) -> Spectrum:
+    """A CIE standard illuminant shipped by colour-science: A, D50, D65, FL1–FL12, LED-*, HP*..."""
+    import colour
+
+    sds = colour.SDS_ILLUMINANTS
+    if key not in sds:
+        raise SpectrumNotFoundError(f"unknown CIE illuminant {key!r}" + did_you_mean(key, sds))
+    sd = sds[key]
+    return _illuminant(f"cie:{key}", sd.wavelengths, sd.values, "CIE illuminants via colour-science")
+
+
+def light_source(key: str) -> Spectrum:
+    """A measured light source from colour-science's ``SDS_LIGHT_SOURCES``."""
+    import colour
+
+    sds = colour.SDS_LIGHT_SOURCES
+    if key not in sds:
+        raise SpectrumNotFoundError(f"unknown light source {key!r}" + did_you_mean(key, sds))
+    sd = sds[key]
+    return _illuminant(f"light:{key}", sd.wavelengths, sd.values, "colour-science SDS_LIGHT_SOURCES")
+
+
+def sfu_illuminant(key: str, data_dir: str | None = None) -> Spectrum:
+    """An SFU illuminant by id: ``"mws_081"`` (measured + lab sources) or ``"train_001"``."""
+    table = io.read_sfu_illuminants(data_dir)
+    if key not in table.labels:
+        raise SpectrumNotFoundError(
+            f"unknown SFU illuminant {key!r}; expected 'mws_000'..'mws_101' or 'train_001'..'train_087'"
+            + did_you_mean(key, table.labels)
+        )
+    i = table.labels.index(key)
+    return _illuminant(
+        f"sfu-illum:{key}", table.wavelengths, table.values[i],
+        "Barnard et al., Color Res. Appl. 27(3):147-151, 2002",
+    )

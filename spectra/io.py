@@ -1,0 +1,166 @@
+"""Readers for spectral data files: the only module of :mod:`spectrinsic.spectra` that reads files.
+
+Sources
+-------
+* Munsell: the 1269 matte Munsell chips measured at the University of Eastern Finland
+  (Parkkinen, Hallikainen & Jaaskelainen 1989), as shipped in the ``luxpy`` wheel
+  (``luxpy/data/rfls/Munsell1269.dat``, 380–800 nm at 1 nm). luxpy is located, never imported.
+* SFU: Barnard, Martin, Funt & Coath, "A Data Set for Colour Research", Color Res. Appl.
+  27(3):147–151, 2002, read from a configured data directory.
+* Cameras: Jiang, Liu, Gu & Süsstrunk, WACV 2013 (28 cameras, CC BY-NC-SA 4.0) and Image
+  Engineering 2024 (98 entries), read from a configured data directory.
+"""
+
+from __future__ import annotations
+
+import csv
+import functools
+import importlib.util
+import os
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+
+from spectrinsic.config import require_data_file
+from spectrinsic.errors import DataDirectoryError, SpectralDataError
+from spectrinsic.spectra.grid import validate_wavelengths
+
+__all__ = [
+    "Table",
+    "luxpy_data_file",
+    "read_munsell",
+    "read_spectra_csv",
+    "read_sfu_reflectances",
+    "read_sfu_illuminants",
+    "read_camera_table",
+    "read_user_csv",
+]
+
+
+class Table(NamedTuple):
+    """Spectra sharing one grid: ``wavelengths`` (W,) nm, ``values`` (N, W), ``labels`` (N,)."""
+
+    wavelengths: np.ndarray
+    values: np.ndarray
+    labels: tuple[str, ...]
+
+
+def luxpy_data_file(*parts: str) -> Path:
+    """Path of a data file inside the installed ``luxpy`` package, found without importing it.
+
+    Importing luxpy unpickles look-up tables that need numpy >= 2; only its data files are needed.
+    """
+    spec = importlib.util.find_spec("luxpy")
+    if spec is None or not spec.submodule_search_locations:
+        raise DataDirectoryError("the 'luxpy' package (which ships the Munsell spectra) is not installed")
+    path = Path(next(iter(spec.submodule_search_locations)), "data", *parts)
+    if not path.is_file():
+        raise DataDirectoryError(f"luxpy installation lacks the expected file {str(path)!r}")
+    return path
+
+
+@functools.lru_cache(maxsize=1)
+def read_munsell() -> tuple[Table, tuple[tuple[str, float, float], ...]]:
+    """The 1269 matte Munsell reflectances and their notations ``(hue, value, chroma)``."""
+    data = np.loadtxt(luxpy_data_file("rfls", "Munsell1269.dat"), delimiter=",")
+    wl, values = data[:, 0], data[:, 1:].T.copy()
+    notations: list[tuple[str, float, float]] = []
+    with luxpy_data_file("rfls", "Munsell1269NotationInfo.dat").open(newline="") as fh:
+        reader = csv.reader(fh)
+        next(reader)
+        for row in reader:
+            notations.append((row[1].strip(), float(row[2]), float(row[3])))
+    if values.shape[0] != len(notations):
+        raise SpectralDataError(
+            f"Munsell1269.dat holds {values.shape[0]} spectra but its notation file {len(notations)}"
+        )
+    labels = tuple(f"#{i}" for i in range(values.shape[0]))
+    return Table(wl, values, labels), tuple(notations)
+
+
+def read_spectra_csv(path: str | os.PathLike[str]) -> Table:
+    """A CSV with a header row, first column ``wavelength_nm``, one column per spectrum.
+
+    Empty cells (not measured) are read as NaN.
+    """
+    path = Path(path)
+    with path.open(newline="", encoding="utf-8") as fh:
+        rows = list(csv.reader(fh))
+    if len(rows) < 3:
+        raise SpectralDataError(f"{path}: expected a header row and at least 2 wavelength rows")
+    header, body = rows[0], rows[1:]
+    try:
+        arr = np.array([[float(c) if c.strip() else np.nan for c in r] for r in body if r])
+    except ValueError as exc:
+        raise SpectralDataError(f"{path}: non-numeric value ({exc})") from None
+    wl = validate_wavelengths(arr[:, 0], what=str(path))
+    return Table(wl, arr[:, 1:].T.copy(), tuple(h.strip() for h in header[1:]))
+
+
+@functools.lru_cache(maxsize=4)
+def read_sfu_reflectances(data_dir: str | None) -> tuple[Table, tuple[tuple[str, int], ...]]:
+    """The 1995 SFU reflectances and ``(group, index_in_group)`` per spectrum (1-based index)."""
+    table = read_spectra_csv(require_data_file("sfu_barnard2002/reflect_db_1995.csv", data_dir))
+    index_path = require_data_file("sfu_barnard2002/reflect_db_index.csv", data_dir)
+    with index_path.open(newline="", encoding="utf-8") as fh:
+        keys = tuple((r["group"], int(r["index_in_group"])) for r in csv.DictReader(fh))
+    if len(keys) != table.values.shape[0]:
+        raise SpectralDataError(f"{index_path}: {len(keys)} rows for {table.values.shape[0]} spectra")
+    return table, keys
+
+
+@functools.lru_cache(maxsize=4)
+def read_sfu_illuminants(data_dir: str | None) -> Table:
+    """SFU illuminants: the 102 measured + lab sources (``mws_NNN``) and 87 training (``train_NNN``).
+
+    Labels are the ids before any ``": name"`` suffix.
+    """
+    a = read_spectra_csv(require_data_file("sfu_barnard2002/measured_with_sources_102.csv", data_dir))
+    b = read_spectra_csv(require_data_file("sfu_barnard2002/train_illum_87.csv", data_dir))
+    if not np.array_equal(a.wavelengths, b.wavelengths):
+        raise SpectralDataError("SFU illuminant files disagree in wavelengths")
+    labels = tuple(lbl.split(":")[0].strip() for lbl in a.labels + b.labels)
+    return Table(a.wavelengths, np.vstack([a.values, b.values]), labels)
+
+
+@functools.lru_cache(maxsize=8)
+def read_camera_table(data_dir: str | None, relative: str) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Cameras from a ``<camera>_R/_G/_B`` CSV: name -> (wavelengths (W,), curves (3, W)).
+
+    Cells not measured (empty) become 0: they lie beyond ~760 nm where sensors hardly respond.
+    """
+    table = read_spectra_csv(require_data_file(relative, data_dir))
+    cams: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    for i in range(0, len(table.labels) - 2, 3):
+        names = table.labels[i : i + 3]
+        if not (names[0].endswith("_R") and names[1].endswith("_G") and names[2].endswith("_B")):
+            raise SpectralDataError(f"{relative}: columns {names} are not an _R/_G/_B triple")
+        curves = np.nan_to_num(table.values[i : i + 3], nan=0.0)
+        cams[names[0][:-2]] = (table.wavelengths, curves)
+    return cams
+
+
+def read_user_csv(path: str | os.PathLike[str], *, kind: str) -> Table:
+    """A user's spectra CSV (``wavelength_nm`` then one column per spectrum or sensor).
+
+    Raises
+    ------
+    SpectralDataError
+        On a missing file, an empty or non-increasing wavelength column, NaNs, or negative
+        values (sensitivities and reflectances cannot be negative).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise SpectralDataError(f"{kind} file {str(path)!r} does not exist")
+    table = read_spectra_csv(path)
+    if table.values.size == 0:
+        raise SpectralDataError(f"{path}: expected at least one {kind} column after the wavelengths")
+    if not np.all(np.isfinite(table.values)):
+        raise SpectralDataError(f"{path}: {kind} values must all be finite numbers")
+    if np.any(table.values < 0):
+        col = int(np.argwhere(table.values < 0)[0, 0])
+        raise SpectralDataError(
+            f"{path}: negative {kind} values in column {table.labels[col]!r}; expected values >= 0"
+        )
+    return table

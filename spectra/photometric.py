@@ -1,0 +1,107 @@
+"""The photometric model of thesis chapter 4: ``I = L_CLig · S_Sen · (I_Shad ∘ I_Refl^a + I_Spec)``.
+
+3×3 matrices act on column vectors of responses: ``p = M @ q``. ``S_Sen`` maps canonical
+(D65, sRGB) values to a camera's values under D65, ``L_CLig`` maps a camera's values under D65 to
+its values under the scene light (section 4.4.1), both fitted by least squares.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from spectrinsic.errors import SpectralDataError
+from spectrinsic.typing import Matrix3, SensorCurves, Wavelengths
+
+__all__ = ["fit_matrix", "fit_projection", "sharpening_transform", "angular_error"]
+
+
+def _pairs(src: np.ndarray, dst: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    a = np.asarray(src, float).reshape(-1, np.shape(src)[-1])
+    b = np.asarray(dst, float).reshape(-1, np.shape(dst)[-1])
+    if a.shape[0] != b.shape[0] or a.shape[0] < a.shape[1]:
+        raise SpectralDataError(
+            f"matrix fit needs as many source as target samples, at least {a.shape[1]}; "
+            f"got {a.shape} and {b.shape}"
+        )
+    return a, b
+
+
+def fit_matrix(src: np.ndarray, dst: np.ndarray, *, diagonal: bool = False) -> Matrix3:
+    """Least-squares ``M`` (3×3) with ``dst ≈ src @ M.T`` (i.e. ``p_dst = M p_src``).
+
+    Parameters
+    ----------
+    src, dst
+        ``(N, 3)`` responses of the same surfaces in two conditions.
+    diagonal
+        Fit a diagonal (von Kries) model ``m_k = Σ src_k dst_k / Σ src_k²`` instead of a full one.
+
+    >>> q = np.random.default_rng(0).random((20, 3)); M = np.diag([2.0, 1.0, 0.5])
+    >>> bool(np.allclose(fit_matrix(q, q @ M.T), M))
+    True
+    """
+    a, b = _pairs(src, dst)
+    if diagonal:
+        return np.diag((a * b).sum(axis=0) / (a * a).sum(axis=0))
+    x, *_ = np.linalg.lstsq(a, b, rcond=None)
+    return x.T
+
+
+def fit_projection(src: np.ndarray, dst: np.ndarray) -> np.ndarray:
+    """Least-squares linear regression ``P`` (3×K) with ``dst ≈ src @ P.T``.
+
+    Projects K-sensor responses (e.g. the 6 sensors of the thesis' two-pass method) back to
+    3 channels (XYZ or linear sRGB), section 5.2.3.
+    """
+    a, b = _pairs(src, dst)
+    x, *_ = np.linalg.lstsq(a, b, rcond=None)
+    return x.T
+
+
+def sharpening_transform(
+    curves: SensorCurves,
+    wavelengths: Wavelengths,
+    *,
+    intervals: tuple[tuple[float, float], ...] | None = None,
+) -> np.ndarray:
+    """Sensor-based spectral sharpening (Finlayson, Drew & Funt 1994), thesis section 4.2.3.
+
+    For each sensor k, the combination ``t_k · S`` with the smallest fraction of its squared
+    sensitivity outside the interval ``intervals[k]`` (a generalised eigenproblem). Returns
+    ``T`` (K×K) with sharpened curves ``T @ curves``; each row is signed so its curve peaks
+    positive. Default intervals split the sensors' joint support into K equal parts.
+    """
+    from scipy.linalg import eigh
+
+    s = np.asarray(curves, float)
+    wl = np.asarray(wavelengths, float)
+    k = s.shape[0]
+    if intervals is None:
+        support = wl[np.any(np.abs(s) > 1e-6 * np.abs(s).max(), axis=0)]
+        edges = np.linspace(support.min(), support.max(), k + 1)
+        intervals = tuple((edges[i], edges[i + 1]) for i in range(k))
+    gram_all = (s * np.gradient(wl)) @ s.T
+    t = np.empty((k, k))
+    for i, (lo, hi) in enumerate(intervals):
+        inside = (wl >= lo) & (wl <= hi)
+        gram_in = (s[:, inside] * np.gradient(wl)[inside]) @ s[:, inside].T
+        _, vecs = eigh(gram_all - gram_in, gram_all)
+        v = vecs[:, 0]
+        curve = v @ s
+        t[i] = v if curve[np.argmax(np.abs(curve))] > 0 else -v
+    return t
+
+
+def angular_error(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Angle in degrees between colour vectors (thesis Eq. 4.31): ``acos(a·b / (|a||b|))``.
+
+    >>> float(angular_error(np.array([1.0, 0, 0]), np.array([0, 1.0, 0])))
+    90.0
+    """
+    a = np.asarray(a, float)
+    b = np.asarray(b, float)
+    num = (a * b).sum(axis=-1)
+    den = np.linalg.norm(a, axis=-1) * np.linalg.norm(b, axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cos = np.clip(num / den, -1.0, 1.0)
+    return np.degrees(np.arccos(cos))

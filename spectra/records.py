@@ -1,0 +1,84 @@
+"""Frozen records for spectra and sensor sets."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from spectrinsic.spectra.grid import resample
+from spectrinsic.typing import SensorCurves, SpectralValues, Wavelengths
+
+__all__ = ["Spectrum", "SensorSet", "SpectrumKind"]
+
+SpectrumKind = Literal["reflectance", "illuminant"]
+
+
+@dataclass(frozen=True, eq=False)
+class Spectrum:
+    """A measured or computed spectrum on its own wavelength grid.
+
+    Attributes
+    ----------
+    name
+        Canonical registry name, e.g. ``"munsell:5R 4/14"``.
+    kind
+        ``"reflectance"`` (fraction in [0, 1]) or ``"illuminant"`` (relative spectral power,
+        normalised to unit luminance-weighted mean: ``Σ L ȳ = Σ ȳ`` on its grid).
+    wavelengths
+        ``(W,)`` nm, strictly increasing.
+    values
+        ``(W,)`` float64.
+    source
+        Citation of the data.
+    """
+
+    name: str
+    kind: SpectrumKind
+    wavelengths: Wavelengths
+    values: SpectralValues
+    source: str = field(default="", repr=False)
+
+    def on(self, wavelengths: Wavelengths) -> SpectralValues:
+        """Values resampled onto *wavelengths* (nm), edge values held beyond the data."""
+        return resample(self.wavelengths, self.values, wavelengths, outside="hold")
+
+
+@dataclass(frozen=True, eq=False)
+class SensorSet:
+    """K sensor sensitivity curves (a camera, an observer, Gaussian or box bands).
+
+    Attributes
+    ----------
+    name
+        Canonical registry name, e.g. ``"gaussian:6@400-700"``.
+    channels
+        One label per curve, e.g. ``("R", "G", "B")``.
+    wavelengths
+        ``(W,)`` nm.
+    curves
+        ``(K, W)`` float64 relative sensitivities (may be negative for ``"srgb"``, whose curves
+        are a linear transform of the CIE 1931 colour-matching functions).
+    source
+        Citation of the data.
+    """
+
+    name: str
+    channels: tuple[str, ...]
+    wavelengths: Wavelengths
+    curves: SensorCurves
+    source: str = field(default="", repr=False)
+
+    @property
+    def n(self) -> int:
+        """Number of sensors K."""
+        return len(self.channels)
+
+    def on(self, wavelengths: Wavelengths) -> SensorCurves:
+        """``(K, W')`` curves resampled onto *wavelengths*, zero outside the measured range."""
+        return resample(self.wavelengths, self.curves, wavelengths, outside="zero")
+
+    def __repr__(self) -> str:
+        lo, hi = float(np.min(self.wavelengths)), float(np.max(self.wavelengths))
+        return f"SensorSet({self.name!r}, channels={self.channels}, {lo:g}-{hi:g} nm)"

@@ -1,0 +1,128 @@
+"""One registry of spectra and sensor sets with names people can type.
+
+A name is ``family:key``. Reflectances and illuminants (:func:`get_spectrum`):
+
+============  ====================================  ===========================================
+family        example                               source
+============  ====================================  ===========================================
+munsell       ``munsell:5R 4/14``, ``munsell:#12``  1269 matte Munsell chips (luxpy wheel)
+colorchecker  ``colorchecker:dark skin``            BabelColor average (colour-science)
+sfu           ``sfu:munsell/17``, ``sfu:krinov/3``  Barnard et al. 2002 (data directory)
+flat          ``flat:0.5``                          spectrally flat grey
+planck        ``planck:2800K``                      Planck's law (Eq. B.1)
+daylight      ``daylight:6500K``                    CIE D-series at any CCT
+cie           ``cie:D65``, ``cie:FL11``             colour-science ``SDS_ILLUMINANTS``
+light         ``light:Cool White FL``               colour-science ``SDS_LIGHT_SOURCES``
+sfu-illum     ``sfu-illum:mws_090``                 Barnard et al. 2002 (data directory)
+============  ====================================  ===========================================
+
+Sensor sets (:func:`get_sensors`): ``cie1931``, ``srgb``, ``gaussian:6@400-700``,
+``bands:31@400-700``, ``camera:Nikon 5100 (NPL)``, ``csv:/path/to/file.csv``.
+
+Everything is loaded lazily on first use.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+
+from spectrinsic.config import resolve_data_dir
+from spectrinsic.errors import SpectrumNotFoundError, did_you_mean
+from spectrinsic.spectra import illuminants, reflectances, sensors
+from spectrinsic.spectra.records import SensorSet, Spectrum
+
+__all__ = ["get_spectrum", "get_sensors", "list_spectra", "SPECTRUM_FAMILIES", "SENSOR_FAMILIES"]
+
+DataDir = str | os.PathLike[str] | None
+
+
+
+
+#: family -> loader(key, data_dir)
+SPECTRUM_FAMILIES: dict[str, Callable[[str, str | None], Spectrum]] = {
+    "munsell": lambda k, d: reflectances.munsell(k),
+    "colorchecker": lambda k, d: reflectances.colorchecker(k),
+    "sfu": reflectances.sfu_reflectance,
+    "flat": lambda k, d: reflectances.flat(k),
+    "planck": lambda k, d: illuminants.planckian(k),
+    "daylight": lambda k, d: illuminants.daylight(k),
+    "cie": lambda k, d: illuminants.cie_illuminant(k),
+    "light": lambda k, d: illuminants.light_source(k),
+    "sfu-illum": illuminants.sfu_illuminant,
+}
+
+#: family -> loader(key, data_dir); families without a key take an empty key.
+SENSOR_FAMILIES: dict[str, Callable[[str, str | None], SensorSet]] = {
+    "cie1931": lambda k, d: sensors.cie1931(),
+    "srgb": lambda k, d: sensors.srgb(),
+    "gaussian": lambda k, d: sensors.gaussian(k),
+    "bands": lambda k, d: sensors.bands(k),
+    "camera": sensors.camera,
+    "csv": lambda k, d: sensors.user_csv(k),
+}
+
+
+def _split(name: str, families: dict[str, object], what: str) -> tuple[str, str]:
+    if not isinstance(name, str) or not name.strip():
+        raise SpectrumNotFoundError(f"{what} name {name!r}: expected 'family:key', e.g. 'munsell:5R 4/14'")
+    family, sep, key = name.strip().partition(":")
+    family = family.strip().lower()
+    if family not in families:
+        raise SpectrumNotFoundError(
+            f"unknown {what} family {family!r} in {name!r}; expected one of "
+            f"{', '.join(sorted(families))}" + did_you_mean(family, families)
+        )
+    return family, key.strip() if sep else ""
+
+
+def _data(data_dir: DataDir) -> str | None:
+    root = resolve_data_dir(data_dir)
+    return None if root is None else str(root)
+
+
+def get_spectrum(name: str, *, data_dir: DataDir = None) -> Spectrum:
+    """Return the reflectance or illuminant called *name* (see the module table).
+
+    Raises
+    ------
+    SpectrumNotFoundError
+        Unknown family or key, with close matches suggested.
+    DataDirectoryError
+        A data-directory family (``sfu``, ``sfu-illum``) without a configured directory.
+    """
+    family, key = _split(name, SPECTRUM_FAMILIES, "spectrum")
+    return SPECTRUM_FAMILIES[family](key, _data(data_dir) if family.startswith("sfu") else None)
+
+
+def get_sensors(name: str, *, data_dir: DataDir = None) -> SensorSet:
+    """Return the sensor set called *name*, e.g. ``"gaussian:6@400-700"`` or ``"camera:Nikon D50"``."""
+    family, key = _split(name, SENSOR_FAMILIES, "sensor set")
+    return SENSOR_FAMILIES[family](key, _data(data_dir) if family == "camera" else None)
+
+
+def list_spectra(family: str, *, data_dir: DataDir = None) -> list[str]:
+    """Full names of every spectrum of an enumerable family.
+
+    Enumerable: ``munsell``, ``colorchecker``, ``sfu``, ``cie``, ``light``, ``sfu-illum``,
+    ``camera`` (sensor sets). ``planck``, ``daylight`` and ``flat`` are continuous.
+    """
+    import colour
+
+    from spectrinsic.spectra import io
+
+    listing: dict[str, Callable[[], list[str]]] = {
+        "munsell": reflectances.munsell_names,
+        "colorchecker": reflectances.colorchecker_names,
+        "sfu": lambda: reflectances.sfu_reflectance_names(_data(data_dir)),
+        "cie": lambda: list(colour.SDS_ILLUMINANTS),
+        "light": lambda: list(colour.SDS_LIGHT_SOURCES),
+        "sfu-illum": lambda: list(io.read_sfu_illuminants(_data(data_dir)).labels),
+        "camera": lambda: sensors.camera_names(_data(data_dir)),
+    }
+    if family not in listing:
+        raise SpectrumNotFoundError(
+            f"family {family!r} cannot be listed; expected one of {', '.join(listing)}"
+            + did_you_mean(family, listing)
+        )
+    return [f"{family}:{k}" for k in listing[family]()]
