@@ -1,0 +1,39 @@
+"""``make bench``: run every benchmark module and write its results as JSON.
+
+Each ``spectrinsic.bench_<name>`` module exposes ``run(out_dir) -> dict``. Results are ratios
+measured within one run where possible, so they compare across machines.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import sys
+import time
+from pathlib import Path
+
+BENCHMARKS = ("bench_render", "bench_dataset", "bench_decompose")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m spectrinsic.bench")
+    parser.add_argument("--out", default="bench", help="folder for the JSON results")
+    parser.add_argument("--only", nargs="*", choices=BENCHMARKS, help="run only these")
+    args = parser.parse_args(argv)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    summary = {}
+    for name in args.only or BENCHMARKS:
+        start = time.perf_counter()
+        result = importlib.import_module(f"spectrinsic.{name}").run(out)
+        result["wall_seconds"] = time.perf_counter() - start
+        (out / f"{name}.json").write_text(json.dumps(result, indent=2, default=str))
+        summary[name] = result
+        print(f"{name}: {json.dumps(result, default=str)[:2000]}")
+    (out / "summary.json").write_text(json.dumps(summary, indent=2, default=str))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
