@@ -10,7 +10,7 @@ PACKAGES := core spectra scenes render gt_export decompose
 # the files present at install time, so the package is relinked then.
 PKG_DIRS := $(shell find $(PACKAGES) -type d -not -name __pycache__ 2>/dev/null)
 # Optional: OUT, PRESET, DATASET, DATA_DIR (spectral data directory, default ../shared/data if present)
-DATA_DIR ?= $(firstword $(wildcard ../shared/data))
+DATA_DIR ?= $(abspath $(firstword $(wildcard ../shared/data)))
 export PYTHONSAFEPATH := 1
 export SPECTRINSIC_DATA ?= $(DATA_DIR)
 

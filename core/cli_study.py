@@ -1,0 +1,122 @@
+"""``spectrinsic study``: the thesis' studies, printed and written as JSON, CSV and PNG.
+
+* ``reconstruction-error``: Table 5.2 and its extension (:mod:`spectrinsic.study_reconstruction`);
+* ``photometric``: Table 4.4 (:mod:`spectrinsic.study_photometric`);
+* ``rendering``: the rendering study (:mod:`spectrinsic.study_rendering`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+__all__ = ["register", "run", "STUDIES"]
+
+STUDIES: tuple[str, ...] = ("reconstruction-error", "photometric", "rendering")
+
+#: Root seed of the photometric study's random scenes unless ``--seed`` is given.
+DEFAULT_SEED = 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "study", help="run a study of the thesis (Table 5.2, Table 4.4, rendering)",
+        description="Run a study, print its table and write JSON, CSV and PNG files into --out.",
+    )
+    p.add_argument("study", choices=STUDIES, help="which study")
+    p.add_argument("--out", type=Path, default=Path("results"), help="output folder (default: results)")
+    p.add_argument("--seed", type=int, default=DEFAULT_SEED,
+                   help=f"root seed of random choices (default: {DEFAULT_SEED})")
+    p.add_argument("--include-ie", action="store_true",
+                   help="photometric: add the Image Engineering 2024 cameras of the data directory")
+    p.add_argument("--no-extension", action="store_true",
+                   help="reconstruction-error: only Table 5.2, without the extended sweep")
+    p.add_argument("--quality", default="preview", help="rendering: quality preset (default: preview)")
+    p.set_defaults(func=run)
+
+
+@contextmanager
+def _progress(quiet: bool, what: str) -> Iterator[Callable[..., None]]:
+    """A progress callback (a tqdm bar on stderr, or nothing with -q)."""
+    if quiet:
+        yield lambda *a, **k: None
+        return
+    from tqdm import tqdm
+
+    bar = tqdm(desc=what, unit="step", file=sys.stderr, leave=False)
+
+    def step(message: Any = None, *_: Any, **__: Any) -> None:
+        if message is not None:
+            bar.set_postfix_str(str(message)[:60], refresh=False)
+        bar.update(1)
+
+    try:
+        yield step
+    finally:
+        bar.close()
+
+
+def _print_paths(paths: dict[str, Path]) -> None:
+    for path in paths.values():
+        print(f"wrote {path}")
+
+
+def run(args: argparse.Namespace) -> int:
+    out = Path(args.out)
+    data_dir = getattr(args, "data_dir", None)
+    quiet = bool(getattr(args, "quiet", False))
+    if args.study == "reconstruction-error":
+        from spectrinsic.study_reconstruction import (
+            format_extension,
+            format_table,
+            reconstruction_table,
+            run_extension,
+            write_extension_outputs,
+            write_table_outputs,
+        )
+
+        with _progress(quiet, "reconstruction error") as progress:
+            table = reconstruction_table(data_dir=data_dir, progress=progress)
+        print(format_table(table))
+        paths = write_table_outputs(table, out)
+        if not args.no_extension:
+            with _progress(quiet, "extension") as progress:
+                ext = run_extension(data_dir=data_dir, progress=progress)
+            print()
+            print(format_extension(ext))
+            paths.update({f"extended_{k}": v for k, v in write_extension_outputs(ext, out).items()})
+        _print_paths(paths)
+        return 0
+    if args.study == "photometric":
+        from spectrinsic.study_photometric import (
+            PhotometricSettings,
+            format_photometric,
+            run_photometric_study,
+        )
+
+        settings = PhotometricSettings(seed=args.seed, include_ie=args.include_ie)
+        with _progress(quiet, "photometric") as progress:
+            result, paths = run_photometric_study(out, settings, data_dir=data_dir, progress=progress)
+        print(format_photometric(result))
+        _print_paths(paths)
+        return 0
+    from spectrinsic.study_rendering import run_rendering_study
+
+    with _progress(quiet, "rendering study") as progress:
+        summary = run_rendering_study(out, quality=args.quality, data_dir=data_dir, progress=progress)
+    if summary is not None:
+        print(summary if isinstance(summary, str) else _describe(summary))
+    return 0
+
+
+def _describe(summary: Any) -> str:
+    import json
+
+    try:
+        return json.dumps(summary, indent=2, default=str)
+    except (TypeError, ValueError):
+        return str(summary)
