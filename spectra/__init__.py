@@ -22,7 +22,12 @@ from spectrinsic.spectra.grid import (
     wavelength_grid,
 )
 from spectrinsic.spectra.illuminants import ILLUMINANT_SETS, illuminant_set, planck_law
-from spectrinsic.spectra.photometric import angular_error, fit_matrix, fit_projection, sharpening_transform
+from spectrinsic.spectra.photometric import (
+    angular_error,
+    fit_matrix,
+    fit_projection,
+    sharpening_transform,
+)
 from spectrinsic.spectra.records import SensorSet, Spectrum
 from spectrinsic.spectra.registry import get_sensors, get_spectrum, list_spectra
 from spectrinsic.spectra.sensors import box_bands, gaussian_sensors

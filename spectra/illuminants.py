@@ -11,7 +11,12 @@ import functools
 
 import numpy as np
 
-from spectrinsic.errors import SpectralDataError, SpectrumNotFoundError, did_you_mean, validate_choice
+from spectrinsic.errors import (
+    SpectralDataError,
+    SpectrumNotFoundError,
+    did_you_mean,
+    validate_choice,
+)
 from spectrinsic.spectra import io
 from spectrinsic.spectra.grid import wavelength_grid
 from spectrinsic.spectra.records import Spectrum
