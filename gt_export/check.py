@@ -1,0 +1,159 @@
+"""Verification of a built dataset (``spectrinsic check DIR``).
+
+Checks, per sample: ``meta.json`` readable; every listed file present; every layer readable
+with the recorded shape; no NaN or Inf anywhere; no negative values in layers marked
+non-negative; ids integral and >= -1; mask 0/1; ``image = reflectance ∘ shading`` (and the same
+per camera) wherever reflectance is non-zero. Per dataset: ``manifest.json`` present, its
+samples present, and the SHA-256 of every file matching.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export.layers import REFLECTANCE_FLOOR
+from spectrinsic.gt_export.writer import (
+    MANIFEST_NAME,
+    META_NAME,
+    TMP_PREFIX,
+    file_sha256,
+    sample_dirs,
+)
+
+__all__ = ["check_dataset", "check_sample", "IDENTITY_RTOL"]
+
+#: Relative tolerance of ``image = reflectance ∘ shading``: float32 storage of the two factors
+#: and their product rounds three times (≤ 1.5 ulp), so 4 float32 epsilons is generous yet tight.
+IDENTITY_RTOL = 4 * float(np.finfo(np.float32).eps)
+
+
+def _identity_problem(image: np.ndarray, refl: np.ndarray, shad: np.ndarray) -> str | None:
+    valid = np.abs(refl) > REFLECTANCE_FLOOR
+    if not valid.any():
+        return None
+    product = refl.astype(np.float64) * shad.astype(np.float64)
+    err = np.abs(product - image)[valid]
+    scale = np.maximum(np.abs(image), np.abs(product))[valid]
+    bad = err > IDENTITY_RTOL * scale + np.finfo(np.float32).tiny
+    if bad.any():
+        worst = float((err / np.maximum(scale, np.finfo(np.float32).tiny)).max())
+        return (f"image != reflectance * shading at {int(bad.sum())} channel values "
+                f"(worst relative error {worst:.2e}, tolerance {IDENTITY_RTOL:.1e})")
+    return None
+
+
+def _layer_problems(key: str, rec: Mapping[str, Any], data: np.ndarray) -> list[str]:
+    out = []
+    shape = tuple(rec.get("shape", data.shape))
+    if data.shape != shape:
+        out.append(f"layer {key!r} has shape {data.shape}, meta.json says {shape}")
+    finite = np.isfinite(data)
+    if not finite.all():
+        nan, inf = int(np.isnan(data).sum()), int(np.isinf(data).sum())
+        out.append(f"layer {key!r} has {nan} NaN and {inf} Inf values")
+    if rec.get("nonnegative") and (data[finite] < 0).any():
+        out.append(f"layer {key!r} has {int((data[finite] < 0).sum())} negative values")
+    if key in ("material_id", "object_id"):
+        if (data[finite] != np.rint(data[finite])).any() or (data[finite] < -1).any():
+            out.append(f"layer {key!r} holds values that are not integer ids >= -1")
+    if key == "mask" and not np.isin(data[finite], (0.0, 1.0)).all():
+        out.append("layer 'mask' holds values other than 0 and 1")
+    return out
+
+
+def check_sample(sample: str | os.PathLike[str]) -> list[str]:
+    """Problems of one sample folder (empty list: fine). Messages do not repeat the sample id."""
+    from spectrinsic.gt_export.exr import read_exr
+
+    sample = Path(sample)
+    try:
+        meta = json.loads((sample / META_NAME).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        return [f"{META_NAME} cannot be read ({exc})"]
+    problems = [f"file {f!r} listed in meta.json is missing"
+                for f in meta.get("files", []) if not (sample / f).is_file()]
+    records: dict[str, Any] = meta.get("layers", {})
+    for required in ("image", "reflectance", "shading", "illuminant"):
+        if required not in records:
+            problems.append(f"layer {required!r} is missing from meta.json")
+    data: dict[str, np.ndarray] = {}
+    by_file: dict[str, list[str]] = {}
+    for key, rec in records.items():
+        by_file.setdefault(rec["file"], []).append(key)
+    for file, keys in by_file.items():
+        try:
+            arrays = read_exr(sample / file)
+        except DatasetError as exc:
+            problems.append(str(exc).replace(str(sample) + os.sep, ""))
+            continue
+        for key in keys:
+            exr_layer = records[key]["exr_layer"]
+            if exr_layer not in arrays:
+                problems.append(f"layer {key!r} is missing from {file}")
+                continue
+            data[key] = arrays[exr_layer]
+            problems.extend(_layer_problems(key, records[key], data[key]))
+    for image_key in [k for k in data if k == "image" or k.startswith("image_camera/")]:
+        suffix = image_key.removeprefix("image")
+        refl_key, shad_key = f"reflectance{suffix}", f"shading{suffix}"
+        if refl_key in data and shad_key in data:
+            issue = _identity_problem(data[image_key], data[refl_key], data[shad_key])
+            if issue:
+                problems.append(f"{image_key}: {issue}")
+    return problems
+
+
+def check_dataset(
+    dataset_dir: str | os.PathLike[str], *, progress: Callable[[str], None] | None = None
+) -> list[str]:
+    """Verify a built dataset; return one line per problem (empty list: the set is sound).
+
+    Lines start with the sample id (or ``"<dataset>"`` for set-wide problems). *progress*, if
+    given, is called with each sample id once that sample is checked.
+    """
+    root = Path(dataset_dir)
+    if not root.is_dir():
+        return [f"<dataset>: folder {str(root)!r} does not exist"]
+    problems: list[str] = []
+    samples = sample_dirs(root)
+    if not samples:
+        problems.append("<dataset>: no sample folders with meta.json")
+    for leftover in sorted(root.glob(f"{TMP_PREFIX}*")):
+        problems.append(f"<dataset>: leftover temporary {leftover.name!r} from an interrupted write")
+    for sample in samples:
+        problems.extend(f"{sample.name}: {p}" for p in check_sample(sample))
+        if progress is not None:
+            progress(sample.name)
+    try:
+        manifest = json.loads((root / MANIFEST_NAME).read_text(encoding="utf-8"))
+    except OSError:
+        problems.append(f"<dataset>: {MANIFEST_NAME} is missing")
+        return problems
+    except ValueError as exc:
+        problems.append(f"<dataset>: {MANIFEST_NAME} is not valid JSON ({exc})")
+        return problems
+    listed: dict[str, Any] = manifest.get("samples", {})
+    on_disk = {s.name for s in samples}
+    for name in sorted(set(listed) - on_disk):
+        problems.append(f"{name}: listed in {MANIFEST_NAME} but missing or incomplete")
+    for name in sorted(on_disk - set(listed)):
+        problems.append(f"{name}: present but not listed in {MANIFEST_NAME}")
+    for name in sorted(set(listed) & on_disk):
+        expected = listed[name].get("files", {})
+        actual = {p.relative_to(root).as_posix() for p in (root / name).rglob("*") if p.is_file()}
+        for rel in sorted(actual - set(expected)):
+            problems.append(f"{name}: file {rel!r} is not in {MANIFEST_NAME}")
+        for rel, digest in sorted(expected.items()):
+            path = root / rel
+            if not path.is_file():
+                problems.append(f"{name}: file {rel!r} from {MANIFEST_NAME} is missing")
+            elif file_sha256(path) != digest:
+                problems.append(f"{name}: file {rel!r} does not match its SHA-256 in {MANIFEST_NAME}")
+    return problems

@@ -1,0 +1,207 @@
+"""Float32 OpenEXR files with named layers and channels.
+
+A *layer* is a named array: ``(H, W)`` for one channel, ``(H, W, C)`` for several. It is stored
+as EXR channels ``<layer>.<channel>`` (``reflectance.R``, ``depth.Z``, ``cube.b05``), always as
+32-bit float: ground truth is never written as half floats. The channel order of every layer is
+kept in a header attribute so that reading gives back the arrays bit for bit.
+
+This is the only module of spectrinsic that imports ``OpenEXR``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from spectrinsic.errors import DatasetError
+
+__all__ = ["write_exr", "read_exr", "read_exr_attributes", "default_channel_names"]
+
+#: Header attribute holding ``{layer: [channel, ...]}`` as JSON.
+CHANNELS_ATTRIBUTE = "spectrinsic.channels"
+#: float32 represents every integer of magnitude up to 2**24 exactly (ids are stored as float32).
+_MAX_EXACT_INT = 2**24
+
+
+def default_channel_names(n_channels: int) -> tuple[str, ...]:
+    """Channel names used when none are given: ``Y`` for 1, ``R, G, B`` for 3, else ``c00, ...``."""
+    if n_channels == 1:
+        return ("Y",)
+    if n_channels == 3:
+        return ("R", "G", "B")
+    return tuple(f"c{i:02d}" for i in range(n_channels))
+
+
+def _as_float32(name: str, array: np.ndarray) -> np.ndarray:
+    array = np.asarray(array)
+    if array.dtype == np.float16:
+        raise DatasetError(f"layer {name!r} is float16; ground truth is stored as float32 only")
+    if array.dtype.kind in "iub":
+        if array.size and np.abs(array.astype(np.int64)).max() > _MAX_EXACT_INT:
+            raise DatasetError(
+                f"layer {name!r} holds integers beyond 2**24, which float32 cannot store exactly"
+            )
+    elif array.dtype.kind != "f":
+        raise DatasetError(f"layer {name!r} has dtype {array.dtype}; expected a numeric array")
+    if array.dtype == np.float64:
+        finite = np.isfinite(array)
+        big = np.abs(array[finite]) > np.finfo(np.float32).max
+        if big.any():
+            raise DatasetError(f"layer {name!r} has values beyond the float32 range")
+    return array.astype(np.float32, copy=False)
+
+
+def write_exr(
+    path: str | os.PathLike[str],
+    layers: Mapping[str, np.ndarray],
+    *,
+    channel_names: Mapping[str, Sequence[str]] | None = None,
+    attributes: Mapping[str, str] | None = None,
+) -> Path:
+    """Write *layers* as float32 channels ``<layer>.<channel>`` of one scanline EXR file.
+
+    Parameters
+    ----------
+    path
+        Destination ``.exr`` file.
+    layers
+        ``{name: array}`` with arrays ``(H, W)`` or ``(H, W, C)``, all of the same ``H, W``.
+        Floats are stored as float32 (float16 is refused); integer arrays (ids) are stored as
+        float32, exact up to 2**24.
+    channel_names
+        Channel names per layer, e.g. ``{"normals": ("X", "Y", "Z")}``; default
+        :func:`default_channel_names`.
+    attributes
+        Extra string header attributes (provenance).
+
+    Returns
+    -------
+    Path
+        *path*.
+    """
+    import OpenEXR
+
+    channel_names = dict(channel_names or {})
+    channels: dict[str, np.ndarray] = {}
+    order: dict[str, list[str]] = {}
+    shape: tuple[int, int] | None = None
+    for name, array in layers.items():
+        if "." in name:
+            raise DatasetError(f"layer name {name!r} contains '.'; expected a plain name")
+        data = _as_float32(name, array)
+        if data.ndim == 2:
+            data = data[..., None]
+        if data.ndim != 3:
+            raise DatasetError(f"layer {name!r} has shape {data.shape}; expected (H, W) or (H, W, C)")
+        if shape is None:
+            shape = (int(data.shape[0]), int(data.shape[1]))
+        elif data.shape[:2] != shape:
+            raise DatasetError(
+                f"layer {name!r} has size {data.shape[:2]}; expected {shape} like the other layers"
+            )
+        names = tuple(channel_names.get(name, default_channel_names(data.shape[2])))
+        if len(names) != data.shape[2] or len(set(names)) != len(names):
+            raise DatasetError(
+                f"layer {name!r} has {data.shape[2]} channels but channel names {names!r}"
+            )
+        order[name] = list(names)
+        for i, channel in enumerate(names):
+            # The bindings read the buffer as C-contiguous regardless of strides: a channel
+            # slice a[..., i] written directly comes back scrambled.
+            channels[f"{name}.{channel}"] = np.ascontiguousarray(data[..., i])
+    if not channels:
+        raise DatasetError(f"no layers to write to {str(path)!r}")
+    header = {
+        "compression": OpenEXR.ZIP_COMPRESSION,
+        "type": OpenEXR.scanlineimage,
+        CHANNELS_ATTRIBUTE: json.dumps(order, separators=(",", ":")),
+    }
+    for key, value in (attributes or {}).items():
+        header[str(key)] = str(value)
+    path = Path(path)
+    OpenEXR.File(header, channels).write(str(path))
+    return path
+
+
+def _open(path: Path, *, header_only: bool):  # noqa: ANN202 - OpenEXR.File
+    import OpenEXR
+
+    if not path.is_file():
+        raise DatasetError(f"EXR file {str(path)!r} does not exist")
+    try:
+        return OpenEXR.File(str(path), separate_channels=True, header_only=header_only)
+    except Exception as exc:  # the bindings raise bare RuntimeError/Exception on corrupt files
+        raise DatasetError(f"EXR file {str(path)!r} cannot be read: {exc}") from exc
+
+
+def read_exr_attributes(path: str | os.PathLike[str]) -> dict[str, object]:
+    """Return the header of an EXR file (attributes only, no pixels)."""
+    try:
+        return dict(_open(Path(path), header_only=True).header())
+    except Exception as exc:
+        if isinstance(exc, DatasetError):
+            raise
+        raise DatasetError(f"EXR file {str(path)!r} has no readable header: {exc}") from exc
+
+
+def read_exr(
+    path: str | os.PathLike[str], *, layers: Sequence[str] | None = None
+) -> dict[str, np.ndarray]:
+    """Read an EXR file written by :func:`write_exr` back into ``{layer: array}``.
+
+    Parameters
+    ----------
+    path
+        The ``.exr`` file.
+    layers
+        Only these layers (default: all).
+
+    Returns
+    -------
+    dict
+        ``(H, W)`` float32 arrays for one-channel layers and ``(H, W, C)`` float32 arrays in the
+        written channel order otherwise. Files from other writers are grouped by the prefix
+        before the last ``.``, channels R, G, B / X, Y, Z in that order, others sorted.
+    """
+    path = Path(path)
+    exr = _open(path, header_only=False)
+    try:
+        # a corrupt chunk makes the bindings warn and return a file with no parts, not raise
+        header = exr.header()
+        pixels = {name: ch.pixels for name, ch in exr.channels().items()}
+    except Exception as exc:
+        raise DatasetError(f"EXR file {str(path)!r} cannot be decoded: {exc}") from exc
+    order: dict[str, list[str]]
+    if CHANNELS_ATTRIBUTE in header:
+        order = json.loads(header[CHANNELS_ATTRIBUTE])
+    else:
+        order = {}
+        for full in pixels:
+            layer, _, channel = full.rpartition(".")
+            order.setdefault(layer, []).append(channel)
+        for names in order.values():
+            for canonical in (["R", "G", "B"], ["X", "Y", "Z"]):
+                if sorted(names) == sorted(canonical):
+                    names[:] = canonical
+                    break
+            else:
+                names.sort()
+    wanted = list(order) if layers is None else list(layers)
+    out: dict[str, np.ndarray] = {}
+    for layer in wanted:
+        if layer not in order:
+            raise DatasetError(
+                f"EXR file {str(path)!r} has no layer {layer!r}; it holds {sorted(order)}"
+            )
+        names = order[layer]
+        keys = [f"{layer}.{c}" if layer else c for c in names]
+        missing = [k for k in keys if k not in pixels]
+        if missing:
+            raise DatasetError(f"EXR file {str(path)!r} lacks channels {missing} of layer {layer!r}")
+        arrays = [np.asarray(pixels[k], dtype=np.float32) for k in keys]
+        out[layer] = arrays[0] if len(arrays) == 1 else np.stack(arrays, axis=-1)
+    return out

@@ -1,0 +1,122 @@
+"""8-bit PNG previews: tone-mapped linear colour, false colour for depth, ids and normals.
+
+Previews are for looking only; the data are in the float32 EXR files. Colour previews are
+linear values scaled by an exposure (a robust percentile of luminance maps to 1), clipped to
+[0, 1] and sRGB-encoded with colour-science's ``cctf_encoding`` (IEC 61966-2-1).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from spectrinsic.errors import DatasetError
+
+__all__ = [
+    "EXPOSURE_PERCENTILE",
+    "exposure",
+    "encode_srgb8",
+    "tone_map",
+    "false_colour",
+    "id_colours",
+    "normals_preview",
+    "write_png",
+]
+
+#: Percentile of the positive luminances mapped to 1.0 by :func:`tone_map` (a few highlights clip).
+EXPOSURE_PERCENTILE = 99.0
+#: Luminance weights of linear sRGB (the Y row of the IEC 61966-2-1 matrix).
+_Y_WEIGHTS = np.array([0.2126, 0.7152, 0.0722])
+
+
+def exposure(rgb: np.ndarray, *, percentile: float = EXPOSURE_PERCENTILE) -> float:
+    """Scale factor mapping the *percentile*-th positive luminance of linear *rgb* to 1.
+
+    Returns 1.0 for an image with no positive finite luminance.
+    """
+    rgb = np.asarray(rgb, float)
+    y = rgb @ _Y_WEIGHTS if rgb.ndim == 3 else rgb
+    y = y[np.isfinite(y) & (y > 0)]
+    if y.size == 0:
+        return 1.0
+    level = float(np.percentile(y, percentile))
+    return 1.0 / level if level > 0 else 1.0
+
+
+def encode_srgb8(linear: np.ndarray, scale: float = 1.0) -> np.ndarray:
+    """``(H, W, 3)`` linear values × *scale* -> sRGB-encoded ``uint8`` (clipped to [0, 1]).
+
+    >>> encode_srgb8(np.array([[[0.0, 1.0, 0.2158605]]])).tolist()  # sRGB 0.5 + 1/510
+    [[[0, 255, 128]]]
+    """
+    import colour
+
+    x = np.nan_to_num(np.asarray(linear, float) * scale, nan=0.0, posinf=1.0, neginf=0.0)
+    encoded = colour.cctf_encoding(np.clip(x, 0.0, 1.0), function="sRGB")
+    return np.round(np.asarray(encoded) * 255.0).astype(np.uint8)
+
+
+def tone_map(rgb: np.ndarray, *, percentile: float = EXPOSURE_PERCENTILE) -> np.ndarray:
+    """Linear ``(H, W, 3)`` -> sRGB ``uint8`` with the exposure of :func:`exposure`."""
+    return encode_srgb8(rgb, exposure(rgb, percentile=percentile))
+
+
+def false_colour(
+    values: np.ndarray,
+    *,
+    mask: np.ndarray | None = None,
+    cmap: str = "viridis",
+    vmin: float | None = None,
+    vmax: float | None = None,
+) -> np.ndarray:
+    """``(H, W)`` scalars -> ``(H, W, 3) uint8`` through a matplotlib colormap; black off *mask*.
+
+    The range defaults to the 1st–99th percentile of the finite values on *mask*.
+    """
+    import matplotlib
+
+    v = np.asarray(values, float)
+    valid = np.isfinite(v) if mask is None else (np.asarray(mask, bool) & np.isfinite(v))
+    data = v[valid]
+    lo = (float(np.percentile(data, 1)) if data.size else 0.0) if vmin is None else vmin
+    hi = (float(np.percentile(data, 99)) if data.size else 1.0) if vmax is None else vmax
+    span = hi - lo if hi > lo else 1.0
+    t = np.clip((np.nan_to_num(v) - lo) / span, 0.0, 1.0)
+    rgba = matplotlib.colormaps[cmap](t)
+    out = np.round(rgba[..., :3] * 255.0).astype(np.uint8)
+    out[~valid] = 0
+    return out
+
+
+def id_colours(ids: np.ndarray) -> np.ndarray:
+    """``(H, W)`` integer ids -> ``(H, W, 3) uint8`` categorical colours (tab20); -1 is black."""
+    import matplotlib
+
+    ids = np.rint(np.asarray(ids, float)).astype(np.int64)
+    palette = np.round(matplotlib.colormaps["tab20"](np.arange(20))[:, :3] * 255).astype(np.uint8)
+    out = palette[np.mod(ids, len(palette))]
+    out[ids < 0] = 0
+    return out
+
+
+def normals_preview(normals: np.ndarray, mask: np.ndarray | None = None) -> np.ndarray:
+    """World-space unit normals -> ``uint8`` RGB as ``(n + 1) / 2`` (the usual normal-map look)."""
+    n = np.nan_to_num(np.asarray(normals, float))
+    out = np.round(np.clip((n + 1.0) / 2.0, 0.0, 1.0) * 255.0).astype(np.uint8)
+    if mask is not None:
+        out[~np.asarray(mask, bool)] = 0
+    return out
+
+
+def write_png(path: str | os.PathLike[str], rgb8: np.ndarray) -> Path:
+    """Write an ``(H, W, 3)`` or ``(H, W)`` uint8 array as PNG (no metadata, so deterministic)."""
+    from PIL import Image
+
+    rgb8 = np.asarray(rgb8)
+    if rgb8.dtype != np.uint8 or rgb8.ndim not in (2, 3):
+        raise DatasetError(f"PNG {str(path)!r}: expected (H, W[, 3]) uint8, got {rgb8.dtype} {rgb8.shape}")
+    path = Path(path)
+    Image.fromarray(np.ascontiguousarray(rgb8)).save(path, format="PNG", optimize=False)
+    return path

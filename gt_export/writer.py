@@ -1,0 +1,530 @@
+"""Writing samples and datasets: EXR data, PNG previews, ``meta.json``, manifest and card.
+
+A sample folder ``<out_dir>/<sample_id>/`` holds
+
+* ``image.exr``, ``intrinsics.exr``, ``geometry.exr``, ``camera-<slug>.exr`` (and ``cube.exr``
+  on request): float32 layers with named channels (see ``meta.json["layers"]``);
+* ``previews/<layer>.png``: 8-bit sRGB previews for looking only;
+* ``scene.json``: the scene as plain data; ``meta.json``: provenance, materials, lights,
+  matrices, the units of every layer. ``meta.json`` is written last.
+
+Everything is written into a hidden temporary folder next to the target and renamed into
+place, so a folder named ``<sample_id>`` is always whole: partial output never looks complete.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import os
+import shutil
+import sys
+import tempfile
+import uuid
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import asdict, fields, is_dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export import png
+from spectrinsic.gt_export.exr import write_exr
+from spectrinsic.gt_export.layers import GroundTruth, Layer, compute_ground_truth
+from spectrinsic.scenes.model import Scene, scene_hash, scene_to_dict
+
+__all__ = [
+    "FORMAT_VERSION",
+    "META_NAME",
+    "MANIFEST_NAME",
+    "CARD_NAME",
+    "DEFAULT_CAMERAS",
+    "config_hash",
+    "software_versions",
+    "export_sample",
+    "is_complete",
+    "sample_dirs",
+    "remove_stale_temporaries",
+    "write_manifest",
+    "write_dataset_card",
+    "file_sha256",
+    "read_template",
+]
+
+log = logging.getLogger(__name__)
+
+FORMAT_VERSION = 1
+META_NAME = "meta.json"
+MANIFEST_NAME = "manifest.json"
+CARD_NAME = "DATASET.md"
+PREVIEW_DIR = "previews"
+#: Prefix of the temporary folders a sample is written into before the rename.
+TMP_PREFIX = ".tmp-"
+#: Cameras exported by default when the 31-band cube is available (shipped by colour-science).
+DEFAULT_CAMERAS: tuple[str, ...] = ("camera:Nikon 5100 (NPL)", "camera:Sigma SDMerill (NPL)")
+#: Render metadata that varies from run to run and so is not written (files stay reproducible).
+_VOLATILE_META = ("timings",)
+#: Distributions whose versions are recorded.
+_DISTRIBUTIONS = (
+    "spectrinsic", "numpy", "scipy", "colour-science", "OpenEXR", "mitsuba", "drjit", "luxpy",
+    "matplotlib", "pillow",
+)
+
+
+# ----------------------------------------------------------------------------------------------
+# Plain data and hashes
+
+
+def _jsonable(value: Any) -> Any:
+    if is_dataclass(value) and not isinstance(value, type):
+        return {f.name: _jsonable(getattr(value, f.name)) for f in fields(value)}
+    if isinstance(value, Mapping):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, np.ndarray):
+        return _jsonable(value.tolist())
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, float):
+        return value if np.isfinite(value) else str(value)
+    if value is None or isinstance(value, (str, int, bool)):
+        return value
+    return str(value)
+
+
+def _dump_json(path: Path, data: Any) -> None:
+    path.write_text(json.dumps(_jsonable(data), indent=2, sort_keys=True, ensure_ascii=False) + "\n",
+                    encoding="utf-8")
+
+
+def config_hash(config: Mapping[str, Any]) -> str:
+    """The hash a sample records for *config*: equal settings, equal hashes.
+
+    A config that carries its own ``"config_hash"`` (as ``DatasetConfig.to_dict()`` does) is
+    trusted; otherwise the SHA-256 of its canonical JSON (sorted keys, no whitespace).
+
+    >>> config_hash({"spp": 16, "seed": 1}) == config_hash({"seed": 1, "spp": 16})
+    True
+    >>> config_hash({"spp": 16, "config_hash": "abc"})
+    'abc'
+    """
+    own = config.get("config_hash")
+    if isinstance(own, str) and own:
+        return own
+    blob = json.dumps(_jsonable(config), sort_keys=True, separators=(",", ":"), ensure_ascii=False)
+    return hashlib.sha256(blob.encode("utf-8")).hexdigest()
+
+
+def file_sha256(path: str | os.PathLike[str]) -> str:
+    """SHA-256 hex digest of a file's bytes."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(chunk)
+    return digest.hexdigest()
+
+
+def software_versions() -> dict[str, str]:
+    """Versions of Python and of the distributions that shape the output (``"absent"`` if not installed)."""
+    from importlib import metadata
+
+    out = {"python": sys.version.split()[0]}
+    for dist in _DISTRIBUTIONS:
+        try:
+            out[dist] = metadata.version(dist)
+        except metadata.PackageNotFoundError:
+            out[dist] = "absent"
+    return out
+
+
+# ----------------------------------------------------------------------------------------------
+# Previews
+
+
+def _colour_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
+    return png.tone_map(layer.data)
+
+
+def _reflectance_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
+    return png.encode_srgb8(layer.data)  # absolute scale: the perfect white is 1
+
+
+def _illuminant_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
+    peak = np.max(layer.data, axis=-1, keepdims=True)
+    return png.encode_srgb8(np.where(peak > 0, layer.data / np.where(peak > 0, peak, 1), 0))
+
+
+def _grey_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
+    return png.tone_map(np.repeat(layer.data[..., None], 3, axis=-1))
+
+
+def _error_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
+    return png.false_colour(layer.data, cmap="magma", vmin=0.0, vmax=0.1)
+
+
+def _mask_of(layers: Mapping[str, Layer]) -> np.ndarray | None:
+    return layers["mask"].data > 0.5 if "mask" in layers else None
+
+
+def _depth_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
+    return png.false_colour(layer.data, mask=_mask_of(layers), cmap="viridis")
+
+
+def _normals_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
+    return png.normals_preview(layer.data, _mask_of(layers))
+
+
+def _ids_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
+    return png.id_colours(layer.data)
+
+
+def _mask_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
+    return np.repeat((layer.data > 0.5).astype(np.uint8)[..., None] * 255, 3, axis=-1)
+
+
+#: (layer-name prefix, preview maker); the first matching prefix wins; no match, no preview.
+_PREVIEWS: tuple[tuple[str, Callable[[Layer, Mapping[str, Layer]], np.ndarray]], ...] = (
+    ("image", _colour_preview),
+    ("shading_grey", _grey_preview),
+    ("shading", _colour_preview),
+    ("reflectance", _reflectance_preview),
+    ("illuminant", _illuminant_preview),
+    ("error_", _error_preview),
+    ("depth", _depth_preview),
+    ("normals", _normals_preview),
+    ("material_id", _ids_preview),
+    ("object_id", _ids_preview),
+    ("mask", _mask_preview),
+)
+
+
+def _preview_name(layer: Layer) -> str:
+    base, _, camera = layer.name.partition("/")
+    return f"{base}--{layer.group.removeprefix('camera-')}.png" if camera else f"{base}.png"
+
+
+# ----------------------------------------------------------------------------------------------
+# One sample
+
+
+def _layer_records(gt: GroundTruth, previews: Mapping[str, str]) -> dict[str, Any]:
+    return {
+        layer.name: {
+            "file": f"{layer.group}.exr",
+            "exr_layer": layer.name.split("/", 1)[0],
+            "channels": list(layer.channels),
+            "shape": list(layer.data.shape),
+            "dtype": "float32",
+            "units": layer.units,
+            "nonnegative": layer.nonnegative,
+            "preview": previews.get(layer.name),
+        }
+        for layer in gt.layers.values()
+    }
+
+
+def _meta(
+    scene: Scene, result: Any, gt: GroundTruth, *, sample_id: str, config: Mapping[str, Any],
+    seed: int, previews: Mapping[str, str], files: Sequence[str],
+) -> dict[str, Any]:
+    from spectrinsic.spectra import DEFAULT_WAVELENGTHS, get_spectrum
+
+    render_meta = {k: v for k, v in (getattr(result, "meta", None) or {}).items()
+                   if k not in _VOLATILE_META}
+    lights = []
+    for record in gt.lights:
+        entry = asdict(record)
+        entry["spd"] = get_spectrum(record.spectrum).on(DEFAULT_WAVELENGTHS)
+        lights.append(entry)
+    height, width = gt.layers["image"].data.shape[:2]
+    return {
+        "format_version": FORMAT_VERSION,
+        "sample_id": sample_id,
+        "scene": scene.name,
+        "scene_hash": scene_hash(scene),
+        "scene_metadata": scene.metadata,
+        "config_hash": config_hash(config),
+        "seed": int(seed),
+        "variant": render_meta.get("variant"),
+        "render": render_meta,
+        "reference_mode": gt.reference_mode,
+        "size": [height, width],
+        "spectral_grid": {
+            "ground_truth": "360-830 nm at 1 nm (CIE 1931 grid); colours integrated by the rectangle rule",
+            "render": render_meta.get("wavelengths"),
+            "lights_spd": {"start_nm": 380.0, "end_nm": 780.0, "step_nm": 5.0},
+        },
+        "materials": gt.materials,
+        "lights": lights,
+        "cameras": [c.split(":", 1)[-1] for c in gt.cameras],
+        "cube_sensors": gt.cube_sensors,
+        "matrices": gt.matrices,
+        "layers": _layer_records(gt, previews),
+        "files": sorted(files),
+        "versions": software_versions(),
+    }
+
+
+def _fill_folder(folder: Path, scene: Scene, result: Any, gt: GroundTruth, **meta_kw: Any) -> None:
+    files: list[str] = []
+    groups: dict[str, list[Layer]] = {}
+    for layer in gt.layers.values():
+        groups.setdefault(layer.group, []).append(layer)
+    for group, members in groups.items():
+        name = f"{group}.exr"
+        write_exr(
+            folder / name,
+            {layer.name.split("/", 1)[0]: layer.data for layer in members},
+            channel_names={layer.name.split("/", 1)[0]: layer.channels for layer in members},
+            attributes={"spectrinsic.sample": meta_kw["sample_id"]},
+        )
+        files.append(name)
+    (folder / PREVIEW_DIR).mkdir()
+    previews: dict[str, str] = {}
+    for layer in gt.layers.values():
+        maker = next((f for prefix, f in _PREVIEWS if layer.name.startswith(prefix)), None)
+        if maker is None:
+            continue
+        rel = f"{PREVIEW_DIR}/{_preview_name(layer)}"
+        png.write_png(folder / rel, maker(layer, gt.layers))
+        previews[layer.name] = rel
+        files.append(rel)
+    _dump_json(folder / "scene.json", scene_to_dict(scene))
+    files.append("scene.json")
+    # meta.json last: its presence (with the right config hash) marks the folder complete
+    _dump_json(folder / META_NAME, _meta(scene, result, gt, previews=previews, files=files, **meta_kw))
+
+
+def export_sample(
+    out_dir: str | os.PathLike[str],
+    scene: Scene,
+    result: Any,
+    *,
+    sample_id: str,
+    config: Mapping[str, Any],
+    seed: int,
+    cameras: Sequence[str] | None = None,
+    write_cube: bool = False,
+    data_dir: str | os.PathLike[str] | None = None,
+) -> Path:
+    """Compute every ground-truth layer of a rendered sample and write it atomically.
+
+    Parameters
+    ----------
+    out_dir
+        Dataset folder; the sample goes to ``out_dir/sample_id``.
+    scene
+        The rendered scene.
+    result
+        RenderResult-like record (see CONTRACTS.md); never a live renderer.
+    sample_id
+        Folder name, e.g. ``"obj-vase__v0__two-colour-a"``.
+    config
+        The settings the sample was built with; ``meta.json`` records :func:`config_hash` of it.
+    seed
+        The sample's render seed.
+    cameras
+        Camera sensor sets for per-camera layers; default :data:`DEFAULT_CAMERAS` when the
+        render has the 31-band cube, none otherwise.
+    write_cube
+        Also write the multispectral cube (``cube.exr``).
+    data_dir
+        Spectral data directory (for ``sfu:``/data-directory cameras).
+
+    Returns
+    -------
+    Path
+        The complete sample folder.
+    """
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    if not sample_id or "/" in sample_id or sample_id.startswith("."):
+        raise DatasetError(f"sample id {sample_id!r}: expected a plain folder name")
+    if cameras is None:
+        cameras = DEFAULT_CAMERAS if "bands31" in (getattr(result, "raw", None) or {}) else ()
+    gt = compute_ground_truth(scene, result, cameras=cameras, write_cube=write_cube,
+                              data_dir=data_dir)
+    final = out_dir / sample_id
+    tmp = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{sample_id}-", dir=out_dir))
+    try:
+        tmp.chmod(0o755)
+        _fill_folder(tmp, scene, result, gt, sample_id=sample_id, config=config, seed=seed)
+        _move_into_place(tmp, final, config_hash(config))
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    log.debug("wrote sample %s", final)
+    return final
+
+
+def _move_into_place(tmp: Path, final: Path, chash: str) -> None:
+    if final.exists():
+        # an older or foreign version: move it aside first, so no moment shows a mixed folder
+        aside = final.with_name(f"{TMP_PREFIX}old-{final.name}-{uuid.uuid4().hex[:8]}")
+        final.rename(aside)
+        shutil.rmtree(aside, ignore_errors=True)
+    try:
+        tmp.rename(final)
+    except OSError:
+        # another worker finished the same sample meanwhile (e.g. a retried distributed task)
+        if is_complete(final, chash):
+            shutil.rmtree(tmp, ignore_errors=True)
+        else:
+            raise
+
+
+def is_complete(sample_dir: str | os.PathLike[str], config_hash: str) -> bool:
+    """True iff *sample_dir* holds a ``meta.json`` with this *config_hash* and all its files."""
+    sample_dir = Path(sample_dir)
+    try:
+        meta = json.loads((sample_dir / META_NAME).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    if not isinstance(meta, dict) or meta.get("config_hash") != config_hash:
+        return False
+    return all((sample_dir / f).is_file() for f in meta.get("files", []))
+
+
+def sample_dirs(dataset_dir: str | os.PathLike[str]) -> list[Path]:
+    """Sample folders of a dataset (visible sub-folders holding ``meta.json``), sorted by name."""
+    root = Path(dataset_dir)
+    if not root.is_dir():
+        raise DatasetError(f"dataset folder {str(root)!r} does not exist")
+    return sorted(p for p in root.iterdir()
+                  if p.is_dir() and not p.name.startswith(".") and (p / META_NAME).is_file())
+
+
+def remove_stale_temporaries(dataset_dir: str | os.PathLike[str]) -> list[Path]:
+    """Delete temporary folders left by interrupted writes; return what was removed.
+
+    Call it only when no other writer works on *dataset_dir*.
+    """
+    root = Path(dataset_dir)
+    stale = sorted(p for p in root.glob(f"{TMP_PREFIX}*") if p.is_dir()) if root.is_dir() else []
+    for path in stale:
+        shutil.rmtree(path, ignore_errors=True)
+    return stale
+
+
+# ----------------------------------------------------------------------------------------------
+# Dataset level
+
+
+def _read_meta(sample: Path) -> dict[str, Any]:
+    try:
+        return json.loads((sample / META_NAME).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise DatasetError(f"{sample / META_NAME}: cannot be read as JSON ({exc})") from exc
+
+
+def _sample_files(sample: Path) -> Iterable[Path]:
+    return sorted(p for p in sample.rglob("*") if p.is_file())
+
+
+def _spectral_provenance(metas: Sequence[Mapping[str, Any]], data_dir: Any) -> dict[str, Any]:
+    from spectrinsic.config import resolve_data_dir
+
+    used: set[str] = set()
+    for meta in metas:
+        used.update(meta.get("materials", {}).values())
+        used.update(light["spectrum"] for light in meta.get("lights", []))
+        used.update(f"camera:{c}" for c in meta.get("cameras", []))
+        if meta.get("cube_sensors"):
+            used.add(meta["cube_sensors"])
+    versions = software_versions()
+    out: dict[str, Any] = {
+        "spectra_used": sorted(used),
+        "munsell": f"Munsell1269.dat from luxpy {versions['luxpy']} (Parkkinen et al. 1989)",
+        "cie_and_cameras": f"colour-science {versions['colour-science']} (CIE 1931 2°, "
+                           "CIE illuminants, NPL camera sensitivities)",
+        "ground_truth_grid": "360-830 nm at 1 nm",
+    }
+    root = resolve_data_dir(data_dir)
+    if root is not None and (root / "PROVENANCE.md").is_file():
+        out["data_directory_provenance_sha256"] = file_sha256(root / "PROVENANCE.md")
+    return out
+
+
+def write_manifest(
+    dataset_dir: str | os.PathLike[str],
+    config: Mapping[str, Any],
+    *,
+    data_dir: str | os.PathLike[str] | None = None,
+) -> Path:
+    """Write ``manifest.json``: settings, seed, versions, variants, provenance, SHA-256 per file.
+
+    Every file inside every sample folder is hashed (paths relative to the dataset folder).
+    Nothing time-dependent is recorded, so the same build gives the same manifest.
+    """
+    root = Path(dataset_dir)
+    samples = sample_dirs(root)
+    metas = [_read_meta(s) for s in samples]
+    manifest = {
+        "format_version": FORMAT_VERSION,
+        "config": config,
+        "config_hash": config_hash(config),
+        "seed": config.get("seed"),
+        "versions": software_versions(),
+        "mitsuba_variants": sorted({str(m.get("variant")) for m in metas}),
+        "spectral_data": _spectral_provenance(metas, data_dir),
+        "n_samples": len(samples),
+        "samples": {
+            s.name: {
+                "config_hash": m.get("config_hash"),
+                "scene": m.get("scene"),
+                "seed": m.get("seed"),
+                "files": {p.relative_to(root).as_posix(): file_sha256(p) for p in _sample_files(s)},
+            }
+            for s, m in zip(samples, metas)
+        },
+    }
+    path = root / MANIFEST_NAME
+    tmp = path.with_name(f"{TMP_PREFIX}{MANIFEST_NAME}")
+    _dump_json(tmp, manifest)
+    tmp.replace(path)
+    return path
+
+
+def read_template(name: str) -> str:
+    """Text of a package template (``gt_export/templates/<name>``)."""
+    from importlib import resources
+
+    return resources.files("spectrinsic.gt_export").joinpath("templates", name).read_text("utf-8")
+
+
+def write_dataset_card(
+    dataset_dir: str | os.PathLike[str], config: Mapping[str, Any] | None = None
+) -> Path:
+    """Write ``DATASET.md``: what each layer is, its units, colour space, and how to load it."""
+    import string
+
+    root = Path(dataset_dir)
+    samples = sample_dirs(root)
+    if not samples:
+        raise DatasetError(f"dataset folder {str(root)!r} has no complete samples to describe")
+    metas = [_read_meta(s) for s in samples]
+    rows: dict[str, Any] = {}
+    for meta in metas:
+        for name, rec in meta["layers"].items():
+            rows.setdefault(name, rec)
+    table = "\n".join(
+        f"| `{name}` | `{rec['file']}` | {', '.join(rec['channels'])} | {rec['units']} |"
+        for name, rec in rows.items()
+    )
+    scenes = sorted({m["scene"] for m in metas})
+    text = string.Template(read_template("DATASET.md")).substitute(
+        n_samples=len(samples),
+        n_scenes=len(scenes),
+        scenes=", ".join(scenes),
+        layer_table=table,
+        config_hash=config_hash(config) if config is not None else metas[0].get("config_hash"),
+        config=json.dumps(_jsonable(config or {}), indent=2, sort_keys=True),
+        versions=json.dumps(software_versions(), indent=2, sort_keys=True),
+        variants=", ".join(sorted({str(m.get("variant")) for m in metas})),
+    )
+    path = root / CARD_NAME
+    path.write_text(text, encoding="utf-8")
+    return path

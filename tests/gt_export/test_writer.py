@@ -1,0 +1,166 @@
+"""Writing samples (atomic, reproducible), manifest, dataset card, and loading them back."""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+import pytest
+
+from spectrinsic.errors import MissingDependencyError
+from spectrinsic.gt_export import (
+    config_hash,
+    export_sample,
+    is_complete,
+    load_dataset,
+    load_sample,
+    sample_dirs,
+    torch_dataset,
+    write_dataset_card,
+    write_manifest,
+)
+
+FLOAT32_RTOL = 4 * float(np.finfo(np.float32).eps)
+
+
+@pytest.fixture
+def built(tmp_path, two_light_sample, one_light_sample, config):
+    """A two-sample dataset with manifest and card."""
+    for sid, (scene, result) in (("b-two", two_light_sample), ("a-one", one_light_sample)):
+        export_sample(tmp_path, scene, result, sample_id=sid, config=config, seed=11)
+    write_manifest(tmp_path, config)
+    write_dataset_card(tmp_path, config)
+    return tmp_path
+
+
+def test_sample_round_trips_through_the_loader(tmp_path, two_light_sample, config):
+    scene, result = two_light_sample
+    folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=5,
+                           cameras=("camera:Nikon 5100 (NPL)",), write_cube=True)
+    sample = load_sample(folder)
+    for key in ("image", "reflectance", "shading", "illuminant", "mask", "depth", "normals",
+                "ids", "meta", "image_camera/Nikon 5100 (NPL)", "cube", "image_rgb3"):
+        assert key in sample, key
+    assert sample["image"].shape == (12, 16, 3) and sample["image"].dtype == np.float32
+    assert sample["mask"].dtype == bool
+    np.testing.assert_array_equal(sample["mask"], result.aovs["mask"])
+    np.testing.assert_array_equal(sample["ids"]["material"], result.aovs["material_id"])
+    np.testing.assert_array_equal(sample["depth"], result.aovs["depth"])
+    # the cube is stored bit-exactly
+    assert sample["cube"].tobytes() == result.raw["bands31"].tobytes()
+    valid = np.abs(sample["reflectance"]) > 1e-6
+    product = sample["reflectance"].astype(np.float64) * sample["shading"]
+    np.testing.assert_allclose(product[valid], sample["image"][valid], rtol=FLOAT32_RTOL)
+    meta = sample["meta"]
+    assert meta["materials"]["0"] == "munsell:5R 4/14"
+    assert [light["spectrum"] for light in meta["lights"]] == ["planck:2800K", "cie:FL11"]
+    assert len(meta["lights"][0]["spd"]) == 81
+    assert meta["seed"] == 5 and meta["variant"] == "synthetic"
+    assert meta["config_hash"] == config_hash(config)
+    assert "timings" not in meta["render"]  # run-dependent: would break reproducible files
+    for key, record in meta["layers"].items():
+        assert record["units"], key
+    assert set(meta["matrices"]["S_Sen"]) == {"Nikon 5100 (NPL)"}
+
+
+def test_is_complete_follows_the_config_hash(tmp_path, one_light_sample, config):
+    scene, result = one_light_sample
+    folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=1)
+    assert is_complete(folder, config_hash(config))
+    assert not is_complete(folder, config_hash({**config, "spp": 2}))
+    (folder / "intrinsics.exr").unlink()
+    assert not is_complete(folder, config_hash(config))
+    assert not is_complete(tmp_path / "absent", config_hash(config))
+
+
+def test_a_write_failing_midway_leaves_nothing_complete_looking(
+    tmp_path, one_light_sample, config, monkeypatch
+):
+    from spectrinsic.gt_export import png
+
+    scene, result = one_light_sample
+    calls = {"n": 0}
+    real = png.write_png
+
+    def failing(path, rgb8):
+        calls["n"] += 1
+        if calls["n"] == 3:
+            raise OSError("disk full (simulated)")
+        return real(path, rgb8)
+
+    monkeypatch.setattr(png, "write_png", failing)
+    with pytest.raises(OSError, match="simulated"):
+        export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=1)
+    assert calls["n"] == 3  # it really failed midway, after EXR files and two previews
+    assert not (tmp_path / "s").exists()
+    assert list(tmp_path.iterdir()) == []  # the temporary folder is gone too
+    assert sample_dirs(tmp_path) == []
+
+
+def test_a_rewrite_replaces_an_old_sample_whole(tmp_path, one_light_sample, config):
+    scene, result = one_light_sample
+    folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=1)
+    (folder / "stale.txt").write_text("from an older build")
+    new_config = {**config, "spp": 4}
+    export_sample(tmp_path, scene, result, sample_id="s", config=new_config, seed=1)
+    assert not (folder / "stale.txt").exists()
+    assert is_complete(folder, config_hash(new_config))
+    assert [p.name for p in tmp_path.iterdir()] == ["s"]
+
+
+def test_same_inputs_give_identical_files(tmp_path, two_light_sample, config):
+    scene, result = two_light_sample
+    a = export_sample(tmp_path / "a", scene, result, sample_id="s", config=config, seed=3)
+    b = export_sample(tmp_path / "b", scene, result, sample_id="s", config=config, seed=3)
+    files_a = sorted(p.relative_to(a) for p in a.rglob("*") if p.is_file())
+    files_b = sorted(p.relative_to(b) for p in b.rglob("*") if p.is_file())
+    assert files_a == files_b
+    for rel in files_a:
+        assert (a / rel).read_bytes() == (b / rel).read_bytes(), rel
+
+
+def test_manifest_hashes_every_file_and_records_provenance(built, config):
+    import hashlib
+
+    manifest = json.loads((built / "manifest.json").read_text())
+    assert manifest["n_samples"] == 2 and set(manifest["samples"]) == {"a-one", "b-two"}
+    files = manifest["samples"]["a-one"]["files"]
+    on_disk = {p.relative_to(built).as_posix() for p in (built / "a-one").rglob("*") if p.is_file()}
+    assert set(files) == on_disk
+    for rel, digest in files.items():
+        assert hashlib.sha256((built / rel).read_bytes()).hexdigest() == digest
+    assert manifest["config"] == config and manifest["seed"] == 7
+    assert manifest["mitsuba_variants"] == ["synthetic"]
+    assert "munsell:5R 4/14" in manifest["spectral_data"]["spectra_used"]
+    assert manifest["versions"]["OpenEXR"] != "absent"
+
+
+def test_dataset_card_describes_every_layer(built):
+    card = (built / "DATASET.md").read_text()
+    meta = json.loads((built / "b-two" / "meta.json").read_text())
+    for key, record in meta["layers"].items():
+        assert f"`{key}`" in card
+        assert record["units"] in card
+    assert "linear" in card and "D65" in card and "load_sample" in card
+
+
+def test_load_dataset_iterates_complete_samples_in_order(built):
+    (built / ".tmp-c-x").mkdir()  # an interrupted write is not a sample
+    ids = [s["meta"]["sample_id"] for s in load_dataset(built, layers=["image"])]
+    assert ids == ["a-one", "b-two"]
+
+
+def test_torch_adapter_without_torch_says_what_to_install(built, monkeypatch):
+    monkeypatch.setitem(sys.modules, "torch", None)  # makes `import torch` fail
+    with pytest.raises(MissingDependencyError, match="spectrinsic\\[torch\\]"):
+        torch_dataset(built)
+
+
+def test_torch_adapter_yields_channel_first_tensors(built):
+    torch = pytest.importorskip("torch", reason="PyTorch is an optional extra, not installed here")
+    ds = torch_dataset(built, keys=("image", "mask"))
+    item = ds[0]
+    assert len(ds) == 2 and item["sample_id"] == "a-one"
+    assert item["image"].shape == (3, 12, 16) and item["image"].dtype == torch.float32
+    assert item["mask"].dtype == torch.bool
