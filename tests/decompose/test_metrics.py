@@ -1,0 +1,170 @@
+"""Metrics against independent values: identities, hand-computed cases, scikit-image."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from skimage.metrics import structural_similarity
+
+from spectrinsic.decompose import metrics as M
+from spectrinsic.decompose._validation import ImageShapeError
+from spectrinsic.decompose.judgements import (
+    DARKER_1,
+    DARKER_2,
+    EQUAL,
+    Judgements,
+    sample_judgements,
+)
+from spectrinsic.errors import SpectrinsicError
+
+#: Float64 round-off on sums of a few thousand terms.
+EXACT = 1e-12
+#: Round-off after multiplying by a scale that is not a power of two.
+SCALED = 1e-9
+#: acos near 1 turns a 1e-16 cosine error into ~1e-6 degrees.
+ANGLE_ROUNDOFF_DEG = 1e-5
+
+
+@pytest.fixture()
+def pair():
+    rng = np.random.default_rng(7)
+    truth = rng.uniform(0.05, 1.0, (48, 52, 3))
+    estimate = truth * rng.uniform(0.5, 1.5, truth.shape)
+    return truth, estimate
+
+
+@pytest.mark.parametrize("grey", [False, True])
+def test_identical_images_score_perfectly(pair, grey):
+    truth = pair[0].mean(axis=2) if grey else pair[0]
+    names = [n for n in M.METRICS if not (grey and n.startswith("angular"))]
+    scores = M.compute_metrics(truth, truth.copy(), names)
+    for name, value in scores.items():
+        expected = 1.0 if M.METRICS[name].better == "higher" else 0.0
+        tol = ANGLE_ROUNDOFF_DEG if name.startswith("angular") else EXACT
+        assert value == pytest.approx(expected, abs=tol), name
+
+
+def test_scaled_estimate_scores_zero_on_scale_invariant_metrics(pair):
+    truth = pair[0]
+    mask = np.zeros(truth.shape[:2], bool)
+    mask[5:40, 3:50] = True
+    for name, metric in M.METRICS.items():
+        assert metric.scale_invariant
+        value = metric.func(truth, 3.7 * truth, mask=mask)
+        expected = 1.0 if metric.better == "higher" else 0.0
+        tol = ANGLE_ROUNDOFF_DEG if name.startswith("angular") else SCALED
+        assert value == pytest.approx(expected, abs=tol), name
+    judgements = sample_judgements(truth, seed=1, n_pairs=300, mask=mask)
+    assert M.whdr(3.7 * truth, judgements) == 0.0
+
+
+def test_lmse_hand_computed_two_windows():
+    # truth 1 everywhere; estimate 1 left of column 15, 2 from it. Windows (20x20, step 10) on a
+    # 20x30 image: columns 0-19 and 10-29. Per window alpha = sum(TE)/sum(E^2):
+    # w1: alpha = 500/700, residual 300(1-5/7)^2 + 100(1-10/7)^2 = 300/7, energy 400;
+    # w2: alpha = 700/1300, residual 100(6/13)^2 + 300(1/13)^2 = 300/13, energy 400.
+    truth = np.ones((20, 30))
+    estimate = np.where(np.arange(30) < 15, 1.0, 2.0)[None, :].repeat(20, axis=0)
+    expected = (300 / 7 + 300 / 13) / 800  # = 15/182
+    assert M.lmse(truth, estimate) == pytest.approx(expected, rel=EXACT)
+    # colour copies of the same grey image give the same value with one alpha per window
+    colour = np.repeat(estimate[:, :, None], 3, axis=2)
+    assert M.lmse(np.ones((20, 30, 3)), colour) == pytest.approx(expected, rel=EXACT)
+
+
+def test_lmse_window_straddling_the_mask():
+    # As above, but pixels from column 25 on are masked out (and hold garbage): window 2 keeps
+    # columns 10-24: 100 px of E=1, 200 px of E=2; alpha = 500/900, residual = 1600/81 + 200/81
+    # = 200/9, energy 300. Window 1 is unchanged (300/7 over 400).
+    truth = np.ones((20, 30))
+    estimate = np.where(np.arange(30) < 15, 1.0, 2.0)[None, :].repeat(20, axis=0)
+    mask = np.broadcast_to(np.arange(30) < 25, (20, 30))
+    truth[:, 25:] = 123.0
+    estimate[:, 25:] = -7.0
+    expected = (300 / 7 + 200 / 9) / (400 + 300)
+    assert M.lmse(truth, estimate, mask=mask) == pytest.approx(expected, rel=EXACT)
+
+
+def test_mit_score_averages_shading_and_reflectance(pair):
+    truth, estimate = pair
+    s, r = truth[..., 0], truth
+    es, er = estimate[..., 0], estimate
+    assert M.mit_score(s, r, es, er) == pytest.approx(
+        0.5 * M.lmse(s, es) + 0.5 * M.lmse(r, er), rel=EXACT
+    )
+
+
+def test_si_mse_closed_form():
+    # truth (1, 2), estimate (1, 1): alpha = 3/2, residual (1-1.5)^2 + (2-1.5)^2 = 0.5 over 2.
+    assert M.si_mse(np.array([[1.0, 2.0]]), np.array([[1.0, 1.0]])) == pytest.approx(0.25)
+
+
+def test_correlation_matches_numpy(pair):
+    truth, estimate = pair
+    assert M.correlation(truth, estimate) == pytest.approx(
+        np.corrcoef(truth.ravel(), estimate.ravel())[0, 1], rel=1e-12
+    )
+
+
+def test_dssim_equals_scikit_image(pair):
+    truth, estimate = pair
+    ssim = structural_similarity(truth, estimate, data_range=1.0, channel_axis=-1)
+    value = M.dssim(truth, estimate, data_range=1.0, fit_scale=False)
+    assert value == pytest.approx((1.0 - ssim) / 2.0, rel=EXACT)
+    grey = structural_similarity(truth[..., 1], estimate[..., 1], data_range=1.0)
+    assert M.dssim(truth[..., 1], estimate[..., 1], data_range=1.0, fit_scale=False) == (
+        pytest.approx((1.0 - grey) / 2.0, rel=EXACT)
+    )
+
+
+def test_whdr_hand_computed():
+    reflectance = np.array([[1.0, 1.05, 2.0, 0.5]])
+    p = lambda *cols: np.array([[0, c] for c in cols])  # noqa: E731
+    # predictions (delta 0.1): (0,1) E; (0,2) 1 [2/1 > 1.1]; (0,3) 2; (1,0) E [1.05 < 1.1]
+    judgements = Judgements(
+        points1=p(0, 0, 0, 1),
+        points2=p(1, 2, 3, 0),
+        labels=np.array([EQUAL, DARKER_1, EQUAL, DARKER_2]),
+        weights=np.array([1.0, 1.0, 2.0, 0.5]),
+        within=np.zeros(4, bool),
+    )
+    # disagreements: the third (weight 2) and the fourth (weight 0.5) -> 2.5 / 4.5
+    assert M.whdr(reflectance, judgements) == pytest.approx(2.5 / 4.5)
+
+
+def test_sample_judgements_is_seeded_and_mixes_materials():
+    rng = np.random.default_rng(0)
+    ids = np.repeat(np.arange(4), 100).reshape(20, 20)
+    refl = np.array([0.2, 0.4, 0.41, 0.8])[ids][:, :, None] * np.ones(3)
+    a = sample_judgements(refl, seed=5, n_pairs=200, material_ids=ids)
+    b = sample_judgements(refl, seed=5, n_pairs=200, material_ids=ids)
+    np.testing.assert_array_equal(a.points1, b.points1)
+    i1 = ids[a.points1[:, 0], a.points1[:, 1]]
+    i2 = ids[a.points2[:, 0], a.points2[:, 1]]
+    assert np.all(i1[a.within] == i2[a.within]) and np.all(i1[~a.within] != i2[~a.within])
+    assert np.all(a.labels[a.within] == EQUAL)  # flat materials: equal reflectance
+    assert {DARKER_1, DARKER_2} <= set(a.labels[~a.within].tolist())
+    assert M.whdr(refl, a) == 0.0 and M.whdr(refl[..., ::-1] * 0 + rng.uniform(size=refl.shape), a) > 0
+
+
+def test_angular_error_stats():
+    truth = np.ones((2, 2, 3))
+    estimate = np.ones((2, 2, 3))
+    estimate[0, 0] = [1.0, 0.0, 0.0]  # angle to (1,1,1): acos(1/sqrt(3)) = 54.7356 deg
+    angle = np.degrees(np.arccos(1 / np.sqrt(3)))
+    assert M.angular_error_mean(truth, estimate) == pytest.approx(angle / 4)
+    assert M.angular_error_median(truth, estimate) == pytest.approx(0.0)
+
+
+def test_shape_checks_and_registry():
+    with pytest.raises(ImageShapeError, match="differs"):
+        M.lmse(np.ones((30, 30)), np.ones((30, 31)))
+    with pytest.raises(ImageShapeError, match="mask must have shape"):
+        M.lmse(np.ones((30, 30)), np.ones((30, 30)), mask=np.ones((3, 3), bool))
+    with pytest.raises(ImageShapeError, match="smaller than"):
+        M.lmse(np.ones((10, 10)), np.ones((10, 10)))
+    with pytest.raises(ImageShapeError, match="NaN"):
+        M.si_mse(np.full((4, 4), np.nan), np.ones((4, 4)))
+    with pytest.raises(SpectrinsicError, match="did you mean 'lmse'"):
+        M.get_metric("lmsee")
+    assert M.get_metric("lmse").equation == "Eq. 2.5"
