@@ -1,0 +1,536 @@
+"""Scene files: a human-editable YAML format <-> :class:`~spectrinsic.scenes.model.Scene`.
+
+Files are read with ``yaml.safe_load`` only (no Python object tags). Every problem is a
+one-line :class:`~spectrinsic.errors.SceneError` ``"<file>: <field>: <problem>"``.
+
+Format (version 1; the full reference with an example is ``scenes/FORMAT.md``)::
+
+    format: 1                        # optional format version
+    name: red-cup                    # scene name
+    materials:                       # material name -> reflectance spectrum name
+      red: "munsell:5R 4/14"
+      ground: "flat:0.5"
+    meshes:
+      - name: cup                    # unique mesh name
+        object_id: 1                 # optional; default: position in the list
+        file: meshes/cup.ply         # an OBJ/PLY/STL/OFF file in this file's folder (or below) ...
+        transform:                   # optional, for files: scale, rotate (x, y, z degrees), translate
+          scale: 0.5
+          rotate_deg: [0, 0, 30]
+          translate: [0, 0, 0.1]
+        material: red                # one material for every face ...
+      - name: ground
+        vertices: [[-2, -2, 0], [2, -2, 0], [2, 2, 0], [-2, 2, 0]]   # ... or inline geometry
+        faces: [[0, 1, 2], [0, 2, 3]]
+        face_materials: [[ground, 2]]  # ... or [material, count] runs over the faces in order
+    lights:
+      - kind: point                  # point | spot | area | directional
+        spectrum: "cie:D65"          # illuminant spectrum name
+        power: 4.0                   # > 0
+        position: [1, -1, 2]
+    camera:
+      origin: [0.6, -0.8, 0.5]
+      target: [0, 0, 0.1]
+      up: [0, 0, 1]                  # optional
+      fov_deg: 40                    # optional, horizontal
+      width: 128
+      height: 128
+    metadata: {}                     # optional, free-form
+
+Paths are relative to the YAML file's folder; absolute paths and paths leading out of that
+folder (``..``, symbolic links) are rejected, so a scene folder can be shared and loaded
+without reading anything outside it. Loaded scenes are checked with
+:func:`spectrinsic.scenes.validate.validate_scene`.
+
+:func:`save_scene` writes inline geometry for small meshes and double-precision binary PLY
+files (in ``<stem>_meshes/``) for larger ones, so ``load_scene(save_scene(s, p)) == s``.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Mapping
+from dataclasses import fields
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from spectrinsic.errors import SceneError, did_you_mean
+from spectrinsic.scenes.geometry import Part, moved
+from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene, scene_to_dict
+from spectrinsic.scenes.validate import LIGHT_KINDS, validate_scene
+
+__all__ = [
+    "FORMAT_VERSION",
+    "MESH_SUFFIXES",
+    "load_scene",
+    "save_scene",
+    "scene_from_dict",
+    "scene_to_yaml_dict",
+]
+
+FORMAT_VERSION = 1
+#: Mesh file types read through trimesh.
+MESH_SUFFIXES = (".obj", ".ply", ".stl", ".off")
+
+_TOP = ("format", "name", "materials", "meshes", "lights", "camera", "metadata")
+_MESH = (
+    "name",
+    "object_id",
+    "file",
+    "transform",
+    "vertices",
+    "faces",
+    "material",
+    "face_materials",
+)
+_TRANSFORM = ("scale", "rotate_deg", "translate")
+_LIGHT = tuple(f.name for f in fields(Light))
+_CAMERA = tuple(f.name for f in fields(Camera))
+
+
+class _Doc:
+    """Typed access to a parsed YAML document, with errors naming the file and field."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def fail(self, field: str, problem: str) -> SceneError:
+        return SceneError(f"{self.source}: {field}: {problem}")
+
+    def mapping(
+        self, value: Any, field: str, allowed: tuple[str, ...], required: tuple[str, ...] = ()
+    ) -> dict:
+        if not isinstance(value, dict):
+            raise self.fail(field, f"expected a mapping, got {type(value).__name__}")
+        for key in value:
+            if key not in allowed:
+                raise self.fail(
+                    f"{field}.{key}" if field else str(key),
+                    f"unknown key; expected one of {', '.join(allowed)}"
+                    + did_you_mean(str(key), allowed),
+                )
+        for key in required:
+            if key not in value:
+                raise self.fail(f"{field}.{key}" if field else key, "missing required key")
+        return value
+
+    def string(self, value: Any, field: str) -> str:
+        if not isinstance(value, str) or not value.strip():
+            raise self.fail(field, f"expected a non-empty string, got {value!r}")
+        return value
+
+    def number(self, value: Any, field: str) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise self.fail(field, f"expected a number, got {type(value).__name__} {value!r}")
+        return float(value)
+
+    def integer(self, value: Any, field: str, minimum: int = 0) -> int:
+        if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+            raise self.fail(field, f"expected an integer >= {minimum}, got {value!r}")
+        return value
+
+    def vector(self, value: Any, field: str, n: int = 3) -> tuple[float, ...]:
+        if not isinstance(value, list) or len(value) != n:
+            raise self.fail(field, f"expected a list of {n} numbers, got {value!r}")
+        return tuple(self.number(v, f"{field}[{i}]") for i, v in enumerate(value))
+
+    def array(self, value: Any, field: str, dtype: type, columns: int) -> np.ndarray:
+        if not isinstance(value, list) or not value:
+            raise self.fail(field, f"expected a non-empty list of [{columns} numbers] rows")
+        for i, row in enumerate(value):
+            if not isinstance(row, list) or len(row) != columns:
+                raise self.fail(
+                    f"{field}[{i}]", f"expected a list of {columns} numbers, got {row!r}"
+                )
+            for j, x in enumerate(row):
+                ok = isinstance(x, int) if dtype is np.int64 else isinstance(x, (int, float))
+                if isinstance(x, bool) or not ok:
+                    kind = "an integer" if dtype is np.int64 else "a number"
+                    raise self.fail(f"{field}[{i}][{j}]", f"expected {kind}, got {x!r}")
+        return np.asarray(value, dtype=dtype)
+
+
+# --- reading --------------------------------------------------------------------------------
+
+
+def _resolve(doc: _Doc, base: Path, value: Any, field: str) -> Path:
+    """*value* as a path inside *base* (the scene's folder), or a one-line error."""
+    rel = doc.string(value, field)
+    if Path(rel).is_absolute() or re.match(r"^[A-Za-z]:[\\/]", rel):
+        raise doc.fail(
+            field, f"absolute path {rel!r} not allowed; give a path relative to the scene's folder"
+        )
+    root = base.resolve()
+    path = (root / rel).resolve()
+    if not path.is_relative_to(root):
+        raise doc.fail(field, f"path {rel!r} leads outside the scene's folder {str(root)!r}")
+    if path.suffix.lower() not in MESH_SUFFIXES:
+        raise doc.fail(
+            field,
+            f"unsupported mesh file type {path.suffix!r}; expected {', '.join(MESH_SUFFIXES)}",
+        )
+    if not path.is_file():
+        raise doc.fail(field, f"mesh file {rel!r} not found in {str(root)!r}")
+    return path
+
+
+def _read_mesh_file(doc: _Doc, path: Path, field: str) -> tuple[np.ndarray, np.ndarray]:
+    import trimesh
+
+    try:
+        # process=False keeps vertex and face order, so face_materials runs stay valid
+        mesh = trimesh.load(str(path), force="mesh", process=False)
+    except Exception as exc:  # noqa: BLE001 - trimesh raises many types for corrupt files
+        raise doc.fail(
+            field, f"cannot read {path.name!r} as a mesh ({type(exc).__name__}: {exc})"
+        ) from exc
+    faces = np.asarray(getattr(mesh, "faces", np.empty((0, 3))), dtype=np.int64)
+    if faces.ndim != 2 or len(faces) == 0:
+        raise doc.fail(field, f"{path.name!r} holds no triangles")
+    return np.asarray(getattr(mesh, "vertices"), dtype=np.float64), faces  # noqa: B009
+
+
+def _face_materials(
+    doc: _Doc, entry: dict, field: str, n_faces: int, materials: dict[str, int]
+) -> np.ndarray:
+    def index(name: Any, where: str) -> int:
+        name = doc.string(name, where)
+        if name not in materials:
+            raise doc.fail(
+                where,
+                f"unknown material {name!r}; expected one of {', '.join(materials)}"
+                + did_you_mean(name, materials),
+            )
+        return materials[name]
+
+    if ("material" in entry) == ("face_materials" in entry):
+        raise doc.fail(
+            field, "give exactly one of 'material' (every face) or 'face_materials' (runs)"
+        )
+    if "material" in entry:
+        return np.full(n_faces, index(entry["material"], f"{field}.material"), dtype=np.int64)
+    runs = entry["face_materials"]
+    where = f"{field}.face_materials"
+    if not isinstance(runs, list) or not runs:
+        raise doc.fail(
+            where, "expected a list of [material, count] runs or one material name per face"
+        )
+    if all(isinstance(r, str) for r in runs):
+        out = np.array([index(r, f"{where}[{i}]") for i, r in enumerate(runs)], dtype=np.int64)
+    else:
+        parts = []
+        for i, run in enumerate(runs):
+            if not isinstance(run, list) or len(run) != 2:
+                raise doc.fail(f"{where}[{i}]", f"expected a [material, count] pair, got {run!r}")
+            parts.append(
+                np.full(
+                    doc.integer(run[1], f"{where}[{i}][1]", 1),
+                    index(run[0], f"{where}[{i}][0]"),
+                    dtype=np.int64,
+                )
+            )
+        out = np.concatenate(parts)
+    if len(out) != n_faces:
+        raise doc.fail(where, f"covers {len(out)} faces but the mesh has {n_faces}")
+    return out
+
+
+def _mesh(doc: _Doc, base: Path, entry: Any, i: int, materials: dict[str, int]) -> Mesh:
+    field = f"meshes[{i}]"
+    entry = doc.mapping(entry, field, _MESH, ("name",))
+    name = doc.string(entry["name"], f"{field}.name")
+    if ("file" in entry) == ("vertices" in entry or "faces" in entry):
+        raise doc.fail(field, "give either 'file' or inline 'vertices' and 'faces'")
+    if "file" in entry:
+        path = _resolve(doc, base, entry["file"], f"{field}.file")
+        vertices, faces = _read_mesh_file(doc, path, f"{field}.file")
+        if "transform" in entry:
+            t = doc.mapping(entry["transform"], f"{field}.transform", _TRANSFORM)
+            scale = t.get("scale", 1.0)
+            scale = (
+                doc.vector(scale, f"{field}.transform.scale")
+                if isinstance(scale, list)
+                else doc.number(scale, f"{field}.transform.scale")
+            )
+            if np.any(np.asarray(scale) <= 0):
+                raise doc.fail(f"{field}.transform.scale", f"must be > 0, got {scale!r}")
+            part = moved(
+                Part(vertices, faces, np.zeros(len(faces), dtype=np.int64), ("",)),
+                scale=scale,
+                rotate_deg=doc.vector(
+                    t.get("rotate_deg", [0, 0, 0]), f"{field}.transform.rotate_deg"
+                ),
+                translate=doc.vector(t.get("translate", [0, 0, 0]), f"{field}.transform.translate"),
+            )
+            vertices = part.vertices
+    else:
+        if "transform" in entry:
+            raise doc.fail(f"{field}.transform", "only meshes read from a file take a transform")
+        for key in ("vertices", "faces"):
+            if key not in entry:
+                raise doc.fail(
+                    f"{field}.{key}",
+                    "missing required key (inline geometry needs vertices and faces)",
+                )
+        # YAML's .nan reaches here as a float: validation reports it with the mesh's name
+        vertices = doc.array(entry["vertices"], f"{field}.vertices", np.float64, 3)
+        faces = doc.array(entry["faces"], f"{field}.faces", np.int64, 3)
+    object_id = doc.integer(entry.get("object_id", i), f"{field}.object_id")
+    face_materials = _face_materials(doc, entry, field, len(faces), materials)
+    return Mesh(
+        name=name,
+        vertices=vertices,
+        faces=faces,
+        face_materials=face_materials,
+        object_id=object_id,
+    )
+
+
+def _light(doc: _Doc, entry: Any, i: int) -> Light:
+    field = f"lights[{i}]"
+    entry = doc.mapping(entry, field, _LIGHT, ("kind", "spectrum", "power"))
+    kind = doc.string(entry["kind"], f"{field}.kind")
+    if kind not in LIGHT_KINDS:
+        raise doc.fail(
+            f"{field}.kind",
+            f"unknown light kind {kind!r}; expected one of {', '.join(LIGHT_KINDS)}"
+            + did_you_mean(kind, LIGHT_KINDS),
+        )
+    needs = {
+        "point": ("position",),
+        "spot": ("position", "direction"),
+        "area": ("position", "direction", "size"),
+        "directional": ("direction",),
+    }
+    for key in needs[kind]:
+        if key not in entry:
+            raise doc.fail(
+                f"{field}.{key}", f"missing; a {kind} light needs {' and '.join(needs[kind])}"
+            )
+    kw: dict[str, Any] = {
+        "kind": kind,
+        "spectrum": doc.string(entry["spectrum"], f"{field}.spectrum"),
+        "power": doc.number(entry["power"], f"{field}.power"),
+    }
+    for key in ("position", "direction"):
+        if key in entry:
+            kw[key] = doc.vector(entry[key], f"{field}.{key}")
+    if "size" in entry:
+        kw["size"] = doc.vector(entry["size"], f"{field}.size", 2)
+    if "cutoff_deg" in entry:
+        kw["cutoff_deg"] = doc.number(entry["cutoff_deg"], f"{field}.cutoff_deg")
+    if "name" in entry:
+        kw["name"] = doc.string(entry["name"], f"{field}.name")
+    return Light(**kw)
+
+
+def _camera(doc: _Doc, entry: Any) -> Camera:
+    entry = doc.mapping(entry, "camera", _CAMERA, ("origin", "target", "width", "height"))
+    kw: dict[str, Any] = {
+        k: doc.vector(entry[k], f"camera.{k}") for k in ("origin", "target", "up") if k in entry
+    }
+    if "fov_deg" in entry:
+        kw["fov_deg"] = doc.number(entry["fov_deg"], "camera.fov_deg")
+    kw["width"] = doc.integer(entry["width"], "camera.width", 1)
+    kw["height"] = doc.integer(entry["height"], "camera.height", 1)
+    if "name" in entry:
+        kw["name"] = doc.string(entry["name"], "camera.name")
+    return Camera(**kw)
+
+
+def scene_from_dict(data: Any, *, base: str | os.PathLike[str], source: str = "<scene>") -> Scene:
+    """Build a scene from parsed YAML *data*; mesh files are resolved inside folder *base*.
+
+    Only the structure and types are checked here; see :func:`load_scene` for validation.
+    """
+    doc = _Doc(source)
+    data = doc.mapping(data, "", _TOP, ("name", "materials", "meshes", "lights", "camera"))
+    if data.get("format", FORMAT_VERSION) != FORMAT_VERSION:
+        raise doc.fail(
+            "format", f"unsupported format version {data['format']!r}; expected {FORMAT_VERSION}"
+        )
+    mats = data["materials"]
+    if not isinstance(mats, dict) or not mats:
+        raise doc.fail(
+            "materials", "expected a non-empty mapping of material name -> spectrum name"
+        )
+    materials = tuple(
+        Material(name=doc.string(k, "materials"), spectrum=doc.string(v, f"materials.{k}"))
+        for k, v in mats.items()
+    )
+    lookup = {m.name: i for i, m in enumerate(materials)}
+    for key in ("meshes", "lights"):
+        if not isinstance(data[key], list) or not data[key]:
+            raise doc.fail(key, f"expected a non-empty list, got {data[key]!r}")
+    meshes = tuple(_mesh(doc, Path(base), m, i, lookup) for i, m in enumerate(data["meshes"]))
+    lights = tuple(_light(doc, x, i) for i, x in enumerate(data["lights"]))
+    metadata = data.get("metadata", {}) or {}
+    if not isinstance(metadata, dict):
+        raise doc.fail("metadata", f"expected a mapping, got {type(metadata).__name__}")
+    return Scene(
+        name=doc.string(data["name"], "name"),
+        meshes=meshes,
+        materials=materials,
+        lights=lights,
+        camera=_camera(doc, data["camera"]),
+        metadata=metadata,
+    )
+
+
+def load_scene(
+    path: str | os.PathLike[str], *, data_dir: str | None = None, validate: bool = True
+) -> Scene:
+    """Read and validate a YAML scene file.
+
+    Parameters
+    ----------
+    path
+        The ``.yaml`` file; mesh files are looked up in its folder.
+    data_dir
+        Spectral data directory for spectra that need one (``sfu:...``).
+    validate
+        Run :func:`~spectrinsic.scenes.validate.validate_scene` (spectra, light placement,
+        camera visibility). Structure and types are always checked.
+
+    Raises
+    ------
+    SceneError
+        One line naming the file and the field.
+    """
+    import yaml
+
+    path = Path(path)
+    source = str(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SceneError(f"{source}: cannot read scene file ({type(exc).__name__}: {exc})") from exc
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f"line {mark.line + 1}" if mark is not None else "YAML"
+        problem = " ".join(str(getattr(exc, "problem", None) or exc).split())
+        raise SceneError(f"{source}: {where}: invalid YAML ({problem})") from exc
+    scene = scene_from_dict(data, base=path.parent, source=source)
+    if validate:
+        validate_scene(scene, source=source, data_dir=data_dir)
+    return scene
+
+
+# --- writing --------------------------------------------------------------------------------
+
+
+def _write_ply(path: Path, vertices: np.ndarray, faces: np.ndarray) -> None:
+    """Binary little-endian PLY with float64 vertices (trimesh's writer rounds to float32)."""
+    header = (
+        "ply\nformat binary_little_endian 1.0\ncomment written by spectrinsic\n"
+        f"element vertex {len(vertices)}\nproperty double x\nproperty double y\nproperty double z\n"
+        f"element face {len(faces)}\nproperty list uchar int vertex_indices\nend_header\n"
+    )
+    packed = np.empty(len(faces), dtype=[("n", "u1"), ("v", "<i4", (3,))])
+    packed["n"] = 3
+    packed["v"] = faces
+    with path.open("wb") as fh:
+        fh.write(header.encode("ascii"))
+        fh.write(np.ascontiguousarray(vertices, dtype="<f8").tobytes())
+        fh.write(packed.tobytes())
+
+
+def _runs(face_materials: np.ndarray, names: list[str]) -> list[list[Any]]:
+    fm = np.asarray(face_materials)
+    starts = np.flatnonzero(np.r_[True, fm[1:] != fm[:-1]])
+    counts = np.diff(np.r_[starts, len(fm)])
+    return [[names[int(fm[s])], int(c)] for s, c in zip(starts, counts, strict=True)]
+
+
+def scene_to_yaml_dict(scene: Scene, mesh_files: Mapping[str, str] | None = None) -> dict[str, Any]:
+    """The YAML document of *scene*; meshes named in *mesh_files* reference that relative path
+    instead of holding inline geometry."""
+    names = [m.name for m in scene.materials]
+    if len(set(names)) != len(names):
+        raise SceneError(
+            f"scene {scene.name!r}: materials: names must be unique to be saved, got {names}"
+        )
+    mesh_files = mesh_files or {}
+    meshes = []
+    for m in scene.meshes:
+        entry: dict[str, Any] = {"name": m.name, "object_id": int(m.object_id)}
+        if m.name in mesh_files:
+            entry["file"] = mesh_files[m.name]
+        else:
+            entry["vertices"] = np.asarray(m.vertices, dtype=np.float64).tolist()
+            entry["faces"] = np.asarray(m.faces, dtype=np.int64).tolist()
+        runs = _runs(m.face_materials, names)
+        if len(runs) == 1:
+            entry["material"] = runs[0][0]
+        else:
+            entry["face_materials"] = runs
+        meshes.append(entry)
+    defaults = Light(kind="point", spectrum="", power=1.0)
+    lights = []
+    for light in scene.lights:
+        entry = {"kind": light.kind, "spectrum": light.spectrum, "power": float(light.power)}
+        for f in fields(Light):
+            value = getattr(light, f.name)
+            if f.name not in entry and value != getattr(defaults, f.name):
+                entry[f.name] = list(map(float, value)) if isinstance(value, tuple) else value
+        lights.append(entry)
+    cam = scene_to_dict(scene)["camera"]
+    doc: dict[str, Any] = {
+        "format": FORMAT_VERSION,
+        "name": scene.name,
+        "materials": {m.name: m.spectrum for m in scene.materials},
+        "meshes": meshes,
+        "lights": lights,
+        "camera": cam,
+    }
+    if scene.metadata:
+        doc["metadata"] = scene_to_dict(scene)["metadata"]
+    return doc
+
+
+def _dumper() -> type:
+    """A SafeDumper writing rows of numbers (and other scalar lists) on one line each."""
+    import yaml
+
+    class Dumper(yaml.SafeDumper):
+        pass
+
+    def seq(dumper: yaml.SafeDumper, data: list) -> Any:
+        flat = all(not isinstance(x, (list, dict)) for x in data)
+        return dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=flat)
+
+    Dumper.add_representer(list, seq)
+    return Dumper
+
+
+def save_scene(scene: Scene, path: str | os.PathLike[str], *, inline_max_faces: int = 64) -> Path:
+    """Write *scene* as YAML at *path*; meshes with more than *inline_max_faces* faces go to
+    float64 binary PLY files in ``<stem>_meshes/`` next to it. Returns *path*."""
+    import yaml
+
+    path = Path(path)
+    folder = path.parent / f"{path.stem}_meshes"
+    mesh_files: dict[str, str] = {}
+    for i, m in enumerate(scene.meshes):
+        if len(m.faces) > inline_max_faces:
+            folder.mkdir(parents=True, exist_ok=True)
+            fname = f"{i:03d}-{re.sub(r'[^A-Za-z0-9._-]+', '_', m.name)}.ply"
+            _write_ply(folder / fname, m.vertices, m.faces)
+            mesh_files[m.name] = f"{folder.name}/{fname}"
+    doc = scene_to_yaml_dict(scene, mesh_files)
+    header = f"# spectrinsic scene (format {FORMAT_VERSION}); see spectrinsic/scenes/FORMAT.md\n"
+    text = yaml.dump(
+        doc,
+        Dumper=_dumper(),
+        sort_keys=False,
+        default_flow_style=False,
+        width=4096,
+        allow_unicode=True,
+    )
+    path.write_text(header + text, encoding="utf-8")
+    return path
