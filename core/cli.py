@@ -19,6 +19,7 @@ __all__ = ["main", "build_parser"]
 #: Sub-command modules, in the order ``--help`` lists them.
 _COMMANDS: tuple[str, ...] = (
     "spectrinsic.cli_info",
+    "spectrinsic.cli_render",
     "spectrinsic.cli_dataset",
     "spectrinsic.cli_check",
     "spectrinsic.cli_study",

@@ -1,1 +1,54 @@
-"""spectrinsic.render"""
+"""spectrinsic.render: Mitsuba 3 backends (the only package importing ``mitsuba``/``drjit``).
+
+Nothing is imported from Mitsuba when this package is imported; variants are chosen per pass
+(:mod:`~spectrinsic.render.variants`) and set only inside ``variant_scope`` blocks.
+
+- :func:`render_scene` -> :class:`RenderResult`: the spectral reference and K-channel diagonal
+  renders (``rgb3``, ``rgb6``, ``bands31``) of one scene, all as CIE XYZ, with per-light and
+  direct-only renders and coverage/id/depth/normal maps.
+- :mod:`~spectrinsic.render.modes`: the mode registry and the colour maths of Eq. 5.2.
+- :mod:`~spectrinsic.render.passes`: the passes themselves, for any sensor set.
+- :func:`scene_to_mitsuba`: the one translation of a scene into a Mitsuba dict.
+"""
+
+from spectrinsic.render.modes import (
+    RENDER_MODES,
+    RenderMode,
+    channel_values,
+    get_mode,
+    mode_names,
+    to_xyz_matrix,
+)
+from spectrinsic.render.passes import render_aovs, render_diagonal, render_spectral
+from spectrinsic.render.pipeline import DEFAULT_MODES, count_passes, render_scene
+from spectrinsic.render.result import RenderResult
+from spectrinsic.render.translate import scene_to_mitsuba
+from spectrinsic.render.variants import (
+    available_variants,
+    choose_variant,
+    llvm_library,
+    variant_report,
+    variant_scope,
+)
+
+__all__ = [
+    "DEFAULT_MODES",
+    "RENDER_MODES",
+    "RenderMode",
+    "RenderResult",
+    "available_variants",
+    "channel_values",
+    "choose_variant",
+    "count_passes",
+    "get_mode",
+    "llvm_library",
+    "mode_names",
+    "render_aovs",
+    "render_diagonal",
+    "render_scene",
+    "render_spectral",
+    "scene_to_mitsuba",
+    "to_xyz_matrix",
+    "variant_report",
+    "variant_scope",
+]

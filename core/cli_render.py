@@ -1,0 +1,131 @@
+"""``spectrinsic render``: render one scene in several modes and write the raw passes as EXR.
+
+``SCENE`` is a library scene name (``spectrinsic.scenes.library``) or a YAML scene file. For
+every mode ``DIR/<mode>.exr`` holds float32 layers ``raw`` (the K raw channels, named after the
+sensors, e.g. ``raw.B400``), ``xyz`` (CIE 1931 XYZ), and when asked ``direct`` and
+``light<i>`` (XYZ); ``DIR/aovs.exr`` holds coverage, ids, depth and normals; ``DIR/meta.json``
+the render settings, variants, timings and the scene. Ground-truth layers are written by
+``spectrinsic dataset``, not here.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from spectrinsic.errors import SceneError
+
+__all__ = ["register", "run", "load_scene_argument", "write_render"]
+
+DEFAULT_MODES = "spectral,rgb3,rgb6,bands31"
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "render", help="render a scene in several colour modes and write raw passes as EXR",
+        description="Render SCENE (a library scene name or a YAML file) with Mitsuba 3 in each mode "
+                    "and write float32 EXR files with named channels into --out.",
+    )
+    p.add_argument("scene", metavar="SCENE", help="library scene name (e.g. room-living) or a .yaml scene file")
+    p.add_argument("--condition", default="white", help="library scenes: illumination condition (default: white)")
+    p.add_argument("--view", type=int, default=0, help="library scenes: camera viewpoint (default: 0)")
+    p.add_argument("--modes", default=DEFAULT_MODES, help=f"comma-separated render modes (default: {DEFAULT_MODES})")
+    p.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder")
+    p.add_argument("--spp", type=int, default=64, help="samples per pixel of every pass (default: 64)")
+    p.add_argument("--seed", type=int, default=0, help="sampler seed and library illuminant seed (default: 0)")
+    p.add_argument("--width", type=int, default=None, help="image width (default: the scene's, 128 for the library)")
+    p.add_argument("--height", type=int, default=None, help="image height (default: the scene's, 128 for the library)")
+    p.add_argument("--max-depth", type=int, default=8, help="longest path, 2 = direct light only (default: 8)")
+    p.add_argument("--variant", default=None, help="Mitsuba backend or variant (default: best usable)")
+    p.add_argument("--per-light", action="store_true", help="also write one image per light")
+    p.add_argument("--direct", action="store_true", help="also write direct-light-only images")
+    p.add_argument("--no-aovs", action="store_true", help="skip coverage/id/depth/normal maps")
+    p.set_defaults(func=run)
+
+
+def load_scene_argument(
+    scene: str, *, condition: str, view: int, seed: int, width: int | None, height: int | None,
+    data_dir: str | None = None,
+) -> Any:
+    """The Scene named by the ``SCENE`` argument: a YAML file if it looks like a path, else a library name."""
+    path = Path(scene)
+    if path.suffix.lower() in (".yaml", ".yml") or path.exists():
+        from spectrinsic.scenes.io import load_scene
+
+        loaded = load_scene(path, data_dir=data_dir)
+        camera = loaded.camera
+        if width is not None or height is not None:
+            camera = dataclasses.replace(camera, width=width or camera.width, height=height or camera.height)
+        return dataclasses.replace(loaded, camera=camera)
+    from spectrinsic.scenes import library
+
+    return library.build(scene, view=view, condition=condition, seed=seed, width=width or 128, height=height or 128)
+
+
+def write_render(out: Path, scene: Any, result: Any, *, data_dir: str | None = None) -> dict[str, Path]:
+    """Write a :class:`~spectrinsic.render.RenderResult` as EXR files and ``meta.json`` into *out*."""
+    from spectrinsic.gt_export.exr import write_exr
+    from spectrinsic.scenes.model import scene_to_dict
+    from spectrinsic.spectra import get_sensors
+
+    out.mkdir(parents=True, exist_ok=True)
+    paths: dict[str, Path] = {}
+    for mode, raw in result.raw.items():
+        labels = get_sensors(result.meta["sensors"][mode], data_dir=data_dir).channels
+        layers = {"raw": raw, "xyz": result.images[mode]}
+        names: dict[str, tuple[str, ...]] = {"raw": tuple(labels), "xyz": ("X", "Y", "Z")}
+        if mode in result.direct:
+            layers["direct"], names["direct"] = result.direct[mode], ("X", "Y", "Z")
+        for i, light in enumerate(result.per_light):
+            layers[f"light{i}"], names[f"light{i}"] = light[mode], ("X", "Y", "Z")
+        paths[mode] = write_exr(out / f"{mode}.exr", layers, channel_names=names,
+                                attributes={"spectrinsic.mode": mode, "spectrinsic.units": result.meta["units"]})
+    if result.aovs:
+        a = result.aovs
+        paths["aovs"] = write_exr(
+            out / "aovs.exr",
+            {"coverage": a["coverage"], "material_id": a["material_id"], "object_id": a["object_id"],
+             "depth": a["depth"], "normals": a["normals"], "mask": a["mask"].astype("float32")},
+            channel_names={"coverage": tuple(f"m{i:02d}" for i in range(a["coverage"].shape[-1])),
+                           "material_id": ("id",), "object_id": ("id",), "depth": ("Z",),
+                           "normals": ("X", "Y", "Z"), "mask": ("A",)},
+        )
+    meta = {**result.meta, "scene": scene_to_dict(scene), "files": {k: v.name for k, v in paths.items()}}
+    meta["scene"]["meshes"] = [{"name": m.name, "object_id": m.object_id, "faces": len(m.faces)} for m in scene.meshes]
+    paths["meta"] = out / "meta.json"
+    paths["meta"].write_text(json.dumps(meta, indent=2, default=str) + "\n", encoding="utf-8")
+    return paths
+
+
+def run(args: argparse.Namespace) -> int:
+    from spectrinsic.render import count_passes, render_scene
+
+    modes = [m.strip() for m in str(args.modes).split(",") if m.strip()]
+    if not modes:
+        raise SceneError(f"--modes {args.modes!r}: expected a comma-separated list such as {DEFAULT_MODES}")
+    data_dir = getattr(args, "data_dir", None)
+    scene = load_scene_argument(args.scene, condition=args.condition, view=args.view, seed=args.seed,
+                                width=args.width, height=args.height, data_dir=data_dir)
+    options = dict(modes=modes, per_light=args.per_light, direct=args.direct, aovs=not args.no_aovs)
+    total = count_passes(scene, data_dir=data_dir, **options)
+    bar = None
+    if not getattr(args, "quiet", False):
+        from tqdm import tqdm
+
+        bar = tqdm(total=total, desc=f"render {scene.name}", unit="pass", file=sys.stderr)
+    try:
+        result = render_scene(scene, spp=args.spp, seed=args.seed, max_depth=args.max_depth, variant=args.variant,
+                              progress=None if bar is None else bar.update, data_dir=data_dir, **options)
+    finally:
+        if bar is not None:
+            bar.close()
+    paths = write_render(Path(args.out), scene, result, data_dir=data_dir)
+    timings = result.meta["timings"]
+    for mode in result.images:
+        print(f"{mode:<9} {timings[mode]['passes']:>3} passes {timings[mode]['seconds']:7.2f} s  -> {paths[mode]}")
+    print(f"wrote {paths['meta']}")
+    return 0

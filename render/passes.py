@@ -1,0 +1,382 @@
+"""Mitsuba passes: K-channel diagonal renders, the spectral reference, and AOVs.
+
+Every pass of one image uses the same sampler seed, sample count and path depth with Russian
+roulette off, so passes trace identical paths (common random numbers): the differences between
+3-, 6- and K-channel renders are spectral error, not Monte Carlo noise. A scene is loaded once
+per variant and light subset; between passes only BSDF and emitter values change, through
+``mi.traverse``/``params.update()``, so Dr.Jit reuses its compiled kernels.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from spectrinsic.errors import RenderError, SceneError
+from spectrinsic.render import translate as tr
+from spectrinsic.render.modes import ChannelValues, light_spectra, pad_to_passes
+from spectrinsic.render.variants import choose_variant, variant_scope
+from spectrinsic.scenes.model import Scene
+from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, SensorSet, get_spectrum
+
+__all__ = [
+    "DIRECT_DEPTH",
+    "Progress",
+    "PassOutput",
+    "render_diagonal",
+    "render_spectral",
+    "render_aovs",
+    "AOV_NAMES",
+]
+
+logger = logging.getLogger(__name__)
+
+#: Path depth of a direct-light-only render (camera -> surface -> light).
+DIRECT_DEPTH = 2
+#: Called with 1 after each Mitsuba pass (e.g. ``tqdm.update``).
+Progress = Callable[[int], Any]
+#: Keys of the dict :func:`render_aovs` returns.
+AOV_NAMES = ("coverage", "material_id", "object_id", "depth", "normals", "mask")
+
+
+@dataclass(frozen=True, eq=False)
+class PassOutput:
+    """Raw images of one set of channel values.
+
+    Attributes
+    ----------
+    image
+        ``(H, W, K)`` float32 full render (all bounces up to ``max_depth``).
+    direct
+        ``(H, W, K)`` float32 direct-light-only render, or ``None`` when not asked for.
+    seconds
+        Wall-clock seconds of each Mitsuba pass, in order (full passes, then direct ones).
+    variant
+        The Mitsuba variant used.
+    """
+
+    image: np.ndarray
+    direct: np.ndarray | None
+    seconds: tuple[float, ...]
+    variant: str
+
+
+def _check_render_args(scene: Scene, spp: int, max_depth: int) -> None:
+    if int(spp) < 1:
+        raise SceneError(f"spp {spp}: expected at least 1 sample per pixel")
+    if int(max_depth) < 1:
+        raise SceneError(f"max_depth {max_depth}: expected >= 1")
+    if not scene.lights:
+        raise SceneError(f"scene {scene.name!r} has no lights: nothing to render")
+
+
+def _active(scene: Scene, active_lights: Sequence[int] | None) -> set[int]:
+    active = set(range(len(scene.lights))) if active_lights is None else {int(i) for i in active_lights}
+    bad = sorted(i for i in active if not 0 <= i < len(scene.lights))
+    if bad or not active:
+        raise SceneError(
+            f"scene {scene.name!r}: active lights {sorted(active)} must be a non-empty subset of "
+            f"0..{len(scene.lights) - 1}"
+        )
+    return active
+
+
+def _timed_render(mi: Any, loaded: Any, *, spp: int, seed: int, integrator: Any = None) -> tuple[np.ndarray, float]:
+    start = time.perf_counter()
+    try:
+        image = np.array(mi.render(loaded, spp=int(spp), seed=int(seed), integrator=integrator), dtype=np.float32)
+    except RuntimeError as exc:
+        raise RenderError(f"Mitsuba render failed: {exc}") from exc
+    return image, time.perf_counter() - start
+
+
+def _placeholder(index: int) -> dict[str, Any]:
+    """Distinct emission per light at load time (identical dicts could be merged into one
+    shared object); every pass sets the real values before rendering."""
+    return tr.rgb_spectrum([1.0 + index, 1.0, 1.0])
+
+
+def _parameters(mi: Any, loaded: Any, keys: Sequence[str]) -> Any:
+    """``mi.traverse`` of a loaded scene, checked to expose every parameter a pass updates."""
+    params = mi.traverse(loaded)
+    missing = [k for k in keys if k not in params]
+    if missing:
+        raise RenderError(f"Mitsuba scene lacks the parameters {missing[:3]} the passes update")
+    return params
+
+
+def _set_rgb(mi: Any, params: Any, key: str, values: np.ndarray) -> None:
+    params[key] = mi.Color3f(*(float(v) for v in values))
+
+
+def render_diagonal(
+    scene: Scene,
+    value_sets: Sequence[ChannelValues],
+    *,
+    spp: int,
+    seed: int,
+    max_depth: int = 8,
+    direct: Sequence[bool] | bool = False,
+    active_lights: Sequence[int] | None = None,
+    variant: str | None = None,
+    progress: Progress | None = None,
+    geometry: Sequence[tr.SurfaceGeometry] | None = None,
+) -> list[PassOutput]:
+    """Diagonal renders of *scene*, one per entry of *value_sets*, all on one loaded scene.
+
+    Each K-channel value set is rendered as ⌈K/3⌉ RGB passes (the last zero-padded) that share
+    seed, sample count and paths with every other pass (Eq. 5.2 per channel).
+
+    Parameters
+    ----------
+    value_sets
+        Channel values (:func:`spectrinsic.render.modes.channel_values`) of each render.
+    direct
+        Per value set (or for all): also render direct light only (``max_depth`` 2), for the
+        energy ratio r of Eq. 5.8.
+    active_lights
+        Indices of the lights to render (default all); others are left out (per-light renders).
+    variant
+        Backend or variant name (:func:`spectrinsic.render.variants.choose_variant`).
+    geometry
+        :func:`spectrinsic.render.translate.prepare_geometry` of *scene*, if already computed.
+
+    Returns
+    -------
+    One :class:`PassOutput` per value set, ``(H, W, K)`` float32 raw channels.
+    """
+    _check_render_args(scene, spp, max_depth)
+    active = _active(scene, active_lights)
+    flags = [bool(direct)] * len(value_sets) if isinstance(direct, bool) else [bool(d) for d in direct]
+    if len(flags) != len(value_sets):
+        raise SceneError(f"direct flags {flags}: expected one per value set ({len(value_sets)})")
+    if not value_sets:
+        return []
+    surfaces = [s for s in tr.surfaces(scene) if s.material >= 0]
+    chosen = choose_variant("rgb", variant)
+    outputs = []
+    with variant_scope(chosen) as mi:
+        mitsuba_dict = tr.scene_to_mitsuba(
+            scene,
+            # placeholders: every pass sets its own values before rendering
+            materials=[tr.rgb_spectrum([0.0, 0.0, 0.0])] * len(scene.materials),
+            lights=[_placeholder(j) if j in active else None for j in range(len(scene.lights))],
+            film=tr.hdr_film(scene.camera.width, scene.camera.height),
+            integrator=tr.path_integrator(max_depth),
+            sample_count=spp,
+            geometry=geometry,
+        )
+        loaded = mi.load_dict(mitsuba_dict)
+        params = _parameters(mi, loaded, [tr.reflectance_key(s, spectral=False) for s in surfaces]
+                             + [tr.emission_key(scene, j, spectral=False) for j in sorted(active)])
+        direct_integrator = mi.load_dict(tr.path_integrator(DIRECT_DEPTH)) if any(flags) else None
+        for values, want_direct in zip(value_sets, flags, strict=True):
+            k = values.materials.shape[1]
+            material_blocks = pad_to_passes(values.materials)
+            light_blocks = pad_to_passes(values.lights)
+            full, direct_parts, seconds = [], [], []
+            for mats, lights in zip(material_blocks, light_blocks, strict=True):
+                for s in surfaces:
+                    _set_rgb(mi, params, tr.reflectance_key(s, spectral=False), mats[s.material])
+                for j in sorted(active):
+                    _set_rgb(mi, params, tr.emission_key(scene, j, spectral=False), lights[j])
+                params.update()
+                image, dt = _timed_render(mi, loaded, spp=spp, seed=seed)
+                full.append(image)
+                seconds.append(dt)
+                if progress is not None:
+                    progress(1)
+                if want_direct:
+                    image, dt = _timed_render(mi, loaded, spp=spp, seed=seed, integrator=direct_integrator)
+                    direct_parts.append(image)
+                    seconds.append(dt)
+                    if progress is not None:
+                        progress(1)
+            outputs.append(PassOutput(
+                image=np.concatenate(full, axis=-1)[..., :k],
+                direct=np.concatenate(direct_parts, axis=-1)[..., :k] if want_direct else None,
+                seconds=tuple(seconds),
+                variant=chosen,
+            ))
+    return outputs
+
+
+def render_spectral(
+    scene: Scene,
+    sensors: SensorSet,
+    *,
+    spp: int,
+    seed: int,
+    max_depth: int = 8,
+    direct: bool = False,
+    active_lights: Sequence[int] | None = None,
+    variant: str | None = None,
+    data_dir: str | None = None,
+    progress: Progress | None = None,
+    geometry: Sequence[tr.SurfaceGeometry] | None = None,
+) -> PassOutput:
+    """Spectral reference: Mitsuba's spectral variant with a ``specfilm`` of *sensors*' curves.
+
+    Materials and lights are their registry spectra on the 1 nm CIE grid (360–830 nm), lights
+    scaled by their power; channel k is ``∫ L(λ) S_k(λ) dλ`` (nm), the exact counterpart of a
+    diagonal render's channel k. Works with any sensor set (CIE 1931, a camera's curves);
+    negative lobes (``"srgb"``) are not supported by ``specfilm`` and are clipped.
+    """
+    _check_render_args(scene, spp, max_depth)
+    active = _active(scene, active_lights)
+    wl = COLORIMETRIC_WAVELENGTHS
+    if np.any(sensors.curves < 0):
+        raise SceneError(f"sensor set {sensors.name!r} has negative lobes; render 'cie1931' and convert instead")
+    chosen = choose_variant("spectral", variant)
+    emission = light_spectra(scene, wl, data_dir=data_dir)
+    with variant_scope(chosen) as mi:
+        mitsuba_dict = tr.scene_to_mitsuba(
+            scene,
+            materials=[tr.regular_spectrum(get_spectrum(m.spectrum, data_dir=data_dir).on(wl), wl)
+                       for m in scene.materials],
+            lights=[tr.regular_spectrum(emission[j], wl) if j in active else None for j in range(len(scene.lights))],
+            film=tr.spectral_film(scene.camera.width, scene.camera.height, sensors.on(wl), wl),
+            integrator=tr.path_integrator(max_depth),
+            sample_count=spp,
+            geometry=geometry,
+        )
+        loaded = mi.load_dict(mitsuba_dict)
+        image, dt = _timed_render(mi, loaded, spp=spp, seed=seed)
+        seconds = [dt]
+        if progress is not None:
+            progress(1)
+        direct_image = None
+        if direct:
+            integrator = mi.load_dict(tr.path_integrator(DIRECT_DEPTH))
+            direct_image, dt = _timed_render(mi, loaded, spp=spp, seed=seed, integrator=integrator)
+            seconds.append(dt)
+            if progress is not None:
+                progress(1)
+    k = sensors.n
+    if image.shape[-1] < k:
+        raise RenderError(f"specfilm returned {image.shape[-1]} channels for {k} sensors")
+    return PassOutput(
+        image=image[..., :k],
+        direct=None if direct_image is None else direct_image[..., :k],
+        seconds=tuple(seconds),
+        variant=chosen,
+    )
+
+
+def render_aovs(
+    scene: Scene,
+    *,
+    spp: int,
+    seed: int,
+    variant: str | None = None,
+    progress: Progress | None = None,
+    geometry: Sequence[tr.SurfaceGeometry] | None = None,
+) -> tuple[dict[str, np.ndarray], tuple[float, ...]]:
+    """Coverage, id, depth and normal maps, box-filtered over the same pixel samples as a render.
+
+    Each BSDF-carrying surface gets a one-hot diffuse reflectance in turn (three per pass) and
+    the ``albedo`` AOV, averaged by a box filter, is the fraction of the pixel's samples hitting
+    it; with the seed and sample count of the colour passes these are the very samples those
+    passes averaged, so ``Σ_m coverage_m ρ_m`` is the ground-truth reflectance of each pixel.
+    Mitsuba's own albedo of the real materials is not used (it assumes RGB wavelengths).
+
+    Returns
+    -------
+    aovs
+        ``coverage`` ``(H, W, M)`` float32 per material; ``material_id`` and ``object_id``
+        ``(H, W)`` int32, the material (object) covering most of the pixel, -1 where background
+        or light geometry covers most; ``depth`` ``(H, W)`` float32 mean ray distance from the
+        camera centre over the pixel's hits (scene units, 0 where nothing is hit);
+        ``normals`` ``(H, W, 3)`` float32 unit mean shading normal in world space as wound by
+        the mesh (zero where nothing is hit); ``mask`` ``(H, W)`` bool, ``material_id >= 0``.
+    seconds
+        Seconds per pass.
+    """
+    if int(spp) < 1:
+        raise SceneError(f"spp {spp}: expected at least 1 sample per pixel")
+    surfaces = tr.surfaces(scene)
+    n_pass = max(1, -(-len(surfaces) // 3))
+    chosen = choose_variant("rgb", variant)
+    h, w = scene.camera.height, scene.camera.width
+    cover = np.zeros((h, w, len(surfaces)), np.float64)
+    seconds = []
+    with variant_scope(chosen) as mi:
+        zero = tr.rgb_spectrum([0.0, 0.0, 0.0])
+        mitsuba_dict = tr.scene_to_mitsuba(
+            scene,
+            materials=[zero] * len(scene.materials),
+            lights=[_placeholder(j) for j in range(len(scene.lights))],
+            film=tr.hdr_film(w, h),
+            integrator=tr.aov_integrator(),
+            sample_count=spp,
+            geometry=geometry,
+        )
+        loaded = mi.load_dict(mitsuba_dict)
+        params = _parameters(mi, loaded, [tr.reflectance_key(s, spectral=False) for s in surfaces])
+        depth_sum = normal_sum = None
+        for p in range(n_pass):
+            for i, s in enumerate(surfaces):
+                onehot = np.zeros(3)
+                if i // 3 == p:
+                    onehot[i % 3] = 1.0
+                _set_rgb(mi, params, tr.reflectance_key(s, spectral=False), onehot)
+            params.update()
+            image, dt = _timed_render(mi, loaded, spp=spp, seed=seed)
+            seconds.append(dt)
+            if progress is not None:
+                progress(1)
+            if image.shape[-1] != 7:
+                raise RenderError(f"AOV pass returned {image.shape[-1]} channels; expected 7 (depth, normal, albedo)")
+            if p == 0:
+                depth_sum, normal_sum = image[..., 0].astype(np.float64), image[..., 1:4].astype(np.float64)
+            block = surfaces[3 * p: 3 * p + 3]
+            cover[..., 3 * p: 3 * p + len(block)] = image[..., 4: 4 + len(block)]
+    return _assemble_aovs(scene, surfaces, cover, depth_sum, normal_sum), tuple(seconds)
+
+
+def _majority(coverage: np.ndarray) -> np.ndarray:
+    """Index of the largest coverage per pixel, -1 where the uncovered rest is larger."""
+    if coverage.shape[-1] == 0:
+        return np.full(coverage.shape[:2], -1, np.int32)
+    rest = 1.0 - coverage.sum(axis=-1, keepdims=True)
+    winner = np.argmax(np.concatenate([coverage, rest], axis=-1), axis=-1)
+    return np.where(winner == coverage.shape[-1], -1, winner).astype(np.int32)
+
+
+def _assemble_aovs(
+    scene: Scene,
+    surfaces: Sequence[tr.Surface],
+    cover: np.ndarray,
+    depth_sum: np.ndarray | None,
+    normal_sum: np.ndarray | None,
+) -> dict[str, np.ndarray]:
+    h, w = cover.shape[:2]
+    n_mat = len(scene.materials)
+    material_cov = np.zeros((h, w, n_mat))
+    object_ids = sorted({m.object_id for m in scene.meshes})
+    object_cov = np.zeros((h, w, len(object_ids)))
+    for i, s in enumerate(surfaces):
+        if s.material >= 0:
+            material_cov[..., s.material] += cover[..., i]
+            object_cov[..., object_ids.index(scene.meshes[s.mesh].object_id)] += cover[..., i]
+    hit = cover.sum(axis=-1)
+    material_id = _majority(material_cov)
+    winner = _majority(object_cov)
+    object_id = np.where(winner >= 0, np.asarray(object_ids + [-1], np.int64)[winner], -1).astype(np.int32)
+    depth = np.zeros((h, w)) if depth_sum is None else np.divide(depth_sum, hit, out=np.zeros((h, w)), where=hit > 1e-6)
+    normals = np.zeros((h, w, 3)) if normal_sum is None else normal_sum
+    length = np.linalg.norm(normals, axis=-1, keepdims=True)
+    normals = np.divide(normals, length, out=np.zeros_like(normals), where=length > 1e-6)
+    return {
+        "coverage": np.clip(material_cov, 0.0, 1.0).astype(np.float32),
+        "material_id": material_id,
+        "object_id": object_id,
+        "depth": depth.astype(np.float32),
+        "normals": normals.astype(np.float32),
+        "mask": material_id >= 0,
+    }

@@ -1,0 +1,60 @@
+"""The record a render returns: arrays and metadata, no live renderer."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from spectrinsic.errors import RenderError
+
+__all__ = ["RenderResult"]
+
+
+@dataclass(frozen=True, eq=False)
+class RenderResult:
+    """Images of one scene in several render modes, with ground-truth helper maps.
+
+    Attributes
+    ----------
+    images
+        mode -> ``(H, W, 3)`` float32 linear CIE 1931 XYZ (``∫ L x̄ dλ`` etc., λ in nm).
+    raw
+        mode -> ``(H, W, K)`` float32 raw channels (the ``(H, W, 31)`` band cube, the 6 Gaussian
+        sensors, ...), ``∫ L S_k dλ`` under each mode's diagonal approximation.
+    per_light
+        One dict mode -> ``(H, W, 3)`` XYZ per scene light (empty unless asked for);
+        ``images[mode]`` is exactly their sum.
+    direct
+        mode -> ``(H, W, 3)`` XYZ of direct light only (path depth 2), for the energy ratio r of
+        Eq. 5.8 (empty unless asked for).
+    aovs
+        ``coverage`` ``(H, W, M)`` float32, ``material_id`` / ``object_id`` ``(H, W)`` int32 (-1
+        background), ``depth`` ``(H, W)`` float32, ``normals`` ``(H, W, 3)`` float32, ``mask``
+        ``(H, W)`` bool; see :func:`spectrinsic.render.passes.render_aovs` (empty unless asked).
+    meta
+        Variants, spp, seed, max_depth, sensors and XYZ matrices per mode, wavelength grid,
+        timings (seconds per pass), Mitsuba version.
+    """
+
+    images: dict[str, np.ndarray]
+    raw: dict[str, np.ndarray]
+    per_light: tuple[dict[str, np.ndarray], ...] = ()
+    direct: dict[str, np.ndarray] = field(default_factory=dict)
+    aovs: dict[str, np.ndarray] = field(default_factory=dict)
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """``(H, W)`` of the images."""
+        first = next(iter(self.images.values()))
+        return int(first.shape[0]), int(first.shape[1])
+
+    def energy_ratio(self, mode: str) -> float:
+        """r = Σ_x ‖p¹(x)‖ / Σ_x ‖p^∞(x)‖ (Eq. 5.8) on *mode*'s XYZ, from the direct-only render."""
+        if mode not in self.direct:
+            raise RenderError(f"no direct-only render of mode {mode!r}; render with direct=True")
+        full = float(np.linalg.norm(self.images[mode].astype(np.float64), axis=-1).sum())
+        one = float(np.linalg.norm(self.direct[mode].astype(np.float64), axis=-1).sum())
+        return one / full if full > 0 else float("nan")

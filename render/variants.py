@@ -1,0 +1,276 @@
+"""Choosing a Mitsuba variant, and importing Mitsuba safely.
+
+Dr.Jit's LLVM backend JIT-compiles through a system ``libLLVM``. The LLVM 14 and 15 libraries
+that Debian ships crash it (``Cannot select: fminimum``); LLVM 16 or newer works. So, before the
+first ``import drjit``, :func:`configure_llvm` points ``DRJIT_LIBLLVM_PATH`` at the newest
+``libLLVM`` >= 16 it finds, unless the user already set that variable. When none exists the
+LLVM variants are not used: renders fall back to the (about twice slower) scalar variants with one
+:class:`~spectrinsic.errors.SpectrinsicWarning`.
+
+Variants are chosen per pass (cuda > llvm > scalar; ``*_spectral`` for the spectral reference,
+``*_rgb`` for diagonal passes and AOVs) and activated only inside :func:`variant_scope`; nothing
+here runs at import time and no variant is ever set globally by spectrinsic on its own.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import glob
+import importlib
+import logging
+import os
+import re
+import warnings
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from types import ModuleType
+from typing import Any, Literal
+
+from spectrinsic.errors import (
+    MissingDependencyError,
+    RenderError,
+    SpectrinsicWarning,
+    validate_choice,
+)
+
+__all__ = [
+    "LLVM_ENV",
+    "LLVM_MIN_VERSION",
+    "BACKENDS",
+    "VariantKind",
+    "llvm_version_from_name",
+    "find_libllvm",
+    "configure_llvm",
+    "import_mitsuba",
+    "usable_backends",
+    "choose_variant",
+    "available_variants",
+    "llvm_library",
+    "variant_report",
+    "variant_scope",
+]
+
+logger = logging.getLogger(__name__)
+
+#: Environment variable Dr.Jit reads for the path of ``libLLVM``.
+LLVM_ENV = "DRJIT_LIBLLVM_PATH"
+#: Oldest LLVM major version whose instruction selection handles Dr.Jit's ``fminimum``.
+LLVM_MIN_VERSION = 16
+#: Dr.Jit backends in order of preference, with the prefix of their Mitsuba variants.
+BACKENDS: dict[str, str] = {"cuda": "cuda_ad", "llvm": "llvm_ad", "scalar": "scalar"}
+
+VariantKind = Literal["rgb", "spectral"]
+
+#: Where distributions put ``libLLVM`` (globs allowed); searched in this order.
+_LIB_DIRS: tuple[str, ...] = (
+    "/usr/lib/x86_64-linux-gnu",
+    "/usr/lib/aarch64-linux-gnu",
+    "/usr/lib64",
+    "/usr/lib",
+    "/usr/local/lib",
+    "/usr/lib/llvm-*/lib",
+    "/usr/lib64/llvm*/lib",
+    "/opt/homebrew/opt/llvm/lib",
+    "/usr/local/opt/llvm/lib",
+)
+_NAME_DASH = re.compile(r"^libLLVM-(\d+)")  # libLLVM-19.so, libLLVM-14.0.6.so.1
+_NAME_SOVERSION = re.compile(r"^libLLVM\.(?:so|dylib)\.(\d+)")  # libLLVM.so.19.1
+_DIR_VERSION = re.compile(r"llvm-?(\d+)")  # /usr/lib/llvm-19/lib/libLLVM.so
+
+
+def llvm_version_from_name(path: str | os.PathLike[str]) -> int | None:
+    """Major LLVM version encoded in a ``libLLVM`` file name (or its folder), else ``None``.
+
+    >>> llvm_version_from_name("/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1")
+    19
+    >>> llvm_version_from_name("libLLVM-14.0.6.so.1")
+    14
+    >>> llvm_version_from_name("/usr/lib/llvm-17/lib/libLLVM.so") is None
+    False
+    """
+    p = Path(path)
+    for pattern in (_NAME_DASH, _NAME_SOVERSION):
+        m = pattern.match(p.name)
+        if m:
+            return int(m.group(1))
+    m = _DIR_VERSION.search(str(p.parent))
+    return int(m.group(1)) if m and p.name.startswith("libLLVM") else None
+
+
+def find_libllvm(
+    dirs: Sequence[str] | None = None, *, min_version: int = LLVM_MIN_VERSION
+) -> Path | None:
+    """The newest ``libLLVM`` shared library of version >= *min_version* in *dirs*, or ``None``.
+
+    Parameters
+    ----------
+    dirs
+        Folders (glob patterns allowed) to search; default: the usual system library folders.
+    """
+    best: tuple[int, Path] | None = None
+    for pattern in dirs if dirs is not None else _LIB_DIRS:
+        for folder in sorted(glob.glob(pattern)):
+            for lib in sorted(Path(folder).glob("libLLVM*")):
+                if not (lib.suffix in (".so", ".dylib") or ".so." in lib.name) or not lib.exists():
+                    continue
+                version = llvm_version_from_name(lib)
+                if version is not None and version >= min_version and (best is None or version > best[0]):
+                    best = (version, lib)
+    return None if best is None else best[1]
+
+
+def configure_llvm() -> str | None:
+    """Set ``DRJIT_LIBLLVM_PATH`` to a suitable ``libLLVM`` unless already set; return its value.
+
+    Must run before the first ``import drjit``; :func:`import_mitsuba` does so. Returns ``None``
+    when the variable is unset and no ``libLLVM`` >= :data:`LLVM_MIN_VERSION` exists.
+    """
+    current = os.environ.get(LLVM_ENV, "").strip()
+    if current:
+        return current
+    found = find_libllvm()
+    if found is None:
+        return None
+    # Dr.Jit reads this once, when its LLVM backend first initialises: it has to be an
+    # environment variable, set before drjit is imported.
+    os.environ[LLVM_ENV] = str(found)
+    logger.debug("using %s for Dr.Jit's LLVM backend", found)
+    return str(found)
+
+
+def import_mitsuba() -> ModuleType:
+    """Return the ``mitsuba`` module, configuring Dr.Jit's LLVM library first.
+
+    Raises
+    ------
+    MissingDependencyError
+        If Mitsuba 3 is not installed.
+    """
+    configure_llvm()
+    try:
+        return importlib.import_module("mitsuba")
+    except ImportError as exc:  # pragma: no cover - mitsuba is a declared dependency
+        raise MissingDependencyError(
+            f"rendering needs Mitsuba 3 ('pip install mitsuba'): {exc}"
+        ) from exc
+
+
+def _llvm_suitable() -> bool:
+    path = os.environ.get(LLVM_ENV, "").strip()
+    if not path:
+        return False  # Dr.Jit would pick whatever libLLVM it finds: possibly 14/15, which crash
+    version = llvm_version_from_name(path)
+    return version is None or version >= LLVM_MIN_VERSION  # an unversioned path set by the user is trusted
+
+
+def usable_backends() -> tuple[str, ...]:
+    """Dr.Jit backends that can render here, best first (always ends with ``"scalar"``)."""
+    import_mitsuba()
+    import drjit as dr
+
+    found = []
+    if dr.has_backend(dr.JitBackend.CUDA):
+        found.append("cuda")
+    if _llvm_suitable() and dr.has_backend(dr.JitBackend.LLVM):
+        found.append("llvm")
+    found.append("scalar")
+    return tuple(found)
+
+
+def _backend_of(requested: str) -> str:
+    """``"llvm"`` for ``"llvm"``, ``"llvm_ad_rgb"`` or ``"llvm_ad_spectral"``; likewise cuda/scalar."""
+    head = requested.split("_", 1)[0]
+    return validate_choice(head, BACKENDS, "Mitsuba backend")
+
+
+def choose_variant(kind: VariantKind, requested: str | None = None) -> str:
+    """The Mitsuba variant for a pass of *kind* (``"rgb"`` or ``"spectral"``).
+
+    Parameters
+    ----------
+    kind
+        ``"spectral"`` for the spectral reference, ``"rgb"`` for diagonal passes and AOVs.
+    requested
+        A backend (``"cuda"``, ``"llvm"``, ``"scalar"``) or any variant name, whose backend is
+        used (``"llvm_ad_rgb"`` also selects ``llvm_ad_spectral`` for spectral passes).
+        ``None``: the best usable backend, cuda > llvm > scalar.
+
+    Raises
+    ------
+    RenderError
+        If the requested backend cannot run here or Mitsuba lacks the variant.
+    """
+    validate_choice(kind, ("rgb", "spectral"), "variant kind")
+    mi = import_mitsuba()
+    usable = usable_backends()
+    if requested is not None:
+        backend = _backend_of(requested)
+        if backend not in usable:
+            raise RenderError(
+                f"Mitsuba backend {backend!r} (from {requested!r}) is not usable here; usable: "
+                f"{', '.join(usable)}"
+            )
+    else:
+        backend = usable[0]
+        if backend == "scalar":
+            warnings.warn(
+                f"no libLLVM >= {LLVM_MIN_VERSION} found (set {LLVM_ENV}); rendering with Mitsuba's "
+                "scalar variants, about twice slower",
+                SpectrinsicWarning,
+                stacklevel=2,
+            )
+    variant = f"{BACKENDS[backend]}_{kind}"
+    if variant not in mi.variants():
+        raise RenderError(f"this Mitsuba build lacks variant {variant!r}; it has {', '.join(mi.variants())}")
+    return variant
+
+
+def llvm_library() -> str | None:
+    """Path of the ``libLLVM`` Dr.Jit's LLVM backend will use, or ``None`` if none is suitable."""
+    path = configure_llvm()
+    return path if path and _llvm_suitable() else None
+
+
+def available_variants() -> list[str]:
+    """Mitsuba variants usable here for spectrinsic's passes, best backend first
+    (e.g. ``["llvm_ad_rgb", "llvm_ad_spectral", "scalar_rgb", "scalar_spectral"]``)."""
+    mi = import_mitsuba()
+    compiled = set(mi.variants())
+    return [
+        f"{BACKENDS[b]}_{kind}" for b in usable_backends() for kind in ("rgb", "spectral")
+        if f"{BACKENDS[b]}_{kind}" in compiled
+    ]
+
+
+def variant_report() -> dict[str, Any]:
+    """Versions, compiled and usable variants, the LLVM library and the variants chosen by default."""
+    mi = import_mitsuba()
+    import drjit as dr
+
+    usable = usable_backends()
+    prefix = BACKENDS[usable[0]]
+    return {
+        "mitsuba": mi.__version__,
+        "drjit": getattr(dr, "__version__", "unknown"),
+        "compiled": list(mi.variants()),
+        "usable": available_variants(),
+        "libllvm": llvm_library(),
+        "backends": list(usable),
+        "rgb": f"{prefix}_rgb",
+        "spectral": f"{prefix}_spectral",
+    }
+
+
+@contextlib.contextmanager
+def variant_scope(variant: str) -> Iterator[ModuleType]:
+    """Activate *variant* for the duration of a ``with`` block; yields the ``mitsuba`` module.
+
+    Wraps ``mitsuba.util.variant_context``, which cannot restore "no variant" (Mitsuba 3.9
+    raises on ``set_variant(None)``): on the very first use the variant is set first, so the
+    context has a variant to restore afterwards.
+    """
+    mi = import_mitsuba()
+    if mi.variant() is None:
+        mi.set_variant(variant)
+    with mi.util.variant_context(variant):
+        yield mi

@@ -1,0 +1,110 @@
+"""Variant selection and LLVM discovery."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from spectrinsic.errors import RenderError, SpectrinsicError, SpectrinsicWarning
+from spectrinsic.render import variants
+
+
+@pytest.mark.parametrize(
+    ("name", "version"),
+    [
+        ("/usr/lib/x86_64-linux-gnu/libLLVM-19.so", 19),
+        ("/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1", 19),
+        ("libLLVM-14.0.6.so.1", 14),
+        ("libLLVM-15.so", 15),
+        ("/usr/lib/llvm-17/lib/libLLVM.so", 17),
+        ("/opt/lib/libLLVM.so", None),
+        ("/usr/lib/libfoo-19.so", None),
+    ],
+)
+def test_llvm_version_from_name(name, version):
+    assert variants.llvm_version_from_name(name) == version
+
+
+def test_find_libllvm_prefers_newest_suitable(tmp_path):
+    for name in ("libLLVM-14.so.1", "libLLVM-15.so", "libLLVM.so.19.1", "libLLVM-17.so", "libLLVM-20.a"):
+        (tmp_path / name).write_bytes(b"")
+    assert variants.find_libllvm([str(tmp_path)]).name == "libLLVM.so.19.1"
+
+
+def test_find_libllvm_rejects_old_versions(tmp_path):
+    for name in ("libLLVM-14.so.1", "libLLVM-15.so"):
+        (tmp_path / name).write_bytes(b"")
+    assert variants.find_libllvm([str(tmp_path)]) is None
+
+
+def test_configure_llvm_keeps_user_setting(monkeypatch):
+    monkeypatch.setenv(variants.LLVM_ENV, "/somewhere/libLLVM-18.so")
+    assert variants.configure_llvm() == "/somewhere/libLLVM-18.so"
+
+
+def test_importing_render_does_not_import_mitsuba():
+    code = "import sys, spectrinsic.render; print('mitsuba' in sys.modules or 'drjit' in sys.modules)"
+    out = subprocess.run([sys.executable, "-P", "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
+@pytest.mark.parametrize("kind", ["rgb", "spectral"])
+def test_choose_variant_matches_kind(kind):
+    chosen = variants.choose_variant(kind)
+    assert chosen.endswith("_" + kind)
+    assert chosen.split("_")[0] in variants.usable_backends()
+
+
+def test_choose_variant_honours_backend_of_a_variant_name():
+    assert variants.choose_variant("spectral", "scalar_rgb") == "scalar_spectral"
+
+
+def test_choose_variant_rejects_unknown_backend():
+    with pytest.raises(SpectrinsicError, match="did you mean 'llvm'"):
+        variants.choose_variant("rgb", "llvn")
+
+
+def test_unusable_backend_is_an_error():
+    if "cuda" in variants.usable_backends():
+        pytest.skip("a CUDA device is present, so the cuda backend is usable")
+    with pytest.raises(RenderError, match="not usable"):
+        variants.choose_variant("rgb", "cuda")
+
+
+def test_available_variants_lists_usable_variants():
+    usable = variants.available_variants()
+    assert usable[-2:] == ["scalar_rgb", "scalar_spectral"]
+    report = variants.variant_report()
+    assert report["rgb"] == usable[0] and report["spectral"] == usable[1]
+    assert set(usable) <= set(report["compiled"])
+    if "llvm" in report["backends"]:
+        assert variants.llvm_version_from_name(report["libllvm"]) in (None, *range(variants.LLVM_MIN_VERSION, 100))
+
+
+def test_variant_scope_restores_previous_variant():
+    with variants.variant_scope("scalar_rgb") as mi:
+        with variants.variant_scope("scalar_spectral"):
+            assert mi.variant() == "scalar_spectral"
+        assert mi.variant() == "scalar_rgb"
+
+
+def test_without_suitable_llvm_falls_back_to_scalar_with_one_warning(monkeypatch):
+    monkeypatch.setattr(variants, "_llvm_suitable", lambda: False)
+    if "cuda" in variants.usable_backends():
+        pytest.skip("a CUDA device is present: cuda is chosen before llvm or scalar")
+    with pytest.warns(SpectrinsicWarning, match="scalar") as record:
+        assert variants.choose_variant("rgb") == "scalar_rgb"
+    assert len(record) == 1
+
+
+def test_scalar_variant_renders_the_same_deterministic_plane(make_plane):
+    from spectrinsic.render import render_scene
+
+    scene = make_plane("munsell:5R 5/12", "planck:2800K", tilt_deg=30.0, size=4)
+    scalar = render_scene(scene, modes=("rgb3",), spp=2, seed=0, variant="scalar", aovs=False)
+    best = render_scene(scene, modes=("rgb3",), spp=2, seed=0, aovs=False)
+    assert scalar.meta["variants"]["rgb3"] == "scalar_rgb"
+    np.testing.assert_allclose(scalar.images["rgb3"], best.images["rgb3"], rtol=1e-5)
