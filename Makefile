@@ -15,7 +15,7 @@ export PYTHONSAFEPATH := 1
 export SPECTRINSIC_DATA ?= $(DATA_DIR)
 
 .DEFAULT_GOAL := help
-.PHONY: help setup test test-fast study dataset evaluate bench lint info clean
+.PHONY: help setup test test-fast study study-spectral dataset evaluate bench lint info clean
 
 help: ## list the targets
 	@awk 'BEGIN {FS = ":.*## "} /^[a-zA-Z_-]+:.*## / {printf "  make %-10s %s\n", $$1, $$2}' $(MAKEFILE_LIST)
@@ -39,7 +39,10 @@ test: $(PKG) ## run the test suite (tiny renders; < 15 min on 2 cores)
 test-fast: $(PKG) ## run the tests not marked slow
 	$(PY) -m pytest -n 2 -q -m "not slow"
 
-study: $(PKG) ## spectral studies: reconstruction error (Table 5.2) and photometric scenarios (Table 4.4)
+study: study-spectral ## all studies: Table 5.2, Table 4.4 and the rendered study (< 15 min)
+	$(BIN)/spectrinsic study rendering
+
+study-spectral: $(PKG) ## the two spectral studies only: Table 5.2 and Table 4.4 (< 3 min)
 	$(BIN)/spectrinsic study reconstruction-error
 	$(BIN)/spectrinsic study photometric
 

@@ -35,7 +35,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="photometric: add the Image Engineering 2024 cameras of the data directory")
     p.add_argument("--no-extension", action="store_true",
                    help="reconstruction-error: only Table 5.2, without the extended sweep")
-    p.add_argument("--quality", default="preview", help="rendering: quality preset (default: preview)")
+    p.add_argument("--quality", default="default", choices=("preview", "default", "paper"),
+                   help="rendering: quality preset (default: default, < 10 min on 2 cores)")
     p.set_defaults(func=run)
 
 
@@ -104,19 +105,9 @@ def run(args: argparse.Namespace) -> int:
         print(format_photometric(result))
         _print_paths(paths)
         return 0
-    from spectrinsic.study_rendering import run_rendering_study
+    from spectrinsic.study_rendering import format_rendering, run_rendering_study
 
     with _progress(quiet, "rendering study") as progress:
-        summary = run_rendering_study(out, quality=args.quality, data_dir=data_dir, progress=progress)
-    if summary is not None:
-        print(summary if isinstance(summary, str) else _describe(summary))
+        payload = run_rendering_study(out, quality=args.quality, data_dir=data_dir, progress=progress)
+    print(format_rendering(payload))
     return 0
-
-
-def _describe(summary: Any) -> str:
-    import json
-
-    try:
-        return json.dumps(summary, indent=2, default=str)
-    except (TypeError, ValueError):
-        return str(summary)
