@@ -248,7 +248,7 @@ def _meta(
         "scene_metadata": scene.metadata,
         "config_hash": config_hash(config),
         "seed": int(seed),
-        "variant": render_meta.get("variant"),
+        "variant": ", ".join(sorted(set((render_meta.get("variants") or {}).values()))) or None,
         "render": render_meta,
         "reference_mode": gt.reference_mode,
         "size": [height, width],

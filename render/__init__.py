@@ -27,6 +27,7 @@ from spectrinsic.render.variants import (
     available_variants,
     choose_variant,
     llvm_library,
+    set_thread_count,
     variant_report,
     variant_scope,
 )
@@ -48,6 +49,7 @@ __all__ = [
     "render_scene",
     "render_spectral",
     "scene_to_mitsuba",
+    "set_thread_count",
     "to_xyz_matrix",
     "variant_report",
     "variant_scope",

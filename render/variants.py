@@ -42,6 +42,7 @@ __all__ = [
     "find_libllvm",
     "configure_llvm",
     "import_mitsuba",
+    "set_thread_count",
     "usable_backends",
     "choose_variant",
     "available_variants",
@@ -153,6 +154,21 @@ def import_mitsuba() -> ModuleType:
         raise MissingDependencyError(
             f"rendering needs Mitsuba 3 ('pip install mitsuba'): {exc}"
         ) from exc
+
+
+def set_thread_count(n: int | None) -> None:
+    """Limit Dr.Jit's thread pool in this process to *n* threads (``None``: leave it).
+
+    With several worker processes on one machine, one pool per process sized to its share of
+    the cores avoids oversubscription.
+    """
+    if n is None:
+        return
+    import_mitsuba()  # points Dr.Jit at a suitable libLLVM before drjit is first imported
+    import drjit
+
+    if drjit.thread_count() != n:
+        drjit.set_thread_count(n)
 
 
 def _llvm_suitable() -> bool:

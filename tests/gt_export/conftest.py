@@ -128,7 +128,7 @@ def make_result(
     }
     raw = {"bands31": cube.astype(np.float32)} if "bands31" in modes else {}
     meta = {
-        "variant": "synthetic", "spp": 1, "seed": 0, "max_depth": 8,
+        "variants": {"spectral": "synthetic", "bands31": "synthetic"}, "spp": 1, "seed": 0, "max_depth": 8,
         "sensors": {"bands31": "bands:31@400-700"}, "timings": {"total": 0.123},
     }
     return FakeResult(images=images, raw=raw, per_light=per_light, aovs=aovs, meta=meta)

@@ -1,0 +1,420 @@
+"""Build a dataset: plan the samples, skip the complete ones, render and export the rest.
+
+The pipeline per sample (:func:`build_sample`) is scene → render → ground truth:
+:func:`spectrinsic.scenes.library.build`, :func:`spectrinsic.render.render_scene`,
+:func:`spectrinsic.gt_export.export_sample`. ``export_sample`` writes into a temporary folder
+and renames it into place, so a sample folder either is complete (its ``meta.json`` holds the
+config hash) or does not exist under its final name: an interrupted build never leaves a sample
+that looks complete, and re-running resumes where it stopped.
+
+After all samples, :func:`finalize_dataset` writes ``manifest.json``, ``DATASET.md`` and the
+gallery. Each sample's seed is ``seed_from_key(config.seed, sample_id)``, independent of the
+order and the executor, so the same config and seed give the same pixels.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import logging
+import os
+import resource
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+from spectrinsic.errors import DatasetError
+from spectrinsic.executors import Executor, SerialExecutor
+from spectrinsic.presets import DatasetConfig
+from spectrinsic.rng import seed_from_key
+
+__all__ = [
+    "SampleTask",
+    "SampleOutcome",
+    "SampleFailure",
+    "DatasetReport",
+    "plan_samples",
+    "select_samples",
+    "build_sample",
+    "build_dataset",
+    "finalize_dataset",
+    "set_render_threads",
+]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class SampleTask:
+    """Everything a worker needs to build one sample (picklable; no live objects).
+
+    Attributes
+    ----------
+    scene, view, condition
+        Which library scene, camera view and lighting condition.
+    sample_id
+        Folder name of the sample, e.g. ``"obj-vase__v0__two-colour-a"``.
+    seed
+        The sample's render seed, ``seed_from_key(config.seed, sample_id)``. The scene library
+        draws the lights from the root seed ``config.seed`` instead, so every view of a scene
+        under one condition shares its lights.
+    out_dir
+        Dataset folder; the sample is written to ``out_dir/sample_id``.
+    config
+        The build settings.
+    data_dir
+        Spectral data directory, or ``None`` for ``$SPECTRINSIC_DATA``.
+    render_threads
+        Dr.Jit worker threads per process, or ``None`` to leave Dr.Jit's default (all cores).
+    """
+
+    scene: str
+    view: int
+    condition: str
+    sample_id: str
+    seed: int
+    out_dir: str
+    config: DatasetConfig
+    data_dir: str | None = None
+    render_threads: int | None = None
+
+
+@dataclass(frozen=True)
+class SampleOutcome:
+    """The result of one sample.
+
+    Attributes
+    ----------
+    sample_id
+        Which sample.
+    status
+        ``"built"`` or ``"skipped"`` (already complete with the same config hash).
+    path
+        The sample folder.
+    seconds
+        Wall time of the whole task in s (scene, render, export).
+    render_seconds
+        Wall time spent inside ``render_scene`` in s (Mitsuba plus its array conversions).
+    mitsuba_seconds
+        Time inside Mitsuba's ``render`` calls in s, as reported by the renderer's
+        ``meta["timings"]``; equal to *render_seconds* when the renderer reports none.
+    peak_rss_mb
+        Peak resident memory of the worker process so far, MiB (``ru_maxrss``).
+    """
+
+    sample_id: str
+    status: Literal["built", "skipped"]
+    path: str
+    seconds: float = 0.0
+    render_seconds: float = 0.0
+    mitsuba_seconds: float = 0.0
+    peak_rss_mb: float = 0.0
+
+
+@dataclass(frozen=True)
+class SampleFailure:
+    """A sample whose task raised; *error* is ``"ExceptionType: message"``."""
+
+    sample_id: str
+    error: str
+
+
+@dataclass(frozen=True)
+class DatasetReport:
+    """What a build did.
+
+    Attributes
+    ----------
+    out_dir
+        The dataset folder.
+    config
+        The settings used.
+    built, skipped, failed
+        Per-sample outcomes.
+    seconds
+        Wall time of the whole build (including finalisation), s.
+    finalized
+        Whether manifest, dataset card and gallery were written.
+    """
+
+    out_dir: Path
+    config: DatasetConfig
+    built: tuple[SampleOutcome, ...] = ()
+    skipped: tuple[SampleOutcome, ...] = ()
+    failed: tuple[SampleFailure, ...] = ()
+    seconds: float = 0.0
+    finalized: bool = False
+    files: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        """True when no sample failed."""
+        return not self.failed
+
+    def timing_summary(self) -> dict[str, float]:
+        """Mean s per built sample and the fraction of task time spent outside Mitsuba."""
+        if not self.built:
+            return {}
+        total = sum(o.seconds for o in self.built)
+        mitsuba = sum(o.mitsuba_seconds for o in self.built)
+        return {
+            "seconds_per_sample": total / len(self.built),
+            "render_seconds_per_sample": sum(o.render_seconds for o in self.built)
+            / len(self.built),
+            "fraction_outside_mitsuba": (total - mitsuba) / total if total > 0 else 0.0,
+            "peak_rss_mb": max(o.peak_rss_mb for o in self.built),
+        }
+
+
+def plan_samples(
+    out_dir: str | os.PathLike[str],
+    config: DatasetConfig,
+    *,
+    only: Sequence[str] | str | None = None,
+    data_dir: str | os.PathLike[str] | None = None,
+    render_threads: int | None = None,
+) -> list[SampleTask]:
+    """The tasks of the default sample layout (68 samples), optionally filtered by *only*.
+
+    Parameters
+    ----------
+    only
+        Glob pattern(s) on the sample id (``"obj-*"``, ``"*__white"``); a string may hold
+        several separated by commas. ``None`` keeps every sample.
+
+    Raises
+    ------
+    DatasetError
+        If *only* matches no sample.
+    """
+    from spectrinsic.scenes.library import default_samples
+
+    specs = select_samples(default_samples(), only)
+    out = str(Path(out_dir))
+    return [
+        SampleTask(
+            scene=s.scene,
+            view=s.view,
+            condition=s.condition,
+            sample_id=s.sample_id,
+            seed=seed_from_key(config.seed, s.sample_id),
+            out_dir=out,
+            config=config,
+            data_dir=None if data_dir is None else str(data_dir),
+            render_threads=render_threads,
+        )
+        for s in specs
+    ]
+
+
+def select_samples(specs: Sequence[Any], only: Sequence[str] | str | None) -> list[Any]:
+    """Keep the specs whose ``sample_id`` matches one of the glob patterns *only*."""
+    if only is None:
+        return list(specs)
+    patterns = [p.strip() for p in only.split(",")] if isinstance(only, str) else list(only)
+    patterns = [p for p in patterns if p]
+    kept = [s for s in specs if any(fnmatch.fnmatchcase(s.sample_id, p) for p in patterns)]
+    if not kept:
+        raise DatasetError(
+            f"--only {','.join(patterns)!r} matches no sample; ids look like "
+            f"{specs[0].sample_id!r}" if specs else "no samples to select from"
+        )
+    return kept
+
+
+def set_render_threads(n: int | None) -> None:
+    """Limit Dr.Jit's thread pool in this process to *n* threads (``None``: leave it).
+
+    With several worker processes on one machine, one pool per process sized to its share of
+    the cores avoids oversubscription.
+    """
+    from spectrinsic.render import set_thread_count
+
+    set_thread_count(n)
+
+
+def build_sample(task: SampleTask) -> SampleOutcome:
+    """Build one sample: scene → render → ground-truth export. Runs in a worker.
+
+    Returns
+    -------
+    SampleOutcome
+        Status ``"built"`` with timings and the worker's peak memory.
+    """
+    from spectrinsic.gt_export import export_sample
+    from spectrinsic.render import render_scene
+    from spectrinsic.scenes.library import build
+
+    set_render_threads(task.render_threads)
+    cfg = task.config
+    t0 = time.perf_counter()
+    scene = build(
+        task.scene,
+        view=task.view,
+        condition=task.condition,
+        seed=cfg.seed,
+        width=cfg.width,
+        height=cfg.height,
+    )
+    t_render = time.perf_counter()
+    result = render_scene(
+        scene,
+        modes=cfg.modes,
+        spp=cfg.spp,
+        seed=task.seed,
+        max_depth=cfg.max_depth,
+        variant=cfg.variant,
+        per_light=cfg.per_light,
+        direct=cfg.direct,
+        aovs=True,
+        data_dir=task.data_dir,
+    )
+    render_seconds = time.perf_counter() - t_render
+    path = export_sample(
+        task.out_dir,
+        scene,
+        result,
+        sample_id=task.sample_id,
+        config=cfg.to_dict(),
+        seed=task.seed,
+        cameras=cfg.resolved_cameras(),
+        write_cube=cfg.write_cube,
+        data_dir=task.data_dir,
+    )
+    seconds = time.perf_counter() - t0
+    return SampleOutcome(
+        sample_id=task.sample_id,
+        status="built",
+        path=str(path),
+        seconds=seconds,
+        render_seconds=render_seconds,
+        mitsuba_seconds=_mitsuba_seconds(result.meta, render_seconds),
+        peak_rss_mb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+    )
+
+
+def _mitsuba_seconds(meta: dict[str, Any], fallback: float) -> float:
+    """Seconds spent in Mitsuba's ``render`` calls, summed over the renderer's reported passes
+    (``meta["timings"][pass_group]["seconds"]``); *fallback* when none are reported."""
+    timings = meta.get("timings") if isinstance(meta, dict) else None
+    if not isinstance(timings, dict):
+        return fallback
+    seconds = [
+        float(t["seconds"])
+        for t in timings.values()
+        if isinstance(t, dict) and isinstance(t.get("seconds"), int | float)
+    ]
+    return sum(seconds) if seconds else fallback
+
+
+def build_dataset(
+    out_dir: str | os.PathLike[str],
+    config: DatasetConfig,
+    *,
+    executor: Executor | None = None,
+    only: Sequence[str] | str | None = None,
+    data_dir: str | os.PathLike[str] | None = None,
+    render_threads: int | None = None,
+    task_fn: Callable[[SampleTask], SampleOutcome] = build_sample,
+    on_plan: Callable[[int, int], None] | None = None,
+    progress: Callable[[SampleOutcome | SampleFailure], None] | None = None,
+    finalize: bool = True,
+) -> DatasetReport:
+    """Build (or resume) the dataset in *out_dir*.
+
+    Parameters
+    ----------
+    out_dir
+        Dataset folder (created if needed).
+    config
+        Build settings; samples whose folder is complete for ``config.config_hash()`` are
+        skipped.
+    executor
+        Where tasks run (default: serially in this process).
+    only
+        Glob pattern(s) selecting sample ids (see :func:`plan_samples`).
+    task_fn
+        The per-sample function (default :func:`build_sample`); picklable for process and
+        Dask executors.
+    on_plan
+        Called once with ``(n_to_build, n_skipped)`` before building starts.
+    progress
+        Called with each sample's outcome or failure as it finishes.
+    finalize
+        Write manifest, dataset card and gallery at the end.
+
+    Returns
+    -------
+    DatasetReport
+        Built, skipped and failed samples and the timings. A failed sample does not stop the
+        others. ``KeyboardInterrupt`` propagates after completed samples are safely in place.
+    """
+    from spectrinsic.gt_export.writer import is_complete, remove_stale_temporaries
+
+    start = time.perf_counter()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    for stale in remove_stale_temporaries(out):
+        log.info("removed %s, left by an interrupted build", stale.name)
+    executor = executor if executor is not None else SerialExecutor()
+    config_hash = config.config_hash()
+    tasks = plan_samples(out, config, only=only, data_dir=data_dir, render_threads=render_threads)
+    todo, skipped = [], []
+    for t in tasks:
+        folder = out / t.sample_id
+        if is_complete(folder, config_hash):
+            skipped.append(SampleOutcome(t.sample_id, "skipped", str(folder)))
+        else:
+            todo.append(t)
+    # Rooms cost ~5x objects and the layout lists all objects first; a fixed pseudo-random
+    # order (by sample seed) mixes them, so the progress bar's ETA holds from the start.
+    todo.sort(key=lambda t: (t.seed, t.sample_id))
+    log.info("%d sample(s) to build, %d already complete", len(todo), len(skipped))
+    if on_plan is not None:
+        on_plan(len(todo), len(skipped))
+
+    built: list[SampleOutcome] = []
+    failed: list[SampleFailure] = []
+    for task, outcome in executor.map_unordered(task_fn, todo):
+        record: SampleOutcome | SampleFailure
+        if isinstance(outcome, BaseException):
+            record = SampleFailure(task.sample_id, f"{type(outcome).__name__}: {outcome}")
+            log.error("sample %s failed: %s", task.sample_id, record.error)
+            failed.append(record)
+        else:
+            record = outcome
+            built.append(outcome)
+        if progress is not None:
+            progress(record)
+
+    files: dict[str, str] = {}
+    if finalize:
+        files = finalize_dataset(out, config, data_dir=data_dir)
+    return DatasetReport(
+        out_dir=out,
+        config=config,
+        built=tuple(sorted(built, key=lambda o: o.sample_id)),
+        skipped=tuple(skipped),
+        failed=tuple(sorted(failed, key=lambda f: f.sample_id)),
+        seconds=time.perf_counter() - start,
+        finalized=finalize,
+        files=files,
+    )
+
+
+def finalize_dataset(
+    out_dir: str | os.PathLike[str],
+    config: DatasetConfig,
+    *,
+    data_dir: str | os.PathLike[str] | None = None,
+) -> dict[str, str]:
+    """Write ``manifest.json``, ``DATASET.md`` and the gallery; return their paths by kind."""
+    from spectrinsic.gt_export import build_gallery, write_dataset_card, write_manifest
+
+    out = Path(out_dir)
+    cfg = config.to_dict()
+    manifest = write_manifest(out, cfg, data_dir=data_dir)
+    card = write_dataset_card(out, cfg)
+    gallery = build_gallery(out)
+    return {"manifest": str(manifest), "card": str(card), "gallery": str(gallery)}

@@ -1,0 +1,209 @@
+"""Dataset build settings: the :class:`DatasetConfig` record, its hash and the named presets.
+
+A config holds every setting that changes the files of a sample (resolution, samples per pixel,
+render modes, passes, seed). Its hash (:meth:`DatasetConfig.config_hash`) is the SHA-256 of
+canonical JSON of those settings, the preset name and the versions of the software that
+computes the pixels; a sample folder is reused only when the hash in its ``meta.json``
+matches. How the build is run (workers, threads, scheduler, which samples) never enters it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, replace
+from importlib.metadata import PackageNotFoundError, version
+from typing import Any
+
+from spectrinsic.errors import DatasetError, validate_choice
+
+__all__ = [
+    "DatasetConfig",
+    "PRESETS",
+    "RENDER_MODES",
+    "HASHED_PACKAGES",
+    "preset_names",
+    "get_preset",
+    "software_versions",
+]
+
+#: Render modes a config may ask for (see :func:`spectrinsic.render.render_scene`).
+RENDER_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
+
+#: Distributions whose versions change rendered or derived pixels, hence enter the config hash.
+HASHED_PACKAGES: tuple[str, ...] = ("spectrinsic", "mitsuba", "drjit", "colour-science", "numpy")
+
+
+def software_versions() -> dict[str, str]:
+    """Installed versions of :data:`HASHED_PACKAGES` (``"missing"`` when one is absent).
+
+    Read from package metadata, so nothing heavy (Mitsuba) is imported.
+    """
+    out = {}
+    for name in HASHED_PACKAGES:
+        try:
+            out[name] = version(name)
+        except PackageNotFoundError:
+            out[name] = "missing"
+    return out
+
+
+@dataclass(frozen=True)
+class DatasetConfig:
+    """Settings of one dataset build.
+
+    Attributes
+    ----------
+    preset
+        Name of the preset this config started from (recorded and hashed).
+    width, height
+        Image size in pixels.
+    spp
+        Samples per pixel of every render pass.
+    max_depth
+        Maximum path length (Mitsuba's ``max_depth``; 2 = direct light only).
+    modes
+        Render modes, a subset of :data:`RENDER_MODES`; ``"spectral"`` is the physical reference.
+    per_light
+        Also render each light alone (needed for the per-pixel illuminant map of multi-light
+        scenes).
+    direct
+        Also render direct illumination only.
+    write_cube
+        Write the multispectral (31-band) cube of each sample.
+    cameras
+        Camera sensitivity names (``spectrinsic.spectra.get_sensors``) whose images and relative
+        reflectances the ground truth also holds (they need the ``bands31`` cube); ``None``:
+        :data:`spectrinsic.gt_export.DEFAULT_CAMERAS` when ``bands31`` is rendered, else none
+        (see :meth:`resolved_cameras`).
+    variant
+        Mitsuba variant, or ``None`` for the render package's automatic choice.
+    seed
+        Root seed; each sample's seed is ``seed_from_key(seed, sample_id)``.
+    """
+
+    preset: str
+    width: int
+    height: int
+    spp: int
+    max_depth: int = 8
+    modes: tuple[str, ...] = RENDER_MODES
+    per_light: bool = True
+    direct: bool = False
+    write_cube: bool = False
+    cameras: tuple[str, ...] | None = None
+    variant: str | None = None
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        # lists from JSON or the command line become tuples, so configs stay hashable records
+        object.__setattr__(self, "modes", tuple(self.modes))
+        if self.cameras is not None:
+            object.__setattr__(self, "cameras", tuple(self.cameras))
+        for name in ("width", "height", "spp", "max_depth"):
+            value = getattr(self, name)
+            if not isinstance(value, int) or isinstance(value, bool) or value < 1:
+                raise DatasetError(f"dataset setting {name}={value!r}; expected a positive integer")
+        if not self.modes:
+            raise DatasetError("dataset setting modes=(); expected at least one render mode")
+        for mode in self.modes:
+            validate_choice(mode, RENDER_MODES, "render mode")
+        if not isinstance(self.seed, int) or self.seed < 0:
+            raise DatasetError(f"dataset seed {self.seed!r}; expected a non-negative integer")
+
+    def with_options(self, **changes: Any) -> DatasetConfig:
+        """A copy with some settings changed (validated like a new config)."""
+        unknown = set(changes) - set(self.settings()) - {"preset"}
+        if unknown:
+            raise DatasetError(
+                f"unknown dataset setting(s) {sorted(unknown)}; expected some of "
+                f"{sorted(self.settings())}"
+            )
+        return replace(self, **changes)
+
+    def settings(self) -> dict[str, Any]:
+        """The settings that change output files, as JSON-ready values (no preset name)."""
+        d = asdict(self)
+        d.pop("preset")
+        d["modes"] = list(self.modes)
+        d["cameras"] = list(self.resolved_cameras())
+        return d
+
+    def resolved_cameras(self) -> tuple[str, ...]:
+        """The camera sensor sets exported, with ``cameras=None`` resolved."""
+        if self.cameras is not None:
+            return tuple(self.cameras)
+        if "bands31" not in self.modes:
+            return ()
+        from spectrinsic.gt_export import DEFAULT_CAMERAS
+
+        return tuple(DEFAULT_CAMERAS)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The record written with the dataset (``export_sample``, manifest): preset name,
+        settings and :func:`software_versions`. Its canonical hash is :meth:`config_hash`."""
+        return {"preset": self.preset, **self.settings(), "software": software_versions()}
+
+    def config_hash(self) -> str:
+        """SHA-256 (hex) of the canonical JSON of :meth:`to_dict`.
+
+        Computed by :func:`spectrinsic.gt_export.writer.config_hash`, the function that stamps
+        ``meta.json``, so the hash a build checks is the hash its samples carry.
+        """
+        from spectrinsic.gt_export.writer import config_hash
+
+        return config_hash(self.to_dict())
+
+
+#: Named presets. Times were measured on this project's 2-core reference machine
+#: (``spectrinsic.bench_dataset``). ``direct`` stays off: the ground truth does not use the
+#: direct-only renders, which would double every pass.
+PRESETS: dict[str, DatasetConfig] = {
+    # The whole set in < 2 minutes: a look at the layout, not data to learn from.
+    "preview": DatasetConfig(
+        preset="preview",
+        width=48,
+        height=48,
+        spp=4,
+        max_depth=4,
+        modes=("spectral", "rgb3"),
+        per_light=True,
+    ),
+    # The thesis layout (68 samples) in <= 20 minutes on 2 cores; every render mode, so the
+    # reference image is the 31-band cube and the 3-/6-sensor approximations carry error maps.
+    "default": DatasetConfig(
+        preset="default",
+        width=128,
+        height=128,
+        spp=32,
+        max_depth=6,
+        modes=RENDER_MODES,
+        per_light=True,
+    ),
+    # Publication quality, for a GPU (variant cuda) or a cluster (--scheduler).
+    "paper": DatasetConfig(
+        preset="paper",
+        width=512,
+        height=512,
+        spp=1024,
+        max_depth=8,
+        modes=RENDER_MODES,
+        per_light=True,
+        write_cube=True,
+    ),
+}
+
+
+def preset_names() -> list[str]:
+    """Names of the presets, fastest first."""
+    return list(PRESETS)
+
+
+def get_preset(name: str, *, seed: int = 0) -> DatasetConfig:
+    """Return the preset called *name* with root seed *seed*.
+
+    Raises
+    ------
+    SpectrinsicError
+        If *name* is not a preset (the message suggests close names).
+    """
+    validate_choice(name, PRESETS, "dataset preset")
+    return PRESETS[name].with_options(seed=seed)

@@ -1,0 +1,66 @@
+"""Presets and config hashes: validation, canonical hashing, what enters the hash."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+
+import pytest
+
+from spectrinsic.errors import SpectrinsicError
+from spectrinsic.presets import PRESETS, DatasetConfig, get_preset, software_versions
+
+
+def test_presets_exist_and_scale_up():
+    assert list(PRESETS) == ["preview", "default", "paper"]
+    pixels_spp = [c.width * c.height * c.spp for c in PRESETS.values()]
+    assert pixels_spp == sorted(pixels_spp) and len(set(pixels_spp)) == 3
+
+
+def test_default_preset_renders_what_the_ground_truth_needs():
+    cfg = get_preset("default")
+    assert set(cfg.modes) == {"spectral", "rgb3", "rgb6", "bands31"}
+    assert cfg.per_light  # illuminant map of two-light scenes
+    assert cfg.resolved_cameras()  # camera views need the bands31 cube
+
+
+def test_unknown_preset_suggests_a_close_name():
+    with pytest.raises(SpectrinsicError, match="did you mean 'preview'"):
+        get_preset("previw")
+
+
+@pytest.mark.parametrize(
+    "bad", [{"spp": 0}, {"width": -1}, {"modes": ()}, {"modes": ("rgb9",)}, {"seed": -2}]
+)
+def test_invalid_settings_raise(bad):
+    with pytest.raises(SpectrinsicError):
+        get_preset("preview").with_options(**bad)
+
+
+def test_with_options_rejects_unknown_settings():
+    with pytest.raises(SpectrinsicError, match="unknown dataset setting"):
+        get_preset("preview").with_options(samples_per_pixel=3)
+
+
+def test_config_hash_is_sha256_of_canonical_json():
+    cfg = get_preset("default", seed=7)
+    record = cfg.to_dict()
+    # Independent computation: sorted keys, compact separators, UTF-8.
+    text = json.dumps(record, sort_keys=True, separators=(",", ":"), ensure_ascii=False)
+    assert cfg.config_hash() == hashlib.sha256(text.encode("utf-8")).hexdigest()
+    assert record["software"] == software_versions()
+    assert "spectrinsic" in record["software"] and "mitsuba" in record["software"]
+
+
+def test_hash_changes_with_output_settings_only():
+    base = get_preset("preview")
+    assert base.config_hash() == get_preset("preview").config_hash()
+    assert base.with_options(spp=base.spp + 1).config_hash() != base.config_hash()
+    assert base.with_options(seed=1).config_hash() != base.config_hash()
+    assert base.with_options(modes=("rgb3",)).config_hash() != base.config_hash()
+
+
+def test_config_is_frozen():
+    cfg = DatasetConfig(preset="x", width=8, height=8, spp=1)
+    with pytest.raises(AttributeError):
+        cfg.spp = 2  # type: ignore[misc]
