@@ -65,11 +65,16 @@ def run(args: argparse.Namespace) -> int:
     from spectrinsic.gt_export.loader import load_sample
 
     bar = tqdm(total=len(folders), desc="evaluate", unit="sample", disable=args.quiet)
+
+    def progress(sample_id: str) -> None:
+        bar.set_postfix_str(sample_id)
+        bar.update(1)
+
     try:
         result = evaluate(
             (load_sample(f) for f in folders), args.out, methods=methods, seed=args.seed,
             cameras=not args.no_cameras, figures=not args.no_figures,
-            progress=lambda sid: (bar.set_postfix_str(sid), bar.update(1)),
+            progress=progress,
         )
     finally:
         bar.close()

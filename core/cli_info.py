@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import importlib.metadata as md
 import platform
+from typing import Any
 
 from spectrinsic.config import DATA_SUBDIRS, resolve_data_dir
 
@@ -14,9 +15,9 @@ _DISTRIBUTIONS = ("spectrinsic", "numpy", "colour-science", "luxpy", "mitsuba", 
                   "trimesh", "scikit-image", "gco-wrapper", "bpy", "distributed")
 
 
-def collect_info(data_dir: str | None = None) -> dict[str, object]:
+def collect_info(data_dir: str | None = None) -> dict[str, Any]:
     """Everything ``info`` prints, as plain data (also recorded in dataset manifests)."""
-    versions = {}
+    versions: dict[str, str | None] = {}
     for dist in _DISTRIBUTIONS:
         try:
             versions[dist] = md.version(dist)

@@ -33,7 +33,7 @@ def as_image(image: npt.ArrayLike, what: str, *, channels: int | None = None) ->
     return arr
 
 
-def as_mask(mask: npt.ArrayLike | None, shape: tuple[int, int], what: str = "mask") -> np.ndarray:
+def as_mask(mask: npt.ArrayLike | None, shape: tuple[int, ...], what: str = "mask") -> np.ndarray:
     """Return *mask* as a bool ``(H, W)`` array (all True when None); check its shape."""
     if mask is None:
         return np.ones(shape, dtype=bool)

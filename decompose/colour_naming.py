@@ -121,7 +121,7 @@ def srgb_to_lab(srgb: npt.ArrayLike) -> npt.NDArray[np.float64]:
 
     rgb = np.clip(_check_rgb(srgb, "srgb"), 0.0, 1.0)
     xyz = colour.RGB_to_XYZ(rgb, "sRGB", apply_cctf_decoding=True)
-    return colour.XYZ_to_Lab(xyz, colour.XYZ_to_xy(_LAB_WHITE_XYZ))
+    return np.asarray(colour.XYZ_to_Lab(xyz, colour.XYZ_to_xy(_LAB_WHITE_XYZ)), dtype=np.float64)
 
 
 def _sigmoid(x: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:

@@ -88,7 +88,7 @@ def _windows(a: np.ndarray, window: int, step: int) -> np.ndarray:
         raise ImageShapeError(f"window and step must be >= 1; got window={window}, step={step}")
     if h < window or w < window:
         raise ImageShapeError(f"image of size {h}x{w} is smaller than the {window}x{window} window")
-    view = np.lib.stride_tricks.sliding_window_view(a, (window, window), axis=(0, 1))
+    view = np.lib.stride_tricks.sliding_window_view(a, (window, window), axis=(0, 1))  # type: ignore[call-overload]
     view = view[::step, ::step]  # (ny, nx, C, window, window)
     return np.moveaxis(view, 2, -1).reshape(-1, window * window, c)
 
@@ -153,10 +153,9 @@ def mit_score(
     step: int = STEP,
 ) -> float:
     """MIT benchmark score: the mean of the shading and reflectance :func:`lmse` (Grosse 2009)."""
-    kwargs = {"mask": mask, "window": window, "step": step}
-    return 0.5 * lmse(true_shading, estimated_shading, **kwargs) + 0.5 * lmse(
-        true_reflectance, estimated_reflectance, **kwargs
-    )
+    shading = lmse(true_shading, estimated_shading, mask=mask, window=window, step=step)
+    reflectance = lmse(true_reflectance, estimated_reflectance, mask=mask, window=window, step=step)
+    return 0.5 * shading + 0.5 * reflectance
 
 
 def _centred(a: np.ndarray, m: np.ndarray) -> np.ndarray:

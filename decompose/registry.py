@@ -16,7 +16,7 @@ from spectrinsic.errors import validate_choice
 __all__ = ["DECOMPOSERS", "get_decomposer", "decompose"]
 
 #: Name -> factory (keyword parameters -> decomposer), in the order tables list them.
-DECOMPOSERS: Mapping[str, Callable[..., Decomposer]] = {
+DECOMPOSERS: Mapping[str, Callable[..., Any]] = {
     "names-shades": NamesAndShades,
     "colour-retinex": ColourRetinex,
     "image-as-reflectance": ImageAsReflectance,

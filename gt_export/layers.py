@@ -574,7 +574,7 @@ def compute_ground_truth(
             "camera images need the 31-band cube (render mode 'bands31'); render it or pass cameras=()"
         )
     if cube is not None:
-        band_set = get_sensors(cube_name, data_dir=data_dir)
+        band_set = get_sensors(cube_name or DEFAULT_CUBE_SENSORS, data_dir=data_dir)
         if band_set.n != cube.shape[-1]:
             raise DatasetError(
                 f"cube has {cube.shape[-1]} channels but its sensors {cube_name!r} have {band_set.n}"

@@ -129,7 +129,8 @@ def _light(source: str, obj: Any, default: str, data_dir: str | None) -> Light:
     data = obj.data
     m = _matrix(obj)
     position = tuple(map(float, m[:3, 3]))
-    direction = tuple(map(float, -m[:3, 2] / np.linalg.norm(m[:3, 2])))
+    dx, dy, dz = (float(v) for v in -m[:3, 2] / np.linalg.norm(m[:3, 2]))
+    direction = (dx, dy, dz)
     spectrum = _prop(obj, data) or default
     _check_spectrum(
         source,

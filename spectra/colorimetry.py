@@ -123,7 +123,9 @@ def absolute_reflectance(
     from spectrinsic.spectra.registry import get_sensors, get_spectrum
 
     single = isinstance(reflectances, (Spectrum, str))
-    items = [reflectances] if single else list(reflectances)  # type: ignore[list-item]
+    items: list[Spectrum | str] = (
+        [reflectances] if isinstance(reflectances, (Spectrum, str)) else list(reflectances)
+    )
     spectra = [get_spectrum(s, data_dir=data_dir) if isinstance(s, str) else s for s in items]
     wl = COLORIMETRIC_WAVELENGTHS
     cmf = get_sensors("cie1931").on(wl)

@@ -25,7 +25,7 @@ Everything is loaded lazily on first use.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 from spectrinsic.config import resolve_data_dir
 from spectrinsic.errors import SpectrumNotFoundError, did_you_mean
@@ -63,7 +63,7 @@ SENSOR_FAMILIES: dict[str, Callable[[str, str | None], SensorSet]] = {
 }
 
 
-def _split(name: str, families: dict[str, object], what: str) -> tuple[str, str]:
+def _split(name: str, families: Mapping[str, object], what: str) -> tuple[str, str]:
     if not isinstance(name, str) or not name.strip():
         raise SpectrumNotFoundError(f"{what} name {name!r}: expected 'family:key', e.g. 'munsell:5R 4/14'")
     family, sep, key = name.strip().partition(":")
