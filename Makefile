@@ -49,8 +49,17 @@ study-spectral: $(PKG) ## the two spectral studies only: Table 5.2 and Table 4.4
 dataset: $(PKG) ## render the default dataset into OUT (default data/dataset); PRESET=preview|default|paper
 	$(BIN)/spectrinsic dataset --out $(or $(OUT),data/dataset) --preset $(or $(PRESET),default)
 
-evaluate: $(PKG) ## run the bundled decomposers on DATASET (default data/dataset) and write results/evaluation
-	$(BIN)/spectrinsic evaluate --dataset $(or $(DATASET),data/dataset)
+evaluate: $(PKG) ## run the bundled decomposers on DATASET (default: data/dataset, else a preview set it builds)
+	@set -e; dataset="$(DATASET)"; \
+	if [ -z "$$dataset" ]; then \
+	  dataset=data/dataset; \
+	  if [ ! -f "$$dataset/manifest.json" ]; then \
+	    dataset=data/preview; \
+	    echo "no dataset in data/dataset (make dataset builds it): using the preview set in $$dataset"; \
+	    $(BIN)/spectrinsic dataset --out "$$dataset" --preset preview; \
+	  fi; \
+	fi; \
+	$(BIN)/spectrinsic evaluate --dataset "$$dataset" --out results/evaluation
 
 bench: $(PKG) ## benchmarks, written as JSON under bench/
 	$(PY) -m spectrinsic.bench --out bench
