@@ -75,6 +75,8 @@ def _bench_preset(preset: str, work: str) -> dict[str, Any]:
             "seconds": round(by_id[sid].seconds, 3),
             "render_seconds": round(by_id[sid].render_seconds, 3),
             "mitsuba_seconds": round(by_id[sid].mitsuba_seconds, 3),
+            # the fixed cost the fraction below hides: independent of spp and of the load
+            "outside_mitsuba_seconds": round(by_id[sid].seconds - by_id[sid].mitsuba_seconds, 3),
         }
         for (kind, n), sid in CLASS_SAMPLES.items()
     }

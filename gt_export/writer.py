@@ -5,7 +5,7 @@ A sample folder ``<out_dir>/<sample_id>/`` holds
 * ``image.exr``, ``intrinsics.exr``, ``geometry.exr``, ``camera-<slug>.exr`` (and ``cube.exr``
   on request): float32 layers with named channels (see ``meta.json["layers"]``);
 * ``previews/<layer>.png``: 8-bit sRGB previews for looking only;
-* ``scene.json``: the scene as plain data; ``meta.json``: provenance, materials, lights,
+* ``scene.json``: the scene as plain data (compact JSON); ``meta.json``: provenance, materials, lights,
   matrices, the units of every layer. ``meta.json`` is written last.
 
 Everything is written into a hidden temporary folder next to the target and renamed into
@@ -33,11 +33,12 @@ from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import png
 from spectrinsic.gt_export.exr import write_exr
 from spectrinsic.gt_export.layers import GroundTruth, Layer, compute_ground_truth
-from spectrinsic.scenes.model import Scene, scene_hash, scene_to_dict
+from spectrinsic.scenes.model import Scene, scene_hash
 
 __all__ = [
     "FORMAT_VERSION",
     "META_NAME",
+    "SCENE_NAME",
     "MANIFEST_NAME",
     "CARD_NAME",
     "DEFAULT_CAMERAS",
@@ -57,6 +58,8 @@ log = logging.getLogger(__name__)
 
 FORMAT_VERSION = 1
 META_NAME = "meta.json"
+#: The rendered scene as plain data (:func:`spectrinsic.scenes.model.scene_to_dict`), compact JSON.
+SCENE_NAME = "scene.json"
 MANIFEST_NAME = "manifest.json"
 CARD_NAME = "DATASET.md"
 PREVIEW_DIR = "previews"
@@ -83,6 +86,8 @@ def _jsonable(value: Any) -> Any:
     if isinstance(value, Mapping):
         return {str(k): _jsonable(v) for k, v in value.items()}
     if isinstance(value, np.ndarray):
+        if value.dtype.kind in "biu" or (value.dtype.kind == "f" and np.isfinite(value).all()):
+            return value.tolist()  # plain bools, ints and finite floats all the way down
         return _jsonable(value.tolist())
     if isinstance(value, np.generic):
         return value.item()
@@ -95,8 +100,11 @@ def _jsonable(value: Any) -> Any:
     return str(value)
 
 
-def _dump_json(path: Path, data: Any) -> None:
-    path.write_text(json.dumps(_jsonable(data), indent=2, sort_keys=True, ensure_ascii=False) + "\n",
+def _dump_json(path: Path, data: Any, *, compact: bool = False) -> None:
+    """Write *data* as sorted-key JSON: indented, or *compact* (one line, no spaces) for large
+    files, which the json module's C encoder then writes (it is bypassed whenever indenting)."""
+    layout: dict[str, Any] = {"separators": (",", ":")} if compact else {"indent": 2}
+    path.write_text(json.dumps(_jsonable(data), sort_keys=True, ensure_ascii=False, **layout) + "\n",
                     encoding="utf-8")
 
 
@@ -292,8 +300,10 @@ def _fill_folder(folder: Path, scene: Scene, result: Any, gt: GroundTruth, **met
         png.write_png(folder / rel, maker(layer, gt.layers))
         previews[layer.name] = rel
         files.append(rel)
-    _dump_json(folder / "scene.json", scene_to_dict(scene))
-    files.append("scene.json")
+    # the Scene itself, not scene_to_dict(scene): _jsonable makes the same plain data of it, but
+    # converts its vertex and face arrays whole rather than element by element
+    _dump_json(folder / SCENE_NAME, scene, compact=True)
+    files.append(SCENE_NAME)
     # meta.json last: its presence (with the right config hash) marks the folder complete
     _dump_json(folder / META_NAME, _meta(scene, result, gt, previews=previews, files=files, **meta_kw))
 

@@ -125,31 +125,45 @@ def render_scene(
     groups: list[Sequence[int] | None] = [[j] for j in range(len(scene.lights))] if per_light else [None]
 
     from spectrinsic.render.translate import prepare_geometry
+    from spectrinsic.render.variants import choose_variant, import_mitsuba, variant_scope
 
     geometry = prepare_geometry(scene)
     timings: dict[str, list[float]] = {m.name: [] for m in objs}
     variants: dict[str, str] = {}
-    raw_groups: list[dict[str, PassOutput]] = []
-    for group in groups:
-        outputs: dict[str, PassOutput] = {}
-        if diagonal:
-            for m, out in zip(diagonal, render_diagonal(
-                scene, values, spp=spp, seed=seed, max_depth=max_depth,
-                direct=[m.name in wanted for m in diagonal], active_lights=group, variant=variant,
-                progress=progress, geometry=geometry,
-            ), strict=True):
-                outputs[m.name] = out
-        for m in objs:
-            if m.kind == "spectral":
-                outputs[m.name] = render_spectral(
-                    scene, sensors[m.name], spp=spp, seed=seed, max_depth=max_depth,
-                    direct=m.name in wanted, active_lights=group, variant=variant, data_dir=data_dir,
-                    progress=progress, geometry=geometry,
-                )
+    raw_groups: list[dict[str, PassOutput]] = [{} for _ in groups]
+    aov_maps: dict[str, np.ndarray] = {}
+    # Passes are grouped by Mitsuba variant: each switch between the RGB and the spectral variant
+    # reloads Mitsuba's Python modules (~0.1 s), so every RGB-variant pass (all diagonal modes of
+    # every light group, then the AOVs) runs in one scope and every spectral pass in another.
+    # Passes do not depend on each other's order: each sets its own values, seed and spp.
+    if diagonal or aovs:
+        rgb_variant = choose_variant("rgb", variant)
+        with variant_scope(rgb_variant):
+            for outputs, group in zip(raw_groups, groups, strict=True):
+                if diagonal:
+                    outputs.update(zip((m.name for m in diagonal), render_diagonal(
+                        scene, values, spp=spp, seed=seed, max_depth=max_depth,
+                        direct=[m.name in wanted for m in diagonal], active_lights=group,
+                        variant=rgb_variant, progress=progress, geometry=geometry,
+                    ), strict=True))
+            if aovs:
+                aov_maps, aov_seconds = render_aovs(scene, spp=spp, seed=seed, variant=rgb_variant,
+                                                    progress=progress, geometry=geometry)
+    spectral = [m for m in objs if m.kind == "spectral"]
+    if spectral:
+        spectral_variant = choose_variant("spectral", variant)
+        with variant_scope(spectral_variant):
+            for outputs, group in zip(raw_groups, groups, strict=True):
+                for m in spectral:
+                    outputs[m.name] = render_spectral(
+                        scene, sensors[m.name], spp=spp, seed=seed, max_depth=max_depth, direct=m.name in wanted,
+                        active_lights=group, variant=spectral_variant, data_dir=data_dir,
+                        progress=progress, geometry=geometry,
+                    )
+    for outputs in raw_groups:
         for name, out in outputs.items():
             timings[name].extend(out.seconds)
             variants[name] = out.variant
-        raw_groups.append(outputs)
 
     names = [m.name for m in objs]
     raw = {n: np.sum([g[n].image for g in raw_groups], axis=0, dtype=np.float64).astype(np.float32) for n in names}
@@ -159,13 +173,8 @@ def render_scene(
         n: raw_to_xyz(np.sum([g[n].direct for g in raw_groups], axis=0, dtype=np.float64), matrices[n])
         for n in names if n in wanted
     }
-    aov_maps: dict[str, np.ndarray] = {}
     if aovs:
-        aov_maps, aov_seconds = render_aovs(scene, spp=spp, seed=seed, variant=variant, progress=progress,
-                                              geometry=geometry)
         timings["aovs"] = list(aov_seconds)
-
-    from spectrinsic.render.variants import import_mitsuba
 
     meta = {
         "mitsuba": import_mitsuba().__version__,

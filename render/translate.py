@@ -180,19 +180,21 @@ def smooth_corner_normals(
     cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])  # length = 2 × area
     length = np.linalg.norm(cross, axis=1)
     unit = np.divide(cross, length[:, None], out=np.zeros_like(cross), where=length[:, None] > 0)
-    corner_vertex = f.ravel()
-    corner_face = np.repeat(np.arange(len(f)), 3)
+    corner_vertex = f.ravel()  # corner i is corner i % 3 of face i // 3
     order = np.argsort(corner_vertex, kind="stable")
     sorted_v = corner_vertex[order]
+    sorted_face = order // 3
     starts = np.flatnonzero(np.r_[True, sorted_v[1:] != sorted_v[:-1]])
     counts = np.diff(np.r_[starts, sorted_v.size])
-    group = np.repeat(np.arange(starts.size), counts)  # group of each sorted corner
-    per = counts[group]  # pairs each sorted corner takes part in
-    a = np.repeat(np.arange(sorted_v.size), per)
-    b = starts[group[a]] + (np.arange(a.size) - np.repeat(np.cumsum(per) - per, per))
-    fa, fb = corner_face[order[a]], corner_face[order[b]]
-    keep = np.einsum("ij,ij->i", unit[fa], unit[fb]) >= np.cos(np.radians(crease_deg))
-    target, weights = order[a][keep], cross[fb][keep]
+    # every ordered pair (a, b) of sorted corners at one vertex: a runs over the sorted corners,
+    # each repeated once per corner of its vertex, and b over that vertex's corners. Built with
+    # np.repeat rather than fancy indexing, which is the costly part on large meshes.
+    per = np.repeat(counts, counts)  # pairs each sorted corner takes part in
+    b = np.repeat(starts, counts * counts) + (np.arange(per.sum()) - np.repeat(np.cumsum(per) - per, per))
+    fb = sorted_face[b]
+    unit_a = np.repeat(unit[sorted_face], per, axis=0)
+    keep = np.einsum("ij,ij->i", unit_a, unit[fb]) >= np.cos(np.radians(crease_deg))
+    target, weights = np.repeat(order, per)[keep], cross[fb[keep]]
     acc = np.stack([np.bincount(target, weights=weights[:, c], minlength=corner_vertex.size) for c in range(3)], axis=1)
     norm = np.linalg.norm(acc, axis=1)
     out = np.divide(acc, norm[:, None], out=np.zeros_like(acc), where=norm[:, None] > 0)

@@ -64,6 +64,24 @@ def test_sample_round_trips_through_the_loader(tmp_path, two_light_sample, confi
     assert set(meta["matrices"]["S_Sen"]) == {"Nikon 5100 (NPL)"}
 
 
+def test_scene_json_is_the_scene_as_plain_data(tmp_path, one_light_sample, config):
+    import dataclasses
+    import hashlib
+
+    from spectrinsic.scenes.model import scene_hash, scene_to_dict
+
+    scene, result = one_light_sample
+    scene = dataclasses.replace(scene, metadata={"kind": "test", "seed": np.int64(4), "views": (1, 2)})
+    folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=5)
+    data = json.loads((folder / "scene.json").read_text(encoding="utf-8"))
+    assert data == scene_to_dict(scene)
+    # the file reproduces scene_hash: the canonical JSON of everything but the metadata
+    del data["metadata"]
+    blob = json.dumps(data, sort_keys=True, separators=(",", ":")).encode()
+    assert hashlib.sha256(blob).hexdigest() == scene_hash(scene) == json.loads(
+        (folder / "meta.json").read_text(encoding="utf-8"))["scene_hash"]
+
+
 def test_is_complete_follows_the_config_hash(tmp_path, one_light_sample, config):
     scene, result = one_light_sample
     folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=1)

@@ -36,6 +36,32 @@ def test_crease_keeps_box_corners_sharp_and_smooths_shallow_edges():
     assert 0.0 < np.degrees(np.arccos(n[0, 0] @ [0, 0, 1])) < 10.0
 
 
+def _corner_normals_by_loop(v: np.ndarray, f: np.ndarray, crease_deg: float) -> np.ndarray:
+    """The docstring's definition, corner by corner: an independent reference."""
+    cross = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    unit = [c / np.linalg.norm(c) if np.linalg.norm(c) > 0 else np.zeros(3) for c in cross]
+    out = np.zeros((len(f), 3, 3))
+    for i, face in enumerate(f):
+        for k, vertex in enumerate(face):
+            around = [j for j in range(len(f)) if vertex in f[j]]
+            total = sum((cross[j] for j in around if unit[i] @ unit[j] >= np.cos(np.radians(crease_deg))), np.zeros(3))
+            out[i, k] = total / np.linalg.norm(total) if np.linalg.norm(total) > 0 else (0.0, 0.0, 1.0)
+    return out
+
+
+def test_corner_normals_match_a_corner_by_corner_reference():
+    import trimesh
+
+    sphere = trimesh.creation.icosphere(subdivisions=1)
+    box = trimesh.creation.box()
+    v = np.concatenate([sphere.vertices, box.vertices + 3.0, [[9.0, 9.0, 9.0]]])
+    f = np.concatenate([sphere.faces, box.faces + len(sphere.vertices),
+                        [[len(v) - 1, len(v) - 1, len(v) - 1]]])  # plus a degenerate face
+    for crease in (10.0, 30.0, 60.0):
+        np.testing.assert_allclose(smooth_corner_normals(v, f, crease), _corner_normals_by_loop(v, f, crease),
+                                   atol=1e-12)
+
+
 def _marker_scene(x_offset: float) -> Scene:
     """A white floor with a small dark patch displaced along the camera's right (+x)."""
     floor_v = np.array([[-5, -5, 0], [5, -5, 0], [5, 5, 0], [-5, 5, 0]], float)
