@@ -45,6 +45,8 @@ __all__ = [
     "sample_condition",
     "sample_kind",
     "evaluate_sample",
+    "evaluation_mask",
+    "BACKGROUND_OBJECTS",
     "evaluate",
     "condition_table",
     "scenario_table",
@@ -128,6 +130,26 @@ def _slug(text: str) -> str:
 def _grey(a: np.ndarray) -> np.ndarray:
     a = np.asarray(a, dtype=np.float64)
     return a.mean(axis=2) if a.ndim == 3 else a
+
+
+#: Object names excluded from the evaluation mask of single-object scenes: like the MIT
+#: benchmark (Grosse et al. 2009), an object is scored on its own mask, not on the ground.
+BACKGROUND_OBJECTS = frozenset({"ground"})
+
+
+def evaluation_mask(sample: Mapping[str, Any]) -> np.ndarray:
+    """Pixels scored: the ``mask``, minus background objects in single-object scenes."""
+    image = np.asarray(sample["image"])
+    mask = np.asarray(sample.get("mask", np.ones(image.shape[:2], bool)), dtype=bool)
+    if sample_kind(sample) != "object":
+        return mask
+    objects = sample.get("meta", {}).get("objects") or {}
+    ids = sample.get("ids")
+    object_ids = ids.get("object") if isinstance(ids, Mapping) else None
+    background = [int(k) for k, name in objects.items() if name in BACKGROUND_OBJECTS]
+    if object_ids is None or not background:
+        return mask
+    return mask & ~np.isin(np.asarray(object_ids), background)
 
 
 def _material_ids(sample: Mapping[str, Any]) -> np.ndarray | None:
@@ -220,7 +242,7 @@ def evaluate_sample(
     reflectance = np.asarray(sample["reflectance"], dtype=np.float64)
     shading = sample.get("shading_grey")
     shading = _grey(sample["shading"] if shading is None else shading)
-    mask = np.asarray(sample.get("mask", np.ones(image.shape[:2], bool)), dtype=bool)
+    mask = evaluation_mask(sample)
     names = list(METRICS) if metrics is None else list(metrics)
     judgements = sample_judgements(
         reflectance, seed=seed_from_key(seed, sid), n_pairs=n_judgements, mask=mask,

@@ -266,6 +266,7 @@ def _meta(
             "lights_spd": {"start_nm": 380.0, "end_nm": 780.0, "step_nm": 5.0},
         },
         "materials": gt.materials,
+        "objects": {str(m.object_id): m.name for m in scene.meshes},
         "lights": lights,
         "cameras": [c.split(":", 1)[-1] for c in gt.cameras],
         "cube_sensors": gt.cube_sensors,

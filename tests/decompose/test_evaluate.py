@@ -108,3 +108,18 @@ def test_cli_without_dataset_says_how_to_build_it(tmp_path, capsys):
     status = main(["evaluate", "--dataset", str(tmp_path / "missing"), "--out", str(tmp_path)])
     assert status == 2
     assert "spectrinsic dataset" in capsys.readouterr().err
+
+
+def test_single_objects_are_scored_on_their_own_mask_not_the_ground():
+    from spectrinsic.decompose.evaluate import evaluation_mask
+
+    sample = _sample("obj-a__v0__white", 0, (1, 1, 1), False)
+    objects = np.zeros((48, 48), np.int32)
+    objects[:, 24:] = 1  # right half is the ground
+    sample["ids"]["object"] = objects
+    sample["meta"]["objects"] = {"0": "cup", "1": "ground"}
+    mask = evaluation_mask(sample)
+    assert mask[:, :24].all() and not mask[:, 24:].any()
+
+    room = dict(sample, meta={"sample_id": "room-b__v0__white", "objects": {"1": "ground"}})
+    assert evaluation_mask(room).all()  # complex scenes keep every surface
