@@ -2,23 +2,12 @@
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable, Sequence
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
-
-
-@pytest.fixture(scope="session")
-def data_dir() -> Path:
-    env = os.environ.get("SPECTRINSIC_DATA", "").strip()
-    path = Path(env) if env else Path(__file__).resolve().parents[2].parent / "shared" / "data"
-    if not path.is_dir():
-        pytest.skip(f"spectral data directory not found ({path}); set SPECTRINSIC_DATA")
-    return path
 
 
 def quad(corner: Sequence[float], u: Sequence[float], v: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
