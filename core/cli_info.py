@@ -3,32 +3,26 @@
 from __future__ import annotations
 
 import argparse
-import importlib.metadata as md
-import platform
 from typing import Any
 
 from spectrinsic.config import DATA_SUBDIRS, resolve_data_dir
+from spectrinsic.provenance import DISTRIBUTIONS, software_versions
 
 __all__ = ["register", "run", "collect_info"]
 
-_DISTRIBUTIONS = ("spectrinsic", "numpy", "colour-science", "luxpy", "mitsuba", "drjit", "OpenEXR",
-                  "trimesh", "scikit-image", "gco-wrapper", "bpy", "distributed")
+#: What ``info`` reports: the provenance set plus the optional extras.
+_DISTRIBUTIONS = (*DISTRIBUTIONS, "bpy", "distributed")
 
 
 def collect_info(data_dir: str | None = None) -> dict[str, Any]:
     """Everything ``info`` prints, as plain data (also recorded in dataset manifests)."""
-    versions: dict[str, str | None] = {}
-    for dist in _DISTRIBUTIONS:
-        try:
-            versions[dist] = md.version(dist)
-        except md.PackageNotFoundError:
-            versions[dist] = None
+    versions = software_versions(_DISTRIBUTIONS, python=False)
     from spectrinsic.render.variants import available_variants, llvm_library
 
     root = resolve_data_dir(data_dir)
     found = {} if root is None else {k: (root / k).is_dir() for k in DATA_SUBDIRS}
     return {
-        "python": platform.python_version(),
+        "python": software_versions((), python=True)["python"],
         "versions": versions,
         "llvm_library": llvm_library(),
         "variants": available_variants(),
@@ -47,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"spectrinsic {info['versions']['spectrinsic']} on Python {info['python']}")
     for dist, ver in info["versions"].items():  # type: ignore[union-attr]
         if dist != "spectrinsic":
-            print(f"  {dist:<14} {ver or 'not installed'}")
+            print(f"  {dist:<14} {ver}")
     print(f"LLVM for Dr.Jit: {info['llvm_library'] or 'none found (scalar variants only)'}")
     print("Mitsuba variants usable here: " + ", ".join(info["variants"]))  # type: ignore[arg-type]
     if info["data_dir"] is None:

@@ -10,9 +10,9 @@ matches. How the build is run (workers, threads, scheduler, which samples) never
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, replace
-from importlib.metadata import PackageNotFoundError, version
 from typing import Any
 
+from spectrinsic import provenance
 from spectrinsic.errors import DatasetError, validate_choice
 
 __all__ = [
@@ -33,17 +33,8 @@ HASHED_PACKAGES: tuple[str, ...] = ("spectrinsic", "mitsuba", "drjit", "colour-s
 
 
 def software_versions() -> dict[str, str]:
-    """Installed versions of :data:`HASHED_PACKAGES` (``"missing"`` when one is absent).
-
-    Read from package metadata, so nothing heavy (Mitsuba) is imported.
-    """
-    out = {}
-    for name in HASHED_PACKAGES:
-        try:
-            out[name] = version(name)
-        except PackageNotFoundError:
-            out[name] = "missing"
-    return out
+    """Installed versions of :data:`HASHED_PACKAGES` (``"absent"`` when one is absent)."""
+    return provenance.software_versions(HASHED_PACKAGES, python=False)
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,7 @@ import numpy as np
 
 from spectrinsic.config import resolve_data_dir
 from spectrinsic.errors import SpectralDataError, validate_choice
+from spectrinsic.results import provenance, write_csv, write_json
 from spectrinsic.rng import generator
 from spectrinsic.spectra import (
     angular_error,
@@ -53,7 +54,6 @@ from spectrinsic.spectra import (
     responses,
     wavelength_grid,
 )
-from spectrinsic.study_reconstruction import provenance, write_csv, write_json
 
 __all__ = [
     "SCENARIOS",

@@ -35,11 +35,8 @@ exact spectral colour (Lab relative to the D65 white).
 
 from __future__ import annotations
 
-import csv
-import json
 import logging
-import subprocess
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -48,6 +45,7 @@ import numpy as np
 
 from spectrinsic.config import resolve_data_dir
 from spectrinsic.errors import SpectralDataError
+from spectrinsic.results import provenance, write_csv, write_json
 from spectrinsic.spectra import (
     diagonal_values,
     fit_projection,
@@ -554,37 +552,6 @@ def format_extension(result: ExtensionResult) -> str:
     for note in result.skipped:
         lines.append(f"note: skipped {note}")
     return "\n".join(lines)
-
-
-def provenance() -> dict[str, Any]:
-    """Versions of the software that computed a study, and the git commit when available."""
-    from spectrinsic.presets import software_versions
-
-    try:
-        sha = subprocess.run(
-            ["git", "rev-parse", "HEAD"], cwd=Path(__file__).resolve().parent, capture_output=True,
-            text=True, timeout=5, check=False,
-        ).stdout.strip() or None
-    except (OSError, subprocess.SubprocessError):
-        sha = None
-    return {"software": software_versions(), "git_sha": sha}
-
-
-def write_json(path: Path, payload: dict[str, Any]) -> Path:
-    """Write *payload* as indented JSON (``NaN`` refused), creating parent folders."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(payload, indent=2, allow_nan=False) + "\n", encoding="utf-8")
-    return path
-
-
-def write_csv(path: Path, rows: Sequence[dict[str, Any]]) -> Path:
-    """Write dict rows (same keys) as CSV with a header."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with path.open("w", newline="", encoding="utf-8") as fh:
-        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
-    return path
 
 
 def _row_dict(row: ErrorRow, with_thesis: bool) -> dict[str, Any]:

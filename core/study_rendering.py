@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import validate_choice
-from spectrinsic.study_reconstruction import provenance, write_csv, write_json
+from spectrinsic.results import provenance, write_csv, write_json
 
 __all__ = [
     "QUALITIES",

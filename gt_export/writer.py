@@ -19,7 +19,6 @@ import json
 import logging
 import os
 import shutil
-import sys
 import tempfile
 import uuid
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -33,6 +32,7 @@ from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import png
 from spectrinsic.gt_export.exr import write_exr
 from spectrinsic.gt_export.layers import GroundTruth, Layer, compute_ground_truth
+from spectrinsic.provenance import software_versions
 from spectrinsic.scenes.model import Scene, scene_hash
 
 __all__ = [
@@ -43,7 +43,6 @@ __all__ = [
     "CARD_NAME",
     "DEFAULT_CAMERAS",
     "config_hash",
-    "software_versions",
     "export_sample",
     "is_complete",
     "sample_dirs",
@@ -70,10 +69,6 @@ DEFAULT_CAMERAS: tuple[str, ...] = ("camera:Nikon 5100 (NPL)", "camera:Sigma SDM
 #: Render metadata that varies from run to run and so is not written (files stay reproducible).
 _VOLATILE_META = ("timings",)
 #: Distributions whose versions are recorded.
-_DISTRIBUTIONS = (
-    "spectrinsic", "numpy", "scipy", "colour-science", "OpenEXR", "mitsuba", "drjit", "luxpy",
-    "matplotlib", "pillow",
-)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -133,19 +128,6 @@ def file_sha256(path: str | os.PathLike[str]) -> str:
         for chunk in iter(lambda: fh.read(1 << 20), b""):
             digest.update(chunk)
     return digest.hexdigest()
-
-
-def software_versions() -> dict[str, str]:
-    """Versions of Python and of the distributions that shape the output (``"absent"`` if not installed)."""
-    from importlib import metadata
-
-    out = {"python": sys.version.split()[0]}
-    for dist in _DISTRIBUTIONS:
-        try:
-            out[dist] = metadata.version(dist)
-        except metadata.PackageNotFoundError:
-            out[dist] = "absent"
-    return out
 
 
 # ----------------------------------------------------------------------------------------------

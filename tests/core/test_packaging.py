@@ -18,7 +18,7 @@ FOLDERS = {
 }
 #: Data flows one way: a package may import only packages to its left (and core's base modules).
 ORDER = ["spectra", "scenes", "render", "gt_export", "decompose"]
-CORE_BASE = {"errors", "typing", "config", "rng"}
+CORE_BASE = {"errors", "typing", "config", "rng", "provenance"}
 
 
 def _pyproject(repo_root: Path) -> dict:
