@@ -7,7 +7,7 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 
-from spectrinsic.errors import SceneError
+from spectrinsic.errors import RenderError, SceneError
 from spectrinsic.render.modes import (
     RenderMode,
     channel_values,
@@ -70,6 +70,14 @@ def count_passes(
     from spectrinsic.render.translate import surfaces
 
     return groups * colour + (max(1, -(-len(surfaces(scene)) // 3)) if aovs else 0)
+
+
+def _sum_direct(parts: Sequence[np.ndarray | None]) -> np.ndarray:
+    """Sum of the direct-only renders of every light group (each was asked for)."""
+    present = [p for p in parts if p is not None]
+    if len(present) != len(parts):
+        raise RenderError("a direct-only render is missing for a light group")
+    return np.sum(present, axis=0, dtype=np.float64)
 
 
 def render_scene(
@@ -170,7 +178,7 @@ def render_scene(
     images = {n: raw_to_xyz(raw[n], matrices[n]) for n in names}
     lights = tuple({n: raw_to_xyz(g[n].image, matrices[n]) for n in names} for g in raw_groups) if per_light else ()
     direct_images = {
-        n: raw_to_xyz(np.sum([g[n].direct for g in raw_groups], axis=0, dtype=np.float64), matrices[n])
+        n: raw_to_xyz(_sum_direct([g[n].direct for g in raw_groups]), matrices[n])
         for n in names if n in wanted
     }
     if aovs:
