@@ -18,7 +18,7 @@ export SPECTRINSIC_DATA ?= $(DATA_DIR)
 .PHONY: help setup test test-fast study study-spectral dataset evaluate bench lint info clean
 
 help: ## list the targets
-	@awk 'BEGIN {FS = ":.*## "} /^[a-zA-Z_-]+:.*## / {printf "  make %-10s %s\n", $$1, $$2}' $(MAKEFILE_LIST)
+	@awk 'BEGIN {FS = ":.*## "} /^[a-zA-Z_-]+:.*## / {printf "  make %-15s %s\n", $$1, $$2}' $(MAKEFILE_LIST)
 
 $(DEPS): pyproject.toml scripts/setup-system.sh
 	bash scripts/setup-system.sh
@@ -39,10 +39,10 @@ test: $(PKG) ## run the test suite (tiny renders; < 15 min on 2 cores)
 test-fast: $(PKG) ## run the tests not marked slow
 	$(PY) -m pytest -n 2 -q -m "not slow"
 
-study: study-spectral ## all studies: Table 5.2, Table 4.4 and the rendered study (< 15 min)
+study: study-spectral ## all studies: Table 5.2, Table 4.4 and the rendered study (a few minutes)
 	$(BIN)/spectrinsic study rendering
 
-study-spectral: $(PKG) ## the two spectral studies only: Table 5.2 and Table 4.4 (< 3 min)
+study-spectral: $(PKG) ## only the two spectral studies: Table 5.2 and Table 4.4 (seconds)
 	$(BIN)/spectrinsic study reconstruction-error
 	$(BIN)/spectrinsic study photometric
 
