@@ -330,6 +330,14 @@ def light_shares(per_light_y: np.ndarray, mask: np.ndarray | None = None) -> np.
     return totals / total
 
 
+def _shares_paths(mode: str, reference: str) -> bool:
+    """Whether two render modes trace the same light paths (both K-channel diagonal passes of
+    one scene, same seed and spp), so that their per-pixel difference is purely spectral."""
+    from spectrinsic.render.modes import RENDER_MODES
+
+    return all(m in RENDER_MODES and RENDER_MODES[m].kind == "diagonal" for m in (mode, reference))
+
+
 def illuminant_map(per_light_y: np.ndarray, colours: np.ndarray) -> np.ndarray:
     """Per-pixel colour of the light arriving: luminance-share-weighted light colours.
 
@@ -466,6 +474,8 @@ def compute_ground_truth(
         xyz = np.asarray(result.images[mode], float)
         add(f"image_{mode}", xyz_to_linear_srgb(xyz), rgb, _UNITS_IMAGE + f"; render mode {mode!r}",
             "image")
+        if not _shares_paths(mode, ref):
+            continue  # independent Monte Carlo paths: the difference would be noise, not error
         add(f"error_{mode}", relative_error_map(xyz, ref_xyz), ("Y",),
             f"dimensionless ‖XYZ_{mode} − XYZ_{ref}‖₂ / ‖XYZ_{ref}‖₂ per pixel (0 where unlit)",
             "image", nonnegative=True)
@@ -595,8 +605,12 @@ def compute_ground_truth(
                 "(perfect white has mean channel 1)", slug, nonnegative=True)
             add(f"shading_camera/{key}", shading_from(cam_image, cam_refl), rgb,
                 "camera image / camera reflectance per channel", slug)
-            add(f"illuminant_camera/{key}", illuminant_map(y_maps, colours[cam]), rgb,
-                "camera RGB of the light arriving, unit luminance where lit", slug)
+            # Relative to the camera's own D65 white, as reflectance_camera already holds that
+            # white: on a neutral surface shading_camera = shading_grey ∘ illuminant_camera.
+            d65_white = canonical_responses(white, d65, spaces[cam], wl)
+            add(f"illuminant_camera/{key}", illuminant_map(y_maps, colours[cam] / d65_white), rgb,
+                "camera RGB of the light arriving relative to the camera's response to D65 "
+                "(D65 light = (1, 1, 1)), unit luminance where lit", slug)
         if write_cube:
             add("cube", cube, band_set.channels,
                 f"band radiance ∫ L B_b dλ (render units) for the bands of {cube_name!r}", "cube",
