@@ -53,6 +53,7 @@ from spectrinsic.spectra import (
     list_spectra,
     responses,
     wavelength_grid,
+    white_normalised_responses,
 )
 
 __all__ = [
@@ -203,10 +204,8 @@ def srgb_responses(reflectances: np.ndarray, illuminant: np.ndarray, wavelengths
     Under D65 this is the absolute reflectance ``p^{s,c}`` (Eq. 4.15), normalised like
     :func:`spectrinsic.spectra.absolute_reflectance` but integrated on *wavelengths* (nm).
     """
-    srgb = get_sensors("srgb").on(wavelengths)
-    ybar = get_sensors("cie1931").on(wavelengths)[1:2]
-    return responses(np.asarray(reflectances, float) * illuminant, srgb, wavelengths) / responses(
-        illuminant, ybar, wavelengths)
+    return white_normalised_responses(reflectances, illuminant, get_sensors("srgb").on(wavelengths),
+                                      wavelengths)
 
 
 def _camera_curves(name: str, wl: np.ndarray, data_dir: str | None) -> tuple[np.ndarray | None, str]:

@@ -30,6 +30,9 @@ import numpy as np
 from spectrinsic.errors import DatasetError
 from spectrinsic.scenes.model import Scene
 
+# Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
+from spectrinsic.spectra import white_normalised_responses as canonical_responses
+
 __all__ = [
     "Layer",
     "LightRecord",
@@ -140,35 +143,6 @@ def _grid() -> np.ndarray:
     from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS
 
     return COLORIMETRIC_WAVELENGTHS
-
-
-def canonical_responses(
-    reflectances: np.ndarray, illuminant: np.ndarray, curves: np.ndarray, wavelengths: np.ndarray
-) -> np.ndarray:
-    """``p = ∫ ρ E S dλ / ∫ E ȳ dλ``: responses of reflectances under *illuminant*, white Y = 1.
-
-    Parameters
-    ----------
-    reflectances
-        ``(..., W)`` fractions in [0, 1] on *wavelengths* (nm).
-    illuminant
-        ``(W,)`` relative spectral power.
-    curves
-        ``(K, W)`` sensor sensitivities.
-    wavelengths
-        ``(W,)`` nm.
-
-    Returns
-    -------
-    ``(..., K)`` float64, dimensionless.
-    """
-    from spectrinsic.spectra import get_sensors, responses
-
-    ybar = get_sensors("cie1931").on(wavelengths)[1:2]
-    white_y = float(responses(np.asarray(illuminant, float), ybar, wavelengths)[0])
-    if not white_y > 0:
-        raise DatasetError("illuminant has no luminance; expected positive power in 360-830 nm")
-    return responses(np.asarray(reflectances, float) * illuminant, curves, wavelengths) / white_y
 
 
 def camera_curves(name: str, wavelengths: np.ndarray, *, data_dir: Any = None) -> np.ndarray:

@@ -11,6 +11,7 @@ from spectrinsic.spectra.colorimetry import (
     diagonal_values,
     linear_srgb_to_xyz,
     responses,
+    white_normalised_responses,
     xyz_to_linear_srgb,
     xyz_to_xy,
 )
@@ -58,6 +59,7 @@ __all__ = [
     "sharpening_transform",
     "validate_wavelengths",
     "wavelength_grid",
+    "white_normalised_responses",
     "xyz_to_linear_srgb",
     "xyz_to_xy",
 ]

@@ -24,6 +24,7 @@ __all__ = [
     "xyz_to_linear_srgb",
     "linear_srgb_to_xyz",
     "xyz_to_xy",
+    "white_normalised_responses",
     "absolute_reflectance",
 ]
 
@@ -105,6 +106,37 @@ def xyz_to_xy(xyz: np.ndarray) -> np.ndarray:
     return xy
 
 
+def white_normalised_responses(
+    reflectances: SpectralValues, illuminant: SpectralValues, curves: SensorCurves,
+    wavelengths: Wavelengths,
+) -> Responses:
+    """Responses of reflectances under a light, scaled so the perfect white has luminance Y = 1.
+
+    ``p_k = Σ ρ E S_k Δλ / Σ E ȳ Δλ`` (thesis Eq. 4.9 with the light's own white as unit).
+
+    Parameters
+    ----------
+    reflectances
+        ``(..., W)`` fractions in [0, 1] on *wavelengths* (nm).
+    illuminant
+        ``(W,)`` relative spectral power.
+    curves
+        ``(K, W)`` sensor sensitivities.
+
+    Returns
+    -------
+    ``(..., K)`` float64, dimensionless.
+    """
+    from spectrinsic.spectra.registry import get_sensors
+
+    light = np.asarray(illuminant, float)
+    ybar = get_sensors("cie1931").on(wavelengths)[1:2]
+    white_y = float(responses(light, ybar, wavelengths)[0])
+    if not white_y > 0:
+        raise SpectralDataError("illuminant has no luminance on the wavelength grid")
+    return responses(np.asarray(reflectances, float) * light, curves, wavelengths) / white_y
+
+
 def absolute_reflectance(
     reflectances: Spectrum | str | Sequence[Spectrum | str],
     *,
@@ -131,6 +163,5 @@ def absolute_reflectance(
     cmf = get_sensors("cie1931").on(wl)
     d65 = get_spectrum("cie:D65").on(wl)
     rho = np.stack([s.on(wl) for s in spectra]) if spectra else np.zeros((0, wl.size))
-    xyz = responses(rho * d65, cmf, wl) / responses(d65, cmf[1:2], wl)
-    rgb = xyz_to_linear_srgb(xyz)
+    rgb = xyz_to_linear_srgb(white_normalised_responses(rho, d65, cmf, wl))
     return rgb[0] if single else rgb
