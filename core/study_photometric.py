@@ -46,6 +46,7 @@ from spectrinsic.results import provenance, write_csv, write_json
 from spectrinsic.rng import generator
 from spectrinsic.spectra import (
     angular_error,
+    family_values,
     fit_matrix,
     get_sensors,
     get_spectrum,
@@ -294,8 +295,7 @@ def run_photometric(
     """Run the experiment of section 4.4.1 for every camera, light set and scenario."""
     wl = settings.wavelengths
     family = _reflectance_family(settings, data_dir)
-    names = list_spectra(family, data_dir=data_dir)
-    refl = np.stack([get_spectrum(n, data_dir=data_dir).on(wl) for n in names])
+    refl = family_values(family, wl, data_dir=data_dir)
     rng = generator(settings.seed)
     if settings.reflectances_per_scene > refl.shape[0]:
         raise SpectralDataError(

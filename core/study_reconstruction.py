@@ -48,11 +48,11 @@ from spectrinsic.errors import SpectralDataError
 from spectrinsic.results import provenance, write_csv, write_json
 from spectrinsic.spectra import (
     diagonal_values,
+    family_values,
     fit_projection,
     gaussian_sensors,
     get_sensors,
     get_spectrum,
-    list_spectra,
     responses,
     wavelength_grid,
 )
@@ -251,8 +251,7 @@ class ExtensionResult:
 
 def reflectance_matrix(family: str, wavelengths: np.ndarray, *, data_dir: str | None = None) -> np.ndarray:
     """``(N, W)`` reflectances of a listable family (``"munsell"``, ``"sfu"``...) on *wavelengths*."""
-    names = list_spectra(family, data_dir=data_dir)
-    return np.stack([get_spectrum(n, data_dir=data_dir).on(wavelengths) for n in names])
+    return family_values(family, wavelengths, data_dir=data_dir)
 
 
 def _stats(errors: np.ndarray) -> tuple[float, float, float]:

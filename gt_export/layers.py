@@ -175,9 +175,9 @@ def cube_to_sensors(cube_sensors: np.ndarray, curves: np.ndarray, wavelengths: n
 
 
 def _training_reflectances(wavelengths: np.ndarray) -> np.ndarray:
-    from spectrinsic.spectra import get_spectrum, list_spectra
+    from spectrinsic.spectra import family_values
 
-    return np.stack([get_spectrum(n).on(wavelengths) for n in list_spectra(TRAINING_FAMILY)])
+    return family_values(TRAINING_FAMILY, wavelengths)
 
 
 def photometric_matrices(

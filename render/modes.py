@@ -28,7 +28,6 @@ reflectance keeps its value and every product of reflectances and a light is in 
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
@@ -41,10 +40,10 @@ from spectrinsic.spectra import (
     COLORIMETRIC_WAVELENGTHS,
     SensorSet,
     diagonal_values,
+    family_values,
     fit_projection,
     get_sensors,
     get_spectrum,
-    list_spectra,
     responses,
 )
 from spectrinsic.typing import Wavelengths
@@ -216,18 +215,10 @@ def integration_matrix(
     return responses(t, extended, wavelengths) / area[None, :]
 
 
-@functools.lru_cache(maxsize=4)
-def _munsell_on(grid: tuple[float, ...]) -> np.ndarray:
-    # resampling the 1269 chips costs ~30 ms, paid by every rgb6 render otherwise
-    table = np.stack([get_spectrum(n).on(np.asarray(grid)) for n in list_spectra("munsell")])
-    table.setflags(write=False)
-    return table
-
-
 def munsell_reflectances(wavelengths: Wavelengths = COLORIMETRIC_WAVELENGTHS) -> np.ndarray:
     """``(1269, W)`` reflectances of the matte Munsell chips on *wavelengths* (nm); read-only,
     cached per wavelength grid."""
-    return _munsell_on(tuple(np.asarray(wavelengths, float).ravel().tolist()))
+    return family_values("munsell", wavelengths)
 
 
 def regression_matrix(

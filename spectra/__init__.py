@@ -30,7 +30,7 @@ from spectrinsic.spectra.photometric import (
     sharpening_transform,
 )
 from spectrinsic.spectra.records import SensorSet, Spectrum
-from spectrinsic.spectra.registry import get_sensors, get_spectrum, list_spectra
+from spectrinsic.spectra.registry import family_values, get_sensors, get_spectrum, list_spectra
 from spectrinsic.spectra.sensors import box_bands, gaussian_sensors
 
 __all__ = [
@@ -45,6 +45,7 @@ __all__ = [
     "angular_error",
     "box_bands",
     "diagonal_values",
+    "family_values",
     "fit_matrix",
     "fit_projection",
     "gaussian_sensors",

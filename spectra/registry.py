@@ -24,15 +24,25 @@ Everything is loaded lazily on first use.
 
 from __future__ import annotations
 
+import functools
 import os
 from collections.abc import Callable, Mapping
+
+import numpy as np
 
 from spectrinsic.config import resolve_data_dir
 from spectrinsic.errors import SpectrumNotFoundError, did_you_mean
 from spectrinsic.spectra import illuminants, reflectances, sensors
 from spectrinsic.spectra.records import SensorSet, Spectrum
 
-__all__ = ["get_spectrum", "get_sensors", "list_spectra", "SPECTRUM_FAMILIES", "SENSOR_FAMILIES"]
+__all__ = [
+    "get_spectrum",
+    "get_sensors",
+    "list_spectra",
+    "family_values",
+    "SPECTRUM_FAMILIES",
+    "SENSOR_FAMILIES",
+]
 
 DataDir = str | os.PathLike[str] | None
 
@@ -126,3 +136,23 @@ def list_spectra(family: str, *, data_dir: DataDir = None) -> list[str]:
             + did_you_mean(family, listing)
         )
     return [f"{family}:{k}" for k in listing[family]()]
+
+
+def family_values(family: str, wavelengths: np.ndarray, *, data_dir: DataDir = None) -> np.ndarray:
+    """``(N, W)`` values of every spectrum of a listable family (``"munsell"``, ``"sfu"``...),
+    in :func:`list_spectra` order, resampled onto *wavelengths* (nm).
+
+    Read-only and cached per family, grid and data directory: resampling the 1269 Munsell chips
+    costs tens of milliseconds, and renders, ground truth and studies all need them.
+    """
+    grid = tuple(np.asarray(wavelengths, float).ravel().tolist())
+    return _family_values(family, grid, _data(data_dir))
+
+
+@functools.lru_cache(maxsize=8)
+def _family_values(family: str, grid: tuple[float, ...], data_dir: str | None) -> np.ndarray:
+    wl = np.asarray(grid)
+    names = list_spectra(family, data_dir=data_dir)
+    table = np.stack([get_spectrum(n, data_dir=data_dir).on(wl) for n in names])
+    table.setflags(write=False)
+    return table
