@@ -66,6 +66,10 @@ PREVIEW_DIR = "previews"
 TMP_PREFIX = ".tmp-"
 #: Cameras exported by default when the 31-band cube is available (shipped by colour-science).
 DEFAULT_CAMERAS: tuple[str, ...] = ("camera:Nikon 5100 (NPL)", "camera:Sigma SDMerill (NPL)")
+#: Significant digits of every float in ``meta.json`` (fitted matrices, light colours, noise
+#: figures): far above their physical accuracy, and far enough below float64's 15.9 that the
+#: last-bit differences of floating-point reductions between machines never reach the file.
+META_DIGITS = 12
 #: Render metadata that varies from run to run and so is not written (files stay reproducible).
 _VOLATILE_META = ("timings",)
 #: Distributions whose versions are recorded.
@@ -75,32 +79,37 @@ _VOLATILE_META = ("timings",)
 # Plain data and hashes
 
 
-def _jsonable(value: Any) -> Any:
+def _jsonable(value: Any, digits: int | None = None) -> Any:
+    """Plain JSON data of *value*; floats rounded to *digits* significant digits if given."""
     if is_dataclass(value) and not isinstance(value, type):
-        return {f.name: _jsonable(getattr(value, f.name)) for f in fields(value)}
+        return {f.name: _jsonable(getattr(value, f.name), digits) for f in fields(value)}
     if isinstance(value, Mapping):
-        return {str(k): _jsonable(v) for k, v in value.items()}
+        return {str(k): _jsonable(v, digits) for k, v in value.items()}
     if isinstance(value, np.ndarray):
-        if value.dtype.kind in "biu" or (value.dtype.kind == "f" and np.isfinite(value).all()):
+        finite = value.dtype.kind in "biu" or (value.dtype.kind == "f" and np.isfinite(value).all())
+        if finite and (digits is None or value.dtype.kind != "f"):
             return value.tolist()  # plain bools, ints and finite floats all the way down
-        return _jsonable(value.tolist())
+        return _jsonable(value.tolist(), digits)
     if isinstance(value, np.generic):
-        return value.item()
+        return _jsonable(value.item(), digits)
     if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
+        return [_jsonable(v, digits) for v in value]
     if isinstance(value, float):
-        return value if np.isfinite(value) else str(value)
+        if not np.isfinite(value):
+            return str(value)
+        return value if digits is None else float(f"{value:.{digits}g}")
     if value is None or isinstance(value, (str, int, bool)):
         return value
     return str(value)
 
 
-def _dump_json(path: Path, data: Any, *, compact: bool = False) -> None:
+def _dump_json(path: Path, data: Any, *, compact: bool = False, digits: int | None = None) -> None:
     """Write *data* as sorted-key JSON: indented, or *compact* (one line, no spaces) for large
-    files, which the json module's C encoder then writes (it is bypassed whenever indenting)."""
+    files, which the json module's C encoder then writes (it is bypassed whenever indenting).
+    *digits* rounds every float to that many significant digits."""
     layout: dict[str, Any] = {"separators": (",", ":")} if compact else {"indent": 2}
-    path.write_text(json.dumps(_jsonable(data), sort_keys=True, ensure_ascii=False, **layout) + "\n",
-                    encoding="utf-8")
+    text = json.dumps(_jsonable(data, digits), sort_keys=True, ensure_ascii=False, **layout)
+    path.write_text(text + "\n", encoding="utf-8")
 
 
 def config_hash(config: Mapping[str, Any]) -> str:
@@ -288,7 +297,8 @@ def _fill_folder(folder: Path, scene: Scene, result: Any, gt: GroundTruth, **met
     _dump_json(folder / SCENE_NAME, scene, compact=True)
     files.append(SCENE_NAME)
     # meta.json last: its presence (with the right config hash) marks the folder complete
-    _dump_json(folder / META_NAME, _meta(scene, result, gt, previews=previews, files=files, **meta_kw))
+    _dump_json(folder / META_NAME, _meta(scene, result, gt, previews=previews, files=files, **meta_kw),
+               digits=META_DIGITS)
 
 
 def export_sample(

@@ -71,7 +71,9 @@ def responses(spectra: SpectralValues, curves: SensorCurves, wavelengths: Wavele
     s = np.asarray(curves, float)
     wl = np.asarray(wavelengths, float)
     _check(x, s, wl)
-    return (x * integration_weights(wl)) @ s.T
+    # einsum's own loop rather than BLAS: its summation order does not depend on the thread
+    # count or the CPU kernel, so fitted matrices and written files are reproducible anywhere.
+    return np.einsum("...w,kw->...k", x * integration_weights(wl), s)
 
 
 def diagonal_values(spectra: SpectralValues, curves: SensorCurves, wavelengths: Wavelengths) -> Responses:

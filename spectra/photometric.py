@@ -26,6 +26,26 @@ def _pairs(src: np.ndarray, dst: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return a, b
 
 
+def _least_squares(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``X`` minimising ``‖a X − b‖²`` through the normal equations ``(aᵀa) X = aᵀb``.
+
+    The Gram matrices are summed by einsum's own loop, not BLAS or LAPACK's ``gelsd``, whose
+    reductions change their last bits with the thread count and CPU kernel (1.0000000000000002
+    vs 0.9999999999999997 between two processes); the K×K solve is single-threaded. Sensor
+    responses of a few channels are well conditioned, so the squared condition number costs
+    nothing measurable.
+    """
+    gram = np.einsum("nk,nj->kj", a, a)
+    cross = np.einsum("nk,nj->kj", a, b)
+    try:
+        return np.linalg.solve(gram, cross)
+    except np.linalg.LinAlgError as exc:
+        raise SpectralDataError(
+            f"least-squares fit of {a.shape[1]} source channels is degenerate (linearly "
+            "dependent responses)"
+        ) from exc
+
+
 def fit_matrix(src: np.ndarray, dst: np.ndarray, *, diagonal: bool = False) -> Matrix3:
     """Least-squares ``M`` (3×3) with ``dst ≈ src @ M.T`` (i.e. ``p_dst = M p_src``).
 
@@ -42,9 +62,8 @@ def fit_matrix(src: np.ndarray, dst: np.ndarray, *, diagonal: bool = False) -> M
     """
     a, b = _pairs(src, dst)
     if diagonal:
-        return np.diag((a * b).sum(axis=0) / (a * a).sum(axis=0))
-    x, *_ = np.linalg.lstsq(a, b, rcond=None)
-    return x.T
+        return np.diag(np.einsum("nk,nk->k", a, b) / np.einsum("nk,nk->k", a, a))
+    return _least_squares(a, b).T
 
 
 def fit_projection(src: np.ndarray, dst: np.ndarray) -> np.ndarray:
@@ -54,8 +73,7 @@ def fit_projection(src: np.ndarray, dst: np.ndarray) -> np.ndarray:
     3 channels (XYZ or linear sRGB), section 5.2.3.
     """
     a, b = _pairs(src, dst)
-    x, *_ = np.linalg.lstsq(a, b, rcond=None)
-    return x.T
+    return _least_squares(a, b).T
 
 
 def sharpening_transform(

@@ -182,3 +182,29 @@ def test_torch_adapter_yields_channel_first_tensors(built):
     assert len(ds) == 2 and item["sample_id"] == "a-one"
     assert item["image"].shape == (3, 12, 16) and item["image"].dtype == torch.float32
     assert item["mask"].dtype == torch.bool
+
+
+def test_meta_json_floats_carry_at_most_the_stated_digits(tmp_path, two_light_sample, config):
+    """Fitted matrices and colours are rounded (issue 9, point 10), so BLAS's last bits never
+    reach the file; the rounding keeps 12 significant digits, far above their accuracy."""
+    from spectrinsic.gt_export.writer import META_DIGITS
+
+    scene, result = two_light_sample
+    folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=3)
+    floats: list[float] = []
+
+    def walk(value):
+        if isinstance(value, float):
+            floats.append(value)
+        elif isinstance(value, dict):
+            for v in value.values():
+                walk(v)
+        elif isinstance(value, list):
+            for v in value:
+                walk(v)
+
+    meta = json.loads((folder / "meta.json").read_text())
+    walk(meta["matrices"])
+    assert len(floats) > 50
+    assert all(float(f"{x:.{META_DIGITS}g}") == x for x in floats)
+    assert any(float(f"{x:.{META_DIGITS - 2}g}") != x for x in floats)  # not rounded coarser

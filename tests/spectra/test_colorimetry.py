@@ -132,3 +132,40 @@ def test_sharpening_narrows_overlapping_sensors():
 def test_angular_error_closed_forms():
     assert angular_error(np.array([1.0, 1, 1]), np.array([2.0, 2, 2])) == pytest.approx(0.0, abs=1e-6)
     assert angular_error(np.array([1.0, 0, 0]), np.array([1.0, 1, 0])) == pytest.approx(45.0)
+
+
+def test_fits_and_responses_do_not_depend_on_blas_threads(tmp_path):
+    """The fitted matrices written to meta.json come out bit-identical with 1 and 2 BLAS threads
+    (issue 9, point 10): responses and least squares avoid threaded BLAS reductions."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "fit.py"
+    script.write_text(
+        "import numpy as np\n"
+        "from spectrinsic.spectra import fit_matrix, fit_projection, family_values, responses\n"
+        "from spectrinsic.spectra import get_sensors, COLORIMETRIC_WAVELENGTHS as wl\n"
+        "rho = family_values('munsell', wl)\n"
+        "q = responses(rho, get_sensors('srgb').on(wl), wl)\n"
+        "p = responses(rho, get_sensors('gaussian:6@400-700').on(wl), wl)\n"
+        "out = np.concatenate([fit_matrix(q, q[:, ::-1] ** 1.1).ravel(), fit_projection(p, q).ravel(), q.ravel()])\n"
+        "print(out.tobytes().hex())\n"
+    )
+    outputs = set()
+    for threads in ("1", "2"):
+        env = {**__import__("os").environ, "OPENBLAS_NUM_THREADS": threads, "OMP_NUM_THREADS": threads}
+        run = subprocess.run([sys.executable, "-P", str(script)], capture_output=True, text=True,
+                             env=env, check=True)
+        outputs.add(run.stdout)
+    assert len(outputs) == 1
+
+
+def test_normal_equations_agree_with_lstsq():
+    """Independent reference: numpy's SVD least squares."""
+    from spectrinsic.spectra import fit_projection
+
+    rng = np.random.default_rng(3)
+    a = rng.random((500, 6))
+    b = a @ rng.random((6, 3)) + 1e-3 * rng.standard_normal((500, 3))
+    ref, *_ = np.linalg.lstsq(a, b, rcond=None)
+    np.testing.assert_allclose(fit_projection(a, b), ref.T, rtol=1e-10, atol=1e-12)
