@@ -61,7 +61,13 @@ def register(subparsers: Any) -> None:
         default=None,
         help="build only sample ids matching these comma-separated globs ('obj-*,*__white')",
     )
-    p.add_argument("--spp", type=int, default=None, metavar="N", help="override samples per pixel")
+    p.add_argument("--spp", type=int, default=None, metavar="N",
+                   help="override samples per pixel (the total over all batches)")
+    p.add_argument("--batches", type=int, default=None, metavar="N",
+                   help="override the number of independent batches the samples are split into "
+                        "(>= 2 measures the noise; spp must be divisible by it)")
+    p.add_argument("--no-denoise", action="store_true",
+                   help="keep shading from the raw Monte Carlo irradiance (no OIDN)")
     p.add_argument(
         "--resolution",
         default=None,
@@ -75,6 +81,10 @@ def _overrides(args: argparse.Namespace) -> dict[str, int]:
     changes: dict[str, int] = {}
     if args.spp is not None:
         changes["spp"] = args.spp
+    if args.batches is not None:
+        changes["batches"] = args.batches
+    if args.no_denoise:
+        changes["denoise"] = False
     if args.resolution is not None:
         w, sep, h = args.resolution.lower().partition("x")
         if not (sep and w.isdigit() and h.isdigit()):

@@ -243,7 +243,7 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         Status ``"built"`` with timings and the worker's peak memory.
     """
     from spectrinsic.gt_export import export_sample
-    from spectrinsic.render import render_scene
+    from spectrinsic.render import render_batches
     from spectrinsic.scenes.library import build
 
     set_render_threads(task.render_threads)
@@ -258,14 +258,16 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         height=cfg.height,
     )
     t_render = time.perf_counter()
-    result = render_scene(
+    result = render_batches(
         scene,
+        batches=cfg.batches,
         modes=cfg.modes,
-        spp=cfg.spp,
+        spp=cfg.spp // cfg.batches,
         seed=task.seed,
         max_depth=cfg.max_depth,
         variant=cfg.variant,
         per_light=cfg.per_light,
+        per_light_modes=(cfg.share_mode,) if cfg.per_light and cfg.share_mode else None,
         direct=cfg.direct,
         aovs=True,
         data_dir=task.data_dir,
@@ -280,6 +282,7 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         seed=task.seed,
         cameras=cfg.resolved_cameras(),
         write_cube=cfg.write_cube,
+        denoise=cfg.denoise,
         data_dir=task.data_dir,
     )
     seconds = time.perf_counter() - t0

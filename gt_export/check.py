@@ -2,9 +2,11 @@
 
 Checks, per sample: ``meta.json`` readable; every listed file present; every layer readable
 with the recorded shape; no NaN or Inf anywhere; no negative values in layers marked
-non-negative; ids integral and >= -1; mask 0/1; ``image = reflectance ∘ shading`` (and the same
-per camera) wherever reflectance is non-zero. Per dataset: ``manifest.json`` present, its
-samples present, and the SHA-256 of every file matching.
+non-negative; ids integral and >= -1; mask 0/1; every identity ``meta.json`` records,
+``image = reflectance ∘ shading + residual`` per sensor space, and
+``image = reflectance ∘ shading_ratio`` wherever reflectance is non-zero. Per dataset:
+``manifest.json`` present, its samples present, and the SHA-256 of every file matching.
+Noise: :func:`noise_report` lists the samples whose measured noise exceeds a threshold.
 """
 
 from __future__ import annotations
@@ -34,19 +36,45 @@ __all__ = ["check_dataset", "check_sample", "IDENTITY_RTOL"]
 IDENTITY_RTOL = 4 * float(np.finfo(np.float32).eps)
 
 
-def _identity_problem(image: np.ndarray, refl: np.ndarray, shad: np.ndarray) -> str | None:
-    valid = np.abs(refl) > REFLECTANCE_FLOOR
+def _identity_problem(
+    image: np.ndarray, refl: np.ndarray, shad: np.ndarray, residual: np.ndarray | None = None,
+    *, names: str = "image != reflectance * shading",
+) -> str | None:
+    """``image = refl ∘ shad (+ residual)`` to float32 rounding, where reflectance is non-zero
+    (everywhere when a residual is given)."""
+    valid = np.ones(image.shape, bool) if residual is not None else np.abs(refl) > REFLECTANCE_FLOOR
     if not valid.any():
         return None
     product = refl.astype(np.float64) * shad.astype(np.float64)
-    err = np.abs(product - image)[valid]
-    scale = np.maximum(np.abs(image), np.abs(product))[valid]
+    rebuilt = product + (0.0 if residual is None else residual.astype(np.float64))
+    err = np.abs(rebuilt - image)[valid]
+    scale = np.maximum.reduce([np.abs(image), np.abs(product), np.abs(rebuilt)])[valid]
     bad = err > IDENTITY_RTOL * scale + np.finfo(np.float32).tiny
     if bad.any():
         worst = float((err / np.maximum(scale, np.finfo(np.float32).tiny)).max())
-        return (f"image != reflectance * shading at {int(bad.sum())} channel values "
+        return (f"{names} at {int(bad.sum())} channel values "
                 f"(worst relative error {worst:.2e}, tolerance {IDENTITY_RTOL:.1e})")
     return None
+
+
+def _identity_problems(meta: Mapping[str, Any], data: Mapping[str, np.ndarray]) -> list[str]:
+    out = []
+    for ident in meta.get("identities", []):
+        keys = [ident.get(k) for k in ("image", "reflectance", "shading", "residual")]
+        missing = [k for k in keys if k not in data]
+        if missing:
+            out.append(f"identity {ident}: layer(s) {missing} missing")
+            continue
+        issue = _identity_problem(*(data[k] for k in keys),  # type: ignore[index]
+                                  names=f"{keys[0]} != {keys[1]} * {keys[2]} + {keys[3]}")
+        if issue:
+            out.append(f"{keys[0]}: {issue}")
+    if all(k in data for k in ("image", "reflectance", "shading_ratio")):
+        issue = _identity_problem(data["image"], data["reflectance"], data["shading_ratio"],
+                                  names="image != reflectance * shading_ratio")
+        if issue:
+            out.append(f"image: {issue}")
+    return out
 
 
 def _layer_problems(key: str, rec: Mapping[str, Any], data: np.ndarray) -> list[str]:
@@ -100,13 +128,9 @@ def check_sample(sample: str | os.PathLike[str]) -> list[str]:
                 continue
             data[key] = arrays[exr_layer]
             problems.extend(_layer_problems(key, records[key], data[key]))
-    for image_key in [k for k in data if k == "image" or k.startswith("image_camera/")]:
-        suffix = image_key.removeprefix("image")
-        refl_key, shad_key = f"reflectance{suffix}", f"shading{suffix}"
-        if refl_key in data and shad_key in data:
-            issue = _identity_problem(data[image_key], data[refl_key], data[shad_key])
-            if issue:
-                problems.append(f"{image_key}: {issue}")
+    if "identities" not in meta:
+        problems.append("meta.json records no identities (image = reflectance * shading + residual)")
+    problems.extend(_identity_problems(meta, data))
     return problems
 
 

@@ -1,8 +1,10 @@
 """Ground-truth layers computed from a render result and the scene's spectra (pure functions).
 
 Nothing here reads or writes files or touches a renderer: inputs are a :class:`Scene` (which
-names every spectrum) and a *RenderResult-like* record with the attributes ``images``, ``raw``,
-``per_light``, ``aovs`` and ``meta`` described in CONTRACTS.md.
+names every spectrum) and a :class:`RenderRecord` (a :class:`spectrinsic.render.RenderResult`
+or anything with its fields). :func:`compute_ground_truth` composes one function per family of
+layers: images and errors, geometry, reflectance, irradiance shading (with noise and
+denoising), lights, cameras and the chapter-4 matrices.
 
 Colour conventions (thesis chapter 4, Eq. 4.9–4.16). For sensor curves ``S`` (sRGB = the
 IEC 61966-2-1 matrix applied to the CIE 1931 CMFs, or a camera), the *canonical response* of a
@@ -15,7 +17,8 @@ so the perfect white has luminance 1 under any light, and under D65 with sRGB se
 (white = (1, 1, 1) up to the 1 nm integration of D65). Camera curves are first scaled by one
 factor so that the mean channel of the perfect white under D65 is 1 (white balance is left to
 the camera, as the thesis' relative reflectance ``S_Sen · I^a`` keeps it). Every integral uses
-the 1 nm CIE grid (360–830 nm).
+the 1 nm CIE grid (360–830 nm). Shading, residual and illuminant come from the spectral
+irradiance (:mod:`spectrinsic.gt_export.irradiance`).
 """
 
 from __future__ import annotations
@@ -23,17 +26,19 @@ from __future__ import annotations
 import logging
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export import irradiance as irr
 from spectrinsic.scenes.model import Scene
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 from spectrinsic.spectra import white_normalised_responses as canonical_responses
 
 __all__ = [
+    "RenderRecord",
     "Layer",
     "LightRecord",
     "GroundTruth",
@@ -46,12 +51,12 @@ __all__ = [
     "camera_curves",
     "cube_to_sensors",
     "coverage_weighted",
-    "shading_from",
+    "shading_ratio",
     "luminance",
     "relative_error_map",
-    "illuminant_map",
     "light_shares",
     "photometric_matrices",
+    "identities",
 ]
 
 log = logging.getLogger(__name__)
@@ -59,15 +64,35 @@ log = logging.getLogger(__name__)
 #: Render modes in order of preference for the reference ``image``: the 31-band cube shares
 #: its light paths with the 3- and 6-sensor passes (differences are purely spectral), the
 #: spectral Monte Carlo render is unbiased but noisier.
-REFERENCE_MODES: tuple[str, ...] = ("bands31", "spectral", "rgb6", "rgb3")
+REFERENCE_MODES: tuple[str, ...] = ("bands31", "spectral", "rgb6", "gauss3", "rgb3")
 #: Sensor set assumed for ``raw["bands31"]`` when the render metadata does not name one.
 DEFAULT_CUBE_SENSORS = "bands:31@400-700"
-#: |reflectance| at or below this (per channel) has no defined shading (shading stored as 0).
+#: |reflectance| at or below this (per channel) has no defined ratio shading (stored as 0).
 REFLECTANCE_FLOOR = 1e-6
 #: Error maps are 0 where the reference colour norm is below this fraction of its 99th percentile.
 ERROR_FLOOR = 1e-3
 #: Training reflectances of the photometric matrices (thesis section 4.4 uses Munsell chips).
 TRAINING_FAMILY = "munsell"
+
+
+class RenderRecord(Protocol):
+    """What ground truth reads of a render (the fields of :class:`spectrinsic.render.RenderResult`).
+
+    ``images`` mode -> ``(H, W, 3)`` XYZ; ``raw`` mode -> ``(H, W, K)`` raw channels;
+    ``per_light`` one dict mode -> XYZ per light; ``aovs`` coverage, ids, depth, normals, mask;
+    ``meta`` sensors and ``to_xyz`` per mode; ``batch_raw`` per independent batch, mode -> raw.
+    """
+
+    @property
+    def images(self) -> Mapping[str, np.ndarray]: ...
+    @property
+    def raw(self) -> Mapping[str, np.ndarray]: ...
+    @property
+    def per_light(self) -> Sequence[Mapping[str, np.ndarray]]: ...
+    @property
+    def aovs(self) -> Mapping[str, np.ndarray]: ...
+    @property
+    def meta(self) -> Mapping[str, Any]: ...
 
 
 @dataclass(frozen=True)
@@ -133,6 +158,13 @@ class GroundTruth:
     reference_mode: str
     cameras: tuple[str, ...]
     cube_sensors: str | None
+    #: Names of the layers computed from the denoised white-surface radiance.
+    denoised: tuple[str, ...] = ()
+    #: Relative standard error per layer (``{"image": {"median", "p95", "pixels"}, ...}``),
+    #: from the spread of independent batches; empty for a single batch.
+    noise: dict[str, dict[str, float | int]] = field(default_factory=dict)
+    #: Fraction of the lit pixels whose shading had a channel clipped at 0 (out of gamut).
+    clipped_fraction: float = 0.0
 
 
 # ----------------------------------------------------------------------------------------------
@@ -261,11 +293,13 @@ def coverage_weighted(coverage: np.ndarray, colours: np.ndarray) -> np.ndarray:
     return coverage @ colours
 
 
-def shading_from(image: np.ndarray, reflectance: np.ndarray) -> np.ndarray:
-    """Shading-illumination ``image / reflectance`` per channel (thesis Fig. 5.8).
+def shading_ratio(image: np.ndarray, reflectance: np.ndarray) -> np.ndarray:
+    """The per-channel ratio ``image / reflectance`` (thesis Fig. 5.8), layer ``shading_ratio``.
 
-    Where ``|reflectance| <= REFLECTANCE_FLOOR`` (background, black) shading is 0; elsewhere
-    ``image = reflectance ∘ shading`` holds to float precision. Same shape as *image*.
+    Ill-conditioned: where a reflectance channel is near 0 (saturated colours), or the light
+    arriving is not D65, it depends on the material and can reach thousands. Where
+    ``|reflectance| <= REFLECTANCE_FLOOR`` (background, black) it is 0; elsewhere
+    ``image = reflectance ∘ shading_ratio`` holds to float precision. Same shape as *image*.
     """
     image = np.asarray(image, float)
     reflectance = np.asarray(reflectance, float)
@@ -310,33 +344,6 @@ def _shares_paths(mode: str, reference: str) -> bool:
     from spectrinsic.render.modes import RENDER_MODES
 
     return all(m in RENDER_MODES and RENDER_MODES[m].kind == "diagonal" for m in (mode, reference))
-
-
-def illuminant_map(per_light_y: np.ndarray, colours: np.ndarray) -> np.ndarray:
-    """Per-pixel colour of the light arriving: luminance-share-weighted light colours.
-
-    ``E(x) = Σ_l w_l(x) c_l`` with ``w_l(x) = Y_l(x) / Σ_k Y_k(x)``, where ``Y_l`` is the
-    luminance of light l's own render (direct and indirect light it causes) and ``c_l`` its
-    colour at unit luminance. As every light's render shares the same reflectance at x, ``w_l``
-    is light l's share of the light arriving there. ``E`` has luminance 1 where any light
-    arrives and is 0 where none does.
-
-    Parameters
-    ----------
-    per_light_y
-        ``(L, H, W)`` luminance of each per-light render (negative noise clipped to 0).
-    colours
-        ``(L, C)`` light colours at unit luminance.
-
-    Returns
-    -------
-    ``(H, W, C)`` float64.
-    """
-    y = np.clip(np.asarray(per_light_y, float), 0.0, None)
-    total = y.sum(axis=0)
-    lit = total > 0
-    w = np.where(lit, y / np.where(lit, total, 1.0), 0.0)
-    return np.einsum("lhw,lc->hwc", w, np.asarray(colours, float))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -388,14 +395,309 @@ _UNITS_CAMERA = (
     "relative radiance (render units) in the camera's raw linear RGB; curves scaled so the "
     "perfect white under D65 has mean channel 1"
 )
+_RGB = ("R", "G", "B")
+
+
+def _layer(name: str, data: np.ndarray, channels: Sequence[str], units: str, group: str,
+           nonnegative: bool = False) -> Layer:
+    return Layer(name, np.asarray(data, dtype=np.float32), tuple(channels), units, group, nonnegative)
+
+
+@dataclass(frozen=True, eq=False)
+class _Sample:
+    """What every family of layers reads: the scene, the render and the spectra on the 1 nm grid."""
+
+    scene: Scene
+    result: Any
+    ref: str
+    wl: np.ndarray
+    material_rho: np.ndarray
+    d65: np.ndarray
+    data_dir: Any
+
+
+def _image_layers(s: _Sample) -> list[Layer]:
+    """``image`` (the reference mode), every other mode, and error maps of the modes that
+    share the reference's light paths (Eq. 5.7 per pixel)."""
+    from spectrinsic.spectra import xyz_to_linear_srgb
+
+    ref_xyz = np.asarray(s.result.images[s.ref], float)
+    out = [_layer("image", xyz_to_linear_srgb(ref_xyz), _RGB, _UNITS_IMAGE + f"; render mode {s.ref!r}",
+                  "image")]
+    for mode in sorted(m for m in s.result.images if m != s.ref):
+        xyz = np.asarray(s.result.images[mode], float)
+        out.append(_layer(f"image_{mode}", xyz_to_linear_srgb(xyz), _RGB,
+                          _UNITS_IMAGE + f"; render mode {mode!r}", "image"))
+        if _shares_paths(mode, s.ref):  # else independent paths: the difference would be noise
+            out.append(_layer(
+                f"error_{mode}", relative_error_map(xyz, ref_xyz), ("Y",),
+                f"dimensionless ‖XYZ_{mode} − XYZ_{s.ref}‖₂ / ‖XYZ_{s.ref}‖₂ per pixel (0 where unlit)",
+                "image", nonnegative=True))
+    return out
+
+
+_GEOMETRY = (
+    ("depth", ("Z",), "scene units, distance from the camera to the first hit (0: background)"),
+    ("normals", ("X", "Y", "Z"), "world-space unit surface normals (0: background)"),
+    ("material_id", ("id",), "index into meta['materials'], stored as float32; -1 background"),
+    ("object_id", ("id",), "object id of the scene meshes, stored as float32; -1 background"),
+)
+
+
+def _coverage(s: _Sample, shape: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """``(H, W, M)`` material coverage and the ``(H, W)`` mask of the render."""
+    mask = _aov(s.result, "mask")
+    mask = np.ones(shape, bool) if mask is None else mask.astype(bool)
+    coverage = _aov(s.result, "coverage")
+    if coverage is None:
+        material_id = _aov(s.result, "material_id")
+        if material_id is None:
+            raise DatasetError("render result has neither a 'coverage' nor a 'material_id' AOV")
+        log.warning("no coverage AOV: reflectance is not anti-aliased at edges")
+        coverage = (material_id[..., None] == np.arange(len(s.scene.materials))).astype(float)
+    return np.asarray(coverage, float), mask
+
+
+def _geometry_layers(s: _Sample, mask: np.ndarray) -> list[Layer]:
+    out = [_layer("mask", mask, ("Y",), "1 where a surface covers the pixel centre, else 0",
+                  "geometry", nonnegative=True)]
+    for name, channels, units in _GEOMETRY:
+        value = _aov(s.result, name)
+        if value is not None:
+            out.append(_layer(name, value, channels, units, "geometry", nonnegative=name == "depth"))
+    return out
+
+
+def _white_radiance(s: _Sample, coverage: np.ndarray, raw: np.ndarray | None = None) -> irr.WhiteRadiance:
+    """``W = E/π`` from the reference render (or one of its batches, *raw*), Eq. 1 of
+    :mod:`~spectrinsic.gt_export.irradiance`, with the band albedos the renderer used."""
+    from spectrinsic.render.modes import channel_values, get_mode, to_xyz_matrix
+    from spectrinsic.spectra import get_sensors
+
+    mode = get_mode(s.ref)
+    sensors = (s.result.meta or {}).get("sensors", {}).get(s.ref, mode.sensors)
+    albedos = channel_values(s.scene, get_sensors(sensors, data_dir=s.data_dir),
+                             data_dir=s.data_dir).materials
+    matrices = (s.result.meta or {}).get("to_xyz", {})
+    to_xyz = (np.asarray(matrices[s.ref], float) if s.ref in matrices
+              else to_xyz_matrix(mode, s.scene, data_dir=s.data_dir))
+    if raw is None:
+        raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
+    return irr.white_radiance(raw, coverage, albedos, to_xyz, mode=s.ref)
+
+
+def _srgb_white(s: _Sample) -> np.ndarray:
+    from spectrinsic.spectra import get_sensors
+
+    return canonical_responses(np.ones(s.wl.size), s.d65, get_sensors("srgb").on(s.wl), s.wl)
+
+
+def _srgb_of(w: irr.WhiteRadiance) -> np.ndarray:
+    from spectrinsic.spectra import xyz_to_linear_srgb
+
+    return xyz_to_linear_srgb(w.xyz())
+
+
+def _shading_set(
+    w: irr.WhiteRadiance, colour: np.ndarray, white: np.ndarray, image: np.ndarray,
+    reflectance: np.ndarray, *, names: tuple[str, str, str], group: str, space: str,
+) -> list[Layer]:
+    """``shading``, ``residual`` and ``illuminant`` of one sensor space from ``W``'s colour."""
+    shading = irr.relative_shading(colour, white, w.valid)
+    grey = irr.luminance_of(w)
+    return [
+        _layer(names[0], shading, _RGB,
+               f"shading-illumination: {space} of the light a perfect white would reflect here "
+               "(render units, relative to that space's white under D65; ≥ 0, 0 where no surface)",
+               group, nonnegative=True),
+        _layer(names[1], irr.residual(image, reflectance, shading), _RGB,
+               "image − reflectance ∘ shading (render units): spectral non-commutativity and "
+               "out-of-gamut light; the image itself where no surface", group),
+        _layer(names[2], irr.unit_luminance(shading, grey), _RGB,
+               f"{space} colour of the light arriving at unit luminance (D65 = (1, 1, 1)); "
+               "0 where none arrives", group, nonnegative=True),
+    ]
+
+
+def _intrinsic_layers(
+    s: _Sample, w_raw: irr.WhiteRadiance, w: irr.WhiteRadiance, image: np.ndarray,
+    reflectance: np.ndarray, *, denoised: bool,
+) -> list[Layer]:
+    """sRGB shading, residual, grey shading and illuminant (from the denoised ``W`` if asked,
+    with ``image_denoised`` rebuilt from it and the raw ``shading_raw``/``residual_raw``)."""
+    from spectrinsic.spectra import xyz_to_linear_srgb
+
+    white = _srgb_white(s)
+    used = image
+    out: list[Layer] = []
+    if denoised:
+        raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
+        used = xyz_to_linear_srgb(np.einsum("hwk,ck->hwc", irr.recompose(w, raw), w.to_xyz))
+        out.append(_layer("image_denoised", used, _RGB,
+                          _UNITS_IMAGE + "; rebuilt as reflectance-weighted denoised white-surface "
+                          "radiance (the raw image where no surface)", "image"))
+        out += _shading_set(w_raw, _srgb_of(w_raw), white, image, reflectance, space="linear sRGB",
+                            names=("shading_raw", "residual_raw", "illuminant_raw"),
+                            group="intrinsics")[:2]
+    out += _shading_set(w, _srgb_of(w), white, used, reflectance, space="linear sRGB",
+                        names=("shading", "residual", "illuminant"), group="intrinsics")
+    out.append(_layer("shading_grey", irr.luminance_of(w), ("Y",),
+                      "luminance Y of the light a perfect white would reflect (render units)",
+                      "intrinsics", nonnegative=True))
+    out.append(_layer("shading_ratio", shading_ratio(image, reflectance), _RGB,
+                      "image / reflectance per channel (thesis Fig. 5.8; ill-conditioned where a "
+                      f"reflectance channel is small); 0 where |reflectance| <= {REFLECTANCE_FLOOR:g}",
+                      "intrinsics"))
+    return out
+
+
+def _noise(s: _Sample, w: irr.WhiteRadiance, coverage: np.ndarray) -> tuple[list[Layer], dict[str, Any]]:
+    """Relative standard error maps of ``image`` and ``shading`` from the independent batches."""
+    from spectrinsic.spectra import xyz_to_linear_srgb
+
+    batches = [b[s.ref] for b in getattr(s.result, "batch_raw", ()) or () if s.ref in b]
+    if len(batches) < 2:
+        return [], {}
+    white = _srgb_white(s)
+    images = [xyz_to_linear_srgb(np.einsum("hwk,ck->hwc", np.asarray(b, float), w.to_xyz)) for b in batches]
+    shadings = [irr.relative_shading(_srgb_of(_white_radiance(s, coverage, b)), white, w.valid)
+                for b in batches]
+    lit = w.valid
+    maps = {"image": irr.relative_standard_error(images, lit),
+            "shading_raw": irr.relative_standard_error(shadings, lit)}
+    layers = [_layer(f"noise_{k}", v, ("Y",),
+                     f"relative standard error of the raw {k.removesuffix('_raw')} per pixel, "
+                     f"‖se‖₂/‖mean‖₂ over channels, from {len(batches)} independent batches",
+                     "noise", nonnegative=True) for k, v in maps.items()]
+    figures: dict[str, Any] = {k: irr.noise_figures(v, lit) for k, v in maps.items()}
+    figures["batches"] = len(batches)
+    return layers, figures
+
+
+def _light_records(
+    s: _Sample, shares: np.ndarray, spaces: Mapping[str, np.ndarray], cameras: Sequence[str]
+) -> tuple[LightRecord, ...]:
+    from spectrinsic.spectra import get_sensors, get_spectrum, xyz_to_xy
+
+    white = np.ones(s.wl.size)
+    cie = get_sensors("cie1931").on(s.wl)
+    records = []
+    for i, light in enumerate(s.scene.lights):
+        spd = get_spectrum(light.spectrum, data_dir=s.data_dir).on(s.wl)
+        colour = {k: canonical_responses(white, spd, c, s.wl) for k, c in spaces.items()}
+        xy = xyz_to_xy(canonical_responses(white, spd, cie, s.wl))
+        records.append(LightRecord(
+            index=i, name=light.name, kind=light.kind, spectrum=light.spectrum,
+            power=float(light.power), position=tuple(map(float, light.position)),
+            direction=tuple(map(float, light.direction)), size=tuple(map(float, light.size)),
+            cutoff_deg=float(light.cutoff_deg), xy=(float(xy[0]), float(xy[1])),
+            srgb=tuple(float(v) for v in colour["srgb"]),
+            camera={_camera_key(c): tuple(float(v) for v in colour[c]) for c in cameras},
+            share=float(shares[i]),
+        ))
+    return tuple(records)
+
+
+def _per_light_luminance(s: _Sample) -> np.ndarray:
+    """``(L, H, W)`` luminance of each light's own render (the reference mode if rendered per
+    light, else the per-light share mode)."""
+    per_light = tuple(getattr(s.result, "per_light", None) or ())
+    lights = s.scene.lights
+    if per_light:
+        if len(per_light) != len(lights):
+            raise DatasetError(f"render has {len(per_light)} per-light images but the scene has "
+                               f"{len(lights)} lights")
+        return np.stack([np.asarray(pl[s.ref] if s.ref in pl else next(iter(pl.values())),
+                                    float)[..., 1] for pl in per_light])
+    if len(lights) == 1:
+        return np.asarray(s.result.images[s.ref], float)[None, ..., 1]
+    raise DatasetError(f"scene {s.scene.name!r} has {len(lights)} lights but the render has no "
+                       "per-light images; render with per_light=True")
+
+
+def _share_layers(s: _Sample, w: irr.WhiteRadiance, mask: np.ndarray) -> tuple[list[Layer], np.ndarray]:
+    """Per-pixel share of each light in the light arriving, and each light's share of the
+    image's white-surface luminance."""
+    y_maps = _per_light_luminance(s)
+    share = np.where(w.valid[..., None], irr.share_maps(y_maps), 0.0)
+    grey = irr.luminance_of(w)
+    weights = share[mask] * grey[mask][:, None]
+    totals = weights.sum(axis=0)
+    shares = totals / totals.sum() if totals.sum() > 0 else light_shares(y_maps, mask)
+    # one light: an (H, W) map, as every single-channel layer is stored
+    layer = _layer("light_share", share[..., 0] if share.shape[-1] == 1 else share,
+                   tuple(f"L{i}" for i in range(len(s.scene.lights))),
+                   "fraction of the light arriving (white-surface luminance) due to each light "
+                   "(channel L<i> = meta['lights'][i]); 0 where no surface", "lights",
+                   nonnegative=True)
+    return [layer], shares
+
+
+def _camera_layers(
+    s: _Sample, cam: str, curves: np.ndarray, coverage: np.ndarray, w_raw: irr.WhiteRadiance,
+    w: irr.WhiteRadiance, *, denoised: bool,
+) -> list[Layer]:
+    """Camera image from the cube, relative reflectance, and shading/residual/illuminant from
+    ``W`` in the camera's RGB (relative to its own white under D65)."""
+    from spectrinsic.spectra import get_sensors
+
+    band_set = get_sensors(_cube_sensor_name(s.result), data_dir=s.data_dir)
+    weights = cube_to_sensors(band_set.curves, camera_curves(cam, band_set.wavelengths,
+                                                             data_dir=s.data_dir), band_set.wavelengths)
+    key, slug = _camera_key(cam), "camera-" + _slug(cam)
+    image = np.asarray(s.result.raw["bands31"], float) @ weights.T
+    refl = coverage_weighted(coverage, canonical_responses(s.material_rho, s.d65, curves, s.wl))
+    white = canonical_responses(np.ones(s.wl.size), s.d65, curves, s.wl)
+    out = [_layer(f"image_camera/{key}", image, _RGB, _UNITS_CAMERA, slug, nonnegative=True),
+           _layer(f"reflectance_camera/{key}", refl, _RGB,
+                  "dimensionless relative reflectance S_Sen·I^a: camera RGB under D65 "
+                  "(perfect white has mean channel 1)", slug, nonnegative=True)]
+    used = image
+    if denoised:
+        used = irr.recompose(w, s.result.raw["bands31"]) @ weights.T
+        out.append(_layer(f"image_camera_denoised/{key}", used, _RGB,
+                          _UNITS_CAMERA + "; rebuilt from the denoised white-surface radiance", slug))
+    names = (f"shading_camera/{key}", f"residual_camera/{key}", f"illuminant_camera/{key}")
+    return out + _shading_set(w, w.bands @ weights.T, white, used, refl, names=names, group=slug,
+                              space="camera RGB")
+
+
+def _matrices(s: _Sample, shares: np.ndarray, spaces: Mapping[str, np.ndarray], training: Any) -> dict[str, Any]:
+    """The chapter-4 matrices for the scene's effective light and for each light."""
+    from spectrinsic.spectra import get_spectrum
+
+    spds = [get_spectrum(light.spectrum, data_dir=s.data_dir).on(s.wl) for light in s.scene.lights]
+    illum: dict[str, np.ndarray] = {}
+    if spds:
+        illum["scene"] = np.einsum("l,lw->w", shares, np.stack(spds))
+        illum.update({f"light {i}": spd for i, spd in enumerate(spds)})
+    matrices = photometric_matrices(illum, spaces, s.wl, training=training) if illum else {}
+    matrices["convention"] = (
+        "p = M @ q on column vectors; S_Sen: canonical (D65, sRGB) -> camera under D65; "
+        "L_CLig: sensor space under D65 -> under the illuminant; 'scene' is the share-weighted "
+        "mix of the lights; least squares over the 1269 Munsell chips, lights at unit luminance"
+    )
+    return {k: ({_camera_key(c): v for c, v in m.items()} if isinstance(m, dict) else m)
+            for k, m in matrices.items()}
+
+
+def _sample(scene: Scene, result: Any, data_dir: Any) -> _Sample:
+    from spectrinsic.spectra import get_spectrum
+
+    wl = _grid()
+    rho = (np.stack([get_spectrum(m.spectrum, data_dir=data_dir).on(wl) for m in scene.materials])
+           if scene.materials else np.zeros((0, wl.size)))
+    return _Sample(scene, result, reference_mode(result), wl, rho,
+                   get_spectrum("cie:D65").on(wl), data_dir)
 
 
 def compute_ground_truth(
     scene: Scene,
-    result: Any,
+    result: RenderRecord,
     *,
     cameras: Sequence[str] = (),
     write_cube: bool = False,
+    denoise: bool = False,
     data_dir: Any = None,
     training: np.ndarray | None = None,
 ) -> GroundTruth:
@@ -406,213 +708,105 @@ def compute_ground_truth(
     scene
         The scene that was rendered (names every material and light spectrum).
     result
-        RenderResult-like record (``images``, ``raw``, ``per_light``, ``aovs``, ``meta``).
+        The render (:class:`RenderRecord`).
     cameras
         Sensor-set names (``"camera:Nikon 5100 (NPL)"``); each adds an image integrated from
-        the 31-band cube, a relative reflectance, shading and illuminant in that camera's RGB.
+        the 31-band cube, a relative reflectance, shading, residual and illuminant in that
+        camera's RGB.
     write_cube
         Add the raw multispectral cube as layer ``cube``.
+    denoise
+        Denoise the white-surface radiance with OIDN (:mod:`~spectrinsic.gt_export.denoise`):
+        ``shading``, ``residual``, ``illuminant``, ``shading_grey`` and the camera shading
+        come from it, ``image_denoised = reflectance ∘ shading + residual`` is rebuilt from it,
+        and the raw ``shading_raw``/``residual_raw`` are kept beside ``image``.
     training
         ``(N, 471)`` reflectances on the 1 nm grid for the matrix fits (default: all Munsell chips).
-
-    Returns
-    -------
-    GroundTruth
     """
-    from spectrinsic.spectra import (
-        absolute_reflectance,
-        get_sensors,
-        get_spectrum,
-        xyz_to_linear_srgb,
-        xyz_to_xy,
-    )
+    from spectrinsic.spectra import absolute_reflectance, get_sensors
 
-    wl = _grid()
-    layers: dict[str, Layer] = {}
-
-    def add(name: str, data: np.ndarray, channels: Sequence[str], units: str, group: str,
-            nonnegative: bool = False) -> None:
-        layers[name] = Layer(name, np.asarray(data, dtype=np.float32), tuple(channels), units,
-                             group, nonnegative)
-
-    rgb = ("R", "G", "B")
-    # -- images: the reference, every other mode, and its error against the reference
-    ref = reference_mode(result)
-    ref_xyz = np.asarray(result.images[ref], float)
-    height, width = ref_xyz.shape[:2]
-    image = xyz_to_linear_srgb(ref_xyz)
-    add("image", image, rgb, _UNITS_IMAGE + f"; render mode {ref!r}", "image")
-    for mode in sorted(result.images):
-        if mode == ref:
-            continue
-        xyz = np.asarray(result.images[mode], float)
-        add(f"image_{mode}", xyz_to_linear_srgb(xyz), rgb, _UNITS_IMAGE + f"; render mode {mode!r}",
-            "image")
-        if not _shares_paths(mode, ref):
-            continue  # independent Monte Carlo paths: the difference would be noise, not error
-        add(f"error_{mode}", relative_error_map(xyz, ref_xyz), ("Y",),
-            f"dimensionless ‖XYZ_{mode} − XYZ_{ref}‖₂ / ‖XYZ_{ref}‖₂ per pixel (0 where unlit)",
-            "image", nonnegative=True)
-
-    # -- geometry AOVs
-    mask = _aov(result, "mask")
-    mask = np.ones((height, width), bool) if mask is None else mask.astype(bool)
-    material_id = _aov(result, "material_id")
-    coverage = _aov(result, "coverage")
-    n_mat = len(scene.materials)
-    if coverage is None:
-        if material_id is None:
-            raise DatasetError("render result has neither a 'coverage' nor a 'material_id' AOV")
-        log.warning("no coverage AOV: reflectance is not anti-aliased at edges")
-        coverage = (material_id[..., None] == np.arange(n_mat)).astype(float)
-    add("mask", mask, ("Y",), "1 where a surface covers the pixel centre, else 0", "geometry",
-        nonnegative=True)
-    for name, channels, units in (
-        ("depth", ("Z",), "scene units, distance from the camera to the first hit (0: background)"),
-        ("normals", ("X", "Y", "Z"), "world-space unit surface normals (0: background)"),
-        ("material_id", ("id",), "index into meta['materials'], stored as float32; -1 background"),
-        ("object_id", ("id",), "object id of the scene meshes, stored as float32; -1 background"),
-    ):
-        value = _aov(result, name)
-        if value is not None:
-            add(name, value, channels, units, "geometry", nonnegative=name == "depth")
-
-    # -- absolute reflectance (exact, from the spectra) and shading-illumination
+    s = _sample(scene, result, data_dir)
+    layers = _image_layers(s)
+    image = layers[0].data.astype(np.float64)
+    coverage, mask = _coverage(s, image.shape[:2])
+    layers += _geometry_layers(s, mask)
     names = [m.spectrum for m in scene.materials]
-    abs_refl = absolute_reflectance(names, data_dir=data_dir) if names else np.zeros((0, 3))
-    reflectance = coverage_weighted(coverage, abs_refl)
-    shading = shading_from(image, reflectance)
-    refl_y = luminance(reflectance)
-    valid_y = refl_y > REFLECTANCE_FLOOR
-    grey = np.where(valid_y, luminance(image) / np.where(valid_y, refl_y, 1.0), 0.0)
-    add("reflectance", reflectance, rgb,
-        "dimensionless absolute reflectance, linear sRGB under D65 (perfect white = 1); "
-        "box-filtered by pixel coverage, 0 for background", "intrinsics")
-    add("shading", shading, rgb,
-        "shading-illumination = image / reflectance per channel (render units, linear sRGB); "
-        f"0 where |reflectance| <= {REFLECTANCE_FLOOR:g}", "intrinsics")
-    add("shading_grey", grey, ("Y",),
-        "grey shading = Y(image) / Y(reflectance) (render units); 0 where Y(reflectance) is 0",
-        "intrinsics", nonnegative=True)
+    reflectance = coverage_weighted(
+        coverage, absolute_reflectance(names, data_dir=data_dir) if names else np.zeros((0, 3)))
+    layers.append(_layer("reflectance", reflectance, _RGB,
+                         "dimensionless absolute reflectance, linear sRGB under D65 (perfect white = 1); "
+                         "box-filtered by pixel coverage, 0 for background", "intrinsics"))
+    w_raw = _white_radiance(s, coverage)
+    w = w_raw
+    if denoise:
+        from spectrinsic.gt_export.denoise import denoise_white_radiance
 
-    # -- sensor spaces: sRGB and each camera
-    spaces: dict[str, np.ndarray] = {"srgb": get_sensors("srgb").on(wl)}
-    for cam in cameras:
-        spaces[cam] = camera_curves(cam, wl, data_dir=data_dir)
-    d65 = get_spectrum("cie:D65").on(wl)
-    material_rho = (
-        np.stack([get_spectrum(n, data_dir=data_dir).on(wl) for n in names])
-        if names else np.zeros((0, wl.size))
-    )
-
-    # -- lights: SPD, chromaticity, colours, shares; the illuminant map
-    light_spds = [get_spectrum(light.spectrum, data_dir=data_dir).on(wl) for light in scene.lights]
-    white = np.ones(wl.size)
-    per_light = tuple(getattr(result, "per_light", None) or ())
-    if per_light:
-        if len(per_light) != len(scene.lights):
-            raise DatasetError(
-                f"render has {len(per_light)} per-light images but the scene has "
-                f"{len(scene.lights)} lights"
-            )
-        y_maps = np.stack([np.asarray(pl[ref] if ref in pl else next(iter(pl.values())),
-                                      float)[..., 1] for pl in per_light])
-    elif len(scene.lights) == 1:
-        y_maps = ref_xyz[None, ..., 1]
-    else:
-        raise DatasetError(
-            f"scene {scene.name!r} has {len(scene.lights)} lights but the render has no "
-            "per-light images; render with per_light=True"
-        )
-    shares = light_shares(y_maps, mask)
-    colours = {
-        space: np.stack([canonical_responses(white, spd, curves, wl) for spd in light_spds])
-        if light_spds else np.zeros((0, 3))
-        for space, curves in spaces.items()
-    }
-    cie = get_sensors("cie1931").on(wl)
-    lights = []
-    for i, light in enumerate(scene.lights):
-        xy = xyz_to_xy(canonical_responses(white, light_spds[i], cie, wl))
-        lights.append(LightRecord(
-            index=i, name=light.name, kind=light.kind, spectrum=light.spectrum,
-            power=float(light.power), position=tuple(map(float, light.position)),
-            direction=tuple(map(float, light.direction)), size=tuple(map(float, light.size)),
-            cutoff_deg=float(light.cutoff_deg), xy=(float(xy[0]), float(xy[1])),
-            srgb=tuple(float(v) for v in colours["srgb"][i]),
-            camera={_camera_key(c): tuple(float(v) for v in colours[c][i]) for c in cameras},
-            share=float(shares[i]),
-        ))
-    add("illuminant", illuminant_map(y_maps, colours["srgb"]), rgb,
-        "linear sRGB colour of the light arriving (luminance-share-weighted light colours, "
-        "Y = 1 where lit, 0 where no light arrives)", "intrinsics")
-
-    # -- cameras: image from the band cube, relative reflectance, shading, illuminant
-    cube_name: str | None = None
-    cube = None
-    if "bands31" in getattr(result, "raw", {}):
-        cube = np.asarray(result.raw["bands31"], float)
-        cube_name = _cube_sensor_name(result)
-    if cameras and cube is None:
+        w = denoise_white_radiance(w_raw, _aov(result, "normals"))
+    layers += _intrinsic_layers(s, w_raw, w, image, reflectance, denoised=denoise)
+    noise_layers, noise = _noise(s, w_raw, coverage)
+    share_layers, shares = _share_layers(s, w, mask)
+    layers += noise_layers + share_layers
+    spaces: dict[str, np.ndarray] = {"srgb": get_sensors("srgb").on(s.wl)}
+    spaces.update({cam: camera_curves(cam, s.wl, data_dir=data_dir) for cam in cameras})
+    if cameras and "bands31" not in result.raw:
         raise DatasetError(
             "camera images need the 31-band cube (render mode 'bands31'); render it or pass cameras=()"
         )
-    if cube is not None:
-        band_set = get_sensors(cube_name or DEFAULT_CUBE_SENSORS, data_dir=data_dir)
-        if band_set.n != cube.shape[-1]:
-            raise DatasetError(
-                f"cube has {cube.shape[-1]} channels but its sensors {cube_name!r} have {band_set.n}"
-            )
-        bands_wl = band_set.wavelengths
-        for cam in cameras:
-            key, slug = _camera_key(cam), "camera-" + _slug(cam)
-            weights = cube_to_sensors(
-                band_set.curves, camera_curves(cam, bands_wl, data_dir=data_dir), bands_wl
-            )
-            cam_image = cube @ weights.T
-            cam_refl = coverage_weighted(
-                coverage, canonical_responses(material_rho, d65, spaces[cam], wl)
-            )
-            add(f"image_camera/{key}", cam_image, rgb, _UNITS_CAMERA, slug, nonnegative=True)
-            add(f"reflectance_camera/{key}", cam_refl, rgb,
-                "dimensionless relative reflectance S_Sen·I^a: camera RGB under D65 "
-                "(perfect white has mean channel 1)", slug, nonnegative=True)
-            add(f"shading_camera/{key}", shading_from(cam_image, cam_refl), rgb,
-                "camera image / camera reflectance per channel", slug)
-            # Relative to the camera's own D65 white, as reflectance_camera already holds that
-            # white: on a neutral surface shading_camera = shading_grey ∘ illuminant_camera.
-            d65_white = canonical_responses(white, d65, spaces[cam], wl)
-            add(f"illuminant_camera/{key}", illuminant_map(y_maps, colours[cam] / d65_white), rgb,
-                "camera RGB of the light arriving relative to the camera's response to D65 "
-                "(D65 light = (1, 1, 1)), unit luminance where lit", slug)
-        if write_cube:
-            add("cube", cube, band_set.channels,
-                f"band radiance ∫ L B_b dλ (render units) for the bands of {cube_name!r}", "cube",
-                nonnegative=True)
-    elif write_cube:
-        raise DatasetError("write_cube needs the 31-band cube (render mode 'bands31')")
-
-    # -- photometric matrices (chapter 4) for the scene's effective light and each light
-    illum: dict[str, np.ndarray] = {}
-    if light_spds:
-        illum["scene"] = np.einsum("l,lw->w", shares, np.stack(light_spds))
-        for i, spd in enumerate(light_spds):
-            illum[f"light {i}"] = spd
-    matrices = photometric_matrices(illum, spaces, wl, training=training) if illum else {}
-    matrices["convention"] = (
-        "p = M @ q on column vectors; S_Sen: canonical (D65, sRGB) -> camera under D65; "
-        "L_CLig: sensor space under D65 -> under the illuminant; 'scene' is the share-weighted "
-        "mix of the lights; least squares over the 1269 Munsell chips, lights at unit luminance"
-    )
-    matrices = {k: ({_camera_key(c): v for c, v in m.items()} if isinstance(m, dict) else m)
-                for k, m in matrices.items()}
-
+    for cam in cameras:
+        layers += _camera_layers(s, cam, spaces[cam], coverage, w_raw, w, denoised=denoise)
+    cube_name = _cube_sensor_name(result) if "bands31" in result.raw else None
+    if write_cube:
+        layers.append(_cube_layer(s, cube_name))
+    colour = _srgb_of(w) / _srgb_white(s)
+    lit = w.valid & (irr.luminance_of(w) > 0)
     return GroundTruth(
-        layers=layers,
-        lights=tuple(lights),
+        layers={layer.name: layer for layer in layers},
+        lights=_light_records(s, shares, spaces, cameras),
         materials={str(i): n for i, n in enumerate(names)},
-        matrices=matrices,
-        reference_mode=ref,
+        matrices=_matrices(s, shares, spaces, training),
+        reference_mode=s.ref,
         cameras=tuple(cameras),
         cube_sensors=cube_name,
+        denoised=tuple(sorted(layer.name for layer in layers if denoise and _from_denoised(layer.name))),
+        noise=noise,
+        clipped_fraction=float((colour[lit] < 0).any(axis=-1).mean()) if lit.any() else 0.0,
     )
+
+
+def _from_denoised(name: str) -> bool:
+    base = name.split("/", 1)[0]
+    return base in ("image_denoised", "shading", "residual", "illuminant", "shading_grey",
+                    "light_share", "image_camera_denoised", "shading_camera", "residual_camera",
+                    "illuminant_camera")
+
+
+def _cube_layer(s: _Sample, cube_name: str | None) -> Layer:
+    from spectrinsic.spectra import get_sensors
+
+    if cube_name is None:
+        raise DatasetError("write_cube needs the 31-band cube (render mode 'bands31')")
+    cube = np.asarray(s.result.raw["bands31"], float)
+    band_set = get_sensors(cube_name, data_dir=s.data_dir)
+    if band_set.n != cube.shape[-1]:
+        raise DatasetError(f"cube has {cube.shape[-1]} channels but its sensors {cube_name!r} have {band_set.n}")
+    return _layer("cube", cube, band_set.channels,
+                  f"band radiance ∫ L B_b dλ (render units) for the bands of {cube_name!r}", "cube",
+                  nonnegative=True)
+
+
+def identities(gt: GroundTruth) -> list[dict[str, str]]:
+    """The exact identities the layers satisfy: ``image = reflectance ∘ shading + residual``
+    per sensor space (and on the raw layers when denoised); recorded in ``meta.json``."""
+    out = []
+    denoised = "image_denoised" in gt.layers
+    out.append({"image": "image_denoised" if denoised else "image", "reflectance": "reflectance",
+                "shading": "shading", "residual": "residual"})
+    if denoised:
+        out.append({"image": "image", "reflectance": "reflectance", "shading": "shading_raw",
+                    "residual": "residual_raw"})
+    for cam in gt.cameras:
+        key = _camera_key(cam)
+        image = f"image_camera_denoised/{key}" if denoised else f"image_camera/{key}"
+        out.append({"image": image, "reflectance": f"reflectance_camera/{key}",
+                    "shading": f"shading_camera/{key}", "residual": f"residual_camera/{key}"})
+    return out

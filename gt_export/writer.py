@@ -31,7 +31,7 @@ import numpy as np
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import png
 from spectrinsic.gt_export.exr import write_exr
-from spectrinsic.gt_export.layers import GroundTruth, Layer, compute_ground_truth
+from spectrinsic.gt_export.layers import GroundTruth, Layer, compute_ground_truth, identities
 from spectrinsic.provenance import software_versions
 from spectrinsic.scenes.model import Scene, scene_hash
 
@@ -164,6 +164,18 @@ def _error_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
     return png.false_colour(layer.data, cmap="magma", vmin=0.0, vmax=0.1)
 
 
+def _residual_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
+    """Magnitude of the residual relative to the image: 0 (black) to 10 % (bright)."""
+    base = layers.get(layer.name.replace("residual", "image", 1).replace("image_raw", "image"))
+    norm = np.linalg.norm(base.data, axis=-1) if base is not None else np.ones(layer.data.shape[:2])
+    rel = np.divide(np.linalg.norm(layer.data, axis=-1), norm, out=np.zeros(norm.shape), where=norm > 0)
+    return png.false_colour(rel, cmap="magma", vmin=0.0, vmax=0.1)
+
+
+def _noise_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
+    return png.false_colour(layer.data, cmap="magma", vmin=0.0, vmax=0.2)
+
+
 def _mask_of(layers: Mapping[str, Layer]) -> np.ndarray | None:
     return layers["mask"].data > 0.5 if "mask" in layers else None
 
@@ -192,6 +204,8 @@ _PREVIEWS: tuple[tuple[str, Callable[[Layer, Mapping[str, Layer]], np.ndarray]],
     ("reflectance", _reflectance_preview),
     ("illuminant", _illuminant_preview),
     ("error_", _error_preview),
+    ("residual", _residual_preview),
+    ("noise_", _noise_preview),
     ("depth", _depth_preview),
     ("normals", _normals_preview),
     ("material_id", _ids_preview),
@@ -263,6 +277,10 @@ def _meta(
         "cube_sensors": gt.cube_sensors,
         "matrices": gt.matrices,
         "layers": _layer_records(gt, previews),
+        "identities": identities(gt),
+        "denoised_layers": list(gt.denoised),
+        "noise": gt.noise,
+        "shading_clipped_fraction": gt.clipped_fraction,
         "files": sorted(files),
         "versions": software_versions(),
     }
@@ -311,6 +329,7 @@ def export_sample(
     seed: int,
     cameras: Sequence[str] | None = None,
     write_cube: bool = False,
+    denoise: bool = False,
     data_dir: str | os.PathLike[str] | None = None,
 ) -> Path:
     """Compute every ground-truth layer of a rendered sample and write it atomically.
@@ -334,6 +353,8 @@ def export_sample(
         render has the 31-band cube, none otherwise.
     write_cube
         Also write the multispectral cube (``cube.exr``).
+    denoise
+        Compute shading, residual and illuminant from the OIDN-denoised irradiance.
     data_dir
         Spectral data directory (for ``sfu:``/data-directory cameras).
 
@@ -349,7 +370,7 @@ def export_sample(
     if cameras is None:
         cameras = DEFAULT_CAMERAS if "bands31" in (getattr(result, "raw", None) or {}) else ()
     gt = compute_ground_truth(scene, result, cameras=cameras, write_cube=write_cube,
-                              data_dir=data_dir)
+                              denoise=denoise, data_dir=data_dir)
     final = out_dir / sample_id
     tmp = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{sample_id}-", dir=out_dir))
     try:

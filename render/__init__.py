@@ -5,7 +5,8 @@ Nothing is imported from Mitsuba when this package is imported; variants are cho
 
 - :func:`render_scene` -> :class:`RenderResult`: the spectral reference and K-channel diagonal
   renders (``rgb3``, ``rgb6``, ``bands31``) of one scene, all as CIE XYZ, with per-light and
-  direct-only renders and coverage/id/depth/normal maps.
+  direct-only renders and coverage/id/depth/normal maps; :func:`render_batches` renders it as
+  independent batches whose spread measures the Monte Carlo noise.
 - :mod:`~spectrinsic.render.modes`: the mode registry and the colour maths of Eq. 5.2.
 - :mod:`~spectrinsic.render.passes`: the passes themselves, for any sensor set.
 - :func:`scene_to_mitsuba`: the one translation of a scene into a Mitsuba dict.
@@ -20,7 +21,14 @@ from spectrinsic.render.modes import (
     to_xyz_matrix,
 )
 from spectrinsic.render.passes import render_aovs, render_diagonal, render_spectral
-from spectrinsic.render.pipeline import DEFAULT_MODES, count_passes, render_scene
+from spectrinsic.render.pipeline import (
+    DEFAULT_MODES,
+    batch_seeds,
+    count_passes,
+    merge_batches,
+    render_batches,
+    render_scene,
+)
 from spectrinsic.render.result import RenderResult
 from spectrinsic.render.translate import scene_to_mitsuba
 from spectrinsic.render.variants import (
@@ -38,13 +46,16 @@ __all__ = [
     "RenderMode",
     "RenderResult",
     "available_variants",
+    "batch_seeds",
     "channel_values",
     "choose_variant",
     "count_passes",
     "get_mode",
     "llvm_library",
+    "merge_batches",
     "mode_names",
     "render_aovs",
+    "render_batches",
     "render_diagonal",
     "render_scene",
     "render_spectral",

@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from spectrinsic.errors import RenderError, SceneError
+from spectrinsic.rng import seed_from_key
 from spectrinsic.render.modes import (
     RenderMode,
     channel_values,
@@ -27,7 +30,7 @@ from spectrinsic.render.result import RenderResult
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
 
-__all__ = ["DEFAULT_MODES", "render_scene", "count_passes"]
+__all__ = ["DEFAULT_MODES", "render_scene", "render_batches", "batch_seeds", "merge_batches", "count_passes"]
 
 logger = logging.getLogger(__name__)
 
@@ -58,6 +61,7 @@ def count_passes(
     modes: Iterable[str] = DEFAULT_MODES,
     *,
     per_light: bool = False,
+    per_light_modes: Iterable[str] | None = None,
     direct: bool | Iterable[str] = False,
     aovs: bool = True,
     data_dir: str | None = None,
@@ -65,11 +69,14 @@ def count_passes(
     """Number of Mitsuba passes :func:`render_scene` runs (the total of its progress calls)."""
     objs = _modes(modes)
     wanted = _direct_modes(direct, objs)
-    groups = len(scene.lights) if per_light else 1
+    split = per_light and per_light_modes is not None
+    groups = len(scene.lights) if per_light and not split else 1
     colour = sum(n_passes(m, data_dir=data_dir) * (2 if m.name in wanted else 1) for m in objs)
+    shares = sum(n_passes(m, data_dir=data_dir) for m in _modes(per_light_modes)) if split else 0  # type: ignore[arg-type]
     from spectrinsic.render.translate import surfaces
 
-    return groups * colour + (max(1, -(-len(surfaces(scene)) // 3)) if aovs else 0)
+    aov_passes = max(1, -(-len(surfaces(scene)) // 3)) if aovs else 0
+    return groups * colour + len(scene.lights) * shares + aov_passes
 
 
 def _sum_direct(parts: Sequence[np.ndarray | None]) -> np.ndarray:
@@ -78,6 +85,65 @@ def _sum_direct(parts: Sequence[np.ndarray | None]) -> np.ndarray:
     if len(present) != len(parts):
         raise RenderError("a direct-only render is missing for a light group")
     return np.sum(present, axis=0, dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class _Job:
+    """One set of passes: some modes with some lights on (``None``: all)."""
+
+    modes: tuple[RenderMode, ...]
+    group: Sequence[int] | None
+    #: Whether the modes asked for a direct-only render get one in this job.
+    with_direct: bool = True
+
+
+def _run_jobs(
+    scene: Scene, jobs: Sequence[_Job], *, wanted: set[str], spp: int, seed: int, max_depth: int,
+    variant: str | None, aovs: bool, progress: Progress | None, data_dir: str | None,
+) -> tuple[list[dict[str, PassOutput]], dict[str, np.ndarray], tuple[float, ...]]:
+    """Every pass of *jobs*, grouped by Mitsuba variant, plus the AOVs.
+
+    Each switch between the RGB and the spectral variant reloads Mitsuba's Python modules
+    (~0.1 s), so every RGB-variant pass (all diagonal modes of every job, then the AOVs) runs in
+    one scope and every spectral pass in another. Passes do not depend on each other's order:
+    each sets its own values, seed and spp.
+    """
+    from spectrinsic.render.translate import prepare_geometry
+    from spectrinsic.render.variants import choose_variant, variant_scope
+
+    geometry = prepare_geometry(scene)
+    outputs: list[dict[str, PassOutput]] = [{} for _ in jobs]
+    aov_maps: dict[str, np.ndarray] = {}
+    aov_seconds: tuple[float, ...] = ()
+    common = dict(spp=spp, seed=seed, max_depth=max_depth, progress=progress, geometry=geometry)
+    if aovs or any(m.kind == "diagonal" for job in jobs for m in job.modes):
+        rgb_variant = choose_variant("rgb", variant)
+        with variant_scope(rgb_variant):
+            for out, job in zip(outputs, jobs, strict=True):
+                diagonal = [m for m in job.modes if m.kind == "diagonal"]
+                if not diagonal:
+                    continue
+                values = [channel_values(scene, get_sensors(m.sensors, data_dir=data_dir),
+                                         data_dir=data_dir) for m in diagonal]
+                out.update(zip((m.name for m in diagonal), render_diagonal(
+                    scene, values, direct=[job.with_direct and m.name in wanted for m in diagonal],
+                    active_lights=job.group, variant=rgb_variant, **common,
+                ), strict=True))
+            if aovs:
+                aov_maps, aov_seconds = render_aovs(scene, spp=spp, seed=seed, variant=rgb_variant,
+                                                    progress=progress, geometry=geometry)
+    if any(m.kind == "spectral" for job in jobs for m in job.modes):
+        spectral_variant = choose_variant("spectral", variant)
+        with variant_scope(spectral_variant):
+            for out, job in zip(outputs, jobs, strict=True):
+                for m in (m for m in job.modes if m.kind == "spectral"):
+                    out[m.name] = render_spectral(
+                        scene, get_sensors(m.sensors, data_dir=data_dir),
+                        direct=job.with_direct and m.name in wanted,
+                        active_lights=job.group, variant=spectral_variant, data_dir=data_dir,
+                        **common,
+                    )
+    return outputs, aov_maps, aov_seconds
 
 
 def render_scene(
@@ -89,6 +155,7 @@ def render_scene(
     max_depth: int = 8,
     variant: str | None = None,
     per_light: bool = False,
+    per_light_modes: Iterable[str] | None = None,
     direct: bool | Iterable[str] = False,
     aovs: bool = True,
     progress: Progress | None = None,
@@ -110,8 +177,13 @@ def render_scene(
     variant
         Backend (``"cuda"``, ``"llvm"``, ``"scalar"``) or variant name; default: the best usable.
     per_light
-        Also render each light alone (one scene per light); ``images`` is then exactly the sum
-        of the per-light images (and ``direct`` of per-light direct images), costing no extra.
+        Also render each light alone (one scene per light). Without *per_light_modes* every
+        mode is rendered light by light and ``images`` is exactly the sum of the per-light
+        images (and ``direct`` of per-light direct images), costing no extra.
+    per_light_modes
+        With *per_light*: render only these modes light by light, and *modes* once with every
+        light on. For light shares a 1-pass mode (``"rgb3"``) costs one pass per light instead
+        of every mode's passes per light.
     direct
         ``True`` for a direct-only render of every mode, or an iterable of the modes that need
         one (e.g. only the reference, for r of Eq. 5.8).
@@ -126,72 +198,63 @@ def render_scene(
     """
     objs = _modes(modes)
     wanted = _direct_modes(direct, objs)
-    sensors = {m.name: get_sensors(m.sensors, data_dir=data_dir) for m in objs}
     matrices = {m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in objs}
-    diagonal = [m for m in objs if m.kind == "diagonal"]
-    values = [channel_values(scene, sensors[m.name], data_dir=data_dir) for m in diagonal]
-    groups: list[Sequence[int] | None] = [[j] for j in range(len(scene.lights))] if per_light else [None]
-
-    from spectrinsic.render.translate import prepare_geometry
-    from spectrinsic.render.variants import choose_variant, import_mitsuba, variant_scope
-
-    geometry = prepare_geometry(scene)
-    timings: dict[str, list[float]] = {m.name: [] for m in objs}
+    lights = [[j] for j in range(len(scene.lights))]
+    split = per_light and per_light_modes is not None
+    share = _modes(per_light_modes) if split else []  # type: ignore[arg-type]
+    main = [_Job(tuple(objs), g) for g in (lights if per_light and not split else [None])]
+    jobs = main + [_Job(tuple(share), g, with_direct=False) for g in lights] if split else main
+    outputs, aov_maps, aov_seconds = _run_jobs(
+        scene, jobs, wanted=wanted, spp=spp, seed=seed, max_depth=max_depth, variant=variant,
+        aovs=aovs, progress=progress, data_dir=data_dir,
+    )
+    main_out, share_out = outputs[:len(main)], outputs[len(main):]
+    timings: dict[str, list[float]] = {m.name: [] for m in objs + share}
     variants: dict[str, str] = {}
-    raw_groups: list[dict[str, PassOutput]] = [{} for _ in groups]
-    aov_maps: dict[str, np.ndarray] = {}
-    # Passes are grouped by Mitsuba variant: each switch between the RGB and the spectral variant
-    # reloads Mitsuba's Python modules (~0.1 s), so every RGB-variant pass (all diagonal modes of
-    # every light group, then the AOVs) runs in one scope and every spectral pass in another.
-    # Passes do not depend on each other's order: each sets its own values, seed and spp.
-    if diagonal or aovs:
-        rgb_variant = choose_variant("rgb", variant)
-        with variant_scope(rgb_variant):
-            for outputs, group in zip(raw_groups, groups, strict=True):
-                if diagonal:
-                    outputs.update(zip((m.name for m in diagonal), render_diagonal(
-                        scene, values, spp=spp, seed=seed, max_depth=max_depth,
-                        direct=[m.name in wanted for m in diagonal], active_lights=group,
-                        variant=rgb_variant, progress=progress, geometry=geometry,
-                    ), strict=True))
-            if aovs:
-                aov_maps, aov_seconds = render_aovs(scene, spp=spp, seed=seed, variant=rgb_variant,
-                                                    progress=progress, geometry=geometry)
-    spectral = [m for m in objs if m.kind == "spectral"]
-    if spectral:
-        spectral_variant = choose_variant("spectral", variant)
-        with variant_scope(spectral_variant):
-            for outputs, group in zip(raw_groups, groups, strict=True):
-                for m in spectral:
-                    outputs[m.name] = render_spectral(
-                        scene, sensors[m.name], spp=spp, seed=seed, max_depth=max_depth, direct=m.name in wanted,
-                        active_lights=group, variant=spectral_variant, data_dir=data_dir,
-                        progress=progress, geometry=geometry,
-                    )
-    for outputs in raw_groups:
-        for name, out in outputs.items():
-            timings[name].extend(out.seconds)
-            variants[name] = out.variant
-
+    for out in outputs:
+        for name, o in out.items():
+            timings[name].extend(o.seconds)
+            variants[name] = o.variant
     names = [m.name for m in objs]
-    raw = {n: np.sum([g[n].image for g in raw_groups], axis=0, dtype=np.float64).astype(np.float32) for n in names}
+    raw = {n: np.sum([g[n].image for g in main_out], axis=0, dtype=np.float64).astype(np.float32) for n in names}
     images = {n: raw_to_xyz(raw[n], matrices[n]) for n in names}
-    lights = tuple({n: raw_to_xyz(g[n].image, matrices[n]) for n in names} for g in raw_groups) if per_light else ()
+    if split:
+        share_xyz = {m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in share}
+        per_light_images = tuple({n: raw_to_xyz(g[n].image, share_xyz[n]) for n in share_xyz} for g in share_out)
+    elif per_light:
+        per_light_images = tuple({n: raw_to_xyz(g[n].image, matrices[n]) for n in names} for g in main_out)
+    else:
+        per_light_images = ()
     direct_images = {
-        n: raw_to_xyz(_sum_direct([g[n].direct for g in raw_groups]), matrices[n])
+        n: raw_to_xyz(_sum_direct([g[n].direct for g in main_out]), matrices[n])
         for n in names if n in wanted
     }
     if aovs:
         timings["aovs"] = list(aov_seconds)
+    meta = _render_meta(scene, objs, matrices, variants, timings, spp=spp, seed=seed,
+                        max_depth=max_depth, per_light=per_light, wanted=wanted, data_dir=data_dir)
+    meta["per_light_modes"] = [m.name for m in share] if split else (names if per_light else [])
+    logger.debug("rendered %s: %s", scene.name, {k: v["seconds"] for k, v in meta["timings"].items()})
+    return RenderResult(images=images, raw=raw, per_light=per_light_images, direct=direct_images,
+                        aovs=aov_maps, meta=meta)
 
-    meta = {
+
+def _render_meta(
+    scene: Scene, objs: Sequence[RenderMode], matrices: dict[str, np.ndarray],
+    variants: dict[str, str], timings: dict[str, list[float]], *, spp: int, seed: int,
+    max_depth: int, per_light: bool, wanted: set[str], data_dir: str | None,
+) -> dict[str, Any]:
+    from spectrinsic.render.variants import import_mitsuba
+
+    names = [m.name for m in objs]
+    return {
         "mitsuba": import_mitsuba().__version__,
         "variants": variants,
         "spp": int(spp),
         "seed": int(seed),
         "max_depth": int(max_depth),
         "modes": names,
-        "sensors": {n: sensors[n].name for n in names},
+        "sensors": {m.name: get_sensors(m.sensors, data_dir=data_dir).name for m in objs},
         "to_xyz": {n: np.asarray(matrices[n]).tolist() for n in names},
         "wavelengths": {
             "start": float(COLORIMETRIC_WAVELENGTHS[0]), "end": float(COLORIMETRIC_WAVELENGTHS[-1]),
@@ -203,5 +266,76 @@ def render_scene(
                     for k, v in timings.items()},
         "units": "XYZ = integral of radiance times CIE 1931 CMF over nm; raw = integral of radiance times S_k",
     }
-    logger.debug("rendered %s: %s", scene.name, {k: v["seconds"] for k, v in meta["timings"].items()})
-    return RenderResult(images=images, raw=raw, per_light=lights, direct=direct_images, aovs=aov_maps, meta=meta)
+
+
+def batch_seeds(seed: int, batches: int) -> list[int]:
+    """Sampler seeds of *batches* independent batches: the sample's own seed first (so one
+    batch is exactly :func:`render_scene`), then seeds derived from it by key."""
+    if isinstance(batches, bool) or not isinstance(batches, int) or batches < 1:
+        raise SceneError(f"batches {batches!r}: expected a positive integer")
+    return [int(seed)] + [seed_from_key(int(seed), f"batch-{b}") for b in range(1, batches)]
+
+
+def render_batches(
+    scene: Scene, *, batches: int, spp: int, seed: int, **options: Any
+) -> RenderResult:
+    """:func:`render_scene` as *batches* independent batches of *spp* samples each, merged.
+
+    Inside a batch every mode and the AOVs share seed and paths (common random numbers); the
+    batches differ only in their seed (:func:`batch_seeds`), so the spread between them is a
+    direct estimate of the Monte Carlo error of their mean (the noise budget of the ground
+    truth). *options* are those of :func:`render_scene`.
+    """
+    results = [render_scene(scene, spp=spp, seed=s, **options) for s in batch_seeds(seed, batches)]
+    return merge_batches(results)
+
+
+def _mean(arrays: Sequence[np.ndarray]) -> np.ndarray:
+    return np.mean(np.stack(arrays), axis=0, dtype=np.float64).astype(np.float32)
+
+
+def _merge_aovs(parts: Sequence[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
+    """Coverage, depth and normals averaged over the batches (each batch's AOVs saw that
+    batch's own pixel samples); the integer maps and the mask are those of the first batch."""
+    if not parts or not parts[0]:
+        return {}
+    merged = dict(parts[0])
+    for key in ("coverage", "depth", "normals"):
+        if key in merged:
+            merged[key] = _mean([p[key] for p in parts])
+    if "normals" in merged:
+        n = merged["normals"].astype(np.float64)
+        length = np.linalg.norm(n, axis=-1, keepdims=True)
+        merged["normals"] = np.divide(n, length, out=np.zeros_like(n), where=length > 1e-6).astype(np.float32)
+    return merged
+
+
+def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
+    """The mean of independent batch renders of one scene, keeping each batch's raw channels."""
+    if not results:
+        raise RenderError("no batches to merge")
+    if len(results) == 1:
+        return results[0]
+    first = results[0]
+    modes = list(first.images)
+    meta = dict(first.meta)
+    meta.update(
+        spp=int(first.meta["spp"]) * len(results),
+        batches=len(results),
+        batch_spp=int(first.meta["spp"]),
+        batch_seeds=[int(r.meta["seed"]) for r in results],
+        timings={k: {"passes": sum(r.meta["timings"][k]["passes"] for r in results),
+                     "seconds": sum(r.meta["timings"][k]["seconds"] for r in results),
+                     "per_pass": [x for r in results for x in r.meta["timings"][k]["per_pass"]]}
+                 for k in first.meta["timings"]},
+    )
+    return RenderResult(
+        images={m: _mean([r.images[m] for r in results]) for m in modes},
+        raw={m: _mean([r.raw[m] for r in results]) for m in first.raw},
+        per_light=tuple({m: _mean([r.per_light[i][m] for r in results]) for m in pl}
+                        for i, pl in enumerate(first.per_light)),
+        direct={m: _mean([r.direct[m] for r in results]) for m in first.direct},
+        aovs=_merge_aovs([r.aovs for r in results]),
+        meta=meta,
+        batch_raw=tuple(dict(r.raw) for r in results),
+    )

@@ -35,7 +35,13 @@ class RenderResult:
         ``(H, W)`` bool; see :func:`spectrinsic.render.passes.render_aovs` (empty unless asked).
     meta
         Variants, spp, seed, max_depth, sensors and XYZ matrices per mode, wavelength grid,
-        timings (seconds per pass), Mitsuba version.
+        timings (seconds per pass), Mitsuba version; with batches also ``batches``,
+        ``batch_spp`` and ``batch_seeds``.
+    batch_raw
+        Per independent batch (:func:`spectrinsic.render.render_batches`), mode -> ``(H, W, K)``
+        float32 raw channels of that batch alone; ``raw`` is their mean. Empty for a single
+        batch. Inside a batch every mode shares its paths; batches have independent seeds, so
+        their spread measures the Monte Carlo noise.
     """
 
     images: dict[str, np.ndarray]
@@ -44,6 +50,7 @@ class RenderResult:
     direct: dict[str, np.ndarray] = field(default_factory=dict)
     aovs: dict[str, np.ndarray] = field(default_factory=dict)
     meta: dict[str, Any] = field(default_factory=dict)
+    batch_raw: tuple[dict[str, np.ndarray], ...] = ()
 
     @property
     def shape(self) -> tuple[int, int]:

@@ -238,14 +238,14 @@ def test_cli_reports_failures_and_exits_nonzero(tmp_path, monkeypatch, capsys):
     import spectrinsic.render as render
     from spectrinsic.cli import main
 
-    real = render.render_scene
+    real = render.render_batches
 
     def failing_for_rooms(scene, **kwargs):
         if scene.name.startswith("room-"):
             raise RuntimeError("simulated render failure")
         return real(scene, **kwargs)
 
-    monkeypatch.setattr(render, "render_scene", failing_for_rooms)
+    monkeypatch.setattr(render, "render_batches", failing_for_rooms)
     rc = main(["-q", "dataset", "--out", str(tmp_path / "ds"), "--workers", "1", *CLI_TINY])
     captured = capsys.readouterr()
     assert rc == 1

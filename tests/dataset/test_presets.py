@@ -55,7 +55,7 @@ def test_config_hash_is_sha256_of_canonical_json():
 def test_hash_changes_with_output_settings_only():
     base = get_preset("preview")
     assert base.config_hash() == get_preset("preview").config_hash()
-    assert base.with_options(spp=base.spp + 1).config_hash() != base.config_hash()
+    assert base.with_options(spp=base.spp + base.batches).config_hash() != base.config_hash()
     assert base.with_options(seed=1).config_hash() != base.config_hash()
     assert base.with_options(modes=("rgb3",)).config_hash() != base.config_hash()
 

@@ -31,6 +31,7 @@ class FakeResult:
     direct: dict[str, np.ndarray] = field(default_factory=dict)
     aovs: dict[str, np.ndarray] = field(default_factory=dict)
     meta: dict[str, Any] = field(default_factory=dict)
+    batch_raw: tuple[dict[str, np.ndarray], ...] = ()
 
 
 def coverage_map() -> np.ndarray:

@@ -75,19 +75,29 @@ def test_interior_and_edge_reflectance_match_colour_science(one_light_sample, sy
     assert gt.materials == {str(i): m for i, m in enumerate(synth.MATERIALS)}
 
 
-def test_image_equals_reflectance_times_shading(two_light_sample):
+def test_image_equals_reflectance_times_shading_plus_residual(two_light_sample):
+    """(d) of the issue: the identity holds to float32 precision on every pixel, per space."""
+    from spectrinsic.gt_export.layers import identities
+
     scene, result = two_light_sample
     gt = compute_ground_truth(scene, result, cameras=(CAMERA,))
-    for suffix in ("", f"_camera/{CAMERA.split(':')[1]}"):
-        image = gt.layers[f"image{suffix}"].data
-        refl = gt.layers[f"reflectance{suffix}"].data
-        shading = gt.layers[f"shading{suffix}"].data
-        assert image.dtype == refl.dtype == shading.dtype == np.float32
-        valid = np.abs(refl) > REFLECTANCE_FLOOR
-        assert valid.sum() > 0.5 * valid.size
-        product = refl.astype(np.float64) * shading
-        np.testing.assert_allclose(product[valid], image[valid], rtol=FLOAT32_RTOL, atol=0)
-        assert (shading[~valid] == 0).all()
+    assert len(identities(gt)) == 2
+    for ident in identities(gt):
+        image, refl, shading, res = (gt.layers[ident[k]].data
+                                     for k in ("image", "reflectance", "shading", "residual"))
+        assert image.dtype == refl.dtype == shading.dtype == res.dtype == np.float32
+        rebuilt = refl.astype(np.float64) * shading + res
+        scale = np.abs(image).max()
+        np.testing.assert_allclose(rebuilt, image, rtol=FLOAT32_RTOL, atol=FLOAT32_RTOL * scale)
+        assert np.isfinite(shading).all() and (shading >= 0).all()  # (e)
+    # the thesis' per-channel ratio is kept, with its own exact identity
+    image, refl = gt.layers["image"].data, gt.layers["reflectance"].data
+    ratio = gt.layers["shading_ratio"].data
+    valid = np.abs(refl) > REFLECTANCE_FLOOR
+    assert valid.sum() > 0.5 * valid.size
+    np.testing.assert_allclose(refl[valid].astype(np.float64) * ratio[valid], image[valid],
+                               rtol=FLOAT32_RTOL, atol=0)
+    assert (ratio[~valid] == 0).all()
 
 
 def test_shading_of_a_flat_grey_is_geometry_times_light_colour(one_light_sample):
@@ -224,7 +234,8 @@ def test_camera_illuminant_is_relative_to_the_cameras_d65_white(synth):
     gt = compute_ground_truth(scene, result, cameras=(CAMERA,))
     lit = gt.layers["mask"].data > 0
     illum = gt.layers[f"illuminant_camera/{CAMERA.removeprefix('camera:')}"].data[lit]
-    np.testing.assert_allclose(illum, 1.0, atol=1e-6)  # D65 light is the camera's own white
+    # D65 light is the camera's own white; 1.3e-4 is the 10 nm band integration of D65's spikes
+    np.testing.assert_allclose(illum, 1.0, atol=5e-4)
 
 
 def test_missing_inputs_raise_clear_errors(synth):
