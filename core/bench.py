@@ -13,7 +13,7 @@ import sys
 import time
 from pathlib import Path
 
-BENCHMARKS = ("bench_render", "bench_dataset", "bench_decompose")
+BENCHMARKS = ("bench_render", "bench_dataset", "bench_decompose", "bench_ground_truth")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -13,13 +13,22 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "check",
         help="verify a built dataset: files and layers present, no NaN/Inf or forbidden "
-        "negatives, image = reflectance * shading, manifest hashes",
+        "negatives, image = reflectance * shading + residual, manifest hashes; report noise",
+        description="Verify a built dataset and report each sample's measured Monte Carlo noise "
+        "(relative standard error from independent batches). Exit status 1 when a check fails "
+        "or a sample is noisier than --noise-threshold.",
     )
     p.add_argument("dir", metavar="DIR", help="dataset folder (with manifest.json)")
     p.add_argument(
         "--max-per-sample", type=int, default=20, metavar="N",
         help="list at most N problems per sample (default 20)",
     )
+    p.add_argument(
+        "--noise-threshold", type=float, default=None, metavar="F",
+        help="flag samples whose raw shading has a median relative standard error above F "
+        "(default 0.25)",
+    )
+    p.add_argument("--noise", action="store_true", help="print every sample's noise figures")
     p.set_defaults(func=run)
 
 
@@ -28,12 +37,20 @@ def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from spectrinsic.gt_export import check_dataset, sample_dirs
+    from spectrinsic.gt_export.check import NOISE_THRESHOLD, noise_report
 
     root = Path(args.dir)
     n_samples = len(sample_dirs(root)) if root.is_dir() else 0
     with tqdm(total=n_samples, desc="checking", unit="sample", disable=args.quiet or None,
               leave=False) as bar:
         problems = check_dataset(root, progress=lambda _sample: bar.update(1))
+    if n_samples:
+        threshold = NOISE_THRESHOLD if args.noise_threshold is None else args.noise_threshold
+        lines, flagged = noise_report(root, threshold=threshold)
+        for line in lines if args.noise else [x for x in lines if "NOISY" in x]:
+            print(f"noise: {line}")
+        problems += [f"{s}: noisier than the threshold ({threshold:g} median shading error)"
+                     for s in flagged]
     if not problems:
         print(f"ok: {n_samples} samples in {root} passed every check")
         return 0

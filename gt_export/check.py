@@ -29,7 +29,11 @@ from spectrinsic.gt_export.writer import (
     sample_dirs,
 )
 
-__all__ = ["check_dataset", "check_sample", "IDENTITY_RTOL"]
+__all__ = ["check_dataset", "check_sample", "noise_report", "IDENTITY_RTOL", "NOISE_THRESHOLD"]
+
+#: Default flag of :func:`noise_report`: a sample whose raw shading has a median relative
+#: standard error above this is called noisy.
+NOISE_THRESHOLD = 0.25
 
 #: Relative tolerance of ``image = reflectance ∘ shading``: float32 storage of the two factors
 #: and their product rounds three times (≤ 1.5 ulp), so 4 float32 epsilons is generous yet tight.
@@ -181,3 +185,32 @@ def check_dataset(
             elif file_sha256(path) != digest:
                 problems.append(f"{name}: file {rel!r} does not match its SHA-256 in {MANIFEST_NAME}")
     return problems
+
+
+def noise_report(
+    dataset_dir: str | os.PathLike[str], *, threshold: float = NOISE_THRESHOLD
+) -> tuple[list[str], list[str]]:
+    """Per-sample noise lines and the samples flagged as too noisy.
+
+    Returns ``(lines, flagged)``: one line per sample with the median and p95 relative standard
+    error of each measured layer (``meta.json["noise"]``), and the ids whose raw shading median
+    exceeds *threshold*.
+    """
+    lines, flagged = [], []
+    for sample in sample_dirs(Path(dataset_dir)):
+        try:
+            noise = json.loads((sample / META_NAME).read_text(encoding="utf-8")).get("noise") or {}
+        except (OSError, ValueError):
+            continue
+        figures = {k: v for k, v in noise.items() if isinstance(v, Mapping)}
+        if not figures:
+            lines.append(f"{sample.name}: no noise estimate (one batch)")
+            continue
+        parts = [f"{k} median {100 * v['median']:.1f} % p95 {100 * v['p95']:.1f} %"
+                 for k, v in sorted(figures.items())]
+        shading = figures.get("shading_raw", {}).get("median", 0.0)
+        if shading > threshold:
+            flagged.append(sample.name)
+            parts.append(f"NOISY (shading median above {100 * threshold:.0f} %)")
+        lines.append(f"{sample.name}: " + "; ".join(parts))
+    return lines, flagged

@@ -698,6 +698,7 @@ def compute_ground_truth(
     cameras: Sequence[str] = (),
     write_cube: bool = False,
     denoise: bool = False,
+    denoise_quality: str = "fast",
     data_dir: Any = None,
     training: np.ndarray | None = None,
 ) -> GroundTruth:
@@ -720,6 +721,9 @@ def compute_ground_truth(
         ``shading``, ``residual``, ``illuminant``, ``shading_grey`` and the camera shading
         come from it, ``image_denoised = reflectance ∘ shading + residual`` is rebuilt from it,
         and the raw ``shading_raw``/``residual_raw`` are kept beside ``image``.
+    denoise_quality
+        OIDN quality, ``"fast"`` (the dataset's, :data:`~spectrinsic.gt_export.denoise.DENOISE_QUALITY`)
+        or ``"high"``.
     training
         ``(N, 471)`` reflectances on the 1 nm grid for the matrix fits (default: all Munsell chips).
     """
@@ -741,7 +745,7 @@ def compute_ground_truth(
     if denoise:
         from spectrinsic.gt_export.denoise import denoise_white_radiance
 
-        w = denoise_white_radiance(w_raw, _aov(result, "normals"))
+        w = denoise_white_radiance(w_raw, _aov(result, "normals"), quality=denoise_quality)
     layers += _intrinsic_layers(s, w_raw, w, image, reflectance, denoised=denoise)
     noise_layers, noise = _noise(s, w_raw, coverage)
     share_layers, shares = _share_layers(s, w, mask)

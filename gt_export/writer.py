@@ -495,6 +495,7 @@ def write_manifest(
         "mitsuba_variants": sorted({str(m.get("variant")) for m in metas}),
         "spectral_data": _spectral_provenance(metas, data_dir),
         "n_samples": len(samples),
+        "noise": noise_summary(metas),
         "samples": {
             s.name: {
                 "config_hash": m.get("config_hash"),
@@ -510,6 +511,44 @@ def write_manifest(
     _dump_json(tmp, manifest)
     tmp.replace(path)
     return path
+
+
+def noise_summary(metas: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """Median over samples of each sample's median and p95 relative standard error, per layer
+    and scene kind (``object``/``complex``), and the worst sample's median."""
+    out: dict[str, Any] = {}
+    for meta in metas:
+        kind = (meta.get("scene_metadata") or {}).get("kind", "all")
+        for layer, fig in (meta.get("noise") or {}).items():
+            if isinstance(fig, Mapping):
+                out.setdefault(layer, {}).setdefault(kind, []).append((fig["median"], fig["p95"], meta["sample_id"]))
+    summary: dict[str, Any] = {}
+    for layer, kinds in out.items():
+        for kind, rows in kinds.items():
+            medians, p95s = [r[0] for r in rows], [r[1] for r in rows]
+            worst = max(rows)
+            summary.setdefault(layer, {})[kind] = {
+                "samples": len(rows), "median_of_medians": float(np.median(medians)),
+                "median_of_p95": float(np.median(p95s)), "worst_median": float(worst[0]),
+                "worst_sample": worst[2],
+            }
+    return summary
+
+
+def _noise_table(summary: Mapping[str, Any]) -> str:
+    if not summary:
+        return "Rendered as a single batch: no noise estimate (build with `batches` ≥ 2)."
+    lines = ["Relative standard error of the raw Monte Carlo layers, per pixel, from the spread of "
+             "independent batches (the denoised layers are measured against converged renders "
+             "in `make bench`).", "",
+             "| layer | scenes | samples | median of medians | median of p95 | worst median (sample) |",
+             "|---|---|---|---|---|---|"]
+    for layer, kinds in sorted(summary.items()):
+        for kind, row in sorted(kinds.items()):
+            lines.append(f"| `{layer}` | {kind} | {row['samples']} | {100 * row['median_of_medians']:.1f} % "
+                         f"| {100 * row['median_of_p95']:.1f} % | {100 * row['worst_median']:.1f} % "
+                         f"(`{row['worst_sample']}`) |")
+    return "\n".join(lines)
 
 
 def read_template(name: str) -> str:
@@ -540,6 +579,7 @@ def write_dataset_card(
     )
     scenes = sorted({m["scene"] for m in metas})
     text = string.Template(read_template("DATASET.md")).substitute(
+        noise_table=_noise_table(noise_summary(metas)),
         n_samples=len(samples),
         n_scenes=len(scenes),
         scenes=", ".join(scenes),

@@ -10,7 +10,6 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import RenderError, SceneError
-from spectrinsic.rng import seed_from_key
 from spectrinsic.render.modes import (
     RenderMode,
     channel_values,
@@ -27,6 +26,7 @@ from spectrinsic.render.passes import (
     render_spectral,
 )
 from spectrinsic.render.result import RenderResult
+from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
 

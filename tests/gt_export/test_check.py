@@ -87,3 +87,28 @@ def test_cli_exit_status_and_report(built, capsys):
     assert main(["-q", "check", str(built)]) == 1
     out = capsys.readouterr().out
     assert "one: 1 problem(s)" in out and "scene.json" in out
+
+
+def test_noise_from_two_batches_is_reported_and_flagged(tmp_path, synth, config):
+    """Batches at ±10 % of the cube: the relative standard error of their mean is exactly 0.1
+    (sqrt(Σ(±0.1x)² / (2·1)) / x), for image and shading alike."""
+    import dataclasses
+
+    from spectrinsic.gt_export.check import noise_report
+    from spectrinsic.gt_export.writer import noise_summary
+
+    scene = synth.make_scene(("planck:2800K",))
+    result = synth.make_result(scene)
+    cube = result.raw["bands31"]
+    result = dataclasses.replace(result, batch_raw=({"bands31": cube * 1.1}, {"bands31": cube * 0.9}))
+    folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=1)
+    write_manifest(tmp_path, config)
+    meta = json.loads((folder / "meta.json").read_text())
+    for layer in ("image", "shading_raw"):
+        assert meta["noise"][layer]["median"] == pytest.approx(0.1, rel=1e-6)
+    assert meta["noise"]["batches"] == 2
+    manifest = json.loads((tmp_path / "manifest.json").read_text())
+    assert manifest["noise"] == noise_summary([meta])
+    lines, flagged = noise_report(tmp_path, threshold=0.05)
+    assert flagged == ["s"] and "shading_raw median 10.0 %" in lines[0]
+    assert noise_report(tmp_path, threshold=0.2)[1] == []
