@@ -43,6 +43,7 @@ __all__ = [
     "replaceable_sample",
     "remove_sample",
     "dataset_config_hash",
+    "require_folder_path",
     "check_build_folder",
     "write_marker",
     "remove_owned_temporaries",
@@ -192,6 +193,16 @@ def dataset_config_hash(root: Path) -> str | None:
     return None
 
 
+def require_folder_path(root: Path, option: str = "--out") -> None:
+    """Raise a one-line error if *root* is a file or lies below one (so no folder can be made)."""
+    for parent in (root, *root.parents):
+        if parent.is_dir():
+            return
+        if parent.exists() or parent.is_symlink():
+            what = "is a file" if parent == root else f"lies below the file {str(parent)!r}"
+            raise DatasetError(f"{option} {str(root)!r} {what}; expected a folder")
+
+
 def check_build_folder(root: Path, config_hash: str, *, rebuild: bool) -> str | None:
     """Check that a build with *config_hash* may write into *root*; return the hash the folder
     was built with before (``None``: new or empty folder).
@@ -202,12 +213,7 @@ def check_build_folder(root: Path, config_hash: str, *, rebuild: bool) -> str | 
         *root* is a file or lies below one; *root* is non-empty and not a spectrinsic dataset;
         or it was built with another config and *rebuild* is false.
     """
-    for parent in (root, *root.parents):
-        if parent.exists() and not parent.is_dir():
-            what = "is a file" if parent == root else f"lies below the file {str(parent)!r}"
-            raise DatasetError(f"--out {str(root)!r} {what}; expected a folder")
-        if parent.is_dir():
-            break
+    require_folder_path(root)
     if not root.is_dir() or not any(root.iterdir()):
         return None
     previous = dataset_config_hash(root)
