@@ -55,8 +55,8 @@ def test_config_hash_is_sha256_of_canonical_json():
 def test_config_hash_ignores_versions_that_do_not_change_pixels(monkeypatch):
     """A numpy or colour-science patch release, or any other package, keeps the hash; a new
     Mitsuba or a bumped pixel version changes it."""
-    import spectrinsic.provenance as provenance
     import spectrinsic.presets as presets
+    import spectrinsic.provenance as provenance
 
     real = provenance.software_versions
     base = get_preset("preview").config_hash()
