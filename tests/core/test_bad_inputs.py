@@ -72,6 +72,14 @@ def _sfu_data_dir(tmp: Path, value: str, encoding: str = "utf-8") -> Path:
     return tmp / "data"
 
 
+def _sfu_render(tmp: Path, value: str | None, encoding: str = "utf-8") -> list[str]:
+    """``render`` of a scene using an SFU reflectance from a data directory holding *value*
+    (``None``: a data directory that does not exist)."""
+    data = _sfu_data_dir(tmp, value, encoding) if value is not None else tmp / "nope"
+    scene = _scene(tmp, SCENE.replace("flat:0.5", "sfu:mine/1"))
+    return ["--data-dir", str(data), "render", scene, "--out", str(tmp / "o")]
+
+
 def _scene(tmp: Path, text: str = SCENE, name: str = "scene.yaml") -> str:
     path = tmp / name
     path.write_text(text) if isinstance(text, str) else path.write_bytes(text)
@@ -155,9 +163,7 @@ CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
     ("yaml-5000-deep-flow", lambda t: ["render", _scene(t, "[" * 5000 + "]" * 5000), "--out", str(t / "o")],
      "nesting deeper"),
     ("yaml-not-utf8", lambda t: ["render", _scene(t, b"name: \xff\xfe\n"), "--out", str(t / "o")], "scene.yaml"),
-    ("data-dir-csv-not-utf8", lambda t: ["--data-dir", str(_sfu_data_dir(t, "0.5\xe9", "latin-1")), "render",
-                                         _scene(t, SCENE.replace("flat:0.5", "sfu:mine/1")),
-                                         "--out", str(t / "o")], "reflect_db_1995.csv"),
+    ("data-dir-csv-not-utf8", lambda t: _sfu_render(t, "0.5\xe9", "latin-1"), "reflect_db_1995.csv"),
     ("blend-garbage", lambda t: ["render", _scene(t, b"BLENDER-v300 not really", "room.blend"),
                                  "--out", str(t / "o")], "room.blend"),
     ("blend-magic-any-name", lambda t: ["render", _scene(t, b"BLENDER-v300 not really", "room.dat"),
@@ -167,21 +173,11 @@ CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
         t, manifest={}, meta={"layers": {"image": {"exr_layer": "image"}}})], "layers.image.file"),
     ("check-not-a-folder", lambda t: ["check", str(t / "nothing")], "nothing"),
     # --- point 5: spectra from the data directory
-    ("data-dir-nan", lambda t: ["--data-dir", str(_sfu_data_dir(t, "nan")), "render",
-                                _scene(t, SCENE.replace("flat:0.5", "sfu:mine/1")), "--out", str(t / "o")],
-     "reflect_db_1995.csv"),
-    ("data-dir-inf", lambda t: ["--data-dir", str(_sfu_data_dir(t, "inf")), "render",
-                                _scene(t, SCENE.replace("flat:0.5", "sfu:mine/1")), "--out", str(t / "o")],
-     "reflect_db_1995.csv"),
-    ("data-dir-negative", lambda t: ["--data-dir", str(_sfu_data_dir(t, "-0.2")), "render",
-                                     _scene(t, SCENE.replace("flat:0.5", "sfu:mine/1")), "--out", str(t / "o")],
-     "reflect_db_1995.csv"),
-    ("data-dir-empty-cell", lambda t: ["--data-dir", str(_sfu_data_dir(t, "")), "render",
-                                       _scene(t, SCENE.replace("flat:0.5", "sfu:mine/1")), "--out", str(t / "o")],
-     "reflect_db_1995.csv"),
-    ("data-dir-missing", lambda t: ["--data-dir", str(t / "nope"), "render",
-                                    _scene(t, SCENE.replace("flat:0.5", "sfu:mine/1")), "--out", str(t / "o")],
-     "nope"),
+    ("data-dir-nan", lambda t: _sfu_render(t, "nan"), "reflect_db_1995.csv"),
+    ("data-dir-inf", lambda t: _sfu_render(t, "inf"), "reflect_db_1995.csv"),
+    ("data-dir-negative", lambda t: _sfu_render(t, "-0.2"), "reflect_db_1995.csv"),
+    ("data-dir-empty-cell", lambda t: _sfu_render(t, ""), "reflect_db_1995.csv"),
+    ("data-dir-missing", lambda t: _sfu_render(t, None), "nope"),
     # --- point 8: limits
     ("yaml-alias-bomb", lambda t: ["render", _bomb(t), "--out", str(t / "o")], "alias"),
     ("yaml-recursive-alias", lambda t: ["render", _scene(t, "a: &a [*a]\n"), "--out", str(t / "o")], "recursive"),
