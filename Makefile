@@ -20,11 +20,11 @@ export SPECTRINSIC_DATA ?= $(DATA_DIR)
 help: ## list the targets
 	@awk 'BEGIN {FS = ":.*## "} /^[a-zA-Z_-]+:.*## / {printf "  make %-15s %s\n", $$1, $$2}' $(MAKEFILE_LIST)
 
-$(DEPS): pyproject.toml scripts/setup-system.sh
+$(DEPS): pyproject.toml constraints.txt scripts/setup-system.sh
 	bash scripts/setup-system.sh
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
-	$(BIN)/pip install -q -e ".[dev,blender,distributed]" --config-settings editable_mode=strict
+	$(BIN)/pip install -q -c constraints.txt -e ".[dev,blender,distributed]" --config-settings editable_mode=strict
 	touch $@ $(PKG)
 
 $(PKG): $(DEPS) $(PKG_DIRS)

@@ -10,6 +10,7 @@ import argparse
 import importlib
 import logging
 import sys
+import traceback
 from collections.abc import Sequence
 
 from spectrinsic.errors import SpectrinsicError
@@ -39,7 +40,10 @@ def build_parser() -> argparse.ArgumentParser:
         help="spectral data directory (SFU set, extra cameras); default: $SPECTRINSIC_DATA",
     )
     parser.add_argument("-v", "--verbose", action="count", default=0, help="more logging")
-    parser.add_argument("-q", "--quiet", action="store_true", help="no progress bars")
+    parser.add_argument("-q", "--quiet", action="store_true", help="no progress bars or plan lines")
+    parser.add_argument(
+        "--debug", action="store_true", help="print the traceback behind an error message"
+    )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in _COMMANDS:
         importlib.import_module(name).register(sub)
@@ -47,7 +51,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point. Returns the process exit status (0 ok, 2 bad input)."""
+    """Entry point. Returns the process exit status (0 ok, 1 problems found or samples failed,
+    2 bad input or a resource that failed: one line on stderr, the traceback only with
+    ``--debug``)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(
@@ -57,11 +63,23 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args) or 0)
     except SpectrinsicError as exc:
-        print(f"spectrinsic: error: {exc}", file=sys.stderr)
-        return 2
+        return _error(args, str(exc))
+    except OSError as exc:  # a file the command could not read or write, named by the OS
+        where = f"{exc.filename}: " if exc.filename else ""
+        return _error(args, f"{where}{exc.strerror or exc}")
+    except MemoryError:
+        return _error(args, "out of memory; try a smaller --resolution/--width/--height or fewer --workers")
     except KeyboardInterrupt:
         print("spectrinsic: interrupted; completed work is kept, re-run to resume", file=sys.stderr)
         return 130
+
+
+def _error(args: argparse.Namespace, message: str) -> int:
+    """Print the one-line error (after the traceback with ``--debug``); return status 2."""
+    if getattr(args, "debug", False):
+        traceback.print_exc()
+    print(f"spectrinsic: error: {' '.join(message.split())}", file=sys.stderr)
+    return 2
 
 
 if __name__ == "__main__":  # pragma: no cover

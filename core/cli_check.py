@@ -6,6 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from spectrinsic.errors import DatasetError
+
 __all__ = ["register", "run"]
 
 
@@ -40,7 +42,9 @@ def run(args: argparse.Namespace) -> int:
     from spectrinsic.gt_export.check import NOISE_THRESHOLD, noise_report
 
     root = Path(args.dir)
-    n_samples = len(sample_dirs(root)) if root.is_dir() else 0
+    if not root.is_dir():
+        raise DatasetError(f"check {str(root)!r}: no such folder; expected a dataset folder")
+    n_samples = len(sample_dirs(root))
     with tqdm(total=n_samples, desc="checking", unit="sample", disable=args.quiet or None,
               leave=False) as bar:
         problems = check_dataset(root, progress=lambda _sample: bar.update(1))

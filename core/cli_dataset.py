@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from pathlib import Path
 from typing import Any
 
 from spectrinsic.errors import DatasetError
@@ -24,7 +25,9 @@ def register(subparsers: Any) -> None:
             "Render the dataset layout of the thesis (8 objects x 4 conditions + 3 complex "
             "scenes x 3 views x 4 conditions) with ground-truth layers, then write "
             "manifest.json, DATASET.md and the gallery. Complete samples with the same config "
-            "hash are skipped, so an interrupted build resumes where it stopped."
+            "hash whose files match their SHA-256 are skipped, so an interrupted build resumes "
+            "where it stopped. --out must be new, empty, or a dataset built with the same "
+            "config (--rebuild to rebuild one built with another)."
         ),
     )
     p.add_argument("--out", metavar="DIR", default=DEFAULT_OUT, help=f"dataset folder ({DEFAULT_OUT})")
@@ -74,6 +77,11 @@ def register(subparsers: Any) -> None:
         metavar="WxH",
         help="override the image size in pixels, e.g. 256x256",
     )
+    p.add_argument(
+        "--rebuild",
+        action="store_true",
+        help="--out was built with another config: rebuild its samples with this one",
+    )
     p.set_defaults(func=run)
 
 
@@ -87,50 +95,72 @@ def _overrides(args: argparse.Namespace) -> dict[str, int]:
         changes["denoise"] = False
     if args.resolution is not None:
         w, sep, h = args.resolution.lower().partition("x")
-        if not (sep and w.isdigit() and h.isdigit()):
-            raise DatasetError(f"--resolution {args.resolution!r}; expected WIDTHxHEIGHT, e.g. 256x256")
+        if not (sep and w.isdigit() and h.isdigit() and int(w) > 0 and int(h) > 0):
+            raise DatasetError(f"--resolution {args.resolution!r}; expected WIDTHxHEIGHT of positive integers, e.g. 256x256")
         changes["width"], changes["height"] = int(w), int(h)
     return changes
+
+
+def _preflight(args: argparse.Namespace, config: Any) -> None:
+    """Every refusal that needs no rendering, before anything is written or started."""
+    from spectrinsic.executors import check_scheduler
+    from spectrinsic.gt_export.integrity import check_build_folder
+    from spectrinsic.render.budget import check_render_size
+
+    if args.workers is not None and args.workers < 1:
+        raise DatasetError(f"--workers {args.workers}; expected a positive integer")
+    if args.threads is not None and args.threads < 1:
+        raise DatasetError(f"--threads {args.threads}; expected a positive integer")
+    check_build_folder(Path(args.out), config.config_hash(), rebuild=args.rebuild)
+    if args.scheduler:
+        check_scheduler(args.scheduler)
+    # two lights: the library's two-colour conditions, rendered once per light
+    check_render_size(config.width, config.height, what=f"--resolution {config.width}x{config.height}",
+                      processes=args.workers or 1, modes=config.modes, per_light=config.per_light,
+                      direct=config.direct, n_lights=2)
+
+
+def _executor(args: argparse.Namespace) -> tuple[Any, int | None, str]:
+    """The executor the options ask for, the render threads per worker, and where it runs."""
+    from spectrinsic.executors import make_executor
+
+    cores = os.cpu_count() or 1
+    # One process whose Dr.Jit pool uses every core beat one single-threaded process per core
+    # on the 2-core reference machine (28 s vs 42 s for 4 default samples): each process
+    # compiles its own kernels and holds its own scene.
+    workers = 1 if args.workers is None else args.workers
+    threads = args.threads
+    if args.scheduler:
+        return (make_executor("dask", scheduler=args.scheduler),
+                threads if threads is not None else 1, f"Dask scheduler {args.scheduler}")
+    if workers == 1:
+        return make_executor("serial"), threads, "this process"
+    return (make_executor("process", workers=workers),
+            threads if threads is not None else max(1, cores // workers),
+            f"{workers} local worker processes")
 
 
 def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from spectrinsic.dataset import SampleFailure, build_dataset
-    from spectrinsic.executors import make_executor
     from spectrinsic.presets import get_preset
 
     config = get_preset(args.preset, seed=args.seed).with_options(**_overrides(args))
-    cores = os.cpu_count() or 1
-    # One process whose Dr.Jit pool uses every core beat one single-threaded process per core
-    # on the 2-core reference machine (28 s vs 42 s for 4 default samples): each process
-    # compiles its own kernels and holds its own scene.
-    workers = 1 if args.workers is None else args.workers
-    if workers < 1:
-        raise DatasetError(f"--workers {workers}; expected a positive integer")
-    threads = args.threads
-    if args.scheduler:
-        executor = make_executor("dask", scheduler=args.scheduler)
-        threads = threads if threads is not None else 1
-        where = f"Dask scheduler {args.scheduler}"
-    elif workers == 1:
-        executor = make_executor("serial")
-        where = "this process"
-    else:
-        executor = make_executor("process", workers=workers)
-        threads = threads if threads is not None else max(1, cores // workers)
-        where = f"{workers} local worker processes"
+    _preflight(args, config)
+    executor, threads, where = _executor(args)
 
     bar: Any = None
     failures: list[str] = []
 
     def on_plan(n_todo: int, n_skipped: int) -> None:
         nonlocal bar
-        print(
-            f"spectrinsic dataset: preset {config.preset!r}, {n_todo} sample(s) to build, "
-            f"{n_skipped} already complete, on {where}",
-            file=sys.stderr,
-        )
+        if not args.quiet:
+            print(
+                f"spectrinsic dataset: preset {config.preset!r}, {n_todo} sample(s) to build, "
+                f"{n_skipped} already complete, on {where}",
+                file=sys.stderr,
+            )
         bar = tqdm(total=n_todo, unit="sample", disable=args.quiet or n_todo == 0, file=sys.stderr)
 
     def progress(record: Any) -> None:
@@ -148,18 +178,31 @@ def run(args: argparse.Namespace) -> int:
             only=args.only,
             data_dir=args.data_dir,
             render_threads=threads,
+            rebuild=args.rebuild,
             on_plan=on_plan,
             progress=progress,
         )
     except KeyboardInterrupt:
-        if bar is not None:
-            bar.close()
         done = bar.n if bar is not None else 0
         print(f"spectrinsic dataset: {done} sample(s) finished before the interrupt", file=sys.stderr)
         raise
-    if bar is not None:
-        bar.close()
+    finally:
+        if bar is not None:
+            bar.close()
+    print("\n".join(_summary(report)))
+    if report.failed:
+        print(
+            f"spectrinsic dataset: {len(report.failed)} sample(s) failed: "
+            + ", ".join(f.sample_id for f in report.failed)
+            + "; re-run to retry them",
+            file=sys.stderr,
+        )
+        return 1
+    return 0
 
+
+def _summary(report: Any) -> list[str]:
+    """The lines printed after a build: counts, timings, files written, failed samples."""
     timing = report.timing_summary()
     lines = [
         f"built {len(report.built)}, skipped {len(report.skipped)}, failed {len(report.failed)} "
@@ -174,15 +217,8 @@ def run(args: argparse.Namespace) -> int:
     lines.append(f"dataset: {report.out_dir.resolve()}")
     for kind, path in report.files.items():
         lines.append(f"  {kind}: {path}")
+    if not report.finalized:
+        lines.append("  no complete sample: manifest, DATASET.md and gallery not written")
     for f in report.failed:
         lines.append(f"FAILED {f.sample_id}: {f.error}")
-    print("\n".join(lines))
-    if report.failed:
-        print(
-            f"spectrinsic dataset: {len(report.failed)} sample(s) failed: "
-            + ", ".join(f.sample_id for f in report.failed)
-            + "; re-run to retry them",
-            file=sys.stderr,
-        )
-        return 1
-    return 0
+    return lines

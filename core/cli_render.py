@@ -17,11 +17,13 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from spectrinsic.errors import SceneError
+from spectrinsic.errors import RenderError, SceneError
 
 __all__ = ["register", "run", "load_scene_argument", "write_render"]
 
 DEFAULT_MODES = "spectral,rgb3,rgb6,bands31"
+#: First bytes of every uncompressed ``.blend`` file.
+BLEND_MAGIC = b"BLENDER"
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -51,19 +53,45 @@ def load_scene_argument(
     scene: str, *, condition: str, view: int, seed: int, width: int | None, height: int | None,
     data_dir: str | None = None,
 ) -> Any:
-    """The Scene named by the ``SCENE`` argument: a YAML file if it looks like a path, else a library name."""
+    """The Scene named by the ``SCENE`` argument: a ``.blend`` file (by extension or its
+    ``BLENDER`` magic bytes) through the Blender importer, a YAML file if it looks like a path,
+    else a library name."""
     path = Path(scene)
+    if _is_blend(path):
+        from spectrinsic.scenes.blender import load_blend
+
+        size = None if width is None and height is None else (width or 128, height or 128)
+        return load_blend(path, resolution=size, data_dir=data_dir)
     if path.suffix.lower() in (".yaml", ".yml") or path.exists():
         from spectrinsic.scenes.io import load_scene
 
         loaded = load_scene(path, data_dir=data_dir)
         camera = loaded.camera
-        if width is not None or height is not None:
-            camera = dataclasses.replace(camera, width=width or camera.width, height=height or camera.height)
+        camera = dataclasses.replace(camera, width=camera.width if width is None else width,
+                                     height=camera.height if height is None else height)
         return dataclasses.replace(loaded, camera=camera)
     from spectrinsic.scenes import library
 
-    return library.build(scene, view=view, condition=condition, seed=seed, width=width or 128, height=height or 128)
+    return library.build(scene, view=view, condition=condition, seed=seed,
+                         width=128 if width is None else width, height=128 if height is None else height)
+
+
+def _is_blend(path: Path) -> bool:
+    """True for a ``.blend`` name or a file starting with Blender's magic bytes."""
+    if path.suffix.lower() == ".blend":
+        return True
+    try:
+        with path.open("rb") as fh:
+            return fh.read(len(BLEND_MAGIC)) == BLEND_MAGIC
+    except OSError:
+        return False
+
+
+def _check_size_options(args: argparse.Namespace) -> None:
+    """``--width``/``--height``/``--spp`` must be positive before anything is loaded."""
+    for option, value in (("--width", args.width), ("--height", args.height), ("--spp", args.spp)):
+        if value is not None and value < 1:
+            raise RenderError(f"{option} {value}; expected a positive integer")
 
 
 def write_render(out: Path, scene: Any, result: Any, *, data_dir: str | None = None) -> dict[str, Path]:
@@ -102,14 +130,24 @@ def write_render(out: Path, scene: Any, result: Any, *, data_dir: str | None = N
 
 
 def run(args: argparse.Namespace) -> int:
-    from spectrinsic.render import count_passes, render_scene
+    from spectrinsic.gt_export.integrity import require_folder_path
+    from spectrinsic.render import count_passes, get_mode, render_scene
+    from spectrinsic.render.budget import check_render_size
 
     modes = [m.strip() for m in str(args.modes).split(",") if m.strip()]
     if not modes:
         raise SceneError(f"--modes {args.modes!r}: expected a comma-separated list such as {DEFAULT_MODES}")
+    for mode in modes:
+        get_mode(mode)
+    _check_size_options(args)
+    require_folder_path(Path(args.out))
     data_dir = getattr(args, "data_dir", None)
     scene = load_scene_argument(args.scene, condition=args.condition, view=args.view, seed=args.seed,
                                 width=args.width, height=args.height, data_dir=data_dir)
+    given = " ".join(f"--{k} {v}" for k, v in (("width", args.width), ("height", args.height)) if v is not None)
+    check_render_size(scene.camera.width, scene.camera.height, what=given or f"scene {args.scene!r}",
+                      modes=modes, n_lights=len(scene.lights), per_light=args.per_light,
+                      direct=args.direct, data_dir=data_dir)
     options = dict(modes=modes, per_light=args.per_light, direct=args.direct, aovs=not args.no_aovs)
     total = count_passes(scene, data_dir=data_dir, **options)
     bar = None

@@ -323,16 +323,17 @@ def build_dataset(
     on_plan: Callable[[int, int], None] | None = None,
     progress: Callable[[SampleOutcome | SampleFailure], None] | None = None,
     finalize: bool = True,
+    rebuild: bool = False,
 ) -> DatasetReport:
     """Build (or resume) the dataset in *out_dir*.
 
     Parameters
     ----------
     out_dir
-        Dataset folder (created if needed).
+        Dataset folder (created if needed). It must be new, empty, or a spectrinsic dataset.
     config
-        Build settings; samples whose folder is complete for ``config.config_hash()`` are
-        skipped.
+        Build settings; samples whose folder is complete and intact for
+        ``config.config_hash()`` are skipped, the others (re-)rendered.
     executor
         Where tasks run (default: serially in this process).
     only
@@ -345,52 +346,38 @@ def build_dataset(
     progress
         Called with each sample's outcome or failure as it finishes.
     finalize
-        Write manifest, dataset card and gallery at the end.
+        Write manifest, dataset card and gallery at the end (only if a sample is complete).
+    rebuild
+        Allow a folder built with another config: its samples are removed and rebuilt with
+        *config* (together with those *only* selects), so the folder holds one config.
 
     Returns
     -------
     DatasetReport
         Built, skipped and failed samples and the timings. A failed sample does not stop the
         others. ``KeyboardInterrupt`` propagates after completed samples are safely in place.
-    """
-    from spectrinsic.gt_export.writer import is_complete, remove_stale_temporaries
 
+    Raises
+    ------
+    DatasetError
+        Before anything is written, if *out_dir* is not a folder this build may write into
+        (see :func:`spectrinsic.gt_export.integrity.check_build_folder`) or a sample's folder
+        holds files spectrinsic did not write.
+    DiskFullError
+        When the disk is full: the build stops at the first sample that hits it.
+    """
     start = time.perf_counter()
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    for stale in remove_stale_temporaries(out):
-        log.info("removed %s, left by an interrupted build", stale.name)
     executor = executor if executor is not None else SerialExecutor()
-    config_hash = config.config_hash()
-    tasks = plan_samples(out, config, only=only, data_dir=data_dir, render_threads=render_threads)
-    todo, skipped = [], []
-    for t in tasks:
-        folder = out / t.sample_id
-        if is_complete(folder, config_hash):
-            skipped.append(SampleOutcome(t.sample_id, "skipped", str(folder)))
-        else:
-            todo.append(t)
+    todo, skipped = _prepare(out, config, only=only, data_dir=data_dir,
+                             render_threads=render_threads, rebuild=rebuild)
     # Rooms cost ~5x objects and the layout lists all objects first; a fixed pseudo-random
     # order (by sample seed) mixes them, so the progress bar's ETA holds from the start.
     todo.sort(key=lambda t: (t.seed, t.sample_id))
     log.info("%d sample(s) to build, %d already complete", len(todo), len(skipped))
     if on_plan is not None:
         on_plan(len(todo), len(skipped))
-
-    built: list[SampleOutcome] = []
-    failed: list[SampleFailure] = []
-    for task, outcome in executor.map_unordered(task_fn, todo):
-        record: SampleOutcome | SampleFailure
-        if isinstance(outcome, BaseException):
-            record = SampleFailure(task.sample_id, f"{type(outcome).__name__}: {outcome}")
-            log.error("sample %s failed: %s", task.sample_id, record.error)
-            failed.append(record)
-        else:
-            record = outcome
-            built.append(outcome)
-        if progress is not None:
-            progress(record)
-
+    built, failed = _run(executor, task_fn, todo, progress)
     files: dict[str, str] = {}
     if finalize:
         files = finalize_dataset(out, config, data_dir=data_dir)
@@ -401,9 +388,84 @@ def build_dataset(
         skipped=tuple(skipped),
         failed=tuple(sorted(failed, key=lambda f: f.sample_id)),
         seconds=time.perf_counter() - start,
-        finalized=finalize,
+        finalized=bool(files),
         files=files,
     )
+
+
+def _prepare(
+    out: Path, config: DatasetConfig, *, only: Sequence[str] | str | None,
+    data_dir: str | os.PathLike[str] | None, render_threads: int | None, rebuild: bool,
+) -> tuple[list[SampleTask], list[SampleOutcome]]:
+    """Check *out*, split the planned samples into to-build and intact, then mark the folder.
+
+    Everything that can refuse the build runs before the first write.
+    """
+    from spectrinsic.gt_export.integrity import (
+        check_build_folder,
+        remove_owned_temporaries,
+        remove_sample,
+        replaceable_sample,
+        sample_problem,
+        write_marker,
+    )
+
+    config_hash = config.config_hash()
+    previous = check_build_folder(out, config_hash, rebuild=rebuild)
+    kw: dict[str, Any] = {"data_dir": data_dir, "render_threads": render_threads}
+    tasks = plan_samples(out, config, only=only, **kw)
+    if previous is not None and previous != config_hash:
+        # --rebuild: every sample of the old config present on disk is rebuilt too
+        chosen = {t.sample_id for t in tasks}
+        tasks += [t for t in plan_samples(out, config, **kw)
+                  if t.sample_id not in chosen and (out / t.sample_id).exists()]
+    todo, skipped, stale = [], [], []
+    for t in tasks:
+        folder = out / t.sample_id
+        problem = sample_problem(folder, config_hash)
+        if problem is None:
+            skipped.append(SampleOutcome(t.sample_id, "skipped", str(folder)))
+            continue
+        replaceable_sample(folder)  # refuses a folder (or a file in it) spectrinsic did not write
+        if problem != "absent":
+            log.warning("sample %s: %s; re-rendering it", t.sample_id, problem)
+            stale.append(folder)
+        todo.append(t)
+    write_marker(out, config_hash)
+    for path in remove_owned_temporaries(out):
+        log.info("removed %s, left by an interrupted build", path.name)
+    if previous is not None and previous != config_hash:
+        log.warning("--rebuild: removing %d sample(s) built with config %s", len(stale), previous[:12])
+        for folder in stale:
+            remove_sample(folder)  # no old-config sample survives a failed re-render
+    return todo, skipped
+
+
+def _run(
+    executor: Executor,
+    task_fn: Callable[[SampleTask], SampleOutcome],
+    todo: list[SampleTask],
+    progress: Callable[[SampleOutcome | SampleFailure], None] | None,
+) -> tuple[list[SampleOutcome], list[SampleFailure]]:
+    """Run the tasks; a failed sample does not stop the others, a full disk stops them all."""
+    from spectrinsic.errors import DiskFullError
+
+    built: list[SampleOutcome] = []
+    failed: list[SampleFailure] = []
+    for task, outcome in executor.map_unordered(task_fn, todo):
+        if isinstance(outcome, DiskFullError):
+            raise outcome  # every further sample would fail the same way
+        record: SampleOutcome | SampleFailure
+        if isinstance(outcome, BaseException):
+            record = SampleFailure(task.sample_id, f"{type(outcome).__name__}: {outcome}")
+            log.error("sample %s failed: %s", task.sample_id, record.error)
+            failed.append(record)
+        else:
+            record = outcome
+            built.append(outcome)
+        if progress is not None:
+            progress(record)
+    return built, failed
 
 
 def finalize_dataset(
@@ -412,10 +474,24 @@ def finalize_dataset(
     *,
     data_dir: str | os.PathLike[str] | None = None,
 ) -> dict[str, str]:
-    """Write ``manifest.json``, ``DATASET.md`` and the gallery; return their paths by kind."""
-    from spectrinsic.gt_export import build_gallery, write_dataset_card, write_manifest
+    """Write ``manifest.json``, ``DATASET.md`` and the gallery; return their paths by kind.
+
+    First removes spectrinsic's temporaries, whichever worker left them (all have finished).
+    A folder without any complete sample gets nothing (``{}``): no empty manifest.
+    """
+    from spectrinsic.gt_export import (
+        build_gallery,
+        remove_stale_temporaries,
+        sample_dirs,
+        write_dataset_card,
+        write_manifest,
+    )
 
     out = Path(out_dir)
+    for path in remove_stale_temporaries(out):
+        log.info("removed %s, left by a worker that died", path.name)
+    if not sample_dirs(out):
+        return {}
     cfg = config.to_dict()
     manifest = write_manifest(out, cfg, data_dir=data_dir)
     card = write_dataset_card(out, cfg)

@@ -18,6 +18,8 @@ __all__ = [
     "SceneError",
     "RenderError",
     "DatasetError",
+    "WriteError",
+    "DiskFullError",
     "MissingDependencyError",
     "SpectrinsicWarning",
     "validate_choice",
@@ -54,6 +56,15 @@ class RenderError(SpectrinsicError, RuntimeError):
 
 class DatasetError(SpectrinsicError, RuntimeError):
     """A dataset folder that is incomplete, corrupt or inconsistent with its manifest."""
+
+
+class WriteError(DatasetError):
+    """An output file that could not be written (permission denied, read-only file system...)."""
+
+
+class DiskFullError(WriteError):
+    """No space left (``ENOSPC``, ``EDQUOT``): every further sample would fail the same way,
+    so a dataset build stops at the first one."""
 
 
 class MissingDependencyError(SpectrinsicError, ImportError):

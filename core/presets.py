@@ -2,8 +2,8 @@
 
 A config holds every setting that changes the files of a sample (resolution, samples per pixel,
 render modes, passes, seed). Its hash (:meth:`DatasetConfig.config_hash`) is the SHA-256 of
-canonical JSON of those settings, the preset name and the versions of the software that
-computes the pixels; a sample folder is reused only when the hash in its ``meta.json``
+canonical JSON of those settings, the preset name, spectrinsic's pixel version and the versions
+of the software that computes the pixels (:func:`software_versions`); a sample folder is reused only when the hash in its ``meta.json``
 matches. How the build is run (workers, threads, scheduler, which samples) never enters it.
 """
 
@@ -20,6 +20,7 @@ __all__ = [
     "PRESETS",
     "RENDER_MODES",
     "HASHED_PACKAGES",
+    "PIXELS_VERSION",
     "preset_names",
     "get_preset",
     "software_versions",
@@ -31,13 +32,26 @@ RENDER_MODES: tuple[str, ...] = ("spectral", "rgb3", "gauss3", "rgb6", "bands31"
 #: it measures, and the spectral Monte Carlo render.
 _STANDARD_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
 
-#: Distributions whose versions change rendered or derived pixels, hence enter the config hash.
-HASHED_PACKAGES: tuple[str, ...] = ("spectrinsic", "mitsuba", "drjit", "colour-science", "numpy")
+#: Version of spectrinsic's own computation of pixels and ground truth. Bump it whenever a
+#: change alters any written value (a new or changed layer, formula, sampling or file layout),
+#: so existing datasets are rebuilt; a release that changes none keeps old datasets valid.
+PIXELS_VERSION = 1
+#: What of the installed software changes pixels, hence enters the config hash, and how much
+#: of its version: the renderer exactly (its sampling changes between patch releases);
+#: colour-science's data tables (CMFs, illuminants, cameras) by minor release; numpy by major
+#: release (type promotion rules). Other packages and patch releases do not enter it, so a
+#: fresh environment with the tested versions (constraints.txt) keeps a dataset complete.
+HASHED_PACKAGES: dict[str, int | None] = {"mitsuba": None, "drjit": None, "colour-science": 2, "numpy": 1}
 
 
 def software_versions() -> dict[str, str]:
-    """Installed versions of :data:`HASHED_PACKAGES` (``"absent"`` when one is absent)."""
-    return provenance.software_versions(HASHED_PACKAGES, python=False)
+    """:data:`PIXELS_VERSION` and the versions of :data:`HASHED_PACKAGES`, each cut to the
+    parts that change pixels (``"absent"`` when a package is absent)."""
+    installed = provenance.software_versions(HASHED_PACKAGES, python=False)
+    out = {"spectrinsic-pixels": str(PIXELS_VERSION)}
+    for name, parts in HASHED_PACKAGES.items():
+        out[name] = installed[name] if parts is None else ".".join(installed[name].split(".")[:parts])
+    return out
 
 
 @dataclass(frozen=True)

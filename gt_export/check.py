@@ -4,9 +4,14 @@ Checks, per sample: ``meta.json`` readable; every listed file present; every lay
 with the recorded shape; no NaN or Inf anywhere; no negative values in layers marked
 non-negative; ids integral and >= -1; mask 0/1; every identity ``meta.json`` records,
 ``image = reflectance ∘ shading + residual`` per sensor space, and
-``image = reflectance ∘ shading_ratio`` wherever reflectance is non-zero. Per dataset:
-``manifest.json`` present, its samples present, and the SHA-256 of every file matching.
-Noise: :func:`noise_report` lists the samples whose measured noise exceeds a threshold.
+``image = reflectance ∘ shading_ratio`` wherever reflectance is non-zero; every file matching
+the SHA-256 its ``meta.json`` records. Per dataset: ``manifest.json`` present, its samples
+present, every sample built with the manifest's config hash, and the SHA-256 of every file
+matching. Noise: :func:`noise_report` lists the samples whose measured noise exceeds a threshold.
+
+A ``meta.json`` or ``manifest.json`` that does not have spectrinsic's structure (a manifest that is
+not an object, a layer record without ``file``, a file entry leading outside its sample folder)
+cannot be checked at all: that raises a one-line :class:`~spectrinsic.errors.DatasetError`.
 """
 
 from __future__ import annotations
@@ -20,14 +25,16 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export.layers import REFLECTANCE_FLOOR
-from spectrinsic.gt_export.writer import (
+from spectrinsic.gt_export.integrity import (
+    HASHES_KEY,
     MANIFEST_NAME,
     META_NAME,
     TMP_PREFIX,
+    confined_path,
     file_sha256,
-    sample_dirs,
 )
+from spectrinsic.gt_export.layers import REFLECTANCE_FLOOR
+from spectrinsic.gt_export.writer import sample_dirs
 
 __all__ = ["check_dataset", "check_sample", "noise_report", "IDENTITY_RTOL", "NOISE_THRESHOLD"]
 
@@ -100,8 +107,54 @@ def _layer_problems(key: str, rec: Mapping[str, Any], data: np.ndarray) -> list[
     return out
 
 
+def _malformed(path: Path, field: str, expected: str) -> DatasetError:
+    return DatasetError(f"{path}: {field}: expected {expected}; not a spectrinsic file")
+
+
+def _check_meta_structure(sample: Path, meta: Any) -> None:
+    """Raise a one-line error if *meta* is not shaped like a ``meta.json`` spectrinsic writes."""
+    path = sample / META_NAME
+    if not isinstance(meta, dict):
+        raise _malformed(path, "top level", f"a JSON object, got {type(meta).__name__}")
+    files = meta.get("files", [])
+    if not isinstance(files, list):
+        raise _malformed(path, "files", "a list of paths inside the sample folder")
+    for rel in files:
+        if confined_path(sample, rel) is None:
+            raise _malformed(path, "files", f"paths inside the sample folder, got {rel!r}")
+    layers = meta.get("layers", {})
+    if not isinstance(layers, dict):
+        raise _malformed(path, "layers", "an object of layer records")
+    for key, rec in layers.items():
+        if not isinstance(rec, dict):
+            raise _malformed(path, f"layers.{key}", "an object")
+        for field in ("file", "exr_layer"):
+            if not isinstance(rec.get(field), str):
+                raise _malformed(path, f"layers.{key}.{field}", "a string")
+        if confined_path(sample, rec["file"]) is None:
+            raise _malformed(path, f"layers.{key}.file", f"a file inside the sample folder, got {rec['file']!r}")
+
+
+def _file_problems(sample: Path, meta: Mapping[str, Any]) -> list[str]:
+    """Listed files missing, or not matching the SHA-256 that ``meta.json`` records."""
+    hashes = meta.get(HASHES_KEY) if isinstance(meta.get(HASHES_KEY), dict) else {}
+    problems = []
+    for rel in meta.get("files", []):
+        if not (sample / rel).is_file():
+            problems.append(f"file {rel!r} listed in meta.json is missing")
+        elif rel in hashes and file_sha256(sample / rel) != hashes[rel]:
+            problems.append(f"file {rel!r} does not match its SHA-256 in {META_NAME}")
+    return problems
+
+
 def check_sample(sample: str | os.PathLike[str]) -> list[str]:
-    """Problems of one sample folder (empty list: fine). Messages do not repeat the sample id."""
+    """Problems of one sample folder (empty list: fine). Messages do not repeat the sample id.
+
+    Raises
+    ------
+    DatasetError
+        If ``meta.json`` is JSON but not shaped like spectrinsic's (see the module notes).
+    """
     from spectrinsic.gt_export.exr import read_exr
 
     sample = Path(sample)
@@ -109,8 +162,8 @@ def check_sample(sample: str | os.PathLike[str]) -> list[str]:
         meta = json.loads((sample / META_NAME).read_text(encoding="utf-8"))
     except (OSError, ValueError) as exc:
         return [f"{META_NAME} cannot be read ({exc})"]
-    problems = [f"file {f!r} listed in meta.json is missing"
-                for f in meta.get("files", []) if not (sample / f).is_file()]
+    _check_meta_structure(sample, meta)
+    problems = _file_problems(sample, meta)
     records: dict[str, Any] = meta.get("layers", {})
     for required in ("image", "reflectance", "shading", "illuminant"):
         if required not in records:
@@ -149,6 +202,9 @@ def check_dataset(
     root = Path(dataset_dir)
     if not root.is_dir():
         return [f"<dataset>: folder {str(root)!r} does not exist"]
+    manifest, unreadable = _read_manifest(root)
+    # a manifest of the wrong shape stops the check before the (slow) per-sample checks
+    listed = _manifest_samples(root, manifest) if unreadable is None else {}
     problems: list[str] = []
     samples = sample_dirs(root)
     if not samples:
@@ -159,22 +215,73 @@ def check_dataset(
         problems.extend(f"{sample.name}: {p}" for p in check_sample(sample))
         if progress is not None:
             progress(sample.name)
+    if unreadable is not None:
+        return [*problems, f"<dataset>: {unreadable}"]
+    problems.extend(_config_problems(manifest, listed, samples))
+    problems.extend(_manifest_problems(root, listed, samples))
+    return problems
+
+
+def _read_manifest(root: Path) -> tuple[Any, str | None]:
+    """The parsed ``manifest.json``, or ``(None, why it cannot be read)``."""
     try:
-        manifest = json.loads((root / MANIFEST_NAME).read_text(encoding="utf-8"))
+        return json.loads((root / MANIFEST_NAME).read_text(encoding="utf-8")), None
     except OSError:
-        problems.append(f"<dataset>: {MANIFEST_NAME} is missing")
-        return problems
+        return None, f"{MANIFEST_NAME} is missing"
     except ValueError as exc:
-        problems.append(f"<dataset>: {MANIFEST_NAME} is not valid JSON ({exc})")
-        return problems
-    listed: dict[str, Any] = manifest.get("samples", {})
+        return None, f"{MANIFEST_NAME} is not valid JSON ({exc})"
+
+
+def _manifest_samples(root: Path, manifest: Any) -> dict[str, dict[str, Any]]:
+    """The manifest's ``samples`` after checking its structure (one-line error if malformed)."""
+    path = root / MANIFEST_NAME
+    if not isinstance(manifest, dict):
+        raise _malformed(path, "top level", f"a JSON object, got {type(manifest).__name__}")
+    listed = manifest.get("samples", {})
+    if not isinstance(listed, dict):
+        raise _malformed(path, "samples", "an object of sample records")
+    for name, record in listed.items():
+        files = record.get("files", {}) if isinstance(record, dict) else None
+        if not isinstance(files, dict):
+            raise _malformed(path, f"samples.{name}", "an object with a 'files' object")
+        for rel in files:
+            inside = rel.startswith(f"{name}/") and confined_path(root / name, rel[len(name) + 1:])
+            if not inside:
+                raise _malformed(path, f"samples.{name}.files", f"paths inside {name}/, got {rel!r}")
+    return listed
+
+
+def _config_problems(
+    manifest: Mapping[str, Any], listed: Mapping[str, Any], samples: list[Path]
+) -> list[str]:
+    """Samples whose config hash (in ``meta.json`` or the manifest) is not the dataset's."""
+    expected = manifest.get("config_hash")
+    problems = []
+    for sample in samples:
+        try:
+            own = json.loads((sample / META_NAME).read_text(encoding="utf-8")).get("config_hash")
+        except (OSError, ValueError, AttributeError):
+            continue  # reported by check_sample
+        if own != expected:
+            problems.append(f"{sample.name}: built with config hash {str(own)[:12]}, but "
+                            f"{MANIFEST_NAME} describes config hash {str(expected)[:12]}")
+        recorded = listed.get(sample.name, {}).get("config_hash", expected)
+        if recorded != expected:
+            problems.append(f"{sample.name}: {MANIFEST_NAME} lists it with config hash "
+                            f"{str(recorded)[:12]}, not the dataset's {str(expected)[:12]}")
+    return problems
+
+
+def _manifest_problems(root: Path, listed: Mapping[str, Any], samples: list[Path]) -> list[str]:
+    """Samples missing from the manifest or the disk, and files not matching their SHA-256."""
+    problems = []
     on_disk = {s.name for s in samples}
     for name in sorted(set(listed) - on_disk):
         problems.append(f"{name}: listed in {MANIFEST_NAME} but missing or incomplete")
     for name in sorted(on_disk - set(listed)):
         problems.append(f"{name}: present but not listed in {MANIFEST_NAME}")
     for name in sorted(set(listed) & on_disk):
-        expected = listed[name].get("files", {})
+        expected = listed[name]["files"]
         actual = {p.relative_to(root).as_posix() for p in (root / name).rglob("*") if p.is_file()}
         for rel in sorted(actual - set(expected)):
             problems.append(f"{name}: file {rel!r} is not in {MANIFEST_NAME}")

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export.integrity import guarded_write
 
 __all__ = ["write_exr", "read_exr", "read_exr_attributes", "default_channel_names"]
 
@@ -123,7 +124,8 @@ def write_exr(
     for key, value in (attributes or {}).items():
         header[str(key)] = str(value)
     path = Path(path)
-    OpenEXR.File(header, channels).write(str(path))
+    with guarded_write(path):
+        OpenEXR.File(header, channels).write(str(path))
     return path
 
 

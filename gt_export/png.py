@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export.integrity import guarded_write
 
 __all__ = [
     "EXPOSURE_PERCENTILE",
@@ -118,5 +119,6 @@ def write_png(path: str | os.PathLike[str], rgb8: np.ndarray) -> Path:
     if rgb8.dtype != np.uint8 or rgb8.ndim not in (2, 3):
         raise DatasetError(f"PNG {str(path)!r}: expected (H, W[, 3]) uint8, got {rgb8.dtype} {rgb8.shape}")
     path = Path(path)
-    Image.fromarray(np.ascontiguousarray(rgb8)).save(path, format="PNG", optimize=False)
+    with guarded_write(path):
+        Image.fromarray(np.ascontiguousarray(rgb8)).save(path, format="PNG", optimize=False)
     return path

@@ -31,6 +31,18 @@ import numpy as np
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import png
 from spectrinsic.gt_export.exr import write_exr
+from spectrinsic.gt_export.integrity import (
+    HASHES_KEY,
+    MANIFEST_NAME,
+    META_NAME,
+    TMP_PREFIX,
+    file_hashes,
+    file_sha256,
+    guarded_write,
+    remove_owned_temporaries,
+    replaceable_sample,
+    sample_problem,
+)
 from spectrinsic.gt_export.layers import GroundTruth, Layer, compute_ground_truth, identities
 from spectrinsic.provenance import software_versions
 from spectrinsic.scenes.model import Scene, scene_hash
@@ -56,14 +68,10 @@ __all__ = [
 log = logging.getLogger(__name__)
 
 FORMAT_VERSION = 1
-META_NAME = "meta.json"
 #: The rendered scene as plain data (:func:`spectrinsic.scenes.model.scene_to_dict`), compact JSON.
 SCENE_NAME = "scene.json"
-MANIFEST_NAME = "manifest.json"
 CARD_NAME = "DATASET.md"
 PREVIEW_DIR = "previews"
-#: Prefix of the temporary folders a sample is written into before the rename.
-TMP_PREFIX = ".tmp-"
 #: Cameras exported by default when the 31-band cube is available (shipped by colour-science).
 DEFAULT_CAMERAS: tuple[str, ...] = ("camera:Nikon 5100 (NPL)", "camera:Sigma SDMerill (NPL)")
 #: Significant digits of every float in ``meta.json`` (fitted matrices, light colours, noise
@@ -108,8 +116,9 @@ def _dump_json(path: Path, data: Any, *, compact: bool = False, digits: int | No
     files, which the json module's C encoder then writes (it is bypassed whenever indenting).
     *digits* rounds every float to that many significant digits."""
     layout: dict[str, Any] = {"separators": (",", ":")} if compact else {"indent": 2}
-    text = json.dumps(_jsonable(data, digits), sort_keys=True, ensure_ascii=False, **layout)
-    path.write_text(text + "\n", encoding="utf-8")
+    text = json.dumps(_jsonable(data, digits), sort_keys=True, ensure_ascii=False, **layout) + "\n"
+    with guarded_write(path):
+        path.write_text(text, encoding="utf-8")
 
 
 def config_hash(config: Mapping[str, Any]) -> str:
@@ -128,15 +137,6 @@ def config_hash(config: Mapping[str, Any]) -> str:
         return own
     blob = json.dumps(_jsonable(config), sort_keys=True, separators=(",", ":"), ensure_ascii=False)
     return hashlib.sha256(blob.encode("utf-8")).hexdigest()
-
-
-def file_sha256(path: str | os.PathLike[str]) -> str:
-    """SHA-256 hex digest of a file's bytes."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for chunk in iter(lambda: fh.read(1 << 20), b""):
-            digest.update(chunk)
-    return digest.hexdigest()
 
 
 # ----------------------------------------------------------------------------------------------
@@ -314,9 +314,11 @@ def _fill_folder(folder: Path, scene: Scene, result: Any, gt: GroundTruth, **met
     # converts its vertex and face arrays whole rather than element by element
     _dump_json(folder / SCENE_NAME, scene, compact=True)
     files.append(SCENE_NAME)
-    # meta.json last: its presence (with the right config hash) marks the folder complete
-    _dump_json(folder / META_NAME, _meta(scene, result, gt, previews=previews, files=files, **meta_kw),
-               digits=META_DIGITS)
+    # meta.json last: its presence (with the right config hash) marks the folder complete; it
+    # records the SHA-256 of every other file, so a resumed build can tell an intact sample
+    meta = _meta(scene, result, gt, previews=previews, files=files, **meta_kw)
+    meta[HASHES_KEY] = file_hashes(folder, files)
+    _dump_json(folder / META_NAME, meta, digits=META_DIGITS)
 
 
 def export_sample(
@@ -385,8 +387,10 @@ def export_sample(
 
 
 def _move_into_place(tmp: Path, final: Path, chash: str) -> None:
-    if final.exists():
-        # an older or foreign version: move it aside first, so no moment shows a mixed folder
+    if final.exists() or final.is_symlink():
+        # an older version: move it aside first, so no moment shows a mixed folder; a folder
+        # spectrinsic did not write (or one holding a user's file) is never replaced
+        replaceable_sample(final)
         aside = final.with_name(f"{TMP_PREFIX}old-{final.name}-{uuid.uuid4().hex[:8]}")
         final.rename(aside)
         shutil.rmtree(aside, ignore_errors=True)
@@ -401,15 +405,9 @@ def _move_into_place(tmp: Path, final: Path, chash: str) -> None:
 
 
 def is_complete(sample_dir: str | os.PathLike[str], config_hash: str) -> bool:
-    """True iff *sample_dir* holds a ``meta.json`` with this *config_hash* and all its files."""
-    sample_dir = Path(sample_dir)
-    try:
-        meta = json.loads((sample_dir / META_NAME).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return False
-    if not isinstance(meta, dict) or meta.get("config_hash") != config_hash:
-        return False
-    return all((sample_dir / f).is_file() for f in meta.get("files", []))
+    """True iff *sample_dir* holds a ``meta.json`` with this *config_hash* and all its files,
+    each matching its recorded SHA-256 (see :func:`~spectrinsic.gt_export.integrity.sample_problem`)."""
+    return sample_problem(sample_dir, config_hash) is None
 
 
 def sample_dirs(dataset_dir: str | os.PathLike[str]) -> list[Path]:
@@ -422,15 +420,12 @@ def sample_dirs(dataset_dir: str | os.PathLike[str]) -> list[Path]:
 
 
 def remove_stale_temporaries(dataset_dir: str | os.PathLike[str]) -> list[Path]:
-    """Delete temporary folders left by interrupted writes; return what was removed.
+    """Delete spectrinsic's temporaries left by interrupted writes; return what was removed.
 
-    Call it only when no other writer works on *dataset_dir*.
+    Only names starting with :data:`TMP_PREFIX`, and only in a recognised dataset folder. Call
+    it only when no other writer works on *dataset_dir*.
     """
-    root = Path(dataset_dir)
-    stale = sorted(p for p in root.glob(f"{TMP_PREFIX}*") if p.is_dir()) if root.is_dir() else []
-    for path in stale:
-        shutil.rmtree(path, ignore_errors=True)
-    return stale
+    return remove_owned_temporaries(Path(dataset_dir))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -590,5 +585,6 @@ def write_dataset_card(
         variants=", ".join(sorted({str(m.get("variant")) for m in metas})),
     )
     path = root / CARD_NAME
-    path.write_text(text, encoding="utf-8")
+    with guarded_write(path):
+        path.write_text(text, encoding="utf-8")
     return path

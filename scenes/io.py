@@ -1,7 +1,9 @@
 """Scene files: a human-editable YAML format <-> :class:`~spectrinsic.scenes.model.Scene`.
 
-Files are read with ``yaml.safe_load`` only (no Python object tags). Every problem is a
-one-line :class:`~spectrinsic.errors.SceneError` ``"<file>: <field>: <problem>"``.
+Files are read with a ``yaml.SafeLoader`` (no Python object tags) bounded in size, nesting and
+alias expansion, rejecting duplicate keys (:mod:`spectrinsic.scenes.yaml_limits`). Problems are
+one-line :class:`~spectrinsic.errors.SceneError` ``"<file>: <field>: <problem>"``; a file with
+several mistakes reports all of them in that one line, separated by ``;``.
 
 Format (version 1; the full reference with an example is ``scenes/FORMAT.md``)::
 
@@ -60,7 +62,7 @@ import numpy as np
 from spectrinsic.errors import SceneError, did_you_mean
 from spectrinsic.scenes.geometry import Part, moved
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene, scene_to_dict
-from spectrinsic.scenes.validate import LIGHT_KINDS, validate_scene
+from spectrinsic.scenes.validate import LIGHT_KINDS, Problems, validate_scene
 
 __all__ = [
     "FORMAT_VERSION",
@@ -104,18 +106,21 @@ class _Doc:
         self, value: Any, field: str, allowed: tuple[str, ...], required: tuple[str, ...] = ()
     ) -> dict:
         if not isinstance(value, dict):
-            raise self.fail(field, f"expected a mapping, got {type(value).__name__}")
+            raise self.fail(field or "top level", f"expected a mapping, got {type(value).__name__}")
+        problems = Problems(self.source)
         for key in value:
             if key not in allowed:
-                raise self.fail(
-                    f"{field}.{key}" if field else str(key),
-                    f"unknown key; expected one of {', '.join(allowed)}"
-                    + did_you_mean(str(key), allowed),
-                )
+                problems.get(self._raise, f"{field}.{key}" if field else str(key),
+                             f"unknown key; expected one of {', '.join(allowed)}"
+                             + did_you_mean(str(key), allowed))
         for key in required:
             if key not in value:
-                raise self.fail(f"{field}.{key}" if field else key, "missing required key")
+                problems.get(self._raise, f"{field}.{key}" if field else key, "missing required key")
+        problems.raise_if_any()
         return value
+
+    def _raise(self, field: str, problem: str) -> None:
+        raise self.fail(field, problem)
 
     def string(self, value: Any, field: str) -> str:
         if not isinstance(value, str) or not value.strip():
@@ -194,10 +199,12 @@ def _read_mesh_file(doc: _Doc, path: Path, field: str) -> tuple[np.ndarray, np.n
 
 
 def _face_materials(
-    doc: _Doc, entry: dict, field: str, n_faces: int, materials: dict[str, int]
+    doc: _Doc, entry: dict, field: str, n_faces: int, materials: dict[str, int] | None
 ) -> np.ndarray:
     def index(name: Any, where: str) -> int:
         name = doc.string(name, where)
+        if materials is None:
+            return 0  # the materials themselves are reported broken
         if name not in materials:
             raise doc.fail(
                 where,
@@ -238,7 +245,7 @@ def _face_materials(
     return out
 
 
-def _mesh(doc: _Doc, base: Path, entry: Any, i: int, materials: dict[str, int]) -> Mesh:
+def _mesh(doc: _Doc, base: Path, entry: Any, i: int, materials: dict[str, int] | None) -> Mesh:
     field = f"meshes[{i}]"
     entry = doc.mapping(entry, field, _MESH, ("name",))
     name = doc.string(entry["name"], f"{field}.name")
@@ -347,37 +354,53 @@ def scene_from_dict(data: Any, *, base: str | os.PathLike[str], source: str = "<
     Only the structure and types are checked here; see :func:`load_scene` for validation.
     """
     doc = _Doc(source)
-    data = doc.mapping(data, "", _TOP, ("name", "materials", "meshes", "lights", "camera"))
+    problems = Problems(source)
+    if not isinstance(data, dict):
+        raise doc.fail("top level", f"expected a mapping, got {type(data).__name__}")
+    problems.get(doc.mapping, data, "", _TOP, ("name", "materials", "meshes", "lights", "camera"))
     if data.get("format", FORMAT_VERSION) != FORMAT_VERSION:
-        raise doc.fail(
-            "format", f"unsupported format version {data['format']!r}; expected {FORMAT_VERSION}"
-        )
-    mats = data["materials"]
+        problems.get(doc._raise, "format",
+                     f"unsupported format version {data['format']!r}; expected {FORMAT_VERSION}")
+    materials = problems.get(_materials, doc, data.get("materials"))
+    # without sound materials, every mesh would also report its material as unknown
+    lookup = None if materials is None else {m.name: i for i, m in enumerate(materials)}
+    meshes = [problems.get(_mesh, doc, Path(base), m, i, lookup)
+              for i, m in enumerate(problems.get(_entries, doc, data, "meshes") or [])]
+    lights = [problems.get(_light, doc, x, i)
+              for i, x in enumerate(problems.get(_entries, doc, data, "lights") or [])]
+    camera = problems.get(_camera, doc, data["camera"]) if "camera" in data else None
+    name = problems.get(doc.string, data.get("name"), "name") if "name" in data else None
+    metadata = data.get("metadata", {}) or {}
+    if not isinstance(metadata, dict):
+        problems.get(doc._raise, "metadata", f"expected a mapping, got {type(metadata).__name__}")
+    problems.raise_if_any()
+    return Scene(
+        name=name,  # type: ignore[arg-type]  # None only when a problem was raised above
+        meshes=tuple(meshes),  # type: ignore[arg-type]
+        materials=materials,  # type: ignore[arg-type]
+        lights=tuple(lights),  # type: ignore[arg-type]
+        camera=camera,  # type: ignore[arg-type]
+        metadata=metadata,
+    )
+
+
+def _materials(doc: _Doc, mats: Any) -> tuple[Material, ...]:
     if not isinstance(mats, dict) or not mats:
         raise doc.fail(
             "materials", "expected a non-empty mapping of material name -> spectrum name"
         )
-    materials = tuple(
+    return tuple(
         Material(name=doc.string(k, "materials"), spectrum=doc.string(v, f"materials.{k}"))
         for k, v in mats.items()
     )
-    lookup = {m.name: i for i, m in enumerate(materials)}
-    for key in ("meshes", "lights"):
-        if not isinstance(data[key], list) or not data[key]:
-            raise doc.fail(key, f"expected a non-empty list, got {data[key]!r}")
-    meshes = tuple(_mesh(doc, Path(base), m, i, lookup) for i, m in enumerate(data["meshes"]))
-    lights = tuple(_light(doc, x, i) for i, x in enumerate(data["lights"]))
-    metadata = data.get("metadata", {}) or {}
-    if not isinstance(metadata, dict):
-        raise doc.fail("metadata", f"expected a mapping, got {type(metadata).__name__}")
-    return Scene(
-        name=doc.string(data["name"], "name"),
-        meshes=meshes,
-        materials=materials,
-        lights=lights,
-        camera=_camera(doc, data["camera"]),
-        metadata=metadata,
-    )
+
+
+def _entries(doc: _Doc, data: dict, key: str) -> list[Any]:
+    if key not in data:
+        return []  # reported as a missing required key
+    if not isinstance(data[key], list) or not data[key]:
+        raise doc.fail(key, f"expected a non-empty list, got {data[key]!r}")
+    return data[key]
 
 
 def load_scene(
@@ -400,21 +423,11 @@ def load_scene(
     SceneError
         One line naming the file and the field.
     """
-    import yaml
+    from spectrinsic.scenes.yaml_limits import load_yaml_file
 
     path = Path(path)
     source = str(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SceneError(f"{source}: cannot read scene file ({type(exc).__name__}: {exc})") from exc
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f"line {mark.line + 1}" if mark is not None else "YAML"
-        problem = " ".join(str(getattr(exc, "problem", None) or exc).split())
-        raise SceneError(f"{source}: {where}: invalid YAML ({problem})") from exc
+    data = load_yaml_file(path)
     scene = scene_from_dict(data, base=path.parent, source=source)
     if validate:
         validate_scene(scene, source=source, data_dir=data_dir)

@@ -20,7 +20,8 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import TypeVar
 
 import numpy as np
 
@@ -31,6 +32,7 @@ __all__ = [
     "LIGHT_KINDS",
     "VISIBILITY_GRID",
     "validate_scene",
+    "Problems",
     "camera_rays",
     "winding_numbers",
     "is_closed",
@@ -45,6 +47,37 @@ VISIBILITY_GRID = 16
 #: 0 outside for a closed outward-oriented surface; overlapping parts add up).
 _INSIDE_WINDING = 0.5
 _RAY_BATCHES = 16
+
+
+T = TypeVar("T")
+
+
+class Problems:
+    """Collects the errors of a scene's independent parts, so one run reports all of them.
+
+    Each part runs through :meth:`get`; a :class:`SceneError` there is recorded and ``None``
+    returned. :meth:`raise_if_any` then raises one one-line error listing every problem.
+    """
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+        self.messages: list[str] = []
+
+    def get(self, fn: Callable[..., T], *args: object) -> T | None:
+        """``fn(*args)``, or ``None`` after recording its SceneError."""
+        try:
+            return fn(*args)
+        except SceneError as exc:
+            message = str(exc)
+            self.messages.append(message.removeprefix(f"{self.source}: "))
+            return None
+
+    def raise_if_any(self) -> None:
+        """Raise ``"<source>: <problem>"``, or ``"<source>: N problems: a; b; ..."``."""
+        if len(self.messages) == 1:
+            raise SceneError(f"{self.source}: {self.messages[0]}")
+        if self.messages:
+            raise SceneError(f"{self.source}: {len(self.messages)} problems: " + "; ".join(self.messages))
 
 
 def _fail(source: str, field: str, problem: str) -> SceneError:
@@ -367,27 +400,23 @@ def validate_scene(
     ------
     SceneError
         ``"<source>: <field>: <problem>"``, e.g.
-        ``"room.yaml: lights[1].power: must be a finite number > 0, got 0.0"``.
+        ``"room.yaml: lights[1].power: must be a finite number > 0, got 0.0"``; several
+        problems of independent parts (meshes, lights, camera, each spectrum) are listed in
+        the one line.
     """
     source = source or f"scene {scene.name!r}"
-    _check_meshes(scene, source)
-    _check_lights(scene, source)
-    _check_camera(scene, source)
+    problems = Problems(source)
+    for check in (_check_meshes, _check_lights, _check_camera):
+        problems.get(check, scene, source)
     if check_spectra:
         cache: dict[str, object] = {}
         for i, mat in enumerate(scene.materials):
-            _check_spectrum(
-                source,
-                f"materials[{i}] ({mat.name!r}).spectrum",
-                mat.spectrum,
-                "reflectance",
-                data_dir,
-                cache,
-            )
+            problems.get(_check_spectrum, source, f"materials[{i}] ({mat.name!r}).spectrum",
+                         mat.spectrum, "reflectance", data_dir, cache)
         for i, light in enumerate(scene.lights):
-            _check_spectrum(
-                source, f"lights[{i}].spectrum", light.spectrum, "illuminant", data_dir, cache
-            )
-    if check_placement:
-        _check_placement(scene, source)
+            problems.get(_check_spectrum, source, f"lights[{i}].spectrum", light.spectrum,
+                         "illuminant", data_dir, cache)
+    if check_placement and not problems.messages:  # placement needs sound geometry
+        problems.get(_check_placement, scene, source)
+    problems.raise_if_any()
     return scene

@@ -63,8 +63,11 @@ def luxpy_data_file(*parts: str) -> Path:
 @functools.lru_cache(maxsize=1)
 def read_munsell() -> tuple[Table, tuple[tuple[str, float, float], ...]]:
     """The 1269 matte Munsell reflectances and their notations ``(hue, value, chroma)``."""
-    data = np.loadtxt(luxpy_data_file("rfls", "Munsell1269.dat"), delimiter=",")
+    source = luxpy_data_file("rfls", "Munsell1269.dat")
+    data = np.loadtxt(source, delimiter=",")
     wl, values = data[:, 0], data[:, 1:].T.copy()
+    if not (np.isfinite(values).all() and (values >= 0).all()):
+        raise SpectralDataError(f"{source}: expected finite reflectances >= 0")
     notations: list[tuple[str, float, float]] = []
     with luxpy_data_file("rfls", "Munsell1269NotationInfo.dat").open(newline="") as fh:
         reader = csv.reader(fh)
@@ -79,23 +82,74 @@ def read_munsell() -> tuple[Table, tuple[tuple[str, float, float], ...]]:
     return Table(wl, values, labels), tuple(notations)
 
 
-def read_spectra_csv(path: str | os.PathLike[str]) -> Table:
+def _read_rows(path: Path) -> list[list[str]]:
+    """The CSV rows of *path*, or a one-line error for bytes that are not UTF-8."""
+    try:
+        with path.open(newline="", encoding="utf-8") as fh:
+            return list(csv.reader(fh))
+    except UnicodeDecodeError as exc:
+        raise SpectralDataError(
+            f"{path}: byte {exc.start} (0x{exc.object[exc.start]:02x}) is not UTF-8; "
+            "expected a UTF-8 (or ASCII) CSV file"
+        ) from None
+    except csv.Error as exc:
+        raise SpectralDataError(f"{path}: malformed CSV ({exc})") from None
+
+
+def _first(mask: np.ndarray) -> tuple[int, int]:
+    """(row, column) of the first true cell of *mask*."""
+    row, col = np.argwhere(mask)[0]
+    return int(row), int(col)
+
+
+def _check_values(
+    path: Path, values: np.ndarray, empty: np.ndarray, labels: tuple[str, ...], *, missing: bool
+) -> None:
+    """Every spectral value finite (empty cells aside when *missing*) and >= 0: reflectances,
+    illuminant powers and sensitivities cannot be negative, and a NaN would reach the pixels."""
+    checks = (
+        (~empty & ~np.isfinite(values), "non-finite", "finite numbers"),
+        (empty if not missing else np.zeros_like(empty), "empty", "a number in every cell"),
+        (~empty & (np.nan_to_num(values) < 0), "negative", "values >= 0"),
+    )
+    for mask, problem, expected in checks:
+        if mask.any():
+            row, col = _first(mask)
+            where = "wavelength_nm" if col == 0 else labels[col - 1]
+            raise SpectralDataError(
+                f"{path}: {problem} value {values[row, col]:g} in row {row + 2}, column "
+                f"{where!r}; expected {expected}"
+            )
+
+
+def read_spectra_csv(path: str | os.PathLike[str], *, missing: bool = False) -> Table:
     """A CSV with a header row, first column ``wavelength_nm``, one column per spectrum.
 
-    Empty cells (not measured) are read as NaN.
+    Every value is validated at load time: finite, >= 0, wavelengths increasing. Empty cells
+    (not measured) are read as NaN when *missing* is true (camera tables that stop at 720 nm)
+    and are an error otherwise; a literal ``nan`` or ``inf`` always is.
+
+    Raises
+    ------
+    SpectralDataError
+        One line naming the file (and the row and column of a bad value).
     """
     path = Path(path)
-    with path.open(newline="", encoding="utf-8") as fh:
-        rows = list(csv.reader(fh))
+    rows = _read_rows(path)
     if len(rows) < 3:
         raise SpectralDataError(f"{path}: expected a header row and at least 2 wavelength rows")
-    header, body = rows[0], rows[1:]
+    header, body = rows[0], [r for r in rows[1:] if r]
+    if any(len(r) != len(header) for r in body):
+        raise SpectralDataError(f"{path}: a row has not {len(header)} columns like the header")
     try:
-        arr = np.array([[float(c) if c.strip() else np.nan for c in r] for r in body if r])
+        arr = np.array([[float(c) if c.strip() else np.nan for c in r] for r in body])
     except ValueError as exc:
         raise SpectralDataError(f"{path}: non-numeric value ({exc})") from None
+    empty = np.array([[not c.strip() for c in r] for r in body])
+    labels = tuple(h.strip() for h in header[1:])
+    _check_values(path, arr, empty, labels, missing=missing)
     wl = validate_wavelengths(arr[:, 0], what=str(path))
-    return Table(wl, arr[:, 1:].T.copy(), tuple(h.strip() for h in header[1:]))
+    return Table(wl, arr[:, 1:].T.copy(), labels)
 
 
 @functools.lru_cache(maxsize=4)
@@ -130,7 +184,7 @@ def read_camera_table(data_dir: str | None, relative: str) -> dict[str, tuple[np
 
     Cells not measured (empty) become 0: they lie beyond ~760 nm where sensors hardly respond.
     """
-    table = read_spectra_csv(require_data_file(relative, data_dir))
+    table = read_spectra_csv(require_data_file(relative, data_dir), missing=True)
     cams: dict[str, tuple[np.ndarray, np.ndarray]] = {}
     for i in range(0, len(table.labels) - 2, 3):
         names = table.labels[i : i + 3]
@@ -147,8 +201,8 @@ def read_user_csv(path: str | os.PathLike[str], *, kind: str) -> Table:
     Raises
     ------
     SpectralDataError
-        On a missing file, an empty or non-increasing wavelength column, NaNs, or negative
-        values (sensitivities and reflectances cannot be negative).
+        On a missing file, bytes that are not UTF-8, an empty or non-increasing wavelength
+        column, empty cells, NaN/inf, or negative values (see :func:`read_spectra_csv`).
     """
     path = Path(path)
     if not path.is_file():
@@ -156,11 +210,4 @@ def read_user_csv(path: str | os.PathLike[str], *, kind: str) -> Table:
     table = read_spectra_csv(path)
     if table.values.size == 0:
         raise SpectralDataError(f"{path}: expected at least one {kind} column after the wavelengths")
-    if not np.all(np.isfinite(table.values)):
-        raise SpectralDataError(f"{path}: {kind} values must all be finite numbers")
-    if np.any(table.values < 0):
-        col = int(np.argwhere(table.values < 0)[0, 0])
-        raise SpectralDataError(
-            f"{path}: negative {kind} values in column {table.labels[col]!r}; expected values >= 0"
-        )
     return table

@@ -7,6 +7,7 @@ from typing import Literal
 
 import numpy as np
 
+from spectrinsic.errors import SpectralDataError
 from spectrinsic.spectra.grid import resample
 from spectrinsic.typing import SensorCurves, SpectralValues, Wavelengths
 
@@ -40,6 +41,22 @@ class Spectrum:
     values: SpectralValues
     source: str = field(default="", repr=False)
 
+    def __post_init__(self) -> None:
+        # validated wherever the data came from (package data, colour-science, a data
+        # directory): a NaN would reach the pixels, a negative value crash Mitsuba
+        values = np.asarray(self.values)
+        if values.shape != np.shape(self.wavelengths) or values.size == 0:
+            raise SpectralDataError(
+                f"spectrum {self.name!r}: {values.shape} values for {np.shape(self.wavelengths)} "
+                "wavelengths; expected one value per wavelength"
+            )
+        if not np.isfinite(values).all() or (values < 0).any():
+            raise SpectralDataError(
+                f"spectrum {self.name!r} ({self.source or 'no source'}): expected finite values "
+                f">= 0, got min {np.nanmin(values) if not np.isnan(values).all() else 'nan'}"
+                f"{' and NaN/inf' if not np.isfinite(values).all() else ''}"
+            )
+
     def on(self, wavelengths: Wavelengths) -> SpectralValues:
         """Values resampled onto *wavelengths* (nm), edge values held beyond the data."""
         return resample(self.wavelengths, self.values, wavelengths, outside="hold")
@@ -69,6 +86,10 @@ class SensorSet:
     wavelengths: Wavelengths
     curves: SensorCurves
     source: str = field(default="", repr=False)
+
+    def __post_init__(self) -> None:
+        if not np.isfinite(np.asarray(self.curves)).all():
+            raise SpectralDataError(f"sensor set {self.name!r} ({self.source}): NaN or inf in its curves")
 
     @property
     def n(self) -> int:

@@ -39,3 +39,22 @@ def square(item: FakeItem) -> tuple[int, int]:
 def failing_initializer() -> None:
     """A worker initializer that always fails."""
     raise RuntimeError("this worker cannot start")
+
+
+def parent_death_signal(item: FakeItem) -> int:
+    """The signal the kernel sends this worker when its parent dies (0: none), via
+    ``prctl(PR_GET_PDEATHSIG)``."""
+    import ctypes
+
+    value = ctypes.c_int(0)
+    ctypes.CDLL(None).prctl(2, ctypes.byref(value), 0, 0, 0)  # 2 = PR_GET_PDEATHSIG
+    return value.value
+
+
+def run_sleepers(marker_dir: str) -> None:
+    """Run two long tasks in a two-worker pool (for a parent killed with SIGKILL meanwhile)."""
+    from spectrinsic.executors import ProcessExecutor
+
+    items = [FakeItem(i, marker_dir, seconds=600.0) for i in range(2)]
+    for _ in ProcessExecutor(workers=2).map_unordered(square, items):
+        pass

@@ -127,3 +127,39 @@ def test_process_pool_gives_up_when_workers_cannot_start(fakes, tmp_path):
     assert sorted(out) == [0, 1, 2]
     assert all(isinstance(o, WorkerCrashedError) for o in out.values())
     assert not list(tmp_path.glob("start-*"))
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PR_SET_PDEATHSIG is Linux only")
+def test_pool_workers_ask_to_die_with_their_parent(fakes, tmp_path):
+    items = [fakes.FakeItem(i, str(tmp_path)) for i in range(2)]
+    out = _results(ProcessExecutor(workers=2).map_unordered(fakes.parent_death_signal, items))
+    assert set(out.values()) == {signal.SIGKILL}
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PR_SET_PDEATHSIG is Linux only")
+def test_kill_9_of_the_parent_kills_busy_workers(fakes, tmp_path):
+    """The parent is SIGKILLed while both workers sleep in 600-s tasks: they must go too."""
+    import subprocess
+
+    code = f"import dataset_fakes; dataset_fakes.run_sleepers({str(tmp_path)!r})"
+    parent = subprocess.Popen([sys.executable, "-P", "-c", code], env=os.environ.copy())
+    deadline = time.monotonic() + 120
+    while len(list(tmp_path.glob("start-*"))) < 2:
+        assert parent.poll() is None and time.monotonic() < deadline, "workers never started"
+        time.sleep(0.05)
+    pids = [int(p.name.rsplit("-", 1)[1]) for p in tmp_path.glob("start-*")]
+    os.kill(parent.pid, signal.SIGKILL)
+    parent.wait()
+    deadline = time.monotonic() + 60
+    while alive := [p for p in pids if _running(p)]:
+        assert time.monotonic() < deadline, f"workers {alive} outlived their parent"
+        time.sleep(0.05)
+
+
+def _running(pid: int) -> bool:
+    """True while *pid* exists and is not a zombie."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (OSError, IndexError):
+        return False
+    return state != "Z"

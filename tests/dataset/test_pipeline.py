@@ -21,6 +21,7 @@ from pathlib import Path
 import pytest
 
 from spectrinsic.dataset import build_dataset
+from spectrinsic.errors import DatasetError
 from spectrinsic.executors import ProcessExecutor
 from spectrinsic.gt_export import check_dataset, is_complete
 from spectrinsic.presets import DatasetConfig, get_preset
@@ -120,7 +121,10 @@ def test_config_change_rerenders(built, tmp_path):
     shutil.copytree(out, copy)
     changed = TINY.with_options(spp=TINY.spp * 2)
     assert changed.config_hash() != TINY.config_hash()
-    report = build_dataset(copy, changed, only=ONLY)
+    with pytest.raises(DatasetError, match="--rebuild"):  # one config per dataset folder
+        build_dataset(copy, changed, only=ONLY)
+    assert _hashes(copy) == _hashes(out)  # refused before touching anything
+    report = build_dataset(copy, changed, only=ONLY, rebuild=True)
     assert sorted(o.sample_id for o in report.built) == sorted(IDS)
     assert report.skipped == ()
     for sample_id in IDS:
@@ -188,12 +192,12 @@ def test_hard_kill_mid_write_then_rerun_completes(tmp_path):
     proc = _cli(out)
 
     def writing() -> bool:
-        return out.is_dir() and any(p.name.startswith(".tmp-") and p.is_dir() for p in out.iterdir())
+        return out.is_dir() and any(p.name.startswith(".spectrinsic-tmp-") and p.is_dir() for p in out.iterdir())
 
     _wait_for(writing, proc, "the middle of writing a sample")
     os.kill(proc.pid, signal.SIGKILL)
     proc.wait()
-    assert any(p.name.startswith(".tmp-") for p in out.iterdir())
+    assert any(p.name.startswith(".spectrinsic-tmp-") for p in out.iterdir())
     for sample_id in IDS:
         # a folder under a sample's own name is always whole
         folder = out / sample_id
@@ -203,7 +207,7 @@ def test_hard_kill_mid_write_then_rerun_completes(tmp_path):
     rerun = _cli(out)
     stdout, stderr = rerun.communicate(timeout=WAIT_S)
     assert rerun.returncode == 0, stderr
-    assert not list(out.glob(".tmp-*"))
+    assert not list(out.glob(".spectrinsic-tmp-*"))
     assert check_dataset(out) == []
     assert sorted(p.name for p in out.iterdir() if p.is_dir()) == sorted(IDS)
 

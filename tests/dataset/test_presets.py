@@ -49,7 +49,32 @@ def test_config_hash_is_sha256_of_canonical_json():
     text = json.dumps(record, sort_keys=True, separators=(",", ":"), ensure_ascii=False)
     assert cfg.config_hash() == hashlib.sha256(text.encode("utf-8")).hexdigest()
     assert record["software"] == software_versions()
-    assert "spectrinsic" in record["software"] and "mitsuba" in record["software"]
+    assert "spectrinsic-pixels" in record["software"] and "mitsuba" in record["software"]
+
+
+def test_config_hash_ignores_versions_that_do_not_change_pixels(monkeypatch):
+    """A numpy or colour-science patch release, or any other package, keeps the hash; a new
+    Mitsuba or a bumped pixel version changes it."""
+    import spectrinsic.presets as presets
+    import spectrinsic.provenance as provenance
+
+    real = provenance.software_versions
+    base = get_preset("preview").config_hash()
+
+    def bumped(**changes):
+        def fake(dists, *, python=True):
+            return {**real(dists, python=python), **{k: v for k, v in changes.items() if k in dists}}
+        return fake
+
+    installed = real(("numpy", "colour-science"), python=False)
+    patch = {k: installed[k] + ".99" for k in installed}  # same major/minor, new patch
+    monkeypatch.setattr(provenance, "software_versions", bumped(**patch, scipy="99.0"))
+    assert get_preset("preview").config_hash() == base
+    monkeypatch.setattr(provenance, "software_versions", bumped(mitsuba="3.9.99"))
+    assert get_preset("preview").config_hash() != base
+    monkeypatch.setattr(provenance, "software_versions", real)
+    monkeypatch.setattr(presets, "PIXELS_VERSION", presets.PIXELS_VERSION + 1)
+    assert get_preset("preview").config_hash() != base
 
 
 def test_hash_changes_with_output_settings_only():

@@ -86,7 +86,7 @@ def test_cli_exit_status_and_report(built, capsys):
     (built / "one" / "scene.json").write_text("{}")
     assert main(["-q", "check", str(built)]) == 1
     out = capsys.readouterr().out
-    assert "one: 1 problem(s)" in out and "scene.json" in out
+    assert "one: 2 problem(s)" in out and "SHA-256 in meta.json" in out and "SHA-256 in manifest.json" in out
 
 
 def test_noise_from_two_batches_is_reported_and_flagged(tmp_path, synth, config):

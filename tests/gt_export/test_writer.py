@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
 import sys
 
 import numpy as np
 import pytest
 
-from spectrinsic.errors import MissingDependencyError
+from spectrinsic.errors import DatasetError, MissingDependencyError
 from spectrinsic.gt_export import (
     config_hash,
     export_sample,
@@ -67,7 +68,6 @@ def test_sample_round_trips_through_the_loader(tmp_path, two_light_sample, confi
 
 def test_scene_json_is_the_scene_as_plain_data(tmp_path, one_light_sample, config):
     import dataclasses
-    import hashlib
 
     from spectrinsic.scenes.model import scene_hash, scene_to_dict
 
@@ -120,12 +120,47 @@ def test_a_write_failing_midway_leaves_nothing_complete_looking(
 def test_a_rewrite_replaces_an_old_sample_whole(tmp_path, one_light_sample, config):
     scene, result = one_light_sample
     folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=1)
-    (folder / "stale.txt").write_text("from an older build")
+    old_meta = (folder / "meta.json").read_text()
     new_config = {**config, "spp": 4}
     export_sample(tmp_path, scene, result, sample_id="s", config=new_config, seed=1)
-    assert not (folder / "stale.txt").exists()
+    assert (folder / "meta.json").read_text() != old_meta
     assert is_complete(folder, config_hash(new_config))
     assert [p.name for p in tmp_path.iterdir()] == ["s"]
+
+
+def test_a_sample_folder_holding_a_users_file_is_never_replaced(tmp_path, one_light_sample, config):
+    scene, result = one_light_sample
+    folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=1)
+    (folder / "notes.txt").write_text("mine")
+    with pytest.raises(DatasetError, match="notes.txt"):
+        export_sample(tmp_path, scene, result, sample_id="s", config={**config, "spp": 4}, seed=1)
+    assert (folder / "notes.txt").read_text() == "mine"
+    assert is_complete(folder, config_hash(config))  # the old sample is untouched
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s"]  # no temporary left
+
+
+def test_a_folder_named_like_the_sample_but_not_spectrinsics_is_refused(
+    tmp_path, one_light_sample, config
+):
+    scene, result = one_light_sample
+    (tmp_path / "s").mkdir()
+    (tmp_path / "s" / "thesis.tex").write_text("a")
+    with pytest.raises(DatasetError, match="no valid spectrinsic meta.json"):
+        export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=1)
+    assert (tmp_path / "s" / "thesis.tex").read_text() == "a"
+    assert [p.name for p in tmp_path.iterdir()] == ["s"]
+
+
+def test_meta_json_records_the_sha256_of_every_listed_file(tmp_path, one_light_sample, config):
+    scene, result = one_light_sample
+    folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=1)
+    meta = json.loads((folder / "meta.json").read_text())
+    assert set(meta["sha256"]) == set(meta["files"]) and "meta.json" not in meta["files"]
+    for rel, digest in meta["sha256"].items():
+        assert hashlib.sha256((folder / rel).read_bytes()).hexdigest() == digest
+    # a file swapped for another (valid) file of the same kind is caught
+    (folder / "geometry.exr").write_bytes((folder / "image.exr").read_bytes())
+    assert not is_complete(folder, config_hash(config))
 
 
 def test_same_inputs_give_identical_files(tmp_path, two_light_sample, config):
@@ -140,7 +175,6 @@ def test_same_inputs_give_identical_files(tmp_path, two_light_sample, config):
 
 
 def test_manifest_hashes_every_file_and_records_provenance(built, config):
-    import hashlib
 
     manifest = json.loads((built / "manifest.json").read_text())
     assert manifest["n_samples"] == 2 and set(manifest["samples"]) == {"a-one", "b-two"}
@@ -165,7 +199,7 @@ def test_dataset_card_describes_every_layer(built):
 
 
 def test_load_dataset_iterates_complete_samples_in_order(built):
-    (built / ".tmp-c-x").mkdir()  # an interrupted write is not a sample
+    (built / ".spectrinsic-tmp-c-x").mkdir()  # an interrupted write is not a sample
     ids = [s["meta"]["sample_id"] for s in load_dataset(built, layers=["image"])]
     assert ids == ["a-one", "b-two"]
 

@@ -1,0 +1,260 @@
+"""What spectrinsic owns in a dataset folder, and whether a sample is what it claims to be.
+
+A dataset folder knows it is one: the build writes :data:`MARKER_NAME` (the config hash of the
+dataset) before its first sample, and ``manifest.json`` after its last. spectrinsic only ever
+removes or replaces
+
+* its own temporaries, named :data:`TMP_PREFIX` ``<id>``, inside a folder it recognises as a
+  dataset;
+* sample folders whose ``meta.json`` it wrote and that hold no file that ``meta.json`` does not
+  list (so a user's notes inside a sample folder stop the build instead of vanishing).
+
+A sample is *intact* when its ``meta.json`` has the expected config hash and every file it lists
+lies inside the sample folder and matches the SHA-256 recorded next to it (``meta.json`` cannot
+hash itself; ``manifest.json`` holds its hash). Only intact samples are resumed.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import hashlib
+import json
+import os
+import shutil
+from collections.abc import Iterator, Mapping
+from pathlib import Path, PurePosixPath
+from typing import Any
+
+from spectrinsic.errors import DatasetError, DiskFullError, WriteError
+
+__all__ = [
+    "META_NAME",
+    "MANIFEST_NAME",
+    "MARKER_NAME",
+    "TMP_PREFIX",
+    "HASHES_KEY",
+    "file_sha256",
+    "guarded_write",
+    "confined_path",
+    "file_hashes",
+    "read_sample_meta",
+    "sample_problem",
+    "replaceable_sample",
+    "remove_sample",
+    "dataset_config_hash",
+    "require_folder_path",
+    "check_build_folder",
+    "write_marker",
+    "remove_owned_temporaries",
+]
+
+META_NAME = "meta.json"
+MANIFEST_NAME = "manifest.json"
+#: Written first into every dataset folder: ``{"spectrinsic_dataset": 1, "config_hash": ...}``.
+MARKER_NAME = ".spectrinsic-dataset"
+#: Prefix of every temporary file or folder spectrinsic creates inside a dataset folder. Only
+#: names with this prefix are ever cleaned up: ``.tmp-*`` belongs to other programs.
+TMP_PREFIX = ".spectrinsic-tmp-"
+#: Key of ``meta.json`` holding ``{relative path: SHA-256}`` of every file it lists.
+HASHES_KEY = "sha256"
+#: errno values that mean "no space": retrying another sample cannot help.
+_NO_SPACE = frozenset({errno.ENOSPC, errno.EDQUOT})
+
+
+def file_sha256(path: str | os.PathLike[str]) -> str:
+    """SHA-256 hex digest of a file's bytes."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(chunk)
+    return digest.hexdigest()
+
+
+@contextlib.contextmanager
+def guarded_write(path: str | os.PathLike[str]) -> Iterator[None]:
+    """Turn an ``OSError`` while writing *path* into a one-line error naming *path*.
+
+    ``write()`` failures (a full disk) carry no file name of their own, so without this the
+    message would not say which file could not be written.
+    """
+    try:
+        yield
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
+        cls = DiskFullError if exc.errno in _NO_SPACE else WriteError
+        raise cls(f"cannot write {str(path)!r}: {reason}") from exc
+
+
+def confined_path(folder: Path, rel: object) -> Path | None:
+    """``folder/rel`` if *rel* is a relative POSIX path that stays inside *folder* (symbolic
+    links resolved), else ``None``."""
+    if not isinstance(rel, str) or not rel or "\\" in rel:
+        return None
+    pure = PurePosixPath(rel)
+    if pure.is_absolute() or ".." in pure.parts:
+        return None
+    root = folder.resolve()
+    path = (root / pure).resolve()
+    return folder / pure if path.is_relative_to(root) and path != root else None
+
+
+def file_hashes(folder: Path, files: list[str]) -> dict[str, str]:
+    """``{rel: SHA-256}`` of *files* inside *folder*, for ``meta.json[HASHES_KEY]``."""
+    return {rel: file_sha256(folder / rel) for rel in sorted(files)}
+
+
+def read_sample_meta(folder: Path) -> dict[str, Any] | None:
+    """The ``meta.json`` of *folder* if spectrinsic wrote it (a JSON object naming this folder
+    as its sample and listing its files inside it), else ``None``."""
+    try:
+        meta = json.loads((folder / META_NAME).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(meta, dict) or meta.get("sample_id") != folder.name:
+        return None
+    files = meta.get("files")
+    if not isinstance(files, list) or not all(confined_path(folder, f) for f in files):
+        return None
+    return meta
+
+
+def sample_problem(folder: str | os.PathLike[str], config_hash: str) -> str | None:
+    """Why the sample in *folder* cannot be resumed, or ``None`` if it is complete and intact."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        return "absent"
+    meta = read_sample_meta(folder)
+    if meta is None:
+        return f"{META_NAME} is missing or not spectrinsic's"
+    if meta.get("config_hash") != config_hash:
+        return "built with another config"
+    hashes = meta.get(HASHES_KEY)
+    if not isinstance(hashes, Mapping) or set(hashes) != set(meta["files"]):
+        return f"{META_NAME} records no SHA-256 for its files"
+    for rel in sorted(meta["files"]):
+        path = folder / rel
+        if not path.is_file():
+            return f"file {rel!r} is missing"
+        if file_sha256(path) != hashes[rel]:
+            return f"file {rel!r} does not match its SHA-256 in {META_NAME}"
+    return None
+
+
+def replaceable_sample(folder: Path) -> None:
+    """Check that *folder* may be replaced: absent, or a sample spectrinsic wrote holding only
+    files its ``meta.json`` lists.
+
+    Raises
+    ------
+    DatasetError
+        One line naming the folder or the file that is not spectrinsic's.
+    """
+    if not folder.exists() and not folder.is_symlink():
+        return
+    if folder.is_symlink() or not folder.is_dir():
+        raise DatasetError(
+            f"{str(folder)!r} is in the way of a sample folder and is not one spectrinsic wrote; "
+            "move it away or choose another --out"
+        )
+    meta = read_sample_meta(folder)
+    if meta is None:
+        raise DatasetError(
+            f"{str(folder)!r} has the name of a sample but no valid spectrinsic {META_NAME}; "
+            "move it away or choose another --out"
+        )
+    listed = {PurePosixPath(f) for f in meta["files"]} | {PurePosixPath(META_NAME)}
+    for path in sorted(folder.rglob("*")):
+        rel = PurePosixPath(path.relative_to(folder).as_posix())
+        if (path.is_symlink() or not path.is_dir()) and rel not in listed:
+            raise DatasetError(
+                f"{str(path)!r} was not written by spectrinsic, so its sample folder is not "
+                "replaced; move the file away to rebuild the sample"
+            )
+
+
+def remove_sample(folder: Path) -> None:
+    """Delete a sample folder after :func:`replaceable_sample` allowed it."""
+    replaceable_sample(folder)
+    if folder.exists():
+        shutil.rmtree(folder)
+
+
+def dataset_config_hash(root: Path) -> str | None:
+    """The config hash *root* was built with (marker first, then manifest), or ``None`` if
+    *root* is not a spectrinsic dataset folder."""
+    for name, key in ((MARKER_NAME, "spectrinsic_dataset"), (MANIFEST_NAME, "format_version")):
+        try:
+            record = json.loads((root / name).read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            continue
+        if isinstance(record, dict) and key in record and isinstance(record.get("config_hash"), str):
+            return record["config_hash"]
+    return None
+
+
+def require_folder_path(root: Path, option: str = "--out") -> None:
+    """Raise a one-line error if *root* is a file or lies below one (so no folder can be made)."""
+    for parent in (root, *root.parents):
+        if parent.is_dir():
+            return
+        if parent.exists() or parent.is_symlink():
+            what = "is a file" if parent == root else f"lies below the file {str(parent)!r}"
+            raise DatasetError(f"{option} {str(root)!r} {what}; expected a folder")
+
+
+def check_build_folder(root: Path, config_hash: str, *, rebuild: bool) -> str | None:
+    """Check that a build with *config_hash* may write into *root*; return the hash the folder
+    was built with before (``None``: new or empty folder).
+
+    Raises
+    ------
+    DatasetError
+        *root* is a file or lies below one; *root* is non-empty and not a spectrinsic dataset;
+        or it was built with another config and *rebuild* is false.
+    """
+    require_folder_path(root)
+    if not root.is_dir() or not any(root.iterdir()):
+        return None
+    previous = dataset_config_hash(root)
+    if previous is None:
+        raise DatasetError(
+            f"--out {str(root)!r} is not empty and is not a spectrinsic dataset (no {MARKER_NAME} "
+            f"or {MANIFEST_NAME}); choose a new or empty folder"
+        )
+    if previous != config_hash and not rebuild:
+        raise DatasetError(
+            f"--out {str(root)!r} was built with another config (hash {previous[:12]}, this run "
+            f"{config_hash[:12]}); pass --rebuild to rebuild it, or choose another folder"
+        )
+    return previous
+
+
+def write_marker(root: Path, config_hash: str) -> None:
+    """Create *root* if needed and record that it is a dataset built with *config_hash*."""
+    try:
+        root.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise WriteError(f"--out {str(root)!r}: cannot create the folder ({exc.strerror})") from exc
+    tmp = root / f"{TMP_PREFIX}{MARKER_NAME.lstrip('.')}"
+    with guarded_write(root / MARKER_NAME):
+        tmp.write_text(json.dumps({"spectrinsic_dataset": 1, "config_hash": config_hash}) + "\n",
+                       encoding="utf-8")
+        tmp.replace(root / MARKER_NAME)
+
+
+def remove_owned_temporaries(root: Path) -> list[Path]:
+    """Delete spectrinsic's temporaries (:data:`TMP_PREFIX`) in a dataset folder; return them.
+
+    Nothing is removed from a folder without the dataset marker or manifest. Call it only when
+    no writer of this build is still running.
+    """
+    if not root.is_dir() or dataset_config_hash(root) is None:
+        return []
+    stale = sorted(root.glob(f"{TMP_PREFIX}*"))
+    for path in stale:
+        if path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            path.unlink(missing_ok=True)
+    return stale

@@ -1,0 +1,242 @@
+"""Every bad input of issue 9 through the command line: exit status 2, one line on stderr that
+names the input, no traceback, and no user file touched (nor any output left behind).
+
+Each case builds its input under ``tmp_path``, next to a few files standing for the user's own
+data; the whole tree is snapshotted (paths, bytes, mtimes) before and compared after the run.
+None of these cases renders: every refusal comes before the first pass.
+"""
+
+from __future__ import annotations
+
+import json
+import socket
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from spectrinsic.cli import main
+from spectrinsic.gt_export.integrity import MARKER_NAME, write_marker
+from spectrinsic.presets import get_preset
+
+#: The dataset options of the tiny builds (as in tests/dataset/test_pipeline.py).
+TINY = ["--preset", "preview", "--resolution", "16x16", "--spp", "2", "--only", "obj-apple__v0__white"]
+TINY_HASH = get_preset("preview").with_options(width=16, height=16, spp=2).config_hash()
+APPLE = "obj-apple__v0__white"
+
+#: A small valid scene (as in tests/scenes/test_io.py), as YAML text.
+SCENE = """\
+name: quad
+materials: {grey: "flat:0.5"}
+meshes:
+  - name: ground
+    vertices: [[-2, -2, 0], [2, -2, 0], [2, 2, 0], [-2, 2, 0]]
+    faces: [[0, 1, 2], [0, 2, 3]]
+    material: grey
+lights:
+  - {kind: point, spectrum: "cie:D65", power: 4, position: [0, 0, 2]}
+camera: {origin: [0, -3, 2], target: [0, 0, 0], width: 16, height: 16}
+"""
+
+
+def _snapshot(root: Path) -> dict[str, tuple[bytes, int]]:
+    return {p.relative_to(root).as_posix(): (p.read_bytes(), p.stat().st_mtime_ns)
+            for p in sorted(root.rglob("*")) if p.is_file()} | {
+            p.relative_to(root).as_posix() + "/": (b"", 0) for p in root.rglob("*") if p.is_dir()}
+
+
+def _user_files(tmp: Path) -> None:
+    """Files standing for the user's own data, which no run may touch."""
+    (tmp / "thesis").mkdir()
+    (tmp / "thesis" / "thesis.tex").write_text("\\chapter{Intro}\n")
+    (tmp / ".tmp-mine").mkdir()
+    (tmp / ".tmp-mine" / "db").write_text("b")
+
+
+def _closed_port() -> int:
+    """A TCP port on 127.0.0.1 with nothing listening (bound, then released)."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _sfu_data_dir(tmp: Path, value: str, encoding: str = "utf-8") -> Path:
+    """A data directory whose SFU reflectance file holds *value* for spectrum 1 at 500 nm."""
+    folder = tmp / "data" / "sfu_barnard2002"
+    folder.mkdir(parents=True)
+    rows = [f"{wl},{value if wl == 500 else 0.5},0.4" for wl in range(380, 790, 10)]
+    text = "wavelength_nm,s1,s2\n" + "\n".join(rows) + "\n"
+    (folder / "reflect_db_1995.csv").write_bytes(text.encode(encoding))
+    (folder / "reflect_db_index.csv").write_text(
+        "column_1based,label,group,index_in_group\n1,s1,mine,1\n2,s2,mine,2\n")
+    return tmp / "data"
+
+
+def _sfu_render(tmp: Path, value: str | None, encoding: str = "utf-8") -> list[str]:
+    """``render`` of a scene using an SFU reflectance from a data directory holding *value*
+    (``None``: a data directory that does not exist)."""
+    data = _sfu_data_dir(tmp, value, encoding) if value is not None else tmp / "nope"
+    scene = _scene(tmp, SCENE.replace("flat:0.5", "sfu:mine/1"))
+    return ["--data-dir", str(data), "render", scene, "--out", str(tmp / "o")]
+
+
+def _scene(tmp: Path, text: str = SCENE, name: str = "scene.yaml") -> str:
+    path = tmp / name
+    path.write_text(text) if isinstance(text, str) else path.write_bytes(text)
+    return str(path)
+
+
+def _fake_sample(root: Path, name: str, extra: str | None = None) -> None:
+    """A sample folder with a spectrinsic-shaped meta.json (another config), and maybe a
+    user's file in it."""
+    folder = root / name
+    folder.mkdir(parents=True)
+    (folder / "meta.json").write_text(json.dumps(
+        {"format_version": 1, "sample_id": name, "config_hash": "old", "files": []}))
+    if extra:
+        (folder / extra).write_text("mine")
+
+
+def _dataset_with(tmp: Path, setup: Callable[[Path], None], config_hash: str = TINY_HASH) -> str:
+    root = tmp / "ds"
+    write_marker(root, config_hash)
+    setup(root)
+    return str(root)
+
+
+def _built_like(tmp: Path, manifest: object | None = None, meta: dict | None = None) -> str:
+    """A dataset folder holding one sample whose meta.json is *meta*, and *manifest*."""
+    root = tmp / "ds"
+    (root / APPLE).mkdir(parents=True)
+    base = {"format_version": 1, "sample_id": APPLE, "config_hash": "h", "files": [],
+            "layers": {}}
+    (root / APPLE / "meta.json").write_text(json.dumps({**base, **(meta or {})}))
+    if manifest is not None:
+        (root / "manifest.json").write_text(json.dumps(manifest))
+    return str(root)
+
+
+def _bomb(tmp: Path) -> str:
+    """A 1.2 KB "billion laughs": 10 levels of 9 aliases each."""
+    lines = ["l0: &l0 [" + ", ".join(["lol" * 16] * 9) + "]"]
+    lines += [f"l{i}: &l{i} [" + ", ".join([f"*l{i - 1}"] * 9) + "]" for i in range(1, 11)]
+    text = "\n".join(lines) + "\n"
+    assert 1000 < len(text) < 1300
+    return _scene(tmp, text)
+
+
+#: (case id, builder of argv from tmp_path, text the one stderr line must contain)
+CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
+    # --- point 1: dataset --out never deletes user data
+    ("out-nonempty-not-dataset", lambda t: ["dataset", *TINY, "--out", str(t)], "not a spectrinsic dataset"),
+    ("out-sample-named-folder", lambda t: (lambda d: ["dataset", *TINY, "--out", d])(
+        _dataset_with(t, lambda r: (r / APPLE).mkdir() or (r / APPLE / "thesis.tex").write_text("a"))),
+     "no valid spectrinsic meta.json"),
+    ("out-sample-holds-user-file", lambda t: ["dataset", *TINY, "--out", _dataset_with(
+        t, lambda r: _fake_sample(r, APPLE, "notes.txt"))], "notes.txt"),
+    ("out-sample-name-is-a-file", lambda t: ["dataset", *TINY, "--out", _dataset_with(
+        t, lambda r: (r / APPLE).write_text("mine"))], APPLE),
+    # --- point 3: one config per dataset
+    ("out-other-config", lambda t: ["dataset", *TINY, "--out", _dataset_with(
+        t, lambda r: None, config_hash="0" * 64)], "--rebuild"),
+    # --- point 7: one-line errors
+    ("out-is-a-file", lambda t: ["dataset", *TINY, "--out", str(t / "thesis" / "thesis.tex")], "is a file"),
+    ("out-below-a-file", lambda t: ["dataset", *TINY, "--out", str(t / "thesis" / "thesis.tex" / "x")],
+     "lies below the file"),
+    ("render-out-below-a-file", lambda t: ["render", "obj-apple", "--out", str(t / "thesis" / "thesis.tex" / "x")],
+     "lies below the file"),
+    ("render-width-negative", lambda t: ["render", "obj-apple", "--width", "-5", "--out", str(t / "o")], "--width -5"),
+    ("render-width-zero", lambda t: ["render", "obj-apple", "--width", "0", "--out", str(t / "o")], "--width 0"),
+    ("render-width-huge", lambda t: ["render", "obj-apple", "--width", "100000", "--out", str(t / "o")],
+     "--width 100000"),
+    ("render-spp-zero", lambda t: ["render", "obj-apple", "--spp", "0", "--out", str(t / "o")], "--spp 0"),
+    ("render-unknown-mode", lambda t: ["render", "obj-apple", "--modes", "spectral,rgb9", "--out", str(t / "o")],
+     "rgb9"),
+    ("render-unknown-scene", lambda t: ["render", "obj-apricot", "--out", str(t / "o")], "obj-apricot"),
+    ("scheduler-closed-port", lambda t: ["dataset", *TINY, "--out", str(t / "new"), "--scheduler",
+                                         f"tcp://127.0.0.1:{_closed_port()}"], "127.0.0.1"),
+    ("scheduler-malformed", lambda t: ["dataset", *TINY, "--out", str(t / "new"), "--scheduler", "tcp//nohost"],
+     "tcp//nohost"),
+    ("scheduler-bad-port", lambda t: ["dataset", *TINY, "--out", str(t / "new"), "--scheduler",
+                                      "tcp://127.0.0.1:99999"], "99999"),
+    ("yaml-5000-deep", lambda t: ["render", _scene(t, "- " * 5000 + "x\n"), "--out", str(t / "o")], "scene.yaml"),
+    ("yaml-5000-deep-flow", lambda t: ["render", _scene(t, "[" * 5000 + "]" * 5000), "--out", str(t / "o")],
+     "nesting deeper"),
+    ("yaml-not-utf8", lambda t: ["render", _scene(t, b"name: \xff\xfe\n"), "--out", str(t / "o")], "scene.yaml"),
+    ("data-dir-csv-not-utf8", lambda t: _sfu_render(t, "0.5\xe9", "latin-1"), "reflect_db_1995.csv"),
+    ("blend-garbage", lambda t: ["render", _scene(t, b"BLENDER-v300 not really", "room.blend"),
+                                 "--out", str(t / "o")], "room.blend"),
+    ("blend-magic-any-name", lambda t: ["render", _scene(t, b"BLENDER-v300 not really", "room.dat"),
+                                        "--out", str(t / "o")], "room.dat"),
+    ("check-manifest-list", lambda t: ["check", _built_like(t, manifest=[])], "manifest.json"),
+    ("check-layer-without-file", lambda t: ["check", _built_like(
+        t, manifest={}, meta={"layers": {"image": {"exr_layer": "image"}}})], "layers.image.file"),
+    ("check-not-a-folder", lambda t: ["check", str(t / "nothing")], "nothing"),
+    # --- point 5: spectra from the data directory
+    ("data-dir-nan", lambda t: _sfu_render(t, "nan"), "reflect_db_1995.csv"),
+    ("data-dir-inf", lambda t: _sfu_render(t, "inf"), "reflect_db_1995.csv"),
+    ("data-dir-negative", lambda t: _sfu_render(t, "-0.2"), "reflect_db_1995.csv"),
+    ("data-dir-empty-cell", lambda t: _sfu_render(t, ""), "reflect_db_1995.csv"),
+    ("data-dir-missing", lambda t: _sfu_render(t, None), "nope"),
+    # --- point 8: limits
+    ("yaml-alias-bomb", lambda t: ["render", _bomb(t), "--out", str(t / "o")], "alias"),
+    ("yaml-recursive-alias", lambda t: ["render", _scene(t, "a: &a [*a]\n"), "--out", str(t / "o")], "recursive"),
+    ("yaml-duplicate-key", lambda t: ["render", _scene(t, SCENE + "name: again\n"), "--out", str(t / "o")],
+     "duplicate key 'name'"),
+    ("yaml-too-large", lambda t: ["render", _scene(t, "# " + "x" * (17 * 2**20) + "\n"), "--out", str(t / "o")],
+     "limited to"),
+    ("yaml-several-mistakes", lambda t: ["render", _scene(t, SCENE.replace("point,", "pointy,").replace(
+        "width: 16", "width: -3").replace("material: grey", "material: blue") + "colour: 3\n"),
+        "--out", str(t / "o")], "4 problems"),
+    ("dataset-resolution-zero", lambda t: ["dataset", "--preset", "preview", "--resolution", "0x16",
+                                           "--out", str(t / "new")], "--resolution '0x16'"),
+    ("dataset-resolution-garbage", lambda t: ["dataset", "--preset", "preview", "--resolution", "big",
+                                              "--out", str(t / "new")], "--resolution 'big'"),
+    ("dataset-workers-zero", lambda t: ["dataset", *TINY, "--workers", "0", "--out", str(t / "new")], "--workers 0"),
+    ("dataset-threads-zero", lambda t: ["dataset", *TINY, "--threads", "0", "--out", str(t / "new")], "--threads 0"),
+    ("dataset-only-nothing", lambda t: ["dataset", "--preset", "preview", "--only", "obj-apricot*",
+                                        "--out", str(t / "new")], "obj-apricot*"),
+    # --- point 9: check confines file entries
+    ("check-meta-file-outside", lambda t: ["check", _built_like(t, manifest={}, meta={
+        "files": ["../../thesis/thesis.tex"]})], "../../thesis/thesis.tex"),
+    ("check-manifest-file-outside", lambda t: ["check", _built_like(t, manifest={
+        "config_hash": "h", "samples": {APPLE: {"files": {"thesis/thesis.tex": "0"}}}})], "thesis/thesis.tex"),
+]
+
+
+@pytest.mark.parametrize("build_argv, expected", [c[1:] for c in CASES], ids=[c[0] for c in CASES])
+def test_bad_input_is_one_line_rc2_and_touches_nothing(tmp_path, capsys, build_argv, expected):
+    _user_files(tmp_path)
+    argv = build_argv(tmp_path)
+    before = _snapshot(tmp_path)
+    rc = main(["-q", *argv])
+    captured = capsys.readouterr()
+    err = captured.err.strip()
+    assert rc == 2, captured
+    assert len(err.splitlines()) == 1, err
+    assert err.startswith("spectrinsic: error: ") and "Traceback" not in err
+    assert expected in err, err
+    assert _snapshot(tmp_path) == before  # nothing touched, nothing created
+
+
+def test_render_size_beyond_memory_is_refused_before_rendering(tmp_path, capsys, monkeypatch):
+    import spectrinsic.render.budget as budget
+
+    monkeypatch.setattr(budget, "available_memory_bytes", lambda: 2**30)
+    rc = main(["-q", "render", "obj-apple", "--width", "8000", "--height", "8000", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1
+    assert "--width 8000 --height 8000" in err and "GiB" in err and "1.0 GiB" in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_debug_adds_the_traceback(tmp_path, capsys):
+    rc = main(["--debug", "render", "obj-apple", "--width", "-5", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "Traceback" in err and err.strip().endswith("expected a positive integer")
+
+
+def test_marker_is_what_makes_a_folder_a_dataset(tmp_path):
+    write_marker(tmp_path / "ds", TINY_HASH)
+    assert json.loads((tmp_path / "ds" / MARKER_NAME).read_text())["config_hash"] == TINY_HASH
+    assert [p.name for p in (tmp_path / "ds").iterdir()] == [MARKER_NAME]  # no temporary left
