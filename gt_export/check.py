@@ -137,7 +137,8 @@ def _check_meta_structure(sample: Path, meta: Any) -> None:
 
 def _file_problems(sample: Path, meta: Mapping[str, Any]) -> list[str]:
     """Listed files missing, or not matching the SHA-256 that ``meta.json`` records."""
-    hashes = meta.get(HASHES_KEY) if isinstance(meta.get(HASHES_KEY), dict) else {}
+    recorded = meta.get(HASHES_KEY)
+    hashes: Mapping[str, Any] = recorded if isinstance(recorded, dict) else {}
     problems = []
     for rel in meta.get("files", []):
         if not (sample / rel).is_file():

@@ -116,9 +116,9 @@ def _check_values(
         if mask.any():
             row, col = _first(mask)
             where = "wavelength_nm" if col == 0 else labels[col - 1]
+            what = "empty cell" if problem == "empty" else f"{problem} value {values[row, col]:g}"
             raise SpectralDataError(
-                f"{path}: {problem} value {values[row, col]:g} in row {row + 2}, column "
-                f"{where!r}; expected {expected}"
+                f"{path}: {what} in row {row + 2}, column {where!r}; expected {expected}"
             )
 
 

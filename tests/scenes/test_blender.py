@@ -148,3 +148,17 @@ def test_missing_bpy_gives_a_helpful_error(monkeypatch, tmp_path):
     monkeypatch.setitem(sys.modules, "bpy", None)  # import bpy -> ImportError
     with pytest.raises(MissingDependencyError, match=r"pip install 'spectrinsic\[blender\]'"):
         load_blend(tmp_path / "any.blend")
+
+
+@pytest.mark.blender
+def test_render_routes_a_blend_file_to_the_importer(blend_file, tmp_path, capsys):
+    """``spectrinsic render x.blend`` reads it with the importer (not as YAML): here the
+    importer's own one-line error for the material named after no spectrum."""
+    from spectrinsic.cli import main
+
+    path, _ = blend_file
+    rc = main(["-q", "render", str(path), "--modes", "rgb3", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1
+    assert str(path) in err and "'Paint'" in err and "UnicodeDecodeError" not in err
+    assert not (tmp_path / "o").exists()
