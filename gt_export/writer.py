@@ -67,7 +67,8 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-FORMAT_VERSION = 1
+#: 2: shading from spectral irradiance, residual, noise, denoised layers (1: per-channel ratio).
+FORMAT_VERSION = 2
 #: The rendered scene as plain data (:func:`spectrinsic.scenes.model.scene_to_dict`), compact JSON.
 SCENE_NAME = "scene.json"
 CARD_NAME = "DATASET.md"
