@@ -69,6 +69,11 @@ def register(subparsers: Any) -> None:
     p.add_argument("--batches", type=int, default=None, metavar="N",
                    help="override the number of independent batches the samples are split into "
                         "(>= 2 measures the noise; spp must be divisible by it)")
+    p.add_argument("--noise-target", type=float, default=None, metavar="F",
+                   help="adaptive sampling: add batches until the image's median relative "
+                        "standard error is below F (e.g. 0.02) or --max-batches is reached")
+    p.add_argument("--max-batches", type=int, default=None, metavar="N",
+                   help="cap of the adaptive batches (default 4 x batches)")
     p.add_argument("--no-denoise", action="store_true",
                    help="keep shading from the raw Monte Carlo irradiance (no OIDN)")
     p.add_argument(
@@ -85,14 +90,18 @@ def register(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
-def _overrides(args: argparse.Namespace) -> dict[str, int]:
-    changes: dict[str, int] = {}
+def _overrides(args: argparse.Namespace) -> dict[str, Any]:
+    changes: dict[str, Any] = {}
     if args.spp is not None:
         changes["spp"] = args.spp
     if args.batches is not None:
         changes["batches"] = args.batches
     if args.no_denoise:
         changes["denoise"] = False
+    if args.noise_target is not None:
+        changes["noise_target"] = args.noise_target
+    if args.max_batches is not None:
+        changes["max_batches"] = args.max_batches
     if args.resolution is not None:
         w, sep, h = args.resolution.lower().partition("x")
         if not (sep and w.isdigit() and h.isdigit() and int(w) > 0 and int(h) > 0):

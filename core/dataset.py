@@ -261,6 +261,8 @@ def build_sample(task: SampleTask) -> SampleOutcome:
     result = render_batches(
         scene,
         batches=cfg.batches,
+        noise_target=cfg.noise_target,
+        max_batches=cfg.max_batches,
         modes=cfg.modes,
         spp=cfg.spp // cfg.batches,
         seed=task.seed,

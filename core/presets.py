@@ -84,6 +84,11 @@ class DatasetConfig:
     denoise
         Take shading, residual and illuminant from the OIDN-denoised irradiance (raw layers
         kept as ``shading_raw``/``residual_raw``).
+    noise_target
+        Adaptive sampling: add batches of ``spp / batches`` samples while the median relative
+        standard error of the image is above this (e.g. 0.02), up to *max_batches*.
+    max_batches
+        Cap of the adaptive batches (default ``4 * batches``).
     share_mode
         With *per_light*: render only this 1-pass mode light by light, for the light shares,
         and every other mode once with all lights (``None``: every mode light by light).
@@ -110,6 +115,8 @@ class DatasetConfig:
     batches: int = 1
     denoise: bool = False
     share_mode: str | None = "rgb3"
+    noise_target: float | None = None
+    max_batches: int | None = None
     cameras: tuple[str, ...] | None = None
     variant: str | None = None
     seed: int = 0
@@ -123,6 +130,14 @@ class DatasetConfig:
             value = getattr(self, name)
             if not isinstance(value, int) or isinstance(value, bool) or value < 1:
                 raise DatasetError(f"dataset setting {name}={value!r}; expected a positive integer")
+        if self.noise_target is not None and not (isinstance(self.noise_target, int | float)
+                                                  and 0 < self.noise_target < 1):
+            raise DatasetError(f"dataset setting noise_target={self.noise_target!r}; expected a "
+                               "fraction in (0, 1), e.g. 0.02")
+        if self.max_batches is not None and (not isinstance(self.max_batches, int)
+                                             or self.max_batches < self.batches):
+            raise DatasetError(f"dataset setting max_batches={self.max_batches!r}; expected an "
+                               f"integer >= batches ({self.batches})")
         if self.spp % self.batches:
             raise DatasetError(
                 f"dataset setting spp={self.spp} with batches={self.batches}; expected spp "

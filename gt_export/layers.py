@@ -163,8 +163,10 @@ class GroundTruth:
     #: Relative standard error per layer (``{"image": {"median", "p95", "pixels"}, ...}``),
     #: from the spread of independent batches; empty for a single batch.
     noise: dict[str, dict[str, float | int]] = field(default_factory=dict)
-    #: Fraction of the lit pixels whose shading had a channel clipped at 0 (out of gamut).
-    clipped_fraction: float = 0.0
+    #: Out-of-gamut light clipped from the sRGB shading into the residual: ``pixels``, the
+    #: fraction of lit pixels with a clipped channel; ``mean``/``max``, the clipped part's norm
+    #: relative to the shading's norm over those pixels.
+    clipping: dict[str, float] = field(default_factory=dict)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -500,12 +502,13 @@ def _srgb_of(w: irr.WhiteRadiance) -> np.ndarray:
 
 def _shading_set(
     w: irr.WhiteRadiance, colour: np.ndarray, white: np.ndarray, image: np.ndarray,
-    reflectance: np.ndarray, *, names: tuple[str, str, str], group: str, space: str,
+    reflectance: np.ndarray, *, names: tuple[str, ...], group: str, space: str,
 ) -> list[Layer]:
-    """``shading``, ``residual`` and ``illuminant`` of one sensor space from ``W``'s colour."""
+    """``shading``, ``residual`` and, if a third name is given, ``illuminant`` of one sensor
+    space from ``W``'s colour."""
     shading = irr.relative_shading(colour, white, w.valid)
     grey = irr.luminance_of(w)
-    return [
+    layers = [
         _layer(names[0], shading, _RGB,
                f"shading-illumination: {space} of the light a perfect white would reflect here "
                "(render units, relative to that space's white under D65; ≥ 0, 0 where no surface)",
@@ -513,10 +516,12 @@ def _shading_set(
         _layer(names[1], irr.residual(image, reflectance, shading), _RGB,
                "image − reflectance ∘ shading (render units): spectral non-commutativity and "
                "out-of-gamut light; the image itself where no surface", group),
-        _layer(names[2], irr.unit_luminance(shading, grey), _RGB,
-               f"{space} colour of the light arriving at unit luminance (D65 = (1, 1, 1)); "
-               "0 where none arrives", group, nonnegative=True),
     ]
+    if len(names) > 2:
+        layers.append(_layer(names[2], irr.unit_luminance(shading, grey), _RGB,
+                             f"{space} colour of the light arriving at unit luminance "
+                             "(D65 = (1, 1, 1)); 0 where none arrives", group, nonnegative=True))
+    return layers
 
 
 def _intrinsic_layers(
@@ -537,8 +542,7 @@ def _intrinsic_layers(
                           _UNITS_IMAGE + "; rebuilt as reflectance-weighted denoised white-surface "
                           "radiance (the raw image where no surface)", "image"))
         out += _shading_set(w_raw, _srgb_of(w_raw), white, image, reflectance, space="linear sRGB",
-                            names=("shading_raw", "residual_raw", "illuminant_raw"),
-                            group="intrinsics")[:2]
+                            names=("shading_raw", "residual_raw"), group="intrinsics")
     out += _shading_set(w, _srgb_of(w), white, used, reflectance, space="linear sRGB",
                         names=("shading", "residual", "illuminant"), group="intrinsics")
     out.append(_layer("shading_grey", irr.luminance_of(w), ("Y",),
@@ -634,8 +638,8 @@ def _share_layers(s: _Sample, w: irr.WhiteRadiance, mask: np.ndarray) -> tuple[l
 
 
 def _camera_layers(
-    s: _Sample, cam: str, curves: np.ndarray, coverage: np.ndarray, w_raw: irr.WhiteRadiance,
-    w: irr.WhiteRadiance, *, denoised: bool,
+    s: _Sample, cam: str, curves: np.ndarray, coverage: np.ndarray, w: irr.WhiteRadiance,
+    *, denoised: bool,
 ) -> list[Layer]:
     """Camera image from the cube, relative reflectance, and shading/residual/illuminant from
     ``W`` in the camera's RGB (relative to its own white under D65)."""
@@ -732,7 +736,7 @@ def compute_ground_truth(
     s = _sample(scene, result, data_dir)
     layers = _image_layers(s)
     image = layers[0].data.astype(np.float64)
-    coverage, mask = _coverage(s, image.shape[:2])
+    coverage, mask = _coverage(s, (image.shape[0], image.shape[1]))
     layers += _geometry_layers(s, mask)
     names = [m.spectrum for m in scene.materials]
     reflectance = coverage_weighted(
@@ -757,12 +761,10 @@ def compute_ground_truth(
             "camera images need the 31-band cube (render mode 'bands31'); render it or pass cameras=()"
         )
     for cam in cameras:
-        layers += _camera_layers(s, cam, spaces[cam], coverage, w_raw, w, denoised=denoise)
+        layers += _camera_layers(s, cam, spaces[cam], coverage, w, denoised=denoise)
     cube_name = _cube_sensor_name(result) if "bands31" in result.raw else None
     if write_cube:
         layers.append(_cube_layer(s, cube_name))
-    colour = _srgb_of(w) / _srgb_white(s)
-    lit = w.valid & (irr.luminance_of(w) > 0)
     return GroundTruth(
         layers={layer.name: layer for layer in layers},
         lights=_light_records(s, shares, spaces, cameras),
@@ -773,8 +775,20 @@ def compute_ground_truth(
         cube_sensors=cube_name,
         denoised=tuple(sorted(layer.name for layer in layers if denoise and _from_denoised(layer.name))),
         noise=noise,
-        clipped_fraction=float((colour[lit] < 0).any(axis=-1).mean()) if lit.any() else 0.0,
+        clipping=_clipping(_srgb_of(w) / _srgb_white(s), w.valid & (irr.luminance_of(w) > 0)),
     )
+
+
+def _clipping(colour: np.ndarray, lit: np.ndarray) -> dict[str, float]:
+    """How much out-of-gamut light the clip of the sRGB shading moved into the residual."""
+    values = colour[lit]
+    if not values.size:
+        return {"pixels": 0.0, "mean": 0.0, "max": 0.0}
+    clipped = np.linalg.norm(np.clip(values, None, 0.0), axis=-1)
+    rel = clipped / np.maximum(np.linalg.norm(values, axis=-1), np.finfo(float).tiny)
+    hit = clipped > 0
+    return {"pixels": float(hit.mean()), "mean": float(rel[hit].mean()) if hit.any() else 0.0,
+            "max": float(rel.max())}
 
 
 def _from_denoised(name: str) -> bool:

@@ -281,7 +281,7 @@ def _meta(
         "identities": identities(gt),
         "denoised_layers": list(gt.denoised),
         "noise": gt.noise,
-        "shading_clipped_fraction": gt.clipped_fraction,
+        "shading_clipping": gt.clipping,
         "files": sorted(files),
         "versions": software_versions(),
     }

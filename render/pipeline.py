@@ -30,7 +30,15 @@ from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
 
-__all__ = ["DEFAULT_MODES", "render_scene", "render_batches", "batch_seeds", "merge_batches", "count_passes"]
+__all__ = [
+    "DEFAULT_MODES",
+    "render_scene",
+    "render_batches",
+    "batch_seeds",
+    "merge_batches",
+    "image_noise",
+    "count_passes",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -72,7 +80,8 @@ def count_passes(
     split = per_light and per_light_modes is not None
     groups = len(scene.lights) if per_light and not split else 1
     colour = sum(n_passes(m, data_dir=data_dir) * (2 if m.name in wanted else 1) for m in objs)
-    shares = sum(n_passes(m, data_dir=data_dir) for m in _modes(per_light_modes)) if split else 0  # type: ignore[arg-type]
+    share_modes = _modes(per_light_modes) if per_light and per_light_modes is not None else []
+    shares = sum(n_passes(m, data_dir=data_dir) for m in share_modes)
     from spectrinsic.render.translate import surfaces
 
     aov_passes = max(1, -(-len(surfaces(scene)) // 3)) if aovs else 0
@@ -115,7 +124,8 @@ def _run_jobs(
     outputs: list[dict[str, PassOutput]] = [{} for _ in jobs]
     aov_maps: dict[str, np.ndarray] = {}
     aov_seconds: tuple[float, ...] = ()
-    common = dict(spp=spp, seed=seed, max_depth=max_depth, progress=progress, geometry=geometry)
+    common: dict[str, Any] = dict(spp=spp, seed=seed, max_depth=max_depth, progress=progress,
+                                  geometry=geometry)
     if aovs or any(m.kind == "diagonal" for job in jobs for m in job.modes):
         rgb_variant = choose_variant("rgb", variant)
         with variant_scope(rgb_variant):
@@ -201,7 +211,7 @@ def render_scene(
     matrices = {m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in objs}
     lights = [[j] for j in range(len(scene.lights))]
     split = per_light and per_light_modes is not None
-    share = _modes(per_light_modes) if split else []  # type: ignore[arg-type]
+    share = _modes(per_light_modes) if per_light and per_light_modes is not None else []
     main = [_Job(tuple(objs), g) for g in (lights if per_light and not split else [None])]
     jobs = main + [_Job(tuple(share), g, with_direct=False) for g in lights] if split else main
     outputs, aov_maps, aov_seconds = _run_jobs(
@@ -277,7 +287,14 @@ def batch_seeds(seed: int, batches: int) -> list[int]:
 
 
 def render_batches(
-    scene: Scene, *, batches: int, spp: int, seed: int, **options: Any
+    scene: Scene,
+    *,
+    batches: int,
+    spp: int,
+    seed: int,
+    noise_target: float | None = None,
+    max_batches: int | None = None,
+    **options: Any,
 ) -> RenderResult:
     """:func:`render_scene` as *batches* independent batches of *spp* samples each, merged.
 
@@ -285,9 +302,41 @@ def render_batches(
     batches differ only in their seed (:func:`batch_seeds`), so the spread between them is a
     direct estimate of the Monte Carlo error of their mean (the noise budget of the ground
     truth). *options* are those of :func:`render_scene`.
+
+    Adaptive sampling: with *noise_target*, batches are added one at a time while the median
+    relative standard error of the image (:func:`image_noise`) is above it, up to
+    *max_batches* (default ``4 * batches``). ``meta["noise_target"]`` records the target and
+    the median reached.
     """
-    results = [render_scene(scene, spp=spp, seed=s, **options) for s in batch_seeds(seed, batches)]
-    return merge_batches(results)
+    cap = max(batches, max_batches if max_batches is not None else 4 * batches)
+    seeds = batch_seeds(seed, cap if noise_target is not None else batches)
+    results = [render_scene(scene, spp=spp, seed=s, **options) for s in seeds[:batches]]
+    reached = image_noise(results) if noise_target is not None else None
+    while reached is not None and reached > float(noise_target) and len(results) < cap:  # type: ignore[arg-type]
+        results.append(render_scene(scene, spp=spp, seed=seeds[len(results)], **options))
+        reached = image_noise(results)
+    merged = merge_batches(results)
+    if noise_target is not None:
+        merged.meta["noise_target"] = {"target": float(noise_target), "reached": reached,
+                                       "max_batches": cap}
+    return merged
+
+
+def image_noise(results: Sequence[RenderResult]) -> float | None:
+    """Median over lit pixels of the relative standard error of the mean image (XYZ of the
+    31-band cube, else of the first mode), from independent batch renders; ``None`` for fewer
+    than two."""
+    if len(results) < 2:
+        return None
+    images = results[0].images
+    mode = "bands31" if "bands31" in images else next(iter(images))
+    stack = np.stack([np.asarray(r.images[mode], np.float64) for r in results])
+    mean = stack.mean(axis=0)
+    b = stack.shape[0]
+    se = np.sqrt(((stack - mean) ** 2).sum(axis=(0, -1)) / (b * (b - 1)))
+    norm = np.linalg.norm(mean, axis=-1)
+    lit = norm > 1e-3 * np.percentile(norm, 99) if norm.any() else norm > 0
+    return float(np.median(se[lit] / norm[lit])) if lit.any() else 0.0
 
 
 def _mean(arrays: Sequence[np.ndarray]) -> np.ndarray:

@@ -183,3 +183,19 @@ def test_h_denoised_shading_is_closer_to_the_converged_render(noisy_and_converge
     denoised = _relative_error(gt.layers["shading"].data, ref.layers["shading"].data, valid)
     assert np.median(denoised) < 0.7 * np.median(raw)
     assert "shading" in gt.denoised and "shading_raw" not in gt.denoised
+
+
+def test_adaptive_batches_stop_at_the_target_or_the_cap(make_room):
+    """--noise-target: more batches only while the measured noise is above the target."""
+    from spectrinsic.render import image_noise
+
+    scene = make_room(size=12)
+    options = dict(modes=("rgb3",), spp=2, seed=1, batches=2, aovs=False)
+    capped = render_batches(scene, noise_target=1e-9, max_batches=3, **options)
+    assert capped.meta["batches"] == 3 and len(capped.batch_raw) == 3
+    assert capped.meta["noise_target"]["reached"] > 1e-9
+    easy = render_batches(scene, noise_target=0.99, max_batches=3, **options)
+    assert easy.meta["batches"] == 2
+    assert easy.meta["noise_target"]["reached"] == pytest.approx(
+        image_noise([render_scene(scene, modes=("rgb3",), spp=2, seed=s, aovs=False)
+                     for s in easy.meta["batch_seeds"]]))
