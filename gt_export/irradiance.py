@@ -222,9 +222,13 @@ def relative_standard_error(batches: Sequence[np.ndarray], valid: np.ndarray) ->
 
 
 def noise_figures(rel_se: np.ndarray, valid: np.ndarray) -> dict[str, float | int]:
-    """Median and 95th percentile of a relative-standard-error map over *valid* pixels."""
+    """Median, 95th percentile and RMS of a relative-standard-error map over *valid* pixels.
+
+    The RMS is the unbiased figure: with two batches each pixel's estimate has one degree of
+    freedom, so its median sits at about 0.67 of the typical standard error.
+    """
     values = rel_se[valid & (rel_se > 0)]
     if not values.size:
-        return {"median": 0.0, "p95": 0.0, "pixels": 0}
+        return {"median": 0.0, "p95": 0.0, "rms": 0.0, "pixels": 0}
     return {"median": float(np.median(values)), "p95": float(np.percentile(values, 95)),
-            "pixels": int(values.size)}
+            "rms": float(np.sqrt(np.mean(values ** 2))), "pixels": int(values.size)}
