@@ -144,61 +144,91 @@ def config_hash(config: Mapping[str, Any]) -> str:
 # Previews
 
 
-def _colour_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
-    return png.tone_map(layer.data)
+#: A preview and how its pixels encode the layer: ``{"kind": "srgb", "scale": k}`` (PNG =
+#: sRGB-encoded ``clip(value × k)``, so ``value = decode(PNG) / k`` below the clip),
+#: ``{"kind": "colormap", "cmap", "vmin", "vmax"}`` (false colour of a scalar) or
+#: ``{"kind": "categorical"}`` (ids, normals, mask).
+Preview = tuple[np.ndarray, dict[str, Any]]
+
+#: Layers that share one exposure per sample, so brightness differences between them are real:
+#: every image mode and camera image uses ``image``'s, every shading ``shading``'s.
+_EXPOSURE_OF = (("image", "image"), ("shading", "shading"))
 
 
-def _reflectance_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
-    return png.encode_srgb8(layer.data)  # absolute scale: the perfect white is 1
+def _srgb(data: np.ndarray, scale: float) -> Preview:
+    return png.encode_srgb8(data, scale), {"kind": "srgb", "scale": float(scale)}
 
 
-def _illuminant_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
-    peak = np.max(layer.data, axis=-1, keepdims=True)
-    return png.encode_srgb8(np.where(peak > 0, layer.data / np.where(peak > 0, peak, 1), 0))
+def _colour_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
+    base = next((b for prefix, b in _EXPOSURE_OF if layer.name.startswith(prefix)), layer.name)
+    return _srgb(layer.data, png.exposure(layers.get(base, layer).data))
 
 
-def _grey_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
-    return png.tone_map(np.repeat(layer.data[..., None], 3, axis=-1))
+def _reflectance_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
+    return _srgb(layer.data, 1.0)  # absolute scale: the perfect white is 1
 
 
-def _error_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
-    return png.false_colour(layer.data, cmap="magma", vmin=0.0, vmax=0.1)
+def _illuminant_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
+    # unit luminance: D65 light is (1, 1, 1); a scale of 1/2 keeps saturated light unclipped
+    return _srgb(layer.data, 0.5)
 
 
-def _residual_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
+def _grey_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
+    return _srgb(np.repeat(layer.data[..., None], 3, axis=-1), png.exposure(layer.data))
+
+
+def _colormap(values: np.ndarray, vmin: float, vmax: float, cmap: str = "magma",
+              mask: np.ndarray | None = None) -> Preview:
+    return (png.false_colour(values, mask=mask, cmap=cmap, vmin=vmin, vmax=vmax),
+            {"kind": "colormap", "cmap": cmap, "vmin": float(vmin), "vmax": float(vmax)})
+
+
+def _error_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
+    return _colormap(layer.data, 0.0, 0.1)
+
+
+def _residual_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
     """Magnitude of the residual relative to the image: 0 (black) to 10 % (bright)."""
     base = layers.get(layer.name.replace("residual", "image", 1).replace("image_raw", "image"))
     norm = np.linalg.norm(base.data, axis=-1) if base is not None else np.ones(layer.data.shape[:2])
     rel = np.divide(np.linalg.norm(layer.data, axis=-1), norm, out=np.zeros(norm.shape), where=norm > 0)
-    return png.false_colour(rel, cmap="magma", vmin=0.0, vmax=0.1)
+    preview, encoding = _colormap(rel, 0.0, 0.1)
+    return preview, {**encoding, "of": "‖residual‖ / ‖image‖"}
 
 
-def _noise_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
-    return png.false_colour(layer.data, cmap="magma", vmin=0.0, vmax=0.2)
+def _noise_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
+    return _colormap(layer.data, 0.0, 0.2)
 
 
 def _mask_of(layers: Mapping[str, Layer]) -> np.ndarray | None:
     return layers["mask"].data > 0.5 if "mask" in layers else None
 
 
-def _depth_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
-    return png.false_colour(layer.data, mask=_mask_of(layers), cmap="viridis")
+def _depth_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
+    mask = _mask_of(layers)
+    valid = layer.data[mask] if mask is not None else layer.data.ravel()
+    lo, hi = (float(np.percentile(valid, 1)), float(np.percentile(valid, 99))) if valid.size else (0.0, 1.0)
+    return _colormap(layer.data, lo, hi, cmap="viridis", mask=mask)
 
 
-def _normals_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
-    return png.normals_preview(layer.data, _mask_of(layers))
+def _categorical(rgb8: np.ndarray) -> Preview:
+    return rgb8, {"kind": "categorical"}
 
 
-def _ids_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
-    return png.id_colours(layer.data)
+def _normals_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
+    return _categorical(png.normals_preview(layer.data, _mask_of(layers)))
 
 
-def _mask_preview(layer: Layer, layers: Mapping[str, Layer]) -> np.ndarray:
-    return np.repeat((layer.data > 0.5).astype(np.uint8)[..., None] * 255, 3, axis=-1)
+def _ids_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
+    return _categorical(png.id_colours(layer.data))
+
+
+def _mask_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
+    return _categorical(np.repeat((layer.data > 0.5).astype(np.uint8)[..., None] * 255, 3, axis=-1))
 
 
 #: (layer-name prefix, preview maker); the first matching prefix wins; no match, no preview.
-_PREVIEWS: tuple[tuple[str, Callable[[Layer, Mapping[str, Layer]], np.ndarray]], ...] = (
+_PREVIEWS: tuple[tuple[str, Callable[[Layer, Mapping[str, Layer]], Preview]], ...] = (
     ("image", _colour_preview),
     ("shading_grey", _grey_preview),
     ("shading", _colour_preview),
@@ -224,7 +254,7 @@ def _preview_name(layer: Layer) -> str:
 # One sample
 
 
-def _layer_records(gt: GroundTruth, previews: Mapping[str, str]) -> dict[str, Any]:
+def _layer_records(gt: GroundTruth, previews: Mapping[str, tuple[str, dict[str, Any]]]) -> dict[str, Any]:
     return {
         layer.name: {
             "file": f"{layer.group}.exr",
@@ -234,7 +264,8 @@ def _layer_records(gt: GroundTruth, previews: Mapping[str, str]) -> dict[str, An
             "dtype": "float32",
             "units": layer.units,
             "nonnegative": layer.nonnegative,
-            "preview": previews.get(layer.name),
+            "preview": previews[layer.name][0] if layer.name in previews else None,
+            "preview_encoding": previews[layer.name][1] if layer.name in previews else None,
         }
         for layer in gt.layers.values()
     }
@@ -242,7 +273,7 @@ def _layer_records(gt: GroundTruth, previews: Mapping[str, str]) -> dict[str, An
 
 def _meta(
     scene: Scene, result: Any, gt: GroundTruth, *, sample_id: str, config: Mapping[str, Any],
-    seed: int, previews: Mapping[str, str], files: Sequence[str],
+    seed: int, previews: Mapping[str, tuple[str, dict[str, Any]]], files: Sequence[str],
 ) -> dict[str, Any]:
     from spectrinsic.spectra import DEFAULT_WAVELENGTHS, get_spectrum
 
@@ -302,14 +333,15 @@ def _fill_folder(folder: Path, scene: Scene, result: Any, gt: GroundTruth, **met
         )
         files.append(name)
     (folder / PREVIEW_DIR).mkdir()
-    previews: dict[str, str] = {}
+    previews: dict[str, tuple[str, dict[str, Any]]] = {}
     for layer in gt.layers.values():
         maker = next((f for prefix, f in _PREVIEWS if layer.name.startswith(prefix)), None)
         if maker is None:
             continue
         rel = f"{PREVIEW_DIR}/{_preview_name(layer)}"
-        png.write_png(folder / rel, maker(layer, gt.layers))
-        previews[layer.name] = rel
+        rgb8, encoding = maker(layer, gt.layers)
+        png.write_png(folder / rel, rgb8)
+        previews[layer.name] = (rel, encoding)
         files.append(rel)
     # the Scene itself, not scene_to_dict(scene): _jsonable makes the same plain data of it, but
     # converts its vertex and face arrays whole rather than element by element

@@ -243,3 +243,25 @@ def test_meta_json_floats_carry_at_most_the_stated_digits(tmp_path, two_light_sa
     assert len(floats) > 50
     assert all(float(f"{x:.{META_DIGITS}g}") == x for x in floats)
     assert any(float(f"{x:.{META_DIGITS - 2}g}") != x for x in floats)  # not rounded coarser
+
+
+def test_previews_of_one_kind_share_an_exposure_and_state_their_encoding(tmp_path, two_light_sample, config):
+    """Every image mode uses the exposure of ``image`` (so brightness differences are real), and
+    the stated scale turns a PNG pixel back into the EXR value within 8-bit precision."""
+    import colour
+    import matplotlib.image
+
+    scene, result = two_light_sample
+    folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=3)
+    layers = json.loads((folder / "meta.json").read_text())["layers"]
+    scales = {k: r["preview_encoding"]["scale"] for k, r in layers.items() if k.startswith("image")}
+    assert len(scales) >= 2 and len(set(scales.values())) == 1
+    assert layers["error_rgb3"]["preview_encoding"] == {"kind": "colormap", "cmap": "magma",
+                                                        "vmin": 0.0, "vmax": 0.1}
+    png_rgb = matplotlib.image.imread(folder / layers["image_rgb3"]["preview"])[..., :3]
+    linear = colour.cctf_decoding(png_rgb.astype(float), function="sRGB") / scales["image_rgb3"]
+    exr = load_sample(folder)["image_rgb3"]
+    unclipped = (png_rgb < 0.98).all(axis=-1) & (png_rgb > 0.1).all(axis=-1)
+    assert unclipped.sum() > 20
+    rel = np.abs(linear[unclipped] - exr[unclipped]) / np.abs(exr[unclipped])
+    assert rel.max() < 0.03  # one 8-bit step of sRGB at mid-grey is about 1 %
