@@ -23,6 +23,7 @@ __all__ = [
     "MissingDependencyError",
     "SpectrinsicWarning",
     "validate_choice",
+    "with_article",
     "did_you_mean",
 ]
 
@@ -81,6 +82,15 @@ def did_you_mean(value: str, choices: Iterable[str], n: int = 3) -> str:
     if not close:
         return ""
     return " (did you mean " + ", ".join(repr(c) for c in close) + "?)"
+
+
+def with_article(word: str) -> str:
+    """*word* with its indefinite article, for messages.
+
+    >>> with_article("area"), with_article("reflectance"), with_article("illuminant")
+    ('an area', 'a reflectance', 'an illuminant')
+    """
+    return f"{'an' if word[:1].lower() in 'aeiou' else 'a'} {word}"
 
 
 def validate_choice(value: str, choices: Iterable[str], what: str) -> str:

@@ -45,7 +45,7 @@ from spectrinsic.gt_export.integrity import (
 )
 from spectrinsic.gt_export.layers import GroundTruth, Layer, compute_ground_truth, identities
 from spectrinsic.provenance import software_versions
-from spectrinsic.scenes.model import Scene, scene_hash
+from spectrinsic.scenes.model import LIGHT_FIELDS, Scene, scene_hash
 
 __all__ = [
     "FORMAT_VERSION",
@@ -281,7 +281,8 @@ def _meta(
                    if k not in _VOLATILE_META}
     lights = []
     for record in gt.lights:
-        entry = asdict(record)
+        unused = {"position", "direction", "size", "cutoff_deg"} - set(LIGHT_FIELDS[record.kind])
+        entry = {k: v for k, v in asdict(record).items() if k not in unused}
         entry["spd"] = get_spectrum(record.spectrum).on(DEFAULT_WAVELENGTHS)
         lights.append(entry)
     height, width = gt.layers["image"].data.shape[:2]
@@ -293,7 +294,7 @@ def _meta(
         "scene_metadata": scene.metadata,
         "config_hash": config_hash(config),
         "seed": int(seed),
-        "variant": ", ".join(sorted(set((render_meta.get("variants") or {}).values()))) or None,
+        "variants": sorted(set((render_meta.get("variants") or {}).values())),
         "render": render_meta,
         "reference_mode": gt.reference_mode,
         "size": [height, width],
@@ -520,7 +521,7 @@ def write_manifest(
         "config_hash": config_hash(config),
         "seed": config.get("seed"),
         "versions": software_versions(),
-        "mitsuba_variants": sorted({str(m.get("variant")) for m in metas}),
+        "mitsuba_variants": _variants(metas),
         "spectral_data": _spectral_provenance(metas, data_dir),
         "n_samples": len(samples),
         "noise": noise_summary(metas),
@@ -539,6 +540,11 @@ def write_manifest(
     _dump_json(tmp, manifest)
     tmp.replace(path)
     return path
+
+
+def _variants(metas: Sequence[Mapping[str, Any]]) -> list[str]:
+    """Every Mitsuba variant the samples were rendered with, sorted."""
+    return sorted({str(v) for m in metas for v in m.get("variants", [])})
 
 
 def noise_summary(metas: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
@@ -619,7 +625,7 @@ def write_dataset_card(
         config_hash=config_hash(config) if config is not None else metas[0].get("config_hash"),
         config=json.dumps(_jsonable(config or {}), indent=2, sort_keys=True),
         versions=json.dumps(software_versions(), indent=2, sort_keys=True),
-        variants=", ".join(sorted({str(m.get("variant")) for m in metas})),
+        variants=", ".join(_variants(metas)),
     )
     path = root / CARD_NAME
     with guarded_write(path):

@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from spectrinsic.errors import MissingDependencyError, SceneError, SpectrinsicError
+from spectrinsic.errors import MissingDependencyError, SceneError, SpectrinsicError, with_article
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.scenes.validate import validate_scene
 
@@ -78,7 +78,7 @@ def _check_spectrum(
         raise SceneError(f"{source}: {field}: {exc}; {hint}") from exc
     if spectrum.kind != kind:
         raise SceneError(
-            f"{source}: {field}: {name!r} is an {spectrum.kind} spectrum; expected a {kind}"
+            f"{source}: {field}: {name!r} is {with_article(spectrum.kind)} spectrum; expected {with_article(kind)}"
         )
 
 

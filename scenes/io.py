@@ -59,9 +59,17 @@ from typing import Any
 
 import numpy as np
 
-from spectrinsic.errors import SceneError, did_you_mean
+from spectrinsic.errors import SceneError, did_you_mean, with_article
 from spectrinsic.scenes.geometry import Part, moved
-from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene, scene_to_dict
+from spectrinsic.scenes.model import (
+    LIGHT_FIELDS,
+    Camera,
+    Light,
+    Material,
+    Mesh,
+    Scene,
+    scene_to_dict,
+)
 from spectrinsic.scenes.validate import LIGHT_KINDS, Problems, validate_scene
 
 __all__ = [
@@ -306,16 +314,11 @@ def _light(doc: _Doc, entry: Any, i: int) -> Light:
             f"unknown light kind {kind!r}; expected one of {', '.join(LIGHT_KINDS)}"
             + did_you_mean(kind, LIGHT_KINDS),
         )
-    needs = {
-        "point": ("position",),
-        "spot": ("position", "direction"),
-        "area": ("position", "direction", "size"),
-        "directional": ("direction",),
-    }
-    for key in needs[kind]:
+    needs = [f for f in LIGHT_FIELDS[kind] if f != "cutoff_deg"]  # a spot's cone has a default
+    for key in needs:
         if key not in entry:
             raise doc.fail(
-                f"{field}.{key}", f"missing; a {kind} light needs {' and '.join(needs[kind])}"
+                f"{field}.{key}", f"missing; {with_article(kind)} light needs {' and '.join(needs)}"
             )
     kw: dict[str, Any] = {
         "kind": kind,

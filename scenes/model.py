@@ -26,11 +26,20 @@ __all__ = [
     "Camera",
     "Scene",
     "LightKind",
+    "LIGHT_FIELDS",
     "scene_to_dict",
     "scene_hash",
 ]
 
 LightKind = Literal["point", "spot", "area", "directional"]
+#: The one table of light kinds: the placement fields each kind uses (the others are ignored,
+#: and records such as meta.json leave them out).
+LIGHT_FIELDS: dict[str, tuple[str, ...]] = {
+    "point": ("position",),
+    "spot": ("position", "direction", "cutoff_deg"),
+    "area": ("position", "direction", "size"),
+    "directional": ("direction",),
+}
 
 
 @dataclass(frozen=True)

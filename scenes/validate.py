@@ -25,8 +25,8 @@ from typing import TypeVar
 
 import numpy as np
 
-from spectrinsic.errors import SceneError, SpectrinsicError
-from spectrinsic.scenes.model import Scene
+from spectrinsic.errors import SceneError, SpectrinsicError, with_article
+from spectrinsic.scenes.model import LIGHT_FIELDS, Scene
 
 __all__ = [
     "LIGHT_KINDS",
@@ -40,7 +40,7 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-LIGHT_KINDS = ("point", "spot", "area", "directional")
+LIGHT_KINDS = tuple(LIGHT_FIELDS)
 #: Rays per image side of the "camera looking at nothing" test.
 VISIBILITY_GRID = 16
 #: A point is inside a closed mesh when its winding number exceeds this (exactly 1 inside,
@@ -189,7 +189,7 @@ def _check_spectrum(
     if isinstance(found, SpectrinsicError):
         raise _fail(source, field, str(found)) from found
     if getattr(found, "kind", kind) != kind:
-        raise _fail(source, field, f"{name!r} is an {found.kind} spectrum; expected a {kind}")  # type: ignore[attr-defined]
+        raise _fail(source, field, f"{name!r} is {with_article(found.kind)} spectrum; expected {with_article(kind)}")  # type: ignore[attr-defined]
 
 
 def _check_meshes(scene: Scene, source: str) -> None:

@@ -41,6 +41,10 @@ class Spectrum:
     values: SpectralValues
     source: str = field(default="", repr=False)
 
+    def __repr__(self) -> str:
+        lo, hi = float(np.min(self.wavelengths)), float(np.max(self.wavelengths))
+        return f"Spectrum({self.name!r}, {self.kind}, {self.wavelengths.size} samples, {lo:g}-{hi:g} nm)"
+
     def __post_init__(self) -> None:
         # validated wherever the data came from (package data, colour-science, a data
         # directory): a NaN would reach the pixels, a negative value crash Mitsuba

@@ -58,7 +58,7 @@ def test_sample_round_trips_through_the_loader(tmp_path, two_light_sample, confi
     assert meta["materials"]["0"] == "munsell:5R 4/14"
     assert [light["spectrum"] for light in meta["lights"]] == ["planck:2800K", "cie:FL11"]
     assert len(meta["lights"][0]["spd"]) == 81
-    assert meta["seed"] == 5 and meta["variant"] == "synthetic"
+    assert meta["seed"] == 5 and meta["variants"] == ["synthetic"]
     assert meta["config_hash"] == config_hash(config)
     assert "timings" not in meta["render"]  # run-dependent: would break reproducible files
     for key, record in meta["layers"].items():
@@ -265,3 +265,11 @@ def test_previews_of_one_kind_share_an_exposure_and_state_their_encoding(tmp_pat
     assert unclipped.sum() > 20
     rel = np.abs(linear[unclipped] - exr[unclipped]) / np.abs(exr[unclipped])
     assert rel.max() < 0.03  # one 8-bit step of sRGB at mid-grey is about 1 %
+
+
+def test_light_records_carry_only_the_fields_of_their_kind(tmp_path, two_light_sample, config):
+    scene, result = two_light_sample  # point lights: a position, no direction, size or cone
+    folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=3)
+    for light in json.loads((folder / "meta.json").read_text())["lights"]:
+        assert light["kind"] == "point" and len(light["position"]) == 3
+        assert not {"direction", "size", "cutoff_deg"} & set(light)
