@@ -32,7 +32,13 @@ def collect_info(data_dir: str | None = None) -> dict[str, Any]:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("info", help="versions, usable Mitsuba variants, data directories")
+    p = sub.add_parser(
+        "info", help="versions, usable Mitsuba variants, data directories",
+        description="Print the installed versions of spectrinsic and the libraries that compute "
+        "its pixels, the Mitsuba variants usable here (cuda > llvm > scalar) and the libLLVM "
+        "Dr.Jit uses, and the spectral data directory found (--data-dir, $SPECTRINSIC_DATA or "
+        "../shared/data through make) with its subfolders.",
+    )
     p.set_defaults(func=run)
 
 

@@ -26,22 +26,40 @@ DEFAULT_MODES = "spectral,rgb3,rgb6,bands31"
 BLEND_MAGIC = b"BLENDER"
 
 
+def _modes_help() -> str:
+    from spectrinsic.render.modes import RENDER_MODES
+
+    return "; ".join(f"{m.name}: {m.description}" for m in RENDER_MODES.values())
+
+
 def register(sub: argparse._SubParsersAction) -> None:
+    from spectrinsic.presets import get_preset
+
+    # one set of documented defaults: those of the dataset's default preset
+    default = get_preset("default")
     p = sub.add_parser(
         "render", help="render a scene in several colour modes and write raw passes as EXR",
-        description="Render SCENE (a library scene name or a YAML file) with Mitsuba 3 in each mode "
-                    "and write float32 EXR files with named channels into --out.",
+        description="Render SCENE (a library scene name, a YAML or a .blend file) with Mitsuba 3 "
+                    "in each mode and write float32 EXR files with named channels into --out "
+                    "(raw passes, XYZ, AOVs; ground-truth layers come from `spectrinsic dataset`). "
+                    f"Defaults are the dataset's default preset: {default.spp} spp, path depth "
+                    f"{default.max_depth}, library scenes at {default.width}x{default.height}. "
+                    f"Modes: {_modes_help()}.",
     )
     p.add_argument("scene", metavar="SCENE", help="library scene name (e.g. room-living) or a .yaml scene file")
     p.add_argument("--condition", default="white", help="library scenes: illumination condition (default: white)")
     p.add_argument("--view", type=int, default=0, help="library scenes: camera viewpoint (default: 0)")
     p.add_argument("--modes", default=DEFAULT_MODES, help=f"comma-separated render modes (default: {DEFAULT_MODES})")
     p.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder")
-    p.add_argument("--spp", type=int, default=64, help="samples per pixel of every pass (default: 64)")
+    p.add_argument("--spp", type=int, default=default.spp,
+                   help=f"samples per pixel of every pass (default: {default.spp})")
     p.add_argument("--seed", type=int, default=0, help="sampler seed and library illuminant seed (default: 0)")
-    p.add_argument("--width", type=int, default=None, help="image width (default: the scene's, 128 for the library)")
-    p.add_argument("--height", type=int, default=None, help="image height (default: the scene's, 128 for the library)")
-    p.add_argument("--max-depth", type=int, default=8, help="longest path, 2 = direct light only (default: 8)")
+    p.add_argument("--width", type=int, default=None,
+                   help=f"image width (default: the scene's, {default.width} for the library)")
+    p.add_argument("--height", type=int, default=None,
+                   help=f"image height (default: the scene's, {default.height} for the library)")
+    p.add_argument("--max-depth", type=int, default=default.max_depth,
+                   help=f"longest path, 2 = direct light only (default: {default.max_depth})")
     p.add_argument("--variant", default=None, help="Mitsuba backend or variant (default: best usable)")
     p.add_argument("--per-light", action="store_true", help="also write one image per light")
     p.add_argument("--direct", action="store_true", help="also write direct-light-only images")
@@ -72,8 +90,12 @@ def load_scene_argument(
         return dataclasses.replace(loaded, camera=camera)
     from spectrinsic.scenes import library
 
+    from spectrinsic.presets import get_preset
+
+    default = get_preset("default")
     return library.build(scene, view=view, condition=condition, seed=seed,
-                         width=128 if width is None else width, height=128 if height is None else height)
+                         width=default.width if width is None else width,
+                         height=default.height if height is None else height)
 
 
 def _is_blend(path: Path) -> bool:
