@@ -248,3 +248,4 @@ def test_missing_inputs_raise_clear_errors(synth):
         compute_ground_truth(scene, no_split, cameras=())
     with pytest.raises(DatasetError, match="bands31"):
         compute_ground_truth(scene, result, cameras=(CAMERA,))
+

@@ -199,3 +199,15 @@ def test_adaptive_batches_stop_at_the_target_or_the_cap(make_room):
     assert easy.meta["noise_target"]["reached"] == pytest.approx(
         image_noise([render_scene(scene, modes=("rgb3",), spp=2, seed=s, aovs=False)
                      for s in easy.meta["batch_seeds"]]))
+
+
+def test_residual_vanishes_on_a_flat_grey_and_not_on_a_saturated_chip():
+    """A flat reflectance commutes with any light, here the red bounce: the residual of the grey
+    wall is float32 round-off; the green chip in the same light does not commute."""
+    grey, _ = _gt(_corner_scene(grey="flat:0.8"))
+    green, _ = _gt(_corner_scene(grey="munsell:5G 6/8"))
+    inside = _interior(grey)
+    image, residual = grey.layers["image"].data[inside], grey.layers["residual"].data[inside]
+    assert np.abs(residual).max() < 1e-5 * np.abs(image).max()
+    image, residual = green.layers["image"].data[inside], green.layers["residual"].data[inside]
+    assert np.median(np.linalg.norm(residual, axis=-1) / np.linalg.norm(image, axis=-1)) > 0.01
