@@ -246,7 +246,8 @@
       const report = { x: px, y: py, layers: {} };
       for (const [img, n] of [[imgA, view.a], [imgB, view.b]]) {
         const data = pixels(img);
-        if (!data) { lines.push(`${n}: pixel values need a served page or a browser that lets file:// pages read their images`); continue; }
+        if (!data) { lines.push(`${n}: the browser does not let this file:// page read its images; serve the folder `
+          + "(python -m http.server) or start Chromium with --allow-file-access-from-files"); continue; }
         const o = 4 * (py * data.w + px);
         const d = describe(n, [data.rgba[o], data.rgba[o + 1], data.rgba[o + 2]], s.layers[n][1]);
         lines.push(d.text);
@@ -279,4 +280,5 @@
   if (!G) { app.textContent = "gallery-index.js is missing: rebuild the gallery (spectrinsic dataset)."; return; }
   window.addEventListener("hashchange", route);
   route();
+  performance.mark("gallery-rendered"); // the first view is in the DOM (for measuring first paint)
 })();
