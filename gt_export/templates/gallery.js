@@ -204,7 +204,7 @@
     const imgA = el("img", { class: "a", alt: "layer A" }), imgB = el("img", { class: "b", alt: "layer B" });
     const divider = el("div", { class: "divider" });
     const stack = el("div", { class: "stack" }, imgA, imgB, divider);
-    const viewer = el("div", { class: "viewer", id: "viewer", title: "click to zoom; shift-click to zoom out" }, stack);
+    const viewer = el("div", { class: "viewer", id: "viewer", title: "click to zoom in (×2, up to ×16, then back); shift-click to zoom out" }, stack);
     const readout = el("div", { class: "readout", id: "readout", text: "move the cursor over the image for linear values" });
     const slider = el("input", { type: "range", id: "ab-slider", min: "0", max: "100", value: "50" });
     const bSelect = el("select", { id: "layer-b" }, ...names.map((n) => el("option", { value: n, text: n })));
@@ -236,7 +236,7 @@
     imgA.addEventListener("load", size);
     bSelect.addEventListener("change", (e) => { view.b = e.target.value; update(); });
     slider.addEventListener("input", (e) => { view.split = parseFloat(e.target.value); clip(); });
-    viewer.addEventListener("click", (e) => { view.zoom = e.shiftKey ? Math.max(1, view.zoom / 2) : Math.min(16, view.zoom * 2); size(); });
+    viewer.addEventListener("click", (e) => { view.zoom = e.shiftKey ? Math.max(1, view.zoom / 2) : view.zoom >= 16 ? 1 : view.zoom * 2; size(); });
     stack.addEventListener("mousemove", (e) => {
       const r = imgA.getBoundingClientRect();
       const px = Math.floor(((e.clientX - r.left) / r.width) * imgA.naturalWidth);

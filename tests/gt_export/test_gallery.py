@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import importlib.util
 import json
 import shutil
 from pathlib import Path
@@ -15,6 +16,12 @@ from spectrinsic.gt_export.gallery import COLUMNS, INDEX_VARIABLE, TILE, gallery
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 CHROMEDRIVER = shutil.which("chromedriver")
+HAVE_SELENIUM = importlib.util.find_spec("selenium") is not None
+#: The browser tests run where Chromium, its WebDriver and Selenium are installed.
+needs_browser = pytest.mark.skipif(
+    CHROMIUM is None or CHROMEDRIVER is None or not HAVE_SELENIUM,
+    reason="headless Chromium, chromium-driver or selenium not installed (scripts/setup-system.sh "
+           "installs the Debian packages chromium and chromium-driver, `make setup` selenium)")
 #: Seconds the browser may take to show an element (it starts in ~1 s here).
 BROWSER_WAIT_S = 20
 #: Slack on top of a preview's stated precision (float32 EXR vs float64 decoding in the page).
@@ -145,16 +152,14 @@ def _check_readout_against_exr(report: dict, root: Path, sample: str, layer: str
 
 
 @pytest.mark.browser
-@pytest.mark.skipif(CHROMIUM is None or CHROMEDRIVER is None,
-                    reason="headless Chromium or its WebDriver not installed (Debian packages "
-                           "chromium and chromium-driver; scripts/setup-system.sh installs them)")
+@needs_browser
 def test_a_person_filters_opens_a_sample_and_reads_a_pixel(gallery, tmp_path):
     from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.keys import Keys
     from selenium.webdriver.support import expected_conditions as ec
     from selenium.webdriver.support.select import Select
     from selenium.webdriver.support.ui import WebDriverWait
 
-    pytest.importorskip("selenium")
     root, shots = gallery.parent, tmp_path / "screenshots"
     driver = _driver(shots)
     try:
@@ -173,6 +178,13 @@ def test_a_person_filters_opens_a_sample_and_reads_a_pixel(gallery, tmp_path):
         image = driver.find_element("css selector", "#viewer img.a")
         wait.until(lambda d: d.execute_script("return arguments[0].naturalWidth", image) > 0)
         assert len(driver.find_elements("css selector", "#lights svg.spd")) == 1
+        # click to zoom: the image doubles in size
+        width = image.size["width"]
+        driver.find_element("id", "viewer").click()
+        assert image.size["width"] == 2 * width
+        viewer = driver.find_element("id", "viewer")
+        ActionChains(driver).key_down(Keys.SHIFT).click(viewer).key_up(Keys.SHIFT).perform()  # zoom out
+        assert image.size["width"] == width
         assert len(driver.find_elements("css selector", "#lights circle.light-dot")) == 1
         # switch layers: A to the error map (a colour bar appears), back to the image
         driver.find_element("css selector", '#layers button[data-layer="noise_image"], #layers button[data-layer="depth"]').click()
@@ -202,9 +214,7 @@ def test_a_person_filters_opens_a_sample_and_reads_a_pixel(gallery, tmp_path):
 
 
 @pytest.mark.browser
-@pytest.mark.skipif(CHROMIUM is None or CHROMEDRIVER is None,
-                    reason="headless Chromium or its WebDriver not installed (Debian packages "
-                           "chromium and chromium-driver)")
+@needs_browser
 def test_the_readout_check_can_fail(gallery, tmp_path):
     """A preview whose stated scale is wrong gives readouts the EXR check rejects."""
     root = gallery.parent
