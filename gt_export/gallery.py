@@ -8,7 +8,9 @@
   lights with their SPDs and chromaticities, and every layer's preview with its encoding), and
   ``gallery-index.js``, the same index assigned to ``window.SPECTRINSIC_GALLERY`` (a page opened
   from ``file://`` may not ``fetch()`` a local JSON file, but it may load a script);
-* ``contact_sheet.png`` (every sample) and ``contact_sheets/<condition>.png`` (one per condition).
+* ``contact_sheet.png`` (every sample) and ``contact_sheets/<condition>.png`` (one per condition);
+* ``gallery-pixels/<id>.js``: a sample's previews as ``data:`` URLs, loaded when the sample is
+  opened, for the pixel readout of a page opened from ``file://`` (see :func:`build_gallery`).
 
 The page decodes a pixel of a preview back to the linear value it stands for from the layer's
 ``preview_encoding`` (``meta.json["layers"][name]``): ``srgb`` previews are sRGB-encoded
@@ -60,6 +62,7 @@ COLUMNS = 8
 _CAPTION_HEIGHT = 14
 #: Folder of the per-condition contact sheets and file-name pattern of summary plots.
 _SHEETS_DIR = "contact_sheets"
+_PIXELS_DIR = "gallery-pixels"
 _SUMMARY_GLOBS = ("*.png", "plots/*.png", "summary/*.png", "figures/*.png")
 
 
@@ -261,12 +264,44 @@ def _condition_sheets(root: Path, index: Mapping[str, Any]) -> dict[str, str]:
     return out
 
 
-def build_gallery(dataset_dir: str | os.PathLike[str], *, title: str | None = None) -> Path:
-    """Write the gallery (see the module docstring) into *dataset_dir*; return ``index.html``."""
+def _write_pixel_scripts(root: Path, index: Mapping[str, Any]) -> None:
+    """Write ``gallery-pixels/<id>.js`` per sample: its value-bearing previews (``srgb`` and
+    ``colormap`` encodings) as ``data:`` URLs, which a page opened from ``file://`` may read
+    into a canvas (Chromium forbids reading the files themselves); set each entry's ``pixels``."""
+    import base64
+    import shutil
+
+    folder = root / _PIXELS_DIR
+    shutil.rmtree(folder, ignore_errors=True)
+    folder.mkdir()
+    for entry in index["samples"]:
+        urls = {
+            name: "data:image/png;base64," + base64.b64encode((root / src).read_bytes()).decode("ascii")
+            for name, (src, enc) in entry["layers"].items()
+            if isinstance(enc, Mapping) and enc.get("kind") in ("srgb", "colormap")
+        }
+        rel = f"{_PIXELS_DIR}/{entry['id']}.js"
+        (root / rel).write_text(
+            f"(window.SPECTRINSIC_PIXELS = window.SPECTRINSIC_PIXELS || {{}})[{json.dumps(entry['id'])}] = "
+            f"{json.dumps(urls)};\n", encoding="utf-8")
+        entry["pixels"] = rel
+
+
+def build_gallery(
+    dataset_dir: str | os.PathLike[str], *, title: str | None = None, pixel_scripts: bool = True
+) -> Path:
+    """Write the gallery (see the module docstring) into *dataset_dir*; return ``index.html``.
+
+    *pixel_scripts* also writes ``gallery-pixels/<id>.js`` (about 1.35 × the size of the
+    previews), so the pixel readout works from ``file://`` in Chromium too; without them it needs
+    the folder served (``python -m http.server``) or a browser that lets such a page read its files.
+    """
     root = Path(dataset_dir)
     index = gallery_index(root)
     if title:
         index["title"] = title
+    if pixel_scripts:
+        _write_pixel_scripts(root, index)
     contact_sheet(root)
     index["contact_sheets"] = {"all": "contact_sheet.png", **_condition_sheets(root, index)}
     data = json.dumps(_jsonable(index), ensure_ascii=False, separators=(",", ":"))

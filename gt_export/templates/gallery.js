@@ -177,22 +177,70 @@
     return s;
   }
 
-  // Pixels of each preview, read once through a canvas (null where the browser forbids it).
+  // Pixels of each preview, read once through a canvas. A page opened from file:// may not
+  // read its own images in Chromium (a tainted canvas); the gallery then loads the sample's
+  // gallery-pixels/<id>.js, which holds the same PNGs as data: URLs, which a canvas may read.
   const pixelCache = new Map();
-  function pixels(img) {
-    if (pixelCache.has(img.src)) return pixelCache.get(img.src);
-    let data = null;
+  const pixelScripts = new Map();
+  let filesReadable = true;
+  function readCanvas(img) {
     try {
       const c = document.createElement("canvas");
       c.width = img.naturalWidth; c.height = img.naturalHeight;
       const ctx = c.getContext("2d", { willReadFrequently: true });
       ctx.drawImage(img, 0, 0);
-      data = { w: c.width, h: c.height, rgba: ctx.getImageData(0, 0, c.width, c.height).data };
+      return { w: c.width, h: c.height, rgba: ctx.getImageData(0, 0, c.width, c.height).data };
     } catch (e) {
-      data = null; // a tainted canvas: file:// pages in Chromium without --allow-file-access-from-files
+      return null;
     }
-    pixelCache.set(img.src, data);
+  }
+  function embeddedPixels(s, n, redraw) {
+    const all = (window.SPECTRINSIC_PIXELS || {})[s.id];
+    if (!all) {
+      if (s.pixels && !pixelScripts.has(s.id)) {
+        const tag = el("script", { src: s.pixels });
+        tag.addEventListener("load", redraw);
+        pixelScripts.set(s.id, tag);
+        document.head.append(tag);
+      }
+      return s.pixels ? "pending" : null;
+    }
+    if (!all[n]) return null;
+    const key = `${s.id}|${n}`;
+    pixelCache.set(key, "pending");
+    const im = new Image();
+    im.addEventListener("load", () => { pixelCache.set(key, readCanvas(im)); redraw(); });
+    im.src = all[n];
+    return "pending";
+  }
+  // {w, h, rgba, source}, "pending" (asked for; redraw() runs when it comes) or null (none).
+  function pixels(s, n, img, redraw) {
+    const key = `${s.id}|${n}`;
+    if (pixelCache.has(key)) return pixelCache.get(key);
+    if (filesReadable) {
+      if (!(img.complete && img.naturalWidth)) { img.addEventListener("load", redraw, { once: true }); return "pending"; }
+      const data = readCanvas(img);
+      if (data) { data.source = "file"; pixelCache.set(key, data); return data; }
+      filesReadable = false;
+    }
+    const data = embeddedPixels(s, n, redraw);
+    if (data && data !== "pending") data.source = "embedded";
     return data;
+  }
+  function readoutAt(s, layers, px, py, redraw) {
+    const lines = [`pixel x=${px} y=${py}`];
+    const report = { x: px, y: py, layers: {}, source: null };
+    for (const [img, n] of layers) {
+      const data = pixels(s, n, img, redraw);
+      if (data === "pending") { lines.push(`${n}: loading pixel values…`); continue; }
+      if (!data) { lines.push(`${n}: no pixel values (serve the folder, python -m http.server, or rebuild the gallery)`); continue; }
+      const o = 4 * (py * data.w + px);
+      const d = describe(n, [data.rgba[o], data.rgba[o + 1], data.rgba[o + 2]], s.layers[n][1]);
+      lines.push(d.text);
+      report.layers[n] = d;
+      report.source = data.source || "embedded";
+    }
+    return { text: lines.join("\n"), report };
   }
 
   function renderSample(id) {
@@ -237,26 +285,19 @@
     bSelect.addEventListener("change", (e) => { view.b = e.target.value; update(); });
     slider.addEventListener("input", (e) => { view.split = parseFloat(e.target.value); clip(); });
     viewer.addEventListener("click", (e) => { view.zoom = e.shiftKey ? Math.max(1, view.zoom / 2) : view.zoom >= 16 ? 1 : view.zoom * 2; size(); });
-    stack.addEventListener("mousemove", (e) => {
+    let last = null;
+    function onMove(e) {
+      last = e;
       const r = imgA.getBoundingClientRect();
       const px = Math.floor(((e.clientX - r.left) / r.width) * imgA.naturalWidth);
       const py = Math.floor(((e.clientY - r.top) / r.height) * imgA.naturalHeight);
       if (px < 0 || py < 0 || px >= imgA.naturalWidth || py >= imgA.naturalHeight) return;
-      const lines = [`pixel x=${px} y=${py}`];
-      const report = { x: px, y: py, layers: {} };
-      for (const [img, n] of [[imgA, view.a], [imgB, view.b]]) {
-        const data = pixels(img);
-        if (!data) { lines.push(`${n}: the browser does not let this file:// page read its images; serve the folder `
-          + "(python -m http.server) or start Chromium with --allow-file-access-from-files"); continue; }
-        const o = 4 * (py * data.w + px);
-        const d = describe(n, [data.rgba[o], data.rgba[o + 1], data.rgba[o + 2]], s.layers[n][1]);
-        lines.push(d.text);
-        report.layers[n] = d;
-        if (n === view.b && view.a === view.b) break;
-      }
-      readout.textContent = lines.join("\n");
-      readout.dataset.report = JSON.stringify(report);
-    });
+      const layers = view.a === view.b ? [[imgA, view.a]] : [[imgA, view.a], [imgB, view.b]];
+      const out = readoutAt(s, layers, px, py, () => { if (last === e) onMove(e); });
+      readout.textContent = out.text;
+      readout.dataset.report = JSON.stringify(out.report);
+    }
+    stack.addEventListener("mousemove", onMove);
     const links = el("div", { class: "files" }, "files: ", ...s.files.map((f) => el("a", { href: f, text: f.split("/").pop() })));
     const lights = el("div", { class: "lights", id: "lights" }, ...s.lights.map(spdPlot), cieDiagram(s.lights));
     app.replaceChildren(el("div", { class: "sample", id: "sample", "data-id": s.id },

@@ -73,6 +73,9 @@ def test_index_records_every_sample_with_its_previews_and_encodings(gallery):
                 assert enc == rec["preview_encoding"]
         assert len(entry["lights"]) == len(meta["lights"]) and len(entry["lights"][0]["spd"]) == 81
         assert all((root / f).is_file() for f in entry["files"])
+        pixels = (root / entry["pixels"]).read_text()
+        assert pixels.count("data:image/png;base64,") == sum(
+            enc["kind"] != "categorical" for _, enc in entry["layers"].values())
     for name, lut in index["colormaps"].items():
         assert len(lut) == 256, name
     # the locus starts in the violet corner (x≈0.17, y≈0.005) and passes near the green peak
@@ -103,15 +106,18 @@ def test_index_without_splits_or_a_manifest(dataset):
 # In the browser
 
 
-def _driver(screenshots: Path):
-    """A headless Chromium WebDriver that keeps the browser's console log."""
+def _driver(screenshots: Path, *, file_access: bool = False):
+    """A headless Chromium WebDriver that keeps the browser's console log; *file_access* lets
+    file:// pages read their own images (by default, as for a person, they may not)."""
     from selenium import webdriver
     from selenium.webdriver.chrome.service import Service
 
     options = webdriver.ChromeOptions()
     for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                "--allow-file-access-from-files", "--window-size=1400,1000"):
+                "--window-size=1400,1000"):
         options.add_argument(arg)
+    if file_access:
+        options.add_argument("--allow-file-access-from-files")
     options.binary_location = CHROMIUM or ""
     options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
     screenshots.mkdir(exist_ok=True)
@@ -122,14 +128,19 @@ def _errors(driver) -> list[str]:
     return [e["message"] for e in driver.get_log("browser") if e["level"] in ("SEVERE", "ERROR")]
 
 
-def _pixel_report(driver, element, dx: int, dy: int) -> dict:
-    """Move the mouse to (dx, dy) from *element*'s centre; return the readout's report."""
+def _pixel_report(driver, element, dx: int, dy: int, layers: tuple[str, ...]) -> dict:
+    """Move the mouse to (dx, dy) from *element*'s centre; return the readout's report once it
+    holds *layers* (pixel values may load after the first move)."""
     from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.support.ui import WebDriverWait
 
     ActionChains(driver).move_to_element_with_offset(element, dx, dy).perform()
-    report = driver.find_element("id", "readout").get_attribute("data-report")
-    assert report, driver.find_element("id", "readout").text
-    return json.loads(report)
+
+    def ready(d):
+        report = json.loads(d.find_element("id", "readout").get_attribute("data-report") or "{}")
+        return report if set(layers) <= set(report.get("layers", {})) else False
+
+    return WebDriverWait(driver, BROWSER_WAIT_S).until(ready, driver.find_element("id", "readout").text)
 
 
 def _check_readout_against_exr(report: dict, root: Path, sample: str, layer: str, info: dict) -> int:
@@ -204,7 +215,8 @@ def test_a_person_filters_opens_a_sample_and_reads_a_pixel(gallery, tmp_path):
         info = json.loads((root / "gallery.json").read_text())["layer_info"]
         compared = 0
         for dx, dy in ((-60, -40), (60, -40), (-60, 60), (60, 60)):
-            report = _pixel_report(driver, image, dx, dy)
+            report = _pixel_report(driver, image, dx, dy, ("image", "reflectance"))
+            assert report["source"] == "embedded"  # file:// images are not readable in Chromium
             for layer in ("image", "reflectance"):
                 compared += _check_readout_against_exr(report, root, "one", layer, info[layer])
         assert compared >= 8
@@ -216,14 +228,15 @@ def test_a_person_filters_opens_a_sample_and_reads_a_pixel(gallery, tmp_path):
 @pytest.mark.browser
 @needs_browser
 def test_the_readout_check_can_fail(gallery, tmp_path):
-    """A preview whose stated scale is wrong gives readouts the EXR check rejects."""
+    """A preview whose stated scale is wrong gives readouts the EXR check rejects (read from the
+    PNG files themselves, as a served page or a permissive browser does)."""
     root = gallery.parent
     index_js = root / "gallery-index.js"
     index = _script_index(root)
     sample = next(s for s in index["samples"] if s["id"] == "one")
     sample["layers"]["image"][1]["scale"] *= 2.0
     index_js.write_text(f"window.{INDEX_VARIABLE} = {json.dumps(index)};\n")
-    driver = _driver(tmp_path / "screenshots")
+    driver = _driver(tmp_path / "screenshots", file_access=True)
     try:
         driver.get(gallery.as_uri() + "#sample=one")
         image = driver.find_element("css selector", "#viewer img.a")
@@ -231,7 +244,8 @@ def test_the_readout_check_can_fail(gallery, tmp_path):
 
         WebDriverWait(driver, BROWSER_WAIT_S).until(
             lambda d: d.execute_script("return arguments[0].naturalWidth", image) > 0)
-        report = _pixel_report(driver, image, -60, -40)
+        report = _pixel_report(driver, image, -60, -40, ("image",))
+        assert report["source"] == "file"  # this browser may read the previews themselves
         with pytest.raises(AssertionError):
             _check_readout_against_exr(report, root, "one", "image", index["layer_info"]["image"])
     finally:
