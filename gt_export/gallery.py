@@ -40,7 +40,8 @@ from spectrinsic.gt_export.writer import (
     sample_dirs,
 )
 
-__all__ = ["build_gallery", "contact_sheet", "gallery_index", "GALLERY_LAYERS", "INDEX_VARIABLE"]
+__all__ = ["build_gallery", "contact_sheet", "gallery_index", "GALLERY_DIRS", "GALLERY_LAYERS",
+           "INDEX_VARIABLE"]
 
 #: Layer order in the per-sample switcher (others follow in name order; camera views last).
 GALLERY_LAYERS: tuple[str, ...] = (
@@ -63,6 +64,8 @@ _CAPTION_HEIGHT = 14
 #: Folder of the per-condition contact sheets and file-name pattern of summary plots.
 _SHEETS_DIR = "contact_sheets"
 _PIXELS_DIR = "gallery-pixels"
+#: The folders the gallery writes into the dataset folder beside the sample folders.
+GALLERY_DIRS: tuple[str, ...] = (_SHEETS_DIR, _PIXELS_DIR)
 _SUMMARY_GLOBS = ("*.png", "plots/*.png", "summary/*.png", "figures/*.png")
 
 
