@@ -37,6 +37,8 @@
     return { value: srgbDecode(code / 255) / scale, precision: (hi - lo) / 2 / scale,
              clipped: code >= 255, under: code <= 0, clip: 1 / scale };
   }
+  // A colormap preview's colour -> its value. matplotlib maps t = (v - vmin) / span to colour
+  // floor(256 t) (clipped to 0..255), so colour i stands for t in [i/256, (i+1)/256).
   function decodeColormap(rgb, enc) {
     const lut = G.colormaps[enc.cmap];
     let best = 0, dist = Infinity;
@@ -45,8 +47,8 @@
       if (d < dist) { dist = d; best = i; }
     }
     const span = enc.vmax - enc.vmin;
-    return { value: enc.vmin + (best / 255) * span, precision: span / 510,
-             clipped: best === 255, under: best === 0, clip: enc.vmax, exact: dist === 0 };
+    return { value: enc.vmin + ((best + 0.5) / 256) * span, precision: span / 512,
+             clipped: best === 255, under: best === 0, onMap: dist <= 3 };
   }
   function describe(layer, rgb, enc) {
     if (!enc || enc.kind === "categorical") {
@@ -61,7 +63,9 @@
                under: d.map((x) => x.under) };
     }
     const d = decodeColormap(rgb, enc);
-    const txt = d.clipped ? `≥ ${fmt(enc.vmax)} (≥ clip)` : d.under ? `≤ ${fmt(enc.vmin)}` : `${fmt(d.value)} ± ${fmt(d.precision)}`;
+    if (!d.onMap) return { text: `${layer}: rgb8 ${rgb.join(", ")} is off the ${enc.cmap} colour map (masked: no value)`, values: null };
+    const txt = d.clipped ? `≥ ${fmt(d.value - d.precision)} (≥ clip)` : d.under ? `≤ ${fmt(d.value + d.precision)}`
+      : `${fmt(d.value)} ± ${fmt(d.precision)}`;
     return { text: `${layer}: ${txt}  (${enc.cmap} ${fmt(enc.vmin)}–${fmt(enc.vmax)}${enc.of ? ", " + enc.of : ""})`,
              values: [d.value], precision: [d.precision], clipped: [d.clipped], under: [d.under] };
   }

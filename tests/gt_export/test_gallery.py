@@ -220,6 +220,16 @@ def test_a_person_filters_opens_a_sample_and_reads_a_pixel(gallery, tmp_path):
             for layer in ("image", "reflectance"):
                 compared += _check_readout_against_exr(report, root, "one", layer, info[layer])
         assert compared >= 8
+        # an error map (a colormap preview) reads back too, in the other condition's sample
+        driver.execute_script("location.hash = 'sample=two'")
+        wait.until(lambda d: d.find_element("id", "sample").get_attribute("data-id") == "two")
+        driver.find_element("css selector", '#layers button[data-layer="error_rgb3"]').click()
+        image = driver.find_element("css selector", "#viewer img.a")
+        wait.until(lambda d: d.execute_script("return arguments[0].complete && arguments[0].naturalWidth", image))
+        compared = sum(_check_readout_against_exr(_pixel_report(driver, image, dx, dy, ("error_rgb3",)),
+                                                  root, "two", "error_rgb3", info["error_rgb3"])
+                       for dx, dy in ((-60, -40), (60, -40), (-60, 60), (60, 60)))
+        assert compared >= 1
         assert _errors(driver) == []
     finally:
         driver.quit()
