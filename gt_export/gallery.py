@@ -1,192 +1,325 @@
-"""A static HTML gallery of a dataset and a contact sheet of all its images.
+"""An interactive static gallery of a dataset, and contact sheets of its images.
 
-``index.html`` (in the dataset folder) shows, per sample, the image and its ground-truth layers
-side by side (the PNG previews of the sample folder) and the chromaticities of the sample's
-lights on a CIE 1931 xy diagram drawn as inline SVG (spectral locus, sRGB gamut, D65).
-``contact_sheet.png`` tiles every sample's image preview with its id. Neither needs a server
-nor scripts: open ``index.html`` in a browser.
+:func:`build_gallery` writes, into the dataset folder,
+
+* ``index.html``, ``gallery.js`` and ``gallery.css``: a page that opens from the file system (no
+  server, no network) and renders only the current page of samples, with lazy thumbnails;
+* ``gallery.json``: the index (per sample its scene, condition, kind, split, noise figure,
+  lights with their SPDs and chromaticities, and every layer's preview with its encoding), and
+  ``gallery-index.js``, the same index assigned to ``window.SPECTRINSIC_GALLERY`` (a page opened
+  from ``file://`` may not ``fetch()`` a local JSON file, but it may load a script);
+* ``contact_sheet.png`` (every sample) and ``contact_sheets/<condition>.png`` (one per condition);
+* ``gallery-pixels/<id>.js``: a sample's previews as ``data:`` URLs, loaded when the sample is
+  opened, for the pixel readout of a page opened from ``file://`` (see :func:`build_gallery`).
+
+The page decodes a pixel of a preview back to the linear value it stands for from the layer's
+``preview_encoding`` (``meta.json["layers"][name]``): ``srgb`` previews are sRGB-encoded
+``clip(value × scale)``, ``colormap`` previews map ``[vmin, vmax]`` through a matplotlib colormap
+(whose 256 colours the index carries), ``categorical`` ones have no scalar value.
 """
 
 from __future__ import annotations
 
-import html
 import json
 import os
+import re
 import string
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export import png
-from spectrinsic.gt_export.writer import META_NAME, read_template, sample_dirs
-
-__all__ = ["build_gallery", "chromaticity_svg", "contact_sheet", "GALLERY_LAYERS"]
-
-#: Layers shown per sample, in order (those a sample lacks are left out), then camera images.
-GALLERY_LAYERS: tuple[str, ...] = (
-    "image", "reflectance", "shading", "illuminant", "shading_grey", "depth", "normals",
-    "material_id", "object_id", "image_rgb3", "error_rgb3", "image_rgb6", "error_rgb6",
-    "image_spectral", "error_spectral",
+from spectrinsic.gt_export.integrity import MANIFEST_NAME
+from spectrinsic.gt_export.writer import (
+    META_NAME,
+    SCENE_NAME,
+    _jsonable,
+    read_template,
+    sample_dirs,
 )
+
+__all__ = ["build_gallery", "contact_sheet", "gallery_index", "GALLERY_DIRS", "GALLERY_LAYERS",
+           "INDEX_VARIABLE"]
+
+#: Layer order in the per-sample switcher (others follow in name order; camera views last).
+GALLERY_LAYERS: tuple[str, ...] = (
+    "image", "image_denoised", "image_rgb3", "image_rgb6", "image_spectral", "reflectance",
+    "shading", "shading_raw", "shading_grey", "shading_ratio", "residual", "residual_raw",
+    "illuminant", "error_rgb3", "error_rgb6", "error_spectral", "noise_image", "noise_shading_raw",
+    "depth", "normals", "material_id", "object_id", "mask",
+)
+#: The JavaScript variable ``gallery-index.js`` assigns the index to.
+INDEX_VARIABLE = "SPECTRINSIC_GALLERY"
+#: Static files copied from ``gt_export/templates`` next to ``index.html``.
+_STATIC = ("gallery.js", "gallery.css")
+#: Significant digits of the lights' SPDs in the index (for plotting; every other number is
+#: copied from ``meta.json`` unrounded, so preview encodings decode exactly).
+_SPD_DIGITS = 5
 #: Contact-sheet tile width in pixels and number of columns.
 TILE = 160
 COLUMNS = 8
 _CAPTION_HEIGHT = 14
-#: Plot window of the xy diagram.
-_X_RANGE, _Y_RANGE = (0.0, 0.8), (0.0, 0.9)
-_SVG_W, _SVG_H, _PAD = 200, 220, 22
+#: Folder of the per-condition contact sheets and file-name pattern of summary plots.
+_SHEETS_DIR = "contact_sheets"
+_PIXELS_DIR = "gallery-pixels"
+#: The folders the gallery writes into the dataset folder beside the sample folders.
+GALLERY_DIRS: tuple[str, ...] = (_SHEETS_DIR, _PIXELS_DIR)
+_SUMMARY_GLOBS = ("*.png", "plots/*.png", "summary/*.png", "figures/*.png")
 
 
-def _spectral_locus() -> np.ndarray:
-    """``(N, 2)`` xy of the CIE 1931 spectral locus, 380–700 nm."""
+def _spectral_locus() -> list[list[float]]:
+    """xy of the CIE 1931 2° spectral locus, 380–700 nm at 1 nm (colour-science's CMFs)."""
     from spectrinsic.spectra import get_sensors, xyz_to_xy
 
     cmf = get_sensors("cie1931")
     keep = (cmf.wavelengths >= 380) & (cmf.wavelengths <= 700)
-    return xyz_to_xy(cmf.curves[:, keep].T)
+    return np.round(xyz_to_xy(cmf.curves[:, keep].T), 5).tolist()
 
 
-def _hex(rgb_linear: Sequence[float]) -> str:
-    rgb = np.clip(np.asarray(rgb_linear, float), 0.0, None)
-    peak = rgb.max()
-    encoded = png.encode_srgb8((rgb / peak if peak > 0 else rgb)[None, None, :])[0, 0]
-    return "#" + "".join(f"{int(v):02x}" for v in encoded)
-
-
-def chromaticity_svg(lights: Sequence[Mapping[str, Any]], *, locus: np.ndarray | None = None) -> str:
-    """Inline SVG of a CIE 1931 xy diagram with one dot per light (filled with its sRGB colour).
-
-    Parameters
-    ----------
-    lights
-        Records with ``"xy"``, ``"srgb"`` and ``"spectrum"`` (as in ``meta.json["lights"]``).
-    locus
-        Precomputed spectral locus (``(N, 2)`` xy); computed when omitted.
-    """
+def _srgb_primaries() -> dict[str, list[float]]:
+    """xy of the sRGB primaries and of its white (D65), from colour-science."""
     import colour
 
-    locus = _spectral_locus() if locus is None else locus
-    sx = (_SVG_W - 2 * _PAD) / (_X_RANGE[1] - _X_RANGE[0])
-    sy = (_SVG_H - 2 * _PAD) / (_Y_RANGE[1] - _Y_RANGE[0])
-
-    def pt(x: float, y: float) -> str:
-        return f"{_PAD + (x - _X_RANGE[0]) * sx:.1f},{_SVG_H - _PAD - (y - _Y_RANGE[0]) * sy:.1f}"
-
-    primaries = np.asarray(colour.RGB_COLOURSPACES["sRGB"].primaries, float)
-    white = np.asarray(colour.RGB_COLOURSPACES["sRGB"].whitepoint, float)
-    parts = [
-        f'<svg xmlns="http://www.w3.org/2000/svg" width="{_SVG_W}" height="{_SVG_H}" '
-        f'viewBox="0 0 {_SVG_W} {_SVG_H}" role="img" aria-label="CIE 1931 xy chromaticities">',
-        f'<rect x="0" y="0" width="{_SVG_W}" height="{_SVG_H}" fill="#fff"/>',
-        f'<polyline points="{pt(_X_RANGE[0], _Y_RANGE[1])} {pt(_X_RANGE[0], _Y_RANGE[0])} '
-        f'{pt(_X_RANGE[1], _Y_RANGE[0])}" fill="none" stroke="#999"/>',
-        '<polygon points="' + " ".join(pt(x, y) for x, y in locus) + '" fill="#f2f2f2" stroke="#333"/>',
-        '<polygon points="' + " ".join(pt(x, y) for x, y in primaries)
-        + '" fill="none" stroke="#888" stroke-dasharray="3,2"><title>sRGB gamut</title></polygon>',
-        f'<circle cx="{pt(*white).split(",")[0]}" cy="{pt(*white).split(",")[1]}" r="2" '
-        'fill="#000"><title>D65</title></circle>',
-        f'<text x="{_PAD}" y="{_SVG_H - 5}" font-size="9">x</text>',
-        f'<text x="4" y="{_PAD}" font-size="9">y</text>',
-    ]
-    for light in lights:
-        x, y = light["xy"]
-        cx, cy = pt(x, y).split(",")
-        label = html.escape(f'{light.get("name", "light")}: {light["spectrum"]} (x={x:.4f}, y={y:.4f})')
-        parts.append(
-            f'<circle cx="{cx}" cy="{cy}" r="5" fill="{_hex(light["srgb"])}" stroke="#000">'
-            f"<title>{label}</title></circle>"
-        )
-    parts.append("</svg>")
-    return "".join(parts)
+    space = colour.RGB_COLOURSPACES["sRGB"]
+    return {"primaries": np.asarray(space.primaries, float).round(5).tolist(),
+            "white": np.asarray(space.whitepoint, float).round(5).tolist()}
 
 
-def _figure(src: str, caption: str) -> str:
-    src_q, cap = html.escape(src, quote=True), html.escape(caption)
-    return f'<figure><img src="{src_q}" alt="{cap}"><figcaption>{cap}</figcaption></figure>'
+def _colormap_luts(names: Iterable[str]) -> dict[str, list[list[int]]]:
+    """The 256 8-bit RGB colours of each named matplotlib colormap (as ``png.false_colour``
+    quantises them), so the page can draw true colour bars and invert a colour to its value."""
+    import matplotlib
+
+    out = {}
+    for name in sorted(set(names)):
+        rgba = matplotlib.colormaps[name](np.linspace(0.0, 1.0, 256))
+        out[name] = np.round(rgba[:, :3] * 255.0).astype(int).tolist()
+    return out
 
 
-def _sample_section(sample: Path, meta: Mapping[str, Any], locus: np.ndarray) -> str:
+def _split_of(manifest: Mapping[str, Any]) -> dict[str, str]:
+    """Sample id -> split name from ``manifest["splits"]``, read as ``{split: [ids]}``,
+    ``{split: {"samples": [ids]}}`` or ``{id: split}``; empty without splits."""
+    splits = manifest.get("splits")
+    out: dict[str, str] = {}
+    if not isinstance(splits, Mapping):
+        return out
+    for key, value in splits.items():
+        if isinstance(value, str):
+            out[str(key)] = value
+        else:
+            ids = value.get("samples", []) if isinstance(value, Mapping) else value
+            out.update({str(sid): str(key) for sid in ids if isinstance(sid, str)})
+    return out
+
+
+def _noise_figure(meta: Mapping[str, Any]) -> float | None:
+    """The median relative standard error of ``shading_raw`` (None when not measured)."""
+    fig = (meta.get("noise") or {}).get("shading_raw")
+    return float(fig["median"]) if isinstance(fig, Mapping) and "median" in fig else None
+
+
+def _layer_order(names: Iterable[str]) -> list[str]:
+    """*names* in :data:`GALLERY_LAYERS` order, then the rest by name, camera views last."""
+    rank = {name: i for i, name in enumerate(GALLERY_LAYERS)}
+    return sorted(names, key=lambda n: ("/" in n, rank.get(n, len(rank)), n))
+
+
+def _sample_entry(sample: Path, meta: Mapping[str, Any], split: str | None) -> dict[str, Any]:
+    """One sample's record in the index (paths relative to the dataset folder)."""
+    smeta = meta.get("scene_metadata") or {}
     records = meta.get("layers", {})
-    keys = [k for k in GALLERY_LAYERS if k in records]
-    keys += [k for k in records if k.startswith("image_camera/")]
-    figures = []
-    for key in keys:
-        preview = records[key].get("preview")
-        if preview:
-            figures.append(_figure(f"{sample.name}/{preview}", key))
-    lights = meta.get("lights", [])
-    light_text = "; ".join(
-        f'<span class="swatch" style="background:{_hex(light["srgb"])}"></span> '
-        f'{html.escape(str(light.get("name", "")))} {html.escape(light["spectrum"])} '
-        f'(xy {light["xy"][0]:.3f}, {light["xy"][1]:.3f}; share {light.get("share", 1):.2f})'
-        for light in lights
-    )
-    figures.append(
-        f"<figure>{chromaticity_svg(lights, locus=locus)}"
-        "<figcaption>light chromaticities (CIE 1931 xy)</figcaption></figure>"
-    )
-    sid = html.escape(sample.name)
-    return (
-        f'<section class="sample" id="{html.escape(sample.name, quote=True)}"><h2>{sid}</h2>'
-        f'<p class="lights">scene {html.escape(str(meta.get("scene")))} · render '
-        f'{html.escape(str(meta.get("reference_mode")))} · {light_text}</p>'
-        f'<div class="row">{"".join(figures)}</div></section>'
-    )
+    layers = {
+        name: [f"{sample.name}/{records[name]['preview']}", records[name].get("preview_encoding")]
+        for name in _layer_order(records) if records[name].get("preview")
+    }
+    lights = [
+        {"name": light.get("name"), "spectrum": light.get("spectrum"), "kind": light.get("kind"),
+         "xy": light.get("xy"), "srgb": light.get("srgb"), "share": light.get("share"),
+         "spd": [float(f"{v:.{_SPD_DIGITS}g}") for v in light.get("spd") or []]}
+        for light in meta.get("lights", [])
+    ]
+    return {
+        "id": sample.name, "scene": meta.get("scene"), "condition": smeta.get("condition"),
+        "kind": smeta.get("kind"), "split": split, "noise": _noise_figure(meta),
+        "size": meta.get("size"), "reference_mode": meta.get("reference_mode"),
+        "layers": layers, "lights": lights,
+        "files": sorted({f"{sample.name}/{r['file']}" for r in records.values() if r.get("file")}
+                        | {f"{sample.name}/{META_NAME}", f"{sample.name}/{SCENE_NAME}"}),
+    }
 
 
-def contact_sheet(dataset_dir: str | os.PathLike[str], *, out: str | os.PathLike[str] | None = None) -> Path:
-    """Tile every sample's ``image`` preview, captioned with its id, into one PNG."""
+def _layer_info(metas: Sequence[Mapping[str, Any]]) -> dict[str, dict[str, Any]]:
+    """Per layer name (first sample holding it): file, EXR layer, channels and units."""
+    info: dict[str, dict[str, Any]] = {}
+    for meta in metas:
+        for name, rec in meta.get("layers", {}).items():
+            info.setdefault(name, {k: rec.get(k) for k in ("file", "exr_layer", "channels", "units")})
+    return info
+
+
+def _read_json(path: Path) -> dict[str, Any]:
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise DatasetError(f"{path}: cannot be read as JSON ({exc})") from exc
+
+
+def gallery_index(dataset_dir: str | os.PathLike[str]) -> dict[str, Any]:
+    """The gallery's index of *dataset_dir* as plain data (what ``gallery.json`` holds).
+
+    Keys: ``samples`` (one record per sample, see the module docstring), ``layer_info``,
+    ``colormaps`` (name -> 256 RGB triples), ``locus`` (CIE 1931 xy, 380–700 nm), ``srgb``
+    (primaries and white), ``spd_grid`` (the lights' SPD grid in nm), ``splits`` (names, possibly
+    empty), ``contact_sheets`` and ``summary_plots`` (paths relative to the dataset folder).
+    """
+    root = Path(dataset_dir)
+    samples = sample_dirs(root)
+    if not samples:
+        raise DatasetError(f"dataset folder {str(root)!r} has no complete samples for a gallery")
+    manifest_path = root / MANIFEST_NAME
+    split_of = _split_of(_read_json(manifest_path)) if manifest_path.is_file() else {}
+    metas = [_read_json(s / META_NAME) for s in samples]
+    entries = [_sample_entry(s, m, split_of.get(s.name)) for s, m in zip(samples, metas)]
+    cmaps = {enc["cmap"] for e in entries for _, enc in e["layers"].values()
+             if isinstance(enc, Mapping) and enc.get("kind") == "colormap"}
+    grid = (metas[0].get("spectral_grid") or {}).get("lights_spd") or {}
+    return {
+        "title": f"spectrinsic dataset: {root.resolve().name}",
+        "samples": entries,
+        "layer_info": _layer_info(metas),
+        "colormaps": _colormap_luts(cmaps),
+        "locus": _spectral_locus(),
+        "srgb": _srgb_primaries(),
+        "spd_grid": {"start_nm": grid.get("start_nm", 380.0), "step_nm": grid.get("step_nm", 5.0)},
+        "splits": sorted(set(split_of.values())),
+        "contact_sheets": {},
+        "summary_plots": _summary_plots(root),
+    }
+
+
+def _summary_plots(root: Path) -> list[str]:
+    """Summary plots in the dataset folder (PNG files other than the contact sheets)."""
+    found = {p.relative_to(root).as_posix() for pattern in _SUMMARY_GLOBS for p in root.glob(pattern)}
+    return sorted(f for f in found if not f.startswith("contact_sheet"))
+
+
+def _slug(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "-", text).strip("-") or "none"
+
+
+def contact_sheet(
+    dataset_dir: str | os.PathLike[str], *, out: str | os.PathLike[str] | None = None,
+    samples: Sequence[Path] | None = None,
+) -> Path:
+    """Tile the ``image`` preview of every sample (or of *samples*) with its id into one PNG.
+
+    Ids longer than a tile are written on two lines, never truncated.
+    """
     from PIL import Image, ImageDraw, ImageFont
 
     root = Path(dataset_dir)
-    samples = sample_dirs(root)
+    samples = sample_dirs(root) if samples is None else list(samples)
     if not samples:
         raise DatasetError(f"dataset folder {str(root)!r} has no complete samples for a contact sheet")
     font = ImageFont.load_default()
     cols = min(COLUMNS, len(samples))
     rows = -(-len(samples) // cols)
-    sheet = Image.new("RGB", (cols * TILE, rows * (TILE + _CAPTION_HEIGHT)), (255, 255, 255))
+    cell = TILE + 2 * _CAPTION_HEIGHT
+    sheet = Image.new("RGB", (cols * TILE, rows * cell), (255, 255, 255))
     draw = ImageDraw.Draw(sheet)
     for i, sample in enumerate(samples):
-        meta = json.loads((sample / META_NAME).read_text(encoding="utf-8"))
-        preview = meta["layers"]["image"]["preview"]
-        with Image.open(sample / preview) as img:
+        meta = _read_json(sample / META_NAME)
+        with Image.open(sample / meta["layers"]["image"]["preview"]) as img:
             tile = img.convert("RGB")
             tile.thumbnail((TILE, TILE), Image.Resampling.LANCZOS)
-        x0, y0 = (i % cols) * TILE, (i // cols) * (TILE + _CAPTION_HEIGHT)
+        x0, y0 = (i % cols) * TILE, (i // cols) * cell
         sheet.paste(tile, (x0 + (TILE - tile.width) // 2, y0 + (TILE - tile.height) // 2))
-        caption = sample.name if len(sample.name) <= 26 else sample.name[:25] + "…"
-        draw.text((x0 + 2, y0 + TILE + 1), caption, fill=(0, 0, 0), font=font)
+        for line_no, line in enumerate(_wrap(sample.name, draw, font)):
+            draw.text((x0 + 2, y0 + TILE + 1 + line_no * _CAPTION_HEIGHT), line, fill=(0, 0, 0), font=font)
     path = Path(out) if out is not None else root / "contact_sheet.png"
+    path.parent.mkdir(parents=True, exist_ok=True)
     sheet.save(path, format="PNG")
     return path
 
 
-def build_gallery(dataset_dir: str | os.PathLike[str], *, title: str | None = None) -> Path:
-    """Write ``index.html`` and ``contact_sheet.png`` into *dataset_dir*; return the HTML path."""
+def _wrap(text: str, draw: Any, font: Any) -> list[str]:
+    """*text* in at most two lines that fit a tile, split after ``__`` where possible."""
+    if draw.textlength(text, font=font) <= TILE - 4:
+        return [text]
+    cut = text.rfind("__", 0, len(text) // 2 + 8)
+    cut = cut + 2 if cut > 0 else len(text) // 2
+    return [text[:cut], text[cut:]]
+
+
+def _condition_sheets(root: Path, index: Mapping[str, Any]) -> dict[str, str]:
+    """Write one contact sheet per condition; return condition -> path (relative to *root*)."""
+    by_condition: dict[str, list[Path]] = {}
+    for entry in index["samples"]:
+        by_condition.setdefault(str(entry["condition"]), []).append(root / entry["id"])
+    out = {}
+    for condition, members in sorted(by_condition.items()):
+        rel = f"{_SHEETS_DIR}/{_slug(condition)}.png"
+        contact_sheet(root, out=root / rel, samples=members)
+        out[condition] = rel
+    return out
+
+
+def _write_pixel_scripts(root: Path, index: Mapping[str, Any]) -> None:
+    """Write ``gallery-pixels/<id>.js`` per sample: its value-bearing previews (``srgb`` and
+    ``colormap`` encodings) as ``data:`` URLs, which a page opened from ``file://`` may read
+    into a canvas (Chromium forbids reading the files themselves); set each entry's ``pixels``."""
+    import base64
+    import shutil
+
+    folder = root / _PIXELS_DIR
+    shutil.rmtree(folder, ignore_errors=True)
+    folder.mkdir()
+    for entry in index["samples"]:
+        urls = {
+            name: "data:image/png;base64," + base64.b64encode((root / src).read_bytes()).decode("ascii")
+            for name, (src, enc) in entry["layers"].items()
+            if isinstance(enc, Mapping) and enc.get("kind") in ("srgb", "colormap")
+        }
+        rel = f"{_PIXELS_DIR}/{entry['id']}.js"
+        (root / rel).write_text(
+            f"(window.SPECTRINSIC_PIXELS = window.SPECTRINSIC_PIXELS || {{}})[{json.dumps(entry['id'])}] = "
+            f"{json.dumps(urls)};\n", encoding="utf-8")
+        entry["pixels"] = rel
+
+
+def build_gallery(
+    dataset_dir: str | os.PathLike[str], *, title: str | None = None, pixel_scripts: bool = True
+) -> Path:
+    """Write the gallery (see the module docstring) into *dataset_dir*; return ``index.html``.
+
+    *pixel_scripts* also writes ``gallery-pixels/<id>.js`` (about 1.35 × the size of the
+    previews), so the pixel readout works from ``file://`` in Chromium too; without them it needs
+    the folder served (``python -m http.server``) or a browser that lets such a page read its files.
+    """
     root = Path(dataset_dir)
-    samples = sample_dirs(root)
-    if not samples:
-        raise DatasetError(f"dataset folder {str(root)!r} has no complete samples for a gallery")
-    locus = _spectral_locus()
-    sections = []
-    scenes = set()
-    for sample in samples:
-        meta = json.loads((sample / META_NAME).read_text(encoding="utf-8"))
-        scenes.add(str(meta.get("scene")))
-        sections.append(_sample_section(sample, meta, locus))
+    index = gallery_index(root)
+    if title:
+        index["title"] = title
+    if pixel_scripts:
+        _write_pixel_scripts(root, index)
     contact_sheet(root)
-    title = title or f"spectrinsic dataset: {root.resolve().name}"
-    summary = (
-        f"{len(samples)} samples of {len(scenes)} scenes. Previews are tone-mapped sRGB for "
-        "viewing; the data are the float32 EXR files in each sample folder (see DATASET.md)."
-    )
+    index["contact_sheets"] = {"all": "contact_sheet.png", **_condition_sheets(root, index)}
+    data = json.dumps(_jsonable(index), ensure_ascii=False, separators=(",", ":"))
+    (root / "gallery.json").write_text(data + "\n", encoding="utf-8")
+    (root / "gallery-index.js").write_text(f"window.{INDEX_VARIABLE} = {data};\n", encoding="utf-8")
+    for name in _STATIC:
+        (root / name).write_text(read_template(name), encoding="utf-8")
     page = string.Template(read_template("gallery.html")).substitute(
-        title=html.escape(title), summary=html.escape(summary), samples="\n".join(sections)
-    )
+        title=_escape(index["title"]), n_samples=len(index["samples"]))
     path = root / "index.html"
     path.write_text(page, encoding="utf-8")
     return path
+
+
+def _escape(text: str) -> str:
+    import html
+
+    return html.escape(text)

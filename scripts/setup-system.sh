@@ -2,7 +2,7 @@
 # System set-up that pip cannot do. Never fatal: what is missing degrades with a warning.
 # - Dr.Jit 1.5's LLVM backend crashes with Debian's LLVM 14/15 ("Cannot select: fminimum"):
 #   install libllvm19; without it the package falls back to Mitsuba's scalar variants.
-# - Headless Chromium for the dataset gallery's browser test.
+# - Headless Chromium and its WebDriver (chromium-driver) for the dataset gallery's browser test.
 set -u
 updated=0
 apt_install() {  # apt_install PACKAGE WHY
@@ -20,4 +20,5 @@ have_llvm() { ls /usr/lib/x86_64-linux-gnu/libLLVM-1[6-9]*.so* /usr/lib/*/libLLV
 
 have_llvm || apt_install libllvm19 "Dr.Jit's LLVM backend needs LLVM >= 16; else scalar variants"
 command -v chromium >/dev/null 2>&1 || apt_install chromium "browser test of the dataset gallery"
+command -v chromedriver >/dev/null 2>&1 || apt_install chromium-driver "Selenium drives Chromium in the gallery's browser test"
 exit 0
