@@ -55,6 +55,7 @@ from spectrinsic.decompose.colour_naming import (
     discretise_memberships,
     label_centroids,
 )
+from spectrinsic.decompose.constancy import discount_illuminant
 from spectrinsic.decompose.decomposition import Decomposition, finish, prepare_input
 from spectrinsic.decompose.ridges import colour_shades
 from spectrinsic.errors import MissingDependencyError, validate_choice
@@ -204,6 +205,10 @@ class NamesAndShades:
     split_by_ridge
         Regions are connected areas of equal label *and* equal ridge (default) rather than of
         equal label only.
+    colour_constancy
+        Global light colour divided out of the reflectance after sec. 3.4
+        (:data:`spectrinsic.decompose.constancy.CONSTANCY`; not in the thesis, whose MIT images
+        are under near-white light); the shading then carries it.
     """
 
     mu: float = 1.0 / 3.0
@@ -216,6 +221,7 @@ class NamesAndShades:
     global_coherence: bool = True
     reflectance_colour: Literal["label-centroid", "region-mean"] = "region-mean"
     split_by_ridge: bool = True
+    colour_constancy: str = "none"
     name: str = "names-shades"
 
     def __call__(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Decomposition:
@@ -300,12 +306,15 @@ class NamesAndShades:
             lam = global_coherence(regions, colours.mean(axis=1), linear.mean(axis=2))
         else:
             lam = np.ones(n_regions + 1)
-        reflectance = (lam[:, None] * colours)[regions]
+        reflectance, light = discount_illuminant(
+            (lam[:, None] * colours)[regions], linear, m, self.colour_constancy
+        )
         timings["coherence_s"] = time.perf_counter() - t3
         info = {
             "observed_labels": int(candidates.size),
             "regions": n_regions,
             "ridges": shades.n_ridges,
+            "light_colour": light,
             **{k: round(v, 4) for k, v in timings.items()},
         }
         logger.debug("names-shades: %s", info)

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from spectrinsic.decompose.constancy import discount_illuminant
 from spectrinsic.decompose.decomposition import Decomposition, finish, prepare_input
 
 __all__ = ["ColourRetinex", "log_gradients", "poisson_solve"]
@@ -102,10 +103,15 @@ class ColourRetinex:
         mean) above which a derivative is a reflectance change. Grosse et al. chose both by
         cross-validation on ``logspace(-1.5, 0, 5)``; the defaults are from that grid, picked
         on noisy synthetic Mondrians (``tests/decompose``).
+    colour_constancy
+        Global light colour divided out of the reflectance
+        (:data:`spectrinsic.decompose.constancy.CONSTANCY`; a deviation from Grosse et al., whose
+        reflectance keeps the light's colour); the shading then carries it.
     """
 
     threshold_grey: float = 0.178
     threshold_colour: float = 0.178
+    colour_constancy: str = "none"
     name: str = "colour-retinex"
 
     def __call__(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Decomposition:
@@ -125,6 +131,9 @@ class ColourRetinex:
         rx = np.where(kept[1], gx_grey, 0.0)
         log_refl = poisson_solve(ry, rx, m)
         shading_grey = np.exp(grey_log - log_refl)
-        reflectance = img / shading_grey[:, :, None]
-        info = {"reflectance_edges": float((kept[0][m].mean() + kept[1][m].mean()) / 2.0)}
+        reflectance, light = discount_illuminant(
+            img / shading_grey[:, :, None], img, m, self.colour_constancy
+        )
+        info = {"reflectance_edges": float((kept[0][m].mean() + kept[1][m].mean()) / 2.0),
+                "light_colour": light}
         return finish(img, reflectance, m, info)

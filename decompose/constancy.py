@@ -1,0 +1,67 @@
+"""Global colour constancy for decomposers: the light's colour leaves the reflectance.
+
+Both bundled methods recover reflectance up to what they take as shading. Grosse et al.'s colour
+Retinex and the thesis' names-and-shades both keep the image's colour in the reflectance, so a
+coloured light tints the whole reflectance and every colour metric counts the tint as error
+(LMSE fits one scale per window, not one per channel). The dataset's coloured ``shading``
+layer carries the light's colour; estimating it is colour constancy.
+
+:func:`illuminant_colour` estimates one RGB light colour per image with the Minkowski family of
+Finlayson & Trezzi (2004): ``L_c ∝ (mean_p I_c(p)^p)^(1/p)`` over the masked pixels; ``p = 1``
+is grey-world (Buchsbaum 1980), ``p = ∞`` max-RGB (white patch, Land); ``p = 6`` is the
+"shades of grey" value they recommend. The estimate is normalised to mean channel 1, so the
+reflectance keeps its intensity and only its colour changes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from spectrinsic.errors import validate_choice
+
+__all__ = ["CONSTANCY", "illuminant_colour", "discount_illuminant"]
+
+#: Registry: name -> Minkowski norm ``p`` (``None``: no correction; ``inf``: max-RGB).
+CONSTANCY: Mapping[str, float | None] = {
+    "none": None,
+    "grey-world": 1.0,
+    "shades-of-grey": 6.0,
+    "max-rgb": float("inf"),
+}
+#: Max-RGB uses this percentile rather than the maximum (robust to a few hot pixels).
+MAX_RGB_PERCENTILE = 99.5
+
+
+def illuminant_colour(image: np.ndarray, mask: np.ndarray, method: str) -> np.ndarray:
+    """The light colour ``(3,)`` of a linear ``(H, W, 3)`` image, mean channel 1.
+
+    ``(1, 1, 1)`` for ``method="none"`` and for an image that is black in a channel.
+
+    >>> img = np.ones((2, 2, 3)) * np.array([2.0, 1.0, 0.0])
+    >>> illuminant_colour(img + 1.0, np.ones((2, 2), bool), "grey-world").tolist()
+    [1.5, 1.0, 0.5]
+    """
+    p = CONSTANCY[validate_choice(method, CONSTANCY, "colour constancy")]
+    if p is None:
+        return np.ones(3)
+    values = np.clip(image[mask], 0.0, None)
+    if np.isinf(p):
+        light = np.percentile(values, MAX_RGB_PERCENTILE, axis=0)
+    else:
+        light = np.mean(values**p, axis=0) ** (1.0 / p)
+    if not np.all(light > 0.0):
+        return np.ones(3)
+    return light / light.mean()
+
+
+def discount_illuminant(
+    reflectance: np.ndarray, image: np.ndarray, mask: np.ndarray, method: str
+) -> tuple[np.ndarray, list[float]]:
+    """Divide *reflectance* per channel by the light colour estimated from *image*.
+
+    Returns the corrected reflectance and the light colour (for the method's ``info``).
+    """
+    light = illuminant_colour(image, mask, method)
+    return reflectance / light, [round(float(v), 6) for v in light]
