@@ -19,9 +19,10 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from spectrinsic.decompose.decomposition import Decomposition, finish
 from spectrinsic.errors import validate_choice
 
-__all__ = ["CONSTANCY", "illuminant_colour", "discount_illuminant"]
+__all__ = ["CONSTANCY", "illuminant_colour", "discount_illuminant", "with_constancy"]
 
 #: Registry: name -> Minkowski norm ``p`` (``None``: no correction; ``inf``: max-RGB).
 CONSTANCY: Mapping[str, float | None] = {
@@ -65,3 +66,13 @@ def discount_illuminant(
     """
     light = illuminant_colour(image, mask, method)
     return reflectance / light, [round(float(v), 6) for v in light]
+
+
+def with_constancy(
+    result: Decomposition, image: np.ndarray, mask: np.ndarray, *, colour_constancy: str
+) -> Decomposition:
+    """*result* (made with ``colour_constancy="none"``) as the method would give it with
+    *colour_constancy*: the reflectance divided by the light colour, ``shading = image / R``."""
+    refl, light = discount_illuminant(
+        np.asarray(result.reflectance, np.float64), image, mask, colour_constancy)
+    return finish(np.clip(image, 0.0, None), refl, mask, {**result.info, "light_colour": light})

@@ -205,6 +205,9 @@ class NamesAndShades:
     split_by_ridge
         Regions are connected areas of equal label *and* equal ridge (default) rather than of
         equal label only.
+    name_bits
+        Colours are named once per distinct value after rounding the sRGB encoding to
+        ``name_bits`` bits (8: the thesis' 8-bit images; 0: every pixel as it is). Speed only.
     colour_constancy
         Global light colour divided out of the reflectance after sec. 3.4
         (:data:`spectrinsic.decompose.constancy.CONSTANCY`; not in the thesis, whose MIT images
@@ -222,6 +225,7 @@ class NamesAndShades:
     reflectance_colour: Literal["label-centroid", "region-mean"] = "region-mean"
     split_by_ridge: bool = True
     colour_constancy: str = "none"
+    name_bits: int = 8
     name: str = "names-shades"
 
     def __call__(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Decomposition:
@@ -246,7 +250,7 @@ class NamesAndShades:
         pixels = np.clip(linear[m], 0.0, 1.0)
 
         # 1. colour names -> Appendix A labels observed in the image
-        observed = discretise_memberships(colour_name_memberships(_srgb_encode(pixels)))
+        observed = self._observed_labels(_srgb_encode(pixels))
         candidates, y = np.unique(observed, return_inverse=True)
         vectors = appendix_a_labels()[candidates]
         distance = np.abs(vectors[:, None, :] - vectors[None, :, :]).sum(axis=2)
@@ -319,6 +323,21 @@ class NamesAndShades:
         }
         logger.debug("names-shades: %s", info)
         return finish(img, reflectance, m, info)
+
+    def _observed_labels(self, encoded: np.ndarray) -> np.ndarray:
+        """Appendix A label of each sRGB-encoded colour, named once per distinct quantised colour.
+
+        With ``name_bits = b`` the encoded values are rounded to ``2**b`` levels first (the
+        thesis' images are 8-bit, ``b = 8``); ``0`` names every pixel as it is.
+        """
+        if self.name_bits <= 0:
+            return discretise_memberships(colour_name_memberships(encoded))
+        levels = (1 << self.name_bits) - 1
+        codes = np.rint(np.clip(encoded, 0.0, 1.0) * levels).astype(np.int64)
+        packed = (codes[:, 0] * (levels + 1) + codes[:, 1]) * (levels + 1) + codes[:, 2]
+        unique, inverse = np.unique(packed, return_inverse=True)
+        rgb = np.stack(np.unravel_index(unique, (levels + 1,) * 3), axis=1) / levels
+        return discretise_memberships(colour_name_memberships(rgb))[inverse.ravel()]
 
     def _edge_weights(self, edges: np.ndarray, colours: np.ndarray, shades) -> np.ndarray:
         """``w_ij`` of sec. 3.3.2: alpha (different ridges), beta (same, not parallel), gamma."""

@@ -58,18 +58,28 @@ def score_grid(
     make: Callable[..., Callable[[np.ndarray, np.ndarray], Decomposition]],
     grid: Mapping[str, Sequence[Any]],
     *,
+    post_grid: Mapping[str, Sequence[Any]] | None = None,
+    post: Callable[..., Decomposition] | None = None,
     score: Callable[[Mapping[str, Any], np.ndarray, Decomposition], float] = mit_sample_score,
 ) -> dict[GridPoint, dict[str, float]]:
     """``{grid point: {sample id: score}}`` of ``make(**point)`` on each sample.
 
-    *samples* yields ``(sample id, sample dict, input image, evaluation mask)``.
+    *samples* yields ``(sample id, sample dict, input image, evaluation mask)``. Parameters in
+    *post_grid* act after the decomposition: ``post(result, image, mask, **values)`` must give
+    what ``make(**point, **values)`` would (e.g. the colour constancy step), so each is
+    computed without decomposing again; the table's points hold both kinds of parameter.
     """
     points = grid_points(grid)
+    extra = grid_points(post_grid) if post_grid else [()]
     decomposers = {p: make(**dict(p)) for p in points}
-    table: dict[GridPoint, dict[str, float]] = {p: {} for p in points}
+    table: dict[GridPoint, dict[str, float]] = {
+        tuple(sorted(p + e)): {} for p in points for e in extra}
     for sid, sample, image, mask in samples:
         for p, decomposer in decomposers.items():
-            table[p][sid] = score(sample, mask, decomposer(image, mask))
+            result = decomposer(image, mask)
+            for e in extra:
+                final = post(result, image, mask, **dict(e)) if e and post else result
+                table[tuple(sorted(p + e))][sid] = score(sample, mask, final)
     return table
 
 

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from spectrinsic.decompose.constancy import with_constancy
 from spectrinsic.decompose.evaluate import evaluation_mask, input_image
 from spectrinsic.decompose.names_shades import NamesAndShades
 from spectrinsic.decompose.protocol import hold_one_out, scene_group, score_grid
@@ -30,12 +31,12 @@ CONSTANCY = ["none", "grey-world", "shades-of-grey", "max-rgb"]
 RETINEX_THRESHOLDS = [round(float(v), 4) for v in np.logspace(-1.5, 0.0, 5)]
 GRIDS = {
     "retinex": (ColourRetinex, {"threshold_grey": RETINEX_THRESHOLDS,
-                                "threshold_colour": RETINEX_THRESHOLDS,
-                                "colour_constancy": CONSTANCY}),
+                                "threshold_colour": RETINEX_THRESHOLDS}),
     "names-shades": (NamesAndShades, {"gamma_over_alpha": [10.0, 100.0],
-                                      "mu": [1.0 / 3.0, 0.5],
-                                      "colour_constancy": CONSTANCY}),
+                                      "mu": [1.0 / 3.0, 0.5]}),
 }
+#: Applied after each decomposition (with_constancy), so not decomposed again.
+POST_GRID = {"colour_constancy": CONSTANCY}
 
 
 def samples(dataset: Path):
@@ -59,10 +60,10 @@ def main(argv: list[str]) -> int:
     for name in which:
         make, grid = GRIDS[name]
         t0 = time.perf_counter()
-        table = score_grid(data, make, grid)
+        table = score_grid(data, make, grid, post_grid=POST_GRID, post=with_constancy)
         res = hold_one_out(table, groups)
         report[name] = {
-            "grid": grid, "samples": len(data), "groups": sorted(set(groups.values())),
+            "grid": {**grid, **POST_GRID}, "samples": len(data), "groups": sorted(set(groups.values())),
             "chosen": dict(res.chosen), "chosen_score": res.chosen_score,
             "held_out_score": res.held_out_score,
             "folds": [{"held_out": f.held_out, "chosen": dict(f.chosen), "score": f.score}

@@ -59,3 +59,21 @@ def test_colour_constancy_estimates_by_hand():
     np.testing.assert_allclose(refl, 3.5 / 3.0)  # the tint is gone, the mean kept
     with pytest.raises(SpectrinsicError, match="colour constancy"):
         illuminant_colour(image, mask, "gray-world")
+
+
+@pytest.mark.parametrize("method", ["colour-retinex", "names-shades"])
+def test_post_hoc_constancy_equals_the_decomposer_option(method):
+    """score_grid applies colour constancy after the decomposition; it must be what the
+    decomposer's own option gives (up to float32 storage)."""
+    from spectrinsic.decompose.constancy import with_constancy
+    from spectrinsic.decompose.registry import get_decomposer
+    from spectrinsic.decompose.synthetic import mondrian
+
+    scene = mondrian(40, 40, seed=4, light=(1.0, 0.8, 0.5))
+    mask = np.ones((40, 40), bool)
+    direct = get_decomposer(method, colour_constancy="shades-of-grey")(scene.image, mask)
+    plain = get_decomposer(method)(scene.image, mask)
+    post = with_constancy(plain, scene.image, mask, colour_constancy="shades-of-grey")
+    np.testing.assert_allclose(post.reflectance, direct.reflectance, rtol=1e-5)
+    np.testing.assert_allclose(post.shading, direct.shading, rtol=1e-5)
+    assert not np.allclose(plain.reflectance, direct.reflectance, rtol=1e-3)
