@@ -81,11 +81,15 @@ SCORED_LAYERS: dict[str, str] = {
                     "over channels (thesis sec. 5.2.5: grey shading)",
     "shading": "`shading` (linear-sRGB colour of the irradiance, material-free) against the "
                "estimate's coloured shading (`image / reflectance`)",
+    "reflectance_grey": "mean over channels of `reflectance` against that of the estimate "
+                        "(thesis Tables 3.1/3.2: \"grayscale reflectances\")",
 }
 #: Metrics of the grey shading layer (angular error needs colour).
 _SHADING_GREY_METRICS = ("si_mse", "lmse", "almse", "corr", "lcorr", "dssim")
 #: Metrics of the coloured shading layer.
 _SHADING_COLOUR_METRICS = ("si_mse", "lmse", "shading_chromaticity")
+#: Metrics of the grey reflectance (Table 3.2's four).
+_REFLECTANCE_GREY_METRICS = ("si_mse", "lmse", "almse", "corr")
 _PHOTOMETRIC = ("SC1", "SC3b", "SC4")
 
 
@@ -251,7 +255,8 @@ def layer_metrics(layer: str, metrics: Sequence[str] | None = None) -> list[str]
     """
     if layer == "reflectance" and metrics is not None:
         return [get_metric(n).name for n in metrics]
-    defaults = {"shading_grey": _SHADING_GREY_METRICS, "shading": _SHADING_COLOUR_METRICS}
+    defaults = {"shading_grey": _SHADING_GREY_METRICS, "shading": _SHADING_COLOUR_METRICS,
+                "reflectance_grey": _REFLECTANCE_GREY_METRICS}
     if layer in defaults:
         return list(defaults[layer])
     return [n for n, m in METRICS.items() if layer in m.layers]
@@ -286,7 +291,8 @@ def _truth(sample: Mapping[str, Any], seed: int, n_judgements: int) -> _Truth:
         material_ids=_material_ids(sample), delta=WHDR_DELTA,
     )
     layers = {"reflectance": reflectance, "shading": colour,
-              "shading_grey": _grey(colour if grey is None else grey)}
+              "shading_grey": _grey(colour if grey is None else grey),
+              "reflectance_grey": _grey(reflectance)}
     return _Truth(sid, mask, layers, judgements)
 
 
@@ -298,7 +304,8 @@ def _score(
     extra = {"camera": camera, "photometric": photometric}
     estimates = {"reflectance": result.reflectance}
     if scenario == "srgb":
-        estimates.update(shading=result.shading, shading_grey=_grey(result.shading))
+        estimates.update(shading=result.shading, shading_grey=_grey(result.shading),
+                         reflectance_grey=_grey(result.reflectance))
     out = []
     for layer, est in estimates.items():
         which = names if layer == "reflectance" else layer_metrics(layer)

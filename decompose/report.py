@@ -29,7 +29,9 @@ from spectrinsic.decompose.registry import DECOMPOSERS
 __all__ = [
     "LMSE_COLUMNS",
     "COLOUR_COLUMNS",
+    "TABLE_3_2_COLUMNS",
     "condition_table",
+    "table_3_2",
     "scenario_table",
     "method_parameters",
     "write_report",
@@ -103,6 +105,42 @@ def scenario_table(scores: Iterable[Score], *, metric: str = "lmse") -> list[dic
             row: dict[str, Any] = {"camera": camera, "method": method}
             for sc in _PHOTOMETRIC:
                 row[sc] = _mean(groups.get((camera, method, sc), []))
+            rows.append(row)
+    return rows
+
+
+#: Thesis Table 3.2's columns: (key, metric, header); each the mean over samples of
+#: ``(shading_grey + reflectance_grey) / 2``.
+TABLE_3_2_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("corr", "corr", "Corr."), ("mse", "si_mse", "MSE"), ("lmse", "lmse", "LMSE"),
+    ("almse", "almse", "aLMSE"),
+)
+
+
+def table_3_2(
+    scores: Iterable[Score], samples: Mapping[str, tuple[str, str]], *, kind: str = "object"
+) -> list[dict[str, Any]]:
+    """Rows like thesis Table 3.2 on the samples of *kind*: per method and lighting group (and
+    ``"all"``), the mean over samples of ``(shading_grey + reflectance_grey) / 2`` of each
+    metric, grey layers as the thesis (sec. 3.5)."""
+    per: dict[tuple[str, str, str], dict[str, list[float]]] = defaultdict(lambda: defaultdict(list))
+    for s in scores:
+        if s.scenario == "srgb" and s.layer in ("shading_grey", "reflectance_grey"):
+            k, cond = samples[s.sample]
+            if k == kind:
+                per[(s.method, s.metric, s.sample)][s.layer].append(s.value)
+    groups: dict[tuple[str, str, str], list[float]] = defaultdict(list)
+    for (method, metric, sid), layers in per.items():
+        if len(layers) == 2:
+            value = 0.5 * (layers["shading_grey"][0] + layers["reflectance_grey"][0])
+            for g in (CONDITION_GROUPS[samples[sid][1]], "all"):
+                groups[(method, metric, g)].append(value)
+    rows = []
+    for method in sorted({k[0] for k in groups}, key=_method_order):
+        for g in (*_GROUP_ORDER, "all"):
+            row: dict[str, Any] = {"method": method, "lighting": g}
+            for key, metric, _ in TABLE_3_2_COLUMNS:
+                row[key] = _mean(groups.get((method, metric, g), []))
             rows.append(row)
     return rows
 
@@ -205,6 +243,17 @@ def write_report(
            else "No camera renderings scored: Table 5.1 needs `image_camera/<name>`."]
     (out / "lmse_by_scenario.md").write_text("\n".join(md) + "\n", encoding="utf-8")
     files.update(scenario_csv=out / "lmse_by_scenario.csv", scenario_md=out / "lmse_by_scenario.md")
+    t32 = table_3_2(scores, samples)
+    cols = ["method", "lighting", *(k for k, _, _ in TABLE_3_2_COLUMNS)]
+    _write_csv(out / "table_3_2_objects.csv", t32, cols)
+    md = ["# Single objects, like thesis Table 3.2 (MIT-20)", "",
+          "Mean over samples of (grey shading + grey reflectance) / 2, grey = mean over "
+          "channels, as the thesis (sec. 3.5); MSE is the scale-invariant MSE (Eq. 2.4).", "",
+          _markdown(t32, cols, ["method", "light", *(h for _, _, h in TABLE_3_2_COLUMNS)]) if t32
+          else "No single-object samples scored."]
+    (out / "table_3_2_objects.md").write_text("\n".join(md) + "\n", encoding="utf-8")
+    files.update(table_3_2_csv=out / "table_3_2_objects.csv",
+                 table_3_2_md=out / "table_3_2_objects.md")
     files["methods"] = out / "methods.json"
     files["methods"].write_text(json.dumps(method_parameters(methods), indent=2, default=str),
                                 encoding="utf-8")

@@ -64,7 +64,8 @@ def test_predictions_folder_scores_exactly_like_the_builtin_baseline(tmp_path):
     assert any(k[2].startswith("SC1_") for k in got)  # camera scenarios were scored too
     for k, v in expected.items():
         assert (math.isnan(v) and math.isnan(got[k])) or got[k] == v, k
-    for name in ("lmse_by_condition.csv", "colour_by_condition.csv", "lmse_by_scenario.csv"):
+    for name in ("lmse_by_condition.csv", "colour_by_condition.csv", "lmse_by_scenario.csv",
+                 "table_3_2_objects.csv"):
         assert (tmp_path / "scored" / name).read_text() == (tmp_path / "builtin" / name).read_text()
     report = (tmp_path / "scored" / "REPORT.md").read_text()
     assert "predictions.Predictions" in report and "`shading_grey`" in report
