@@ -10,7 +10,10 @@ layer carries the light's colour; estimating it is colour constancy.
 Finlayson & Trezzi (2004): ``L_c ∝ (mean_p I_c(p)^p)^(1/p)`` over the masked pixels; ``p = 1``
 is grey-world (Buchsbaum 1980), ``p = ∞`` max-RGB (white patch, Land); ``p = 6`` is the
 "shades of grey" value they recommend. The estimate is normalised to mean channel 1, so the
-reflectance keeps its intensity and only its colour changes.
+reflectance keeps its intensity and only its colour changes. The light is estimated over every
+pixel of the image that received light, not only the decomposer's mask: the surroundings of a
+masked object (its ground, walls) tell the light's colour better than the object alone, whose
+own colour grey-world would take for the light's.
 """
 
 from __future__ import annotations
@@ -62,9 +65,13 @@ def discount_illuminant(
 ) -> tuple[np.ndarray, list[float]]:
     """Divide *reflectance* per channel by the light colour estimated from *image*.
 
+    The estimate uses every pixel of *image* with a positive channel (module docstring);
+    *mask* only when none has.
+
     Returns the corrected reflectance and the light colour (for the method's ``info``).
     """
-    light = illuminant_colour(image, mask, method)
+    lit = np.asarray(image).max(axis=-1) > 0.0
+    light = illuminant_colour(image, lit if lit.any() else mask, method)
     return reflectance / light, [round(float(v), 6) for v in light]
 
 

@@ -13,12 +13,14 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
 
 from spectrinsic.decompose.constancy import discount_illuminant
 from spectrinsic.decompose.decomposition import Decomposition, finish, prepare_input
+from spectrinsic.errors import validate_choice
 
 __all__ = ["ColourRetinex", "log_gradients", "poisson_solve"]
 
@@ -49,25 +51,29 @@ def poisson_solve(
     Parameters
     ----------
     gy, gx
-        ``(H, W)`` forward differences as :func:`log_gradients` returns.
+        ``(H, W)`` forward differences as :func:`log_gradients` returns, or ``(H, W, C)`` to
+        integrate C fields with one factorisation.
     mask
         ``(H, W)`` bool domain.
 
     Returns
     -------
-    ``(H, W)`` float64 solution, 0 outside the mask.
+    ``(H, W)`` (or ``(H, W, C)``) float64 solution, 0 outside the mask.
     """
     import scipy.sparse as sp
-    from scipy.sparse.linalg import spsolve
+    from scipy.sparse.linalg import factorized
 
+    stacked = gy.ndim == 3
+    gy3 = gy if stacked else gy[:, :, None]
+    gx3 = gx if stacked else gx[:, :, None]
     h, w = mask.shape
     index = np.full(mask.shape, -1, dtype=np.int64)
     index[mask] = np.arange(int(mask.sum()))
     rows, cols, vals, rhs = [], [], [], []
     n_eq = 0
     pairs = (
-        (index[:-1, :], index[1:, :], gy[:-1, :]),  # vertical neighbours
-        (index[:, :-1], index[:, 1:], gx[:, :-1]),  # horizontal neighbours
+        (index[:-1, :], index[1:, :], gy3[:-1, :]),  # vertical neighbours
+        (index[:, :-1], index[:, 1:], gx3[:, :-1]),  # horizontal neighbours
     )
     for i0, i1, g in pairs:
         ok = (i0 >= 0) & (i1 >= 0)
@@ -82,11 +88,12 @@ def poisson_solve(
     d = sp.csr_matrix(
         (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n_eq, n)
     )
-    lhs = (d.T @ d + regularisation * sp.identity(n, format="csr")).tocsc()
-    solution = spsolve(lhs, d.T @ np.concatenate(rhs))
-    out = np.zeros((h, w))
-    out[mask] = solution
-    return out
+    solve = factorized((d.T @ d + regularisation * sp.identity(n, format="csr")).tocsc())
+    b = d.T @ np.concatenate(rhs)
+    out = np.zeros((h, w, gy3.shape[2]))
+    for c in range(gy3.shape[2]):
+        out[mask, c] = solve(np.ascontiguousarray(b[:, c]))
+    return out if stacked else out[:, :, 0]
 
 
 @dataclass(frozen=True)
@@ -107,14 +114,23 @@ class ColourRetinex:
         Global light colour divided out of the reflectance
         (:data:`spectrinsic.decompose.constancy.CONSTANCY`; a deviation from Grosse et al., whose
         reflectance keeps the light's colour); the shading then carries it.
+    shading_colour
+        ``"grey"``: Grosse et al.: the grey log-derivatives kept as reflectance changes are
+        integrated and ``R = I / S_grey`` keeps all the image's colour. ``"colour"``: each
+        channel's log-derivatives are kept or dropped with the same classification and
+        integrated on their own, so slow changes of the light's colour (two lights,
+        interreflections) go to a coloured shading; each channel's free constant is fixed by
+        the integration's near-zero mean (a grey-world in log space).
     """
 
     threshold_grey: float = 0.178
     threshold_colour: float = 0.178
     colour_constancy: str = "none"
+    shading_colour: Literal["grey", "colour"] = "grey"
     name: str = "colour-retinex"
 
     def __call__(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Decomposition:
+        validate_choice(self.shading_colour, ("grey", "colour"), "shading_colour")
         img, m = prepare_input(image, mask)
         scale = float(np.percentile(img[m].max(axis=1), 99.0))
         floor = _FLOOR * (scale if scale > 0.0 else 1.0)
@@ -127,13 +143,15 @@ class ColourRetinex:
             mean = g.mean(axis=2)
             chroma = np.linalg.norm(g - mean[:, :, None], axis=2)
             kept.append((chroma > self.threshold_colour) | (np.abs(mean) > self.threshold_grey))
-        ry = np.where(kept[0], gy_grey, 0.0)
-        rx = np.where(kept[1], gx_grey, 0.0)
-        log_refl = poisson_solve(ry, rx, m)
-        shading_grey = np.exp(grey_log - log_refl)
-        reflectance, light = discount_illuminant(
-            img / shading_grey[:, :, None], img, m, self.colour_constancy
-        )
+        if self.shading_colour == "colour":
+            ry = np.where(kept[0][:, :, None], gy_all, 0.0)
+            rx = np.where(kept[1][:, :, None], gx_all, 0.0)
+            raw = np.exp(poisson_solve(ry, rx, m))
+        else:
+            ry = np.where(kept[0], gy_grey, 0.0)
+            rx = np.where(kept[1], gx_grey, 0.0)
+            raw = img / np.exp(grey_log - poisson_solve(ry, rx, m))[:, :, None]
+        reflectance, light = discount_illuminant(raw, img, m, self.colour_constancy)
         info = {"reflectance_edges": float((kept[0][m].mean() + kept[1][m].mean()) / 2.0),
                 "light_colour": light}
         return finish(img, reflectance, m, info)
