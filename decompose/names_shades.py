@@ -208,6 +208,10 @@ class NamesAndShades:
     name_bits
         Colours are named once per distinct value after rounding the sRGB encoding to
         ``name_bits`` bits (8: the thesis' 8-bit images; 0: every pixel as it is). Speed only.
+    expansion_cycles
+        Cycles of alpha-expansion over all labels (``-1``: until no expansion lowers the energy,
+        as the thesis' graph cuts). Default 2: on a 400x400 Mondrian the reflectance LMSE is the
+        same (2e-4) and the MRF takes 2.5 times less.
     colour_constancy
         Global light colour divided out of the reflectance after sec. 3.4
         (:data:`spectrinsic.decompose.constancy.CONSTANCY`; not in the thesis, whose MIT images
@@ -226,6 +230,7 @@ class NamesAndShades:
     split_by_ridge: bool = True
     colour_constancy: str = "none"
     name_bits: int = 8
+    expansion_cycles: int = 2
     name: str = "names-shades"
 
     def __call__(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Decomposition:
@@ -273,7 +278,7 @@ class NamesAndShades:
                 (1.0 - self.mu) * weights,
                 unary,
                 distance,
-                n_iter=-1,
+                n_iter=self.expansion_cycles,
                 algorithm="expansion",
                 init_labels=y.astype(np.int32),
             )

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
-from typing import Literal
+from typing import ClassVar, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -26,6 +26,15 @@ __all__ = ["ColourRetinex", "log_gradients", "poisson_solve"]
 
 logger = logging.getLogger(__name__)
 
+#: The parameter protocol and its outcome (scripts/choose_parameters.py, seed-free).
+PROTOCOL = (
+    "hold-one-object-out over the 32 rendered single-object samples (8 objects x 4 lights, "
+    "default set, 256^2, image_denoised), score (LMSE grey shading + LMSE colour reflectance)/2; "
+    "grid threshold_grey x threshold_colour in logspace(-1.5, 0, 5) x colour_constancy in "
+    "{none, grey-world, shades-of-grey, max-rgb}; chosen on all objects: threshold_grey=1.0, "
+    "threshold_colour=0.1778, grey-world (score 0.0346; 7 of 8 folds chose the same); held-out "
+    "score 0.0365; Grosse's defaults without constancy scored 0.0662"
+)
 #: Grosse et al. clip 8-bit images at 3/255 before the log; relative to the 99th percentile here.
 _FLOOR = 3.0 / 255.0
 
@@ -108,8 +117,8 @@ class ColourRetinex:
     threshold_colour
         Norm of the chromatic part of the log-derivative (per-channel derivative minus its
         mean) above which a derivative is a reflectance change. Grosse et al. chose both by
-        cross-validation on ``logspace(-1.5, 0, 5)``; the defaults are from that grid, picked
-        on noisy synthetic Mondrians (``tests/decompose``).
+        cross-validation on ``logspace(-1.5, 0, 5)``; the defaults (and ``colour_constancy``)
+        are chosen on that grid by :data:`PROTOCOL`.
     colour_constancy
         Global light colour divided out of the reflectance
         (:data:`spectrinsic.decompose.constancy.CONSTANCY`; a deviation from Grosse et al., whose
@@ -123,11 +132,14 @@ class ColourRetinex:
         the integration's near-zero mean (a grey-world in log space).
     """
 
-    threshold_grey: float = 0.178
-    threshold_colour: float = 0.178
-    colour_constancy: str = "none"
+    threshold_grey: float = 1.0
+    threshold_colour: float = 0.1778
+    colour_constancy: str = "grey-world"
     shading_colour: Literal["grey", "colour"] = "grey"
     name: str = "colour-retinex"
+
+    #: How the defaults were chosen (recorded in every evaluation report).
+    protocol: ClassVar[str] = PROTOCOL
 
     def __call__(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Decomposition:
         validate_choice(self.shading_colour, ("grey", "colour"), "shading_colour")
