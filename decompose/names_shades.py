@@ -248,6 +248,17 @@ class NamesAndShades:
     #: How the defaults were chosen (recorded in every evaluation report).
     protocol: ClassVar[str] = PROTOCOL
 
+    @classmethod
+    def thesis(cls) -> NamesAndShades:
+        """The thesis' own settings (sec. 3.3-3.5): every documented deviation switched off.
+
+        ``mu = 1/3``, ``gamma/alpha = 100``, ``gamma/beta = 2``, label-centroid colours, regions
+        of equal label only, no colour constancy, alpha-expansion to convergence.
+        """
+        return cls(gamma_over_alpha=100.0, gamma_over_beta=2.0, mu=1.0 / 3.0,
+                   reflectance_colour="label-centroid", split_by_ridge=False,
+                   colour_constancy="none", expansion_cycles=-1, name="names-shades-thesis")
+
     def __call__(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Decomposition:
         validate_choice(
             self.reflectance_colour, ("label-centroid", "region-mean"), "reflectance_colour"

@@ -66,7 +66,8 @@ def test_defaults_beat_image_as_reflectance_under_a_coloured_light(name):
 def test_names_shades_thesis_variant_runs_and_is_documented_worse(mondrians):
     # sec. 3.3.3 label centroids quantise chromaticity; kept as an option (module docstring)
     scene = mondrians[0]
-    faithful = NamesAndShades(reflectance_colour="label-centroid", split_by_ridge=False)
+    faithful = NamesAndShades.thesis()
+    assert (faithful.mu, faithful.gamma_over_alpha, faithful.gamma_over_beta) == (1 / 3, 100, 2)
     out = faithful(scene.image)
     base = decompose(scene.image, method="image-as-reflectance").reflectance
     assert lmse(scene.reflectance, out.reflectance) > lmse(scene.reflectance, base)
