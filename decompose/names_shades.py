@@ -28,14 +28,20 @@ linear least-squares problem (``scipy.optimize.lsq_linear``) instead of belief p
 ``L^orig`` measured on the pixels along each shared boundary and each term divided by its mean
 product so that dark and bright boundaries weigh alike.
 
-Two deviations are defaults because they matter for the scores, and both can be switched off:
-``split_by_ridge`` also separates regions of one label that lie on different ridges (two
-neighbouring materials with the same colour name would otherwise merge into one region), and
-``reflectance_colour="region-mean"`` colours a region with its mean image colour rather than the
-label's centroid. On synthetic Mondrians (``tests/decompose``) the label centroids, which quantise
-every chromaticity to the ~250 labels in use, gave reflectance LMSE near 0.2, ten times worse
-than taking the image itself as reflectance; the region mean keeps the thesis' segmentation and
-coherence steps and brings the error below that baseline.
+Deviations that are defaults, each a named parameter (:meth:`NamesAndShades.thesis` switches
+all of them off):
+
+* ``split_by_ridge``: regions of one label that lie on different ridges are separated (two
+  neighbouring materials with the same colour name would otherwise merge into one region);
+* ``reflectance_colour="region-mean"``: a region takes its mean image colour rather than the
+  label's centroid. On synthetic Mondrians (``tests/decompose``) the label centroids, which
+  quantise every chromaticity to the ~250 labels in use, gave reflectance LMSE near 0.2, ten
+  times worse than taking the image itself as reflectance;
+* ``colour_constancy="grey-world"``: the light's colour, estimated over the whole image, is
+  divided out of the reflectance (the MIT images of the thesis are under near-white light;
+  the rendered set has coloured lights, under which every colour metric counts the cast);
+* ``gamma_over_alpha=10`` (thesis 100) and ``colour_constancy`` chosen by :data:`PROTOCOL`;
+* ``expansion_cycles=2`` and ``name_bits=8``: speed (same scores on Mondrians).
 """
 
 from __future__ import annotations
