@@ -3,7 +3,8 @@
 Usage: python -P scripts/choose_parameters.py DATASET OUT.json [retinex|names-shades ...]
 
 The protocol is :mod:`spectrinsic.decompose.protocol`; the grids are below. The chosen values
-are copied by hand into the decomposers' defaults, which cite this script and the JSON.
+are copied by hand into the decomposers' defaults (PROTOCOL in retinex.py and names_shades.py);
+the run of record, per grid point and sample, is scripts/choose_parameters.json.
 """
 
 from __future__ import annotations
