@@ -33,6 +33,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help=f"root seed of random choices (default: {DEFAULT_SEED})")
     p.add_argument("--include-ie", action="store_true",
                    help="photometric: add the Image Engineering 2024 cameras of the data directory")
+    p.add_argument("--camera-balance", default="equal-energy-white",
+                   choices=("none", "per-channel-peak", "d65-white", "equal-energy-white"),
+                   help="photometric: normalisation of the camera curves (default: "
+                        "equal-energy-white, the one giving the thesis' SC3 behaviour)")
     p.add_argument("--no-extension", action="store_true",
                    help="reconstruction-error: only Table 5.2, without the extended sweep")
     p.add_argument("--quality", default="default", choices=("preview", "default", "paper"),
@@ -99,7 +103,8 @@ def run(args: argparse.Namespace) -> int:
             run_photometric_study,
         )
 
-        settings = PhotometricSettings(seed=args.seed, include_ie=args.include_ie)
+        settings = PhotometricSettings(seed=args.seed, include_ie=args.include_ie,
+                                       camera_balance=args.camera_balance)
         with _progress(quiet, "photometric") as progress:
             result, paths = run_photometric_study(out, settings, data_dir=data_dir, progress=progress)
         print(format_photometric(result))

@@ -1,10 +1,12 @@
 """spectrinsic.decompose: intrinsic-image decomposers, error metrics and evaluation.
 
-Decomposers (registry :data:`DECOMPOSERS`): the thesis' names-and-shades method (chapter 3),
-colour Retinex (Grosse et al. 2009) and two trivial baselines. Metrics (registry
-:data:`METRICS`) of thesis section 2.4.3 and Eq. 4.31, plus WHDR on judgements derived from
-ground truth. :func:`evaluate` reproduces the thesis' evaluations (Tables 5.1, 5.3, 5.4) on a
-rendered dataset.
+Decomposers (registry :data:`DECOMPOSERS`, plus plugins of the entry-point group
+:data:`ENTRY_POINT_GROUP`): the thesis' names-and-shades method (chapter 3), colour Retinex
+(Grosse et al. 2009) and two trivial baselines. Metrics (registry :data:`METRICS`) of thesis
+section 2.4.3 and Eq. 4.31, the coloured-shading metrics (shading chromaticity, MAW-style
+intensity/chromaticity split), plus WHDR on judgements derived from ground truth.
+:func:`evaluate` reproduces the thesis' evaluations (Tables 5.1, 5.3, 5.4) on a rendered
+dataset, for bundled methods and for :class:`Predictions` read from files.
 """
 
 from spectrinsic.decompose.colour_naming import (
@@ -30,15 +32,26 @@ from spectrinsic.decompose.metrics import (
     lmse,
     local_correlation,
     mit_score,
+    reflectance_chromaticity_error,
+    reflectance_intensity_error,
+    shading_chromaticity_error,
     si_mse,
     whdr,
 )
 from spectrinsic.decompose.photometric import SCENARIOS, photometric_correction
-from spectrinsic.decompose.registry import DECOMPOSERS, decompose, get_decomposer
+from spectrinsic.decompose.predictions import Predictions
+from spectrinsic.decompose.registry import (
+    DECOMPOSERS,
+    ENTRY_POINT_GROUP,
+    available_decomposers,
+    decompose,
+    get_decomposer,
+)
 
 __all__ = [
     "COLOUR_NAMES",
     "DECOMPOSERS",
+    "ENTRY_POINT_GROUP",
     "METRICS",
     "SCENARIOS",
     "Decomposer",
@@ -46,11 +59,13 @@ __all__ = [
     "EvaluationResult",
     "Judgements",
     "Metric",
+    "Predictions",
     "Score",
     "almse",
     "angular_error_mean",
     "angular_error_median",
     "appendix_a_labels",
+    "available_decomposers",
     "colour_name_memberships",
     "colour_names",
     "compute_metrics",
@@ -66,7 +81,10 @@ __all__ = [
     "local_correlation",
     "mit_score",
     "photometric_correction",
+    "reflectance_chromaticity_error",
+    "reflectance_intensity_error",
     "sample_judgements",
+    "shading_chromaticity_error",
     "si_mse",
     "whdr",
 ]

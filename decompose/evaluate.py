@@ -1,28 +1,31 @@
-"""Evaluation of the bundled decomposers on rendered samples (thesis Tables 5.1, 5.3, 5.4).
+"""Evaluation of decomposers on rendered samples (thesis Tables 5.1, 5.3, 5.4).
 
 Input: any iterable of sample dicts as :func:`spectrinsic.gt_export.load_sample` returns them
-(``image``, ``reflectance``, ``shading``, ``mask``, ``ids``, ``meta``, optional
-``image_camera/<name>`` and ``meta["matrices"]``). For each sample and method:
+(``image`` / ``image_denoised``, ``reflectance``, ``shading``, ``shading_grey``, ``mask``,
+``ids``, ``meta``, optional ``image_camera/<name>`` and ``meta["matrices"]``). Methods are
+registered decomposers (plugins included) or :class:`~spectrinsic.decompose.predictions.
+Predictions`, a user's estimates read from files. For each sample and method:
 
-* scenario ``"srgb"``: the linear sRGB rendering is decomposed; reflectance is scored in colour
-  against the absolute reflectance, shading in grey (mean over channels) against the grey
-  shading, as sec. 5.2.5 does ("the shading evaluation ... discards color information");
+* scenario ``"srgb"``: the linear sRGB image (:data:`INPUT_LAYERS`: ``image_denoised`` when
+  present) is decomposed; reflectance is scored in colour against the absolute reflectance;
+  shading twice (:data:`SCORED_LAYERS`): in grey against ``shading_grey``, as sec. 5.2.5 does
+  ("the shading evaluation ... discards color information"), and in colour against the
+  coloured ``shading`` (LMSE and the shading chromaticity error);
 * scenarios ``SC1``, ``SC3b``, ``SC4`` per camera (sec. 5.1.3): the camera rendering, corrected
   by :func:`spectrinsic.decompose.photometric.photometric_correction`, is decomposed and its
   reflectance scored against the absolute reflectance.
 
-Outputs in ``out_dir``: ``scores.csv`` (sample, method, scenario, layer, metric, value), the
-condition table (``lmse_by_condition.{csv,md}``, like Tables 5.3/5.4), the scenario table
-(``lmse_by_scenario.{csv,md}``, like Table 5.1), ``figures/<sample>.png`` and
-``estimates/<method>/<scenario>/<sample>/{reflectance,shading}.exr``.
+Outputs in ``out_dir`` (:func:`spectrinsic.decompose.report.write_report`): ``scores.csv``
+(sample, method, scenario, layer, metric, value), the condition tables like Tables 5.3/5.4,
+the scenario table like Table 5.1, ``REPORT.md`` (input, layers, methods and their parameters),
+``figures/<sample>.png`` and ``estimates/<method>/<scenario>/<sample>/{reflectance,shading}.exr``
+(the predictions layout, so an estimates folder can be scored again with ``--predictions``).
 """
 
 from __future__ import annotations
 
-import csv
 import logging
 import re
-from collections import defaultdict
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -31,10 +34,11 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.decompose.decomposition import Decomposer, Decomposition
-from spectrinsic.decompose.judgements import sample_judgements
+from spectrinsic.decompose.judgements import Judgements, sample_judgements
 from spectrinsic.decompose.metrics import METRICS, WHDR_DELTA, get_metric, whdr
 from spectrinsic.decompose.photometric import photometric_correction
-from spectrinsic.decompose.registry import DECOMPOSERS, get_decomposer
+from spectrinsic.decompose.predictions import Predictions
+from spectrinsic.decompose.registry import available_decomposers, get_decomposer
 from spectrinsic.errors import DatasetError
 from spectrinsic.rng import seed_from_key
 
@@ -47,9 +51,11 @@ __all__ = [
     "evaluate_sample",
     "evaluation_mask",
     "BACKGROUND_OBJECTS",
+    "INPUT_LAYERS",
+    "SCORED_LAYERS",
+    "input_image",
+    "layer_metrics",
     "evaluate",
-    "condition_table",
-    "scenario_table",
 ]
 
 logger = logging.getLogger(__name__)
@@ -63,8 +69,27 @@ CONDITION_GROUPS: dict[str, str] = {
 }
 _GROUP_ORDER = ("WL", "1L", "2L")
 _KINDS = {"object": "single objects", "complex": "complex scenes"}
+#: The image a method decomposes: the first of these layers a sample has. ``image_denoised``
+#: (``reflectance * shading + residual`` exactly, from the denoised irradiance) is the input
+#: consistent with the ground truth; ``image`` is the raw Monte Carlo rendering.
+INPUT_LAYERS: tuple[str, ...] = ("image_denoised", "image")
+#: Layers scored, and what each one is: the thesis scores shading in grey (sec. 5.2.5), the
+#: coloured-shading literature scores its colour too.
+SCORED_LAYERS: dict[str, str] = {
+    "reflectance": "`reflectance` (absolute, linear sRGB under D65) against the estimate, in colour",
+    "shading_grey": "`shading_grey` (luminance Y of the irradiance) against the estimate's mean "
+                    "over channels (thesis sec. 5.2.5: grey shading)",
+    "shading": "`shading` (linear-sRGB colour of the irradiance, material-free) against the "
+               "estimate's coloured shading (`image / reflectance`)",
+    "reflectance_grey": "mean over channels of `reflectance` against that of the estimate "
+                        "(thesis Tables 3.1/3.2: \"grayscale reflectances\")",
+}
 #: Metrics of the grey shading layer (angular error needs colour).
-_SHADING_METRICS = ("si_mse", "lmse", "almse", "corr", "lcorr", "dssim")
+_SHADING_GREY_METRICS = ("si_mse", "lmse", "almse", "corr", "lcorr", "dssim")
+#: Metrics of the coloured shading layer.
+_SHADING_COLOUR_METRICS = ("si_mse", "lmse", "shading_chromaticity")
+#: Metrics of the grey reflectance (Table 3.2's four).
+_REFLECTANCE_GREY_METRICS = ("si_mse", "lmse", "almse", "corr")
 _PHOTOMETRIC = ("SC1", "SC3b", "SC4")
 
 
@@ -167,7 +192,7 @@ def _camera_inputs(sample: Mapping[str, Any]) -> list[tuple[str, str, np.ndarray
     out = []
     for key in sorted(k for k in sample if k.startswith("image_camera/")):
         camera = key.split("/", 1)[1]
-        image = np.asarray(sample[key], dtype=np.float64)
+        image = input_image(sample, camera)[1]
         light_cam = (l_clig.get(camera) or {}).get("scene")
         light_srgb = (l_clig.get("srgb") or {}).get("scene")
         available = {
@@ -209,9 +234,91 @@ def _write_estimate(directory: Path, result: Decomposition) -> None:
     write_exr(directory / "shading.exr", {"shading": result.shading})
 
 
+def input_image(sample: Mapping[str, Any], camera: str | None = None) -> tuple[str, np.ndarray]:
+    """The image a method decomposes: the first of :data:`INPUT_LAYERS` the sample has.
+
+    For a camera, ``image_camera_denoised/<camera>`` else ``image_camera/<camera>``.
+    Returns ``(layer key, float64 array)``.
+    """
+    keys = [f"{k.replace('image', 'image_camera', 1)}/{camera}" if camera else k
+            for k in INPUT_LAYERS]
+    for key in keys:
+        if key in sample:
+            return key, np.asarray(sample[key], dtype=np.float64)
+    raise DatasetError(f"sample {_sample_id(sample)!r} has none of the layers {keys}")
+
+
+def layer_metrics(layer: str, metrics: Sequence[str] | None = None) -> list[str]:
+    """Registered metrics the evaluation applies to *layer* (:data:`SCORED_LAYERS`).
+
+    *metrics* restricts the reflectance metrics (default: every metric registered for it).
+    """
+    if layer == "reflectance" and metrics is not None:
+        return [get_metric(n).name for n in metrics]
+    defaults = {"shading_grey": _SHADING_GREY_METRICS, "shading": _SHADING_COLOUR_METRICS,
+                "reflectance_grey": _REFLECTANCE_GREY_METRICS}
+    if layer in defaults:
+        return list(defaults[layer])
+    return [n for n, m in METRICS.items() if layer in m.layers]
+
+
+def _estimate(
+    method: Decomposer | Predictions, sid: str, scenario: str, image: np.ndarray, mask: np.ndarray
+) -> Decomposition | None:
+    if isinstance(method, Predictions):
+        return method.load(sid, scenario, image, mask)
+    return method(image, mask)
+
+
+@dataclass(frozen=True)
+class _Truth:
+    """Ground truth of one sample as the scoring needs it."""
+
+    sid: str
+    mask: np.ndarray
+    layers: dict[str, np.ndarray]
+    judgements: Judgements
+
+
+def _truth(sample: Mapping[str, Any], seed: int, n_judgements: int) -> _Truth:
+    sid = _sample_id(sample)
+    reflectance = np.asarray(sample["reflectance"], dtype=np.float64)
+    colour = np.asarray(sample["shading"], dtype=np.float64)
+    grey = sample.get("shading_grey")
+    mask = evaluation_mask(sample)
+    judgements = sample_judgements(
+        reflectance, seed=seed_from_key(seed, sid), n_pairs=n_judgements, mask=mask,
+        material_ids=_material_ids(sample), delta=WHDR_DELTA,
+    )
+    layers = {"reflectance": reflectance, "shading": colour,
+              "shading_grey": _grey(colour if grey is None else grey),
+              "reflectance_grey": _grey(reflectance)}
+    return _Truth(sid, mask, layers, judgements)
+
+
+def _score(
+    truth: _Truth, result: Decomposition, method: str, scenario: str, names: Sequence[str],
+    camera: str = "", photometric: str = "",
+) -> list[Score]:
+    """Scores of one estimate: reflectance always, shading (grey and colour) for sRGB input."""
+    extra = {"camera": camera, "photometric": photometric}
+    estimates = {"reflectance": result.reflectance}
+    if scenario == "srgb":
+        estimates.update(shading=result.shading, shading_grey=_grey(result.shading),
+                         reflectance_grey=_grey(result.reflectance))
+    out = []
+    for layer, est in estimates.items():
+        which = names if layer == "reflectance" else layer_metrics(layer)
+        for metric, value in _layer_scores(truth.layers[layer], est, truth.mask, which).items():
+            out.append(Score(truth.sid, method, scenario, layer, metric, value, **extra))
+    out.append(Score(truth.sid, method, scenario, "reflectance", "whdr",
+                     whdr(result.reflectance, truth.judgements), **extra))
+    return out
+
+
 def evaluate_sample(
     sample: Mapping[str, Any],
-    methods: Mapping[str, Decomposer],
+    methods: Mapping[str, Decomposer | Predictions],
     *,
     seed: int,
     metrics: Sequence[str] | None = None,
@@ -219,58 +326,48 @@ def evaluate_sample(
     out_dir: str | Path | None = None,
     cameras: bool = True,
     figure: bool = True,
+    save_estimates: bool = True,
 ) -> list[Score]:
-    """Decompose one sample with every method and score the estimates.
+    """Decompose one sample with every method (or read its predictions) and score the estimates.
 
     Parameters
     ----------
     sample
         A loader dict (module docstring).
     methods
-        ``{name: decomposer}``.
+        ``{name: decomposer or Predictions}``.
     seed
         Root seed of the WHDR judgements (per sample: ``seed_from_key(seed, sample_id)``).
     metrics
-        Reflectance metrics (registry names; default all); ``"whdr"`` is always added.
+        Reflectance metrics (registry names; default all registered for reflectance);
+        ``"whdr"`` is always added. Shading metrics: :func:`layer_metrics`.
     out_dir
         Where estimates and the figure go (nothing is written when None).
     cameras
         Also run the photometric scenarios on the camera renderings.
+    figure, save_estimates
+        Draw the figure, write the estimates (of decomposers; predictions are files already).
     """
-    sid = _sample_id(sample)
-    image = np.asarray(sample["image"], dtype=np.float64)
-    reflectance = np.asarray(sample["reflectance"], dtype=np.float64)
-    shading = sample.get("shading_grey")
-    shading = _grey(sample["shading"] if shading is None else shading)
-    mask = evaluation_mask(sample)
-    names = list(METRICS) if metrics is None else list(metrics)
-    judgements = sample_judgements(
-        reflectance, seed=seed_from_key(seed, sid), n_pairs=n_judgements, mask=mask,
-        material_ids=_material_ids(sample), delta=WHDR_DELTA,
-    )
-    inputs: list[tuple[str, str, str, np.ndarray]] = [("srgb", "", "", image)]
+    truth = _truth(sample, seed, n_judgements)
+    names = layer_metrics("reflectance", metrics)
+    inputs: list[tuple[str, str, str, np.ndarray]] = [("srgb", "", "", input_image(sample)[1])]
     if cameras:
         inputs += [(f"{sc}_{_slug(cam)}", cam, sc, img) for cam, sc, img in _camera_inputs(sample)]
     scores: list[Score] = []
     figure_rows: list[tuple[str, Decomposition]] = []
     for method, decomposer in methods.items():
         for scenario, camera, photometric, img in inputs:
-            result = decomposer(img, mask)
-            extra = {"camera": camera, "photometric": photometric}
-            for metric, value in _layer_scores(reflectance, result.reflectance, mask, names).items():
-                scores.append(Score(sid, method, scenario, "reflectance", metric, value, **extra))
-            scores.append(Score(sid, method, scenario, "reflectance", "whdr",
-                                whdr(result.reflectance, judgements), **extra))
+            result = _estimate(decomposer, truth.sid, scenario, img, truth.mask)
+            if result is None:
+                continue
+            scores += _score(truth, result, method, scenario, names, camera, photometric)
             if scenario == "srgb":
-                est = _grey(result.shading)
-                for metric, value in _layer_scores(shading, est, mask, _SHADING_METRICS).items():
-                    scores.append(Score(sid, method, scenario, "shading", metric, value))
                 figure_rows.append((method, result))
-            if out_dir is not None:
-                _write_estimate(Path(out_dir) / "estimates" / method / scenario / sid, result)
+            if save_estimates and out_dir is not None and not isinstance(decomposer, Predictions):
+                _write_estimate(Path(out_dir) / "estimates" / method / scenario / truth.sid, result)
     if out_dir is not None and figure:
-        _figure(Path(out_dir) / "figures" / f"{sid}.png", sid, image, reflectance,
-                np.asarray(sample["shading"]), figure_rows)
+        _figure(Path(out_dir) / "figures" / f"{truth.sid}.png", truth.sid, inputs[0][3],
+                truth.layers["reflectance"], truth.layers["shading"], figure_rows)
     return scores
 
 
@@ -307,80 +404,11 @@ def _figure(path: Path, sid: str, image, reflectance, shading, rows) -> None:
     fig.savefig(path, dpi=80)
 
 
-def _mean(values: list[float]) -> float:
-    finite = [v for v in values if np.isfinite(v)]
-    return float(np.mean(finite)) if finite else float("nan")
-
-
-def condition_table(
-    scores: Iterable[Score], kinds: Mapping[str, str], conditions: Mapping[str, str],
-    *, metric: str = "lmse",
-) -> list[dict[str, Any]]:
-    """Rows like Tables 5.3/5.4: mean *metric* per method, scene kind, layer and WL/1L/2L.
-
-    ``kinds`` and ``conditions`` map sample ids to ``"object"/"complex"`` and a condition.
-    """
-    groups: dict[tuple[str, str, str, str], list[float]] = defaultdict(list)
-    for s in scores:
-        if s.scenario == "srgb" and s.metric == metric:
-            group = CONDITION_GROUPS[conditions[s.sample]]
-            groups[(kinds[s.sample], s.method, s.layer, group)].append(s.value)
-    rows = []
-    for kind in _KINDS:
-        methods = sorted({k[1] for k in groups if k[0] == kind}, key=_method_order)
-        for method in methods:
-            row: dict[str, Any] = {"scene_kind": kind, "method": method}
-            for layer in ("reflectance", "shading"):
-                for g in _GROUP_ORDER:
-                    vals = groups.get((kind, method, layer, g), [])
-                    row[f"{layer}_{g}"] = _mean(vals)
-            rows.append(row)
-    return rows
-
-
-def scenario_table(scores: Iterable[Score], *, metric: str = "lmse") -> list[dict[str, Any]]:
-    """Rows like Table 5.1: mean reflectance *metric* per method, camera and SC1/SC3b/SC4."""
-    groups: dict[tuple[str, str, str], list[float]] = defaultdict(list)
-    for s in scores:
-        if s.camera and s.layer == "reflectance" and s.metric == metric:
-            groups[(s.camera, s.method, s.photometric)].append(s.value)
-    rows = []
-    for camera in sorted({k[0] for k in groups}):
-        for method in sorted({k[1] for k in groups if k[0] == camera}, key=_method_order):
-            row: dict[str, Any] = {"camera": camera, "method": method}
-            for sc in _PHOTOMETRIC:
-                row[sc] = _mean(groups.get((camera, method, sc), []))
-            rows.append(row)
-    return rows
-
-
-def _method_order(name: str) -> tuple[int, str]:
-    order = list(DECOMPOSERS)
-    return (order.index(name) if name in order else len(order), name)
-
-
-def _write_csv(path: Path, rows: list[dict[str, Any]], columns: Sequence[str]) -> None:
-    with path.open("w", newline="", encoding="utf-8") as fh:
-        writer = csv.DictWriter(fh, fieldnames=list(columns))
-        writer.writeheader()
-        for row in rows:
-            writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
-
-
-def _markdown(rows: list[dict[str, Any]], columns: Sequence[str], headers: Sequence[str]) -> str:
-    def fmt(v: Any) -> str:
-        return ("—" if not np.isfinite(v) else f"{v:.3f}") if isinstance(v, float) else str(v)
-
-    lines = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
-    lines += ["| " + " | ".join(fmt(r[c]) for c in columns) + " |" for r in rows]
-    return "\n".join(lines)
-
-
 def evaluate(
     samples: Iterable[Mapping[str, Any]],
     out_dir: str | Path,
     *,
-    methods: Sequence[str] | Mapping[str, Decomposer] | None = None,
+    methods: Sequence[str] | Mapping[str, Decomposer | Predictions] | None = None,
     seed: int = 0,
     metrics: Sequence[str] | None = None,
     n_judgements: int = 1000,
@@ -389,7 +417,7 @@ def evaluate(
     save_estimates: bool = True,
     progress: Callable[[str], None] | None = None,
 ) -> EvaluationResult:
-    """Evaluate decomposers on *samples* and write scores, tables, figures and estimates.
+    """Evaluate decomposers (or predictions) on *samples* and write scores, tables and figures.
 
     Parameters
     ----------
@@ -398,67 +426,35 @@ def evaluate(
     out_dir
         Output folder (created).
     methods
-        Registry names or ``{name: decomposer}``; default every registered decomposer.
+        Registry names or ``{name: decomposer or Predictions}``; default every registered
+        decomposer, plugins included (:func:`spectrinsic.decompose.registry.available_decomposers`).
     seed
         Root seed of the WHDR judgements.
     progress
         Called with each sample id once it is done (the CLI passes a tqdm update).
     """
+    from spectrinsic.decompose.report import write_report
+
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if methods is None:
-        methods = list(DECOMPOSERS)
+        methods = list(available_decomposers())
     if not isinstance(methods, Mapping):
         methods = {name: get_decomposer(name) for name in methods}
     scores: list[Score] = []
-    kinds: dict[str, str] = {}
-    conditions: dict[str, str] = {}
+    samples_info: dict[str, tuple[str, str]] = {}
+    inputs: set[str] = set()
     for sample in samples:
         sid = _sample_id(sample)
-        kinds[sid], conditions[sid] = sample_kind(sample), sample_condition(sample)
+        samples_info[sid] = (sample_kind(sample), sample_condition(sample))
+        inputs.add(input_image(sample)[0])
         scores += evaluate_sample(
             sample, methods, seed=seed, metrics=metrics, n_judgements=n_judgements,
-            out_dir=out if (save_estimates or figures) else None, cameras=cameras,
-            figure=figures,
+            out_dir=out, cameras=cameras, figure=figures, save_estimates=save_estimates,
         )
         if progress is not None:
             progress(sid)
     if not scores:
         raise DatasetError("no samples to evaluate")
-    files: dict[str, Path] = {}
-    files["scores"] = out / "scores.csv"
-    _write_csv(files["scores"], [
-        {"sample": s.sample, "method": s.method, "scenario": s.scenario, "layer": s.layer,
-         "metric": s.metric, "value": s.value} for s in scores
-    ], ("sample", "method", "scenario", "layer", "metric", "value"))
-
-    cond_rows = condition_table(scores, kinds, conditions)
-    cond_cols = ["scene_kind", "method"] + [
-        f"{layer}_{g}" for layer in ("reflectance", "shading") for g in _GROUP_ORDER
-    ]
-    files["condition_csv"] = out / "lmse_by_condition.csv"
-    _write_csv(files["condition_csv"], cond_rows, cond_cols)
-    md = ["# LMSE by lighting condition (like thesis Tables 5.3 and 5.4)", "",
-          "Reflectance in colour, shading in grey; 20x20 windows every 10 px, one scale per "
-          "window; mean over samples.", ""]
-    for kind, title in _KINDS.items():
-        rows = [r for r in cond_rows if r["scene_kind"] == kind]
-        if rows:
-            md += [f"## {title.capitalize()}", "", _markdown(
-                rows, cond_cols[1:],
-                ["method"] + [f"{lay[:4]}. {g}" for lay in ("reflectance", "shading")
-                              for g in _GROUP_ORDER],
-            ), ""]
-    files["condition_md"] = out / "lmse_by_condition.md"
-    files["condition_md"].write_text("\n".join(md), encoding="utf-8")
-
-    scen_rows = scenario_table(scores)
-    scen_cols = ["camera", "method", *_PHOTOMETRIC]
-    files["scenario_csv"] = out / "lmse_by_scenario.csv"
-    _write_csv(files["scenario_csv"], scen_rows, scen_cols)
-    md = ["# Reflectance LMSE by photometric scenario (like thesis Table 5.1)", ""]
-    md += [_markdown(scen_rows, scen_cols, scen_cols) if scen_rows
-           else "No camera renderings in this dataset: Table 5.1 needs `image_camera/<name>`."]
-    files["scenario_md"] = out / "lmse_by_scenario.md"
-    files["scenario_md"].write_text("\n".join(md) + "\n", encoding="utf-8")
+    files = write_report(out, scores, samples_info, methods, sorted(inputs))
     return EvaluationResult(tuple(scores), files)

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 import numpy.typing as npt
 
-from spectrinsic.decompose._validation import ImageShapeError, as_image, image_pair
+from spectrinsic.decompose._validation import ImageShapeError, as_image, as_mask, image_pair
 from spectrinsic.errors import validate_choice
 
 if TYPE_CHECKING:
@@ -47,6 +47,9 @@ __all__ = [
     "angular_error_map",
     "angular_error_mean",
     "angular_error_median",
+    "shading_chromaticity_error",
+    "reflectance_intensity_error",
+    "reflectance_chromaticity_error",
     "whdr",
 ]
 
@@ -329,6 +332,119 @@ def angular_error_median(
     return _angular_stat(truth, estimate, mask, np.median)
 
 
+def _statistic(values: np.ndarray, statistic: str, what: str) -> float:
+    """Mean or median of *values* (degrees); NaN when empty."""
+    validate_choice(statistic, ("mean", "median"), f"{what} statistic")
+    if values.size == 0:
+        return float("nan")
+    return float(np.mean(values) if statistic == "mean" else np.median(values))
+
+
+def _colour_or_grey(a: np.ndarray, what: str) -> np.ndarray:
+    """``(H, W, 3)`` unchanged; ``(H, W, 1)`` repeated to 3 achromatic channels; else an error."""
+    if a.shape[2] == 1:
+        return np.repeat(a, 3, axis=2)
+    if a.shape[2] != 3:
+        raise ImageShapeError(f"{what} must be (H, W, 3) colour or (H, W) grey; got {a.shape}")
+    return a
+
+
+def shading_chromaticity_error(
+    truth: npt.ArrayLike,
+    estimate: npt.ArrayLike,
+    *,
+    mask: npt.ArrayLike | None = None,
+    statistic: Literal["mean", "median"] = "mean",
+) -> float:
+    """Angular error (degrees) of the shading's colour, Eq. 4.31 applied to shading.
+
+    ``e_p = acos(S_p . S'_p / (|S_p| |S'_p|))`` per pixel ``p`` between the true coloured
+    shading ``S`` (the colour of the light arriving, e.g. the dataset's ``shading`` layer, linear)
+    and the estimate ``S'``; the mean (or median) over the masked pixels where light arrives
+    (``|S_p| > 0``). The error does not depend on the intensity of either shading.
+
+    Parameters
+    ----------
+    truth
+        ``(H, W, 3)`` linear coloured shading.
+    estimate
+        ``(H, W, 3)`` estimate, or ``(H, W)`` / ``(H, W, 1)`` grey shading, which is taken as
+        achromatic ``(s, s, s)``: a method that assumes white light is scored as such.
+    statistic
+        ``"mean"`` or ``"median"`` over the scored pixels.
+
+    Notes
+    -----
+    Where the estimate is the zero vector but light arrives, the angle is undefined; it counts
+    as 90 degrees, the largest angle between non-negative colours, so that zeroing pixels never
+    lowers the error. NaN when no masked pixel receives light.
+    """
+    t = _colour_or_grey(as_image(truth, "truth shading"), "truth shading")
+    e = _colour_or_grey(as_image(estimate, "estimate shading"), "estimate shading")
+    if t.shape != e.shape:
+        raise ImageShapeError(
+            f"estimate shading shape {np.shape(estimate)} differs from truth shape {np.shape(truth)}"
+        )
+    from spectrinsic.spectra import angular_error
+
+    m = as_mask(mask, t.shape[:2])
+    lit = m & (np.linalg.norm(t, axis=-1) > 0.0)
+    zero = np.linalg.norm(e, axis=-1) == 0.0
+    errors = np.where(zero, 90.0, angular_error(t, np.where(zero[..., None], 1.0, e)))
+    return _statistic(errors[lit], statistic, "shading chromaticity error")
+
+
+def _intensity(a: np.ndarray) -> np.ndarray:
+    """Mean over channels, ``(H, W, 1)``."""
+    return a.mean(axis=2, keepdims=True)
+
+
+def reflectance_intensity_error(
+    truth: npt.ArrayLike, estimate: npt.ArrayLike, *, mask: npt.ArrayLike | None = None
+) -> float:
+    """Scale-invariant relative error of the reflectance intensity (MAW-style split).
+
+    As Wu et al. (MAW, ICCP 2023) separate albedo error into intensity and chromaticity, the
+    intensity part compares ``I = mean over channels`` of both images:
+    ``min_alpha sum_p (I_p - alpha I'_p)^2 / sum_p I_p^2`` over the masked pixels. 0 is best;
+    an estimate with the right colours but flat intensity scores ``1 - (sum I)^2 / (N sum I^2)``.
+    Chromatic errors that keep the channel mean do not change it.
+
+    Raises
+    ------
+    ImageShapeError
+        When the masked truth intensity is all zero.
+    """
+    t, e, m = image_pair(truth, estimate, mask)
+    ti, ei = _intensity(t)[m], _intensity(e)[m]
+    energy = float((ti * ti).sum())
+    if energy <= 0.0:
+        raise ImageShapeError("reflectance intensity error undefined: the masked truth is zero")
+    alpha = _scale(ti, ei, np.ones_like(ti), axis=None)
+    return float(((ti - alpha * ei) ** 2).sum() / energy)
+
+
+def reflectance_chromaticity_error(
+    truth: npt.ArrayLike,
+    estimate: npt.ArrayLike,
+    *,
+    mask: npt.ArrayLike | None = None,
+    statistic: Literal["mean", "median"] = "mean",
+) -> float:
+    """Angular error (degrees) of the reflectance colour, the chromaticity half of the MAW split.
+
+    ``acos(R_p . R'_p / (|R_p| |R'_p|))`` per masked pixel with non-zero truth (Eq. 4.31), its
+    mean or median. Independent of the intensity of either image, pixel by pixel, so together with
+    :func:`reflectance_intensity_error` it separates "wrong lightness" from "wrong colour".
+    Zero estimates where the truth is not zero count as 90 degrees, as in
+    :func:`shading_chromaticity_error`.
+    """
+    t, e, m = image_pair(truth, estimate, mask)
+    if t.shape[2] != 3:
+        raise ImageShapeError(f"reflectance chromaticity error needs (H, W, 3) images; got {t.shape}")
+    return shading_chromaticity_error(t, e, mask=m, statistic=statistic)
+
+
 def whdr(
     reflectance: npt.ArrayLike, judgements: Judgements, *, delta: float = WHDR_DELTA
 ) -> float:
@@ -376,6 +492,9 @@ class Metric:
         ``"lower"`` or ``"higher"``.
     scale_invariant
         Whether scaling the estimate leaves the value unchanged.
+    layers
+        The layers the evaluation scores with it (``"reflectance"``, ``"shading"`` for the
+        coloured shading, ``"shading_grey"`` for the grey one).
     """
 
     name: str
@@ -383,6 +502,7 @@ class Metric:
     equation: str
     better: Literal["lower", "higher"]
     scale_invariant: bool
+    layers: tuple[str, ...] = ("reflectance", "shading", "shading_grey")
 
 
 METRICS: Mapping[str, Metric] = {
@@ -394,8 +514,15 @@ METRICS: Mapping[str, Metric] = {
         Metric("corr", correlation, "Eq. 2.7", "higher", True),
         Metric("lcorr", local_correlation, "Eq. 2.8", "higher", True),
         Metric("dssim", dssim, "Eq. 2.11", "lower", True),
-        Metric("angular_mean", angular_error_mean, "Eq. 4.31", "lower", True),
-        Metric("angular_median", angular_error_median, "Eq. 4.31", "lower", True),
+        Metric("angular_mean", angular_error_mean, "Eq. 4.31", "lower", True, ("reflectance",)),
+        Metric("angular_median", angular_error_median, "Eq. 4.31", "lower", True,
+               ("reflectance",)),
+        Metric("intensity_error", reflectance_intensity_error, "MAW intensity (Wu et al. 2023)",
+               "lower", True, ("reflectance",)),
+        Metric("chromaticity_error", reflectance_chromaticity_error,
+               "MAW chromaticity (Wu et al. 2023), Eq. 4.31", "lower", True, ("reflectance",)),
+        Metric("shading_chromaticity", shading_chromaticity_error, "Eq. 4.31 on shading",
+               "lower", True, ("shading",)),
     )
 }
 

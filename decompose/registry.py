@@ -1,8 +1,23 @@
-"""Registry of the bundled decomposers, with validated dispatch."""
+"""Registry of the decomposers, with validated dispatch and a plugin hook.
+
+Bundled methods are in :data:`DECOMPOSERS`. An installed package adds its own through the
+entry-point group :data:`ENTRY_POINT_GROUP`: in its ``pyproject.toml``::
+
+    [project.entry-points."spectrinsic.decomposers"]
+    my-method = "my_package.module:MyDecomposer"
+
+The entry point's name is the method's name in the registry and the tables; the object it loads
+is a factory: called with keyword parameters (none for the defaults) it returns a decomposer,
+``decomposer(image, mask=None) -> Decomposition``
+(:class:`spectrinsic.decompose.decomposition.Decomposer`). A frozen dataclass like the bundled
+ones works as is. :func:`available_decomposers` lists both, bundled first.
+"""
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable, Mapping
+from importlib import metadata
 from typing import Any
 
 import numpy.typing as npt
@@ -11,9 +26,19 @@ from spectrinsic.decompose.baselines import ImageAsReflectance, ImageAsShading
 from spectrinsic.decompose.decomposition import Decomposer, Decomposition
 from spectrinsic.decompose.names_shades import NamesAndShades
 from spectrinsic.decompose.retinex import ColourRetinex
-from spectrinsic.errors import validate_choice
+from spectrinsic.errors import SpectrinsicError, validate_choice
 
-__all__ = ["DECOMPOSERS", "get_decomposer", "decompose"]
+__all__ = [
+    "DECOMPOSERS",
+    "ENTRY_POINT_GROUP",
+    "PluginError",
+    "available_decomposers",
+    "plugin_decomposers",
+    "get_decomposer",
+    "decompose",
+]
+
+logger = logging.getLogger(__name__)
 
 #: Name -> factory (keyword parameters -> decomposer), in the order tables list them.
 DECOMPOSERS: Mapping[str, Callable[..., Any]] = {
@@ -23,10 +48,57 @@ DECOMPOSERS: Mapping[str, Callable[..., Any]] = {
     "image-as-shading": ImageAsShading,
 }
 
+#: Entry-point group through which installed packages add decomposers.
+ENTRY_POINT_GROUP = "spectrinsic.decomposers"
+
+
+class PluginError(SpectrinsicError, RuntimeError):
+    """A ``spectrinsic.decomposers`` entry point that cannot be loaded or is not a factory."""
+
+
+def plugin_decomposers() -> dict[str, Callable[..., Any]]:
+    """Factories registered by installed packages under :data:`ENTRY_POINT_GROUP`.
+
+    Raises :class:`PluginError` for an entry point that fails to import, is not callable, or
+    reuses a bundled method's name.
+    """
+    found: dict[str, Callable[..., Any]] = {}
+    for ep in sorted(metadata.entry_points(group=ENTRY_POINT_GROUP), key=lambda e: e.name):
+        if ep.name in DECOMPOSERS:
+            raise PluginError(
+                f"entry point {ep.name!r} ({ep.value}) in {ENTRY_POINT_GROUP!r} reuses the name "
+                f"of a bundled decomposer; choose another name"
+            )
+        try:
+            factory = ep.load()
+        except Exception as exc:  # any import failure of third-party code
+            raise PluginError(
+                f"entry point {ep.name!r} ({ep.value}) in {ENTRY_POINT_GROUP!r} cannot be "
+                f"loaded: {type(exc).__name__}: {exc}"
+            ) from exc
+        if not callable(factory):
+            raise PluginError(
+                f"entry point {ep.name!r} ({ep.value}) must load a callable factory of "
+                f"decomposers; got {type(factory).__name__}"
+            )
+        found[ep.name] = factory
+        logger.debug("decomposer plugin %s from %s", ep.name, ep.value)
+    return found
+
+
+def available_decomposers() -> dict[str, Callable[..., Any]]:
+    """Bundled decomposers, then the installed plugins (read afresh at each call)."""
+    return {**DECOMPOSERS, **plugin_decomposers()}
+
 
 def get_decomposer(name: str, **params: Any) -> Decomposer:
-    """The decomposer called *name*, built with *params* (e.g. ``threshold_grey=0.1``)."""
-    return DECOMPOSERS[validate_choice(name, DECOMPOSERS, "decomposer")](**params)
+    """The decomposer called *name* (bundled or plugin), built with *params*."""
+    factories = DECOMPOSERS if name in DECOMPOSERS else available_decomposers()
+    decomposer = factories[validate_choice(name, factories, "decomposer")](**params)
+    if not callable(decomposer):
+        raise PluginError(f"decomposer {name!r}: its factory returned a non-callable "
+                          f"{type(decomposer).__name__}")
+    return decomposer
 
 
 def decompose(

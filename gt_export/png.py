@@ -1,4 +1,4 @@
-"""8-bit PNG previews: tone-mapped linear colour, false colour for depth, ids and normals.
+"""PNG files: 8-bit previews (tone-mapped colour, false colour) and 16-bit data images.
 
 Previews are for looking only; the data are in the float32 EXR files. Colour previews are
 linear values scaled by an exposure (a robust percentile of luminance maps to 1), clipped to
@@ -24,7 +24,13 @@ __all__ = [
     "id_colours",
     "normals_preview",
     "write_png",
+    "PNG16_MAX",
+    "write_png16",
+    "read_png16",
 ]
+
+#: Largest code of a 16-bit PNG: a 16-bit data image stores ``value = code / PNG16_MAX``.
+PNG16_MAX = 65535
 
 #: Percentile of the positive luminances mapped to 1.0 by :func:`tone_map` (a few highlights clip).
 EXPOSURE_PERCENTILE = 99.0
@@ -122,3 +128,44 @@ def write_png(path: str | os.PathLike[str], rgb8: np.ndarray) -> Path:
     with guarded_write(path):
         Image.fromarray(np.ascontiguousarray(rgb8)).save(path, format="PNG", optimize=False)
     return path
+
+
+def write_png16(path: str | os.PathLike[str], image: np.ndarray) -> Path:
+    """Write ``(H, W)`` grey or ``(H, W, 3)`` RGB uint16 codes as a 16-bit PNG (pypng)."""
+    import png
+
+    codes = np.asarray(image)
+    if codes.dtype != np.uint16 or codes.ndim not in (2, 3) or (codes.ndim == 3 and codes.shape[2] != 3):
+        raise DatasetError(
+            f"16-bit PNG {str(path)!r}: expected (H, W) or (H, W, 3) uint16, got {codes.dtype} {codes.shape}"
+        )
+    h, w = codes.shape[:2]
+    grey = codes.ndim == 2
+    writer = png.Writer(w, h, greyscale=grey, bitdepth=16)
+    path = Path(path)
+    with guarded_write(path), path.open("wb") as fh:
+        writer.write(fh, codes.reshape(h, -1).tolist())
+    return path
+
+
+def read_png16(path: str | os.PathLike[str]) -> np.ndarray:
+    """Read a 16-bit PNG as uint16 codes: ``(H, W)`` grey or ``(H, W, 3)`` RGB (alpha dropped).
+
+    Raises :class:`DatasetError` if the file is not a PNG or not 16 bits per channel (8-bit
+    files cannot carry linear data without banding, so they are refused rather than rescaled).
+    """
+    import png
+
+    try:
+        w, h, rows, info = png.Reader(filename=str(path)).asDirect()
+        data = np.vstack([np.asarray(r, dtype=np.uint16) for r in rows])
+    except (OSError, png.Error) as exc:
+        raise DatasetError(f"PNG {str(path)!r} cannot be read: {exc}") from exc
+    if info["bitdepth"] != 16:
+        raise DatasetError(
+            f"PNG {str(path)!r} has {info['bitdepth']} bits per channel; expected 16-bit data"
+        )
+    planes = int(info["planes"])
+    data = data.reshape(h, w, planes)
+    colour = planes - int(bool(info.get("alpha")))
+    return data[:, :, 0] if colour == 1 else data[:, :, :3]

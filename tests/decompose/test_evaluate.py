@@ -123,3 +123,22 @@ def test_single_objects_are_scored_on_their_own_mask_not_the_ground():
 
     room = dict(sample, meta={"sample_id": "room-b__v0__white", "objects": {"1": "ground"}})
     assert evaluation_mask(room).all()  # complex scenes keep every surface
+
+
+def test_table_3_2_averages_grey_shading_and_grey_reflectance():
+    from spectrinsic.decompose.evaluate import Score
+    from spectrinsic.decompose.report import table_3_2
+
+    samples = {"obj-a__v0__white": ("object", "white"), "obj-b__v0__one-colour":
+               ("object", "one-colour"), "room__v0__white": ("complex", "white")}
+    scores = []
+    for sid, refl, shad in (("obj-a__v0__white", 0.2, 0.4), ("obj-b__v0__one-colour", 0.6, 0.0),
+                            ("room__v0__white", 9.0, 9.0)):
+        scores += [Score(sid, "m", "srgb", "reflectance_grey", "lmse", refl),
+                   Score(sid, "m", "srgb", "shading_grey", "lmse", shad),
+                   Score(sid, "m", "srgb", "reflectance", "lmse", 99.0)]
+    rows = {r["lighting"]: r for r in table_3_2(scores, samples)}
+    assert rows["WL"]["lmse"] == pytest.approx(0.3)  # (0.2 + 0.4) / 2; the room is not an object
+    assert rows["1L"]["lmse"] == pytest.approx(0.3)  # (0.6 + 0.0) / 2
+    assert rows["all"]["lmse"] == pytest.approx(0.3)
+    assert np.isnan(rows["2L"]["lmse"]) and np.isnan(rows["all"]["corr"])

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from skimage.metrics import structural_similarity
@@ -36,11 +38,12 @@ def pair():
 @pytest.mark.parametrize("grey", [False, True])
 def test_identical_images_score_perfectly(pair, grey):
     truth = pair[0].mean(axis=2) if grey else pair[0]
-    names = [n for n in M.METRICS if not (grey and n.startswith("angular"))]
+    names = [n for n in M.METRICS if not (grey and "reflectance" in M.METRICS[n].layers
+                                            and n.startswith(("angular", "chromaticity")))]
     scores = M.compute_metrics(truth, truth.copy(), names)
     for name, value in scores.items():
         expected = 1.0 if M.METRICS[name].better == "higher" else 0.0
-        tol = ANGLE_ROUNDOFF_DEG if name.startswith("angular") else EXACT
+        tol = ANGLE_ROUNDOFF_DEG if "angular" in M.METRICS[name].equation or "4.31" in M.METRICS[name].equation else EXACT
         assert value == pytest.approx(expected, abs=tol), name
 
 
@@ -52,7 +55,7 @@ def test_scaled_estimate_scores_zero_on_scale_invariant_metrics(pair):
         assert metric.scale_invariant
         value = metric.func(truth, 3.7 * truth, mask=mask)
         expected = 1.0 if metric.better == "higher" else 0.0
-        tol = ANGLE_ROUNDOFF_DEG if name.startswith("angular") else SCALED
+        tol = ANGLE_ROUNDOFF_DEG if "angular" in M.METRICS[name].equation or "4.31" in M.METRICS[name].equation else SCALED
         assert value == pytest.approx(expected, abs=tol), name
     judgements = sample_judgements(truth, seed=1, n_pairs=300, mask=mask)
     assert M.whdr(3.7 * truth, judgements) == 0.0
@@ -168,3 +171,85 @@ def test_shape_checks_and_registry():
     with pytest.raises(SpectrinsicError, match="did you mean 'lmse'"):
         M.get_metric("lmsee")
     assert M.get_metric("lmse").equation == "Eq. 2.5"
+
+
+# --- coloured-shading metrics and the MAW-style split of reflectance error -----------------
+
+#: acos(1/sqrt(3)): the angle between a primary and the achromatic axis, degrees.
+PRIMARY_TO_GREY_DEG = math.degrees(math.acos(1.0 / math.sqrt(3.0)))
+
+
+def _shading_case():
+    truth = np.ones((2, 3, 3))
+    estimate = np.ones((2, 3, 3))
+    estimate[0, 0] = (1.0, 0.0, 0.0)  # 54.7356 degrees
+    estimate[0, 1] = (2.0, 2.0, 2.0)  # same colour, other intensity: 0
+    estimate[0, 2] = (0.0, 0.0, 0.0)  # zero estimate under light: 90 degrees
+    estimate[1, 0] = (0.0, 1.0, 0.0)  # masked out below
+    truth[1, 1] = 0.0  # no light arrives: not scored
+    mask = np.ones((2, 3), bool)
+    mask[1, 0] = False
+    return truth, estimate, mask
+
+
+def test_shading_chromaticity_error_hand_computed():
+    truth, estimate, mask = _shading_case()
+    # scored pixels: (0,0) 54.74, (0,1) 0, (0,2) 90, (1,2) 0
+    expected_mean = (PRIMARY_TO_GREY_DEG + 0.0 + 90.0 + 0.0) / 4.0
+    value = M.shading_chromaticity_error(truth, estimate, mask=mask)
+    assert value == pytest.approx(expected_mean, abs=ANGLE_ROUNDOFF_DEG)
+    median = M.shading_chromaticity_error(truth, estimate, mask=mask, statistic="median")
+    assert median == pytest.approx(PRIMARY_TO_GREY_DEG / 2.0, abs=ANGLE_ROUNDOFF_DEG)
+
+
+def test_shading_chromaticity_error_scores_grey_shading_as_white_light():
+    truth = np.zeros((4, 4, 3))
+    truth[..., 0] = 2.0  # red light everywhere
+    grey = np.full((4, 4), 0.3)
+    value = M.shading_chromaticity_error(truth, grey)
+    assert value == pytest.approx(PRIMARY_TO_GREY_DEG, abs=ANGLE_ROUNDOFF_DEG)
+    assert M.shading_chromaticity_error(truth, 5.0 * truth) == pytest.approx(0.0, abs=1e-6)
+
+
+def test_shading_chromaticity_error_rejects_bad_input():
+    with pytest.raises(ImageShapeError, match="differs from truth shape"):
+        M.shading_chromaticity_error(np.ones((4, 4, 3)), np.ones((4, 5, 3)))
+    with pytest.raises(ImageShapeError, match="colour or"):
+        M.shading_chromaticity_error(np.ones((4, 4, 2)), np.ones((4, 4, 2)))
+    with pytest.raises(SpectrinsicError, match="statistic"):
+        M.shading_chromaticity_error(np.ones((4, 4, 3)), np.ones((4, 4, 3)), statistic="max")
+
+
+def test_reflectance_intensity_error_hand_computed():
+    # grey truth intensities 1, 2, 3 against a flat estimate: alpha = 6 / 3 = 2,
+    # residual (1-2)^2 + 0 + (3-2)^2 = 2, energy 1 + 4 + 9 = 14.
+    truth = np.array([1.0, 2.0, 3.0])[None, :, None] * np.ones((1, 3, 3))
+    flat = np.full((1, 3, 3), 0.4)
+    assert M.reflectance_intensity_error(truth, flat) == pytest.approx(2.0 / 14.0, abs=EXACT)
+    mask = np.array([[True, False, True]])  # intensities 1 and 3: alpha 2, residual 2, energy 10
+    assert M.reflectance_intensity_error(truth, flat, mask=mask) == pytest.approx(0.2, abs=EXACT)
+    with pytest.raises(ImageShapeError, match="masked truth is zero"):
+        M.reflectance_intensity_error(np.zeros((2, 2, 3)), np.ones((2, 2, 3)))
+
+
+def test_maw_split_separates_colour_from_lightness():
+    truth = np.ones((3, 3, 3))
+    recoloured = np.broadcast_to(np.array([1.5, 0.5, 1.0]), (3, 3, 3))  # same channel mean
+    # (1,1,1).(1.5,0.5,1) = 3; |.| = sqrt(3) sqrt(3.5)
+    angle = math.degrees(math.acos(3.0 / math.sqrt(3.0 * 3.5)))
+    assert M.reflectance_intensity_error(truth, recoloured) == pytest.approx(0.0, abs=EXACT)
+    assert M.reflectance_chromaticity_error(truth, recoloured) == pytest.approx(
+        angle, abs=ANGLE_ROUNDOFF_DEG)
+    darker = truth.copy()
+    darker[0] *= 0.5  # lightness change, colour kept
+    assert M.reflectance_chromaticity_error(truth, darker) == pytest.approx(
+        0.0, abs=ANGLE_ROUNDOFF_DEG)
+    # intensities 1 (6 px) and 0.5 (3 px) against 1: alpha = 7.5/9, see the formula above
+    t = np.array([1.0] * 6 + [1.0] * 3)
+    e = np.array([1.0] * 6 + [0.5] * 3)
+    alpha = (t * e).sum() / (e * e).sum()
+    expected = ((t - alpha * e) ** 2).sum() / (t * t).sum()
+    assert M.reflectance_intensity_error(darker, truth) > 0.0
+    assert M.reflectance_intensity_error(truth, darker) == pytest.approx(expected, abs=EXACT)
+    with pytest.raises(ImageShapeError, match="needs .H, W, 3. images"):
+        M.reflectance_chromaticity_error(np.ones((3, 3)), np.ones((3, 3)))

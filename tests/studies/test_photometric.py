@@ -139,3 +139,42 @@ def test_bad_settings_are_one_line_errors():
         PhotometricSettings(seed=0, sc3_light_space="xyz")  # type: ignore[arg-type]
     with pytest.raises(SpectrinsicError, match="reflectances"):
         PhotometricSettings(seed=0, reflectances_per_scene=2)
+
+
+#: Thesis sec. 4.4.1: "the errors in scenario 3 are reduced by 42% with respect to ... scenario 4".
+THESIS_SC3_VS_SC4 = -42.0
+#: How close the mean change must come under the default normalisation (percentage points).
+SC3_TOLERANCE_POINTS = 5.0
+
+
+def _reduction(res, camera, illuminant_set="planckian"):
+    row = {r.scenario: r.mean_angular_error_deg for r in res.rows
+           if r.camera == camera and r.illuminant_set == illuminant_set}
+    return (row["SC3"] - row["SC4"]) / row["SC4"] * 100.0
+
+
+def test_default_camera_normalisation_gives_the_thesis_sc3_behaviour(default_result):
+    """Equal-energy-white (unit-area) curves: the mean SC3-vs-SC4 change is the thesis' -42 %
+    within 5 points; the Foveon camera we share with the thesis (Sigma SDMerill vs its Sigma
+    Foveon D10, -5.8 % in Table 4.4) gains less than 10 %; the Canon 1D (EOS1D -65 % in the
+    thesis, 1DMarkIII here) more than 40 %."""
+    res = default_result
+    assert res.settings.camera_balance == "equal-energy-white"
+    assert abs(res.changes["ours"]["SC3_vs_SC4"] - THESIS_SC3_VS_SC4) < SC3_TOLERANCE_POINTS
+    sigma = "camera:Sigma SDMerill (NPL)"
+    assert -10.0 < _reduction(res, sigma) < 0.0
+    assert _reduction(res, "camera:Canon 1DMarkIII") < -40.0
+
+
+def test_raw_camera_curves_do_not_give_the_thesis_sc3_behaviour():
+    """Without the data directory: colour-science's two cameras, Munsell chips. Raw curves make
+    SC3 worse than SC4 for the Foveon camera; white-balanced curves do not."""
+    cams = ("camera:Sigma SDMerill (NPL)",)
+    raw = run_photometric(PhotometricSettings(seed=0, cameras=cams, camera_balance="none",
+                                              n_scenes=3, reflectances="munsell"))
+    ee = run_photometric(PhotometricSettings(seed=0, cameras=cams, n_scenes=3,
+                                             reflectances="munsell"))
+    assert _reduction(raw, cams[0]) > 0.0
+    assert _reduction(ee, cams[0]) < 0.0
+    with pytest.raises(SpectrinsicError, match="camera balance"):
+        PhotometricSettings(seed=0, camera_balance="white")  # type: ignore[arg-type]
