@@ -492,6 +492,9 @@ def write_manifest(
         "spectral_data": _spectral_provenance(metas, data_dir),
         "n_samples": len(samples),
         "noise": noise_summary(metas),
+        "split_by": "scene",
+        "split_fractions": dict(SPLIT_FRACTIONS),
+        "splits": splits_by_scene({s.name: str(m.get("scene")) for s, m in zip(samples, metas)}),
         "samples": {
             s.name: {
                 "config_hash": m.get("config_hash"),
@@ -507,6 +510,38 @@ def write_manifest(
     _dump_json(tmp, manifest)
     tmp.replace(path)
     return path
+
+
+#: Train / val / test shares of the scenes (each scene's samples go to one split).
+SPLIT_FRACTIONS: tuple[tuple[str, float], ...] = (("train", 0.8), ("val", 0.1), ("test", 0.1))
+
+
+def split_of(scene: str) -> str:
+    """The split of scene *scene*: its ``seed_from_key(0, "split:" + scene)`` as a fraction of
+    2³² against the cumulative :data:`SPLIT_FRACTIONS`. It depends on the scene name only, so a
+    scene keeps its split when the set grows and all its views and conditions share it.
+
+    >>> split_of("room-living") == split_of("room-living")
+    True
+    """
+    from spectrinsic.rng import seed_from_key
+
+    u = seed_from_key(0, f"split:{scene}") / 2**32
+    edge = 0.0
+    for name, share in SPLIT_FRACTIONS:
+        edge += share
+        if u < edge:
+            return name
+    return SPLIT_FRACTIONS[-1][0]
+
+
+def splits_by_scene(sample_scenes: Mapping[str, str]) -> dict[str, list[str]]:
+    """``{split: [sample ids]}`` from ``{sample id: scene name}``, made by scene (no scene in two
+    splits, so no view or condition of a scene leaks across)."""
+    out: dict[str, list[str]] = {name: [] for name, _ in SPLIT_FRACTIONS}
+    for sample, scene in sorted(sample_scenes.items()):
+        out[split_of(scene)].append(sample)
+    return out
 
 
 def noise_summary(metas: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
