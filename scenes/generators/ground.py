@@ -55,13 +55,18 @@ def objects_on_ground(rng: np.random.Generator, options: GeneratorOptions) -> La
     centre = (lo + hi) / 2
     radius = max(float(np.linalg.norm(hi - lo)) / 2, 0.05)
 
+    spots = [((p.vertices.min(axis=0) + p.vertices.max(axis=0)) / 2,
+              float(np.linalg.norm(np.ptp(p.vertices, axis=0))) / 2) for _, p in objects]
+
     def propose(r: np.random.Generator) -> tuple[np.ndarray, np.ndarray, float]:
+        """Aim at one object (or the group), far enough to frame it and some neighbours."""
         fov = float(r.uniform(30, 55))
+        aim, size = spots[int(r.integers(len(spots)))] if r.random() < 0.6 else (centre, radius)
         elevation, azimuth = math.radians(r.uniform(12, 65)), r.uniform(0, 2 * math.pi)
-        distance = radius / math.sin(math.radians(fov) / 2) * r.uniform(0.9, 1.5)
+        distance = max(size, 0.25 * radius) / math.sin(math.radians(fov) / 2) * r.uniform(0.8, 1.4)
         direction = np.array([math.cos(elevation) * math.cos(azimuth),
                               math.cos(elevation) * math.sin(azimuth), math.sin(elevation)])
-        target = centre + r.uniform(-0.2, 0.2, 3) * radius
+        target = aim + r.uniform(-0.1, 0.1, 3) * size
         return target + distance * direction, target, fov
 
     d = max(6 * radius, 0.5)
