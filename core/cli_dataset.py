@@ -74,6 +74,8 @@ def register(subparsers: Any) -> None:
                         "standard error is below F (e.g. 0.02) or --max-batches is reached")
     p.add_argument("--max-batches", type=int, default=None, metavar="N",
                    help="cap of the adaptive batches (default 4 x batches)")
+    p.add_argument("--direct", action="store_true",
+                   help="also render direct light only, to record the energy ratio r per sample")
     p.add_argument("--no-denoise", action="store_true",
                    help="keep shading from the raw Monte Carlo irradiance (no OIDN)")
     p.add_argument(
@@ -155,6 +157,8 @@ def _overrides(args: argparse.Namespace) -> dict[str, Any]:
         changes["batches"] = args.batches
     if args.no_denoise:
         changes["denoise"] = False
+    if args.direct:
+        changes["direct"] = True
     if args.noise_target is not None:
         changes["noise_target"] = args.noise_target
     if args.max_batches is not None:

@@ -277,6 +277,9 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         data_dir=task.data_dir,
     )
     render_seconds = time.perf_counter() - t_render
+    if cfg.direct:  # the energy ratio r of Eq. 5.8, recorded for the dataset card's diversity plots
+        mode = "spectral" if "spectral" in result.direct else next(iter(result.direct))
+        scene.metadata["energy_ratio_r"] = float(result.energy_ratio(mode))
     path = export_sample(
         task.out_dir,
         scene,

@@ -544,6 +544,19 @@ def splits_by_scene(sample_scenes: Mapping[str, str]) -> dict[str, list[str]]:
     return out
 
 
+def _diversity_section(root: Path, samples: Sequence[Path], metas: Sequence[Mapping[str, Any]]) -> str:
+    """The card's diversity section: splits by scene and ``diversity.png`` (written here)."""
+    from spectrinsic.gt_export.diversity import DIVERSITY_NAME, write_diversity
+
+    write_diversity(root, samples, metas)
+    splits = splits_by_scene({s.name: str(m.get("scene")) for s, m in zip(samples, metas, strict=True)})
+    counts = ", ".join(f"{k} {len(v)}" for k, v in splits.items())
+    return (f"\n## Splits and diversity\n\nSplits by scene (no scene in two splits; "
+            f"`manifest.json[\"splits\"]`): {counts} samples.\n\n"
+            f"![r, light CCT and xy, materials per image, object coverage, luminance range]"
+            f"({DIVERSITY_NAME})\n")
+
+
 def noise_summary(metas: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     """Median over samples of each sample's median and p95 relative standard error, per layer
     and scene kind (``object``/``complex``), and the worst sample's median."""
@@ -619,7 +632,7 @@ def write_dataset_card(
         config=json.dumps(_jsonable(config or {}), indent=2, sort_keys=True),
         versions=json.dumps(software_versions(), indent=2, sort_keys=True),
         variants=", ".join(sorted({str(m.get("variant")) for m in metas})),
-    )
+    ) + _diversity_section(root, samples, metas)
     path = root / CARD_NAME
     with guarded_write(path):
         path.write_text(text, encoding="utf-8")
