@@ -13,6 +13,7 @@ import math
 import os
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -32,7 +33,7 @@ def _geometries(path: Path) -> list[tuple[str, str, np.ndarray, np.ndarray]]:
     import trimesh
 
     try:
-        loaded = trimesh.load(str(path), force="scene", process=False)
+        loaded: Any = trimesh.load(str(path), force="scene", process=False)
     except Exception as exc:  # noqa: BLE001 - trimesh raises many types for corrupt files
         raise SceneError(f"{path}: cannot read it as a mesh ({type(exc).__name__}: {exc})") from exc
     out = []

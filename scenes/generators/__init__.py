@@ -16,7 +16,13 @@ import numpy as np
 
 from spectrinsic.errors import validate_choice
 from spectrinsic.rng import seed_from_key
-from spectrinsic.scenes.generators.base import GeneratorOptions, Layout, assemble, family_of, scene_rngs
+from spectrinsic.scenes.generators.base import (
+    GeneratorOptions,
+    Layout,
+    assemble,
+    family_of,
+    scene_rngs,
+)
 from spectrinsic.scenes.generators.ground import objects_on_ground
 from spectrinsic.scenes.generators.materials import MaterialDistribution
 from spectrinsic.scenes.generators.rooms import rooms

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -30,7 +31,7 @@ class Footprints:
 
     rects: list[tuple[float, float, float, float]]
 
-    def try_add(self, centre: Sequence[float], half: Sequence[float], gap: float = 0.01) -> bool:
+    def try_add(self, centre: Any, half: Any, gap: float = 0.01) -> bool:
         """Occupy the rectangle around *centre* with half-sizes *half*, if it overlaps none."""
         x0, y0 = centre[0] - half[0] - gap, centre[1] - half[1] - gap
         x1, y1 = centre[0] + half[0] + gap, centre[1] + half[1] + gap
@@ -78,7 +79,7 @@ def coverage(meshes: Sequence[Mesh], camera: Camera, is_object: Callable[[Mesh],
     return float(flags[hit].mean())
 
 
-def is_free(meshes: Sequence[Mesh], point: Sequence[float]) -> bool:
+def is_free(meshes: Sequence[Mesh], point: Sequence[float] | np.ndarray) -> bool:
     """True when *point* is inside no closed mesh (generalised winding number < 0.5)."""
     p = np.asarray(point, float).reshape(1, 3)
     for m in meshes:

@@ -73,7 +73,7 @@ def _vessel(rng: np.random.Generator, spectrum: str) -> g.Part:
 def _library(key: str) -> Builder:
     def build(rng: np.random.Generator, spectrum: str) -> g.Part:
         stretch = rng.uniform(0.8, 1.25, 3)
-        return g.moved(OBJECTS[key](), scale=float(rng.uniform(0.8, 2.0)) * stretch)
+        return g.moved(OBJECTS[key](), scale=tuple(float(rng.uniform(0.8, 2.0)) * stretch))
 
     build.__doc__ = f"The library's {key!r} with random scale and proportions (its own paint)."
     return build
