@@ -10,8 +10,8 @@ from spectrinsic.scenes import geometry as g
 from spectrinsic.scenes.generators.base import GeneratorOptions, Layout
 from spectrinsic.scenes.generators.camera import Footprints
 from spectrinsic.scenes.generators.lights import LightVolume
-from spectrinsic.scenes.generators.materials import MaterialDistribution, paint
-from spectrinsic.scenes.generators.shapes import make_shape, shape_names
+from spectrinsic.scenes.generators.materials import MaterialDistribution
+from spectrinsic.scenes.generators.shapes import draw_object
 
 __all__ = ["objects_on_ground"]
 
@@ -28,17 +28,12 @@ def _ground(rng: np.random.Generator) -> g.Part:
 
 def _place(rng: np.random.Generator, options: GeneratorOptions) -> tuple[list[tuple[str, g.Part]], list[str]]:
     """Objects at random spots within 0.35 m of the origin, footprints not overlapping."""
-    names = shape_names()
     floor = Footprints([])
     parts: list[tuple[str, g.Part]] = []
     patterns: list[str] = []
     for i in range(int(rng.integers(1, 6))):
-        shape = names[int(rng.integers(len(names)))]
-        part = make_shape(shape, rng, "flat:0.5")
-        if not shape.startswith("lib-"):
-            part, pattern = paint(part, rng, options.materials, options.sfu_reflectances)
-            patterns.append(pattern)
-        half = np.ptp(part.vertices[:, :2], axis=0) / 2
+        shape, part, pattern, half = draw_object(rng, options.materials, options.sfu_reflectances)
+        patterns += [pattern] if pattern else []
         for _ in range(30):
             centre = rng.uniform(-0.35, 0.35, 2)
             if floor.try_add(centre, half):

@@ -15,9 +15,8 @@ from spectrinsic.scenes.generators.lights import LightVolume
 from spectrinsic.scenes.generators.materials import (
     MaterialDistribution,
     draw_reflectance,
-    paint,
 )
-from spectrinsic.scenes.generators.shapes import make_shape, shape_names
+from spectrinsic.scenes.generators.shapes import draw_object
 
 __all__ = ["rooms"]
 
@@ -112,16 +111,13 @@ def _objects(rng: np.random.Generator, size: tuple[float, float, float], floor: 
              tops: list[tuple[np.ndarray, np.ndarray, float]], options: GeneratorOptions) -> tuple[list[tuple[str, g.Part]], list[str]]:
     """2-8 objects resting on table tops (preferred) or the floor, without overlaps."""
     w, d, _ = size
-    names, parts, patterns = shape_names(), [], []
+    parts: list[tuple[str, g.Part]] = []
+    patterns: list[str] = []
     supports = [(lo, hi, z, Footprints([])) for lo, hi, z in tops]
     supports.append((np.array([0.1, 0.1]), np.array([w - 0.1, d - 0.1]), 0.0, floor))
     for i in range(int(rng.integers(2, 9))):
-        shape = names[int(rng.integers(len(names)))]
-        part = make_shape(shape, rng, "flat:0.5")
-        if not shape.startswith("lib-"):
-            part, pattern = paint(part, rng, options.materials, options.sfu_reflectances)
-            patterns.append(pattern)
-        half = np.ptp(part.vertices[:, :2], axis=0) / 2
+        shape, part, pattern, half = draw_object(rng, options.materials, options.sfu_reflectances)
+        patterns += [pattern] if pattern else []
         for _ in range(20):
             lo, hi, z, taken = supports[int(rng.integers(len(supports)))]
             if np.any(hi - lo < 2 * half):
@@ -141,7 +137,7 @@ def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
     floor = Footprints([])
     furniture, tops = _furniture(rng, size, floor, MaterialDistribution((2, 8), (0, 12)))
     objects, patterns = _objects(rng, size, floor, tops, options)
-    targets = [p.vertices.mean(axis=0) for _, p in objects + furniture]
+    targets = [p.vertices.mean(axis=0) for _, p in objects + furniture] or [np.array([w / 2, d / 2, 0.5])]
 
     def propose(r: np.random.Generator) -> tuple[np.ndarray, np.ndarray, float]:
         origin = r.uniform([0.25, 0.25, 0.9], [w - 0.25, d - 0.25, min(1.9, h - 0.3)])

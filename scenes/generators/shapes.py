@@ -7,14 +7,15 @@ and returns a closed :class:`~spectrinsic.scenes.geometry.Part`. Units: metres, 
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
 from spectrinsic.scenes import geometry as g
+from spectrinsic.scenes.generators.materials import MaterialDistribution, paint
 from spectrinsic.scenes.objects import OBJECTS
 
-__all__ = ["SHAPES", "shape_names", "make_shape", "on_ground"]
+__all__ = ["SHAPES", "shape_names", "make_shape", "draw_object", "on_ground"]
 
 Builder = Callable[[np.random.Generator, str], g.Part]
 
@@ -102,3 +103,22 @@ def make_shape(name: str, rng: np.random.Generator, spectrum: str) -> g.Part:
     turned about z by a random angle (degrees)."""
     part = SHAPES[name](rng, spectrum)
     return on_ground(g.moved(part, rotate_deg=(0, 0, float(rng.uniform(0, 360)))))
+
+
+def draw_object(
+    rng: np.random.Generator, materials: MaterialDistribution, sfu: Sequence[str] = ()
+) -> tuple[str, g.Part, str | None, np.ndarray]:
+    """A random shape, painted from *materials* (library objects keep their own paint).
+
+    Returns
+    -------
+    tuple
+        ``(shape name, part on z = 0, pattern name or None, (2,) footprint half-sizes in m)``.
+    """
+    names = shape_names()
+    shape = names[int(rng.integers(len(names)))]
+    part = make_shape(shape, rng, "flat:0.5")
+    pattern = None
+    if not shape.startswith("lib-"):
+        part, pattern = paint(part, rng, materials, sfu)
+    return shape, part, pattern, np.ptp(part.vertices[:, :2], axis=0) / 2
