@@ -548,7 +548,10 @@ def _diversity_section(root: Path, samples: Sequence[Path], metas: Sequence[Mapp
     """The card's diversity section: splits by scene and ``diversity.png`` (written here)."""
     from spectrinsic.gt_export.diversity import DIVERSITY_NAME, write_diversity
 
-    write_diversity(root, samples, metas)
+    figure = root / DIVERSITY_NAME
+    newest = max((s / META_NAME).stat().st_mtime_ns for s in samples)
+    if not figure.is_file() or figure.stat().st_mtime_ns < newest:  # a resumed build: keep it
+        write_diversity(root, samples, metas)
     splits = splits_by_scene({s.name: str(m.get("scene")) for s, m in zip(samples, metas, strict=True)})
     counts = ", ".join(f"{k} {len(v)}" for k, v in splits.items())
     return (f"\n## Splits and diversity\n\nSplits by scene (no scene in two splits; "

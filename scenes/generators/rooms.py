@@ -53,7 +53,10 @@ def _wall(key: str, size: tuple[float, float, float], spectrum: str, hole: tuple
 
 def _shell(rng: np.random.Generator, size: tuple[float, float, float]) -> tuple[list[tuple[str, g.Part]], dict]:
     w, d, h = size
-    walls = MaterialDistribution((2.0, 9.0), (0.0, 10.0))
+    # half the rooms have light, low-chroma walls (strong interreflection: low r), the others
+    # any walls; with missing walls and ceilings this spreads r
+    bright = rng.random() < 0.5
+    walls = MaterialDistribution((7.0, 9.5), (0.0, 4.0)) if bright else MaterialDistribution((2.0, 9.0), (0.0, 10.0))
     missing = [k for k in _WALLS if k != "back" and rng.random() < 0.3]
     ceiling = rng.random() >= 0.35
     parts = [("floor", _slab(np.array([-_T, -_T, -_T]), np.array([w + _T, d + _T, 0.0]),
@@ -70,7 +73,7 @@ def _shell(rng: np.random.Generator, size: tuple[float, float, float]) -> tuple[
             a = rng.uniform(0.15, 0.5)
             hole, windows = (a, a + rng.uniform(0.2, 0.4), rng.uniform(0.6, 1.0), rng.uniform(1.6, h - 0.2)), windows + 1
         parts.append((f"wall-{key}", _wall(key, size, draw_reflectance(rng, walls), hole)))
-    return parts, {"missing_walls": missing, "ceiling": ceiling, "windows": windows}
+    return parts, {"missing_walls": missing, "ceiling": ceiling, "windows": windows, "light_walls": bright}
 
 
 def _furniture(rng: np.random.Generator, size: tuple[float, float, float], floor: Footprints,

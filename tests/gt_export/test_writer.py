@@ -263,3 +263,16 @@ def test_meta_json_floats_carry_at_most_the_stated_digits(tmp_path, two_light_sa
     assert len(floats) > 50
     assert all(float(f"{x:.{META_DIGITS}g}") == x for x in floats)
     assert any(float(f"{x:.{META_DIGITS - 2}g}") != x for x in floats)  # not rounded coarser
+
+
+def test_dataset_card_shows_the_diversity_figure(built):
+    from spectrinsic.gt_export.diversity import diversity_figure, diversity_stats
+    from spectrinsic.gt_export.writer import _read_meta, sample_dirs
+
+    assert "diversity.png" in (built / "DATASET.md").read_text() and (built / "diversity.png").is_file()
+    samples = sample_dirs(built)
+    stats = diversity_stats(samples, [_read_meta(s) for s in samples])
+    n_lights = sum(len(_read_meta(s)["lights"]) for s in samples)
+    assert len(stats["luminance_decades"]) == len(samples) and len(stats["light_cct"]) == n_lights
+    assert all(1000 < t < 25000 for t in stats["light_cct"])
+    assert len(diversity_figure(stats).axes) == 6
