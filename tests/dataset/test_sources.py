@@ -144,3 +144,15 @@ def test_cli_generator_typo_is_a_one_line_error(tmp_path, capsys):
     rc = main(["dataset", "--out", str(tmp_path / "x"), "--generator", "room", "--count", "1"])
     err = capsys.readouterr().err.strip()
     assert rc == 2 and "did you mean 'rooms'" in err and len(err.splitlines()) == 1
+
+
+def test_render_ground_truth_is_the_dataset_path(tmp_path):
+    from spectrinsic.cli import main
+    from spectrinsic.scenes import build, save_scene
+
+    path = save_scene(build("obj-cup", seed=0, width=8, height=8), tmp_path / "mine" / "cup.yaml")
+    out = tmp_path / "gt"
+    rc = main(["-q", "render", str(path), "--ground-truth", "--out", str(out), "--width", "8",
+               "--height", "8", "--spp", "2"])
+    assert rc == 0 and check_dataset(out) == []
+    assert LAYERS <= _layers(out, "cup__v0__file")
