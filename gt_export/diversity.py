@@ -56,7 +56,7 @@ def diversity_stats(sample_dirs: Sequence[Path], metas: Sequence[Mapping[str, An
                                                  "coverage", "luminance_decades")}
     for folder, meta in zip(sample_dirs, metas, strict=True):
         extra = meta.get("scene_metadata") or {}
-        if isinstance(extra.get("energy_ratio_r"), float):
+        if isinstance(extra.get("energy_ratio_r"), float) and np.isfinite(extra["energy_ratio_r"]):
             out["r"].append(extra["energy_ratio_r"])
         for light in meta.get("lights", []):
             out["light_xy"].append(tuple(light["xy"]))

@@ -30,11 +30,13 @@ _FLUORESCENTS = tuple(f"cie:FL{i}" for i in range(1, 13))
 
 @dataclass(frozen=True)
 class LightVolume:
-    """Where lights may go: the box ``[lo, hi]`` (metres) and the point they aim at."""
+    """Where lights may go: the box ``[lo, hi]`` (metres), the point they aim at, and the kinds
+    that can light the scene (a directional light cannot enter a room with a ceiling)."""
 
     lo: tuple[float, float, float]
     hi: tuple[float, float, float]
     focus: tuple[float, float, float]
+    kinds: tuple[LightKind, ...] = LIGHT_KINDS
 
 
 def _spd_draws(sfu: Sequence[str]) -> dict[str, Callable[[np.random.Generator], str]]:
@@ -147,7 +149,7 @@ def draw_lights(
     lo, hi = np.asarray(volume.lo, float), np.asarray(volume.hi, float)
     lights = []
     for i, spectrum in enumerate(spectra):
-        kind = LIGHT_KINDS[int(rng.integers(len(LIGHT_KINDS)))]
+        kind = volume.kinds[int(rng.integers(len(volume.kinds)))]
         for _ in range(50):
             position = rng.uniform(lo, hi)
             if free(position):

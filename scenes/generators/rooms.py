@@ -11,7 +11,7 @@ import numpy as np
 from spectrinsic.scenes import geometry as g
 from spectrinsic.scenes.generators.base import GeneratorOptions, Layout
 from spectrinsic.scenes.generators.camera import Footprints
-from spectrinsic.scenes.generators.lights import LightVolume
+from spectrinsic.scenes.generators.lights import LIGHT_KINDS, LightVolume
 from spectrinsic.scenes.generators.materials import (
     MaterialDistribution,
     draw_reflectance,
@@ -148,7 +148,8 @@ def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
         return origin, target, float(r.uniform(50, 75))
 
     volume = LightVolume(lo=(0.3, 0.3, 0.6 * h), hi=(w - 0.3, d - 0.3, h - 0.15),
-                         focus=(w / 2, d / 2, 0.6))
+                         focus=(w / 2, d / 2, 0.6),
+                         kinds=("point", "spot", "area") if openness["ceiling"] else LIGHT_KINDS)
     info = {"generator": "rooms", "room_size": list(size), **openness,
             "n_furniture": len(furniture), "n_objects": len(objects),
             "shapes": [n.rsplit("-", 1)[0] for n, _ in objects], "patterns": patterns}

@@ -114,3 +114,9 @@ def test_unknown_generator_is_a_one_line_error_with_a_suggestion():
     with pytest.raises(SpectrinsicError, match="did you mean 'rooms'") as info:
         _scene("room", 0)
     assert "\n" not in str(info.value)
+
+
+def test_rooms_with_a_ceiling_get_no_directional_light():
+    scenes = [_scene("rooms", 9, i) for i in range(8)]
+    roofed = [s for s in scenes if s.metadata["ceiling"]]
+    assert roofed and all(light.kind != "directional" for s in roofed for light in s.lights)
