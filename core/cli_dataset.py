@@ -74,6 +74,8 @@ def register(subparsers: Any) -> None:
                         "standard error is below F (e.g. 0.02) or --max-batches is reached")
     p.add_argument("--max-batches", type=int, default=None, metavar="N",
                    help="cap of the adaptive batches (default 4 x batches)")
+    p.add_argument("--direct", action="store_true",
+                   help="also render direct light only, to record the energy ratio r per sample")
     p.add_argument("--no-denoise", action="store_true",
                    help="keep shading from the raw Monte Carlo irradiance (no OIDN)")
     p.add_argument(
@@ -82,6 +84,23 @@ def register(subparsers: Any) -> None:
         metavar="WxH",
         help="override the image size in pixels, e.g. 256x256",
     )
+    src = p.add_argument_group("scene source (default: the built-in library layout)")
+    src.add_argument("--generator", metavar="NAME", default=None,
+                     help="generate scenes procedurally: objects-on-ground or rooms")
+    src.add_argument("--count", type=int, default=20, metavar="N", help="generated scenes (20)")
+    src.add_argument("--views", type=int, default=1, metavar="V", help="cameras per generated scene (1)")
+    src.add_argument("--value-range", default="2,9", metavar="LO,HI",
+                     help="Munsell value range of generated materials (2,9)")
+    src.add_argument("--chroma-range", default="0,16", metavar="LO,HI",
+                     help="Munsell chroma range of generated materials (0,16)")
+    src.add_argument("--sfu", action="store_true",
+                     help="also draw SFU reflectances and illuminants (needs --data-dir)")
+    src.add_argument("--scenes", nargs="+", metavar="PATH", default=None,
+                     help="render your own scene files (.yaml, .blend, .obj/.ply/.glb) with full ground truth")
+    src.add_argument("--material-map", metavar="FILE", default=None,
+                     help="YAML/JSON mapping material name -> spectrum for .blend and mesh scenes")
+    src.add_argument("--default-spectrum", metavar="NAME", default=None,
+                     help="reflectance of unmapped materials in .blend and mesh scenes")
     p.add_argument(
         "--rebuild",
         action="store_true",
@@ -90,14 +109,56 @@ def register(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
+def _range(option: str, text: str) -> tuple[float, float]:
+    try:
+        lo, hi = (float(v) for v in text.split(","))
+    except ValueError:
+        raise DatasetError(f"{option} {text!r}; expected LO,HI, e.g. 2,9") from None
+    if lo > hi:
+        raise DatasetError(f"{option} {text!r}; expected LO <= HI")
+    return lo, hi
+
+
+def _material_map(path: str | None) -> dict[str, str]:
+    if path is None:
+        return {}
+    from spectrinsic.scenes.yaml_limits import load_yaml_file
+
+    data = load_yaml_file(Path(path))
+    if not isinstance(data, dict) or not all(isinstance(k, str) and isinstance(v, str) for k, v in data.items()):
+        raise DatasetError(f"--material-map {path!r}: expected a mapping of material name -> spectrum name")
+    return data
+
+
+def _source(args: argparse.Namespace) -> str | None:
+    """The config's ``source`` for --generator / --scenes (``None``: the library)."""
+    from spectrinsic.dataset_sources import files_source, generator_source
+
+    if args.generator and args.scenes:
+        raise DatasetError("--generator and --scenes exclude each other; give one")
+    if args.generator:
+        return generator_source(args.generator, args.count, views=args.views, sfu=args.sfu,
+                                value_range=_range("--value-range", args.value_range),
+                                chroma_range=_range("--chroma-range", args.chroma_range))
+    if args.scenes:
+        return files_source(args.scenes, materials=_material_map(args.material_map),
+                            default_spectrum=args.default_spectrum)
+    return None
+
+
 def _overrides(args: argparse.Namespace) -> dict[str, Any]:
     changes: dict[str, Any] = {}
+    source = _source(args)
+    if source is not None:
+        changes["source"] = source
     if args.spp is not None:
         changes["spp"] = args.spp
     if args.batches is not None:
         changes["batches"] = args.batches
     if args.no_denoise:
         changes["denoise"] = False
+    if args.direct:
+        changes["direct"] = True
     if args.noise_target is not None:
         changes["noise_target"] = args.noise_target
     if args.max_batches is not None:

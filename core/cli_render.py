@@ -51,8 +51,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--view", type=int, default=0, help="library scenes: camera viewpoint (default: 0)")
     p.add_argument("--modes", default=DEFAULT_MODES, help=f"comma-separated render modes (default: {DEFAULT_MODES})")
     p.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder")
-    p.add_argument("--spp", type=int, default=default.spp,
-                   help=f"samples per pixel of every pass (default: {default.spp})")
+    p.add_argument("--spp", type=int, default=None,
+                   help=f"samples per pixel of every pass (default: {default.spp}, the default "
+                        "preset's; with --ground-truth the chosen preset's)")
     p.add_argument("--seed", type=int, default=0, help="sampler seed and library illuminant seed (default: 0)")
     p.add_argument("--width", type=int, default=None,
                    help=f"image width (default: the scene's, {default.width} for the library)")
@@ -64,6 +65,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--per-light", action="store_true", help="also write one image per light")
     p.add_argument("--direct", action="store_true", help="also write direct-light-only images")
     p.add_argument("--no-aovs", action="store_true", help="skip coverage/id/depth/normal maps")
+    p.add_argument("--ground-truth", action="store_true",
+                   help="write every ground-truth layer instead of raw passes: a one-sample dataset "
+                        "built by the same path as `spectrinsic dataset --scenes` (uses --preset)")
+    p.add_argument("--preset", default="preview", help="with --ground-truth: quality preset (preview)")
+    p.add_argument("--material-map", metavar="FILE", default=None,
+                   help="with --ground-truth: material name -> spectrum map for .blend and mesh files")
     p.set_defaults(func=run)
 
 
@@ -88,14 +95,19 @@ def load_scene_argument(
         camera = dataclasses.replace(camera, width=camera.width if width is None else width,
                                      height=camera.height if height is None else height)
         return dataclasses.replace(loaded, camera=camera)
-    from spectrinsic.scenes import library
-
     from spectrinsic.presets import get_preset
+    from spectrinsic.scenes import library
 
     default = get_preset("default")
     return library.build(scene, view=view, condition=condition, seed=seed,
                          width=default.width if width is None else width,
                          height=default.height if height is None else height)
+
+
+def _default_spp() -> int:
+    from spectrinsic.presets import get_preset
+
+    return get_preset("default").spp
 
 
 def _is_blend(path: Path) -> bool:
@@ -151,7 +163,29 @@ def write_render(out: Path, scene: Any, result: Any, *, data_dir: str | None = N
     return paths
 
 
+def _ground_truth(args: argparse.Namespace) -> int:
+    """``render --ground-truth``: a thin alias of ``dataset`` (one sample; library name or file)."""
+    from spectrinsic import cli_dataset
+
+    path = Path(args.scene)
+    is_file = path.suffix.lower() in (".yaml", ".yml", ".blend") or path.exists()
+    resolution = None
+    if args.width is not None or args.height is not None:
+        resolution = f"{args.width or 128}x{args.height or 128}"
+    dataset_args = argparse.Namespace(
+        out=str(args.out), preset=args.preset, seed=args.seed, workers=None, threads=None,
+        scheduler=None, spp=args.spp, batches=None, noise_target=None, max_batches=None,
+        no_denoise=False, direct=args.direct, resolution=resolution, rebuild=False,
+        only=None if is_file else f"{args.scene}__v{args.view}__{args.condition}",
+        generator=None, scenes=[args.scene] if is_file else None, material_map=args.material_map,
+        default_spectrum=None, count=1, views=1, value_range="2,9", chroma_range="0,16", sfu=False,
+        data_dir=getattr(args, "data_dir", None), quiet=getattr(args, "quiet", False))
+    return cli_dataset.run(dataset_args)
+
+
 def run(args: argparse.Namespace) -> int:
+    if args.ground_truth:
+        return _ground_truth(args)
     from spectrinsic.gt_export.integrity import require_folder_path
     from spectrinsic.render import count_passes, get_mode, render_scene
     from spectrinsic.render.budget import check_render_size
@@ -178,7 +212,7 @@ def run(args: argparse.Namespace) -> int:
 
         bar = tqdm(total=total, desc=f"render {scene.name}", unit="pass", file=sys.stderr)
     try:
-        result = render_scene(scene, spp=args.spp, seed=args.seed, max_depth=args.max_depth, variant=args.variant,
+        result = render_scene(scene, spp=_default_spp() if args.spp is None else args.spp, seed=args.seed, max_depth=args.max_depth, variant=args.variant,
                               progress=None if bar is None else bar.update, data_dir=data_dir, **options)
     finally:
         if bar is not None:

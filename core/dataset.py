@@ -67,6 +67,9 @@ class SampleTask:
         Spectral data directory, or ``None`` for ``$SPECTRINSIC_DATA``.
     render_threads
         Dr.Jit worker threads per process, or ``None`` to leave Dr.Jit's default (all cores).
+    source
+        A :mod:`spectrinsic.scenes.sources` record (generated scene or scene file) the worker
+        builds the scene from; ``None`` for a library scene.
     """
 
     scene: str
@@ -78,6 +81,7 @@ class SampleTask:
     config: DatasetConfig
     data_dir: str | None = None
     render_threads: int | None = None
+    source: Any = None
 
 
 @dataclass(frozen=True)
@@ -190,8 +194,14 @@ def plan_samples(
     """
     from spectrinsic.scenes.library import default_samples
 
-    specs = select_samples(default_samples(), only)
     out = str(Path(out_dir))
+    if config.source is not None:
+        from spectrinsic.dataset_sources import plan_source_samples
+
+        tasks = plan_source_samples(out, config, render_threads=render_threads,
+                                    data_dir=None if data_dir is None else str(data_dir))
+        return select_samples(tasks, only)
+    specs = select_samples(default_samples(), only)
     return [
         SampleTask(
             scene=s.scene,
@@ -244,19 +254,11 @@ def build_sample(task: SampleTask) -> SampleOutcome:
     """
     from spectrinsic.gt_export import export_sample
     from spectrinsic.render import render_batches
-    from spectrinsic.scenes.library import build
 
     set_render_threads(task.render_threads)
     cfg = task.config
     t0 = time.perf_counter()
-    scene = build(
-        task.scene,
-        view=task.view,
-        condition=task.condition,
-        seed=cfg.seed,
-        width=cfg.width,
-        height=cfg.height,
-    )
+    scene = _task_scene(task)
     t_render = time.perf_counter()
     result = render_batches(
         scene,
@@ -275,6 +277,9 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         data_dir=task.data_dir,
     )
     render_seconds = time.perf_counter() - t_render
+    if cfg.direct:  # the energy ratio r of Eq. 5.8, recorded for the dataset card's diversity plots
+        mode = "spectral" if "spectral" in result.direct else next(iter(result.direct))
+        scene.metadata["energy_ratio_r"] = float(result.energy_ratio(mode))
     path = export_sample(
         task.out_dir,
         scene,
@@ -297,6 +302,24 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         mitsuba_seconds=_mitsuba_seconds(result.meta, render_seconds),
         peak_rss_mb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
     )
+
+
+def _task_scene(task: SampleTask) -> Any:
+    """The task's scene: from its source (a generated one is saved as a scene file), else the
+    library."""
+    from spectrinsic.scenes.library import build
+
+    if task.source is None:
+        cfg = task.config
+        return build(task.scene, view=task.view, condition=task.condition, seed=cfg.seed,
+                     width=cfg.width, height=cfg.height)
+    from spectrinsic.dataset_sources import save_generated
+    from spectrinsic.scenes.sources import GeneratedSource
+
+    scene = task.source.build(task.data_dir)
+    if isinstance(task.source, GeneratedSource):
+        save_generated(task.out_dir, task.sample_id, scene)
+    return scene
 
 
 def _mitsuba_seconds(meta: dict[str, Any], fallback: float) -> float:

@@ -101,6 +101,11 @@ class DatasetConfig:
         Mitsuba variant, or ``None`` for the render package's automatic choice.
     seed
         Root seed; each sample's seed is ``seed_from_key(seed, sample_id)``.
+    source
+        Where the scenes come from, as canonical JSON: ``None`` for the library layout,
+        ``{"generator": ..., "count": ..., ...}`` or ``{"scenes": [...], ...}`` (see
+        :func:`spectrinsic.dataset.plan_samples`). Left out of the settings when ``None``, so
+        library configs keep their hash.
     """
 
     preset: str
@@ -120,6 +125,7 @@ class DatasetConfig:
     cameras: tuple[str, ...] | None = None
     variant: str | None = None
     seed: int = 0
+    source: str | None = None
 
     def __post_init__(self) -> None:
         # lists from JSON or the command line become tuples, so configs stay hashable records
@@ -152,7 +158,7 @@ class DatasetConfig:
 
     def with_options(self, **changes: Any) -> DatasetConfig:
         """A copy with some settings changed (validated like a new config)."""
-        unknown = set(changes) - set(self.settings()) - {"preset"}
+        unknown = set(changes) - set(self.settings()) - {"preset", "source"}
         if unknown:
             raise DatasetError(
                 f"unknown dataset setting(s) {sorted(unknown)}; expected some of "
@@ -166,6 +172,8 @@ class DatasetConfig:
         d.pop("preset")
         d["modes"] = list(self.modes)
         d["cameras"] = list(self.resolved_cameras())
+        if self.source is None:
+            d.pop("source")
         return d
 
     def resolved_cameras(self) -> tuple[str, ...]:

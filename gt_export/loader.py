@@ -14,7 +14,7 @@ from spectrinsic.errors import DatasetError, MissingDependencyError
 from spectrinsic.gt_export.exr import read_exr
 from spectrinsic.gt_export.writer import META_NAME, sample_dirs
 
-__all__ = ["load_sample", "load_dataset", "torch_dataset"]
+__all__ = ["load_sample", "load_dataset", "split_samples", "prepare_item", "torch_dataset"]
 
 _INT_LAYERS = ("material_id", "object_id")
 
@@ -81,15 +81,97 @@ def load_dataset(
         yield load_sample(sample, layers=layers)
 
 
+#: Layers in radiometric units that exposure normalisation scales (reflectance is unitless).
+EXPOSED_PREFIXES = ("image", "shading", "illuminant", "residual", "cube")
+#: Luminance percentile mapped to 1 by exposure normalisation.
+EXPOSURE_PERCENTILE = 99.0
+
+
+def split_samples(dataset_dir: str | os.PathLike[str], split: str | None) -> list[Path]:
+    """Sample folders of *split* (``"train"``, ``"val"``, ``"test"``; ``None``: all) from the
+    manifest's ``splits`` (made by scene, so no scene is in two splits)."""
+    folders = sample_dirs(dataset_dir)
+    if split is None:
+        return folders
+    try:
+        splits = json.loads((Path(dataset_dir) / "manifest.json").read_text(encoding="utf-8"))["splits"]
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise DatasetError(f"{dataset_dir}: manifest.json has no splits; rebuild the dataset") from exc
+    if split not in splits:
+        raise DatasetError(f"split {split!r}; expected one of {sorted(splits)}")
+    chosen = set(splits[split])
+    return [f for f in folders if f.name in chosen]
+
+
+def _channel_first(value: np.ndarray) -> np.ndarray:
+    """``(H, W)`` -> ``(1, H, W)``; ``(H, W, C)`` -> ``(C, H, W)``."""
+    value = value[..., None] if value.ndim == 2 else value
+    return np.ascontiguousarray(np.moveaxis(value, -1, 0))
+
+
+def prepare_item(
+    sample: dict[str, Any],
+    *,
+    crop: tuple[int, int] | None = None,
+    rng: np.random.Generator | None = None,
+    normalize_exposure: bool = False,
+) -> dict[str, Any]:
+    """A loaded sample as channel-first arrays: every layer ``(C, H, W)`` (depth and masks get
+    ``C = 1``), ``ids`` as ``{"material"|"object": (1, H, W) int32}``, ``sample_id``,
+    ``scene`` and ``exposure_scale``.
+
+    Parameters
+    ----------
+    crop
+        ``(height, width)`` of one random crop shared by all layers (needs *rng*).
+    rng
+        Generator of the crop position (explicit: no hidden global state).
+    normalize_exposure
+        Scale the radiometric layers (:data:`EXPOSED_PREFIXES`) so the image's
+        :data:`EXPOSURE_PERCENTILE`-th luminance percentile is 1 (image = reflectance x shading
+        + residual still holds, each side scaled alike).
+    """
+    arrays = {k: v for k, v in sample.items() if isinstance(v, np.ndarray)}
+    scale = 1.0
+    if normalize_exposure and "image" in arrays:
+        y = arrays["image"] @ np.array([0.2126, 0.7152, 0.0722], dtype=np.float32)
+        scale = 1.0 / max(float(np.percentile(y, EXPOSURE_PERCENTILE)), 1e-12)
+    if crop is not None:
+        if rng is None:
+            raise DatasetError("a random crop needs an explicit numpy Generator (rng=...)")
+        h, w = next(iter(arrays.values())).shape[:2]
+        if crop[0] > h or crop[1] > w:
+            raise DatasetError(f"crop {crop} is larger than the {h}x{w} sample")
+        y0, x0 = int(rng.integers(h - crop[0] + 1)), int(rng.integers(w - crop[1] + 1))
+        arrays = {k: v[y0:y0 + crop[0], x0:x0 + crop[1]] for k, v in arrays.items()}
+    item: dict[str, Any] = {}
+    for key, value in arrays.items():
+        if normalize_exposure and key.startswith(EXPOSED_PREFIXES):
+            value = (value * np.float32(scale)).astype(value.dtype)
+        item[key] = _channel_first(value)
+    item["ids"] = {k.removesuffix("_id"): item[k] for k in _INT_LAYERS if k in item}
+    meta = sample.get("meta", {})
+    item.update(sample_id=meta.get("sample_id"), scene=meta.get("scene"), exposure_scale=scale)
+    return item
+
+
 def torch_dataset(
     dataset_dir: str | os.PathLike[str],
     *,
-    keys: Sequence[str] = ("image", "reflectance", "shading", "mask"),
+    keys: Sequence[str] | None = None,
+    split: str | None = None,
+    crop: tuple[int, int] | None = None,
+    seed: int | None = None,
+    normalize_exposure: bool = False,
+    transform: Any = None,
 ) -> Any:
     """A map-style ``torch.utils.data.Dataset`` over a dataset folder.
 
-    Each item is ``{key: tensor}`` with images as ``(C, H, W)`` float32 and masks as ``(H, W)``
-    bool, plus ``"sample_id"``. torch is imported only here.
+    Each item is :func:`prepare_item` with arrays as tensors: every layer (``keys=None``) or
+    the chosen ones, ``ids`` (a dict of int tensors), the cube when written, ``sample_id`` and
+    ``scene``; images ``(C, H, W)`` float32, masks ``(1, H, W)`` bool. *transform*, if given,
+    is applied to each item dict. Random crops need *seed*: item *i* is cropped with
+    ``default_rng([seed, i])``, the same on every worker and epoch. torch is imported only here.
 
     Raises
     ------
@@ -103,9 +185,15 @@ def torch_dataset(
         raise MissingDependencyError(
             "torch_dataset needs PyTorch, which is not installed: pip install 'spectrinsic[torch]'"
         ) from exc
+    if crop is not None and seed is None:
+        raise DatasetError("torch_dataset: a random crop needs an explicit seed")
+    folders = split_samples(dataset_dir, split)
+    wanted = None if keys is None else [k for k in keys if k != "ids"]
 
-    folders = sample_dirs(dataset_dir)
-    wanted = [k for k in keys if k != "ids"]
+    def tensors(value: Any) -> Any:
+        if isinstance(value, np.ndarray):
+            return torch.from_numpy(value)
+        return {k: tensors(v) for k, v in value.items()} if isinstance(value, dict) else value
 
     class SpectrinsicDataset(Dataset):  # type: ignore[misc, valid-type]
         def __len__(self) -> int:
@@ -113,12 +201,9 @@ def torch_dataset(
 
         def __getitem__(self, index: int) -> dict[str, Any]:
             sample = load_sample(folders[index], layers=wanted)
-            item: dict[str, Any] = {"sample_id": folders[index].name}
-            for key in wanted:
-                value = np.ascontiguousarray(sample[key])
-                if value.ndim == 3:
-                    value = np.ascontiguousarray(value.transpose(2, 0, 1))
-                item[key] = torch.from_numpy(value)
-            return item
+            rng = None if seed is None else np.random.default_rng([seed, index])
+            item = tensors(prepare_item(sample, crop=crop, rng=rng,
+                                        normalize_exposure=normalize_exposure))
+            return transform(item) if transform is not None else item
 
     return SpectrinsicDataset()

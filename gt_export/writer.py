@@ -525,6 +525,9 @@ def write_manifest(
         "spectral_data": _spectral_provenance(metas, data_dir),
         "n_samples": len(samples),
         "noise": noise_summary(metas),
+        "split_by": "scene",
+        "split_fractions": dict(SPLIT_FRACTIONS),
+        "splits": splits_by_scene({s.name: str(m.get("scene")) for s, m in zip(samples, metas)}),
         "samples": {
             s.name: {
                 "config_hash": m.get("config_hash"),
@@ -545,6 +548,54 @@ def write_manifest(
 def _variants(metas: Sequence[Mapping[str, Any]]) -> list[str]:
     """Every Mitsuba variant the samples were rendered with, sorted."""
     return sorted({str(v) for m in metas for v in m.get("variants", [])})
+
+
+#: Train / val / test shares of the scenes (each scene's samples go to one split).
+SPLIT_FRACTIONS: tuple[tuple[str, float], ...] = (("train", 0.8), ("val", 0.1), ("test", 0.1))
+
+
+def split_of(scene: str) -> str:
+    """The split of scene *scene*: its ``seed_from_key(0, "split:" + scene)`` as a fraction of
+    2³² against the cumulative :data:`SPLIT_FRACTIONS`. It depends on the scene name only, so a
+    scene keeps its split when the set grows and all its views and conditions share it.
+
+    >>> split_of("room-living") == split_of("room-living")
+    True
+    """
+    from spectrinsic.rng import seed_from_key
+
+    u = seed_from_key(0, f"split:{scene}") / 2**32
+    edge = 0.0
+    for name, share in SPLIT_FRACTIONS:
+        edge += share
+        if u < edge:
+            return name
+    return SPLIT_FRACTIONS[-1][0]
+
+
+def splits_by_scene(sample_scenes: Mapping[str, str]) -> dict[str, list[str]]:
+    """``{split: [sample ids]}`` from ``{sample id: scene name}``, made by scene (no scene in two
+    splits, so no view or condition of a scene leaks across)."""
+    out: dict[str, list[str]] = {name: [] for name, _ in SPLIT_FRACTIONS}
+    for sample, scene in sorted(sample_scenes.items()):
+        out[split_of(scene)].append(sample)
+    return out
+
+
+def _diversity_section(root: Path, samples: Sequence[Path], metas: Sequence[Mapping[str, Any]]) -> str:
+    """The card's diversity section: splits by scene and ``diversity.png`` (written here)."""
+    from spectrinsic.gt_export.diversity import DIVERSITY_NAME, write_diversity
+
+    figure = root / DIVERSITY_NAME
+    newest = max((s / META_NAME).stat().st_mtime_ns for s in samples)
+    if not figure.is_file() or figure.stat().st_mtime_ns < newest:  # a resumed build: keep it
+        write_diversity(root, samples, metas)
+    splits = splits_by_scene({s.name: str(m.get("scene")) for s, m in zip(samples, metas, strict=True)})
+    counts = ", ".join(f"{k} {len(v)}" for k, v in splits.items())
+    return (f"\n## Splits and diversity\n\nSplits by scene (no scene in two splits; "
+            f"`manifest.json[\"splits\"]`): {counts} samples.\n\n"
+            f"![r, light CCT and xy, materials per image, object coverage, luminance range]"
+            f"({DIVERSITY_NAME})\n")
 
 
 def noise_summary(metas: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
@@ -626,7 +677,7 @@ def write_dataset_card(
         config=json.dumps(_jsonable(config or {}), indent=2, sort_keys=True),
         versions=json.dumps(software_versions(), indent=2, sort_keys=True),
         variants=", ".join(_variants(metas)),
-    )
+    ) + _diversity_section(root, samples, metas)
     path = root / CARD_NAME
     with guarded_write(path):
         path.write_text(text, encoding="utf-8")

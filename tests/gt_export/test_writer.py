@@ -216,7 +216,27 @@ def test_torch_adapter_yields_channel_first_tensors(built):
     item = ds[0]
     assert len(ds) == 2 and item["sample_id"] == "a-one"
     assert item["image"].shape == (3, 12, 16) and item["image"].dtype == torch.float32
-    assert item["mask"].dtype == torch.bool
+    assert item["mask"].shape == (1, 12, 16) and item["mask"].dtype == torch.bool
+
+
+def test_torch_adapter_every_key_crop_transform_exposure_split(built):
+    torch = pytest.importorskip("torch", reason="PyTorch is an optional extra, not installed here")
+    full = torch_dataset(built)[0]
+    sample = load_sample(built / "a-one")
+    arrays = {k for k, v in sample.items() if isinstance(v, np.ndarray)}
+    assert arrays <= set(full) and {"ids", "sample_id", "scene"} <= set(full)
+    assert full["depth"].shape == (1, 12, 16) and full["ids"]["object"].dtype == torch.int32
+    crops = torch_dataset(built, keys=("image", "depth"), crop=(5, 7), seed=1,
+                          transform=lambda item: {**item, "seen": True})
+    a, b = crops[0], crops[0]
+    assert a["seen"] and a["image"].shape == (3, 5, 7) and a["depth"].shape == (1, 5, 7)
+    assert torch.equal(a["image"], b["image"])  # the crop of item i is fixed by the seed
+    bright = torch_dataset(built, keys=("image", "reflectance"), normalize_exposure=True)[0]
+    assert torch.allclose(bright["reflectance"], full["reflectance"])
+    assert torch.allclose(bright["image"], full["image"] * bright["exposure_scale"])
+    manifest = json.loads((built / "manifest.json").read_text())
+    for split, ids in manifest["splits"].items():
+        assert [torch_dataset(built, split=split)[i]["sample_id"] for i in range(len(ids))] == sorted(ids)
 
 
 def test_meta_json_floats_carry_at_most_the_stated_digits(tmp_path, two_light_sample, config):
@@ -273,3 +293,16 @@ def test_light_records_carry_only_the_fields_of_their_kind(tmp_path, two_light_s
     for light in json.loads((folder / "meta.json").read_text())["lights"]:
         assert light["kind"] == "point" and len(light["position"]) == 3
         assert not {"direction", "size", "cutoff_deg"} & set(light)
+
+
+def test_dataset_card_shows_the_diversity_figure(built):
+    from spectrinsic.gt_export.diversity import diversity_figure, diversity_stats
+    from spectrinsic.gt_export.writer import _read_meta, sample_dirs
+
+    assert "diversity.png" in (built / "DATASET.md").read_text() and (built / "diversity.png").is_file()
+    samples = sample_dirs(built)
+    stats = diversity_stats(samples, [_read_meta(s) for s in samples])
+    n_lights = sum(len(_read_meta(s)["lights"]) for s in samples)
+    assert len(stats["luminance_decades"]) == len(samples) and len(stats["light_cct"]) == n_lights
+    assert all(1000 < t < 25000 for t in stats["light_cct"])
+    assert len(diversity_figure(stats).axes) == 6

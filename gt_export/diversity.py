@@ -1,0 +1,102 @@
+"""Diversity report of a dataset: the distributions that matter for learning, as a figure.
+
+Per sample, from ``meta.json`` and the image layer: the energy ratio r (Eq. 5.8, recorded in
+``scene_metadata.energy_ratio_r`` when the build rendered direct light), the lights' CIE 1931
+xy and correlated colour temperature (McCamy), the number of materials and their colours, the
+object coverage of the camera (generated scenes) and the image's luminance range. The figure is
+built with matplotlib's object API (``Figure``, no pyplot state) and saved as ``diversity.png``.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["DIVERSITY_NAME", "diversity_stats", "diversity_figure", "write_diversity"]
+
+DIVERSITY_NAME = "diversity.png"
+#: Luminance percentiles whose ratio is the "luminance range" (decades).
+_RANGE_PERCENTILES = (1.0, 99.0)
+
+
+def _cct(xy: Sequence[float]) -> float:
+    """McCamy's CCT in K from CIE 1931 xy (``colour.temperature.xy_to_CCT``)."""
+    import colour
+
+    return float(colour.temperature.xy_to_CCT(np.asarray(xy, float), method="McCamy 1992"))
+
+
+def _luminance_decades(image: np.ndarray, mask: np.ndarray | None) -> float:
+    y = image @ np.array([0.2126, 0.7152, 0.0722])
+    y = y[mask] if mask is not None and mask.any() else y.ravel()
+    y = y[y > 0]  # unlit pixels (no Monte Carlo sample reached a light) have no decade
+    if y.size == 0:
+        return 0.0
+    lo, hi = np.percentile(y, _RANGE_PERCENTILES)
+    return float(np.log10(max(hi, 1e-12) / max(lo, 1e-12)))
+
+
+def diversity_stats(sample_dirs: Sequence[Path], metas: Sequence[Mapping[str, Any]]) -> dict[str, list[Any]]:
+    """Per-sample statistics (lists aligned with *sample_dirs*; ``r`` only where recorded).
+
+    Returns
+    -------
+    dict
+        ``r`` (unitless), ``light_xy`` (one ``(x, y)`` per light), ``light_cct`` (K),
+        ``n_materials``, ``material_srgb`` (linear sRGB of each material under D65, if
+        recorded), ``coverage`` (fraction), ``luminance_decades`` (log10 of p99/p1).
+    """
+    from spectrinsic.gt_export.loader import load_sample
+
+    out: dict[str, list[Any]] = {k: [] for k in ("r", "light_xy", "light_cct", "n_materials",
+                                                 "coverage", "luminance_decades")}
+    for folder, meta in zip(sample_dirs, metas, strict=True):
+        extra = meta.get("scene_metadata") or {}
+        if isinstance(extra.get("energy_ratio_r"), float) and np.isfinite(extra["energy_ratio_r"]):
+            out["r"].append(extra["energy_ratio_r"])
+        for light in meta.get("lights", []):
+            out["light_xy"].append(tuple(light["xy"]))
+            out["light_cct"].append(_cct(light["xy"]))
+        out["n_materials"].append(len(meta.get("materials", {})))
+        if isinstance(extra.get("object_coverage"), float):
+            out["coverage"].append(extra["object_coverage"])
+        sample = load_sample(folder, layers=[k for k in ("image", "mask") if k in meta.get("layers", {})])
+        out["luminance_decades"].append(_luminance_decades(sample["image"], sample.get("mask")))
+    return out
+
+
+def diversity_figure(stats: Mapping[str, Sequence[Any]]) -> Any:
+    """A 2 x 3 :class:`matplotlib.figure.Figure` of the statistics (empty panels say why)."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(12, 7), layout="constrained")
+    axes = fig.subplots(2, 3).ravel()
+    panels = [("r", "energy ratio r (direct / total)", "needs a build with --direct"),
+              ("light_cct", "light CCT (K, McCamy)", "no lights"),
+              ("n_materials", "materials per image", "no materials"),
+              ("coverage", "object coverage of the camera", "library scenes: not recorded"),
+              ("luminance_decades", "luminance range, log10(p99/p1)", "no images")]
+    for ax, (key, title, empty) in zip(axes[[0, 1, 3, 4, 5]], panels, strict=True):
+        values = list(stats.get(key, []))
+        ax.set_title(title, fontsize=10)
+        if values:
+            ax.hist(values, bins=min(20, max(3, len(values))), color="0.35")
+        else:
+            ax.text(0.5, 0.5, empty, ha="center", va="center", transform=ax.transAxes)
+    ax = axes[2]
+    xy = np.asarray(stats.get("light_xy", []), float).reshape(-1, 2)
+    ax.scatter(xy[:, 0], xy[:, 1], s=12, c="k")
+    ax.set(title="light chromaticities (CIE 1931 xy)", xlabel="x", ylabel="y", xlim=(0.2, 0.6), ylim=(0.2, 0.5))
+    return fig
+
+
+def write_diversity(dataset_dir: str | os.PathLike[str], sample_dirs: Sequence[Path],
+                    metas: Sequence[Mapping[str, Any]]) -> Path:
+    """Compute the statistics and save the figure as ``<dataset>/diversity.png``."""
+    path = Path(dataset_dir) / DIVERSITY_NAME
+    diversity_figure(diversity_stats(sample_dirs, metas)).savefig(path, dpi=90)
+    return path

@@ -1,0 +1,94 @@
+"""Procedural scene generators: seeded, reproducible scenes for datasets of any size.
+
+:data:`GENERATORS` maps a name to a layout function (``objects-on-ground``, ``rooms``);
+:func:`generate` turns (generator, root seed, index, view) into a complete
+:class:`~spectrinsic.scenes.model.Scene`. Scene *index* is named ``<generator>-<index:05d>``
+and seeded by ``seed_from_key(root_seed, name)``, so a scene does not depend on how many others
+are generated, nor on their order or the executor. The per-scene seed is recorded in the
+scene's metadata.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from spectrinsic.errors import validate_choice
+from spectrinsic.rng import seed_from_key
+from spectrinsic.scenes.generators.base import (
+    GeneratorOptions,
+    Layout,
+    assemble,
+    family_of,
+    scene_rngs,
+)
+from spectrinsic.scenes.generators.ground import objects_on_ground
+from spectrinsic.scenes.generators.materials import MaterialDistribution
+from spectrinsic.scenes.generators.rooms import rooms
+from spectrinsic.scenes.model import Scene
+
+__all__ = [
+    "GENERATORS",
+    "GeneratorOptions",
+    "MaterialDistribution",
+    "generator_names",
+    "generated_scene_name",
+    "generated_scene_seed",
+    "generated_family",
+    "generate",
+]
+
+#: Layout functions by generator name.
+GENERATORS: dict[str, Callable[[np.random.Generator, GeneratorOptions], Layout]] = {
+    "objects-on-ground": objects_on_ground,
+    "rooms": rooms,
+}
+
+
+def generator_names() -> list[str]:
+    """Names of the scene generators."""
+    return list(GENERATORS)
+
+
+def generated_scene_name(generator: str, index: int) -> str:
+    """``"<generator>-<index:05d>"``, e.g. ``"rooms-00007"``."""
+    return f"{validate_choice(generator, GENERATORS, 'scene generator')}-{int(index):05d}"
+
+
+def generated_scene_seed(root_seed: int, generator: str, index: int) -> int:
+    """The seed of scene *index*: ``seed_from_key(root_seed, generated_scene_name(...))``."""
+    return seed_from_key(root_seed, generated_scene_name(generator, index))
+
+
+def generated_family(root_seed: int, generator: str, index: int) -> str:
+    """The lighting condition family of scene *index* (``white``, ``one-colour``, ``two-colour``)."""
+    return family_of(generated_scene_seed(root_seed, generator, index))
+
+
+def generate(generator: str, *, root_seed: int, index: int, view: int, options: GeneratorOptions) -> Scene:
+    """Generate scene *index* of *generator* seen from camera *view*.
+
+    Parameters
+    ----------
+    generator
+        One of :func:`generator_names` (an unknown name raises with a did-you-mean).
+    root_seed
+        The dataset's root seed.
+    index
+        Scene number, >= 0.
+    view
+        Camera number, ``0 <= view < options.views``.
+    options
+        Image size, views, material distribution, coverage threshold, SFU names.
+
+    Returns
+    -------
+    Scene
+        Its metadata records the generator, the scene seed, the draws and the coverage.
+    """
+    name = generated_scene_name(generator, index)
+    seed = generated_scene_seed(root_seed, generator, index)
+    rngs = scene_rngs(seed)
+    layout = GENERATORS[generator](rngs["layout"], options)
+    return assemble(name, layout, seed, view, options, rngs)

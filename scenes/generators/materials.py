@@ -1,0 +1,188 @@
+"""Reflectances and spatially varying paint for generated scenes.
+
+Materials are drawn from the 1269 matte Munsell chips (and the SFU reflectances when a data
+directory is configured), with a controllable distribution of Munsell value and chroma
+(:class:`MaterialDistribution`). Patterns (:data:`PATTERNS`: stripes, checkers, patches,
+printed labels, noise partitions) repaint faces by their centroids, so every region is still
+one exact spectrum (no texture filtering).
+"""
+
+from __future__ import annotations
+
+import functools
+import re
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from spectrinsic.errors import SceneError
+from spectrinsic.scenes import geometry as g
+
+__all__ = [
+    "MaterialDistribution",
+    "PATTERNS",
+    "munsell_chips",
+    "draw_reflectance",
+    "draw_palette",
+    "paint",
+]
+
+_NOTATION = re.compile(r"^\S+ (\d+(?:\.\d+)?)/(\d+(?:\.\d+)?)$")
+
+
+@dataclass(frozen=True)
+class MaterialDistribution:
+    """Which reflectances a generator draws.
+
+    Attributes
+    ----------
+    value_range
+        Munsell value (lightness, 0-10) interval of the chips drawn.
+    chroma_range
+        Munsell chroma interval of the chips drawn (0: grey; the matte set reaches 16).
+    sfu_fraction
+        Probability of drawing an SFU reflectance instead of a Munsell chip (only when the
+        caller passes SFU names).
+    pattern_probability
+        Probability that an object is painted with a pattern of several spectra.
+    """
+
+    value_range: tuple[float, float] = (2.0, 9.0)
+    chroma_range: tuple[float, float] = (0.0, 16.0)
+    sfu_fraction: float = 0.0
+    pattern_probability: float = 0.5
+
+    def __post_init__(self) -> None:
+        for name in ("value_range", "chroma_range"):
+            lo, hi = getattr(self, name)
+            if not lo <= hi:
+                raise SceneError(f"material distribution {name}={(lo, hi)}; expected low <= high")
+        for name in ("sfu_fraction", "pattern_probability"):
+            if not 0.0 <= getattr(self, name) <= 1.0:
+                raise SceneError(f"material distribution {name}={getattr(self, name)}; expected 0..1")
+
+
+@functools.lru_cache(maxsize=1)
+def munsell_chips() -> tuple[tuple[str, float, float], ...]:
+    """Every matte Munsell chip as ``(name, value, chroma)``, e.g. ``("munsell:5R 4/14", 4, 14)``."""
+    from spectrinsic.spectra import list_spectra
+
+    out = []
+    for name in list_spectra("munsell"):
+        m = _NOTATION.match(name.split(":", 1)[1])
+        if m:
+            out.append((name, float(m.group(1)), float(m.group(2))))
+    return tuple(out)
+
+
+def draw_reflectance(
+    rng: np.random.Generator, dist: MaterialDistribution, sfu: Sequence[str] = ()
+) -> str:
+    """One reflectance name drawn from *dist* (Munsell, or SFU with ``dist.sfu_fraction``)."""
+    if sfu and rng.random() < dist.sfu_fraction:
+        return sfu[int(rng.integers(len(sfu)))]
+    (v0, v1), (c0, c1) = dist.value_range, dist.chroma_range
+    pool = [n for n, v, c in munsell_chips() if v0 <= v <= v1 and c0 <= c <= c1]
+    if not pool:
+        raise SceneError(f"no Munsell chip has value in {dist.value_range} and chroma in "
+                         f"{dist.chroma_range}; widen the ranges")
+    return pool[int(rng.integers(len(pool)))]
+
+
+def draw_palette(
+    rng: np.random.Generator, dist: MaterialDistribution, n: int, sfu: Sequence[str] = ()
+) -> list[str]:
+    """*n* distinct reflectance names (fewer only if the distribution has fewer)."""
+    names: list[str] = []
+    for _ in range(8 * n):
+        name = draw_reflectance(rng, dist, sfu)
+        if name not in names:
+            names.append(name)
+        if len(names) == n:
+            break
+    return names
+
+
+def _labelled(part: g.Part, palette: Sequence[str], index: np.ndarray) -> g.Part:
+    """*part* repainted: face f takes ``palette[index[f] % len(palette)]``."""
+    names = tuple(dict.fromkeys(palette))
+    lookup = np.array([names.index(p) for p in palette], dtype=np.int64)
+    labels = lookup[np.asarray(index, dtype=np.int64) % len(palette)]
+    used, labels = np.unique(labels, return_inverse=True)
+    return g.Part(part.vertices, part.faces, labels.astype(np.int64),
+                  tuple(names[i] for i in used))
+
+
+def _extent(part: g.Part) -> np.ndarray:
+    return np.maximum(np.ptp(part.vertices, axis=0), 1e-6)
+
+
+def _stripes(part: g.Part, rng: np.random.Generator, palette: Sequence[str]) -> g.Part:
+    axis = int(rng.integers(3))
+    width = float(_extent(part)[axis]) / rng.uniform(2, 8)
+    return g.stripes(part, list(palette), axis=axis, width=width, offset=float(rng.uniform(0, width)))
+
+
+def _checkers(part: g.Part, rng: np.random.Generator, palette: Sequence[str]) -> g.Part:
+    cell = float(_extent(part).max()) / rng.uniform(2, 6)
+    k = np.floor((part.centroids - part.vertices.min(axis=0)) / cell).astype(np.int64)
+    return _labelled(part, palette, k.sum(axis=1))
+
+
+def _patches(part: g.Part, rng: np.random.Generator, palette: Sequence[str]) -> g.Part:
+    out = _labelled(part, palette[:1], np.zeros(len(part.faces)))
+    centres = part.centroids[rng.integers(len(part.faces), size=int(rng.integers(1, 5)))]
+    radius = float(_extent(part).max()) * rng.uniform(0.1, 0.3)
+    for i, c in enumerate(centres):
+        out = g.patches(out, palette[1 + i % max(1, len(palette) - 1)], [c], radius)
+    return out
+
+
+def _noise(part: g.Part, rng: np.random.Generator, palette: Sequence[str]) -> g.Part:
+    """A Voronoi partition of the surface around random seed points (a noise-like partition)."""
+    lo, hi = part.vertices.min(axis=0), part.vertices.max(axis=0)
+    seeds = rng.uniform(lo, hi, size=(int(rng.integers(3, 12)), 3))
+    cell = np.linalg.norm(part.centroids[:, None] - seeds[None], axis=-1).argmin(axis=1)
+    return _labelled(part, palette, cell)
+
+
+def _label(part: g.Part, rng: np.random.Generator, palette: Sequence[str]) -> g.Part:
+    """A printed-paper-like label on the side facing -y: random ink rows on the base colour."""
+    lo, hi = part.vertices.min(axis=0), part.vertices.max(axis=0)
+    cols, nrows = int(rng.integers(4, 10)), int(rng.integers(3, 8))
+    cell = float(min(hi[0] - lo[0], hi[2] - lo[2])) / max(cols, nrows)
+    legend = {chr(65 + i): p for i, p in enumerate(palette[1:])} or {"A": palette[0]}
+    keys = [*legend, ".", "."]
+    rows = ["".join(keys[int(k)] for k in rng.integers(len(keys), size=cols)) for _ in range(nrows)]
+    base = _labelled(part, palette[:1], np.zeros(len(part.faces)))
+    return g.printed(base, rows, legend, origin=(float(lo[0]), float(lo[2])), cell=cell,
+                     axes=(0, 2), facing=(0, -1, 0))
+
+
+#: Pattern painters by name: ``(part, rng, palette) -> part``.
+PATTERNS: dict[str, Callable[[g.Part, np.random.Generator, Sequence[str]], g.Part]] = {
+    "stripes": _stripes,
+    "checkers": _checkers,
+    "patches": _patches,
+    "noise": _noise,
+    "label": _label,
+}
+
+
+def paint(
+    part: g.Part, rng: np.random.Generator, dist: MaterialDistribution, sfu: Sequence[str] = ()
+) -> tuple[g.Part, str]:
+    """Paint *part*: one reflectance, or with ``dist.pattern_probability`` a pattern of 2-4.
+
+    Returns
+    -------
+    tuple
+        The painted part and the pattern's name (``"plain"`` for one spectrum).
+    """
+    if rng.random() >= dist.pattern_probability:
+        return _labelled(part, [draw_reflectance(rng, dist, sfu)], np.zeros(len(part.faces))), "plain"
+    names = list(PATTERNS)
+    pattern = names[int(rng.integers(len(names)))]
+    palette = draw_palette(rng, dist, int(rng.integers(2, 5)), sfu)
+    return PATTERNS[pattern](part, rng, palette), pattern

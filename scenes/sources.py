@@ -1,0 +1,98 @@
+"""Where a dataset sample's scene comes from: a generator draw or a scene file.
+
+A source is a small picklable record that a worker turns into a
+:class:`~spectrinsic.scenes.model.Scene` with :meth:`build`; the planner never ships a scene.
+Scene files are YAML (``FORMAT.md``), ``.blend`` (optional extra ``blender``; scripts never
+run) or meshes (:data:`~spectrinsic.scenes.meshes.MESH_SUFFIXES`, with a material map).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+
+from spectrinsic.errors import SceneError
+from spectrinsic.scenes.generators import GeneratorOptions, generate
+from spectrinsic.scenes.meshes import MESH_SUFFIXES, load_mesh_scene
+from spectrinsic.scenes.model import Scene
+
+__all__ = ["GeneratedSource", "FileSource", "scene_file_kind"]
+
+#: First bytes of every uncompressed ``.blend`` file.
+BLEND_MAGIC = b"BLENDER"
+
+
+@dataclass(frozen=True)
+class GeneratedSource:
+    """Scene *index* of *generator* under the dataset's root seed, seen from camera *view*."""
+
+    generator: str
+    root_seed: int
+    index: int
+    view: int
+    options: GeneratorOptions
+
+    def build(self, data_dir: str | None = None) -> Scene:
+        """Generate the scene (deterministic: same record, same scene)."""
+        options = dataclasses.replace(self.options, data_dir=data_dir)
+        return generate(self.generator, root_seed=self.root_seed, index=self.index,
+                        view=self.view, options=options)
+
+
+def scene_file_kind(path: str | Path) -> str:
+    """``"yaml"``, ``"blend"`` or ``"mesh"`` for a scene file, by suffix (``.blend`` also by
+    its magic bytes); one-line error for anything else."""
+    p = Path(path)
+    suffix = p.suffix.lower()
+    if suffix in (".yaml", ".yml"):
+        return "yaml"
+    if suffix in MESH_SUFFIXES:
+        return "mesh"
+    if suffix == ".blend":
+        return "blend"
+    try:
+        with p.open("rb") as fh:
+            if fh.read(len(BLEND_MAGIC)) == BLEND_MAGIC:
+                return "blend"
+    except OSError:
+        pass
+    raise SceneError(f"scene file {str(p)!r}: expected .yaml/.yml, .blend or a mesh "
+                     f"({', '.join(MESH_SUFFIXES)})")
+
+
+@dataclass(frozen=True)
+class FileSource:
+    """A scene file rendered at ``width x height`` (the file's camera, resized).
+
+    Attributes
+    ----------
+    materials
+        Material name -> spectrum pairs, for meshes and ``.blend`` files.
+    default_spectrum
+        Reflectance of mesh or ``.blend`` materials not in *materials*.
+    """
+
+    path: str
+    width: int
+    height: int
+    materials: tuple[tuple[str, str], ...] = ()
+    default_spectrum: str | None = None
+
+    def build(self, data_dir: str | None = None) -> Scene:
+        """Read and validate the file; one-line :class:`SceneError` naming it on bad input."""
+        kind = scene_file_kind(self.path)
+        mapping = dict(self.materials)
+        if kind == "mesh":
+            return load_mesh_scene(self.path, materials=mapping, width=self.width, height=self.height,
+                                   default_spectrum=self.default_spectrum, data_dir=data_dir)
+        if kind == "blend":
+            from spectrinsic.scenes.blender import load_blend
+
+            return load_blend(self.path, materials=mapping or None, resolution=(self.width, self.height),
+                              default_spectrum=self.default_spectrum, data_dir=data_dir)
+        from spectrinsic.scenes.io import load_scene
+
+        scene = load_scene(self.path, data_dir=data_dir)
+        camera = dataclasses.replace(scene.camera, width=self.width, height=self.height)
+        return dataclasses.replace(scene, camera=camera)
