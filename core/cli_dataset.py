@@ -15,6 +15,16 @@ __all__ = ["register", "run"]
 DEFAULT_OUT = "data/dataset"
 
 
+def _presets_help() -> str:
+    """The presets with their numbers, for ``--help``."""
+    from spectrinsic.presets import PRESETS
+
+    parts = [f"{name}: {c.width}x{c.height}, {c.batches} batch(es) x {c.spp // c.batches} spp, "
+             f"depth {c.max_depth}, modes {'+'.join(c.modes)}{', denoised' if c.denoise else ''}"
+             for name, c in PRESETS.items()]
+    return "quality preset (default: default). " + "; ".join(parts)
+
+
 def register(subparsers: Any) -> None:
     from spectrinsic.presets import preset_names
 
@@ -32,7 +42,7 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument("--out", metavar="DIR", default=DEFAULT_OUT, help=f"dataset folder ({DEFAULT_OUT})")
     p.add_argument(
-        "--preset", default="default", choices=preset_names(), help="quality preset (default)"
+        "--preset", default="default", choices=preset_names(), help=_presets_help()
     )
     p.add_argument("--seed", type=int, default=0, help="root seed (0)")
     p.add_argument(

@@ -4,7 +4,7 @@
 
 * ``index.html``, ``gallery.js`` and ``gallery.css``: a page that opens from the file system (no
   server, no network) and renders only the current page of samples, with lazy thumbnails;
-* ``gallery.json``: the index (per sample its scene, condition, kind, split, noise figure,
+* ``gallery.json``: the index (per sample its scene, generator, condition, kind, split, noise figure,
   lights with their SPDs and chromaticities, and every layer's preview with its encoding), and
   ``gallery-index.js``, the same index assigned to ``window.SPECTRINSIC_GALLERY`` (a page opened
   from ``file://`` may not ``fetch()`` a local JSON file, but it may load a script);
@@ -143,6 +143,8 @@ def _sample_entry(sample: Path, meta: Mapping[str, Any], split: str | None) -> d
     ]
     return {
         "id": sample.name, "scene": meta.get("scene"), "condition": smeta.get("condition"),
+        # generated scenes name their generator; the built-in library and user scenes do not
+        "generator": smeta.get("generator") or ("library" if "library" in smeta else "own scene"),
         "kind": smeta.get("kind"), "split": split, "noise": _noise_figure(meta),
         "size": meta.get("size"), "reference_mode": meta.get("reference_mode"),
         "layers": layers, "lights": lights,

@@ -7,7 +7,7 @@
   const G = window.SPECTRINSIC_GALLERY;
   const PAGE_SIZE = 60;
   const SVG = "http://www.w3.org/2000/svg";
-  const state = { scene: "", condition: "", kind: "", split: "", noiseMax: "", page: 0 };
+  const state = { scene: "", generator: "", condition: "", kind: "", split: "", noiseMax: "", page: 0 };
   const app = document.getElementById("app");
 
   function el(tag, attrs, ...children) {
@@ -74,6 +74,7 @@
   function filtered() {
     const max = state.noiseMax === "" ? Infinity : parseFloat(state.noiseMax);
     return G.samples.filter((s) => (!state.scene || s.scene === state.scene)
+      && (!state.generator || s.generator === state.generator)
       && (!state.condition || s.condition === state.condition)
       && (!state.kind || s.kind === state.kind)
       && (!state.split || s.split === state.split)
@@ -87,7 +88,7 @@
   }
   function filterBar() {
     const bar = el("div", { class: "filters" }, select("scene", "scene", uniq("scene")),
-      select("condition", "condition", uniq("condition")), select("kind", "kind", uniq("kind")));
+      select("generator", "generator", uniq("generator")), select("condition", "condition", uniq("condition")), select("kind", "kind", uniq("kind")));
     if (G.splits.length) bar.append(select("split", "split", G.splits));
     const noise = el("input", { id: "filter-noise", type: "number", step: "0.001", min: "0", placeholder: "any",
       on: { change: (e) => { state.noiseMax = e.target.value; state.page = 0; renderList(); } } });

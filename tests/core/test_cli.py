@@ -43,3 +43,21 @@ def test_every_registered_command_has_help():
     assert set(sub.choices) >= {"info"}
     for name, p in sub.choices.items():
         assert p.description or p.format_help(), name
+
+
+def test_every_verb_and_option_explains_itself():
+    """Issue 13: each verb has a description and every option a help text."""
+    import argparse
+
+    from spectrinsic.cli import build_parser
+
+    parser = build_parser()
+    verbs = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    missing = []
+    for name, sub in verbs.choices.items():
+        if not sub.description:
+            missing.append(f"{name}: no description")
+        for action in sub._actions:
+            if not isinstance(action, argparse._HelpAction) and not action.help:
+                missing.append(f"{name} {'/'.join(action.option_strings) or action.dest}: no help")
+    assert not missing, missing

@@ -66,6 +66,7 @@ def test_index_records_every_sample_with_its_previews_and_encodings(gallery):
     for sid, entry in by_id.items():
         meta = json.loads((root / sid / "meta.json").read_text())
         assert entry["condition"] == CONDITIONS[sid]
+        assert entry["generator"] == "own scene"  # the synthetic scenes name no library or generator
         for name, rec in meta["layers"].items():
             if rec["preview"]:
                 src, enc = entry["layers"][name]
