@@ -37,12 +37,12 @@ albedos (a 3-band estimate; the residual then also holds its spectral error).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from spectrinsic.errors import DatasetError
+from spectrinsic.render.pipeline import relative_standard_error
 
 __all__ = [
     "COVERAGE_MIN",
@@ -94,6 +94,10 @@ class WhiteRadiance:
         """The same record with other band values (a batch, or the denoised estimate)."""
         return WhiteRadiance(self.mode, np.where(self.valid[..., None], bands, 0.0), self.albedo,
                              self.valid, self.to_xyz)
+
+    def from_raw(self, raw: np.ndarray) -> WhiteRadiance:
+        """``W`` of other raw channels of the same pixels (an independent batch), Eq. 1."""
+        return self.with_bands(np.asarray(raw, np.float64) / np.maximum(self.albedo, ALBEDO_FLOOR))
 
     def xyz(self) -> np.ndarray:
         """``(H, W, 3)`` CIE XYZ of ``W`` (render units)."""
@@ -195,30 +199,6 @@ def share_maps(per_light_y: np.ndarray) -> np.ndarray:
     total = y.sum(axis=0)
     lit = total > 0
     return np.moveaxis(np.where(lit, y / np.where(lit, total, 1.0), 0.0), 0, -1)
-
-
-def relative_standard_error(batches: Sequence[np.ndarray], valid: np.ndarray) -> np.ndarray:
-    """Per-pixel relative standard error of the mean of independent batch estimates.
-
-    ``se = sqrt(Σ_b ‖x_b − x̄‖² / (B (B − 1)))`` over channels, divided by ``‖x̄‖``; 0 where
-    not *valid* or where ``‖x̄‖`` is below 1e-3 of its 99th percentile (unlit).
-
-    Parameters
-    ----------
-    batches
-        ``B >= 2`` arrays ``(H, W, C)``, one estimate per independent batch.
-    """
-    stack = np.stack([np.asarray(b, np.float64) for b in batches])
-    if stack.shape[0] < 2:
-        raise DatasetError("a noise estimate needs at least two independent batches")
-    mean = stack.mean(axis=0)
-    b = stack.shape[0]
-    se = np.sqrt(((stack - mean) ** 2).sum(axis=(0, -1)) / (b * (b - 1)))
-    norm = np.linalg.norm(mean, axis=-1)
-    positive = norm[valid & (norm > 0)]
-    floor = 1e-3 * np.percentile(positive, 99) if positive.size else np.inf
-    ok = valid & (norm > floor)
-    return np.where(ok, se / np.where(ok, norm, 1.0), 0.0)
 
 
 def noise_figures(rel_se: np.ndarray, valid: np.ndarray) -> dict[str, float | int]:

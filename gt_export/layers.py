@@ -470,8 +470,8 @@ def _geometry_layers(s: _Sample, mask: np.ndarray) -> list[Layer]:
     return out
 
 
-def _white_radiance(s: _Sample, coverage: np.ndarray, raw: np.ndarray | None = None) -> irr.WhiteRadiance:
-    """``W = E/π`` from the reference render (or one of its batches, *raw*), Eq. 1 of
+def _white_radiance(s: _Sample, coverage: np.ndarray) -> irr.WhiteRadiance:
+    """``W = E/π`` from the reference render, Eq. 1 of
     :mod:`~spectrinsic.gt_export.irradiance`, with the band albedos the renderer used."""
     from spectrinsic.render.modes import channel_values, get_mode, to_xyz_matrix
     from spectrinsic.spectra import get_sensors
@@ -483,8 +483,7 @@ def _white_radiance(s: _Sample, coverage: np.ndarray, raw: np.ndarray | None = N
     matrices = (s.result.meta or {}).get("to_xyz", {})
     to_xyz = (np.asarray(matrices[s.ref], float) if s.ref in matrices
               else to_xyz_matrix(mode, s.scene, data_dir=s.data_dir))
-    if raw is None:
-        raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
+    raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
     return irr.white_radiance(raw, coverage, albedos, to_xyz, mode=s.ref)
 
 
@@ -555,7 +554,7 @@ def _intrinsic_layers(
     return out
 
 
-def _noise(s: _Sample, w: irr.WhiteRadiance, coverage: np.ndarray) -> tuple[list[Layer], dict[str, Any]]:
+def _noise(s: _Sample, w: irr.WhiteRadiance) -> tuple[list[Layer], dict[str, Any]]:
     """Relative standard error maps of ``image`` and ``shading`` from the independent batches."""
     from spectrinsic.spectra import xyz_to_linear_srgb
 
@@ -564,8 +563,7 @@ def _noise(s: _Sample, w: irr.WhiteRadiance, coverage: np.ndarray) -> tuple[list
         return [], {}
     white = _srgb_white(s)
     images = [xyz_to_linear_srgb(np.einsum("hwk,ck->hwc", np.asarray(b, float), w.to_xyz)) for b in batches]
-    shadings = [irr.relative_shading(_srgb_of(_white_radiance(s, coverage, b)), white, w.valid)
-                for b in batches]
+    shadings = [irr.relative_shading(_srgb_of(w.from_raw(b)), white, w.valid) for b in batches]
     lit = w.valid
     maps = {"image": irr.relative_standard_error(images, lit),
             "shading_raw": irr.relative_standard_error(shadings, lit)}
@@ -751,7 +749,7 @@ def compute_ground_truth(
 
         w = denoise_white_radiance(w_raw, _aov(result, "normals"), quality=denoise_quality)
     layers += _intrinsic_layers(s, w_raw, w, image, reflectance, denoised=denoise)
-    noise_layers, noise = _noise(s, w_raw, coverage)
+    noise_layers, noise = _noise(s, w_raw)
     share_layers, shares = _share_layers(s, w, mask)
     layers += noise_layers + share_layers
     spaces: dict[str, np.ndarray] = {"srgb": get_sensors("srgb").on(s.wl)}

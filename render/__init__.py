@@ -27,6 +27,7 @@ from spectrinsic.render.pipeline import (
     count_passes,
     image_noise,
     merge_batches,
+    relative_standard_error,
     render_batches,
     render_scene,
 )
@@ -56,6 +57,7 @@ __all__ = [
     "llvm_library",
     "merge_batches",
     "mode_names",
+    "relative_standard_error",
     "render_aovs",
     "render_batches",
     "render_diagonal",

@@ -37,6 +37,7 @@ __all__ = [
     "batch_seeds",
     "merge_batches",
     "image_noise",
+    "relative_standard_error",
     "count_passes",
 ]
 
@@ -322,6 +323,30 @@ def render_batches(
     return merged
 
 
+def relative_standard_error(batches: Sequence[np.ndarray], valid: np.ndarray) -> np.ndarray:
+    """Per-pixel relative standard error of the mean of independent batch estimates.
+
+    ``se = sqrt(Σ_b ‖x_b − x̄‖² / (B (B − 1)))`` over channels, divided by ``‖x̄‖``; 0 where
+    not *valid* or where ``‖x̄‖`` is below 1e-3 of its 99th percentile (unlit).
+
+    Parameters
+    ----------
+    batches
+        ``B >= 2`` arrays ``(H, W, C)``, one estimate per independent batch.
+    """
+    stack = np.stack([np.asarray(b, np.float64) for b in batches])
+    if stack.shape[0] < 2:
+        raise RenderError("a noise estimate needs at least two independent batches")
+    mean = stack.mean(axis=0)
+    b = stack.shape[0]
+    se = np.sqrt(((stack - mean) ** 2).sum(axis=(0, -1)) / (b * (b - 1)))
+    norm = np.linalg.norm(mean, axis=-1)
+    positive = norm[valid & (norm > 0)]
+    floor = 1e-3 * np.percentile(positive, 99) if positive.size else np.inf
+    ok = valid & (norm > floor)
+    return np.where(ok, se / np.where(ok, norm, 1.0), 0.0)
+
+
 def image_noise(results: Sequence[RenderResult]) -> float | None:
     """Median over lit pixels of the relative standard error of the mean image (XYZ of the
     31-band cube, else of the first mode), from independent batch renders; ``None`` for fewer
@@ -330,13 +355,9 @@ def image_noise(results: Sequence[RenderResult]) -> float | None:
         return None
     images = results[0].images
     mode = "bands31" if "bands31" in images else next(iter(images))
-    stack = np.stack([np.asarray(r.images[mode], np.float64) for r in results])
-    mean = stack.mean(axis=0)
-    b = stack.shape[0]
-    se = np.sqrt(((stack - mean) ** 2).sum(axis=(0, -1)) / (b * (b - 1)))
-    norm = np.linalg.norm(mean, axis=-1)
-    lit = norm > 1e-3 * np.percentile(norm, 99) if norm.any() else norm > 0
-    return float(np.median(se[lit] / norm[lit])) if lit.any() else 0.0
+    stack = [np.asarray(r.images[mode], np.float64) for r in results]
+    rel = relative_standard_error(stack, np.ones(stack[0].shape[:2], bool))
+    return float(np.median(rel[rel > 0])) if (rel > 0).any() else 0.0
 
 
 def _mean(arrays: Sequence[np.ndarray]) -> np.ndarray:
