@@ -81,7 +81,7 @@ def test_entry_point_adds_a_method_to_the_registry_and_the_tables(plugin_dir, tm
 def test_cli_lists_plugins_by_default(plugin_dir):
     _install_dist(plugin_dir, {"toy-half": "toy_spectrinsic_plugin:HalfImage"})
     from spectrinsic.cli import build_parser
-    from spectrinsic.cli_evaluate import _methods
+    from spectrinsic.cli.evaluate import _methods
 
     methods = _methods(build_parser().parse_args(["evaluate"]))
     assert list(methods) == [*DECOMPOSERS, "toy-half"]

@@ -118,7 +118,7 @@ def test_missing_and_bad_predictions_are_one_line_errors(tmp_path):
 
 def test_cli_predictions_options(tmp_path):
     from spectrinsic.cli import build_parser
-    from spectrinsic.cli_evaluate import _methods
+    from spectrinsic.cli.evaluate import _methods
 
     (tmp_path / "mine").mkdir()
     args = build_parser().parse_args(

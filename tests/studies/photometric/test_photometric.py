@@ -15,7 +15,7 @@ from spectrinsic.spectra import (
     get_spectrum,
     list_spectra,
 )
-from spectrinsic.study_photometric import (
+from spectrinsic.studies.photometric import (
     SCENARIOS,
     THESIS_TABLE_4_4,
     PhotometricSettings,

@@ -17,9 +17,9 @@ import pytest
 
 from spectrinsic.cli import main
 from spectrinsic.gt_export.integrity import MARKER_NAME, write_marker
-from spectrinsic.presets import get_preset
+from spectrinsic.pipeline.presets import get_preset
 
-#: The dataset options of the tiny builds (as in tests/dataset/test_pipeline.py).
+#: The dataset options of the tiny builds (as in tests/pipeline/test_pipeline.py).
 TINY = ["--preset", "preview", "--resolution", "16x16", "--spp", "2", "--only", "obj-apple__v0__white"]
 TINY_HASH = get_preset("preview").with_options(width=16, height=16, spp=2).config_hash()
 APPLE = "obj-apple__v0__white"

@@ -9,11 +9,11 @@ from pathlib import Path
 
 import pytest
 
-from spectrinsic.dataset import build_dataset
-from spectrinsic.dataset_sources import files_source, generator_source
 from spectrinsic.errors import SpectrinsicError
 from spectrinsic.gt_export import check_dataset
-from spectrinsic.presets import DatasetConfig
+from spectrinsic.pipeline.dataset import build_dataset
+from spectrinsic.pipeline.presets import DatasetConfig
+from spectrinsic.pipeline.sources import files_source, generator_source
 from spectrinsic.scenes import load_scene
 
 TINY = DatasetConfig(preset="tiny-test", width=8, height=8, spp=2, max_depth=3,

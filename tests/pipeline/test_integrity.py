@@ -21,9 +21,9 @@ from pathlib import Path
 import pytest
 
 from spectrinsic.cli import main
-from spectrinsic.dataset import build_dataset
 from spectrinsic.gt_export import check_dataset, is_complete
-from spectrinsic.presets import get_preset
+from spectrinsic.pipeline.dataset import build_dataset
+from spectrinsic.pipeline.presets import get_preset
 
 IDS = ("obj-apple__v0__white", "obj-box__v0__white")
 ONLY = ",".join(IDS)
@@ -64,7 +64,7 @@ def test_a_corrupt_sample_is_rerendered_not_resumed(copy, built, corrupt, caplog
     else:
         next((apple / "previews").glob("*.png")).unlink()
     assert check_dataset(copy) != []
-    with caplog.at_level(logging.WARNING, logger="spectrinsic.dataset"):
+    with caplog.at_level(logging.WARNING, logger="spectrinsic.pipeline.dataset"):
         report = build_dataset(copy, CONFIG, only=ONLY)
     assert [o.sample_id for o in report.built] == [IDS[0]]  # re-rendered, and said so
     assert [o.sample_id for o in report.skipped] == [IDS[1]]

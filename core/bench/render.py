@@ -65,7 +65,7 @@ def _bare_seconds(scene: Any, spp: int) -> float:
 
 
 def _errors(estimate: np.ndarray, truth: np.ndarray) -> dict[str, float]:
-    from spectrinsic.study_rendering import pixel_errors
+    from spectrinsic.studies.rendering import pixel_errors
 
     err = pixel_errors(estimate, truth)
     mean_est, mean_truth = estimate.reshape(-1, 3).mean(axis=0), truth.reshape(-1, 3).mean(axis=0)

@@ -20,12 +20,12 @@ from pathlib import Path
 
 import pytest
 
-from spectrinsic.dataset import build_dataset
 from spectrinsic.errors import DatasetError
-from spectrinsic.executors import ProcessExecutor
 from spectrinsic.gt_export import check_dataset, is_complete
 from spectrinsic.gt_export.gallery import GALLERY_DIRS
-from spectrinsic.presets import DatasetConfig, get_preset
+from spectrinsic.pipeline.dataset import build_dataset
+from spectrinsic.pipeline.executors import ProcessExecutor
+from spectrinsic.pipeline.presets import DatasetConfig, get_preset
 from spectrinsic.rng import seed_from_key
 
 TINY = DatasetConfig(
@@ -264,7 +264,7 @@ def test_cli_reports_failures_and_exits_nonzero(tmp_path, monkeypatch, capsys):
 def test_dask_cluster_builds_the_same_files(built, tmp_path):
     """The real pipeline through a Dask LocalCluster gives the same bytes as the serial build."""
     distributed = pytest.importorskip("distributed", reason="dask.distributed not installed")
-    from spectrinsic.executors import DaskExecutor
+    from spectrinsic.pipeline.executors import DaskExecutor
 
     out, _ = built
     again = tmp_path / "dask"

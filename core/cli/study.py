@@ -1,8 +1,8 @@
 """``spectrinsic study``: the thesis' studies, printed and written as JSON, CSV and PNG.
 
-* ``reconstruction-error``: Table 5.2 and its extension (:mod:`spectrinsic.study_reconstruction`);
-* ``photometric``: Table 4.4 (:mod:`spectrinsic.study_photometric`);
-* ``rendering``: the rendering study (:mod:`spectrinsic.study_rendering`).
+* ``reconstruction-error``: Table 5.2 and its extension (:mod:`spectrinsic.studies.reconstruction`);
+* ``photometric``: Table 4.4 (:mod:`spectrinsic.studies.photometric`);
+* ``rendering``: the rendering study (:mod:`spectrinsic.studies.rendering`).
 """
 
 from __future__ import annotations
@@ -75,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
     data_dir = getattr(args, "data_dir", None)
     quiet = bool(getattr(args, "quiet", False))
     if args.study == "reconstruction-error":
-        from spectrinsic.study_reconstruction import (
+        from spectrinsic.studies.reconstruction import (
             format_extension,
             format_table,
             reconstruction_table,
@@ -97,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
         _print_paths(paths)
         return 0
     if args.study == "photometric":
-        from spectrinsic.study_photometric import (
+        from spectrinsic.studies.photometric import (
             PhotometricSettings,
             format_photometric,
             run_photometric_study,
@@ -110,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
         print(format_photometric(result))
         _print_paths(paths)
         return 0
-    from spectrinsic.study_rendering import format_rendering, run_rendering_study
+    from spectrinsic.studies.rendering import format_rendering, run_rendering_study
 
     with _progress(quiet, "rendering study") as progress:
         payload = run_rendering_study(out, quality=args.quality, data_dir=data_dir, progress=progress)

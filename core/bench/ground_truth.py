@@ -59,7 +59,7 @@ def _sample_seconds(cfg: Any, name: str, view: int, condition: str) -> float:
 
 def run(out_dir: Path) -> dict[str, Any]:
     from spectrinsic.gt_export.layers import compute_ground_truth
-    from spectrinsic.presets import get_preset
+    from spectrinsic.pipeline.presets import get_preset
     from spectrinsic.scenes.library import build
 
     cfg = get_preset("default")

@@ -53,7 +53,7 @@ def parent_death_signal(item: FakeItem) -> int:
 
 def run_sleepers(marker_dir: str) -> None:
     """Run two long tasks in a two-worker pool (for a parent killed with SIGKILL meanwhile)."""
-    from spectrinsic.executors import ProcessExecutor
+    from spectrinsic.pipeline.executors import ProcessExecutor
 
     items = [FakeItem(i, marker_dir, seconds=600.0) for i in range(2)]
     for _ in ProcessExecutor(workers=2).map_unordered(square, items):

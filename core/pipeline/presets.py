@@ -104,7 +104,7 @@ class DatasetConfig:
     source
         Where the scenes come from, as canonical JSON: ``None`` for the library layout,
         ``{"generator": ..., "count": ..., ...}`` or ``{"scenes": [...], ...}`` (see
-        :func:`spectrinsic.dataset.plan_samples`). Left out of the settings when ``None``, so
+        :func:`spectrinsic.pipeline.dataset.plan_samples`). Left out of the settings when ``None``, so
         library configs keep their hash.
     """
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from spectrinsic.cli import main
-from spectrinsic.study_rendering import pixel_errors, run_rendering_study
+from spectrinsic.studies.rendering import pixel_errors, run_rendering_study
 
 
 def test_render_command_writes_named_float32_channels(tmp_path, capsys):

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from spectrinsic.spectra import get_spectrum, wavelength_grid
-from spectrinsic.study_reconstruction import (
+from spectrinsic.studies.reconstruction import (
     THESIS_TABLE_5_2,
     ExtensionSettings,
     ReconstructionSettings,

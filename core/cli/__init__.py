@@ -1,6 +1,6 @@
 """The ``spectrinsic`` command line. The only place that configures logging and progress bars.
 
-Each sub-command lives in its own ``spectrinsic.cli_<name>`` module exposing
+Each sub-command lives in its own ``spectrinsic.cli.<name>`` module exposing
 ``register(subparsers)``; the module's ``run(args)`` is called with the parsed namespace.
 """
 
@@ -19,12 +19,12 @@ __all__ = ["main", "build_parser"]
 
 #: Sub-command modules, in the order ``--help`` lists them.
 _COMMANDS: tuple[str, ...] = (
-    "spectrinsic.cli_info",
-    "spectrinsic.cli_render",
-    "spectrinsic.cli_dataset",
-    "spectrinsic.cli_check",
-    "spectrinsic.cli_study",
-    "spectrinsic.cli_evaluate",
+    "spectrinsic.cli.info",
+    "spectrinsic.cli.render",
+    "spectrinsic.cli.dataset",
+    "spectrinsic.cli.check",
+    "spectrinsic.cli.study",
+    "spectrinsic.cli.evaluate",
 )
 
 

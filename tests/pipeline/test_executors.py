@@ -1,6 +1,6 @@
 """Executors: every item comes back exactly once, failures and crashes stay local.
 
-The tasks are fakes (tests/dataset/dataset_fakes.py) so these tests need no renderer; the
+The tasks are fakes (tests/pipeline/dataset_fakes.py) so these tests need no renderer; the
 real pipeline runs in test_pipeline.py.
 """
 
@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 from spectrinsic.errors import SpectrinsicError
-from spectrinsic.executors import (
+from spectrinsic.pipeline.executors import (
     DaskExecutor,
     ProcessExecutor,
     SerialExecutor,

@@ -17,7 +17,7 @@ DEFAULT_OUT = "data/dataset"
 
 def _presets_help() -> str:
     """The presets with their numbers, for ``--help``."""
-    from spectrinsic.presets import PRESETS
+    from spectrinsic.pipeline.presets import PRESETS
 
     parts = [f"{name}: {c.width}x{c.height}, {c.batches} batch(es) x {c.spp // c.batches} spp, "
              f"depth {c.max_depth}, modes {'+'.join(c.modes)}{', denoised' if c.denoise else ''}"
@@ -26,7 +26,7 @@ def _presets_help() -> str:
 
 
 def register(subparsers: Any) -> None:
-    from spectrinsic.presets import preset_names
+    from spectrinsic.pipeline.presets import preset_names
 
     p = subparsers.add_parser(
         "dataset",
@@ -142,7 +142,7 @@ def _material_map(path: str | None) -> dict[str, str]:
 
 def _source(args: argparse.Namespace) -> str | None:
     """The config's ``source`` for --generator / --scenes (``None``: the library)."""
-    from spectrinsic.dataset_sources import files_source, generator_source
+    from spectrinsic.pipeline.sources import files_source, generator_source
 
     if args.generator and args.scenes:
         raise DatasetError("--generator and --scenes exclude each other; give one")
@@ -183,8 +183,8 @@ def _overrides(args: argparse.Namespace) -> dict[str, Any]:
 
 def _preflight(args: argparse.Namespace, config: Any) -> None:
     """Every refusal that needs no rendering, before anything is written or started."""
-    from spectrinsic.executors import check_scheduler
     from spectrinsic.gt_export.integrity import check_build_folder
+    from spectrinsic.pipeline.executors import check_scheduler
     from spectrinsic.render.budget import check_render_size
 
     if args.workers is not None and args.workers < 1:
@@ -202,7 +202,7 @@ def _preflight(args: argparse.Namespace, config: Any) -> None:
 
 def _executor(args: argparse.Namespace) -> tuple[Any, int | None, str]:
     """The executor the options ask for, the render threads per worker, and where it runs."""
-    from spectrinsic.executors import make_executor
+    from spectrinsic.pipeline.executors import make_executor
 
     cores = os.cpu_count() or 1
     # One process whose Dr.Jit pool uses every core beat one single-threaded process per core
@@ -223,8 +223,8 @@ def _executor(args: argparse.Namespace) -> tuple[Any, int | None, str]:
 def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
-    from spectrinsic.dataset import SampleFailure, build_dataset
-    from spectrinsic.presets import get_preset
+    from spectrinsic.pipeline.dataset import SampleFailure, build_dataset
+    from spectrinsic.pipeline.presets import get_preset
 
     config = get_preset(args.preset, seed=args.seed).with_options(**_overrides(args))
     _preflight(args, config)

@@ -8,7 +8,7 @@ import json
 import pytest
 
 from spectrinsic.errors import SpectrinsicError
-from spectrinsic.presets import PRESETS, DatasetConfig, get_preset, software_versions
+from spectrinsic.pipeline.presets import PRESETS, DatasetConfig, get_preset, software_versions
 
 
 def test_presets_exist_and_scale_up():
@@ -55,7 +55,7 @@ def test_config_hash_is_sha256_of_canonical_json():
 def test_config_hash_ignores_versions_that_do_not_change_pixels(monkeypatch):
     """A numpy or colour-science patch release, or any other package, keeps the hash; a new
     Mitsuba or a bumped pixel version changes it."""
-    import spectrinsic.presets as presets
+    import spectrinsic.pipeline.presets as presets
     import spectrinsic.provenance as provenance
 
     real = provenance.software_versions

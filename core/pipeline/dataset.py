@@ -25,8 +25,8 @@ from pathlib import Path
 from typing import Any, Literal
 
 from spectrinsic.errors import DatasetError
-from spectrinsic.executors import Executor, SerialExecutor
-from spectrinsic.presets import DatasetConfig
+from spectrinsic.pipeline.executors import Executor, SerialExecutor
+from spectrinsic.pipeline.presets import DatasetConfig
 from spectrinsic.rng import seed_from_key
 
 __all__ = [
@@ -196,7 +196,7 @@ def plan_samples(
 
     out = str(Path(out_dir))
     if config.source is not None:
-        from spectrinsic.dataset_sources import plan_source_samples
+        from spectrinsic.pipeline.sources import plan_source_samples
 
         tasks = plan_source_samples(out, config, render_threads=render_threads,
                                     data_dir=None if data_dir is None else str(data_dir))
@@ -313,7 +313,7 @@ def _task_scene(task: SampleTask) -> Any:
         cfg = task.config
         return build(task.scene, view=task.view, condition=task.condition, seed=cfg.seed,
                      width=cfg.width, height=cfg.height)
-    from spectrinsic.dataset_sources import save_generated
+    from spectrinsic.pipeline.sources import save_generated
     from spectrinsic.scenes.sources import GeneratedSource
 
     scene = task.source.build(task.data_dir)

@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from spectrinsic.errors import DatasetError
-from spectrinsic.presets import DatasetConfig
+from spectrinsic.pipeline.presets import DatasetConfig
 from spectrinsic.rng import seed_from_key
 
 __all__ = ["SCENES_FOLDER", "generator_source", "files_source", "plan_source_samples", "save_generated"]
@@ -93,8 +93,8 @@ def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir:
 
 def plan_source_samples(out: str, config: DatasetConfig, *, data_dir: str | None,
                         render_threads: int | None) -> list[Any]:
-    """The :class:`~spectrinsic.dataset.SampleTask` list of ``config.source``."""
-    from spectrinsic.dataset import SampleTask
+    """The :class:`~spectrinsic.pipeline.dataset.SampleTask` list of ``config.source``."""
+    from spectrinsic.pipeline.dataset import SampleTask
     from spectrinsic.scenes.generators import generated_family, generated_scene_name
     from spectrinsic.scenes.sources import FileSource, GeneratedSource
 

@@ -1,6 +1,7 @@
 """``make bench``: run every benchmark module and write its results as JSON.
 
-Each ``spectrinsic.bench_<name>`` module exposes ``run(out_dir) -> dict``. Results are ratios
+Each ``spectrinsic.bench.<name>`` module exposes ``run(out_dir) -> dict``; its results are
+written to ``bench_<name>.json``. Results are ratios
 measured within one run where possible, so they compare across machines.
 """
 
@@ -9,11 +10,10 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
-import sys
 import time
 from pathlib import Path
 
-BENCHMARKS = ("bench_render", "bench_dataset", "bench_decompose", "bench_ground_truth")
+BENCHMARKS = ("render", "dataset", "decompose", "ground_truth")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -26,14 +26,10 @@ def main(argv: list[str] | None = None) -> int:
     summary = {}
     for name in args.only or BENCHMARKS:
         start = time.perf_counter()
-        result = importlib.import_module(f"spectrinsic.{name}").run(out)
+        result = importlib.import_module(f"spectrinsic.bench.{name}").run(out)
         result["wall_seconds"] = time.perf_counter() - start
-        (out / f"{name}.json").write_text(json.dumps(result, indent=2, default=str))
-        summary[name] = result
-        print(f"{name}: {json.dumps(result, default=str)[:2000]}")
+        (out / f"bench_{name}.json").write_text(json.dumps(result, indent=2, default=str))
+        summary[f"bench_{name}"] = result
+        print(f"bench_{name}: {json.dumps(result, default=str)[:2000]}")
     (out / "summary.json").write_text(json.dumps(summary, indent=2, default=str))
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -54,8 +54,8 @@ def _class_counts() -> dict[tuple[str, int], int]:
 
 def _bench_preset(preset: str, work: str) -> dict[str, Any]:
     """Build the warm-up and the class representatives of *preset* serially in this process."""
-    from spectrinsic.dataset import build_dataset
-    from spectrinsic.presets import get_preset
+    from spectrinsic.pipeline.dataset import build_dataset
+    from spectrinsic.pipeline.presets import get_preset
 
     config = get_preset(preset)
     warm = build_dataset(work, config, only=WARMUP_SAMPLE, finalize=False)

@@ -33,7 +33,7 @@ def _modes_help() -> str:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from spectrinsic.presets import get_preset
+    from spectrinsic.pipeline.presets import get_preset
 
     # one set of documented defaults: those of the dataset's default preset
     default = get_preset("default")
@@ -95,7 +95,7 @@ def load_scene_argument(
         camera = dataclasses.replace(camera, width=camera.width if width is None else width,
                                      height=camera.height if height is None else height)
         return dataclasses.replace(loaded, camera=camera)
-    from spectrinsic.presets import get_preset
+    from spectrinsic.pipeline.presets import get_preset
     from spectrinsic.scenes import library
 
     default = get_preset("default")
@@ -105,7 +105,7 @@ def load_scene_argument(
 
 
 def _default_spp() -> int:
-    from spectrinsic.presets import get_preset
+    from spectrinsic.pipeline.presets import get_preset
 
     return get_preset("default").spp
 
@@ -165,7 +165,7 @@ def write_render(out: Path, scene: Any, result: Any, *, data_dir: str | None = N
 
 def _ground_truth(args: argparse.Namespace) -> int:
     """``render --ground-truth``: a thin alias of ``dataset`` (one sample; library name or file)."""
-    from spectrinsic import cli_dataset
+    from spectrinsic.cli import dataset as cli_dataset
 
     path = Path(args.scene)
     is_file = path.suffix.lower() in (".yaml", ".yml", ".blend") or path.exists()

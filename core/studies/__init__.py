@@ -1,0 +1,4 @@
+"""The thesis' studies: Table 5.2 (``reconstruction``), Table 4.4 (``photometric``) and the
+rendered accuracy study (``rendering``). Each computes, reports and plots; the physics they use
+lives in :mod:`spectrinsic.spectra` and :mod:`spectrinsic.render`.
+"""
