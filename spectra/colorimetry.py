@@ -26,6 +26,8 @@ __all__ = [
     "xyz_to_xy",
     "white_normalised_responses",
     "absolute_reflectance",
+    "encode_srgb",
+    "decode_srgb",
 ]
 
 
@@ -167,3 +169,29 @@ def absolute_reflectance(
     rho = np.stack([s.on(wl) for s in spectra]) if spectra else np.zeros((0, wl.size))
     rgb = xyz_to_linear_srgb(white_normalised_responses(rho, d65, cmf, wl))
     return rgb[0] if single else rgb
+
+
+def encode_srgb(linear: np.ndarray) -> np.ndarray:
+    """IEC 61966-2-1 sRGB encoding (colour-science's ``cctf_encoding``) of linear values.
+
+    Values are clipped to [0, 1] first and NaN maps to 0, so the result is a float array in
+    [0, 1] of the input's shape. The one home of sRGB encoding in spectrinsic.
+
+    >>> encode_srgb(np.array([0.0, 0.0031308, 1.0, 2.0])).round(6).tolist()
+    [0.0, 0.04045, 1.0, 1.0]
+    """
+    import colour
+
+    x = np.nan_to_num(np.asarray(linear, float), nan=0.0, posinf=1.0, neginf=0.0)
+    return np.asarray(colour.cctf_encoding(np.clip(x, 0.0, 1.0), function="sRGB"), float)
+
+
+def decode_srgb(encoded: np.ndarray) -> np.ndarray:
+    """Inverse of :func:`encode_srgb`: sRGB-encoded values in [0, 1] -> linear (clipped first).
+
+    >>> decode_srgb(encode_srgb(np.array([0.25]))).round(12).tolist()
+    [0.25]
+    """
+    import colour
+
+    return np.asarray(colour.cctf_decoding(np.clip(np.asarray(encoded, float), 0.0, 1.0), function="sRGB"), float)
