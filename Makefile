@@ -15,7 +15,7 @@ export PYTHONSAFEPATH := 1
 export SPECTRINSIC_DATA ?= $(DATA_DIR)
 
 .DEFAULT_GOAL := help
-.PHONY: help setup test test-fast study study-spectral dataset evaluate bench lint info clean
+.PHONY: help setup test test-torch test-fast study study-spectral dataset evaluate bench lint info clean
 
 help: ## list the targets
 	@awk 'BEGIN {FS = ":.*## "} /^[a-zA-Z_-]+:.*## / {printf "  make %-15s %s\n", $$1, $$2}' $(MAKEFILE_LIST)
@@ -35,6 +35,11 @@ setup: $(PKG) ## create .venv, install the package (strict editable) and the sys
 
 test: $(PKG) ## run the test suite (tiny renders; < 15 min on 2 cores)
 	$(PY) -m pytest -n 2 -q
+
+# torch is an optional extra: installed only for this step (the CPU build, pinned in the lock).
+test-torch: $(PKG) ## install the CPU build of PyTorch, then run the torch adapter tests (CI runs it)
+	$(BIN)/pip install -q -c constraints.txt torch
+	SPECTRINSIC_REQUIRE_TORCH=1 $(PY) -m pytest -q -p no:xdist -m torch
 
 test-fast: $(PKG) ## run the tests not marked slow
 	$(PY) -m pytest -n 2 -q -m "not slow"

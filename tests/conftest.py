@@ -32,3 +32,14 @@ def data_dir() -> Path:
     if path is None:
         pytest.skip("no spectral data directory: set SPECTRINSIC_DATA or place ../shared/data")
     return path
+
+
+@pytest.fixture(scope="session")
+def torch():
+    """PyTorch for the adapter tests. ``make test-torch`` (run by CI) installs it and sets
+    ``SPECTRINSIC_REQUIRE_TORCH=1``, so there a missing torch fails instead of skipping."""
+    if os.environ.get("SPECTRINSIC_REQUIRE_TORCH") == "1":
+        import torch
+
+        return torch
+    return pytest.importorskip("torch", reason="PyTorch is an optional extra: make test-torch installs it")

@@ -1,7 +1,7 @@
 """``rooms``: rooms of random size and shape, closed or open (missing walls or ceiling,
 window openings), with furniture standing on the floor and objects resting on table tops and
 the floor. Open rooms with dark walls let light escape, so the energy ratio r of direct to
-total light spans roughly 0.3 (closed, light walls) to 0.9 (open, dark walls).
+total light spans roughly 0.3 (closed, light walls, lit indirectly) to 0.9 (open, dark walls).
 """
 
 from __future__ import annotations
@@ -132,6 +132,24 @@ def _objects(rng: np.random.Generator, size: tuple[float, float, float], floor: 
     return parts, patterns
 
 
+def _light_volume(rng: np.random.Generator, size: tuple[float, float, float],
+                  openness: dict) -> tuple[LightVolume, str]:
+    """Where the lights go, and whether they light the room ``"direct"`` or ``"indirect"``.
+
+    Three in four light rooms with a ceiling are lit indirectly: spots and panels below the
+    ceiling aim up at it, so the visible surfaces get their light after one bounce or more.
+    These give the lowest energy ratios r (direct / total), down to about 0.3 and below;
+    lights aimed at the furniture give the high ones.
+    """
+    w, d, h = size
+    if openness["ceiling"] and openness["light_walls"] and rng.random() < 0.75:
+        return LightVolume(lo=(0.4, 0.4, 0.35 * h), hi=(w - 0.4, d - 0.4, 0.6 * h),
+                           focus=(w / 2, d / 2, h), kinds=("spot", "area")), "indirect"
+    return LightVolume(lo=(0.3, 0.3, 0.6 * h), hi=(w - 0.3, d - 0.3, h - 0.15),
+                       focus=(w / 2, d / 2, 0.6),
+                       kinds=("point", "spot", "area") if openness["ceiling"] else LIGHT_KINDS), "direct"
+
+
 def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
     """Lay out a generated room (see the module docstring)."""
     size = (float(rng.uniform(2.5, 6.0)), float(rng.uniform(2.5, 6.0)), float(rng.uniform(2.3, 3.2)))
@@ -147,10 +165,8 @@ def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
         target = targets[int(r.integers(len(targets)))] + r.uniform(-0.1, 0.1, 3)
         return origin, target, float(r.uniform(50, 75))
 
-    volume = LightVolume(lo=(0.3, 0.3, 0.6 * h), hi=(w - 0.3, d - 0.3, h - 0.15),
-                         focus=(w / 2, d / 2, 0.6),
-                         kinds=("point", "spot", "area") if openness["ceiling"] else LIGHT_KINDS)
-    info = {"generator": "rooms", "room_size": list(size), **openness,
+    volume, lighting = _light_volume(rng, size, openness)
+    info = {"generator": "rooms", "room_size": list(size), **openness, "lighting": lighting,
             "n_furniture": len(furniture), "n_objects": len(objects),
             "shapes": [n.rsplit("-", 1)[0] for n, _ in objects], "patterns": patterns}
     return Layout(parts=(*shell, *furniture, *objects), lights=volume, propose_camera=propose,

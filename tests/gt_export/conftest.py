@@ -160,3 +160,15 @@ def synth() -> Any:
     return SimpleNamespace(make_scene=make_scene, make_result=make_result,
                            coverage_map=coverage_map, H=H, W=W, MATERIALS=MATERIALS,
                            FakeResult=FakeResult)
+
+
+@pytest.fixture
+def built(tmp_path, two_light_sample, one_light_sample, config):
+    """A two-sample dataset with manifest and card."""
+    from spectrinsic.gt_export import export_sample, write_dataset_card, write_manifest
+
+    for sid, (scene, result) in (("b-two", two_light_sample), ("a-one", one_light_sample)):
+        export_sample(tmp_path, scene, result, sample_id=sid, config=config, seed=11)
+    write_manifest(tmp_path, config)
+    write_dataset_card(tmp_path, config)
+    return tmp_path

@@ -18,21 +18,9 @@ from spectrinsic.gt_export import (
     load_sample,
     sample_dirs,
     torch_dataset,
-    write_dataset_card,
-    write_manifest,
 )
 
 FLOAT32_RTOL = 4 * float(np.finfo(np.float32).eps)
-
-
-@pytest.fixture
-def built(tmp_path, two_light_sample, one_light_sample, config):
-    """A two-sample dataset with manifest and card."""
-    for sid, (scene, result) in (("b-two", two_light_sample), ("a-one", one_light_sample)):
-        export_sample(tmp_path, scene, result, sample_id=sid, config=config, seed=11)
-    write_manifest(tmp_path, config)
-    write_dataset_card(tmp_path, config)
-    return tmp_path
 
 
 def test_sample_round_trips_through_the_loader(tmp_path, two_light_sample, config):
@@ -208,35 +196,6 @@ def test_torch_adapter_without_torch_says_what_to_install(built, monkeypatch):
     monkeypatch.setitem(sys.modules, "torch", None)  # makes `import torch` fail
     with pytest.raises(MissingDependencyError, match="spectrinsic\\[torch\\]"):
         torch_dataset(built)
-
-
-def test_torch_adapter_yields_channel_first_tensors(built):
-    torch = pytest.importorskip("torch", reason="PyTorch is an optional extra, not installed here")
-    ds = torch_dataset(built, keys=("image", "mask"))
-    item = ds[0]
-    assert len(ds) == 2 and item["sample_id"] == "a-one"
-    assert item["image"].shape == (3, 12, 16) and item["image"].dtype == torch.float32
-    assert item["mask"].shape == (1, 12, 16) and item["mask"].dtype == torch.bool
-
-
-def test_torch_adapter_every_key_crop_transform_exposure_split(built):
-    torch = pytest.importorskip("torch", reason="PyTorch is an optional extra, not installed here")
-    full = torch_dataset(built)[0]
-    sample = load_sample(built / "a-one")
-    arrays = {k for k, v in sample.items() if isinstance(v, np.ndarray)}
-    assert arrays <= set(full) and {"ids", "sample_id", "scene"} <= set(full)
-    assert full["depth"].shape == (1, 12, 16) and full["ids"]["object"].dtype == torch.int32
-    crops = torch_dataset(built, keys=("image", "depth"), crop=(5, 7), seed=1,
-                          transform=lambda item: {**item, "seen": True})
-    a, b = crops[0], crops[0]
-    assert a["seen"] and a["image"].shape == (3, 5, 7) and a["depth"].shape == (1, 5, 7)
-    assert torch.equal(a["image"], b["image"])  # the crop of item i is fixed by the seed
-    bright = torch_dataset(built, keys=("image", "reflectance"), normalize_exposure=True)[0]
-    assert torch.allclose(bright["reflectance"], full["reflectance"])
-    assert torch.allclose(bright["image"], full["image"] * bright["exposure_scale"])
-    manifest = json.loads((built / "manifest.json").read_text())
-    for split, ids in manifest["splits"].items():
-        assert [torch_dataset(built, split=split)[i]["sample_id"] for i in range(len(ids))] == sorted(ids)
 
 
 def test_meta_json_floats_carry_at_most_the_stated_digits(tmp_path, two_light_sample, config):

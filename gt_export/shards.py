@@ -1,0 +1,281 @@
+"""WebDataset tar shards of a built dataset, for streaming training on large sets.
+
+A shard is a plain POSIX tar in the `WebDataset <https://github.com/webdataset/webdataset>`_
+convention: the members of one sample share its sample id as the key, and the part after the
+first dot names the entry. Every array layer of :func:`spectrinsic.gt_export.load_sample` is
+stored as ``<sample_id>.<layer>.npy`` (numpy's ``.npy`` format, the dtype and shape as loaded:
+``(H, W, 3)`` float32 linear radiometric layers, ``(H, W)`` depth, bool mask, int32 ids), and the
+sample's ``meta.json`` as ``<sample_id>.meta.json``. WebDataset lower-cases entry names and reads
+a ``/`` as a folder, so a layer key is written lower-case with ``/`` as :data:`KEY_SEPARATOR`
+(``image_camera/Nikon D50`` -> ``image_camera~nikon d50.npy``); the index's ``entries`` maps each
+entry name back to its layer key.
+
+Shards are made per split of the manifest (by scene, so no scene spans two splits), named
+``<split>-<n:06d>.tar``, with at most *samples_per_shard* samples each, in sample-id order.
+Members carry ``mtime = 0`` and fixed owners, so the same dataset gives byte-identical shards.
+Each shard is written under a temporary name and renamed into place; the index
+:data:`SHARD_INDEX` (shard names, sample counts, SHA-256, the layer names) is written last and
+is what marks an export complete.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import os
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from spectrinsic.errors import DatasetError, MissingDependencyError
+from spectrinsic.gt_export.loader import load_sample, split_samples
+
+__all__ = ["SHARD_INDEX", "KEY_SEPARATOR", "ShardSet", "write_shards", "shard_urls", "shard_dataset"]
+
+#: The export's index; written last, so its presence means every listed shard is complete.
+SHARD_INDEX = "shards.json"
+#: Stands for ``/`` of a layer key inside a tar member name.
+KEY_SEPARATOR = "~"
+_FORMAT = "spectrinsic-webdataset"
+_VERSION = 1
+_TMP_PREFIX = ".spectrinsic-tmp-"
+
+
+@dataclass(frozen=True)
+class ShardSet:
+    """What :func:`write_shards` wrote: shard names per split and their sample counts."""
+
+    folder: Path
+    shards: dict[str, tuple[str, ...]]
+    samples: dict[str, int]
+    layers: tuple[str, ...]
+
+
+def _webdataset() -> Any:
+    try:
+        import webdataset
+    except ImportError as exc:
+        raise MissingDependencyError(
+            "tar shards need the webdataset package, which is not installed: "
+            "pip install 'spectrinsic[shards]'"
+        ) from exc
+    return webdataset
+
+
+def _member_name(layer: str) -> str:
+    """``image_camera/Nikon D50`` -> ``image_camera~nikon d50.npy``."""
+    if "." in layer or KEY_SEPARATOR in layer:
+        raise DatasetError(f"layer {layer!r}: a shard entry name may not contain '.' or {KEY_SEPARATOR!r}")
+    return layer.replace("/", KEY_SEPARATOR).lower() + ".npy"
+
+
+def _entries(layers: set[str]) -> dict[str, str]:
+    """Entry name -> layer key; two keys differing only in case cannot share a shard."""
+    entries = {_member_name(k): k for k in sorted(layers)}
+    if len(entries) != len(layers):
+        raise DatasetError(f"layers {sorted(layers)}: two differ only in case, which WebDataset merges")
+    return entries
+
+
+def _npy(array: np.ndarray) -> bytes:
+    stream = io.BytesIO()
+    np.lib.format.write_array(stream, np.ascontiguousarray(array), allow_pickle=False)
+    return stream.getvalue()
+
+
+def _encode(sample: dict[str, Any]) -> dict[str, Any]:
+    """One loaded sample -> the WebDataset record (entry name -> bytes)."""
+    sample_id = str(sample["meta"]["sample_id"])
+    if "." in sample_id:
+        raise DatasetError(f"sample id {sample_id!r}: a WebDataset key may not contain '.'")
+    record: dict[str, Any] = {"__key__": sample_id}
+    for key, value in sample.items():
+        if isinstance(value, np.ndarray):
+            record[_member_name(key)] = _npy(value)
+    record["meta.json"] = json.dumps(sample["meta"], sort_keys=True).encode("utf-8")
+    return record
+
+
+def _sha256(path: Path) -> str:
+    digest = hashlib.sha256()
+    with path.open("rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def _prepare_out(out: Path) -> set[str]:
+    """The files an earlier export of ours wrote in *out* (listed by its index, complete or
+    interrupted); refuse a folder holding anything else."""
+    out.mkdir(parents=True, exist_ok=True)
+    index_path = out / SHARD_INDEX
+    ours: set[str] = set()
+    if index_path.is_file():
+        try:
+            previous = json.loads(index_path.read_text(encoding="utf-8"))
+        except ValueError as exc:
+            raise DatasetError(f"{index_path}: not a spectrinsic shard index ({exc})") from exc
+        if not isinstance(previous, dict) or previous.get("format") != _FORMAT:
+            raise DatasetError(f"{index_path}: not a spectrinsic shard index")
+        ours = set(previous.get("files", {}))
+    foreign = sorted(p.name for p in out.iterdir()
+                     if p.name not in ours | {SHARD_INDEX} and not p.name.startswith(_TMP_PREFIX))
+    if foreign:
+        raise DatasetError(f"shard folder {str(out)!r} holds files spectrinsic did not write "
+                           f"({', '.join(foreign[:3])}{', ...' if len(foreign) > 3 else ''}); "
+                           "expected a new, empty or earlier shard folder")
+    return ours
+
+
+def _write_index(out: Path, index: dict[str, Any]) -> None:
+    tmp = out / f"{_TMP_PREFIX}{SHARD_INDEX}"
+    tmp.write_text(json.dumps(index, indent=2, sort_keys=True), encoding="utf-8")
+    os.replace(tmp, out / SHARD_INDEX)
+
+
+def _plan(source: Path, samples_per_shard: int) -> dict[str, dict[str, list[Path]]]:
+    """``{split: {shard name: sample folders}}`` in sample-id order."""
+    plan: dict[str, dict[str, list[Path]]] = {}
+    for split in list(_manifest(source).get("splits") or {}) or [None]:
+        folders = split_samples(source, split)
+        label = split or "all"
+        plan[label] = {f"{label}-{i // samples_per_shard:06d}.tar": folders[i:i + samples_per_shard]
+                       for i in range(0, len(folders), samples_per_shard)}
+    return plan
+
+
+def _write_shard(out: Path, name: str, folders: Sequence[Path], layers: Sequence[str] | None,
+                 progress: Callable[[str], None] | None) -> set[str]:
+    """Write one shard under a temporary name, then rename it; return the layer keys seen."""
+    wds = _webdataset()
+    tmp = out / f"{_TMP_PREFIX}{name}"
+    seen: set[str] = set()
+    try:
+        with open(tmp, "wb") as stream:
+            writer = wds.TarWriter(stream, mtime=0, user="spectrinsic", group="spectrinsic")
+            for folder in folders:
+                sample = load_sample(folder, layers=layers)
+                seen.update(k for k, v in sample.items() if isinstance(v, np.ndarray))
+                writer.write(_encode(sample))
+                if progress is not None:
+                    progress(folder.name)
+            writer.close()
+        os.replace(tmp, out / name)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return seen
+
+
+def _manifest(dataset_dir: Path) -> dict[str, Any]:
+    try:
+        manifest = json.loads((dataset_dir / "manifest.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise DatasetError(f"{dataset_dir}: no readable manifest.json; expected a built dataset") from exc
+    if not isinstance(manifest, dict):
+        raise DatasetError(f"{dataset_dir}/manifest.json: expected a JSON object")
+    return manifest
+
+
+def write_shards(
+    dataset_dir: str | os.PathLike[str],
+    out_dir: str | os.PathLike[str],
+    *,
+    samples_per_shard: int = 1000,
+    layers: Sequence[str] | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> ShardSet:
+    """Export the complete samples of *dataset_dir* as WebDataset shards in *out_dir*.
+
+    Parameters
+    ----------
+    samples_per_shard
+        Most samples in one shard (>= 1).
+    layers
+        Only these layer keys (default: every layer of each sample).
+    progress
+        Called with each sample id once its record is written.
+
+    Raises
+    ------
+    DatasetError
+        *out_dir* holds files spectrinsic did not write, or the dataset has no manifest.
+    """
+    if samples_per_shard < 1:
+        raise DatasetError(f"samples per shard {samples_per_shard}; expected a whole number >= 1")
+    source, out = Path(dataset_dir), Path(out_dir)
+    ours = _prepare_out(out)
+    plan = _plan(source, samples_per_shard)
+    planned = {name for shards in plan.values() for name in shards}
+    base = {"format": _FORMAT, "version": _VERSION, "key_separator": KEY_SEPARATOR,
+            "config_hash": _manifest(source).get("config_hash")}
+    # Before any shard: record every name this export may write, so a re-run after an
+    # interruption knows them as its own (and nothing else in the folder is ever touched).
+    _write_index(out, {**base, "complete": False, "files": dict.fromkeys(sorted(ours | planned), "")})
+    files: dict[str, str] = {}
+    seen: set[str] = set()
+    for shards in plan.values():
+        for name, folders in shards.items():
+            seen |= _write_shard(out, name, folders, layers, progress)
+            files[name] = _sha256(out / name)
+    _write_index(out, {**base, "complete": True, "entries": _entries(seen), "files": files,
+                       "splits": {k: {"shards": list(v), "samples": sum(map(len, v.values()))}
+                                  for k, v in plan.items()}})
+    for stale in ours - planned:
+        (out / stale).unlink(missing_ok=True)  # a shard an earlier export of ours wrote
+    return ShardSet(out, {k: tuple(v) for k, v in plan.items()},
+                    {k: sum(map(len, v.values())) for k, v in plan.items()}, tuple(sorted(seen)))
+
+
+def _index(out: Path) -> dict[str, Any]:
+    try:
+        index = json.loads((out / SHARD_INDEX).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise DatasetError(f"{out}: no shard export ({SHARD_INDEX} missing or unreadable)") from exc
+    if not isinstance(index, dict) or not index.get("complete"):
+        raise DatasetError(f"{out}: the shard export was interrupted; run it again to finish")
+    return index
+
+
+def shard_urls(out_dir: str | os.PathLike[str], split: str | None = None) -> list[str]:
+    """Paths of the shards of *split* (``None``: every split) from a complete export's index."""
+    out = Path(out_dir)
+    splits = _index(out)["splits"]
+    if split is not None and split not in splits:
+        raise DatasetError(f"split {split!r}; the shards have {sorted(splits)}")
+    chosen = [split] if split is not None else sorted(splits)
+    return [str(out / name) for s in chosen for name in splits[s]["shards"]]
+
+
+def _decoder(entries: dict[str, str]) -> Callable[[dict[str, Any]], dict[str, Any]]:
+    """A raw WebDataset record (entry -> bytes) -> ``{layer: array, "meta": dict, ...}``."""
+
+    def decode(record: dict[str, Any]) -> dict[str, Any]:
+        item: dict[str, Any] = {"sample_id": record["__key__"]}
+        for entry, value in record.items():
+            if entry in entries:
+                item[entries[entry]] = np.lib.format.read_array(io.BytesIO(value), allow_pickle=False)
+            elif entry == "meta.json":
+                item["meta"] = json.loads(value)
+        return item
+
+    return decode
+
+
+def shard_dataset(out_dir: str | os.PathLike[str], split: str | None = None) -> Iterator[dict[str, Any]]:
+    """A ``webdataset.WebDataset`` over the shards of *split*, each item decoded as
+    :func:`load_sample` returns it (arrays ``(H, W[, C])`` under their layer keys, ``meta``)
+    plus ``sample_id``; an empty iterator for a split with no samples.
+
+    It is an ``IterableDataset`` when torch is installed, so it feeds a
+    ``torch.utils.data.DataLoader`` directly; chain ``.map(...)`` for crops or tensors.
+    """
+    wds = _webdataset()
+    urls = shard_urls(out_dir, split)
+    if not urls:
+        return iter(())
+    decode = _decoder(_index(Path(out_dir))["entries"])
+    return wds.WebDataset(urls, shardshuffle=False, empty_check=False).map(decode)
