@@ -1,10 +1,12 @@
 """Array aliases with their shapes and units, shared by every package.
 
-All images are linear (never gamma-encoded) unless a name says ``sRGB8``.
+All images are linear (never gamma-encoded) unless a name says ``sRGB8``. Besides the arrays,
+the callback type of the top layer (:data:`StepProgress`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import TypeAlias
 
 import numpy as np
@@ -22,6 +24,7 @@ __all__ = [
     "SpectralImage",
     "Mask",
     "IdMap",
+    "StepProgress",
 ]
 
 FloatArray: TypeAlias = npt.NDArray[np.floating]
@@ -46,3 +49,8 @@ SpectralImage: TypeAlias = npt.NDArray[np.float32]
 Mask: TypeAlias = npt.NDArray[np.bool_]
 #: ``(H, W)`` int32 material or object ids, -1 for background.
 IdMap: TypeAlias = npt.NDArray[np.int32]
+#: Progress callback of a long computation (a study, a benchmark): called once per step with a
+#: one-line description of it (e.g. ``"munsell / cie:D65: 3 sensors, 1 bounce(s)"`` or a sample
+#: id); the CLI turns it into a progress bar. Not the renderer's pass counter
+#: (:data:`spectrinsic.render.passes.Progress`, called with a number of passes).
+StepProgress: TypeAlias = Callable[[str], None]

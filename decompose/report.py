@@ -7,9 +7,7 @@ coloured irradiance shading).
 
 from __future__ import annotations
 
-import csv
 import dataclasses
-import json
 from collections import defaultdict
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
@@ -25,6 +23,7 @@ from spectrinsic.decompose.evaluate import (
 )
 from spectrinsic.decompose.metrics import METRICS
 from spectrinsic.decompose.registry import DECOMPOSERS
+from spectrinsic.results import write_csv, write_json
 
 __all__ = [
     "LMSE_COLUMNS",
@@ -161,11 +160,8 @@ def method_parameters(methods: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
 
 
 def _write_csv(path: Path, rows: list[dict[str, Any]], columns: Sequence[str]) -> None:
-    with path.open("w", newline="", encoding="utf-8") as fh:
-        writer = csv.DictWriter(fh, fieldnames=list(columns))
-        writer.writeheader()
-        for row in rows:
-            writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
+    """A table of the report: floats to 6 significant digits."""
+    write_csv(path, rows, columns=columns, float_format=".6g")
 
 
 def _markdown(rows: list[dict[str, Any]], columns: Sequence[str], headers: Sequence[str]) -> str:
@@ -255,8 +251,7 @@ def write_report(
     files.update(table_3_2_csv=out / "table_3_2_objects.csv",
                  table_3_2_md=out / "table_3_2_objects.md")
     files["methods"] = out / "methods.json"
-    files["methods"].write_text(json.dumps(method_parameters(methods), indent=2, default=str),
-                                encoding="utf-8")
+    write_json(files["methods"], method_parameters(methods), strict=False, default=str, end="")
     files["report"] = out / "REPORT.md"
     files["report"].write_text(_report_md(methods, inputs, len(samples), files), encoding="utf-8")
     return files

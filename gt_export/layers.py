@@ -310,19 +310,15 @@ def shading_ratio(image: np.ndarray, reflectance: np.ndarray) -> np.ndarray:
 
 
 def relative_error_map(approx: np.ndarray, reference: np.ndarray) -> np.ndarray:
-    """Per-pixel ``‖p̂ − p‖₂ / ‖p‖₂`` over channels (the ε of thesis Table 5.2).
+    """Per-pixel ``‖p̂ − p‖₂ / ‖p‖₂`` over channels (the ε of thesis Table 5.2, Eq. 5.7).
 
-    Pixels whose reference norm is below ``ERROR_FLOOR`` times its 99th percentile get 0.
+    :func:`spectrinsic.spectra.relative_error` with ``dark_fraction=ERROR_FLOOR``: pixels whose
+    reference norm is at most ``ERROR_FLOOR`` times its 99th percentile get 0.
     Returns ``(H, W)`` float64.
     """
-    approx = np.asarray(approx, float)
-    reference = np.asarray(reference, float)
-    norm = np.linalg.norm(reference, axis=-1)
-    positive = norm[norm > 0]
-    floor = ERROR_FLOOR * np.percentile(positive, 99) if positive.size else np.inf
-    valid = norm > floor
-    err = np.linalg.norm(approx - reference, axis=-1)
-    return np.where(valid, err / np.where(valid, norm, 1.0), 0.0)
+    from spectrinsic.spectra import relative_error
+
+    return relative_error(approx, reference, dark_fraction=ERROR_FLOOR, fill=0.0)
 
 
 def light_shares(per_light_y: np.ndarray, mask: np.ndarray | None = None) -> np.ndarray:

@@ -11,6 +11,7 @@ from spectrinsic.spectra.colorimetry import (
     diagonal_values,
     linear_srgb_to_xyz,
     responses,
+    srgb_responses,
     white_normalised_responses,
     xyz_to_linear_srgb,
     xyz_to_xy,
@@ -24,10 +25,19 @@ from spectrinsic.spectra.grid import (
 )
 from spectrinsic.spectra.illuminants import ILLUMINANT_SETS, illuminant_set, planck_law
 from spectrinsic.spectra.photometric import (
+    ESTIMATE_SCENARIOS,
     angular_error,
     fit_matrix,
     fit_projection,
+    scenario_estimates,
     sharpening_transform,
+)
+from spectrinsic.spectra.reconstruction import (
+    one_bounce_errors,
+    ordered_pairs,
+    pair_responses,
+    relative_error,
+    two_bounce_errors,
 )
 from spectrinsic.spectra.records import SensorSet, Spectrum
 from spectrinsic.spectra.registry import family_values, get_sensors, get_spectrum, list_spectra
@@ -36,6 +46,7 @@ from spectrinsic.spectra.sensors import box_bands, gaussian_sensors
 __all__ = [
     "COLORIMETRIC_WAVELENGTHS",
     "DEFAULT_WAVELENGTHS",
+    "ESTIMATE_SCENARIOS",
     "ILLUMINANT_SETS",
     "LINEAR_SRGB_TO_XYZ",
     "XYZ_TO_LINEAR_SRGB",
@@ -54,10 +65,17 @@ __all__ = [
     "illuminant_set",
     "linear_srgb_to_xyz",
     "list_spectra",
+    "one_bounce_errors",
+    "ordered_pairs",
+    "pair_responses",
     "planck_law",
+    "relative_error",
     "resample",
     "responses",
+    "scenario_estimates",
     "sharpening_transform",
+    "srgb_responses",
+    "two_bounce_errors",
     "validate_wavelengths",
     "wavelength_grid",
     "white_normalised_responses",

@@ -26,6 +26,7 @@ __all__ = [
     "xyz_to_xy",
     "white_normalised_responses",
     "absolute_reflectance",
+    "srgb_responses",
     "encode_srgb",
     "decode_srgb",
 ]
@@ -169,6 +170,22 @@ def absolute_reflectance(
     rho = np.stack([s.on(wl) for s in spectra]) if spectra else np.zeros((0, wl.size))
     rgb = xyz_to_linear_srgb(white_normalised_responses(rho, d65, cmf, wl))
     return rgb[0] if single else rgb
+
+
+def srgb_responses(
+    reflectances: SpectralValues, illuminant: SpectralValues, wavelengths: Wavelengths
+) -> Responses:
+    """Linear sRGB ``(N, 3)`` of reflectances ``(N, W)`` under a light ``(W,)``, white Y = 1.
+
+    :func:`white_normalised_responses` with the sRGB sensors (the CIE 1931 observer followed
+    by the sRGB matrix) on *wavelengths* (nm). Under D65 this is the absolute reflectance
+    ``p^{s,c}`` (Eq. 4.15), normalised like :func:`absolute_reflectance` but integrated on
+    *wavelengths*. Linear: no transfer function.
+    """
+    from spectrinsic.spectra.registry import get_sensors
+
+    return white_normalised_responses(reflectances, illuminant, get_sensors("srgb").on(wavelengths),
+                                      wavelengths)
 
 
 def encode_srgb(linear: np.ndarray) -> np.ndarray:

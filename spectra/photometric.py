@@ -12,7 +12,18 @@ import numpy as np
 from spectrinsic.errors import SpectralDataError
 from spectrinsic.typing import Matrix3, SensorCurves, Wavelengths
 
-__all__ = ["fit_matrix", "fit_projection", "sharpening_transform", "angular_error"]
+__all__ = [
+    "ESTIMATE_SCENARIOS",
+    "fit_matrix",
+    "fit_projection",
+    "sharpening_transform",
+    "angular_error",
+    "scenario_estimates",
+]
+
+#: The scenarios of thesis Table 4.3 (section 4.4.1), keys of :func:`scenario_estimates`: what is
+#: known when estimating the absolute reflectance ``p^{s,c}`` from camera values ``p``.
+ESTIMATE_SCENARIOS: tuple[str, ...] = ("SC1", "SC2", "SC3", "SC4")
 
 
 def _pairs(src: np.ndarray, dst: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -123,3 +134,62 @@ def angular_error(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     with np.errstate(invalid="ignore", divide="ignore"):
         cos = np.clip(num / den, -1.0, 1.0)
     return np.degrees(np.arccos(cos))
+
+
+def _solve(m: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """``M⁻¹ p`` for row vectors ``p`` (N, 3)."""
+    return np.linalg.solve(m, p.T).T
+
+
+def scenario_estimates(
+    p: np.ndarray, p_c: np.ndarray, p_sc: np.ndarray, *, p_s: np.ndarray | None = None,
+    sc3_light_space: str = "camera",
+) -> dict[str, np.ndarray]:
+    """Each scenario's estimate of the absolute reflectance ``p^{s,c}`` from ``p`` (Table 4.3).
+
+    The model is Eq. 4.16, ``p = L_CLig · S_Sen · p^{s,c}``. ``S_Sen`` is fitted by least squares
+    from ``p^{s,c}`` to ``p^c``, ``L_CLig`` (full, or diagonal ``D``) from ``p^c`` to ``p``
+    (:func:`fit_matrix`); each scenario inverts what it knows:
+
+    =====  =======  =======  ===================================================
+    name   sensors  light    estimate
+    =====  =======  =======  ===================================================
+    SC1    known    known    ``S_Sen⁻¹ · L_CLig⁻¹ · p`` (full light model)
+    SC2    known    known    ``S_Sen⁻¹ · D⁻¹ · p`` (diagonal light model)
+    SC3    unknown  known    ``D⁻¹ · p`` (sRGB sensors assumed: ``S_Sen = Id``)
+    SC4    unknown  unknown  ``p`` (D65 and sRGB sensors assumed)
+    =====  =======  =======  ===================================================
+
+    With ``sc3_light_space="srgb"`` SC3's ``D`` is fitted between sRGB values under the two
+    lights (``p^{s,c}`` to ``p^s``) instead of in the camera's space.
+
+    Parameters
+    ----------
+    p
+        ``(N, 3)`` linear camera responses under the scene light.
+    p_c
+        ``(N, 3)`` linear camera responses under the canonical light.
+    p_sc
+        ``(N, 3)`` linear sRGB under the canonical light (the ground truth).
+    p_s
+        ``(N, 3)`` linear sRGB under the scene light; needed only for ``sc3_light_space="srgb"``.
+
+    Returns
+    -------
+    ``{"SC1": (N, 3), ..., "SC4": (N, 3)}`` float64, keys :data:`ESTIMATE_SCENARIOS`.
+    """
+    s_sen = fit_matrix(p_sc, p_c)
+    l_full = fit_matrix(p_c, p)
+    l_diag = fit_matrix(p_c, p, diagonal=True)
+    if sc3_light_space == "srgb":
+        if p_s is None:
+            raise SpectralDataError("sc3_light_space='srgb' needs the sRGB values under the scene light")
+        l_sc3 = fit_matrix(p_sc, p_s, diagonal=True)
+    else:
+        l_sc3 = l_diag
+    return {
+        "SC1": _solve(s_sen, _solve(l_full, p)),
+        "SC2": _solve(s_sen, _solve(l_diag, p)),
+        "SC3": _solve(l_sc3, p),
+        "SC4": np.asarray(p, float),
+    }

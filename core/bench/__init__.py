@@ -13,6 +13,8 @@ import json
 import time
 from pathlib import Path
 
+from spectrinsic.results import write_json
+
 BENCHMARKS = ("render", "dataset", "decompose", "ground_truth")
 
 
@@ -28,8 +30,8 @@ def main(argv: list[str] | None = None) -> int:
         start = time.perf_counter()
         result = importlib.import_module(f"spectrinsic.bench.{name}").run(out)
         result["wall_seconds"] = time.perf_counter() - start
-        (out / f"bench_{name}.json").write_text(json.dumps(result, indent=2, default=str))
+        write_json(out / f"bench_{name}.json", result, strict=False, default=str, end="")
         summary[f"bench_{name}"] = result
         print(f"bench_{name}: {json.dumps(result, default=str)[:2000]}")
-    (out / "summary.json").write_text(json.dumps(summary, indent=2, default=str))
+    write_json(out / "summary.json", summary, strict=False, default=str, end="")
     return 0

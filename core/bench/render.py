@@ -65,9 +65,9 @@ def _bare_seconds(scene: Any, spp: int) -> float:
 
 
 def _errors(estimate: np.ndarray, truth: np.ndarray) -> dict[str, float]:
-    from spectrinsic.studies.rendering import pixel_errors
+    from spectrinsic.spectra import relative_error
 
-    err = pixel_errors(estimate, truth)
+    err = relative_error(estimate, truth)
     mean_est, mean_truth = estimate.reshape(-1, 3).mean(axis=0), truth.reshape(-1, 3).mean(axis=0)
     return {
         "pixel_error_mean_pct": 100 * float(np.nanmean(err)),

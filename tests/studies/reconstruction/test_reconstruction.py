@@ -7,17 +7,15 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from spectrinsic.spectra import get_spectrum, wavelength_grid
+from spectrinsic.spectra import get_spectrum, one_bounce_errors, two_bounce_errors, wavelength_grid
 from spectrinsic.studies.reconstruction import (
     THESIS_TABLE_5_2,
     ExtensionSettings,
     ReconstructionSettings,
     delta_e_rows,
-    one_bounce_errors,
     reconstruction_table,
     reflectance_matrix,
     run_extension,
-    two_bounce_errors,
 )
 
 #: Cells reproduced to two decimals (|ours - thesis| <= half a unit of the last printed digit).

@@ -5,10 +5,9 @@ from __future__ import annotations
 import json
 
 import numpy as np
-import pytest
 
 from spectrinsic.cli import main
-from spectrinsic.studies.rendering import pixel_errors, run_rendering_study
+from spectrinsic.studies.rendering import run_rendering_study
 
 
 def test_render_command_writes_named_float32_channels(tmp_path, capsys):
@@ -39,14 +38,6 @@ def test_render_command_rejects_unknown_mode(tmp_path, capsys):
                    "--width", "8", "--height", "8"])
     assert status == 2
     assert "did you mean" in capsys.readouterr().err
-
-
-def test_pixel_errors_is_eq_5_7():
-    ref = np.array([[[1.0, 2.0, 2.0], [0.0, 0.0, 0.0]]])
-    est = np.array([[[1.0, 2.0, 5.0], [1.0, 1.0, 1.0]]])
-    err = pixel_errors(est, ref)
-    assert err[0, 0] == pytest.approx(1.0)  # ‖(0, 0, 3)‖ / ‖(1, 2, 2)‖
-    assert np.isnan(err[0, 1])
 
 
 def test_rendering_study_writes_rows(tmp_path):
