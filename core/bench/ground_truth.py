@@ -36,8 +36,9 @@ def _render(cfg: Any, scene: Any, *, spp: int, batches: int, seed: int,
 
 
 def _errors(estimate: np.ndarray, reference: np.ndarray, ref_se: np.ndarray, valid: np.ndarray) -> dict[str, float]:
-    norm = np.linalg.norm(reference, axis=-1)[valid]
-    err = np.linalg.norm(estimate - reference, axis=-1)[valid] / norm
+    from spectrinsic.spectra.reconstruction import relative_error
+
+    err = relative_error(estimate, reference, where=valid)[valid]  # Eq. 5.7 per pixel
     corrected = np.sqrt(np.clip(err ** 2 - ref_se[valid] ** 2, 0.0, None))
     return {"median": float(np.median(err)), "p95": float(np.percentile(err, 95)),
             "rms": float(np.sqrt(np.mean(err ** 2))),
