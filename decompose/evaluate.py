@@ -41,6 +41,7 @@ from spectrinsic.decompose.predictions import Predictions
 from spectrinsic.decompose.registry import available_decomposers, get_decomposer
 from spectrinsic.errors import DatasetError
 from spectrinsic.rng import seed_from_key
+from spectrinsic.spectra.colorimetry import encode_srgb
 
 __all__ = [
     "CONDITION_GROUPS",
@@ -377,8 +378,7 @@ def _display(a: np.ndarray) -> np.ndarray:
     if a.ndim == 2:
         a = np.repeat(a[:, :, None], 3, axis=2)
     top = np.percentile(a, 99.0)
-    a = np.clip(a / (top if top > 0 else 1.0), 0.0, 1.0)
-    return np.where(a <= 0.0031308, 12.92 * a, 1.055 * a ** (1 / 2.4) - 0.055)
+    return encode_srgb(a / (top if top > 0 else 1.0))
 
 
 def _figure(path: Path, sid: str, image, reflectance, shading, rows) -> None:
