@@ -41,6 +41,7 @@ from spectrinsic.decompose.predictions import Predictions
 from spectrinsic.decompose.registry import available_decomposers, get_decomposer
 from spectrinsic.errors import DatasetError
 from spectrinsic.rng import seed_from_key
+from spectrinsic.scenes.sample_id import SampleId
 from spectrinsic.spectra.colorimetry import encode_srgb
 
 __all__ = [
@@ -125,11 +126,12 @@ def _sample_id(sample: Mapping[str, Any]) -> str:
 
 
 def sample_condition(sample: Mapping[str, Any]) -> str:
-    """Lighting condition: ``meta["condition"]``, else the last ``__`` field of the sample id."""
+    """Lighting condition: ``meta["condition"]``, else the sample id's
+    (:meth:`spectrinsic.scenes.sample_id.SampleId.parse`)."""
     meta = sample.get("meta", {})
     cond = meta.get("condition") or meta.get("scene_metadata", {}).get("condition")
     if not cond:
-        cond = _sample_id(sample).rsplit("__", 1)[-1]
+        cond = SampleId.parse(_sample_id(sample)).condition
     if cond not in CONDITION_GROUPS:
         raise DatasetError(
             f"sample {_sample_id(sample)!r}: unknown condition {cond!r}; "

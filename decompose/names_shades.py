@@ -65,7 +65,6 @@ from spectrinsic.decompose.constancy import discount_illuminant
 from spectrinsic.decompose.decomposition import Decomposition, finish, prepare_input
 from spectrinsic.decompose.ridges import colour_shades
 from spectrinsic.errors import MissingDependencyError, validate_choice
-# the one sRGB transfer function; private names keep the call sites in __call__ unchanged
 from spectrinsic.spectra.colorimetry import decode_srgb as _srgb_decode
 from spectrinsic.spectra.colorimetry import encode_srgb as _srgb_encode
 
