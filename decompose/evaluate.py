@@ -25,7 +25,6 @@ the scenario table like Table 5.1, ``REPORT.md`` (input, layers, methods and the
 from __future__ import annotations
 
 import logging
-import re
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -40,6 +39,7 @@ from spectrinsic.decompose.photometric import photometric_correction
 from spectrinsic.decompose.predictions import Predictions
 from spectrinsic.decompose.registry import available_decomposers, get_decomposer
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export.names import camera_slug
 from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.sample_id import SampleId
 from spectrinsic.spectra.colorimetry import encode_srgb
@@ -149,10 +149,6 @@ def sample_kind(sample: Mapping[str, Any]) -> str:
     if kind not in _KINDS:
         raise DatasetError(f"sample {_sample_id(sample)!r}: unknown scene kind {kind!r}")
     return str(kind)
-
-
-def _slug(text: str) -> str:
-    return re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-") or "camera"
 
 
 def _grey(a: np.ndarray) -> np.ndarray:
@@ -355,7 +351,7 @@ def evaluate_sample(
     names = layer_metrics("reflectance", metrics)
     inputs: list[tuple[str, str, str, np.ndarray]] = [("srgb", "", "", input_image(sample)[1])]
     if cameras:
-        inputs += [(f"{sc}_{_slug(cam)}", cam, sc, img) for cam, sc, img in _camera_inputs(sample)]
+        inputs += [(f"{sc}_{camera_slug(cam)}", cam, sc, img) for cam, sc, img in _camera_inputs(sample)]
     scores: list[Score] = []
     figure_rows: list[tuple[str, Decomposition]] = []
     for method, decomposer in methods.items():

@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import string
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
@@ -32,6 +31,7 @@ import numpy as np
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.integrity import MANIFEST_NAME
+from spectrinsic.gt_export.names import slug
 from spectrinsic.gt_export.writer import (
     META_NAME,
     SCENE_NAME,
@@ -208,10 +208,6 @@ def _summary_plots(root: Path) -> list[str]:
     return sorted(f for f in found if not f.startswith("contact_sheet"))
 
 
-def _slug(text: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_.-]+", "-", text).strip("-") or "none"
-
-
 def contact_sheet(
     dataset_dir: str | os.PathLike[str], *, out: str | os.PathLike[str] | None = None,
     samples: Sequence[Path] | None = None,
@@ -263,7 +259,7 @@ def _condition_sheets(root: Path, index: Mapping[str, Any]) -> dict[str, str]:
         by_condition.setdefault(str(entry["condition"]), []).append(root / entry["id"])
     out = {}
     for condition, members in sorted(by_condition.items()):
-        rel = f"{_SHEETS_DIR}/{_slug(condition)}.png"
+        rel = f"{_SHEETS_DIR}/{slug(condition, fallback='none')}.png"
         contact_sheet(root, out=root / rel, samples=members)
         out[condition] = rel
     return out
