@@ -40,7 +40,7 @@ import numpy as np
 from spectrinsic.errors import SceneError, validate_choice
 from spectrinsic.rng import generator, seed_from_key
 from spectrinsic.scenes import geometry as g
-from spectrinsic.scenes.model import Camera, Light, LightKind, Scene
+from spectrinsic.scenes.model import Camera, Light, LightKind, Scene, light_power
 from spectrinsic.scenes.objects import OBJECTS
 from spectrinsic.scenes.sample_id import SampleId
 
@@ -356,14 +356,10 @@ def condition_illuminants(name: str, condition: str, *, seed: int) -> tuple[str,
 
 
 def _power(spot: _LightSpot, direction: np.ndarray, focus: np.ndarray, irradiance: float) -> float:
-    """Power giving *irradiance* at *focus* on a surface facing the light (inverse square law;
-    an area light of radiance L and area A delivers about ``L A cos θ / d²``)."""
-    offset = focus - np.asarray(spot.position, float)
-    d2 = float(offset @ offset)
-    if spot.kind == "area":
-        cos_light = float(direction @ offset) / math.sqrt(d2)
-        return irradiance * d2 / (spot.size[0] * spot.size[1] * max(cos_light, 0.2))
-    return irradiance * d2
+    """Power giving *irradiance* at *focus* on a surface facing the light
+    (:func:`spectrinsic.scenes.model.light_power`)."""
+    return light_power(spot.kind, np.asarray(spot.position, float), direction, focus, spot.size,
+                       irradiance)
 
 
 def build(

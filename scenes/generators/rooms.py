@@ -11,16 +11,19 @@ import numpy as np
 from spectrinsic.scenes import geometry as g
 from spectrinsic.scenes.generators.base import GeneratorOptions, Layout
 from spectrinsic.scenes.generators.camera import Footprints
-from spectrinsic.scenes.generators.lights import LIGHT_KINDS, LightVolume
+from spectrinsic.scenes.generators.lights import LightVolume
 from spectrinsic.scenes.generators.materials import (
     MaterialDistribution,
     draw_reflectance,
 )
 from spectrinsic.scenes.generators.shapes import draw_object
+from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_KINDS
 
 __all__ = ["rooms"]
 
 _WALLS = ("left", "right", "back", "front")
+#: The light kinds with a position, which can hang inside a room with a ceiling.
+_PLACED_KINDS = tuple(k for k in LIGHT_KINDS if "position" in LIGHT_FIELDS[k])
 _T = 0.1  # wall thickness, m
 
 
@@ -149,7 +152,7 @@ def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
 
     volume = LightVolume(lo=(0.3, 0.3, 0.6 * h), hi=(w - 0.3, d - 0.3, h - 0.15),
                          focus=(w / 2, d / 2, 0.6),
-                         kinds=("point", "spot", "area") if openness["ceiling"] else LIGHT_KINDS)
+                         kinds=_PLACED_KINDS if openness["ceiling"] else LIGHT_KINDS)
     info = {"generator": "rooms", "room_size": list(size), **openness,
             "n_furniture": len(furniture), "n_objects": len(objects),
             "shapes": [n.rsplit("-", 1)[0] for n, _ in objects], "patterns": patterns}
