@@ -35,7 +35,7 @@ import numpy as np
 from spectrinsic.decompose.decomposition import Decomposer, Decomposition
 from spectrinsic.decompose.judgements import Judgements, sample_judgements
 from spectrinsic.decompose.metrics import METRICS, WHDR_DELTA, get_metric, whdr
-from spectrinsic.decompose.photometric import photometric_correction
+from spectrinsic.decompose.photometric import SCENARIOS, photometric_correction
 from spectrinsic.decompose.predictions import Predictions
 from spectrinsic.decompose.registry import available_decomposers, get_decomposer
 from spectrinsic.errors import DatasetError
@@ -92,7 +92,7 @@ _SHADING_GREY_METRICS = ("si_mse", "lmse", "almse", "corr", "lcorr", "dssim")
 _SHADING_COLOUR_METRICS = ("si_mse", "lmse", "shading_chromaticity")
 #: Metrics of the grey reflectance (Table 3.2's four).
 _REFLECTANCE_GREY_METRICS = ("si_mse", "lmse", "almse", "corr")
-_PHOTOMETRIC = ("SC1", "SC3b", "SC4")
+_PHOTOMETRIC = tuple(SCENARIOS)
 
 
 @dataclass(frozen=True)
