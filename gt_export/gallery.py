@@ -39,6 +39,7 @@ from spectrinsic.gt_export.writer import (
     read_template,
     sample_dirs,
 )
+from spectrinsic.scenes.sample_id import SEPARATOR
 
 __all__ = ["build_gallery", "contact_sheet", "gallery_index", "GALLERY_DIRS", "GALLERY_LAYERS",
            "INDEX_VARIABLE"]
@@ -244,11 +245,12 @@ def contact_sheet(
 
 
 def _wrap(text: str, draw: Any, font: Any) -> list[str]:
-    """*text* in at most two lines that fit a tile, split after ``__`` where possible."""
+    """*text* in at most two lines that fit a tile, split after a sample id's ``__`` where
+    possible (:data:`spectrinsic.scenes.sample_id.SEPARATOR`)."""
     if draw.textlength(text, font=font) <= TILE - 4:
         return [text]
-    cut = text.rfind("__", 0, len(text) // 2 + 8)
-    cut = cut + 2 if cut > 0 else len(text) // 2
+    cut = text.rfind(SEPARATOR, 0, len(text) // 2 + 8)
+    cut = cut + len(SEPARATOR) if cut > 0 else len(text) // 2
     return [text[:cut], text[cut:]]
 
 
