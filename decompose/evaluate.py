@@ -25,7 +25,6 @@ the scenario table like Table 5.1, ``REPORT.md`` (input, layers, methods and the
 from __future__ import annotations
 
 import logging
-import re
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,11 +35,14 @@ import numpy as np
 from spectrinsic.decompose.decomposition import Decomposer, Decomposition
 from spectrinsic.decompose.judgements import Judgements, sample_judgements
 from spectrinsic.decompose.metrics import METRICS, WHDR_DELTA, get_metric, whdr
-from spectrinsic.decompose.photometric import photometric_correction
+from spectrinsic.decompose.photometric import SCENARIOS, photometric_correction
 from spectrinsic.decompose.predictions import Predictions
 from spectrinsic.decompose.registry import available_decomposers, get_decomposer
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export.names import camera_slug
 from spectrinsic.rng import seed_from_key
+from spectrinsic.scenes.sample_id import SampleId
+from spectrinsic.spectra.colorimetry import encode_srgb
 
 __all__ = [
     "CONDITION_GROUPS",
@@ -90,7 +92,7 @@ _SHADING_GREY_METRICS = ("si_mse", "lmse", "almse", "corr", "lcorr", "dssim")
 _SHADING_COLOUR_METRICS = ("si_mse", "lmse", "shading_chromaticity")
 #: Metrics of the grey reflectance (Table 3.2's four).
 _REFLECTANCE_GREY_METRICS = ("si_mse", "lmse", "almse", "corr")
-_PHOTOMETRIC = ("SC1", "SC3b", "SC4")
+_PHOTOMETRIC = tuple(SCENARIOS)
 
 
 @dataclass(frozen=True)
@@ -124,11 +126,12 @@ def _sample_id(sample: Mapping[str, Any]) -> str:
 
 
 def sample_condition(sample: Mapping[str, Any]) -> str:
-    """Lighting condition: ``meta["condition"]``, else the last ``__`` field of the sample id."""
+    """Lighting condition: ``meta["condition"]``, else the sample id's
+    (:meth:`spectrinsic.scenes.sample_id.SampleId.parse`)."""
     meta = sample.get("meta", {})
     cond = meta.get("condition") or meta.get("scene_metadata", {}).get("condition")
     if not cond:
-        cond = _sample_id(sample).rsplit("__", 1)[-1]
+        cond = SampleId.parse(_sample_id(sample)).condition
     if cond not in CONDITION_GROUPS:
         raise DatasetError(
             f"sample {_sample_id(sample)!r}: unknown condition {cond!r}; "
@@ -146,10 +149,6 @@ def sample_kind(sample: Mapping[str, Any]) -> str:
     if kind not in _KINDS:
         raise DatasetError(f"sample {_sample_id(sample)!r}: unknown scene kind {kind!r}")
     return str(kind)
-
-
-def _slug(text: str) -> str:
-    return re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-") or "camera"
 
 
 def _grey(a: np.ndarray) -> np.ndarray:
@@ -352,7 +351,7 @@ def evaluate_sample(
     names = layer_metrics("reflectance", metrics)
     inputs: list[tuple[str, str, str, np.ndarray]] = [("srgb", "", "", input_image(sample)[1])]
     if cameras:
-        inputs += [(f"{sc}_{_slug(cam)}", cam, sc, img) for cam, sc, img in _camera_inputs(sample)]
+        inputs += [(f"{sc}_{camera_slug(cam)}", cam, sc, img) for cam, sc, img in _camera_inputs(sample)]
     scores: list[Score] = []
     figure_rows: list[tuple[str, Decomposition]] = []
     for method, decomposer in methods.items():
@@ -377,8 +376,7 @@ def _display(a: np.ndarray) -> np.ndarray:
     if a.ndim == 2:
         a = np.repeat(a[:, :, None], 3, axis=2)
     top = np.percentile(a, 99.0)
-    a = np.clip(a / (top if top > 0 else 1.0), 0.0, 1.0)
-    return np.where(a <= 0.0031308, 12.92 * a, 1.055 * a ** (1 / 2.4) - 0.055)
+    return encode_srgb(a / (top if top > 0 else 1.0))
 
 
 def _figure(path: Path, sid: str, image, reflectance, shading, rows) -> None:

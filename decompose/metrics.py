@@ -192,10 +192,11 @@ def almse(
     return float(residual / energy)
 
 
-def _pearson(t: np.ndarray, e: np.ndarray, m: np.ndarray, axis) -> np.ndarray:
-    n = m.sum(axis=axis)
-    tc = m * (t - (m * t).sum(axis=axis, keepdims=True) / np.maximum(n, 1.0)[..., None, None])
-    ec = m * (e - (m * e).sum(axis=axis, keepdims=True) / np.maximum(n, 1.0)[..., None, None])
+def _pearson(t: np.ndarray, e: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """Per-window Pearson correlation of ``(n, h, w)`` stacks over the mask *m* (NaN where
+    either is constant)."""
+    tc, ec = _centred(t, m), _centred(e, m)
+    axis = (1, 2)
     cov = (tc * ec).sum(axis=axis)
     var = (tc * tc).sum(axis=axis) * (ec * ec).sum(axis=axis)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -211,7 +212,7 @@ def correlation(
     """
     t, e, m = image_pair(truth, estimate, mask)
     w = np.broadcast_to(m[:, :, None], t.shape).astype(np.float64)
-    r = _pearson(t.reshape(1, -1, 1), e.reshape(1, -1, 1), w.reshape(1, -1, 1), axis=(1, 2))
+    r = _pearson(t.reshape(1, -1, 1), e.reshape(1, -1, 1), w.reshape(1, -1, 1))
     return float(r[0])
 
 
@@ -229,7 +230,7 @@ def local_correlation(
     left out of the mean; NaN when no window remains.
     """
     t, e, m = _windowed(truth, estimate, mask, window, step)
-    r = _pearson(t, e, m, axis=(1, 2))
+    r = _pearson(t, e, m)
     if not np.isfinite(r).any():
         return float("nan")
     return float(np.nanmean(r))

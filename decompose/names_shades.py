@@ -65,6 +65,8 @@ from spectrinsic.decompose.constancy import discount_illuminant
 from spectrinsic.decompose.decomposition import Decomposition, finish, prepare_input
 from spectrinsic.decompose.ridges import colour_shades
 from spectrinsic.errors import MissingDependencyError, validate_choice
+from spectrinsic.spectra.colorimetry import decode_srgb as _srgb_decode
+from spectrinsic.spectra.colorimetry import encode_srgb as _srgb_encode
 
 __all__ = ["NamesAndShades", "global_coherence", "grid_edges"]
 
@@ -85,19 +87,6 @@ PROTOCOL = (
 _EXPOSURE_PERCENTILE = 99.0
 #: Floor of normalised linear values before the logarithm (1/255 of the exposure white).
 _LOG_FLOOR = 1.0 / 255.0
-
-
-def _srgb_encode(linear: np.ndarray) -> np.ndarray:
-    """IEC 61966-2-1 sRGB encoding of linear values in [0, 1]."""
-    import colour
-
-    return np.asarray(colour.cctf_encoding(np.clip(linear, 0.0, 1.0), function="sRGB"))
-
-
-def _srgb_decode(encoded: np.ndarray) -> np.ndarray:
-    import colour
-
-    return np.asarray(colour.cctf_decoding(np.clip(encoded, 0.0, 1.0), function="sRGB"))
 
 
 def grid_edges(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -25,7 +25,10 @@ from spectrinsic.errors import validate_choice
 __all__ = ["SCENARIOS", "Scenario", "photometric_correction", "correction_matrix"]
 
 Scenario = Literal["SC1", "SC3b", "SC4"]
-#: Scenarios of thesis sec. 5.1.3 and what each needs.
+#: The photometric scenarios of the evaluation (thesis sec. 5.1.3) and what each needs: the one
+#: registry of scenario names a camera image is corrected for (``evaluate``, ``report`` and the
+#: predictions layout's ``<scenario>`` folders use these keys, in this order). Study tables with
+#: other columns (Table 5.1's SC1-SC4) are not this registry.
 SCENARIOS: dict[str, str] = {
     "SC1": "camera sensors and light known: remove S_Sen and L_CLig (full 3x3 models)",
     "SC3b": "light known, standard sensors assumed: remove L_CLig fitted for sRGB sensors",

@@ -35,6 +35,7 @@ import numpy as np
 
 from spectrinsic.decompose.decomposition import Decomposition, finish
 from spectrinsic.errors import DatasetError, validate_choice
+from spectrinsic.spectra.colorimetry import decode_srgb
 
 __all__ = ["PNG_ENCODINGS", "Predictions", "read_layer"]
 
@@ -61,11 +62,7 @@ def _from_png(path: Path, encoding: str) -> np.ndarray:
     from spectrinsic.gt_export.png import PNG16_MAX, read_png16
 
     values = read_png16(path).astype(np.float64) / PNG16_MAX
-    if encoding == "srgb":
-        import colour
-
-        values = np.asarray(colour.cctf_decoding(values, function="sRGB"))
-    return values
+    return decode_srgb(values) if encoding == "srgb" else values
 
 
 def read_layer(folder: Path, layer: str, shape: tuple[int, int], *, encoding: str) -> np.ndarray | None:

@@ -25,6 +25,7 @@ import numpy as np
 from spectrinsic.decompose.decomposition import Decomposition
 from spectrinsic.decompose.metrics import lmse
 from spectrinsic.errors import SpectrinsicError
+from spectrinsic.scenes.sample_id import SampleId
 
 __all__ = ["Fold", "HoldOutResult", "grid_points", "hold_one_out", "mit_sample_score",
            "scene_group", "score_grid"]
@@ -34,8 +35,10 @@ GridPoint = tuple[tuple[str, Any], ...]
 
 
 def scene_group(sample_id: str) -> str:
-    """The scene a sample shows: its id before the first ``__`` (``obj-apple__v0__white``)."""
-    return sample_id.split("__", 1)[0]
+    """The scene a sample shows: ``obj-apple`` for ``obj-apple__v0__white``
+    (:meth:`spectrinsic.scenes.sample_id.SampleId.parse`; raises ``DatasetError`` for text
+    that is not a sample id)."""
+    return SampleId.parse(sample_id).scene
 
 
 def grid_points(grid: Mapping[str, Sequence[Any]]) -> list[GridPoint]:

@@ -22,6 +22,7 @@ from spectrinsic.decompose.evaluate import (
     Score,
 )
 from spectrinsic.decompose.metrics import METRICS
+from spectrinsic.decompose.photometric import SCENARIOS
 from spectrinsic.decompose.registry import DECOMPOSERS
 from spectrinsic.results import write_csv, write_json
 
@@ -38,7 +39,7 @@ __all__ = [
 
 _GROUP_ORDER = ("WL", "1L", "2L")
 _KINDS = {"object": "single objects", "complex": "complex scenes"}
-_PHOTOMETRIC = ("SC1", "SC3b", "SC4")
+_PHOTOMETRIC = tuple(SCENARIOS)
 #: ``(column prefix, layer, metric, header)`` of the LMSE table (thesis Tables 5.3/5.4).
 LMSE_COLUMNS: tuple[tuple[str, str, str, str], ...] = (
     ("reflectance", "reflectance", "lmse", "refl."),

@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import string
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
@@ -32,6 +31,7 @@ import numpy as np
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.integrity import MANIFEST_NAME
+from spectrinsic.gt_export.names import slug
 from spectrinsic.gt_export.writer import (
     META_NAME,
     SCENE_NAME,
@@ -39,6 +39,7 @@ from spectrinsic.gt_export.writer import (
     read_template,
     sample_dirs,
 )
+from spectrinsic.scenes.sample_id import SEPARATOR
 
 __all__ = ["build_gallery", "contact_sheet", "gallery_index", "GALLERY_DIRS", "GALLERY_LAYERS",
            "INDEX_VARIABLE"]
@@ -208,10 +209,6 @@ def _summary_plots(root: Path) -> list[str]:
     return sorted(f for f in found if not f.startswith("contact_sheet"))
 
 
-def _slug(text: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_.-]+", "-", text).strip("-") or "none"
-
-
 def contact_sheet(
     dataset_dir: str | os.PathLike[str], *, out: str | os.PathLike[str] | None = None,
     samples: Sequence[Path] | None = None,
@@ -248,11 +245,12 @@ def contact_sheet(
 
 
 def _wrap(text: str, draw: Any, font: Any) -> list[str]:
-    """*text* in at most two lines that fit a tile, split after ``__`` where possible."""
+    """*text* in at most two lines that fit a tile, split after a sample id's ``__`` where
+    possible (:data:`spectrinsic.scenes.sample_id.SEPARATOR`)."""
     if draw.textlength(text, font=font) <= TILE - 4:
         return [text]
-    cut = text.rfind("__", 0, len(text) // 2 + 8)
-    cut = cut + 2 if cut > 0 else len(text) // 2
+    cut = text.rfind(SEPARATOR, 0, len(text) // 2 + 8)
+    cut = cut + len(SEPARATOR) if cut > 0 else len(text) // 2
     return [text[:cut], text[cut:]]
 
 
@@ -263,7 +261,7 @@ def _condition_sheets(root: Path, index: Mapping[str, Any]) -> dict[str, str]:
         by_condition.setdefault(str(entry["condition"]), []).append(root / entry["id"])
     out = {}
     for condition, members in sorted(by_condition.items()):
-        rel = f"{_SHEETS_DIR}/{_slug(condition)}.png"
+        rel = f"{_SHEETS_DIR}/{slug(condition, fallback='none')}.png"
         contact_sheet(root, out=root / rel, samples=members)
         out[condition] = rel
     return out

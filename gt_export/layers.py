@@ -32,6 +32,7 @@ import numpy as np
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import irradiance as irr
+from spectrinsic.gt_export.names import camera_slug
 from spectrinsic.scenes.model import Scene
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
@@ -372,15 +373,6 @@ def _cube_sensor_name(result: Any) -> str:
     return DEFAULT_CUBE_SENSORS
 
 
-def _slug(name: str) -> str:
-    """File-name-safe form of a camera name: ``"camera:Nikon 5100 (NPL)"`` -> ``"nikon-5100-npl"``."""
-    core = name.split(":", 1)[-1].lower()
-    out = "".join(c if c.isalnum() else "-" for c in core)
-    while "--" in out:
-        out = out.replace("--", "-")
-    return out.strip("-")
-
-
 def _camera_key(name: str) -> str:
     return name.split(":", 1)[1] if name.startswith("camera:") else name
 
@@ -642,7 +634,7 @@ def _camera_layers(
     band_set = get_sensors(_cube_sensor_name(s.result), data_dir=s.data_dir)
     weights = cube_to_sensors(band_set.curves, camera_curves(cam, band_set.wavelengths,
                                                              data_dir=s.data_dir), band_set.wavelengths)
-    key, slug = _camera_key(cam), "camera-" + _slug(cam)
+    key, slug = _camera_key(cam), "camera-" + camera_slug(cam)
     image = np.asarray(s.result.raw["bands31"], float) @ weights.T
     refl = coverage_weighted(coverage, canonical_responses(s.material_rho, s.d65, curves, s.wl))
     white = canonical_responses(np.ones(s.wl.size), s.d65, curves, s.wl)

@@ -2,7 +2,7 @@
 
 Previews are for looking only; the data are in the float32 EXR files. Colour previews are
 linear values scaled by an exposure (a robust percentile of luminance maps to 1), clipped to
-[0, 1] and sRGB-encoded with colour-science's ``cctf_encoding`` (IEC 61966-2-1).
+[0, 1] and sRGB-encoded by :func:`spectrinsic.spectra.colorimetry.encode_srgb` (IEC 61966-2-1).
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ import numpy as np
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.integrity import guarded_write
+from spectrinsic.spectra.colorimetry import encode_srgb
 
 __all__ = [
     "EXPOSURE_PERCENTILE",
@@ -53,16 +54,15 @@ def exposure(rgb: np.ndarray, *, percentile: float = EXPOSURE_PERCENTILE) -> flo
 
 
 def encode_srgb8(linear: np.ndarray, scale: float = 1.0) -> np.ndarray:
-    """``(H, W, 3)`` linear values × *scale* -> sRGB-encoded ``uint8`` (clipped to [0, 1]).
+    """``(H, W, 3)`` linear values × *scale* -> sRGB-encoded ``uint8`` codes 0-255.
+
+    :func:`~spectrinsic.spectra.colorimetry.encode_srgb` (clip to [0, 1], NaN -> 0), then
+    rounded to the nearest of 256 codes.
 
     >>> encode_srgb8(np.array([[[0.0, 1.0, 0.2158605]]])).tolist()  # sRGB 0.5 + 1/510
     [[[0, 255, 128]]]
     """
-    import colour
-
-    x = np.nan_to_num(np.asarray(linear, float) * scale, nan=0.0, posinf=1.0, neginf=0.0)
-    encoded = colour.cctf_encoding(np.clip(x, 0.0, 1.0), function="sRGB")
-    return np.round(np.asarray(encoded) * 255.0).astype(np.uint8)
+    return np.round(encode_srgb(np.asarray(linear, float) * scale) * 255.0).astype(np.uint8)
 
 
 def tone_map(rgb: np.ndarray, *, percentile: float = EXPOSURE_PERCENTILE) -> np.ndarray:

@@ -45,7 +45,7 @@ from spectrinsic.gt_export.integrity import (
 )
 from spectrinsic.gt_export.layers import GroundTruth, Layer, compute_ground_truth, identities
 from spectrinsic.provenance import software_versions
-from spectrinsic.scenes.model import LIGHT_FIELDS, Scene, scene_hash
+from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash
 
 __all__ = [
     "FORMAT_VERSION",
@@ -281,7 +281,7 @@ def _meta(
                    if k not in _VOLATILE_META}
     lights = []
     for record in gt.lights:
-        unused = {"position", "direction", "size", "cutoff_deg"} - set(LIGHT_FIELDS[record.kind])
+        unused = set(LIGHT_PLACEMENT) - set(LIGHT_FIELDS[record.kind])
         entry = {k: v for k, v in asdict(record).items() if k not in unused}
         entry["spd"] = get_spectrum(record.spectrum).on(DEFAULT_WAVELENGTHS)
         lights.append(entry)

@@ -26,7 +26,7 @@ from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, SensorSet, get_spectru
 
 __all__ = [
     "DIRECT_DEPTH",
-    "Progress",
+    "PassProgress",
     "PassOutput",
     "render_diagonal",
     "render_spectral",
@@ -39,7 +39,7 @@ logger = logging.getLogger(__name__)
 #: Path depth of a direct-light-only render (camera -> surface -> light).
 DIRECT_DEPTH = 2
 #: Called with 1 after each Mitsuba pass (e.g. ``tqdm.update``).
-Progress = Callable[[int], Any]
+PassProgress = Callable[[int], Any]
 #: Keys of the dict :func:`render_aovs` returns.
 AOV_NAMES = ("coverage", "material_id", "object_id", "depth", "normals", "mask")
 
@@ -124,7 +124,7 @@ def render_diagonal(
     direct: Sequence[bool] | bool = False,
     active_lights: Sequence[int] | None = None,
     variant: str | None = None,
-    progress: Progress | None = None,
+    progress: PassProgress | None = None,
     geometry: Sequence[tr.SurfaceGeometry] | None = None,
 ) -> list[PassOutput]:
     """Diagonal renders of *scene*, one per entry of *value_sets*, all on one loaded scene.
@@ -217,7 +217,7 @@ def render_spectral(
     active_lights: Sequence[int] | None = None,
     variant: str | None = None,
     data_dir: str | None = None,
-    progress: Progress | None = None,
+    progress: PassProgress | None = None,
     geometry: Sequence[tr.SurfaceGeometry] | None = None,
 ) -> PassOutput:
     """Spectral reference: Mitsuba's spectral variant with a ``specfilm`` of *sensors*' curves.
@@ -274,7 +274,7 @@ def render_aovs(
     spp: int,
     seed: int,
     variant: str | None = None,
-    progress: Progress | None = None,
+    progress: PassProgress | None = None,
     geometry: Sequence[tr.SurfaceGeometry] | None = None,
 ) -> tuple[dict[str, np.ndarray], tuple[float, ...]]:
     """Coverage, id, depth and normal maps, box-filtered over the same pixel samples as a render.

@@ -20,7 +20,7 @@ from spectrinsic.render.modes import (
 )
 from spectrinsic.render.passes import (
     PassOutput,
-    Progress,
+    PassProgress,
     render_aovs,
     render_diagonal,
     render_spectral,
@@ -109,7 +109,7 @@ class _Job:
 
 def _run_jobs(
     scene: Scene, jobs: Sequence[_Job], *, wanted: set[str], spp: int, seed: int, max_depth: int,
-    variant: str | None, aovs: bool, progress: Progress | None, data_dir: str | None,
+    variant: str | None, aovs: bool, progress: PassProgress | None, data_dir: str | None,
 ) -> tuple[list[dict[str, PassOutput]], dict[str, np.ndarray], tuple[float, ...]]:
     """Every pass of *jobs*, grouped by Mitsuba variant, plus the AOVs.
 
@@ -169,7 +169,7 @@ def render_scene(
     per_light_modes: Iterable[str] | None = None,
     direct: bool | Iterable[str] = False,
     aovs: bool = True,
-    progress: Progress | None = None,
+    progress: PassProgress | None = None,
     data_dir: str | None = None,
 ) -> RenderResult:
     """Render *scene* in each of *modes* and convert every mode to CIE 1931 XYZ.

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import SceneError
-from spectrinsic.scenes.model import Light, Scene
+from spectrinsic.scenes.model import Light, Scene, unknown_light_kind
 
 __all__ = [
     "CREASE_ANGLE_DEG",
@@ -49,7 +49,8 @@ __all__ = [
 
 #: Faces meeting at a smaller angle than this share smoothed vertex normals (degrees).
 CREASE_ANGLE_DEG = 30.0
-#: Emitter parameter holding each light kind's spectrum in Mitsuba.
+#: Emitter parameter holding the spectrum of each kind of
+#: :data:`spectrinsic.scenes.model.LIGHT_KINDS` in Mitsuba (the meaning of ``Light.power``).
 _EMISSION_PARAM = {"point": "intensity", "spot": "intensity", "directional": "irradiance", "area": "radiance"}
 
 
@@ -257,7 +258,7 @@ def _light(mi: Any, light: Light, emission: Mapping | None, what: str) -> dict[s
         if emission is not None:
             shape["emitter"] = {"type": "area", "radiance": dict(emission)}
         return shape
-    raise SceneError(f"{what}: unknown light kind {light.kind!r}; expected point, spot, area or directional")
+    raise SceneError(f"{what}: {unknown_light_kind(light.kind)}")
 
 
 def _camera(mi: Any, scene: Scene, film: Mapping, sample_count: int) -> dict[str, Any]:

@@ -7,6 +7,8 @@
 - :mod:`~spectrinsic.scenes.geometry` and :mod:`~spectrinsic.scenes.objects`: procedural,
   painted geometry;
 - :mod:`~spectrinsic.scenes.library`: the built-in scenes and illumination conditions;
+- :mod:`~spectrinsic.scenes.sample_id`: :class:`SampleId`, a sample's scene, view and
+  condition and its text form ``<scene>__v<view>__<condition>``;
 - :mod:`~spectrinsic.scenes.blender`: :func:`load_blend` (optional extra ``blender``).
 """
 
@@ -14,13 +16,13 @@ from spectrinsic.scenes.blender import load_blend
 from spectrinsic.scenes.io import load_scene, save_scene
 from spectrinsic.scenes.library import (
     CONDITIONS,
-    SampleSpec,
     build,
     default_samples,
     n_views,
     scene_names,
 )
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene, scene_hash, scene_to_dict
+from spectrinsic.scenes.sample_id import SampleId
 from spectrinsic.scenes.validate import validate_scene
 
 __all__ = [
@@ -29,7 +31,7 @@ __all__ = [
     "Light",
     "Material",
     "Mesh",
-    "SampleSpec",
+    "SampleId",
     "Scene",
     "build",
     "default_samples",

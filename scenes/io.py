@@ -62,15 +62,18 @@ import numpy as np
 from spectrinsic.errors import SceneError, did_you_mean, with_article
 from spectrinsic.scenes.geometry import Part, moved
 from spectrinsic.scenes.model import (
+    LIGHT_DEFAULTED,
     LIGHT_FIELDS,
+    LIGHT_KINDS,
     Camera,
     Light,
     Material,
     Mesh,
     Scene,
     scene_to_dict,
+    unknown_light_kind,
 )
-from spectrinsic.scenes.validate import LIGHT_KINDS, Problems, validate_scene
+from spectrinsic.scenes.validate import Problems, validate_scene
 
 __all__ = [
     "FORMAT_VERSION",
@@ -309,12 +312,8 @@ def _light(doc: _Doc, entry: Any, i: int) -> Light:
     entry = doc.mapping(entry, field, _LIGHT, ("kind", "spectrum", "power"))
     kind = doc.string(entry["kind"], f"{field}.kind")
     if kind not in LIGHT_KINDS:
-        raise doc.fail(
-            f"{field}.kind",
-            f"unknown light kind {kind!r}; expected one of {', '.join(LIGHT_KINDS)}"
-            + did_you_mean(kind, LIGHT_KINDS),
-        )
-    needs = [f for f in LIGHT_FIELDS[kind] if f != "cutoff_deg"]  # a spot's cone has a default
+        raise doc.fail(f"{field}.kind", unknown_light_kind(kind))
+    needs = [f for f in LIGHT_FIELDS[kind] if f not in LIGHT_DEFAULTED]
     for key in needs:
         if key not in entry:
             raise doc.fail(

@@ -40,15 +40,15 @@ import numpy as np
 from spectrinsic.errors import SceneError, validate_choice
 from spectrinsic.rng import generator, seed_from_key
 from spectrinsic.scenes import geometry as g
-from spectrinsic.scenes.model import Camera, Light, LightKind, Scene
+from spectrinsic.scenes.model import Camera, Light, LightKind, Scene, light_power
 from spectrinsic.scenes.objects import OBJECTS
+from spectrinsic.scenes.sample_id import SampleId
 
 __all__ = [
     "CONDITIONS",
     "WHITE",
     "MIN_XY_DISTANCE",
     "TARGET_IRRADIANCE",
-    "SampleSpec",
     "scene_names",
     "n_views",
     "build",
@@ -88,20 +88,6 @@ class _Layout:
     focus: tuple[float, float, float]
     single: _LightSpot
     pair: tuple[_LightSpot, _LightSpot]
-
-
-@dataclass(frozen=True)
-class SampleSpec:
-    """One sample of the default dataset: a scene, a view and an illumination condition."""
-
-    scene: str
-    view: int
-    condition: str
-
-    @property
-    def sample_id(self) -> str:
-        """``"<scene>__v<view>__<condition>"``, e.g. ``"obj-vase__v0__two-colour-a"``."""
-        return f"{self.scene}__v{self.view}__{self.condition}"
 
 
 # --- layouts --------------------------------------------------------------------------------
@@ -370,14 +356,10 @@ def condition_illuminants(name: str, condition: str, *, seed: int) -> tuple[str,
 
 
 def _power(spot: _LightSpot, direction: np.ndarray, focus: np.ndarray, irradiance: float) -> float:
-    """Power giving *irradiance* at *focus* on a surface facing the light (inverse square law;
-    an area light of radiance L and area A delivers about ``L A cos θ / d²``)."""
-    offset = focus - np.asarray(spot.position, float)
-    d2 = float(offset @ offset)
-    if spot.kind == "area":
-        cos_light = float(direction @ offset) / math.sqrt(d2)
-        return irradiance * d2 / (spot.size[0] * spot.size[1] * max(cos_light, 0.2))
-    return irradiance * d2
+    """Power giving *irradiance* at *focus* on a surface facing the light
+    (:func:`spectrinsic.scenes.model.light_power`)."""
+    return light_power(spot.kind, np.asarray(spot.position, float), direction, focus, spot.size,
+                       irradiance)
 
 
 def build(
@@ -477,10 +459,10 @@ def build(
     )
 
 
-def default_samples() -> list[SampleSpec]:
+def default_samples() -> list[SampleId]:
     """Every (scene, view, condition) of the library: 8 x 4 + 3 x 3 x 4 = 68 samples."""
     return [
-        SampleSpec(name, view, condition)
+        SampleId(name, view, condition)
         for name in scene_names()
         for view in range(n_views(name))
         for condition in CONDITIONS

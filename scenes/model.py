@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from dataclasses import dataclass, field, fields, is_dataclass
 from typing import Any, Literal
 
@@ -27,6 +28,12 @@ __all__ = [
     "Scene",
     "LightKind",
     "LIGHT_FIELDS",
+    "LIGHT_KINDS",
+    "LIGHT_PLACEMENT",
+    "LIGHT_DEFAULTED",
+    "make_light",
+    "unknown_light_kind",
+    "light_power",
     "scene_to_dict",
     "scene_hash",
 ]
@@ -40,6 +47,13 @@ LIGHT_FIELDS: dict[str, tuple[str, ...]] = {
     "area": ("position", "direction", "size"),
     "directional": ("direction",),
 }
+#: The light kinds, in the table's order (``typing.get_args(LightKind)`` is the same).
+LIGHT_KINDS: tuple[LightKind, ...] = tuple(LIGHT_FIELDS)  # type: ignore[arg-type]
+#: Every placement field some kind uses (the union of :data:`LIGHT_FIELDS`).
+LIGHT_PLACEMENT: tuple[str, ...] = tuple(dict.fromkeys(f for fs in LIGHT_FIELDS.values() for f in fs))
+#: Placement fields with a default that a scene file may leave out (a spot's cone half-angle,
+#: :attr:`Light.cutoff_deg`).
+LIGHT_DEFAULTED: tuple[str, ...] = ("cutoff_deg",)
 
 
 @dataclass(frozen=True)
@@ -104,7 +118,8 @@ class Light:
     Attributes
     ----------
     kind
-        ``"point"``, ``"spot"``, ``"area"`` (a rectangle) or ``"directional"``.
+        One of :data:`LIGHT_KINDS`: ``"point"``, ``"spot"``, ``"area"`` (a rectangle) or
+        ``"directional"``; :data:`LIGHT_FIELDS` lists the placement fields each uses.
     spectrum
         Registry name of an illuminant, e.g. ``"planck:2800K"``. The registry normalises every
         illuminant to unit luminance-weighted mean, so *power* alone sets brightness.
@@ -129,6 +144,57 @@ class Light:
     size: tuple[float, float] = (1.0, 1.0)
     cutoff_deg: float = 30.0
     name: str = "light"
+
+
+def unknown_light_kind(kind: object) -> str:
+    """The message for a light kind not in :data:`LIGHT_KINDS`, with a did-you-mean.
+
+    >>> unknown_light_kind("spto")
+    "unknown light kind 'spto'; expected one of point, spot, area, directional (did you mean 'spot'?)"
+    """
+    from spectrinsic.errors import did_you_mean
+
+    return (f"unknown light kind {kind!r}; expected one of {', '.join(LIGHT_KINDS)}"
+            + did_you_mean(str(kind), LIGHT_KINDS))
+
+
+def make_light(kind: LightKind, spectrum: str, power: float, *, name: str = "light",
+               **placement: Any) -> Light:
+    """A :class:`Light` of *kind* with only the placement fields its kind uses
+    (:data:`LIGHT_FIELDS`) taken from *placement*; the others keep their defaults, so saved
+    scenes and records stay tidy.
+
+    >>> make_light("point", "cie:D65", 1.0, position=(0, 0, 2), direction=(1, 0, 0)).direction
+    (0.0, 0.0, -1.0)
+    """
+    unknown = set(placement) - set(LIGHT_PLACEMENT)
+    if unknown:
+        raise TypeError(f"make_light: unknown placement field(s) {sorted(unknown)}; "
+                        f"expected some of {list(LIGHT_PLACEMENT)}")
+    used = {k: v for k, v in placement.items() if k in LIGHT_FIELDS[kind]}
+    return Light(kind=kind, spectrum=spectrum, power=power, name=name, **used)
+
+
+def light_power(kind: str, position: np.ndarray, direction: np.ndarray, focus: np.ndarray,
+                size: tuple[float, float], irradiance: float) -> float:
+    """:attr:`Light.power` delivering *irradiance* at *focus* on a surface facing the light.
+
+    Inverse square law for point and spot lights (power ``E d²``, a radiant intensity); an
+    area light of radiance L and area A gives about ``L A cos θ / d²`` (cos θ of its normal
+    *direction* towards *focus*, at least 0.2); a directional light's power is the irradiance.
+    Positions in scene units, *direction* a unit vector; relative radiometric units.
+
+    >>> light_power("point", np.zeros(3), np.array([0, 0, 1.0]), np.array([0, 0, 2.0]), (1, 1), 1.0)
+    4.0
+    """
+    if "position" not in LIGHT_FIELDS[kind]:
+        return irradiance
+    offset = focus - np.asarray(position, float)
+    d2 = float(offset @ offset)
+    if "size" in LIGHT_FIELDS[kind]:
+        cos_light = float(direction @ offset) / math.sqrt(d2)
+        return irradiance * d2 / (size[0] * size[1] * max(cos_light, 0.2))
+    return irradiance * d2
 
 
 @dataclass(frozen=True)

@@ -26,10 +26,9 @@ from typing import TypeVar
 import numpy as np
 
 from spectrinsic.errors import SceneError, SpectrinsicError, with_article
-from spectrinsic.scenes.model import LIGHT_FIELDS, Scene
+from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_KINDS, Scene, unknown_light_kind
 
 __all__ = [
-    "LIGHT_KINDS",
     "VISIBILITY_GRID",
     "validate_scene",
     "Problems",
@@ -40,7 +39,6 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-LIGHT_KINDS = tuple(LIGHT_FIELDS)
 #: Rays per image side of the "camera looking at nothing" test.
 VISIBILITY_GRID = 16
 #: A point is inside a closed mesh when its winding number exceeds this (exactly 1 inside,
@@ -250,14 +248,7 @@ def _check_lights(scene: Scene, source: str) -> None:
     for i, light in enumerate(scene.lights):
         where = f"lights[{i}]"
         if light.kind not in LIGHT_KINDS:
-            from spectrinsic.errors import did_you_mean
-
-            raise _fail(
-                source,
-                f"{where}.kind",
-                f"unknown light kind {light.kind!r}; expected one of {', '.join(LIGHT_KINDS)}"
-                + did_you_mean(str(light.kind), LIGHT_KINDS),
-            )
+            raise _fail(source, f"{where}.kind", unknown_light_kind(light.kind))
         power = light.power
         if isinstance(power, bool) or not isinstance(power, (int, float, np.floating, np.integer)):
             raise _fail(source, f"{where}.power", f"expected a number, got {power!r}")
@@ -267,7 +258,8 @@ def _check_lights(scene: Scene, source: str) -> None:
             raise _fail(
                 source, f"{where}.position", f"expected 3 finite numbers, got {light.position!r}"
             )
-        if light.kind != "point":
+        uses = LIGHT_FIELDS[light.kind]
+        if "direction" in uses:
             d = _vec(light.direction)
             if d is None or np.linalg.norm(d) == 0:
                 raise _fail(
@@ -275,13 +267,13 @@ def _check_lights(scene: Scene, source: str) -> None:
                     f"{where}.direction",
                     f"expected a non-zero 3-vector, got {light.direction!r}",
                 )
-        if light.kind == "area":
+        if "size" in uses:
             s = _vec(light.size, 2)
             if s is None or np.any(s <= 0):
                 raise _fail(
                     source, f"{where}.size", f"expected (width, height) > 0, got {light.size!r}"
                 )
-        if light.kind == "spot" and not 0 < light.cutoff_deg <= 90:
+        if "cutoff_deg" in uses and not 0 < light.cutoff_deg <= 90:
             raise _fail(
                 source,
                 f"{where}.cutoff_deg",
@@ -330,7 +322,7 @@ def _check_placement(scene: Scene, source: str) -> None:
     points = {
         f"lights[{i}].position ({light.kind} light)": light.position
         for i, light in enumerate(scene.lights)
-        if light.kind != "directional"
+        if "position" in LIGHT_FIELDS[light.kind]
     }
     points["camera.origin"] = scene.camera.origin
     labels, xyz = list(points), np.asarray(list(points.values()), dtype=np.float64)

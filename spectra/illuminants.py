@@ -116,26 +116,27 @@ def daylight(key: str) -> Spectrum:
     return _illuminant(f"daylight:{t:g}K", sd.wavelengths, sd.values, "CIE 015:2018 daylight")
 
 
-def cie_illuminant(key: str) -> Spectrum:
-    """A CIE standard illuminant shipped by colour-science: A, D50, D65, FL1–FL12, LED-*, HP*..."""
+def _colour_dataset(table: str, key: str, family: str, what: str, source: str) -> Spectrum:
+    """Spectrum *key* of colour-science's dataset ``colour.<table>``, named ``<family>:<key>``."""
     import colour
 
-    sds = colour.SDS_ILLUMINANTS
+    sds = getattr(colour, table)
     if key not in sds:
-        raise SpectrumNotFoundError(f"unknown CIE illuminant {key!r}" + did_you_mean(key, sds))
+        raise SpectrumNotFoundError(f"unknown {what} {key!r}" + did_you_mean(key, sds))
     sd = sds[key]
-    return _illuminant(f"cie:{key}", sd.wavelengths, sd.values, "CIE illuminants via colour-science")
+    return _illuminant(f"{family}:{key}", sd.wavelengths, sd.values, source)
+
+
+def cie_illuminant(key: str) -> Spectrum:
+    """A CIE standard illuminant shipped by colour-science: A, D50, D65, FL1–FL12, LED-*, HP*..."""
+    return _colour_dataset("SDS_ILLUMINANTS", key, "cie", "CIE illuminant",
+                           "CIE illuminants via colour-science")
 
 
 def light_source(key: str) -> Spectrum:
     """A measured light source from colour-science's ``SDS_LIGHT_SOURCES``."""
-    import colour
-
-    sds = colour.SDS_LIGHT_SOURCES
-    if key not in sds:
-        raise SpectrumNotFoundError(f"unknown light source {key!r}" + did_you_mean(key, sds))
-    sd = sds[key]
-    return _illuminant(f"light:{key}", sd.wavelengths, sd.values, "colour-science SDS_LIGHT_SOURCES")
+    return _colour_dataset("SDS_LIGHT_SOURCES", key, "light", "light source",
+                           "colour-science SDS_LIGHT_SOURCES")
 
 
 def sfu_illuminant(key: str, data_dir: str | None = None) -> Spectrum:

@@ -166,6 +166,7 @@ def write_render(out: Path, scene: Any, result: Any, *, data_dir: str | None = N
 def _ground_truth(args: argparse.Namespace) -> int:
     """``render --ground-truth``: a thin alias of ``dataset`` (one sample; library name or file)."""
     from spectrinsic.cli import dataset as cli_dataset
+    from spectrinsic.scenes.sample_id import SampleId
 
     path = Path(args.scene)
     is_file = path.suffix.lower() in (".yaml", ".yml", ".blend") or path.exists()
@@ -176,7 +177,7 @@ def _ground_truth(args: argparse.Namespace) -> int:
         out=str(args.out), preset=args.preset, seed=args.seed, workers=None, threads=None,
         scheduler=None, spp=args.spp, batches=None, noise_target=None, max_batches=None,
         no_denoise=False, direct=args.direct, resolution=resolution, rebuild=False,
-        only=None if is_file else f"{args.scene}__v{args.view}__{args.condition}",
+        only=None if is_file else str(SampleId(args.scene, args.view, args.condition)),
         generator=None, scenes=[args.scene] if is_file else None, material_map=args.material_map,
         default_spectrum=None, count=1, views=1, value_range="2,9", chroma_range="0,16", sfu=False,
         data_dir=getattr(args, "data_dir", None), quiet=getattr(args, "quiet", False))

@@ -28,6 +28,7 @@ from spectrinsic.errors import DatasetError
 from spectrinsic.pipeline.executors import Executor, SerialExecutor
 from spectrinsic.pipeline.presets import DatasetConfig
 from spectrinsic.rng import seed_from_key
+from spectrinsic.scenes.sample_id import SampleId
 
 __all__ = [
     "SampleTask",
@@ -39,7 +40,6 @@ __all__ = [
     "build_sample",
     "build_dataset",
     "finalize_dataset",
-    "set_render_threads",
 ]
 
 log = logging.getLogger(__name__)
@@ -51,10 +51,9 @@ class SampleTask:
 
     Attributes
     ----------
-    scene, view, condition
-        Which library scene, camera view and lighting condition.
-    sample_id
-        Folder name of the sample, e.g. ``"obj-vase__v0__two-colour-a"``.
+    id
+        Which scene, camera view and lighting condition; ``str(id)`` is the sample's folder
+        name (:attr:`sample_id`).
     seed
         The sample's render seed, ``seed_from_key(config.seed, sample_id)``. The scene library
         draws the lights from the root seed ``config.seed`` instead, so every view of a scene
@@ -72,16 +71,30 @@ class SampleTask:
         builds the scene from; ``None`` for a library scene.
     """
 
-    scene: str
-    view: int
-    condition: str
-    sample_id: str
+    id: SampleId
     seed: int
     out_dir: str
     config: DatasetConfig
     data_dir: str | None = None
     render_threads: int | None = None
     source: Any = None
+
+    @property
+    def sample_id(self) -> str:
+        """Folder name of the sample, ``str(self.id)``, e.g. ``"obj-vase__v0__two-colour-a"``."""
+        return str(self.id)
+
+    @property
+    def scene(self) -> str:
+        """The scene's name, ``self.id.scene``."""
+        return self.id.scene
+
+    @classmethod
+    def planned(cls, sid: SampleId, config: DatasetConfig, out_dir: str, **options: Any) -> SampleTask:
+        """The task of sample *sid*, seeded ``seed_from_key(config.seed, str(sid))``; *options*
+        are the remaining fields (``data_dir``, ``render_threads``, ``source``)."""
+        return cls(id=sid, seed=seed_from_key(config.seed, str(sid)), out_dir=out_dir,
+                   config=config, **options)
 
 
 @dataclass(frozen=True)
@@ -201,25 +214,14 @@ def plan_samples(
         tasks = plan_source_samples(out, config, render_threads=render_threads,
                                     data_dir=None if data_dir is None else str(data_dir))
         return select_samples(tasks, only)
-    specs = select_samples(default_samples(), only)
-    return [
-        SampleTask(
-            scene=s.scene,
-            view=s.view,
-            condition=s.condition,
-            sample_id=s.sample_id,
-            seed=seed_from_key(config.seed, s.sample_id),
-            out_dir=out,
-            config=config,
-            data_dir=None if data_dir is None else str(data_dir),
-            render_threads=render_threads,
-        )
-        for s in specs
-    ]
+    tasks = [SampleTask.planned(sid, config, out, render_threads=render_threads,
+                                data_dir=None if data_dir is None else str(data_dir))
+             for sid in default_samples()]
+    return select_samples(tasks, only)
 
 
-def select_samples(specs: Sequence[Any], only: Sequence[str] | str | None) -> list[Any]:
-    """Keep the specs whose ``sample_id`` matches one of the glob patterns *only*."""
+def select_samples(specs: Sequence[SampleTask], only: Sequence[str] | str | None) -> list[SampleTask]:
+    """Keep the tasks whose ``sample_id`` matches one of the glob patterns *only*."""
     if only is None:
         return list(specs)
     patterns = [p.strip() for p in only.split(",")] if isinstance(only, str) else list(only)
@@ -233,17 +235,6 @@ def select_samples(specs: Sequence[Any], only: Sequence[str] | str | None) -> li
     return kept
 
 
-def set_render_threads(n: int | None) -> None:
-    """Limit Dr.Jit's thread pool in this process to *n* threads (``None``: leave it).
-
-    With several worker processes on one machine, one pool per process sized to its share of
-    the cores avoids oversubscription.
-    """
-    from spectrinsic.render import set_thread_count
-
-    set_thread_count(n)
-
-
 def build_sample(task: SampleTask) -> SampleOutcome:
     """Build one sample: scene → render → ground-truth export. Runs in a worker.
 
@@ -253,9 +244,9 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         Status ``"built"`` with timings and the worker's peak memory.
     """
     from spectrinsic.gt_export import export_sample
-    from spectrinsic.render import render_batches
+    from spectrinsic.render import render_batches, set_thread_count
 
-    set_render_threads(task.render_threads)
+    set_thread_count(task.render_threads)  # one pool per worker, sized to its share of cores
     cfg = task.config
     t0 = time.perf_counter()
     scene = _task_scene(task)
@@ -311,7 +302,7 @@ def _task_scene(task: SampleTask) -> Any:
 
     if task.source is None:
         cfg = task.config
-        return build(task.scene, view=task.view, condition=task.condition, seed=cfg.seed,
+        return build(task.id.scene, view=task.id.view, condition=task.id.condition, seed=cfg.seed,
                      width=cfg.width, height=cfg.height)
     from spectrinsic.pipeline.sources import save_generated
     from spectrinsic.scenes.sources import GeneratedSource

@@ -3,8 +3,8 @@
 A config holds every setting that changes the files of a sample (resolution, samples per pixel,
 render modes, passes, seed). Its hash (:meth:`DatasetConfig.config_hash`) is the SHA-256 of
 canonical JSON of those settings, the preset name, spectrinsic's pixel version and the versions
-of the software that computes the pixels (:func:`software_versions`); a sample folder is reused only when the hash in its ``meta.json``
-matches. How the build is run (workers, threads, scheduler, which samples) never enters it.
+of the software that computes the pixels (:func:`hashed_versions`); a sample folder is reused
+only when the hash in its ``meta.json`` matches. How the build is run (workers, threads, scheduler, which samples) never enters it.
 """
 
 from __future__ import annotations
@@ -14,20 +14,18 @@ from typing import Any
 
 from spectrinsic import provenance
 from spectrinsic.errors import DatasetError, validate_choice
+from spectrinsic.render.modes import RENDER_MODES
 
 __all__ = [
     "DatasetConfig",
     "PRESETS",
-    "RENDER_MODES",
     "HASHED_PACKAGES",
     "PIXELS_VERSION",
     "preset_names",
     "get_preset",
-    "software_versions",
+    "hashed_versions",
 ]
 
-#: Render modes a config may ask for (see :func:`spectrinsic.render.render_scene`).
-RENDER_MODES: tuple[str, ...] = ("spectral", "rgb3", "gauss3", "rgb6", "bands31")
 #: Modes of the default and paper presets: the reference cube, the 3-/6-sensor approximations
 #: it measures, and the spectral Monte Carlo render.
 _STANDARD_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
@@ -44,9 +42,10 @@ PIXELS_VERSION = 2
 HASHED_PACKAGES: dict[str, int | None] = {"mitsuba": None, "drjit": None, "colour-science": 2, "numpy": 1}
 
 
-def software_versions() -> dict[str, str]:
-    """:data:`PIXELS_VERSION` and the versions of :data:`HASHED_PACKAGES`, each cut to the
-    parts that change pixels (``"absent"`` when a package is absent)."""
+def hashed_versions() -> dict[str, str]:
+    """The versions that enter the config hash: :data:`PIXELS_VERSION` and the versions of
+    :data:`HASHED_PACKAGES` (:func:`spectrinsic.provenance.software_versions`), each cut to
+    the parts that change pixels (``"absent"`` when a package is absent)."""
     installed = provenance.software_versions(HASHED_PACKAGES, python=False)
     out = {"spectrinsic-pixels": str(PIXELS_VERSION)}
     for name, parts in HASHED_PACKAGES.items():
@@ -69,7 +68,8 @@ class DatasetConfig:
     max_depth
         Maximum path length (Mitsuba's ``max_depth``; 2 = direct light only).
     modes
-        Render modes, a subset of :data:`RENDER_MODES`; ``"spectral"`` is the physical reference.
+        Render modes, names registered in :data:`spectrinsic.render.modes.RENDER_MODES`;
+        ``"spectral"`` is the physical reference.
     per_light
         Also render each light alone (needed for the per-pixel illuminant map of multi-light
         scenes).
@@ -188,8 +188,8 @@ class DatasetConfig:
 
     def to_dict(self) -> dict[str, Any]:
         """The record written with the dataset (``export_sample``, manifest): preset name,
-        settings and :func:`software_versions`. Its canonical hash is :meth:`config_hash`."""
-        return {"preset": self.preset, **self.settings(), "software": software_versions()}
+        settings and :func:`hashed_versions`. Its canonical hash is :meth:`config_hash`."""
+        return {"preset": self.preset, **self.settings(), "software": hashed_versions()}
 
     def config_hash(self) -> str:
         """SHA-256 (hex) of the canonical JSON of :meth:`to_dict`.

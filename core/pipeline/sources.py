@@ -22,7 +22,6 @@ from typing import Any
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.pipeline.presets import DatasetConfig
-from spectrinsic.rng import seed_from_key
 
 __all__ = ["SCENES_FOLDER", "generator_source", "files_source", "plan_source_samples", "save_generated"]
 
@@ -96,6 +95,7 @@ def plan_source_samples(out: str, config: DatasetConfig, *, data_dir: str | None
     """The :class:`~spectrinsic.pipeline.dataset.SampleTask` list of ``config.source``."""
     from spectrinsic.pipeline.dataset import SampleTask
     from spectrinsic.scenes.generators import generated_family, generated_scene_name
+    from spectrinsic.scenes.sample_id import SampleId
     from spectrinsic.scenes.sources import FileSource, GeneratedSource
 
     spec = json.loads(config.source or "{}")
@@ -112,9 +112,8 @@ def plan_source_samples(out: str, config: DatasetConfig, *, data_dir: str | None
             name = _SAFE.sub("-", Path(entry["path"]).stem)
             rows.append((name, 0, "file", FileSource(entry["path"], config.width, config.height,
                                                      materials, spec.get("default_spectrum"))))
-    return [SampleTask(scene=name, view=v, condition=cond, sample_id=f"{name}__v{v}__{cond}",
-                       seed=seed_from_key(config.seed, f"{name}__v{v}__{cond}"), out_dir=out,
-                       config=config, data_dir=data_dir, render_threads=render_threads, source=src)
+    return [SampleTask.planned(SampleId(name, v, cond), config, out, data_dir=data_dir,
+                               render_threads=render_threads, source=src)
             for name, v, cond, src in rows]
 
 

@@ -17,12 +17,18 @@ import numpy as np
 
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes.library import MIN_XY_DISTANCE, TARGET_IRRADIANCE, WHITE
-from spectrinsic.scenes.model import Light, LightKind
+from spectrinsic.scenes.model import (
+    LIGHT_FIELDS,
+    LIGHT_KINDS,
+    Light,
+    LightKind,
+    light_power,
+    make_light,
+)
 
-__all__ = ["FAMILIES", "LIGHT_KINDS", "LightVolume", "draw_illuminant", "draw_lights"]
+__all__ = ["FAMILIES", "LightVolume", "draw_illuminant", "draw_lights"]
 
 FAMILIES: tuple[str, ...] = ("white", "one-colour", "two-colour")
-LIGHT_KINDS: tuple[LightKind, ...] = ("point", "spot", "area", "directional")
 _LEDS = ("cie:LED-B1", "cie:LED-B2", "cie:LED-B3", "cie:LED-B4", "cie:LED-B5", "cie:LED-BH1",
          "cie:LED-RGB1", "cie:LED-V1", "cie:LED-V2")
 _FLUORESCENTS = tuple(f"cie:FL{i}" for i in range(1, 13))
@@ -88,36 +94,18 @@ def _family_spectra(family: str, n: int, rng: np.random.Generator, sfu: Sequence
     raise SceneError(f"could not draw distinct coloured illuminants for {family!r}")
 
 
-def _power(kind: str, position: np.ndarray, direction: np.ndarray, focus: np.ndarray,
-           size: tuple[float, float], irradiance: float) -> float:
-    """Power delivering *irradiance* at *focus* on a surface facing the light (inverse square
-    law; an area light of radiance L and area A gives about ``L A cos θ / d²``)."""
-    if kind == "directional":
-        return irradiance
-    offset = focus - position
-    d2 = float(offset @ offset)
-    if kind == "area":
-        return irradiance * d2 / (size[0] * size[1] * max(float(direction @ offset) / math.sqrt(d2), 0.2))
-    return irradiance * d2
-
-
 def _one_light(i: int, kind: LightKind, spectrum: str, position: np.ndarray,
                volume: LightVolume, share: float, rng: np.random.Generator) -> Light:
     focus = np.asarray(volume.focus, float)
     direction = focus - position
     direction /= np.linalg.norm(direction)
     size = (float(rng.uniform(0.2, 0.8)), float(rng.uniform(0.2, 0.8)))
-    power = _power(kind, position, direction, focus, size, share) * float(rng.uniform(0.5, 2.0))
-    extra: dict[str, object] = {}
-    if kind != "point":
-        extra["direction"] = tuple(float(x) for x in direction)
-    if kind == "area":
-        extra["size"] = size
-    if kind == "spot":
-        extra["cutoff_deg"] = float(rng.uniform(25.0, 60.0))
-    pos = (0.0, 0.0, 0.0) if kind == "directional" else tuple(float(x) for x in position)
-    return Light(kind=kind, spectrum=spectrum, power=power, position=pos,  # type: ignore[arg-type]
-                 name=f"light{i}", **extra)  # type: ignore[arg-type]
+    power = light_power(kind, position, direction, focus, size, share) * float(rng.uniform(0.5, 2.0))
+    placement: dict[str, object] = {"position": tuple(float(x) for x in position),
+                                    "direction": tuple(float(x) for x in direction), "size": size}
+    if "cutoff_deg" in LIGHT_FIELDS[kind]:  # drawn only for the kinds that have a cone
+        placement["cutoff_deg"] = float(rng.uniform(25.0, 60.0))
+    return make_light(kind, spectrum, power, name=f"light{i}", **placement)
 
 
 def draw_lights(

@@ -11,16 +11,21 @@ import numpy as np
 from spectrinsic.scenes import geometry as g
 from spectrinsic.scenes.generators.base import GeneratorOptions, Layout
 from spectrinsic.scenes.generators.camera import Footprints
-from spectrinsic.scenes.generators.lights import LIGHT_KINDS, LightVolume
+from spectrinsic.scenes.generators.lights import LightVolume
 from spectrinsic.scenes.generators.materials import (
     MaterialDistribution,
     draw_reflectance,
 )
 from spectrinsic.scenes.generators.shapes import draw_object
+from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_KINDS
 
 __all__ = ["rooms"]
 
 _WALLS = ("left", "right", "back", "front")
+#: The light kinds with a position, which can hang inside a room with a ceiling.
+_PLACED_KINDS = tuple(k for k in LIGHT_KINDS if "position" in LIGHT_FIELDS[k])
+#: Placed kinds that can be aimed: the uplights of indirectly lit rooms.
+_AIMED_KINDS = tuple(k for k in _PLACED_KINDS if "direction" in LIGHT_FIELDS[k])
 _T = 0.1  # wall thickness, m
 
 
@@ -144,10 +149,10 @@ def _light_volume(rng: np.random.Generator, size: tuple[float, float, float],
     w, d, h = size
     if openness["ceiling"] and openness["light_walls"] and rng.random() < 0.75:
         return LightVolume(lo=(0.4, 0.4, 0.35 * h), hi=(w - 0.4, d - 0.4, 0.6 * h),
-                           focus=(w / 2, d / 2, h), kinds=("spot", "area")), "indirect"
+                           focus=(w / 2, d / 2, h), kinds=_AIMED_KINDS), "indirect"
     return LightVolume(lo=(0.3, 0.3, 0.6 * h), hi=(w - 0.3, d - 0.3, h - 0.15),
                        focus=(w / 2, d / 2, 0.6),
-                       kinds=("point", "spot", "area") if openness["ceiling"] else LIGHT_KINDS), "direct"
+                       kinds=_PLACED_KINDS if openness["ceiling"] else LIGHT_KINDS), "direct"
 
 
 def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:

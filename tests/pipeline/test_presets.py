@@ -8,7 +8,7 @@ import json
 import pytest
 
 from spectrinsic.errors import SpectrinsicError
-from spectrinsic.pipeline.presets import PRESETS, DatasetConfig, get_preset, software_versions
+from spectrinsic.pipeline.presets import PRESETS, DatasetConfig, get_preset, hashed_versions
 
 
 def test_presets_exist_and_scale_up():
@@ -37,6 +37,18 @@ def test_invalid_settings_raise(bad):
         get_preset("preview").with_options(**bad)
 
 
+def test_every_registered_render_mode_validates():
+    """The config accepts exactly the render package's registry (gauss3 included), no list of
+    its own."""
+    from spectrinsic.render.modes import RENDER_MODES
+
+    assert "gauss3" in RENDER_MODES
+    cfg = get_preset("preview").with_options(modes=tuple(RENDER_MODES), share_mode="gauss3")
+    assert cfg.modes == tuple(RENDER_MODES) and cfg.share_mode == "gauss3"
+    with pytest.raises(SpectrinsicError, match="did you mean 'gauss3'"):
+        get_preset("preview").with_options(modes=("gaus3",))
+
+
 def test_with_options_rejects_unknown_settings():
     with pytest.raises(SpectrinsicError, match="unknown dataset setting"):
         get_preset("preview").with_options(samples_per_pixel=3)
@@ -48,7 +60,7 @@ def test_config_hash_is_sha256_of_canonical_json():
     # Independent computation: sorted keys, compact separators, UTF-8.
     text = json.dumps(record, sort_keys=True, separators=(",", ":"), ensure_ascii=False)
     assert cfg.config_hash() == hashlib.sha256(text.encode("utf-8")).hexdigest()
-    assert record["software"] == software_versions()
+    assert record["software"] == hashed_versions()
     assert "spectrinsic-pixels" in record["software"] and "mitsuba" in record["software"]
 
 

@@ -119,3 +119,26 @@ def test_room_coverage_partitions_each_pixel(make_room):
     assert np.all(picked[inside] >= cov.max(axis=-1)[inside] - FLOAT32_ATOL)
     assert set(np.unique(result.aovs["object_id"])) <= {-1, 0, 1} and 1 in result.aovs["object_id"]
     assert result.meta["timings"]["aovs"]["passes"] == 3
+
+
+def test_every_light_kind_of_the_scene_model_translates(make_plane):
+    """The translator covers exactly the scene model's table of light kinds."""
+    from dataclasses import replace
+
+    from spectrinsic.render.translate import emission_key
+    from spectrinsic.scenes.model import LIGHT_KINDS, make_light
+
+    base = make_plane("flat:0.5", "cie:D65")
+    for kind in LIGHT_KINDS:
+        light = make_light(kind, "cie:D65", 1.0, position=(0.0, 0.0, 1.5), direction=(0.0, 0.0, -1.0))
+        scene = replace(base, lights=(light,))
+        assert emission_key(scene, 0, spectral=True).endswith(".values")
+        with variant_scope("scalar_rgb"):
+            d = scene_to_mitsuba(scene, materials=[rgb_spectrum([0.5, 0.5, 0.5])],
+                                 lights=[rgb_spectrum([1, 1, 1])], film=hdr_film(4, 4),
+                                 integrator=path_integrator(2), sample_count=1)
+        assert "light_0" in d
+    bogus = replace(base, lights=(replace(base.lights[0], kind="laser"),))
+    with variant_scope("scalar_rgb"), pytest.raises(SceneError, match="unknown light kind 'laser'; expected one of point, spot, area, directional"):
+        scene_to_mitsuba(bogus, materials=[rgb_spectrum([0.5, 0.5, 0.5])], lights=[rgb_spectrum([1, 1, 1])],
+                         film=hdr_film(4, 4), integrator=path_integrator(2), sample_count=1)

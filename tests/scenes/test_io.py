@@ -14,7 +14,7 @@ import yaml
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes import library
 from spectrinsic.scenes.io import load_scene, save_scene
-from spectrinsic.scenes.model import scene_hash
+from spectrinsic.scenes.model import Light, scene_hash
 
 SEED = 7
 
@@ -332,3 +332,27 @@ def test_format_documentation_example_loads(tmp_path):
     assert len(scene.meshes[0].faces) == len(part.faces)
     # scale 0.5 then lift by 0.1: the cup's foot sits at z = 0.1
     assert scene.meshes[0].vertices[:, 2].min() == pytest.approx(0.1, abs=1e-6)
+
+
+def test_light_kind_table_is_the_one_list_of_kinds():
+    """LightKind, LIGHT_KINDS and LIGHT_FIELDS agree; make_light keeps only a kind's fields."""
+    import typing
+
+    from spectrinsic.scenes.model import (
+        LIGHT_FIELDS,
+        LIGHT_KINDS,
+        LIGHT_PLACEMENT,
+        LightKind,
+        make_light,
+    )
+
+    assert typing.get_args(LightKind) == LIGHT_KINDS == tuple(LIGHT_FIELDS)
+    assert set(LIGHT_PLACEMENT) == {"position", "direction", "size", "cutoff_deg"}
+    placement = {"position": (1.0, 2.0, 3.0), "direction": (0.0, 1.0, 0.0), "size": (2.0, 3.0),
+                 "cutoff_deg": 45.0}
+    for kind in LIGHT_KINDS:
+        light = make_light(kind, "cie:D65", 1.0, **placement)
+        default = Light(kind, "cie:D65", 1.0)
+        for f in LIGHT_PLACEMENT:
+            expected = placement[f] if f in LIGHT_FIELDS[kind] else getattr(default, f)
+            assert getattr(light, f) == expected, (kind, f)

@@ -44,7 +44,7 @@ def test_counts_and_names():
 def test_default_samples():
     samples = library.default_samples()
     assert len(samples) == 68 == 8 * 4 + 3 * 3 * 4
-    ids = [s.sample_id for s in samples]
+    ids = [str(s) for s in samples]
     assert len(set(ids)) == 68
     assert "obj-vase__v0__two-colour-a" in ids
     assert "room-living__v2__white" in ids
