@@ -134,8 +134,9 @@ def evaluate_sample(
     from spectrinsic.render import render_scene
     from spectrinsic.rng import seed_from_key
     from spectrinsic.scenes import library
+    from spectrinsic.scenes.sample_id import SampleId
 
-    sample = f"{name}__v{view}__{condition}"
+    sample = str(SampleId(name, view, condition))
     scene = library.build(name, view=view, condition=condition, seed=seed, width=quality.width,
                           height=quality.height)
     t0 = time.perf_counter()
