@@ -36,7 +36,7 @@ setup: $(PKG) ## create .venv, install the package (strict editable) and the sys
 test: $(PKG) ## run the test suite (tiny renders; < 15 min on 2 cores)
 	$(PY) -m pytest -n 2 -q
 
-test-fast: $(PKG) ## run the tests not marked slow
+test-fast: $(PKG) ## the tests not marked slow (no dataset builds or converged renders)
 	$(PY) -m pytest -n 2 -q -m "not slow"
 
 study: study-spectral ## all studies: Table 5.2, Table 4.4 and the rendered study (a few minutes)

@@ -76,6 +76,7 @@ def test_plane_diagonal_renders_are_eq_5_2(make_plane):
     assert abs(result.images["rgb3"][0, 0, 0] / exact[0] - 1) > 0.05
 
 
+@pytest.mark.slow
 def test_cube_agrees_with_spectral_reference(make_room):
     """31-band cube vs spectral reference: mean colour within 0.5 %, pixels within noise."""
     scene = make_room(lights=(("point", "planck:3500K", 1.5), ("area", "daylight:6500K", 3.0)), size=24)
