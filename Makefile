@@ -41,7 +41,7 @@ test-torch: $(PKG) ## install the CPU build of PyTorch, then run the torch adapt
 	$(BIN)/pip install -q -c constraints.txt torch
 	SPECTRINSIC_REQUIRE_TORCH=1 $(PY) -m pytest -q -p no:xdist -m torch
 
-test-fast: $(PKG) ## run the tests not marked slow
+test-fast: $(PKG) ## the tests not marked slow (no dataset builds or converged renders)
 	$(PY) -m pytest -n 2 -q -m "not slow"
 
 study: study-spectral ## all studies: Table 5.2, Table 4.4 and the rendered study (a few minutes)

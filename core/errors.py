@@ -20,6 +20,7 @@ __all__ = [
     "DatasetError",
     "WriteError",
     "DiskFullError",
+    "DecomposeError",
     "MissingDependencyError",
     "SpectrinsicWarning",
     "validate_choice",
@@ -68,6 +69,11 @@ class DiskFullError(WriteError):
     so a dataset build stops at the first one."""
 
 
+class DecomposeError(SpectrinsicError, ValueError):
+    """A decomposer, metric or decomposition setting that is unknown or given a parameter it
+    does not take."""
+
+
 class MissingDependencyError(SpectrinsicError, ImportError):
     """An optional dependency needed by the requested feature is not installed."""
 
@@ -93,16 +99,39 @@ def with_article(word: str) -> str:
     return f"{'an' if word[:1].lower() in 'aeiou' else 'a'} {word}"
 
 
-def validate_choice(value: str, choices: Iterable[str], what: str) -> str:
-    """Return *value* if it is one of *choices*, else raise a one-line ``ValueError``.
+def validate_choice(
+    value: str,
+    choices: Iterable[str],
+    what: str,
+    *,
+    error: type[SpectrinsicError] = SpectrinsicError,
+) -> str:
+    """Return *value* if it is one of *choices*, else raise a one-line *error*.
+
+    Parameters
+    ----------
+    value
+        The name given by the user.
+    choices
+        The valid names, in the order the message lists them.
+    what
+        What the name names, for the message (``"render mode"``).
+    error
+        The :class:`SpectrinsicError` subclass raised, so the error belongs to the caller's
+        domain (``SceneError`` in :mod:`spectrinsic.scenes`, ``RenderError`` in
+        :mod:`spectrinsic.render`...).
 
     >>> validate_choice("rgb3", ["rgb3", "rgb6"], "render mode")
     'rgb3'
+    >>> validate_choice("rgb4", ["rgb3", "rgb6"], "render mode", error=SceneError)
+    Traceback (most recent call last):
+    ...
+    spectrinsic.errors.SceneError: unknown render mode 'rgb4'; expected one of 'rgb3', 'rgb6' (did you mean 'rgb6', 'rgb3'?)
     """
     choices = list(choices)
     if value in choices:
         return value
-    raise SpectrinsicError(
+    raise error(
         f"unknown {what} {value!r}; expected one of {', '.join(map(repr, choices))}"
         + did_you_mean(value, choices)
     )

@@ -23,7 +23,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from spectrinsic.decompose.decomposition import Decomposition, finish
-from spectrinsic.errors import validate_choice
+from spectrinsic.errors import DecomposeError, validate_choice
 
 __all__ = ["CONSTANCY", "illuminant_colour", "discount_illuminant", "with_constancy"]
 
@@ -47,7 +47,7 @@ def illuminant_colour(image: np.ndarray, mask: np.ndarray, method: str) -> np.nd
     >>> illuminant_colour(img + 1.0, np.ones((2, 2), bool), "grey-world").tolist()
     [1.5, 1.0, 0.5]
     """
-    p = CONSTANCY[validate_choice(method, CONSTANCY, "colour constancy")]
+    p = CONSTANCY[validate_choice(method, CONSTANCY, "colour constancy", error=DecomposeError)]
     if p is None:
         return np.ones(3)
     values = np.clip(image[mask], 0.0, None)

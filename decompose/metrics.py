@@ -24,7 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from spectrinsic.decompose._validation import ImageShapeError, as_image, as_mask, image_pair
-from spectrinsic.errors import validate_choice
+from spectrinsic.errors import DecomposeError, validate_choice
 
 if TYPE_CHECKING:
     from spectrinsic.decompose.judgements import Judgements
@@ -335,7 +335,7 @@ def angular_error_median(
 
 def _statistic(values: np.ndarray, statistic: str, what: str) -> float:
     """Mean or median of *values* (degrees); NaN when empty."""
-    validate_choice(statistic, ("mean", "median"), f"{what} statistic")
+    validate_choice(statistic, ("mean", "median"), f"{what} statistic", error=DecomposeError)
     if values.size == 0:
         return float("nan")
     return float(np.mean(values) if statistic == "mean" else np.median(values))
@@ -530,7 +530,7 @@ METRICS: Mapping[str, Metric] = {
 
 def get_metric(name: str) -> Metric:
     """The registered :class:`Metric` called *name* (one-line error with close matches)."""
-    return METRICS[validate_choice(name, METRICS, "metric")]
+    return METRICS[validate_choice(name, METRICS, "metric", error=DecomposeError)]
 
 
 def compute_metrics(

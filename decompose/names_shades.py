@@ -50,7 +50,7 @@ import logging
 import time
 import warnings
 from dataclasses import dataclass
-from typing import ClassVar, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -64,7 +64,7 @@ from spectrinsic.decompose.colour_naming import (
 from spectrinsic.decompose.constancy import discount_illuminant
 from spectrinsic.decompose.decomposition import Decomposition, finish, prepare_input
 from spectrinsic.decompose.ridges import colour_shades
-from spectrinsic.errors import MissingDependencyError, validate_choice
+from spectrinsic.errors import DecomposeError, MissingDependencyError, validate_choice
 from spectrinsic.spectra.colorimetry import decode_srgb as _srgb_decode
 from spectrinsic.spectra.colorimetry import encode_srgb as _srgb_encode
 
@@ -184,6 +184,19 @@ def global_coherence(
     return lam / lam[1:].min()
 
 
+def _import_gco() -> Any:
+    """The ``gco`` module of gco-wrapper (alpha-expansion graph cuts), its import warnings hushed."""
+    try:
+        with warnings.catch_warnings():  # gco aliases np.int/np.float/np.bool on import
+            warnings.simplefilter("ignore", FutureWarning)
+            import gco
+    except ImportError as exc:  # pragma: no cover - declared dependency
+        raise MissingDependencyError(
+            "names-shades needs gco-wrapper (pip install gco-wrapper)"
+        ) from exc
+    return gco
+
+
 @dataclass(frozen=True)
 class NamesAndShades:
     """Serra et al. (2012) names-and-shades intrinsic decomposition (thesis chapter 3).
@@ -255,19 +268,15 @@ class NamesAndShades:
                    colour_constancy="none", expansion_cycles=-1, name="names-shades-thesis")
 
     def __call__(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Decomposition:
-        validate_choice(
-            self.reflectance_colour, ("label-centroid", "region-mean"), "reflectance_colour"
-        )
-        try:
-            with warnings.catch_warnings():  # gco aliases np.int/np.float/np.bool on import
-                warnings.simplefilter("ignore", FutureWarning)
-                import gco
-        except ImportError as exc:  # pragma: no cover - declared dependency
-            raise MissingDependencyError(
-                "names-shades needs gco-wrapper (pip install gco-wrapper)"
-            ) from exc
-        from skimage.measure import label as connected_regions
+        """Decompose a linear ``(H, W, 3)`` image into reflectance and shading.
 
+        The five steps of the module docstring; ``info`` records each step's time in seconds.
+        """
+        validate_choice(
+            self.reflectance_colour, ("label-centroid", "region-mean"), "reflectance_colour",
+            error=DecomposeError,
+        )
+        gco = _import_gco()
         timings: dict[str, float] = {}
         t0 = time.perf_counter()
         img, m = prepare_input(image, mask)
@@ -276,10 +285,7 @@ class NamesAndShades:
         pixels = np.clip(linear[m], 0.0, 1.0)
 
         # 1. colour names -> Appendix A labels observed in the image
-        observed = self._observed_labels(_srgb_encode(pixels))
-        candidates, y = np.unique(observed, return_inverse=True)
-        vectors = appendix_a_labels()[candidates]
-        distance = np.abs(vectors[:, None, :] - vectors[None, :, :]).sum(axis=2)
+        candidates, y, distance = self._names(pixels)
         timings["names_s"] = time.perf_counter() - t0
 
         # 2. colour shades on the log image
@@ -290,46 +296,13 @@ class NamesAndShades:
 
         # 3. MRF (Eq. 3.4) by alpha-expansion
         t2 = time.perf_counter()
-        edges, _ = grid_edges(m)
-        weights = self._edge_weights(edges, log_colours, shades)
-        unary = self.mu * distance[y]
-        if candidates.size > 1 and edges.shape[0] > 0:
-            labels = gco.cut_general_graph(
-                edges,
-                (1.0 - self.mu) * weights,
-                unary,
-                distance,
-                n_iter=self.expansion_cycles,
-                algorithm="expansion",
-                init_labels=y.astype(np.int32),
-            )
-        else:
-            labels = y
+        labels = self._mrf(gco, m, log_colours, shades, y, distance)
         timings["mrf_s"] = time.perf_counter() - t2
 
         # 4. labels -> regions -> colours (linear RGB)
         t3 = time.perf_counter()
-        label_image = np.zeros(m.shape, dtype=np.int64)
-        label_image[m] = np.asarray(labels) + 1
-        if self.split_by_ridge:
-            label_image[m] += (candidates.size + 1) * shades.ridge
-        regions = connected_regions(label_image, background=0, connectivity=1)
+        regions, colours = self._regions(m, labels, candidates, shades, pixels)
         n_regions = int(regions.max())
-        region_of_pixel = regions[m]
-        counts = np.bincount(region_of_pixel, minlength=n_regions + 1).astype(np.float64)
-        mean_colour = np.stack(
-            [np.bincount(region_of_pixel, weights=pixels[:, c], minlength=n_regions + 1)
-             for c in range(3)], axis=1,
-        ) / np.maximum(counts, 1.0)[:, None]
-        region_label = np.zeros(n_regions + 1, dtype=np.int64)
-        region_label[region_of_pixel] = candidates[np.asarray(labels)]
-        if self.reflectance_colour == "label-centroid":
-            colours = _srgb_decode(np.nan_to_num(label_centroids()[region_label], nan=-1.0))
-            missing = ~np.isfinite(label_centroids()[region_label][:, 0])
-            colours[missing] = mean_colour[missing]  # labels the cube sampling never reached
-        else:
-            colours = mean_colour
-        colours = np.maximum(colours, 1e-6)
 
         # 5. global coherence (sec. 3.4)
         if self.global_coherence:
@@ -349,6 +322,76 @@ class NamesAndShades:
         }
         logger.debug("names-shades: %s", info)
         return finish(img, reflectance, m, info)
+
+    def _names(self, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Step 1: the candidate labels ``(K,)`` (Appendix A indices observed in the image), each
+        pixel's observation ``y`` ``(N,)`` as an index into them, and the label-to-label L1
+        distance ``(K, K)`` of their membership vectors."""
+        observed = self._observed_labels(_srgb_encode(pixels))
+        candidates, y = np.unique(observed, return_inverse=True)
+        vectors = appendix_a_labels()[candidates]
+        distance = np.abs(vectors[:, None, :] - vectors[None, :, :]).sum(axis=2)
+        return candidates, y, distance
+
+    def _mrf(
+        self,
+        gco: Any,
+        m: np.ndarray,
+        log_colours: np.ndarray,
+        shades: Any,
+        y: np.ndarray,
+        distance: np.ndarray,
+    ) -> np.ndarray:
+        """Step 3: each masked pixel's label ``(N,)`` (an index into the candidates) minimising
+        Eq. 3.4 by alpha-expansion; the observations themselves if there is nothing to cut."""
+        edges, _ = grid_edges(m)
+        weights = self._edge_weights(edges, log_colours, shades)
+        unary = self.mu * distance[y]
+        if distance.shape[0] > 1 and edges.shape[0] > 0:
+            return np.asarray(gco.cut_general_graph(
+                edges,
+                (1.0 - self.mu) * weights,
+                unary,
+                distance,
+                n_iter=self.expansion_cycles,
+                algorithm="expansion",
+                init_labels=y.astype(np.int32),
+            ))
+        return np.asarray(y)
+
+    def _regions(
+        self,
+        m: np.ndarray,
+        labels: np.ndarray,
+        candidates: np.ndarray,
+        shades: Any,
+        pixels: np.ndarray,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Step 4: the region image ``(H, W)`` (0 off the mask, regions 1..R) and each region's
+        linear RGB colour ``(R + 1, 3)``, at least 1e-6 (row 0 is unused)."""
+        from skimage.measure import label as connected_regions
+
+        label_image = np.zeros(m.shape, dtype=np.int64)
+        label_image[m] = labels + 1
+        if self.split_by_ridge:
+            label_image[m] += (candidates.size + 1) * shades.ridge
+        regions = connected_regions(label_image, background=0, connectivity=1)
+        n_regions = int(regions.max())
+        region_of_pixel = regions[m]
+        counts = np.bincount(region_of_pixel, minlength=n_regions + 1).astype(np.float64)
+        mean_colour = np.stack(
+            [np.bincount(region_of_pixel, weights=pixels[:, c], minlength=n_regions + 1)
+             for c in range(3)], axis=1,
+        ) / np.maximum(counts, 1.0)[:, None]
+        region_label = np.zeros(n_regions + 1, dtype=np.int64)
+        region_label[region_of_pixel] = candidates[labels]
+        if self.reflectance_colour == "label-centroid":
+            colours = _srgb_decode(np.nan_to_num(label_centroids()[region_label], nan=-1.0))
+            missing = ~np.isfinite(label_centroids()[region_label][:, 0])
+            colours[missing] = mean_colour[missing]  # labels the cube sampling never reached
+        else:
+            colours = mean_colour
+        return regions, np.maximum(colours, 1e-6)
 
     def _observed_labels(self, encoded: np.ndarray) -> np.ndarray:
         """Appendix A label of each sRGB-encoded colour, named once per distinct quantised colour.

@@ -20,7 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from spectrinsic.decompose._validation import ImageShapeError, as_image
-from spectrinsic.errors import validate_choice
+from spectrinsic.errors import DecomposeError, validate_choice
 
 __all__ = ["SCENARIOS", "Scenario", "photometric_correction", "correction_matrix"]
 
@@ -65,7 +65,7 @@ def correction_matrix(
     S_Sen
         Sensor transformation (SC1 only).
     """
-    validate_choice(scenario, SCENARIOS, "photometric scenario")
+    validate_choice(scenario, SCENARIOS, "photometric scenario", error=DecomposeError)
     if scenario == "SC4":
         return np.eye(3)
     light = _matrix(L_CLig, "L_CLig", scenario)

@@ -117,7 +117,7 @@ class Predictions:
     name: str = "predictions"
 
     def __post_init__(self) -> None:
-        validate_choice(self.encoding, PNG_ENCODINGS, "PNG encoding")
+        validate_choice(self.encoding, PNG_ENCODINGS, "PNG encoding", error=DatasetError)
         if not Path(self.root).is_dir():
             raise DatasetError(f"predictions folder {str(self.root)!r} does not exist")
 

@@ -15,6 +15,7 @@ ones works as is. :func:`available_decomposers` lists both, bundled first.
 
 from __future__ import annotations
 
+import inspect
 import logging
 from collections.abc import Callable, Mapping
 from importlib import metadata
@@ -26,7 +27,7 @@ from spectrinsic.decompose.baselines import ImageAsReflectance, ImageAsShading
 from spectrinsic.decompose.decomposition import Decomposer, Decomposition
 from spectrinsic.decompose.names_shades import NamesAndShades
 from spectrinsic.decompose.retinex import ColourRetinex
-from spectrinsic.errors import SpectrinsicError, validate_choice
+from spectrinsic.errors import DecomposeError, SpectrinsicError, did_you_mean, validate_choice
 
 __all__ = [
     "DECOMPOSERS",
@@ -91,10 +92,45 @@ def available_decomposers() -> dict[str, Callable[..., Any]]:
     return {**DECOMPOSERS, **plugin_decomposers()}
 
 
+def _check_parameters(name: str, factory: Callable[..., Any], params: Mapping[str, Any]) -> None:
+    """Raise :class:`DecomposeError` naming any of *params* that *factory* does not take.
+
+    Factories whose signature cannot be read, or that take ``**kwargs``, are not checked.
+    """
+    try:
+        signature = inspect.signature(factory)
+    except (TypeError, ValueError):  # some builtins and extension types have none
+        return
+    accepted = [
+        p.name for p in signature.parameters.values()
+        if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
+    ]
+    if any(p.kind is p.VAR_KEYWORD for p in signature.parameters.values()):
+        return
+    unknown = [k for k in params if k not in accepted]
+    if unknown:
+        bad = unknown[0]
+        raise DecomposeError(
+            f"decomposer {name!r} has no parameter {bad!r}"
+            + (f" (nor {', '.join(map(repr, unknown[1:]))})" if len(unknown) > 1 else "")
+            + f"; it accepts {', '.join(map(repr, accepted)) or 'none'}"
+            + did_you_mean(bad, accepted)
+        )
+
+
 def get_decomposer(name: str, **params: Any) -> Decomposer:
-    """The decomposer called *name* (bundled or plugin), built with *params*."""
+    """The decomposer called *name* (bundled or plugin), built with keyword *params*.
+
+    Raises
+    ------
+    DecomposeError
+        For an unknown *name* (with the known ones), or a parameter the decomposer does not
+        take (with the ones it does).
+    """
     factories = DECOMPOSERS if name in DECOMPOSERS else available_decomposers()
-    decomposer = factories[validate_choice(name, factories, "decomposer")](**params)
+    factory = factories[validate_choice(name, factories, "decomposer", error=DecomposeError)]
+    _check_parameters(name, factory, params)
+    decomposer = factory(**params)
     if not callable(decomposer):
         raise PluginError(f"decomposer {name!r}: its factory returned a non-callable "
                           f"{type(decomposer).__name__}")

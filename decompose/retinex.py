@@ -20,7 +20,7 @@ import numpy.typing as npt
 
 from spectrinsic.decompose.constancy import discount_illuminant
 from spectrinsic.decompose.decomposition import Decomposition, finish, prepare_input
-from spectrinsic.errors import validate_choice
+from spectrinsic.errors import DecomposeError, validate_choice
 
 __all__ = ["ColourRetinex", "log_gradients", "poisson_solve"]
 
@@ -142,7 +142,7 @@ class ColourRetinex:
     protocol: ClassVar[str] = PROTOCOL
 
     def __call__(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Decomposition:
-        validate_choice(self.shading_colour, ("grey", "colour"), "shading_colour")
+        validate_choice(self.shading_colour, ("grey", "colour"), "shading_colour", error=DecomposeError)
         img, m = prepare_input(image, mask)
         scale = float(np.percentile(img[m].max(axis=1), 99.0))
         floor = _FLOOR * (scale if scale > 0.0 else 1.0)

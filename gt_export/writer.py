@@ -377,7 +377,9 @@ def export_sample(
     scene
         The rendered scene.
     result
-        RenderResult-like record (see CONTRACTS.md); never a live renderer.
+        A :class:`~spectrinsic.render.result.RenderResult`, or any record with its fields
+        (``images``, ``raw``, ``per_light``, ``direct``, ``aovs``, ``meta``, ``batch_raw``);
+        never a live renderer.
     sample_id
         Folder name, e.g. ``"obj-vase__v0__two-colour-a"``.
     config

@@ -34,7 +34,7 @@ from typing import Literal
 
 import numpy as np
 
-from spectrinsic.errors import SpectralDataError, validate_choice
+from spectrinsic.errors import RenderError, SpectralDataError, validate_choice
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import (
     COLORIMETRIC_WAVELENGTHS,
@@ -116,7 +116,7 @@ RENDER_MODES: dict[str, RenderMode] = {
 
 def get_mode(name: str) -> RenderMode:
     """The :class:`RenderMode` called *name*; a one-line error with close matches otherwise."""
-    return RENDER_MODES[validate_choice(name, RENDER_MODES, "render mode")]
+    return RENDER_MODES[validate_choice(name, RENDER_MODES, "render mode", error=RenderError)]
 
 
 def mode_names() -> list[str]:

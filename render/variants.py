@@ -1,15 +1,22 @@
 """Choosing a Mitsuba variant, and importing Mitsuba safely.
 
 Dr.Jit's LLVM backend JIT-compiles through a system ``libLLVM``. The LLVM 14 and 15 libraries
-that Debian ships crash it (``Cannot select: fminimum``); LLVM 16 or newer works. So, before the
-first ``import drjit``, :func:`configure_llvm` points ``DRJIT_LIBLLVM_PATH`` at the newest
-``libLLVM`` >= 16 it finds, unless the user already set that variable. When none exists the
-LLVM variants are not used: renders fall back to the (about twice slower) scalar variants with one
+that Debian ships crash it (``Cannot select: fminimum``); LLVM 16 or newer works. Dr.Jit loads
+the library named by the environment variable ``DRJIT_LIBLLVM_PATH`` when ``drjit`` is first
+imported, and has no other way to be told.
+
+The set-up step is :func:`import_mitsuba`, the one place that imports Mitsuba (and so Dr.Jit).
+On its first call it picks the library (:func:`configure_llvm`: the user's
+``DRJIT_LIBLLVM_PATH`` if set, else the newest ``libLLVM`` >= 16 found), sets the variable for
+the duration of ``import drjit`` only, and restores the environment as it was. So the process
+environment is never changed for good, and child processes (which call :func:`import_mitsuba`
+themselves) inherit the user's. When no suitable library exists the LLVM variants are not used:
+renders fall back to the (about twice slower) scalar variants with one
 :class:`~spectrinsic.errors.SpectrinsicWarning`.
 
 Variants are chosen per pass (cuda > llvm > scalar; ``*_spectral`` for the spectral reference,
 ``*_rgb`` for diagonal passes and AOVs) and activated only inside :func:`variant_scope`; nothing
-here runs at import time and no variant is ever set globally by spectrinsic on its own.
+here runs at import time.
 """
 
 from __future__ import annotations
@@ -20,6 +27,7 @@ import importlib
 import logging
 import os
 import re
+import sys
 import warnings
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -121,34 +129,62 @@ def find_libllvm(
 
 
 def configure_llvm() -> str | None:
-    """Set ``DRJIT_LIBLLVM_PATH`` to a suitable ``libLLVM`` unless already set; return its value.
+    """The ``libLLVM`` Dr.Jit should load: ``DRJIT_LIBLLVM_PATH`` if the user set it, else the
+    newest ``libLLVM`` >= :data:`LLVM_MIN_VERSION` found (``None`` if neither).
 
-    Must run before the first ``import drjit``; :func:`import_mitsuba` does so. Returns ``None``
-    when the variable is unset and no ``libLLVM`` >= :data:`LLVM_MIN_VERSION` exists.
+    Changes nothing: :func:`import_mitsuba` hands the path to Dr.Jit.
     """
     current = os.environ.get(LLVM_ENV, "").strip()
     if current:
         return current
     found = find_libllvm()
-    if found is None:
-        return None
-    # Dr.Jit reads this once, when its LLVM backend first initialises: it has to be an
-    # environment variable, set before drjit is imported.
-    os.environ[LLVM_ENV] = str(found)
-    logger.debug("using %s for Dr.Jit's LLVM backend", found)
-    return str(found)
+    return None if found is None else str(found)
+
+
+#: The ``libLLVM`` Dr.Jit was pointed at when :func:`import_mitsuba` first imported it (None: no
+#: suitable one, or Dr.Jit imported before without ``DRJIT_LIBLLVM_PATH``). Set once, by the
+#: set-up step; a record of what this process loaded, not a setting.
+_loaded_libllvm: str | None = None
+_set_up = False
+
+
+@contextlib.contextmanager
+def _environment_variable(name: str, value: str | None) -> Iterator[None]:
+    """Set *name* to *value* (unless None or already set) inside the block, then restore it."""
+    if value is None or name in os.environ:
+        yield
+        return
+    os.environ[name] = value
+    try:
+        yield
+    finally:
+        del os.environ[name]
 
 
 def import_mitsuba() -> ModuleType:
-    """Return the ``mitsuba`` module, configuring Dr.Jit's LLVM library first.
+    """Return the ``mitsuba`` module; the first call is spectrinsic's Mitsuba set-up step.
+
+    That call imports Dr.Jit with ``DRJIT_LIBLLVM_PATH`` pointing at :func:`configure_llvm`'s
+    library, for the duration of the import only (Dr.Jit loads ``libLLVM`` then), and records
+    the library used. If ``drjit`` was imported before, by someone else, its library is the one
+    ``DRJIT_LIBLLVM_PATH`` names now, if any.
 
     Raises
     ------
     MissingDependencyError
         If Mitsuba 3 is not installed.
     """
-    configure_llvm()
+    global _loaded_libllvm, _set_up
     try:
+        if not _set_up:
+            if "drjit" in sys.modules:
+                _loaded_libllvm = os.environ.get(LLVM_ENV, "").strip() or None
+            else:
+                _loaded_libllvm = configure_llvm()
+                with _environment_variable(LLVM_ENV, _loaded_libllvm):
+                    importlib.import_module("drjit")
+                logger.debug("Dr.Jit's LLVM backend uses %s", _loaded_libllvm)
+            _set_up = True
         return importlib.import_module("mitsuba")
     except ImportError as exc:  # pragma: no cover - mitsuba is a declared dependency
         raise MissingDependencyError(
@@ -172,7 +208,9 @@ def set_thread_count(n: int | None) -> None:
 
 
 def _llvm_suitable() -> bool:
-    path = os.environ.get(LLVM_ENV, "").strip()
+    """Whether Dr.Jit loaded a ``libLLVM`` that can run spectrinsic's kernels."""
+    import_mitsuba()
+    path = _loaded_libllvm
     if not path:
         return False  # Dr.Jit would pick whatever libLLVM it finds: possibly 14/15, which crash
     version = llvm_version_from_name(path)
@@ -196,7 +234,7 @@ def usable_backends() -> tuple[str, ...]:
 def _backend_of(requested: str) -> str:
     """``"llvm"`` for ``"llvm"``, ``"llvm_ad_rgb"`` or ``"llvm_ad_spectral"``; likewise cuda/scalar."""
     head = requested.split("_", 1)[0]
-    return validate_choice(head, BACKENDS, "Mitsuba backend")
+    return validate_choice(head, BACKENDS, "Mitsuba backend", error=RenderError)
 
 
 def choose_variant(kind: VariantKind, requested: str | None = None) -> str:
@@ -216,7 +254,7 @@ def choose_variant(kind: VariantKind, requested: str | None = None) -> str:
     RenderError
         If the requested backend cannot run here or Mitsuba lacks the variant.
     """
-    validate_choice(kind, ("rgb", "spectral"), "variant kind")
+    validate_choice(kind, ("rgb", "spectral"), "variant kind", error=RenderError)
     mi = import_mitsuba()
     usable = usable_backends()
     if requested is not None:
@@ -242,9 +280,8 @@ def choose_variant(kind: VariantKind, requested: str | None = None) -> str:
 
 
 def llvm_library() -> str | None:
-    """Path of the ``libLLVM`` Dr.Jit's LLVM backend will use, or ``None`` if none is suitable."""
-    path = configure_llvm()
-    return path if path and _llvm_suitable() else None
+    """Path of the ``libLLVM`` Dr.Jit's LLVM backend uses, or ``None`` if none is suitable."""
+    return _loaded_libllvm if _llvm_suitable() else None
 
 
 def available_variants() -> list[str]:
@@ -279,14 +316,22 @@ def variant_report() -> dict[str, Any]:
 
 @contextlib.contextmanager
 def variant_scope(variant: str) -> Iterator[ModuleType]:
-    """Activate *variant* for the duration of a ``with`` block; yields the ``mitsuba`` module.
+    """Make *variant* Mitsuba's active variant inside a ``with`` block; yields ``mitsuba``.
 
-    Wraps ``mitsuba.util.variant_context``, which cannot restore "no variant" (Mitsuba 3.9
-    raises on ``set_variant(None)``): on the very first use the variant is set first, so the
-    context has a variant to restore afterwards.
+    On leaving the block, normally or by an exception, the variant that was active before it
+    is active again (nested scopes unwind in order).
+
+    One case cannot be undone: Mitsuba 3.9 keeps its current variant in C++ state that only
+    ``set_variant(name)`` replaces (``set_variant(None)`` raises ``TypeError``), so there is no
+    way back to "no variant". When no variant was active before the block, *variant* stays
+    active after it: ``mi.variant()`` returns it until another variant is set. This happens
+    at most once per process, at the first scope; spectrinsic sets variants nowhere else.
     """
     mi = import_mitsuba()
-    if mi.variant() is None:
-        mi.set_variant(variant)
-    with mi.util.variant_context(variant):
+    previous = mi.variant()
+    mi.set_variant(variant)
+    try:
         yield mi
+    finally:
+        if previous is not None:
+            mi.set_variant(previous)

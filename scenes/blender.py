@@ -176,6 +176,107 @@ def _light(source: str, obj: Any, default: str, data_dir: str | None) -> Light:
     )
 
 
+def _open_blend(bpy: Any, path: Path) -> None:
+    """Open *path* in the running ``bpy`` session with the file's Python kept off."""
+    source = str(path)
+    if not path.is_file():
+        raise SceneError(f"{source}: no such .blend file")
+    # belt and braces: the preference and the operator flag both keep the file's Python off
+    bpy.context.preferences.filepaths.use_scripts_auto_execute = False
+    try:
+        bpy.ops.wm.open_mainfile(filepath=str(path.resolve()), load_ui=False, use_scripts=False)
+    except RuntimeError as exc:
+        raise SceneError(
+            f"{source}: cannot open as a .blend file ({' '.join(str(exc).split())})"
+        ) from exc
+
+
+class _MaterialTable:
+    """Blender materials met so far, in order, each checked once to be a reflectance spectrum."""
+
+    def __init__(
+        self,
+        source: str,
+        mapping: Mapping[str, str],
+        default_spectrum: str | None,
+        data_dir: str | None,
+    ) -> None:
+        self.source = source
+        self.mapping = dict(mapping)
+        self.default_spectrum = default_spectrum
+        self.data_dir = data_dir
+        self.table: dict[str, Material] = {}
+
+    def index(self, mat: Any, obj_name: str) -> int:
+        """Index of the scene material for Blender material *mat* (None: the default one)."""
+        if mat is None:
+            if self.default_spectrum is None:
+                raise SceneError(
+                    f"{self.source}: object {obj_name!r}: faces without a material; assign one or pass default_spectrum="
+                )
+            name, spectrum = "default", self.default_spectrum
+        else:
+            name = mat.name
+            spectrum = self.mapping.get(name) or _prop(mat) or name
+        if name not in self.table:
+            _check_spectrum(
+                self.source,
+                f"material {name!r}",
+                spectrum,
+                "reflectance",
+                f"name the material after a spectrum, set its custom property {SPECTRUM_PROPERTY!r}, "
+                f"or pass materials={{{name!r}: ...}}",
+                self.data_dir,
+            )
+            self.table[name] = Material(name=name, spectrum=spectrum)
+        return list(self.table).index(name)
+
+
+def _triangles(obj: Any, depsgraph: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Object-space vertices ``(V, 3)``, triangles ``(F, 3)`` and material slots ``(F,)`` of
+    *obj* with its modifiers applied; None if it has no faces."""
+    evaluated = obj.evaluated_get(depsgraph)
+    me = evaluated.to_mesh()
+    try:
+        me.calc_loop_triangles()
+        n_tri = len(me.loop_triangles)
+        if n_tri == 0:
+            return None
+        co = np.empty(len(me.vertices) * 3, dtype=np.float64)
+        me.vertices.foreach_get("co", co)
+        tri = np.empty(n_tri * 3, dtype=np.int64)
+        me.loop_triangles.foreach_get("vertices", tri)
+        slot = np.empty(n_tri, dtype=np.int64)
+        me.loop_triangles.foreach_get("material_index", slot)
+    finally:
+        evaluated.to_mesh_clear()
+    return co.reshape(-1, 3), tri.reshape(-1, 3), slot
+
+
+def _mesh(obj: Any, depsgraph: Any, materials: _MaterialTable, object_id: int) -> Mesh | None:
+    """*obj* as a world-space :class:`Mesh`, each face naming its scene material; None if empty."""
+    triangles = _triangles(obj, depsgraph)
+    if triangles is None:
+        return None
+    co, faces, slot = triangles
+    m = _matrix(obj)
+    vertices = co @ m[:3, :3].T + m[:3, 3]
+    if np.linalg.det(m[:3, :3]) < 0:  # a mirroring transform reverses the winding
+        faces = faces[:, ::-1].copy()
+    slots = [s.material for s in obj.material_slots] or [None]
+    used = np.unique(slot)
+    lookup = np.zeros(int(used.max()) + 1, dtype=np.int64)
+    for s in used:  # Blender clamps indices past the last slot to it
+        lookup[s] = materials.index(slots[min(int(s), len(slots) - 1)], obj.name)
+    return Mesh(
+        name=obj.name,
+        vertices=vertices,
+        faces=faces,
+        face_materials=lookup[slot],
+        object_id=object_id,
+    )
+
+
 def load_blend(
     path: str | os.PathLike[str],
     *,
@@ -217,46 +318,11 @@ def load_blend(
     bpy = _require_bpy()
     path = Path(path)
     source = str(path)
-    if not path.is_file():
-        raise SceneError(f"{source}: no such .blend file")
-    # belt and braces: the preference and the operator flag both keep the file's Python off
-    bpy.context.preferences.filepaths.use_scripts_auto_execute = False
-    try:
-        bpy.ops.wm.open_mainfile(filepath=str(path.resolve()), load_ui=False, use_scripts=False)
-    except RuntimeError as exc:
-        raise SceneError(
-            f"{source}: cannot open as a .blend file ({' '.join(str(exc).split())})"
-        ) from exc
+    _open_blend(bpy, path)
     bpy_scene = bpy.context.scene
     camera = _camera(source, bpy_scene, resolution)
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    mapping = dict(materials or {})
-
-    table: dict[str, Material] = {}
-
-    def material_index(mat: Any, obj_name: str) -> int:
-        if mat is None:
-            if default_spectrum is None:
-                raise SceneError(
-                    f"{source}: object {obj_name!r}: faces without a material; assign one or pass default_spectrum="
-                )
-            name, spectrum = "default", default_spectrum
-        else:
-            name = mat.name
-            spectrum = mapping.get(name) or _prop(mat) or name
-        if name not in table:
-            _check_spectrum(
-                source,
-                f"material {name!r}",
-                spectrum,
-                "reflectance",
-                f"name the material after a spectrum, set its custom property {SPECTRUM_PROPERTY!r}, "
-                f"or pass materials={{{name!r}: ...}}",
-                data_dir,
-            )
-            table[name] = Material(name=name, spectrum=spectrum)
-        return list(table).index(name)
-
+    table = _MaterialTable(source, materials or {}, default_spectrum, data_dir)
     meshes: list[Mesh] = []
     lights: list[Light] = []
     for obj in sorted(bpy_scene.objects, key=lambda o: o.name):
@@ -264,47 +330,14 @@ def load_blend(
             continue
         if obj.type == "LIGHT":
             lights.append(_light(source, obj, light_spectrum, data_dir))
-            continue
-        if obj.type not in _MESH_LIKE:
-            continue
-        evaluated = obj.evaluated_get(depsgraph)
-        me = evaluated.to_mesh()
-        try:
-            me.calc_loop_triangles()
-            n_tri = len(me.loop_triangles)
-            if n_tri == 0:
-                continue
-            co = np.empty(len(me.vertices) * 3, dtype=np.float64)
-            me.vertices.foreach_get("co", co)
-            tri = np.empty(n_tri * 3, dtype=np.int64)
-            me.loop_triangles.foreach_get("vertices", tri)
-            slot = np.empty(n_tri, dtype=np.int64)
-            me.loop_triangles.foreach_get("material_index", slot)
-        finally:
-            evaluated.to_mesh_clear()
-        m = _matrix(obj)
-        vertices = co.reshape(-1, 3) @ m[:3, :3].T + m[:3, 3]
-        faces = tri.reshape(-1, 3)
-        if np.linalg.det(m[:3, :3]) < 0:  # a mirroring transform reverses the winding
-            faces = faces[:, ::-1].copy()
-        slots = [s.material for s in obj.material_slots] or [None]
-        used = np.unique(slot)
-        lookup = np.zeros(int(used.max()) + 1, dtype=np.int64)
-        for s in used:  # Blender clamps indices past the last slot to it
-            lookup[s] = material_index(slots[min(int(s), len(slots) - 1)], obj.name)
-        meshes.append(
-            Mesh(
-                name=obj.name,
-                vertices=vertices,
-                faces=faces,
-                face_materials=lookup[slot],
-                object_id=len(meshes),
-            )
-        )
+        elif obj.type in _MESH_LIKE:
+            mesh = _mesh(obj, depsgraph, table, object_id=len(meshes))
+            if mesh is not None:
+                meshes.append(mesh)
     scene = Scene(
         name=path.stem,
         meshes=tuple(meshes),
-        materials=tuple(table.values()),
+        materials=tuple(table.table.values()),
         lights=tuple(lights),
         camera=camera,
         metadata={"source": "blender", "file": path.name, "blender": bpy.app.version_string},

@@ -296,12 +296,12 @@ def scene_names(kind: str | None = None) -> list[str]:
     """Library scene names: ``kind`` None (all), ``"object"`` (8) or ``"complex"`` (3)."""
     if kind is None:
         return [*_OBJECT_SCENES, *_COMPLEX]
-    validate_choice(kind, ("object", "complex"), "library scene kind")
+    validate_choice(kind, ("object", "complex"), "library scene kind", error=SceneError)
     return list(_OBJECT_SCENES) if kind == "object" else list(_COMPLEX)
 
 
 def _check_name(name: str) -> str:
-    return validate_choice(name, scene_names(), "library scene")
+    return validate_choice(name, scene_names(), "library scene", error=SceneError)
 
 
 def n_views(name: str) -> int:
@@ -332,7 +332,7 @@ def condition_illuminants(name: str, condition: str, *, seed: int) -> tuple[str,
     from spectrinsic.spectra import illuminant_set
 
     _check_name(name)
-    validate_choice(condition, CONDITIONS, "illumination condition")
+    validate_choice(condition, CONDITIONS, "illumination condition", error=SceneError)
     if condition == "white":
         return (WHITE,)
     planck, other = illuminant_set("planckian"), illuminant_set("non-planckian")
@@ -360,6 +360,61 @@ def _power(spot: _LightSpot, direction: np.ndarray, focus: np.ndarray, irradianc
     (:func:`spectrinsic.scenes.model.light_power`)."""
     return light_power(spot.kind, np.asarray(spot.position, float), direction, focus, spot.size,
                        irradiance)
+
+
+def _check_view(name: str, view: int) -> None:
+    """Raise :class:`SceneError` unless *name* is a library scene and *view* one of its views."""
+    _check_name(name)
+    if (
+        isinstance(view, bool)
+        or not isinstance(view, (int, np.integer))
+        or not 0 <= view < n_views(name)
+    ):
+        raise SceneError(
+            f"view {view!r} of library scene {name!r}: expected 0..{n_views(name) - 1}"
+        )
+
+
+def _light(
+    spot: _LightSpot, spectrum: str, focus: np.ndarray, irradiance: float, *, name: str
+) -> Light:
+    """The light at *spot* aimed at *focus* (area lights face down) delivering *irradiance*
+    (relative units, see :data:`TARGET_IRRADIANCE` and :func:`_power`) with illuminant
+    *spectrum*."""
+    direction = focus - np.asarray(spot.position, float)
+    direction = direction / np.linalg.norm(direction)
+    if spot.kind == "area":
+        direction = np.array([0.0, 0.0, -1.0])
+    # only the fields a light's kind uses are set, so saved scenes stay tidy
+    extra: dict[str, object] = {}
+    if spot.kind != "point":
+        extra["direction"] = tuple(float(x) for x in direction)
+    if spot.kind == "area":
+        extra["size"] = spot.size
+    if spot.kind == "spot":
+        extra["cutoff_deg"] = SPOT_CUTOFF_DEG
+    return Light(
+        kind=spot.kind,
+        spectrum=spectrum,
+        power=_power(spot, direction, focus, irradiance),
+        position=spot.position,
+        name=name,
+        **extra,  # type: ignore[arg-type]
+    )
+
+
+def _camera(layout: _Layout, view: int, width: int, height: int) -> Camera:
+    """The perspective camera of *layout*'s viewpoint *view*, ``width x height`` pixels, z up."""
+    origin, target, fov = layout.views[view]
+    return Camera(
+        origin=tuple(float(x) for x in origin),  # type: ignore[arg-type]
+        target=tuple(float(x) for x in target),  # type: ignore[arg-type]
+        up=(0.0, 0.0, 1.0),
+        fov_deg=fov,
+        width=width,
+        height=height,
+        name=f"view{view}",
+    )
 
 
 def build(
@@ -393,54 +448,17 @@ def build(
         With ``metadata`` ``{"library": name, "kind", "view", "condition", "seed",
         "illuminants"}``.
     """
-    _check_name(name)
-    if (
-        isinstance(view, bool)
-        or not isinstance(view, (int, np.integer))
-        or not 0 <= view < n_views(name)
-    ):
-        raise SceneError(
-            f"view {view!r} of library scene {name!r}: expected 0..{n_views(name) - 1}"
-        )
+    _check_view(name, view)
     illuminants = condition_illuminants(name, condition, seed=seed)
     layout = _layout(name)
     meshes, materials = g.to_meshes(layout.parts)
-    focus = np.asarray(layout.focus, float)
     spots = (layout.single,) if len(illuminants) == 1 else layout.pair
-    lights = []
-    for i, (spot, spectrum) in enumerate(zip(spots, illuminants, strict=True)):
-        direction = focus - np.asarray(spot.position, float)
-        direction = direction / np.linalg.norm(direction)
-        if spot.kind == "area":
-            direction = np.array([0.0, 0.0, -1.0])
-        # only the fields a light's kind uses are set, so saved scenes stay tidy
-        extra: dict[str, object] = {}
-        if spot.kind != "point":
-            extra["direction"] = tuple(float(x) for x in direction)
-        if spot.kind == "area":
-            extra["size"] = spot.size
-        if spot.kind == "spot":
-            extra["cutoff_deg"] = SPOT_CUTOFF_DEG
-        lights.append(
-            Light(
-                kind=spot.kind,
-                spectrum=spectrum,
-                power=_power(spot, direction, focus, TARGET_IRRADIANCE / len(spots)),
-                position=spot.position,
-                name=f"light{i}",
-                **extra,  # type: ignore[arg-type]
-            )
-        )
-    origin, target, fov = layout.views[int(view)]
-    camera = Camera(
-        origin=tuple(float(x) for x in origin),  # type: ignore[arg-type]
-        target=tuple(float(x) for x in target),  # type: ignore[arg-type]
-        up=(0.0, 0.0, 1.0),
-        fov_deg=fov,
-        width=int(width),
-        height=int(height),
-        name=f"view{int(view)}",
-    )
+    focus = np.asarray(layout.focus, float)
+    lights = [
+        _light(spot, spectrum, focus, TARGET_IRRADIANCE / len(spots), name=f"light{i}")
+        for i, (spot, spectrum) in enumerate(zip(spots, illuminants, strict=True))
+    ]
+    camera = _camera(layout, int(view), int(width), int(height))
     kind = "object" if name in _OBJECT_SCENES else "complex"
     return Scene(
         name=name,

@@ -4,9 +4,10 @@ Pure functions on arrays and small frozen records; numpy and colour-science only
 :mod:`spectrinsic.spectra.io` reads files.
 """
 
+import numpy as np
+
+from spectrinsic.spectra import colorimetry as _colorimetry
 from spectrinsic.spectra.colorimetry import (
-    LINEAR_SRGB_TO_XYZ,
-    XYZ_TO_LINEAR_SRGB,
     absolute_reflectance,
     diagonal_values,
     linear_srgb_to_xyz,
@@ -82,3 +83,16 @@ __all__ = [
     "xyz_to_linear_srgb",
     "xyz_to_xy",
 ]
+
+
+#: The sRGB matrices of :mod:`~spectrinsic.spectra.colorimetry`, computed on first access.
+XYZ_TO_LINEAR_SRGB: np.ndarray
+LINEAR_SRGB_TO_XYZ: np.ndarray
+
+
+def __getattr__(name: str) -> np.ndarray:
+    """``XYZ_TO_LINEAR_SRGB``, ``LINEAR_SRGB_TO_XYZ``: the sRGB matrices, computed on first access
+    (see :mod:`spectrinsic.spectra.colorimetry`), so importing the package computes nothing."""
+    if name in ("XYZ_TO_LINEAR_SRGB", "LINEAR_SRGB_TO_XYZ"):
+        return getattr(_colorimetry, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -12,8 +12,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from spectrinsic.errors import SpectralDataError
+from spectrinsic.spectra.colourspace import srgb_matrices
 from spectrinsic.spectra.grid import COLORIMETRIC_WAVELENGTHS, integration_weights
 from spectrinsic.spectra.records import Spectrum
+from spectrinsic.spectra.registry import get_sensors, get_spectrum
 from spectrinsic.typing import Responses, SensorCurves, SpectralValues, Wavelengths
 
 __all__ = [
@@ -32,15 +34,20 @@ __all__ = [
 ]
 
 
-def _srgb_matrices() -> tuple[np.ndarray, np.ndarray]:
-    import colour
+#: IEC 61966-2-1 sRGB matrices (D65 white), from colour-science: declared here, computed on
+#: first access by :func:`__getattr__` (they are not bound at import).
+XYZ_TO_LINEAR_SRGB: np.ndarray
+LINEAR_SRGB_TO_XYZ: np.ndarray
+_LAZY_MATRICES = {"XYZ_TO_LINEAR_SRGB": 0, "LINEAR_SRGB_TO_XYZ": 1}
 
-    cs = colour.RGB_COLOURSPACES["sRGB"]
-    return np.asarray(cs.matrix_XYZ_to_RGB, float), np.asarray(cs.matrix_RGB_to_XYZ, float)
 
-
-#: IEC 61966-2-1 sRGB matrices (D65 white), from colour-science.
-XYZ_TO_LINEAR_SRGB, LINEAR_SRGB_TO_XYZ = _srgb_matrices()
+def __getattr__(name: str) -> np.ndarray:
+    """``XYZ_TO_LINEAR_SRGB`` and ``LINEAR_SRGB_TO_XYZ``: the IEC 61966-2-1 sRGB matrices (D65
+    white) from colour-science, ``(3, 3)`` float64, read-only, computed on first access rather
+    than at import (:func:`spectrinsic.spectra.colourspace.srgb_matrices`)."""
+    if name in _LAZY_MATRICES:
+        return srgb_matrices()[_LAZY_MATRICES[name]]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def _check(values: np.ndarray, curves: np.ndarray, wavelengths: np.ndarray) -> None:
@@ -67,8 +74,8 @@ def responses(spectra: SpectralValues, curves: SensorCurves, wavelengths: Wavele
     -------
     ``(..., K)`` float64.
 
-    >>> wl = np.array([500.0, 505.0]); responses(np.ones(2), np.ones((1, 2)), wl)
-    array([10.])
+    >>> wl = np.array([500.0, 505.0]); responses(np.ones(2), np.ones((1, 2)), wl).tolist()
+    [10.0]
     """
     x = np.asarray(spectra, float)
     s = np.asarray(curves, float)
@@ -94,12 +101,12 @@ def diagonal_values(spectra: SpectralValues, curves: SensorCurves, wavelengths: 
 
 def xyz_to_linear_srgb(xyz: np.ndarray) -> np.ndarray:
     """CIE XYZ (..., 3) to linear sRGB (..., 3) with the IEC 61966-2-1 matrix; no gamma."""
-    return np.asarray(xyz, float) @ XYZ_TO_LINEAR_SRGB.T
+    return np.asarray(xyz, float) @ srgb_matrices()[0].T
 
 
 def linear_srgb_to_xyz(rgb: np.ndarray) -> np.ndarray:
     """Linear sRGB (..., 3) to CIE XYZ (..., 3)."""
-    return np.asarray(rgb, float) @ LINEAR_SRGB_TO_XYZ.T
+    return np.asarray(rgb, float) @ srgb_matrices()[1].T
 
 
 def xyz_to_xy(xyz: np.ndarray) -> np.ndarray:
@@ -132,8 +139,6 @@ def white_normalised_responses(
     -------
     ``(..., K)`` float64, dimensionless.
     """
-    from spectrinsic.spectra.registry import get_sensors
-
     light = np.asarray(illuminant, float)
     ybar = get_sensors("cie1931").on(wavelengths)[1:2]
     white_y = float(responses(light, ybar, wavelengths)[0])
@@ -157,8 +162,6 @@ def absolute_reflectance(
     -------
     ``(3,)`` for one spectrum, ``(N, 3)`` for a sequence; float64, linear sRGB.
     """
-    from spectrinsic.spectra.registry import get_sensors, get_spectrum
-
     single = isinstance(reflectances, (Spectrum, str))
     items: list[Spectrum | str] = (
         [reflectances] if isinstance(reflectances, (Spectrum, str)) else list(reflectances)

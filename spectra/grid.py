@@ -29,8 +29,8 @@ __all__ = [
 def wavelength_grid(start: float = 380.0, end: float = 780.0, step: float = 5.0) -> Wavelengths:
     """Return the grid ``start, start + step, ..., end`` in nm (end included).
 
-    >>> wavelength_grid(400, 700, 100)
-    array([400., 500., 600., 700.])
+    >>> wavelength_grid(400, 700, 100).tolist()
+    [400.0, 500.0, 600.0, 700.0]
     """
     if not (step > 0 and end > start):
         raise SpectralDataError(

@@ -44,15 +44,20 @@ ILLUMINANT_SETS: dict[str, tuple[str, ...]] = {
 
 def illuminant_set(name: str) -> tuple[str, ...]:
     """The 5 spectrum names of set ``"planckian"`` or ``"non-planckian"``."""
-    return ILLUMINANT_SETS[validate_choice(name, ILLUMINANT_SETS, "illuminant set")]
+    return ILLUMINANT_SETS[validate_choice(name, ILLUMINANT_SETS, "illuminant set", error=SpectrumNotFoundError)]
 
 
 @functools.lru_cache(maxsize=1)
 def _ybar() -> tuple[np.ndarray, np.ndarray]:
+    """CIE 1931 ȳ ``(W,)`` and its wavelengths ``(W,)`` nm (360-830 at 1 nm), read-only."""
     import colour
 
     cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
-    return np.asarray(cmfs.wavelengths, float), np.asarray(cmfs.values[:, 1], float)
+    wavelengths = np.array(cmfs.wavelengths, dtype=float)  # copies: colour's own stay writable
+    ybar = np.array(cmfs.values[:, 1], dtype=float)
+    for array in (wavelengths, ybar):
+        array.flags.writeable = False  # cached: shared by every caller
+    return wavelengths, ybar
 
 
 def normalise_illuminant(wavelengths: np.ndarray, values: np.ndarray) -> np.ndarray:

@@ -17,7 +17,9 @@ import csv
 import functools
 import importlib.util
 import os
+from collections.abc import Mapping
 from pathlib import Path
+from types import MappingProxyType
 from typing import NamedTuple
 
 import numpy as np
@@ -46,6 +48,14 @@ class Table(NamedTuple):
     labels: tuple[str, ...]
 
 
+def _read_only(table: Table) -> Table:
+    """*table* with its arrays made read-only: the cached readers share one table with every
+    caller, so an in-place change by one would corrupt the spectra of all the others."""
+    for array in (table.wavelengths, table.values):
+        array.flags.writeable = False
+    return table
+
+
 def luxpy_data_file(*parts: str) -> Path:
     """Path of a data file inside the installed ``luxpy`` package, found without importing it.
 
@@ -62,10 +72,11 @@ def luxpy_data_file(*parts: str) -> Path:
 
 @functools.lru_cache(maxsize=1)
 def read_munsell() -> tuple[Table, tuple[tuple[str, float, float], ...]]:
-    """The 1269 matte Munsell reflectances and their notations ``(hue, value, chroma)``."""
+    """The 1269 matte Munsell reflectances (read-only, cached) and their notations
+    ``(hue, value, chroma)``."""
     source = luxpy_data_file("rfls", "Munsell1269.dat")
     data = np.loadtxt(source, delimiter=",")
-    wl, values = data[:, 0], data[:, 1:].T.copy()
+    wl, values = data[:, 0].copy(), data[:, 1:].T.copy()
     if not (np.isfinite(values).all() and (values >= 0).all()):
         raise SpectralDataError(f"{source}: expected finite reflectances >= 0")
     notations: list[tuple[str, float, float]] = []
@@ -79,7 +90,7 @@ def read_munsell() -> tuple[Table, tuple[tuple[str, float, float], ...]]:
             f"Munsell1269.dat holds {values.shape[0]} spectra but its notation file {len(notations)}"
         )
     labels = tuple(f"#{i}" for i in range(values.shape[0]))
-    return Table(wl, values, labels), tuple(notations)
+    return _read_only(Table(wl, values, labels)), tuple(notations)
 
 
 def _read_rows(path: Path) -> list[list[str]]:
@@ -154,45 +165,50 @@ def read_spectra_csv(path: str | os.PathLike[str], *, missing: bool = False) -> 
 
 @functools.lru_cache(maxsize=4)
 def read_sfu_reflectances(data_dir: str | None) -> tuple[Table, tuple[tuple[str, int], ...]]:
-    """The 1995 SFU reflectances and ``(group, index_in_group)`` per spectrum (1-based index)."""
+    """The 1995 SFU reflectances (read-only, cached) and ``(group, index_in_group)`` per spectrum
+    (1-based index)."""
     table = read_spectra_csv(require_data_file("sfu_barnard2002/reflect_db_1995.csv", data_dir))
     index_path = require_data_file("sfu_barnard2002/reflect_db_index.csv", data_dir)
     with index_path.open(newline="", encoding="utf-8") as fh:
         keys = tuple((r["group"], int(r["index_in_group"])) for r in csv.DictReader(fh))
     if len(keys) != table.values.shape[0]:
         raise SpectralDataError(f"{index_path}: {len(keys)} rows for {table.values.shape[0]} spectra")
-    return table, keys
+    return _read_only(table), keys
 
 
 @functools.lru_cache(maxsize=4)
 def read_sfu_illuminants(data_dir: str | None) -> Table:
     """SFU illuminants: the 102 measured + lab sources (``mws_NNN``) and 87 training (``train_NNN``).
 
-    Labels are the ids before any ``": name"`` suffix.
+    Labels are the ids before any ``": name"`` suffix. The arrays are read-only (cached).
     """
     a = read_spectra_csv(require_data_file("sfu_barnard2002/measured_with_sources_102.csv", data_dir))
     b = read_spectra_csv(require_data_file("sfu_barnard2002/train_illum_87.csv", data_dir))
     if not np.array_equal(a.wavelengths, b.wavelengths):
         raise SpectralDataError("SFU illuminant files disagree in wavelengths")
     labels = tuple(lbl.split(":")[0].strip() for lbl in a.labels + b.labels)
-    return Table(a.wavelengths, np.vstack([a.values, b.values]), labels)
+    return _read_only(Table(a.wavelengths, np.vstack([a.values, b.values]), labels))
 
 
 @functools.lru_cache(maxsize=8)
-def read_camera_table(data_dir: str | None, relative: str) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Cameras from a ``<camera>_R/_G/_B`` CSV: name -> (wavelengths (W,), curves (3, W)).
+def read_camera_table(
+    data_dir: str | None, relative: str
+) -> Mapping[str, tuple[np.ndarray, np.ndarray]]:
+    """Cameras from a ``<camera>_R/_G/_B`` CSV: name -> (wavelengths (W,) nm, curves (3, W)).
 
     Cells not measured (empty) become 0: they lie beyond ~760 nm where sensors hardly respond.
+    Cached: the mapping and its arrays are read-only.
     """
-    table = read_spectra_csv(require_data_file(relative, data_dir), missing=True)
+    table = _read_only(read_spectra_csv(require_data_file(relative, data_dir), missing=True))
     cams: dict[str, tuple[np.ndarray, np.ndarray]] = {}
     for i in range(0, len(table.labels) - 2, 3):
         names = table.labels[i : i + 3]
         if not (names[0].endswith("_R") and names[1].endswith("_G") and names[2].endswith("_B")):
             raise SpectralDataError(f"{relative}: columns {names} are not an _R/_G/_B triple")
         curves = np.nan_to_num(table.values[i : i + 3], nan=0.0)
+        curves.flags.writeable = False
         cams[names[0][:-2]] = (table.wavelengths, curves)
-    return cams
+    return MappingProxyType(cams)
 
 
 def read_user_csv(path: str | os.PathLike[str], *, kind: str) -> Table:

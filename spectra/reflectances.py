@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import functools
 import re
+from collections.abc import Mapping
+from types import MappingProxyType
 
 import numpy as np
 
@@ -44,9 +46,10 @@ def _canonical(hue: str, value: float, chroma: float) -> str:
 
 
 @functools.lru_cache(maxsize=1)
-def _munsell_index() -> dict[str, int]:
+def _munsell_index() -> Mapping[str, int]:
+    """Canonical notation -> row of the Munsell table; read-only, as it is cached."""
     _, notations = io.read_munsell()
-    return {_canonical(*n): i for i, n in enumerate(notations)}
+    return MappingProxyType({_canonical(*n): i for i, n in enumerate(notations)})
 
 
 def munsell_names() -> list[str]:

@@ -13,6 +13,7 @@ import numpy as np
 
 from spectrinsic.errors import SpectrumNotFoundError, did_you_mean
 from spectrinsic.spectra import io
+from spectrinsic.spectra.colourspace import srgb_matrices
 from spectrinsic.spectra.grid import wavelength_grid
 from spectrinsic.spectra.records import SensorSet
 
@@ -49,9 +50,13 @@ def cie1931() -> SensorSet:
     import colour
 
     cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+    wavelengths = np.array(cmfs.wavelengths, dtype=float)
+    curves = np.asarray(cmfs.values, float).T.copy()
+    for array in (wavelengths, curves):
+        array.flags.writeable = False  # cached: shared by every caller
     return SensorSet(
-        "cie1931", ("X", "Y", "Z"), np.asarray(cmfs.wavelengths, float),
-        np.asarray(cmfs.values, float).T.copy(), "CIE 1931 2 degree observer (colour-science)",
+        "cie1931", ("X", "Y", "Z"), wavelengths, curves,
+        "CIE 1931 2 degree observer (colour-science)",
     )
 
 
@@ -62,11 +67,11 @@ def srgb() -> SensorSet:
     Responses to these curves are linear sRGB values, identical to converting XYZ responses with
     :func:`spectrinsic.spectra.xyz_to_linear_srgb`.
     """
-    from spectrinsic.spectra.colorimetry import XYZ_TO_LINEAR_SRGB
-
     cmf = cie1931()
+    curves = srgb_matrices()[0] @ cmf.curves
+    curves.flags.writeable = False
     return SensorSet(
-        "srgb", ("R", "G", "B"), cmf.wavelengths, XYZ_TO_LINEAR_SRGB @ cmf.curves,
+        "srgb", ("R", "G", "B"), cmf.wavelengths, curves,
         "linear sRGB from the CIE 1931 observer (IEC 61966-2-1)",
     )
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -26,8 +25,7 @@ def _presets_help() -> str:
 
 
 def register(subparsers: Any) -> None:
-    from spectrinsic.pipeline.presets import preset_names
-
+    """Add the ``dataset`` subcommand to the CLI's *subparsers*."""
     p = subparsers.add_parser(
         "dataset",
         help="render the dataset (68 samples) with ground truth; resumable",
@@ -40,6 +38,21 @@ def register(subparsers: Any) -> None:
             "config (--rebuild to rebuild one built with another)."
         ),
     )
+    _add_build_options(p)
+    _add_quality_options(p)
+    _add_source_options(p.add_argument_group("scene source (default: the built-in library layout)"))
+    p.add_argument(
+        "--rebuild",
+        action="store_true",
+        help="--out was built with another config: rebuild its samples with this one",
+    )
+    p.set_defaults(func=run)
+
+
+def _add_build_options(p: Any) -> None:
+    """Where the dataset goes, which preset and seed, and what it runs on."""
+    from spectrinsic.pipeline.presets import preset_names
+
     p.add_argument("--out", metavar="DIR", default=DEFAULT_OUT, help=f"dataset folder ({DEFAULT_OUT})")
     p.add_argument(
         "--preset", default="default", choices=preset_names(), help=_presets_help()
@@ -74,6 +87,10 @@ def register(subparsers: Any) -> None:
         default=None,
         help="build only sample ids matching these comma-separated globs ('obj-*,*__white')",
     )
+
+
+def _add_quality_options(p: Any) -> None:
+    """Overrides of the preset's sampling, denoising and image size."""
     p.add_argument("--spp", type=int, default=None, metavar="N",
                    help="override samples per pixel (the total over all batches)")
     p.add_argument("--batches", type=int, default=None, metavar="N",
@@ -94,7 +111,10 @@ def register(subparsers: Any) -> None:
         metavar="WxH",
         help="override the image size in pixels, e.g. 256x256",
     )
-    src = p.add_argument_group("scene source (default: the built-in library layout)")
+
+
+def _add_source_options(src: Any) -> None:
+    """Where the scenes come from: the library (default), a generator, or scene files."""
     src.add_argument("--generator", metavar="NAME", default=None,
                      help="generate scenes procedurally: objects-on-ground or rooms")
     src.add_argument("--count", type=int, default=20, metavar="N", help="generated scenes (20)")
@@ -111,12 +131,6 @@ def register(subparsers: Any) -> None:
                      help="YAML/JSON mapping material name -> spectrum for .blend and mesh scenes")
     src.add_argument("--default-spectrum", metavar="NAME", default=None,
                      help="reflectance of unmapped materials in .blend and mesh scenes")
-    p.add_argument(
-        "--rebuild",
-        action="store_true",
-        help="--out was built with another config: rebuild its samples with this one",
-    )
-    p.set_defaults(func=run)
 
 
 def _range(option: str, text: str) -> tuple[float, float]:
@@ -200,35 +214,17 @@ def _preflight(args: argparse.Namespace, config: Any) -> None:
                       direct=config.direct, n_lights=2)
 
 
-def _executor(args: argparse.Namespace) -> tuple[Any, int | None, str]:
-    """The executor the options ask for, the render threads per worker, and where it runs."""
-    from spectrinsic.pipeline.executors import make_executor
-
-    cores = os.cpu_count() or 1
-    # One process whose Dr.Jit pool uses every core beat one single-threaded process per core
-    # on the 2-core reference machine (28 s vs 42 s for 4 default samples): each process
-    # compiles its own kernels and holds its own scene.
-    workers = 1 if args.workers is None else args.workers
-    threads = args.threads
-    if args.scheduler:
-        return (make_executor("dask", scheduler=args.scheduler),
-                threads if threads is not None else 1, f"Dask scheduler {args.scheduler}")
-    if workers == 1:
-        return make_executor("serial"), threads, "this process"
-    return (make_executor("process", workers=workers),
-            threads if threads is not None else max(1, cores // workers),
-            f"{workers} local worker processes")
-
-
 def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from spectrinsic.pipeline.dataset import SampleFailure, build_dataset
+    from spectrinsic.pipeline.executors import choose_executor
     from spectrinsic.pipeline.presets import get_preset
 
     config = get_preset(args.preset, seed=args.seed).with_options(**_overrides(args))
     _preflight(args, config)
-    executor, threads, where = _executor(args)
+    choice = choose_executor(workers=args.workers, threads=args.threads, scheduler=args.scheduler)
+    executor, threads, where = choice.executor, choice.render_threads, choice.where
 
     bar: Any = None
     failures: list[str] = []

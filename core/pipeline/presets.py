@@ -152,7 +152,7 @@ class DatasetConfig:
         if not self.modes:
             raise DatasetError("dataset setting modes=(); expected at least one render mode")
         for mode in self.modes + ((self.share_mode,) if self.share_mode else ()):
-            validate_choice(mode, RENDER_MODES, "render mode")
+            validate_choice(mode, RENDER_MODES, "render mode", error=DatasetError)
         if not isinstance(self.seed, int) or self.seed < 0:
             raise DatasetError(f"dataset seed {self.seed!r}; expected a non-negative integer")
 
@@ -261,5 +261,5 @@ def get_preset(name: str, *, seed: int = 0) -> DatasetConfig:
     SpectrinsicError
         If *name* is not a preset (the message suggests close names).
     """
-    validate_choice(name, PRESETS, "dataset preset")
+    validate_choice(name, PRESETS, "dataset preset", error=DatasetError)
     return PRESETS[name].with_options(seed=seed)

@@ -38,7 +38,7 @@ def generator_source(generator: str, count: int, *, views: int = 1,
     from spectrinsic.errors import validate_choice
     from spectrinsic.scenes.generators import GENERATORS
 
-    validate_choice(generator, GENERATORS, "scene generator")
+    validate_choice(generator, GENERATORS, "scene generator", error=DatasetError)
     if count < 1 or views < 1:
         raise DatasetError(f"--count {count} / --views {views}; expected positive integers")
     spec = {"generator": generator, "count": int(count), "views": int(views),

@@ -14,7 +14,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from spectrinsic.errors import validate_choice
+from spectrinsic.errors import SceneError, validate_choice
 from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.generators.base import (
     GeneratorOptions,
@@ -53,7 +53,7 @@ def generator_names() -> list[str]:
 
 def generated_scene_name(generator: str, index: int) -> str:
     """``"<generator>-<index:05d>"``, e.g. ``"rooms-00007"``."""
-    return f"{validate_choice(generator, GENERATORS, 'scene generator')}-{int(index):05d}"
+    return f"{validate_choice(generator, GENERATORS, 'scene generator', error=SceneError)}-{int(index):05d}"
 
 
 def generated_scene_seed(root_seed: int, generator: str, index: int) -> int:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from spectrinsic.cli import build_parser, main
 
 
@@ -14,6 +16,7 @@ def test_study_is_registered_with_three_studies():
     assert str(args.out) == "results"
 
 
+@pytest.mark.slow
 def test_reconstruction_error_cli_writes_table_and_extension(tmp_path, capsys, monkeypatch):
     monkeypatch.delenv("SPECTRINSIC_DATA", raising=False)
     assert main(["-q", "study", "reconstruction-error", "--out", str(tmp_path)]) == 0

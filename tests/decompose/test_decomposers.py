@@ -12,7 +12,7 @@ from spectrinsic.decompose.metrics import lmse
 from spectrinsic.decompose.names_shades import NamesAndShades, global_coherence
 from spectrinsic.decompose.retinex import log_gradients, poisson_solve
 from spectrinsic.decompose.synthetic import mondrian
-from spectrinsic.errors import SpectrinsicError
+from spectrinsic.errors import DecomposeError, SpectrinsicError
 
 #: float32 storage of reflectance and shading.
 FLOAT32 = 1e-5
@@ -100,6 +100,24 @@ def test_registry_rejects_unknown_names():
     with pytest.raises(SpectrinsicError, match="did you mean 'colour-retinex'"):
         get_decomposer("color-retinex")
     assert get_decomposer("colour-retinex", threshold_grey=0.3).threshold_grey == 0.3
+
+
+def test_registry_rejects_unknown_parameters_with_the_accepted_ones():
+    with pytest.raises(DecomposeError, match="unknown decomposer 'color-retinex'"):
+        get_decomposer("color-retinex")
+    with pytest.raises(DecomposeError) as info:
+        get_decomposer("colour-retinex", threshhold_grey=0.3)
+    message = str(info.value)
+    assert "'colour-retinex' has no parameter 'threshhold_grey'" in message
+    assert "accepts 'threshold_grey', 'threshold_colour'" in message
+    assert "did you mean 'threshold_grey'" in message
+    assert not isinstance(info.value, TypeError)  # a domain error, not Python's own
+    with pytest.raises(DecomposeError, match=r"no parameter 'mu_'.*'mu'"):
+        decompose(np.ones((4, 4, 3)), method="names-shades", mu_=0.5)
+    # a factory taking **kwargs is not second-guessed
+    from spectrinsic.decompose.registry import _check_parameters
+
+    _check_parameters("any", lambda **kw: kw, {"whatever": 1})
 
 
 def test_retinex_on_pure_shading_gives_flat_reflectance():

@@ -23,7 +23,7 @@ MATERIALS = ("munsell:5R 4/14", "munsell:5PB 4/10", "colorchecker:dark skin", "f
 
 @dataclass(frozen=True)
 class FakeResult:
-    """Mirrors the RenderResult fields of CONTRACTS.md."""
+    """Mirrors the fields of :class:`spectrinsic.render.result.RenderResult`."""
 
     images: dict[str, np.ndarray]
     raw: dict[str, np.ndarray] = field(default_factory=dict)

@@ -15,12 +15,13 @@ from pathlib import Path
 
 import pytest
 
-from spectrinsic.errors import SpectrinsicError
+from spectrinsic.errors import DatasetError, SpectrinsicError
 from spectrinsic.pipeline.executors import (
     DaskExecutor,
     ProcessExecutor,
     SerialExecutor,
     WorkerCrashedError,
+    choose_executor,
     make_executor,
 )
 
@@ -76,6 +77,24 @@ def test_make_executor_validates():
         make_executor("proces")
     with pytest.raises(SpectrinsicError, match="scheduler"):
         make_executor("dask")
+    with pytest.raises(DatasetError, match="unknown executor"):
+        make_executor("proces")
+
+
+def test_executor_policy_serial_local_or_dask():
+    """--workers/--threads/--scheduler -> executor, render threads per worker, where it runs."""
+    one = choose_executor(cores=8)
+    assert isinstance(one.executor, SerialExecutor)
+    assert (one.render_threads, one.where) == (None, "this process")  # Dr.Jit uses every core
+    assert choose_executor(workers=1, threads=3, cores=8).render_threads == 3
+    local = choose_executor(workers=3, cores=8)
+    assert isinstance(local.executor, ProcessExecutor) and local.executor.workers == 3
+    assert (local.render_threads, local.where) == (2, "3 local worker processes")
+    assert choose_executor(workers=4, cores=2).render_threads == 1  # never 0 threads
+    assert choose_executor(workers=4, threads=5, cores=2).render_threads == 5
+    dask = choose_executor(workers=4, scheduler="tcp://10.0.0.5:8786", cores=8)
+    assert isinstance(dask.executor, DaskExecutor) and dask.executor.address == "tcp://10.0.0.5:8786"
+    assert (dask.render_threads, dask.where) == (1, "Dask scheduler tcp://10.0.0.5:8786")
 
 
 def test_dask_retries_the_task_of_a_killed_worker(fakes, tmp_path):

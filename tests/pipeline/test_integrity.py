@@ -159,6 +159,7 @@ def _workers(pid: int) -> list[int]:
             if b"spawn_main" in Path(f"/proc/{c}/cmdline").read_bytes()]
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc to find the workers")
 def test_a_worker_killed_mid_write_leaves_a_clean_complete_set(tmp_path):
     """kill -9 of both pool workers while a sample is being written: the build re-runs their

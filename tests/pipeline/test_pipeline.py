@@ -185,6 +185,7 @@ def _wait_for(predicate, proc: subprocess.Popen[str], what: str) -> None:
         time.sleep(0.002)
 
 
+@pytest.mark.slow
 def test_hard_kill_mid_write_then_rerun_completes(tmp_path):
     """SIGKILL (no clean-up at all) while a sample is being written: the half-written sample
     sits in a hidden temporary folder, never under its own name; a re-run removes it and
@@ -214,6 +215,7 @@ def test_hard_kill_mid_write_then_rerun_completes(tmp_path):
     assert folders == sorted(IDS)
 
 
+@pytest.mark.slow
 def test_ctrl_c_keeps_completed_samples(tmp_path):
     # Four samples, interrupted once the first is whole: the other three cannot all finish in
     # the moment the signal takes to arrive, so the interrupt always lands mid-build.
@@ -261,6 +263,7 @@ def test_cli_reports_failures_and_exits_nonzero(tmp_path, monkeypatch, capsys):
     assert (tmp_path / "ds" / IDS[0] / "meta.json").is_file()  # the other sample was built
 
 
+@pytest.mark.slow
 def test_dask_cluster_builds_the_same_files(built, tmp_path):
     """The real pipeline through a Dask LocalCluster gives the same bytes as the serial build."""
     distributed = pytest.importorskip("distributed", reason="dask.distributed not installed")

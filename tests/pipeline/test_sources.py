@@ -42,6 +42,7 @@ def generated(tmp_path_factory):
     return out, report
 
 
+@pytest.mark.slow
 def test_twenty_generated_samples_pass_check_with_distinct_scenes(generated):
     out, report = generated
     assert len(report.built) == 20
@@ -51,6 +52,7 @@ def test_twenty_generated_samples_pass_check_with_distinct_scenes(generated):
     assert all(LAYERS <= set(m["layers"]) for m in metas)
 
 
+@pytest.mark.slow  # the shared 20-sample build takes ~100 s
 def test_generated_scene_files_load_back_to_the_rendered_scene(generated):
     out, report = generated
     sample = report.built[0].sample_id
@@ -60,6 +62,7 @@ def test_generated_scene_files_load_back_to_the_rendered_scene(generated):
     assert scene_hash(scene) == json.loads((out / sample / "meta.json").read_text())["scene_hash"]
 
 
+@pytest.mark.slow  # the shared 20-sample build takes ~100 s
 def test_same_seed_rebuild_gives_identical_samples_and_scene_files(generated, tmp_path):
     out, report = generated
     again = tmp_path / "again"
@@ -71,6 +74,7 @@ def test_same_seed_rebuild_gives_identical_samples_and_scene_files(generated, tm
         assert (again / name).read_bytes() == (out / name).read_bytes()
 
 
+@pytest.mark.slow  # the shared 20-sample build takes ~100 s
 def test_splits_share_no_scene(generated):
     out, _ = generated
     manifest = json.loads((out / "manifest.json").read_text())
@@ -81,6 +85,7 @@ def test_splits_share_no_scene(generated):
     assert not (scenes["val"] & scenes["test"]) and len(scenes["train"]) > len(scenes["test"])
 
 
+@pytest.mark.slow
 def test_views_of_one_scene_land_in_one_split(tmp_path):
     cfg = TINY.with_options(source=generator_source("rooms", 2, views=2))
     out = tmp_path / "rooms"

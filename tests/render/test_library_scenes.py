@@ -1,4 +1,4 @@
-"""Every library scene renders in every mode (issue 3: 'every library scene renders in all modes').
+"""Every library scene renders in every mode.
 
 Tiny images and one sample per pixel: this checks that each scene translates, loads and
 renders in each mode with finite, non-negative-luminance output and light where the camera

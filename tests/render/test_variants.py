@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 
@@ -108,3 +109,62 @@ def test_scalar_variant_renders_the_same_deterministic_plane(make_plane):
     best = render_scene(scene, modes=("rgb3",), spp=2, seed=0, aovs=False)
     assert scalar.meta["variants"]["rgb3"] == "scalar_rgb"
     np.testing.assert_allclose(scalar.images["rgb3"], best.images["rgb3"], rtol=1e-5)
+
+
+def _fresh(code: str, **env: str) -> list[str]:
+    """stdout lines of *code* run in a new interpreter (a process whose Mitsuba is not set up)."""
+    environ = {k: v for k, v in os.environ.items() if k != variants.LLVM_ENV} | env
+    out = subprocess.run([sys.executable, "-P", "-c", code], capture_output=True, text=True,
+                         check=True, env=environ)
+    return out.stdout.strip().splitlines()
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/maps (Linux)")
+def test_set_up_leaves_the_environment_as_it_was():
+    """Dr.Jit gets the chosen libLLVM while it is imported; the environment is not changed."""
+    code = (
+        "import os, sys\n"
+        "from spectrinsic.render import variants\n"
+        "variants.import_mitsuba()\n"
+        "print(repr(os.environ.get(variants.LLVM_ENV)))\n"
+        "print(repr(variants.llvm_library()))\n"
+        "print(repr(variants.configure_llvm()))\n"
+        "print(sorted({l.split()[-1] for l in open('/proc/self/maps') if 'libLLVM' in l}))\n"
+    )
+    env_after, used, chosen, mapped = _fresh(code)
+    assert env_after == "None"
+    if chosen == "None":
+        pytest.skip(f"no libLLVM >= {variants.LLVM_MIN_VERSION} on this machine")
+    assert used == chosen
+    # the library Dr.Jit actually loaded is the chosen one, not another libLLVM on the system
+    assert mapped == repr([os.path.realpath(eval(chosen))])
+
+
+def test_set_up_keeps_the_users_libllvm_setting():
+    code = (
+        "import os\n"
+        "from spectrinsic.render import variants\n"
+        "variants.import_mitsuba()\n"
+        "print(os.environ[variants.LLVM_ENV])\n"
+    )
+    assert _fresh(code, **{variants.LLVM_ENV: "/nowhere/libLLVM-18.so"}) == ["/nowhere/libLLVM-18.so"]
+
+
+def test_variant_scope_restores_on_errors_and_documents_the_first_scope():
+    code = (
+        "from spectrinsic.render import variants\n"
+        "mi = variants.import_mitsuba()\n"
+        "print(mi.variant())\n"
+        "with variants.variant_scope('scalar_spectral'):\n"
+        "    print(mi.variant())\n"
+        "print(mi.variant())  # no way back to None: the first variant stays\n"
+        "with variants.variant_scope('scalar_rgb'):\n"
+        "    try:\n"
+        "        with variants.variant_scope('scalar_spectral'):\n"
+        "            raise KeyError\n"
+        "    except KeyError:\n"
+        "        print(mi.variant())\n"
+        "print(mi.variant())\n"
+    )
+    assert _fresh(code) == ["None", "scalar_spectral", "scalar_spectral", "scalar_rgb",
+                            "scalar_spectral"]

@@ -9,7 +9,7 @@ import colour
 import numpy as np
 import pytest
 
-from spectrinsic.errors import SpectrinsicError
+from spectrinsic.errors import SceneError, SpectrinsicError
 from spectrinsic.scenes import library
 from spectrinsic.scenes.validate import validate_scene
 from spectrinsic.spectra import get_spectrum, illuminant_set
@@ -62,6 +62,24 @@ def test_unknown_names_are_one_line_errors():
         library.build("obj-vase", view=1, seed=SEED)
     with pytest.raises(SpectrinsicError, match="library scene kind"):
         library.scene_names("objects")
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: library.build("obj-vace", seed=SEED),
+        lambda: library.build("obj-vase", condition="x", seed=SEED),
+        lambda: library.build("obj-vase", view=1, seed=SEED),
+        lambda: library.scene_names("objects"),
+        lambda: library.n_views("room"),
+        lambda: library.condition_illuminants("obj-vase", "blue", seed=SEED),
+    ],
+    ids=["name", "condition", "view", "kind", "n_views", "illuminants"],
+)
+def test_bad_names_are_scene_errors(call):
+    """``except SceneError`` catches every bad name given to the scene library."""
+    with pytest.raises(SceneError):
+        call()
 
 
 def test_conditions_are_reproducible_and_seed_dependent():

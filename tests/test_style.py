@@ -1,0 +1,76 @@
+"""House rules checked on the source tree: short functions (STYLE.md, issue 12)."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+#: The longest function body allowed, in source lines, not counting its docstring.
+MAX_BODY_LINES = 60
+#: The folders that make up the installed package (see pyproject's ``package-dir``).
+PACKAGE_FOLDERS = ("core", "spectra", "scenes", "render", "gt_export", "decompose")
+
+
+def _body_lines(node: ast.FunctionDef | ast.AsyncFunctionDef) -> int:
+    """Source lines spanned by a function's body, its docstring left out (0 for a bare docstring)."""
+    body = node.body
+    first = body[0]
+    if (
+        isinstance(first, ast.Expr)
+        and isinstance(first.value, ast.Constant)
+        and isinstance(first.value.value, str)
+    ):
+        body = body[1:]
+    if not body:
+        return 0
+    end = max(getattr(n, "end_lineno", n.lineno) or n.lineno for n in body)
+    return end - body[0].lineno + 1
+
+
+def long_functions(source: str, filename: str = "<string>") -> list[tuple[str, int, int]]:
+    """Every function in ``source`` whose body exceeds :data:`MAX_BODY_LINES`.
+
+    Returns ``(qualified name, line number, body lines)`` tuples; methods and nested functions
+    are named ``Outer.inner``.
+    """
+    found: list[tuple[str, int, int]] = []
+
+    def visit(node: ast.AST, prefix: str) -> None:
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+                name = f"{prefix}{child.name}"
+                if not isinstance(child, ast.ClassDef):
+                    lines = _body_lines(child)
+                    if lines > MAX_BODY_LINES:
+                        found.append((name, child.lineno, lines))
+                visit(child, name + ".")
+            else:
+                visit(child, prefix)
+
+    visit(ast.parse(source, filename=filename), "")
+    return found
+
+
+def test_the_checker_counts_body_lines_without_the_docstring():
+    body = "\n".join(f"    x{i} = {i}" for i in range(MAX_BODY_LINES))
+    ok = f'def f():\n    """Doc\n    string."""\n{body}\n'
+    assert long_functions(ok) == []
+    too_long = ok + "    return x0\n"
+    assert long_functions(too_long) == [("f", 1, MAX_BODY_LINES + 1)]
+    nested = "class A:\n    def g(self):\n" + "\n".join(
+        f"        y{i} = {i}" for i in range(MAX_BODY_LINES + 5)
+    )
+    assert long_functions(nested) == [("A.g", 2, MAX_BODY_LINES + 5)]
+
+
+def test_no_function_body_is_over_sixty_lines(repo_root: Path):
+    offenders = []
+    for folder in PACKAGE_FOLDERS:
+        for path in sorted((repo_root / folder).rglob("*.py")):
+            rel = path.relative_to(repo_root)
+            for name, line, lines in long_functions(path.read_text(), str(rel)):
+                offenders.append(f"{rel}:{line} {name} ({lines} lines)")
+    assert not offenders, (
+        f"functions with more than {MAX_BODY_LINES} body lines; split them into named steps:\n"
+        + "\n".join(offenders)
+    )
