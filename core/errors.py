@@ -21,6 +21,7 @@ __all__ = [
     "WriteError",
     "DiskFullError",
     "DecomposeError",
+    "StudyError",
     "MissingDependencyError",
     "SpectrinsicWarning",
     "validate_choice",
@@ -72,6 +73,10 @@ class DiskFullError(WriteError):
 class DecomposeError(SpectrinsicError, ValueError):
     """A decomposer, metric or decomposition setting that is unknown or given a parameter it
     does not take."""
+
+
+class StudyError(SpectrinsicError, ValueError):
+    """A study setting that is unknown (a camera balance, a fit scope, a quality preset...)."""
 
 
 class MissingDependencyError(SpectrinsicError, ImportError):

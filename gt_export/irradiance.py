@@ -131,8 +131,8 @@ def white_radiance(
         ``(3, K)`` the mode's raw -> XYZ matrix.
 
     >>> cov = np.ones((1, 1, 1)); rho = np.array([[0.5, 0.25]])
-    >>> white_radiance(np.array([[[1.0, 1.0]]]), cov, rho, np.eye(3)[:, :2], mode="x").bands
-    array([[[2., 4.]]])
+    >>> white_radiance(np.array([[[1.0, 1.0]]]), cov, rho, np.eye(3)[:, :2], mode="x").bands.tolist()
+    [[[2.0, 4.0]]]
     """
     raw = np.asarray(raw, np.float64)
     coverage = np.asarray(coverage, np.float64)

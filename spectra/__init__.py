@@ -4,7 +4,7 @@ Pure functions on arrays and small frozen records; numpy and colour-science only
 :mod:`spectrinsic.spectra.io` reads files.
 """
 
-import numpy as np
+import numpy as _np
 
 from spectrinsic.spectra import colorimetry as _colorimetry
 from spectrinsic.spectra.colorimetry import (
@@ -86,11 +86,11 @@ __all__ = [
 
 
 #: The sRGB matrices of :mod:`~spectrinsic.spectra.colorimetry`, computed on first access.
-XYZ_TO_LINEAR_SRGB: np.ndarray
-LINEAR_SRGB_TO_XYZ: np.ndarray
+XYZ_TO_LINEAR_SRGB: _np.ndarray
+LINEAR_SRGB_TO_XYZ: _np.ndarray
 
 
-def __getattr__(name: str) -> np.ndarray:
+def __getattr__(name: str) -> _np.ndarray:
     """``XYZ_TO_LINEAR_SRGB``, ``LINEAR_SRGB_TO_XYZ``: the sRGB matrices, computed on first access
     (see :mod:`spectrinsic.spectra.colorimetry`), so importing the package computes nothing."""
     if name in ("XYZ_TO_LINEAR_SRGB", "LINEAR_SRGB_TO_XYZ"):

@@ -13,7 +13,7 @@ from typing import Any
 __all__ = ["run", "SIZE", "GOAL_SECONDS"]
 
 SIZE = 256
-#: Issue 5: names-and-shades under 60 s on a 256x256 image on the 2-core machine.
+#: The goal: names-and-shades under 60 s on a 256x256 image on the 2-core machine.
 GOAL_SECONDS = 60.0
 
 

@@ -1,4 +1,4 @@
-"""Benchmark of the shading ground truth against a converged render (issue 8's goal).
+"""Benchmark of the shading ground truth against a converged render.
 
 One room of the default set (``room-living``, view 1, white light) is rendered as the
 ``default`` preset renders it, and again at 16× its spp in 4 batches as the reference. Per

@@ -24,6 +24,8 @@ from typing import Any
 
 import numpy as np
 
+from spectrinsic.render.modes import RENDER_MODES
+
 __all__ = ["run", "SCENE", "SIZE", "SPP", "OVERHEAD_GOAL", "TRUTH_FACTOR"]
 
 SCENE = ("room-living", 0, "two-colour-a")
@@ -39,7 +41,8 @@ REPEATS = 5
 OVERHEAD_GOAL = 0.10
 #: The equal-time comparison's truth has this many times the samples of the spectral render.
 TRUTH_FACTOR = 8
-MODES = ("spectral", "rgb3", "gauss3", "rgb6", "bands31")
+#: Every registered render mode (render.modes.RENDER_MODES), in the registry's order.
+MODES = tuple(RENDER_MODES)
 
 
 def _bare_seconds(scene: Any, spp: int) -> float:

@@ -23,6 +23,9 @@ DEFAULT_SEED = 0
 
 
 def register(sub: argparse._SubParsersAction) -> None:
+    from spectrinsic.studies.photometric import CAMERA_BALANCES
+    from spectrinsic.studies.rendering import QUALITIES
+
     p = sub.add_parser(
         "study", help="run a study of the thesis (Table 5.2, Table 4.4, rendering)",
         description="Run a study, print its table and write JSON, CSV and PNG files into --out.",
@@ -34,12 +37,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--include-ie", action="store_true",
                    help="photometric: add the Image Engineering 2024 cameras of the data directory")
     p.add_argument("--camera-balance", default="equal-energy-white",
-                   choices=("none", "per-channel-peak", "d65-white", "equal-energy-white"),
+                   choices=CAMERA_BALANCES,
                    help="photometric: normalisation of the camera curves (default: "
                         "equal-energy-white, the one giving the thesis' SC3 behaviour)")
     p.add_argument("--no-extension", action="store_true",
                    help="reconstruction-error: only Table 5.2, without the extended sweep")
-    p.add_argument("--quality", default="default", choices=("preview", "default", "paper"),
+    p.add_argument("--quality", default="default", choices=tuple(QUALITIES),
                    help="rendering: quality preset (default: default, < 10 min on 2 cores)")
     p.set_defaults(func=run)
 

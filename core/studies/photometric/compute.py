@@ -15,7 +15,7 @@ from typing import Literal
 import numpy as np
 
 from spectrinsic.config import resolve_data_dir
-from spectrinsic.errors import SpectralDataError, validate_choice
+from spectrinsic.errors import SpectralDataError, StudyError, validate_choice
 from spectrinsic.rng import generator
 from spectrinsic.spectra import (
     ESTIMATE_SCENARIOS,
@@ -137,12 +137,13 @@ class PhotometricSettings:
     )
 
     def __post_init__(self) -> None:
-        validate_choice(self.reflectances, ("auto", "sfu", "munsell"), "photometric reflectance set")
-        validate_choice(self.fit_scope, ("scene", "all"), "matrix fit scope")
-        validate_choice(self.sc3_light_space, ("camera", "srgb"), "SC3 light space")
-        validate_choice(self.camera_balance, CAMERA_BALANCES, "camera balance")
+        validate_choice(self.reflectances, ("auto", "sfu", "munsell"), "photometric reflectance set",
+                        error=StudyError)
+        validate_choice(self.fit_scope, ("scene", "all"), "matrix fit scope", error=StudyError)
+        validate_choice(self.sc3_light_space, ("camera", "srgb"), "SC3 light space", error=StudyError)
+        validate_choice(self.camera_balance, CAMERA_BALANCES, "camera balance", error=StudyError)
         for s in self.illuminant_sets:
-            validate_choice(s, ILLUMINANT_SETS, "illuminant set")
+            validate_choice(s, ILLUMINANT_SETS, "illuminant set", error=StudyError)
         if self.n_scenes < 1 or self.reflectances_per_scene < 3:
             raise SpectralDataError(
                 f"{self.n_scenes} scenes of {self.reflectances_per_scene} reflectances: expected "
@@ -218,7 +219,7 @@ def balance_curves(
     perfect white under *canonical* gives ``(1, 1, 1)``; ``"equal-energy-white"``: ``S_k /
     sum(S_k)``, the same for a flat spectrum; ``"none"``: unchanged.
     """
-    validate_choice(balance, CAMERA_BALANCES, "camera balance")
+    validate_choice(balance, CAMERA_BALANCES, "camera balance", error=StudyError)
     if balance == "per-channel-peak":
         return curves / curves.max(axis=1, keepdims=True)
     if balance == "d65-white":

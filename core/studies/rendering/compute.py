@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from spectrinsic.errors import validate_choice
+from spectrinsic.errors import SceneError, StudyError, validate_choice
 from spectrinsic.scenes.library import CONDITIONS
 from spectrinsic.spectra import relative_error
 
@@ -86,7 +86,7 @@ class SampleResult:
 
 def study_quality(quality: str) -> StudyQuality:
     """The preset named *quality* (one of :data:`QUALITIES`)."""
-    return QUALITIES[validate_choice(quality, QUALITIES, "rendering study quality")]
+    return QUALITIES[validate_choice(quality, QUALITIES, "rendering study quality", error=StudyError)]
 
 
 def samples(
@@ -97,7 +97,7 @@ def samples(
     from spectrinsic.scenes import library
 
     for condition in conditions:
-        validate_choice(condition, CONDITIONS, "illumination condition")
+        validate_choice(condition, CONDITIONS, "illumination condition", error=SceneError)
     names = list(scenes) if scenes is not None else library.scene_names("complex")
     for name in names:
         for view in (list(views) if views is not None else range(library.n_views(name))):
