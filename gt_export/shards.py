@@ -20,7 +20,6 @@ is what marks an export complete.
 
 from __future__ import annotations
 
-import hashlib
 import io
 import json
 import os
@@ -32,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import DatasetError, MissingDependencyError
+from spectrinsic.gt_export.integrity import file_sha256
 from spectrinsic.gt_export.loader import load_sample, split_samples
 
 __all__ = ["SHARD_INDEX", "KEY_SEPARATOR", "ShardSet", "write_shards", "shard_urls", "shard_dataset"]
@@ -98,14 +98,6 @@ def _encode(sample: dict[str, Any]) -> dict[str, Any]:
             record[_member_name(key)] = _npy(value)
     record["meta.json"] = json.dumps(sample["meta"], sort_keys=True).encode("utf-8")
     return record
-
-
-def _sha256(path: Path) -> str:
-    digest = hashlib.sha256()
-    with path.open("rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
 
 
 def _prepare_out(out: Path) -> set[str]:
@@ -220,7 +212,7 @@ def write_shards(
     for shards in plan.values():
         for name, folders in shards.items():
             seen |= _write_shard(out, name, folders, layers, progress)
-            files[name] = _sha256(out / name)
+            files[name] = file_sha256(out / name)
     _write_index(out, {**base, "complete": True, "entries": _entries(seen), "files": files,
                        "splits": {k: {"shards": list(v), "samples": sum(map(len, v.values()))}
                                   for k, v in plan.items()}})
