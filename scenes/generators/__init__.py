@@ -11,6 +11,7 @@ scene's metadata.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 
@@ -40,6 +41,9 @@ __all__ = [
 ]
 
 #: Layout functions by generator name.
+#: Layouts drawn for one scene before it fails (see :func:`generate`).
+LAYOUT_ATTEMPTS = 4
+
 GENERATORS: dict[str, Callable[[np.random.Generator, GeneratorOptions], Layout]] = {
     "objects-on-ground": objects_on_ground,
     "rooms": rooms,
@@ -86,9 +90,27 @@ def generate(generator: str, *, root_seed: int, index: int, view: int, options: 
     -------
     Scene
         Its metadata records the generator, the scene seed, the draws and the coverage.
+
+    Notes
+    -----
+    A layout in which no light finds free space, or no camera of some view sees enough of the
+    objects, is drawn again from ``seed_from_key(seed, "layout-<k>")``, up to
+    :data:`LAYOUT_ATTEMPTS` times (recorded as ``layout_attempt``). Whether a layout passes
+    is judged on all ``options.views`` cameras, so every view of a scene shows one layout.
+    Scenes whose first layout passes are unchanged by this.
     """
     name = generated_scene_name(generator, index)
     seed = generated_scene_seed(root_seed, generator, index)
-    rngs = scene_rngs(seed)
-    layout = GENERATORS[generator](rngs["layout"], options)
-    return assemble(name, layout, seed, view, options, rngs)
+    problems = []
+    for attempt in range(LAYOUT_ATTEMPTS):
+        rngs = scene_rngs(seed if attempt == 0 else seed_from_key(seed, f"layout-{attempt}"))
+        layout = GENERATORS[generator](rngs["layout"], options)
+        try:
+            scene = assemble(name, layout, seed, view, options, rngs)
+        except SceneError as exc:  # this layout cannot be lit or seen: draw another
+            problems.append(str(exc))
+            continue
+        if attempt == 0:
+            return scene
+        return replace(scene, metadata={**scene.metadata, "layout_attempt": attempt})
+    raise SceneError(f"{name}: no usable layout in {LAYOUT_ATTEMPTS} draws ({problems[-1]})")

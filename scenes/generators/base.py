@@ -106,11 +106,15 @@ def assemble(name: str, layout: Layout, seed: int, view: int, options: Generator
     lights = draw_lights(rngs["lights"], family, layout.lights,
                          free=lambda p: is_free(meshes, p), sfu=options.sfu_illuminants,
                          data_dir=options.data_dir, max_lights=options.max_lights)
-    for k in range(view + 1):  # views 0..view drawn in order: view k is the same in any build
-        camera, cov = sample_camera(rngs["camera"], meshes, layout.propose_camera,
-                                    width=options.width, height=options.height,
-                                    is_object=_is_object, min_coverage=options.min_coverage,
-                                    name=f"view{k}")
+    # Views 0..views-1 are drawn in order, so view k is the same in any build, and all of them
+    # must pass for the layout to be used (every view of a scene shows one layout).
+    for k in range(max(view + 1, options.views)):
+        drawn = sample_camera(rngs["camera"], meshes, layout.propose_camera,
+                              width=options.width, height=options.height,
+                              is_object=_is_object, min_coverage=options.min_coverage,
+                              name=f"view{k}")
+        if k == view:
+            camera, cov = drawn
     meta = {**layout.info, "generator_seed": int(seed), "view": int(view), "condition": family,
             "object_coverage": cov, "illuminants": [light.spectrum for light in lights],
             "light_kinds": [light.kind for light in lights]}

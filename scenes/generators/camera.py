@@ -122,4 +122,4 @@ def sample_camera(
         best = max(best, cov)
         if cov >= min_coverage:
             return cam, cov
-    raise SceneError(f"no camera of {tries} draws saw >= {min_coverage:.0%} objects (best {best:.0%})")
+    raise SceneError(f"no camera of {tries} draws saw >= {min_coverage:.1%} objects (best {best:.1%})")

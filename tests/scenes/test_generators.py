@@ -137,3 +137,36 @@ def test_rooms_are_lit_directly_and_indirectly():
         for light in s.lights:
             assert light.kind in ("spot", "area") and light.direction[2] > 0
             assert light.position[2] < 0.6 * height + 1e-9
+
+
+def test_a_layout_no_camera_can_see_is_drawn_again(monkeypatch):
+    """The first layout's cameras all fail: the scene is the next layout, the same in every view
+    and every build; when every layout fails, the error names the scene and the reason."""
+    import spectrinsic.scenes.generators.base as base
+
+    real, calls = base.sample_camera, {"n": 0}
+
+    from spectrinsic.errors import SceneError
+
+    def blind_once(*args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] == 1:
+            raise SceneError("no camera of 40 draws saw >= 15.0% objects (best 14.9%)")
+        return real(*args, **kwargs)
+
+    plain = _scene("objects-on-ground", 5, view=1)
+    monkeypatch.setattr(base, "sample_camera", blind_once)
+    redrawn = _scene("objects-on-ground", 5, view=1)
+    assert redrawn.metadata["layout_attempt"] == 1 and "layout_attempt" not in plain.metadata
+    assert scene_hash(redrawn) != scene_hash(plain)
+    calls["n"] = 0
+    view0 = _scene("objects-on-ground", 5, view=0)
+    assert [m.name for m in view0.meshes] == [m.name for m in redrawn.meshes]
+    assert all(np.array_equal(a.vertices, b.vertices) for a, b in zip(view0.meshes, redrawn.meshes))
+
+    def always_blind(*args, **kwargs):
+        raise SceneError("no camera saw the objects")
+
+    monkeypatch.setattr(base, "sample_camera", always_blind)
+    with pytest.raises(SceneError, match="objects-on-ground-00000: no usable layout in 4 draws"):
+        _scene("objects-on-ground", 5)
