@@ -68,7 +68,8 @@ def srgb() -> SensorSet:
     :func:`spectrinsic.spectra.xyz_to_linear_srgb`.
     """
     cmf = cie1931()
-    curves = srgb_matrices()[0] @ cmf.curves
+    # einsum's own loop, not BLAS: the curves' bits must not change with the CPU kernel.
+    curves = np.einsum("kj,jw->kw", srgb_matrices()[0], cmf.curves)
     curves.flags.writeable = False
     return SensorSet(
         "srgb", ("R", "G", "B"), cmf.wavelengths, curves,
