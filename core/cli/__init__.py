@@ -14,6 +14,7 @@ import traceback
 from collections.abc import Sequence
 
 from spectrinsic.errors import SpectrinsicError
+from spectrinsic.interrupts import interrupts_reach_python
 
 __all__ = ["main", "build_parser"]
 
@@ -54,7 +55,13 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point. Returns the process exit status (0 ok, 1 problems found or samples failed,
     2 bad input or a resource that failed: one line on stderr, the traceback only with
-    ``--debug``)."""
+    ``--debug``; 130 interrupted)."""
+    # Before anything starts a thread: Ctrl-C must reach Python even mid-render.
+    with interrupts_reach_python():
+        return _main(argv)
+
+
+def _main(argv: Sequence[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(
