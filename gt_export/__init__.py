@@ -5,20 +5,20 @@ live renderer, and computes the exact ground truth (absolute reflectance, shadin
 illuminant, camera views, chapter-4 matrices) from the scene's spectra.
 """
 
+from spectrinsic.gt_export.card import write_dataset_card
 from spectrinsic.gt_export.check import check_dataset, check_sample
 from spectrinsic.gt_export.exr import read_exr, write_exr
 from spectrinsic.gt_export.gallery import build_gallery, contact_sheet
 from spectrinsic.gt_export.layers import GroundTruth, Layer, LightRecord, compute_ground_truth
 from spectrinsic.gt_export.loader import load_dataset, load_sample, torch_dataset
+from spectrinsic.gt_export.manifest import write_manifest
+from spectrinsic.gt_export.sample import config_hash, sample_dirs
+from spectrinsic.gt_export.sample_meta import SampleMeta, read_meta
 from spectrinsic.gt_export.writer import (
     DEFAULT_CAMERAS,
-    config_hash,
     export_sample,
     is_complete,
     remove_stale_temporaries,
-    sample_dirs,
-    write_dataset_card,
-    write_manifest,
 )
 
 __all__ = [
@@ -26,6 +26,7 @@ __all__ = [
     "GroundTruth",
     "Layer",
     "LightRecord",
+    "SampleMeta",
     "build_gallery",
     "check_dataset",
     "check_sample",
@@ -37,6 +38,7 @@ __all__ = [
     "load_dataset",
     "load_sample",
     "read_exr",
+    "read_meta",
     "remove_stale_temporaries",
     "sample_dirs",
     "torch_dataset",
