@@ -105,7 +105,7 @@ class Layer:
     name
         Loader key, e.g. ``"reflectance"`` or ``"image_camera/Nikon 5100 (NPL)"``.
     data
-        ``(H, W)`` or ``(H, W, C)`` float32.
+        ``(H, W)`` or ``(H, W, C)`` float32; ids ``(H, W)`` int32.
     channels
         Channel names in order (``("R", "G", "B")``, ``("Z",)``...).
     units
@@ -429,9 +429,21 @@ def _image_layers(s: _Sample) -> list[Layer]:
 _GEOMETRY = (
     ("depth", ("Z",), "scene units, distance from the camera to the first hit (0: background)"),
     ("normals", ("X", "Y", "Z"), "world-space unit surface normals (0: background)"),
-    ("material_id", ("id",), "index into meta['materials'], stored as float32; -1 background"),
-    ("object_id", ("id",), "object id of the scene meshes, stored as float32; -1 background"),
+    ("material_id", ("id",), "index into meta['materials'], int32 (an EXR UINT channel holding "
+     "the int32 bits); -1 background"),
+    ("object_id", ("id",), "object id of the scene meshes, int32 (an EXR UINT channel holding "
+     "the int32 bits); -1 background"),
 )
+_ID_LAYERS = ("material_id", "object_id")
+
+
+def _ids(name: str, value: np.ndarray) -> np.ndarray:
+    """An id AOV as int32: whole numbers in [-1, 2**31 - 1] (-1 background), else an error."""
+    value = np.asarray(value)
+    ints = value if value.dtype.kind in "iu" else np.rint(value)
+    if value.size and ((ints != value).any() or ints.min() < -1 or ints.max() >= 2**31):
+        raise DatasetError(f"render AOV {name!r}: expected whole ids from -1 to 2**31 - 1")
+    return ints.astype(np.int32)
 
 
 def _coverage(s: _Sample, shape: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
@@ -453,7 +465,11 @@ def _geometry_layers(s: _Sample, mask: np.ndarray) -> list[Layer]:
                   "geometry", nonnegative=True)]
     for name, channels, units in _GEOMETRY:
         value = _aov(s.result, name)
-        if value is not None:
+        if value is None:
+            continue
+        if name in _ID_LAYERS:
+            out.append(Layer(name, _ids(name, value), channels, units, "geometry"))
+        else:
             out.append(_layer(name, value, channels, units, "geometry", nonnegative=name == "depth"))
     return out
 

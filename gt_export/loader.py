@@ -84,7 +84,8 @@ def load_sample(
     ids = {}
     for key in _INT_LAYERS:
         if key in out:
-            out[key] = np.rint(out[key]).astype(np.int32)
+            if out[key].dtype != np.int32:  # format 2 stored ids as float32
+                out[key] = np.rint(out[key]).astype(np.int32)
             ids[key.removesuffix("_id")] = out[key]
     if ids:
         out["ids"] = ids

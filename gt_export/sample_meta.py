@@ -26,7 +26,7 @@ from types import MappingProxyType
 from typing import Any
 
 from spectrinsic.errors import SampleMetaError
-from spectrinsic.gt_export.json_fields import JsonFields, reject_constant, load_json
+from spectrinsic.gt_export.json_fields import JsonFields, load_json, reject_constant
 from spectrinsic.gt_export.sample import (
     HASHES_KEY,
     META_NAME,

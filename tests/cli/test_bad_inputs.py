@@ -180,6 +180,7 @@ CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
     ("data-dir-nan", lambda t: _sfu_render(t, "nan"), "reflect_db_1995.csv"),
     ("data-dir-inf", lambda t: _sfu_render(t, "inf"), "reflect_db_1995.csv"),
     ("data-dir-negative", lambda t: _sfu_render(t, "-0.2"), "reflect_db_1995.csv"),
+    ("data-dir-above-one", lambda t: _sfu_render(t, "1e30"), "too large value 1e+30"),
     ("data-dir-empty-cell", lambda t: _sfu_render(t, ""), "reflect_db_1995.csv"),
     ("data-dir-missing", lambda t: _sfu_render(t, None), "nope"),
     # --- point 8: limits

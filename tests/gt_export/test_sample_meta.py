@@ -145,3 +145,22 @@ def test_no_module_outside_the_sample_module_parses_meta_json():
             lines = _raw_meta_reads(ast.parse(path.read_text(encoding="utf-8")))
             offenders += [f"{path.relative_to(PACKAGE)}:{line}" for line in lines]
     assert offenders == []
+
+
+def test_object_id_16777217_is_exported_and_loaded_exactly(tmp_path, synth, config):
+    import dataclasses
+
+    from spectrinsic.gt_export import check_dataset
+
+    scene = synth.make_scene(("planck:2800K",))
+    result = synth.make_result(scene)
+    big = np.where(result.aovs["object_id"] >= 0, 16777217, -1).astype(np.int32)
+    result = dataclasses.replace(result, aovs={**result.aovs, "object_id": big})
+    folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=1)
+    sample = load_sample(folder)
+    assert sample["object_id"].dtype == np.int32
+    np.testing.assert_array_equal(sample["object_id"], big)
+    np.testing.assert_array_equal(sample["ids"]["object"], big)
+    assert read_meta(folder).layers["object_id"].dtype == "int32"
+    write_manifest(tmp_path, config)
+    assert check_dataset(tmp_path) == []
