@@ -31,6 +31,7 @@ import numpy as np
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.card import read_template
+from spectrinsic.gt_export.integrity import guarded_write
 from spectrinsic.gt_export.manifest import read_manifest
 from spectrinsic.gt_export.names import slug
 from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, plain_data, sample_dirs
@@ -220,8 +221,9 @@ def contact_sheet(
         for line_no, line in enumerate(_wrap(sample.name, draw, font)):
             draw.text((x0 + 2, y0 + TILE + 1 + line_no * _CAPTION_HEIGHT), line, fill=(0, 0, 0), font=font)
     path = Path(out) if out is not None else root / "contact_sheet.png"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    sheet.save(path, format="PNG")
+    with guarded_write(path):
+        path.parent.mkdir(parents=True, exist_ok=True)
+        sheet.save(path, format="PNG")
     return path
 
 
@@ -248,16 +250,40 @@ def _condition_sheets(root: Path, index: Mapping[str, Any]) -> dict[str, str]:
     return out
 
 
+#: How every ``gallery-pixels/<id>.js`` starts: the mark of a file the gallery wrote.
+_PIXELS_HEAD = "(window.SPECTRINSIC_PIXELS = window.SPECTRINSIC_PIXELS || {})["
+
+
+def _written_by_us(path: Path) -> bool:
+    """Whether *path* is a pixel script the gallery wrote (a plain file starting with
+    :data:`_PIXELS_HEAD`); anything else in ``gallery-pixels/`` is the user's and stays."""
+    if path.is_symlink() or not path.is_file():
+        return False
+    try:
+        with path.open(encoding="utf-8") as fh:
+            return fh.read(len(_PIXELS_HEAD)) == _PIXELS_HEAD
+    except (OSError, UnicodeDecodeError):
+        return False
+
+
+def _write_text(path: Path, text: str) -> None:
+    with guarded_write(path):  # a full disk names the file
+        path.write_text(text, encoding="utf-8")
+
+
 def _write_pixel_scripts(root: Path, index: Mapping[str, Any]) -> None:
     """Write ``gallery-pixels/<id>.js`` per sample: its value-bearing previews (``srgb`` and
     ``colormap`` encodings) as ``data:`` URLs, which a page opened from ``file://`` may read
-    into a canvas (Chromium forbids reading the files themselves); set each entry's ``pixels``."""
+    into a canvas (Chromium forbids reading the files themselves); set each entry's ``pixels``.
+    Earlier scripts of ours are replaced; no other file in the folder is touched."""
     import base64
-    import shutil
 
     folder = root / _PIXELS_DIR
-    shutil.rmtree(folder, ignore_errors=True)
-    folder.mkdir()
+    with guarded_write(folder):
+        folder.mkdir(exist_ok=True)
+    for old in sorted(folder.glob("*.js")):
+        if _written_by_us(old):
+            old.unlink()
     for entry in index["samples"]:
         urls = {
             name: "data:image/png;base64," + base64.b64encode((root / src).read_bytes()).decode("ascii")
@@ -265,9 +291,11 @@ def _write_pixel_scripts(root: Path, index: Mapping[str, Any]) -> None:
             if isinstance(enc, Mapping) and enc.get("kind") in ("srgb", "colormap")
         }
         rel = f"{_PIXELS_DIR}/{entry['id']}.js"
-        (root / rel).write_text(
-            f"(window.SPECTRINSIC_PIXELS = window.SPECTRINSIC_PIXELS || {{}})[{json.dumps(entry['id'])}] = "
-            f"{json.dumps(urls)};\n", encoding="utf-8")
+        target = root / rel
+        if target.exists() and not _written_by_us(target):
+            raise DatasetError(f"{target}: not a gallery file spectrinsic wrote; move it away to "
+                               "rebuild the gallery")
+        _write_text(target, f"{_PIXELS_HEAD}{json.dumps(entry['id'])}] = {json.dumps(urls)};\n")
         entry["pixels"] = rel
 
 
@@ -289,14 +317,14 @@ def build_gallery(
     contact_sheet(root)
     index["contact_sheets"] = {"all": "contact_sheet.png", **_condition_sheets(root, index)}
     data = json.dumps(plain_data(index), ensure_ascii=False, separators=(",", ":"))
-    (root / "gallery.json").write_text(data + "\n", encoding="utf-8")
-    (root / "gallery-index.js").write_text(f"window.{INDEX_VARIABLE} = {data};\n", encoding="utf-8")
+    _write_text(root / "gallery.json", data + "\n")
+    _write_text(root / "gallery-index.js", f"window.{INDEX_VARIABLE} = {data};\n")
     for name in _STATIC:
-        (root / name).write_text(read_template(name), encoding="utf-8")
+        _write_text(root / name, read_template(name))
     page = string.Template(read_template("gallery.html")).substitute(
         title=_escape(index["title"]), n_samples=len(index["samples"]))
     path = root / "index.html"
-    path.write_text(page, encoding="utf-8")
+    _write_text(path, page)
     return path
 
 
