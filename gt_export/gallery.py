@@ -20,6 +20,8 @@ The page decodes a pixel of a preview back to the linear value it stands for fro
 
 from __future__ import annotations
 
+import base64
+import html
 import json
 import os
 import string
@@ -37,6 +39,7 @@ from spectrinsic.gt_export.names import slug
 from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, plain_data, sample_dirs
 from spectrinsic.gt_export.sample_meta import SampleMeta, read_meta
 from spectrinsic.scenes.sample_id import SEPARATOR
+from spectrinsic.spectra import get_sensors, xyz_to_xy
 
 __all__ = ["build_gallery", "contact_sheet", "gallery_index", "GALLERY_DIRS", "GALLERY_LAYERS",
            "INDEX_VARIABLE"]
@@ -69,8 +72,6 @@ _SUMMARY_GLOBS = ("*.png", "plots/*.png", "summary/*.png", "figures/*.png")
 
 def _spectral_locus() -> list[list[float]]:
     """xy of the CIE 1931 2° spectral locus, 380–700 nm at 1 nm (colour-science's CMFs)."""
-    from spectrinsic.spectra import get_sensors, xyz_to_xy
-
     cmf = get_sensors("cie1931")
     keep = (cmf.wavelengths >= 380) & (cmf.wavelengths <= 700)
     return np.round(xyz_to_xy(cmf.curves[:, keep].T), 5).tolist()
@@ -276,8 +277,6 @@ def _write_pixel_scripts(root: Path, index: Mapping[str, Any]) -> None:
     ``colormap`` encodings) as ``data:`` URLs, which a page opened from ``file://`` may read
     into a canvas (Chromium forbids reading the files themselves); set each entry's ``pixels``.
     Earlier scripts of ours are replaced; no other file in the folder is touched."""
-    import base64
-
     folder = root / _PIXELS_DIR
     with guarded_write(folder):
         folder.mkdir(exist_ok=True)
@@ -329,6 +328,4 @@ def build_gallery(
 
 
 def _escape(text: str) -> str:
-    import html
-
     return html.escape(text)

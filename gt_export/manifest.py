@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from spectrinsic.config import resolve_data_dir
 from spectrinsic.errors import DatasetError, SampleMetaError
 from spectrinsic.gt_export.integrity import guarded_write
 from spectrinsic.gt_export.json_fields import JsonFields, load_json
@@ -52,8 +53,6 @@ SPLIT_FRACTIONS: tuple[tuple[str, float], ...] = (("train", 0.8), ("val", 0.1), 
 
 
 def _spectral_provenance(metas: Sequence[SampleMeta], data_dir: Any) -> dict[str, Any]:
-    from spectrinsic.config import resolve_data_dir
-
     used: set[str] = set()
     for meta in metas:
         used.update(meta.materials.values())

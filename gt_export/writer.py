@@ -57,6 +57,7 @@ from spectrinsic.gt_export.sample import (
 )
 from spectrinsic.provenance import software_versions
 from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash
+from spectrinsic.spectra import DEFAULT_WAVELENGTHS, get_spectrum
 
 __all__ = [
     "DEFAULT_CAMERAS",
@@ -99,8 +100,6 @@ def _meta(
     scene: Scene, result: Any, gt: GroundTruth, *, sample_id: str, config: Mapping[str, Any],
     seed: int, previews: Mapping[str, tuple[str, dict[str, Any]]], files: Sequence[str],
 ) -> dict[str, Any]:
-    from spectrinsic.spectra import DEFAULT_WAVELENGTHS, get_spectrum
-
     render_meta = {k: v for k, v in (getattr(result, "meta", None) or {}).items()
                    if k not in _VOLATILE_META}
     lights = []

@@ -27,6 +27,7 @@ from spectrinsic.gt_export.layers.spectral import (
     photometric_matrices,
 )
 from spectrinsic.gt_export.names import camera_slug
+from spectrinsic.spectra import get_sensors, get_spectrum
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 from spectrinsic.spectra import white_normalised_responses as canonical_responses
@@ -40,8 +41,6 @@ def camera_layers(
 ) -> list[Layer]:
     """Camera image from the cube, relative reflectance, and shading/residual/illuminant from
     ``W`` in the camera's RGB (relative to its own white under D65)."""
-    from spectrinsic.spectra import get_sensors
-
     band_set = get_sensors(cube_sensor_name(s.result), data_dir=s.data_dir)
     weights = cube_to_sensors(band_set.curves, camera_curves(cam, band_set.wavelengths,
                                                              data_dir=s.data_dir), band_set.wavelengths)
@@ -65,8 +64,6 @@ def camera_layers(
 
 def matrices_of(s: SampleInputs, shares: np.ndarray, spaces: Mapping[str, np.ndarray], training: Any) -> dict[str, Any]:
     """The chapter-4 matrices for the scene's effective light and for each light."""
-    from spectrinsic.spectra import get_spectrum
-
     spds = [get_spectrum(light.spectrum, data_dir=s.data_dir).on(s.wl) for light in s.scene.lights]
     illum: dict[str, np.ndarray] = {}
     if spds:

@@ -10,6 +10,7 @@ import numpy as np
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import irradiance as irr
+from spectrinsic.gt_export.denoise import denoise_white_radiance
 from spectrinsic.gt_export.layers.cameras import camera_layers, matrices_of
 from spectrinsic.gt_export.layers.geometry import coverage_of, geometry_layers
 from spectrinsic.gt_export.layers.images import cube_layer, image_layers
@@ -38,6 +39,7 @@ from spectrinsic.gt_export.layers.records import (
 )
 from spectrinsic.gt_export.layers.spectral import camera_curves
 from spectrinsic.scenes.model import Scene
+from spectrinsic.spectra import absolute_reflectance, get_sensors, get_spectrum
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 
@@ -45,8 +47,6 @@ __all__ = ["compute_ground_truth", "identities"]
 
 
 def _sample(scene: Scene, result: Any, data_dir: Any) -> SampleInputs:
-    from spectrinsic.spectra import get_spectrum
-
     wl = grid()
     rho = (np.stack([get_spectrum(m.spectrum, data_dir=data_dir).on(wl) for m in scene.materials])
            if scene.materials else np.zeros((0, wl.size)))
@@ -90,8 +90,6 @@ def compute_ground_truth(
     training
         ``(N, 471)`` reflectances on the 1 nm grid for the matrix fits (default: all Munsell chips).
     """
-    from spectrinsic.spectra import absolute_reflectance, get_sensors
-
     s = _sample(scene, result, data_dir)
     layers = image_layers(s)
     image = layers[0].data.astype(np.float64)
@@ -106,8 +104,6 @@ def compute_ground_truth(
     w_raw = white_radiance(s, coverage)
     w = w_raw
     if denoise:
-        from spectrinsic.gt_export.denoise import denoise_white_radiance
-
         w = denoise_white_radiance(w_raw, aov(result, "normals"), quality=denoise_quality)
     layers += intrinsic_layers(s, w_raw, w, image, reflectance, denoised=denoise)
     noise_maps, noise = noise_of(s, w_raw)

@@ -9,6 +9,8 @@ import numpy as np
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.layers.imaging import relative_error_map
 from spectrinsic.gt_export.layers.records import RGB, UNITS_IMAGE, Layer, SampleInputs, make_layer
+from spectrinsic.render.modes import RENDER_MODES
+from spectrinsic.spectra import get_sensors, xyz_to_linear_srgb
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 
@@ -18,16 +20,12 @@ __all__ = ["image_layers", "cube_layer"]
 def _shares_paths(mode: str, reference: str) -> bool:
     """Whether two render modes trace the same light paths (both K-channel diagonal passes of
     one scene, same seed and spp), so that their per-pixel difference is purely spectral."""
-    from spectrinsic.render.modes import RENDER_MODES
-
     return all(m in RENDER_MODES and RENDER_MODES[m].kind == "diagonal" for m in (mode, reference))
 
 
 def image_layers(s: SampleInputs) -> list[Layer]:
     """``image`` (the reference mode), every other mode, and error maps of the modes that
     share the reference's light paths (Eq. 5.7 per pixel)."""
-    from spectrinsic.spectra import xyz_to_linear_srgb
-
     ref_xyz = np.asarray(s.result.images[s.ref], float)
     out = [make_layer("image", xyz_to_linear_srgb(ref_xyz), RGB, UNITS_IMAGE + f"; render mode {s.ref!r}",
                   "image")]
@@ -44,8 +42,6 @@ def image_layers(s: SampleInputs) -> list[Layer]:
 
 
 def cube_layer(s: SampleInputs, cube_name: str | None) -> Layer:
-    from spectrinsic.spectra import get_sensors
-
     if cube_name is None:
         raise DatasetError("write_cube needs the 31-band cube (render mode 'bands31')")
     cube = np.asarray(s.result.raw["bands31"], float)

@@ -8,6 +8,7 @@ import numpy as np
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.layers.records import ERROR_FLOOR, REFLECTANCE_FLOOR
+from spectrinsic.spectra import LINEAR_SRGB_TO_XYZ, relative_error
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 
@@ -16,8 +17,6 @@ __all__ = ["luminance", "coverage_weighted", "shading_ratio", "relative_error_ma
 
 def luminance(rgb: np.ndarray) -> np.ndarray:
     """CIE Y of linear sRGB ``(..., 3)`` -> ``(...)``."""
-    from spectrinsic.spectra import LINEAR_SRGB_TO_XYZ
-
     return np.asarray(rgb, float) @ LINEAR_SRGB_TO_XYZ[1]
 
 
@@ -65,8 +64,6 @@ def relative_error_map(approx: np.ndarray, reference: np.ndarray) -> np.ndarray:
     reference norm is at most ``ERROR_FLOOR`` times its 99th percentile get 0.
     Returns ``(H, W)`` float64.
     """
-    from spectrinsic.spectra import relative_error
-
     return relative_error(approx, reference, dark_fraction=ERROR_FLOOR, fill=0.0)
 
 

@@ -19,6 +19,8 @@ from spectrinsic.gt_export.layers.records import (
     SampleInputs,
     make_layer,
 )
+from spectrinsic.render.modes import channel_values, get_mode, to_xyz_matrix
+from spectrinsic.spectra import get_sensors, xyz_to_linear_srgb
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 from spectrinsic.spectra import white_normalised_responses as canonical_responses
@@ -29,9 +31,6 @@ __all__ = ["white_radiance", "srgb_white", "srgb_of", "shading_set", "intrinsic_
 def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
     """``W = E/π`` from the reference render, Eq. 1 of
     :mod:`~spectrinsic.gt_export.irradiance`, with the band albedos the renderer used."""
-    from spectrinsic.render.modes import channel_values, get_mode, to_xyz_matrix
-    from spectrinsic.spectra import get_sensors
-
     mode = get_mode(s.ref)
     sensors = (s.result.meta or {}).get("sensors", {}).get(s.ref, mode.sensors)
     albedos = channel_values(s.scene, get_sensors(sensors, data_dir=s.data_dir),
@@ -44,14 +43,10 @@ def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
 
 
 def srgb_white(s: SampleInputs) -> np.ndarray:
-    from spectrinsic.spectra import get_sensors
-
     return canonical_responses(np.ones(s.wl.size), s.d65, get_sensors("srgb").on(s.wl), s.wl)
 
 
 def srgb_of(w: irr.WhiteRadiance) -> np.ndarray:
-    from spectrinsic.spectra import xyz_to_linear_srgb
-
     return xyz_to_linear_srgb(w.xyz())
 
 
@@ -85,8 +80,6 @@ def intrinsic_layers(
 ) -> list[Layer]:
     """sRGB shading, residual, grey shading and illuminant (from the denoised ``W`` if asked,
     with ``image_denoised`` rebuilt from it and the raw ``shading_raw``/``residual_raw``)."""
-    from spectrinsic.spectra import xyz_to_linear_srgb
-
     white = srgb_white(s)
     used = image
     out: list[Layer] = []
@@ -112,8 +105,6 @@ def intrinsic_layers(
 
 def noise_of(s: SampleInputs, w: irr.WhiteRadiance) -> tuple[list[Layer], dict[str, Any]]:
     """Relative standard error maps of ``image`` and ``shading`` from the independent batches."""
-    from spectrinsic.spectra import xyz_to_linear_srgb
-
     batches = [b[s.ref] for b in getattr(s.result, "batch_raw", ()) or () if s.ref in b]
     if len(batches) < 2:
         return [], {}

@@ -18,6 +18,7 @@ from spectrinsic.gt_export.layers.records import (
     camera_key,
     make_layer,
 )
+from spectrinsic.spectra import get_sensors, get_spectrum, xyz_to_xy
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 from spectrinsic.spectra import white_normalised_responses as canonical_responses
@@ -28,8 +29,6 @@ __all__ = ["light_records", "share_layers"]
 def light_records(
     s: SampleInputs, shares: np.ndarray, spaces: Mapping[str, np.ndarray], cameras: Sequence[str]
 ) -> tuple[LightRecord, ...]:
-    from spectrinsic.spectra import get_sensors, get_spectrum, xyz_to_xy
-
     white = np.ones(s.wl.size)
     cie = get_sensors("cie1931").on(s.wl)
     records = []

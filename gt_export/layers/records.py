@@ -13,6 +13,7 @@ import numpy as np
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.scenes.model import Scene
+from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 
@@ -138,8 +139,6 @@ class GroundTruth:
 
 
 def grid() -> np.ndarray:
-    from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS
-
     return COLORIMETRIC_WAVELENGTHS
 
 

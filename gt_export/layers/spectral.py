@@ -11,9 +11,11 @@ import numpy as np
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.layers.records import TRAINING_FAMILY
+from spectrinsic.spectra import family_values, fit_matrix, get_sensors, get_spectrum
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 from spectrinsic.spectra import white_normalised_responses as canonical_responses
+from spectrinsic.spectra.grid import integration_weights
 
 __all__ = ["camera_curves", "cube_to_sensors", "photometric_matrices"]
 
@@ -22,8 +24,6 @@ def camera_curves(name: str, wavelengths: np.ndarray, *, data_dir: Any = None) -
     """``(3, W)`` sensitivities of camera *name* on *wavelengths*, scaled so that the perfect
     white under D65 has mean channel 1 in :func:`canonical_responses` (one factor for all
     channels: the camera's own white balance is kept)."""
-    from spectrinsic.spectra import get_sensors, get_spectrum
-
     curves = get_sensors(name, data_dir=data_dir).on(wavelengths)
     d65 = get_spectrum("cie:D65").on(wavelengths)
     white = canonical_responses(np.ones(wavelengths.size), d65, curves, wavelengths)
@@ -39,8 +39,6 @@ def cube_to_sensors(cube_sensors: np.ndarray, curves: np.ndarray, wavelengths: n
     disjoint box bands ``A_kb`` is the mean of ``S_k`` over band ``b``. Light outside the
     bands' support is not seen.
     """
-    from spectrinsic.spectra.grid import integration_weights
-
     w = integration_weights(wavelengths)
     gram = (cube_sensors * w) @ cube_sensors.T
     cross = (curves * w) @ cube_sensors.T
@@ -48,8 +46,6 @@ def cube_to_sensors(cube_sensors: np.ndarray, curves: np.ndarray, wavelengths: n
 
 
 def _training_reflectances(wavelengths: np.ndarray) -> np.ndarray:
-    from spectrinsic.spectra import family_values
-
     return family_values(TRAINING_FAMILY, wavelengths)
 
 
@@ -81,8 +77,6 @@ def photometric_matrices(
         ``{"S_Sen": {camera: 3×3 list}, "L_CLig": {space: {label: 3×3 list}},
         "L_CLig_diagonal": {...}}`` (the diagonal fits are the von Kries models of SC2/SC3).
     """
-    from spectrinsic.spectra import fit_matrix, get_spectrum
-
     rho = _training_reflectances(wavelengths) if training is None else training
     d65 = get_spectrum("cie:D65").on(wavelengths)
     canon = {k: canonical_responses(rho, d65, s, wavelengths) for k, s in sensor_spaces.items()}
