@@ -3,6 +3,19 @@
 The only package that imports OpenEXR. It takes arrays and a RenderResult-like record, never a
 live renderer, and computes the exact ground truth (absolute reflectance, shading-illumination,
 illuminant, camera views, chapter-4 matrices) from the scene's spectra.
+
+Its modules, by stage (each imports only from the stages above it):
+
+* computation: ``layers/`` (one module per family of layers, composed by
+  ``layers.compose.compute_ground_truth``), ``irradiance``, ``denoise``;
+* the sample folder's format: ``sample`` (file names, canonical JSON, hashes, the seal of
+  ``meta.json``, listing), ``json_fields`` and ``sample_meta`` (the one validated reader of
+  ``meta.json``: :class:`SampleMeta`), ``exr``, ``png``, ``names``, ``integrity`` (what may be
+  resumed, replaced or removed);
+* writing a sample: ``previews``, ``writer``; reading one: ``loader`` (``load_sample``);
+* dataset products: ``manifest`` (hashes, splits, noise summary), ``card`` (``DATASET.md``),
+  ``diversity``, ``check``, ``shards``;
+* the viewer: ``gallery``.
 """
 
 from spectrinsic.gt_export.card import write_dataset_card
