@@ -4,7 +4,7 @@ The only package that imports OpenEXR. It takes arrays and a RenderResult-like r
 live renderer, and computes the exact ground truth (absolute reflectance, shading-illumination,
 illuminant, camera views, chapter-4 matrices) from the scene's spectra.
 
-Its modules, by stage (each imports only from the stages above it):
+Its modules, by stage (no import cycle among them: tests/gt_export/test_imports.py):
 
 * computation: ``layers/`` (one module per family of layers, composed by
   ``layers.compose.compute_ground_truth``), ``irradiance``, ``denoise``;
