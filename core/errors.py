@@ -18,6 +18,7 @@ __all__ = [
     "SceneError",
     "RenderError",
     "DatasetError",
+    "SampleMetaError",
     "WriteError",
     "DiskFullError",
     "DecomposeError",
@@ -59,6 +60,12 @@ class RenderError(SpectrinsicError, RuntimeError):
 
 class DatasetError(SpectrinsicError, RuntimeError):
     """A dataset folder that is incomplete, corrupt or inconsistent with its manifest."""
+
+
+class SampleMetaError(DatasetError):
+    """A sample's ``meta.json`` that cannot be trusted: not JSON, a field missing, misnamed or of
+    the wrong type, a non-finite number, or content that no longer matches its seal. The message
+    names the file and the field."""
 
 
 class WriteError(DatasetError):

@@ -234,11 +234,12 @@ def _check_meshes(scene: Scene, source: str) -> None:
             raise _fail(
                 source, f"{where}.face_materials", f"material index out of range 0..{n_mat - 1}"
             )
-        if not isinstance(m.object_id, (int, np.integer)) or m.object_id < 0:
+        # ids are stored as 32-bit integers (int32 bits in an EXR UINT channel, -1 background)
+        if not isinstance(m.object_id, (int, np.integer)) or not 0 <= m.object_id < 2**31:
             raise _fail(
                 source,
                 f"{where}.object_id",
-                f"expected a non-negative integer, got {m.object_id!r}",
+                f"expected an integer from 0 to 2**31 - 1, got {m.object_id!r}",
             )
 
 

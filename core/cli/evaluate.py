@@ -77,7 +77,7 @@ def _methods(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def _folders(dataset: Path, patterns: str | None) -> list[Path]:
-    from spectrinsic.gt_export.writer import sample_dirs
+    from spectrinsic.gt_export.sample import sample_dirs
 
     if not dataset.is_dir():
         raise DatasetError(

@@ -197,7 +197,7 @@ class DatasetConfig:
         Computed by :func:`spectrinsic.gt_export.writer.config_hash`, the function that stamps
         ``meta.json``, so the hash a build checks is the hash its samples carry.
         """
-        from spectrinsic.gt_export.writer import config_hash
+        from spectrinsic.gt_export.sample import config_hash
 
         return config_hash(self.to_dict())
 

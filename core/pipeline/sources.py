@@ -52,7 +52,7 @@ def files_source(paths: Sequence[str | os.PathLike[str]], *,
                  materials: Mapping[str, str] | None = None,
                  default_spectrum: str | None = None) -> str:
     """The canonical ``source`` JSON of a set of scene files (each must exist)."""
-    from spectrinsic.gt_export.integrity import file_sha256
+    from spectrinsic.gt_export.sample import file_sha256
     from spectrinsic.scenes.sources import scene_file_kind
 
     entries = []

@@ -108,8 +108,12 @@ def _built_like(tmp: Path, manifest: object | None = None, meta: dict | None = N
     """A dataset folder holding one sample whose meta.json is *meta*, and *manifest*."""
     root = tmp / "ds"
     (root / APPLE).mkdir(parents=True)
-    base = {"format_version": 1, "sample_id": APPLE, "config_hash": "h", "files": [],
-            "layers": {}}
+    base = {"format_version": 3, "sample_id": APPLE, "config_hash": "h", "files": [], "sha256": {},
+            "layers": {}, "scene": "obj-apple", "scene_hash": "0", "scene_metadata": {}, "seed": 1,
+            "variants": [], "render": {}, "reference_mode": "spectral", "size": [16, 16],
+            "spectral_grid": {}, "materials": {}, "objects": {}, "lights": [], "cameras": [],
+            "cube_sensors": None, "matrices": {}, "identities": [], "denoised_layers": [],
+            "noise": {}, "shading_clipping": {}, "versions": {}, "meta_sha256": "0" * 64}
     (root / APPLE / "meta.json").write_text(json.dumps({**base, **(meta or {})}))
     if manifest is not None:
         (root / "manifest.json").write_text(json.dumps(manifest))
@@ -176,6 +180,7 @@ CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
     ("data-dir-nan", lambda t: _sfu_render(t, "nan"), "reflect_db_1995.csv"),
     ("data-dir-inf", lambda t: _sfu_render(t, "inf"), "reflect_db_1995.csv"),
     ("data-dir-negative", lambda t: _sfu_render(t, "-0.2"), "reflect_db_1995.csv"),
+    ("data-dir-above-one", lambda t: _sfu_render(t, "1e30"), "too large value 1e+30"),
     ("data-dir-empty-cell", lambda t: _sfu_render(t, ""), "reflect_db_1995.csv"),
     ("data-dir-missing", lambda t: _sfu_render(t, None), "nope"),
     # --- point 8: limits
