@@ -35,11 +35,12 @@ def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from spectrinsic.gt_export import sample_dirs
-    from spectrinsic.gt_export.shards import write_shards
+    from spectrinsic.gt_export.shards import check_shard_folder, write_shards
 
     root = Path(args.dir)
     if not (root / "manifest.json").is_file():
         raise DatasetError(f"export {str(root)!r}: no manifest.json; expected a built dataset folder")
+    check_shard_folder(Path(args.out))  # before the progress bar: new, empty or an earlier export
     layers = [k.strip() for k in args.layers.split(",") if k.strip()] if args.layers else None
     with tqdm(total=len(sample_dirs(root)), desc="exporting", unit="sample",
               disable=args.quiet or None, leave=False) as bar:
