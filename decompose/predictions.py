@@ -79,12 +79,12 @@ def _check_header_size(path: Path, layer: str, shape: tuple[int, int]) -> None:
         height, width, channels = exr_size(path)
     else:
         (height, width), channels = png_size(path), 0
-    if (height, width) != tuple(shape) or channels > MAX_CHANNELS:
-        raise DatasetError(
-            f"{path}: its header declares a {width}x{height} image with {channels or 'its'} "
-            f"channel(s); expected the sample's {shape[1]}x{shape[0]} {layer} image with at most "
-            f"{MAX_CHANNELS} channels"
-        )
+    if (height, width) != tuple(shape):
+        raise DatasetError(f"{path}: expected a {layer} image of shape {(*shape, 3)}; its header "
+                           f"declares {width}x{height} pixels (refused before decoding)")
+    if channels > MAX_CHANNELS:
+        raise DatasetError(f"{path}: its header declares {channels} channels; expected a {layer} "
+                           f"image of at most {MAX_CHANNELS}")
 
 
 def read_layer(folder: Path, layer: str, shape: tuple[int, int], *, encoding: str) -> np.ndarray | None:

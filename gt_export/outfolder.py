@@ -48,7 +48,7 @@ OUTPUT_MARKER = ".spectrinsic-output"
 #: Prefix of spectrinsic's temporaries (as in :mod:`spectrinsic.gt_export.integrity`).
 _TMP_PREFIX = ".spectrinsic-tmp-"
 #: Files whose presence makes a folder a dataset or a shard export (a folder of spectrinsic's).
-_DATASET_MARKERS = ((".spectrinsic-dataset", "spectrinsic_dataset"), ("manifest.json", "config_hash"))
+_DATASET_MARKERS = ((".spectrinsic-dataset", "spectrinsic_dataset"), ("manifest.json", "format_version"))
 _SHARD_INDEX = ("shards.json", "format")
 #: Folders whose lock this process holds: checks made under the lock must not probe it (a
 #: second ``flock`` on a new descriptor conflicts with the process's own lock).
@@ -193,13 +193,14 @@ def _acquire(root: Path, option: str) -> int:
 @contextlib.contextmanager
 def folder_lock(root: Path, option: str = "--out") -> Iterator[None]:
     """Hold *root*'s advisory lock (creating *root*) for the block; the lock file is removed
-    when the block ends, so a finished run leaves no trace of it.
+    when the block ends, and so are the folders it created if they are still empty.
 
     Raises
     ------
     FolderLockedError
         Another run holds it; the message names its pid, host and start time.
     """
+    made = [p for p in (root, *root.parents) if not p.exists()]  # deepest first
     try:
         root.mkdir(parents=True, exist_ok=True)
         fd = _acquire(root, option)
@@ -217,6 +218,9 @@ def folder_lock(root: Path, option: str = "--out") -> Iterator[None]:
         with contextlib.suppress(OSError):
             (root / LOCK_NAME).unlink()  # still locked: a run waiting on this file retries
         os.close(fd)
+        for folder in made:  # a run refused under the lock leaves no empty folder behind
+            with contextlib.suppress(OSError):
+                folder.rmdir()
 
 
 # ----------------------------------------------------------------------------------------------
@@ -265,7 +269,8 @@ def check_output_folder(root: Path, option: str = "--out") -> None:
         *root* breaks :func:`check_out_folder`'s rule; the message names the first file
         spectrinsic did not write.
     """
-    if check_out_folder(root, own=lambda p: _marker(p) is not None, option=option,
+    # own: the marker's, or holding only other folders of spectrinsic's (results/evaluation)
+    if check_out_folder(root, own=lambda p: _marker(p) is not None or not _files_below(p), option=option,
                         what=f"a spectrinsic output folder (no {OUTPUT_MARKER})"):
         return
     foreign, died = _foreign(root)
