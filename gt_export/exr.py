@@ -14,6 +14,7 @@ import json
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -158,8 +159,9 @@ def exr_size(path: str | os.PathLike[str]) -> tuple[int, int, int]:
     refused before any pixel is decoded (a small file may declare a huge image)."""
     header = read_exr_attributes(path)
     try:
-        (x0, y0), (x1, y1) = header["dataWindow"]  # type: ignore[misc]
-        return int(y1) - int(y0) + 1, int(x1) - int(x0) + 1, len(header["channels"])  # type: ignore[arg-type]
+        lo, hi = np.asarray(header["dataWindow"], dtype=np.int64)  # ((xMin, yMin), (xMax, yMax))
+        channels: Any = header["channels"]
+        return int(hi[1] - lo[1]) + 1, int(hi[0] - lo[0]) + 1, len(channels)
     except (KeyError, TypeError, ValueError) as exc:
         raise DatasetError(f"EXR file {str(path)!r} has no readable dataWindow") from exc
 

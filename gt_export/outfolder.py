@@ -252,7 +252,8 @@ def _marker(root: Path) -> dict[str, object] | None:
 def _foreign(root: Path) -> tuple[list[str], bool]:
     """Files below *root* the marker does not list, and whether a run died while writing."""
     record = _marker(root) or {}
-    listed = {f for f in record.get("files", []) if isinstance(f, str)}  # type: ignore[union-attr]
+    files = record.get("files")
+    listed = {f for f in files if isinstance(f, str)} if isinstance(files, list) else set()
     return sorted(_files_below(root) - listed), bool(record.get("writing"))
 
 

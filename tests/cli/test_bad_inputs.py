@@ -304,7 +304,20 @@ CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
     # --- item 7: bounded inputs
     ("dataset-count-huge", lambda t: ["dataset", "--generator", "rooms", "--count", "100000000",
                                       "--out", str(t / "new")], "--count 100000000"),
+    ("ply-million-vertices", lambda t: ["render", _scene(t, _ply_header(10**6, 1), "big.ply"), "--material-map",
+                                        _scene(t, 'big.ply: "flat:0.5"\n', "map.yaml"), "--out", str(t / "o")],
+     "1,000,000 vertices"),
+    ("obj-too-many-faces", lambda t: ["dataset", "--preset", "preview", "--scenes", _scene(
+        t, "v 0 0 0\nv 1 0 0\nv 0 1 0\n" + "f 1 2 3\n" * 1_000_001, "many.obj"), "--default-spectrum", "flat:0.5",
+        "--out", str(t / "new")], "1,000,001 faces"),
 ]
+
+
+def _ply_header(vertices: int, faces: int) -> str:
+    """A binary PLY header declaring *vertices* and *faces*, with no data after it."""
+    return (f"ply\nformat binary_little_endian 1.0\nelement vertex {vertices}\nproperty float x\n"
+            f"property float y\nproperty float z\nelement face {faces}\n"
+            "property list uchar int vertex_indices\nend_header\n")
 
 
 @pytest.mark.parametrize("build_argv, expected", [c[1:] for c in CASES], ids=[c[0] for c in CASES])
@@ -386,3 +399,30 @@ def test_an_exr_whose_channels_attribute_is_not_json_is_one_line(tmp_path, capsy
     OpenEXR.File(header, {"reflectance.R": np.zeros((4, 4), np.float32)}).write(str(path))
     with pytest.raises(DatasetError, match=CHANNELS_ATTRIBUTE):
         read_exr(path)
+
+
+def test_yaml_node_count_is_bounded_while_composing(tmp_path, monkeypatch, capsys):
+    """Issue 17 item 7: a 15 MB YAML under the byte cap took 6 GB; nodes are now counted as the
+    composer builds them (the bound is lowered here so the file stays small)."""
+    import spectrinsic.scenes.yaml_limits as limits
+
+    monkeypatch.setattr(limits, "MAX_NODES", 1000)
+    text = "vertices:\n" + "".join(f"  - [{i}, 0, 0]\n" for i in range(400))  # 1602 nodes, no alias
+    rc = main(["-q", "render", _scene(tmp_path, text), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "more than 1,000 YAML nodes" in err and "line " in err
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("name, text, expected", [
+    ("a.ply", _ply_header(7, 3), (7, 3)),
+    ("a.obj", "# c\nv 0 0 0\nv 1 0 0\nvn 0 0 1\nv 0 1 0\nf 1 2 3\nf 1 3 2\n", (3, 2)),
+    ("a.off", "OFF\n# comment\n4 2 0\n", (4, 2)),
+    ("a.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+              "endloop\nendfacet\nendsolid x\n", (3, 1)),
+])
+def test_mesh_counts_come_from_the_header_or_a_line_count(tmp_path, name, text, expected):
+    from spectrinsic.scenes.meshes import mesh_counts
+
+    (tmp_path / name).write_text(text)
+    assert mesh_counts(tmp_path / name) == expected
