@@ -72,6 +72,10 @@ class WriteError(DatasetError):
     """An output file that could not be written (permission denied, read-only file system...)."""
 
 
+class FolderLockedError(DatasetError):
+    """Another spectrinsic run holds the advisory lock of the folder this run would write."""
+
+
 class DiskFullError(WriteError):
     """No space left (``ENOSPC``, ``EDQUOT``): every further sample would fail the same way,
     so a dataset build stops at the first one."""

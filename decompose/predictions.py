@@ -65,6 +65,28 @@ def _from_png(path: Path, encoding: str) -> np.ndarray:
     return decode_srgb(values) if encoding == "srgb" else values
 
 
+#: Most channels a prediction file may hold (a layer is 1 or 3; a few extra are tolerated).
+MAX_CHANNELS = 8
+
+
+def _check_header_size(path: Path, layer: str, shape: tuple[int, int]) -> None:
+    """Refuse a file whose header declares another image size than the sample's, before its
+    pixels are decoded: memory then stays bounded by the dataset's own image size."""
+    from spectrinsic.gt_export.exr import exr_size
+    from spectrinsic.gt_export.png import png_size
+
+    if path.suffix == ".exr":
+        height, width, channels = exr_size(path)
+    else:
+        (height, width), channels = png_size(path), 0
+    if (height, width) != tuple(shape):
+        raise DatasetError(f"{path}: expected a {layer} image of shape {(*shape, 3)}; its header "
+                           f"declares {width}x{height} pixels (refused before decoding)")
+    if channels > MAX_CHANNELS:
+        raise DatasetError(f"{path}: its header declares {channels} channels; expected a {layer} "
+                           f"image of at most {MAX_CHANNELS}")
+
+
 def read_layer(folder: Path, layer: str, shape: tuple[int, int], *, encoding: str) -> np.ndarray | None:
     """Read ``folder/<layer>.exr`` (else ``.png``) as float64 ``(H, W, 3)``; None when absent.
 
@@ -73,8 +95,10 @@ def read_layer(folder: Path, layer: str, shape: tuple[int, int], *, encoding: st
     """
     exr, png = folder / f"{layer}.exr", folder / f"{layer}.png"
     if exr.is_file():
+        _check_header_size(exr, layer, shape)
         values, path = _from_exr(exr, layer), exr
     elif png.is_file():
+        _check_header_size(png, layer, shape)
         values, path = _from_png(png, encoding), png
     else:
         return None

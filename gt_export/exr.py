@@ -16,13 +16,14 @@ import json
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.integrity import guarded_write
 
-__all__ = ["write_exr", "read_exr", "read_exr_attributes", "default_channel_names"]
+__all__ = ["write_exr", "read_exr", "read_exr_attributes", "exr_size", "default_channel_names"]
 
 #: Header attribute holding ``{layer: [channel, ...]}`` as JSON.
 CHANNELS_ATTRIBUTE = "spectrinsic.channels"
@@ -154,6 +155,31 @@ def _open(path: Path, *, header_only: bool):  # noqa: ANN202 - OpenEXR.File
         raise DatasetError(f"EXR file {str(path)!r} cannot be read: {exc}") from exc
 
 
+def _channel_order(path: Path, text: object) -> dict[str, list[str]]:
+    """The :data:`CHANNELS_ATTRIBUTE` of *path*'s header: ``{layer: [channel, ...]}``."""
+    try:
+        order = json.loads(str(text))
+    except ValueError:
+        order = None
+    if not (isinstance(order, dict) and all(isinstance(v, list) and all(isinstance(c, str) for c in v)
+                                            for v in order.values())):
+        raise DatasetError(f"EXR file {str(path)!r}: header attribute {CHANNELS_ATTRIBUTE!r} is not "
+                           "a JSON object of layer -> channel names")
+    return order
+
+
+def exr_size(path: str | os.PathLike[str]) -> tuple[int, int, int]:
+    """``(height, width, channels)`` of an EXR file from its header alone, so a size can be
+    refused before any pixel is decoded (a small file may declare a huge image)."""
+    header = read_exr_attributes(path)
+    try:
+        lo, hi = np.asarray(header["dataWindow"], dtype=np.int64)  # ((xMin, yMin), (xMax, yMax))
+        channels: Any = header["channels"]
+        return int(hi[1] - lo[1]) + 1, int(hi[0] - lo[0]) + 1, len(channels)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise DatasetError(f"EXR file {str(path)!r} has no readable dataWindow") from exc
+
+
 def read_exr_attributes(path: str | os.PathLike[str]) -> dict[str, object]:
     """Return the header of an EXR file (attributes only, no pixels)."""
     try:
@@ -200,7 +226,7 @@ def read_exr(
         raise DatasetError(f"EXR file {str(path)!r} cannot be decoded: {exc}") from exc
     order: dict[str, list[str]]
     if CHANNELS_ATTRIBUTE in header:
-        order = json.loads(header[CHANNELS_ATTRIBUTE])
+        order = _channel_order(path, header[CHANNELS_ATTRIBUTE])
     else:
         order = {}
         for full in pixels:

@@ -26,6 +26,7 @@ from collections.abc import Iterator
 from pathlib import Path, PurePosixPath
 
 from spectrinsic.errors import DatasetError, DiskFullError, SampleMetaError, WriteError
+from spectrinsic.gt_export.outfolder import check_out_folder, require_folder_path
 from spectrinsic.gt_export.sample import (
     FORMAT_VERSION,
     MANIFEST_NAME,
@@ -147,16 +148,6 @@ def dataset_config_hash(root: Path) -> str | None:
     return None
 
 
-def require_folder_path(root: Path, option: str = "--out") -> None:
-    """Raise a one-line error if *root* is a file or lies below one (so no folder can be made)."""
-    for parent in (root, *root.parents):
-        if parent.is_dir():
-            return
-        if parent.exists() or parent.is_symlink():
-            what = "is a file" if parent == root else f"lies below the file {str(parent)!r}"
-            raise DatasetError(f"{option} {str(root)!r} {what}; expected a folder")
-
-
 def check_build_folder(root: Path, config_hash: str, *, rebuild: bool) -> str | None:
     """Check that a build with *config_hash* may write into *root*; return the hash the folder
     was built with before (``None``: new or empty folder).
@@ -164,19 +155,16 @@ def check_build_folder(root: Path, config_hash: str, *, rebuild: bool) -> str | 
     Raises
     ------
     DatasetError
-        *root* is a file or lies below one; *root* is non-empty and not a spectrinsic dataset;
-        or it was built with another config and *rebuild* is false.
+        *root* breaks the rule of every writing verb
+        (:func:`spectrinsic.gt_export.outfolder.check_out_folder`: a file, inside a dataset,
+        locked by another run, non-empty and not a spectrinsic dataset), or it was built with
+        another config and *rebuild* is false.
     """
-    require_folder_path(root)
-    if not root.is_dir() or not any(root.iterdir()):
+    if check_out_folder(root, own=lambda p: dataset_config_hash(p) is not None,
+                        what=f"a spectrinsic dataset (no {MARKER_NAME} or {MANIFEST_NAME})"):
         return None
     previous = dataset_config_hash(root)
-    if previous is None:
-        raise DatasetError(
-            f"--out {str(root)!r} is not empty and is not a spectrinsic dataset (no {MARKER_NAME} "
-            f"or {MANIFEST_NAME}); choose a new or empty folder"
-        )
-    if previous != config_hash and not rebuild:
+    if previous is not None and previous != config_hash and not rebuild:
         raise DatasetError(
             f"--out {str(root)!r} was built with another config (hash {previous[:12]}, this run "
             f"{config_hash[:12]}); pass --rebuild to rebuild it, or choose another folder"

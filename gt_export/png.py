@@ -29,6 +29,7 @@ __all__ = [
     "PNG16_MAX",
     "write_png16",
     "read_png16",
+    "png_size",
 ]
 
 #: Largest code of a 16-bit PNG: a 16-bit data image stores ``value = code / PNG16_MAX``.
@@ -172,3 +173,16 @@ def read_png16(path: str | os.PathLike[str]) -> np.ndarray:
     data = data.reshape(h, w, planes)
     colour = planes - int(bool(info.get("alpha")))
     return data[:, :, 0] if colour == 1 else data[:, :, :3]
+
+
+def png_size(path: str | os.PathLike[str]) -> tuple[int, int]:
+    """``(height, width)`` of a PNG from its IHDR chunk alone, so a size can be refused before
+    the image is decoded (a small file may declare a huge image)."""
+    import png
+
+    try:
+        reader = png.Reader(filename=str(path))
+        reader.preamble()
+    except (OSError, png.Error) as exc:
+        raise DatasetError(f"PNG {str(path)!r} cannot be read: {exc}") from exc
+    return int(reader.height), int(reader.width)

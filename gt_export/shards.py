@@ -33,10 +33,11 @@ import numpy as np
 from spectrinsic.errors import DatasetError, MissingDependencyError
 from spectrinsic.gt_export.loader import load_sample, split_samples
 from spectrinsic.gt_export.manifest import read_manifest
+from spectrinsic.gt_export.outfolder import LOCK_NAME, check_out_folder, folder_lock
 from spectrinsic.gt_export.sample import MANIFEST_NAME, META_NAME, TMP_PREFIX, file_sha256
 from spectrinsic.gt_export.sample_meta import meta_from_bytes
 
-__all__ = ["SHARD_INDEX", "KEY_SEPARATOR", "ShardSet", "write_shards", "shard_urls", "shard_dataset"]
+__all__ = ["SHARD_INDEX", "KEY_SEPARATOR", "ShardSet", "check_shard_folder", "write_shards", "shard_urls", "shard_dataset"]
 
 #: The export's index; written last, so its presence means every listed shard is complete.
 SHARD_INDEX = "shards.json"
@@ -101,22 +102,23 @@ def _encode(sample: dict[str, Any]) -> dict[str, Any]:
     return record
 
 
-def _prepare_out(out: Path) -> set[str]:
+def check_shard_folder(out: Path, option: str = "--out") -> set[str]:
     """The files an earlier export of ours wrote in *out* (listed by its index, complete or
-    interrupted); refuse a folder holding anything else."""
-    out.mkdir(parents=True, exist_ok=True)
+    interrupted); refuse a folder holding anything else, or one breaking the rule of every
+    writing verb (:func:`~spectrinsic.gt_export.outfolder.check_out_folder`). Writes nothing."""
+    if check_out_folder(out, own=lambda p: (p / SHARD_INDEX).is_file(), option=option,
+                        what=f"an earlier shard export (no {SHARD_INDEX})"):
+        return set()
     index_path = out / SHARD_INDEX
-    ours: set[str] = set()
-    if index_path.is_file():
-        try:
-            previous = json.loads(index_path.read_text(encoding="utf-8"))
-        except ValueError as exc:
-            raise DatasetError(f"{index_path}: not a spectrinsic shard index ({exc})") from exc
-        if not isinstance(previous, dict) or previous.get("format") != _FORMAT:
-            raise DatasetError(f"{index_path}: not a spectrinsic shard index")
-        ours = set(previous.get("files", {}))
+    try:
+        previous = json.loads(index_path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise DatasetError(f"{index_path}: not a spectrinsic shard index ({exc})") from exc
+    if not isinstance(previous, dict) or previous.get("format") != _FORMAT:
+        raise DatasetError(f"{index_path}: not a spectrinsic shard index")
+    ours = set(previous.get("files", {}))
     foreign = sorted(p.name for p in out.iterdir()
-                     if p.name not in ours | {SHARD_INDEX} and not p.name.startswith(TMP_PREFIX))
+                     if p.name not in ours | {SHARD_INDEX, LOCK_NAME} and not p.name.startswith(TMP_PREFIX))
     if foreign:
         raise DatasetError(f"shard folder {str(out)!r} holds files spectrinsic did not write "
                            f"({', '.join(foreign[:3])}{', ...' if len(foreign) > 3 else ''}); "
@@ -192,12 +194,22 @@ def write_shards(
     Raises
     ------
     DatasetError
-        *out_dir* holds files spectrinsic did not write, or the dataset has no manifest.
+        *out_dir* holds files spectrinsic did not write, lies inside a dataset, or the
+        dataset has no manifest.
+    FolderLockedError
+        Another export holds *out_dir*.
     """
     if samples_per_shard < 1:
         raise DatasetError(f"samples per shard {samples_per_shard}; expected a whole number >= 1")
     source, out = Path(dataset_dir), Path(out_dir)
-    ours = _prepare_out(out)
+    check_shard_folder(out)
+    with folder_lock(out):  # one export per folder; a second is refused, naming this one
+        return _write_locked(source, out, check_shard_folder(out), samples_per_shard, layers, progress)
+
+
+def _write_locked(source: Path, out: Path, ours: set[str], samples_per_shard: int,
+                  layers: Sequence[str] | None, progress: Callable[[str], None] | None) -> ShardSet:
+    """:func:`write_shards` once the folder's lock is held; *ours*: files of an earlier export."""
     plan = _plan(source, samples_per_shard)
     planned = {name for shards in plan.values() for name in shards}
     base = {"format": _FORMAT, "version": _VERSION, "key_separator": KEY_SEPARATOR,

@@ -21,6 +21,11 @@ __all__ = ["GeneratedSource", "FileSource", "scene_file_kind"]
 
 #: First bytes of every uncompressed ``.blend`` file.
 BLEND_MAGIC = b"BLENDER"
+#: First bytes of a gzip stream and of a zstd frame (Blender compresses ``.blend`` files so).
+GZIP_MAGIC = b"\x1f\x8b"
+ZSTD_MAGIC = b"\x28\xb5\x2f\xfd"
+#: Image size of a mesh file's framing camera when none is given, pixels.
+MESH_IMAGE_SIZE = 256
 
 
 @dataclass(frozen=True)
@@ -40,9 +45,33 @@ class GeneratedSource:
                         view=self.view, options=options)
 
 
+def _compressed_blend(head: bytes, path: Path) -> bool:
+    """True for a gzip- or zstd-compressed file whose content starts with Blender's magic."""
+    if head.startswith(GZIP_MAGIC):
+        import gzip
+
+        try:
+            with gzip.open(path, "rb") as fh:
+                return fh.read(len(BLEND_MAGIC)) == BLEND_MAGIC
+        except (OSError, EOFError):
+            return False
+    if head.startswith(ZSTD_MAGIC):
+        try:
+            import zstandard
+        except ImportError:  # Blender writes zstd .blend files; without a reader, trust the magic
+            return True
+        try:
+            with path.open("rb") as raw, zstandard.ZstdDecompressor().stream_reader(raw) as fh:
+                return fh.read(len(BLEND_MAGIC)) == BLEND_MAGIC
+        except (OSError, zstandard.ZstdError):
+            return False
+    return False
+
+
 def scene_file_kind(path: str | Path) -> str:
-    """``"yaml"``, ``"blend"`` or ``"mesh"`` for a scene file, by suffix (``.blend`` also by
-    its magic bytes); one-line error for anything else."""
+    """``"yaml"``, ``"blend"`` or ``"mesh"`` for a scene file, by suffix; a ``.blend`` also by
+    its magic bytes, plain or compressed (gzip, zstd), under any name. One-line error for
+    anything else. The one dispatcher of scene files (``render``, ``dataset --scenes``)."""
     p = Path(path)
     suffix = p.suffix.lower()
     if suffix in (".yaml", ".yml"):
@@ -53,17 +82,19 @@ def scene_file_kind(path: str | Path) -> str:
         return "blend"
     try:
         with p.open("rb") as fh:
-            if fh.read(len(BLEND_MAGIC)) == BLEND_MAGIC:
-                return "blend"
+            head = fh.read(len(BLEND_MAGIC))
+        if head == BLEND_MAGIC or _compressed_blend(head, p):
+            return "blend"
     except OSError:
         pass
-    raise SceneError(f"scene file {str(p)!r}: expected .yaml/.yml, .blend or a mesh "
-                     f"({', '.join(MESH_SUFFIXES)})")
+    raise SceneError(f"scene file {str(p)!r}: expected .yaml/.yml, .blend (plain, gzip or zstd) "
+                     f"or a mesh ({', '.join(MESH_SUFFIXES)})")
 
 
 @dataclass(frozen=True)
 class FileSource:
-    """A scene file rendered at ``width x height`` (the file's camera, resized).
+    """A scene file rendered at ``width x height`` (the file's camera, resized; ``None``: the
+    file's own size, :data:`MESH_IMAGE_SIZE` for a mesh).
 
     Attributes
     ----------
@@ -74,8 +105,8 @@ class FileSource:
     """
 
     path: str
-    width: int
-    height: int
+    width: int | None
+    height: int | None
     materials: tuple[tuple[str, str], ...] = ()
     default_spectrum: str | None = None
 
@@ -84,15 +115,19 @@ class FileSource:
         kind = scene_file_kind(self.path)
         mapping = dict(self.materials)
         if kind == "mesh":
-            return load_mesh_scene(self.path, materials=mapping, width=self.width, height=self.height,
+            return load_mesh_scene(self.path, materials=mapping, width=self.width or MESH_IMAGE_SIZE,
+                                   height=self.height or MESH_IMAGE_SIZE,
                                    default_spectrum=self.default_spectrum, data_dir=data_dir)
         if kind == "blend":
             from spectrinsic.scenes.blender import load_blend
 
-            return load_blend(self.path, materials=mapping or None, resolution=(self.width, self.height),
+            size = None if self.width is None and self.height is None else (
+                self.width or MESH_IMAGE_SIZE, self.height or MESH_IMAGE_SIZE)
+            return load_blend(self.path, materials=mapping or None, resolution=size,
                               default_spectrum=self.default_spectrum, data_dir=data_dir)
         from spectrinsic.scenes.io import load_scene
 
         scene = load_scene(self.path, data_dir=data_dir)
-        camera = dataclasses.replace(scene.camera, width=self.width, height=self.height)
+        camera = dataclasses.replace(scene.camera, width=self.width or scene.camera.width,
+                                     height=self.height or scene.camera.height)
         return dataclasses.replace(scene, camera=camera)

@@ -190,6 +190,15 @@ def _check_spectrum(
         raise _fail(source, field, f"{name!r} is {with_article(found.kind)} spectrum; expected {with_article(kind)}")  # type: ignore[attr-defined]
 
 
+def _check_area(v: np.ndarray, f: np.ndarray, source: str, where: str) -> None:
+    """A mesh needs a face of non-zero area (all-degenerate faces give no surface, and no
+    normal to shade with)."""
+    tri = v.astype(np.float64)[f]
+    if not np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).any():
+        raise _fail(source, f"{where}.faces", f"all {len(f)} faces have zero area (collinear "
+                    "or repeated vertices); the mesh has no surface to render")
+
+
 def _check_meshes(scene: Scene, source: str) -> None:
     if not scene.meshes:
         raise _fail(source, "meshes", "a scene needs at least one mesh")
@@ -224,6 +233,7 @@ def _check_meshes(scene: Scene, source: str) -> None:
             )
         if f.min() < 0 or f.max() >= len(v):
             raise _fail(source, f"{where}.faces", f"vertex index out of range 0..{len(v) - 1}")
+        _check_area(v, f, source, where)
         if fm.shape != (len(f),) or not np.issubdtype(fm.dtype, np.integer):
             raise _fail(
                 source,

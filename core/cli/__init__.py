@@ -12,6 +12,7 @@ import logging
 import sys
 import traceback
 from collections.abc import Sequence
+from typing import NoReturn
 
 from spectrinsic.errors import SpectrinsicError
 from spectrinsic.interrupts import interrupts_reach_python
@@ -30,8 +31,19 @@ _COMMANDS: tuple[str, ...] = (
 )
 
 
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (``spectrinsic: error: ...``, status 2),
+    like every other bad input; ``--help`` still prints the usage. Sub-command parsers are of
+    this class too (``add_subparsers`` makes them with the parent's class)."""
+
+    def error(self, message: str) -> NoReturn:
+        where = self.prog.removeprefix("spectrinsic").strip()
+        text = " ".join(message.split())
+        self.exit(2, f"spectrinsic: error: {where + ': ' if where else ''}{text} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="spectrinsic",
         description="Spectral rendering of synthetic intrinsic-image datasets.",
     )
@@ -69,6 +81,10 @@ def _main(argv: Sequence[str] | None) -> int:
         format="%(levelname)s %(name)s: %(message)s",
     )
     try:
+        if args.data_dir is not None:  # a wrong --data-dir is an input error, before any work
+            from spectrinsic.config import resolve_data_dir
+
+            resolve_data_dir(args.data_dir)
         return int(args.func(args) or 0)
     except SpectrinsicError as exc:
         return _error(args, str(exc))

@@ -36,11 +36,18 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Print problems grouped per sample; exit status 0 when the set is sound, 1 otherwise."""
+    import math
+
     from tqdm import tqdm
 
     from spectrinsic.gt_export import check_dataset, sample_dirs
     from spectrinsic.gt_export.check import NOISE_THRESHOLD, noise_report
 
+    if args.noise_threshold is not None and not (math.isfinite(args.noise_threshold) and args.noise_threshold > 0):
+        raise DatasetError(f"--noise-threshold {args.noise_threshold}; expected a positive finite "
+                           "relative error, e.g. 0.25")
+    if args.max_per_sample < 0:
+        raise DatasetError(f"--max-per-sample {args.max_per_sample}; expected a whole number >= 0")
     root = Path(args.dir)
     if not root.is_dir():
         raise DatasetError(f"check {str(root)!r}: no such folder; expected a dataset folder")

@@ -12,6 +12,8 @@ from spectrinsic.errors import DatasetError
 __all__ = ["register", "run"]
 
 DEFAULT_OUT = "data/dataset"
+#: Largest root seed and samples per pixel (Mitsuba's sampler takes unsigned 32-bit values).
+UINT32_MAX = 2**32 - 1
 
 
 def _presets_help() -> str:
@@ -143,7 +145,8 @@ def _range(option: str, text: str) -> tuple[float, float]:
     return lo, hi
 
 
-def _material_map(path: str | None) -> dict[str, str]:
+def material_map(path: str | None) -> dict[str, str]:
+    """The ``--material-map`` file as ``{material name: spectrum name}`` (``{}`` for none)."""
     if path is None:
         return {}
     from spectrinsic.scenes.yaml_limits import load_yaml_file
@@ -165,7 +168,7 @@ def _source(args: argparse.Namespace) -> str | None:
                                 value_range=_range("--value-range", args.value_range),
                                 chroma_range=_range("--chroma-range", args.chroma_range))
     if args.scenes:
-        return files_source(args.scenes, materials=_material_map(args.material_map),
+        return files_source(args.scenes, materials=material_map(args.material_map),
                             default_spectrum=args.default_spectrum)
     return None
 
@@ -205,13 +208,44 @@ def _preflight(args: argparse.Namespace, config: Any) -> None:
         raise DatasetError(f"--workers {args.workers}; expected a positive integer")
     if args.threads is not None and args.threads < 1:
         raise DatasetError(f"--threads {args.threads}; expected a positive integer")
+    if not 0 <= args.seed <= UINT32_MAX or config.spp > UINT32_MAX:
+        raise DatasetError(f"--seed {args.seed} / --spp {config.spp}; expected a seed from 0 to "
+                           f"{UINT32_MAX} and at most {UINT32_MAX} samples per pixel")
     check_build_folder(Path(args.out), config.config_hash(), rebuild=args.rebuild)
+    _check_scene_files(config, args.data_dir)
     if args.scheduler:
         check_scheduler(args.scheduler)
     # two lights: the library's two-colour conditions, rendered once per light
     check_render_size(config.width, config.height, what=f"--resolution {config.width}x{config.height}",
                       processes=args.workers or 1, modes=config.modes, per_light=config.per_light,
                       direct=config.direct, n_lights=2)
+
+
+def _check_scene_files(config: Any, data_dir: str | None) -> None:
+    """``--scenes``: every file reads as a valid scene with this material map and default
+    spectrum, before the folder is stamped with the config (a bad file is an input error, not
+    a failed sample)."""
+    import json
+
+    from spectrinsic.errors import SpectrinsicError
+    from spectrinsic.scenes.sources import FileSource
+    from spectrinsic.spectra import get_spectrum
+
+    spec = json.loads(config.source or "{}")
+    if "scenes" not in spec:
+        return
+    materials = spec.get("materials") or {}
+    named = [("--default-spectrum", spec.get("default_spectrum"))]
+    named += [(f"--material-map entry {k!r}", v) for k, v in sorted(materials.items())]
+    for option, name in named:
+        try:
+            if name is not None:
+                get_spectrum(name, data_dir=data_dir)
+        except SpectrinsicError as exc:
+            raise DatasetError(f"{option} {name!r}: {exc}") from exc
+    for entry in spec["scenes"]:
+        FileSource(entry["path"], config.width, config.height, tuple(sorted(materials.items())),
+                   spec.get("default_spectrum")).build(data_dir)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -97,13 +97,26 @@ def _folders(dataset: Path, patterns: str | None) -> list[Path]:
 
 
 def run(args: argparse.Namespace) -> int:
+    from spectrinsic.gt_export.outfolder import output_folder
+
+    folders = _folders(Path(args.dataset), args.samples)
+    methods = _methods(args)
+    with output_folder(Path(args.out)):  # locked; its files recorded as spectrinsic's
+        result = _evaluate(args, folders, methods)
+    for key in ("lmse_by_condition_md", "colour_by_condition_md", "scenario_md"):
+        print(result.files[key].read_text(encoding="utf-8"))
+    print(f"{len(result.scores)} scores for {len(folders)} samples in {args.out} "
+          f"(REPORT.md, scores.csv, tables, figures/, estimates/)")
+    return 0
+
+
+def _evaluate(args: argparse.Namespace, folders: list[Path], methods: dict[str, Any]) -> Any:
+    """Score every sample with a progress bar; return the evaluation result."""
     from tqdm import tqdm
 
     from spectrinsic.decompose.evaluate import evaluate
     from spectrinsic.gt_export.loader import load_sample
 
-    folders = _folders(Path(args.dataset), args.samples)
-    methods = _methods(args)
     bar = tqdm(total=len(folders), desc="evaluate", unit="sample", disable=args.quiet)
 
     def progress(sample_id: str) -> None:
@@ -118,8 +131,4 @@ def run(args: argparse.Namespace) -> int:
         )
     finally:
         bar.close()
-    for key in ("lmse_by_condition_md", "colour_by_condition_md", "scenario_md"):
-        print(result.files[key].read_text(encoding="utf-8"))
-    print(f"{len(result.scores)} scores for {len(folders)} samples in {args.out} "
-          f"(REPORT.md, scores.csv, tables, figures/, estimates/)")
-    return 0
+    return result

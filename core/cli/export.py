@@ -36,11 +36,12 @@ def run(args: argparse.Namespace) -> int:
 
     from spectrinsic.gt_export import sample_dirs
     from spectrinsic.gt_export.sample import MANIFEST_NAME
-    from spectrinsic.gt_export.shards import write_shards
+    from spectrinsic.gt_export.shards import check_shard_folder, write_shards
 
     root = Path(args.dir)
     if not (root / MANIFEST_NAME).is_file():
         raise DatasetError(f"export {str(root)!r}: no {MANIFEST_NAME}; expected a built dataset folder")
+    check_shard_folder(Path(args.out))  # before the progress bar: new, empty or an earlier export
     layers = [k.strip() for k in args.layers.split(",") if k.strip()] if args.layers else None
     with tqdm(total=len(sample_dirs(root)), desc="exporting", unit="sample",
               disable=args.quiet or None, leave=False) as bar:

@@ -11,7 +11,6 @@ the render settings, variants, timings and the scene. Ground-truth layers are wr
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import sys
 from pathlib import Path
@@ -22,8 +21,6 @@ from spectrinsic.errors import RenderError, SceneError
 __all__ = ["register", "run", "load_scene_argument", "write_render"]
 
 DEFAULT_MODES = "spectral,rgb3,rgb6,bands31"
-#: First bytes of every uncompressed ``.blend`` file.
-BLEND_MAGIC = b"BLENDER"
 
 
 def _modes_help() -> str:
@@ -70,38 +67,33 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "built by the same path as `spectrinsic dataset --scenes` (uses --preset)")
     p.add_argument("--preset", default="preview", help="with --ground-truth: quality preset (preview)")
     p.add_argument("--material-map", metavar="FILE", default=None,
-                   help="with --ground-truth: material name -> spectrum map for .blend and mesh files")
+                   help="material name -> spectrum map for .blend and mesh files")
     p.set_defaults(func=run)
 
 
 def load_scene_argument(
     scene: str, *, condition: str, view: int, seed: int, width: int | None, height: int | None,
-    data_dir: str | None = None,
+    data_dir: str | None = None, materials: dict[str, str] | None = None,
 ) -> Any:
-    """The Scene named by the ``SCENE`` argument: a ``.blend`` file (by extension or its
-    ``BLENDER`` magic bytes) through the Blender importer, a YAML file if it looks like a path,
-    else a library name."""
-    path = Path(scene)
-    if _is_blend(path):
-        from spectrinsic.scenes.blender import load_blend
-
-        size = None if width is None and height is None else (width or 128, height or 128)
-        return load_blend(path, resolution=size, data_dir=data_dir)
-    if path.suffix.lower() in (".yaml", ".yml") or path.exists():
-        from spectrinsic.scenes.io import load_scene
-
-        loaded = load_scene(path, data_dir=data_dir)
-        camera = loaded.camera
-        camera = dataclasses.replace(camera, width=camera.width if width is None else width,
-                                     height=camera.height if height is None else height)
-        return dataclasses.replace(loaded, camera=camera)
+    """The Scene named by the ``SCENE`` argument: a scene file (YAML, ``.blend`` by suffix or
+    magic bytes, a mesh; :func:`spectrinsic.scenes.sources.scene_file_kind`) if it exists or
+    has a scene file's suffix, else a library name."""
     from spectrinsic.pipeline.presets import get_preset
     from spectrinsic.scenes import library
+    from spectrinsic.scenes.sources import FileSource
 
+    if _is_scene_file(Path(scene)):
+        return FileSource(scene, width, height, tuple(sorted((materials or {}).items()))).build(data_dir)
     default = get_preset("default")
     return library.build(scene, view=view, condition=condition, seed=seed,
                          width=default.width if width is None else width,
                          height=default.height if height is None else height)
+
+
+def _is_scene_file(path: Path) -> bool:
+    from spectrinsic.scenes.meshes import MESH_SUFFIXES
+
+    return path.exists() or path.suffix.lower() in (".yaml", ".yml", ".blend", *MESH_SUFFIXES)
 
 
 def _default_spp() -> int:
@@ -110,22 +102,25 @@ def _default_spp() -> int:
     return get_preset("default").spp
 
 
-def _is_blend(path: Path) -> bool:
-    """True for a ``.blend`` name or a file starting with Blender's magic bytes."""
-    if path.suffix.lower() == ".blend":
-        return True
-    try:
-        with path.open("rb") as fh:
-            return fh.read(len(BLEND_MAGIC)) == BLEND_MAGIC
-    except OSError:
-        return False
+#: Largest sampler seed and samples per pixel Mitsuba takes (both are unsigned 32-bit).
+UINT32_MAX = 2**32 - 1
 
 
 def _check_size_options(args: argparse.Namespace) -> None:
-    """``--width``/``--height``/``--spp`` must be positive before anything is loaded."""
+    """Every number and name the render needs, checked before anything is loaded or written."""
     for option, value in (("--width", args.width), ("--height", args.height), ("--spp", args.spp)):
         if value is not None and value < 1:
             raise RenderError(f"{option} {value}; expected a positive integer")
+    if args.spp is not None and args.spp > UINT32_MAX:
+        raise RenderError(f"--spp {args.spp}; expected at most {UINT32_MAX}")
+    if not 0 <= args.seed <= UINT32_MAX:
+        raise RenderError(f"--seed {args.seed}; expected a whole number from 0 to {UINT32_MAX}")
+    if args.max_depth < 1:
+        raise RenderError(f"--max-depth {args.max_depth}; expected >= 1 (2 = direct light only)")
+    if args.variant is not None:
+        from spectrinsic.render import choose_variant
+
+        choose_variant("rgb", args.variant)  # an unknown or unusable backend, before any work
 
 
 def write_render(out: Path, scene: Any, result: Any, *, data_dir: str | None = None) -> dict[str, Path]:
@@ -168,8 +163,7 @@ def _ground_truth(args: argparse.Namespace) -> int:
     from spectrinsic.cli import dataset as cli_dataset
     from spectrinsic.scenes.sample_id import SampleId
 
-    path = Path(args.scene)
-    is_file = path.suffix.lower() in (".yaml", ".yml", ".blend") or path.exists()
+    is_file = _is_scene_file(Path(args.scene))
     resolution = None
     if args.width is not None or args.height is not None:
         resolution = f"{args.width or 128}x{args.height or 128}"
@@ -185,9 +179,11 @@ def _ground_truth(args: argparse.Namespace) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
+    _check_size_options(args)
     if args.ground_truth:
         return _ground_truth(args)
-    from spectrinsic.gt_export.integrity import require_folder_path
+    from spectrinsic.cli.dataset import material_map
+    from spectrinsic.gt_export.outfolder import check_output_folder, output_folder
     from spectrinsic.render import count_passes, get_mode, render_scene
     from spectrinsic.render.budget import check_render_size
 
@@ -196,11 +192,11 @@ def run(args: argparse.Namespace) -> int:
         raise SceneError(f"--modes {args.modes!r}: expected a comma-separated list such as {DEFAULT_MODES}")
     for mode in modes:
         get_mode(mode)
-    _check_size_options(args)
-    require_folder_path(Path(args.out))
+    check_output_folder(Path(args.out))
     data_dir = getattr(args, "data_dir", None)
     scene = load_scene_argument(args.scene, condition=args.condition, view=args.view, seed=args.seed,
-                                width=args.width, height=args.height, data_dir=data_dir)
+                                width=args.width, height=args.height, data_dir=data_dir,
+                                materials=material_map(args.material_map))
     given = " ".join(f"--{k} {v}" for k, v in (("width", args.width), ("height", args.height)) if v is not None)
     check_render_size(scene.camera.width, scene.camera.height, what=given or f"scene {args.scene!r}",
                       modes=modes, n_lights=len(scene.lights), per_light=args.per_light,
@@ -212,13 +208,14 @@ def run(args: argparse.Namespace) -> int:
         from tqdm import tqdm
 
         bar = tqdm(total=total, desc=f"render {scene.name}", unit="pass", file=sys.stderr)
-    try:
-        result = render_scene(scene, spp=_default_spp() if args.spp is None else args.spp, seed=args.seed, max_depth=args.max_depth, variant=args.variant,
-                              progress=None if bar is None else bar.update, data_dir=data_dir, **options)
-    finally:
-        if bar is not None:
-            bar.close()
-    paths = write_render(Path(args.out), scene, result, data_dir=data_dir)
+    with output_folder(Path(args.out)):  # locked; its files recorded as spectrinsic's
+        try:
+            result = render_scene(scene, spp=_default_spp() if args.spp is None else args.spp, seed=args.seed, max_depth=args.max_depth, variant=args.variant,
+                                  progress=None if bar is None else bar.update, data_dir=data_dir, **options)
+        finally:
+            if bar is not None:
+                bar.close()
+        paths = write_render(Path(args.out), scene, result, data_dir=data_dir)
     timings = result.meta["timings"]
     for mode in result.images:
         print(f"{mode:<9} {timings[mode]['passes']:>3} passes {timings[mode]['seconds']:7.2f} s  -> {paths[mode]}")

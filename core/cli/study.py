@@ -74,7 +74,27 @@ def _print_paths(paths: dict[str, Path]) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    out = Path(args.out)
+    from spectrinsic.gt_export.outfolder import output_folder
+
+    _check_options(args)
+    with output_folder(Path(args.out)):  # checked and locked; its files recorded as spectrinsic's
+        return _run(args, Path(args.out))
+
+
+def _check_options(args: argparse.Namespace) -> None:
+    """Refusals that need no computation, before the output folder is made."""
+    if args.study == "photometric" and args.include_ie:
+        from spectrinsic.errors import StudyError
+        from spectrinsic.studies.photometric.compute import default_cameras
+
+        data_dir = getattr(args, "data_dir", None)
+        if not any(n.endswith("[IE]") for n in default_cameras(data_dir=data_dir, include_ie=True)):
+            where = f"--data-dir {data_dir!r}" if data_dir else "no data directory (--data-dir, $SPECTRINSIC_DATA)"
+            raise StudyError(f"--include-ie: {where} holds no Image Engineering cameras; "
+                             "give the data directory that has them, or leave --include-ie out")
+
+
+def _run(args: argparse.Namespace, out: Path) -> int:
     data_dir = getattr(args, "data_dir", None)
     quiet = bool(getattr(args, "quiet", False))
     if args.study == "reconstruction-error":

@@ -379,11 +379,33 @@ def build_dataset(
         Before anything is written, if *out_dir* is not a folder this build may write into
         (see :func:`spectrinsic.gt_export.integrity.check_build_folder`) or a sample's folder
         holds files spectrinsic did not write.
+    FolderLockedError
+        Another build holds *out_dir* (its advisory lock); the message names its pid, host and
+        start time.
     DiskFullError
         When the disk is full: the build stops at the first sample that hits it.
     """
-    start = time.perf_counter()
+    from spectrinsic.gt_export.integrity import check_build_folder
+    from spectrinsic.gt_export.outfolder import folder_lock
+
     out = Path(out_dir)
+    check_build_folder(out, config.config_hash(), rebuild=rebuild)  # before the folder is made
+    with folder_lock(out):  # one build per folder: a second one is refused, naming this one
+        return _build_locked(out, config, executor=executor, only=only, data_dir=data_dir,
+                             render_threads=render_threads, task_fn=task_fn, on_plan=on_plan,
+                             progress=progress, finalize=finalize, rebuild=rebuild)
+
+
+def _build_locked(
+    out: Path, config: DatasetConfig, *, executor: Executor | None, only: Sequence[str] | str | None,
+    data_dir: str | os.PathLike[str] | None, render_threads: int | None,
+    task_fn: Callable[[SampleTask], SampleOutcome],
+    on_plan: Callable[[int, int], None] | None,
+    progress: Callable[[SampleOutcome | SampleFailure], None] | None,
+    finalize: bool, rebuild: bool,
+) -> DatasetReport:
+    """:func:`build_dataset` once the folder's lock is held."""
+    start = time.perf_counter()
     executor = executor if executor is not None else SerialExecutor()
     todo, skipped = _prepare(out, config, only=only, data_dir=data_dir,
                              render_threads=render_threads, rebuild=rebuild)

@@ -28,6 +28,10 @@ __all__ = ["SCENES_FOLDER", "generator_source", "files_source", "plan_source_sam
 #: Folder of a dataset holding the generated scenes' YAML files.
 SCENES_FOLDER = "scenes"
 _SAFE = re.compile(r"[^A-Za-z0-9._-]+")
+#: Most generated scenes and cameras per scene in one dataset: planning is O(count x views)
+#: before the first render, and 10^5 scenes already take days to render on a workstation.
+MAX_COUNT = 100_000
+MAX_VIEWS = 64
 
 
 def generator_source(generator: str, count: int, *, views: int = 1,
@@ -39,8 +43,9 @@ def generator_source(generator: str, count: int, *, views: int = 1,
     from spectrinsic.scenes.generators import GENERATORS
 
     validate_choice(generator, GENERATORS, "scene generator", error=DatasetError)
-    if count < 1 or views < 1:
-        raise DatasetError(f"--count {count} / --views {views}; expected positive integers")
+    if not (1 <= count <= MAX_COUNT and 1 <= views <= MAX_VIEWS):
+        raise DatasetError(f"--count {count} / --views {views}; expected whole numbers from 1 to "
+                           f"{MAX_COUNT} scenes and 1 to {MAX_VIEWS} views")
     spec = {"generator": generator, "count": int(count), "views": int(views),
             "value_range": [float(v) for v in value_range],
             "chroma_range": [float(c) for c in chroma_range],
