@@ -12,10 +12,11 @@ could never have worked, and a size it lets through can still be too large for t
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
 from pathlib import Path
 
 from spectrinsic.errors import RenderError
+from spectrinsic.render.modes import get_mode, n_passes
+from spectrinsic.render.settings import RenderSettings
 
 __all__ = [
     "BYTES_PER_VALUE",
@@ -37,21 +38,19 @@ MAX_SIDE = 65_536
 def estimate_render_bytes(
     width: int,
     height: int,
+    settings: RenderSettings,
     *,
-    modes: Sequence[str],
     n_lights: int = 1,
-    per_light: bool = False,
-    direct: bool = False,
     data_dir: str | None = None,
 ) -> int:
-    """Least memory in bytes that rendering *modes* at ``width x height`` takes (see module)."""
-    from spectrinsic.render.modes import get_mode, n_passes
-
+    """Least memory in bytes that rendering ``settings.modes`` at ``width x height`` takes
+    (see module)."""
     values = 0
-    for name in modes:
+    for name in settings.modes:
         raw = 3 * n_passes(get_mode(name), data_dir=data_dir)
         values += raw + 3  # raw channels + XYZ
-    copies = 1 + (n_lights if per_light and n_lights > 1 else 0) + (1 if direct else 0)
+    per_light = settings.per_light and n_lights > 1
+    copies = 1 + (n_lights if per_light else 0) + (1 if settings.direct else 0)
     return width * height * values * copies * BYTES_PER_VALUE * OVERHEAD_FACTOR
 
 
@@ -70,7 +69,8 @@ def available_memory_bytes() -> int | None:
 
 
 def check_render_size(
-    width: int, height: int, *, what: str, processes: int = 1, **estimate: object
+    width: int, height: int, settings: RenderSettings, *, what: str, processes: int = 1,
+    n_lights: int = 1, data_dir: str | None = None,
 ) -> int:
     """Refuse a size that is not positive, too large, or cannot fit in memory; return the estimate.
 
@@ -80,8 +80,8 @@ def check_render_size(
         How the user gave the size, for the message (``"--width 100000 --height 128"``).
     processes
         Renders running at once (worker processes), each needing the estimate.
-    **estimate
-        Keyword arguments of :func:`estimate_render_bytes`.
+    n_lights
+        Lights of the scene (each rendered alone with ``settings.per_light``).
 
     Raises
     ------
@@ -93,7 +93,7 @@ def check_render_size(
             raise RenderError(f"{what}: image {side} {value!r}; expected a positive integer")
         if value > MAX_SIDE:
             raise RenderError(f"{what}: image {side} {value} exceeds the largest supported, {MAX_SIDE}")
-    need = processes * estimate_render_bytes(width, height, **estimate)  # type: ignore[arg-type]
+    need = processes * estimate_render_bytes(width, height, settings, n_lights=n_lights, data_dir=data_dir)
     have = available_memory_bytes()
     if have is not None and need > have:
         raise RenderError(

@@ -29,9 +29,9 @@ def _render(cfg: Any, scene: Any, *, spp: int, batches: int, seed: int,
     from spectrinsic.render import render_batches
 
     start = time.perf_counter()
-    result = render_batches(scene, batches=batches, modes=modes or cfg.modes, spp=spp // batches, seed=seed,
-                            max_depth=cfg.max_depth, per_light=True,
-                            per_light_modes=(cfg.share_mode,))
+    settings = cfg.render.with_options(spp=spp, batches=batches, max_batches=None,
+                                       modes=modes or cfg.render.modes)
+    result = render_batches(scene, settings, seed=seed)
     return result, time.perf_counter() - start
 
 
@@ -53,7 +53,7 @@ def _sample_seconds(cfg: Any, name: str, view: int, condition: str) -> float:
 
     scene = build(name, view=view, condition=condition, seed=0, width=cfg.width, height=cfg.height)
     start = time.perf_counter()
-    result, _ = _render(cfg, scene, spp=cfg.spp, batches=cfg.batches, seed=1)
+    result, _ = _render(cfg, scene, spp=cfg.render.spp, batches=cfg.render.batches, seed=1)
     compute_ground_truth(scene, result, cameras=cfg.resolved_cameras(), denoise=cfg.denoise)
     return time.perf_counter() - start
 
@@ -65,12 +65,12 @@ def run(out_dir: Path) -> dict[str, Any]:
 
     cfg = get_preset("default")
     scene = build(SCENE, view=VIEW, condition=CONDITION, seed=0, width=cfg.width, height=cfg.height)
-    noisy, t_render = _render(cfg, scene, spp=cfg.spp, batches=cfg.batches, seed=1)
+    noisy, t_render = _render(cfg, scene, spp=cfg.render.spp, batches=cfg.render.batches, seed=1)
     start = time.perf_counter()
     gt = compute_ground_truth(scene, noisy, denoise=True)
     t_gt = time.perf_counter() - start
     # the shading needs only the cube: the reference renders nothing else
-    reference, t_ref = _render(cfg, scene, spp=REFERENCE_FACTOR * cfg.spp, batches=4, seed=7,
+    reference, t_ref = _render(cfg, scene, spp=REFERENCE_FACTOR * cfg.render.spp, batches=4, seed=7,
                                modes=("bands31",))
     ref = compute_ground_truth(scene, reference)
     valid = (ref.layers["shading_grey"].data > 0) & (gt.layers["shading_grey"].data > 0)
@@ -88,7 +88,7 @@ def run(out_dir: Path) -> dict[str, Any]:
     set_minutes = (32 * kinds["object"] + 18 * kinds["room_one_light"] + 18 * kinds["room_two_lights"]) / 60
     return {
         "scene": f"{SCENE} view {VIEW} {CONDITION}, {cfg.width}x{cfg.height}",
-        "default_spp": cfg.spp, "batches": cfg.batches, "reference_spp": REFERENCE_FACTOR * cfg.spp,
+        "default_spp": cfg.render.spp, "batches": cfg.render.batches, "reference_spp": REFERENCE_FACTOR * cfg.render.spp,
         "render_seconds": t_render, "ground_truth_seconds": t_gt, "reference_seconds": t_ref,
         "reference_own_noise": ref.noise["shading_raw"],
         "shading_stored_denoised": ours,

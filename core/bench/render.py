@@ -82,7 +82,7 @@ def _overhead(name: str, view: int, condition: str) -> dict[str, Any]:
     """Our pipeline's seconds over a bare Mitsuba render of the same dict (rgb3 only, at
     :data:`OVERHEAD_SIZE`², :data:`OVERHEAD_SPP` spp; medians of :data:`REPEATS` interleaved
     runs), and the seconds spent smoothing normals."""
-    from spectrinsic.render import render_scene
+    from spectrinsic.render import RenderSettings, render_scene
     from spectrinsic.render.translate import prepare_geometry
     from spectrinsic.scenes import library
 
@@ -90,7 +90,7 @@ def _overhead(name: str, view: int, condition: str) -> dict[str, Any]:
     ours, bare, geometry = [], [], []
     for _ in range(REPEATS):
         start = time.perf_counter()
-        render_scene(big, modes=("rgb3",), spp=OVERHEAD_SPP, seed=SEED, aovs=False)
+        render_scene(big, RenderSettings(OVERHEAD_SPP, modes=("rgb3",), aovs=False), seed=SEED)
         ours.append(time.perf_counter() - start)
         bare.append(_bare_seconds(big, OVERHEAD_SPP))
         start = time.perf_counter()
@@ -111,14 +111,15 @@ def _overhead(name: str, view: int, condition: str) -> dict[str, Any]:
 def _equal_time(scene: Any, timed: Any) -> dict[str, Any]:
     """Colour errors (%) of the spectral reference and the 31-band cube of *timed* at equal render
     seconds, against a spectral render with :data:`TRUTH_FACTOR` times the samples."""
-    from spectrinsic.render import render_scene
+    from spectrinsic.render import RenderSettings, render_scene
 
     t = timed.meta["timings"]
     # equal time: the spectral render gets the samples the 11-pass cube's time buys
     cube_seconds = t["bands31"]["seconds"]
     spectral_spp = max(1, int(round(SPP * cube_seconds / t["spectral"]["seconds"])))
-    spectral = render_scene(scene, modes=("spectral",), spp=spectral_spp, seed=SEED + 1, aovs=False)
-    truth = render_scene(scene, modes=("spectral",), spp=TRUTH_FACTOR * spectral_spp, seed=SEED + 2, aovs=False)
+    spectral_only = RenderSettings(spectral_spp, modes=("spectral",), aovs=False)
+    spectral = render_scene(scene, spectral_only, seed=SEED + 1)
+    truth = render_scene(scene, spectral_only.with_options(spp=TRUTH_FACTOR * spectral_spp), seed=SEED + 2)
     truth_xyz = truth.images["spectral"].astype(np.float64)
     return {
         "seconds": round(cube_seconds, 3),
@@ -133,16 +134,17 @@ def _equal_time(scene: Any, timed: Any) -> dict[str, Any]:
 
 def run(out_dir: Path) -> dict[str, Any]:
     """Run the rendering benchmark; return JSON-serialisable results (seconds and ratios)."""
-    from spectrinsic.render import render_scene
+    from spectrinsic.render import RenderSettings, render_scene
     from spectrinsic.render.variants import variant_report
     from spectrinsic.scenes import library
 
     name, view, condition = SCENE
     load_start = list(os.getloadavg())
     scene = library.build(name, view=view, condition=condition, seed=SEED, width=SIZE, height=SIZE)
-    render_scene(scene, modes=MODES, spp=SPP, seed=SEED, aovs=True)  # warm-up: compile kernels
+    settings = RenderSettings(SPP, modes=MODES, aovs=True)
+    render_scene(scene, settings, seed=SEED)  # warm-up: compile kernels
 
-    timed = render_scene(scene, modes=MODES, spp=SPP, seed=SEED, aovs=True)
+    timed = render_scene(scene, settings, seed=SEED)
     t = timed.meta["timings"]
     per_pass = {m: t[m]["seconds"] / t[m]["passes"] for m in t}
     overhead = _overhead(name, view, condition)

@@ -251,24 +251,9 @@ def build_sample(task: SampleTask) -> SampleOutcome:
     t0 = time.perf_counter()
     scene = _task_scene(task)
     t_render = time.perf_counter()
-    result = render_batches(
-        scene,
-        batches=cfg.batches,
-        noise_target=cfg.noise_target,
-        max_batches=cfg.max_batches,
-        modes=cfg.modes,
-        spp=cfg.spp // cfg.batches,
-        seed=task.seed,
-        max_depth=cfg.max_depth,
-        variant=cfg.variant,
-        per_light=cfg.per_light,
-        per_light_modes=(cfg.share_mode,) if cfg.per_light and cfg.share_mode else None,
-        direct=cfg.direct,
-        aovs=True,
-        data_dir=task.data_dir,
-    )
+    result = render_batches(scene, cfg.render, seed=task.seed, data_dir=task.data_dir)
     render_seconds = time.perf_counter() - t_render
-    if cfg.direct:  # the energy ratio r of Eq. 5.8, recorded for the dataset card's diversity plots
+    if cfg.render.direct:  # the energy ratio r of Eq. 5.8, recorded for the dataset card's diversity plots
         mode = "spectral" if "spectral" in result.direct else next(iter(result.direct))
         scene.metadata["energy_ratio_r"] = float(result.energy_ratio(mode))
     path = export_sample(

@@ -135,7 +135,7 @@ def test_a_full_disk_stops_the_build_in_one_line_naming_the_file(tmp_path, monke
 def test_when_every_sample_fails_failed_lines_and_no_manifest(tmp_path, monkeypatch, capsys):
     import spectrinsic.render as render
 
-    def failing(scene, **kwargs):
+    def failing(scene, settings, **kwargs):
         raise RuntimeError(f"simulated failure of {scene.name}")
 
     monkeypatch.setattr(render, "render_batches", failing)

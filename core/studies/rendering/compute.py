@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import SceneError, StudyError, validate_choice
+from spectrinsic.render.settings import RenderSettings
 from spectrinsic.scenes.library import CONDITIONS
 from spectrinsic.spectra import relative_error
 
@@ -48,6 +49,12 @@ class StudyQuality:
     width: int
     height: int
     spp: int
+
+    def render_settings(self, variant: str | None = None) -> RenderSettings:
+        """One batch of :attr:`spp` samples of the compared modes and the reference, path depth
+        :data:`MAX_DEPTH`, the reference also direct-only (for r of Eq. 5.8), with AOVs."""
+        return RenderSettings(self.spp, modes=(*COMPARED_MODES, REFERENCE_MODE), max_depth=MAX_DEPTH,
+                              variant=variant, direct=(REFERENCE_MODE,), aovs=True)
 
 
 #: Quality presets; "default" runs in about 5 minutes on 2 shared cores.
@@ -140,10 +147,8 @@ def evaluate_sample(
     scene = library.build(name, view=view, condition=condition, seed=seed, width=quality.width,
                           height=quality.height)
     t0 = time.perf_counter()
-    result = render_scene(
-        scene, modes=(*COMPARED_MODES, REFERENCE_MODE), spp=quality.spp, seed=seed_from_key(seed, sample),
-        max_depth=MAX_DEPTH, variant=variant, direct=(REFERENCE_MODE,), aovs=True, data_dir=data_dir,
-    )
+    result = render_scene(scene, quality.render_settings(variant), seed=seed_from_key(seed, sample),
+                          data_dir=data_dir)
     seconds = time.perf_counter() - t0
     ref = result.images[REFERENCE_MODE]
     valid = valid_pixels(ref, result.aovs["mask"])
