@@ -22,6 +22,7 @@ from typing import Any
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.pipeline.presets import DatasetConfig
+from spectrinsic.pipeline.tasks import SampleTask
 
 __all__ = ["SCENES_FOLDER", "generator_source", "files_source", "plan_source_samples", "save_generated"]
 
@@ -91,9 +92,8 @@ def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir:
 
 
 def plan_source_samples(out: str, config: DatasetConfig, *, data_dir: str | None,
-                        render_threads: int | None) -> list[Any]:
-    """The :class:`~spectrinsic.pipeline.dataset.SampleTask` list of ``config.source``."""
-    from spectrinsic.pipeline.dataset import SampleTask
+                        render_threads: int | None) -> list[SampleTask]:
+    """The :class:`~spectrinsic.pipeline.tasks.SampleTask` list of ``config.source``."""
     from spectrinsic.scenes.generators import generated_family, generated_scene_name
     from spectrinsic.scenes.sample_id import SampleId
     from spectrinsic.scenes.sources import FileSource, GeneratedSource
