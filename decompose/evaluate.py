@@ -41,6 +41,7 @@ from spectrinsic.decompose.registry import available_decomposers, get_decomposer
 from spectrinsic.decompose.report import write_report
 from spectrinsic.decompose.scores import CONDITION_GROUPS, INPUT_LAYERS, SCORED_LAYERS, Score
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export.exr import write_exr
 from spectrinsic.gt_export.names import camera_slug
 from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.sample_id import SampleId
@@ -192,8 +193,6 @@ def _layer_scores(
 
 
 def _write_estimate(directory: Path, result: Decomposition) -> None:
-    from spectrinsic.gt_export.exr import write_exr
-
     directory.mkdir(parents=True, exist_ok=True)
     write_exr(directory / "reflectance.exr", {"reflectance": result.reflectance})
     write_exr(directory / "shading.exr", {"shading": result.shading})

@@ -27,6 +27,8 @@ from spectrinsic.render.passes import (
 )
 from spectrinsic.render.result import RenderResult
 from spectrinsic.render.settings import DEFAULT_MODES, RenderSettings
+from spectrinsic.render.translate import prepare_geometry, surfaces
+from spectrinsic.render.variants import choose_variant, import_mitsuba, variant_scope
 from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
@@ -74,7 +76,6 @@ def count_passes(scene: Scene, settings: RenderSettings, *, data_dir: str | None
     colour = sum(n_passes(m, data_dir=data_dir) * (2 if m.name in wanted else 1) for m in objs)
     share_modes = _modes(per_light_modes) if per_light and per_light_modes is not None else []
     shares = sum(n_passes(m, data_dir=data_dir) for m in share_modes)
-    from spectrinsic.render.translate import surfaces
 
     aov_passes = max(1, -(-len(surfaces(scene)) // 3)) if aovs else 0
     return groups * colour + len(scene.lights) * shares + aov_passes
@@ -109,9 +110,6 @@ def _run_jobs(
     one scope and every spectral pass in another. Passes do not depend on each other's order:
     each sets its own values, seed and spp.
     """
-    from spectrinsic.render.translate import prepare_geometry
-    from spectrinsic.render.variants import choose_variant, variant_scope
-
     geometry = prepare_geometry(scene)
     outputs: list[dict[str, PassOutput]] = [{} for _ in jobs]
     aov_maps: dict[str, np.ndarray] = {}
@@ -230,8 +228,6 @@ def _render_meta(
     variants: dict[str, str], timings: dict[str, list[float]], *, spp: int, seed: int,
     max_depth: int, per_light: bool, wanted: set[str], data_dir: str | None,
 ) -> dict[str, Any]:
-    from spectrinsic.render.variants import import_mitsuba
-
     names = [m.name for m in objs]
     return {
         "mitsuba": import_mitsuba().__version__,

@@ -19,6 +19,7 @@ import numpy as np
 
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
+from spectrinsic.scenes.validate import validate_scene
 
 __all__ = ["MESH_SUFFIXES", "load_mesh_scene"]
 
@@ -97,8 +98,6 @@ def load_mesh_scene(
     SceneError
         One line naming the file and the unmapped material, or an unreadable file.
     """
-    from spectrinsic.scenes.validate import validate_scene
-
     path = Path(path)
     geoms = _geometries(path)
     names: list[str] = []

@@ -20,14 +20,18 @@ from typing import Any
 
 import numpy as np
 
+from spectrinsic.gt_export.layers import compute_ground_truth
+from spectrinsic.pipeline.presets import get_preset
+from spectrinsic.render import render_batches
+from spectrinsic.scenes.library import build
+from spectrinsic.spectra.reconstruction import relative_error
+
 REFERENCE_FACTOR = 16
 SCENE, VIEW, CONDITION = "room-living", 1, "white"
 
 
 def _render(cfg: Any, scene: Any, *, spp: int, batches: int, seed: int,
             modes: tuple[str, ...] | None = None) -> tuple[Any, float]:
-    from spectrinsic.render import render_batches
-
     start = time.perf_counter()
     settings = cfg.render.with_options(spp=spp, batches=batches, max_batches=None,
                                        modes=modes or cfg.render.modes)
@@ -36,8 +40,6 @@ def _render(cfg: Any, scene: Any, *, spp: int, batches: int, seed: int,
 
 
 def _errors(estimate: np.ndarray, reference: np.ndarray, ref_se: np.ndarray, valid: np.ndarray) -> dict[str, float]:
-    from spectrinsic.spectra.reconstruction import relative_error
-
     err = relative_error(estimate, reference, where=valid)[valid]  # Eq. 5.7 per pixel
     corrected = np.sqrt(np.clip(err ** 2 - ref_se[valid] ** 2, 0.0, None))
     return {"median": float(np.median(err)), "p95": float(np.percentile(err, 95)),
@@ -48,9 +50,6 @@ def _errors(estimate: np.ndarray, reference: np.ndarray, ref_se: np.ndarray, val
 
 
 def _sample_seconds(cfg: Any, name: str, view: int, condition: str) -> float:
-    from spectrinsic.gt_export.layers import compute_ground_truth
-    from spectrinsic.scenes.library import build
-
     scene = build(name, view=view, condition=condition, seed=0, width=cfg.width, height=cfg.height)
     start = time.perf_counter()
     result, _ = _render(cfg, scene, spp=cfg.render.spp, batches=cfg.render.batches, seed=1)
@@ -59,10 +58,6 @@ def _sample_seconds(cfg: Any, name: str, view: int, condition: str) -> float:
 
 
 def run(out_dir: Path) -> dict[str, Any]:
-    from spectrinsic.gt_export.layers import compute_ground_truth
-    from spectrinsic.pipeline.presets import get_preset
-    from spectrinsic.scenes.library import build
-
     cfg = get_preset("default")
     scene = build(SCENE, view=VIEW, condition=CONDITION, seed=0, width=cfg.width, height=cfg.height)
     noisy, t_render = _render(cfg, scene, spp=cfg.render.spp, batches=cfg.render.batches, seed=1)

@@ -24,7 +24,13 @@ from typing import Any
 
 import numpy as np
 
+from spectrinsic.render import RenderSettings, channel_values, get_mode, render_scene
+from spectrinsic.render import translate as tr
 from spectrinsic.render.modes import RENDER_MODES
+from spectrinsic.render.translate import prepare_geometry
+from spectrinsic.render.variants import choose_variant, variant_report, variant_scope
+from spectrinsic.scenes import library
+from spectrinsic.spectra import get_sensors, relative_error
 
 __all__ = ["run", "SCENE", "SIZE", "SPP", "OVERHEAD_GOAL", "TRUTH_FACTOR"]
 
@@ -47,11 +53,6 @@ MODES = tuple(RENDER_MODES)
 
 def _bare_seconds(scene: Any, spp: int) -> float:
     """Seconds of a bare Mitsuba load + render + readback of the rgb3 pass's scene dict."""
-    from spectrinsic.render import channel_values, get_mode
-    from spectrinsic.render import translate as tr
-    from spectrinsic.render.variants import choose_variant, variant_scope
-    from spectrinsic.spectra import get_sensors
-
     values = channel_values(scene, get_sensors(get_mode("rgb3").sensors))
     with variant_scope(choose_variant("rgb")) as mi:
         mitsuba_dict = tr.scene_to_mitsuba(
@@ -68,8 +69,6 @@ def _bare_seconds(scene: Any, spp: int) -> float:
 
 
 def _errors(estimate: np.ndarray, truth: np.ndarray) -> dict[str, float]:
-    from spectrinsic.spectra import relative_error
-
     err = relative_error(estimate, truth)
     mean_est, mean_truth = estimate.reshape(-1, 3).mean(axis=0), truth.reshape(-1, 3).mean(axis=0)
     return {
@@ -82,10 +81,6 @@ def _overhead(name: str, view: int, condition: str) -> dict[str, Any]:
     """Our pipeline's seconds over a bare Mitsuba render of the same dict (rgb3 only, at
     :data:`OVERHEAD_SIZE`², :data:`OVERHEAD_SPP` spp; medians of :data:`REPEATS` interleaved
     runs), and the seconds spent smoothing normals."""
-    from spectrinsic.render import RenderSettings, render_scene
-    from spectrinsic.render.translate import prepare_geometry
-    from spectrinsic.scenes import library
-
     big = library.build(name, view=view, condition=condition, seed=SEED, width=OVERHEAD_SIZE, height=OVERHEAD_SIZE)
     ours, bare, geometry = [], [], []
     for _ in range(REPEATS):
@@ -111,8 +106,6 @@ def _overhead(name: str, view: int, condition: str) -> dict[str, Any]:
 def _equal_time(scene: Any, timed: Any) -> dict[str, Any]:
     """Colour errors (%) of the spectral reference and the 31-band cube of *timed* at equal render
     seconds, against a spectral render with :data:`TRUTH_FACTOR` times the samples."""
-    from spectrinsic.render import RenderSettings, render_scene
-
     t = timed.meta["timings"]
     # equal time: the spectral render gets the samples the 11-pass cube's time buys
     cube_seconds = t["bands31"]["seconds"]
@@ -134,10 +127,6 @@ def _equal_time(scene: Any, timed: Any) -> dict[str, Any]:
 
 def run(out_dir: Path) -> dict[str, Any]:
     """Run the rendering benchmark; return JSON-serialisable results (seconds and ratios)."""
-    from spectrinsic.render import RenderSettings, render_scene
-    from spectrinsic.render.variants import variant_report
-    from spectrinsic.scenes import library
-
     name, view, condition = SCENE
     load_start = list(os.getloadavg())
     scene = library.build(name, view=view, condition=condition, seed=SEED, width=SIZE, height=SIZE)

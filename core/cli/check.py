@@ -6,7 +6,11 @@ import argparse
 import sys
 from pathlib import Path
 
+from tqdm import tqdm
+
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export import check_dataset, sample_dirs
+from spectrinsic.gt_export.check import NOISE_THRESHOLD, noise_report
 
 __all__ = ["register", "run"]
 
@@ -36,11 +40,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Print problems grouped per sample; exit status 0 when the set is sound, 1 otherwise."""
-    from tqdm import tqdm
-
-    from spectrinsic.gt_export import check_dataset, sample_dirs
-    from spectrinsic.gt_export.check import NOISE_THRESHOLD, noise_report
-
     root = Path(args.dir)
     if not root.is_dir():
         raise DatasetError(f"check {str(root)!r}: no such folder; expected a dataset folder")

@@ -10,9 +10,13 @@ from typing import Any
 from tqdm import tqdm
 
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export.integrity import check_build_folder
 from spectrinsic.pipeline.dataset import SampleFailure, build_dataset
-from spectrinsic.pipeline.executors import choose_executor
+from spectrinsic.pipeline.executors import check_scheduler, choose_executor
 from spectrinsic.pipeline.presets import PRESETS, DatasetConfig, get_preset, preset_names
+from spectrinsic.pipeline.sources import files_source, generator_source
+from spectrinsic.render.budget import check_render_size
+from spectrinsic.scenes.yaml_limits import load_yaml_file
 
 __all__ = ["register", "run", "config_from_args", "preflight", "build", "material_map"]
 
@@ -148,7 +152,6 @@ def _range(option: str, text: str) -> tuple[float, float]:
 def material_map(path: str | None) -> dict[str, str]:
     if path is None:
         return {}
-    from spectrinsic.scenes.yaml_limits import load_yaml_file
 
     data = load_yaml_file(Path(path))
     if not isinstance(data, dict) or not all(isinstance(k, str) and isinstance(v, str) for k, v in data.items()):
@@ -158,8 +161,6 @@ def material_map(path: str | None) -> dict[str, str]:
 
 def _source(args: argparse.Namespace) -> str | None:
     """The config's ``source`` for --generator / --scenes (``None``: the library)."""
-    from spectrinsic.pipeline.sources import files_source, generator_source
-
     if args.generator and args.scenes:
         raise DatasetError("--generator and --scenes exclude each other; give one")
     if args.generator:
@@ -202,10 +203,6 @@ def preflight(
     scheduler: str | None = None, rebuild: bool = False,
 ) -> None:
     """Every refusal that needs no rendering, before anything is written or started."""
-    from spectrinsic.gt_export.integrity import check_build_folder
-    from spectrinsic.pipeline.executors import check_scheduler
-    from spectrinsic.render.budget import check_render_size
-
     if workers is not None and workers < 1:
         raise DatasetError(f"--workers {workers}; expected a positive integer")
     if threads is not None and threads < 1:

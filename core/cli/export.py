@@ -5,7 +5,11 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from tqdm import tqdm
+
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export import sample_dirs
+from spectrinsic.gt_export.shards import write_shards
 
 __all__ = ["register", "run"]
 
@@ -32,11 +36,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Write the shards with a progress bar; print where they are and how many samples each split has."""
-    from tqdm import tqdm
-
-    from spectrinsic.gt_export import sample_dirs
-    from spectrinsic.gt_export.shards import write_shards
-
     root = Path(args.dir)
     if not (root / "manifest.json").is_file():
         raise DatasetError(f"export {str(root)!r}: no manifest.json; expected a built dataset folder")

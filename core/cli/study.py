@@ -14,6 +14,24 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+from tqdm import tqdm
+
+from spectrinsic.studies.photometric import (
+    CAMERA_BALANCES,
+    PhotometricSettings,
+    format_photometric,
+    run_photometric_study,
+)
+from spectrinsic.studies.reconstruction import (
+    format_extension,
+    format_table,
+    reconstruction_table,
+    run_extension,
+    write_extension_outputs,
+    write_table_outputs,
+)
+from spectrinsic.studies.rendering import QUALITIES, format_rendering, run_rendering_study
+
 __all__ = ["register", "run", "STUDIES"]
 
 STUDIES: tuple[str, ...] = ("reconstruction-error", "photometric", "rendering")
@@ -23,9 +41,6 @@ DEFAULT_SEED = 0
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from spectrinsic.studies.photometric import CAMERA_BALANCES
-    from spectrinsic.studies.rendering import QUALITIES
-
     p = sub.add_parser(
         "study", help="run a study of the thesis (Table 5.2, Table 4.4, rendering)",
         description="Run a study, print its table and write JSON, CSV and PNG files into --out.",
@@ -53,7 +68,6 @@ def _progress(quiet: bool, what: str) -> Iterator[Callable[..., None]]:
     if quiet:
         yield lambda *a, **k: None
         return
-    from tqdm import tqdm
 
     bar = tqdm(desc=what, unit="step", file=sys.stderr, leave=False)
 
@@ -78,15 +92,6 @@ def run(args: argparse.Namespace) -> int:
     data_dir = getattr(args, "data_dir", None)
     quiet = bool(getattr(args, "quiet", False))
     if args.study == "reconstruction-error":
-        from spectrinsic.studies.reconstruction import (
-            format_extension,
-            format_table,
-            reconstruction_table,
-            run_extension,
-            write_extension_outputs,
-            write_table_outputs,
-        )
-
         with _progress(quiet, "reconstruction error") as progress:
             table = reconstruction_table(data_dir=data_dir, progress=progress)
         print(format_table(table))
@@ -100,12 +105,6 @@ def run(args: argparse.Namespace) -> int:
         _print_paths(paths)
         return 0
     if args.study == "photometric":
-        from spectrinsic.studies.photometric import (
-            PhotometricSettings,
-            format_photometric,
-            run_photometric_study,
-        )
-
         settings = PhotometricSettings(seed=args.seed, include_ie=args.include_ie,
                                        camera_balance=args.camera_balance)
         with _progress(quiet, "photometric") as progress:
@@ -113,7 +112,6 @@ def run(args: argparse.Namespace) -> int:
         print(format_photometric(result))
         _print_paths(paths)
         return 0
-    from spectrinsic.studies.rendering import format_rendering, run_rendering_study
 
     with _progress(quiet, "rendering study") as progress:
         payload = run_rendering_study(out, quality=args.quality, data_dir=data_dir, progress=progress)

@@ -24,11 +24,30 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from spectrinsic.errors import DatasetError
+from spectrinsic.errors import DatasetError, DiskFullError
+from spectrinsic.gt_export import (
+    build_gallery,
+    export_sample,
+    remove_stale_temporaries,
+    sample_dirs,
+    write_dataset_card,
+    write_manifest,
+)
+from spectrinsic.gt_export.integrity import (
+    check_build_folder,
+    remove_owned_temporaries,
+    remove_sample,
+    replaceable_sample,
+    sample_problem,
+    write_marker,
+)
 from spectrinsic.pipeline.executors import Executor, SerialExecutor
 from spectrinsic.pipeline.presets import DatasetConfig
 from spectrinsic.pipeline.sources import plan_source_samples, save_generated
 from spectrinsic.pipeline.tasks import SampleFailure, SampleOutcome, SampleTask
+from spectrinsic.render import render_batches, set_thread_count
+from spectrinsic.scenes.library import build, default_samples
+from spectrinsic.scenes.sources import GeneratedSource
 
 __all__ = [
     "SampleTask",
@@ -113,8 +132,6 @@ def plan_samples(
     DatasetError
         If *only* matches no sample.
     """
-    from spectrinsic.scenes.library import default_samples
-
     out = str(Path(out_dir))
     if config.source is not None:
         tasks = plan_source_samples(out, config, render_threads=render_threads,
@@ -149,9 +166,6 @@ def build_sample(task: SampleTask) -> SampleOutcome:
     SampleOutcome
         Status ``"built"`` with timings and the worker's peak memory.
     """
-    from spectrinsic.gt_export import export_sample
-    from spectrinsic.render import render_batches, set_thread_count
-
     set_thread_count(task.render_threads)  # one pool per worker, sized to its share of cores
     cfg = task.config
     t0 = time.perf_counter()
@@ -189,13 +203,10 @@ def build_sample(task: SampleTask) -> SampleOutcome:
 def _task_scene(task: SampleTask) -> Any:
     """The task's scene: from its source (a generated one is saved as a scene file), else the
     library."""
-    from spectrinsic.scenes.library import build
-
     if task.source is None:
         cfg = task.config
         return build(task.id.scene, view=task.id.view, condition=task.id.condition, seed=cfg.seed,
                      width=cfg.width, height=cfg.height)
-    from spectrinsic.scenes.sources import GeneratedSource
 
     scene = task.source.build(task.data_dir)
     if isinstance(task.source, GeneratedSource):
@@ -307,15 +318,6 @@ def _prepare(
 
     Everything that can refuse the build runs before the first write.
     """
-    from spectrinsic.gt_export.integrity import (
-        check_build_folder,
-        remove_owned_temporaries,
-        remove_sample,
-        replaceable_sample,
-        sample_problem,
-        write_marker,
-    )
-
     config_hash = config.config_hash()
     previous = check_build_folder(out, config_hash, rebuild=rebuild)
     kw: dict[str, Any] = {"data_dir": data_dir, "render_threads": render_threads}
@@ -354,8 +356,6 @@ def _run(
     progress: Callable[[SampleOutcome | SampleFailure], None] | None,
 ) -> tuple[list[SampleOutcome], list[SampleFailure]]:
     """Run the tasks; a failed sample does not stop the others, a full disk stops them all."""
-    from spectrinsic.errors import DiskFullError
-
     built: list[SampleOutcome] = []
     failed: list[SampleFailure] = []
     for task, outcome in executor.map_unordered(task_fn, todo):
@@ -385,14 +385,6 @@ def finalize_dataset(
     First removes spectrinsic's temporaries, whichever worker left them (all have finished).
     A folder without any complete sample gets nothing (``{}``): no empty manifest.
     """
-    from spectrinsic.gt_export import (
-        build_gallery,
-        remove_stale_temporaries,
-        sample_dirs,
-        write_dataset_card,
-        write_manifest,
-    )
-
     out = Path(out_dir)
     for path in remove_stale_temporaries(out):
         log.info("removed %s, left by a worker that died", path.name)

@@ -14,6 +14,8 @@ from typing import Any
 
 from spectrinsic import provenance
 from spectrinsic.errors import DatasetError, RenderError, validate_choice
+from spectrinsic.gt_export import DEFAULT_CAMERAS
+from spectrinsic.gt_export.writer import config_hash
 from spectrinsic.render.modes import RENDER_MODES
 from spectrinsic.render.settings import RenderSettings
 
@@ -176,7 +178,6 @@ class DatasetConfig:
             return tuple(self.cameras)
         if "bands31" not in self.render.modes:
             return ()
-        from spectrinsic.gt_export import DEFAULT_CAMERAS
 
         return tuple(DEFAULT_CAMERAS)
 
@@ -191,8 +192,6 @@ class DatasetConfig:
         Computed by :func:`spectrinsic.gt_export.writer.config_hash`, the function that stamps
         ``meta.json``, so the hash a build checks is the hash its samples carry.
         """
-        from spectrinsic.gt_export.writer import config_hash
-
         return config_hash(self.to_dict())
 
 

@@ -20,9 +20,21 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from spectrinsic.errors import DatasetError
+from spectrinsic.errors import DatasetError, validate_choice
+from spectrinsic.gt_export.integrity import file_sha256
 from spectrinsic.pipeline.presets import DatasetConfig
 from spectrinsic.pipeline.tasks import SampleTask
+from spectrinsic.scenes.generators import (
+    GENERATORS,
+    GeneratorOptions,
+    MaterialDistribution,
+    generated_family,
+    generated_scene_name,
+)
+from spectrinsic.scenes.io import save_scene
+from spectrinsic.scenes.sample_id import SampleId
+from spectrinsic.scenes.sources import FileSource, GeneratedSource, scene_file_kind
+from spectrinsic.spectra import list_spectra
 
 __all__ = ["SCENES_FOLDER", "generator_source", "files_source", "plan_source_samples", "save_generated"]
 
@@ -36,9 +48,6 @@ def generator_source(generator: str, count: int, *, views: int = 1,
                      chroma_range: Sequence[float] = (0.0, 16.0),
                      min_coverage: float = 0.15, sfu: bool = False) -> str:
     """The canonical ``source`` JSON of a generated set (validated)."""
-    from spectrinsic.errors import validate_choice
-    from spectrinsic.scenes.generators import GENERATORS
-
     validate_choice(generator, GENERATORS, "scene generator", error=DatasetError)
     if count < 1 or views < 1:
         raise DatasetError(f"--count {count} / --views {views}; expected positive integers")
@@ -53,9 +62,6 @@ def files_source(paths: Sequence[str | os.PathLike[str]], *,
                  materials: Mapping[str, str] | None = None,
                  default_spectrum: str | None = None) -> str:
     """The canonical ``source`` JSON of a set of scene files (each must exist)."""
-    from spectrinsic.gt_export.integrity import file_sha256
-    from spectrinsic.scenes.sources import scene_file_kind
-
     entries = []
     for p in paths:
         path = Path(p).resolve()
@@ -73,9 +79,6 @@ def files_source(paths: Sequence[str | os.PathLike[str]], *,
 
 
 def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir: str | None) -> Any:
-    from spectrinsic.scenes.generators import GeneratorOptions, MaterialDistribution
-    from spectrinsic.spectra import list_spectra
-
     sfu_r: tuple[str, ...] = ()
     sfu_i: tuple[str, ...] = ()
     if spec.get("sfu"):
@@ -94,10 +97,6 @@ def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir:
 def plan_source_samples(out: str, config: DatasetConfig, *, data_dir: str | None,
                         render_threads: int | None) -> list[SampleTask]:
     """The :class:`~spectrinsic.pipeline.tasks.SampleTask` list of ``config.source``."""
-    from spectrinsic.scenes.generators import generated_family, generated_scene_name
-    from spectrinsic.scenes.sample_id import SampleId
-    from spectrinsic.scenes.sources import FileSource, GeneratedSource
-
     spec = json.loads(config.source or "{}")
     rows: list[tuple[str, int, str, Any]] = []
     if "generator" in spec:
@@ -119,8 +118,6 @@ def plan_source_samples(out: str, config: DatasetConfig, *, data_dir: str | None
 
 def save_generated(out_dir: str | os.PathLike[str], sample_id: str, scene: Any) -> Path:
     """Write a generated scene as ``<out>/scenes/<sample id>.yaml`` (meshes beside it)."""
-    from spectrinsic.scenes.io import save_scene
-
     folder = Path(out_dir) / SCENES_FOLDER
     folder.mkdir(parents=True, exist_ok=True)
     return save_scene(scene, folder / f"{sample_id}.yaml")

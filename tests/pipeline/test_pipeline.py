@@ -243,17 +243,17 @@ def test_ctrl_c_keeps_completed_samples(tmp_path):
 
 
 def test_cli_reports_failures_and_exits_nonzero(tmp_path, monkeypatch, capsys):
-    import spectrinsic.render as render
+    import spectrinsic.pipeline.dataset as pipeline_dataset
     from spectrinsic.cli import main
 
-    real = render.render_batches
+    real = pipeline_dataset.render_batches
 
     def failing_for_rooms(scene, settings, **kwargs):
         if scene.name.startswith("room-"):
             raise RuntimeError("simulated render failure")
         return real(scene, settings, **kwargs)
 
-    monkeypatch.setattr(render, "render_batches", failing_for_rooms)
+    monkeypatch.setattr(pipeline_dataset, "render_batches", failing_for_rooms)
     rc = main(["-q", "dataset", "--out", str(tmp_path / "ds"), "--workers", "1", *CLI_TINY])
     captured = capsys.readouterr()
     assert rc == 1

@@ -16,8 +16,12 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import SceneError, StudyError, validate_choice
+from spectrinsic.render import render_scene
 from spectrinsic.render.settings import RenderSettings
+from spectrinsic.rng import seed_from_key
+from spectrinsic.scenes import library
 from spectrinsic.scenes.library import CONDITIONS
+from spectrinsic.scenes.sample_id import SampleId
 from spectrinsic.spectra import relative_error
 
 __all__ = [
@@ -101,8 +105,6 @@ def samples(
 ) -> Iterator[tuple[str, int, str]]:
     """``(scene, view, condition)`` of every sample: each complex scene (or *scenes*), each of
     its views (or *views*), each condition (validated against the library's)."""
-    from spectrinsic.scenes import library
-
     for condition in conditions:
         validate_choice(condition, CONDITIONS, "illumination condition", error=SceneError)
     names = list(scenes) if scenes is not None else library.scene_names("complex")
@@ -138,11 +140,6 @@ def evaluate_sample(
     The row holds, per compared mode, the mean, s.d. and max of ε in percent, the energy ratio
     r (Eq. 5.8) of the reference, the number of evaluated pixels and the render time (s).
     """
-    from spectrinsic.render import render_scene
-    from spectrinsic.rng import seed_from_key
-    from spectrinsic.scenes import library
-    from spectrinsic.scenes.sample_id import SampleId
-
     sample = str(SampleId(name, view, condition))
     scene = library.build(name, view=view, condition=condition, seed=seed, width=quality.width,
                           height=quality.height)
