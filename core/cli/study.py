@@ -16,25 +16,11 @@ from typing import Any
 
 from tqdm import tqdm
 
-from spectrinsic.studies.photometric import (
-    CAMERA_BALANCES,
-    PhotometricSettings,
-    format_photometric,
-    run_photometric_study,
-)
-from spectrinsic.studies.reconstruction import (
-    format_extension,
-    format_table,
-    reconstruction_table,
-    run_extension,
-    write_extension_outputs,
-    write_table_outputs,
-)
-from spectrinsic.studies.rendering import QUALITIES, format_rendering, run_rendering_study
+from spectrinsic.studies.photometric import CAMERA_BALANCES
+from spectrinsic.studies.registry import STUDIES, StudyOptions, run_study
+from spectrinsic.studies.rendering import QUALITIES
 
-__all__ = ["register", "run", "STUDIES"]
-
-STUDIES: tuple[str, ...] = ("reconstruction-error", "photometric", "rendering")
+__all__ = ["register", "run"]
 
 #: Root seed of the photometric study's random scenes unless ``--seed`` is given.
 DEFAULT_SEED = 0
@@ -43,9 +29,10 @@ DEFAULT_SEED = 0
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "study", help="run a study of the thesis (Table 5.2, Table 4.4, rendering)",
-        description="Run a study, print its table and write JSON, CSV and PNG files into --out.",
+        description="Run a study, print its table and write JSON, CSV and PNG files into --out. "
+                    + " ".join(f"{s.name}: {s.summary}." for s in STUDIES.values()),
     )
-    p.add_argument("study", choices=STUDIES, help="which study")
+    p.add_argument("study", choices=tuple(STUDIES), help="which study")
     p.add_argument("--out", type=Path, default=Path("results"), help="output folder (default: results)")
     p.add_argument("--seed", type=int, default=DEFAULT_SEED,
                    help=f"root seed of random choices (default: {DEFAULT_SEED})")
@@ -88,32 +75,12 @@ def _print_paths(paths: dict[str, Path]) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    out = Path(args.out)
-    data_dir = getattr(args, "data_dir", None)
-    quiet = bool(getattr(args, "quiet", False))
-    if args.study == "reconstruction-error":
-        with _progress(quiet, "reconstruction error") as progress:
-            table = reconstruction_table(data_dir=data_dir, progress=progress)
-        print(format_table(table))
-        paths = write_table_outputs(table, out)
-        if not args.no_extension:
-            with _progress(quiet, "extension") as progress:
-                ext = run_extension(data_dir=data_dir, progress=progress)
-            print()
-            print(format_extension(ext))
-            paths.update({f"extended_{k}": v for k, v in write_extension_outputs(ext, out).items()})
-        _print_paths(paths)
-        return 0
-    if args.study == "photometric":
-        settings = PhotometricSettings(seed=args.seed, include_ie=args.include_ie,
-                                       camera_balance=args.camera_balance)
-        with _progress(quiet, "photometric") as progress:
-            result, paths = run_photometric_study(out, settings, data_dir=data_dir, progress=progress)
-        print(format_photometric(result))
-        _print_paths(paths)
-        return 0
-
-    with _progress(quiet, "rendering study") as progress:
-        payload = run_rendering_study(out, quality=args.quality, data_dir=data_dir, progress=progress)
-    print(format_rendering(payload))
+    options = StudyOptions(seed=args.seed, include_ie=args.include_ie,
+                           camera_balance=args.camera_balance, extension=not args.no_extension,
+                           quality=args.quality)
+    with _progress(bool(getattr(args, "quiet", False)), args.study) as progress:
+        done = run_study(args.study, Path(args.out), options,
+                         data_dir=getattr(args, "data_dir", None), progress=progress)
+    print(done.text)
+    _print_paths(done.paths)
     return 0
