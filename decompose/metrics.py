@@ -24,7 +24,9 @@ import numpy as np
 import numpy.typing as npt
 
 from spectrinsic.decompose._validation import ImageShapeError, as_image, as_mask, image_pair
+from spectrinsic.decompose.judgements import predict_judgements
 from spectrinsic.errors import DecomposeError, validate_choice
+from spectrinsic.spectra import angular_error
 
 if TYPE_CHECKING:
     from spectrinsic.decompose.judgements import Judgements
@@ -301,8 +303,6 @@ def angular_error_map(
     Returns a ``(H, W)`` float64 map, NaN outside the mask and where either colour is zero.
     Uses :func:`spectrinsic.spectra.angular_error`.
     """
-    from spectrinsic.spectra import angular_error
-
     t, e, m = image_pair(truth, estimate, mask)
     if t.shape[2] != 3:
         raise ImageShapeError(f"angular error needs (H, W, 3) colour images; got {t.shape}")
@@ -386,7 +386,6 @@ def shading_chromaticity_error(
         raise ImageShapeError(
             f"estimate shading shape {np.shape(estimate)} differs from truth shape {np.shape(truth)}"
         )
-    from spectrinsic.spectra import angular_error
 
     m = as_mask(mask, t.shape[:2])
     lit = m & (np.linalg.norm(t, axis=-1) > 0.0)
@@ -464,8 +463,6 @@ def whdr(
         Point pairs, labels and weights (e.g. from
         :func:`spectrinsic.decompose.judgements.sample_judgements`).
     """
-    from spectrinsic.decompose.judgements import predict_judgements
-
     r = as_image(reflectance, "reflectance")
     predicted = predict_judgements(r, judgements.points1, judgements.points2, delta=delta)
     w = judgements.weights

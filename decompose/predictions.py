@@ -35,6 +35,8 @@ import numpy as np
 
 from spectrinsic.decompose.decomposition import Decomposition, finish
 from spectrinsic.errors import DatasetError, validate_choice
+from spectrinsic.gt_export.exr import read_exr
+from spectrinsic.gt_export.png import PNG16_MAX, read_png16
 from spectrinsic.spectra.colorimetry import decode_srgb
 
 __all__ = ["PNG_ENCODINGS", "Predictions", "read_layer"]
@@ -46,8 +48,6 @@ PNG_ENCODINGS = ("linear", "srgb")
 
 
 def _from_exr(path: Path, layer: str) -> np.ndarray:
-    from spectrinsic.gt_export.exr import read_exr
-
     arrays = read_exr(path)
     if layer in arrays:
         return arrays[layer]
@@ -59,8 +59,6 @@ def _from_exr(path: Path, layer: str) -> np.ndarray:
 
 
 def _from_png(path: Path, encoding: str) -> np.ndarray:
-    from spectrinsic.gt_export.png import PNG16_MAX, read_png16
-
     values = read_png16(path).astype(np.float64) / PNG16_MAX
     return decode_srgb(values) if encoding == "srgb" else values
 

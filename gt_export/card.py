@@ -21,7 +21,7 @@ from spectrinsic.gt_export.diversity import DIVERSITY_NAME, write_diversity
 from spectrinsic.gt_export.integrity import guarded_write
 from spectrinsic.gt_export.manifest import noise_summary, splits_by_scene, variants_of
 from spectrinsic.gt_export.sample import CARD_NAME, META_NAME, config_hash, plain_data, sample_dirs
-from spectrinsic.gt_export.sample_meta import SampleMeta, read_meta
+from spectrinsic.gt_export.sample_meta import LayerRecord, SampleMeta, read_meta
 from spectrinsic.provenance import software_versions
 
 __all__ = ["write_dataset_card", "read_template"]
@@ -71,7 +71,7 @@ def _noise_table(summary: Mapping[str, Any]) -> str:
 
 
 def _layer_table(metas: Sequence[SampleMeta]) -> str:
-    rows = {}
+    rows: dict[str, LayerRecord] = {}
     for meta in metas:
         for name, rec in meta.layers.items():
             rows.setdefault(name, rec)

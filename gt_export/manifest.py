@@ -221,7 +221,7 @@ def _manifest_samples(f: JsonFields, root: Path, listed: Mapping[str, Any]) -> d
     return out
 
 
-def read_manifest(dataset_dir: str | Path) -> ManifestRecord | None:
+def read_manifest(dataset_dir: str | os.PathLike[str]) -> ManifestRecord | None:
     """Read and validate ``<dataset_dir>/manifest.json``; ``None`` if there is none.
 
     Raises

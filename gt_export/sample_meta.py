@@ -19,6 +19,7 @@ spectrinsic write this ``meta.json`` (then its folder may be rebuilt, even when 
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -315,7 +316,7 @@ def meta_from_bytes(data: bytes, path: Path, *, verify: bool = True) -> SampleMe
     return parse_meta(parsed, path, verify=verify)
 
 
-def read_meta(folder: str | Path, *, verify: bool = True) -> SampleMeta:
+def read_meta(folder: str | os.PathLike[str], *, verify: bool = True) -> SampleMeta:
     """Read and validate ``<folder>/meta.json`` (see the module notes).
 
     Parameters

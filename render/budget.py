@@ -26,10 +26,11 @@ worked, and a size let through fits with the margin of the table.
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
 from pathlib import Path
 
 from spectrinsic.errors import RenderError
+from spectrinsic.render.modes import get_mode, n_passes
+from spectrinsic.render.settings import RenderSettings
 
 __all__ = [
     "BYTES_PER_VALUE",
@@ -59,22 +60,19 @@ MAX_SIDE = 65_536
 def estimate_render_bytes(
     width: int,
     height: int,
+    settings: RenderSettings,
     *,
-    modes: Sequence[str],
     n_lights: int = 1,
-    per_light: bool = False,
-    direct: bool = False,
     data_dir: str | None = None,
 ) -> int:
-    """Upper bound of the peak memory in bytes of rendering *modes* at ``width x height`` in
-    one process (see the module's table)."""
-    from spectrinsic.render.modes import get_mode, n_passes
-
+    """Upper bound of the peak memory in bytes of rendering ``settings.modes`` at
+    ``width x height`` in one process (see the module's table)."""
     values = 0
-    for name in modes:
+    for name in settings.modes:
         raw = 3 * n_passes(get_mode(name), data_dir=data_dir)
         values += raw + 3  # raw channels + XYZ
-    copies = 1 + (n_lights if per_light and n_lights > 1 else 0) + (1 if direct else 0)
+    per_light = settings.per_light and n_lights > 1
+    copies = 1 + (n_lights if per_light else 0) + (1 if settings.direct else 0)
     per_pixel = (values * copies + AOV_VALUES) * BYTES_PER_VALUE * OVERHEAD_FACTOR
     return BASE_BYTES + width * height * per_pixel
 
@@ -94,7 +92,8 @@ def available_memory_bytes() -> int | None:
 
 
 def check_render_size(
-    width: int, height: int, *, what: str, processes: int = 1, **estimate: object
+    width: int, height: int, settings: RenderSettings, *, what: str, processes: int = 1,
+    n_lights: int = 1, data_dir: str | None = None,
 ) -> int:
     """Refuse a size that is not positive, too large, or cannot fit in memory; return the estimate.
 
@@ -104,8 +103,8 @@ def check_render_size(
         How the user gave the size, for the message (``"--width 100000 --height 128"``).
     processes
         Renders running at once (worker processes), each needing the estimate.
-    **estimate
-        Keyword arguments of :func:`estimate_render_bytes`.
+    n_lights
+        Lights of the scene (each rendered alone with ``settings.per_light``).
 
     Raises
     ------
@@ -117,7 +116,7 @@ def check_render_size(
             raise RenderError(f"{what}: image {side} {value!r}; expected a positive integer")
         if value > MAX_SIDE:
             raise RenderError(f"{what}: image {side} {value} exceeds the largest supported, {MAX_SIDE}")
-    need = processes * estimate_render_bytes(width, height, **estimate)  # type: ignore[arg-type]
+    need = processes * estimate_render_bytes(width, height, settings, n_lights=n_lights, data_dir=data_dir)
     have = available_memory_bytes()
     if have is not None and need > have:
         raise RenderError(

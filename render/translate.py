@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import SceneError
+from spectrinsic.render.variants import import_mitsuba
 from spectrinsic.scenes.model import Light, Scene, unknown_light_kind
 
 __all__ = [
@@ -336,8 +337,6 @@ def scene_to_mitsuba(
     geometry
         :func:`prepare_geometry` of *scene*, if already computed.
     """
-    from spectrinsic.render.variants import import_mitsuba
-
     mi = import_mitsuba()
     if len(materials) != len(scene.materials) or len(lights) != len(scene.lights):
         raise SceneError(

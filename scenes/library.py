@@ -43,6 +43,7 @@ from spectrinsic.scenes import geometry as g
 from spectrinsic.scenes.model import Camera, Light, LightKind, Scene, light_power
 from spectrinsic.scenes.objects import OBJECTS
 from spectrinsic.scenes.sample_id import SampleId
+from spectrinsic.spectra import get_sensors, get_spectrum, illuminant_set, responses, xyz_to_xy
 
 __all__ = [
     "CONDITIONS",
@@ -314,8 +315,6 @@ def _layout(name: str) -> _Layout:
 
 
 def _chromaticities(names: Sequence[str]) -> dict[str, np.ndarray]:
-    from spectrinsic.spectra import get_sensors, get_spectrum, responses, xyz_to_xy
-
     cmf = get_sensors("cie1931")
     return {
         n: xyz_to_xy(responses(get_spectrum(n).on(cmf.wavelengths), cmf.curves, cmf.wavelengths))
@@ -329,8 +328,6 @@ def condition_illuminants(name: str, condition: str, *, seed: int) -> tuple[str,
     All conditions of a scene are drawn from one generator seeded by ``seed_from_key(seed,
     name)``, in a fixed order, so ``two-colour-b`` always differs from ``two-colour-a``.
     """
-    from spectrinsic.spectra import illuminant_set
-
     _check_name(name)
     validate_choice(condition, CONDITIONS, "illumination condition", error=SceneError)
     if condition == "white":

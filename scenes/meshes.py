@@ -19,6 +19,7 @@ import numpy as np
 
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
+from spectrinsic.scenes.validate import validate_scene
 
 __all__ = ["MESH_SUFFIXES", "MAX_VERTICES", "MAX_FACES", "mesh_counts", "check_mesh_size", "load_mesh_scene"]
 
@@ -177,8 +178,6 @@ def load_mesh_scene(
     SceneError
         One line naming the file and the unmapped material, or an unreadable file.
     """
-    from spectrinsic.scenes.validate import validate_scene
-
     path = Path(path)
     geoms = _geometries(path)
     names: list[str] = []

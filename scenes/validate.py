@@ -27,6 +27,7 @@ import numpy as np
 
 from spectrinsic.errors import SceneError, SpectrinsicError, with_article
 from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_KINDS, Scene, unknown_light_kind
+from spectrinsic.spectra import get_spectrum
 
 __all__ = [
     "VISIBILITY_GRID",
@@ -174,8 +175,6 @@ def _vec(value: object, n: int = 3) -> np.ndarray | None:
 def _check_spectrum(
     source: str, field: str, name: object, kind: str, data_dir: str | None, cache: dict[str, object]
 ) -> None:
-    from spectrinsic.spectra import get_spectrum
-
     if not isinstance(name, str) or not name:
         raise _fail(source, field, f"expected a spectrum name string, got {name!r}")
     if name not in cache:

@@ -188,8 +188,6 @@ def srgb_responses(
     ``p^{s,c}`` (Eq. 4.15), normalised like :func:`absolute_reflectance` but integrated on
     *wavelengths*. Linear: no transfer function.
     """
-    from spectrinsic.spectra.registry import get_sensors
-
     return white_normalised_responses(reflectances, illuminant, get_sensors("srgb").on(wavelengths),
                                       wavelengths)
 

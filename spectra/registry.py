@@ -32,7 +32,7 @@ import numpy as np
 
 from spectrinsic.config import resolve_data_dir
 from spectrinsic.errors import SpectrumNotFoundError, did_you_mean
-from spectrinsic.spectra import illuminants, reflectances, sensors
+from spectrinsic.spectra import illuminants, io, reflectances, sensors
 from spectrinsic.spectra.records import SensorSet, Spectrum
 
 __all__ = [
@@ -118,8 +118,6 @@ def list_spectra(family: str, *, data_dir: DataDir = None) -> list[str]:
     ``camera`` (sensor sets). ``planck``, ``daylight`` and ``flat`` are continuous.
     """
     import colour
-
-    from spectrinsic.spectra import io
 
     listing: dict[str, Callable[[], list[str]]] = {
         "munsell": reflectances.munsell_names,

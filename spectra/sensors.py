@@ -11,6 +11,7 @@ import re
 
 import numpy as np
 
+from spectrinsic.config import resolve_data_dir
 from spectrinsic.errors import SpectrumNotFoundError, did_you_mean
 from spectrinsic.spectra import io
 from spectrinsic.spectra.colourspace import srgb_matrices
@@ -149,8 +150,6 @@ def _builtin_cameras() -> dict[str, tuple[np.ndarray, np.ndarray, str]]:
 
 
 def _all_cameras(data_dir: str | None) -> dict[str, tuple[np.ndarray, np.ndarray, str]]:
-    from spectrinsic.config import resolve_data_dir
-
     cams = _builtin_cameras()
     root = resolve_data_dir(data_dir)
     if root is not None:

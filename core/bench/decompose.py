@@ -10,6 +10,10 @@ import time
 from pathlib import Path
 from typing import Any
 
+from spectrinsic.decompose.metrics import lmse
+from spectrinsic.decompose.registry import DECOMPOSERS, get_decomposer
+from spectrinsic.decompose.synthetic import mondrian
+
 __all__ = ["run", "SIZE", "GOAL_SECONDS"]
 
 SIZE = 256
@@ -19,10 +23,6 @@ GOAL_SECONDS = 60.0
 
 def run(out_dir: Path) -> dict[str, Any]:
     """Time every registered decomposer on one 256x256 Mondrian; return JSON-serialisable results."""
-    from spectrinsic.decompose.metrics import lmse
-    from spectrinsic.decompose.registry import DECOMPOSERS, get_decomposer
-    from spectrinsic.decompose.synthetic import mondrian
-
     scene = mondrian(SIZE, SIZE, seed=0, n_patches=40, noise=0.02)
     methods: dict[str, Any] = {}
     for name in DECOMPOSERS:

@@ -3,10 +3,15 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
+from tqdm import tqdm
+
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export import check_dataset, sample_dirs
+from spectrinsic.gt_export.check import NOISE_THRESHOLD, noise_report
 
 __all__ = ["register", "run"]
 
@@ -36,13 +41,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Print problems grouped per sample; exit status 0 when the set is sound, 1 otherwise."""
-    import math
-
-    from tqdm import tqdm
-
-    from spectrinsic.gt_export import check_dataset, sample_dirs
-    from spectrinsic.gt_export.check import NOISE_THRESHOLD, noise_report
-
     if args.noise_threshold is not None and not (math.isfinite(args.noise_threshold) and args.noise_threshold > 0):
         raise DatasetError(f"--noise-threshold {args.noise_threshold}; expected a positive finite "
                            "relative error, e.g. 0.25")

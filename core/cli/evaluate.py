@@ -8,7 +8,15 @@ import logging
 from pathlib import Path
 from typing import Any
 
+from tqdm import tqdm
+
+from spectrinsic.decompose.evaluate import evaluate
+from spectrinsic.decompose.predictions import Predictions
+from spectrinsic.decompose.registry import available_decomposers, get_decomposer
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export.loader import load_sample
+from spectrinsic.gt_export.outfolder import output_folder
+from spectrinsic.gt_export.sample import sample_dirs
 
 __all__ = ["register", "run", "DEFAULT_DATASET", "DEFAULT_OUT"]
 
@@ -57,9 +65,6 @@ def register(subparsers: Any) -> None:
 
 
 def _methods(args: argparse.Namespace) -> dict[str, Any]:
-    from spectrinsic.decompose.predictions import Predictions
-    from spectrinsic.decompose.registry import available_decomposers, get_decomposer
-
     names = (args.methods.split(",") if args.methods is not None
              else [] if args.predictions else list(available_decomposers()))
     methods: dict[str, Any] = {m.strip(): get_decomposer(m.strip()) for m in names if m.strip()}
@@ -77,8 +82,6 @@ def _methods(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def _folders(dataset: Path, patterns: str | None) -> list[Path]:
-    from spectrinsic.gt_export.sample import sample_dirs
-
     if not dataset.is_dir():
         raise DatasetError(
             f"dataset folder {str(dataset)!r} does not exist; build it first with "
@@ -97,8 +100,6 @@ def _folders(dataset: Path, patterns: str | None) -> list[Path]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from spectrinsic.gt_export.outfolder import output_folder
-
     folders = _folders(Path(args.dataset), args.samples)
     methods = _methods(args)
     with output_folder(Path(args.out)):  # locked; its files recorded as spectrinsic's
@@ -112,11 +113,6 @@ def run(args: argparse.Namespace) -> int:
 
 def _evaluate(args: argparse.Namespace, folders: list[Path], methods: dict[str, Any]) -> Any:
     """Score every sample with a progress bar; return the evaluation result."""
-    from tqdm import tqdm
-
-    from spectrinsic.decompose.evaluate import evaluate
-    from spectrinsic.gt_export.loader import load_sample
-
     bar = tqdm(total=len(folders), desc="evaluate", unit="sample", disable=args.quiet)
 
     def progress(sample_id: str) -> None:

@@ -1,6 +1,7 @@
 """``spectrinsic render``: render one scene in several modes and write the raw passes as EXR.
 
-``SCENE`` is a library scene name (``spectrinsic.scenes.library``) or a YAML scene file. For
+``SCENE`` is a library scene name (``spectrinsic.scenes.library``) or a scene file (YAML,
+``.blend`` or mesh, read as ``dataset --scenes`` reads them). For
 every mode ``DIR/<mode>.exr`` holds float32 layers ``raw`` (the K raw channels, named after the
 sensors, e.g. ``raw.B400``), ``xyz`` (CIE 1931 XYZ), and when asked ``direct`` and
 ``light<i>`` (XYZ); ``DIR/aovs.exr`` holds coverage, ids, depth and normals; ``DIR/meta.json``
@@ -13,51 +14,66 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from tqdm import tqdm
+
+from spectrinsic.cli import dataset as cli_dataset
+from spectrinsic.cli.dataset import material_map
 from spectrinsic.errors import RenderError, SceneError
+from spectrinsic.gt_export.exr import write_exr
+from spectrinsic.gt_export.outfolder import check_output_folder, output_folder
+from spectrinsic.pipeline.presets import get_preset
+from spectrinsic.pipeline.sources import files_source
+from spectrinsic.render import RenderResult, RenderSettings, count_passes, get_mode, render_scene
+from spectrinsic.render.budget import check_render_size
+from spectrinsic.render.modes import RENDER_MODES
+from spectrinsic.render.settings import DEFAULT_MODES as RENDER_DEFAULT_MODES
+from spectrinsic.scenes import library
+from spectrinsic.scenes.model import Scene, scene_to_dict
+from spectrinsic.scenes.sample_id import SampleId
+from spectrinsic.scenes.sources import FILE_SIZE, is_scene_file, load_scene_file
+from spectrinsic.spectra import get_sensors
 
 __all__ = ["register", "run", "load_scene_argument", "write_render"]
 
-DEFAULT_MODES = "spectral,rgb3,rgb6,bands31"
+DEFAULT_MODES = ",".join(RENDER_DEFAULT_MODES)
 
 
 def _modes_help() -> str:
-    from spectrinsic.render.modes import RENDER_MODES
-
     return "; ".join(f"{m.name}: {m.description}" for m in RENDER_MODES.values())
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from spectrinsic.pipeline.presets import get_preset
-
     # one set of documented defaults: those of the dataset's default preset
     default = get_preset("default")
     p = sub.add_parser(
         "render", help="render a scene in several colour modes and write raw passes as EXR",
-        description="Render SCENE (a library scene name, a YAML or a .blend file) with Mitsuba 3 "
+        description="Render SCENE (a library scene name, a YAML, .blend or mesh file) with Mitsuba 3 "
                     "in each mode and write float32 EXR files with named channels into --out "
                     "(raw passes, XYZ, AOVs; ground-truth layers come from `spectrinsic dataset`). "
-                    f"Defaults are the dataset's default preset: {default.spp} spp, path depth "
-                    f"{default.max_depth}, library scenes at {default.width}x{default.height}. "
+                    f"Defaults are the dataset's default preset: {default.render.spp} spp, path depth "
+                    f"{default.render.max_depth}, library scenes at {default.width}x{default.height}. "
                     f"Modes: {_modes_help()}.",
     )
-    p.add_argument("scene", metavar="SCENE", help="library scene name (e.g. room-living) or a .yaml scene file")
+    p.add_argument("scene", metavar="SCENE",
+                   help="library scene name (e.g. room-living) or a scene file (.yaml, .blend, .obj/.ply/.glb)")
     p.add_argument("--condition", default="white", help="library scenes: illumination condition (default: white)")
     p.add_argument("--view", type=int, default=0, help="library scenes: camera viewpoint (default: 0)")
     p.add_argument("--modes", default=DEFAULT_MODES, help=f"comma-separated render modes (default: {DEFAULT_MODES})")
     p.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder")
     p.add_argument("--spp", type=int, default=None,
-                   help=f"samples per pixel of every pass (default: {default.spp}, the default "
+                   help=f"samples per pixel of every pass (default: {default.render.spp}, the default "
                         "preset's; with --ground-truth the chosen preset's)")
     p.add_argument("--seed", type=int, default=0, help="sampler seed and library illuminant seed (default: 0)")
     p.add_argument("--width", type=int, default=None,
                    help=f"image width (default: the scene's, {default.width} for the library)")
     p.add_argument("--height", type=int, default=None,
                    help=f"image height (default: the scene's, {default.height} for the library)")
-    p.add_argument("--max-depth", type=int, default=default.max_depth,
-                   help=f"longest path, 2 = direct light only (default: {default.max_depth})")
+    p.add_argument("--max-depth", type=int, default=default.render.max_depth,
+                   help=f"longest path, 2 = direct light only (default: {default.render.max_depth})")
     p.add_argument("--variant", default=None, help="Mitsuba backend or variant (default: best usable)")
     p.add_argument("--per-light", action="store_true", help="also write one image per light")
     p.add_argument("--direct", action="store_true", help="also write direct-light-only images")
@@ -68,38 +84,26 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--preset", default="preview", help="with --ground-truth: quality preset (preview)")
     p.add_argument("--material-map", metavar="FILE", default=None,
                    help="material name -> spectrum map for .blend and mesh files")
+    p.add_argument("--default-spectrum", metavar="NAME", default=None,
+                   help="reflectance of unmapped materials in .blend and mesh files")
     p.set_defaults(func=run)
 
 
 def load_scene_argument(
     scene: str, *, condition: str, view: int, seed: int, width: int | None, height: int | None,
-    data_dir: str | None = None, materials: dict[str, str] | None = None,
-) -> Any:
-    """The Scene named by the ``SCENE`` argument: a scene file (YAML, ``.blend`` by suffix or
-    magic bytes, a mesh; :func:`spectrinsic.scenes.sources.scene_file_kind`) if it exists or
-    has a scene file's suffix, else a library name."""
-    from spectrinsic.pipeline.presets import get_preset
-    from spectrinsic.scenes import library
-    from spectrinsic.scenes.sources import FileSource
-
-    if _is_scene_file(Path(scene)):
-        return FileSource(scene, width, height, tuple(sorted((materials or {}).items()))).build(data_dir)
+    materials: Mapping[str, str] | None = None, default_spectrum: str | None = None,
+    data_dir: str | None = None,
+) -> Scene:
+    """The Scene named by the ``SCENE`` argument: a scene file (YAML, ``.blend`` or mesh,
+    :func:`spectrinsic.scenes.sources.load_scene_file`, the dispatch ``dataset --scenes`` uses),
+    else a library scene at the default preset's size unless *width*/*height* say otherwise."""
+    if is_scene_file(scene):
+        return load_scene_file(scene, width=width, height=height, materials=materials,
+                               default_spectrum=default_spectrum, data_dir=data_dir)
     default = get_preset("default")
     return library.build(scene, view=view, condition=condition, seed=seed,
                          width=default.width if width is None else width,
                          height=default.height if height is None else height)
-
-
-def _is_scene_file(path: Path) -> bool:
-    from spectrinsic.scenes.meshes import MESH_SUFFIXES
-
-    return path.exists() or path.suffix.lower() in (".yaml", ".yml", ".blend", *MESH_SUFFIXES)
-
-
-def _default_spp() -> int:
-    from spectrinsic.pipeline.presets import get_preset
-
-    return get_preset("default").spp
 
 
 #: Largest sampler seed and samples per pixel Mitsuba takes (both are unsigned 32-bit).
@@ -123,12 +127,8 @@ def _check_size_options(args: argparse.Namespace) -> None:
         choose_variant("rgb", args.variant)  # an unknown or unusable backend, before any work
 
 
-def write_render(out: Path, scene: Any, result: Any, *, data_dir: str | None = None) -> dict[str, Path]:
+def write_render(out: Path, scene: Scene, result: RenderResult, *, data_dir: str | None = None) -> dict[str, Path]:
     """Write a :class:`~spectrinsic.render.RenderResult` as EXR files and ``meta.json`` into *out*."""
-    from spectrinsic.gt_export.exr import write_exr
-    from spectrinsic.scenes.model import scene_to_dict
-    from spectrinsic.spectra import get_sensors
-
     out.mkdir(parents=True, exist_ok=True)
     paths: dict[str, Path] = {}
     for mode, raw in result.raw.items():
@@ -159,59 +159,61 @@ def write_render(out: Path, scene: Any, result: Any, *, data_dir: str | None = N
 
 
 def _ground_truth(args: argparse.Namespace) -> int:
-    """``render --ground-truth``: a thin alias of ``dataset`` (one sample; library name or file)."""
-    from spectrinsic.cli import dataset as cli_dataset
-    from spectrinsic.scenes.sample_id import SampleId
-
-    is_file = _is_scene_file(Path(args.scene))
-    resolution = None
+    """``render --ground-truth``: a one-sample dataset (library name or scene file), built by
+    the same call as ``spectrinsic dataset`` (:func:`spectrinsic.cli.dataset.build`)."""
+    changes: dict[str, Any] = {}
+    if args.spp is not None:
+        changes["spp"] = args.spp
+    if args.direct:
+        changes["direct"] = True
     if args.width is not None or args.height is not None:
-        resolution = f"{args.width or 128}x{args.height or 128}"
-    dataset_args = argparse.Namespace(
-        out=str(args.out), preset=args.preset, seed=args.seed, workers=None, threads=None,
-        scheduler=None, spp=args.spp, batches=None, noise_target=None, max_batches=None,
-        no_denoise=False, direct=args.direct, resolution=resolution, rebuild=False,
-        only=None if is_file else str(SampleId(args.scene, args.view, args.condition)),
-        generator=None, scenes=[args.scene] if is_file else None, material_map=args.material_map,
-        default_spectrum=None, count=1, views=1, value_range="2,9", chroma_range="0,16", sfu=False,
-        data_dir=getattr(args, "data_dir", None), quiet=getattr(args, "quiet", False))
-    return cli_dataset.run(dataset_args)
+        changes["width"], changes["height"] = args.width or FILE_SIZE, args.height or FILE_SIZE
+    only = None
+    if is_scene_file(args.scene):
+        changes["source"] = files_source([args.scene], materials=material_map(args.material_map),
+                                         default_spectrum=args.default_spectrum)
+    else:
+        only = str(SampleId(args.scene, args.view, args.condition))
+    config = get_preset(args.preset, seed=args.seed).with_options(**changes)
+    cli_dataset.preflight(args.out, config, data_dir=getattr(args, "data_dir", None))
+    return cli_dataset.build(args.out, config, only=only, data_dir=getattr(args, "data_dir", None),
+                             quiet=getattr(args, "quiet", False))
+
+
+def _render_settings(args: argparse.Namespace, modes: list[str]) -> RenderSettings:
+    """The render settings the options give (defaults: the default preset's spp and depth)."""
+    spp = get_preset("default").render.spp if args.spp is None else args.spp
+    return RenderSettings(spp, modes=tuple(modes), max_depth=args.max_depth, variant=args.variant,
+                          per_light=args.per_light, direct=args.direct, aovs=not args.no_aovs)
 
 
 def run(args: argparse.Namespace) -> int:
     _check_size_options(args)
     if args.ground_truth:
         return _ground_truth(args)
-    from spectrinsic.cli.dataset import material_map
-    from spectrinsic.gt_export.outfolder import check_output_folder, output_folder
-    from spectrinsic.render import count_passes, get_mode, render_scene
-    from spectrinsic.render.budget import check_render_size
-
     modes = [m.strip() for m in str(args.modes).split(",") if m.strip()]
     if not modes:
         raise SceneError(f"--modes {args.modes!r}: expected a comma-separated list such as {DEFAULT_MODES}")
     for mode in modes:
         get_mode(mode)
+    settings = _render_settings(args, modes)
     check_output_folder(Path(args.out))
     data_dir = getattr(args, "data_dir", None)
     scene = load_scene_argument(args.scene, condition=args.condition, view=args.view, seed=args.seed,
-                                width=args.width, height=args.height, data_dir=data_dir,
-                                materials=material_map(args.material_map))
+                                width=args.width, height=args.height,
+                                materials=material_map(args.material_map),
+                                default_spectrum=args.default_spectrum, data_dir=data_dir)
     given = " ".join(f"--{k} {v}" for k, v in (("width", args.width), ("height", args.height)) if v is not None)
-    check_render_size(scene.camera.width, scene.camera.height, what=given or f"scene {args.scene!r}",
-                      modes=modes, n_lights=len(scene.lights), per_light=args.per_light,
-                      direct=args.direct, data_dir=data_dir)
-    options = dict(modes=modes, per_light=args.per_light, direct=args.direct, aovs=not args.no_aovs)
-    total = count_passes(scene, data_dir=data_dir, **options)
-    bar = None
-    if not getattr(args, "quiet", False):
-        from tqdm import tqdm
-
-        bar = tqdm(total=total, desc=f"render {scene.name}", unit="pass", file=sys.stderr)
+    check_render_size(scene.camera.width, scene.camera.height, settings,
+                      what=given or f"scene {args.scene!r}", n_lights=len(scene.lights),
+                      data_dir=data_dir)
+    total = count_passes(scene, settings, data_dir=data_dir)
+    bar = None if getattr(args, "quiet", False) else tqdm(
+        total=total, desc=f"render {scene.name}", unit="pass", file=sys.stderr)
     with output_folder(Path(args.out)):  # locked; its files recorded as spectrinsic's
         try:
-            result = render_scene(scene, spp=_default_spp() if args.spp is None else args.spp, seed=args.seed, max_depth=args.max_depth, variant=args.variant,
-                                  progress=None if bar is None else bar.update, data_dir=data_dir, **options)
+            result = render_scene(scene, settings, seed=args.seed,
+                                  progress=None if bar is None else bar.update, data_dir=data_dir)
         finally:
             if bar is not None:
                 bar.close()

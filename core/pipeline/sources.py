@@ -20,8 +20,21 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from spectrinsic.errors import DatasetError
+from spectrinsic.errors import DatasetError, validate_choice
+from spectrinsic.gt_export.sample import file_sha256
 from spectrinsic.pipeline.presets import DatasetConfig
+from spectrinsic.pipeline.tasks import SampleTask
+from spectrinsic.scenes.generators import (
+    GENERATORS,
+    GeneratorOptions,
+    MaterialDistribution,
+    generated_family,
+    generated_scene_name,
+)
+from spectrinsic.scenes.io import save_scene
+from spectrinsic.scenes.sample_id import SampleId
+from spectrinsic.scenes.sources import FileSource, GeneratedSource, scene_file_kind
+from spectrinsic.spectra import list_spectra
 
 __all__ = ["SCENES_FOLDER", "generator_source", "files_source", "plan_source_samples", "save_generated"]
 
@@ -39,9 +52,6 @@ def generator_source(generator: str, count: int, *, views: int = 1,
                      chroma_range: Sequence[float] = (0.0, 16.0),
                      min_coverage: float = 0.15, sfu: bool = False) -> str:
     """The canonical ``source`` JSON of a generated set (validated)."""
-    from spectrinsic.errors import validate_choice
-    from spectrinsic.scenes.generators import GENERATORS
-
     validate_choice(generator, GENERATORS, "scene generator", error=DatasetError)
     if not (1 <= count <= MAX_COUNT and 1 <= views <= MAX_VIEWS):
         raise DatasetError(f"--count {count} / --views {views}; expected whole numbers from 1 to "
@@ -57,9 +67,6 @@ def files_source(paths: Sequence[str | os.PathLike[str]], *,
                  materials: Mapping[str, str] | None = None,
                  default_spectrum: str | None = None) -> str:
     """The canonical ``source`` JSON of a set of scene files (each must exist)."""
-    from spectrinsic.gt_export.sample import file_sha256
-    from spectrinsic.scenes.sources import scene_file_kind
-
     entries = []
     for p in paths:
         path = Path(p).resolve()
@@ -77,9 +84,6 @@ def files_source(paths: Sequence[str | os.PathLike[str]], *,
 
 
 def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir: str | None) -> Any:
-    from spectrinsic.scenes.generators import GeneratorOptions, MaterialDistribution
-    from spectrinsic.spectra import list_spectra
-
     sfu_r: tuple[str, ...] = ()
     sfu_i: tuple[str, ...] = ()
     if spec.get("sfu"):
@@ -96,13 +100,8 @@ def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir:
 
 
 def plan_source_samples(out: str, config: DatasetConfig, *, data_dir: str | None,
-                        render_threads: int | None) -> list[Any]:
-    """The :class:`~spectrinsic.pipeline.dataset.SampleTask` list of ``config.source``."""
-    from spectrinsic.pipeline.dataset import SampleTask
-    from spectrinsic.scenes.generators import generated_family, generated_scene_name
-    from spectrinsic.scenes.sample_id import SampleId
-    from spectrinsic.scenes.sources import FileSource, GeneratedSource
-
+                        render_threads: int | None) -> list[SampleTask]:
+    """The :class:`~spectrinsic.pipeline.tasks.SampleTask` list of ``config.source``."""
     spec = json.loads(config.source or "{}")
     rows: list[tuple[str, int, str, Any]] = []
     if "generator" in spec:
@@ -124,8 +123,6 @@ def plan_source_samples(out: str, config: DatasetConfig, *, data_dir: str | None
 
 def save_generated(out_dir: str | os.PathLike[str], sample_id: str, scene: Any) -> Path:
     """Write a generated scene as ``<out>/scenes/<sample id>.yaml`` (meshes beside it)."""
-    from spectrinsic.scenes.io import save_scene
-
     folder = Path(out_dir) / SCENES_FOLDER
     folder.mkdir(parents=True, exist_ok=True)
     return save_scene(scene, folder / f"{sample_id}.yaml")

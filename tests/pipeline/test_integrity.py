@@ -171,12 +171,12 @@ def test_a_full_disk_stops_the_build_in_one_line_naming_the_file(tmp_path, monke
 
 
 def test_when_every_sample_fails_failed_lines_and_no_manifest(tmp_path, monkeypatch, capsys):
-    import spectrinsic.render as render
+    import spectrinsic.pipeline.dataset as pipeline_dataset
 
-    def failing(scene, **kwargs):
+    def failing(scene, settings, **kwargs):
         raise RuntimeError(f"simulated failure of {scene.name}")
 
-    monkeypatch.setattr(render, "render_batches", failing)
+    monkeypatch.setattr(pipeline_dataset, "render_batches", failing)
     out = tmp_path / "ds"
     rc = main([*CLI, "--out", str(out)])
     captured = capsys.readouterr()

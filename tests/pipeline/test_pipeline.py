@@ -28,8 +28,8 @@ from spectrinsic.pipeline.executors import ProcessExecutor
 from spectrinsic.pipeline.presets import DatasetConfig, get_preset
 from spectrinsic.rng import seed_from_key
 
-TINY = DatasetConfig(
-    preset="tiny-test",
+TINY = DatasetConfig.from_settings(
+    "tiny-test",
     width=12,
     height=12,
     spp=2,
@@ -120,7 +120,7 @@ def test_config_change_rerenders(built, tmp_path):
     out, _ = built
     copy = tmp_path / "copy"
     shutil.copytree(out, copy)
-    changed = TINY.with_options(spp=TINY.spp * 2)
+    changed = TINY.with_options(spp=TINY.render.spp * 2)
     assert changed.config_hash() != TINY.config_hash()
     with pytest.raises(DatasetError, match="--rebuild"):  # one config per dataset folder
         build_dataset(copy, changed, only=ONLY)
@@ -253,17 +253,17 @@ def test_ctrl_c_keeps_completed_samples(tmp_path, workers):
 
 
 def test_cli_reports_failures_and_exits_nonzero(tmp_path, monkeypatch, capsys):
-    import spectrinsic.render as render
+    import spectrinsic.pipeline.dataset as pipeline_dataset
     from spectrinsic.cli import main
 
-    real = render.render_batches
+    real = pipeline_dataset.render_batches
 
-    def failing_for_rooms(scene, **kwargs):
+    def failing_for_rooms(scene, settings, **kwargs):
         if scene.name.startswith("room-"):
             raise RuntimeError("simulated render failure")
-        return real(scene, **kwargs)
+        return real(scene, settings, **kwargs)
 
-    monkeypatch.setattr(render, "render_batches", failing_for_rooms)
+    monkeypatch.setattr(pipeline_dataset, "render_batches", failing_for_rooms)
     rc = main(["-q", "dataset", "--out", str(tmp_path / "ds"), "--workers", "1", *CLI_TINY])
     captured = capsys.readouterr()
     assert rc == 1

@@ -9,6 +9,7 @@ import sys
 
 import pytest
 
+from spectrinsic.render import RenderSettings
 from spectrinsic.render.budget import estimate_render_bytes
 
 #: A render in a fresh process that prints its own peak resident memory in bytes (Linux
@@ -32,5 +33,6 @@ def test_the_estimate_bounds_the_measured_peak(tmp_path, size):
     assert rc == 0, done.stderr
     meta = json.loads((tmp_path / "o" / "meta.json").read_text())
     n_lights = len(meta["scene"]["lights"])
-    estimate = estimate_render_bytes(size, size, modes=modes.split(","), n_lights=n_lights)
+    settings = RenderSettings(2, modes=tuple(modes.split(",")))
+    estimate = estimate_render_bytes(size, size, settings, n_lights=n_lights)
     assert peak <= estimate, f"{size}x{size}: peak {peak / 2**20:.0f} MiB > estimate {estimate / 2**20:.0f} MiB"
