@@ -148,7 +148,8 @@ class Predictions:
             if scenario == "srgb":
                 raise DatasetError(
                     f"predictions {self.name!r}: no reflectance or shading (.exr or 16-bit .png) "
-                    f"in {str(folder)!r}"
+                    f"in {str(folder)!r}; to score only the samples you predicted, pass "
+                    "--samples with their ids or globs (e.g. --samples 'obj-*')"
                 )
             logger.info("predictions %s: no files for %s / %s", self.name, sample_id, scenario)
             return None

@@ -93,3 +93,10 @@ def test_ground_truth_written_as_predictions_scores_perfectly(tmp_path, fmt):
                      seed=0, figures=False, save_estimates=False)
     assert max(x.value for x in worse.scores if x.metric == "lmse") > 1e-3
     assert input_image(s)[1].shape == s["reflectance"].shape
+
+
+def test_a_sample_without_predictions_suggests_samples(tmp_path):
+    refl, _, _ = _arrays()
+    write_predictions(tmp_path, "done", reflectance=refl)
+    with pytest.raises(DatasetError, match=r"no reflectance or shading .* pass --samples"):
+        Predictions(tmp_path).load("not-done", "srgb", refl, np.ones(refl.shape[:2], bool))
