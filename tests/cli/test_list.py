@@ -75,3 +75,12 @@ def test_a_family_that_cannot_be_listed_is_one_line(capsys):
     assert err.count("\n") == 0 and "'planck'" in err and "munsell" in err
     assert main(["list", "scenes", "munsell"]) == 2
     assert "only 'list spectra' takes a FAMILY" in capsys.readouterr().err
+
+
+def test_the_data_directory_families_examples_resolve(data_dir):
+    from spectrinsic.spectra import get_spectrum
+    from spectrinsic.spectra.registry import SPECTRUM_FAMILY_NOTES
+
+    for family in ("sfu", "sfu-illum"):
+        example = SPECTRUM_FAMILY_NOTES[family].split(";")[0]
+        assert get_spectrum(example, data_dir=data_dir).name == example
