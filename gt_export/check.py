@@ -39,11 +39,16 @@ from spectrinsic.gt_export.sample import (
 )
 from spectrinsic.gt_export.sample_meta import Identity, LayerRecord, SampleMeta, read_meta
 
-__all__ = ["check_dataset", "check_sample", "noise_report", "IDENTITY_RTOL", "NOISE_THRESHOLD"]
+__all__ = ["check_dataset", "check_sample", "noise_report", "IDENTITY_RTOL", "NOISE_THRESHOLD",
+           "NOISY", "TARGET_MISSED"]
 
 #: Default flag of :func:`noise_report`: a sample whose raw shading has a median relative
-#: standard error above this is called noisy.
+#: standard error above this is called noisy. Advisory: a preset promises no noise level
+#: unless its config sets ``noise_target`` (``spectrinsic check`` fails on it only when asked).
 NOISE_THRESHOLD = 0.25
+#: Marks of :func:`noise_report` lines: above the threshold; the config's ``noise_target``
+#: (adaptive sampling, recorded in ``meta.json["render"]["noise_target"]``) not reached.
+NOISY, TARGET_MISSED = "NOISY", "TARGET MISSED"
 
 #: Relative tolerance of ``image = reflectance ∘ shading``: float32 storage of the two factors
 #: and their product rounds three times (≤ 1.5 ulp), so 4 float32 epsilons is generous yet tight.
@@ -245,19 +250,34 @@ def noise_report(
 
     Returns ``(lines, flagged)``: one line per sample with the median and p95 relative standard
     error of each measured layer (``meta.json["noise"]``), and the ids whose raw shading median
-    exceeds *threshold*.
+    exceeds *threshold*. A line holds :data:`NOISY` for a flagged sample and
+    :data:`TARGET_MISSED` where the build promised a noise target its image did not reach.
     """
     lines, flagged = [], []
     for sample in sample_dirs(Path(dataset_dir)):
-        figures = read_meta(sample, verify=False).noise
+        meta = read_meta(sample, verify=False)
+        figures, missed = meta.noise, _missed_target(meta.raw.get("render"))
         if not figures:
-            lines.append(f"{sample.name}: no noise estimate (one batch)")
+            lines.append(f"{sample.name}: no noise estimate (one batch)" + missed)
             continue
         parts = [f"{k} median {100 * v.median:.1f} % p95 {100 * v.p95:.1f} %"
                  for k, v in sorted(figures.items())]
         shading = figures["shading_raw"].median if "shading_raw" in figures else 0.0
         if shading > threshold:
             flagged.append(sample.name)
-            parts.append(f"NOISY (shading median above {100 * threshold:.0f} %)")
-        lines.append(f"{sample.name}: " + "; ".join(parts))
+            parts.append(f"{NOISY} (shading median above {100 * threshold:.0f} %)")
+        lines.append(f"{sample.name}: " + "; ".join(parts) + missed)
     return lines, flagged
+
+
+def _missed_target(render: object) -> str:
+    """``"; TARGET MISSED (...)"`` when the recorded ``noise_target`` (the build's promise of a
+    median relative standard error of the image) was not reached, else ``""``."""
+    record = render.get("noise_target") if isinstance(render, Mapping) else None
+    if not isinstance(record, Mapping):
+        return ""
+    target, reached = record.get("target"), record.get("reached")
+    if not isinstance(target, int | float) or not isinstance(reached, int | float) or reached <= target:
+        return ""
+    return (f"; {TARGET_MISSED} (image median {100 * reached:.1f} % above the config's "
+            f"noise_target {100 * target:.1f} % after {record.get('max_batches')} batches)")

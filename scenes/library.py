@@ -47,6 +47,7 @@ from spectrinsic.spectra import get_sensors, get_spectrum, illuminant_set, respo
 
 __all__ = [
     "CONDITIONS",
+    "CONDITION_DESCRIPTIONS",
     "WHITE",
     "MIN_XY_DISTANCE",
     "TARGET_IRRADIANCE",
@@ -58,6 +59,13 @@ __all__ = [
 ]
 
 CONDITIONS: tuple[str, ...] = ("white", "one-colour", "two-colour-a", "two-colour-b")
+#: One line per condition (``spectrinsic list conditions``); the module docstring has the rules.
+CONDITION_DESCRIPTIONS: dict[str, str] = {
+    "white": "one light of CIE D65",
+    "one-colour": "one coloured light, Planckian or not, distinct from D65",
+    "two-colour-a": "two lights of distinct colours: one Planckian, one non-Planckian",
+    "two-colour-b": "two lights of distinct colours, a pair other than two-colour-a",
+}
 #: The spectrum of the ``white`` condition.
 WHITE = "cie:D65"
 #: Least CIE 1931 xy distance between the two lights of a pair and between a coloured light and

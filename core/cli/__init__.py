@@ -28,6 +28,7 @@ _COMMANDS: tuple[str, ...] = (
     "spectrinsic.cli.export",
     "spectrinsic.cli.study",
     "spectrinsic.cli.evaluate",
+    "spectrinsic.cli.list",
 )
 
 
@@ -53,6 +54,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="spectral data directory (SFU set, extra cameras); default: $SPECTRINSIC_DATA",
     )
+    parser.add_argument("--version", action="version", version=f"spectrinsic {_version()}")
     parser.add_argument("-v", "--verbose", action="count", default=0, help="more logging")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress bars or plan lines")
     parser.add_argument(
@@ -62,6 +64,13 @@ def build_parser() -> argparse.ArgumentParser:
     for name in _COMMANDS:
         importlib.import_module(name).register(sub)
     return parser
+
+
+def _version() -> str:
+    """spectrinsic's installed version, from package metadata (nothing heavy imported)."""
+    from spectrinsic.provenance import software_versions
+
+    return software_versions(("spectrinsic",), python=False)["spectrinsic"]
 
 
 def main(argv: Sequence[str] | None = None) -> int:
