@@ -63,12 +63,12 @@ from spectrinsic.decompose.colour_naming import (
 )
 from spectrinsic.decompose.constancy import discount_illuminant
 from spectrinsic.decompose.decomposition import Decomposition, finish, prepare_input
-from spectrinsic.decompose.ridges import colour_shades
+from spectrinsic.decompose.ridges import ColourShades, colour_shades
 from spectrinsic.errors import DecomposeError, MissingDependencyError, validate_choice
 from spectrinsic.spectra.colorimetry import decode_srgb as _srgb_decode
 from spectrinsic.spectra.colorimetry import encode_srgb as _srgb_encode
 
-__all__ = ["NamesAndShades", "global_coherence", "grid_edges"]
+__all__ = ["Labelling", "NamesAndShades", "global_coherence", "grid_edges"]
 
 logger = logging.getLogger(__name__)
 
@@ -198,6 +198,47 @@ def _import_gco() -> Any:
 
 
 @dataclass(frozen=True)
+class Labelling:
+    """What steps 1-3 of :class:`NamesAndShades` produce (the stages the figures show).
+
+    Attributes
+    ----------
+    image
+        ``(H, W, 3)`` float64 input as given (clipped at 0).
+    mask
+        ``(H, W)`` bool pixels decomposed; the per-pixel arrays below follow its raster order.
+    linear
+        ``(H, W, 3)`` input divided by its exposure white (99th percentile of the brightest
+        channel).
+    pixels
+        ``(N, 3)`` masked ``linear`` clipped to [0, 1].
+    candidates
+        ``(K,)`` Appendix A label indices observed in the image (the MRF's label set).
+    observed
+        ``(N,)`` observation ``y_i`` of each pixel, an index into ``candidates`` (sec. 3.2.1).
+    shades
+        Colour-shade descriptor of the log colours (sec. 3.2.2).
+    weights
+        ``(E,)`` ``w_ij`` of the 4-neighbour edges (:func:`grid_edges` order; sec. 3.3.2).
+    labels
+        ``(N,)`` MRF output, an index into ``candidates`` (sec. 3.3).
+    timings
+        Seconds per step (``names_s``, ``shades_s``, ``mrf_s``).
+    """
+
+    image: np.ndarray
+    mask: np.ndarray
+    linear: np.ndarray
+    pixels: np.ndarray
+    candidates: np.ndarray
+    observed: np.ndarray
+    shades: ColourShades
+    weights: np.ndarray
+    labels: np.ndarray
+    timings: dict[str, float]
+
+
+@dataclass(frozen=True)
 class NamesAndShades:
     """Serra et al. (2012) names-and-shades intrinsic decomposition (thesis chapter 3).
 
@@ -270,14 +311,18 @@ class NamesAndShades:
     def __call__(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Decomposition:
         """Decompose a linear ``(H, W, 3)`` image into reflectance and shading.
 
-        The five steps of the module docstring; ``info`` records each step's time in seconds.
+        The five steps of the module docstring (:meth:`labelling` then :meth:`reflectance`);
+        ``info`` records each step's time in seconds.
         """
+        return self.reflectance(self.labelling(image, mask))
+
+    def labelling(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Labelling:
+        """Steps 1-3 (names, shades, MRF) of a linear ``(H, W, 3)`` image (:class:`Labelling`)."""
         validate_choice(
             self.reflectance_colour, ("label-centroid", "region-mean"), "reflectance_colour",
             error=DecomposeError,
         )
         gco = _import_gco()
-        timings: dict[str, float] = {}
         t0 = time.perf_counter()
         img, m = prepare_input(image, mask)
         scale = float(np.percentile(img[m].max(axis=1), _EXPOSURE_PERCENTILE))
@@ -286,25 +331,32 @@ class NamesAndShades:
 
         # 1. colour names -> Appendix A labels observed in the image
         candidates, y, distance = self._names(pixels)
-        timings["names_s"] = time.perf_counter() - t0
+        t1 = time.perf_counter()
 
         # 2. colour shades on the log image
-        t1 = time.perf_counter()
         log_colours = np.log(np.maximum(pixels, _LOG_FLOOR))
         shades = colour_shades(log_colours, bins=self.bins, sigma=self.sigma)
-        timings["shades_s"] = time.perf_counter() - t1
+        t2 = time.perf_counter()
 
         # 3. MRF (Eq. 3.4) by alpha-expansion
-        t2 = time.perf_counter()
-        labels = self._mrf(gco, m, log_colours, shades, y, distance)
-        timings["mrf_s"] = time.perf_counter() - t2
+        edges, _ = grid_edges(m)
+        weights = self._edge_weights(edges, log_colours, shades)
+        labels = self._mrf(gco, edges, weights, y, distance)
+        timings = {"names_s": t1 - t0, "shades_s": t2 - t1, "mrf_s": time.perf_counter() - t2}
+        return Labelling(img, m, linear, pixels, candidates, y, shades, weights, labels, timings)
 
-        # 4. labels -> regions -> colours (linear RGB)
+    def reflectance(self, stages: Labelling) -> Decomposition:
+        """Steps 4-5 (regions, their colour, global coherence) on a :meth:`labelling`.
+
+        Only the fields acting after the MRF (``reflectance_colour``, ``split_by_ridge``,
+        ``global_coherence``, ``colour_constancy``) are read, so one labelling serves every
+        value of them.
+        """
         t3 = time.perf_counter()
-        regions, colours = self._regions(m, labels, candidates, shades, pixels)
+        m, linear = stages.mask, stages.linear
+        regions, colours = self._regions(m, stages.labels, stages.candidates, stages.shades,
+                                         stages.pixels)
         n_regions = int(regions.max())
-
-        # 5. global coherence (sec. 3.4)
         if self.global_coherence:
             lam = global_coherence(regions, colours.mean(axis=1), linear.mean(axis=2))
         else:
@@ -312,16 +364,17 @@ class NamesAndShades:
         reflectance, light = discount_illuminant(
             (lam[:, None] * colours)[regions], linear, m, self.colour_constancy
         )
-        timings["coherence_s"] = time.perf_counter() - t3
+        timings = {**stages.timings, "coherence_s": time.perf_counter() - t3}
         info = {
-            "observed_labels": int(candidates.size),
+            "observed_labels": int(stages.candidates.size),
+            "labels": int(np.unique(stages.labels).size),
             "regions": n_regions,
-            "ridges": shades.n_ridges,
+            "ridges": stages.shades.n_ridges,
             "light_colour": light,
             **{k: round(v, 4) for k, v in timings.items()},
         }
         logger.debug("names-shades: %s", info)
-        return finish(img, reflectance, m, info)
+        return finish(stages.image, reflectance, m, info)
 
     def _names(self, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Step 1: the candidate labels ``(K,)`` (Appendix A indices observed in the image), each
@@ -336,16 +389,13 @@ class NamesAndShades:
     def _mrf(
         self,
         gco: Any,
-        m: np.ndarray,
-        log_colours: np.ndarray,
-        shades: Any,
+        edges: np.ndarray,
+        weights: np.ndarray,
         y: np.ndarray,
         distance: np.ndarray,
     ) -> np.ndarray:
         """Step 3: each masked pixel's label ``(N,)`` (an index into the candidates) minimising
         Eq. 3.4 by alpha-expansion; the observations themselves if there is nothing to cut."""
-        edges, _ = grid_edges(m)
-        weights = self._edge_weights(edges, log_colours, shades)
         unary = self.mu * distance[y]
         if distance.shape[0] > 1 and edges.shape[0] > 0:
             return np.asarray(gco.cut_general_graph(
