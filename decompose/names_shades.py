@@ -55,6 +55,7 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 import numpy.typing as npt
 
+from spectrinsic.decompose.coherence import global_coherence, grid_edges
 from spectrinsic.decompose.colour_naming import (
     appendix_a_labels,
     colour_name_memberships,
@@ -87,101 +88,6 @@ PROTOCOL = (
 _EXPOSURE_PERCENTILE = 99.0
 #: Floor of normalised linear values before the logarithm (1/255 of the exposure white).
 _LOG_FLOOR = 1.0 / 255.0
-
-
-def grid_edges(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """4-neighbour edges between masked pixels.
-
-    Returns
-    -------
-    edges
-        ``(E, 2)`` int32 indices into the masked pixels (raster order), first < second.
-    flat
-        ``(E, 2)`` int64 flat pixel indices of the same pairs.
-    """
-    h, w = mask.shape
-    index = np.full(mask.shape, -1, dtype=np.int64)
-    index[mask] = np.arange(int(mask.sum()))
-    pix = np.arange(h * w).reshape(h, w)
-    pairs, flats = [], []
-    for a, b in (((slice(0, -1), slice(None)), (slice(1, None), slice(None))),
-                 ((slice(None), slice(0, -1)), (slice(None), slice(1, None)))):
-        ok = (index[a] >= 0) & (index[b] >= 0)
-        pairs.append(np.stack([index[a][ok], index[b][ok]], axis=1))
-        flats.append(np.stack([pix[a][ok], pix[b][ok]], axis=1))
-    return np.concatenate(pairs).astype(np.int32), np.concatenate(flats)
-
-
-def global_coherence(
-    regions: np.ndarray, region_intensity: np.ndarray, image_intensity: np.ndarray
-) -> np.ndarray:
-    """Per-region reflectance scales of thesis sec. 3.4 (Eqs. 3.8-3.10).
-
-    Minimises ``sum_{i<j} l_ij (lambda_i L_i L_j^orig - lambda_j L_j L_i^orig)^2 / m_ij^2`` subject
-    to ``lambda >= 1``, where ``l_ij`` counts the pixels of both regions that touch the other
-    (4-neighbourhood), ``L^orig`` is the mean image intensity of those boundary pixels on each
-    side, and ``m_ij`` the mean of the two products (scale normalisation).
-
-    Parameters
-    ----------
-    regions
-        ``(H, W)`` int region index ``1..R``, 0 outside the mask.
-    region_intensity
-        ``(R + 1,)`` intensity ``L_i`` of each region's reflectance colour (entry 0 unused).
-    image_intensity
-        ``(H, W)`` intensity of the input image.
-
-    Returns
-    -------
-    ``(R + 1,)`` float64 scales (entry 0 is 1).
-    """
-    import scipy.sparse as sp
-    from scipy.optimize import lsq_linear
-
-    n = int(regions.max()) + 1
-    flat_regions = regions.ravel()
-    flat_intensity = image_intensity.ravel()
-    _, flat = grid_edges(regions > 0)
-    ra, rb = flat_regions[flat[:, 0]], flat_regions[flat[:, 1]]
-    cross = ra != rb
-    if not cross.any():
-        return np.ones(n)
-    pa, pb, ra, rb = flat[cross, 0], flat[cross, 1], ra[cross], rb[cross]
-    # (own region, other region, pixel): each boundary pixel once per neighbouring region.
-    own = np.concatenate([ra, rb])
-    other = np.concatenate([rb, ra])
-    pixel = np.concatenate([pa, pb])
-    key = np.unique(np.stack([own, other, pixel], axis=1), axis=0)
-    pair_id = key[:, 0] * n + key[:, 1]
-    uniq, inverse, counts = np.unique(pair_id, return_inverse=True, return_counts=True)
-    mean_int = np.bincount(inverse, weights=flat_intensity[key[:, 2]]) / counts
-    lookup = dict(zip(uniq.tolist(), range(uniq.size), strict=True))
-    rows, cols, vals = [], [], []
-    eq = 0
-    for pid, k in lookup.items():
-        i, j = divmod(pid, n)
-        if i >= j:
-            continue
-        back = lookup[j * n + i]
-        l_ij = counts[k] + counts[back]
-        a_i = region_intensity[i] * mean_int[back]  # lambda_i L_i L_j^orig
-        a_j = region_intensity[j] * mean_int[k]  # lambda_j L_j L_i^orig
-        m = 0.5 * (a_i + a_j)
-        if m <= 0.0:
-            continue
-        s = np.sqrt(l_ij) / m
-        rows += [eq, eq]
-        cols += [i, j]
-        vals += [s * a_i, -s * a_j]
-        eq += 1
-    if eq == 0:
-        return np.ones(n)
-    a = sp.csr_matrix((vals, (rows, cols)), shape=(eq, n))
-    result = lsq_linear(a, np.zeros(eq), bounds=(1.0, np.inf), lsq_solver="lsmr", tol=1e-10)
-    lam = np.where(np.isfinite(result.x), result.x, 1.0)
-    lam[0] = 1.0
-    # The objective is flat along the common scale; report the smallest solution (min = 1).
-    return lam / lam[1:].min()
 
 
 def _import_gco() -> Any:

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from spectrinsic.decompose.constancy import with_constancy
 from spectrinsic.decompose.mit import MEASURES, load_mit_object, mit_folder_objects, mit_measures
 from spectrinsic.decompose.names_shades import NamesAndShades
 from spectrinsic.decompose.protocol import grid_points, hold_one_out
@@ -32,7 +33,9 @@ from spectrinsic.decompose.registry import get_decomposer
 MRF_GRID = {"gamma": [1.0, 3.0, 10.0, 30.0], "gamma_over_alpha": [10.0, 100.0]}
 #: Parameters of steps 4-5 (run on each labelling).
 POST_GRID = {"reflectance_colour": ["label-centroid", "region-mean"],
-             "split_by_ridge": [False, True], "colour_constancy": ["none", "grey-world"]}
+             "split_by_ridge": [False, True]}
+#: Applied to each result above (with_constancy: the same as the method's own step).
+CONSTANCY = ["none", "grey-world"]
 #: The thesis' point (NamesAndShades.thesis()) with expansion to convergence, and extra rows.
 EXTRA = {
     "thesis, alpha-expansion to convergence": {"expansion_cycles": -1},
@@ -60,10 +63,13 @@ def run(mit_dir: Path) -> dict:
             labelling = method.labelling(obj.image, obj.mask)
             seconds[f"{obj.name} {key(dict(mrf))}"] = time.perf_counter() - t0
             for post in grid_points(POST_GRID):
-                point = {**dict(mrf), **dict(post)}
-                result = dataclasses.replace(method, **dict(post)).reflectance(labelling)
-                scores.setdefault(key(point), {})[obj.name] = {
-                    **mit_measures(obj, result), "regions": result.info["regions"]}
+                plain = dataclasses.replace(method, **dict(post)).reflectance(labelling)
+                for constancy in CONSTANCY:
+                    point = {**dict(mrf), **dict(post), "colour_constancy": constancy}
+                    result = with_constancy(plain, obj.image, obj.mask,
+                                            colour_constancy=constancy)
+                    scores.setdefault(key(point), {})[obj.name] = {
+                        **mit_measures(obj, result), "regions": plain.info["regions"]}
         for label, change in EXTRA.items():
             method = dataclasses.replace(NamesAndShades.thesis(), **change)
             result = method(obj.image, obj.mask)
@@ -104,12 +110,12 @@ def markdown(report: dict) -> str:
     lines.append(row("thesis (2 expansion cycles)", s[key(thesis)], base))
     for label in EXTRA:
         lines.append(row(label, s[label], base))
-    for p, values in {**MRF_GRID, **POST_GRID}.items():
+    for p, values in {**MRF_GRID, **POST_GRID, "colour_constancy": CONSTANCY}.items():
         for v in values:
             if v != thesis[p]:
                 lines.append(row(f"thesis, {p} = {v}", s[key({**thesis, p: v})], base))
     lines.append(row(f"**chosen**: {chosen}", s[key(chosen)], base))
-    for p, values in {**MRF_GRID, **POST_GRID}.items():
+    for p, values in {**MRF_GRID, **POST_GRID, "colour_constancy": CONSTANCY}.items():
         for v in values:
             if v != chosen[p]:
                 lines.append(row(f"chosen, {p} = {v}", s[key({**chosen, p: v})], base))
