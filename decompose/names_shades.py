@@ -24,7 +24,8 @@ offered); the thesis gives only ratios of ``alpha, beta, gamma`` and leaves the 
 the angle threshold open (``gamma = 1``, 30 degrees here); the angle ``theta_ij`` is measured
 against the ridge tangent at ``pi(p_i)``, the limit of the chord ``pi(p_i) pi(p_j)`` for
 neighbouring colours, and identical colours count as parallel; Eq. 3.9 is solved as a bounded
-linear least-squares problem (``scipy.optimize.lsq_linear``) instead of belief propagation, with
+linear least-squares problem (:func:`spectrinsic.decompose.coherence.bounded_minimum`, exact
+active set) instead of belief propagation, with
 ``L^orig`` measured on the pixels along each shared boundary and each term divided by its mean
 product so that dark and bright boundaries weigh alike.
 
