@@ -64,12 +64,15 @@ STEP = 10
 WHDR_DELTA = 0.10
 
 
-def _scale(truth: np.ndarray, estimate: np.ndarray, weight: np.ndarray, axis) -> np.ndarray:
-    """Least-squares ``alpha = sum(w t e) / sum(w e^2)`` (0 where the estimate is all zero)."""
+def _scale(
+    truth: np.ndarray, estimate: np.ndarray, weight: np.ndarray, axis, floor: float = 0.0
+) -> np.ndarray:
+    """Least-squares ``alpha = sum(w t e) / sum(w e^2)`` (0 where ``sum(w e^2) <= floor``)."""
     num = (weight * truth * estimate).sum(axis=axis, keepdims=True)
     den = (weight * estimate * estimate).sum(axis=axis, keepdims=True)
+    ok = den > floor
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), 0.0)
+        return np.where(ok, num / np.where(ok, den, 1.0), 0.0)
 
 
 def si_mse(
@@ -113,6 +116,7 @@ def lmse(
     window: int = WINDOW,
     step: int = STEP,
     per_channel: bool = False,
+    energy_floor: float = 0.0,
 ) -> float:
     """Local mean squared error, thesis Eq. 2.5, as the MIT benchmark computes it.
 
@@ -125,11 +129,10 @@ def lmse(
     per_channel
         Fit one ``alpha`` per window and channel instead of one per window (thesis section
         5.2.5: "an alpha factor fitted for each local patch").
-
-    Notes
-    -----
-    The MIT code sets ``alpha = 0`` when ``sum(e^2) <= 1e-5`` in a window; here only an
-    all-zero estimate gives ``alpha = 0``, since linear renderings have no fixed scale.
+    energy_floor
+        ``alpha = 0`` in a window whose masked ``sum(e^2)`` is at most this. The MIT code uses
+        ``1e-5`` on images in [0, 1] (:mod:`spectrinsic.decompose.mit`); the default 0 leaves
+        only an all-zero estimate at ``alpha = 0``, since linear renderings have no fixed scale.
 
     Raises
     ------
@@ -139,7 +142,7 @@ def lmse(
     """
     t, e, m = _windowed(truth, estimate, mask, window, step)
     axis = 1 if per_channel else (1, 2)
-    alpha = _scale(t, e, m, axis=axis)
+    alpha = _scale(t, e, m, axis=axis, floor=energy_floor)
     residual = (m * (t - alpha * e) ** 2).sum()
     energy = (m * t * t).sum()
     if energy <= 0.0:

@@ -44,6 +44,10 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument("--dataset", metavar="DIR", default=DEFAULT_DATASET,
                    help=f"dataset folder built by `spectrinsic dataset` ({DEFAULT_DATASET})")
+    p.add_argument("--mit", metavar="DIR", default=None,
+                   help="score on an MIT-format folder (<object>.npz, e.g. $SPECTRINSIC_DATA/"
+                        "mit_intrinsic_dev) with the thesis' protocol and Table 3.2's measures "
+                        "instead of a rendered dataset; see spectrinsic.decompose.mit")
     p.add_argument("--out", metavar="DIR", default=DEFAULT_OUT, help=f"output folder ({DEFAULT_OUT})")
     p.add_argument("--methods", default=None,
                    help="comma-separated decomposers (default: all registered, plugins included, "
@@ -99,7 +103,22 @@ def _folders(dataset: Path, patterns: str | None) -> list[Path]:
     return folders
 
 
+def _run_mit(args: argparse.Namespace) -> int:
+    from spectrinsic.decompose.mit import evaluate_mit, mit_folder_objects
+
+    patterns = [g.strip() for g in args.samples.split(",") if g.strip()] if args.samples else None
+    files = mit_folder_objects(Path(args.mit), patterns)
+    methods = _methods(args)
+    with output_folder(Path(args.out)):  # locked; its files recorded as spectrinsic's
+        written = evaluate_mit(files, methods, Path(args.out))
+    print(written["table_md"].read_text(encoding="utf-8"))
+    print(f"MIT protocol on {len(files)} objects in {args.out} (mit_scores.csv, mit_table_3_2.*)")
+    return 0
+
+
 def run(args: argparse.Namespace) -> int:
+    if args.mit is not None:
+        return _run_mit(args)
     folders = _folders(Path(args.dataset), args.samples)
     methods = _methods(args)
     with output_folder(Path(args.out)):  # locked; its files recorded as spectrinsic's

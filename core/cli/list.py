@@ -83,10 +83,11 @@ def _presets(_data_dir: str | None) -> list[Row]:
 
     rows = []
     for name, cfg in PRESETS.items():
-        spp = f"{cfg.batches} batches × {cfg.spp // cfg.batches} spp" if cfg.batches > 1 else f"{cfg.spp} spp"
-        extras = [", ".join(cfg.modes)] + (["denoised"] if cfg.denoise else [])
-        if cfg.noise_target is not None:
-            extras.append(f"noise target {cfg.noise_target:g}")
+        r = cfg.render
+        spp = f"{r.batches} batches × {r.batch_spp} spp" if r.batches > 1 else f"{r.spp} spp"
+        extras = [", ".join(r.modes)] + (["denoised"] if cfg.denoise else [])
+        if r.noise_target is not None:
+            extras.append(f"noise target {r.noise_target:g}")
         rows.append((name, f"{cfg.width}×{cfg.height}, {spp}; " + "; ".join(extras)))
     return rows
 
