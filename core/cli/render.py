@@ -21,7 +21,6 @@ from typing import Any
 from tqdm import tqdm
 
 from spectrinsic.cli import dataset as cli_dataset
-from spectrinsic.cli.dataset import material_map
 from spectrinsic.errors import RenderError, SceneError
 from spectrinsic.gt_export.exr import write_exr
 from spectrinsic.gt_export.outfolder import check_output_folder, output_folder
@@ -170,7 +169,7 @@ def _ground_truth(args: argparse.Namespace) -> int:
         changes["width"], changes["height"] = args.width or FILE_SIZE, args.height or FILE_SIZE
     only = None
     if is_scene_file(args.scene):
-        changes["source"] = files_source([args.scene], materials=material_map(args.material_map),
+        changes["source"] = files_source([args.scene], materials=cli_dataset.material_map(args.material_map),
                                          default_spectrum=args.default_spectrum)
     else:
         only = str(SampleId(args.scene, args.view, args.condition))
@@ -201,7 +200,7 @@ def run(args: argparse.Namespace) -> int:
     data_dir = getattr(args, "data_dir", None)
     scene = load_scene_argument(args.scene, condition=args.condition, view=args.view, seed=args.seed,
                                 width=args.width, height=args.height,
-                                materials=material_map(args.material_map),
+                                materials=cli_dataset.material_map(args.material_map),
                                 default_spectrum=args.default_spectrum, data_dir=data_dir)
     given = " ".join(f"--{k} {v}" for k, v in (("width", args.width), ("height", args.height)) if v is not None)
     check_render_size(scene.camera.width, scene.camera.height, settings,

@@ -13,6 +13,7 @@ from spectrinsic.render import (
     RenderSettings,
     channel_values,
     get_mode,
+    render_batches,
     render_diagonal,
     render_scene,
     to_xyz_matrix,
@@ -156,3 +157,19 @@ def test_to_xyz_uses_the_scene_lights_for_rgb6(make_plane):
     a = to_xyz_matrix(get_mode("rgb6"), make_plane("flat:0.5", "planck:2800K"))
     b = to_xyz_matrix(get_mode("rgb6"), make_plane("flat:0.5", "daylight:6500K"))
     assert a.shape == (3, 6) and not np.allclose(a, b)
+
+
+def test_adaptive_batches_stop_at_the_target_or_the_cap(make_room):
+    """--noise-target: more batches only while the measured noise is above the target."""
+    from spectrinsic.render import image_noise
+
+    scene = make_room(size=12)
+    settings = RenderSettings(4, modes=("rgb3",), batches=2, aovs=False, max_batches=3)
+    capped = render_batches(scene, settings.with_options(noise_target=1e-9), seed=1)
+    assert capped.meta["batches"] == 3 and len(capped.batch_raw) == 3
+    assert capped.meta["noise_target"]["reached"] > 1e-9
+    easy = render_batches(scene, settings.with_options(noise_target=0.99), seed=1)
+    assert easy.meta["batches"] == 2
+    assert easy.meta["noise_target"]["reached"] == pytest.approx(
+        image_noise([render_scene(scene, RenderSettings(2, modes=("rgb3",), aovs=False), seed=s)
+                     for s in easy.meta["batch_seeds"]]))

@@ -187,22 +187,6 @@ def test_h_denoised_shading_is_closer_to_the_converged_render(noisy_and_converge
     assert "shading" in gt.denoised and "shading_raw" not in gt.denoised
 
 
-def test_adaptive_batches_stop_at_the_target_or_the_cap(make_room):
-    """--noise-target: more batches only while the measured noise is above the target."""
-    from spectrinsic.render import image_noise
-
-    scene = make_room(size=12)
-    settings = RenderSettings(4, modes=("rgb3",), batches=2, aovs=False, max_batches=3)
-    capped = render_batches(scene, settings.with_options(noise_target=1e-9), seed=1)
-    assert capped.meta["batches"] == 3 and len(capped.batch_raw) == 3
-    assert capped.meta["noise_target"]["reached"] > 1e-9
-    easy = render_batches(scene, settings.with_options(noise_target=0.99), seed=1)
-    assert easy.meta["batches"] == 2
-    assert easy.meta["noise_target"]["reached"] == pytest.approx(
-        image_noise([render_scene(scene, RenderSettings(2, modes=("rgb3",), aovs=False), seed=s)
-                     for s in easy.meta["batch_seeds"]]))
-
-
 def test_residual_vanishes_on_a_flat_grey_and_not_on_a_saturated_chip():
     """A flat reflectance commutes with any light, here the red bounce: the residual of the grey
     wall is float32 round-off; the green chip in the same light does not commute."""
