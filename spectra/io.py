@@ -127,7 +127,7 @@ def _check_values(
         (~empty & ~np.isfinite(values), "non-finite", "finite numbers"),
         (empty if not missing else np.zeros_like(empty), "empty", "a number in every cell"),
         (~empty & (np.nan_to_num(values) < 0), "negative", "values >= 0"),
-        (above, "too large", f"values <= {maximum} (reflectances)"),
+        (above, "too large", f"values <= {maximum if maximum is not None else 0:g} (reflectances)"),
     )
     for mask, problem, expected in checks:
         if mask.any():
