@@ -25,6 +25,8 @@ class JsonFields:
 
     def __init__(self, path: Path) -> None:
         self.path = path
+        #: Paths already found inside the folder (a file is named by several layers).
+        self._inside: set[str] = set()
 
     def fail(self, name: str, expected: str, value: object = ...) -> SampleMetaError:
         got = "" if value is ... else f", got {_short(value)}"
@@ -72,8 +74,10 @@ class JsonFields:
 
     def inside(self, value: object, name: str) -> str:
         rel = self.text(value, name)
-        if confined_path(self.path.parent, rel) is None:
-            raise self.fail(name, "a path inside the sample folder", rel)
+        if rel not in self._inside:
+            if confined_path(self.path.parent, rel) is None:
+                raise self.fail(name, "a path inside the sample folder", rel)
+            self._inside.add(rel)
         return rel
 
     def numeric_tree(self, value: object, name: str) -> None:

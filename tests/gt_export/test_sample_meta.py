@@ -164,3 +164,20 @@ def test_object_id_16777217_is_exported_and_loaded_exactly(tmp_path, synth, conf
     assert read_meta(folder).layers["object_id"].dtype == "int32"
     write_manifest(tmp_path, config)
     assert check_dataset(tmp_path) == []
+
+
+def test_a_symbolic_link_out_of_the_sample_folder_is_not_inside(tmp_path):
+    from spectrinsic.gt_export.sample import confined_path
+
+    folder, outside = tmp_path / "s", tmp_path / "outside"
+    (folder / "previews").mkdir(parents=True)
+    outside.mkdir()
+    (outside / "secret.exr").write_text("x")
+    (folder / "image.exr").write_text("x")
+    (folder / "previews" / "image.png").symlink_to(outside / "secret.exr")
+    (folder / "linked").symlink_to(outside, target_is_directory=True)
+    assert confined_path(folder, "image.exr") == folder / "image.exr"
+    assert confined_path(folder, "previews/image.png") is None
+    assert confined_path(folder, "linked/secret.exr") is None
+    for bad in ("../outside/secret.exr", "/etc/passwd", "a\\b", ""):
+        assert confined_path(folder, bad) is None
