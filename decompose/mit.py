@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import fnmatch
 import logging
+import time
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,6 +39,7 @@ import numpy as np
 from spectrinsic.decompose.decomposition import Decomposition
 from spectrinsic.decompose.metrics import almse, correlation, lmse, si_mse
 from spectrinsic.errors import DatasetError
+from spectrinsic.results import write_csv
 
 __all__ = [
     "ARRAYS",
@@ -216,7 +218,6 @@ def score_mit(
     progress: Callable[[str], None] | None = None,
 ) -> Iterator[MitScore]:
     """Decompose (or read) each object of *files* with each method and yield its scores."""
-    import time
 
     for path in files:
         obj = load_mit_object(path)
@@ -262,7 +263,6 @@ def evaluate_mit(
     """Score *methods* on the MIT objects *files* and write, under *out*, ``mit_scores.csv``
     (one row per method and object, each measure per layer and their mean),
     ``mit_table_3_2.csv`` and ``mit_table_3_2.md`` (:func:`mit_table`). Returns the paths."""
-    from spectrinsic.results import write_csv
 
     scores = list(score_mit(files, methods, progress=progress))
     out = Path(out)

@@ -38,9 +38,9 @@ import numpy as np
 
 from spectrinsic.decompose.decomposition import Decomposition, finish
 from spectrinsic.errors import DatasetError, validate_choice
-from spectrinsic.gt_export.exr import read_exr
-from spectrinsic.gt_export.png import PNG16_MAX, read_png16
-from spectrinsic.spectra.colorimetry import decode_srgb
+from spectrinsic.gt_export.exr import exr_size, read_exr, write_exr
+from spectrinsic.gt_export.png import PNG16_MAX, png_size, read_png16, write_png16
+from spectrinsic.spectra.colorimetry import decode_srgb, encode_srgb
 
 __all__ = ["PNG_ENCODINGS", "PREDICTION_FORMATS", "Predictions", "PredictionFiles", "read_layer",
            "write_predictions"]
@@ -76,8 +76,6 @@ MAX_CHANNELS = 8
 def _check_header_size(path: Path, layer: str, shape: tuple[int, int]) -> None:
     """Refuse a file whose header declares another image size than the sample's, before its
     pixels are decoded: memory then stays bounded by the dataset's own image size."""
-    from spectrinsic.gt_export.exr import exr_size
-    from spectrinsic.gt_export.png import png_size
 
     if path.suffix == ".exr":
         height, width, channels = exr_size(path)
@@ -231,8 +229,6 @@ def _layer_values(layer: str, values: np.ndarray) -> np.ndarray:
 def _png_codes(values: np.ndarray, encoding: str) -> tuple[np.ndarray, float]:
     """16-bit codes of linear *values* (negatives clipped to 0) and the scale divided out:
     the layer's maximum when it exceeds 1, so the codes use their whole range."""
-    from spectrinsic.gt_export.png import PNG16_MAX
-    from spectrinsic.spectra.colorimetry import encode_srgb
 
     values = np.clip(values, 0.0, None)
     scale = max(1.0, float(values.max(initial=0.0)))
@@ -313,9 +309,6 @@ def write_predictions(
 
 def _write_layers(folder: Path, arrays: Mapping[str, np.ndarray], fmt: str,
                   encoding: str) -> tuple[dict[str, Path], dict[str, float]]:
-    from spectrinsic.gt_export.exr import write_exr
-    from spectrinsic.gt_export.png import write_png16
-
     files, scales = {}, {}
     for name, arr in arrays.items():
         if fmt == "exr":

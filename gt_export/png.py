@@ -11,6 +11,7 @@ import os
 from pathlib import Path
 
 import numpy as np
+import png
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.integrity import guarded_write
@@ -136,8 +137,6 @@ def write_png(path: str | os.PathLike[str], rgb8: np.ndarray) -> Path:
 
 def write_png16(path: str | os.PathLike[str], image: np.ndarray) -> Path:
     """Write ``(H, W)`` grey or ``(H, W, 3)`` RGB uint16 codes as a 16-bit PNG (pypng)."""
-    import png
-
     codes = np.asarray(image)
     if codes.dtype != np.uint16 or codes.ndim not in (2, 3) or (codes.ndim == 3 and codes.shape[2] != 3):
         raise DatasetError(
@@ -158,8 +157,6 @@ def read_png16(path: str | os.PathLike[str]) -> np.ndarray:
     Raises :class:`DatasetError` if the file is not a PNG or not 16 bits per channel (8-bit
     files cannot carry linear data without banding, so they are refused rather than rescaled).
     """
-    import png
-
     try:
         w, h, rows, info = png.Reader(filename=str(path)).asDirect()
         data = np.vstack([np.asarray(r, dtype=np.uint16) for r in rows])
@@ -178,8 +175,6 @@ def read_png16(path: str | os.PathLike[str]) -> np.ndarray:
 def png_size(path: str | os.PathLike[str]) -> tuple[int, int]:
     """``(height, width)`` of a PNG from its IHDR chunk alone, so a size can be refused before
     the image is decoded (a small file may declare a huge image)."""
-    import png
-
     try:
         reader = png.Reader(filename=str(path))
         reader.preamble()

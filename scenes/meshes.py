@@ -9,8 +9,10 @@ the named file is read (no textures, no referenced files outside its folder are 
 
 from __future__ import annotations
 
+import json
 import math
 import os
+import struct
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -69,8 +71,6 @@ def mesh_counts(path: Path) -> tuple[int, int]:
     STL, glTF/GLB) or counted line by line (OBJ, ASCII STL) without building the mesh; faces
     are 0 where a format does not say (glTF). Malformed headers count as 0: trimesh reports
     them when it reads the file."""
-    import json
-    import struct
 
     suffix = path.suffix.lower()
     with path.open("rb") as fh:

@@ -9,6 +9,7 @@ run) or meshes (:data:`~spectrinsic.scenes.meshes.MESH_SUFFIXES`, with a materia
 from __future__ import annotations
 
 import dataclasses
+import gzip
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -53,8 +54,6 @@ class GeneratedSource:
 def _compressed_blend(head: bytes, path: Path) -> bool:
     """True for a gzip- or zstd-compressed file whose content starts with Blender's magic."""
     if head.startswith(GZIP_MAGIC):
-        import gzip
-
         try:
             with gzip.open(path, "rb") as fh:
                 return fh.read(len(BLEND_MAGIC)) == BLEND_MAGIC

@@ -34,19 +34,13 @@ FOLDERS = {
 #: Top-level names that may be imported inside a function (see the module docstring).
 HEAVY = frozenset({
     "mitsuba", "drjit", "bpy", "torch", "dask", "distributed", "selenium", "pyoidn", "webdataset",
-    "gco", "colour", "matplotlib", "scipy", "skimage", "trimesh",
+    "gco", "colour", "matplotlib", "scipy", "skimage", "trimesh", "zstandard", "OpenEXR", "PIL",
 })
-#: Cycles left to the work that owns the folder, as sorted module sets.
-#: TODO(issue 18, gt_export split): the writer -> diversity -> loader -> writer cycle is broken
-#: by the gt_export sample module; remove this entry once that branch is merged.
-KNOWN_CYCLES: list[frozenset[str]] = [
-    frozenset({"spectrinsic.gt_export.writer", "spectrinsic.gt_export.diversity",
-               "spectrinsic.gt_export.loader"}),
-]
+#: Cycles left to the work that owns the folder, as sorted module sets (none left).
+KNOWN_CYCLES: list[frozenset[str]] = []
 #: Folders whose function-level imports of light modules are left to the work that owns them,
-#: with the most they may still hold (a ratchet: the count may only go down).
-#: TODO(issue 18, gt_export split): gt_export moves its own imports to the top; remove then.
-PENDING_FOLDERS: dict[str, int] = {"gt_export": 52}
+#: with the most they may still hold (a ratchet: the count may only go down; none left).
+PENDING_FOLDERS: dict[str, int] = {}
 
 
 def module_files() -> Iterator[tuple[str, Path]]:

@@ -14,8 +14,10 @@ import traceback
 from collections.abc import Sequence
 from typing import NoReturn
 
+from spectrinsic.config import resolve_data_dir
 from spectrinsic.errors import SpectrinsicError
 from spectrinsic.interrupts import interrupts_reach_python
+from spectrinsic.provenance import software_versions
 
 __all__ = ["main", "build_parser"]
 
@@ -68,7 +70,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _version() -> str:
     """spectrinsic's installed version, from package metadata (nothing heavy imported)."""
-    from spectrinsic.provenance import software_versions
 
     return software_versions(("spectrinsic",), python=False)["spectrinsic"]
 
@@ -91,7 +92,6 @@ def _main(argv: Sequence[str] | None) -> int:
     )
     try:
         if args.data_dir is not None:  # a wrong --data-dir is an input error, before any work
-            from spectrinsic.config import resolve_data_dir
 
             resolve_data_dir(args.data_dir)
         return int(args.func(args) or 0)

@@ -12,7 +12,7 @@ from tqdm import tqdm
 from spectrinsic.cli.problems import problem_lines
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import check_dataset, sample_dirs
-from spectrinsic.gt_export.check import NOISE_THRESHOLD, noise_report
+from spectrinsic.gt_export.check import NOISE_THRESHOLD, TARGET_MISSED, noise_report
 
 __all__ = ["register", "run"]
 
@@ -72,7 +72,6 @@ def run(args: argparse.Namespace) -> int:
 def _noise_problems(root: Path, threshold: float | None, n_samples: int, *, verbose: bool) -> list[str]:
     """Noise problems: a missed ``noise_target`` always, samples above *threshold* when one was
     given; above the default threshold otherwise only one warning line on stderr."""
-    from spectrinsic.gt_export.check import TARGET_MISSED
 
     lines, flagged = noise_report(root, threshold=NOISE_THRESHOLD if threshold is None else threshold)
     for line in lines if verbose else []:

@@ -3,20 +3,23 @@
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from pathlib import Path
 from typing import Any
 
 from tqdm import tqdm
 
-from spectrinsic.errors import DatasetError
+from spectrinsic.errors import DatasetError, SpectrinsicError
 from spectrinsic.gt_export.integrity import check_build_folder
 from spectrinsic.pipeline.dataset import SampleFailure, build_dataset
 from spectrinsic.pipeline.executors import check_scheduler, choose_executor
 from spectrinsic.pipeline.presets import PRESETS, DatasetConfig, get_preset, preset_names
 from spectrinsic.pipeline.sources import files_source, generator_source
 from spectrinsic.render.budget import check_render_size
+from spectrinsic.scenes.sources import FileSource
 from spectrinsic.scenes.yaml_limits import load_yaml_file
+from spectrinsic.spectra import get_spectrum
 
 __all__ = ["register", "run", "config_from_args", "preflight", "build", "material_map"]
 
@@ -227,11 +230,6 @@ def _check_scene_files(config: Any, data_dir: str | None) -> None:
     """``--scenes``: every file reads as a valid scene with this material map and default
     spectrum, before the folder is stamped with the config (a bad file is an input error, not
     a failed sample)."""
-    import json
-
-    from spectrinsic.errors import SpectrinsicError
-    from spectrinsic.scenes.sources import FileSource
-    from spectrinsic.spectra import get_spectrum
 
     spec = json.loads(config.source or "{}")
     if "scenes" not in spec:

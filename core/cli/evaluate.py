@@ -11,6 +11,7 @@ from typing import Any
 from tqdm import tqdm
 
 from spectrinsic.decompose.evaluate import evaluate
+from spectrinsic.decompose.mit import evaluate_mit, mit_folder_objects
 from spectrinsic.decompose.predictions import Predictions
 from spectrinsic.decompose.registry import available_decomposers, get_decomposer
 from spectrinsic.errors import DatasetError
@@ -104,8 +105,6 @@ def _folders(dataset: Path, patterns: str | None) -> list[Path]:
 
 
 def _run_mit(args: argparse.Namespace) -> int:
-    from spectrinsic.decompose.mit import evaluate_mit, mit_folder_objects
-
     patterns = [g.strip() for g in args.samples.split(",") if g.strip()] if args.samples else None
     files = mit_folder_objects(Path(args.mit), patterns)
     methods = _methods(args)

@@ -15,7 +15,13 @@ import re
 import sys
 from collections.abc import Callable
 
+from spectrinsic.decompose.registry import DECOMPOSERS, available_decomposers
 from spectrinsic.errors import SpectrinsicError, validate_choice
+from spectrinsic.pipeline.presets import PRESETS
+from spectrinsic.scenes.generators import GENERATORS
+from spectrinsic.scenes.library import CONDITION_DESCRIPTIONS, CONDITIONS, n_views, scene_names
+from spectrinsic.spectra import get_sensors, list_spectra
+from spectrinsic.spectra.registry import SPECTRUM_FAMILIES, SPECTRUM_FAMILY_NOTES
 
 __all__ = ["register", "run", "catalogue", "CATALOGUES"]
 
@@ -34,8 +40,6 @@ def _first_sentence(text: str | None) -> str:
 
 
 def _scenes(_data_dir: str | None) -> list[Row]:
-    from spectrinsic.scenes.library import n_views, scene_names
-
     objects = set(scene_names("object"))
     return [(name, f"{'single object' if name in objects else 'room'}, "
                    f"{n_views(name)} view{'s' if n_views(name) > 1 else ''}")
@@ -43,34 +47,24 @@ def _scenes(_data_dir: str | None) -> list[Row]:
 
 
 def _conditions(_data_dir: str | None) -> list[Row]:
-    from spectrinsic.scenes.library import CONDITION_DESCRIPTIONS, CONDITIONS
-
     return [(name, CONDITION_DESCRIPTIONS.get(name, "")) for name in CONDITIONS]
 
 
 def _spectra(_data_dir: str | None) -> list[Row]:
-    from spectrinsic.spectra.registry import SPECTRUM_FAMILIES, SPECTRUM_FAMILY_NOTES
-
     return [(family, SPECTRUM_FAMILY_NOTES.get(family, "")) for family in SPECTRUM_FAMILIES]
 
 
 def _cameras(data_dir: str | None) -> list[Row]:
-    from spectrinsic.spectra import get_sensors, list_spectra
-
     return [(name, get_sensors(name, data_dir=data_dir).source or "")
             for name in list_spectra("camera", data_dir=data_dir)]
 
 
 def _methods(_data_dir: str | None) -> list[Row]:
-    from spectrinsic.decompose.registry import DECOMPOSERS, available_decomposers
-
     return [(name, ("" if name in DECOMPOSERS else "plugin: ") + _first_sentence(factory.__doc__))
             for name, factory in available_decomposers().items()]
 
 
 def _generators(_data_dir: str | None) -> list[Row]:
-    from spectrinsic.scenes.generators import GENERATORS
-
     rows = []
     for name, layout in GENERATORS.items():
         text = _first_sentence(sys.modules[layout.__module__].__doc__)
@@ -79,8 +73,6 @@ def _generators(_data_dir: str | None) -> list[Row]:
 
 
 def _presets(_data_dir: str | None) -> list[Row]:
-    from spectrinsic.pipeline.presets import PRESETS
-
     rows = []
     for name, cfg in PRESETS.items():
         r = cfg.render
@@ -118,7 +110,6 @@ def catalogue(what: str, *, family: str | None = None, data_dir: str | None = No
         return CATALOGUES[what][0](data_dir)
     if what != "spectra":
         raise SpectrinsicError(f"list {what} {family!r}: only 'list spectra' takes a FAMILY")
-    from spectrinsic.spectra import list_spectra
 
     return [(name, "") for name in list_spectra(family, data_dir=data_dir)]
 

@@ -26,7 +26,14 @@ from spectrinsic.gt_export.exr import write_exr
 from spectrinsic.gt_export.outfolder import check_output_folder, output_folder
 from spectrinsic.pipeline.presets import get_preset
 from spectrinsic.pipeline.sources import files_source
-from spectrinsic.render import RenderResult, RenderSettings, count_passes, get_mode, render_scene
+from spectrinsic.render import (
+    RenderResult,
+    RenderSettings,
+    choose_variant,
+    count_passes,
+    get_mode,
+    render_scene,
+)
 from spectrinsic.render.budget import check_render_size
 from spectrinsic.render.modes import RENDER_MODES
 from spectrinsic.render.settings import DEFAULT_MODES as RENDER_DEFAULT_MODES
@@ -121,8 +128,6 @@ def _check_size_options(args: argparse.Namespace) -> None:
     if args.max_depth < 1:
         raise RenderError(f"--max-depth {args.max_depth}; expected >= 1 (2 = direct light only)")
     if args.variant is not None:
-        from spectrinsic.render import choose_variant
-
         choose_variant("rgb", args.variant)  # an unknown or unusable backend, before any work
 
 

@@ -41,6 +41,7 @@ from spectrinsic.gt_export.integrity import (
     sample_problem,
     write_marker,
 )
+from spectrinsic.gt_export.outfolder import folder_lock
 from spectrinsic.pipeline.executors import Executor, SerialExecutor
 from spectrinsic.pipeline.presets import DatasetConfig
 from spectrinsic.pipeline.sources import plan_source_samples, save_generated
@@ -286,8 +287,6 @@ def build_dataset(
     DiskFullError
         When the disk is full: the build stops at the first sample that hits it.
     """
-    from spectrinsic.gt_export.integrity import check_build_folder
-    from spectrinsic.gt_export.outfolder import folder_lock
 
     out = Path(out_dir)
     check_build_folder(out, config.config_hash(), rebuild=rebuild)  # before the folder is made
