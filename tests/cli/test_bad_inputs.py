@@ -290,8 +290,9 @@ CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
                                                 "--out", str(t / "new")], "does not exist"),
     ("render-max-depth-zero", lambda t: ["render", "obj-apple", "--max-depth", "0", "--out", str(t / "o")],
      "--max-depth 0"),
-    ("render-variant-bogus", lambda t: ["render", "obj-apple", "--variant", "bogus", "--out", str(t / "o")],
-     "bogus"),
+    # checked before the scene is even read (this scene file is bad too)
+    ("render-variant-bogus", lambda t: ["render", _scene(t, SCENE.replace("flat:0.5", "flat:7")), "--variant", "bogus",
+                                        "--out", str(t / "o")], "bogus"),
     # --- item 10: unvalidated options
     ("check-noise-threshold-nan", lambda t: ["check", _built_like(t, manifest={}), "--noise-threshold", "nan"],
      "--noise-threshold nan"),
