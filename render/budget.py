@@ -11,10 +11,10 @@ the four default modes (73 values per pixel with the AOVs), spp 16, on the 2-cor
 =========  ==========  ==========
 size       measured    estimate
 =========  ==========  ==========
-8 x 8      277 MiB     320 MiB
-256 x 256  305 MiB     430 MiB
-512 x 512  488 MiB     758 MiB
-2048^2     5.0 GB      7.7 GB
+8 x 8      277 MiB     448 MiB
+256 x 256  305 MiB     558 MiB
+512 x 512  488 MiB     886 MiB
+2048^2     5.0 GB      7.8 GB
 =========  ==========  ==========
 
 (the 2048^2 figure from issue 17, where the former count, 684 B/pixel without the process,
@@ -49,8 +49,9 @@ BYTES_PER_VALUE = 4
 #: arrays, the EXR encoder's buffers (fitted: 1120 B/pixel measured at 2048^2 for 73 values is
 #: 3.8 copies; 6 keeps the estimate above every measurement of the module's table).
 OVERHEAD_FACTOR = 6
-#: Resident memory of a render process before its first pixel (measured 277 MiB at 8 x 8).
-BASE_BYTES = 320 * 2**20
+#: Resident memory of a render process before its first pixel (measured 277 MiB at 8 x 8 and
+#: 318 MiB at 64 x 64 with three modes; the margin covers other builds of the libraries).
+BASE_BYTES = 448 * 2**20
 #: AOV values per pixel: coverage of up to 9 materials, 2 ids, depth, 3 normals, the mask.
 AOV_VALUES = 16
 #: Longest image side accepted at all (OpenEXR and Mitsuba films use 32-bit sizes).

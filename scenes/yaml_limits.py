@@ -109,6 +109,10 @@ def load_yaml_text(text: str, source: str) -> Any:
     if len(text) > MAX_YAML_BYTES:
         raise SceneError(f"{source}: {len(text):,} characters; scene files are limited to "
                          f"{MAX_YAML_BYTES:,} (put large meshes in PLY files)")
+    rough = text.count(",") + text.count("- ") + text.count(": ")
+    if rough > MAX_NODES:  # composing them first would take minutes (pure-Python PyYAML)
+        raise SceneError(f"{source}: about {rough:,} YAML values (counted from commas, list items "
+                         f"and keys), more than {MAX_NODES:,}; put large meshes in PLY files (FORMAT.md)")
     loader = _LimitedLoader(text, source)
     try:
         return loader.get_single_data()

@@ -295,8 +295,9 @@ CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
                                                 "--out", str(t / "new")], "does not exist"),
     ("render-max-depth-zero", lambda t: ["render", "obj-apple", "--max-depth", "0", "--out", str(t / "o")],
      "--max-depth 0"),
-    ("render-variant-bogus", lambda t: ["render", "obj-apple", "--variant", "bogus", "--out", str(t / "o")],
-     "bogus"),
+    # checked before the scene is even read (this scene file is bad too)
+    ("render-variant-bogus", lambda t: ["render", _scene(t, SCENE.replace("flat:0.5", "flat:7")), "--variant", "bogus",
+                                        "--out", str(t / "o")], "bogus"),
     # --- item 10: unvalidated options
     ("check-noise-threshold-nan", lambda t: ["check", _built_like(t, manifest={}), "--noise-threshold", "nan"],
      "--noise-threshold nan"),
@@ -406,16 +407,22 @@ def test_an_exr_whose_channels_attribute_is_not_json_is_one_line(tmp_path, capsy
         read_exr(path)
 
 
-def test_yaml_node_count_is_bounded_while_composing(tmp_path, monkeypatch, capsys):
-    """Issue 17 item 7: a 15 MB YAML under the byte cap took 6 GB; nodes are now counted as the
-    composer builds them (the bound is lowered here so the file stays small)."""
+@pytest.mark.parametrize("text, expected", [
+    # counted before parsing, from commas and list items: 800 + 400
+    ("vertices:\n" + "".join(f"  - [{i}, 0, 0]\n" for i in range(400)), "about 1,200 YAML values"),
+    # block items written "-" + newline escape that count; the composer's count catches them
+    ("-\n  1\n" * 1500, "more than 1,000 YAML nodes"),
+])
+def test_yaml_node_count_is_bounded_before_and_while_composing(tmp_path, monkeypatch, capsys, text, expected):
+    """Issue 17 item 7: a 15 MB YAML under the byte cap took 6 GB and 4.5 min; values are now
+    counted before parsing and nodes as the composer builds them (the bound is lowered here so
+    the files stay small)."""
     import spectrinsic.scenes.yaml_limits as limits
 
     monkeypatch.setattr(limits, "MAX_NODES", 1000)
-    text = "vertices:\n" + "".join(f"  - [{i}, 0, 0]\n" for i in range(400))  # 1602 nodes, no alias
     rc = main(["-q", "render", _scene(tmp_path, text), "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err.strip()
-    assert rc == 2 and "more than 1,000 YAML nodes" in err and "line " in err
+    assert rc == 2 and expected in err, err
     assert not (tmp_path / "o").exists()
 
 
