@@ -118,7 +118,8 @@ def bounded_minimum(a) -> np.ndarray:
     which the primal-dual active-set method (Hintermueller, Ito & Kunisch, SIAM J. Optim.
     13(3), 2002) reaches the exact minimiser in a few sparse solves: bound set
     ``B = {i: nu_i - c (lambda_i - 1) > 0}``, ``lambda_B = 1``, ``Q_FF lambda_F = -Q_FB 1``,
-    ``nu = Q lambda`` on ``B``, until ``B`` repeats. Columns without equations stay at 1. If a
+    ``nu = Q lambda`` on ``B``, until ``B`` repeats (ties, ``nu = 0`` at the bound, stay bound).
+    Columns without equations stay at 1. If a
     free block is singular or the sets cycle, :func:`scipy.optimize.lsq_linear` solves it
     (bounded least squares by LSMR, tolerance 1e-10; the solver used before, 10-100x slower).
     """
@@ -130,7 +131,10 @@ def bounded_minimum(a) -> np.ndarray:
     used = q.diagonal() > 0.0
     lam, nu = np.ones(n), np.asarray(q @ np.ones(n)).ravel()
     c = float(q.diagonal()[used].mean()) if used.any() else 1.0
-    bound = (nu - c * (lam - 1.0) > 0.0) | ~used
+    # A multiplier that is zero at the optimum (a ratio met exactly) keeps its bound: released,
+    # the free block would be singular (the objective is flat along the common scale).
+    tie = 1e-12 * c
+    bound = (nu - c * (lam - 1.0) > -tie) | ~used
     for _ in range(_MAX_ACTIVE_SET_STEPS):
         free = ~bound
         lam = np.ones(n)
@@ -142,7 +146,7 @@ def bounded_minimum(a) -> np.ndarray:
                 break
             lam[free] = solved
         nu = np.where(bound, np.asarray(q @ lam).ravel(), 0.0)
-        new = ((nu - c * (lam - 1.0)) > 0.0) | ~used
+        new = ((nu - c * (lam - 1.0)) > -tie) | ~used
         if np.array_equal(new, bound):
             return lam
         bound = new

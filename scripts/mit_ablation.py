@@ -156,12 +156,13 @@ def per_object(report: dict) -> str:
                "colour-retinex": "colour-retinex", "ours, thesis settings": thesis,
                "ours, chosen": key(chosen)}
     lines = ["| object | " + " | ".join(columns) + " |", "|---" * (len(columns) + 1) + "|"]
-    for obj in sorted(THESIS_TABLES_3_4_3_5):
+    objects = sorted(o for o in THESIS_TABLES_3_4_3_5 if o in s["colour-retinex"])
+    for obj in objects:
         cells = [f"{THESIS_TABLES_3_4_3_5[obj][0]:.4f}"] + [
             f"{s[k][obj]['lmse']:.4f}" for k in list(columns.values())[1:]]
         lines.append(f"| {obj} | " + " | ".join(cells) + " |")
-    means = [np.mean([v[0] for v in THESIS_TABLES_3_4_3_5.values()])] + [
-        np.mean([s[k][o]["lmse"] for o in THESIS_TABLES_3_4_3_5]) for k in list(columns.values())[1:]]
+    means = [np.mean([THESIS_TABLES_3_4_3_5[o][0] for o in objects])] + [
+        np.mean([s[k][o]["lmse"] for o in objects]) for k in list(columns.values())[1:]]
     lines.append("| mean | " + " | ".join(f"{m:.4f}" for m in means) + " |")
     return "\n".join(lines) + "\n"
 

@@ -7,7 +7,17 @@ import pytest
 import scipy.sparse as sp
 from scipy.optimize import lsq_linear
 
+import spectrinsic.decompose.coherence as coherence
 from spectrinsic.decompose.coherence import bounded_minimum, global_coherence
+
+
+@pytest.fixture(autouse=True)
+def _no_fallback(monkeypatch):
+    """The active set must settle by itself on these problems, not hand over to LSMR."""
+    def refuse(a):
+        raise AssertionError("bounded_minimum fell back to LSMR")
+
+    monkeypatch.setattr(coherence, "_bounded_lsmr", refuse)
 
 
 def _ratio_rows(rng, n: int, n_pairs: int) -> sp.csr_matrix:
