@@ -7,7 +7,7 @@ import sys
 
 import pytest
 
-from spectrinsic.cli import build_parser, main
+from spectrinsic.cli import _COMMANDS, build_parser, main
 
 
 def test_help_lists_commands(capsys):
@@ -42,7 +42,8 @@ def test_every_registered_command_has_help():
     of this test, ``description or format_help()``, could not fail: format_help is never empty)."""
     parser = build_parser()
     sub = next(a for a in parser._actions if a.dest == "command")
-    assert set(sub.choices) == {"info", "render", "dataset", "check", "export", "study", "evaluate"}
+    assert set(sub.choices) == {module.rsplit(".", 1)[1] for module in _COMMANDS}
+    assert {"render", "dataset", "check", "export", "study", "evaluate", "list"} <= set(sub.choices)
     listed = {a.dest: a.help for a in sub._choices_actions}
     for name, p in sub.choices.items():
         assert listed.get(name), f"{name}: no help line in `spectrinsic --help`"
