@@ -319,7 +319,8 @@ def _meta(
     }
 
 
-def _fill_folder(folder: Path, scene: Scene, result: Any, gt: GroundTruth, **meta_kw: Any) -> None:
+def _fill_folder(folder: Path, scene: Scene, result: Any, gt: GroundTruth, *, transport: Any = None,
+                 **meta_kw: Any) -> None:
     files: list[str] = []
     groups: dict[str, list[Layer]] = {}
     for layer in gt.layers.values():
@@ -350,7 +351,16 @@ def _fill_folder(folder: Path, scene: Scene, result: Any, gt: GroundTruth, **met
     files.append(SCENE_NAME)
     # meta.json last: its presence (with the right config hash) marks the folder complete; it
     # records the SHA-256 of every other file, so a resumed build can tell an intact sample
+    record = None
+    if transport is not None:  # the per-light transport, for exact relighting
+        from spectrinsic.gt_export.transport_file import TRANSPORT_NAME, write_transport
+
+        record = write_transport(folder, transport, result.aovs["coverage"], sample_id=meta_kw["sample_id"])
+        record["cameras"] = list(gt.cameras)  # full sensor-set names, to relight the camera layers
+        files.append(TRANSPORT_NAME)
     meta = _meta(scene, result, gt, previews=previews, files=files, **meta_kw)
+    if record is not None:
+        meta["transport"] = record
     meta[HASHES_KEY] = file_hashes(folder, files)
     _dump_json(folder / META_NAME, meta, digits=META_DIGITS)
 
@@ -367,6 +377,7 @@ def export_sample(
     write_cube: bool = False,
     denoise: bool = False,
     data_dir: str | os.PathLike[str] | None = None,
+    transport: Any = None,
 ) -> Path:
     """Compute every ground-truth layer of a rendered sample and write it atomically.
 
@@ -395,6 +406,10 @@ def export_sample(
         Compute shading, residual and illuminant from the OIDN-denoised irradiance.
     data_dir
         Spectral data directory (for ``sfu:``/data-directory cameras).
+    transport
+        A :class:`~spectrinsic.render.transport.LightTransport` of this render to store as
+        ``transport.exr`` (:mod:`~spectrinsic.gt_export.transport_file`), for exact
+        relighting (:func:`spectrinsic.gt_export.relight.relight`).
 
     Returns
     -------
@@ -413,7 +428,8 @@ def export_sample(
     tmp = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{sample_id}-", dir=out_dir))
     try:
         tmp.chmod(0o755)
-        _fill_folder(tmp, scene, result, gt, sample_id=sample_id, config=config, seed=seed)
+        _fill_folder(tmp, scene, result, gt, sample_id=sample_id, config=config, seed=seed,
+                     transport=transport)
         _move_into_place(tmp, final, config_hash(config))
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
