@@ -188,7 +188,11 @@ def relit_render(
 
     sample = Path(sample_dir)
     meta = _source_meta(sample)
-    check_light_spectra(lights, len(meta.get("lights", [])), data_dir=data_dir)
+    n_lights = len(meta.get("lights", []))
+    check_light_spectra(lights, n_lights, data_dir=data_dir)
+    stray = [i for i in (powers or {}) if not (isinstance(i, int) and 0 <= i < n_lights)]
+    if stray:
+        raise DatasetError(f"--power {stray[0]!r}: the sample has lights 0..{n_lights - 1}")
     transport, coverage = read_transport(sample, meta["transport"])
     scene = relit_scene(read_sample_scene(sample), lights, powers, source=str(meta["sample_id"]))
     relit = {"from": meta["sample_id"], "from_meta_sha256": file_sha256(sample / META_NAME),

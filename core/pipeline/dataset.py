@@ -251,22 +251,23 @@ def build_sample(task: SampleTask) -> SampleOutcome:
     t0 = time.perf_counter()
     scene = _task_scene(task)
     t_render = time.perf_counter()
-    result = render_batches(
-        scene,
-        batches=cfg.batches,
-        noise_target=cfg.noise_target,
-        max_batches=cfg.max_batches,
-        modes=cfg.modes,
-        spp=cfg.spp // cfg.batches,
-        seed=task.seed,
-        max_depth=cfg.max_depth,
-        variant=cfg.variant,
-        per_light=cfg.per_light,
-        per_light_modes=(cfg.share_mode,) if cfg.per_light and cfg.share_mode else None,
-        direct=cfg.direct,
-        aovs=True,
-        data_dir=task.data_dir,
-    )
+    common: dict[str, Any] = dict(batches=cfg.batches, noise_target=cfg.noise_target,
+                                  max_batches=cfg.max_batches, modes=cfg.modes,
+                                  spp=cfg.spp // cfg.batches, seed=task.seed, max_depth=cfg.max_depth,
+                                  variant=cfg.variant, direct=cfg.direct, data_dir=task.data_dir)
+    transport = None
+    if cfg.store_transport:  # diagonal modes light by light, kept per light for relighting
+        from spectrinsic.render.transport import render_transport_batches
+
+        transport, result = render_transport_batches(scene, **common)
+    else:
+        result = render_batches(
+            scene,
+            per_light=cfg.per_light,
+            per_light_modes=(cfg.share_mode,) if cfg.per_light and cfg.share_mode else None,
+            aovs=True,
+            **common,
+        )
     render_seconds = time.perf_counter() - t_render
     if cfg.direct:  # the energy ratio r of Eq. 5.8, recorded for the dataset card's diversity plots
         mode = "spectral" if "spectral" in result.direct else next(iter(result.direct))
@@ -282,7 +283,12 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         write_cube=cfg.write_cube,
         denoise=cfg.denoise,
         data_dir=task.data_dir,
+        transport=transport,
     )
+    if cfg.relight:
+        from spectrinsic.gt_export.relight_pool import write_relit_variants
+
+        write_relit_variants(path, cfg.relight, seed=task.seed, data_dir=task.data_dir)
     seconds = time.perf_counter() - t0
     return SampleOutcome(
         sample_id=task.sample_id,
@@ -439,6 +445,10 @@ def _prepare(
     for t in tasks:
         folder = out / t.sample_id
         problem = sample_problem(folder, config_hash)
+        if problem is None and config.relight:  # a source whose relit variants are not all there
+            from spectrinsic.gt_export.relight_pool import relit_problem
+
+            problem = relit_problem(folder, config.relight, config_hash)
         if problem is None:
             skipped.append(SampleOutcome(t.sample_id, "skipped", str(folder)))
             continue

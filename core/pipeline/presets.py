@@ -101,6 +101,14 @@ class DatasetConfig:
         Mitsuba variant, or ``None`` for the render package's automatic choice.
     seed
         Root seed; each sample's seed is ``seed_from_key(seed, sample_id)``.
+    store_transport
+        Render the diagonal modes light by light with a flat unit spectrum and store that
+        per-light transport in each sample (``transport.exr``), so the sample can be relit
+        exactly (:mod:`spectrinsic.gt_export.relight`). Left out of the settings when off, so
+        other configs keep their hash.
+    relight
+        Relit variants written per rendered sample (needs *store_transport*), each under light
+        spectra drawn from :data:`spectrinsic.gt_export.relight_pool.RELIGHT_POOL`.
     source
         Where the scenes come from, as canonical JSON: ``None`` for the library layout,
         ``{"generator": ..., "count": ..., ...}`` or ``{"scenes": [...], ...}`` (see
@@ -126,6 +134,8 @@ class DatasetConfig:
     variant: str | None = None
     seed: int = 0
     source: str | None = None
+    store_transport: bool = False
+    relight: int = 0
 
     def __post_init__(self) -> None:
         # lists from JSON or the command line become tuples, so configs stay hashable records
@@ -155,6 +165,22 @@ class DatasetConfig:
             validate_choice(mode, RENDER_MODES, "render mode", error=DatasetError)
         if not isinstance(self.seed, int) or self.seed < 0:
             raise DatasetError(f"dataset seed {self.seed!r}; expected a non-negative integer")
+        self._check_transport()
+
+    def _check_transport(self) -> None:
+        from spectrinsic.render.transport import diagonal_mode_names
+
+        if self.store_transport and not diagonal_mode_names(self.modes):
+            raise DatasetError(f"--store-transport with modes {list(self.modes)}: the transport needs a "
+                               "diagonal mode (rgb3, rgb6 or bands31)")
+        if self.store_transport and self.direct and "spectral" not in self.modes:
+            raise DatasetError("--store-transport with --direct needs the 'spectral' mode (the "
+                               "diagonal modes are composed from the transport, not rendered directly)")
+        if isinstance(self.relight, bool) or not isinstance(self.relight, int) or self.relight < 0:
+            raise DatasetError(f"dataset setting relight={self.relight!r}; expected a non-negative integer")
+        if self.relight and not self.store_transport:
+            raise DatasetError(f"--relight {self.relight} needs --store-transport (relit variants are "
+                               "composed from the stored transport)")
 
     def with_options(self, **changes: Any) -> DatasetConfig:
         """A copy with some settings changed (validated like a new config)."""
@@ -174,6 +200,9 @@ class DatasetConfig:
         d["cameras"] = list(self.resolved_cameras())
         if self.source is None:
             d.pop("source")
+        for key in ("store_transport", "relight"):  # off: out of the hash, as before they existed
+            if not d[key]:
+                d.pop(key)
         return d
 
     def resolved_cameras(self) -> tuple[str, ...]:
