@@ -30,7 +30,12 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import DatasetError, SpectrinsicError
-from spectrinsic.gt_export.integrity import META_NAME, file_sha256, read_sample_meta, replaceable_sample
+from spectrinsic.gt_export.integrity import (
+    META_NAME,
+    file_sha256,
+    read_sample_meta,
+    replaceable_sample,
+)
 from spectrinsic.gt_export.transport_file import read_transport
 from spectrinsic.gt_export.writer import SCENE_NAME
 from spectrinsic.render.result import RenderResult
@@ -71,6 +76,11 @@ def _fail(sample: Path, what: str) -> DatasetError:
     return DatasetError(f"{sample / SCENE_NAME}: {what}; not a scene spectrinsic wrote")
 
 
+def _fields(entry: Any) -> dict[str, Any]:
+    """A record's fields from JSON: lists back to the tuples the frozen records hold."""
+    return {str(k): tuple(v) if isinstance(v, list) else v for k, v in entry.items()}
+
+
 def read_sample_scene(sample_dir: str | os.PathLike[str]) -> Scene:
     """The :class:`Scene` a sample was rendered from, read from its ``scene.json``."""
     sample = Path(sample_dir)
@@ -86,9 +96,8 @@ def read_sample_scene(sample_dir: str | os.PathLike[str]) -> Scene:
                             face_materials=np.asarray(m["face_materials"], np.int64).reshape(-1),
                             object_id=int(m["object_id"])) for m in data["meshes"])
         materials = tuple(Material(str(m["name"]), str(m["spectrum"])) for m in data["materials"])
-        lights = tuple(Light(**{k: tuple(v) if isinstance(v, list) else v for k, v in x.items()})
-                       for x in data["lights"])
-        camera = Camera(**{k: tuple(v) if isinstance(v, list) else v for k, v in data["camera"].items()})
+        lights = tuple(Light(**_fields(x)) for x in data["lights"])
+        camera = Camera(**_fields(data["camera"]))
         metadata = data.get("metadata") or {}
         return Scene(str(data["name"]), meshes, materials, lights, camera, dict(metadata))
     except (KeyError, TypeError, ValueError, AttributeError) as exc:

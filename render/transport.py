@@ -124,8 +124,8 @@ def light_band_means(scene: Scene, sensors: str, *, data_dir: str | None = None)
     >>> from spectrinsic.scenes.model import Camera, Light, Scene
     >>> lamp = Light("point", "flat:1", 2.0)
     >>> s = Scene("s", (), (), (lamp,), Camera((0, 0, 1), (0, 0, 0)))
-    >>> light_band_means(s, "bands:31@400-700").round(12).max()
-    np.float64(2.0)
+    >>> float(light_band_means(s, "bands:31@400-700").round(12).max())
+    2.0
     """
     wl = COLORIMETRIC_WAVELENGTHS
     return diagonal_values(light_spectra(scene, wl, data_dir=data_dir),

@@ -184,7 +184,7 @@ class DatasetConfig:
 
     def with_options(self, **changes: Any) -> DatasetConfig:
         """A copy with some settings changed (validated like a new config)."""
-        unknown = set(changes) - set(self.settings()) - {"preset", "source"}
+        unknown = set(changes) - set(self.settings()) - {"preset", "source", "store_transport", "relight"}
         if unknown:
             raise DatasetError(
                 f"unknown dataset setting(s) {sorted(unknown)}; expected some of "
