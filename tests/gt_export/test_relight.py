@@ -190,3 +190,22 @@ def test_cli_relights_into_a_checkable_sample(built, tmp_path, capsys):
     # the same --out again replaces the sample spectrinsic wrote there (never a foreign one)
     assert main(["-q", "relight", str(sample), "--light", "1=cie:FL2", "--out", str(out)]) == 0
     assert json.loads((out / "meta.json").read_text())["lights"][1]["spectrum"] == "cie:FL2"
+
+
+@pytest.mark.torch
+def test_torch_dataset_relights_each_item_on_the_fly(built, torch, tmp_path):
+    import shutil
+
+    from spectrinsic.gt_export import torch_dataset
+
+    _, _, sample = built
+    shutil.copytree(sample, tmp_path / "ds" / sample.name)
+    draw = RandomRelight(seed=2, pool=("cie:FL11", "cie:LED-RGB1", "planck:2000K", "daylight:9000K"))
+    ds = torch_dataset(tmp_path / "ds", keys=("image", "shading"), relight=draw)
+    expected = relit_layers(sample, draw.lights(2, index=0))
+    item = ds[0]
+    assert torch.equal(item["image"], torch.from_numpy(np.moveaxis(expected["image"], -1, 0).copy()))
+    assert item["shading"].shape == (3, 16, 16) and item["sample_id"] == sample.name
+    ds.set_epoch(3)
+    again = relit_layers(sample, draw.lights(2, index=0, epoch=3))
+    assert torch.equal(ds[0]["image"], torch.from_numpy(np.moveaxis(again["image"], -1, 0).copy()))
