@@ -456,6 +456,7 @@ def _prepare(
         if problem != "absent":
             log.warning("sample %s: %s; re-rendering it", t.sample_id, problem)
             stale.append(folder)
+            stale += _relit_variants(folder)  # made from the old render: go with it
         todo.append(t)
     write_marker(out, config_hash)
     for path in remove_owned_temporaries(out):
@@ -465,6 +466,19 @@ def _prepare(
         for folder in stale:
             remove_sample(folder)  # no old-config sample survives a failed re-render
     return todo, skipped
+
+
+def _relit_variants(folder: Path) -> list[Path]:
+    """The relit variants (``dataset --relight``) on disk beside the sample in *folder*."""
+    import glob
+
+    from spectrinsic.gt_export.integrity import replaceable_sample
+    from spectrinsic.gt_export.relight_pool import RELIT_TAG
+
+    found = sorted(p for p in folder.parent.glob(glob.escape(folder.name + RELIT_TAG) + "*") if p.is_dir())
+    for path in found:
+        replaceable_sample(path)  # refuses a folder (or a file in it) spectrinsic did not write
+    return found
 
 
 def _run(

@@ -68,3 +68,15 @@ def test_transport_settings_leave_other_configs_hash_alone():
         plain.with_options(relight=2)
     with pytest.raises(DatasetError, match="diagonal mode"):
         plain.with_options(modes=("spectral",), store_transport=True)
+
+
+@pytest.mark.slow
+def test_rebuild_without_relight_removes_the_old_relit_variants(built, tmp_path):
+    out, _ = built
+    copy = tmp_path / "dataset"
+    shutil.copytree(out, copy)
+    plain = TINY.with_options(relight=0)
+    report = build_dataset(copy, plain, only=SAMPLE, rebuild=True)
+    assert [o.sample_id for o in report.built] == [SAMPLE]
+    assert not (copy / RELIT).exists()  # made from the old config's render
+    assert check_dataset(copy) == []
