@@ -73,7 +73,7 @@ def run(out_dir: Path) -> dict[str, Any]:
 
     cfg = get_preset("default")
     scene = build(SCENE, view=VIEW, condition=CONDITION, seed=0, width=cfg.width, height=cfg.height)
-    kw = dict(spp=cfg.spp // cfg.batches, seed=SEED, max_depth=cfg.max_depth)
+    kw: dict[str, Any] = dict(spp=cfg.spp // cfg.batches, seed=SEED, max_depth=cfg.max_depth)
     render_batches(dataclasses.replace(scene, camera=dataclasses.replace(scene.camera, width=32, height=32)),
                    batches=1, modes=cfg.modes, per_light=True, **kw)  # warm-up: compile kernels
     _, plain_s = _timed(render_batches, scene, batches=cfg.batches, modes=cfg.modes, per_light=True,
@@ -86,7 +86,7 @@ def run(out_dir: Path) -> dict[str, Any]:
     cameras = cfg.resolved_cameras()
     with tempfile.TemporaryDirectory(dir=out_dir) as tmp:
         root = Path(tmp)
-        common = dict(config=cfg.to_dict(), seed=SEED, cameras=cameras, denoise=cfg.denoise)
+        common: dict[str, Any] = dict(config=cfg.to_dict(), seed=SEED, cameras=cameras, denoise=cfg.denoise)
         sample = export_sample(root, scene, result, sample_id="source__v0__x", transport=transport, **common)
         reference = export_sample(root, new_scene, direct, sample_id="direct__v0__x", **common)
         _, compose_s = _timed(_compose_only, sample)
