@@ -149,18 +149,26 @@ def _render_meta(meta: Mapping[str, Any], transport: LightTransport, relit: Mapp
     return base
 
 
-def _aovs(sample: Path, coverage: np.ndarray) -> dict[str, np.ndarray]:
-    from spectrinsic.gt_export.loader import load_sample
+def _aovs(sample: Path, meta: Mapping[str, Any], coverage: np.ndarray) -> dict[str, np.ndarray]:
+    """The render's AOVs as they were: geometry layers from their EXR file (ids and mask back
+    to their integer and boolean types, exactly: they are small integers stored as float32)."""
+    from spectrinsic.gt_export.exr import read_exr
 
-    loaded = load_sample(sample, layers=[k for k in _AOV_LAYERS if k in _layer_names(sample)])
-    out = {k: loaded[k] for k in _AOV_LAYERS if k in loaded}
+    records = meta.get("layers", {})
+    out: dict[str, np.ndarray] = {}
+    by_file: dict[str, list[str]] = {}
+    for key in (k for k in _AOV_LAYERS if k in records):
+        by_file.setdefault(records[key]["file"], []).append(key)
+    for file, keys in by_file.items():
+        arrays = read_exr(sample / file, layers=[records[k]["exr_layer"] for k in keys])
+        out.update({k: arrays[records[k]["exr_layer"]] for k in keys})
+    for key in ("material_id", "object_id"):
+        if key in out:
+            out[key] = np.rint(out[key]).astype(np.int32)
+    if "mask" in out:
+        out["mask"] = out["mask"] > 0.5
     out["coverage"] = coverage.astype(np.float32)
     return out
-
-
-def _layer_names(sample: Path) -> set[str]:
-    meta = json.loads((sample / META_NAME).read_text(encoding="utf-8"))
-    return set(meta.get("layers", {}))
 
 
 def _source_meta(sample: Path) -> dict[str, Any]:
@@ -212,7 +220,7 @@ def relit_render(
     batches = [transport_result(b, scene, seed=s, spp=transport.spp, meta=base, data_dir=dd)
                for b, s in zip(transport.batches, transport.seeds, strict=True)]
     merged = merge_batches(batches)
-    result = dataclasses.replace(merged, aovs=_aovs(sample, coverage))
+    result = dataclasses.replace(merged, aovs=_aovs(sample, meta, coverage))
     return RelitSample(scene=scene, result=result, meta=meta, transport=transport)
 
 
