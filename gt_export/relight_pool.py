@@ -90,18 +90,26 @@ def relit_problem(sample_dir: str | os.PathLike[str], n: int, config_hash: str) 
 
 
 def relit_layers(sample_dir: str | os.PathLike[str], lights: Mapping[int, str], *,
-                 powers: Mapping[int, float] | None = None, data_dir: Any = None) -> dict[str, Any]:
+                 powers: Mapping[int, float] | None = None, data_dir: Any = None,
+                 denoise: bool | None = None, cameras: bool = True) -> dict[str, Any]:
     """Every layer of a sample under new light spectra, in memory, keyed as
     :func:`~spectrinsic.gt_export.loader.load_sample` returns them (``mask`` bool, ids int32
-    under ``ids``, ``meta`` the source's ``meta.json`` with the new ``lights`` spectra)."""
+    under ``ids``, ``meta`` the source's ``meta.json`` with the new ``lights`` spectra).
+
+    By default the layers are those the sample has, exactly as :func:`~spectrinsic.gt_export.relight.relight`
+    writes them. For cheaper augmentation, ``denoise=False`` leaves out OIDN (the denoised
+    layers then come from the raw irradiance, as in a ``--no-denoise`` build; about half the
+    time at 256²) and ``cameras=False`` the camera layers.
+    """
     from spectrinsic.gt_export.layers import compute_ground_truth
     from spectrinsic.gt_export.relight import relit_render
 
     relit = relit_render(sample_dir, lights, powers=powers, data_dir=data_dir)
     meta = relit.meta
     gt = compute_ground_truth(
-        relit.scene, relit.result, cameras=meta["transport"].get("cameras") or (),
-        write_cube="cube" in meta.get("layers", {}), denoise=bool(meta.get("denoised_layers")),
+        relit.scene, relit.result, cameras=(meta["transport"].get("cameras") or ()) if cameras else (),
+        write_cube="cube" in meta.get("layers", {}),
+        denoise=bool(meta.get("denoised_layers")) if denoise is None else denoise,
         data_dir=data_dir,
     )
     out: dict[str, Any] = {name: layer.data for name, layer in gt.layers.items()}
@@ -134,11 +142,16 @@ class RandomRelight:
         Illuminant names to draw from uniformly; ``None``: the generators' families.
     data_dir
         Spectral data directory, for ``sfu:`` names.
+    denoise, cameras
+        As :func:`relit_layers`: ``None``/``True`` keep the sample's layers exactly;
+        ``denoise=False`` and ``cameras=False`` trade them for speed.
     """
 
     seed: int
     pool: tuple[str, ...] | None = None
     data_dir: str | None = None
+    denoise: bool | None = None
+    cameras: bool = True
 
     def lights(self, n_lights: int, index: int, epoch: int = 0) -> dict[int, str]:
         """The spectra item *index* gets in *epoch*."""
@@ -151,4 +164,5 @@ class RandomRelight:
         if meta is None:
             raise DatasetError(f"{str(sample_dir)!r} is not a spectrinsic sample folder")
         lights = self.lights(len(meta.get("lights", [])), index, epoch)
-        return relit_layers(sample_dir, lights, data_dir=self.data_dir)
+        return relit_layers(sample_dir, lights, data_dir=self.data_dir, denoise=self.denoise,
+                            cameras=self.cameras)

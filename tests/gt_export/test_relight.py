@@ -209,3 +209,13 @@ def test_torch_dataset_relights_each_item_on_the_fly(built, torch, tmp_path):
     ds.set_epoch(3)
     again = relit_layers(sample, draw.lights(2, index=0, epoch=3))
     assert torch.equal(ds[0]["image"], torch.from_numpy(np.moveaxis(again["image"], -1, 0).copy()))
+
+
+def test_cheap_augmentation_leaves_out_denoising_and_cameras_only(built):
+    _, _, sample = built
+    full = relit_layers(sample, NEW_LIGHTS)
+    cheap = relit_layers(sample, NEW_LIGHTS, denoise=False, cameras=False)
+    assert not any(k.startswith(("image_camera", "image_denoised", "shading_raw")) for k in cheap)
+    for key in ("image", "reflectance", "noise_image", "light_share"):
+        np.testing.assert_array_equal(cheap[key], full[key], err_msg=key)
+    np.testing.assert_array_equal(cheap["shading"], full["shading_raw"])  # undenoised = the raw one

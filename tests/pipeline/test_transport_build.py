@@ -17,7 +17,7 @@ from spectrinsic.pipeline.dataset import build_dataset
 from spectrinsic.pipeline.presets import DatasetConfig
 
 TINY = DatasetConfig(preset="tiny-test", width=12, height=12, spp=4, max_depth=3, batches=2,
-                     modes=("spectral", "rgb3", "bands31"), denoise=True, seed=5,
+                     modes=("spectral", "rgb3", "bands31"), denoise=True, seed=5, write_cube=True,
                      store_transport=True, relight=1)
 SAMPLE = "room-living__v0__two-colour-a"
 RELIT = SAMPLE + "-relit1"
@@ -45,6 +45,7 @@ def test_store_transport_and_relit_variants_make_a_sound_dataset(built):
     assert relit["render"]["relit"]["from"] == SAMPLE
     assert [li["spectrum"] for li in relit["lights"]] != [li["spectrum"] for li in source["lights"]]
     assert "noise" in relit and relit["noise"]["batches"] == 2
+    assert "cube" in relit["layers"]  # the relit 31-band cube is written as the source's was
 
 
 @pytest.mark.slow
