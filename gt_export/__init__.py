@@ -10,6 +10,7 @@ from spectrinsic.gt_export.exr import read_exr, write_exr
 from spectrinsic.gt_export.gallery import build_gallery, contact_sheet
 from spectrinsic.gt_export.layers import GroundTruth, Layer, LightRecord, compute_ground_truth
 from spectrinsic.gt_export.loader import load_dataset, load_sample, torch_dataset
+from spectrinsic.gt_export.relight import relight
 from spectrinsic.gt_export.writer import (
     DEFAULT_CAMERAS,
     config_hash,
@@ -37,6 +38,7 @@ __all__ = [
     "load_dataset",
     "load_sample",
     "read_exr",
+    "relight",
     "remove_stale_temporaries",
     "sample_dirs",
     "torch_dataset",
