@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -164,7 +164,7 @@ def torch_dataset(
     seed: int | None = None,
     normalize_exposure: bool = False,
     transform: Any = None,
-    relight: Any = None,
+    relight: Callable[[Path, int, int], dict[str, Any]] | None = None,
 ) -> Any:
     """A map-style ``torch.utils.data.Dataset`` over a dataset folder.
 

@@ -24,7 +24,7 @@ import uuid
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import asdict, fields, is_dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -46,6 +46,9 @@ from spectrinsic.gt_export.integrity import (
 from spectrinsic.gt_export.layers import GroundTruth, Layer, compute_ground_truth, identities
 from spectrinsic.provenance import software_versions
 from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash
+
+if TYPE_CHECKING:
+    from spectrinsic.render.transport import LightTransport
 
 __all__ = [
     "FORMAT_VERSION",
@@ -319,7 +322,8 @@ def _meta(
     }
 
 
-def _fill_folder(folder: Path, scene: Scene, result: Any, gt: GroundTruth, *, transport: Any = None,
+def _fill_folder(folder: Path, scene: Scene, result: Any, gt: GroundTruth, *,
+                 transport: LightTransport | None = None,
                  **meta_kw: Any) -> None:
     files: list[str] = []
     groups: dict[str, list[Layer]] = {}
@@ -377,7 +381,7 @@ def export_sample(
     write_cube: bool = False,
     denoise: bool = False,
     data_dir: str | os.PathLike[str] | None = None,
-    transport: Any = None,
+    transport: LightTransport | None = None,
 ) -> Path:
     """Compute every ground-truth layer of a rendered sample and write it atomically.
 

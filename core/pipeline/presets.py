@@ -108,7 +108,7 @@ class DatasetConfig:
         other configs keep their hash.
     relight
         Relit variants written per rendered sample (needs *store_transport*), each under light
-        spectra drawn from :data:`spectrinsic.gt_export.relight_pool.RELIGHT_POOL`.
+        spectra drawn by :func:`spectrinsic.gt_export.relight_pool.draw_light_spectra`.
     source
         Where the scenes come from, as canonical JSON: ``None`` for the library layout,
         ``{"generator": ..., "count": ..., ...}`` or ``{"scenes": [...], ...}`` (see
