@@ -224,13 +224,17 @@ def relit_render(
     return RelitSample(scene=scene, result=result, meta=meta, transport=transport)
 
 
+def _empty_folder(path: Path) -> bool:
+    return path.is_dir() and not path.is_symlink() and not any(path.iterdir())
+
+
 def _check_out(sample: Path, out: Path) -> None:
     """``out`` must be a new folder or a sample spectrinsic wrote, and not the source."""
     if not out.name or out.name.startswith(".") or out.name in ("..",):
         raise DatasetError(f"--out {str(out)!r}: expected a folder name for the relit sample")
     if out.resolve() == sample.resolve():
         raise DatasetError(f"--out {str(out)!r} is the sample itself; choose a new folder")
-    if out.exists() or out.is_symlink():
+    if (out.exists() or out.is_symlink()) and not _empty_folder(out):
         replaceable_sample(out)  # a sample spectrinsic wrote is replaced; anything else refused
     if out.parent.exists() and not out.parent.is_dir():
         raise DatasetError(f"--out {str(out)!r} lies below a file; expected a folder")
@@ -250,7 +254,7 @@ def relight(
     The new folder is a sample like any other (``spectrinsic check`` verifies it; its
     ``meta.json`` keeps the source's config hash, so it may join the source's dataset), with
     every layer computed for the new lights from the stored transport (module notes). *out_dir*
-    must not exist, or be a sample folder spectrinsic wrote (then it is replaced); its name is
+    must be new, empty, or a sample folder spectrinsic wrote (then it is replaced); its name is
     the relit sample's id. *keep_transport* stores the transport again (the relit sample can
     then be relit itself; by default it is not copied, as relighting the source is the same).
 
@@ -265,6 +269,8 @@ def relight(
     _check_out(sample, out)
     relit = relit_render(sample, lights, powers=powers, data_dir=data_dir)
     meta = relit.meta
+    if _empty_folder(out):
+        out.rmdir()  # an empty --out is allowed, as for `dataset`; rmdir removes nothing else
     cameras = meta["transport"].get("cameras") or [f"camera:{c}" for c in meta.get("cameras", [])]
     return export_sample(
         out.parent, relit.scene, relit.result, sample_id=out.name,

@@ -190,9 +190,10 @@ def _overrides(args: argparse.Namespace) -> dict[str, Any]:
         changes["denoise"] = False
     if args.direct:
         changes["direct"] = True
-    if args.store_transport:
+    # getattr: `render --ground-truth` builds its own namespace of dataset options
+    if getattr(args, "store_transport", False):
         changes["store_transport"] = True
-    if args.relight is not None:
+    if getattr(args, "relight", None) is not None:
         changes["relight"] = args.relight
     if args.noise_target is not None:
         changes["noise_target"] = args.noise_target

@@ -25,7 +25,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "all recomputed from the per-light transport the sample stores (build it with "
                     "`spectrinsic dataset --store-transport`). Spectra are registry names "
                     "(planck:3000K, daylight:5000K, cie:LED-RGB1, cie:FL11, ...). --out must be a "
-                    "new folder or a sample spectrinsic wrote; nothing else is replaced.",
+                    "new or empty folder, or a sample spectrinsic wrote; nothing else is replaced.",
     )
     p.add_argument("sample", metavar="SAMPLE", help="sample folder (with meta.json and transport.exr)")
     p.add_argument("--light", action="append", default=[], metavar="INDEX=SPECTRUM", required=True,

@@ -147,6 +147,9 @@ def test_relight_refuses_bad_requests_before_writing(built, tmp_path):
         relight(sample, {0: "cie:D65"}, foreign)
     assert (foreign / "notes.txt").read_text() == "keep me"
     assert not (tmp_path / "a").exists()
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert check_sample(relight(sample, {0: "cie:D65"}, empty)) == []  # new or empty, as for dataset
 
 
 def test_a_sample_without_transport_is_refused(built, tmp_path):
