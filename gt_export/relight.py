@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import DatasetError, SpectrinsicError
+from spectrinsic.gt_export.exr import read_exr
 from spectrinsic.gt_export.integrity import (
     META_NAME,
     file_sha256,
@@ -37,10 +38,12 @@ from spectrinsic.gt_export.integrity import (
     replaceable_sample,
 )
 from spectrinsic.gt_export.transport_file import read_transport
-from spectrinsic.gt_export.writer import SCENE_NAME
+from spectrinsic.gt_export.writer import SCENE_NAME, export_sample
+from spectrinsic.render.pipeline import merge_batches
 from spectrinsic.render.result import RenderResult
-from spectrinsic.render.transport import LightTransport
+from spectrinsic.render.transport import LightTransport, transport_result
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
+from spectrinsic.spectra import get_spectrum
 
 __all__ = ["RelitSample", "read_sample_scene", "relit_scene", "relit_render", "relight", "check_light_spectra"]
 
@@ -108,8 +111,6 @@ def check_light_spectra(lights: Mapping[int, str], n_lights: int, *, data_dir: A
                         what: str = "light") -> None:
     """Raise a one-line error unless every key is a light index below *n_lights* and every value
     names an illuminant of the spectra registry (with a did-you-mean for near misses)."""
-    from spectrinsic.spectra import get_spectrum
-
     if not lights:
         raise DatasetError(f"{what}: expected at least one INDEX=SPECTRUM, e.g. 0=planck:3000K")
     for index, name in lights.items():
@@ -152,8 +153,6 @@ def _render_meta(meta: Mapping[str, Any], transport: LightTransport, relit: Mapp
 def _aovs(sample: Path, meta: Mapping[str, Any], coverage: np.ndarray) -> dict[str, np.ndarray]:
     """The render's AOVs as they were: geometry layers from their EXR file (ids and mask back
     to their integer and boolean types, exactly: they are small integers stored as float32)."""
-    from spectrinsic.gt_export.exr import read_exr
-
     records = meta.get("layers", {})
     out: dict[str, np.ndarray] = {}
     by_file: dict[str, list[str]] = {}
@@ -200,9 +199,6 @@ def relit_render(
     powers
         ``{light index: power}`` to change brightness too (default: each light's own).
     """
-    from spectrinsic.render.pipeline import merge_batches
-    from spectrinsic.render.transport import transport_result
-
     sample = Path(sample_dir)
     meta = _source_meta(sample)
     n_lights = len(meta.get("lights", []))
@@ -263,8 +259,6 @@ def relight(
     Path
         The relit sample folder.
     """
-    from spectrinsic.gt_export.writer import export_sample
-
     sample, out = Path(sample_dir), Path(out_dir)
     _check_out(sample, out)
     relit = relit_render(sample, lights, powers=powers, data_dir=data_dir)

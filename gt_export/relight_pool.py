@@ -27,6 +27,10 @@ import numpy as np
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.integrity import read_sample_meta, sample_problem
+from spectrinsic.gt_export.layers import compute_ground_truth
+from spectrinsic.gt_export.relight import relight, relit_render
+from spectrinsic.rng import seed_from_key
+from spectrinsic.scenes.generators.lights import draw_illuminant
 
 __all__ = ["RELIT_TAG", "draw_light_spectra", "relit_variant_id", "write_relit_variants",
            "relit_problem", "relit_layers", "RandomRelight"]
@@ -39,8 +43,6 @@ def draw_light_spectra(n_lights: int, rng: np.random.Generator,
                        pool: Sequence[str] | None = None) -> dict[int, str]:
     """``{light index: illuminant name}`` for *n_lights* lights, drawn with *rng* from *pool*
     (uniformly) or, without one, from the generators' illuminant families."""
-    from spectrinsic.scenes.generators.lights import draw_illuminant
-
     if pool is not None and not pool:
         raise DatasetError("relight pool: expected at least one illuminant name")
     if pool:
@@ -58,8 +60,6 @@ def relit_variant_id(sample_id: str, k: int) -> str:
 
 
 def _variant_lights(meta: Mapping[str, Any], k: int, seed: int) -> dict[int, str]:
-    from spectrinsic.rng import seed_from_key
-
     rng = np.random.default_rng(seed_from_key(int(seed), f"relight-{k}"))
     return draw_light_spectra(len(meta.get("lights", [])), rng)
 
@@ -67,8 +67,6 @@ def _variant_lights(meta: Mapping[str, Any], k: int, seed: int) -> dict[int, str
 def write_relit_variants(sample_dir: str | os.PathLike[str], n: int, *, seed: int,
                          data_dir: Any = None) -> list[Path]:
     """Write *n* relit variants of a sample that stores its transport, beside it."""
-    from spectrinsic.gt_export.relight import relight
-
     sample = Path(sample_dir)
     meta = read_sample_meta(sample)
     if meta is None:
@@ -101,9 +99,6 @@ def relit_layers(sample_dir: str | os.PathLike[str], lights: Mapping[int, str], 
     layers then come from the raw irradiance, as in a ``--no-denoise`` build; about half the
     time at 256²) and ``cameras=False`` the camera layers.
     """
-    from spectrinsic.gt_export.layers import compute_ground_truth
-    from spectrinsic.gt_export.relight import relit_render
-
     relit = relit_render(sample_dir, lights, powers=powers, data_dir=data_dir)
     meta = relit.meta
     gt = compute_ground_truth(

@@ -44,6 +44,7 @@ from spectrinsic.gt_export.integrity import (
     sample_problem,
 )
 from spectrinsic.gt_export.layers import GroundTruth, Layer, compute_ground_truth, identities
+from spectrinsic.gt_export.transport_file import TRANSPORT_NAME, write_transport
 from spectrinsic.provenance import software_versions
 from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash
 
@@ -357,8 +358,6 @@ def _fill_folder(folder: Path, scene: Scene, result: Any, gt: GroundTruth, *,
     # records the SHA-256 of every other file, so a resumed build can tell an intact sample
     record = None
     if transport is not None:  # the per-light transport, for exact relighting
-        from spectrinsic.gt_export.transport_file import TRANSPORT_NAME, write_transport
-
         record = write_transport(folder, transport, result.aovs["coverage"], sample_id=meta_kw["sample_id"])
         record["cameras"] = list(gt.cameras)  # full sensor-set names, to relight the camera layers
         files.append(TRANSPORT_NAME)

@@ -43,9 +43,11 @@ from spectrinsic.render.modes import (
     raw_to_xyz,
     to_xyz_matrix,
 )
-from spectrinsic.render.passes import PassProgress
-from spectrinsic.render.pipeline import batch_seeds, image_noise, merge_batches
+from spectrinsic.render.passes import PassProgress, render_aovs, render_diagonal
+from spectrinsic.render.pipeline import batch_seeds, image_noise, merge_batches, render_scene
 from spectrinsic.render.result import RenderResult
+from spectrinsic.render.translate import prepare_geometry
+from spectrinsic.render.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, diagonal_values, get_sensors, responses
 
@@ -159,10 +161,6 @@ def render_transport(
     and the scene's material values, seed *seed*, *spp* samples and Russian roulette off, so
     its paths are those of a per-light render with the same settings.
     """
-    from spectrinsic.render.passes import render_diagonal
-    from spectrinsic.render.translate import prepare_geometry
-    from spectrinsic.render.variants import choose_variant, variant_scope
-
     names = diagonal_mode_names(modes)
     if not names:
         raise SceneError(f"modes {list(modes)}: the transport needs a diagonal mode (rgb3, rgb6, bands31)")
@@ -251,10 +249,6 @@ def _batch(
 ) -> tuple[dict[str, np.ndarray], RenderResult]:
     """Transport of one batch and the sample's render of that batch (other modes rendered
     directly with every light on, the AOVs from the same pixel samples)."""
-    from spectrinsic.render.passes import render_aovs
-    from spectrinsic.render.pipeline import render_scene
-    from spectrinsic.render.variants import choose_variant
-
     names = diagonal_mode_names(modes)
     others = [m for m in dict.fromkeys(modes) if m not in names]
     t, seconds = render_transport(scene, modes=names, spp=spp, seed=seed, max_depth=max_depth,

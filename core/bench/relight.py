@@ -26,6 +26,15 @@ from typing import Any
 
 import numpy as np
 
+from spectrinsic.gt_export import export_sample, load_sample
+from spectrinsic.gt_export.relight import relight, relit_render, relit_scene
+from spectrinsic.gt_export.relight_pool import relit_layers
+from spectrinsic.gt_export.transport_file import TRANSPORT_NAME
+from spectrinsic.pipeline.presets import get_preset
+from spectrinsic.render import render_batches
+from spectrinsic.render.transport import diagonal_mode_names, render_transport_batches
+from spectrinsic.scenes.library import build
+
 SCENE, VIEW, CONDITION = "room-living", 0, "two-colour-a"
 NEW_LIGHTS = {0: "cie:LED-RGB1", 1: "planck:3000K"}
 #: Goals of issue 20.
@@ -46,8 +55,6 @@ def _folder_bytes(folder: Path, skip: str | None = None) -> int:
 
 def _compose_only(sample: Path) -> None:
     """The relit raw channels and images of every batch, merged (no ground-truth layers)."""
-    from spectrinsic.gt_export.relight import relit_render
-
     relit_render(sample, NEW_LIGHTS)
 
 
@@ -62,15 +69,6 @@ def _max_errors(a: dict[str, Any], b: dict[str, Any]) -> dict[str, float]:
 
 
 def run(out_dir: Path) -> dict[str, Any]:
-    from spectrinsic.gt_export import export_sample, load_sample
-    from spectrinsic.gt_export.relight import relight, relit_scene
-    from spectrinsic.gt_export.relight_pool import relit_layers
-    from spectrinsic.gt_export.transport_file import TRANSPORT_NAME
-    from spectrinsic.pipeline.presets import get_preset
-    from spectrinsic.render import render_batches
-    from spectrinsic.render.transport import diagonal_mode_names, render_transport_batches
-    from spectrinsic.scenes.library import build
-
     cfg = get_preset("default")
     scene = build(SCENE, view=VIEW, condition=CONDITION, seed=0, width=cfg.width, height=cfg.height)
     kw: dict[str, Any] = dict(spp=cfg.spp // cfg.batches, seed=SEED, max_depth=cfg.max_depth)

@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export.relight import relight
 
 __all__ = ["register", "run", "parse_assignments"]
 
@@ -61,8 +62,6 @@ def parse_assignments(values: list[str], option: str, *, number: bool = False) -
 
 
 def run(args: argparse.Namespace) -> int:
-    from spectrinsic.gt_export.relight import relight
-
     lights = parse_assignments(args.light, "--light")
     powers = parse_assignments(args.power, "--power", number=True)
     sample = Path(args.sample)

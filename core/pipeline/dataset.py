@@ -15,6 +15,7 @@ order and the executor, so the same config and seed give the same pixels.
 from __future__ import annotations
 
 import fnmatch
+import glob
 import logging
 import os
 import resource
@@ -25,8 +26,11 @@ from pathlib import Path
 from typing import Any, Literal
 
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export.integrity import replaceable_sample
+from spectrinsic.gt_export.relight_pool import RELIT_TAG, relit_problem, write_relit_variants
 from spectrinsic.pipeline.executors import Executor, SerialExecutor
 from spectrinsic.pipeline.presets import DatasetConfig
+from spectrinsic.render.transport import render_transport_batches
 from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.sample_id import SampleId
 
@@ -257,8 +261,6 @@ def build_sample(task: SampleTask) -> SampleOutcome:
                                   variant=cfg.variant, direct=cfg.direct, data_dir=task.data_dir)
     transport = None
     if cfg.store_transport:  # diagonal modes light by light, kept per light for relighting
-        from spectrinsic.render.transport import render_transport_batches
-
         transport, result = render_transport_batches(scene, **common)
     else:
         result = render_batches(
@@ -286,8 +288,6 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         transport=transport,
     )
     if cfg.relight:
-        from spectrinsic.gt_export.relight_pool import write_relit_variants
-
         write_relit_variants(path, cfg.relight, seed=task.seed, data_dir=task.data_dir)
     seconds = time.perf_counter() - t0
     return SampleOutcome(
@@ -446,8 +446,6 @@ def _prepare(
         folder = out / t.sample_id
         problem = sample_problem(folder, config_hash)
         if problem is None and config.relight:  # a source whose relit variants are not all there
-            from spectrinsic.gt_export.relight_pool import relit_problem
-
             problem = relit_problem(folder, config.relight, config_hash)
         if problem is None:
             skipped.append(SampleOutcome(t.sample_id, "skipped", str(folder)))
@@ -470,11 +468,6 @@ def _prepare(
 
 def _relit_variants(folder: Path) -> list[Path]:
     """The relit variants (``dataset --relight``) on disk beside the sample in *folder*."""
-    import glob
-
-    from spectrinsic.gt_export.integrity import replaceable_sample
-    from spectrinsic.gt_export.relight_pool import RELIT_TAG
-
     found = sorted(p for p in folder.parent.glob(glob.escape(folder.name + RELIT_TAG) + "*") if p.is_dir())
     for path in found:
         replaceable_sample(path)  # refuses a folder (or a file in it) spectrinsic did not write

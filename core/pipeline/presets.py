@@ -15,6 +15,7 @@ from typing import Any
 from spectrinsic import provenance
 from spectrinsic.errors import DatasetError, validate_choice
 from spectrinsic.render.modes import RENDER_MODES
+from spectrinsic.render.transport import diagonal_mode_names
 
 __all__ = [
     "DatasetConfig",
@@ -168,8 +169,6 @@ class DatasetConfig:
         self._check_transport()
 
     def _check_transport(self) -> None:
-        from spectrinsic.render.transport import diagonal_mode_names
-
         if self.store_transport and not diagonal_mode_names(self.modes):
             raise DatasetError(f"--store-transport with modes {list(self.modes)}: the transport needs a "
                                "diagonal mode (rgb3, rgb6 or bands31)")
