@@ -31,14 +31,11 @@ import numpy as np
 
 from spectrinsic.errors import DatasetError, SpectrinsicError
 from spectrinsic.gt_export.exr import read_exr
-from spectrinsic.gt_export.integrity import (
-    META_NAME,
-    file_sha256,
-    read_sample_meta,
-    replaceable_sample,
-)
+from spectrinsic.gt_export.integrity import replaceable_sample
+from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, file_sha256
+from spectrinsic.gt_export.sample_meta import read_meta
 from spectrinsic.gt_export.transport_file import read_transport
-from spectrinsic.gt_export.writer import SCENE_NAME, export_sample
+from spectrinsic.gt_export.writer import export_sample
 from spectrinsic.render.pipeline import merge_batches
 from spectrinsic.render.result import RenderResult
 from spectrinsic.render.transport import LightTransport, transport_result
@@ -171,9 +168,7 @@ def _aovs(sample: Path, meta: Mapping[str, Any], coverage: np.ndarray) -> dict[s
 
 
 def _source_meta(sample: Path) -> dict[str, Any]:
-    meta = read_sample_meta(sample)
-    if meta is None:
-        raise DatasetError(f"{str(sample)!r} is not a spectrinsic sample folder (no valid {META_NAME})")
+    meta = dict(read_meta(sample).raw)  # SampleMetaError: one line naming the file and field
     if "transport" not in meta:
         raise DatasetError(f"sample {sample.name!r} stores no per-light transport; build it with "
                            "`spectrinsic dataset --store-transport` to relight it")

@@ -26,9 +26,10 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export.integrity import read_sample_meta, sample_problem
+from spectrinsic.gt_export.integrity import sample_problem
 from spectrinsic.gt_export.layers import compute_ground_truth
 from spectrinsic.gt_export.relight import relight, relit_render
+from spectrinsic.gt_export.sample_meta import read_meta
 from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.generators.lights import draw_illuminant
 
@@ -59,19 +60,17 @@ def relit_variant_id(sample_id: str, k: int) -> str:
     return f"{sample_id}{RELIT_TAG}{int(k)}"
 
 
-def _variant_lights(meta: Mapping[str, Any], k: int, seed: int) -> dict[int, str]:
+def _variant_lights(n_lights: int, k: int, seed: int) -> dict[int, str]:
     rng = np.random.default_rng(seed_from_key(int(seed), f"relight-{k}"))
-    return draw_light_spectra(len(meta.get("lights", [])), rng)
+    return draw_light_spectra(n_lights, rng)
 
 
 def write_relit_variants(sample_dir: str | os.PathLike[str], n: int, *, seed: int,
                          data_dir: Any = None) -> list[Path]:
     """Write *n* relit variants of a sample that stores its transport, beside it."""
     sample = Path(sample_dir)
-    meta = read_sample_meta(sample)
-    if meta is None:
-        raise DatasetError(f"{str(sample)!r} is not a spectrinsic sample folder")
-    return [relight(sample, _variant_lights(meta, k, seed),
+    n_lights = len(read_meta(sample).lights)
+    return [relight(sample, _variant_lights(n_lights, k, seed),
                     sample.parent / relit_variant_id(sample.name, k), data_dir=data_dir)
             for k in range(1, int(n) + 1)]
 
@@ -155,9 +154,6 @@ class RandomRelight:
 
     def __call__(self, sample_dir: str | os.PathLike[str], index: int, epoch: int = 0) -> dict[str, Any]:
         """Every layer of the sample in *sample_dir* under this item's random spectra."""
-        meta = read_sample_meta(Path(sample_dir))
-        if meta is None:
-            raise DatasetError(f"{str(sample_dir)!r} is not a spectrinsic sample folder")
-        lights = self.lights(len(meta.get("lights", [])), index, epoch)
+        lights = self.lights(len(read_meta(sample_dir).lights), index, epoch)
         return relit_layers(sample_dir, lights, data_dir=self.data_dir, denoise=self.denoise,
                             cameras=self.cameras)

@@ -26,12 +26,12 @@ import numpy as np
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.exr import read_exr, write_exr
+from spectrinsic.gt_export.sample import TRANSPORT_NAME
 from spectrinsic.render.transport import LightTransport
 from spectrinsic.spectra import get_sensors
 
 __all__ = ["TRANSPORT_NAME", "COVERAGE_LAYER", "transport_layer", "write_transport", "read_transport"]
 
-TRANSPORT_NAME = "transport.exr"
 COVERAGE_LAYER = "coverage"
 TRANSPORT_UNITS = ("raw channel ∫ radiance · S_k dλ (render units) of one light alone emitting the "
                    "flat unit spectrum L(λ) = 1 at power 1; raw_k = Σ_l T_lk · power_l ∫L_l S_k dλ / ∫S_k dλ")

@@ -3,8 +3,8 @@
 Nothing is imported from Mitsuba when this package is imported; variants are chosen per pass
 (:mod:`~spectrinsic.render.variants`) and set only inside ``variant_scope`` blocks.
 
-- :func:`render_scene` -> :class:`RenderResult`: the spectral reference and K-channel diagonal
-  renders (``rgb3``, ``rgb6``, ``bands31``) of one scene, all as CIE XYZ, with per-light and
+- :func:`render_scene` (:class:`RenderSettings`, a seed) -> :class:`RenderResult`: the
+  spectral reference and K-channel diagonal renders (``rgb3``, ``rgb6``, ``bands31``) of one scene, all as CIE XYZ, with per-light and
   direct-only renders and coverage/id/depth/normal maps; :func:`render_batches` renders it as
   independent batches whose spread measures the Monte Carlo noise.
 - :mod:`~spectrinsic.render.modes`: the mode registry and the colour maths of Eq. 5.2.
@@ -24,7 +24,6 @@ from spectrinsic.render.modes import (
 )
 from spectrinsic.render.passes import render_aovs, render_diagonal, render_spectral
 from spectrinsic.render.pipeline import (
-    DEFAULT_MODES,
     batch_seeds,
     count_passes,
     image_noise,
@@ -34,6 +33,7 @@ from spectrinsic.render.pipeline import (
     render_scene,
 )
 from spectrinsic.render.result import RenderResult
+from spectrinsic.render.settings import DEFAULT_MODES, RenderSettings
 from spectrinsic.render.translate import scene_to_mitsuba
 from spectrinsic.render.transport import LightTransport, render_transport, render_transport_batches
 from spectrinsic.render.variants import (
@@ -51,6 +51,7 @@ __all__ = [
     "RENDER_MODES",
     "RenderMode",
     "RenderResult",
+    "RenderSettings",
     "available_variants",
     "batch_seeds",
     "channel_values",

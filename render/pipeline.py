@@ -26,6 +26,9 @@ from spectrinsic.render.passes import (
     render_spectral,
 )
 from spectrinsic.render.result import RenderResult
+from spectrinsic.render.settings import DEFAULT_MODES, RenderSettings
+from spectrinsic.render.translate import prepare_geometry, surfaces
+from spectrinsic.render.variants import choose_variant, import_mitsuba, variant_scope
 from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
@@ -42,9 +45,6 @@ __all__ = [
 ]
 
 logger = logging.getLogger(__name__)
-
-DEFAULT_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
-
 
 def _modes(modes: Iterable[str]) -> list[RenderMode]:
     names = list(dict.fromkeys(modes))
@@ -65,17 +65,10 @@ def _direct_modes(direct: bool | Iterable[str], modes: Sequence[RenderMode]) -> 
     return wanted
 
 
-def count_passes(
-    scene: Scene,
-    modes: Iterable[str] = DEFAULT_MODES,
-    *,
-    per_light: bool = False,
-    per_light_modes: Iterable[str] | None = None,
-    direct: bool | Iterable[str] = False,
-    aovs: bool = True,
-    data_dir: str | None = None,
-) -> int:
+def count_passes(scene: Scene, settings: RenderSettings, *, data_dir: str | None = None) -> int:
     """Number of Mitsuba passes :func:`render_scene` runs (the total of its progress calls)."""
+    modes, per_light, per_light_modes = settings.modes, settings.per_light, settings.per_light_modes
+    direct, aovs = settings.direct, settings.aovs
     objs = _modes(modes)
     wanted = _direct_modes(direct, objs)
     split = per_light and per_light_modes is not None
@@ -83,7 +76,6 @@ def count_passes(
     colour = sum(n_passes(m, data_dir=data_dir) * (2 if m.name in wanted else 1) for m in objs)
     share_modes = _modes(per_light_modes) if per_light and per_light_modes is not None else []
     shares = sum(n_passes(m, data_dir=data_dir) for m in share_modes)
-    from spectrinsic.render.translate import surfaces
 
     aov_passes = max(1, -(-len(surfaces(scene)) // 3)) if aovs else 0
     return groups * colour + len(scene.lights) * shares + aov_passes
@@ -118,9 +110,6 @@ def _run_jobs(
     one scope and every spectral pass in another. Passes do not depend on each other's order:
     each sets its own values, seed and spp.
     """
-    from spectrinsic.render.translate import prepare_geometry
-    from spectrinsic.render.variants import choose_variant, variant_scope
-
     geometry = prepare_geometry(scene)
     outputs: list[dict[str, PassOutput]] = [{} for _ in jobs]
     aov_maps: dict[str, np.ndarray] = {}
@@ -159,47 +148,28 @@ def _run_jobs(
 
 def render_scene(
     scene: Scene,
+    settings: RenderSettings,
     *,
-    modes: Iterable[str] = DEFAULT_MODES,
-    spp: int,
     seed: int,
-    max_depth: int = 8,
-    variant: str | None = None,
-    per_light: bool = False,
-    per_light_modes: Iterable[str] | None = None,
-    direct: bool | Iterable[str] = False,
-    aovs: bool = True,
     progress: PassProgress | None = None,
     data_dir: str | None = None,
 ) -> RenderResult:
-    """Render *scene* in each of *modes* and convert every mode to CIE 1931 XYZ.
+    """Render *scene* in each of ``settings.modes`` and convert every mode to CIE 1931 XYZ.
 
+    One batch: every pass renders ``settings.batch_spp`` samples with sampler seed *seed*.
     All diagonal modes share one loaded scene and the same paths (same seed and sample count,
     Russian roulette off): ``rgb3``, ``rgb6`` and ``bands31`` differ only by spectral error.
+    With ``settings.per_light`` and no ``share_mode`` every mode is rendered light by light and
+    ``images`` is exactly the sum of the per-light images (and ``direct`` of per-light direct
+    images), costing no extra.
 
     Parameters
     ----------
-    modes
-        Names from :data:`spectrinsic.render.modes.RENDER_MODES`.
-    spp, seed
-        Samples per pixel and sampler seed, shared by every pass.
-    max_depth
-        Longest path (Mitsuba convention: 2 = direct light only).
-    variant
-        Backend (``"cuda"``, ``"llvm"``, ``"scalar"``) or variant name; default: the best usable.
-    per_light
-        Also render each light alone (one scene per light). Without *per_light_modes* every
-        mode is rendered light by light and ``images`` is exactly the sum of the per-light
-        images (and ``direct`` of per-light direct images), costing no extra.
-    per_light_modes
-        With *per_light*: render only these modes light by light, and *modes* once with every
-        light on. For light shares a 1-pass mode (``"rgb3"``) costs one pass per light instead
-        of every mode's passes per light.
-    direct
-        ``True`` for a direct-only render of every mode, or an iterable of the modes that need
-        one (e.g. only the reference, for r of Eq. 5.8).
-    aovs
-        Also compute coverage, ids, depth and normals (:func:`~spectrinsic.render.passes.render_aovs`).
+    settings
+        Modes, samples, path depth, variant, per-light, direct and AOV choices
+        (:class:`~spectrinsic.render.settings.RenderSettings`).
+    seed
+        Sampler seed, shared by every pass.
     progress
         Called with 1 after each Mitsuba pass; :func:`count_passes` gives the total.
 
@@ -207,6 +177,9 @@ def render_scene(
     -------
     RenderResult
     """
+    modes, spp, max_depth, per_light = settings.modes, settings.batch_spp, settings.max_depth, settings.per_light
+    per_light_modes, direct, aovs, variant = (settings.per_light_modes, settings.direct, settings.aovs,
+                                              settings.variant)
     objs = _modes(modes)
     wanted = _direct_modes(direct, objs)
     matrices = {m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in objs}
@@ -255,8 +228,6 @@ def _render_meta(
     variants: dict[str, str], timings: dict[str, list[float]], *, spp: int, seed: int,
     max_depth: int, per_light: bool, wanted: set[str], data_dir: str | None,
 ) -> dict[str, Any]:
-    from spectrinsic.render.variants import import_mitsuba
-
     names = [m.name for m in objs]
     return {
         "mitsuba": import_mitsuba().__version__,
@@ -289,32 +260,35 @@ def batch_seeds(seed: int, batches: int) -> list[int]:
 
 def render_batches(
     scene: Scene,
+    settings: RenderSettings,
     *,
-    batches: int,
-    spp: int,
     seed: int,
-    noise_target: float | None = None,
-    max_batches: int | None = None,
-    **options: Any,
+    progress: PassProgress | None = None,
+    data_dir: str | None = None,
 ) -> RenderResult:
-    """:func:`render_scene` as *batches* independent batches of *spp* samples each, merged.
+    """:func:`render_scene` as ``settings.batches`` independent batches, merged.
 
     Inside a batch every mode and the AOVs share seed and paths (common random numbers); the
     batches differ only in their seed (:func:`batch_seeds`), so the spread between them is a
     direct estimate of the Monte Carlo error of their mean (the noise budget of the ground
-    truth). *options* are those of :func:`render_scene`.
+    truth).
 
-    Adaptive sampling: with *noise_target*, batches are added one at a time while the median
-    relative standard error of the image (:func:`image_noise`) is above it, up to
-    *max_batches* (default ``4 * batches``). ``meta["noise_target"]`` records the target and
-    the median reached.
+    Adaptive sampling: with ``settings.noise_target``, batches are added one at a time while
+    the median relative standard error of the image (:func:`image_noise`) is above it, up to
+    ``settings.max_batches`` (default ``4 * batches``). ``meta["noise_target"]`` records the
+    target and the median reached.
     """
-    cap = max(batches, max_batches if max_batches is not None else 4 * batches)
+    batches, noise_target = settings.batches, settings.noise_target
+    cap = max(batches, settings.max_batches if settings.max_batches is not None else 4 * batches)
     seeds = batch_seeds(seed, cap if noise_target is not None else batches)
-    results = [render_scene(scene, spp=spp, seed=s, **options) for s in seeds[:batches]]
+
+    def one(s: int) -> RenderResult:
+        return render_scene(scene, settings, seed=s, progress=progress, data_dir=data_dir)
+
+    results = [one(s) for s in seeds[:batches]]
     reached = image_noise(results) if noise_target is not None else None
-    while reached is not None and reached > float(noise_target) and len(results) < cap:  # type: ignore[arg-type]
-        results.append(render_scene(scene, spp=spp, seed=seeds[len(results)], **options))
+    while reached is not None and noise_target is not None and reached > noise_target and len(results) < cap:
+        results.append(one(seeds[len(results)]))
         reached = image_noise(results)
     merged = merge_batches(results)
     if noise_target is not None:

@@ -46,6 +46,7 @@ from spectrinsic.render.modes import (
 from spectrinsic.render.passes import PassProgress, render_aovs, render_diagonal
 from spectrinsic.render.pipeline import batch_seeds, image_noise, merge_batches, render_scene
 from spectrinsic.render.result import RenderResult
+from spectrinsic.render.settings import RenderSettings
 from spectrinsic.render.translate import prepare_geometry
 from spectrinsic.render.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Scene
@@ -146,21 +147,20 @@ def _unit_values(scene: Scene, sensors: str, data_dir: str | None) -> ChannelVal
 
 def render_transport(
     scene: Scene,
+    settings: RenderSettings,
     *,
-    modes: Sequence[str],
-    spp: int,
     seed: int,
-    max_depth: int = 8,
-    variant: str | None = None,
     progress: PassProgress | None = None,
     data_dir: str | None = None,
 ) -> tuple[dict[str, np.ndarray], dict[str, tuple[float, ...]]]:
     """One batch of transport: mode -> ``(L, H, W, K)`` float32 ``T_lk`` and the pass seconds.
 
     Each light is rendered alone (its own scene load) with the flat unit spectrum at power 1
-    and the scene's material values, seed *seed*, *spp* samples and Russian roulette off, so
-    its paths are those of a per-light render with the same settings.
+    and the scene's material values, seed *seed*, ``settings.batch_spp`` samples, depth
+    ``settings.max_depth`` and Russian roulette off, so its paths are those of a per-light
+    render with the same settings; only the diagonal ones of ``settings.modes`` are rendered.
     """
+    modes, spp, max_depth, variant = settings.modes, settings.batch_spp, settings.max_depth, settings.variant
     names = diagonal_mode_names(modes)
     if not names:
         raise SceneError(f"modes {list(modes)}: the transport needs a diagonal mode (rgb3, rgb6, bands31)")
@@ -244,23 +244,25 @@ def _join(diagonal: RenderResult, other: RenderResult | None, aovs: Mapping[str,
 
 
 def _batch(
-    scene: Scene, seed: int, *, modes: Sequence[str], spp: int, max_depth: int, variant: str | None,
-    direct: bool, progress: PassProgress | None, data_dir: str | None,
+    scene: Scene, settings: RenderSettings, seed: int, *, progress: PassProgress | None, data_dir: str | None,
 ) -> tuple[dict[str, np.ndarray], RenderResult]:
     """Transport of one batch and the sample's render of that batch (other modes rendered
     directly with every light on, the AOVs from the same pixel samples)."""
+    modes, spp, variant = settings.modes, settings.batch_spp, settings.variant
     names = diagonal_mode_names(modes)
-    others = [m for m in dict.fromkeys(modes) if m not in names]
-    t, seconds = render_transport(scene, modes=names, spp=spp, seed=seed, max_depth=max_depth,
-                                  variant=variant, progress=progress, data_dir=data_dir)
+    others = tuple(m for m in dict.fromkeys(modes) if m not in names)
+    t, seconds = render_transport(scene, settings, seed=seed, progress=progress, data_dir=data_dir)
     rgb = choose_variant("rgb", variant)
     timing = {m: {"passes": len(s), "seconds": float(sum(s)), "per_pass": list(s)} for m, s in seconds.items()}
-    base = {"max_depth": int(max_depth), "timings": timing, "variants": dict.fromkeys(names, rgb)}
+    base = {"max_depth": int(settings.max_depth), "timings": timing, "variants": dict.fromkeys(names, rgb)}
     diagonal = transport_result(t, scene, seed=seed, spp=spp, meta=base, data_dir=data_dir)
     other = None
     if others:
-        other = render_scene(scene, modes=others, spp=spp, seed=seed, max_depth=max_depth, variant=variant,
-                             direct=direct, aovs=True, progress=progress, data_dir=data_dir)
+        direct = settings.direct if isinstance(settings.direct, bool) else tuple(
+            m for m in settings.direct if m in others)
+        other = render_scene(scene, settings.with_options(modes=others, per_light=False, share_mode=None,
+                                                          direct=direct, aovs=True),
+                             seed=seed, progress=progress, data_dir=data_dir)
         aovs = other.aovs
     else:
         aovs, aov_seconds = render_aovs(scene, spp=spp, seed=seed, variant=variant, progress=progress)
@@ -271,16 +273,9 @@ def _batch(
 
 def render_transport_batches(
     scene: Scene,
+    settings: RenderSettings,
     *,
-    modes: Sequence[str],
-    batches: int,
-    spp: int,
     seed: int,
-    max_depth: int = 8,
-    variant: str | None = None,
-    direct: bool = False,
-    noise_target: float | None = None,
-    max_batches: int | None = None,
     progress: PassProgress | None = None,
     data_dir: str | None = None,
 ) -> tuple[LightTransport, RenderResult]:
@@ -289,20 +284,21 @@ def render_transport_batches(
     The diagonal modes of every batch are composed from the transport with the scene's own
     spectra (:func:`transport_result`), so relighting the sample with those spectra gives it
     back exactly; the other modes (the spectral reference) are rendered directly with every
-    light on, with a direct-only render when *direct*. Batches, seeds and adaptive sampling
-    (*noise_target*, *max_batches*) follow :func:`~spectrinsic.render.render_batches`.
+    light on, with a direct-only render when ``settings.direct``. Batches, seeds and adaptive
+    sampling (``settings.noise_target``, ``settings.max_batches``) follow
+    :func:`~spectrinsic.render.render_batches`; ``per_light`` and ``share_mode`` do not apply
+    (the transport is per light already).
     """
-    if direct and not [m for m in modes if m not in diagonal_mode_names(modes)]:
+    modes, batches, noise_target = settings.modes, settings.batches, settings.noise_target
+    if settings.direct and not [m for m in modes if m not in diagonal_mode_names(modes)]:
         raise SceneError("direct-only renders with the transport need the 'spectral' mode "
                          "(the diagonal modes are composed, not rendered with every light)")
-    cap = max(batches, max_batches if max_batches is not None else 4 * batches)
+    cap = max(batches, settings.max_batches if settings.max_batches is not None else 4 * batches)
     seeds = batch_seeds(seed, cap if noise_target is not None else batches)
-    kw: dict[str, Any] = dict(modes=modes, spp=spp, max_depth=max_depth, variant=variant, direct=direct,
-                              progress=progress, data_dir=data_dir)
-    done = [_batch(scene, s, **kw) for s in seeds[:batches]]
+    done = [_batch(scene, settings, s, progress=progress, data_dir=data_dir) for s in seeds[:batches]]
     reached = image_noise([r for _, r in done]) if noise_target is not None else None
-    while reached is not None and reached > float(noise_target) and len(done) < cap:  # type: ignore[arg-type]
-        done.append(_batch(scene, seeds[len(done)], **kw))
+    while reached is not None and noise_target is not None and reached > noise_target and len(done) < cap:
+        done.append(_batch(scene, settings, seeds[len(done)], progress=progress, data_dir=data_dir))
         reached = image_noise([r for _, r in done])
     merged = merge_batches([r for _, r in done])
     if noise_target is not None:
@@ -312,7 +308,7 @@ def render_transport_batches(
     transport = LightTransport(
         modes=names, sensors={m: get_mode(m).sensors for m in names},
         batches=tuple(t for t, _ in done), seeds=tuple(int(s) for s in seeds[:len(done)]),
-        spp=int(spp), max_depth=int(max_depth), seconds=seconds,
+        spp=int(settings.batch_spp), max_depth=int(settings.max_depth), seconds=seconds,
     )
     merged.meta["transport"] = {"modes": list(names), "batches": len(done)}
     logger.debug("transport of %s: %d light(s), %d batch(es)", scene.name, transport.n_lights, len(done))

@@ -71,16 +71,17 @@ def _max_errors(a: dict[str, Any], b: dict[str, Any]) -> dict[str, float]:
 def run(out_dir: Path) -> dict[str, Any]:
     cfg = get_preset("default")
     scene = build(SCENE, view=VIEW, condition=CONDITION, seed=0, width=cfg.width, height=cfg.height)
-    kw: dict[str, Any] = dict(spp=cfg.spp // cfg.batches, seed=SEED, max_depth=cfg.max_depth)
-    render_batches(dataclasses.replace(scene, camera=dataclasses.replace(scene.camera, width=32, height=32)),
-                   batches=1, modes=cfg.modes, per_light=True, **kw)  # warm-up: compile kernels
-    _, plain_s = _timed(render_batches, scene, batches=cfg.batches, modes=cfg.modes, per_light=True,
-                        per_light_modes=(cfg.share_mode,), **kw)
-    (transport, result), transport_s = _timed(render_transport_batches, scene, modes=cfg.modes,
-                                              batches=cfg.batches, **kw)
+    settings = cfg.render
+    small = dataclasses.replace(scene, camera=dataclasses.replace(scene.camera, width=32, height=32))
+    render_batches(small, settings.with_options(batches=1, spp=settings.batch_spp),
+                   seed=SEED)  # warm-up: compile kernels
+    _, plain_s = _timed(render_batches, scene, settings, seed=SEED)
+    (transport, result), transport_s = _timed(render_transport_batches, scene, settings, seed=SEED)
     new_scene = relit_scene(scene, NEW_LIGHTS)
-    direct, direct_s = _timed(render_batches, new_scene, batches=cfg.batches,
-                              modes=diagonal_mode_names(cfg.modes), per_light=True, **kw)
+    # every diagonal mode light by light, as the transport renders them
+    light_by_light = settings.with_options(modes=diagonal_mode_names(settings.modes), per_light=True,
+                                           share_mode=None, direct=False)
+    direct, direct_s = _timed(render_batches, new_scene, light_by_light, seed=SEED)
     cameras = cfg.resolved_cameras()
     with tempfile.TemporaryDirectory(dir=out_dir) as tmp:
         root = Path(tmp)
@@ -96,7 +97,7 @@ def run(out_dir: Path) -> dict[str, Any]:
     worst = max(errors, key=errors.__getitem__)
     return {
         "scene": f"{SCENE}__v{VIEW}__{CONDITION}", "size": [cfg.width, cfg.height],
-        "spp": cfg.spp, "batches": cfg.batches, "lights": len(scene.lights),
+        "spp": settings.spp, "batches": settings.batches, "lights": len(scene.lights),
         "transport_modes": list(transport.modes), "new_lights": {str(k): v for k, v in NEW_LIGHTS.items()},
         "render_seconds_default_build": plain_s,
         "render_seconds_store_transport": transport_s,
@@ -109,7 +110,7 @@ def run(out_dir: Path) -> dict[str, Any]:
                               "sample_folder": transport_s / folder_s},
         "speedup_goal": SPEEDUP_GOAL,
         "disk_bytes": {"transport": transport_bytes, "rest_of_sample": rest_bytes,
-                       "transport_per_light_per_batch": transport_bytes / (len(scene.lights) * cfg.batches),
+                       "transport_per_light_per_batch": transport_bytes / (len(scene.lights) * settings.batches),
                        "ratio_transport_to_rest": transport_bytes / rest_bytes},
         "exactness_max_relative": {"worst_layer": worst, "value": errors[worst], "goal": EXACT_GOAL,
                                    "layers_compared": len(errors), "met": errors[worst] <= EXACT_GOAL},

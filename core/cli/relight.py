@@ -12,7 +12,9 @@ import time
 from pathlib import Path
 
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export.outfolder import check_out_folder, check_unlocked, folder_lock
 from spectrinsic.gt_export.relight import relight
+from spectrinsic.gt_export.sample_meta import owned_files
 
 __all__ = ["register", "run", "parse_assignments"]
 
@@ -26,7 +28,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "all recomputed from the per-light transport the sample stores (build it with "
                     "`spectrinsic dataset --store-transport`). Spectra are registry names "
                     "(planck:3000K, daylight:5000K, cie:LED-RGB1, cie:FL11, ...). --out must be a "
-                    "new or empty folder, or a sample spectrinsic wrote; nothing else is replaced.",
+                    "new or empty folder, or a sample spectrinsic wrote, outside any dataset; "
+                    "nothing else is replaced. The folder holding --out is locked while it is written.",
     )
     p.add_argument("sample", metavar="SAMPLE", help="sample folder (with meta.json and transport.exr)")
     p.add_argument("--light", action="append", default=[], metavar="INDEX=SPECTRUM", required=True,
@@ -67,9 +70,17 @@ def run(args: argparse.Namespace) -> int:
     sample = Path(args.sample)
     if not sample.is_dir():
         raise DatasetError(f"SAMPLE {str(sample)!r} is not a folder; expected a sample folder")
+    # the --out rule of every writing verb: new, empty or a sample spectrinsic wrote
+    check_out_folder(args.out, own=lambda p: owned_files(p) is not None,
+                     what="a sample folder spectrinsic wrote")
+    # the lock is on the folder that receives the sample: the sample folder itself is
+    # replaced whole (a new folder renamed over it), so it cannot hold a lock file
+    parent = args.out.absolute().parent
+    check_unlocked(parent)
     start = time.perf_counter()
-    out = relight(sample, lights, args.out, powers=powers, data_dir=args.data_dir,  # type: ignore[arg-type]
-                  keep_transport=args.keep_transport)
+    with folder_lock(parent):
+        out = relight(sample, lights, args.out, powers=powers, data_dir=args.data_dir,  # type: ignore[arg-type]
+                      keep_transport=args.keep_transport)
     if not args.quiet:
         print(f"spectrinsic relight: wrote {out} in {time.perf_counter() - start:.2f} s", file=sys.stderr)
     print(out)

@@ -61,3 +61,24 @@ def test_every_verb_and_option_explains_itself():
             if not isinstance(action, argparse._HelpAction) and not action.help:
                 missing.append(f"{name} {'/'.join(action.option_strings) or action.dest}: no help")
     assert not missing, missing
+
+
+def test_render_reads_a_mesh_file_as_dataset_scenes_does(tmp_path, capsys):
+    """Issue 18: `render x.obj` works like `render x.obj --ground-truth` (one scene-file
+    dispatch, scenes.sources.load_scene_file); it failed before (read as YAML)."""
+    import json
+
+    from spectrinsic.cli import main
+
+    obj = tmp_path / "tri.obj"
+    (tmp_path / "tri.mtl").write_text("newmtl red\nKd 1 0 0\n")
+    obj.write_text("mtllib tri.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n")
+    (tmp_path / "map.yaml").write_text("red: 'munsell:5R 4/14'\n")
+    out = tmp_path / "out"
+    rc = main(["-q", "render", str(obj), "--material-map", str(tmp_path / "map.yaml"), "--out", str(out),
+               "--modes", "rgb3", "--spp", "1", "--width", "8", "--height", "6", "--no-aovs"])
+    assert rc == 0, capsys.readouterr().err
+    meta = json.loads((out / "meta.json").read_text())
+    assert [m["spectrum"] for m in meta["scene"]["materials"]] == ["munsell:5R 4/14"]
+    assert (meta["scene"]["camera"]["width"], meta["scene"]["camera"]["height"]) == (8, 6)
+    assert (out / "rgb3.exr").is_file()

@@ -19,7 +19,7 @@ from spectrinsic.gt_export import check_sample, export_sample, load_sample
 from spectrinsic.gt_export.relight import relight, relit_scene
 from spectrinsic.gt_export.relight_pool import RandomRelight, relit_layers
 from spectrinsic.gt_export.transport_file import TRANSPORT_NAME
-from spectrinsic.render import render_batches
+from spectrinsic.render import RenderSettings, render_batches
 from spectrinsic.render.transport import render_transport_batches
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "render"))
@@ -30,7 +30,9 @@ from conftest import box_room  # noqa: E402  (the rendering tests' tiny scenes)
 RELIGHT_RTOL = 1e-5
 NEW_LIGHTS = {0: "cie:LED-RGB1", 1: "planck:3000K"}  # were planck:2800K, daylight:6500K
 MODES = ("spectral", "rgb3", "rgb6", "bands31")
-RENDER = {"spp": 2, "seed": 11, "max_depth": 4}
+SEED = 11
+#: Two batches of 2 samples per pixel each.
+SETTINGS = RenderSettings(spp=4, modes=MODES, batches=2, max_depth=4)
 CONFIG = {"test": "relight"}
 
 
@@ -39,9 +41,9 @@ def built(tmp_path_factory):
     """A two-light room sample stored with its transport (2 batches, denoised, two cameras)."""
     out = tmp_path_factory.mktemp("relight")
     scene = box_room(size=16)
-    transport, result = render_transport_batches(scene, modes=MODES, batches=2, **RENDER)
+    transport, result = render_transport_batches(scene, SETTINGS, seed=SEED)
     sample = export_sample(out, scene, result, sample_id="room__v0__two", config=CONFIG,
-                           seed=RENDER["seed"], denoise=True, transport=transport)
+                           seed=SEED, denoise=True, transport=transport)
     return out, scene, sample
 
 
@@ -59,9 +61,9 @@ def test_relit_sample_equals_a_direct_render_with_the_new_spectra(built):
     relit = relight(sample, NEW_LIGHTS, out / "relit__v0__two")
     assert check_sample(relit) == []
     new_scene = relit_scene(scene, NEW_LIGHTS)
-    direct = render_batches(new_scene, batches=2, modes=MODES[1:], per_light=True, aovs=True, **RENDER)
+    direct = render_batches(new_scene, SETTINGS.with_options(modes=MODES[1:], per_light=True), seed=SEED)
     reference = export_sample(out, new_scene, direct, sample_id="direct__v0__two", config=CONFIG,
-                              seed=RENDER["seed"], denoise=True)
+                              seed=SEED, denoise=True)
     a, b = _arrays(load_sample(relit)), _arrays(load_sample(reference))
     assert set(a) == set(b)
     assert {"image", "shading", "residual", "illuminant", "light_share", "noise_image", "image_denoised",
@@ -154,7 +156,8 @@ def test_relight_refuses_bad_requests_before_writing(built, tmp_path):
 
 def test_a_sample_without_transport_is_refused(built, tmp_path):
     out, scene, _ = built
-    result = render_batches(scene, batches=1, modes=("rgb3",), per_light=True, aovs=True, **RENDER)
+    result = render_batches(scene, SETTINGS.with_options(modes=("rgb3",), per_light=True, spp=2, batches=1),
+                            seed=SEED)
     plain = export_sample(out, scene, result, sample_id="plain__v0__two", config=CONFIG, seed=1)
     with pytest.raises(DatasetError, match="--store-transport"):
         relight(plain, {0: "cie:D65"}, tmp_path / "x")

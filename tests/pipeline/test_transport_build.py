@@ -16,9 +16,9 @@ from spectrinsic.gt_export import check_dataset
 from spectrinsic.pipeline.dataset import build_dataset
 from spectrinsic.pipeline.presets import DatasetConfig
 
-TINY = DatasetConfig(preset="tiny-test", width=12, height=12, spp=4, max_depth=3, batches=2,
-                     modes=("spectral", "rgb3", "bands31"), denoise=True, seed=5, write_cube=True,
-                     store_transport=True, relight=1)
+TINY = DatasetConfig.from_settings("tiny-test", width=12, height=12, spp=4, max_depth=3, batches=2,
+                                   modes=("spectral", "rgb3", "bands31"), denoise=True, seed=5,
+                                   write_cube=True, store_transport=True, relight=1)
 SAMPLE = "room-living__v0__two-colour-a"
 RELIT = SAMPLE + "-relit1"
 
@@ -62,8 +62,9 @@ def test_a_missing_relit_variant_is_rebuilt_on_resume(built, tmp_path):
 
 
 def test_transport_settings_leave_other_configs_hash_alone():
-    plain = DatasetConfig(preset="p", width=8, height=8, spp=2)
+    plain = DatasetConfig.from_settings("p", width=8, height=8, spp=2)
     assert "store_transport" not in plain.settings() and "relight" not in plain.settings()
+    assert plain.with_options(store_transport=False, relight=0).config_hash() == plain.config_hash()
     assert plain.with_options(store_transport=True).config_hash() != plain.config_hash()
     with pytest.raises(DatasetError, match="needs --store-transport"):
         plain.with_options(relight=2)

@@ -6,9 +6,12 @@ import dataclasses
 
 import numpy as np
 
+from spectrinsic.render import RenderSettings
 from spectrinsic.render.transport import render_transport, render_transport_batches
 
-RENDER = {"spp": 2, "seed": 4, "max_depth": 3}
+SEED = 4
+#: Two samples per pixel per batch.
+SETTINGS = RenderSettings(spp=2, modes=("rgb3", "bands31"), max_depth=3)
 
 
 def test_transport_does_not_depend_on_the_light_spectra_or_powers(make_room):
@@ -19,8 +22,8 @@ def test_transport_does_not_depend_on_the_light_spectra_or_powers(make_room):
     other = dataclasses.replace(scene, lights=tuple(
         dataclasses.replace(li, spectrum=s, power=7.0 * li.power)
         for li, s in zip(scene.lights, ("cie:LED-RGB1", "cie:FL11"), strict=True)))
-    a, _ = render_transport(scene, modes=("rgb3", "bands31"), **RENDER)
-    b, _ = render_transport(other, modes=("rgb3", "bands31"), **RENDER)
+    a, _ = render_transport(scene, SETTINGS, seed=SEED)
+    b, _ = render_transport(other, SETTINGS, seed=SEED)
     assert set(a) == {"rgb3", "bands31"} and a["bands31"].shape == (2, 8, 8, 31)
     for mode in a:
         np.testing.assert_array_equal(a[mode], b[mode])
@@ -30,9 +33,11 @@ def test_transport_does_not_depend_on_the_light_spectra_or_powers(make_room):
 
 def test_noise_target_adds_batches_to_the_transport_as_to_the_render(make_room):
     scene = make_room(size=8)
-    transport, result = render_transport_batches(scene, modes=("rgb3",), batches=2, noise_target=1e-9,
-                                                 max_batches=3, **RENDER)
+    transport, result = render_transport_batches(
+        scene, SETTINGS.with_options(modes=("rgb3",), spp=4, batches=2, noise_target=1e-9, max_batches=3),
+        seed=SEED)
     assert len(transport.batches) == 3 and len(result.batch_raw) == 3
     assert transport.seeds == tuple(result.meta["batch_seeds"])
     assert result.meta["noise_target"]["max_batches"] == 3
-    assert result.meta["spp"] == 3 * RENDER["spp"]
+    assert result.meta["spp"] == 3 * SETTINGS.batch_spp
+    assert transport.spp == SETTINGS.batch_spp
