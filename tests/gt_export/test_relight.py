@@ -225,3 +225,38 @@ def test_cheap_augmentation_leaves_out_denoising_and_cameras_only(built):
     for key in ("image", "reflectance", "noise_image", "light_share"):
         np.testing.assert_array_equal(cheap[key], full[key], err_msg=key)
     np.testing.assert_array_equal(cheap["shading"], full["shading_raw"])  # undenoised = the raw one
+
+
+def test_cli_follows_the_out_rule_and_the_lock_of_every_writing_verb(built, tmp_path, capsys):
+    """--out inside a dataset is refused, and so is one whose folder another run holds: one
+    line, status 2, before any relighting, and nothing written."""
+    import subprocess
+
+    from spectrinsic.cli import main
+
+    _, _, sample = built
+    dataset = tmp_path / "ds"
+    dataset.mkdir()
+    (dataset / "manifest.json").write_text(json.dumps({"format_version": 1, "config_hash": "h"}))
+    rc = main(["-q", "relight", str(sample), "--light", "0=cie:D65", "--out", str(dataset / "relit__v0__x")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1 and "inside the dataset folder" in err, err
+    assert sorted(p.name for p in dataset.iterdir()) == ["manifest.json"]
+
+    held = tmp_path / "held"
+    code = ("import sys; from pathlib import Path; from spectrinsic.gt_export.outfolder import folder_lock\n"
+            f"with folder_lock(Path({str(held)!r})):\n"
+            "    print('held', flush=True); sys.stdin.read()\n")
+    proc = subprocess.Popen([sys.executable, "-P", "-c", code], stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout is not None and proc.stdout.readline().strip() == "held"
+        rc = main(["-q", "relight", str(sample), "--light", "0=cie:D65", "--out", str(held / "relit__v0__x")])
+        err = capsys.readouterr().err.strip()
+    finally:
+        assert proc.stdin is not None
+        proc.stdin.close()
+        assert proc.wait(timeout=60) == 0
+    assert rc == 2 and len(err.splitlines()) == 1, err
+    assert "in use by another spectrinsic run" in err and f"pid {proc.pid}" in err
+    assert not held.exists()  # the holder removed its folder; the refused run wrote nothing
