@@ -25,6 +25,7 @@ from spectrinsic.gt_export.gallery import build_gallery, contact_sheet
 from spectrinsic.gt_export.layers import GroundTruth, Layer, LightRecord, compute_ground_truth
 from spectrinsic.gt_export.loader import load_dataset, load_sample, torch_dataset
 from spectrinsic.gt_export.manifest import write_manifest
+from spectrinsic.gt_export.relight import relight
 from spectrinsic.gt_export.sample import config_hash, sample_dirs
 from spectrinsic.gt_export.sample_meta import SampleMeta, read_meta
 from spectrinsic.gt_export.writer import (
@@ -52,6 +53,7 @@ __all__ = [
     "load_sample",
     "read_exr",
     "read_meta",
+    "relight",
     "remove_stale_temporaries",
     "sample_dirs",
     "torch_dataset",

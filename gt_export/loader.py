@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -181,13 +181,17 @@ def torch_dataset(
     seed: int | None = None,
     normalize_exposure: bool = False,
     transform: Any = None,
+    relight: Callable[[Path, int, int], dict[str, Any]] | None = None,
 ) -> Any:
     """A map-style ``torch.utils.data.Dataset`` over a dataset folder.
 
     Each item is :func:`prepare_item` with arrays as tensors: every layer (``keys=None``) or
     the chosen ones, ``ids`` (a dict of int tensors), the cube when written, ``sample_id`` and
     ``scene``; images ``(C, H, W)`` float32, masks ``(1, H, W)`` bool. *transform*, if given,
-    is applied to each item dict; *verify* is :func:`load_sample`'s. Random crops need *seed*: item *i* is cropped with
+    is applied to each item dict; *verify* is :func:`load_sample`'s. *relight* (a
+    :class:`~spectrinsic.gt_export.relight_pool.RandomRelight`) replaces each sample by itself
+    relit under random light spectra (samples built with ``--store-transport``). Random crops
+    need *seed*: item *i* is cropped with
     ``default_rng([seed, i])``, the same on every worker and epoch. torch is imported only here.
 
     Raises
@@ -213,11 +217,21 @@ def torch_dataset(
         return {k: tensors(v) for k, v in value.items()} if isinstance(value, dict) else value
 
     class SpectrinsicDataset(Dataset):  # type: ignore[misc, valid-type]
+        #: Epoch passed to *relight* (``set_epoch`` before each epoch draws new spectra).
+        epoch = 0
+
+        def set_epoch(self, epoch: int) -> None:
+            self.epoch = int(epoch)
+
         def __len__(self) -> int:
             return len(folders)
 
         def __getitem__(self, index: int) -> dict[str, Any]:
-            sample = load_sample(folders[index], layers=wanted, verify=verify)
+            if relight is None:
+                sample = load_sample(folders[index], layers=wanted, verify=verify)
+            else:
+                relit = relight(folders[index], index, self.epoch)
+                sample = {k: v for k, v in relit.items() if wanted is None or k in wanted or k == "meta"}
             rng = None if seed is None else np.random.default_rng([seed, index])
             item = tensors(prepare_item(sample, crop=crop, rng=rng,
                                         normalize_exposure=normalize_exposure))

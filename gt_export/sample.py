@@ -59,6 +59,8 @@ META_NAME = "meta.json"
 MANIFEST_NAME = "manifest.json"
 #: The rendered scene as plain data (:func:`spectrinsic.scenes.model.scene_to_dict`), compact JSON.
 SCENE_NAME = "scene.json"
+#: The per-light transport of a sample built with ``dataset --store-transport``.
+TRANSPORT_NAME = "transport.exr"
 CARD_NAME = "DATASET.md"
 PREVIEW_DIR = "previews"
 #: Prefix of every temporary file or folder spectrinsic creates inside a dataset folder. Only

@@ -33,6 +33,7 @@ from spectrinsic.gt_export.sample import (
     META_NAME,
     READABLE_FORMATS,
     SEAL_KEY,
+    TRANSPORT_NAME,
     confined_path,
     meta_seal,
 )
@@ -56,6 +57,9 @@ META_FIELDS = frozenset({
     "lights", "cameras", "cube_sensors", "matrices", "layers", "identities", "denoised_layers",
     "noise", "shading_clipping", "files", "versions", HASHES_KEY,
 })
+#: Fields written only by some builds: ``transport`` (``dataset --store-transport``, the record
+#: of :func:`~spectrinsic.gt_export.transport_file.write_transport`).
+OPTIONAL_META_FIELDS = frozenset({"transport"})
 _LAYER_FIELDS = frozenset({"file", "exr_layer", "channels", "shape", "dtype", "units",
                            "nonnegative", "preview", "preview_encoding"})
 _NOISE_FIELDS = frozenset({"median", "p95", "rms", "pixels"})
@@ -153,6 +157,8 @@ class SampleMeta:
     #: Whether the content matched its seal (``None``: format 2 has none; not verified).
     sealed: bool | None
     raw: Mapping[str, Any] = field(repr=False)
+    #: The stored per-light transport's record (``transport.exr``), ``None`` when not stored.
+    transport: Mapping[str, Any] | None = None
 
     @property
     def folder(self) -> Path:
@@ -268,7 +274,8 @@ def parse_meta(meta: object, path: Path, *, verify: bool = True) -> SampleMeta:
     version = meta.get("format_version")
     if version not in READABLE_FORMATS or isinstance(version, bool):
         raise f.fail("format_version", f"one of {list(READABLE_FORMATS)}", version)
-    f.exact_keys(meta, "", META_FIELDS | ({SEAL_KEY} if version >= 3 else set()))
+    required = META_FIELDS | ({SEAL_KEY} if version >= 3 else set())
+    f.exact_keys(meta, "", required | OPTIONAL_META_FIELDS, required)
     sample_id = f.text(meta["sample_id"], "sample_id")
     if sample_id != path.parent.name:
         raise f.fail("sample_id", f"the folder's name {path.parent.name!r}", sample_id)
@@ -286,6 +293,11 @@ def parse_meta(meta: object, path: Path, *, verify: bool = True) -> SampleMeta:
     f.text(meta["scene_hash"], "scene_hash")
     materials = f.mapping(meta["materials"], "materials")
     files, hashes = _files(f, meta)
+    transport = None
+    if "transport" in meta:
+        transport = MappingProxyType(f.mapping(meta["transport"], "transport"))
+        if TRANSPORT_NAME not in files:
+            raise f.fail("transport", "a record of a transport file the sample lists", dict(transport))
     record = SampleMeta(
         path=path, format_version=version, sample_id=sample_id,
         scene=f.text(meta["scene"], "scene"), config_hash=f.text(meta["config_hash"], "config_hash"),
@@ -301,6 +313,7 @@ def parse_meta(meta: object, path: Path, *, verify: bool = True) -> SampleMeta:
                          for i, v in enumerate(f.sequence(meta["identities"], "identities"))),
         noise=MappingProxyType(_noise(f, meta["noise"])),
         files=files, hashes=MappingProxyType(hashes), sealed=None, raw=MappingProxyType(meta),
+        transport=transport,
     )
     # the seal last: a field that is wrong is named above; this catches what no schema can
     return replace(record, sealed=_sealed(f, meta, verify)) if version >= 3 else record

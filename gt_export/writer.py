@@ -27,7 +27,7 @@ import uuid
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import png
@@ -55,9 +55,13 @@ from spectrinsic.gt_export.sample import (
     meta_seal,
     plain_data,
 )
+from spectrinsic.gt_export.transport_file import TRANSPORT_NAME, write_transport
 from spectrinsic.provenance import software_versions
 from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash
 from spectrinsic.spectra import DEFAULT_WAVELENGTHS, get_spectrum
+
+if TYPE_CHECKING:
+    from spectrinsic.render.transport import LightTransport
 
 __all__ = [
     "DEFAULT_CAMERAS",
@@ -175,7 +179,8 @@ def _write_previews(folder: Path, gt: GroundTruth) -> dict[str, tuple[str, dict[
     return previews
 
 
-def _fill_folder(folder: Path, scene: Scene, result: Any, gt: GroundTruth, **meta_kw: Any) -> None:
+def _fill_folder(folder: Path, scene: Scene, result: Any, gt: GroundTruth, *,
+                 transport: LightTransport | None = None, **meta_kw: Any) -> None:
     files = _write_layers(folder, gt, meta_kw["sample_id"])
     previews = _write_previews(folder, gt)
     files += [rel for rel, _ in previews.values()]
@@ -186,7 +191,14 @@ def _fill_folder(folder: Path, scene: Scene, result: Any, gt: GroundTruth, **met
     # meta.json last: its presence (with the right config hash) marks the folder complete; it
     # records the SHA-256 of every other file, so a resumed build can tell an intact sample,
     # and its own seal, so it can tell an intact meta.json
+    record = None
+    if transport is not None:  # the per-light transport, for exact relighting
+        record = write_transport(folder, transport, result.aovs["coverage"], sample_id=meta_kw["sample_id"])
+        record["cameras"] = list(gt.cameras)  # full sensor-set names, to relight the camera layers
+        files.append(TRANSPORT_NAME)
     meta = _meta(scene, result, gt, previews=previews, files=files, **meta_kw)
+    if record is not None:  # before the hashes and the seal, which cover it
+        meta["transport"] = record
     meta[HASHES_KEY] = {rel: file_sha256(folder / rel) for rel in sorted(files)}
     meta = plain_data(meta, META_DIGITS)
     meta[SEAL_KEY] = meta_seal(meta)
@@ -205,6 +217,7 @@ def export_sample(
     write_cube: bool = False,
     denoise: bool = False,
     data_dir: str | os.PathLike[str] | None = None,
+    transport: LightTransport | None = None,
 ) -> Path:
     """Compute every ground-truth layer of a rendered sample and write it atomically.
 
@@ -233,6 +246,10 @@ def export_sample(
         Compute shading, residual and illuminant from the OIDN-denoised irradiance.
     data_dir
         Spectral data directory (for ``sfu:``/data-directory cameras).
+    transport
+        A :class:`~spectrinsic.render.transport.LightTransport` of this render to store as
+        ``transport.exr`` (:mod:`~spectrinsic.gt_export.transport_file`), for exact
+        relighting (:func:`spectrinsic.gt_export.relight.relight`).
 
     Returns
     -------
@@ -251,7 +268,8 @@ def export_sample(
     tmp = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{sample_id}-", dir=out_dir))
     try:
         tmp.chmod(0o755)
-        _fill_folder(tmp, scene, result, gt, sample_id=sample_id, config=config, seed=seed)
+        _fill_folder(tmp, scene, result, gt, sample_id=sample_id, config=config, seed=seed,
+                     transport=transport)
         _move_into_place(tmp, final, config_hash(config))
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)

@@ -9,6 +9,8 @@ Nothing is imported from Mitsuba when this package is imported; variants are cho
   independent batches whose spread measures the Monte Carlo noise.
 - :mod:`~spectrinsic.render.modes`: the mode registry and the colour maths of Eq. 5.2.
 - :mod:`~spectrinsic.render.passes`: the passes themselves, for any sensor set.
+- :mod:`~spectrinsic.render.transport`: each light's band transport (:func:`render_transport`)
+  and renders under any light spectra composed from it, for exact relighting.
 - :func:`scene_to_mitsuba`: the one translation of a scene into a Mitsuba dict.
 """
 
@@ -33,6 +35,7 @@ from spectrinsic.render.pipeline import (
 from spectrinsic.render.result import RenderResult
 from spectrinsic.render.settings import DEFAULT_MODES, RenderSettings
 from spectrinsic.render.translate import scene_to_mitsuba
+from spectrinsic.render.transport import LightTransport, render_transport, render_transport_batches
 from spectrinsic.render.variants import (
     available_variants,
     choose_variant,
@@ -44,6 +47,7 @@ from spectrinsic.render.variants import (
 
 __all__ = [
     "DEFAULT_MODES",
+    "LightTransport",
     "RENDER_MODES",
     "RenderMode",
     "RenderResult",
@@ -64,6 +68,8 @@ __all__ = [
     "render_diagonal",
     "render_scene",
     "render_spectral",
+    "render_transport",
+    "render_transport_batches",
     "scene_to_mitsuba",
     "set_thread_count",
     "to_xyz_matrix",

@@ -27,6 +27,7 @@ _COMMANDS: tuple[str, ...] = (
     "spectrinsic.cli.render",
     "spectrinsic.cli.dataset",
     "spectrinsic.cli.check",
+    "spectrinsic.cli.relight",
     "spectrinsic.cli.export",
     "spectrinsic.cli.study",
     "spectrinsic.cli.evaluate",

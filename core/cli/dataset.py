@@ -114,6 +114,13 @@ def _add_quality_options(p: Any) -> None:
                    help="cap of the adaptive batches (default 4 x batches)")
     p.add_argument("--direct", action="store_true",
                    help="also render direct light only, to record the energy ratio r per sample")
+    p.add_argument("--store-transport", action="store_true",
+                   help="store each light's 31-band transport in every sample (transport.exr), so "
+                        "`spectrinsic relight` can relight it exactly; renders the diagonal modes "
+                        "light by light")
+    p.add_argument("--relight", type=int, default=None, metavar="N",
+                   help="with --store-transport: also write N relit variants of every sample "
+                        "(<id>-relitK, random light spectra, seeded)")
     p.add_argument("--no-denoise", action="store_true",
                    help="keep shading from the raw Monte Carlo irradiance (no OIDN)")
     p.add_argument(
@@ -192,6 +199,11 @@ def _overrides(args: argparse.Namespace) -> dict[str, Any]:
         changes["denoise"] = False
     if args.direct:
         changes["direct"] = True
+    # getattr: `render --ground-truth` builds its own namespace of dataset options
+    if getattr(args, "store_transport", False):
+        changes["store_transport"] = True
+    if getattr(args, "relight", None) is not None:
+        changes["relight"] = args.relight
     if args.noise_target is not None:
         changes["noise_target"] = args.noise_target
     if args.max_batches is not None:

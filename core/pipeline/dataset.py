@@ -15,6 +15,7 @@ order and the executor, so the same config and seed give the same pixels.
 from __future__ import annotations
 
 import fnmatch
+import glob
 import logging
 import os
 import resource
@@ -42,11 +43,13 @@ from spectrinsic.gt_export.integrity import (
     write_marker,
 )
 from spectrinsic.gt_export.outfolder import folder_lock
+from spectrinsic.gt_export.relight_pool import RELIT_TAG, relit_problem, write_relit_variants
 from spectrinsic.pipeline.executors import Executor, SerialExecutor
 from spectrinsic.pipeline.presets import DatasetConfig
 from spectrinsic.pipeline.sources import plan_source_samples, save_generated
 from spectrinsic.pipeline.tasks import SampleFailure, SampleOutcome, SampleTask
 from spectrinsic.render import render_batches, set_thread_count
+from spectrinsic.render.transport import render_transport_batches
 from spectrinsic.scenes.library import build, default_samples
 from spectrinsic.scenes.sources import GeneratedSource
 
@@ -172,7 +175,11 @@ def build_sample(task: SampleTask) -> SampleOutcome:
     t0 = time.perf_counter()
     scene = _task_scene(task)
     t_render = time.perf_counter()
-    result = render_batches(scene, cfg.render, seed=task.seed, data_dir=task.data_dir)
+    transport = None
+    if cfg.store_transport:  # diagonal modes light by light, kept per light for relighting
+        transport, result = render_transport_batches(scene, cfg.render, seed=task.seed, data_dir=task.data_dir)
+    else:
+        result = render_batches(scene, cfg.render, seed=task.seed, data_dir=task.data_dir)
     render_seconds = time.perf_counter() - t_render
     if cfg.render.direct:  # the energy ratio r of Eq. 5.8, recorded for the dataset card's diversity plots
         mode = "spectral" if "spectral" in result.direct else next(iter(result.direct))
@@ -188,7 +195,10 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         write_cube=cfg.write_cube,
         denoise=cfg.denoise,
         data_dir=task.data_dir,
+        transport=transport,
     )
+    if cfg.relight:
+        write_relit_variants(path, cfg.relight, seed=task.seed, data_dir=task.data_dir)
     seconds = time.perf_counter() - t0
     return SampleOutcome(
         sample_id=task.sample_id,
@@ -352,6 +362,8 @@ def _prepare(
     for t in tasks:
         folder = out / t.sample_id
         problem = sample_problem(folder, config_hash)
+        if problem is None and config.relight:  # a source whose relit variants are not all there
+            problem = relit_problem(folder, config.relight, config_hash)
         if problem is None:
             skipped.append(SampleOutcome(t.sample_id, "skipped", str(folder)))
             continue
@@ -359,6 +371,7 @@ def _prepare(
         if problem != "absent":
             log.warning("sample %s: %s; re-rendering it", t.sample_id, problem)
             stale.append(folder)
+            stale += _relit_variants(folder)  # made from the old render: go with it
         todo.append(t)
     write_marker(out, config_hash)
     for path in remove_owned_temporaries(out):
@@ -368,6 +381,14 @@ def _prepare(
         for folder in stale:
             remove_sample(folder)  # no old-config sample survives a failed re-render
     return todo, skipped
+
+
+def _relit_variants(folder: Path) -> list[Path]:
+    """The relit variants (``dataset --relight``) on disk beside the sample in *folder*."""
+    found = sorted(p for p in folder.parent.glob(glob.escape(folder.name + RELIT_TAG) + "*") if p.is_dir())
+    for path in found:
+        replaceable_sample(path)  # refuses a folder (or a file in it) spectrinsic did not write
+    return found
 
 
 def _run(

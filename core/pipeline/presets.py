@@ -18,6 +18,7 @@ from spectrinsic.gt_export import DEFAULT_CAMERAS
 from spectrinsic.gt_export.sample import config_hash
 from spectrinsic.render.modes import RENDER_MODES
 from spectrinsic.render.settings import RenderSettings
+from spectrinsic.render.transport import diagonal_mode_names
 
 __all__ = [
     "DatasetConfig",
@@ -100,6 +101,17 @@ class DatasetConfig:
         ``{"generator": ..., "count": ..., ...}`` or ``{"scenes": [...], ...}`` (see
         :func:`spectrinsic.pipeline.dataset.plan_samples`). Left out of the settings when ``None``, so
         library configs keep their hash.
+    store_transport
+        Render the diagonal modes light by light with a flat unit spectrum and store that
+        per-light transport in each sample (``transport.exr``), so the sample can be relit
+        exactly (:mod:`spectrinsic.gt_export.relight`). Left out of the settings when off, so
+        other configs keep their hash. A dataset setting rather than a render one: it picks
+        the renderer (:func:`~spectrinsic.render.transport.render_transport_batches`) and a
+        file of the sample, not how a pass is rendered.
+    relight
+        Relit variants written per rendered sample (needs *store_transport*), each under light
+        spectra drawn by :func:`spectrinsic.gt_export.relight_pool.draw_light_spectra`. Left
+        out of the settings when 0.
     """
 
     preset: str
@@ -111,6 +123,8 @@ class DatasetConfig:
     cameras: tuple[str, ...] | None = None
     seed: int = 0
     source: str | None = None
+    store_transport: bool = False
+    relight: int = 0
 
     def __post_init__(self) -> None:
         if self.cameras is not None:  # a list from JSON or the command line
@@ -125,6 +139,21 @@ class DatasetConfig:
             validate_choice(mode, RENDER_MODES, "render mode", error=DatasetError)
         if not isinstance(self.seed, int) or self.seed < 0:
             raise DatasetError(f"dataset seed {self.seed!r}; expected a non-negative integer")
+        self._check_transport()
+
+    def _check_transport(self) -> None:
+        modes, direct = self.render.modes, self.render.direct
+        if self.store_transport and not diagonal_mode_names(modes):
+            raise DatasetError(f"--store-transport with modes {list(modes)}: the transport needs a "
+                               "diagonal mode (rgb3, rgb6 or bands31)")
+        if self.store_transport and direct and "spectral" not in modes:
+            raise DatasetError("--store-transport with --direct needs the 'spectral' mode (the "
+                               "diagonal modes are composed from the transport, not rendered directly)")
+        if isinstance(self.relight, bool) or not isinstance(self.relight, int) or self.relight < 0:
+            raise DatasetError(f"dataset setting relight={self.relight!r}; expected a non-negative integer")
+        if self.relight and not self.store_transport:
+            raise DatasetError(f"--relight {self.relight} needs --store-transport (relit variants are "
+                               "composed from the stored transport)")
 
     @classmethod
     def from_settings(cls, preset: str, **settings: Any) -> DatasetConfig:
@@ -170,6 +199,10 @@ class DatasetConfig:
         }
         if self.source is not None:
             d["source"] = self.source
+        if self.store_transport:  # off: out of the hash, as before these settings existed
+            d["store_transport"] = True
+        if self.relight:
+            d["relight"] = self.relight
         return d
 
     def resolved_cameras(self) -> tuple[str, ...]:

@@ -1,0 +1,117 @@
+"""The per-light transport of a sample on disk: ``transport.exr`` and its ``meta.json`` record.
+
+One float32 OpenEXR file (ZIP compressed, like every layer file) holds
+
+* ``L<l>_b<b>_<mode>``: the transport ``T_lk`` of light ``l`` in independent batch ``b`` for
+  each relightable render mode (channels named after the mode's sensors: ``B400`` ... ``B700``
+  for ``bands31``, ``X, Y, Z`` for ``rgb3``, ``G425`` ... for ``rgb6``): the raw channels
+  ``∫ radiance · S_k dλ`` (render units) light ``l`` alone gives with the flat unit spectrum
+  ``L(λ) = 1`` at power 1 (:mod:`spectrinsic.render.transport`, Eq. 1);
+* ``coverage``: ``(H, W, M)`` fraction of each pixel's samples hitting material ``m`` (the
+  reflectance and the white-surface radiance are built from it, and it cannot be recovered
+  from the reflectance).
+
+``meta.json["transport"]`` records the file, the layer pattern, modes and their sensors, the
+number of lights and batches, each batch's seed and samples per pixel, the units and the file's
+size in bytes. The batches are kept apart because the sample's noise estimate is their spread.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export.exr import read_exr, write_exr
+from spectrinsic.gt_export.sample import TRANSPORT_NAME
+from spectrinsic.render.transport import LightTransport
+from spectrinsic.spectra import get_sensors
+
+__all__ = ["TRANSPORT_NAME", "COVERAGE_LAYER", "transport_layer", "write_transport", "read_transport"]
+
+COVERAGE_LAYER = "coverage"
+TRANSPORT_UNITS = ("raw channel ∫ radiance · S_k dλ (render units) of one light alone emitting the "
+                   "flat unit spectrum L(λ) = 1 at power 1; raw_k = Σ_l T_lk · power_l ∫L_l S_k dλ / ∫S_k dλ")
+
+
+def transport_layer(light: int, batch: int, mode: str) -> str:
+    """EXR layer name of light *light*'s transport in batch *batch* for *mode*.
+
+    >>> transport_layer(1, 0, "bands31")
+    'L1_b0_bands31'
+    """
+    return f"L{int(light)}_b{int(batch)}_{mode}"
+
+
+def write_transport(folder: str | os.PathLike[str], transport: LightTransport, coverage: np.ndarray,
+                    *, sample_id: str) -> dict[str, Any]:
+    """Write ``transport.exr`` into *folder*; return its ``meta.json["transport"]`` record."""
+    layers: dict[str, np.ndarray] = {COVERAGE_LAYER: np.asarray(coverage, np.float32)}
+    names: dict[str, tuple[str, ...]] = {COVERAGE_LAYER: tuple(f"m{m}" for m in range(np.shape(coverage)[-1]))}
+    for b, batch in enumerate(transport.batches):
+        for mode in transport.modes:
+            channels = get_sensors(transport.sensors[mode]).channels
+            for light in range(transport.n_lights):
+                key = transport_layer(light, b, mode)
+                layers[key] = batch[mode][light]
+                names[key] = channels
+    path = Path(folder) / TRANSPORT_NAME
+    write_exr(path, layers, channel_names=names, attributes={"spectrinsic.sample": sample_id})
+    return {
+        "file": TRANSPORT_NAME,
+        "layers": "L<light>_b<batch>_<mode>",
+        "coverage_layer": COVERAGE_LAYER,
+        "modes": list(transport.modes),
+        "sensors": dict(transport.sensors),
+        "lights": transport.n_lights,
+        "batches": len(transport.batches),
+        "batch_seeds": list(transport.seeds),
+        "batch_spp": transport.spp,
+        "max_depth": transport.max_depth,
+        "units": TRANSPORT_UNITS,
+        "dtype": "float32",
+        "bytes": path.stat().st_size,
+    }
+
+
+def _field(record: Any, key: str, kind: type | tuple[type, ...], where: str) -> Any:
+    value = record.get(key) if isinstance(record, dict) else None
+    if not isinstance(value, kind) or isinstance(value, bool):
+        raise DatasetError(f"{where}: meta.json transport.{key} is missing or malformed")
+    return value
+
+
+def read_transport(sample_dir: str | os.PathLike[str], record: Any) -> tuple[LightTransport, np.ndarray]:
+    """The transport and the ``(H, W, M)`` coverage stored in a sample (its ``meta.json``
+    ``transport`` *record*), checked against the record before use."""
+    folder = Path(sample_dir)
+    where = str(folder)
+    modes = _field(record, "modes", list, where)
+    sensors = _field(record, "sensors", dict, where)
+    lights = _field(record, "lights", int, where)
+    seeds = _field(record, "batch_seeds", list, where)
+    if _field(record, "file", str, where) != TRANSPORT_NAME or not modes or set(sensors) != set(modes):
+        raise DatasetError(f"{where}: meta.json transport record is not spectrinsic's")
+    arrays = read_exr(folder / TRANSPORT_NAME)
+    batches = []
+    for b in range(len(seeds)):
+        batch = {}
+        for mode in modes:
+            keys = [transport_layer(j, b, mode) for j in range(lights)]
+            missing = [k for k in keys if k not in arrays]
+            if missing:
+                raise DatasetError(f"{folder / TRANSPORT_NAME}: lacks the transport layers {missing[:3]}")
+            batch[mode] = np.stack([np.atleast_3d(arrays[k]) for k in keys])
+        batches.append(batch)
+    if COVERAGE_LAYER not in arrays:
+        raise DatasetError(f"{folder / TRANSPORT_NAME}: lacks the {COVERAGE_LAYER!r} layer")
+    coverage = np.atleast_3d(arrays[COVERAGE_LAYER])
+    transport = LightTransport(
+        modes=tuple(modes), sensors={str(k): str(v) for k, v in sensors.items()},
+        batches=tuple(batches), seeds=tuple(int(s) for s in seeds),
+        spp=_field(record, "batch_spp", int, where), max_depth=_field(record, "max_depth", int, where),
+    )
+    return transport, coverage

@@ -1,0 +1,262 @@
+"""Exact relighting from the per-light transport (issue 20, part 2), with real renders.
+
+The independent reference is Mitsuba itself: the same scene rendered light by light with the
+new spectra as emitter values (same seed, spp and depth), whose ground truth is computed by the
+usual path. A relit sample must equal it to float rounding in every layer.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export import check_sample, export_sample, load_sample
+from spectrinsic.gt_export.relight import relight, relit_scene
+from spectrinsic.gt_export.relight_pool import RandomRelight, relit_layers
+from spectrinsic.gt_export.transport_file import TRANSPORT_NAME
+from spectrinsic.render import RenderSettings, render_batches
+from spectrinsic.render.transport import render_transport_batches
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "render"))
+from conftest import box_room  # noqa: E402  (the rendering tests' tiny scenes)
+
+#: Issue 20: a relit layer and the direct render's agree to float rounding, 1e-5 of the
+#: layer's largest magnitude (float32 storage, and ē multiplied after the path sum, not inside).
+RELIGHT_RTOL = 1e-5
+NEW_LIGHTS = {0: "cie:LED-RGB1", 1: "planck:3000K"}  # were planck:2800K, daylight:6500K
+MODES = ("spectral", "rgb3", "rgb6", "bands31")
+SEED = 11
+#: Two batches of 2 samples per pixel each.
+SETTINGS = RenderSettings(spp=4, modes=MODES, batches=2, max_depth=4)
+CONFIG = {"test": "relight"}
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    """A two-light room sample stored with its transport (2 batches, denoised, two cameras)."""
+    out = tmp_path_factory.mktemp("relight")
+    scene = box_room(size=16)
+    transport, result = render_transport_batches(scene, SETTINGS, seed=SEED)
+    sample = export_sample(out, scene, result, sample_id="room__v0__two", config=CONFIG,
+                           seed=SEED, denoise=True, transport=transport)
+    return out, scene, sample
+
+
+def _max_rel(a: np.ndarray, b: np.ndarray) -> float:
+    scale = float(np.abs(b).max())
+    return float(np.abs(a.astype(np.float64) - b).max()) / scale if scale > 0 else float(np.abs(a).max())
+
+
+def _arrays(sample: dict) -> dict[str, np.ndarray]:
+    return {k: v for k, v in sample.items() if isinstance(v, np.ndarray)}
+
+
+def test_relit_sample_equals_a_direct_render_with_the_new_spectra(built):
+    out, scene, sample = built
+    relit = relight(sample, NEW_LIGHTS, out / "relit__v0__two")
+    assert check_sample(relit) == []
+    new_scene = relit_scene(scene, NEW_LIGHTS)
+    direct = render_batches(new_scene, SETTINGS.with_options(modes=MODES[1:], per_light=True), seed=SEED)
+    reference = export_sample(out, new_scene, direct, sample_id="direct__v0__two", config=CONFIG,
+                              seed=SEED, denoise=True)
+    a, b = _arrays(load_sample(relit)), _arrays(load_sample(reference))
+    assert set(a) == set(b)
+    assert {"image", "shading", "residual", "illuminant", "light_share", "noise_image", "image_denoised",
+            "shading_camera/Nikon 5100 (NPL)", "image_rgb6", "error_rgb3"} <= set(a)
+    errors = {k: _max_rel(a[k], b[k]) for k in a}
+    assert max(errors.values()) <= RELIGHT_RTOL, {k: e for k, e in errors.items() if e > RELIGHT_RTOL}
+    # the new lights really changed the image (the comparison is not between equal samples)
+    before = load_sample(sample, layers=["image", "illuminant"])
+    assert _max_rel(a["image"], before["image"]) > 0.05
+    meta_a = json.loads((relit / "meta.json").read_text())
+    meta_b = json.loads((reference / "meta.json").read_text())
+    assert [li["spectrum"] for li in meta_a["lights"]] == ["cie:LED-RGB1", "planck:3000K"]
+    for la, lb in zip(meta_a["lights"], meta_b["lights"], strict=True):
+        assert la["share"] == pytest.approx(lb["share"], rel=RELIGHT_RTOL)
+        assert la["xy"] == pytest.approx(lb["xy"], rel=1e-12)
+    assert meta_a["render"]["relit"]["from"] == "room__v0__two"
+    assert meta_a["noise"]["batches"] == 2
+
+
+def test_relighting_with_the_own_spectra_gives_the_sample_back(built):
+    out, scene, sample = built
+    same = relight(sample, {i: li.spectrum for i, li in enumerate(scene.lights)}, out / "same__v0__two")
+    original, again = _arrays(load_sample(sample)), _arrays(load_sample(same))
+    assert set(original) - set(again) == {"image_spectral"}  # not a band render: not relit
+    for key, value in again.items():
+        np.testing.assert_array_equal(value, original[key], err_msg=key)
+
+
+def test_doubling_every_power_doubles_radiometric_layers_only(built):
+    out, scene, sample = built
+    own = {i: li.spectrum for i, li in enumerate(scene.lights)}
+    twice = relit_layers(sample, own, powers={i: 2 * li.power for i, li in enumerate(scene.lights)})
+    base = relit_layers(sample, own)
+    for key in ("image", "shading_raw", "image_rgb6", "image_camera/Sigma SDMerill (NPL)"):
+        np.testing.assert_allclose(twice[key], 2 * base[key], rtol=RELIGHT_RTOL, atol=1e-6 * np.abs(base[key]).max())
+    for key in ("reflectance", "light_share", "error_rgb6", "noise_image"):
+        np.testing.assert_allclose(twice[key], base[key], rtol=RELIGHT_RTOL, atol=1e-6)
+
+
+def test_in_memory_relighting_equals_the_written_relit_sample(built):
+    out, _, sample = built
+    written = _arrays(load_sample(relight(sample, NEW_LIGHTS, out / "mem__v0__two")))
+    memory = relit_layers(sample, NEW_LIGHTS)
+    for key, value in written.items():
+        np.testing.assert_array_equal(memory[key], value, err_msg=key)
+
+
+def test_random_relight_is_seeded_per_item_and_epoch(built):
+    _, _, sample = built
+    draw = RandomRelight(seed=3)
+    assert draw.lights(2, index=5) == RandomRelight(seed=3).lights(2, index=5)
+    assert len({tuple(draw.lights(2, index=5, epoch=e).values()) for e in range(6)}) > 1
+    pooled = RandomRelight(seed=3, pool=("cie:FL11", "planck:2500K"))
+    assert set(pooled.lights(2, index=0).values()) <= {"cie:FL11", "planck:2500K"}
+    item = pooled(sample, index=0)
+    assert [li["spectrum"] for li in item["meta"]["lights"]] == list(pooled.lights(2, index=0).values())
+    assert item["image"].shape == (16, 16, 3)
+
+
+def test_transport_file_is_recorded_with_its_size(built):
+    _, _, sample = built
+    meta = json.loads((sample / "meta.json").read_text())
+    record = meta["transport"]
+    assert TRANSPORT_NAME in meta["files"]
+    assert record["bytes"] == (sample / TRANSPORT_NAME).stat().st_size
+    assert record["lights"] == 2 and record["batches"] == 2 and record["modes"] == ["rgb3", "rgb6", "bands31"]
+
+
+def test_relight_refuses_bad_requests_before_writing(built, tmp_path):
+    out, _, sample = built
+    with pytest.raises(DatasetError, match="did you mean 'planck'"):
+        relight(sample, {0: "plank:3000K"}, tmp_path / "a")
+    with pytest.raises(DatasetError, match="expected an illuminant"):
+        relight(sample, {0: "munsell:5R 4/14"}, tmp_path / "a")
+    with pytest.raises(DatasetError, match="lights 0..1"):
+        relight(sample, {2: "cie:D65"}, tmp_path / "a")
+    with pytest.raises(DatasetError, match="the sample itself"):
+        relight(sample, {0: "cie:D65"}, sample)
+    foreign = tmp_path / "mine"
+    foreign.mkdir()
+    (foreign / "notes.txt").write_text("keep me")
+    with pytest.raises(DatasetError, match="choose another --out"):
+        relight(sample, {0: "cie:D65"}, foreign)
+    assert (foreign / "notes.txt").read_text() == "keep me"
+    assert not (tmp_path / "a").exists()
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert check_sample(relight(sample, {0: "cie:D65"}, empty)) == []  # new or empty, as for dataset
+
+
+def test_a_sample_without_transport_is_refused(built, tmp_path):
+    out, scene, _ = built
+    result = render_batches(scene, SETTINGS.with_options(modes=("rgb3",), per_light=True, spp=2, batches=1),
+                            seed=SEED)
+    plain = export_sample(out, scene, result, sample_id="plain__v0__two", config=CONFIG, seed=1)
+    with pytest.raises(DatasetError, match="--store-transport"):
+        relight(plain, {0: "cie:D65"}, tmp_path / "x")
+
+
+@pytest.mark.parametrize("args, expected", [
+    (["--light", "0=plank:3000K"], "did you mean 'planck'?"),
+    (["--light", "0=cie:LED-RGB9"], "did you mean 'LED-RGB1'"),
+    (["--light", "zero=cie:D65"], "expected INDEX=VALUE"),
+    (["--light", "0=cie:D65", "--light", "0=cie:A"], "given twice"),
+    (["--light", "0=cie:D65", "--power", "0=bright"], "not a number"),
+    (["--light", "0=cie:D65", "--power", "5=2"], "lights 0..1"),
+])
+def test_cli_bad_input_is_one_line_with_status_2(built, tmp_path, capsys, args, expected):
+    from spectrinsic.cli import main
+
+    _, _, sample = built
+    before = sorted(p.name for p in sample.iterdir())
+    rc = main(["relight", str(sample), *args, "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1 and expected in err, err
+    assert "Traceback" not in err and not (tmp_path / "out").exists()
+    assert sorted(p.name for p in sample.iterdir()) == before
+
+
+def test_cli_relights_into_a_checkable_sample(built, tmp_path, capsys):
+    from spectrinsic.cli import main
+
+    _, _, sample = built
+    out = tmp_path / "relit__v0__two"
+    assert main(["-q", "relight", str(sample), "--light", "1=cie:FL11", "--out", str(out)]) == 0
+    assert capsys.readouterr().out.strip() == str(out)
+    assert check_sample(out) == []
+    meta = json.loads((out / "meta.json").read_text())
+    assert [li["spectrum"] for li in meta["lights"]] == ["planck:2800K", "cie:FL11"]
+    # the same --out again replaces the sample spectrinsic wrote there (never a foreign one)
+    assert main(["-q", "relight", str(sample), "--light", "1=cie:FL2", "--out", str(out)]) == 0
+    assert json.loads((out / "meta.json").read_text())["lights"][1]["spectrum"] == "cie:FL2"
+
+
+@pytest.mark.torch
+def test_torch_dataset_relights_each_item_on_the_fly(built, torch, tmp_path):
+    import shutil
+
+    from spectrinsic.gt_export import torch_dataset
+
+    _, _, sample = built
+    shutil.copytree(sample, tmp_path / "ds" / sample.name)
+    draw = RandomRelight(seed=2, pool=("cie:FL11", "cie:LED-RGB1", "planck:2000K", "daylight:9000K"))
+    ds = torch_dataset(tmp_path / "ds", keys=("image", "shading"), relight=draw)
+    expected = relit_layers(sample, draw.lights(2, index=0))
+    item = ds[0]
+    assert torch.equal(item["image"], torch.from_numpy(np.moveaxis(expected["image"], -1, 0).copy()))
+    assert item["shading"].shape == (3, 16, 16) and item["sample_id"] == sample.name
+    ds.set_epoch(3)
+    again = relit_layers(sample, draw.lights(2, index=0, epoch=3))
+    assert torch.equal(ds[0]["image"], torch.from_numpy(np.moveaxis(again["image"], -1, 0).copy()))
+
+
+def test_cheap_augmentation_leaves_out_denoising_and_cameras_only(built):
+    _, _, sample = built
+    full = relit_layers(sample, NEW_LIGHTS)
+    cheap = relit_layers(sample, NEW_LIGHTS, denoise=False, cameras=False)
+    assert not any(k.startswith(("image_camera", "image_denoised", "shading_raw")) for k in cheap)
+    for key in ("image", "reflectance", "noise_image", "light_share"):
+        np.testing.assert_array_equal(cheap[key], full[key], err_msg=key)
+    np.testing.assert_array_equal(cheap["shading"], full["shading_raw"])  # undenoised = the raw one
+
+
+def test_cli_follows_the_out_rule_and_the_lock_of_every_writing_verb(built, tmp_path, capsys):
+    """--out inside a dataset is refused, and so is one whose folder another run holds: one
+    line, status 2, before any relighting, and nothing written."""
+    import subprocess
+
+    from spectrinsic.cli import main
+
+    _, _, sample = built
+    dataset = tmp_path / "ds"
+    dataset.mkdir()
+    (dataset / "manifest.json").write_text(json.dumps({"format_version": 1, "config_hash": "h"}))
+    rc = main(["-q", "relight", str(sample), "--light", "0=cie:D65", "--out", str(dataset / "relit__v0__x")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1 and "inside the dataset folder" in err, err
+    assert sorted(p.name for p in dataset.iterdir()) == ["manifest.json"]
+
+    held = tmp_path / "held"
+    code = ("import sys; from pathlib import Path; from spectrinsic.gt_export.outfolder import folder_lock\n"
+            f"with folder_lock(Path({str(held)!r})):\n"
+            "    print('held', flush=True); sys.stdin.read()\n")
+    proc = subprocess.Popen([sys.executable, "-P", "-c", code], stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout is not None and proc.stdout.readline().strip() == "held"
+        rc = main(["-q", "relight", str(sample), "--light", "0=cie:D65", "--out", str(held / "relit__v0__x")])
+        err = capsys.readouterr().err.strip()
+    finally:
+        assert proc.stdin is not None
+        proc.stdin.close()
+        assert proc.wait(timeout=60) == 0
+    assert rc == 2 and len(err.splitlines()) == 1, err
+    assert "in use by another spectrinsic run" in err and f"pid {proc.pid}" in err
+    assert not held.exists()  # the holder removed its folder; the refused run wrote nothing
