@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import json
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,9 +20,6 @@ from spectrinsic.gt_export.relight_pool import RandomRelight, relit_layers
 from spectrinsic.gt_export.transport_file import TRANSPORT_NAME
 from spectrinsic.render import RenderSettings, render_batches
 from spectrinsic.render.transport import render_transport_batches
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "render"))
-from conftest import box_room  # noqa: E402  (the rendering tests' tiny scenes)
 
 #: Issue 20: a relit layer and the direct render's agree to float rounding, 1e-5 of the
 #: layer's largest magnitude (float32 storage, and ē multiplied after the path sum, not inside).
@@ -37,10 +33,10 @@ CONFIG = {"test": "relight"}
 
 
 @pytest.fixture(scope="module")
-def built(tmp_path_factory):
+def built(tmp_path_factory, make_room):
     """A two-light room sample stored with its transport (2 batches, denoised, two cameras)."""
     out = tmp_path_factory.mktemp("relight")
-    scene = box_room(size=16)
+    scene = make_room(size=16)
     transport, result = render_transport_batches(scene, SETTINGS, seed=SEED)
     sample = export_sample(out, scene, result, sample_id="room__v0__two", config=CONFIG,
                            seed=SEED, denoise=True, transport=transport)
