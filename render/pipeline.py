@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from spectrinsic.errors import RenderError, SceneError
+from spectrinsic.errors import RenderError, SceneError, validate_choice
 from spectrinsic.render.modes import (
     RenderMode,
     channel_values,
@@ -26,6 +26,7 @@ from spectrinsic.render.passes import (
     render_spectral,
 )
 from spectrinsic.render.result import RenderResult
+from spectrinsic.render.single import DEFAULT_INTEGRATOR, INTEGRATORS, SingleTraversal, render_jobs
 from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
@@ -74,19 +75,32 @@ def count_passes(
     direct: bool | Iterable[str] = False,
     aovs: bool = True,
     data_dir: str | None = None,
+    integrator: str | None = None,
 ) -> int:
     """Number of Mitsuba passes :func:`render_scene` runs (the total of its progress calls)."""
     objs = _modes(modes)
     wanted = _direct_modes(direct, objs)
     split = per_light and per_light_modes is not None
     groups = len(scene.lights) if per_light and not split else 1
-    colour = sum(n_passes(m, data_dir=data_dir) * (2 if m.name in wanted else 1) for m in objs)
     share_modes = _modes(per_light_modes) if per_light and per_light_modes is not None else []
+    if _integrator(integrator) == "single":  # diagonal modes: one traversal (+1 direct-only)
+        traversals = 1 + any(m.kind == "diagonal" and m.name in wanted for m in objs)
+        diagonal = traversals if any(m.kind == "diagonal" for m in objs + share_modes) else 0
+        objs, share_modes = [m for m in objs if m.kind != "diagonal"], [m for m in share_modes if m.kind != "diagonal"]
+    else:
+        diagonal = 0
+    colour = sum(n_passes(m, data_dir=data_dir) * (2 if m.name in wanted else 1) for m in objs)
     shares = sum(n_passes(m, data_dir=data_dir) for m in share_modes)
     from spectrinsic.render.translate import surfaces
 
     aov_passes = max(1, -(-len(surfaces(scene)) // 3)) if aovs else 0
-    return groups * colour + len(scene.lights) * shares + aov_passes
+    return diagonal + groups * colour + len(scene.lights) * shares + aov_passes
+
+
+def _integrator(name: str | None) -> str:
+    """*name* checked against :data:`~spectrinsic.render.single.INTEGRATORS` (``None``: the
+    default)."""
+    return DEFAULT_INTEGRATOR if name is None else validate_choice(name, INTEGRATORS, "integrator", error=RenderError)
 
 
 def _sum_direct(parts: Sequence[np.ndarray | None]) -> np.ndarray:
@@ -110,13 +124,16 @@ class _Job:
 def _run_jobs(
     scene: Scene, jobs: Sequence[_Job], *, wanted: set[str], spp: int, seed: int, max_depth: int,
     variant: str | None, aovs: bool, progress: PassProgress | None, data_dir: str | None,
-) -> tuple[list[dict[str, PassOutput]], dict[str, np.ndarray], tuple[float, ...]]:
+    integrator: str = "passes",
+) -> tuple[list[dict[str, PassOutput]], dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
     """Every pass of *jobs*, grouped by Mitsuba variant, plus the AOVs.
 
     Each switch between the RGB and the spectral variant reloads Mitsuba's Python modules
     (~0.1 s), so every RGB-variant pass (all diagonal modes of every job, then the AOVs) runs in
     one scope and every spectral pass in another. Passes do not depend on each other's order:
-    each sets its own values, seed and spp.
+    each sets its own values, seed and spp. With ``integrator="single"`` the diagonal modes of
+    every job come from one band-path traversal
+    (:func:`spectrinsic.render.single.render_jobs`).
     """
     from spectrinsic.render.translate import prepare_geometry
     from spectrinsic.render.variants import choose_variant, variant_scope
@@ -127,10 +144,17 @@ def _run_jobs(
     aov_seconds: tuple[float, ...] = ()
     common: dict[str, Any] = dict(spp=spp, seed=seed, max_depth=max_depth, progress=progress,
                                   geometry=geometry)
+    single = SingleTraversal({}, ())
     if aovs or any(m.kind == "diagonal" for job in jobs for m in job.modes):
         rgb_variant = choose_variant("rgb", variant)
         with variant_scope(rgb_variant):
-            for out, job in zip(outputs, jobs, strict=True):
+            if integrator == "single":
+                parts, single = render_jobs(
+                    scene, [(j.modes, j.group, j.with_direct) for j in jobs], wanted=wanted,
+                    variant=rgb_variant, data_dir=data_dir, **common)
+                for out, part in zip(outputs, parts, strict=True):
+                    out.update(part)
+            for out, job in zip(outputs, jobs, strict=True) if integrator == "passes" else ():
                 diagonal = [m for m in job.modes if m.kind == "diagonal"]
                 if not diagonal:
                     continue
@@ -154,7 +178,7 @@ def _run_jobs(
                         active_lights=job.group, variant=spectral_variant, data_dir=data_dir,
                         **common,
                     )
-    return outputs, aov_maps, aov_seconds
+    return outputs, aov_maps, aov_seconds, single
 
 
 def render_scene(
@@ -171,6 +195,7 @@ def render_scene(
     aovs: bool = True,
     progress: PassProgress | None = None,
     data_dir: str | None = None,
+    integrator: str | None = None,
 ) -> RenderResult:
     """Render *scene* in each of *modes* and convert every mode to CIE 1931 XYZ.
 
@@ -202,6 +227,13 @@ def render_scene(
         Also compute coverage, ids, depth and normals (:func:`~spectrinsic.render.passes.render_aovs`).
     progress
         Called with 1 after each Mitsuba pass; :func:`count_passes` gives the total.
+    integrator
+        How diagonal modes are rendered (:data:`~spectrinsic.render.single.INTEGRATORS`,
+        default :data:`~spectrinsic.render.single.DEFAULT_INTEGRATOR`): ``"passes"``, ⌈K/3⌉
+        RGB passes per mode and one scene per light; ``"single"``, one traversal for every
+        diagonal mode, band and light (:mod:`spectrinsic.render.single`), same images to float
+        rounding, per-light images that are exact shares of the full render, and
+        ``RenderResult.transport``.
 
     Returns
     -------
@@ -209,15 +241,16 @@ def render_scene(
     """
     objs = _modes(modes)
     wanted = _direct_modes(direct, objs)
+    integrator = _integrator(integrator)
     matrices = {m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in objs}
     lights = [[j] for j in range(len(scene.lights))]
     split = per_light and per_light_modes is not None
     share = _modes(per_light_modes) if per_light and per_light_modes is not None else []
     main = [_Job(tuple(objs), g) for g in (lights if per_light and not split else [None])]
     jobs = main + [_Job(tuple(share), g, with_direct=False) for g in lights] if split else main
-    outputs, aov_maps, aov_seconds = _run_jobs(
+    outputs, aov_maps, aov_seconds, single = _run_jobs(
         scene, jobs, wanted=wanted, spp=spp, seed=seed, max_depth=max_depth, variant=variant,
-        aovs=aovs, progress=progress, data_dir=data_dir,
+        aovs=aovs, progress=progress, data_dir=data_dir, integrator=integrator,
     )
     main_out, share_out = outputs[:len(main)], outputs[len(main):]
     timings: dict[str, list[float]] = {m.name: [] for m in objs + share}
@@ -242,12 +275,16 @@ def render_scene(
     }
     if aovs:
         timings["aovs"] = list(aov_seconds)
+    if single.seconds:
+        timings["single"] = list(single.seconds)
     meta = _render_meta(scene, objs, matrices, variants, timings, spp=spp, seed=seed,
                         max_depth=max_depth, per_light=per_light, wanted=wanted, data_dir=data_dir)
     meta["per_light_modes"] = [m.name for m in share] if split else (names if per_light else [])
+    meta["integrator"] = integrator
     logger.debug("rendered %s: %s", scene.name, {k: v["seconds"] for k, v in meta["timings"].items()})
     return RenderResult(images=images, raw=raw, per_light=per_light_images, direct=direct_images,
-                        aovs=aov_maps, meta=meta)
+                        aovs=aov_maps, meta=meta,
+                        transport={n: t.transport for n, t in single.transport.items()})
 
 
 def _render_meta(
@@ -406,6 +443,7 @@ def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
                         for i, pl in enumerate(first.per_light)),
         direct={m: _mean([r.direct[m] for r in results]) for m in first.direct},
         aovs=_merge_aovs([r.aovs for r in results]),
+        transport={m: _mean([r.transport[m] for r in results]) for m in first.transport},
         meta=meta,
         batch_raw=tuple(dict(r.raw) for r in results),
     )
