@@ -76,10 +76,127 @@ def _mis_weight(dr: Any, mi: Any, pdf_a: Any, pdf_b: Any) -> Any:
     return dr.detach(dr.select(dr.isfinite(w), w, mi.Float(0.0)))
 
 
+def _band_max(dr: Any, bands: Sequence) -> Any:
+    """Largest band value per lane (a balanced tree of ``dr.maximum``)."""
+    values = list(bands)
+    while len(values) > 1:
+        values = [dr.maximum(values[i], values[i + 1]) if i + 1 < len(values) else values[i]
+                  for i in range(0, len(values), 2)]
+    return values[0]
+
+
+def _lookups(mi: Any, dr: Any, scene: Any, tables: BandTables) -> tuple[Any, Any, Any]:
+    """Dr.Jit arrays of the band albedos, shape id -> table row and emitter id -> light."""
+    albedo = np.asarray(tables.albedo, np.float32)
+    black = albedo.shape[0] - 1
+    shapes = list(scene.shapes())
+    ids = np.array(dr.reinterpret_array(mi.UInt32, mi.ShapePtr(shapes)), np.int64) if shapes else np.zeros(0, np.int64)
+    rows = np.full(int(ids.max(initial=0)) + 1, black, np.uint32)
+    for sid, shape in zip(ids, shapes, strict=True):
+        rows[sid] = tables.shape_rows.get(shape.id(), black)
+    lights = np.zeros(max(tables.emitter_lights, default=0) + 1, np.uint32)
+    for eid, light in tables.emitter_lights.items():
+        lights[eid] = light
+    return mi.Float(albedo.ravel()), mi.UInt32(rows), mi.UInt32(lights)
+
+
+class _Kernel:
+    """The loop of ``path.cpp`` on band throughputs; *it* is the integrator (depths, sizes,
+    lookups). Each method is one step of the loop body, in ``path.cpp``'s order, so the
+    sampler is called exactly as there and the paths are the same."""
+
+    def __init__(self, mi: Any, dr: Any, it: Any, scene: Any) -> None:
+        self.mi, self.dr, self.it, self.scene = mi, dr, it, scene
+
+    def light_of(self, emitter: Any, mask: Any) -> Any:
+        return self.dr.gather(self.mi.UInt32, self.it.emitter_lut, self.dr.reinterpret_array(self.mi.UInt32, emitter), mask)
+
+    def deposit(self, acc: list, light: Any, weight: Any, bands: Sequence, mask: Any) -> list:
+        """``acc[l·K + k] += bands[k]·weight`` on the lanes whose light is l."""
+        k, out = self.it.n_bands, list(acc)
+        for l in range(self.it.n_lights):
+            w = self.dr.select(mask & (light == l), weight, 0.0)
+            for b in range(k):
+                out[l * k + b] = self.dr.fma(bands[b], w, out[l * k + b])
+        return out
+
+    def emitter_hit(self, si: Any, prev_si: Any, prev_pdf: Any, prev_delta: Any) -> tuple[Any, Any, Any]:
+        """Light, weight (radiance x BSDF-sampling MIS weight) and mask of an emitter hit."""
+        mi, dr = self.mi, self.dr
+        emitter = si.emitter(self.scene)
+        hit = emitter != None  # noqa: E711 (a Dr.Jit pointer array, compared lane by lane)
+        ds = mi.DirectionSample3f(self.scene, si=si, ref=prev_si)
+        em_pdf = dr.select(prev_delta, 0.0, self.scene.pdf_emitter_direction(prev_si, ds, ~prev_delta))
+        radiance = emitter.eval(si, (prev_pdf > 0.0) & hit)[0]
+        return self.light_of(emitter, hit), radiance * _mis_weight(dr, mi, prev_pdf, em_pdf), hit
+
+    def vertex(self, sampler: Any, si: Any, bsdf: Any, active_next: Any) -> tuple:
+        """Emitter sample, then BSDF evaluation and sample (``eval_pdf_sample``)."""
+        mi, dr = self.mi, self.dr
+        active_em = active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth)
+        ds, em_weight = self.scene.sample_emitter_direction(si, sampler.next_2d(), True, active_em)
+        active_em &= ds.pdf != 0.0
+        sample_1, sample_2 = sampler.next_1d(), sampler.next_2d()
+        bsdf_val, bsdf_pdf, bsdf_sample, bsdf_weight = bsdf.eval_pdf_sample(
+            mi.BSDFContext(), si, si.to_local(ds.d), sample_1, sample_2)
+        mis_em = dr.select(ds.delta, 1.0, _mis_weight(dr, mi, ds.pdf, bsdf_pdf))
+        nee = bsdf_val[0] * em_weight[0] * mis_em
+        return self.light_of(ds.emitter, active_em), nee, active_em, bsdf_sample, bsdf_weight[0]
+
+    def albedo(self, si: Any) -> list:
+        """ρ_k of the material of the shape hit (the black row elsewhere)."""
+        mi, dr, k = self.mi, self.dr, self.it.n_bands
+        valid = si.is_valid()
+        row = dr.gather(mi.UInt32, self.it.shape_lut, dr.reinterpret_array(mi.UInt32, si.shape), valid)
+        return [dr.gather(mi.Float, self.it.albedo, row * k + b, valid) for b in range(k)]
+
+    def roulette(self, sampler: Any, depth: Any, beta: Any, bands: Sequence) -> tuple[Any, Any]:
+        """Russian roulette on the largest band (``path.cpp`` uses the largest channel);
+        never active when ``rr_depth`` > ``max_depth``, but its sample is drawn either way."""
+        dr = self.dr
+        throughput_max = beta * _band_max(dr, bands)
+        rr_prob = dr.minimum(throughput_max, 0.95)
+        rr_active = depth >= self.it.rr_depth
+        rr_continue = sampler.next_1d() < rr_prob
+        beta = dr.select(rr_active, beta * dr.rcp(dr.detach(rr_prob)), beta)
+        return beta, (~rr_active | rr_continue) & (throughput_max != 0.0)
+
+    def body(self, sampler: Any, ray: Any, depth: Any, beta: Any, bands: list, acc: list,
+             prev_si: Any, prev_pdf: Any, prev_delta: Any, alive: Any) -> tuple:
+        mi, dr = self.mi, self.dr
+        si = self.scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=depth == 0)
+        light, weight, hit = self.emitter_hit(si, prev_si, prev_pdf, prev_delta)
+        acc = self.deposit(acc, light, beta * weight, bands, hit)
+        active_next = (depth + 1 < self.it.max_depth) & si.is_valid()
+        light, nee, active_em, bsdf_sample, bsdf_weight = self.vertex(sampler, si, si.bsdf(ray), active_next)
+        bands = [b * rho for b, rho in zip(bands, self.albedo(si), strict=True)]
+        acc = self.deposit(acc, light, beta * nee, bands, active_em)
+        ray = si.spawn_ray(si.to_world(bsdf_sample.wo))
+        beta = beta * bsdf_weight
+        depth = dr.select(si.is_valid(), depth + 1, depth)
+        beta, go_on = self.roulette(sampler, depth, beta, bands)
+        delta = mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
+        return (sampler, ray, depth, beta, bands, acc, mi.Interaction3f(si), bsdf_sample.pdf, delta,
+                active_next & go_on)
+
+    def run(self, sampler: Any, ray: Any, active: Any) -> list:
+        """The K·L accumulators of one wavefront of camera rays."""
+        mi, dr, k = self.mi, self.dr, self.it.n_bands
+        state = (sampler, mi.Ray3f(ray), mi.UInt32(0), mi.Float(1.0), [mi.Float(1.0) for _ in range(k)],
+                 [mi.Float(0.0) for _ in range(k * self.it.n_lights)], dr.zeros(mi.Interaction3f),
+                 mi.Float(1.0), mi.Bool(True), mi.Bool(active))
+        state = dr.while_loop(state, lambda *s: s[-1], self.body, label="spectrinsic band path")
+        return list(state[5])
+
+
 @functools.cache
 def band_path_class(variant: str) -> type:
     """The :class:`BandPath` integrator class for the active *variant* (defined per variant,
-    since ``mi.SamplingIntegrator`` is the variant's), registered as :data:`INTEGRATOR_NAME`."""
+    since ``mi.SamplingIntegrator`` is the variant's), registered as :data:`INTEGRATOR_NAME`.
+
+    Properties: ``max_depth``, ``rr_depth`` (as ``path``), ``n_bands`` (K), ``n_lights`` (L).
+    Its AOVs are the L·K transports (:func:`transport_channels`); its RGB output is zero.
+    """
     from spectrinsic.render.variants import import_mitsuba
 
     mi = import_mitsuba()
@@ -96,128 +213,29 @@ def band_path_class(variant: str) -> type:
             self.rr_depth = int(props.get("rr_depth", self.max_depth + 1))
             self.n_bands = int(props.get("n_bands", 3))
             self.n_lights = int(props.get("n_lights", 1))
-            self._albedo = mi.Float(np.zeros(self.n_bands, np.float32))
-            self._shape_lut = mi.UInt32(np.zeros(1, np.uint32))
-            self._emitter_lut = mi.UInt32(np.zeros(1, np.uint32))
+            self.albedo = mi.Float(np.zeros(self.n_bands, np.float32))
+            self.shape_lut = mi.UInt32(np.zeros(1, np.uint32))
+            self.emitter_lut = mi.UInt32(np.zeros(1, np.uint32))
 
         def set_tables(self, scene: Any, tables: BandTables) -> None:
             """Point the lookups at *tables* for the loaded *scene* (no recompilation)."""
-            albedo = np.asarray(tables.albedo, np.float32)
-            if albedo.ndim != 2 or albedo.shape[1] != self.n_bands or tables.n_lights != self.n_lights:
-                raise RenderError(f"band tables {albedo.shape} for {tables.n_lights} lights do not fit an "
+            shape = np.shape(tables.albedo)
+            if len(shape) != 2 or shape[1] != self.n_bands or tables.n_lights != self.n_lights:
+                raise RenderError(f"band tables {shape} for {tables.n_lights} lights do not fit an "
                                   f"integrator of {self.n_bands} bands and {self.n_lights} lights")
-            black = albedo.shape[0] - 1
-            shapes = list(scene.shapes())
-            ids = np.array(dr.reinterpret_array(mi.UInt32, mi.ShapePtr(shapes)), np.int64) if shapes else np.zeros(0, np.int64)
-            lut = np.full(int(ids.max(initial=0)) + 1, black, np.uint32)
-            for sid, shape in zip(ids, shapes, strict=True):
-                lut[sid] = tables.shape_rows.get(shape.id(), black)
-            eids = tables.emitter_lights
-            elut = np.zeros(max(eids, default=0) + 1, np.uint32)
-            for eid, light in eids.items():
-                elut[eid] = light
-            self._albedo = mi.Float(albedo.ravel())
-            self._shape_lut = mi.UInt32(lut)
-            self._emitter_lut = mi.UInt32(elut)
+            self.albedo, self.shape_lut, self.emitter_lut = _lookups(mi, dr, scene, tables)
 
         def aov_names(self) -> list[str]:
             return transport_channels(self.n_lights, self.n_bands)
 
-        def _deposit(self, acc: list, light: Any, weight: Any, bands: Sequence, mask: Any) -> list:
-            """``acc[l·K + k] += bands[k]·weight`` for the lanes whose light is l."""
-            k = self.n_bands
-            out = list(acc)
-            for l in range(self.n_lights):
-                w = dr.select(mask & (light == l), weight, 0.0)
-                for b in range(k):
-                    out[l * k + b] = dr.fma(bands[b], w, out[l * k + b])
-            return out
-
-        def sample(self, scene: Any, sampler: Any, ray_: Any, medium: Any = None, active: Any = True) -> tuple:
-            k = self.n_bands
-            bsdf_ctx = mi.BSDFContext()
-            ray = mi.Ray3f(ray_)
-            depth = mi.UInt32(0)
-            beta = mi.Float(1.0)  # band-independent throughput (white BSDF weights)
-            bands = [mi.Float(1.0) for _ in range(k)]  # Π ρ_k along the path
-            acc = [mi.Float(0.0) for _ in range(k * self.n_lights)]
-            prev_si = dr.zeros(mi.Interaction3f)
-            prev_bsdf_pdf = mi.Float(1.0)
-            prev_bsdf_delta = mi.Bool(True)
-            alive = mi.Bool(active)
-
-            def cond(sampler, ray, depth, beta, bands, acc, prev_si, prev_bsdf_pdf, prev_bsdf_delta, alive):
-                return alive
-
-            def body(sampler, ray, depth, beta, bands, acc, prev_si, prev_bsdf_pdf, prev_bsdf_delta, alive):
-                si = scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=depth == 0)
-                # ---- emitter hit (MIS with the previous vertex's BSDF sample)
-                emitter = si.emitter(scene)
-                hit_em = emitter != None  # noqa: E711 (Dr.Jit pointer comparison)
-                ds = mi.DirectionSample3f(scene, si=si, ref=prev_si)
-                em_pdf = scene.pdf_emitter_direction(prev_si, ds, ~prev_bsdf_delta)
-                em_pdf = dr.select(prev_bsdf_delta, 0.0, em_pdf)
-                mis_bsdf = _mis_weight(dr, mi, prev_bsdf_pdf, em_pdf)
-                radiance = emitter.eval(si, (prev_bsdf_pdf > 0.0) & hit_em)[0]
-                light = dr.gather(mi.UInt32, self._emitter_lut, dr.reinterpret_array(mi.UInt32, emitter), hit_em)
-                acc = self._deposit(acc, light, beta * radiance * mis_bsdf, bands, hit_em)
-
-                active_next = (depth + 1 < self.max_depth) & si.is_valid()
-                bsdf = si.bsdf(ray)
-                # ---- next-event estimation (sampler calls in path.cpp's order)
-                active_em = active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth)
-                ds, em_weight = scene.sample_emitter_direction(si, sampler.next_2d(), True, active_em)
-                active_em &= ds.pdf != 0.0
-                wo = si.to_local(ds.d)
-                sample_1 = sampler.next_1d()
-                sample_2 = sampler.next_2d()
-                bsdf_val, bsdf_pdf, bsdf_sample, bsdf_weight = bsdf.eval_pdf_sample(
-                    bsdf_ctx, si, wo, sample_1, sample_2)
-                row = dr.gather(mi.UInt32, self._shape_lut, dr.reinterpret_array(mi.UInt32, si.shape), si.is_valid())
-                rho = [dr.gather(mi.Float, self._albedo, row * k + b, si.is_valid()) for b in range(k)]
-                next_bands = [bands[b] * rho[b] for b in range(k)]
-                mis_em = dr.select(ds.delta, 1.0, _mis_weight(dr, mi, ds.pdf, bsdf_pdf))
-                light = dr.gather(mi.UInt32, self._emitter_lut, dr.reinterpret_array(mi.UInt32, ds.emitter), active_em)
-                acc = self._deposit(acc, light, beta * bsdf_val[0] * em_weight[0] * mis_em, next_bands, active_em)
-                # ---- BSDF sampling: continue the path
-                ray = si.spawn_ray(si.to_world(bsdf_sample.wo))
-                beta = beta * bsdf_weight[0]
-                bands = next_bands
-                prev_si = mi.Interaction3f(si)
-                prev_bsdf_pdf = bsdf_sample.pdf
-                prev_bsdf_delta = mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
-                depth = dr.select(si.is_valid(), depth + 1, depth)
-                # ---- stopping criterion (Russian roulette on the largest band, as path.cpp
-                # does on the largest channel; off when rr_depth > max_depth)
-                throughput_max = beta * _band_max(dr, bands)
-                rr_prob = dr.minimum(throughput_max, 0.95)
-                rr_active = depth >= self.rr_depth
-                rr_continue = sampler.next_1d() < rr_prob
-                beta = dr.select(rr_active, beta * dr.rcp(dr.detach(rr_prob)), beta)
-                alive = active_next & (~rr_active | rr_continue) & (throughput_max != 0.0)
-                return sampler, ray, depth, beta, bands, acc, prev_si, prev_bsdf_pdf, prev_bsdf_delta, alive
-
-            state = dr.while_loop(
-                (sampler, ray, depth, beta, bands, acc, prev_si, prev_bsdf_pdf, prev_bsdf_delta, alive),
-                cond, body, label="spectrinsic band path",
-            )
-            acc = state[5]
-            return mi.Spectrum(0.0), mi.Bool(True), list(acc)
+        def sample(self, scene: Any, sampler: Any, ray: Any, medium: Any = None, active: Any = True) -> tuple:
+            return mi.Spectrum(0.0), mi.Bool(True), _Kernel(mi, dr, self, scene).run(sampler, ray, active)
 
         def to_string(self) -> str:
             return f"BandPath[max_depth={self.max_depth}, n_bands={self.n_bands}, n_lights={self.n_lights}]"
 
     mi.register_integrator(INTEGRATOR_NAME, lambda props: BandPath(props))
     return BandPath
-
-
-def _band_max(dr: Any, bands: Sequence) -> Any:
-    """Largest band value per lane (a balanced tree of ``dr.maximum``)."""
-    values = list(bands)
-    while len(values) > 1:
-        values = [dr.maximum(values[i], values[i + 1]) if i + 1 < len(values) else values[i]
-                  for i in range(0, len(values), 2)]
-    return values[0]
 
 
 def band_path(mi: Any, *, max_depth: int, n_bands: int, n_lights: int) -> Any:

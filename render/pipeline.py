@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from spectrinsic.errors import RenderError, SceneError, validate_choice
+from spectrinsic.errors import RenderError, SceneError
 from spectrinsic.render.modes import (
     RenderMode,
     channel_values,
@@ -26,7 +26,7 @@ from spectrinsic.render.passes import (
     render_spectral,
 )
 from spectrinsic.render.result import RenderResult
-from spectrinsic.render.single import DEFAULT_INTEGRATOR, INTEGRATORS, SingleTraversal, render_jobs
+from spectrinsic.render.single import SingleTraversal, render_jobs, resolve_integrator
 from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
@@ -76,6 +76,7 @@ def count_passes(
     aovs: bool = True,
     data_dir: str | None = None,
     integrator: str | None = None,
+    variant: str | None = None,
 ) -> int:
     """Number of Mitsuba passes :func:`render_scene` runs (the total of its progress calls)."""
     objs = _modes(modes)
@@ -83,7 +84,7 @@ def count_passes(
     split = per_light and per_light_modes is not None
     groups = len(scene.lights) if per_light and not split else 1
     share_modes = _modes(per_light_modes) if per_light and per_light_modes is not None else []
-    if _integrator(integrator) == "single":  # diagonal modes: one traversal (+1 direct-only)
+    if resolve_integrator(integrator, variant) == "single":  # diagonal modes: one traversal (+1 direct-only)
         traversals = 1 + any(m.kind == "diagonal" and m.name in wanted for m in objs)
         diagonal = traversals if any(m.kind == "diagonal" for m in objs + share_modes) else 0
         objs, share_modes = [m for m in objs if m.kind != "diagonal"], [m for m in share_modes if m.kind != "diagonal"]
@@ -95,12 +96,6 @@ def count_passes(
 
     aov_passes = max(1, -(-len(surfaces(scene)) // 3)) if aovs else 0
     return diagonal + groups * colour + len(scene.lights) * shares + aov_passes
-
-
-def _integrator(name: str | None) -> str:
-    """*name* checked against :data:`~spectrinsic.render.single.INTEGRATORS` (``None``: the
-    default)."""
-    return DEFAULT_INTEGRATOR if name is None else validate_choice(name, INTEGRATORS, "integrator", error=RenderError)
 
 
 def _sum_direct(parts: Sequence[np.ndarray | None]) -> np.ndarray:
@@ -241,7 +236,7 @@ def render_scene(
     """
     objs = _modes(modes)
     wanted = _direct_modes(direct, objs)
-    integrator = _integrator(integrator)
+    integrator = resolve_integrator(integrator, variant)
     matrices = {m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in objs}
     lights = [[j] for j in range(len(scene.lights))]
     split = per_light and per_light_modes is not None

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from spectrinsic.errors import RenderError, SceneError
+from spectrinsic.errors import RenderError, SceneError, validate_choice
 from spectrinsic.render import translate as tr
 from spectrinsic.render.integrator import BandTables, band_path
 from spectrinsic.render.modes import ChannelValues, RenderMode, channel_values
@@ -35,6 +35,8 @@ __all__ = [
     "render_transport",
     "render_jobs",
     "light_of_emitters",
+    "single_traversal_runs",
+    "resolve_integrator",
 ]
 
 #: How diagonal modes are rendered: ``"passes"`` (⌈K/3⌉ RGB passes per mode, one scene per
@@ -76,6 +78,20 @@ class TransportOutput:
         parts = self.per_light(direct=direct)
         chosen = range(parts.shape[0]) if lights is None else [int(j) for j in lights]
         return np.sum(parts[list(chosen)], axis=0, dtype=np.float64).astype(np.float32)
+
+
+def single_traversal_runs(variant: str | None) -> bool:
+    """Whether the band-path traversal runs with *variant*'s RGB variant: a JIT one (LLVM or
+    CUDA), where Dr.Jit traces it into one kernel. On a scalar variant a Python integrator
+    would run once per sample, so :func:`spectrinsic.render.render_scene` uses the passes."""
+    return not choose_variant("rgb", variant).startswith("scalar")
+
+
+def resolve_integrator(name: str | None, variant: str | None = None) -> str:
+    """*name* checked against :data:`INTEGRATORS` (``None``: :data:`DEFAULT_INTEGRATOR`);
+    ``"passes"`` where the traversal does not run (:func:`single_traversal_runs`)."""
+    chosen = DEFAULT_INTEGRATOR if name is None else validate_choice(name, INTEGRATORS, "integrator", error=RenderError)
+    return chosen if chosen == "passes" or single_traversal_runs(variant) else "passes"
 
 
 def light_of_emitters(mi: Any, loaded: Any) -> dict[int, int]:

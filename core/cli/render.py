@@ -206,7 +206,7 @@ def run(args: argparse.Namespace) -> int:
                       modes=modes, n_lights=len(scene.lights), per_light=args.per_light,
                       direct=args.direct, data_dir=data_dir)
     options = dict(modes=modes, per_light=args.per_light, direct=args.direct, aovs=not args.no_aovs)
-    total = count_passes(scene, data_dir=data_dir, **options)
+    total = count_passes(scene, data_dir=data_dir, variant=args.variant, **options)
     bar = None
     if not getattr(args, "quiet", False):
         from tqdm import tqdm

@@ -235,8 +235,12 @@ def select_samples(specs: Sequence[SampleTask], only: Sequence[str] | str | None
     return kept
 
 
-def build_sample(task: SampleTask) -> SampleOutcome:
+def build_sample(task: SampleTask, *, integrator: str | None = None) -> SampleOutcome:
     """Build one sample: scene → render → ground-truth export. Runs in a worker.
+
+    *integrator* chooses how the diagonal modes are rendered
+    (:data:`spectrinsic.render.single.INTEGRATORS`; ``None``: the render package's default);
+    the benchmark compares them.
 
     Returns
     -------
@@ -266,6 +270,7 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         direct=cfg.direct,
         aovs=True,
         data_dir=task.data_dir,
+        integrator=integrator,
     )
     render_seconds = time.perf_counter() - t_render
     if cfg.direct:  # the energy ratio r of Eq. 5.8, recorded for the dataset card's diversity plots
