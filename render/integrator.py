@@ -28,14 +28,15 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from spectrinsic.errors import RenderError
 
-__all__ = ["INTEGRATOR_NAME", "BandTables", "band_path_class", "band_path", "transport_channels"]
+__all__ = ["INTEGRATOR_NAME", "BandTables", "band_path_class", "band_path", "transport_channels",
+           "first_hit_channels"]
 
 #: Name the integrator is registered under (``mi.load_dict({"type": INTEGRATOR_NAME})``).
 INTEGRATOR_NAME = "spectrinsic_bandpath"
@@ -56,17 +57,30 @@ class BandTables:
         ``{Mitsuba emitter registry id (int): light index}``.
     n_lights
         L, the number of accumulator groups.
+    shape_surfaces
+        ``{Mitsuba shape id: surface index}`` for the first-hit maps (coverage one-hot per
+        surface, ray distance, shading normal), empty when not wanted.
     """
 
     albedo: np.ndarray
     shape_rows: dict[str, int]
     emitter_lights: dict[int, int]
     n_lights: int
+    shape_surfaces: dict[str, int] = field(default_factory=dict)
 
 
 def transport_channels(n_lights: int, n_bands: int) -> list[str]:
     """AOV names of the transport channels, light-major: ``t<l>_<k>``."""
-    return [f"t{l:02d}_{k:02d}" for l in range(n_lights) for k in range(n_bands)]
+    return [f"t{j:02d}_{k:02d}" for j in range(n_lights) for k in range(n_bands)]
+
+
+def first_hit_channels(n_surfaces: int) -> list[str]:
+    """AOV names of the first-hit maps after the transport: the coverage of each surface, the
+    ray distance and the shading normal (as Mitsuba's ``aov`` integrator's ``depth`` and
+    ``sh_normal``); none without surfaces."""
+    if n_surfaces == 0:
+        return []
+    return [f"cov{i:03d}" for i in range(n_surfaces)] + ["depth", "normal.x", "normal.y", "normal.z"]
 
 
 def _mis_weight(dr: Any, mi: Any, pdf_a: Any, pdf_b: Any) -> Any:
@@ -85,19 +99,22 @@ def _band_max(dr: Any, bands: Sequence) -> Any:
     return values[0]
 
 
-def _lookups(mi: Any, dr: Any, scene: Any, tables: BandTables) -> tuple[Any, Any, Any]:
-    """Dr.Jit arrays of the band albedos, shape id -> table row and emitter id -> light."""
+def _lookups(mi: Any, dr: Any, scene: Any, tables: BandTables) -> tuple[Any, Any, Any, Any]:
+    """Dr.Jit arrays of the band albedos, shape id -> table row, emitter id -> light and shape
+    id -> surface (``len(shape_surfaces)`` where none)."""
     albedo = np.asarray(tables.albedo, np.float32)
-    black = albedo.shape[0] - 1
+    black, none = albedo.shape[0] - 1, len(tables.shape_surfaces)
     shapes = list(scene.shapes())
     ids = np.array(dr.reinterpret_array(mi.UInt32, mi.ShapePtr(shapes)), np.int64) if shapes else np.zeros(0, np.int64)
     rows = np.full(int(ids.max(initial=0)) + 1, black, np.uint32)
+    surfaces = np.full(rows.size, none, np.uint32)
     for sid, shape in zip(ids, shapes, strict=True):
         rows[sid] = tables.shape_rows.get(shape.id(), black)
+        surfaces[sid] = tables.shape_surfaces.get(shape.id(), none)
     lights = np.zeros(max(tables.emitter_lights, default=0) + 1, np.uint32)
     for eid, light in tables.emitter_lights.items():
         lights[eid] = light
-    return mi.Float(albedo.ravel()), mi.UInt32(rows), mi.UInt32(lights)
+    return mi.Float(albedo.ravel()), mi.UInt32(rows), mi.UInt32(lights), mi.UInt32(surfaces)
 
 
 class _Kernel:
@@ -114,10 +131,10 @@ class _Kernel:
     def deposit(self, acc: list, light: Any, weight: Any, bands: Sequence, mask: Any) -> list:
         """``acc[l·K + k] += bands[k]·weight`` on the lanes whose light is l."""
         k, out = self.it.n_bands, list(acc)
-        for l in range(self.it.n_lights):
-            w = self.dr.select(mask & (light == l), weight, 0.0)
+        for j in range(self.it.n_lights):
+            w = self.dr.select(mask & (light == j), weight, 0.0)
             for b in range(k):
-                out[l * k + b] = self.dr.fma(bands[b], w, out[l * k + b])
+                out[j * k + b] = self.dr.fma(bands[b], w, out[j * k + b])
         return out
 
     def emitter_hit(self, si: Any, prev_si: Any, prev_pdf: Any, prev_delta: Any) -> tuple[Any, Any, Any]:
@@ -161,10 +178,24 @@ class _Kernel:
         beta = dr.select(rr_active, beta * dr.rcp(dr.detach(rr_prob)), beta)
         return beta, (~rr_active | rr_continue) & (throughput_max != 0.0)
 
+    def first_hit(self, si: Any, depth: Any, first: tuple) -> tuple:
+        """Surface index, ray distance and shading normal of the camera ray's hit."""
+        mi, dr = self.mi, self.dr
+        if not self.it.n_surfaces:
+            return first
+        now, valid = depth == 0, si.is_valid()
+        surface = dr.gather(mi.UInt32, self.it.surface_lut, dr.reinterpret_array(mi.UInt32, si.shape), valid)
+        surface = dr.select(valid, surface, self.it.n_surfaces)
+        distance = dr.select(valid, si.t, 0.0)
+        normal = dr.select(valid, si.sh_frame.n, mi.Vector3f(0.0))
+        return (dr.select(now, surface, first[0]), dr.select(now, distance, first[1]),
+                dr.select(now, normal, first[2]))
+
     def body(self, sampler: Any, ray: Any, depth: Any, beta: Any, bands: list, acc: list,
-             prev_si: Any, prev_pdf: Any, prev_delta: Any, alive: Any) -> tuple:
+             prev_si: Any, prev_pdf: Any, prev_delta: Any, first: tuple, alive: Any) -> tuple:
         mi, dr = self.mi, self.dr
         si = self.scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=depth == 0)
+        first = self.first_hit(si, depth, first)
         light, weight, hit = self.emitter_hit(si, prev_si, prev_pdf, prev_delta)
         acc = self.deposit(acc, light, beta * weight, bands, hit)
         active_next = (depth + 1 < self.it.max_depth) & si.is_valid()
@@ -177,16 +208,23 @@ class _Kernel:
         beta, go_on = self.roulette(sampler, depth, beta, bands)
         delta = mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
         return (sampler, ray, depth, beta, bands, acc, mi.Interaction3f(si), bsdf_sample.pdf, delta,
-                active_next & go_on)
+                first, active_next & go_on)
 
     def run(self, sampler: Any, ray: Any, active: Any) -> list:
-        """The K·L accumulators of one wavefront of camera rays."""
+        """The K·L accumulators of one wavefront of camera rays, then the first-hit maps
+        (:func:`first_hit_channels`)."""
         mi, dr, k = self.mi, self.dr, self.it.n_bands
+        first = (mi.UInt32(self.it.n_surfaces), mi.Float(0.0), mi.Vector3f(0.0))
         state = (sampler, mi.Ray3f(ray), mi.UInt32(0), mi.Float(1.0), [mi.Float(1.0) for _ in range(k)],
                  [mi.Float(0.0) for _ in range(k * self.it.n_lights)], dr.zeros(mi.Interaction3f),
-                 mi.Float(1.0), mi.Bool(True), mi.Bool(active))
+                 mi.Float(1.0), mi.Bool(True), first, mi.Bool(active))
         state = dr.while_loop(state, lambda *s: s[-1], self.body, label="spectrinsic band path")
-        return list(state[5])
+        out = list(state[5])
+        if self.it.n_surfaces:
+            surface, distance, normal = state[9]
+            out += [dr.select(surface == i, 1.0, 0.0) for i in range(self.it.n_surfaces)]
+            out += [distance, normal.x, normal.y, normal.z]
+        return out
 
 
 @functools.cache
@@ -213,6 +251,8 @@ def band_path_class(variant: str) -> type:
             self.rr_depth = int(props.get("rr_depth", self.max_depth + 1))
             self.n_bands = int(props.get("n_bands", 3))
             self.n_lights = int(props.get("n_lights", 1))
+            self.n_surfaces = int(props.get("n_surfaces", 0))
+            self.surface_lut = mi.UInt32(np.zeros(1, np.uint32))
             self.albedo = mi.Float(np.zeros(self.n_bands, np.float32))
             self.shape_lut = mi.UInt32(np.zeros(1, np.uint32))
             self.emitter_lut = mi.UInt32(np.zeros(1, np.uint32))
@@ -220,13 +260,14 @@ def band_path_class(variant: str) -> type:
         def set_tables(self, scene: Any, tables: BandTables) -> None:
             """Point the lookups at *tables* for the loaded *scene* (no recompilation)."""
             shape = np.shape(tables.albedo)
-            if len(shape) != 2 or shape[1] != self.n_bands or tables.n_lights != self.n_lights:
+            if (len(shape) != 2 or shape[1] != self.n_bands or tables.n_lights != self.n_lights
+                    or len(tables.shape_surfaces) != self.n_surfaces):
                 raise RenderError(f"band tables {shape} for {tables.n_lights} lights do not fit an "
                                   f"integrator of {self.n_bands} bands and {self.n_lights} lights")
-            self.albedo, self.shape_lut, self.emitter_lut = _lookups(mi, dr, scene, tables)
+            self.albedo, self.shape_lut, self.emitter_lut, self.surface_lut = _lookups(mi, dr, scene, tables)
 
         def aov_names(self) -> list[str]:
-            return transport_channels(self.n_lights, self.n_bands)
+            return transport_channels(self.n_lights, self.n_bands) + first_hit_channels(self.n_surfaces)
 
         def sample(self, scene: Any, sampler: Any, ray: Any, medium: Any = None, active: Any = True) -> tuple:
             return mi.Spectrum(0.0), mi.Bool(True), _Kernel(mi, dr, self, scene).run(sampler, ray, active)
@@ -238,8 +279,9 @@ def band_path_class(variant: str) -> type:
     return BandPath
 
 
-def band_path(mi: Any, *, max_depth: int, n_bands: int, n_lights: int) -> Any:
-    """A :class:`BandPath` instance for the active variant (rr off: ``rr_depth`` > ``max_depth``)."""
+def band_path(mi: Any, *, max_depth: int, n_bands: int, n_lights: int, n_surfaces: int = 0) -> Any:
+    """A :class:`BandPath` instance for the active variant (rr off: ``rr_depth`` > ``max_depth``),
+    with first-hit maps of *n_surfaces* surfaces if not 0."""
     band_path_class(mi.variant())
     return mi.load_dict({"type": INTEGRATOR_NAME, "max_depth": int(max_depth), "rr_depth": int(max_depth) + 1,
-                         "n_bands": int(n_bands), "n_lights": int(n_lights)})
+                         "n_bands": int(n_bands), "n_lights": int(n_lights), "n_surfaces": int(n_surfaces)})

@@ -84,17 +84,17 @@ def count_passes(
     split = per_light and per_light_modes is not None
     groups = len(scene.lights) if per_light and not split else 1
     share_modes = _modes(per_light_modes) if per_light and per_light_modes is not None else []
-    if resolve_integrator(integrator, variant) == "single":  # diagonal modes: one traversal (+1 direct-only)
-        traversals = 1 + any(m.kind == "diagonal" and m.name in wanted for m in objs)
-        diagonal = traversals if any(m.kind == "diagonal" for m in objs + share_modes) else 0
+    single = resolve_integrator(integrator, variant) == "single" and any(
+        m.kind == "diagonal" for m in objs + share_modes)
+    diagonal = 0
+    if single:  # every diagonal mode and the AOVs: one traversal (+1 direct-only)
+        diagonal = 1 + any(m.kind == "diagonal" and m.name in wanted for m in objs)
         objs, share_modes = [m for m in objs if m.kind != "diagonal"], [m for m in share_modes if m.kind != "diagonal"]
-    else:
-        diagonal = 0
     colour = sum(n_passes(m, data_dir=data_dir) * (2 if m.name in wanted else 1) for m in objs)
     shares = sum(n_passes(m, data_dir=data_dir) for m in share_modes)
     from spectrinsic.render.translate import surfaces
 
-    aov_passes = max(1, -(-len(surfaces(scene)) // 3)) if aovs else 0
+    aov_passes = max(1, -(-len(surfaces(scene)) // 3)) if aovs and not single else 0
     return diagonal + groups * colour + len(scene.lights) * shares + aov_passes
 
 
@@ -140,13 +140,16 @@ def _run_jobs(
     common: dict[str, Any] = dict(spp=spp, seed=seed, max_depth=max_depth, progress=progress,
                                   geometry=geometry)
     single = SingleTraversal({}, ())
-    if aovs or any(m.kind == "diagonal" for job in jobs for m in job.modes):
+    if not any(m.kind == "diagonal" for job in jobs for m in job.modes):
+        integrator = "passes"  # nothing to trace: the AOVs come from their own passes
+    if aovs or integrator == "single" or any(m.kind == "diagonal" for job in jobs for m in job.modes):
         rgb_variant = choose_variant("rgb", variant)
         with variant_scope(rgb_variant):
             if integrator == "single":
                 parts, single = render_jobs(
                     scene, [(j.modes, j.group, j.with_direct) for j in jobs], wanted=wanted,
-                    variant=rgb_variant, data_dir=data_dir, **common)
+                    variant=rgb_variant, data_dir=data_dir, aovs=aovs, **common)
+                aov_maps = single.aovs
                 for out, part in zip(outputs, parts, strict=True):
                     out.update(part)
             for out, job in zip(outputs, jobs, strict=True) if integrator == "passes" else ():
@@ -159,7 +162,7 @@ def _run_jobs(
                     scene, values, direct=[job.with_direct and m.name in wanted for m in diagonal],
                     active_lights=job.group, variant=rgb_variant, **common,
                 ), strict=True))
-            if aovs:
+            if aovs and integrator == "passes":
                 aov_maps, aov_seconds = render_aovs(scene, spp=spp, seed=seed, variant=rgb_variant,
                                                     progress=progress, geometry=geometry)
     if any(m.kind == "spectral" for job in jobs for m in job.modes):

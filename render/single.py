@@ -13,16 +13,16 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
 from spectrinsic.errors import RenderError, SceneError, validate_choice
 from spectrinsic.render import translate as tr
-from spectrinsic.render.integrator import BandTables, band_path
+from spectrinsic.render.integrator import BandTables, band_path, first_hit_channels
 from spectrinsic.render.modes import ChannelValues, RenderMode, channel_values
-from spectrinsic.render.passes import DIRECT_DEPTH, PassOutput, PassProgress
+from spectrinsic.render.passes import DIRECT_DEPTH, PassOutput, PassProgress, assemble_aovs
 from spectrinsic.render.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import get_sensors
@@ -42,8 +42,9 @@ __all__ = [
 #: How diagonal modes are rendered: ``"passes"`` (⌈K/3⌉ RGB passes per mode, one scene per
 #: light subset) or ``"single"`` (one band-path traversal for every mode and light).
 INTEGRATORS: tuple[str, ...] = ("passes", "single")
-#: The default of :func:`spectrinsic.render.render_scene`.
-DEFAULT_INTEGRATOR = "passes"
+#: The default of :func:`spectrinsic.render.render_scene`: the traversal, since it gives the
+#: passes' images to float rounding (``tests/render/test_single_traversal.py``) in one render.
+DEFAULT_INTEGRATOR = "single"
 
 
 @dataclass(frozen=True, eq=False)
@@ -115,11 +116,13 @@ def light_of_emitters(mi: Any, loaded: Any) -> dict[int, int]:
     return out
 
 
-def _tables(scene: Scene, value_sets: Sequence[ChannelValues], emitters: dict[int, int]) -> BandTables:
+def _tables(scene: Scene, value_sets: Sequence[ChannelValues], emitters: dict[int, int], aovs: bool) -> BandTables:
     bands = np.concatenate([np.asarray(v.materials, float) for v in value_sets], axis=1)
     albedo = np.vstack([bands, np.zeros((1, bands.shape[1]))])  # last row: black
-    rows = {s.key: s.material for s in tr.surfaces(scene) if s.material >= 0}
-    return BandTables(albedo=albedo, shape_rows=rows, emitter_lights=emitters, n_lights=len(scene.lights))
+    surfaces = tr.surfaces(scene)
+    rows = {s.key: s.material for s in surfaces if s.material >= 0}
+    return BandTables(albedo=albedo, shape_rows=rows, emitter_lights=emitters, n_lights=len(scene.lights),
+                      shape_surfaces={s.key: i for i, s in enumerate(surfaces)} if aovs else {})
 
 
 def _render(mi: Any, loaded: Any, integrator: Any, *, spp: int, seed: int, n: int) -> tuple[np.ndarray, float]:
@@ -141,10 +144,11 @@ def render_transport(
     seed: int,
     max_depth: int = 8,
     direct: bool = False,
+    aovs: bool = False,
     variant: str | None = None,
     progress: PassProgress | None = None,
     geometry: Sequence[tr.SurfaceGeometry] | None = None,
-) -> tuple[list[TransportOutput], tuple[float, ...], str]:
+) -> tuple[list[TransportOutput], dict[str, np.ndarray], tuple[float, ...], str]:
     """Per-light band transport of every value set, in one traversal (two with *direct*).
 
     Parameters
@@ -154,11 +158,16 @@ def render_transport(
         their bands are traced together.
     direct
         Also trace direct light only (path depth 2), for the energy ratio r of Eq. 5.8.
+    aovs
+        Also take coverage, ids, depth and normals from the camera rays' first hits, as
+        :func:`~spectrinsic.render.passes.render_aovs` computes them from the same samples.
 
     Returns
     -------
     outputs
         One :class:`TransportOutput` per value set.
+    aov_maps
+        The maps of :func:`~spectrinsic.render.passes.render_aovs` (empty without *aovs*).
     seconds
         Wall-clock seconds of each traversal.
     variant
@@ -169,7 +178,7 @@ def render_transport(
     if not scene.lights:
         raise SceneError(f"scene {scene.name!r} has no lights: nothing to render")
     if not value_sets:
-        return [], (), choose_variant("rgb", variant)
+        raise SceneError("render_transport: expected at least one set of channel values")
     widths = [np.asarray(v.materials).shape[1] for v in value_sets]
     n_bands, n_lights = sum(widths), len(scene.lights)
     chosen = choose_variant("rgb", variant)
@@ -181,14 +190,17 @@ def render_transport(
             film=tr.hdr_film(w, h), integrator=tr.path_integrator(max_depth), sample_count=spp,
             geometry=geometry,
         ))
-        tables = _tables(scene, value_sets, light_of_emitters(mi, loaded))
+        tables = _tables(scene, value_sets, light_of_emitters(mi, loaded), aovs)
         depths = [int(max_depth)] + ([DIRECT_DEPTH] if direct else [])
-        images, seconds = [], []
+        images, seconds, first = [], [], np.zeros((h, w, 0), np.float32)
         for depth in depths:
-            integrator = band_path(mi, max_depth=depth, n_bands=n_bands, n_lights=n_lights)
-            integrator.set_tables(loaded, tables)
-            image, dt = _render(mi, loaded, integrator, spp=spp, seed=seed, n=n_bands * n_lights)
-            images.append(image.reshape(h, w, n_lights, n_bands).transpose(2, 0, 1, 3))
+            n_surfaces = len(tables.shape_surfaces) if depth == depths[0] else 0
+            integrator = band_path(mi, max_depth=depth, n_bands=n_bands, n_lights=n_lights, n_surfaces=n_surfaces)
+            integrator.set_tables(loaded, tables if n_surfaces else replace(tables, shape_surfaces={}))
+            n_first = len(first_hit_channels(n_surfaces))
+            image, dt = _render(mi, loaded, integrator, spp=spp, seed=seed, n=n_bands * n_lights + n_first)
+            first = image[..., n_bands * n_lights:] if n_surfaces else first
+            images.append(image[..., :n_bands * n_lights].reshape(h, w, n_lights, n_bands).transpose(2, 0, 1, 3))
             seconds.append(dt)
             if progress is not None:
                 progress(1)
@@ -201,7 +213,8 @@ def render_transport(
         )
         for v, a, b in zip(value_sets, edges[:-1], edges[1:], strict=True)
     ]
-    return outputs, tuple(seconds), chosen
+    aov_maps = assemble_aovs(scene, tr.surfaces(scene), first[..., :-4], first[..., -4], first[..., -3:]) if aovs else {}
+    return outputs, aov_maps, tuple(seconds), chosen
 
 
 @dataclass(frozen=True, eq=False)
@@ -210,6 +223,8 @@ class SingleTraversal:
 
     transport: dict[str, TransportOutput]
     seconds: tuple[float, ...]
+    #: First-hit maps (:func:`~spectrinsic.render.passes.render_aovs`'s), when asked for.
+    aovs: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 def render_jobs(
@@ -224,20 +239,23 @@ def render_jobs(
     progress: PassProgress | None,
     geometry: Sequence[tr.SurfaceGeometry] | None,
     data_dir: str | None,
+    aovs: bool = False,
 ) -> tuple[list[dict[str, PassOutput]], SingleTraversal]:
     """The diagonal images of every job ``(modes, lights or None for all, with_direct)`` from
     one traversal: each job's image of a mode is the sum of its lights' shares.
 
     Drop-in for rendering each job's diagonal modes with
     :func:`~spectrinsic.render.passes.render_diagonal`; a direct-only image is made for the
-    modes in *wanted* of the jobs that ask for one.
+    modes in *wanted* of the jobs that ask for one. With *aovs*, the first-hit maps come from
+    the same traversal (drop-in for :func:`~spectrinsic.render.passes.render_aovs`). The jobs
+    must hold at least one diagonal mode.
     """
     diagonal = list({m.name: m for modes, _, _ in jobs for m in modes if m.kind == "diagonal"}.values())
     want_direct = any(flag and m.name in wanted for modes, _, flag in jobs for m in modes if m.kind == "diagonal")
     values = [channel_values(scene, get_sensors(m.sensors, data_dir=data_dir), data_dir=data_dir) for m in diagonal]
-    outs, seconds, chosen = render_transport(scene, values, spp=spp, seed=seed, max_depth=max_depth,
-                                             direct=want_direct, variant=variant, progress=progress,
-                                             geometry=geometry)
+    outs, aov_maps, seconds, chosen = render_transport(
+        scene, values, spp=spp, seed=seed, max_depth=max_depth, direct=want_direct, aovs=aovs,
+        variant=variant, progress=progress, geometry=geometry)
     transport = {m.name: o for m, o in zip(diagonal, outs, strict=True)}
     parts = []
     for modes, group, flag in jobs:
@@ -250,4 +268,4 @@ def render_jobs(
                 seconds=(), variant=chosen,
             )
         parts.append(part)
-    return parts, SingleTraversal(transport, seconds)
+    return parts, SingleTraversal(transport, seconds, aov_maps)

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from spectrinsic.results import write_json
 
-BENCHMARKS = ("render", "dataset", "decompose", "ground_truth")
+BENCHMARKS = ("render", "dataset", "traversal", "decompose", "ground_truth")
 
 
 def main(argv: list[str] | None = None) -> int:

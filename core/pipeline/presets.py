@@ -33,7 +33,9 @@ _STANDARD_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
 #: Version of spectrinsic's own computation of pixels and ground truth. Bump it whenever a
 #: change alters any written value (a new or changed layer, formula, sampling or file layout),
 #: so existing datasets are rebuilt; a release that changes none keeps old datasets valid.
-PIXELS_VERSION = 2
+#: 3: diagonal modes from one band-path traversal; per-light images are shares of the full
+#: render (render/single.py), not one render per light.
+PIXELS_VERSION = 3
 #: What of the installed software changes pixels, hence enters the config hash, and how much
 #: of its version: the renderer exactly (its sampling changes between patch releases);
 #: colour-science's data tables (CMFs, illuminants, cameras) by minor release; numpy by major

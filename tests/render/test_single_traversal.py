@@ -12,7 +12,14 @@ import numpy as np
 import pytest
 
 from spectrinsic.errors import RenderError
-from spectrinsic.render import channel_values, count_passes, get_mode, merge_batches, render_diagonal, render_scene
+from spectrinsic.render import (
+    channel_values,
+    count_passes,
+    get_mode,
+    merge_batches,
+    render_diagonal,
+    render_scene,
+)
 from spectrinsic.render.single import render_transport
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import get_sensors
@@ -47,13 +54,17 @@ def test_single_traversal_equals_the_passes(make_room):
         _close(new.direct[mode], old.direct[mode])
         _close(new.images[mode], old.images[mode])
     np.testing.assert_array_equal(new.raw["spectral"], old.raw["spectral"])
-    # the traversal is the two diagonal renders (full and direct) instead of 2 x (1 + 2 + 11) + 2
-    # per-light passes; the progress calls are what count_passes predicts
+    # two traversals (full with the first-hit maps, and direct-only) replace 2 x (1 + 2 + 11)
+    # diagonal passes, 2 per-light passes and 3 coverage passes; the spectral reference keeps
+    # its 2. The progress calls are what count_passes predicts.
     options = {k: v for k, v in kw.items() if k not in ("spp", "seed")}
     for name, seen in calls.items():
         assert len(seen) == count_passes(scene, integrator=name, **options)
-    assert len(calls["passes"]) - len(calls["single"]) == 2 * 14 + 2 - 2
+    assert (len(calls["passes"]), len(calls["single"])) == (2 + 2 * 14 + 2 + 3, 2 + 2)
     assert new.meta["integrator"] == "single" and new.meta["timings"]["single"]["passes"] == 2
+    # the first-hit maps see the same camera rays as the coverage passes
+    for key, ref in old.aovs.items():
+        np.testing.assert_allclose(new.aovs[key], ref, rtol=0, atol=1e-6, err_msg=key)
     assert not old.transport
 
 
@@ -61,9 +72,9 @@ def test_render_transport_matches_render_diagonal(make_room):
     """Lower level: the transport times the lights' channel values is render_diagonal's image."""
     scene = make_room(size=12)
     values = [channel_values(scene, get_sensors(get_mode(m).sensors)) for m in DIAGONAL]
-    outs, seconds, _ = render_transport(scene, values, spp=8, seed=9)
+    outs, aovs, seconds, _ = render_transport(scene, values, spp=8, seed=9)
     passes = render_diagonal(scene, values, spp=8, seed=9)
-    assert len(seconds) == 1
+    assert len(seconds) == 1 and not aovs
     for out, ref, v in zip(outs, passes, values, strict=True):
         assert out.transport.shape == (2, 12, 12, v.materials.shape[1])
         _close(out.image(), ref.image)
