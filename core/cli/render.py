@@ -222,5 +222,8 @@ def run(args: argparse.Namespace) -> int:
     timings = result.meta["timings"]
     for mode in result.images:
         print(f"{mode:<9} {timings[mode]['passes']:>3} passes {timings[mode]['seconds']:7.2f} s  -> {paths[mode]}")
+    if "single" in timings:  # every diagonal mode (and the AOVs) from one traversal
+        print(f"{'traversal':<9} {timings['single']['passes']:>3} passes {timings['single']['seconds']:7.2f} s  "
+              "(all diagonal modes and lights)")
     print(f"wrote {paths['meta']}")
     return 0
