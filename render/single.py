@@ -7,6 +7,11 @@ mode, one scene per light subset) built on the band-path integrator of
 passes trace identical paths (same seed and spp, Russian roulette off), the images are those of
 the passes to float rounding; each light's image is its exact share of that render (the
 per-light images sum to the total), not a separate render with the other lights removed.
+The coverage, ids, depth and normals of :func:`~spectrinsic.render.passes.render_aovs` come
+from the same traversal's camera rays (their first hits), so no coverage passes are needed.
+
+Cost, measured on ``room-living__v1__two-colour-a`` at the default preset (256², 2 batches of
+8 spp, 2 lights, 25 surfaces): see ``make bench`` (``bench_traversal.json``).
 """
 
 from __future__ import annotations

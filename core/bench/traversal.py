@@ -78,6 +78,7 @@ def _bench(work: str) -> dict[str, Any]:
         seconds = min(o.seconds for o in outcomes)
         out[name] = {
             "seconds_per_sample": [round(o.seconds, 3) for o in outcomes],
+            "render_seconds_per_sample": [round(o.render_seconds, 3) for o in outcomes],
             "mitsuba_seconds_per_sample": [round(o.mitsuba_seconds, 3) for o in outcomes],
             "samples_per_core_hour": round(3600.0 / (seconds * cores), 1),
             **_breakdown(_task(work, f"breakdown-{name}"), name),
