@@ -9,6 +9,9 @@ Nothing is imported from Mitsuba when this package is imported; variants are cho
   independent batches whose spread measures the Monte Carlo noise.
 - :mod:`~spectrinsic.render.modes`: the mode registry and the colour maths of Eq. 5.2.
 - :mod:`~spectrinsic.render.passes`: the passes themselves, for any sensor set.
+- :mod:`~spectrinsic.render.single` and :mod:`~spectrinsic.render.integrator`: every diagonal
+  mode, band and light in one path traversal (``render_scene(integrator="single")``, the
+  default), with the per-light band transport.
 - :func:`scene_to_mitsuba`: the one translation of a scene into a Mitsuba dict.
 """
 
