@@ -34,7 +34,7 @@ $(PKG): $(DEPS) $(PKG_DIRS)
 setup: $(PKG) ## create .venv, install the package (strict editable) and the system LLVM
 
 test: $(PKG) ## run the test suite (tiny renders; < 15 min on 2 cores)
-	$(PY) -m pytest -n 2 -q
+	$(PY) -m pytest -n 2 -q --durations=10
 
 # torch is an optional extra: installed only for this step (the CPU build, pinned in the lock).
 test-torch: $(PKG) ## install the CPU build of PyTorch, then run the torch adapter tests (CI runs it)
@@ -42,7 +42,7 @@ test-torch: $(PKG) ## install the CPU build of PyTorch, then run the torch adapt
 	SPECTRINSIC_REQUIRE_TORCH=1 $(PY) -m pytest -q -p no:xdist -m torch
 
 test-fast: $(PKG) ## the tests not marked slow (no dataset builds or converged renders)
-	$(PY) -m pytest -n 2 -q -m "not slow"
+	$(PY) -m pytest -n 2 -q --durations=10 -m "not slow"
 
 study: study-spectral ## all studies: Table 5.2, Table 4.4 and the rendered study (a few minutes)
 	$(BIN)/spectrinsic study rendering

@@ -18,6 +18,7 @@ __all__ = [
     "SceneError",
     "RenderError",
     "DatasetError",
+    "SampleMetaError",
     "WriteError",
     "DiskFullError",
     "DecomposeError",
@@ -61,8 +62,18 @@ class DatasetError(SpectrinsicError, RuntimeError):
     """A dataset folder that is incomplete, corrupt or inconsistent with its manifest."""
 
 
+class SampleMetaError(DatasetError):
+    """A sample's ``meta.json`` that cannot be trusted: not JSON, a field missing, misnamed or of
+    the wrong type, a non-finite number, or content that no longer matches its seal. The message
+    names the file and the field."""
+
+
 class WriteError(DatasetError):
     """An output file that could not be written (permission denied, read-only file system...)."""
+
+
+class FolderLockedError(DatasetError):
+    """Another spectrinsic run holds the advisory lock of the folder this run would write."""
 
 
 class DiskFullError(WriteError):

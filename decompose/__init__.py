@@ -39,7 +39,7 @@ from spectrinsic.decompose.metrics import (
     whdr,
 )
 from spectrinsic.decompose.photometric import SCENARIOS, photometric_correction
-from spectrinsic.decompose.predictions import Predictions
+from spectrinsic.decompose.predictions import PredictionFiles, Predictions, write_predictions
 from spectrinsic.decompose.registry import (
     DECOMPOSERS,
     ENTRY_POINT_GROUP,
@@ -59,6 +59,7 @@ __all__ = [
     "EvaluationResult",
     "Judgements",
     "Metric",
+    "PredictionFiles",
     "Predictions",
     "Score",
     "almse",
@@ -87,4 +88,5 @@ __all__ = [
     "shading_chromaticity_error",
     "si_mse",
     "whdr",
+    "write_predictions",
 ]

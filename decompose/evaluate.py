@@ -38,7 +38,10 @@ from spectrinsic.decompose.metrics import METRICS, WHDR_DELTA, get_metric, whdr
 from spectrinsic.decompose.photometric import SCENARIOS, photometric_correction
 from spectrinsic.decompose.predictions import Predictions
 from spectrinsic.decompose.registry import available_decomposers, get_decomposer
+from spectrinsic.decompose.report import write_report
+from spectrinsic.decompose.scores import CONDITION_GROUPS, INPUT_LAYERS, SCORED_LAYERS, Score
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export.exr import write_exr
 from spectrinsic.gt_export.names import camera_slug
 from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.sample_id import SampleId
@@ -62,30 +65,8 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-#: Lighting conditions of the dataset and the column of Tables 5.3/5.4 each belongs to.
-CONDITION_GROUPS: dict[str, str] = {
-    "white": "WL",
-    "one-colour": "1L",
-    "two-colour-a": "2L",
-    "two-colour-b": "2L",
-}
 _GROUP_ORDER = ("WL", "1L", "2L")
 _KINDS = {"object": "single objects", "complex": "complex scenes"}
-#: The image a method decomposes: the first of these layers a sample has. ``image_denoised``
-#: (``reflectance * shading + residual`` exactly, from the denoised irradiance) is the input
-#: consistent with the ground truth; ``image`` is the raw Monte Carlo rendering.
-INPUT_LAYERS: tuple[str, ...] = ("image_denoised", "image")
-#: Layers scored, and what each one is: the thesis scores shading in grey (sec. 5.2.5), the
-#: coloured-shading literature scores its colour too.
-SCORED_LAYERS: dict[str, str] = {
-    "reflectance": "`reflectance` (absolute, linear sRGB under D65) against the estimate, in colour",
-    "shading_grey": "`shading_grey` (luminance Y of the irradiance) against the estimate's mean "
-                    "over channels (thesis sec. 5.2.5: grey shading)",
-    "shading": "`shading` (linear-sRGB colour of the irradiance, material-free) against the "
-               "estimate's coloured shading (`image / reflectance`)",
-    "reflectance_grey": "mean over channels of `reflectance` against that of the estimate "
-                        "(thesis Tables 3.1/3.2: \"grayscale reflectances\")",
-}
 #: Metrics of the grey shading layer (angular error needs colour).
 _SHADING_GREY_METRICS = ("si_mse", "lmse", "almse", "corr", "lcorr", "dssim")
 #: Metrics of the coloured shading layer.
@@ -93,20 +74,6 @@ _SHADING_COLOUR_METRICS = ("si_mse", "lmse", "shading_chromaticity")
 #: Metrics of the grey reflectance (Table 3.2's four).
 _REFLECTANCE_GREY_METRICS = ("si_mse", "lmse", "almse", "corr")
 _PHOTOMETRIC = tuple(SCENARIOS)
-
-
-@dataclass(frozen=True)
-class Score:
-    """One number of ``scores.csv``; ``camera`` and ``photometric`` only for camera scenarios."""
-
-    sample: str
-    method: str
-    scenario: str
-    layer: str
-    metric: str
-    value: float
-    camera: str = ""
-    photometric: str = ""
 
 
 @dataclass(frozen=True)
@@ -226,8 +193,6 @@ def _layer_scores(
 
 
 def _write_estimate(directory: Path, result: Decomposition) -> None:
-    from spectrinsic.gt_export.exr import write_exr
-
     directory.mkdir(parents=True, exist_ok=True)
     write_exr(directory / "reflectance.exr", {"reflectance": result.reflectance})
     write_exr(directory / "shading.exr", {"shading": result.shading})
@@ -431,8 +396,6 @@ def evaluate(
     progress
         Called with each sample id once it is done (the CLI passes a tqdm update).
     """
-    from spectrinsic.decompose.report import write_report
-
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if methods is None:

@@ -24,7 +24,9 @@ import numpy as np
 import numpy.typing as npt
 
 from spectrinsic.decompose._validation import ImageShapeError, as_image, as_mask, image_pair
+from spectrinsic.decompose.judgements import predict_judgements
 from spectrinsic.errors import DecomposeError, validate_choice
+from spectrinsic.spectra import angular_error
 
 if TYPE_CHECKING:
     from spectrinsic.decompose.judgements import Judgements
@@ -62,12 +64,15 @@ STEP = 10
 WHDR_DELTA = 0.10
 
 
-def _scale(truth: np.ndarray, estimate: np.ndarray, weight: np.ndarray, axis) -> np.ndarray:
-    """Least-squares ``alpha = sum(w t e) / sum(w e^2)`` (0 where the estimate is all zero)."""
+def _scale(
+    truth: np.ndarray, estimate: np.ndarray, weight: np.ndarray, axis, floor: float = 0.0
+) -> np.ndarray:
+    """Least-squares ``alpha = sum(w t e) / sum(w e^2)`` (0 where ``sum(w e^2) <= floor``)."""
     num = (weight * truth * estimate).sum(axis=axis, keepdims=True)
     den = (weight * estimate * estimate).sum(axis=axis, keepdims=True)
+    ok = den > floor
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), 0.0)
+        return np.where(ok, num / np.where(ok, den, 1.0), 0.0)
 
 
 def si_mse(
@@ -111,6 +116,7 @@ def lmse(
     window: int = WINDOW,
     step: int = STEP,
     per_channel: bool = False,
+    energy_floor: float = 0.0,
 ) -> float:
     """Local mean squared error, thesis Eq. 2.5, as the MIT benchmark computes it.
 
@@ -123,11 +129,10 @@ def lmse(
     per_channel
         Fit one ``alpha`` per window and channel instead of one per window (thesis section
         5.2.5: "an alpha factor fitted for each local patch").
-
-    Notes
-    -----
-    The MIT code sets ``alpha = 0`` when ``sum(e^2) <= 1e-5`` in a window; here only an
-    all-zero estimate gives ``alpha = 0``, since linear renderings have no fixed scale.
+    energy_floor
+        ``alpha = 0`` in a window whose masked ``sum(e^2)`` is at most this. The MIT code uses
+        ``1e-5`` on images in [0, 1] (:mod:`spectrinsic.decompose.mit`); the default 0 leaves
+        only an all-zero estimate at ``alpha = 0``, since linear renderings have no fixed scale.
 
     Raises
     ------
@@ -137,7 +142,7 @@ def lmse(
     """
     t, e, m = _windowed(truth, estimate, mask, window, step)
     axis = 1 if per_channel else (1, 2)
-    alpha = _scale(t, e, m, axis=axis)
+    alpha = _scale(t, e, m, axis=axis, floor=energy_floor)
     residual = (m * (t - alpha * e) ** 2).sum()
     energy = (m * t * t).sum()
     if energy <= 0.0:
@@ -301,8 +306,6 @@ def angular_error_map(
     Returns a ``(H, W)`` float64 map, NaN outside the mask and where either colour is zero.
     Uses :func:`spectrinsic.spectra.angular_error`.
     """
-    from spectrinsic.spectra import angular_error
-
     t, e, m = image_pair(truth, estimate, mask)
     if t.shape[2] != 3:
         raise ImageShapeError(f"angular error needs (H, W, 3) colour images; got {t.shape}")
@@ -386,7 +389,6 @@ def shading_chromaticity_error(
         raise ImageShapeError(
             f"estimate shading shape {np.shape(estimate)} differs from truth shape {np.shape(truth)}"
         )
-    from spectrinsic.spectra import angular_error
 
     m = as_mask(mask, t.shape[:2])
     lit = m & (np.linalg.norm(t, axis=-1) > 0.0)
@@ -464,8 +466,6 @@ def whdr(
         Point pairs, labels and weights (e.g. from
         :func:`spectrinsic.decompose.judgements.sample_judgements`).
     """
-    from spectrinsic.decompose.judgements import predict_judgements
-
     r = as_image(reflectance, "reflectance")
     predicted = predict_judgements(r, judgements.points1, judgements.points2, delta=delta)
     w = judgements.weights

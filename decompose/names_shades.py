@@ -24,7 +24,8 @@ offered); the thesis gives only ratios of ``alpha, beta, gamma`` and leaves the 
 the angle threshold open (``gamma = 1``, 30 degrees here); the angle ``theta_ij`` is measured
 against the ridge tangent at ``pi(p_i)``, the limit of the chord ``pi(p_i) pi(p_j)`` for
 neighbouring colours, and identical colours count as parallel; Eq. 3.9 is solved as a bounded
-linear least-squares problem (``scipy.optimize.lsq_linear``) instead of belief propagation, with
+linear least-squares problem (:func:`spectrinsic.decompose.coherence.bounded_minimum`, exact
+active set) instead of belief propagation, with
 ``L^orig`` measured on the pixels along each shared boundary and each term divided by its mean
 product so that dark and bright boundaries weigh alike.
 
@@ -55,6 +56,7 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 import numpy.typing as npt
 
+from spectrinsic.decompose.coherence import global_coherence, grid_edges
 from spectrinsic.decompose.colour_naming import (
     appendix_a_labels,
     colour_name_memberships,
@@ -63,12 +65,12 @@ from spectrinsic.decompose.colour_naming import (
 )
 from spectrinsic.decompose.constancy import discount_illuminant
 from spectrinsic.decompose.decomposition import Decomposition, finish, prepare_input
-from spectrinsic.decompose.ridges import colour_shades
+from spectrinsic.decompose.ridges import ColourShades, colour_shades
 from spectrinsic.errors import DecomposeError, MissingDependencyError, validate_choice
 from spectrinsic.spectra.colorimetry import decode_srgb as _srgb_decode
 from spectrinsic.spectra.colorimetry import encode_srgb as _srgb_encode
 
-__all__ = ["NamesAndShades", "global_coherence", "grid_edges"]
+__all__ = ["Labelling", "NamesAndShades", "global_coherence", "grid_edges"]
 
 logger = logging.getLogger(__name__)
 
@@ -89,101 +91,6 @@ _EXPOSURE_PERCENTILE = 99.0
 _LOG_FLOOR = 1.0 / 255.0
 
 
-def grid_edges(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """4-neighbour edges between masked pixels.
-
-    Returns
-    -------
-    edges
-        ``(E, 2)`` int32 indices into the masked pixels (raster order), first < second.
-    flat
-        ``(E, 2)`` int64 flat pixel indices of the same pairs.
-    """
-    h, w = mask.shape
-    index = np.full(mask.shape, -1, dtype=np.int64)
-    index[mask] = np.arange(int(mask.sum()))
-    pix = np.arange(h * w).reshape(h, w)
-    pairs, flats = [], []
-    for a, b in (((slice(0, -1), slice(None)), (slice(1, None), slice(None))),
-                 ((slice(None), slice(0, -1)), (slice(None), slice(1, None)))):
-        ok = (index[a] >= 0) & (index[b] >= 0)
-        pairs.append(np.stack([index[a][ok], index[b][ok]], axis=1))
-        flats.append(np.stack([pix[a][ok], pix[b][ok]], axis=1))
-    return np.concatenate(pairs).astype(np.int32), np.concatenate(flats)
-
-
-def global_coherence(
-    regions: np.ndarray, region_intensity: np.ndarray, image_intensity: np.ndarray
-) -> np.ndarray:
-    """Per-region reflectance scales of thesis sec. 3.4 (Eqs. 3.8-3.10).
-
-    Minimises ``sum_{i<j} l_ij (lambda_i L_i L_j^orig - lambda_j L_j L_i^orig)^2 / m_ij^2`` subject
-    to ``lambda >= 1``, where ``l_ij`` counts the pixels of both regions that touch the other
-    (4-neighbourhood), ``L^orig`` is the mean image intensity of those boundary pixels on each
-    side, and ``m_ij`` the mean of the two products (scale normalisation).
-
-    Parameters
-    ----------
-    regions
-        ``(H, W)`` int region index ``1..R``, 0 outside the mask.
-    region_intensity
-        ``(R + 1,)`` intensity ``L_i`` of each region's reflectance colour (entry 0 unused).
-    image_intensity
-        ``(H, W)`` intensity of the input image.
-
-    Returns
-    -------
-    ``(R + 1,)`` float64 scales (entry 0 is 1).
-    """
-    import scipy.sparse as sp
-    from scipy.optimize import lsq_linear
-
-    n = int(regions.max()) + 1
-    flat_regions = regions.ravel()
-    flat_intensity = image_intensity.ravel()
-    _, flat = grid_edges(regions > 0)
-    ra, rb = flat_regions[flat[:, 0]], flat_regions[flat[:, 1]]
-    cross = ra != rb
-    if not cross.any():
-        return np.ones(n)
-    pa, pb, ra, rb = flat[cross, 0], flat[cross, 1], ra[cross], rb[cross]
-    # (own region, other region, pixel): each boundary pixel once per neighbouring region.
-    own = np.concatenate([ra, rb])
-    other = np.concatenate([rb, ra])
-    pixel = np.concatenate([pa, pb])
-    key = np.unique(np.stack([own, other, pixel], axis=1), axis=0)
-    pair_id = key[:, 0] * n + key[:, 1]
-    uniq, inverse, counts = np.unique(pair_id, return_inverse=True, return_counts=True)
-    mean_int = np.bincount(inverse, weights=flat_intensity[key[:, 2]]) / counts
-    lookup = dict(zip(uniq.tolist(), range(uniq.size), strict=True))
-    rows, cols, vals = [], [], []
-    eq = 0
-    for pid, k in lookup.items():
-        i, j = divmod(pid, n)
-        if i >= j:
-            continue
-        back = lookup[j * n + i]
-        l_ij = counts[k] + counts[back]
-        a_i = region_intensity[i] * mean_int[back]  # lambda_i L_i L_j^orig
-        a_j = region_intensity[j] * mean_int[k]  # lambda_j L_j L_i^orig
-        m = 0.5 * (a_i + a_j)
-        if m <= 0.0:
-            continue
-        s = np.sqrt(l_ij) / m
-        rows += [eq, eq]
-        cols += [i, j]
-        vals += [s * a_i, -s * a_j]
-        eq += 1
-    if eq == 0:
-        return np.ones(n)
-    a = sp.csr_matrix((vals, (rows, cols)), shape=(eq, n))
-    result = lsq_linear(a, np.zeros(eq), bounds=(1.0, np.inf), lsq_solver="lsmr", tol=1e-10)
-    lam = np.where(np.isfinite(result.x), result.x, 1.0)
-    lam[0] = 1.0
-    # The objective is flat along the common scale; report the smallest solution (min = 1).
-    return lam / lam[1:].min()
-
-
 def _import_gco() -> Any:
     """The ``gco`` module of gco-wrapper (alpha-expansion graph cuts), its import warnings hushed."""
     try:
@@ -195,6 +102,47 @@ def _import_gco() -> Any:
             "names-shades needs gco-wrapper (pip install gco-wrapper)"
         ) from exc
     return gco
+
+
+@dataclass(frozen=True)
+class Labelling:
+    """What steps 1-3 of :class:`NamesAndShades` produce (the stages the figures show).
+
+    Attributes
+    ----------
+    image
+        ``(H, W, 3)`` float64 input as given (clipped at 0).
+    mask
+        ``(H, W)`` bool pixels decomposed; the per-pixel arrays below follow its raster order.
+    linear
+        ``(H, W, 3)`` input divided by its exposure white (99th percentile of the brightest
+        channel).
+    pixels
+        ``(N, 3)`` masked ``linear`` clipped to [0, 1].
+    candidates
+        ``(K,)`` Appendix A label indices observed in the image (the MRF's label set).
+    observed
+        ``(N,)`` observation ``y_i`` of each pixel, an index into ``candidates`` (sec. 3.2.1).
+    shades
+        Colour-shade descriptor of the log colours (sec. 3.2.2).
+    weights
+        ``(E,)`` ``w_ij`` of the 4-neighbour edges (:func:`grid_edges` order; sec. 3.3.2).
+    labels
+        ``(N,)`` MRF output, an index into ``candidates`` (sec. 3.3).
+    timings
+        Seconds per step (``names_s``, ``shades_s``, ``mrf_s``).
+    """
+
+    image: np.ndarray
+    mask: np.ndarray
+    linear: np.ndarray
+    pixels: np.ndarray
+    candidates: np.ndarray
+    observed: np.ndarray
+    shades: ColourShades
+    weights: np.ndarray
+    labels: np.ndarray
+    timings: dict[str, float]
 
 
 @dataclass(frozen=True)
@@ -270,14 +218,18 @@ class NamesAndShades:
     def __call__(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Decomposition:
         """Decompose a linear ``(H, W, 3)`` image into reflectance and shading.
 
-        The five steps of the module docstring; ``info`` records each step's time in seconds.
+        The five steps of the module docstring (:meth:`labelling` then :meth:`reflectance`);
+        ``info`` records each step's time in seconds.
         """
+        return self.reflectance(self.labelling(image, mask))
+
+    def labelling(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Labelling:
+        """Steps 1-3 (names, shades, MRF) of a linear ``(H, W, 3)`` image (:class:`Labelling`)."""
         validate_choice(
             self.reflectance_colour, ("label-centroid", "region-mean"), "reflectance_colour",
             error=DecomposeError,
         )
         gco = _import_gco()
-        timings: dict[str, float] = {}
         t0 = time.perf_counter()
         img, m = prepare_input(image, mask)
         scale = float(np.percentile(img[m].max(axis=1), _EXPOSURE_PERCENTILE))
@@ -286,25 +238,32 @@ class NamesAndShades:
 
         # 1. colour names -> Appendix A labels observed in the image
         candidates, y, distance = self._names(pixels)
-        timings["names_s"] = time.perf_counter() - t0
+        t1 = time.perf_counter()
 
         # 2. colour shades on the log image
-        t1 = time.perf_counter()
         log_colours = np.log(np.maximum(pixels, _LOG_FLOOR))
         shades = colour_shades(log_colours, bins=self.bins, sigma=self.sigma)
-        timings["shades_s"] = time.perf_counter() - t1
+        t2 = time.perf_counter()
 
         # 3. MRF (Eq. 3.4) by alpha-expansion
-        t2 = time.perf_counter()
-        labels = self._mrf(gco, m, log_colours, shades, y, distance)
-        timings["mrf_s"] = time.perf_counter() - t2
+        edges, _ = grid_edges(m)
+        weights = self._edge_weights(edges, log_colours, shades)
+        labels = self._mrf(gco, edges, weights, y, distance)
+        timings = {"names_s": t1 - t0, "shades_s": t2 - t1, "mrf_s": time.perf_counter() - t2}
+        return Labelling(img, m, linear, pixels, candidates, y, shades, weights, labels, timings)
 
-        # 4. labels -> regions -> colours (linear RGB)
+    def reflectance(self, stages: Labelling) -> Decomposition:
+        """Steps 4-5 (regions, their colour, global coherence) on a :meth:`labelling`.
+
+        Only the fields acting after the MRF (``reflectance_colour``, ``split_by_ridge``,
+        ``global_coherence``, ``colour_constancy``) are read, so one labelling serves every
+        value of them.
+        """
         t3 = time.perf_counter()
-        regions, colours = self._regions(m, labels, candidates, shades, pixels)
+        m, linear = stages.mask, stages.linear
+        regions, colours = self._regions(m, stages.labels, stages.candidates, stages.shades,
+                                         stages.pixels)
         n_regions = int(regions.max())
-
-        # 5. global coherence (sec. 3.4)
         if self.global_coherence:
             lam = global_coherence(regions, colours.mean(axis=1), linear.mean(axis=2))
         else:
@@ -312,16 +271,17 @@ class NamesAndShades:
         reflectance, light = discount_illuminant(
             (lam[:, None] * colours)[regions], linear, m, self.colour_constancy
         )
-        timings["coherence_s"] = time.perf_counter() - t3
+        timings = {**stages.timings, "coherence_s": time.perf_counter() - t3}
         info = {
-            "observed_labels": int(candidates.size),
+            "observed_labels": int(stages.candidates.size),
+            "labels": int(np.unique(stages.labels).size),
             "regions": n_regions,
-            "ridges": shades.n_ridges,
+            "ridges": stages.shades.n_ridges,
             "light_colour": light,
             **{k: round(v, 4) for k, v in timings.items()},
         }
         logger.debug("names-shades: %s", info)
-        return finish(img, reflectance, m, info)
+        return finish(stages.image, reflectance, m, info)
 
     def _names(self, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Step 1: the candidate labels ``(K,)`` (Appendix A indices observed in the image), each
@@ -336,16 +296,13 @@ class NamesAndShades:
     def _mrf(
         self,
         gco: Any,
-        m: np.ndarray,
-        log_colours: np.ndarray,
-        shades: Any,
+        edges: np.ndarray,
+        weights: np.ndarray,
         y: np.ndarray,
         distance: np.ndarray,
     ) -> np.ndarray:
         """Step 3: each masked pixel's label ``(N,)`` (an index into the candidates) minimising
         Eq. 3.4 by alpha-expansion; the observations themselves if there is nothing to cut."""
-        edges, _ = grid_edges(m)
-        weights = self._edge_weights(edges, log_colours, shades)
         unary = self.mu * distance[y]
         if distance.shape[0] > 1 and edges.shape[0] > 0:
             return np.asarray(gco.cut_general_graph(

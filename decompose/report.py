@@ -15,15 +15,10 @@ from typing import Any
 
 import numpy as np
 
-from spectrinsic.decompose.evaluate import (
-    CONDITION_GROUPS,
-    INPUT_LAYERS,
-    SCORED_LAYERS,
-    Score,
-)
 from spectrinsic.decompose.metrics import METRICS
 from spectrinsic.decompose.photometric import SCENARIOS
 from spectrinsic.decompose.registry import DECOMPOSERS
+from spectrinsic.decompose.scores import CONDITION_GROUPS, INPUT_LAYERS, SCORED_LAYERS, Score
 from spectrinsic.results import write_csv, write_json
 
 __all__ = [

@@ -3,22 +3,35 @@
 The only package that imports OpenEXR. It takes arrays and a RenderResult-like record, never a
 live renderer, and computes the exact ground truth (absolute reflectance, shading-illumination,
 illuminant, camera views, chapter-4 matrices) from the scene's spectra.
+
+Its modules, by stage (no import cycle among them: tests/gt_export/test_imports.py):
+
+* computation: ``layers/`` (one module per family of layers, composed by
+  ``layers.compose.compute_ground_truth``), ``irradiance``, ``denoise``;
+* the sample folder's format: ``sample`` (file names, canonical JSON, hashes, the seal of
+  ``meta.json``, listing), ``json_fields`` and ``sample_meta`` (the one validated reader of
+  ``meta.json``: :class:`SampleMeta`), ``exr``, ``png``, ``names``, ``integrity`` (what may be
+  resumed, replaced or removed);
+* writing a sample: ``previews``, ``writer``; reading one: ``loader`` (``load_sample``);
+* dataset products: ``manifest`` (hashes, splits, noise summary), ``card`` (``DATASET.md``),
+  ``diversity``, ``check``, ``shards``;
+* the viewer: ``gallery``.
 """
 
+from spectrinsic.gt_export.card import write_dataset_card
 from spectrinsic.gt_export.check import check_dataset, check_sample
 from spectrinsic.gt_export.exr import read_exr, write_exr
 from spectrinsic.gt_export.gallery import build_gallery, contact_sheet
 from spectrinsic.gt_export.layers import GroundTruth, Layer, LightRecord, compute_ground_truth
 from spectrinsic.gt_export.loader import load_dataset, load_sample, torch_dataset
+from spectrinsic.gt_export.manifest import write_manifest
+from spectrinsic.gt_export.sample import config_hash, sample_dirs
+from spectrinsic.gt_export.sample_meta import SampleMeta, read_meta
 from spectrinsic.gt_export.writer import (
     DEFAULT_CAMERAS,
-    config_hash,
     export_sample,
     is_complete,
     remove_stale_temporaries,
-    sample_dirs,
-    write_dataset_card,
-    write_manifest,
 )
 
 __all__ = [
@@ -26,6 +39,7 @@ __all__ = [
     "GroundTruth",
     "Layer",
     "LightRecord",
+    "SampleMeta",
     "build_gallery",
     "check_dataset",
     "check_sample",
@@ -37,6 +51,7 @@ __all__ = [
     "load_dataset",
     "load_sample",
     "read_exr",
+    "read_meta",
     "remove_stale_temporaries",
     "sample_dirs",
     "torch_dataset",

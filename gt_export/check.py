@@ -10,37 +10,45 @@ present, every sample built with the manifest's config hash, and the SHA-256 of 
 matching. Noise: :func:`noise_report` lists the samples whose measured noise exceeds a threshold.
 
 A ``meta.json`` or ``manifest.json`` that does not have spectrinsic's structure (a manifest that is
-not an object, a layer record without ``file``, a file entry leading outside its sample folder)
-cannot be checked at all: that raises a one-line :class:`~spectrinsic.errors.DatasetError`.
+not an object, a layer record without ``file``, a misspelt field, a file entry leading outside its
+sample folder) cannot be checked at all: that raises a one-line
+:class:`~spectrinsic.errors.SampleMetaError` naming the file and the field. A ``meta.json``
+edited after it was written (its seal does not match) is a problem of its sample; the rest of
+the sample is still checked.
 """
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export.integrity import (
-    HASHES_KEY,
+from spectrinsic.gt_export.exr import read_exr
+from spectrinsic.gt_export.layers import REFLECTANCE_FLOOR
+from spectrinsic.gt_export.manifest import ManifestRecord, read_manifest
+from spectrinsic.gt_export.sample import (
     MANIFEST_NAME,
     META_NAME,
+    SEAL_KEY,
     TMP_PREFIX,
-    confined_path,
     file_sha256,
+    sample_dirs,
 )
-from spectrinsic.gt_export.layers import REFLECTANCE_FLOOR
-from spectrinsic.gt_export.writer import sample_dirs
+from spectrinsic.gt_export.sample_meta import Identity, LayerRecord, SampleMeta, read_meta
 
-__all__ = ["check_dataset", "check_sample", "noise_report", "IDENTITY_RTOL", "NOISE_THRESHOLD"]
+__all__ = ["check_dataset", "check_sample", "noise_report", "IDENTITY_RTOL", "NOISE_THRESHOLD",
+           "NOISY", "TARGET_MISSED"]
 
 #: Default flag of :func:`noise_report`: a sample whose raw shading has a median relative
-#: standard error above this is called noisy.
+#: standard error above this is called noisy. Advisory: a preset promises no noise level
+#: unless its config sets ``noise_target`` (``spectrinsic check`` fails on it only when asked).
 NOISE_THRESHOLD = 0.25
+#: Marks of :func:`noise_report` lines: above the threshold; the config's ``noise_target``
+#: (adaptive sampling, recorded in ``meta.json["render"]["noise_target"]``) not reached.
+NOISY, TARGET_MISSED = "NOISY", "TARGET MISSED"
 
 #: Relative tolerance of ``image = reflectance ∘ shading``: float32 storage of the two factors
 #: and their product rounds three times (≤ 1.5 ulp), so 4 float32 epsilons is generous yet tight.
@@ -68,15 +76,15 @@ def _identity_problem(
     return None
 
 
-def _identity_problems(meta: Mapping[str, Any], data: Mapping[str, np.ndarray]) -> list[str]:
+def _identity_problems(identities: tuple[Identity, ...], data: Mapping[str, np.ndarray]) -> list[str]:
     out = []
-    for ident in meta.get("identities", []):
-        keys = [ident.get(k) for k in ("image", "reflectance", "shading", "residual")]
+    for ident in identities:
+        keys = [ident.image, ident.reflectance, ident.shading, ident.residual]
         missing = [k for k in keys if k not in data]
         if missing:
-            out.append(f"identity {ident}: layer(s) {missing} missing")
+            out.append(f"identity {keys}: layer(s) {missing} missing")
             continue
-        issue = _identity_problem(*(data[k] for k in keys),  # type: ignore[index]
+        issue = _identity_problem(*(data[k] for k in keys),
                                   names=f"{keys[0]} != {keys[1]} * {keys[2]} + {keys[3]}")
         if issue:
             out.append(f"{keys[0]}: {issue}")
@@ -88,16 +96,15 @@ def _identity_problems(meta: Mapping[str, Any], data: Mapping[str, np.ndarray]) 
     return out
 
 
-def _layer_problems(key: str, rec: Mapping[str, Any], data: np.ndarray) -> list[str]:
+def _layer_problems(key: str, rec: LayerRecord, data: np.ndarray) -> list[str]:
     out = []
-    shape = tuple(rec.get("shape", data.shape))
-    if data.shape != shape:
-        out.append(f"layer {key!r} has shape {data.shape}, meta.json says {shape}")
+    if data.shape != rec.shape:
+        out.append(f"layer {key!r} has shape {data.shape}, meta.json says {rec.shape}")
     finite = np.isfinite(data)
     if not finite.all():
         nan, inf = int(np.isnan(data).sum()), int(np.isinf(data).sum())
         out.append(f"layer {key!r} has {nan} NaN and {inf} Inf values")
-    if rec.get("nonnegative") and (data[finite] < 0).any():
+    if rec.nonnegative and (data[finite] < 0).any():
         out.append(f"layer {key!r} has {int((data[finite] < 0).sum())} negative values")
     if key in ("material_id", "object_id"):
         if (data[finite] != np.rint(data[finite])).any() or (data[finite] < -1).any():
@@ -107,45 +114,40 @@ def _layer_problems(key: str, rec: Mapping[str, Any], data: np.ndarray) -> list[
     return out
 
 
-def _malformed(path: Path, field: str, expected: str) -> DatasetError:
-    return DatasetError(f"{path}: {field}: expected {expected}; not a spectrinsic file")
-
-
-def _check_meta_structure(sample: Path, meta: Any) -> None:
-    """Raise a one-line error if *meta* is not shaped like a ``meta.json`` spectrinsic writes."""
-    path = sample / META_NAME
-    if not isinstance(meta, dict):
-        raise _malformed(path, "top level", f"a JSON object, got {type(meta).__name__}")
-    files = meta.get("files", [])
-    if not isinstance(files, list):
-        raise _malformed(path, "files", "a list of paths inside the sample folder")
-    for rel in files:
-        if confined_path(sample, rel) is None:
-            raise _malformed(path, "files", f"paths inside the sample folder, got {rel!r}")
-    layers = meta.get("layers", {})
-    if not isinstance(layers, dict):
-        raise _malformed(path, "layers", "an object of layer records")
-    for key, rec in layers.items():
-        if not isinstance(rec, dict):
-            raise _malformed(path, f"layers.{key}", "an object")
-        for field in ("file", "exr_layer"):
-            if not isinstance(rec.get(field), str):
-                raise _malformed(path, f"layers.{key}.{field}", "a string")
-        if confined_path(sample, rec["file"]) is None:
-            raise _malformed(path, f"layers.{key}.file", f"a file inside the sample folder, got {rec['file']!r}")
-
-
-def _file_problems(sample: Path, meta: Mapping[str, Any]) -> list[str]:
+def _file_problems(meta: SampleMeta) -> list[str]:
     """Listed files missing, or not matching the SHA-256 that ``meta.json`` records."""
-    recorded = meta.get(HASHES_KEY)
-    hashes: Mapping[str, Any] = recorded if isinstance(recorded, dict) else {}
     problems = []
-    for rel in meta.get("files", []):
-        if not (sample / rel).is_file():
+    if meta.sealed is False:
+        problems.append(f"{META_NAME} does not match its seal ({SEAL_KEY}): edited or damaged "
+                        "after it was written")
+    for rel in meta.files:
+        if not (meta.folder / rel).is_file():
             problems.append(f"file {rel!r} listed in meta.json is missing")
-        elif rel in hashes and file_sha256(sample / rel) != hashes[rel]:
+        elif file_sha256(meta.folder / rel) != meta.hashes[rel]:
             problems.append(f"file {rel!r} does not match its SHA-256 in {META_NAME}")
     return problems
+
+
+def _layer_data(meta: SampleMeta, problems: list[str]) -> dict[str, np.ndarray]:
+    """Every layer's array (read file by file); unreadable files and layers go to *problems*."""
+    data: dict[str, np.ndarray] = {}
+    by_file: dict[str, list[str]] = {}
+    for key, rec in meta.layers.items():
+        by_file.setdefault(rec.file, []).append(key)
+    for file, keys in by_file.items():
+        try:
+            arrays = read_exr(meta.folder / file)
+        except DatasetError as exc:
+            problems.append(str(exc).replace(str(meta.folder) + os.sep, ""))
+            continue
+        for key in keys:
+            exr_layer = meta.layers[key].exr_layer
+            if exr_layer not in arrays:
+                problems.append(f"layer {key!r} is missing from {file}")
+                continue
+            data[key] = arrays[exr_layer]
+            problems.extend(_layer_problems(key, meta.layers[key], data[key]))
+    return data
 
 
 def check_sample(sample: str | os.PathLike[str]) -> list[str]:
@@ -154,41 +156,21 @@ def check_sample(sample: str | os.PathLike[str]) -> list[str]:
     Raises
     ------
     DatasetError
-        If ``meta.json`` is JSON but not shaped like spectrinsic's (see the module notes).
+        (:class:`~spectrinsic.errors.SampleMetaError`) If ``meta.json`` is not JSON or not
+        shaped like spectrinsic's (see the module notes).
     """
-    from spectrinsic.gt_export.exr import read_exr
-
     sample = Path(sample)
-    try:
-        meta = json.loads((sample / META_NAME).read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
-        return [f"{META_NAME} cannot be read ({exc})"]
-    _check_meta_structure(sample, meta)
-    problems = _file_problems(sample, meta)
-    records: dict[str, Any] = meta.get("layers", {})
+    if not (sample / META_NAME).is_file():
+        return [f"{META_NAME} is missing"]
+    meta = read_meta(sample, verify=False)  # the seal is reported below, with everything else
+    problems = _file_problems(meta)
     for required in ("image", "reflectance", "shading", "illuminant"):
-        if required not in records:
+        if required not in meta.layers:
             problems.append(f"layer {required!r} is missing from meta.json")
-    data: dict[str, np.ndarray] = {}
-    by_file: dict[str, list[str]] = {}
-    for key, rec in records.items():
-        by_file.setdefault(rec["file"], []).append(key)
-    for file, keys in by_file.items():
-        try:
-            arrays = read_exr(sample / file)
-        except DatasetError as exc:
-            problems.append(str(exc).replace(str(sample) + os.sep, ""))
-            continue
-        for key in keys:
-            exr_layer = records[key]["exr_layer"]
-            if exr_layer not in arrays:
-                problems.append(f"layer {key!r} is missing from {file}")
-                continue
-            data[key] = arrays[exr_layer]
-            problems.extend(_layer_problems(key, records[key], data[key]))
-    if "identities" not in meta:
+    data = _layer_data(meta, problems)
+    if not meta.identities:
         problems.append("meta.json records no identities (image = reflectance * shading + residual)")
-    problems.extend(_identity_problems(meta, data))
+    problems.extend(_identity_problems(meta.identities, data))
     return problems
 
 
@@ -203,9 +185,8 @@ def check_dataset(
     root = Path(dataset_dir)
     if not root.is_dir():
         return [f"<dataset>: folder {str(root)!r} does not exist"]
-    manifest, unreadable = _read_manifest(root)
     # a manifest of the wrong shape stops the check before the (slow) per-sample checks
-    listed = _manifest_samples(root, manifest) if unreadable is None else {}
+    manifest = read_manifest(root)
     problems: list[str] = []
     samples = sample_dirs(root)
     if not samples:
@@ -216,73 +197,40 @@ def check_dataset(
         problems.extend(f"{sample.name}: {p}" for p in check_sample(sample))
         if progress is not None:
             progress(sample.name)
-    if unreadable is not None:
-        return [*problems, f"<dataset>: {unreadable}"]
-    problems.extend(_config_problems(manifest, listed, samples))
-    problems.extend(_manifest_problems(root, listed, samples))
+    if manifest is None:
+        return [*problems, f"<dataset>: {MANIFEST_NAME} is missing"]
+    problems.extend(_config_problems(manifest, samples))
+    problems.extend(_manifest_problems(root, manifest, samples))
     return problems
 
 
-def _read_manifest(root: Path) -> tuple[Any, str | None]:
-    """The parsed ``manifest.json``, or ``(None, why it cannot be read)``."""
-    try:
-        return json.loads((root / MANIFEST_NAME).read_text(encoding="utf-8")), None
-    except OSError:
-        return None, f"{MANIFEST_NAME} is missing"
-    except ValueError as exc:
-        return None, f"{MANIFEST_NAME} is not valid JSON ({exc})"
-
-
-def _manifest_samples(root: Path, manifest: Any) -> dict[str, dict[str, Any]]:
-    """The manifest's ``samples`` after checking its structure (one-line error if malformed)."""
-    path = root / MANIFEST_NAME
-    if not isinstance(manifest, dict):
-        raise _malformed(path, "top level", f"a JSON object, got {type(manifest).__name__}")
-    listed = manifest.get("samples", {})
-    if not isinstance(listed, dict):
-        raise _malformed(path, "samples", "an object of sample records")
-    for name, record in listed.items():
-        files = record.get("files", {}) if isinstance(record, dict) else None
-        if not isinstance(files, dict):
-            raise _malformed(path, f"samples.{name}", "an object with a 'files' object")
-        for rel in files:
-            inside = rel.startswith(f"{name}/") and confined_path(root / name, rel[len(name) + 1:])
-            if not inside:
-                raise _malformed(path, f"samples.{name}.files", f"paths inside {name}/, got {rel!r}")
-    return listed
-
-
-def _config_problems(
-    manifest: Mapping[str, Any], listed: Mapping[str, Any], samples: list[Path]
-) -> list[str]:
+def _config_problems(manifest: ManifestRecord, samples: list[Path]) -> list[str]:
     """Samples whose config hash (in ``meta.json`` or the manifest) is not the dataset's."""
-    expected = manifest.get("config_hash")
+    expected = manifest.config_hash
     problems = []
     for sample in samples:
-        try:
-            own = json.loads((sample / META_NAME).read_text(encoding="utf-8")).get("config_hash")
-        except (OSError, ValueError, AttributeError):
-            continue  # reported by check_sample
+        own = read_meta(sample, verify=False).config_hash
         if own != expected:
             problems.append(f"{sample.name}: built with config hash {str(own)[:12]}, but "
                             f"{MANIFEST_NAME} describes config hash {str(expected)[:12]}")
-        recorded = listed.get(sample.name, {}).get("config_hash", expected)
+        recorded = manifest.sample_hashes.get(sample.name, expected)
         if recorded != expected:
             problems.append(f"{sample.name}: {MANIFEST_NAME} lists it with config hash "
                             f"{str(recorded)[:12]}, not the dataset's {str(expected)[:12]}")
     return problems
 
 
-def _manifest_problems(root: Path, listed: Mapping[str, Any], samples: list[Path]) -> list[str]:
+def _manifest_problems(root: Path, manifest: ManifestRecord, samples: list[Path]) -> list[str]:
     """Samples missing from the manifest or the disk, and files not matching their SHA-256."""
     problems = []
+    listed = manifest.sample_files
     on_disk = {s.name for s in samples}
     for name in sorted(set(listed) - on_disk):
         problems.append(f"{name}: listed in {MANIFEST_NAME} but missing or incomplete")
     for name in sorted(on_disk - set(listed)):
         problems.append(f"{name}: present but not listed in {MANIFEST_NAME}")
     for name in sorted(set(listed) & on_disk):
-        expected = listed[name]["files"]
+        expected = listed[name]
         actual = {p.relative_to(root).as_posix() for p in (root / name).rglob("*") if p.is_file()}
         for rel in sorted(actual - set(expected)):
             problems.append(f"{name}: file {rel!r} is not in {MANIFEST_NAME}")
@@ -302,23 +250,34 @@ def noise_report(
 
     Returns ``(lines, flagged)``: one line per sample with the median and p95 relative standard
     error of each measured layer (``meta.json["noise"]``), and the ids whose raw shading median
-    exceeds *threshold*.
+    exceeds *threshold*. A line holds :data:`NOISY` for a flagged sample and
+    :data:`TARGET_MISSED` where the build promised a noise target its image did not reach.
     """
     lines, flagged = [], []
     for sample in sample_dirs(Path(dataset_dir)):
-        try:
-            noise = json.loads((sample / META_NAME).read_text(encoding="utf-8")).get("noise") or {}
-        except (OSError, ValueError):
-            continue
-        figures = {k: v for k, v in noise.items() if isinstance(v, Mapping)}
+        meta = read_meta(sample, verify=False)
+        figures, missed = meta.noise, _missed_target(meta.raw.get("render"))
         if not figures:
-            lines.append(f"{sample.name}: no noise estimate (one batch)")
+            lines.append(f"{sample.name}: no noise estimate (one batch)" + missed)
             continue
-        parts = [f"{k} median {100 * v['median']:.1f} % p95 {100 * v['p95']:.1f} %"
+        parts = [f"{k} median {100 * v.median:.1f} % p95 {100 * v.p95:.1f} %"
                  for k, v in sorted(figures.items())]
-        shading = figures.get("shading_raw", {}).get("median", 0.0)
+        shading = figures["shading_raw"].median if "shading_raw" in figures else 0.0
         if shading > threshold:
             flagged.append(sample.name)
-            parts.append(f"NOISY (shading median above {100 * threshold:.0f} %)")
-        lines.append(f"{sample.name}: " + "; ".join(parts))
+            parts.append(f"{NOISY} (shading median above {100 * threshold:.0f} %)")
+        lines.append(f"{sample.name}: " + "; ".join(parts) + missed)
     return lines, flagged
+
+
+def _missed_target(render: object) -> str:
+    """``"; TARGET MISSED (...)"`` when the recorded ``noise_target`` (the build's promise of a
+    median relative standard error of the image) was not reached, else ``""``."""
+    record = render.get("noise_target") if isinstance(render, Mapping) else None
+    if not isinstance(record, Mapping):
+        return ""
+    target, reached = record.get("target"), record.get("reached")
+    if not isinstance(target, int | float) or not isinstance(reached, int | float) or reached <= target:
+        return ""
+    return (f"; {TARGET_MISSED} (image median {100 * reached:.1f} % above the config's "
+            f"noise_target {100 * target:.1f} % after {record.get('max_batches')} batches)")

@@ -16,6 +16,10 @@ from typing import Any
 
 import numpy as np
 
+from spectrinsic.gt_export.layers import luminance
+from spectrinsic.gt_export.loader import load_sample
+from spectrinsic.gt_export.sample_meta import SampleMeta
+
 __all__ = ["DIVERSITY_NAME", "diversity_stats", "diversity_figure", "write_diversity"]
 
 DIVERSITY_NAME = "diversity.png"
@@ -31,7 +35,7 @@ def _cct(xy: Sequence[float]) -> float:
 
 
 def _luminance_decades(image: np.ndarray, mask: np.ndarray | None) -> float:
-    y = image @ np.array([0.2126, 0.7152, 0.0722])
+    y = luminance(image)
     y = y[mask] if mask is not None and mask.any() else y.ravel()
     y = y[y > 0]  # unlit pixels (no Monte Carlo sample reached a light) have no decade
     if y.size == 0:
@@ -40,7 +44,7 @@ def _luminance_decades(image: np.ndarray, mask: np.ndarray | None) -> float:
     return float(np.log10(max(hi, 1e-12) / max(lo, 1e-12)))
 
 
-def diversity_stats(sample_dirs: Sequence[Path], metas: Sequence[Mapping[str, Any]]) -> dict[str, list[Any]]:
+def diversity_stats(sample_dirs: Sequence[Path], metas: Sequence[SampleMeta]) -> dict[str, list[Any]]:
     """Per-sample statistics (lists aligned with *sample_dirs*; ``r`` only where recorded).
 
     Returns
@@ -50,21 +54,19 @@ def diversity_stats(sample_dirs: Sequence[Path], metas: Sequence[Mapping[str, An
         ``n_materials``, ``material_srgb`` (linear sRGB of each material under D65, if
         recorded), ``coverage`` (fraction), ``luminance_decades`` (log10 of p99/p1).
     """
-    from spectrinsic.gt_export.loader import load_sample
-
     out: dict[str, list[Any]] = {k: [] for k in ("r", "light_xy", "light_cct", "n_materials",
                                                  "coverage", "luminance_decades")}
     for folder, meta in zip(sample_dirs, metas, strict=True):
-        extra = meta.get("scene_metadata") or {}
+        extra = meta.scene_metadata
         if isinstance(extra.get("energy_ratio_r"), float) and np.isfinite(extra["energy_ratio_r"]):
             out["r"].append(extra["energy_ratio_r"])
-        for light in meta.get("lights", []):
-            out["light_xy"].append(tuple(light["xy"]))
-            out["light_cct"].append(_cct(light["xy"]))
-        out["n_materials"].append(len(meta.get("materials", {})))
+        for light in meta.lights:
+            out["light_xy"].append(light.xy)
+            out["light_cct"].append(_cct(light.xy))
+        out["n_materials"].append(len(meta.materials))
         if isinstance(extra.get("object_coverage"), float):
             out["coverage"].append(extra["object_coverage"])
-        sample = load_sample(folder, layers=[k for k in ("image", "mask") if k in meta.get("layers", {})])
+        sample = load_sample(folder, layers=[k for k in ("image", "mask") if k in meta.layers])
         out["luminance_decades"].append(_luminance_decades(sample["image"], sample.get("mask")))
     return out
 
@@ -95,7 +97,7 @@ def diversity_figure(stats: Mapping[str, Sequence[Any]]) -> Any:
 
 
 def write_diversity(dataset_dir: str | os.PathLike[str], sample_dirs: Sequence[Path],
-                    metas: Sequence[Mapping[str, Any]]) -> Path:
+                    metas: Sequence[SampleMeta]) -> Path:
     """Compute the statistics and save the figure as ``<dataset>/diversity.png``."""
     path = Path(dataset_dir) / DIVERSITY_NAME
     diversity_figure(diversity_stats(sample_dirs, metas)).savefig(path, dpi=90)

@@ -1,9 +1,11 @@
-"""Float32 OpenEXR files with named layers and channels.
+"""OpenEXR files with named layers and channels: float32 data, int32 ids.
 
 A *layer* is a named array: ``(H, W)`` for one channel, ``(H, W, C)`` for several. It is stored
-as EXR channels ``<layer>.<channel>`` (``reflectance.R``, ``depth.Z``, ``cube.b05``), always as
-32-bit float: ground truth is never written as half floats. The channel order of every layer is
-kept in a header attribute so that reading gives back the arrays bit for bit.
+as EXR channels ``<layer>.<channel>`` (``reflectance.R``, ``depth.Z``, ``cube.b05``), as 32-bit
+float (ground truth is never written as half floats), or, for integer layers (material and
+object ids), as 32-bit UINT channels holding the int32 bits, so every id up to 2**31 - 1 reads
+back exactly (float32 stops at 2**24: id 16777217 came back 16777216). The channel order of
+every layer is kept in a header attribute so that reading gives back the arrays bit for bit.
 
 This is the only module of spectrinsic that imports ``OpenEXR``.
 """
@@ -14,18 +16,21 @@ import json
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.integrity import guarded_write
 
-__all__ = ["write_exr", "read_exr", "read_exr_attributes", "default_channel_names"]
+__all__ = ["write_exr", "read_exr", "read_exr_attributes", "exr_size", "default_channel_names"]
 
 #: Header attribute holding ``{layer: [channel, ...]}`` as JSON.
 CHANNELS_ATTRIBUTE = "spectrinsic.channels"
-#: float32 represents every integer of magnitude up to 2**24 exactly (ids are stored as float32).
-_MAX_EXACT_INT = 2**24
+#: Header attribute listing the layers whose UINT channels hold the bits of int32 values (ids,
+#: -1 = 4294967295 for background), so they read back as int32.
+INT32_ATTRIBUTE = "spectrinsic.int32"
+_INT32 = np.iinfo(np.int32)
 
 
 def default_channel_names(n_channels: int) -> tuple[str, ...]:
@@ -37,16 +42,22 @@ def default_channel_names(n_channels: int) -> tuple[str, ...]:
     return tuple(f"c{i:02d}" for i in range(n_channels))
 
 
-def _as_float32(name: str, array: np.ndarray) -> np.ndarray:
+def _as_int32_bits(name: str, array: np.ndarray) -> np.ndarray:
+    """An integer array as the uint32 bits of its int32 values (range-checked: exact or refused)."""
+    if array.size and (array.min() < _INT32.min or array.max() > _INT32.max):
+        raise DatasetError(f"layer {name!r} holds integers beyond the 32-bit range "
+                           f"[{_INT32.min}, {_INT32.max}]; ids are stored as int32")
+    return array.astype(np.int32).view(np.uint32)
+
+
+def _as_stored(name: str, array: np.ndarray) -> np.ndarray:
+    """*array* as it is stored: integers as int32 bits (uint32), everything else as float32."""
     array = np.asarray(array)
     if array.dtype == np.float16:
         raise DatasetError(f"layer {name!r} is float16; ground truth is stored as float32 only")
-    if array.dtype.kind in "iub":
-        if array.size and np.abs(array.astype(np.int64)).max() > _MAX_EXACT_INT:
-            raise DatasetError(
-                f"layer {name!r} holds integers beyond 2**24, which float32 cannot store exactly"
-            )
-    elif array.dtype.kind != "f":
+    if array.dtype.kind in "iu":
+        return _as_int32_bits(name, array)
+    if array.dtype.kind not in "fb":
         raise DatasetError(f"layer {name!r} has dtype {array.dtype}; expected a numeric array")
     if array.dtype == np.float64:
         finite = np.isfinite(array)
@@ -71,8 +82,9 @@ def write_exr(
         Destination ``.exr`` file.
     layers
         ``{name: array}`` with arrays ``(H, W)`` or ``(H, W, C)``, all of the same ``H, W``.
-        Floats are stored as float32 (float16 is refused); integer arrays (ids) are stored as
-        float32, exact up to 2**24.
+        Floats and bools are stored as float32 (float16 is refused); integer arrays (ids) as
+        UINT channels holding their int32 bits (values outside int32 are refused), listed in
+        the header attribute :data:`INT32_ATTRIBUTE`, so they read back as exact int32.
     channel_names
         Channel names per layer, e.g. ``{"normals": ("X", "Y", "Z")}``; default
         :func:`default_channel_names`.
@@ -93,7 +105,7 @@ def write_exr(
     for name, array in layers.items():
         if "." in name:
             raise DatasetError(f"layer name {name!r} contains '.'; expected a plain name")
-        data = _as_float32(name, array)
+        data = _as_stored(name, array)
         if data.ndim == 2:
             data = data[..., None]
         if data.ndim != 3:
@@ -121,6 +133,9 @@ def write_exr(
         "type": OpenEXR.scanlineimage,
         CHANNELS_ATTRIBUTE: json.dumps(order, separators=(",", ":")),
     }
+    int32 = [name for name, array in layers.items() if np.asarray(array).dtype.kind in "iu"]
+    if int32:  # only then: a file without ids keeps its header (and its bytes) as before
+        header[INT32_ATTRIBUTE] = json.dumps(int32, separators=(",", ":"))
     for key, value in (attributes or {}).items():
         header[str(key)] = str(value)
     path = Path(path)
@@ -140,6 +155,31 @@ def _open(path: Path, *, header_only: bool):  # noqa: ANN202 - OpenEXR.File
         raise DatasetError(f"EXR file {str(path)!r} cannot be read: {exc}") from exc
 
 
+def _channel_order(path: Path, text: object) -> dict[str, list[str]]:
+    """The :data:`CHANNELS_ATTRIBUTE` of *path*'s header: ``{layer: [channel, ...]}``."""
+    try:
+        order = json.loads(str(text))
+    except ValueError:
+        order = None
+    if not (isinstance(order, dict) and all(isinstance(v, list) and all(isinstance(c, str) for c in v)
+                                            for v in order.values())):
+        raise DatasetError(f"EXR file {str(path)!r}: header attribute {CHANNELS_ATTRIBUTE!r} is not "
+                           "a JSON object of layer -> channel names")
+    return order
+
+
+def exr_size(path: str | os.PathLike[str]) -> tuple[int, int, int]:
+    """``(height, width, channels)`` of an EXR file from its header alone, so a size can be
+    refused before any pixel is decoded (a small file may declare a huge image)."""
+    header = read_exr_attributes(path)
+    try:
+        lo, hi = np.asarray(header["dataWindow"], dtype=np.int64)  # ((xMin, yMin), (xMax, yMax))
+        channels: Any = header["channels"]
+        return int(hi[1] - lo[1]) + 1, int(hi[0] - lo[0]) + 1, len(channels)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise DatasetError(f"EXR file {str(path)!r} has no readable dataWindow") from exc
+
+
 def read_exr_attributes(path: str | os.PathLike[str]) -> dict[str, object]:
     """Return the header of an EXR file (attributes only, no pixels)."""
     try:
@@ -148,6 +188,13 @@ def read_exr_attributes(path: str | os.PathLike[str]) -> dict[str, object]:
         if isinstance(exc, DatasetError):
             raise
         raise DatasetError(f"EXR file {str(path)!r} has no readable header: {exc}") from exc
+
+
+def _as_read(pixels: np.ndarray, int32: bool) -> np.ndarray:
+    """Stored pixels as returned: int32 ids from their UINT bits, everything else as float32."""
+    if int32:
+        return np.asarray(pixels, dtype=np.uint32).view(np.int32)
+    return np.asarray(pixels, dtype=np.float32)
 
 
 def read_exr(
@@ -166,7 +213,7 @@ def read_exr(
     -------
     dict
         ``(H, W)`` float32 arrays for one-channel layers and ``(H, W, C)`` float32 arrays in the
-        written channel order otherwise. Files from other writers are grouped by the prefix
+        written channel order otherwise; integer layers (:data:`INT32_ATTRIBUTE`) as int32. Files from other writers are grouped by the prefix
         before the last ``.``, channels R, G, B / X, Y, Z in that order, others sorted.
     """
     path = Path(path)
@@ -179,7 +226,7 @@ def read_exr(
         raise DatasetError(f"EXR file {str(path)!r} cannot be decoded: {exc}") from exc
     order: dict[str, list[str]]
     if CHANNELS_ATTRIBUTE in header:
-        order = json.loads(header[CHANNELS_ATTRIBUTE])
+        order = _channel_order(path, header[CHANNELS_ATTRIBUTE])
     else:
         order = {}
         for full in pixels:
@@ -192,6 +239,7 @@ def read_exr(
                     break
             else:
                 names.sort()
+    int32 = set(json.loads(header[INT32_ATTRIBUTE])) if INT32_ATTRIBUTE in header else set()
     wanted = list(order) if layers is None else list(layers)
     out: dict[str, np.ndarray] = {}
     for layer in wanted:
@@ -204,6 +252,6 @@ def read_exr(
         missing = [k for k in keys if k not in pixels]
         if missing:
             raise DatasetError(f"EXR file {str(path)!r} lacks channels {missing} of layer {layer!r}")
-        arrays = [np.asarray(pixels[k], dtype=np.float32) for k in keys]
+        arrays = [_as_read(pixels[k], layer in int32) for k in keys]
         out[layer] = arrays[0] if len(arrays) == 1 else np.stack(arrays, axis=-1)
     return out

@@ -20,6 +20,8 @@ The page decodes a pixel of a preview back to the linear value it stands for fro
 
 from __future__ import annotations
 
+import base64
+import html
 import json
 import os
 import string
@@ -30,16 +32,14 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export.integrity import MANIFEST_NAME
+from spectrinsic.gt_export.card import read_template
+from spectrinsic.gt_export.integrity import guarded_write
+from spectrinsic.gt_export.manifest import read_manifest
 from spectrinsic.gt_export.names import slug
-from spectrinsic.gt_export.writer import (
-    META_NAME,
-    SCENE_NAME,
-    _jsonable,
-    read_template,
-    sample_dirs,
-)
+from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, plain_data, sample_dirs
+from spectrinsic.gt_export.sample_meta import SampleMeta, read_meta
 from spectrinsic.scenes.sample_id import SEPARATOR
+from spectrinsic.spectra import get_sensors, xyz_to_xy
 
 __all__ = ["build_gallery", "contact_sheet", "gallery_index", "GALLERY_DIRS", "GALLERY_LAYERS",
            "INDEX_VARIABLE"]
@@ -72,8 +72,6 @@ _SUMMARY_GLOBS = ("*.png", "plots/*.png", "summary/*.png", "figures/*.png")
 
 def _spectral_locus() -> list[list[float]]:
     """xy of the CIE 1931 2° spectral locus, 380–700 nm at 1 nm (colour-science's CMFs)."""
-    from spectrinsic.spectra import get_sensors, xyz_to_xy
-
     cmf = get_sensors("cie1931")
     keep = (cmf.wavelengths >= 380) & (cmf.wavelengths <= 700)
     return np.round(xyz_to_xy(cmf.curves[:, keep].T), 5).tolist()
@@ -100,26 +98,15 @@ def _colormap_luts(names: Iterable[str]) -> dict[str, list[list[int]]]:
     return out
 
 
-def _split_of(manifest: Mapping[str, Any]) -> dict[str, str]:
-    """Sample id -> split name from ``manifest["splits"]``, read as ``{split: [ids]}``,
-    ``{split: {"samples": [ids]}}`` or ``{id: split}``; empty without splits."""
-    splits = manifest.get("splits")
-    out: dict[str, str] = {}
-    if not isinstance(splits, Mapping):
-        return out
-    for key, value in splits.items():
-        if isinstance(value, str):
-            out[str(key)] = value
-        else:
-            ids = value.get("samples", []) if isinstance(value, Mapping) else value
-            out.update({str(sid): str(key) for sid in ids if isinstance(sid, str)})
-    return out
+def _split_of(splits: Mapping[str, Sequence[str]]) -> dict[str, str]:
+    """Sample id -> split name from the manifest's ``{split: [ids]}``."""
+    return {sid: split for split, ids in splits.items() for sid in ids}
 
 
-def _noise_figure(meta: Mapping[str, Any]) -> float | None:
+def _noise_figure(meta: SampleMeta) -> float | None:
     """The median relative standard error of ``shading_raw`` (None when not measured)."""
-    fig = (meta.get("noise") or {}).get("shading_raw")
-    return float(fig["median"]) if isinstance(fig, Mapping) and "median" in fig else None
+    fig = meta.noise.get("shading_raw")
+    return fig.median if fig is not None else None
 
 
 def _layer_order(names: Iterable[str]) -> list[str]:
@@ -128,46 +115,40 @@ def _layer_order(names: Iterable[str]) -> list[str]:
     return sorted(names, key=lambda n: ("/" in n, rank.get(n, len(rank)), n))
 
 
-def _sample_entry(sample: Path, meta: Mapping[str, Any], split: str | None) -> dict[str, Any]:
+def _sample_entry(sample: Path, meta: SampleMeta, split: str | None) -> dict[str, Any]:
     """One sample's record in the index (paths relative to the dataset folder)."""
-    smeta = meta.get("scene_metadata") or {}
-    records = meta.get("layers", {})
+    smeta = meta.scene_metadata
+    records = meta.layers
     layers = {
-        name: [f"{sample.name}/{records[name]['preview']}", records[name].get("preview_encoding")]
-        for name in _layer_order(records) if records[name].get("preview")
+        name: [f"{sample.name}/{records[name].preview}", records[name].preview_encoding]
+        for name in _layer_order(records) if records[name].preview
     }
     lights = [
-        {"name": light.get("name"), "spectrum": light.get("spectrum"), "kind": light.get("kind"),
-         "xy": light.get("xy"), "srgb": light.get("srgb"), "share": light.get("share"),
-         "spd": [float(f"{v:.{_SPD_DIGITS}g}") for v in light.get("spd") or []]}
-        for light in meta.get("lights", [])
+        {"name": light.name, "spectrum": light.spectrum, "kind": light.kind,
+         "xy": list(light.xy), "srgb": list(light.srgb), "share": light.share,
+         "spd": [float(f"{v:.{_SPD_DIGITS}g}") for v in light.spd]}
+        for light in meta.lights
     ]
     return {
-        "id": sample.name, "scene": meta.get("scene"), "condition": smeta.get("condition"),
+        "id": sample.name, "scene": meta.scene, "condition": smeta.get("condition"),
         # generated scenes name their generator; the built-in library and user scenes do not
         "generator": smeta.get("generator") or ("library" if "library" in smeta else "own scene"),
         "kind": smeta.get("kind"), "split": split, "noise": _noise_figure(meta),
-        "size": meta.get("size"), "reference_mode": meta.get("reference_mode"),
+        "size": list(meta.size), "reference_mode": meta.reference_mode,
         "layers": layers, "lights": lights,
-        "files": sorted({f"{sample.name}/{r['file']}" for r in records.values() if r.get("file")}
+        "files": sorted({f"{sample.name}/{r.file}" for r in records.values()}
                         | {f"{sample.name}/{META_NAME}", f"{sample.name}/{SCENE_NAME}"}),
     }
 
 
-def _layer_info(metas: Sequence[Mapping[str, Any]]) -> dict[str, dict[str, Any]]:
+def _layer_info(metas: Sequence[SampleMeta]) -> dict[str, dict[str, Any]]:
     """Per layer name (first sample holding it): file, EXR layer, channels and units."""
     info: dict[str, dict[str, Any]] = {}
     for meta in metas:
-        for name, rec in meta.get("layers", {}).items():
-            info.setdefault(name, {k: rec.get(k) for k in ("file", "exr_layer", "channels", "units")})
+        for name, rec in meta.layers.items():
+            info.setdefault(name, {"file": rec.file, "exr_layer": rec.exr_layer,
+                                   "channels": list(rec.channels), "units": rec.units})
     return info
-
-
-def _read_json(path: Path) -> dict[str, Any]:
-    try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
-        raise DatasetError(f"{path}: cannot be read as JSON ({exc})") from exc
 
 
 def gallery_index(dataset_dir: str | os.PathLike[str]) -> dict[str, Any]:
@@ -182,13 +163,13 @@ def gallery_index(dataset_dir: str | os.PathLike[str]) -> dict[str, Any]:
     samples = sample_dirs(root)
     if not samples:
         raise DatasetError(f"dataset folder {str(root)!r} has no complete samples for a gallery")
-    manifest_path = root / MANIFEST_NAME
-    split_of = _split_of(_read_json(manifest_path)) if manifest_path.is_file() else {}
-    metas = [_read_json(s / META_NAME) for s in samples]
-    entries = [_sample_entry(s, m, split_of.get(s.name)) for s, m in zip(samples, metas)]
+    manifest = read_manifest(root)
+    split_of = _split_of(manifest.splits) if manifest is not None else {}
+    metas = [read_meta(s) for s in samples]
+    entries = [_sample_entry(s, m, split_of.get(s.name)) for s, m in zip(samples, metas, strict=True)]
     cmaps = {enc["cmap"] for e in entries for _, enc in e["layers"].values()
              if isinstance(enc, Mapping) and enc.get("kind") == "colormap"}
-    grid = (metas[0].get("spectral_grid") or {}).get("lights_spd") or {}
+    grid = metas[0].raw["spectral_grid"].get("lights_spd") or {}
     return {
         "title": f"spectrinsic dataset: {root.resolve().name}",
         "samples": entries,
@@ -230,8 +211,10 @@ def contact_sheet(
     sheet = Image.new("RGB", (cols * TILE, rows * cell), (255, 255, 255))
     draw = ImageDraw.Draw(sheet)
     for i, sample in enumerate(samples):
-        meta = _read_json(sample / META_NAME)
-        with Image.open(sample / meta["layers"]["image"]["preview"]) as img:
+        preview = read_meta(sample).layers["image"].preview
+        if preview is None:
+            raise DatasetError(f"{sample / META_NAME}: layers.image.preview: expected a preview")
+        with Image.open(sample / preview) as img:
             tile = img.convert("RGB")
             tile.thumbnail((TILE, TILE), Image.Resampling.LANCZOS)
         x0, y0 = (i % cols) * TILE, (i // cols) * cell
@@ -239,8 +222,9 @@ def contact_sheet(
         for line_no, line in enumerate(_wrap(sample.name, draw, font)):
             draw.text((x0 + 2, y0 + TILE + 1 + line_no * _CAPTION_HEIGHT), line, fill=(0, 0, 0), font=font)
     path = Path(out) if out is not None else root / "contact_sheet.png"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    sheet.save(path, format="PNG")
+    with guarded_write(path):
+        path.parent.mkdir(parents=True, exist_ok=True)
+        sheet.save(path, format="PNG")
     return path
 
 
@@ -267,16 +251,38 @@ def _condition_sheets(root: Path, index: Mapping[str, Any]) -> dict[str, str]:
     return out
 
 
+#: How every ``gallery-pixels/<id>.js`` starts: the mark of a file the gallery wrote.
+_PIXELS_HEAD = "(window.SPECTRINSIC_PIXELS = window.SPECTRINSIC_PIXELS || {})["
+
+
+def _written_by_us(path: Path) -> bool:
+    """Whether *path* is a pixel script the gallery wrote (a plain file starting with
+    :data:`_PIXELS_HEAD`); anything else in ``gallery-pixels/`` is the user's and stays."""
+    if path.is_symlink() or not path.is_file():
+        return False
+    try:
+        with path.open(encoding="utf-8") as fh:
+            return fh.read(len(_PIXELS_HEAD)) == _PIXELS_HEAD
+    except (OSError, UnicodeDecodeError):
+        return False
+
+
+def _write_text(path: Path, text: str) -> None:
+    with guarded_write(path):  # a full disk names the file
+        path.write_text(text, encoding="utf-8")
+
+
 def _write_pixel_scripts(root: Path, index: Mapping[str, Any]) -> None:
     """Write ``gallery-pixels/<id>.js`` per sample: its value-bearing previews (``srgb`` and
     ``colormap`` encodings) as ``data:`` URLs, which a page opened from ``file://`` may read
-    into a canvas (Chromium forbids reading the files themselves); set each entry's ``pixels``."""
-    import base64
-    import shutil
-
+    into a canvas (Chromium forbids reading the files themselves); set each entry's ``pixels``.
+    Earlier scripts of ours are replaced; no other file in the folder is touched."""
     folder = root / _PIXELS_DIR
-    shutil.rmtree(folder, ignore_errors=True)
-    folder.mkdir()
+    with guarded_write(folder):
+        folder.mkdir(exist_ok=True)
+    for old in sorted(folder.glob("*.js")):
+        if _written_by_us(old):
+            old.unlink()
     for entry in index["samples"]:
         urls = {
             name: "data:image/png;base64," + base64.b64encode((root / src).read_bytes()).decode("ascii")
@@ -284,9 +290,11 @@ def _write_pixel_scripts(root: Path, index: Mapping[str, Any]) -> None:
             if isinstance(enc, Mapping) and enc.get("kind") in ("srgb", "colormap")
         }
         rel = f"{_PIXELS_DIR}/{entry['id']}.js"
-        (root / rel).write_text(
-            f"(window.SPECTRINSIC_PIXELS = window.SPECTRINSIC_PIXELS || {{}})[{json.dumps(entry['id'])}] = "
-            f"{json.dumps(urls)};\n", encoding="utf-8")
+        target = root / rel
+        if target.exists() and not _written_by_us(target):
+            raise DatasetError(f"{target}: not a gallery file spectrinsic wrote; move it away to "
+                               "rebuild the gallery")
+        _write_text(target, f"{_PIXELS_HEAD}{json.dumps(entry['id'])}] = {json.dumps(urls)};\n")
         entry["pixels"] = rel
 
 
@@ -307,19 +315,17 @@ def build_gallery(
         _write_pixel_scripts(root, index)
     contact_sheet(root)
     index["contact_sheets"] = {"all": "contact_sheet.png", **_condition_sheets(root, index)}
-    data = json.dumps(_jsonable(index), ensure_ascii=False, separators=(",", ":"))
-    (root / "gallery.json").write_text(data + "\n", encoding="utf-8")
-    (root / "gallery-index.js").write_text(f"window.{INDEX_VARIABLE} = {data};\n", encoding="utf-8")
+    data = json.dumps(plain_data(index), ensure_ascii=False, separators=(",", ":"))
+    _write_text(root / "gallery.json", data + "\n")
+    _write_text(root / "gallery-index.js", f"window.{INDEX_VARIABLE} = {data};\n")
     for name in _STATIC:
-        (root / name).write_text(read_template(name), encoding="utf-8")
+        _write_text(root / name, read_template(name))
     page = string.Template(read_template("gallery.html")).substitute(
         title=_escape(index["title"]), n_samples=len(index["samples"]))
     path = root / "index.html"
-    path.write_text(page, encoding="utf-8")
+    _write_text(path, page)
     return path
 
 
 def _escape(text: str) -> str:
-    import html
-
     return html.escape(text)

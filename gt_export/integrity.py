@@ -9,36 +9,36 @@ removes or replaces
 * sample folders whose ``meta.json`` it wrote and that hold no file that ``meta.json`` does not
   list (so a user's notes inside a sample folder stop the build instead of vanishing).
 
-A sample is *intact* when its ``meta.json`` has the expected config hash and every file it lists
-lies inside the sample folder and matches the SHA-256 recorded next to it (``meta.json`` cannot
-hash itself; ``manifest.json`` holds its hash). Only intact samples are resumed.
+A sample is *intact* when its ``meta.json`` is valid, matches its own seal (a hash of its
+content, :func:`~spectrinsic.gt_export.sample.meta_seal`), has the expected config hash, and
+every file it lists lies inside the sample folder and matches the SHA-256 recorded there. Only
+intact samples are resumed; any other is rendered again, with a warning that says why.
 """
 
 from __future__ import annotations
 
 import contextlib
 import errno
-import hashlib
 import json
 import os
 import shutil
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator
 from pathlib import Path, PurePosixPath
-from typing import Any
 
-from spectrinsic.errors import DatasetError, DiskFullError, WriteError
+from spectrinsic.errors import DatasetError, DiskFullError, SampleMetaError, WriteError
+from spectrinsic.gt_export.outfolder import check_out_folder, require_folder_path
+from spectrinsic.gt_export.sample import (
+    FORMAT_VERSION,
+    MANIFEST_NAME,
+    META_NAME,
+    TMP_PREFIX,
+    file_sha256,
+)
+from spectrinsic.gt_export.sample_meta import owned_files, read_meta
 
 __all__ = [
-    "META_NAME",
-    "MANIFEST_NAME",
     "MARKER_NAME",
-    "TMP_PREFIX",
-    "HASHES_KEY",
-    "file_sha256",
     "guarded_write",
-    "confined_path",
-    "file_hashes",
-    "read_sample_meta",
     "sample_problem",
     "replaceable_sample",
     "remove_sample",
@@ -49,26 +49,10 @@ __all__ = [
     "remove_owned_temporaries",
 ]
 
-META_NAME = "meta.json"
-MANIFEST_NAME = "manifest.json"
 #: Written first into every dataset folder: ``{"spectrinsic_dataset": 1, "config_hash": ...}``.
 MARKER_NAME = ".spectrinsic-dataset"
-#: Prefix of every temporary file or folder spectrinsic creates inside a dataset folder. Only
-#: names with this prefix are ever cleaned up: ``.tmp-*`` belongs to other programs.
-TMP_PREFIX = ".spectrinsic-tmp-"
-#: Key of ``meta.json`` holding ``{relative path: SHA-256}`` of every file it lists.
-HASHES_KEY = "sha256"
 #: errno values that mean "no space": retrying another sample cannot help.
 _NO_SPACE = frozenset({errno.ENOSPC, errno.EDQUOT})
-
-
-def file_sha256(path: str | os.PathLike[str]) -> str:
-    """SHA-256 hex digest of a file's bytes."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for chunk in iter(lambda: fh.read(1 << 20), b""):
-            digest.update(chunk)
-    return digest.hexdigest()
 
 
 @contextlib.contextmanager
@@ -86,57 +70,28 @@ def guarded_write(path: str | os.PathLike[str]) -> Iterator[None]:
         raise cls(f"cannot write {str(path)!r}: {reason}") from exc
 
 
-def confined_path(folder: Path, rel: object) -> Path | None:
-    """``folder/rel`` if *rel* is a relative POSIX path that stays inside *folder* (symbolic
-    links resolved), else ``None``."""
-    if not isinstance(rel, str) or not rel or "\\" in rel:
-        return None
-    pure = PurePosixPath(rel)
-    if pure.is_absolute() or ".." in pure.parts:
-        return None
-    root = folder.resolve()
-    path = (root / pure).resolve()
-    return folder / pure if path.is_relative_to(root) and path != root else None
-
-
-def file_hashes(folder: Path, files: list[str]) -> dict[str, str]:
-    """``{rel: SHA-256}`` of *files* inside *folder*, for ``meta.json[HASHES_KEY]``."""
-    return {rel: file_sha256(folder / rel) for rel in sorted(files)}
-
-
-def read_sample_meta(folder: Path) -> dict[str, Any] | None:
-    """The ``meta.json`` of *folder* if spectrinsic wrote it (a JSON object naming this folder
-    as its sample and listing its files inside it), else ``None``."""
-    try:
-        meta = json.loads((folder / META_NAME).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    if not isinstance(meta, dict) or meta.get("sample_id") != folder.name:
-        return None
-    files = meta.get("files")
-    if not isinstance(files, list) or not all(confined_path(folder, f) for f in files):
-        return None
-    return meta
-
-
 def sample_problem(folder: str | os.PathLike[str], config_hash: str) -> str | None:
-    """Why the sample in *folder* cannot be resumed, or ``None`` if it is complete and intact."""
+    """Why the sample in *folder* cannot be resumed, or ``None`` if it is complete and intact:
+    its ``meta.json`` valid and matching its seal (:func:`~spectrinsic.gt_export.sample_meta.read_meta`),
+    written in this format with *config_hash*, and every file it lists matching its SHA-256."""
     folder = Path(folder)
     if not folder.is_dir():
         return "absent"
-    meta = read_sample_meta(folder)
-    if meta is None:
-        return f"{META_NAME} is missing or not spectrinsic's"
-    if meta.get("config_hash") != config_hash:
+    if not (folder / META_NAME).is_file():
+        return f"{META_NAME} is missing"
+    try:
+        meta = read_meta(folder)
+    except SampleMetaError as exc:
+        return str(exc)
+    if meta.format_version != FORMAT_VERSION:
+        return f"written in format {meta.format_version}; this version writes {FORMAT_VERSION}"
+    if meta.config_hash != config_hash:
         return "built with another config"
-    hashes = meta.get(HASHES_KEY)
-    if not isinstance(hashes, Mapping) or set(hashes) != set(meta["files"]):
-        return f"{META_NAME} records no SHA-256 for its files"
-    for rel in sorted(meta["files"]):
+    for rel in meta.files:
         path = folder / rel
         if not path.is_file():
             return f"file {rel!r} is missing"
-        if file_sha256(path) != hashes[rel]:
+        if file_sha256(path) != meta.hashes[rel]:
             return f"file {rel!r} does not match its SHA-256 in {META_NAME}"
     return None
 
@@ -157,13 +112,13 @@ def replaceable_sample(folder: Path) -> None:
             f"{str(folder)!r} is in the way of a sample folder and is not one spectrinsic wrote; "
             "move it away or choose another --out"
         )
-    meta = read_sample_meta(folder)
-    if meta is None:
+    owned = owned_files(folder)
+    if owned is None:
         raise DatasetError(
             f"{str(folder)!r} has the name of a sample but no valid spectrinsic {META_NAME}; "
             "move it away or choose another --out"
         )
-    listed = {PurePosixPath(f) for f in meta["files"]} | {PurePosixPath(META_NAME)}
+    listed = {PurePosixPath(f) for f in owned} | {PurePosixPath(META_NAME)}
     for path in sorted(folder.rglob("*")):
         rel = PurePosixPath(path.relative_to(folder).as_posix())
         if (path.is_symlink() or not path.is_dir()) and rel not in listed:
@@ -193,16 +148,6 @@ def dataset_config_hash(root: Path) -> str | None:
     return None
 
 
-def require_folder_path(root: Path, option: str = "--out") -> None:
-    """Raise a one-line error if *root* is a file or lies below one (so no folder can be made)."""
-    for parent in (root, *root.parents):
-        if parent.is_dir():
-            return
-        if parent.exists() or parent.is_symlink():
-            what = "is a file" if parent == root else f"lies below the file {str(parent)!r}"
-            raise DatasetError(f"{option} {str(root)!r} {what}; expected a folder")
-
-
 def check_build_folder(root: Path, config_hash: str, *, rebuild: bool) -> str | None:
     """Check that a build with *config_hash* may write into *root*; return the hash the folder
     was built with before (``None``: new or empty folder).
@@ -210,19 +155,16 @@ def check_build_folder(root: Path, config_hash: str, *, rebuild: bool) -> str | 
     Raises
     ------
     DatasetError
-        *root* is a file or lies below one; *root* is non-empty and not a spectrinsic dataset;
-        or it was built with another config and *rebuild* is false.
+        *root* breaks the rule of every writing verb
+        (:func:`spectrinsic.gt_export.outfolder.check_out_folder`: a file, inside a dataset,
+        locked by another run, non-empty and not a spectrinsic dataset), or it was built with
+        another config and *rebuild* is false.
     """
-    require_folder_path(root)
-    if not root.is_dir() or not any(root.iterdir()):
+    if check_out_folder(root, own=lambda p: dataset_config_hash(p) is not None,
+                        what=f"a spectrinsic dataset (no {MARKER_NAME} or {MANIFEST_NAME})"):
         return None
     previous = dataset_config_hash(root)
-    if previous is None:
-        raise DatasetError(
-            f"--out {str(root)!r} is not empty and is not a spectrinsic dataset (no {MARKER_NAME} "
-            f"or {MANIFEST_NAME}); choose a new or empty folder"
-        )
-    if previous != config_hash and not rebuild:
+    if previous is not None and previous != config_hash and not rebuild:
         raise DatasetError(
             f"--out {str(root)!r} was built with another config (hash {previous[:12]}, this run "
             f"{config_hash[:12]}); pass --rebuild to rebuild it, or choose another folder"

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -12,15 +11,30 @@ import numpy as np
 
 from spectrinsic.errors import DatasetError, MissingDependencyError
 from spectrinsic.gt_export.exr import read_exr
-from spectrinsic.gt_export.writer import META_NAME, sample_dirs
+from spectrinsic.gt_export.manifest import read_splits
+from spectrinsic.gt_export.png import EXPOSURE_PERCENTILE, exposure
+from spectrinsic.gt_export.sample import META_NAME, file_sha256, sample_dirs
+from spectrinsic.gt_export.sample_meta import SampleMeta, read_meta
 
-__all__ = ["load_sample", "load_dataset", "split_samples", "prepare_item", "torch_dataset"]
+__all__ = ["load_sample", "load_dataset", "split_samples", "prepare_item", "torch_dataset",
+           "EXPOSURE_PERCENTILE"]
 
 _INT_LAYERS = ("material_id", "object_id")
 
 
+def _verified(meta: SampleMeta, file: str) -> Path:
+    """The path of *file* of the sample after checking it against its SHA-256 in ``meta.json``."""
+    path = meta.folder / file
+    if not path.is_file():
+        raise DatasetError(f"{path}: listed in {META_NAME} but missing; the sample is incomplete")
+    if file_sha256(path) != meta.hashes.get(file):
+        raise DatasetError(f"{path}: does not match its SHA-256 in {META_NAME}; the sample is "
+                           f"damaged (spectrinsic check finds every such file)")
+    return path
+
+
 def load_sample(
-    path: str | os.PathLike[str], *, layers: Sequence[str] | None = None
+    path: str | os.PathLike[str], *, layers: Sequence[str] | None = None, verify: bool = True
 ) -> dict[str, Any]:
     """Load one sample folder written by :func:`spectrinsic.gt_export.export_sample`.
 
@@ -30,6 +44,9 @@ def load_sample(
         The sample folder.
     layers
         Only these layer keys (default: all that ``meta.json`` lists).
+    verify
+        Check ``meta.json`` against its seal and every file read against its SHA-256 before
+        decoding it (about as long again as reading; ``False`` trusts the files).
 
     Returns
     -------
@@ -39,52 +56,54 @@ def load_sample(
         ``mask`` (``(H, W)`` bool), ``ids`` (``{"material": (H, W) int32, "object": ...}``, -1
         background), per-camera keys ``image_camera/<name>`` etc., ``cube`` when written, and
         ``meta`` (the parsed ``meta.json``). Units are in ``meta["layers"][key]["units"]``.
+
+    Raises
+    ------
+    DatasetError
+        A ``meta.json`` that is damaged (:class:`~spectrinsic.errors.SampleMetaError`, naming
+        the field; layer files outside the sample folder are refused there), an unknown layer,
+        or (with *verify*) a file that does not match its SHA-256.
     """
-    path = Path(path)
-    try:
-        meta = json.loads((path / META_NAME).read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise DatasetError(f"sample folder {str(path)!r} has no readable {META_NAME}") from exc
-    except ValueError as exc:
-        raise DatasetError(f"{path / META_NAME}: not valid JSON ({exc})") from exc
-    records = meta.get("layers", {})
+    meta = read_meta(path, verify=verify)
+    records = meta.layers
     wanted = list(records) if layers is None else list(layers)
     unknown = [k for k in wanted if k not in records]
     if unknown:
-        raise DatasetError(f"sample {path.name!r} has no layers {unknown}; it has {sorted(records)}")
+        raise DatasetError(f"sample {meta.sample_id!r} has no layers {unknown}; it has {sorted(records)}")
     by_file: dict[str, list[str]] = {}
     for key in wanted:
-        by_file.setdefault(records[key]["file"], []).append(key)
+        by_file.setdefault(records[key].file, []).append(key)
     out: dict[str, Any] = {}
     for file, keys in by_file.items():
-        arrays = read_exr(path / file, layers=[records[k]["exr_layer"] for k in keys])
+        source = _verified(meta, file) if verify else meta.folder / file
+        arrays = read_exr(source, layers=[records[k].exr_layer for k in keys])
         for key in keys:
-            out[key] = arrays[records[key]["exr_layer"]]
+            out[key] = arrays[records[key].exr_layer]
     if "mask" in out:
         out["mask"] = out["mask"] > 0.5
     ids = {}
     for key in _INT_LAYERS:
         if key in out:
-            out[key] = np.rint(out[key]).astype(np.int32)
+            if out[key].dtype != np.int32:  # format 2 stored ids as float32
+                out[key] = np.rint(out[key]).astype(np.int32)
             ids[key.removesuffix("_id")] = out[key]
     if ids:
         out["ids"] = ids
-    out["meta"] = meta
+    out["meta"] = dict(meta.raw)
     return out
 
 
 def load_dataset(
-    dataset_dir: str | os.PathLike[str], *, layers: Sequence[str] | None = None
+    dataset_dir: str | os.PathLike[str], *, layers: Sequence[str] | None = None,
+    verify: bool = True,
 ) -> Iterator[dict[str, Any]]:
     """Iterate :func:`load_sample` over the complete samples of *dataset_dir*, sorted by id."""
     for sample in sample_dirs(dataset_dir):
-        yield load_sample(sample, layers=layers)
+        yield load_sample(sample, layers=layers, verify=verify)
 
 
 #: Layers in radiometric units that exposure normalisation scales (reflectance is unitless).
 EXPOSED_PREFIXES = ("image", "shading", "illuminant", "residual", "cube")
-#: Luminance percentile mapped to 1 by exposure normalisation.
-EXPOSURE_PERCENTILE = 99.0
 
 
 def split_samples(dataset_dir: str | os.PathLike[str], split: str | None) -> list[Path]:
@@ -93,10 +112,7 @@ def split_samples(dataset_dir: str | os.PathLike[str], split: str | None) -> lis
     folders = sample_dirs(dataset_dir)
     if split is None:
         return folders
-    try:
-        splits = json.loads((Path(dataset_dir) / "manifest.json").read_text(encoding="utf-8"))["splits"]
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise DatasetError(f"{dataset_dir}: manifest.json has no splits; rebuild the dataset") from exc
+    splits = read_splits(dataset_dir)
     if split not in splits:
         raise DatasetError(f"split {split!r}; expected one of {sorted(splits)}")
     chosen = set(splits[split])
@@ -127,15 +143,15 @@ def prepare_item(
     rng
         Generator of the crop position (explicit: no hidden global state).
     normalize_exposure
-        Scale the radiometric layers (:data:`EXPOSED_PREFIXES`) so the image's
-        :data:`EXPOSURE_PERCENTILE`-th luminance percentile is 1 (image = reflectance x shading
-        + residual still holds, each side scaled alike).
+        Scale the radiometric layers (:data:`EXPOSED_PREFIXES`) by the previews' exposure
+        (:func:`spectrinsic.gt_export.png.exposure`: the :data:`EXPOSURE_PERCENTILE`-th
+        percentile of the image's positive luminances maps to 1; background pixels do not
+        count), so image = reflectance x shading + residual still holds, each side scaled alike.
     """
     arrays = {k: v for k, v in sample.items() if isinstance(v, np.ndarray)}
     scale = 1.0
     if normalize_exposure and "image" in arrays:
-        y = arrays["image"] @ np.array([0.2126, 0.7152, 0.0722], dtype=np.float32)
-        scale = 1.0 / max(float(np.percentile(y, EXPOSURE_PERCENTILE)), 1e-12)
+        scale = exposure(arrays["image"])  # the previews' exposure: one definition
     if crop is not None:
         if rng is None:
             raise DatasetError("a random crop needs an explicit numpy Generator (rng=...)")
@@ -160,6 +176,7 @@ def torch_dataset(
     *,
     keys: Sequence[str] | None = None,
     split: str | None = None,
+    verify: bool = True,
     crop: tuple[int, int] | None = None,
     seed: int | None = None,
     normalize_exposure: bool = False,
@@ -170,7 +187,7 @@ def torch_dataset(
     Each item is :func:`prepare_item` with arrays as tensors: every layer (``keys=None``) or
     the chosen ones, ``ids`` (a dict of int tensors), the cube when written, ``sample_id`` and
     ``scene``; images ``(C, H, W)`` float32, masks ``(1, H, W)`` bool. *transform*, if given,
-    is applied to each item dict. Random crops need *seed*: item *i* is cropped with
+    is applied to each item dict; *verify* is :func:`load_sample`'s. Random crops need *seed*: item *i* is cropped with
     ``default_rng([seed, i])``, the same on every worker and epoch. torch is imported only here.
 
     Raises
@@ -200,7 +217,7 @@ def torch_dataset(
             return len(folders)
 
         def __getitem__(self, index: int) -> dict[str, Any]:
-            sample = load_sample(folders[index], layers=wanted)
+            sample = load_sample(folders[index], layers=wanted, verify=verify)
             rng = None if seed is None else np.random.default_rng([seed, index])
             item = tensors(prepare_item(sample, crop=crop, rng=rng,
                                         normalize_exposure=normalize_exposure))

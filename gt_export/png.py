@@ -11,9 +11,11 @@ import os
 from pathlib import Path
 
 import numpy as np
+import png
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.integrity import guarded_write
+from spectrinsic.gt_export.layers.imaging import luminance
 from spectrinsic.spectra.colorimetry import encode_srgb
 
 __all__ = [
@@ -28,6 +30,7 @@ __all__ = [
     "PNG16_MAX",
     "write_png16",
     "read_png16",
+    "png_size",
 ]
 
 #: Largest code of a 16-bit PNG: a 16-bit data image stores ``value = code / PNG16_MAX``.
@@ -35,17 +38,19 @@ PNG16_MAX = 65535
 
 #: Percentile of the positive luminances mapped to 1.0 by :func:`tone_map` (a few highlights clip).
 EXPOSURE_PERCENTILE = 99.0
-#: Luminance weights of linear sRGB (the Y row of the IEC 61966-2-1 matrix).
-_Y_WEIGHTS = np.array([0.2126, 0.7152, 0.0722])
 
 
 def exposure(rgb: np.ndarray, *, percentile: float = EXPOSURE_PERCENTILE) -> float:
     """Scale factor mapping the *percentile*-th positive luminance of linear *rgb* to 1.
 
-    Returns 1.0 for an image with no positive finite luminance.
+    spectrinsic's one exposure: previews and the loader's ``normalize_exposure`` both use it.
+    Only positive finite luminances count, so an object on a black background is exposed for
+    the object (the background's zeros would pull a percentile of all pixels down). Returns 1.0
+    for an image with no positive finite luminance. Luminance: :func:`~spectrinsic.gt_export.
+    layers.luminance` (CIE Y of linear sRGB).
     """
     rgb = np.asarray(rgb, float)
-    y = rgb @ _Y_WEIGHTS if rgb.ndim == 3 else rgb
+    y = luminance(rgb) if rgb.ndim == 3 else rgb
     y = y[np.isfinite(y) & (y > 0)]
     if y.size == 0:
         return 1.0
@@ -132,8 +137,6 @@ def write_png(path: str | os.PathLike[str], rgb8: np.ndarray) -> Path:
 
 def write_png16(path: str | os.PathLike[str], image: np.ndarray) -> Path:
     """Write ``(H, W)`` grey or ``(H, W, 3)`` RGB uint16 codes as a 16-bit PNG (pypng)."""
-    import png
-
     codes = np.asarray(image)
     if codes.dtype != np.uint16 or codes.ndim not in (2, 3) or (codes.ndim == 3 and codes.shape[2] != 3):
         raise DatasetError(
@@ -154,8 +157,6 @@ def read_png16(path: str | os.PathLike[str]) -> np.ndarray:
     Raises :class:`DatasetError` if the file is not a PNG or not 16 bits per channel (8-bit
     files cannot carry linear data without banding, so they are refused rather than rescaled).
     """
-    import png
-
     try:
         w, h, rows, info = png.Reader(filename=str(path)).asDirect()
         data = np.vstack([np.asarray(r, dtype=np.uint16) for r in rows])
@@ -169,3 +170,14 @@ def read_png16(path: str | os.PathLike[str]) -> np.ndarray:
     data = data.reshape(h, w, planes)
     colour = planes - int(bool(info.get("alpha")))
     return data[:, :, 0] if colour == 1 else data[:, :, :3]
+
+
+def png_size(path: str | os.PathLike[str]) -> tuple[int, int]:
+    """``(height, width)`` of a PNG from its IHDR chunk alone, so a size can be refused before
+    the image is decoded (a small file may declare a huge image)."""
+    try:
+        reader = png.Reader(filename=str(path))
+        reader.preamble()
+    except (OSError, png.Error) as exc:
+        raise DatasetError(f"PNG {str(path)!r} cannot be read: {exc}") from exc
+    return int(reader.height), int(reader.width)

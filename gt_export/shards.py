@@ -31,10 +31,13 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import DatasetError, MissingDependencyError
-from spectrinsic.gt_export.integrity import file_sha256
 from spectrinsic.gt_export.loader import load_sample, split_samples
+from spectrinsic.gt_export.manifest import read_manifest
+from spectrinsic.gt_export.outfolder import LOCK_NAME, check_out_folder, folder_lock
+from spectrinsic.gt_export.sample import MANIFEST_NAME, META_NAME, TMP_PREFIX, file_sha256
+from spectrinsic.gt_export.sample_meta import meta_from_bytes
 
-__all__ = ["SHARD_INDEX", "KEY_SEPARATOR", "ShardSet", "write_shards", "shard_urls", "shard_dataset"]
+__all__ = ["SHARD_INDEX", "KEY_SEPARATOR", "ShardSet", "check_shard_folder", "write_shards", "shard_urls", "shard_dataset"]
 
 #: The export's index; written last, so its presence means every listed shard is complete.
 SHARD_INDEX = "shards.json"
@@ -42,7 +45,6 @@ SHARD_INDEX = "shards.json"
 KEY_SEPARATOR = "~"
 _FORMAT = "spectrinsic-webdataset"
 _VERSION = 1
-_TMP_PREFIX = ".spectrinsic-tmp-"
 
 
 @dataclass(frozen=True)
@@ -100,22 +102,23 @@ def _encode(sample: dict[str, Any]) -> dict[str, Any]:
     return record
 
 
-def _prepare_out(out: Path) -> set[str]:
+def check_shard_folder(out: Path, option: str = "--out") -> set[str]:
     """The files an earlier export of ours wrote in *out* (listed by its index, complete or
-    interrupted); refuse a folder holding anything else."""
-    out.mkdir(parents=True, exist_ok=True)
+    interrupted); refuse a folder holding anything else, or one breaking the rule of every
+    writing verb (:func:`~spectrinsic.gt_export.outfolder.check_out_folder`). Writes nothing."""
+    if check_out_folder(out, own=lambda p: (p / SHARD_INDEX).is_file(), option=option,
+                        what=f"an earlier shard export (no {SHARD_INDEX})"):
+        return set()
     index_path = out / SHARD_INDEX
-    ours: set[str] = set()
-    if index_path.is_file():
-        try:
-            previous = json.loads(index_path.read_text(encoding="utf-8"))
-        except ValueError as exc:
-            raise DatasetError(f"{index_path}: not a spectrinsic shard index ({exc})") from exc
-        if not isinstance(previous, dict) or previous.get("format") != _FORMAT:
-            raise DatasetError(f"{index_path}: not a spectrinsic shard index")
-        ours = set(previous.get("files", {}))
+    try:
+        previous = json.loads(index_path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise DatasetError(f"{index_path}: not a spectrinsic shard index ({exc})") from exc
+    if not isinstance(previous, dict) or previous.get("format") != _FORMAT:
+        raise DatasetError(f"{index_path}: not a spectrinsic shard index")
+    ours = set(previous.get("files", {}))
     foreign = sorted(p.name for p in out.iterdir()
-                     if p.name not in ours | {SHARD_INDEX} and not p.name.startswith(_TMP_PREFIX))
+                     if p.name not in ours | {SHARD_INDEX, LOCK_NAME} and not p.name.startswith(TMP_PREFIX))
     if foreign:
         raise DatasetError(f"shard folder {str(out)!r} holds files spectrinsic did not write "
                            f"({', '.join(foreign[:3])}{', ...' if len(foreign) > 3 else ''}); "
@@ -124,7 +127,7 @@ def _prepare_out(out: Path) -> set[str]:
 
 
 def _write_index(out: Path, index: dict[str, Any]) -> None:
-    tmp = out / f"{_TMP_PREFIX}{SHARD_INDEX}"
+    tmp = out / f"{TMP_PREFIX}{SHARD_INDEX}"
     tmp.write_text(json.dumps(index, indent=2, sort_keys=True), encoding="utf-8")
     os.replace(tmp, out / SHARD_INDEX)
 
@@ -144,7 +147,7 @@ def _write_shard(out: Path, name: str, folders: Sequence[Path], layers: Sequence
                  progress: Callable[[str], None] | None) -> set[str]:
     """Write one shard under a temporary name, then rename it; return the layer keys seen."""
     wds = _webdataset()
-    tmp = out / f"{_TMP_PREFIX}{name}"
+    tmp = out / f"{TMP_PREFIX}{name}"
     seen: set[str] = set()
     try:
         with open(tmp, "wb") as stream:
@@ -163,13 +166,10 @@ def _write_shard(out: Path, name: str, folders: Sequence[Path], layers: Sequence
 
 
 def _manifest(dataset_dir: Path) -> dict[str, Any]:
-    try:
-        manifest = json.loads((dataset_dir / "manifest.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
-        raise DatasetError(f"{dataset_dir}: no readable manifest.json; expected a built dataset") from exc
-    if not isinstance(manifest, dict):
-        raise DatasetError(f"{dataset_dir}/manifest.json: expected a JSON object")
-    return manifest
+    manifest = read_manifest(dataset_dir)
+    if manifest is None:
+        raise DatasetError(f"{dataset_dir}: no readable {MANIFEST_NAME}; expected a built dataset")
+    return dict(manifest.raw)
 
 
 def write_shards(
@@ -194,12 +194,22 @@ def write_shards(
     Raises
     ------
     DatasetError
-        *out_dir* holds files spectrinsic did not write, or the dataset has no manifest.
+        *out_dir* holds files spectrinsic did not write, lies inside a dataset, or the
+        dataset has no manifest.
+    FolderLockedError
+        Another export holds *out_dir*.
     """
     if samples_per_shard < 1:
         raise DatasetError(f"samples per shard {samples_per_shard}; expected a whole number >= 1")
     source, out = Path(dataset_dir), Path(out_dir)
-    ours = _prepare_out(out)
+    check_shard_folder(out)
+    with folder_lock(out):  # one export per folder; a second is refused, naming this one
+        return _write_locked(source, out, check_shard_folder(out), samples_per_shard, layers, progress)
+
+
+def _write_locked(source: Path, out: Path, ours: set[str], samples_per_shard: int,
+                  layers: Sequence[str] | None, progress: Callable[[str], None] | None) -> ShardSet:
+    """:func:`write_shards` once the folder's lock is held; *ours*: files of an earlier export."""
     plan = _plan(source, samples_per_shard)
     planned = {name for shards in plan.values() for name in shards}
     base = {"format": _FORMAT, "version": _VERSION, "key_separator": KEY_SEPARATOR,
@@ -243,18 +253,31 @@ def shard_urls(out_dir: str | os.PathLike[str], split: str | None = None) -> lis
 
 
 def _decoder(entries: dict[str, str]) -> Callable[[dict[str, Any]], dict[str, Any]]:
-    """A raw WebDataset record (entry -> bytes) -> ``{layer: array, "meta": dict, ...}``."""
+    """A raw WebDataset record (entry -> bytes) -> ``{layer: array, "meta": dict, ...}``; the
+    ``meta.json`` entry read by :func:`~spectrinsic.gt_export.sample_meta.meta_from_bytes`."""
 
     def decode(record: dict[str, Any]) -> dict[str, Any]:
         item: dict[str, Any] = {"sample_id": record["__key__"]}
         for entry, value in record.items():
             if entry in entries:
                 item[entries[entry]] = np.lib.format.read_array(io.BytesIO(value), allow_pickle=False)
-            elif entry == "meta.json":
-                item["meta"] = json.loads(value)
+            elif entry == META_NAME:
+                source = Path(str(record.get("__url__", "shard"))) / record["__key__"] / META_NAME
+                item["meta"] = dict(meta_from_bytes(value, source).raw)
         return item
 
     return decode
+
+
+def _verify_shards(urls: Sequence[str], index: dict[str, Any]) -> None:
+    """Check every shard against the SHA-256 the index records, before any item is read."""
+    recorded = index.get("files") or {}
+    for url in urls:
+        if not Path(url).is_file():
+            raise DatasetError(f"{url}: listed in {SHARD_INDEX} but missing; export again")
+        if file_sha256(url) != recorded.get(Path(url).name):
+            raise DatasetError(f"{url}: does not match its SHA-256 in {SHARD_INDEX}; the shard is "
+                               "damaged, export again")
 
 
 def shard_dataset(out_dir: str | os.PathLike[str], split: str | None = None) -> Iterator[dict[str, Any]]:
@@ -262,12 +285,16 @@ def shard_dataset(out_dir: str | os.PathLike[str], split: str | None = None) -> 
     :func:`load_sample` returns it (arrays ``(H, W[, C])`` under their layer keys, ``meta``)
     plus ``sample_id``; an empty iterator for a split with no samples.
 
-    It is an ``IterableDataset`` when torch is installed, so it feeds a
+    Every shard is first checked against its SHA-256 in :data:`SHARD_INDEX` (a damaged shard
+    raises :class:`~spectrinsic.errors.DatasetError` before anything is yielded). It is an
+    ``IterableDataset`` when torch is installed, so it feeds a
     ``torch.utils.data.DataLoader`` directly; chain ``.map(...)`` for crops or tensors.
     """
     wds = _webdataset()
     urls = shard_urls(out_dir, split)
     if not urls:
         return iter(())
-    decode = _decoder(_index(Path(out_dir))["entries"])
+    index = _index(Path(out_dir))
+    _verify_shards(urls, index)
+    decode = _decoder(index["entries"])
     return wds.WebDataset(urls, shardshuffle=False, empty_check=False).map(decode)

@@ -3,15 +3,15 @@
 Nothing is imported from Mitsuba when this package is imported; variants are chosen per pass
 (:mod:`~spectrinsic.render.variants`) and set only inside ``variant_scope`` blocks.
 
-- :func:`render_scene` -> :class:`RenderResult`: the spectral reference and K-channel diagonal
-  renders (``rgb3``, ``rgb6``, ``bands31``) of one scene, all as CIE XYZ, with per-light and
+- :func:`render_scene` (:class:`RenderSettings`, a seed) -> :class:`RenderResult`: the
+  spectral reference and K-channel diagonal renders (``rgb3``, ``rgb6``, ``bands31``) of one scene, all as CIE XYZ, with per-light and
   direct-only renders and coverage/id/depth/normal maps; :func:`render_batches` renders it as
   independent batches whose spread measures the Monte Carlo noise.
 - :mod:`~spectrinsic.render.modes`: the mode registry and the colour maths of Eq. 5.2.
 - :mod:`~spectrinsic.render.passes`: the passes themselves, for any sensor set.
 - :mod:`~spectrinsic.render.single` and :mod:`~spectrinsic.render.integrator`: every diagonal
-  mode, band and light in one path traversal (``render_scene(integrator="single")``, the
-  default), with the per-light band transport.
+  mode, band and light in one path traversal (``RenderSettings(integrator="single")``, the
+  default), with the per-light band transport (``RenderResult.transport``).
 - :func:`scene_to_mitsuba`: the one translation of a scene into a Mitsuba dict.
 """
 
@@ -25,7 +25,6 @@ from spectrinsic.render.modes import (
 )
 from spectrinsic.render.passes import render_aovs, render_diagonal, render_spectral
 from spectrinsic.render.pipeline import (
-    DEFAULT_MODES,
     batch_seeds,
     count_passes,
     image_noise,
@@ -35,6 +34,7 @@ from spectrinsic.render.pipeline import (
     render_scene,
 )
 from spectrinsic.render.result import RenderResult
+from spectrinsic.render.settings import DEFAULT_MODES, RenderSettings
 from spectrinsic.render.translate import scene_to_mitsuba
 from spectrinsic.render.variants import (
     available_variants,
@@ -50,6 +50,7 @@ __all__ = [
     "RENDER_MODES",
     "RenderMode",
     "RenderResult",
+    "RenderSettings",
     "available_variants",
     "batch_seeds",
     "channel_values",

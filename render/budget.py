@@ -1,25 +1,42 @@
 """Memory a render needs, estimated before it starts, against the memory this machine has.
 
 A render holds, per pixel and per colour mode, the raw K channels and their XYZ, once more per
-light when each light is rendered alone, as float32; Mitsuba's film and its numpy copy hold
-another two. :func:`estimate_render_bytes` counts those arrays, times
-:data:`OVERHEAD_FACTOR` for the copies made on the way (measured: 780 B/pixel of peak RSS growth
-for the four default modes of ``obj-apple`` between 128 x 128 and 1024 x 128, where the count
-times the factor gives 684). It is an estimate of the least a render needs, so a refused size
-could never have worked, and a size it lets through can still be too large for the ground truth.
+light when each light is rendered alone, plus the AOVs (coverage, ids, depth, normals), as
+float32. :func:`estimate_render_bytes` counts those values, times :data:`OVERHEAD_FACTOR` for
+the copies made on the way (film, numpy copies, EXR encoding), plus :data:`BASE_BYTES` for the
+process itself (Python, Mitsuba, the compiled kernels). It is calibrated to be an upper bound
+of the measured peak resident memory (``ru_maxrss``) of ``spectrinsic render obj-apple`` with
+the four default modes (73 values per pixel with the AOVs), spp 16, on the 2-core CI machine:
+
+=========  ==========  ==========
+size       measured    estimate
+=========  ==========  ==========
+8 x 8      277 MiB     448 MiB
+256 x 256  305 MiB     558 MiB
+512 x 512  488 MiB     886 MiB
+2048^2     5.0 GB      7.8 GB
+=========  ==========  ==========
+
+(the 2048^2 figure from issue 17, where the former count, 684 B/pixel without the process,
+estimated 1.7 GiB). The samples per pixel do not matter: 256 x 256 at spp 64 peaked at 304 MiB,
+as Mitsuba's symbolic loops keep no per-sample state. So a size refused here could not have
+worked, and a size let through fits with the margin of the table.
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
 from pathlib import Path
 
 from spectrinsic.errors import RenderError
+from spectrinsic.render.modes import get_mode, n_passes
+from spectrinsic.render.settings import RenderSettings
 
 __all__ = [
     "BYTES_PER_VALUE",
     "OVERHEAD_FACTOR",
+    "BASE_BYTES",
+    "AOV_VALUES",
     "MAX_SIDE",
     "estimate_render_bytes",
     "available_memory_bytes",
@@ -28,8 +45,15 @@ __all__ = [
 
 #: float32.
 BYTES_PER_VALUE = 4
-#: Film, its numpy copy and the result's own array: three copies of every channel.
-OVERHEAD_FACTOR = 3
+#: Copies of every value on the way to the files: the film, its numpy copies, the result's
+#: arrays, the EXR encoder's buffers (fitted: 1120 B/pixel measured at 2048^2 for 73 values is
+#: 3.8 copies; 6 keeps the estimate above every measurement of the module's table).
+OVERHEAD_FACTOR = 6
+#: Resident memory of a render process before its first pixel (measured 277 MiB at 8 x 8 and
+#: 318 MiB at 64 x 64 with three modes; the margin covers other builds of the libraries).
+BASE_BYTES = 448 * 2**20
+#: AOV values per pixel: coverage of up to 9 materials, 2 ids, depth, 3 normals, the mask.
+AOV_VALUES = 16
 #: Longest image side accepted at all (OpenEXR and Mitsuba films use 32-bit sizes).
 MAX_SIDE = 65_536
 
@@ -37,22 +61,21 @@ MAX_SIDE = 65_536
 def estimate_render_bytes(
     width: int,
     height: int,
+    settings: RenderSettings,
     *,
-    modes: Sequence[str],
     n_lights: int = 1,
-    per_light: bool = False,
-    direct: bool = False,
     data_dir: str | None = None,
 ) -> int:
-    """Least memory in bytes that rendering *modes* at ``width x height`` takes (see module)."""
-    from spectrinsic.render.modes import get_mode, n_passes
-
+    """Upper bound of the peak memory in bytes of rendering ``settings.modes`` at
+    ``width x height`` in one process (see the module's table)."""
     values = 0
-    for name in modes:
+    for name in settings.modes:
         raw = 3 * n_passes(get_mode(name), data_dir=data_dir)
         values += raw + 3  # raw channels + XYZ
-    copies = 1 + (n_lights if per_light and n_lights > 1 else 0) + (1 if direct else 0)
-    return width * height * values * copies * BYTES_PER_VALUE * OVERHEAD_FACTOR
+    per_light = settings.per_light and n_lights > 1
+    copies = 1 + (n_lights if per_light else 0) + (1 if settings.direct else 0)
+    per_pixel = (values * copies + AOV_VALUES) * BYTES_PER_VALUE * OVERHEAD_FACTOR
+    return BASE_BYTES + width * height * per_pixel
 
 
 def available_memory_bytes() -> int | None:
@@ -70,7 +93,8 @@ def available_memory_bytes() -> int | None:
 
 
 def check_render_size(
-    width: int, height: int, *, what: str, processes: int = 1, **estimate: object
+    width: int, height: int, settings: RenderSettings, *, what: str, processes: int = 1,
+    n_lights: int = 1, data_dir: str | None = None,
 ) -> int:
     """Refuse a size that is not positive, too large, or cannot fit in memory; return the estimate.
 
@@ -80,8 +104,8 @@ def check_render_size(
         How the user gave the size, for the message (``"--width 100000 --height 128"``).
     processes
         Renders running at once (worker processes), each needing the estimate.
-    **estimate
-        Keyword arguments of :func:`estimate_render_bytes`.
+    n_lights
+        Lights of the scene (each rendered alone with ``settings.per_light``).
 
     Raises
     ------
@@ -93,7 +117,7 @@ def check_render_size(
             raise RenderError(f"{what}: image {side} {value!r}; expected a positive integer")
         if value > MAX_SIDE:
             raise RenderError(f"{what}: image {side} {value} exceeds the largest supported, {MAX_SIDE}")
-    need = processes * estimate_render_bytes(width, height, **estimate)  # type: ignore[arg-type]
+    need = processes * estimate_render_bytes(width, height, settings, n_lights=n_lights, data_dir=data_dir)
     have = available_memory_bytes()
     if have is not None and need > have:
         raise RenderError(

@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import RenderError
+from spectrinsic.render.variants import import_mitsuba
 
 __all__ = ["INTEGRATOR_NAME", "BandTables", "band_path_class", "band_path", "transport_channels",
            "first_hit_channels"]
@@ -235,8 +236,6 @@ def band_path_class(variant: str) -> type:
     Properties: ``max_depth``, ``rr_depth`` (as ``path``), ``n_bands`` (K), ``n_lights`` (L).
     Its AOVs are the L·K transports (:func:`transport_channels`); its RGB output is zero.
     """
-    from spectrinsic.render.variants import import_mitsuba
-
     mi = import_mitsuba()
     if mi.variant() != variant:
         raise RenderError(f"band_path_class({variant!r}) called while {mi.variant()!r} is active")

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import RenderError, SceneError
+from spectrinsic.interrupts import raise_if_requested
 from spectrinsic.render import translate as tr
 from spectrinsic.render.modes import ChannelValues, light_spectra, pad_to_passes
 from spectrinsic.render.variants import choose_variant, variant_scope
@@ -88,11 +89,14 @@ def _active(scene: Scene, active_lights: Sequence[int] | None) -> set[int]:
 
 
 def _timed_render(mi: Any, loaded: Any, *, spp: int, seed: int, integrator: Any = None) -> tuple[np.ndarray, float]:
+    raise_if_requested()
     start = time.perf_counter()
     try:
         image = np.array(mi.render(loaded, spp=int(spp), seed=int(seed), integrator=integrator), dtype=np.float32)
     except RuntimeError as exc:
+        raise_if_requested()  # Dr.Jit re-raises a Ctrl-C inside the render as RuntimeError
         raise RenderError(f"Mitsuba render failed: {exc}") from exc
+    raise_if_requested()  # Mitsuba's own SIGINT handler may have cut the pass short
     return image, time.perf_counter() - start
 
 

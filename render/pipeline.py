@@ -26,7 +26,10 @@ from spectrinsic.render.passes import (
     render_spectral,
 )
 from spectrinsic.render.result import RenderResult
+from spectrinsic.render.settings import DEFAULT_MODES, RenderSettings
 from spectrinsic.render.single import SingleTraversal, render_jobs, resolve_integrator
+from spectrinsic.render.translate import prepare_geometry, surfaces
+from spectrinsic.render.variants import choose_variant, import_mitsuba, variant_scope
 from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
@@ -43,9 +46,6 @@ __all__ = [
 ]
 
 logger = logging.getLogger(__name__)
-
-DEFAULT_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
-
 
 def _modes(modes: Iterable[str]) -> list[RenderMode]:
     names = list(dict.fromkeys(modes))
@@ -66,25 +66,16 @@ def _direct_modes(direct: bool | Iterable[str], modes: Sequence[RenderMode]) -> 
     return wanted
 
 
-def count_passes(
-    scene: Scene,
-    modes: Iterable[str] = DEFAULT_MODES,
-    *,
-    per_light: bool = False,
-    per_light_modes: Iterable[str] | None = None,
-    direct: bool | Iterable[str] = False,
-    aovs: bool = True,
-    data_dir: str | None = None,
-    integrator: str | None = None,
-    variant: str | None = None,
-) -> int:
+def count_passes(scene: Scene, settings: RenderSettings, *, data_dir: str | None = None) -> int:
     """Number of Mitsuba passes :func:`render_scene` runs (the total of its progress calls)."""
+    modes, per_light, per_light_modes = settings.modes, settings.per_light, settings.per_light_modes
+    direct, aovs = settings.direct, settings.aovs
     objs = _modes(modes)
     wanted = _direct_modes(direct, objs)
     split = per_light and per_light_modes is not None
     groups = len(scene.lights) if per_light and not split else 1
     share_modes = _modes(per_light_modes) if per_light and per_light_modes is not None else []
-    single = resolve_integrator(integrator, variant) == "single" and any(
+    single = resolve_integrator(settings.integrator, settings.variant) == "single" and any(
         m.kind == "diagonal" for m in objs + share_modes)
     diagonal = 0
     if single:  # every diagonal mode and the AOVs: one traversal (+1 direct-only)
@@ -92,7 +83,6 @@ def count_passes(
         objs, share_modes = [m for m in objs if m.kind != "diagonal"], [m for m in share_modes if m.kind != "diagonal"]
     colour = sum(n_passes(m, data_dir=data_dir) * (2 if m.name in wanted else 1) for m in objs)
     shares = sum(n_passes(m, data_dir=data_dir) for m in share_modes)
-    from spectrinsic.render.translate import surfaces
 
     aov_passes = max(1, -(-len(surfaces(scene)) // 3)) if aovs and not single else 0
     return diagonal + groups * colour + len(scene.lights) * shares + aov_passes
@@ -130,9 +120,6 @@ def _run_jobs(
     every job come from one band-path traversal
     (:func:`spectrinsic.render.single.render_jobs`).
     """
-    from spectrinsic.render.translate import prepare_geometry
-    from spectrinsic.render.variants import choose_variant, variant_scope
-
     geometry = prepare_geometry(scene)
     outputs: list[dict[str, PassOutput]] = [{} for _ in jobs]
     aov_maps: dict[str, np.ndarray] = {}
@@ -181,65 +168,45 @@ def _run_jobs(
 
 def render_scene(
     scene: Scene,
+    settings: RenderSettings,
     *,
-    modes: Iterable[str] = DEFAULT_MODES,
-    spp: int,
     seed: int,
-    max_depth: int = 8,
-    variant: str | None = None,
-    per_light: bool = False,
-    per_light_modes: Iterable[str] | None = None,
-    direct: bool | Iterable[str] = False,
-    aovs: bool = True,
     progress: PassProgress | None = None,
     data_dir: str | None = None,
-    integrator: str | None = None,
 ) -> RenderResult:
-    """Render *scene* in each of *modes* and convert every mode to CIE 1931 XYZ.
+    """Render *scene* in each of ``settings.modes`` and convert every mode to CIE 1931 XYZ.
 
+    One batch: every pass renders ``settings.batch_spp`` samples with sampler seed *seed*.
     All diagonal modes share one loaded scene and the same paths (same seed and sample count,
     Russian roulette off): ``rgb3``, ``rgb6`` and ``bands31`` differ only by spectral error.
+    With ``settings.per_light`` and no ``share_mode`` every mode is rendered light by light and
+    ``images`` is exactly the sum of the per-light images (and ``direct`` of per-light direct
+    images), costing no extra.
 
     Parameters
     ----------
-    modes
-        Names from :data:`spectrinsic.render.modes.RENDER_MODES`.
-    spp, seed
-        Samples per pixel and sampler seed, shared by every pass.
-    max_depth
-        Longest path (Mitsuba convention: 2 = direct light only).
-    variant
-        Backend (``"cuda"``, ``"llvm"``, ``"scalar"``) or variant name; default: the best usable.
-    per_light
-        Also render each light alone (one scene per light). Without *per_light_modes* every
-        mode is rendered light by light and ``images`` is exactly the sum of the per-light
-        images (and ``direct`` of per-light direct images), costing no extra.
-    per_light_modes
-        With *per_light*: render only these modes light by light, and *modes* once with every
-        light on. For light shares a 1-pass mode (``"rgb3"``) costs one pass per light instead
-        of every mode's passes per light.
-    direct
-        ``True`` for a direct-only render of every mode, or an iterable of the modes that need
-        one (e.g. only the reference, for r of Eq. 5.8).
-    aovs
-        Also compute coverage, ids, depth and normals (:func:`~spectrinsic.render.passes.render_aovs`).
+    settings
+        Modes, samples, path depth, variant, per-light, direct and AOV choices
+        (:class:`~spectrinsic.render.settings.RenderSettings`), and the integrator of the
+        diagonal modes: ``"passes"``, ⌈K/3⌉ RGB passes per mode and one scene per light;
+        ``"single"`` (default), one traversal for every diagonal mode, band and light
+        (:mod:`spectrinsic.render.single`): the same images to float rounding, per-light
+        images that are exact shares of the full render, and ``RenderResult.transport``.
+    seed
+        Sampler seed, shared by every pass.
     progress
         Called with 1 after each Mitsuba pass; :func:`count_passes` gives the total.
-    integrator
-        How diagonal modes are rendered (:data:`~spectrinsic.render.single.INTEGRATORS`,
-        default :data:`~spectrinsic.render.single.DEFAULT_INTEGRATOR`): ``"passes"``, ⌈K/3⌉
-        RGB passes per mode and one scene per light; ``"single"``, one traversal for every
-        diagonal mode, band and light (:mod:`spectrinsic.render.single`), same images to float
-        rounding, per-light images that are exact shares of the full render, and
-        ``RenderResult.transport``.
 
     Returns
     -------
     RenderResult
     """
+    modes, spp, max_depth, per_light = settings.modes, settings.batch_spp, settings.max_depth, settings.per_light
+    per_light_modes, direct, aovs, variant = (settings.per_light_modes, settings.direct, settings.aovs,
+                                              settings.variant)
     objs = _modes(modes)
     wanted = _direct_modes(direct, objs)
-    integrator = resolve_integrator(integrator, variant)
+    integrator = resolve_integrator(settings.integrator, variant)
     matrices = {m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in objs}
     lights = [[j] for j in range(len(scene.lights))]
     split = per_light and per_light_modes is not None
@@ -290,8 +257,6 @@ def _render_meta(
     variants: dict[str, str], timings: dict[str, list[float]], *, spp: int, seed: int,
     max_depth: int, per_light: bool, wanted: set[str], data_dir: str | None,
 ) -> dict[str, Any]:
-    from spectrinsic.render.variants import import_mitsuba
-
     names = [m.name for m in objs]
     return {
         "mitsuba": import_mitsuba().__version__,
@@ -324,32 +289,35 @@ def batch_seeds(seed: int, batches: int) -> list[int]:
 
 def render_batches(
     scene: Scene,
+    settings: RenderSettings,
     *,
-    batches: int,
-    spp: int,
     seed: int,
-    noise_target: float | None = None,
-    max_batches: int | None = None,
-    **options: Any,
+    progress: PassProgress | None = None,
+    data_dir: str | None = None,
 ) -> RenderResult:
-    """:func:`render_scene` as *batches* independent batches of *spp* samples each, merged.
+    """:func:`render_scene` as ``settings.batches`` independent batches, merged.
 
     Inside a batch every mode and the AOVs share seed and paths (common random numbers); the
     batches differ only in their seed (:func:`batch_seeds`), so the spread between them is a
     direct estimate of the Monte Carlo error of their mean (the noise budget of the ground
-    truth). *options* are those of :func:`render_scene`.
+    truth).
 
-    Adaptive sampling: with *noise_target*, batches are added one at a time while the median
-    relative standard error of the image (:func:`image_noise`) is above it, up to
-    *max_batches* (default ``4 * batches``). ``meta["noise_target"]`` records the target and
-    the median reached.
+    Adaptive sampling: with ``settings.noise_target``, batches are added one at a time while
+    the median relative standard error of the image (:func:`image_noise`) is above it, up to
+    ``settings.max_batches`` (default ``4 * batches``). ``meta["noise_target"]`` records the
+    target and the median reached.
     """
-    cap = max(batches, max_batches if max_batches is not None else 4 * batches)
+    batches, noise_target = settings.batches, settings.noise_target
+    cap = max(batches, settings.max_batches if settings.max_batches is not None else 4 * batches)
     seeds = batch_seeds(seed, cap if noise_target is not None else batches)
-    results = [render_scene(scene, spp=spp, seed=s, **options) for s in seeds[:batches]]
+
+    def one(s: int) -> RenderResult:
+        return render_scene(scene, settings, seed=s, progress=progress, data_dir=data_dir)
+
+    results = [one(s) for s in seeds[:batches]]
     reached = image_noise(results) if noise_target is not None else None
-    while reached is not None and reached > float(noise_target) and len(results) < cap:  # type: ignore[arg-type]
-        results.append(render_scene(scene, spp=spp, seed=seeds[len(results)], **options))
+    while reached is not None and noise_target is not None and reached > noise_target and len(results) < cap:
+        results.append(one(seeds[len(results)]))
         reached = image_noise(results)
     merged = merge_batches(results)
     if noise_target is not None:

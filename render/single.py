@@ -24,32 +24,25 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import RenderError, SceneError, validate_choice
+from spectrinsic.interrupts import raise_if_requested
 from spectrinsic.render import translate as tr
 from spectrinsic.render.integrator import BandTables, band_path, first_hit_channels
 from spectrinsic.render.modes import ChannelValues, RenderMode, channel_values
 from spectrinsic.render.passes import DIRECT_DEPTH, PassOutput, PassProgress, assemble_aovs
+from spectrinsic.render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
 from spectrinsic.render.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import get_sensors
 
 __all__ = [
-    "INTEGRATORS",
-    "DEFAULT_INTEGRATOR",
     "TransportOutput",
     "SingleTraversal",
-    "render_transport",
+    "render_traversal",
     "render_jobs",
     "light_of_emitters",
     "single_traversal_runs",
     "resolve_integrator",
 ]
-
-#: How diagonal modes are rendered: ``"passes"`` (⌈K/3⌉ RGB passes per mode, one scene per
-#: light subset) or ``"single"`` (one band-path traversal for every mode and light).
-INTEGRATORS: tuple[str, ...] = ("passes", "single")
-#: The default of :func:`spectrinsic.render.render_scene`: the traversal, since it gives the
-#: passes' images to float rounding (``tests/render/test_single_traversal.py``) in one render.
-DEFAULT_INTEGRATOR = "single"
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,7 +87,8 @@ def single_traversal_runs(variant: str | None) -> bool:
 
 
 def resolve_integrator(name: str | None, variant: str | None = None) -> str:
-    """*name* checked against :data:`INTEGRATORS` (``None``: :data:`DEFAULT_INTEGRATOR`);
+    """*name* checked against :data:`~spectrinsic.render.settings.INTEGRATORS` (``None``:
+    :data:`~spectrinsic.render.settings.DEFAULT_INTEGRATOR`);
     ``"passes"`` where the traversal does not run (:func:`single_traversal_runs`)."""
     chosen = DEFAULT_INTEGRATOR if name is None else validate_choice(name, INTEGRATORS, "integrator", error=RenderError)
     return chosen if chosen == "passes" or single_traversal_runs(variant) else "passes"
@@ -131,17 +125,20 @@ def _tables(scene: Scene, value_sets: Sequence[ChannelValues], emitters: dict[in
 
 
 def _render(mi: Any, loaded: Any, integrator: Any, *, spp: int, seed: int, n: int) -> tuple[np.ndarray, float]:
+    raise_if_requested()  # Ctrl-C stops a build within one render
     start = time.perf_counter()
     try:
         image = np.array(mi.render(loaded, spp=int(spp), seed=int(seed), integrator=integrator), dtype=np.float32)
     except RuntimeError as exc:
+        raise_if_requested()  # Dr.Jit re-raises a Ctrl-C inside the render as RuntimeError
         raise RenderError(f"Mitsuba render failed: {exc}") from exc
+    raise_if_requested()  # Mitsuba's own SIGINT handler may have cut the render short
     if image.shape[-1] < n:
         raise RenderError(f"band-path render returned {image.shape[-1]} channels; expected at least {n}")
     return image[..., image.shape[-1] - n:], time.perf_counter() - start
 
 
-def render_transport(
+def render_traversal(
     scene: Scene,
     value_sets: Sequence[ChannelValues],
     *,
@@ -183,7 +180,7 @@ def render_transport(
     if not scene.lights:
         raise SceneError(f"scene {scene.name!r} has no lights: nothing to render")
     if not value_sets:
-        raise SceneError("render_transport: expected at least one set of channel values")
+        raise SceneError("render_traversal: expected at least one set of channel values")
     widths = [np.asarray(v.materials).shape[1] for v in value_sets]
     n_bands, n_lights = sum(widths), len(scene.lights)
     chosen = choose_variant("rgb", variant)
@@ -258,7 +255,7 @@ def render_jobs(
     diagonal = list({m.name: m for modes, _, _ in jobs for m in modes if m.kind == "diagonal"}.values())
     want_direct = any(flag and m.name in wanted for modes, _, flag in jobs for m in modes if m.kind == "diagonal")
     values = [channel_values(scene, get_sensors(m.sensors, data_dir=data_dir), data_dir=data_dir) for m in diagonal]
-    outs, aov_maps, seconds, chosen = render_transport(
+    outs, aov_maps, seconds, chosen = render_traversal(
         scene, values, spp=spp, seed=seed, max_depth=max_depth, direct=want_direct, aovs=aovs,
         variant=variant, progress=progress, geometry=geometry)
     transport = {m.name: o for m, o in zip(diagonal, outs, strict=True)}

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import SceneError
+from spectrinsic.render.variants import import_mitsuba
 from spectrinsic.scenes.model import Light, Scene, unknown_light_kind
 
 __all__ = [
@@ -196,7 +197,8 @@ def smooth_corner_normals(
     unit_a = np.repeat(unit[sorted_face], per, axis=0)
     keep = np.einsum("ij,ij->i", unit_a, unit[fb]) >= np.cos(np.radians(crease_deg))
     target, weights = np.repeat(order, per)[keep], cross[fb[keep]]
-    acc = np.stack([np.bincount(target, weights=weights[:, c], minlength=corner_vertex.size) for c in range(3)], axis=1)
+    acc = np.stack([np.bincount(target, weights=weights[:, c], minlength=corner_vertex.size)
+                    for c in range(3)], axis=1).astype(np.float64)  # no pairs: bincount gives int
     norm = np.linalg.norm(acc, axis=1)
     out = np.divide(acc, norm[:, None], out=np.zeros_like(acc), where=norm[:, None] > 0)
     out[norm == 0] = (0.0, 0.0, 1.0)
@@ -335,8 +337,6 @@ def scene_to_mitsuba(
     geometry
         :func:`prepare_geometry` of *scene*, if already computed.
     """
-    from spectrinsic.render.variants import import_mitsuba
-
     mi = import_mitsuba()
     if len(materials) != len(scene.materials) or len(lights) != len(scene.lights):
         raise SceneError(

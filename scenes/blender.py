@@ -35,6 +35,7 @@ import numpy as np
 from spectrinsic.errors import MissingDependencyError, SceneError, SpectrinsicError, with_article
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.scenes.validate import validate_scene
+from spectrinsic.spectra import get_spectrum
 
 __all__ = ["load_blend", "SPECTRUM_PROPERTY"]
 
@@ -70,8 +71,6 @@ def _prop(*owners: Any) -> str | None:
 def _check_spectrum(
     source: str, field: str, name: str, kind: str, hint: str, data_dir: str | None
 ) -> None:
-    from spectrinsic.spectra import get_spectrum
-
     try:
         spectrum = get_spectrum(name, data_dir=data_dir)
     except SpectrinsicError as exc:

@@ -58,6 +58,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import yaml
 
 from spectrinsic.errors import SceneError, did_you_mean, with_article
 from spectrinsic.scenes.geometry import Part, moved
@@ -74,6 +75,7 @@ from spectrinsic.scenes.model import (
     unknown_light_kind,
 )
 from spectrinsic.scenes.validate import Problems, validate_scene
+from spectrinsic.scenes.yaml_limits import load_yaml_file
 
 __all__ = [
     "FORMAT_VERSION",
@@ -425,8 +427,6 @@ def load_scene(
     SceneError
         One line naming the file and the field.
     """
-    from spectrinsic.scenes.yaml_limits import load_yaml_file
-
     path = Path(path)
     source = str(path)
     data = load_yaml_file(path)
@@ -510,8 +510,6 @@ def scene_to_yaml_dict(scene: Scene, mesh_files: Mapping[str, str] | None = None
 
 def _dumper() -> type:
     """A SafeDumper writing rows of numbers (and other scalar lists) on one line each."""
-    import yaml
-
     class Dumper(yaml.SafeDumper):
         pass
 
@@ -526,8 +524,6 @@ def _dumper() -> type:
 def save_scene(scene: Scene, path: str | os.PathLike[str], *, inline_max_faces: int = 64) -> Path:
     """Write *scene* as YAML at *path*; meshes with more than *inline_max_faces* faces go to
     float64 binary PLY files in ``<stem>_meshes/`` next to it. Returns *path*."""
-    import yaml
-
     path = Path(path)
     folder = path.parent / f"{path.stem}_meshes"
     mesh_files: dict[str, str] = {}

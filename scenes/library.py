@@ -43,9 +43,11 @@ from spectrinsic.scenes import geometry as g
 from spectrinsic.scenes.model import Camera, Light, LightKind, Scene, light_power
 from spectrinsic.scenes.objects import OBJECTS
 from spectrinsic.scenes.sample_id import SampleId
+from spectrinsic.spectra import get_sensors, get_spectrum, illuminant_set, responses, xyz_to_xy
 
 __all__ = [
     "CONDITIONS",
+    "CONDITION_DESCRIPTIONS",
     "WHITE",
     "MIN_XY_DISTANCE",
     "TARGET_IRRADIANCE",
@@ -57,6 +59,13 @@ __all__ = [
 ]
 
 CONDITIONS: tuple[str, ...] = ("white", "one-colour", "two-colour-a", "two-colour-b")
+#: One line per condition (``spectrinsic list conditions``); the module docstring has the rules.
+CONDITION_DESCRIPTIONS: dict[str, str] = {
+    "white": "one light of CIE D65",
+    "one-colour": "one coloured light, Planckian or not, distinct from D65",
+    "two-colour-a": "two lights of distinct colours: one Planckian, one non-Planckian",
+    "two-colour-b": "two lights of distinct colours, a pair other than two-colour-a",
+}
 #: The spectrum of the ``white`` condition.
 WHITE = "cie:D65"
 #: Least CIE 1931 xy distance between the two lights of a pair and between a coloured light and
@@ -314,8 +323,6 @@ def _layout(name: str) -> _Layout:
 
 
 def _chromaticities(names: Sequence[str]) -> dict[str, np.ndarray]:
-    from spectrinsic.spectra import get_sensors, get_spectrum, responses, xyz_to_xy
-
     cmf = get_sensors("cie1931")
     return {
         n: xyz_to_xy(responses(get_spectrum(n).on(cmf.wavelengths), cmf.curves, cmf.wavelengths))
@@ -329,8 +336,6 @@ def condition_illuminants(name: str, condition: str, *, seed: int) -> tuple[str,
     All conditions of a scene are drawn from one generator seeded by ``seed_from_key(seed,
     name)``, in a fixed order, so ``two-colour-b`` always differs from ``two-colour-a``.
     """
-    from spectrinsic.spectra import illuminant_set
-
     _check_name(name)
     validate_choice(condition, CONDITIONS, "illumination condition", error=SceneError)
     if condition == "white":

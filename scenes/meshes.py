@@ -9,8 +9,10 @@ the named file is read (no textures, no referenced files outside its folder are 
 
 from __future__ import annotations
 
+import json
 import math
 import os
+import struct
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -19,12 +21,90 @@ import numpy as np
 
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
+from spectrinsic.scenes.validate import validate_scene
 
-__all__ = ["MESH_SUFFIXES", "load_mesh_scene"]
+__all__ = ["MESH_SUFFIXES", "MAX_VERTICES", "MAX_FACES", "mesh_counts", "check_mesh_size", "load_mesh_scene"]
 
 MESH_SUFFIXES = (".obj", ".ply", ".glb", ".gltf", ".stl", ".off")
+#: Largest mesh read, checked from the file's header before loading: loading takes about
+#: 2.5 KiB per vertex (a 10^6-vertex PLY took 2.5 GB), so these bound it near 1.3 GB.
+MAX_VERTICES = 500_000
+MAX_FACES = 1_000_000
 #: Irradiance (relative units) at the model's centre from the default light.
 _IRRADIANCE = math.pi
+
+
+def _ply_counts(head: bytes) -> tuple[int, int]:
+    """Vertex and face counts from a PLY header (ASCII even in binary PLY files)."""
+    counts = {"vertex": 0, "face": 0}
+    for line in head.split(b"end_header", 1)[0].splitlines():
+        parts = line.split()
+        if len(parts) == 3 and parts[0] == b"element" and parts[1].decode("ascii", "replace") in counts:
+            counts[parts[1].decode("ascii")] = int(parts[2])
+    return counts["vertex"], counts["face"]
+
+
+def _text_counts(path: Path, vertex: bytes, face: bytes) -> tuple[int, int]:
+    """Lines starting with *vertex* / *face*, streamed (no more than one line in memory)."""
+    n_v = n_f = 0
+    with path.open("rb") as fh:
+        for line in fh:
+            stripped = line.lstrip()
+            n_v += stripped.startswith(vertex)
+            n_f += stripped.startswith(face)
+    return n_v, n_f
+
+
+def _gltf_vertices(document: dict[str, Any]) -> int:
+    accessors = document.get("accessors") or []
+    total = 0
+    for mesh in document.get("meshes") or []:
+        for primitive in mesh.get("primitives") or []:
+            index = (primitive.get("attributes") or {}).get("POSITION")
+            if isinstance(index, int) and 0 <= index < len(accessors):
+                total += int(accessors[index].get("count", 0))
+    return total
+
+
+def mesh_counts(path: Path) -> tuple[int, int]:
+    """``(vertices, faces)`` a mesh file declares, read from its header (PLY, OFF, binary
+    STL, glTF/GLB) or counted line by line (OBJ, ASCII STL) without building the mesh; faces
+    are 0 where a format does not say (glTF). Malformed headers count as 0: trimesh reports
+    them when it reads the file."""
+
+    suffix = path.suffix.lower()
+    with path.open("rb") as fh:
+        head = fh.read(1 << 16)
+    try:
+        if suffix == ".ply":
+            return _ply_counts(head)
+        if suffix == ".off":
+            words = b" ".join(line.split(b"#", 1)[0] for line in head.splitlines()).split()
+            return (int(words[1]), int(words[2])) if words[:1] == [b"OFF"] else (int(words[0]), int(words[1]))
+        if suffix == ".stl" and not head.lstrip().startswith(b"solid"):
+            faces = struct.unpack("<I", head[80:84])[0]
+            return 3 * faces, faces
+        if suffix == ".stl":
+            return _text_counts(path, b"vertex", b"facet")
+        if suffix == ".obj":
+            return _text_counts(path, b"v ", b"f ")
+        if suffix == ".glb":
+            length = struct.unpack("<I", head[12:16])[0]
+            return _gltf_vertices(json.loads(head[20:20 + length])), 0
+        if suffix == ".gltf":
+            return _gltf_vertices(json.loads(path.read_bytes())), 0
+    except (ValueError, IndexError, struct.error, AttributeError):
+        pass
+    return 0, 0
+
+
+def check_mesh_size(path: Path) -> None:
+    """Refuse a mesh file declaring more than :data:`MAX_VERTICES` vertices or
+    :data:`MAX_FACES` faces, before it is loaded."""
+    n_v, n_f = mesh_counts(path)
+    if n_v > MAX_VERTICES or n_f > MAX_FACES:
+        raise SceneError(f"{path}: declares {n_v:,} vertices and {n_f:,} faces; meshes are limited to "
+                         f"{MAX_VERTICES:,} vertices and {MAX_FACES:,} faces (simplify it first)")
 
 
 def _geometries(path: Path) -> list[tuple[str, str, np.ndarray, np.ndarray]]:
@@ -32,6 +112,7 @@ def _geometries(path: Path) -> list[tuple[str, str, np.ndarray, np.ndarray]]:
     in world space, sorted by geometry name (file order is not stable across formats)."""
     import trimesh
 
+    check_mesh_size(path)
     try:
         loaded: Any = trimesh.load(str(path), force="scene", process=False)
     except Exception as exc:  # noqa: BLE001 - trimesh raises many types for corrupt files
@@ -97,8 +178,6 @@ def load_mesh_scene(
     SceneError
         One line naming the file and the unmapped material, or an unreadable file.
     """
-    from spectrinsic.scenes.validate import validate_scene
-
     path = Path(path)
     geoms = _geometries(path)
     names: list[str] = []

@@ -20,6 +20,8 @@ from typing import Any, Literal
 
 import numpy as np
 
+from spectrinsic.errors import did_you_mean
+
 __all__ = [
     "Material",
     "Mesh",
@@ -152,8 +154,6 @@ def unknown_light_kind(kind: object) -> str:
     >>> unknown_light_kind("spto")
     "unknown light kind 'spto'; expected one of point, spot, area, directional (did you mean 'spot'?)"
     """
-    from spectrinsic.errors import did_you_mean
-
     return (f"unknown light kind {kind!r}; expected one of {', '.join(LIGHT_KINDS)}"
             + did_you_mean(str(kind), LIGHT_KINDS))
 

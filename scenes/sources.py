@@ -9,18 +9,29 @@ run) or meshes (:data:`~spectrinsic.scenes.meshes.MESH_SUFFIXES`, with a materia
 from __future__ import annotations
 
 import dataclasses
+import gzip
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 from spectrinsic.errors import SceneError
+from spectrinsic.scenes.blender import load_blend
 from spectrinsic.scenes.generators import GeneratorOptions, generate
+from spectrinsic.scenes.io import load_scene
 from spectrinsic.scenes.meshes import MESH_SUFFIXES, load_mesh_scene
 from spectrinsic.scenes.model import Scene
 
-__all__ = ["GeneratedSource", "FileSource", "scene_file_kind"]
+__all__ = ["GeneratedSource", "FileSource", "scene_file_kind", "is_scene_file", "load_scene_file",
+           "FILE_SIZE"]
 
 #: First bytes of every uncompressed ``.blend`` file.
 BLEND_MAGIC = b"BLENDER"
+#: First bytes of a gzip stream and of a zstd frame (Blender compresses ``.blend`` files so).
+GZIP_MAGIC = b"\x1f\x8b"
+ZSTD_MAGIC = b"\x28\xb5\x2f\xfd"
+#: Image side in pixels of a file without a camera size of its own (a mesh), or of the side a
+#: caller left out when it gave the other.
+FILE_SIZE = 128
 
 
 @dataclass(frozen=True)
@@ -40,9 +51,31 @@ class GeneratedSource:
                         view=self.view, options=options)
 
 
+def _compressed_blend(head: bytes, path: Path) -> bool:
+    """True for a gzip- or zstd-compressed file whose content starts with Blender's magic."""
+    if head.startswith(GZIP_MAGIC):
+        try:
+            with gzip.open(path, "rb") as fh:
+                return fh.read(len(BLEND_MAGIC)) == BLEND_MAGIC
+        except (OSError, EOFError):
+            return False
+    if head.startswith(ZSTD_MAGIC):
+        try:
+            import zstandard
+        except ImportError:  # Blender writes zstd .blend files; without a reader, trust the magic
+            return True
+        try:
+            with path.open("rb") as raw, zstandard.ZstdDecompressor().stream_reader(raw) as fh:
+                return fh.read(len(BLEND_MAGIC)) == BLEND_MAGIC
+        except (OSError, zstandard.ZstdError):
+            return False
+    return False
+
+
 def scene_file_kind(path: str | Path) -> str:
-    """``"yaml"``, ``"blend"`` or ``"mesh"`` for a scene file, by suffix (``.blend`` also by
-    its magic bytes); one-line error for anything else."""
+    """``"yaml"``, ``"blend"`` or ``"mesh"`` for a scene file, by suffix; a ``.blend`` also by
+    its magic bytes, plain or compressed (gzip, zstd), under any name. One-line error for
+    anything else. The one dispatcher of scene files (``render``, ``dataset --scenes``)."""
     p = Path(path)
     suffix = p.suffix.lower()
     if suffix in (".yaml", ".yml"):
@@ -53,17 +86,69 @@ def scene_file_kind(path: str | Path) -> str:
         return "blend"
     try:
         with p.open("rb") as fh:
-            if fh.read(len(BLEND_MAGIC)) == BLEND_MAGIC:
-                return "blend"
+            head = fh.read(len(BLEND_MAGIC))
+        if head == BLEND_MAGIC or _compressed_blend(head, p):
+            return "blend"
     except OSError:
         pass
-    raise SceneError(f"scene file {str(p)!r}: expected .yaml/.yml, .blend or a mesh "
-                     f"({', '.join(MESH_SUFFIXES)})")
+    raise SceneError(f"scene file {str(p)!r}: expected .yaml/.yml, .blend (plain, gzip or zstd) "
+                     f"or a mesh ({', '.join(MESH_SUFFIXES)})")
+
+
+def is_scene_file(argument: str | Path) -> bool:
+    """Whether a scene argument names a file (a scene-file suffix, or an existing path) rather
+    than a library scene.
+
+    >>> is_scene_file("chair.OBJ"), is_scene_file("room.yaml"), is_scene_file("room-living")
+    (True, True, False)
+    """
+    p = Path(argument)
+    return p.suffix.lower() in (".yaml", ".yml", ".blend", *MESH_SUFFIXES) or p.exists()
+
+
+def load_scene_file(
+    path: str | Path,
+    *,
+    width: int | None = None,
+    height: int | None = None,
+    materials: Mapping[str, str] | None = None,
+    default_spectrum: str | None = None,
+    data_dir: str | None = None,
+) -> Scene:
+    """Read any scene file (:func:`scene_file_kind`) into a validated scene: the one dispatch
+    over YAML, ``.blend`` and mesh files, for ``dataset --scenes`` and ``render``.
+
+    Parameters
+    ----------
+    width, height
+        Image size in pixels; ``None`` keeps the file's camera size (a YAML or ``.blend`` file;
+        a mesh, which has none, and a side left out beside a given one take :data:`FILE_SIZE`).
+    materials
+        Material name -> spectrum, for meshes and ``.blend`` files.
+    default_spectrum
+        Reflectance of mesh or ``.blend`` materials not in *materials*.
+    """
+    kind = scene_file_kind(path)
+    mapping = dict(materials or {})
+    given = width is not None or height is not None
+    if kind == "mesh":
+        return load_mesh_scene(path, materials=mapping, width=width or FILE_SIZE,
+                               height=height or FILE_SIZE, default_spectrum=default_spectrum,
+                               data_dir=data_dir)
+    if kind == "blend":
+        return load_blend(path, materials=mapping or None,
+                          resolution=(width or FILE_SIZE, height or FILE_SIZE) if given else None,
+                          default_spectrum=default_spectrum, data_dir=data_dir)
+    scene = load_scene(path, data_dir=data_dir)
+    camera = dataclasses.replace(scene.camera, width=scene.camera.width if width is None else width,
+                                 height=scene.camera.height if height is None else height)
+    return dataclasses.replace(scene, camera=camera)
 
 
 @dataclass(frozen=True)
 class FileSource:
-    """A scene file rendered at ``width x height`` (the file's camera, resized).
+    """A scene file rendered at ``width x height`` (the file's camera, resized; ``None``: the
+    file's own size, :data:`FILE_SIZE` for a mesh).
 
     Attributes
     ----------
@@ -74,25 +159,13 @@ class FileSource:
     """
 
     path: str
-    width: int
-    height: int
+    width: int | None
+    height: int | None
     materials: tuple[tuple[str, str], ...] = ()
     default_spectrum: str | None = None
 
     def build(self, data_dir: str | None = None) -> Scene:
         """Read and validate the file; one-line :class:`SceneError` naming it on bad input."""
-        kind = scene_file_kind(self.path)
-        mapping = dict(self.materials)
-        if kind == "mesh":
-            return load_mesh_scene(self.path, materials=mapping, width=self.width, height=self.height,
-                                   default_spectrum=self.default_spectrum, data_dir=data_dir)
-        if kind == "blend":
-            from spectrinsic.scenes.blender import load_blend
-
-            return load_blend(self.path, materials=mapping or None, resolution=(self.width, self.height),
-                              default_spectrum=self.default_spectrum, data_dir=data_dir)
-        from spectrinsic.scenes.io import load_scene
-
-        scene = load_scene(self.path, data_dir=data_dir)
-        camera = dataclasses.replace(scene.camera, width=self.width, height=self.height)
-        return dataclasses.replace(scene, camera=camera)
+        return load_scene_file(self.path, width=self.width, height=self.height,
+                               materials=dict(self.materials),
+                               default_spectrum=self.default_spectrum, data_dir=data_dir)

@@ -27,6 +27,7 @@ import numpy as np
 
 from spectrinsic.errors import SceneError, SpectrinsicError, with_article
 from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_KINDS, Scene, unknown_light_kind
+from spectrinsic.spectra import get_spectrum
 
 __all__ = [
     "VISIBILITY_GRID",
@@ -174,8 +175,6 @@ def _vec(value: object, n: int = 3) -> np.ndarray | None:
 def _check_spectrum(
     source: str, field: str, name: object, kind: str, data_dir: str | None, cache: dict[str, object]
 ) -> None:
-    from spectrinsic.spectra import get_spectrum
-
     if not isinstance(name, str) or not name:
         raise _fail(source, field, f"expected a spectrum name string, got {name!r}")
     if name not in cache:
@@ -188,6 +187,15 @@ def _check_spectrum(
         raise _fail(source, field, str(found)) from found
     if getattr(found, "kind", kind) != kind:
         raise _fail(source, field, f"{name!r} is {with_article(found.kind)} spectrum; expected {with_article(kind)}")  # type: ignore[attr-defined]
+
+
+def _check_area(v: np.ndarray, f: np.ndarray, source: str, where: str) -> None:
+    """A mesh needs a face of non-zero area (all-degenerate faces give no surface, and no
+    normal to shade with)."""
+    tri = v.astype(np.float64)[f]
+    if not np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).any():
+        raise _fail(source, f"{where}.faces", f"all {len(f)} faces have zero area (collinear "
+                    "or repeated vertices); the mesh has no surface to render")
 
 
 def _check_meshes(scene: Scene, source: str) -> None:
@@ -224,6 +232,7 @@ def _check_meshes(scene: Scene, source: str) -> None:
             )
         if f.min() < 0 or f.max() >= len(v):
             raise _fail(source, f"{where}.faces", f"vertex index out of range 0..{len(v) - 1}")
+        _check_area(v, f, source, where)
         if fm.shape != (len(f),) or not np.issubdtype(fm.dtype, np.integer):
             raise _fail(
                 source,
@@ -234,11 +243,12 @@ def _check_meshes(scene: Scene, source: str) -> None:
             raise _fail(
                 source, f"{where}.face_materials", f"material index out of range 0..{n_mat - 1}"
             )
-        if not isinstance(m.object_id, (int, np.integer)) or m.object_id < 0:
+        # ids are stored as 32-bit integers (int32 bits in an EXR UINT channel, -1 background)
+        if not isinstance(m.object_id, (int, np.integer)) or not 0 <= m.object_id < 2**31:
             raise _fail(
                 source,
                 f"{where}.object_id",
-                f"expected a non-negative integer, got {m.object_id!r}",
+                f"expected an integer from 0 to 2**31 - 1, got {m.object_id!r}",
             )
 
 

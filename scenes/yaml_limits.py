@@ -1,4 +1,5 @@
-"""YAML read with limits: file size, nesting depth, alias expansion, and no duplicate keys.
+"""YAML read with limits: file size, node count, nesting depth, alias expansion, and no
+duplicate keys.
 
 ``yaml.safe_load`` blocks Python object tags but not resource exhaustion: a 1.2 KB "billion
 laughs" alias bomb expands to hundreds of millions of nodes, a 5000-deep nested list overflows
@@ -23,9 +24,11 @@ __all__ = ["MAX_YAML_BYTES", "MAX_DEPTH", "MAX_NODES", "load_yaml_file", "load_y
 MAX_YAML_BYTES = 16 * 2**20
 #: Deepest nesting of lists and mappings (a scene needs 4: meshes[i].vertices[j][k]).
 MAX_DEPTH = 64
-#: Most nodes after expanding every alias, each use counted: a generous bound on a 16 MiB file
-#: of inline numbers (about 8 million scalars) and far below an alias bomb.
-MAX_NODES = 10_000_000
+#: Most nodes, counted twice: as the composer builds them (so memory stays bounded while the
+#: file is read: PyYAML's nodes take about 1 KiB each, measured 207 MiB peak for 200,000) and
+#: again after expanding every alias, each use counted (far below an alias bomb). Enough for an
+#: inline mesh of about 100,000 vertices; larger meshes belong in PLY files (FORMAT.md).
+MAX_NODES = 500_000
 
 
 class _LimitedLoader(yaml.SafeLoader):
@@ -35,6 +38,7 @@ class _LimitedLoader(yaml.SafeLoader):
         super().__init__(stream)
         self.source = source
         self._depth = 0
+        self._composed = 0
 
     def _fail(self, node: yaml.Node | None, problem: str) -> SceneError:
         line = f"line {node.start_mark.line + 1}: " if node is not None else ""
@@ -42,7 +46,12 @@ class _LimitedLoader(yaml.SafeLoader):
 
     def compose_node(self, parent: Any, index: Any) -> Any:
         self._depth += 1
+        self._composed += 1
         try:
+            if self._composed > MAX_NODES:
+                mark = self.peek_event().start_mark
+                raise SceneError(f"{self.source}: line {mark.line + 1}: more than {MAX_NODES:,} YAML "
+                                 "nodes; put large meshes in PLY files (FORMAT.md)")
             if self._depth > MAX_DEPTH:
                 mark = self.peek_event().start_mark
                 raise SceneError(
@@ -100,6 +109,10 @@ def load_yaml_text(text: str, source: str) -> Any:
     if len(text) > MAX_YAML_BYTES:
         raise SceneError(f"{source}: {len(text):,} characters; scene files are limited to "
                          f"{MAX_YAML_BYTES:,} (put large meshes in PLY files)")
+    rough = text.count(",") + text.count("- ") + text.count(": ")
+    if rough > MAX_NODES:  # composing them first would take minutes (pure-Python PyYAML)
+        raise SceneError(f"{source}: about {rough:,} YAML values (counted from commas, list items "
+                         f"and keys), more than {MAX_NODES:,}; put large meshes in PLY files (FORMAT.md)")
     loader = _LimitedLoader(text, source)
     try:
         return loader.get_single_data()

@@ -23,7 +23,7 @@ from spectrinsic.decompose.names_shades import NamesAndShades
 from spectrinsic.decompose.protocol import hold_one_out, scene_group, score_grid
 from spectrinsic.decompose.retinex import ColourRetinex
 from spectrinsic.gt_export.loader import load_sample
-from spectrinsic.gt_export.writer import sample_dirs
+from spectrinsic.gt_export.sample import sample_dirs
 
 LAYERS = ["image", "image_denoised", "reflectance", "shading", "shading_grey", "mask",
           "object_id", "material_id"]

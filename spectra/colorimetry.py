@@ -100,13 +100,16 @@ def diagonal_values(spectra: SpectralValues, curves: SensorCurves, wavelengths: 
 
 
 def xyz_to_linear_srgb(xyz: np.ndarray) -> np.ndarray:
-    """CIE XYZ (..., 3) to linear sRGB (..., 3) with the IEC 61966-2-1 matrix; no gamma."""
-    return np.asarray(xyz, float) @ srgb_matrices()[0].T
+    """CIE XYZ (..., 3) to linear sRGB (..., 3) with the IEC 61966-2-1 matrix; no gamma.
+
+    einsum's own loop, not BLAS's matrix product: the bits must not change with the CPU kernel.
+    """
+    return np.einsum("...j,kj->...k", np.asarray(xyz, float), srgb_matrices()[0])
 
 
 def linear_srgb_to_xyz(rgb: np.ndarray) -> np.ndarray:
-    """Linear sRGB (..., 3) to CIE XYZ (..., 3)."""
-    return np.asarray(rgb, float) @ srgb_matrices()[1].T
+    """Linear sRGB (..., 3) to CIE XYZ (..., 3) (einsum, as :func:`xyz_to_linear_srgb`)."""
+    return np.einsum("...j,kj->...k", np.asarray(rgb, float), srgb_matrices()[1])
 
 
 def xyz_to_xy(xyz: np.ndarray) -> np.ndarray:
@@ -185,8 +188,6 @@ def srgb_responses(
     ``p^{s,c}`` (Eq. 4.15), normalised like :func:`absolute_reflectance` but integrated on
     *wavelengths*. Linear: no transfer function.
     """
-    from spectrinsic.spectra.registry import get_sensors
-
     return white_normalised_responses(reflectances, illuminant, get_sensors("srgb").on(wavelengths),
                                       wavelengths)
 

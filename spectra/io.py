@@ -114,14 +114,20 @@ def _first(mask: np.ndarray) -> tuple[int, int]:
 
 
 def _check_values(
-    path: Path, values: np.ndarray, empty: np.ndarray, labels: tuple[str, ...], *, missing: bool
+    path: Path, values: np.ndarray, empty: np.ndarray, labels: tuple[str, ...], *, missing: bool,
+    maximum: float | None = None,
 ) -> None:
     """Every spectral value finite (empty cells aside when *missing*) and >= 0: reflectances,
-    illuminant powers and sensitivities cannot be negative, and a NaN would reach the pixels."""
+    illuminant powers and sensitivities cannot be negative, and a NaN would reach the pixels;
+    and at most *maximum* (1 for reflectances) if given. Column 0 holds the wavelengths."""
+    above = np.zeros_like(empty)
+    if maximum is not None:
+        above[:, 1:] = ~empty[:, 1:] & (np.nan_to_num(values[:, 1:]) > maximum)
     checks = (
         (~empty & ~np.isfinite(values), "non-finite", "finite numbers"),
         (empty if not missing else np.zeros_like(empty), "empty", "a number in every cell"),
         (~empty & (np.nan_to_num(values) < 0), "negative", "values >= 0"),
+        (above, "too large", f"values <= {maximum if maximum is not None else 0:g} (reflectances)"),
     )
     for mask, problem, expected in checks:
         if mask.any():
@@ -133,10 +139,13 @@ def _check_values(
             )
 
 
-def read_spectra_csv(path: str | os.PathLike[str], *, missing: bool = False) -> Table:
+def read_spectra_csv(
+    path: str | os.PathLike[str], *, missing: bool = False, maximum: float | None = None
+) -> Table:
     """A CSV with a header row, first column ``wavelength_nm``, one column per spectrum.
 
-    Every value is validated at load time: finite, >= 0, wavelengths increasing. Empty cells
+    Every value is validated at load time: finite, >= 0 (and <= *maximum* if given: 1 for
+    reflectances), wavelengths increasing. Empty cells
     (not measured) are read as NaN when *missing* is true (camera tables that stop at 720 nm)
     and are an error otherwise; a literal ``nan`` or ``inf`` always is.
 
@@ -158,7 +167,7 @@ def read_spectra_csv(path: str | os.PathLike[str], *, missing: bool = False) -> 
         raise SpectralDataError(f"{path}: non-numeric value ({exc})") from None
     empty = np.array([[not c.strip() for c in r] for r in body])
     labels = tuple(h.strip() for h in header[1:])
-    _check_values(path, arr, empty, labels, missing=missing)
+    _check_values(path, arr, empty, labels, missing=missing, maximum=maximum)
     wl = validate_wavelengths(arr[:, 0], what=str(path))
     return Table(wl, arr[:, 1:].T.copy(), labels)
 
@@ -167,7 +176,8 @@ def read_spectra_csv(path: str | os.PathLike[str], *, missing: bool = False) -> 
 def read_sfu_reflectances(data_dir: str | None) -> tuple[Table, tuple[tuple[str, int], ...]]:
     """The 1995 SFU reflectances (read-only, cached) and ``(group, index_in_group)`` per spectrum
     (1-based index)."""
-    table = read_spectra_csv(require_data_file("sfu_barnard2002/reflect_db_1995.csv", data_dir))
+    table = read_spectra_csv(require_data_file("sfu_barnard2002/reflect_db_1995.csv", data_dir),
+                             maximum=1.0)
     index_path = require_data_file("sfu_barnard2002/reflect_db_index.csv", data_dir)
     with index_path.open(newline="", encoding="utf-8") as fh:
         keys = tuple((r["group"], int(r["index_in_group"])) for r in csv.DictReader(fh))

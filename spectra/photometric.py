@@ -37,24 +37,77 @@ def _pairs(src: np.ndarray, dst: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return a, b
 
 
-def _least_squares(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``X`` minimising ``‖a X − b‖²`` through the normal equations ``(aᵀa) X = aᵀb``.
+#: Eigenvalues of the Gram matrix ``aᵀa`` below this fraction of its largest are taken as zero:
+#: directions whose singular value is under 1e-6 of the largest carry no information that
+#: survives the squared condition number (rounding leaves ~1e-16·λ_max in a zero eigenvalue).
+RANK_TOLERANCE: float = 1e-12
+#: Cyclic Jacobi sweeps before giving up; a K×K symmetric matrix converges in well under 10.
+_JACOBI_SWEEPS = 50
 
-    The Gram matrices are summed by einsum's own loop, not BLAS or LAPACK's ``gelsd``, whose
-    reductions change their last bits with the thread count and CPU kernel (1.0000000000000002
-    vs 0.9999999999999997 between two processes); the K×K solve is single-threaded. Sensor
-    responses of a few channels are well conditioned, so the squared condition number costs
-    nothing measurable.
+
+def _symmetric_eigen(gram: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues ``w`` and eigenvectors ``V`` (columns) of a small symmetric matrix.
+
+    Cyclic Jacobi rotations (Golub & Van Loan, Algorithm 8.5.3) in element-wise numpy
+    operations only: no BLAS or LAPACK call, so the result is the same bits under every BLAS
+    kernel (``OPENBLAS_CORETYPE``), thread count and process.
+    """
+    g = np.array(gram, dtype=np.float64)
+    k = g.shape[0]
+    v = np.eye(k)
+    scale = float(np.abs(g).max()) or 1.0
+    for _ in range(_JACOBI_SWEEPS):
+        off = max((abs(g[p, q]) for p in range(k) for q in range(p + 1, k)), default=0.0)
+        if off <= 1e-300 or off <= np.finfo(np.float64).eps * 1e-3 * scale:
+            break
+        for p in range(k - 1):
+            for q in range(p + 1, k):
+                _jacobi_rotate(g, v, p, q)
+    return np.diag(g).copy(), v
+
+
+def _jacobi_rotate(g: np.ndarray, v: np.ndarray, p: int, q: int) -> None:
+    """Zero ``g[p, q]`` in place by the rotation ``Jᵀ g J``, and accumulate ``v ← v J``."""
+    if g[p, q] == 0.0:
+        return
+    theta = (g[q, q] - g[p, p]) / (2.0 * g[p, q])
+    t = np.copysign(1.0, theta) / (abs(theta) + np.sqrt(theta * theta + 1.0))
+    c = 1.0 / np.sqrt(t * t + 1.0)
+    s = t * c
+    gp, gq = g[:, p].copy(), g[:, q].copy()
+    g[:, p], g[:, q] = c * gp - s * gq, s * gp + c * gq
+    gp, gq = g[p, :].copy(), g[q, :].copy()
+    g[p, :], g[q, :] = c * gp - s * gq, s * gp + c * gq
+    vp, vq = v[:, p].copy(), v[:, q].copy()
+    v[:, p], v[:, q] = c * vp - s * vq, s * vp + c * vq
+
+
+def _least_squares(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The minimum-norm ``X`` minimising ``‖a X − b‖²``: ``X = (aᵀa)⁺ aᵀb``.
+
+    One defined answer also for rank-deficient responses (flat greys make the 6-sensor
+    responses exactly rank 1): the pseudo-inverse drops the Gram matrix's eigen-directions
+    under :data:`RANK_TOLERANCE` of its largest eigenvalue. The Gram matrices are summed by
+    einsum's own loop and decomposed by :func:`_symmetric_eigen`, never by BLAS or LAPACK,
+    whose reductions and pivots change with the thread count and CPU kernel (``solve`` raised
+    on the singular system under ``OPENBLAS_CORETYPE=Haswell`` and returned noise without it).
+
+    >>> a = np.ones((4, 2)); x = _least_squares(a, 2 * np.ones((4, 1)))  # rank 1
+    >>> np.round(x.ravel(), 12).tolist()
+    [1.0, 1.0]
     """
     gram = np.einsum("nk,nj->kj", a, a)
     cross = np.einsum("nk,nj->kj", a, b)
-    try:
-        return np.linalg.solve(gram, cross)
-    except np.linalg.LinAlgError as exc:
+    if not (np.isfinite(gram).all() and np.isfinite(cross).all()):
+        raise SpectralDataError("least-squares fit of non-finite responses")
+    w, v = _symmetric_eigen(gram)
+    if w.max(initial=0.0) <= 0.0:
         raise SpectralDataError(
-            f"least-squares fit of {a.shape[1]} source channels is degenerate (linearly "
-            "dependent responses)"
-        ) from exc
+            f"least-squares fit of {a.shape[1]} source channels that are all zero"
+        )
+    keep = w > RANK_TOLERANCE * w.max()
+    inverse = np.where(keep, 1.0 / np.where(keep, w, 1.0), 0.0)
+    return np.einsum("ki,i,ji,jm->km", v, inverse, v, cross)
 
 
 def fit_matrix(src: np.ndarray, dst: np.ndarray, *, diagonal: bool = False) -> Matrix3:

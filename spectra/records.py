@@ -60,6 +60,11 @@ class Spectrum:
                 f">= 0, got min {np.nanmin(values) if not np.isnan(values).all() else 'nan'}"
                 f"{' and NaN/inf' if not np.isfinite(values).all() else ''}"
             )
+        if self.kind == "reflectance" and values.max() > 1.0:
+            raise SpectralDataError(
+                f"spectrum {self.name!r} ({self.source or 'no source'}): a reflectance reflects "
+                f"at most all the light; expected values in [0, 1], got max {values.max():g}"
+            )
 
     def on(self, wavelengths: Wavelengths) -> SpectralValues:
         """Values resampled onto *wavelengths* (nm), edge values held beyond the data."""

@@ -32,7 +32,7 @@ import numpy as np
 
 from spectrinsic.config import resolve_data_dir
 from spectrinsic.errors import SpectrumNotFoundError, did_you_mean
-from spectrinsic.spectra import illuminants, reflectances, sensors
+from spectrinsic.spectra import illuminants, io, reflectances, sensors
 from spectrinsic.spectra.records import SensorSet, Spectrum
 
 __all__ = [
@@ -41,6 +41,7 @@ __all__ = [
     "list_spectra",
     "family_values",
     "SPECTRUM_FAMILIES",
+    "SPECTRUM_FAMILY_NOTES",
     "SENSOR_FAMILIES",
 ]
 
@@ -60,6 +61,19 @@ SPECTRUM_FAMILIES: dict[str, Callable[[str, str | None], Spectrum]] = {
     "cie": lambda k, d: illuminants.cie_illuminant(k),
     "light": lambda k, d: illuminants.light_source(k),
     "sfu-illum": illuminants.sfu_illuminant,
+}
+
+#: family -> example and source, the module table as data (``spectrinsic list spectra``).
+SPECTRUM_FAMILY_NOTES: dict[str, str] = {
+    "munsell": "munsell:5R 4/14 or munsell:#12; 1269 matte Munsell chips (luxpy wheel)",
+    "colorchecker": "colorchecker:dark skin; BabelColor average (colour-science)",
+    "sfu": "sfu:krinov/3; Barnard et al. 2002 reflectances (data directory)",
+    "flat": "flat:0.5; spectrally flat grey of that reflectance",
+    "planck": "planck:2800K; Planck's law (Eq. B.1), any temperature",
+    "daylight": "daylight:6500K; CIE D-series at any CCT",
+    "cie": "cie:D65, cie:FL11; colour-science SDS_ILLUMINANTS",
+    "light": "light:Cool White FL; colour-science SDS_LIGHT_SOURCES",
+    "sfu-illum": "sfu-illum:mws_090; Barnard et al. 2002 illuminants (data directory)",
 }
 
 #: family -> loader(key, data_dir); families without a key take an empty key.
@@ -118,8 +132,6 @@ def list_spectra(family: str, *, data_dir: DataDir = None) -> list[str]:
     ``camera`` (sensor sets). ``planck``, ``daylight`` and ``flat`` are continuous.
     """
     import colour
-
-    from spectrinsic.spectra import io
 
     listing: dict[str, Callable[[], list[str]]] = {
         "munsell": reflectances.munsell_names,

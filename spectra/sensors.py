@@ -11,6 +11,7 @@ import re
 
 import numpy as np
 
+from spectrinsic.config import resolve_data_dir
 from spectrinsic.errors import SpectrumNotFoundError, did_you_mean
 from spectrinsic.spectra import io
 from spectrinsic.spectra.colourspace import srgb_matrices
@@ -68,7 +69,8 @@ def srgb() -> SensorSet:
     :func:`spectrinsic.spectra.xyz_to_linear_srgb`.
     """
     cmf = cie1931()
-    curves = srgb_matrices()[0] @ cmf.curves
+    # einsum's own loop, not BLAS: the curves' bits must not change with the CPU kernel.
+    curves = np.einsum("kj,jw->kw", srgb_matrices()[0], cmf.curves)
     curves.flags.writeable = False
     return SensorSet(
         "srgb", ("R", "G", "B"), cmf.wavelengths, curves,
@@ -148,8 +150,6 @@ def _builtin_cameras() -> dict[str, tuple[np.ndarray, np.ndarray, str]]:
 
 
 def _all_cameras(data_dir: str | None) -> dict[str, tuple[np.ndarray, np.ndarray, str]]:
-    from spectrinsic.config import resolve_data_dir
-
     cams = _builtin_cameras()
     root = resolve_data_dir(data_dir)
     if root is not None:

@@ -1,11 +1,16 @@
-"""Shared fixtures: the spectral data directory and the repository root."""
+"""Shared fixtures: the spectral data directory, the repository root, and tiny scenes built
+directly from scene-model records for the render and ground-truth tests."""
 
 from __future__ import annotations
 
 import os
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
+import numpy as np
 import pytest
+
+from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 
@@ -43,3 +48,92 @@ def torch():
 
         return torch
     return pytest.importorskip("torch", reason="PyTorch is an optional extra: make test-torch installs it")
+
+def quad(corner: Sequence[float], u: Sequence[float], v: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices (4, 3) and faces (2, 3) of the parallelogram corner + [0,1]u + [0,1]v."""
+    c, a, b = (np.asarray(x, float) for x in (corner, u, v))
+    return np.stack([c, c + a, c + a + b, c + b]), np.array([[0, 1, 2], [0, 2, 3]])
+
+
+def plane_scene(
+    reflectance: str,
+    light_spectrum: str,
+    *,
+    tilt_deg: float = 0.0,
+    size: int = 16,
+    power: float = 1.0,
+) -> Scene:
+    """A large horizontal plane seen straight from above, lit by a directional light.
+
+    The light arrives *tilt_deg* from the normal; the camera sees only the plane.
+    """
+    vertices, faces = quad((-50, -50, 0), (100, 0, 0), (0, 100, 0))
+    t = np.radians(tilt_deg)
+    return Scene(
+        name="plane",
+        meshes=(Mesh("plane", vertices, faces, np.zeros(2, np.int64), object_id=0),),
+        materials=(Material("plane", reflectance),),
+        lights=(Light("directional", light_spectrum, power, direction=(np.sin(t), 0.0, -np.cos(t))),),
+        camera=Camera(origin=(0, 0, 2), target=(0, 0, 0), up=(0, 1, 0), fov_deg=30, width=size, height=size),
+    )
+
+
+def _box(lo: Sequence[float], hi: Sequence[float]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Axis-aligned box: vertices, faces and a face -> side index (0..5: -x,+x,-y,+y,-z,+z)."""
+    (x0, y0, z0), (x1, y1, z1) = lo, hi
+    sides = [
+        quad((x0, y0, z0), (0, 0, z1 - z0), (0, y1 - y0, 0)),
+        quad((x1, y0, z0), (0, y1 - y0, 0), (0, 0, z1 - z0)),
+        quad((x0, y0, z0), (x1 - x0, 0, 0), (0, 0, z1 - z0)),
+        quad((x0, y1, z0), (0, 0, z1 - z0), (x1 - x0, 0, 0)),
+        quad((x0, y0, z0), (0, y1 - y0, 0), (x1 - x0, 0, 0)),
+        quad((x0, y0, z1), (x1 - x0, 0, 0), (0, y1 - y0, 0)),
+    ]
+    vertices = np.concatenate([s[0] for s in sides])
+    faces = np.concatenate([s[1] + 4 * i for i, s in enumerate(sides)])
+    return vertices, faces, np.repeat(np.arange(6), 2)
+
+
+def box_room(
+    wall_spectra: Sequence[str] = (
+        "munsell:5R 5/12", "munsell:5G 6/8", "munsell:5B 5/8", "munsell:5Y 8/10", "munsell:5Y 8/2", "munsell:5Y 8/2",
+    ),
+    cube_spectrum: str = "munsell:5P 5/10",
+    lights: Sequence[tuple[str, str, float]] = (("point", "planck:2800K", 1.5), ("area", "daylight:6500K", 3.0)),
+    size: int = 24,
+) -> Scene:
+    """A closed 2 m room with coloured walls (interreflections), a cube, and its lights.
+
+    ``lights`` are ``(kind, spectrum, power)``: a point light near the ceiling and a downward
+    area light under it.
+    """
+    room_v, room_f, room_side = _box((-1, -1, 0), (1, 1, 2))
+    cube_v, cube_f, _ = _box((-0.3, -0.2, 0), (0.3, 0.4, 0.6))
+    materials = tuple(Material(f"wall{i}", s) for i, s in enumerate(wall_spectra)) + (Material("cube", cube_spectrum),)
+    placed = []
+    for i, (kind, spectrum, power) in enumerate(lights):
+        if kind == "area":
+            placed.append(Light("area", spectrum, power, position=(0.3, -0.3, 1.95), direction=(0, 0, -1),
+                                size=(0.5, 0.5), name=f"light{i}"))
+        else:
+            placed.append(Light(kind, spectrum, power, position=(-0.5, 0.5, 1.6), direction=(0, 0, -1), name=f"light{i}"))
+    return Scene(
+        name="box-room",
+        meshes=(
+            Mesh("room", room_v, room_f, room_side, object_id=0),
+            Mesh("cube", cube_v, cube_f, np.full(len(cube_f), 6, np.int64), object_id=1),
+        ),
+        materials=materials,
+        lights=tuple(placed),
+        camera=Camera(origin=(0.0, -0.95, 1.2), target=(0.1, 0.5, 0.6), up=(0, 0, 1), fov_deg=75, width=size, height=size),
+    )
+
+
+@pytest.fixture(scope="session")
+def make_plane() -> Callable[..., Scene]:
+    return plane_scene
+
+
+@pytest.fixture(scope="session")
+def make_room() -> Callable[..., Scene]:
+    return box_room

@@ -20,6 +20,10 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
 
+from spectrinsic.pipeline.dataset import build_dataset
+from spectrinsic.pipeline.presets import get_preset
+from spectrinsic.scenes.library import default_samples
+
 __all__ = ["run", "BENCH_PRESETS", "CLASS_SAMPLES", "WARMUP_SAMPLE"]
 
 log = logging.getLogger(__name__)
@@ -43,8 +47,6 @@ def _n_lights(condition: str) -> int:
 
 def _class_counts() -> dict[tuple[str, int], int]:
     """How many samples of the default layout fall in each class."""
-    from spectrinsic.scenes.library import default_samples
-
     counts: dict[tuple[str, int], int] = {}
     for s in default_samples():
         key = ("object" if s.scene.startswith("obj-") else "complex", _n_lights(s.condition))
@@ -54,9 +56,6 @@ def _class_counts() -> dict[tuple[str, int], int]:
 
 def _bench_preset(preset: str, work: str) -> dict[str, Any]:
     """Build the warm-up and the class representatives of *preset* serially in this process."""
-    from spectrinsic.pipeline.dataset import build_dataset
-    from spectrinsic.pipeline.presets import get_preset
-
     config = get_preset(preset)
     warm = build_dataset(work, config, only=WARMUP_SAMPLE, finalize=False)
     report = build_dataset(work, config, only=",".join(CLASS_SAMPLES.values()), finalize=False)

@@ -20,24 +20,26 @@ from typing import Any
 
 import numpy as np
 
+from spectrinsic.gt_export.layers import compute_ground_truth
+from spectrinsic.pipeline.presets import get_preset
+from spectrinsic.render import render_batches
+from spectrinsic.scenes.library import build
+from spectrinsic.spectra.reconstruction import relative_error
+
 REFERENCE_FACTOR = 16
 SCENE, VIEW, CONDITION = "room-living", 1, "white"
 
 
 def _render(cfg: Any, scene: Any, *, spp: int, batches: int, seed: int,
             modes: tuple[str, ...] | None = None) -> tuple[Any, float]:
-    from spectrinsic.render import render_batches
-
     start = time.perf_counter()
-    result = render_batches(scene, batches=batches, modes=modes or cfg.modes, spp=spp // batches, seed=seed,
-                            max_depth=cfg.max_depth, per_light=True,
-                            per_light_modes=(cfg.share_mode,))
+    settings = cfg.render.with_options(spp=spp, batches=batches, max_batches=None,
+                                       modes=modes or cfg.render.modes)
+    result = render_batches(scene, settings, seed=seed)
     return result, time.perf_counter() - start
 
 
 def _errors(estimate: np.ndarray, reference: np.ndarray, ref_se: np.ndarray, valid: np.ndarray) -> dict[str, float]:
-    from spectrinsic.spectra.reconstruction import relative_error
-
     err = relative_error(estimate, reference, where=valid)[valid]  # Eq. 5.7 per pixel
     corrected = np.sqrt(np.clip(err ** 2 - ref_se[valid] ** 2, 0.0, None))
     return {"median": float(np.median(err)), "p95": float(np.percentile(err, 95)),
@@ -48,29 +50,22 @@ def _errors(estimate: np.ndarray, reference: np.ndarray, ref_se: np.ndarray, val
 
 
 def _sample_seconds(cfg: Any, name: str, view: int, condition: str) -> float:
-    from spectrinsic.gt_export.layers import compute_ground_truth
-    from spectrinsic.scenes.library import build
-
     scene = build(name, view=view, condition=condition, seed=0, width=cfg.width, height=cfg.height)
     start = time.perf_counter()
-    result, _ = _render(cfg, scene, spp=cfg.spp, batches=cfg.batches, seed=1)
+    result, _ = _render(cfg, scene, spp=cfg.render.spp, batches=cfg.render.batches, seed=1)
     compute_ground_truth(scene, result, cameras=cfg.resolved_cameras(), denoise=cfg.denoise)
     return time.perf_counter() - start
 
 
 def run(out_dir: Path) -> dict[str, Any]:
-    from spectrinsic.gt_export.layers import compute_ground_truth
-    from spectrinsic.pipeline.presets import get_preset
-    from spectrinsic.scenes.library import build
-
     cfg = get_preset("default")
     scene = build(SCENE, view=VIEW, condition=CONDITION, seed=0, width=cfg.width, height=cfg.height)
-    noisy, t_render = _render(cfg, scene, spp=cfg.spp, batches=cfg.batches, seed=1)
+    noisy, t_render = _render(cfg, scene, spp=cfg.render.spp, batches=cfg.render.batches, seed=1)
     start = time.perf_counter()
     gt = compute_ground_truth(scene, noisy, denoise=True)
     t_gt = time.perf_counter() - start
     # the shading needs only the cube: the reference renders nothing else
-    reference, t_ref = _render(cfg, scene, spp=REFERENCE_FACTOR * cfg.spp, batches=4, seed=7,
+    reference, t_ref = _render(cfg, scene, spp=REFERENCE_FACTOR * cfg.render.spp, batches=4, seed=7,
                                modes=("bands31",))
     ref = compute_ground_truth(scene, reference)
     valid = (ref.layers["shading_grey"].data > 0) & (gt.layers["shading_grey"].data > 0)
@@ -88,7 +83,7 @@ def run(out_dir: Path) -> dict[str, Any]:
     set_minutes = (32 * kinds["object"] + 18 * kinds["room_one_light"] + 18 * kinds["room_two_lights"]) / 60
     return {
         "scene": f"{SCENE} view {VIEW} {CONDITION}, {cfg.width}x{cfg.height}",
-        "default_spp": cfg.spp, "batches": cfg.batches, "reference_spp": REFERENCE_FACTOR * cfg.spp,
+        "default_spp": cfg.render.spp, "batches": cfg.render.batches, "reference_spp": REFERENCE_FACTOR * cfg.render.spp,
         "render_seconds": t_render, "ground_truth_seconds": t_gt, "reference_seconds": t_ref,
         "reference_own_noise": ref.noise["shading_raw"],
         "shading_stored_denoised": ours,

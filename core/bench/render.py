@@ -24,7 +24,13 @@ from typing import Any
 
 import numpy as np
 
+from spectrinsic.render import RenderSettings, channel_values, get_mode, render_scene
+from spectrinsic.render import translate as tr
 from spectrinsic.render.modes import RENDER_MODES
+from spectrinsic.render.translate import prepare_geometry
+from spectrinsic.render.variants import choose_variant, variant_report, variant_scope
+from spectrinsic.scenes import library
+from spectrinsic.spectra import get_sensors, relative_error
 
 __all__ = ["run", "SCENE", "SIZE", "SPP", "OVERHEAD_GOAL", "TRUTH_FACTOR"]
 
@@ -47,11 +53,6 @@ MODES = tuple(RENDER_MODES)
 
 def _bare_seconds(scene: Any, spp: int) -> float:
     """Seconds of a bare Mitsuba load + render + readback of the rgb3 pass's scene dict."""
-    from spectrinsic.render import channel_values, get_mode
-    from spectrinsic.render import translate as tr
-    from spectrinsic.render.variants import choose_variant, variant_scope
-    from spectrinsic.spectra import get_sensors
-
     values = channel_values(scene, get_sensors(get_mode("rgb3").sensors))
     with variant_scope(choose_variant("rgb")) as mi:
         mitsuba_dict = tr.scene_to_mitsuba(
@@ -68,8 +69,6 @@ def _bare_seconds(scene: Any, spp: int) -> float:
 
 
 def _errors(estimate: np.ndarray, truth: np.ndarray) -> dict[str, float]:
-    from spectrinsic.spectra import relative_error
-
     err = relative_error(estimate, truth)
     mean_est, mean_truth = estimate.reshape(-1, 3).mean(axis=0), truth.reshape(-1, 3).mean(axis=0)
     return {
@@ -82,15 +81,11 @@ def _overhead(name: str, view: int, condition: str) -> dict[str, Any]:
     """Our pipeline's seconds over a bare Mitsuba render of the same dict (rgb3 only, at
     :data:`OVERHEAD_SIZE`², :data:`OVERHEAD_SPP` spp; medians of :data:`REPEATS` interleaved
     runs), and the seconds spent smoothing normals."""
-    from spectrinsic.render import render_scene
-    from spectrinsic.render.translate import prepare_geometry
-    from spectrinsic.scenes import library
-
     big = library.build(name, view=view, condition=condition, seed=SEED, width=OVERHEAD_SIZE, height=OVERHEAD_SIZE)
     ours, bare, geometry = [], [], []
     for _ in range(REPEATS):
         start = time.perf_counter()
-        render_scene(big, modes=("rgb3",), spp=OVERHEAD_SPP, seed=SEED, aovs=False)
+        render_scene(big, RenderSettings(OVERHEAD_SPP, modes=("rgb3",), aovs=False), seed=SEED)
         ours.append(time.perf_counter() - start)
         bare.append(_bare_seconds(big, OVERHEAD_SPP))
         start = time.perf_counter()
@@ -111,14 +106,13 @@ def _overhead(name: str, view: int, condition: str) -> dict[str, Any]:
 def _equal_time(scene: Any, timed: Any) -> dict[str, Any]:
     """Colour errors (%) of the spectral reference and the 31-band cube of *timed* at equal render
     seconds, against a spectral render with :data:`TRUTH_FACTOR` times the samples."""
-    from spectrinsic.render import render_scene
-
     t = timed.meta["timings"]
     # equal time: the spectral render gets the samples the 11-pass cube's time buys
     cube_seconds = t["bands31"]["seconds"]
     spectral_spp = max(1, int(round(SPP * cube_seconds / t["spectral"]["seconds"])))
-    spectral = render_scene(scene, modes=("spectral",), spp=spectral_spp, seed=SEED + 1, aovs=False)
-    truth = render_scene(scene, modes=("spectral",), spp=TRUTH_FACTOR * spectral_spp, seed=SEED + 2, aovs=False)
+    spectral_only = RenderSettings(spectral_spp, modes=("spectral",), aovs=False)
+    spectral = render_scene(scene, spectral_only, seed=SEED + 1)
+    truth = render_scene(scene, spectral_only.with_options(spp=TRUTH_FACTOR * spectral_spp), seed=SEED + 2)
     truth_xyz = truth.images["spectral"].astype(np.float64)
     return {
         "seconds": round(cube_seconds, 3),
@@ -133,16 +127,13 @@ def _equal_time(scene: Any, timed: Any) -> dict[str, Any]:
 
 def run(out_dir: Path) -> dict[str, Any]:
     """Run the rendering benchmark; return JSON-serialisable results (seconds and ratios)."""
-    from spectrinsic.render import render_scene
-    from spectrinsic.render.variants import variant_report
-    from spectrinsic.scenes import library
-
     name, view, condition = SCENE
     load_start = list(os.getloadavg())
     scene = library.build(name, view=view, condition=condition, seed=SEED, width=SIZE, height=SIZE)
-    render_scene(scene, modes=MODES, spp=SPP, seed=SEED, aovs=True)  # warm-up: compile kernels
+    settings = RenderSettings(SPP, modes=MODES, aovs=True)
+    render_scene(scene, settings, seed=SEED)  # warm-up: compile kernels
 
-    timed = render_scene(scene, modes=MODES, spp=SPP, seed=SEED, aovs=True)
+    timed = render_scene(scene, settings, seed=SEED)
     t = timed.meta["timings"]
     per_pass = {m: t[m]["seconds"] / t[m]["passes"] for m in t}
     overhead = _overhead(name, view, condition)

@@ -20,6 +20,13 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
 
+from spectrinsic.pipeline.dataset import _task_scene, build_sample
+from spectrinsic.pipeline.presets import get_preset
+from spectrinsic.pipeline.tasks import SampleTask
+from spectrinsic.render import count_passes, render_batches
+from spectrinsic.render.settings import INTEGRATORS
+from spectrinsic.scenes.library import default_samples
+
 __all__ = ["run", "SAMPLE", "PRESET", "REPEATS"]
 
 #: The sample timed (as in ``make dataset``; its two lights make it the costliest class).
@@ -27,33 +34,24 @@ SAMPLE = "room-living__v1__two-colour-a"
 PRESET = "default"
 #: Timed builds per integrator, alternating.
 REPEATS = 2
-INTEGRATORS = ("passes", "single")
 
 
-def _task(work: str, tag: str) -> Any:
-    from spectrinsic.pipeline.dataset import SampleTask
-    from spectrinsic.pipeline.presets import get_preset
-    from spectrinsic.scenes.library import default_samples
-
+def _task(work: str, tag: str, integrator: str) -> SampleTask:
+    """The sample's task at :data:`PRESET`, its diagonal modes rendered by *integrator* (a
+    render setting, not hashed: both give the same pixels to float rounding)."""
     sid = next(s for s in default_samples() if str(s) == SAMPLE)
     data = os.environ.get("SPECTRINSIC_DATA") or None
-    return SampleTask.planned(sid, get_preset(PRESET), str(Path(work, tag)), data_dir=data)
+    config = get_preset(PRESET).with_options(integrator=integrator)
+    return SampleTask.planned(sid, config, str(Path(work, tag)), data_dir=data)
 
 
-def _breakdown(task: Any, integrator: str) -> dict[str, Any]:
+def _breakdown(task: SampleTask) -> dict[str, Any]:
     """Render the sample as its build does and report Mitsuba seconds by pass group."""
-    from spectrinsic.pipeline.dataset import _task_scene
-    from spectrinsic.render import count_passes, render_batches
-
-    cfg = task.config
-    options = dict(modes=cfg.modes, max_depth=cfg.max_depth, per_light=cfg.per_light,
-                   per_light_modes=(cfg.share_mode,) if cfg.per_light and cfg.share_mode else None,
-                   direct=cfg.direct, aovs=True, data_dir=task.data_dir, integrator=integrator)
     scene = _task_scene(task)
     calls: list[int] = []
-    result = render_batches(scene, batches=cfg.batches, spp=cfg.spp // cfg.batches, seed=task.seed,
-                            variant=cfg.variant, progress=calls.append, **options)
-    per_batch = count_passes(scene, **{k: v for k, v in options.items() if k != "max_depth"})
+    result = render_batches(scene, task.config.render, seed=task.seed, progress=calls.append,
+                            data_dir=task.data_dir)
+    per_batch = count_passes(scene, task.config.render, data_dir=task.data_dir)
     timings = result.meta["timings"]
     return {
         "traversals_per_sample": len(calls),
@@ -64,14 +62,12 @@ def _breakdown(task: Any, integrator: str) -> dict[str, Any]:
 
 
 def _bench(work: str) -> dict[str, Any]:
-    from spectrinsic.pipeline.dataset import build_sample
-
     for name in INTEGRATORS:  # warm-up: kernels compiled here, not timed
-        build_sample(_task(work, f"warm-{name}"), integrator=name)
+        build_sample(_task(work, f"warm-{name}", name))
     runs: dict[str, list[Any]] = {name: [] for name in INTEGRATORS}
     for r in range(REPEATS):
         for name in INTEGRATORS:
-            runs[name].append(build_sample(_task(work, f"{name}-{r}"), integrator=name))
+            runs[name].append(build_sample(_task(work, f"{name}-{r}", name)))
     cores = os.cpu_count() or 1
     out: dict[str, Any] = {}
     for name, outcomes in runs.items():
@@ -81,7 +77,7 @@ def _bench(work: str) -> dict[str, Any]:
             "render_seconds_per_sample": [round(o.render_seconds, 3) for o in outcomes],
             "mitsuba_seconds_per_sample": [round(o.mitsuba_seconds, 3) for o in outcomes],
             "samples_per_core_hour": round(3600.0 / (seconds * cores), 1),
-            **_breakdown(_task(work, f"breakdown-{name}"), name),
+            **_breakdown(_task(work, f"breakdown-{name}", name)),
         }
     p, s = out["passes"], out["single"]
     out["ratio_samples_per_core_hour_single_over_passes"] = round(

@@ -12,8 +12,12 @@ import logging
 import sys
 import traceback
 from collections.abc import Sequence
+from typing import NoReturn
 
+from spectrinsic.config import resolve_data_dir
 from spectrinsic.errors import SpectrinsicError
+from spectrinsic.interrupts import interrupts_reach_python
+from spectrinsic.provenance import software_versions
 
 __all__ = ["main", "build_parser"]
 
@@ -26,11 +30,23 @@ _COMMANDS: tuple[str, ...] = (
     "spectrinsic.cli.export",
     "spectrinsic.cli.study",
     "spectrinsic.cli.evaluate",
+    "spectrinsic.cli.list",
 )
 
 
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (``spectrinsic: error: ...``, status 2),
+    like every other bad input; ``--help`` still prints the usage. Sub-command parsers are of
+    this class too (``add_subparsers`` makes them with the parent's class)."""
+
+    def error(self, message: str) -> NoReturn:
+        where = self.prog.removeprefix("spectrinsic").strip()
+        text = " ".join(message.split())
+        self.exit(2, f"spectrinsic: error: {where + ': ' if where else ''}{text} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="spectrinsic",
         description="Spectral rendering of synthetic intrinsic-image datasets.",
     )
@@ -40,6 +56,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="spectral data directory (SFU set, extra cameras); default: $SPECTRINSIC_DATA",
     )
+    parser.add_argument("--version", action="version", version=f"spectrinsic {_version()}")
     parser.add_argument("-v", "--verbose", action="count", default=0, help="more logging")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress bars or plan lines")
     parser.add_argument(
@@ -51,10 +68,22 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _version() -> str:
+    """spectrinsic's installed version, from package metadata (nothing heavy imported)."""
+
+    return software_versions(("spectrinsic",), python=False)["spectrinsic"]
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point. Returns the process exit status (0 ok, 1 problems found or samples failed,
     2 bad input or a resource that failed: one line on stderr, the traceback only with
-    ``--debug``)."""
+    ``--debug``; 130 interrupted)."""
+    # Before anything starts a thread: Ctrl-C must reach Python even mid-render.
+    with interrupts_reach_python():
+        return _main(argv)
+
+
+def _main(argv: Sequence[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(
@@ -62,6 +91,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         format="%(levelname)s %(name)s: %(message)s",
     )
     try:
+        if args.data_dir is not None:  # a wrong --data-dir is an input error, before any work
+
+            resolve_data_dir(args.data_dir)
         return int(args.func(args) or 0)
     except SpectrinsicError as exc:
         return _error(args, str(exc))

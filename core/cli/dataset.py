@@ -3,23 +3,36 @@
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from pathlib import Path
 from typing import Any
 
-from spectrinsic.errors import DatasetError
+from tqdm import tqdm
 
-__all__ = ["register", "run"]
+from spectrinsic.errors import DatasetError, SpectrinsicError
+from spectrinsic.gt_export.integrity import check_build_folder
+from spectrinsic.pipeline.dataset import SampleFailure, build_dataset
+from spectrinsic.pipeline.executors import check_scheduler, choose_executor
+from spectrinsic.pipeline.presets import PRESETS, DatasetConfig, get_preset, preset_names
+from spectrinsic.pipeline.sources import files_source, generator_source
+from spectrinsic.render.budget import check_render_size
+from spectrinsic.scenes.sources import FileSource
+from spectrinsic.scenes.yaml_limits import load_yaml_file
+from spectrinsic.spectra import get_spectrum
+
+__all__ = ["register", "run", "config_from_args", "preflight", "build", "material_map"]
 
 DEFAULT_OUT = "data/dataset"
+#: Largest root seed and samples per pixel (Mitsuba's sampler takes unsigned 32-bit values).
+UINT32_MAX = 2**32 - 1
 
 
 def _presets_help() -> str:
     """The presets with their numbers, for ``--help``."""
-    from spectrinsic.pipeline.presets import PRESETS
-
-    parts = [f"{name}: {c.width}x{c.height}, {c.batches} batch(es) x {c.spp // c.batches} spp, "
-             f"depth {c.max_depth}, modes {'+'.join(c.modes)}{', denoised' if c.denoise else ''}"
+    parts = [f"{name}: {c.width}x{c.height}, {c.render.batches} batch(es) x {c.render.batch_spp} spp, "
+             f"depth {c.render.max_depth}, modes {'+'.join(c.render.modes)}"
+             f"{', denoised' if c.denoise else ''}"
              for name, c in PRESETS.items()]
     return "quality preset (default: default). " + "; ".join(parts)
 
@@ -51,8 +64,6 @@ def register(subparsers: Any) -> None:
 
 def _add_build_options(p: Any) -> None:
     """Where the dataset goes, which preset and seed, and what it runs on."""
-    from spectrinsic.pipeline.presets import preset_names
-
     p.add_argument("--out", metavar="DIR", default=DEFAULT_OUT, help=f"dataset folder ({DEFAULT_OUT})")
     p.add_argument(
         "--preset", default="default", choices=preset_names(), help=_presets_help()
@@ -143,10 +154,10 @@ def _range(option: str, text: str) -> tuple[float, float]:
     return lo, hi
 
 
-def _material_map(path: str | None) -> dict[str, str]:
+def material_map(path: str | None) -> dict[str, str]:
+    """The ``--material-map`` file as ``{material name: spectrum name}`` (``{}`` for none)."""
     if path is None:
         return {}
-    from spectrinsic.scenes.yaml_limits import load_yaml_file
 
     data = load_yaml_file(Path(path))
     if not isinstance(data, dict) or not all(isinstance(k, str) and isinstance(v, str) for k, v in data.items()):
@@ -156,8 +167,6 @@ def _material_map(path: str | None) -> dict[str, str]:
 
 def _source(args: argparse.Namespace) -> str | None:
     """The config's ``source`` for --generator / --scenes (``None``: the library)."""
-    from spectrinsic.pipeline.sources import files_source, generator_source
-
     if args.generator and args.scenes:
         raise DatasetError("--generator and --scenes exclude each other; give one")
     if args.generator:
@@ -165,7 +174,7 @@ def _source(args: argparse.Namespace) -> str | None:
                                 value_range=_range("--value-range", args.value_range),
                                 chroma_range=_range("--chroma-range", args.chroma_range))
     if args.scenes:
-        return files_source(args.scenes, materials=_material_map(args.material_map),
+        return files_source(args.scenes, materials=material_map(args.material_map),
                             default_spectrum=args.default_spectrum)
     return None
 
@@ -195,49 +204,89 @@ def _overrides(args: argparse.Namespace) -> dict[str, Any]:
     return changes
 
 
-def _preflight(args: argparse.Namespace, config: Any) -> None:
+def preflight(
+    out: str | Path, config: DatasetConfig, *, workers: int | None = None, threads: int | None = None,
+    scheduler: str | None = None, rebuild: bool = False, data_dir: str | None = None,
+) -> None:
     """Every refusal that needs no rendering, before anything is written or started."""
-    from spectrinsic.gt_export.integrity import check_build_folder
-    from spectrinsic.pipeline.executors import check_scheduler
-    from spectrinsic.render.budget import check_render_size
-
-    if args.workers is not None and args.workers < 1:
-        raise DatasetError(f"--workers {args.workers}; expected a positive integer")
-    if args.threads is not None and args.threads < 1:
-        raise DatasetError(f"--threads {args.threads}; expected a positive integer")
-    check_build_folder(Path(args.out), config.config_hash(), rebuild=args.rebuild)
-    if args.scheduler:
-        check_scheduler(args.scheduler)
+    if workers is not None and workers < 1:
+        raise DatasetError(f"--workers {workers}; expected a positive integer")
+    if threads is not None and threads < 1:
+        raise DatasetError(f"--threads {threads}; expected a positive integer")
+    if not 0 <= config.seed <= UINT32_MAX or config.render.spp > UINT32_MAX:
+        raise DatasetError(f"--seed {config.seed} / --spp {config.render.spp}; expected a seed from 0 "
+                           f"to {UINT32_MAX} and at most {UINT32_MAX} samples per pixel")
+    check_build_folder(Path(out), config.config_hash(), rebuild=rebuild)
+    _check_scene_files(config, data_dir)
+    if scheduler:
+        check_scheduler(scheduler)
     # two lights: the library's two-colour conditions, rendered once per light
-    check_render_size(config.width, config.height, what=f"--resolution {config.width}x{config.height}",
-                      processes=args.workers or 1, modes=config.modes, per_light=config.per_light,
-                      direct=config.direct, n_lights=2)
+    check_render_size(config.width, config.height, config.render,
+                      what=f"--resolution {config.width}x{config.height}",
+                      processes=workers or 1, n_lights=2)
+
+
+def _check_scene_files(config: Any, data_dir: str | None) -> None:
+    """``--scenes``: every file reads as a valid scene with this material map and default
+    spectrum, before the folder is stamped with the config (a bad file is an input error, not
+    a failed sample)."""
+
+    spec = json.loads(config.source or "{}")
+    if "scenes" not in spec:
+        return
+    materials = spec.get("materials") or {}
+    named = [("--default-spectrum", spec.get("default_spectrum"))]
+    named += [(f"--material-map entry {k!r}", v) for k, v in sorted(materials.items())]
+    for option, name in named:
+        try:
+            if name is not None:
+                get_spectrum(name, data_dir=data_dir)
+        except SpectrinsicError as exc:
+            raise DatasetError(f"{option} {name!r}: {exc}") from exc
+    for entry in spec["scenes"]:
+        FileSource(entry["path"], config.width, config.height, tuple(sorted(materials.items())),
+                   spec.get("default_spectrum")).build(data_dir)
 
 
 def run(args: argparse.Namespace) -> int:
-    from tqdm import tqdm
+    config = config_from_args(args)
+    preflight(args.out, config, workers=args.workers, threads=args.threads, scheduler=args.scheduler,
+              rebuild=args.rebuild, data_dir=args.data_dir)
+    return build(args.out, config, only=args.only, workers=args.workers, threads=args.threads,
+                 scheduler=args.scheduler, rebuild=args.rebuild, data_dir=args.data_dir,
+                 quiet=args.quiet)
 
-    from spectrinsic.pipeline.dataset import SampleFailure, build_dataset
-    from spectrinsic.pipeline.executors import choose_executor
-    from spectrinsic.pipeline.presets import get_preset
 
-    config = get_preset(args.preset, seed=args.seed).with_options(**_overrides(args))
-    _preflight(args, config)
-    choice = choose_executor(workers=args.workers, threads=args.threads, scheduler=args.scheduler)
-    executor, threads, where = choice.executor, choice.render_threads, choice.where
+def config_from_args(args: argparse.Namespace) -> DatasetConfig:
+    """The preset named by ``--preset`` with ``--seed`` and every override of the options."""
+    return get_preset(args.preset, seed=args.seed).with_options(**_overrides(args))
+
+
+def build(
+    out: str | Path, config: DatasetConfig, *, only: str | None = None, workers: int | None = None,
+    threads: int | None = None, scheduler: str | None = None, rebuild: bool = False,
+    data_dir: str | None = None, quiet: bool = False,
+) -> int:
+    """Build *config* into *out* with a progress bar and print the summary; the exit status.
+
+    The one path from a command line to :func:`~spectrinsic.pipeline.dataset.build_dataset`,
+    shared by ``dataset`` and ``render --ground-truth``.
+    """
+    choice = choose_executor(workers=workers, threads=threads, scheduler=scheduler)
+    executor, render_threads, where = choice.executor, choice.render_threads, choice.where
 
     bar: Any = None
     failures: list[str] = []
 
     def on_plan(n_todo: int, n_skipped: int) -> None:
         nonlocal bar
-        if not args.quiet:
+        if not quiet:
             print(
                 f"spectrinsic dataset: preset {config.preset!r}, {n_todo} sample(s) to build, "
                 f"{n_skipped} already complete, on {where}",
                 file=sys.stderr,
             )
-        bar = tqdm(total=n_todo, unit="sample", disable=args.quiet or n_todo == 0, file=sys.stderr)
+        bar = tqdm(total=n_todo, unit="sample", disable=quiet or n_todo == 0, file=sys.stderr)
 
     def progress(record: Any) -> None:
         if isinstance(record, SampleFailure):
@@ -248,13 +297,13 @@ def run(args: argparse.Namespace) -> int:
 
     try:
         report = build_dataset(
-            args.out,
+            out,
             config,
             executor=executor,
-            only=args.only,
-            data_dir=args.data_dir,
-            render_threads=threads,
-            rebuild=args.rebuild,
+            only=only,
+            data_dir=data_dir,
+            render_threads=render_threads,
+            rebuild=rebuild,
             on_plan=on_plan,
             progress=progress,
         )

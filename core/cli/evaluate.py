@@ -8,7 +8,16 @@ import logging
 from pathlib import Path
 from typing import Any
 
+from tqdm import tqdm
+
+from spectrinsic.decompose.evaluate import evaluate
+from spectrinsic.decompose.mit import evaluate_mit, mit_folder_objects
+from spectrinsic.decompose.predictions import Predictions
+from spectrinsic.decompose.registry import available_decomposers, get_decomposer
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export.loader import load_sample
+from spectrinsic.gt_export.outfolder import output_folder
+from spectrinsic.gt_export.sample import sample_dirs
 
 __all__ = ["register", "run", "DEFAULT_DATASET", "DEFAULT_OUT"]
 
@@ -36,6 +45,10 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument("--dataset", metavar="DIR", default=DEFAULT_DATASET,
                    help=f"dataset folder built by `spectrinsic dataset` ({DEFAULT_DATASET})")
+    p.add_argument("--mit", metavar="DIR", default=None,
+                   help="score on an MIT-format folder (<object>.npz, e.g. $SPECTRINSIC_DATA/"
+                        "mit_intrinsic_dev) with the thesis' protocol and Table 3.2's measures "
+                        "instead of a rendered dataset; see spectrinsic.decompose.mit")
     p.add_argument("--out", metavar="DIR", default=DEFAULT_OUT, help=f"output folder ({DEFAULT_OUT})")
     p.add_argument("--methods", default=None,
                    help="comma-separated decomposers (default: all registered, plugins included, "
@@ -57,9 +70,6 @@ def register(subparsers: Any) -> None:
 
 
 def _methods(args: argparse.Namespace) -> dict[str, Any]:
-    from spectrinsic.decompose.predictions import Predictions
-    from spectrinsic.decompose.registry import available_decomposers, get_decomposer
-
     names = (args.methods.split(",") if args.methods is not None
              else [] if args.predictions else list(available_decomposers()))
     methods: dict[str, Any] = {m.strip(): get_decomposer(m.strip()) for m in names if m.strip()}
@@ -77,8 +87,6 @@ def _methods(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def _folders(dataset: Path, patterns: str | None) -> list[Path]:
-    from spectrinsic.gt_export.writer import sample_dirs
-
     if not dataset.is_dir():
         raise DatasetError(
             f"dataset folder {str(dataset)!r} does not exist; build it first with "
@@ -96,14 +104,33 @@ def _folders(dataset: Path, patterns: str | None) -> list[Path]:
     return folders
 
 
+def _run_mit(args: argparse.Namespace) -> int:
+    patterns = [g.strip() for g in args.samples.split(",") if g.strip()] if args.samples else None
+    files = mit_folder_objects(Path(args.mit), patterns)
+    methods = _methods(args)
+    with output_folder(Path(args.out)):  # locked; its files recorded as spectrinsic's
+        written = evaluate_mit(files, methods, Path(args.out))
+    print(written["table_md"].read_text(encoding="utf-8"))
+    print(f"MIT protocol on {len(files)} objects in {args.out} (mit_scores.csv, mit_table_3_2.*)")
+    return 0
+
+
 def run(args: argparse.Namespace) -> int:
-    from tqdm import tqdm
-
-    from spectrinsic.decompose.evaluate import evaluate
-    from spectrinsic.gt_export.loader import load_sample
-
+    if args.mit is not None:
+        return _run_mit(args)
     folders = _folders(Path(args.dataset), args.samples)
     methods = _methods(args)
+    with output_folder(Path(args.out)):  # locked; its files recorded as spectrinsic's
+        result = _evaluate(args, folders, methods)
+    for key in ("lmse_by_condition_md", "colour_by_condition_md", "scenario_md"):
+        print(result.files[key].read_text(encoding="utf-8"))
+    print(f"{len(result.scores)} scores for {len(folders)} samples in {args.out} "
+          f"(REPORT.md, scores.csv, tables, figures/, estimates/)")
+    return 0
+
+
+def _evaluate(args: argparse.Namespace, folders: list[Path], methods: dict[str, Any]) -> Any:
+    """Score every sample with a progress bar; return the evaluation result."""
     bar = tqdm(total=len(folders), desc="evaluate", unit="sample", disable=args.quiet)
 
     def progress(sample_id: str) -> None:
@@ -118,8 +145,4 @@ def run(args: argparse.Namespace) -> int:
         )
     finally:
         bar.close()
-    for key in ("lmse_by_condition_md", "colour_by_condition_md", "scenario_md"):
-        print(result.files[key].read_text(encoding="utf-8"))
-    print(f"{len(result.scores)} scores for {len(folders)} samples in {args.out} "
-          f"(REPORT.md, scores.csv, tables, figures/, estimates/)")
-    return 0
+    return result

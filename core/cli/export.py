@@ -5,7 +5,12 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from tqdm import tqdm
+
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export import sample_dirs
+from spectrinsic.gt_export.sample import MANIFEST_NAME
+from spectrinsic.gt_export.shards import check_shard_folder, write_shards
 
 __all__ = ["register", "run"]
 
@@ -32,14 +37,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Write the shards with a progress bar; print where they are and how many samples each split has."""
-    from tqdm import tqdm
-
-    from spectrinsic.gt_export import sample_dirs
-    from spectrinsic.gt_export.shards import write_shards
-
     root = Path(args.dir)
-    if not (root / "manifest.json").is_file():
-        raise DatasetError(f"export {str(root)!r}: no manifest.json; expected a built dataset folder")
+    if not (root / MANIFEST_NAME).is_file():
+        raise DatasetError(f"export {str(root)!r}: no {MANIFEST_NAME}; expected a built dataset folder")
+    check_shard_folder(Path(args.out))  # before the progress bar: new, empty or an earlier export
     layers = [k.strip() for k in args.layers.split(",") if k.strip()] if args.layers else None
     with tqdm(total=len(sample_dirs(root)), desc="exporting", unit="sample",
               disable=args.quiet or None, leave=False) as bar:

@@ -7,6 +7,7 @@ from typing import Any
 
 from spectrinsic.config import DATA_SUBDIRS, resolve_data_dir
 from spectrinsic.provenance import DISTRIBUTIONS, software_versions
+from spectrinsic.render.variants import available_variants, llvm_library
 
 __all__ = ["register", "run", "collect_info"]
 
@@ -17,7 +18,6 @@ _DISTRIBUTIONS = (*DISTRIBUTIONS, "bpy", "distributed")
 def collect_info(data_dir: str | None = None) -> dict[str, Any]:
     """Everything ``info`` prints, as plain data (also recorded in dataset manifests)."""
     versions = software_versions(_DISTRIBUTIONS, python=False)
-    from spectrinsic.render.variants import available_variants, llvm_library
 
     root = resolve_data_dir(data_dir)
     found = {} if root is None else {k: (root / k).is_dir() for k in DATA_SUBDIRS}

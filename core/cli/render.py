@@ -1,6 +1,7 @@
 """``spectrinsic render``: render one scene in several modes and write the raw passes as EXR.
 
-``SCENE`` is a library scene name (``spectrinsic.scenes.library``) or a YAML scene file. For
+``SCENE`` is a library scene name (``spectrinsic.scenes.library``) or a scene file (YAML,
+``.blend`` or mesh, read as ``dataset --scenes`` reads them). For
 every mode ``DIR/<mode>.exr`` holds float32 layers ``raw`` (the K raw channels, named after the
 sensors, e.g. ``raw.B400``), ``xyz`` (CIE 1931 XYZ), and when asked ``direct`` and
 ``light<i>`` (XYZ); ``DIR/aovs.exr`` holds coverage, ids, depth and normals; ``DIR/meta.json``
@@ -11,129 +12,131 @@ the render settings, variants, timings and the scene. Ground-truth layers are wr
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from tqdm import tqdm
+
+from spectrinsic.cli import dataset as cli_dataset
 from spectrinsic.errors import RenderError, SceneError
+from spectrinsic.gt_export.exr import write_exr
+from spectrinsic.gt_export.outfolder import check_output_folder, output_folder
+from spectrinsic.pipeline.presets import get_preset
+from spectrinsic.pipeline.sources import files_source
+from spectrinsic.render import (
+    RenderResult,
+    RenderSettings,
+    choose_variant,
+    count_passes,
+    get_mode,
+    render_scene,
+)
+from spectrinsic.render.budget import check_render_size
+from spectrinsic.render.modes import RENDER_MODES
+from spectrinsic.render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
+from spectrinsic.render.settings import DEFAULT_MODES as RENDER_DEFAULT_MODES
+from spectrinsic.scenes import library
+from spectrinsic.scenes.model import Scene, scene_to_dict
+from spectrinsic.scenes.sample_id import SampleId
+from spectrinsic.scenes.sources import FILE_SIZE, is_scene_file, load_scene_file
+from spectrinsic.spectra import get_sensors
 
 __all__ = ["register", "run", "load_scene_argument", "write_render"]
 
-DEFAULT_MODES = "spectral,rgb3,rgb6,bands31"
-#: First bytes of every uncompressed ``.blend`` file.
-BLEND_MAGIC = b"BLENDER"
+DEFAULT_MODES = ",".join(RENDER_DEFAULT_MODES)
 
 
 def _modes_help() -> str:
-    from spectrinsic.render.modes import RENDER_MODES
-
     return "; ".join(f"{m.name}: {m.description}" for m in RENDER_MODES.values())
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from spectrinsic.pipeline.presets import get_preset
-
     # one set of documented defaults: those of the dataset's default preset
     default = get_preset("default")
     p = sub.add_parser(
         "render", help="render a scene in several colour modes and write raw passes as EXR",
-        description="Render SCENE (a library scene name, a YAML or a .blend file) with Mitsuba 3 "
+        description="Render SCENE (a library scene name, a YAML, .blend or mesh file) with Mitsuba 3 "
                     "in each mode and write float32 EXR files with named channels into --out "
                     "(raw passes, XYZ, AOVs; ground-truth layers come from `spectrinsic dataset`). "
-                    f"Defaults are the dataset's default preset: {default.spp} spp, path depth "
-                    f"{default.max_depth}, library scenes at {default.width}x{default.height}. "
+                    f"Defaults are the dataset's default preset: {default.render.spp} spp, path depth "
+                    f"{default.render.max_depth}, library scenes at {default.width}x{default.height}. "
                     f"Modes: {_modes_help()}.",
     )
-    p.add_argument("scene", metavar="SCENE", help="library scene name (e.g. room-living) or a .yaml scene file")
+    p.add_argument("scene", metavar="SCENE",
+                   help="library scene name (e.g. room-living) or a scene file (.yaml, .blend, .obj/.ply/.glb)")
     p.add_argument("--condition", default="white", help="library scenes: illumination condition (default: white)")
     p.add_argument("--view", type=int, default=0, help="library scenes: camera viewpoint (default: 0)")
     p.add_argument("--modes", default=DEFAULT_MODES, help=f"comma-separated render modes (default: {DEFAULT_MODES})")
     p.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder")
     p.add_argument("--spp", type=int, default=None,
-                   help=f"samples per pixel of every pass (default: {default.spp}, the default "
+                   help=f"samples per pixel of every pass (default: {default.render.spp}, the default "
                         "preset's; with --ground-truth the chosen preset's)")
     p.add_argument("--seed", type=int, default=0, help="sampler seed and library illuminant seed (default: 0)")
     p.add_argument("--width", type=int, default=None,
                    help=f"image width (default: the scene's, {default.width} for the library)")
     p.add_argument("--height", type=int, default=None,
                    help=f"image height (default: the scene's, {default.height} for the library)")
-    p.add_argument("--max-depth", type=int, default=default.max_depth,
-                   help=f"longest path, 2 = direct light only (default: {default.max_depth})")
+    p.add_argument("--max-depth", type=int, default=default.render.max_depth,
+                   help=f"longest path, 2 = direct light only (default: {default.render.max_depth})")
     p.add_argument("--variant", default=None, help="Mitsuba backend or variant (default: best usable)")
     p.add_argument("--per-light", action="store_true", help="also write one image per light")
     p.add_argument("--direct", action="store_true", help="also write direct-light-only images")
     p.add_argument("--no-aovs", action="store_true", help="skip coverage/id/depth/normal maps")
+    p.add_argument("--integrator", choices=INTEGRATORS, default=DEFAULT_INTEGRATOR,
+                   help="diagonal modes from one traversal (single) or K/3 passes per mode and "
+                        f"one scene per light (passes); same images (default: {DEFAULT_INTEGRATOR})")
     p.add_argument("--ground-truth", action="store_true",
                    help="write every ground-truth layer instead of raw passes: a one-sample dataset "
                         "built by the same path as `spectrinsic dataset --scenes` (uses --preset)")
     p.add_argument("--preset", default="preview", help="with --ground-truth: quality preset (preview)")
     p.add_argument("--material-map", metavar="FILE", default=None,
-                   help="with --ground-truth: material name -> spectrum map for .blend and mesh files")
+                   help="material name -> spectrum map for .blend and mesh files")
+    p.add_argument("--default-spectrum", metavar="NAME", default=None,
+                   help="reflectance of unmapped materials in .blend and mesh files")
     p.set_defaults(func=run)
 
 
 def load_scene_argument(
     scene: str, *, condition: str, view: int, seed: int, width: int | None, height: int | None,
+    materials: Mapping[str, str] | None = None, default_spectrum: str | None = None,
     data_dir: str | None = None,
-) -> Any:
-    """The Scene named by the ``SCENE`` argument: a ``.blend`` file (by extension or its
-    ``BLENDER`` magic bytes) through the Blender importer, a YAML file if it looks like a path,
-    else a library name."""
-    path = Path(scene)
-    if _is_blend(path):
-        from spectrinsic.scenes.blender import load_blend
-
-        size = None if width is None and height is None else (width or 128, height or 128)
-        return load_blend(path, resolution=size, data_dir=data_dir)
-    if path.suffix.lower() in (".yaml", ".yml") or path.exists():
-        from spectrinsic.scenes.io import load_scene
-
-        loaded = load_scene(path, data_dir=data_dir)
-        camera = loaded.camera
-        camera = dataclasses.replace(camera, width=camera.width if width is None else width,
-                                     height=camera.height if height is None else height)
-        return dataclasses.replace(loaded, camera=camera)
-    from spectrinsic.pipeline.presets import get_preset
-    from spectrinsic.scenes import library
-
+) -> Scene:
+    """The Scene named by the ``SCENE`` argument: a scene file (YAML, ``.blend`` or mesh,
+    :func:`spectrinsic.scenes.sources.load_scene_file`, the dispatch ``dataset --scenes`` uses),
+    else a library scene at the default preset's size unless *width*/*height* say otherwise."""
+    if is_scene_file(scene):
+        return load_scene_file(scene, width=width, height=height, materials=materials,
+                               default_spectrum=default_spectrum, data_dir=data_dir)
     default = get_preset("default")
     return library.build(scene, view=view, condition=condition, seed=seed,
                          width=default.width if width is None else width,
                          height=default.height if height is None else height)
 
 
-def _default_spp() -> int:
-    from spectrinsic.pipeline.presets import get_preset
-
-    return get_preset("default").spp
-
-
-def _is_blend(path: Path) -> bool:
-    """True for a ``.blend`` name or a file starting with Blender's magic bytes."""
-    if path.suffix.lower() == ".blend":
-        return True
-    try:
-        with path.open("rb") as fh:
-            return fh.read(len(BLEND_MAGIC)) == BLEND_MAGIC
-    except OSError:
-        return False
+#: Largest sampler seed and samples per pixel Mitsuba takes (both are unsigned 32-bit).
+UINT32_MAX = 2**32 - 1
 
 
 def _check_size_options(args: argparse.Namespace) -> None:
-    """``--width``/``--height``/``--spp`` must be positive before anything is loaded."""
+    """Every number and name the render needs, checked before anything is loaded or written."""
     for option, value in (("--width", args.width), ("--height", args.height), ("--spp", args.spp)):
         if value is not None and value < 1:
             raise RenderError(f"{option} {value}; expected a positive integer")
+    if args.spp is not None and args.spp > UINT32_MAX:
+        raise RenderError(f"--spp {args.spp}; expected at most {UINT32_MAX}")
+    if not 0 <= args.seed <= UINT32_MAX:
+        raise RenderError(f"--seed {args.seed}; expected a whole number from 0 to {UINT32_MAX}")
+    if args.max_depth < 1:
+        raise RenderError(f"--max-depth {args.max_depth}; expected >= 1 (2 = direct light only)")
+    if args.variant is not None:
+        choose_variant("rgb", args.variant)  # an unknown or unusable backend, before any work
 
 
-def write_render(out: Path, scene: Any, result: Any, *, data_dir: str | None = None) -> dict[str, Path]:
+def write_render(out: Path, scene: Scene, result: RenderResult, *, data_dir: str | None = None) -> dict[str, Path]:
     """Write a :class:`~spectrinsic.render.RenderResult` as EXR files and ``meta.json`` into *out*."""
-    from spectrinsic.gt_export.exr import write_exr
-    from spectrinsic.scenes.model import scene_to_dict
-    from spectrinsic.spectra import get_sensors
-
     out.mkdir(parents=True, exist_ok=True)
     paths: dict[str, Path] = {}
     for mode, raw in result.raw.items():
@@ -164,61 +167,66 @@ def write_render(out: Path, scene: Any, result: Any, *, data_dir: str | None = N
 
 
 def _ground_truth(args: argparse.Namespace) -> int:
-    """``render --ground-truth``: a thin alias of ``dataset`` (one sample; library name or file)."""
-    from spectrinsic.cli import dataset as cli_dataset
-    from spectrinsic.scenes.sample_id import SampleId
-
-    path = Path(args.scene)
-    is_file = path.suffix.lower() in (".yaml", ".yml", ".blend") or path.exists()
-    resolution = None
+    """``render --ground-truth``: a one-sample dataset (library name or scene file), built by
+    the same call as ``spectrinsic dataset`` (:func:`spectrinsic.cli.dataset.build`)."""
+    changes: dict[str, Any] = {}
+    if args.spp is not None:
+        changes["spp"] = args.spp
+    if args.direct:
+        changes["direct"] = True
     if args.width is not None or args.height is not None:
-        resolution = f"{args.width or 128}x{args.height or 128}"
-    dataset_args = argparse.Namespace(
-        out=str(args.out), preset=args.preset, seed=args.seed, workers=None, threads=None,
-        scheduler=None, spp=args.spp, batches=None, noise_target=None, max_batches=None,
-        no_denoise=False, direct=args.direct, resolution=resolution, rebuild=False,
-        only=None if is_file else str(SampleId(args.scene, args.view, args.condition)),
-        generator=None, scenes=[args.scene] if is_file else None, material_map=args.material_map,
-        default_spectrum=None, count=1, views=1, value_range="2,9", chroma_range="0,16", sfu=False,
-        data_dir=getattr(args, "data_dir", None), quiet=getattr(args, "quiet", False))
-    return cli_dataset.run(dataset_args)
+        changes["width"], changes["height"] = args.width or FILE_SIZE, args.height or FILE_SIZE
+    only = None
+    if is_scene_file(args.scene):
+        changes["source"] = files_source([args.scene], materials=cli_dataset.material_map(args.material_map),
+                                         default_spectrum=args.default_spectrum)
+    else:
+        only = str(SampleId(args.scene, args.view, args.condition))
+    config = get_preset(args.preset, seed=args.seed).with_options(**changes)
+    cli_dataset.preflight(args.out, config, data_dir=getattr(args, "data_dir", None))
+    return cli_dataset.build(args.out, config, only=only, data_dir=getattr(args, "data_dir", None),
+                             quiet=getattr(args, "quiet", False))
+
+
+def _render_settings(args: argparse.Namespace, modes: list[str]) -> RenderSettings:
+    """The render settings the options give (defaults: the default preset's spp and depth)."""
+    spp = get_preset("default").render.spp if args.spp is None else args.spp
+    return RenderSettings(spp, modes=tuple(modes), max_depth=args.max_depth, variant=args.variant,
+                          per_light=args.per_light, direct=args.direct, aovs=not args.no_aovs,
+                          integrator=args.integrator)
 
 
 def run(args: argparse.Namespace) -> int:
+    _check_size_options(args)
     if args.ground_truth:
         return _ground_truth(args)
-    from spectrinsic.gt_export.integrity import require_folder_path
-    from spectrinsic.render import count_passes, get_mode, render_scene
-    from spectrinsic.render.budget import check_render_size
-
     modes = [m.strip() for m in str(args.modes).split(",") if m.strip()]
     if not modes:
         raise SceneError(f"--modes {args.modes!r}: expected a comma-separated list such as {DEFAULT_MODES}")
     for mode in modes:
         get_mode(mode)
-    _check_size_options(args)
-    require_folder_path(Path(args.out))
+    settings = _render_settings(args, modes)
+    check_output_folder(Path(args.out))
     data_dir = getattr(args, "data_dir", None)
     scene = load_scene_argument(args.scene, condition=args.condition, view=args.view, seed=args.seed,
-                                width=args.width, height=args.height, data_dir=data_dir)
+                                width=args.width, height=args.height,
+                                materials=cli_dataset.material_map(args.material_map),
+                                default_spectrum=args.default_spectrum, data_dir=data_dir)
     given = " ".join(f"--{k} {v}" for k, v in (("width", args.width), ("height", args.height)) if v is not None)
-    check_render_size(scene.camera.width, scene.camera.height, what=given or f"scene {args.scene!r}",
-                      modes=modes, n_lights=len(scene.lights), per_light=args.per_light,
-                      direct=args.direct, data_dir=data_dir)
-    options = dict(modes=modes, per_light=args.per_light, direct=args.direct, aovs=not args.no_aovs)
-    total = count_passes(scene, data_dir=data_dir, variant=args.variant, **options)
-    bar = None
-    if not getattr(args, "quiet", False):
-        from tqdm import tqdm
-
-        bar = tqdm(total=total, desc=f"render {scene.name}", unit="pass", file=sys.stderr)
-    try:
-        result = render_scene(scene, spp=_default_spp() if args.spp is None else args.spp, seed=args.seed, max_depth=args.max_depth, variant=args.variant,
-                              progress=None if bar is None else bar.update, data_dir=data_dir, **options)
-    finally:
-        if bar is not None:
-            bar.close()
-    paths = write_render(Path(args.out), scene, result, data_dir=data_dir)
+    check_render_size(scene.camera.width, scene.camera.height, settings,
+                      what=given or f"scene {args.scene!r}", n_lights=len(scene.lights),
+                      data_dir=data_dir)
+    total = count_passes(scene, settings, data_dir=data_dir)
+    bar = None if getattr(args, "quiet", False) else tqdm(
+        total=total, desc=f"render {scene.name}", unit="pass", file=sys.stderr)
+    with output_folder(Path(args.out)):  # locked; its files recorded as spectrinsic's
+        try:
+            result = render_scene(scene, settings, seed=args.seed,
+                                  progress=None if bar is None else bar.update, data_dir=data_dir)
+        finally:
+            if bar is not None:
+                bar.close()
+        paths = write_render(Path(args.out), scene, result, data_dir=data_dir)
     timings = result.meta["timings"]
     for mode in result.images:
         print(f"{mode:<9} {timings[mode]['passes']:>3} passes {timings[mode]['seconds']:7.2f} s  -> {paths[mode]}")

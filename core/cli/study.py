@@ -14,23 +14,28 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-__all__ = ["register", "run", "STUDIES"]
+from tqdm import tqdm
 
-STUDIES: tuple[str, ...] = ("reconstruction-error", "photometric", "rendering")
+from spectrinsic.errors import StudyError
+from spectrinsic.gt_export.outfolder import output_folder
+from spectrinsic.studies.photometric import CAMERA_BALANCES
+from spectrinsic.studies.photometric.compute import default_cameras
+from spectrinsic.studies.registry import STUDIES, StudyOptions, run_study
+from spectrinsic.studies.rendering import QUALITIES
+
+__all__ = ["register", "run"]
 
 #: Root seed of the photometric study's random scenes unless ``--seed`` is given.
 DEFAULT_SEED = 0
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from spectrinsic.studies.photometric import CAMERA_BALANCES
-    from spectrinsic.studies.rendering import QUALITIES
-
     p = sub.add_parser(
         "study", help="run a study of the thesis (Table 5.2, Table 4.4, rendering)",
-        description="Run a study, print its table and write JSON, CSV and PNG files into --out.",
+        description="Run a study, print its table and write JSON, CSV and PNG files into --out. "
+                    + " ".join(f"{s.name}: {s.summary}." for s in STUDIES.values()),
     )
-    p.add_argument("study", choices=STUDIES, help="which study")
+    p.add_argument("study", choices=tuple(STUDIES), help="which study")
     p.add_argument("--out", type=Path, default=Path("results"), help="output folder (default: results)")
     p.add_argument("--seed", type=int, default=DEFAULT_SEED,
                    help=f"root seed of random choices (default: {DEFAULT_SEED})")
@@ -53,7 +58,6 @@ def _progress(quiet: bool, what: str) -> Iterator[Callable[..., None]]:
     if quiet:
         yield lambda *a, **k: None
         return
-    from tqdm import tqdm
 
     bar = tqdm(desc=what, unit="step", file=sys.stderr, leave=False)
 
@@ -74,48 +78,24 @@ def _print_paths(paths: dict[str, Path]) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    out = Path(args.out)
-    data_dir = getattr(args, "data_dir", None)
-    quiet = bool(getattr(args, "quiet", False))
-    if args.study == "reconstruction-error":
-        from spectrinsic.studies.reconstruction import (
-            format_extension,
-            format_table,
-            reconstruction_table,
-            run_extension,
-            write_extension_outputs,
-            write_table_outputs,
-        )
-
-        with _progress(quiet, "reconstruction error") as progress:
-            table = reconstruction_table(data_dir=data_dir, progress=progress)
-        print(format_table(table))
-        paths = write_table_outputs(table, out)
-        if not args.no_extension:
-            with _progress(quiet, "extension") as progress:
-                ext = run_extension(data_dir=data_dir, progress=progress)
-            print()
-            print(format_extension(ext))
-            paths.update({f"extended_{k}": v for k, v in write_extension_outputs(ext, out).items()})
-        _print_paths(paths)
-        return 0
-    if args.study == "photometric":
-        from spectrinsic.studies.photometric import (
-            PhotometricSettings,
-            format_photometric,
-            run_photometric_study,
-        )
-
-        settings = PhotometricSettings(seed=args.seed, include_ie=args.include_ie,
-                                       camera_balance=args.camera_balance)
-        with _progress(quiet, "photometric") as progress:
-            result, paths = run_photometric_study(out, settings, data_dir=data_dir, progress=progress)
-        print(format_photometric(result))
-        _print_paths(paths)
-        return 0
-    from spectrinsic.studies.rendering import format_rendering, run_rendering_study
-
-    with _progress(quiet, "rendering study") as progress:
-        payload = run_rendering_study(out, quality=args.quality, data_dir=data_dir, progress=progress)
-    print(format_rendering(payload))
+    _check_options(args)
+    with output_folder(Path(args.out)):  # checked and locked; its files recorded as spectrinsic's
+        options = StudyOptions(seed=args.seed, include_ie=args.include_ie,
+                               camera_balance=args.camera_balance, extension=not args.no_extension,
+                               quality=args.quality)
+        with _progress(bool(getattr(args, "quiet", False)), args.study) as progress:
+            done = run_study(args.study, Path(args.out), options,
+                             data_dir=getattr(args, "data_dir", None), progress=progress)
+    print(done.text)
+    _print_paths(done.paths)
     return 0
+
+
+def _check_options(args: argparse.Namespace) -> None:
+    """Refusals that need no computation, before the output folder is made."""
+    if args.study == "photometric" and args.include_ie:
+        data_dir = getattr(args, "data_dir", None)
+        if not any(n.endswith("[IE]") for n in default_cameras(data_dir=data_dir, include_ie=True)):
+            where = f"--data-dir {data_dir!r}" if data_dir else "no data directory (--data-dir, $SPECTRINSIC_DATA)"
+            raise StudyError(f"--include-ie: {where} holds no Image Engineering cameras; "
+                             "give the data directory that has them, or leave --include-ie out")

@@ -22,13 +22,33 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
-from spectrinsic.errors import DatasetError
+from spectrinsic.errors import DatasetError, DiskFullError
+from spectrinsic.gt_export import (
+    build_gallery,
+    export_sample,
+    remove_stale_temporaries,
+    sample_dirs,
+    write_dataset_card,
+    write_manifest,
+)
+from spectrinsic.gt_export.integrity import (
+    check_build_folder,
+    remove_owned_temporaries,
+    remove_sample,
+    replaceable_sample,
+    sample_problem,
+    write_marker,
+)
+from spectrinsic.gt_export.outfolder import folder_lock
 from spectrinsic.pipeline.executors import Executor, SerialExecutor
 from spectrinsic.pipeline.presets import DatasetConfig
-from spectrinsic.rng import seed_from_key
-from spectrinsic.scenes.sample_id import SampleId
+from spectrinsic.pipeline.sources import plan_source_samples, save_generated
+from spectrinsic.pipeline.tasks import SampleFailure, SampleOutcome, SampleTask
+from spectrinsic.render import render_batches, set_thread_count
+from spectrinsic.scenes.library import build, default_samples
+from spectrinsic.scenes.sources import GeneratedSource
 
 __all__ = [
     "SampleTask",
@@ -43,98 +63,6 @@ __all__ = [
 ]
 
 log = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class SampleTask:
-    """Everything a worker needs to build one sample (picklable; no live objects).
-
-    Attributes
-    ----------
-    id
-        Which scene, camera view and lighting condition; ``str(id)`` is the sample's folder
-        name (:attr:`sample_id`).
-    seed
-        The sample's render seed, ``seed_from_key(config.seed, sample_id)``. The scene library
-        draws the lights from the root seed ``config.seed`` instead, so every view of a scene
-        under one condition shares its lights.
-    out_dir
-        Dataset folder; the sample is written to ``out_dir/sample_id``.
-    config
-        The build settings.
-    data_dir
-        Spectral data directory, or ``None`` for ``$SPECTRINSIC_DATA``.
-    render_threads
-        Dr.Jit worker threads per process, or ``None`` to leave Dr.Jit's default (all cores).
-    source
-        A :mod:`spectrinsic.scenes.sources` record (generated scene or scene file) the worker
-        builds the scene from; ``None`` for a library scene.
-    """
-
-    id: SampleId
-    seed: int
-    out_dir: str
-    config: DatasetConfig
-    data_dir: str | None = None
-    render_threads: int | None = None
-    source: Any = None
-
-    @property
-    def sample_id(self) -> str:
-        """Folder name of the sample, ``str(self.id)``, e.g. ``"obj-vase__v0__two-colour-a"``."""
-        return str(self.id)
-
-    @property
-    def scene(self) -> str:
-        """The scene's name, ``self.id.scene``."""
-        return self.id.scene
-
-    @classmethod
-    def planned(cls, sid: SampleId, config: DatasetConfig, out_dir: str, **options: Any) -> SampleTask:
-        """The task of sample *sid*, seeded ``seed_from_key(config.seed, str(sid))``; *options*
-        are the remaining fields (``data_dir``, ``render_threads``, ``source``)."""
-        return cls(id=sid, seed=seed_from_key(config.seed, str(sid)), out_dir=out_dir,
-                   config=config, **options)
-
-
-@dataclass(frozen=True)
-class SampleOutcome:
-    """The result of one sample.
-
-    Attributes
-    ----------
-    sample_id
-        Which sample.
-    status
-        ``"built"`` or ``"skipped"`` (already complete with the same config hash).
-    path
-        The sample folder.
-    seconds
-        Wall time of the whole task in s (scene, render, export).
-    render_seconds
-        Wall time spent inside ``render_scene`` in s (Mitsuba plus its array conversions).
-    mitsuba_seconds
-        Time inside Mitsuba's ``render`` calls in s, as reported by the renderer's
-        ``meta["timings"]``; equal to *render_seconds* when the renderer reports none.
-    peak_rss_mb
-        Peak resident memory of the worker process so far, MiB (``ru_maxrss``).
-    """
-
-    sample_id: str
-    status: Literal["built", "skipped"]
-    path: str
-    seconds: float = 0.0
-    render_seconds: float = 0.0
-    mitsuba_seconds: float = 0.0
-    peak_rss_mb: float = 0.0
-
-
-@dataclass(frozen=True)
-class SampleFailure:
-    """A sample whose task raised; *error* is ``"ExceptionType: message"``."""
-
-    sample_id: str
-    error: str
 
 
 @dataclass(frozen=True)
@@ -205,12 +133,8 @@ def plan_samples(
     DatasetError
         If *only* matches no sample.
     """
-    from spectrinsic.scenes.library import default_samples
-
     out = str(Path(out_dir))
     if config.source is not None:
-        from spectrinsic.pipeline.sources import plan_source_samples
-
         tasks = plan_source_samples(out, config, render_threads=render_threads,
                                     data_dir=None if data_dir is None else str(data_dir))
         return select_samples(tasks, only)
@@ -235,45 +159,22 @@ def select_samples(specs: Sequence[SampleTask], only: Sequence[str] | str | None
     return kept
 
 
-def build_sample(task: SampleTask, *, integrator: str | None = None) -> SampleOutcome:
+def build_sample(task: SampleTask) -> SampleOutcome:
     """Build one sample: scene → render → ground-truth export. Runs in a worker.
-
-    *integrator* chooses how the diagonal modes are rendered
-    (:data:`spectrinsic.render.single.INTEGRATORS`; ``None``: the render package's default);
-    the benchmark compares them.
 
     Returns
     -------
     SampleOutcome
         Status ``"built"`` with timings and the worker's peak memory.
     """
-    from spectrinsic.gt_export import export_sample
-    from spectrinsic.render import render_batches, set_thread_count
-
     set_thread_count(task.render_threads)  # one pool per worker, sized to its share of cores
     cfg = task.config
     t0 = time.perf_counter()
     scene = _task_scene(task)
     t_render = time.perf_counter()
-    result = render_batches(
-        scene,
-        batches=cfg.batches,
-        noise_target=cfg.noise_target,
-        max_batches=cfg.max_batches,
-        modes=cfg.modes,
-        spp=cfg.spp // cfg.batches,
-        seed=task.seed,
-        max_depth=cfg.max_depth,
-        variant=cfg.variant,
-        per_light=cfg.per_light,
-        per_light_modes=(cfg.share_mode,) if cfg.per_light and cfg.share_mode else None,
-        direct=cfg.direct,
-        aovs=True,
-        data_dir=task.data_dir,
-        integrator=integrator,
-    )
+    result = render_batches(scene, cfg.render, seed=task.seed, data_dir=task.data_dir)
     render_seconds = time.perf_counter() - t_render
-    if cfg.direct:  # the energy ratio r of Eq. 5.8, recorded for the dataset card's diversity plots
+    if cfg.render.direct:  # the energy ratio r of Eq. 5.8, recorded for the dataset card's diversity plots
         mode = "spectral" if "spectral" in result.direct else next(iter(result.direct))
         scene.metadata["energy_ratio_r"] = float(result.energy_ratio(mode))
     path = export_sample(
@@ -303,14 +204,10 @@ def build_sample(task: SampleTask, *, integrator: str | None = None) -> SampleOu
 def _task_scene(task: SampleTask) -> Any:
     """The task's scene: from its source (a generated one is saved as a scene file), else the
     library."""
-    from spectrinsic.scenes.library import build
-
     if task.source is None:
         cfg = task.config
         return build(task.id.scene, view=task.id.view, condition=task.id.condition, seed=cfg.seed,
                      width=cfg.width, height=cfg.height)
-    from spectrinsic.pipeline.sources import save_generated
-    from spectrinsic.scenes.sources import GeneratedSource
 
     scene = task.source.build(task.data_dir)
     if isinstance(task.source, GeneratedSource):
@@ -384,11 +281,31 @@ def build_dataset(
         Before anything is written, if *out_dir* is not a folder this build may write into
         (see :func:`spectrinsic.gt_export.integrity.check_build_folder`) or a sample's folder
         holds files spectrinsic did not write.
+    FolderLockedError
+        Another build holds *out_dir* (its advisory lock); the message names its pid, host and
+        start time.
     DiskFullError
         When the disk is full: the build stops at the first sample that hits it.
     """
-    start = time.perf_counter()
+
     out = Path(out_dir)
+    check_build_folder(out, config.config_hash(), rebuild=rebuild)  # before the folder is made
+    with folder_lock(out):  # one build per folder: a second one is refused, naming this one
+        return _build_locked(out, config, executor=executor, only=only, data_dir=data_dir,
+                             render_threads=render_threads, task_fn=task_fn, on_plan=on_plan,
+                             progress=progress, finalize=finalize, rebuild=rebuild)
+
+
+def _build_locked(
+    out: Path, config: DatasetConfig, *, executor: Executor | None, only: Sequence[str] | str | None,
+    data_dir: str | os.PathLike[str] | None, render_threads: int | None,
+    task_fn: Callable[[SampleTask], SampleOutcome],
+    on_plan: Callable[[int, int], None] | None,
+    progress: Callable[[SampleOutcome | SampleFailure], None] | None,
+    finalize: bool, rebuild: bool,
+) -> DatasetReport:
+    """:func:`build_dataset` once the folder's lock is held."""
+    start = time.perf_counter()
     executor = executor if executor is not None else SerialExecutor()
     todo, skipped = _prepare(out, config, only=only, data_dir=data_dir,
                              render_threads=render_threads, rebuild=rebuild)
@@ -422,15 +339,6 @@ def _prepare(
 
     Everything that can refuse the build runs before the first write.
     """
-    from spectrinsic.gt_export.integrity import (
-        check_build_folder,
-        remove_owned_temporaries,
-        remove_sample,
-        replaceable_sample,
-        sample_problem,
-        write_marker,
-    )
-
     config_hash = config.config_hash()
     previous = check_build_folder(out, config_hash, rebuild=rebuild)
     kw: dict[str, Any] = {"data_dir": data_dir, "render_threads": render_threads}
@@ -469,8 +377,6 @@ def _run(
     progress: Callable[[SampleOutcome | SampleFailure], None] | None,
 ) -> tuple[list[SampleOutcome], list[SampleFailure]]:
     """Run the tasks; a failed sample does not stop the others, a full disk stops them all."""
-    from spectrinsic.errors import DiskFullError
-
     built: list[SampleOutcome] = []
     failed: list[SampleFailure] = []
     for task, outcome in executor.map_unordered(task_fn, todo):
@@ -500,14 +406,6 @@ def finalize_dataset(
     First removes spectrinsic's temporaries, whichever worker left them (all have finished).
     A folder without any complete sample gets nothing (``{}``): no empty manifest.
     """
-    from spectrinsic.gt_export import (
-        build_gallery,
-        remove_stale_temporaries,
-        sample_dirs,
-        write_dataset_card,
-        write_manifest,
-    )
-
     out = Path(out_dir)
     for path in remove_stale_temporaries(out):
         log.info("removed %s, left by a worker that died", path.name)

@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any, Protocol, TypeVar
 
 from spectrinsic.errors import DatasetError, MissingDependencyError, validate_choice
+from spectrinsic.interrupts import raise_if_requested
 
 __all__ = [
     "Executor",
@@ -102,9 +103,12 @@ class SerialExecutor:
         self, fn: Callable[[T], R], items: Sequence[T]
     ) -> Iterator[tuple[T, R | BaseException]]:
         for item in items:
+            raise_if_requested()
             try:
                 outcome: R | BaseException = fn(item)
             except Exception as exc:  # a failed item must not stop the others
+                # ...but a Ctrl-C that a library re-raised as another error must
+                raise_if_requested()
                 outcome = exc
             yield item, outcome
 
@@ -186,6 +190,12 @@ class ProcessExecutor:
                     i, item = futures[fut]
                     exc = fut.exception()
                     yield i, item, (exc if exc is not None else fut.result())
+        except KeyboardInterrupt:
+            # Workers inherit the blocked SIGINT (spectrinsic.interrupts): stop the running
+            # ones now rather than wait for their samples; those stay temporaries that the
+            # next run removes, as after a kill.
+            _terminate_running(running_dir)
+            raise
         finally:
             # On Ctrl-C or an abandoned generator: drop queued tasks, keep finished ones.
             pool.shutdown(wait=True, cancel_futures=True)
@@ -199,6 +209,15 @@ def _run_recorded(fn: Callable[[T], R], item: T, index: int, running_dir: str) -
         return fn(item)
     finally:
         record.unlink(missing_ok=True)
+
+
+def _terminate_running(running_dir: str) -> None:
+    """Send SIGTERM to every worker that is running a task (named by its record's file name)."""
+    for record in Path(running_dir).iterdir():
+        try:
+            os.kill(int(record.name), signal.SIGTERM)
+        except (ValueError, ProcessLookupError):
+            pass
 
 
 def _running_indices(running_dir: str) -> set[int]:

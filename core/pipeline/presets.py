@@ -9,12 +9,15 @@ only when the hash in its ``meta.json`` matches. How the build is run (workers, 
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, replace
+from dataclasses import dataclass, fields
 from typing import Any
 
 from spectrinsic import provenance
-from spectrinsic.errors import DatasetError, validate_choice
+from spectrinsic.errors import DatasetError, RenderError, validate_choice
+from spectrinsic.gt_export import DEFAULT_CAMERAS
+from spectrinsic.gt_export.sample import config_hash
 from spectrinsic.render.modes import RENDER_MODES
+from spectrinsic.render.settings import RenderSettings
 
 __all__ = [
     "DatasetConfig",
@@ -55,6 +58,17 @@ def hashed_versions() -> dict[str, str]:
     return out
 
 
+#: The render settings of a dataset unless a preset or option says otherwise (``spp`` has
+#: none): every mode, each light alone (the illuminant map of multi-light scenes) through the
+#: 1-pass ``rgb3`` mode, and the AOVs the ground truth is computed from.
+DATASET_RENDER: dict[str, Any] = {"modes": _STANDARD_MODES, "per_light": True, "share_mode": "rgb3",
+                                  "aovs": True}
+#: Settings of :class:`RenderSettings` a dataset config takes (flat, beside its own); all but
+#: ``integrator`` are recorded and hashed (:meth:`DatasetConfig.settings`).
+RENDER_KEYS: tuple[str, ...] = ("spp", "max_depth", "modes", "per_light", "direct", "batches",
+                                "share_mode", "noise_target", "max_batches", "variant", "integrator")
+
+
 @dataclass(frozen=True)
 class DatasetConfig:
     """Settings of one dataset build.
@@ -65,42 +79,23 @@ class DatasetConfig:
         Name of the preset this config started from (recorded and hashed).
     width, height
         Image size in pixels.
-    spp
-        Samples per pixel of every render pass.
-    max_depth
-        Maximum path length (Mitsuba's ``max_depth``; 2 = direct light only).
-    modes
-        Render modes, names registered in :data:`spectrinsic.render.modes.RENDER_MODES`;
-        ``"spectral"`` is the physical reference.
-    per_light
-        Also render each light alone (needed for the per-pixel illuminant map of multi-light
-        scenes).
-    direct
-        Also render direct illumination only.
+    render
+        How every sample is rendered (:class:`~spectrinsic.render.settings.RenderSettings`):
+        modes (``"spectral"`` is the physical reference), samples per pixel in total over the
+        independent batches (two or more give the measured noise budget,
+        ``meta.json["noise"]``), path depth, per-light renders with their share mode, direct
+        light, adaptive batches, Mitsuba variant. The record written and hashed holds its
+        settings flat (:data:`RENDER_KEYS`), the AOVs always on.
     write_cube
         Write the multispectral (31-band) cube of each sample.
-    batches
-        Independent batches the *spp* samples are split into (each ``spp / batches`` samples,
-        its own seed, common random numbers across modes inside it). Two or more give the
-        measured noise budget (``meta.json["noise"]``).
     denoise
         Take shading, residual and illuminant from the OIDN-denoised irradiance (raw layers
         kept as ``shading_raw``/``residual_raw``).
-    noise_target
-        Adaptive sampling: add batches of ``spp / batches`` samples while the median relative
-        standard error of the image is above this (e.g. 0.02), up to *max_batches*.
-    max_batches
-        Cap of the adaptive batches (default ``4 * batches``).
-    share_mode
-        With *per_light*: render only this 1-pass mode light by light, for the light shares,
-        and every other mode once with all lights (``None``: every mode light by light).
     cameras
         Camera sensitivity names (``spectrinsic.spectra.get_sensors``) whose images and relative
         reflectances the ground truth also holds (they need the ``bands31`` cube); ``None``:
         :data:`spectrinsic.gt_export.DEFAULT_CAMERAS` when ``bands31`` is rendered, else none
         (see :meth:`resolved_cameras`).
-    variant
-        Mitsuba variant, or ``None`` for the render package's automatic choice.
     seed
         Root seed; each sample's seed is ``seed_from_key(seed, sample_id)``.
     source
@@ -113,78 +108,79 @@ class DatasetConfig:
     preset: str
     width: int
     height: int
-    spp: int
-    max_depth: int = 8
-    modes: tuple[str, ...] = _STANDARD_MODES
-    per_light: bool = True
-    direct: bool = False
+    render: RenderSettings
     write_cube: bool = False
-    batches: int = 1
     denoise: bool = False
-    share_mode: str | None = "rgb3"
-    noise_target: float | None = None
-    max_batches: int | None = None
     cameras: tuple[str, ...] | None = None
-    variant: str | None = None
     seed: int = 0
     source: str | None = None
 
     def __post_init__(self) -> None:
-        # lists from JSON or the command line become tuples, so configs stay hashable records
-        object.__setattr__(self, "modes", tuple(self.modes))
-        if self.cameras is not None:
+        if self.cameras is not None:  # a list from JSON or the command line
             object.__setattr__(self, "cameras", tuple(self.cameras))
-        for name in ("width", "height", "spp", "max_depth", "batches"):
+        for name in ("width", "height"):
             value = getattr(self, name)
             if not isinstance(value, int) or isinstance(value, bool) or value < 1:
                 raise DatasetError(f"dataset setting {name}={value!r}; expected a positive integer")
-        if self.noise_target is not None and not (isinstance(self.noise_target, int | float)
-                                                  and 0 < self.noise_target < 1):
-            raise DatasetError(f"dataset setting noise_target={self.noise_target!r}; expected a "
-                               "fraction in (0, 1), e.g. 0.02")
-        if self.max_batches is not None and (not isinstance(self.max_batches, int)
-                                             or self.max_batches < self.batches):
-            raise DatasetError(f"dataset setting max_batches={self.max_batches!r}; expected an "
-                               f"integer >= batches ({self.batches})")
-        if self.spp % self.batches:
-            raise DatasetError(
-                f"dataset setting spp={self.spp} with batches={self.batches}; expected spp "
-                "divisible by batches (each batch renders spp / batches samples)"
-            )
-        if not self.modes:
+        if not self.render.modes:
             raise DatasetError("dataset setting modes=(); expected at least one render mode")
-        for mode in self.modes + ((self.share_mode,) if self.share_mode else ()):
+        for mode in self.render.all_modes():
             validate_choice(mode, RENDER_MODES, "render mode", error=DatasetError)
         if not isinstance(self.seed, int) or self.seed < 0:
             raise DatasetError(f"dataset seed {self.seed!r}; expected a non-negative integer")
 
-    def with_options(self, **changes: Any) -> DatasetConfig:
-        """A copy with some settings changed (validated like a new config)."""
-        unknown = set(changes) - set(self.settings()) - {"preset", "source"}
+    @classmethod
+    def from_settings(cls, preset: str, **settings: Any) -> DatasetConfig:
+        """A config from flat settings (those of :meth:`settings`, ``cameras`` unresolved):
+        the render ones (:data:`RENDER_KEYS`) over :data:`DATASET_RENDER`, the others fields;
+        one-line :class:`~spectrinsic.errors.DatasetError` on a bad or unknown one.
+
+        >>> c = DatasetConfig.from_settings("tiny", width=8, height=8, spp=2, max_depth=3)
+        >>> c.render.spp, c.render.max_depth, c.render.share_mode
+        (2, 3, 'rgb3')
+        """
+        known = set(RENDER_KEYS) | {f.name for f in fields(cls)} - {"preset", "render"}
+        unknown = set(settings) - known
         if unknown:
-            raise DatasetError(
-                f"unknown dataset setting(s) {sorted(unknown)}; expected some of "
-                f"{sorted(self.settings())}"
-            )
-        return replace(self, **changes)
+            raise DatasetError(f"unknown dataset setting(s) {sorted(unknown)}; expected some of {sorted(known)}")
+        if "spp" not in settings:
+            raise DatasetError("dataset settings without spp; expected samples per pixel, e.g. spp=16")
+        render = {k: settings.pop(k) for k in RENDER_KEYS if k in settings}
+        try:
+            settings["render"] = RenderSettings(**{**DATASET_RENDER, **render})
+        except RenderError as exc:
+            raise DatasetError(str(exc).replace("render setting", "dataset setting")) from None
+        return cls(preset=preset, **settings)
+
+    def with_options(self, **changes: Any) -> DatasetConfig:
+        """A copy with some flat settings changed (validated like a new config)."""
+        current = {f.name: getattr(self, f.name) for f in fields(self) if f.name not in ("preset", "render")}
+        current.update({k: getattr(self.render, k) for k in RENDER_KEYS})
+        preset = changes.pop("preset", self.preset)
+        return DatasetConfig.from_settings(preset, **{**current, **changes})
 
     def settings(self) -> dict[str, Any]:
         """The settings that change output files, as JSON-ready values (no preset name)."""
-        d = asdict(self)
-        d.pop("preset")
-        d["modes"] = list(self.modes)
-        d["cameras"] = list(self.resolved_cameras())
-        if self.source is None:
-            d.pop("source")
+        r = self.render
+        d: dict[str, Any] = {
+            "width": self.width, "height": self.height, "spp": r.spp, "max_depth": r.max_depth,
+            "modes": list(r.modes), "per_light": r.per_light,
+            "direct": r.direct if isinstance(r.direct, bool) else list(r.direct),
+            "write_cube": self.write_cube, "batches": r.batches, "denoise": self.denoise,
+            "share_mode": r.share_mode, "noise_target": r.noise_target,
+            "max_batches": r.max_batches, "cameras": list(self.resolved_cameras()),
+            "variant": r.variant, "seed": self.seed,
+        }
+        if self.source is not None:
+            d["source"] = self.source
         return d
 
     def resolved_cameras(self) -> tuple[str, ...]:
         """The camera sensor sets exported, with ``cameras=None`` resolved."""
         if self.cameras is not None:
             return tuple(self.cameras)
-        if "bands31" not in self.modes:
+        if "bands31" not in self.render.modes:
             return ()
-        from spectrinsic.gt_export import DEFAULT_CAMERAS
 
         return tuple(DEFAULT_CAMERAS)
 
@@ -196,11 +192,9 @@ class DatasetConfig:
     def config_hash(self) -> str:
         """SHA-256 (hex) of the canonical JSON of :meth:`to_dict`.
 
-        Computed by :func:`spectrinsic.gt_export.writer.config_hash`, the function that stamps
+        Computed by :func:`spectrinsic.gt_export.sample.config_hash`, the function that stamps
         ``meta.json``, so the hash a build checks is the hash its samples carry.
         """
-        from spectrinsic.gt_export.writer import config_hash
-
         return config_hash(self.to_dict())
 
 
@@ -210,8 +204,8 @@ class DatasetConfig:
 PRESETS: dict[str, DatasetConfig] = {
     # The whole set in about a minute: a look at the layout, not data to learn from. Without
     # the cube, shading comes from the spectral render's XYZ (a 3-band estimate).
-    "preview": DatasetConfig(
-        preset="preview",
+    "preview": DatasetConfig.from_settings(
+        "preview",
         width=48,
         height=48,
         spp=4,
@@ -225,8 +219,8 @@ PRESETS: dict[str, DatasetConfig] = {
     # so the reference image is the 31-band cube and the 3-/6-sensor approximations carry error
     # maps; two batches of 8 spp measure the noise. The denoised shading's median error
     # against a 16x-spp reference is measured by make bench (bench_ground_truth.json).
-    "default": DatasetConfig(
-        preset="default",
+    "default": DatasetConfig.from_settings(
+        "default",
         width=256,
         height=256,
         spp=16,
@@ -236,8 +230,8 @@ PRESETS: dict[str, DatasetConfig] = {
         denoise=True,
     ),
     # Publication quality, for a GPU (variant cuda) or a cluster (--scheduler).
-    "paper": DatasetConfig(
-        preset="paper",
+    "paper": DatasetConfig.from_settings(
+        "paper",
         width=512,
         height=512,
         spp=1024,

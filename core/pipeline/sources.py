@@ -20,14 +20,31 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from spectrinsic.errors import DatasetError
+from spectrinsic.errors import DatasetError, validate_choice
+from spectrinsic.gt_export.sample import file_sha256
 from spectrinsic.pipeline.presets import DatasetConfig
+from spectrinsic.pipeline.tasks import SampleTask
+from spectrinsic.scenes.generators import (
+    GENERATORS,
+    GeneratorOptions,
+    MaterialDistribution,
+    generated_family,
+    generated_scene_name,
+)
+from spectrinsic.scenes.io import save_scene
+from spectrinsic.scenes.sample_id import SampleId
+from spectrinsic.scenes.sources import FileSource, GeneratedSource, scene_file_kind
+from spectrinsic.spectra import list_spectra
 
 __all__ = ["SCENES_FOLDER", "generator_source", "files_source", "plan_source_samples", "save_generated"]
 
 #: Folder of a dataset holding the generated scenes' YAML files.
 SCENES_FOLDER = "scenes"
 _SAFE = re.compile(r"[^A-Za-z0-9._-]+")
+#: Most generated scenes and cameras per scene in one dataset: planning is O(count x views)
+#: before the first render, and 10^5 scenes already take days to render on a workstation.
+MAX_COUNT = 100_000
+MAX_VIEWS = 64
 
 
 def generator_source(generator: str, count: int, *, views: int = 1,
@@ -35,12 +52,10 @@ def generator_source(generator: str, count: int, *, views: int = 1,
                      chroma_range: Sequence[float] = (0.0, 16.0),
                      min_coverage: float = 0.15, sfu: bool = False) -> str:
     """The canonical ``source`` JSON of a generated set (validated)."""
-    from spectrinsic.errors import validate_choice
-    from spectrinsic.scenes.generators import GENERATORS
-
     validate_choice(generator, GENERATORS, "scene generator", error=DatasetError)
-    if count < 1 or views < 1:
-        raise DatasetError(f"--count {count} / --views {views}; expected positive integers")
+    if not (1 <= count <= MAX_COUNT and 1 <= views <= MAX_VIEWS):
+        raise DatasetError(f"--count {count} / --views {views}; expected whole numbers from 1 to "
+                           f"{MAX_COUNT} scenes and 1 to {MAX_VIEWS} views")
     spec = {"generator": generator, "count": int(count), "views": int(views),
             "value_range": [float(v) for v in value_range],
             "chroma_range": [float(c) for c in chroma_range],
@@ -52,9 +67,6 @@ def files_source(paths: Sequence[str | os.PathLike[str]], *,
                  materials: Mapping[str, str] | None = None,
                  default_spectrum: str | None = None) -> str:
     """The canonical ``source`` JSON of a set of scene files (each must exist)."""
-    from spectrinsic.gt_export.integrity import file_sha256
-    from spectrinsic.scenes.sources import scene_file_kind
-
     entries = []
     for p in paths:
         path = Path(p).resolve()
@@ -72,9 +84,6 @@ def files_source(paths: Sequence[str | os.PathLike[str]], *,
 
 
 def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir: str | None) -> Any:
-    from spectrinsic.scenes.generators import GeneratorOptions, MaterialDistribution
-    from spectrinsic.spectra import list_spectra
-
     sfu_r: tuple[str, ...] = ()
     sfu_i: tuple[str, ...] = ()
     if spec.get("sfu"):
@@ -91,13 +100,8 @@ def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir:
 
 
 def plan_source_samples(out: str, config: DatasetConfig, *, data_dir: str | None,
-                        render_threads: int | None) -> list[Any]:
-    """The :class:`~spectrinsic.pipeline.dataset.SampleTask` list of ``config.source``."""
-    from spectrinsic.pipeline.dataset import SampleTask
-    from spectrinsic.scenes.generators import generated_family, generated_scene_name
-    from spectrinsic.scenes.sample_id import SampleId
-    from spectrinsic.scenes.sources import FileSource, GeneratedSource
-
+                        render_threads: int | None) -> list[SampleTask]:
+    """The :class:`~spectrinsic.pipeline.tasks.SampleTask` list of ``config.source``."""
     spec = json.loads(config.source or "{}")
     rows: list[tuple[str, int, str, Any]] = []
     if "generator" in spec:
@@ -119,8 +123,6 @@ def plan_source_samples(out: str, config: DatasetConfig, *, data_dir: str | None
 
 def save_generated(out_dir: str | os.PathLike[str], sample_id: str, scene: Any) -> Path:
     """Write a generated scene as ``<out>/scenes/<sample id>.yaml`` (meshes beside it)."""
-    from spectrinsic.scenes.io import save_scene
-
     folder = Path(out_dir) / SCENES_FOLDER
     folder.mkdir(parents=True, exist_ok=True)
     return save_scene(scene, folder / f"{sample_id}.yaml")

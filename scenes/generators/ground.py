@@ -10,7 +10,7 @@ from spectrinsic.scenes import geometry as g
 from spectrinsic.scenes.generators.base import GeneratorOptions, Layout
 from spectrinsic.scenes.generators.camera import Footprints
 from spectrinsic.scenes.generators.lights import LightVolume
-from spectrinsic.scenes.generators.materials import MaterialDistribution
+from spectrinsic.scenes.generators.materials import MaterialDistribution, draw_reflectance
 from spectrinsic.scenes.generators.shapes import draw_object
 
 __all__ = ["objects_on_ground"]
@@ -18,8 +18,6 @@ __all__ = ["objects_on_ground"]
 
 def _ground(rng: np.random.Generator) -> g.Part:
     """A large thin slab whose top is z = 0, spectrally flat grey or a low-chroma chip."""
-    from spectrinsic.scenes.generators.materials import draw_reflectance
-
     grey = rng.random() < 0.5
     spectrum = (f"flat:{rng.uniform(0.2, 0.8):.2f}" if grey
                 else draw_reflectance(rng, MaterialDistribution((3, 8), (0, 4))))

@@ -25,6 +25,7 @@ from spectrinsic.scenes.model import (
     light_power,
     make_light,
 )
+from spectrinsic.spectra import get_sensors, get_spectrum, responses, xyz_to_xy
 
 __all__ = ["FAMILIES", "LightVolume", "draw_illuminant", "draw_lights"]
 
@@ -67,8 +68,6 @@ def draw_illuminant(rng: np.random.Generator, sfu: Sequence[str] = ()) -> str:
 
 @functools.lru_cache(maxsize=4096)
 def _xy(name: str, data_dir: str | None) -> tuple[float, float]:
-    from spectrinsic.spectra import get_sensors, get_spectrum, responses, xyz_to_xy
-
     cmf = get_sensors("cie1931")
     spd = get_spectrum(name, data_dir=data_dir).on(cmf.wavelengths)
     x, y = xyz_to_xy(responses(spd, cmf.curves, cmf.wavelengths))

@@ -18,6 +18,7 @@ import numpy as np
 
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes import geometry as g
+from spectrinsic.spectra import list_spectra
 
 __all__ = [
     "MaterialDistribution",
@@ -66,8 +67,6 @@ class MaterialDistribution:
 @functools.lru_cache(maxsize=1)
 def munsell_chips() -> tuple[tuple[str, float, float], ...]:
     """Every matte Munsell chip as ``(name, value, chroma)``, e.g. ``("munsell:5R 4/14", 4, 14)``."""
-    from spectrinsic.spectra import list_spectra
-
     out = []
     for name in list_spectra("munsell"):
         m = _NOTATION.match(name.split(":", 1)[1])

@@ -98,3 +98,16 @@ def test_appendix_a_label_set():
     brute = np.abs(p[:, None, :] - labels[None]).sum(axis=2)
     chosen = cn.discretise_memberships(p)
     np.testing.assert_allclose(brute[np.arange(200), chosen], brute.min(axis=1), atol=1e-12)
+
+
+def test_cached_colour_naming_tables_are_read_only():
+    params = cn.tse_parameters()
+    _frozen_arrays(params.chromatic, params.present, params.achromatic)
+    _frozen_arrays(cn.appendix_a_labels(), cn.label_centroids())
+
+
+def _frozen_arrays(*arrays: np.ndarray) -> None:
+    for array in arrays:
+        assert isinstance(array, np.ndarray)
+        with pytest.raises(ValueError, match="read-only"):
+            array.flat[0] = 0.5

@@ -133,3 +133,41 @@ def test_cli_predictions_options(tmp_path):
         ["evaluate", "--methods", BASELINE, "--predictions", f"{BASELINE}={tmp_path / 'mine'}"])
     with pytest.raises(DatasetError, match="already used"):
         _methods(args)
+
+
+def _png_declaring(path, width: int, height: int) -> None:
+    """A 16-bit RGB PNG whose IHDR declares *width* x *height* but whose data is a few bytes."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    ihdr = struct.pack(">IIBBBBB", width, height, 16, 2, 0, 0, 0)
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(bytes(64)))
+                     + chunk(b"IEND", b""))
+
+
+def _exr_declaring(path, width: int, height: int) -> None:
+    """A 4 x 4 EXR whose header's dataWindow is patched to declare *width* x *height*."""
+    import struct
+
+    from spectrinsic.gt_export.exr import write_exr
+
+    write_exr(path, {"reflectance": np.zeros((4, 4, 3), np.float32)})
+    data = bytearray(path.read_bytes())
+    at = data.index(b"dataWindow\x00box2i\x00") + len(b"dataWindow\x00box2i\x00") + 4
+    data[at:at + 16] = struct.pack("<iiii", 0, 0, width - 1, height - 1)
+    path.write_bytes(bytes(data))
+
+
+@pytest.mark.parametrize("fmt", ["png", "exr"])
+def test_a_prediction_declaring_a_huge_image_is_refused_from_its_header(tmp_path, fmt):
+    """Issue 17 item 7: a 0.8 MB PNG declaring 20000^2 took 4.8 GB before its shape was refused.
+    The header is read first; the refusal names the declared and the expected size."""
+    from spectrinsic.decompose.predictions import read_layer
+
+    path = tmp_path / f"reflectance.{fmt}"
+    (_png_declaring if fmt == "png" else _exr_declaring)(path, 20000, 20000)
+    with pytest.raises(DatasetError, match=r"shape \(4, 4, 3\); its header declares 20000x20000"):
+        read_layer(tmp_path, "reflectance", (4, 4), encoding="linear")

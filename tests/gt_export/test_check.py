@@ -95,7 +95,8 @@ def test_noise_from_two_batches_is_reported_and_flagged(tmp_path, synth, config)
     import dataclasses
 
     from spectrinsic.gt_export.check import noise_report
-    from spectrinsic.gt_export.writer import noise_summary
+    from spectrinsic.gt_export.manifest import noise_summary
+    from spectrinsic.gt_export.sample_meta import read_meta
 
     scene = synth.make_scene(("planck:2800K",))
     result = synth.make_result(scene)
@@ -108,7 +109,7 @@ def test_noise_from_two_batches_is_reported_and_flagged(tmp_path, synth, config)
         assert meta["noise"][layer]["median"] == pytest.approx(0.1, rel=1e-6)
     assert meta["noise"]["batches"] == 2
     manifest = json.loads((tmp_path / "manifest.json").read_text())
-    assert manifest["noise"] == noise_summary([meta])
+    assert manifest["noise"] == noise_summary([read_meta(folder)])
     lines, flagged = noise_report(tmp_path, threshold=0.05)
     assert flagged == ["s"] and "shading_raw median 10.0 %" in lines[0]
     assert noise_report(tmp_path, threshold=0.2)[1] == []

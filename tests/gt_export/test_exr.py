@@ -30,8 +30,9 @@ def test_round_trip_is_bit_exact(tmp_path):
     back = read_exr(path)
     assert set(back) == set(layers)
     for name, array in layers.items():
-        expected = np.asarray(array).astype(np.float32)
-        assert back[name].dtype == np.float32
+        ints = np.asarray(array).dtype.kind in "iu"  # ids: int32, every other layer float32
+        expected = np.asarray(array).astype(np.int32 if ints else np.float32)
+        assert back[name].dtype == expected.dtype
         assert back[name].shape == expected.shape
         # bit-exact: compare the raw bytes, so -0.0 and denormals count too
         assert back[name].tobytes() == np.ascontiguousarray(expected).tobytes(), name
@@ -55,11 +56,6 @@ def test_float16_is_refused(tmp_path):
         write_exr(tmp_path / "h.exr", {"image": np.zeros((2, 2, 3), np.float16)})
 
 
-def test_ids_beyond_float32_precision_are_refused(tmp_path):
-    with pytest.raises(DatasetError, match="2\\*\\*24"):
-        write_exr(tmp_path / "i.exr", {"object_id": np.array([[2**24 + 1]], np.int64)})
-
-
 def test_files_of_other_writers_group_rgb_channels(tmp_path):
     import OpenEXR
 
@@ -80,3 +76,19 @@ def test_corrupt_and_missing_files_raise_dataset_errors(tmp_path):
     good = write_exr(tmp_path / "g.exr", {"image": np.ones((2, 2, 3), np.float32)})
     with pytest.raises(DatasetError, match="no layer 'depth'"):
         read_exr(good, layers=["depth"])
+
+
+def test_integer_ids_round_trip_exactly_beyond_float32(tmp_path):
+    """float32 stops at 2**24: id 16777217 used to read back as 16777216. Ids are now stored as
+    UINT channels holding the int32 bits, -1 (background) included."""
+    ids = np.array([[-1, 0, 16777217], [2**31 - 1, 5, -1]], dtype=np.int32)
+    path = write_exr(tmp_path / "ids.exr", {"object_id": ids, "depth": np.ones((2, 3), np.float32)})
+    back = read_exr(path)
+    assert back["object_id"].dtype == np.int32 and back["depth"].dtype == np.float32
+    np.testing.assert_array_equal(back["object_id"], ids)
+
+
+def test_ids_outside_int32_are_refused_not_wrapped(tmp_path):
+    with pytest.raises(DatasetError, match="beyond the 32-bit range"):
+        write_exr(tmp_path / "ids.exr", {"object_id": np.array([[3_000_000_000]], dtype=np.int64)})
+    assert not (tmp_path / "ids.exr").exists()

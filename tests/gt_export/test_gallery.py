@@ -261,3 +261,44 @@ def test_the_readout_check_can_fail(gallery, tmp_path):
             _check_readout_against_exr(report, root, "one", "image", index["layer_info"]["image"])
     finally:
         driver.quit()
+
+
+def test_a_users_file_in_gallery_pixels_survives_a_rebuild(gallery):
+    root = gallery.parent
+    pixels = root / "gallery-pixels"
+    (pixels / "notes.txt").write_text("mine")
+    (pixels / "mine.js").write_text("console.log('mine')\n")
+    shutil.rmtree(root / "three")  # a sample gone: its script (ours) goes with it
+    build_gallery(root)
+    assert (pixels / "notes.txt").read_text() == "mine"
+    assert (pixels / "mine.js").read_text() == "console.log('mine')\n"
+    assert sorted(p.name for p in pixels.glob("*.js")) == ["mine.js", "one.js", "two.js"]
+
+
+def test_a_full_disk_while_writing_the_gallery_names_the_file(gallery, monkeypatch):
+    import errno
+
+    from spectrinsic.errors import DiskFullError
+
+    real = Path.write_text
+
+    def full(self, *args, **kwargs):
+        if self.name == "gallery.json":
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "write_text", full)
+    with pytest.raises(DiskFullError, match=r"gallery\.json.*No space left"):
+        build_gallery(gallery.parent)
+
+
+def test_a_script_tag_in_a_scene_name_is_escaped_in_the_card(tmp_path, one_light_sample, config):
+    from spectrinsic.gt_export import write_dataset_card, write_manifest
+
+    scene, result = one_light_sample
+    evil = dataclasses.replace(scene, name="<script>alert(1)</script>")
+    export_sample(tmp_path, evil, result, sample_id="s", config=config, seed=1)
+    write_manifest(tmp_path, config)
+    card = write_dataset_card(tmp_path, config).read_text(encoding="utf-8")
+    assert "<script>" not in card
+    assert "&lt;script&gt;alert(1)&lt;/script&gt;" in card

@@ -7,7 +7,7 @@ import pytest
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.loader import EXPOSURE_PERCENTILE, prepare_item, split_samples
-from spectrinsic.gt_export.writer import split_of, splits_by_scene
+from spectrinsic.gt_export.manifest import split_of, splits_by_scene
 
 
 def _sample(h=6, w=8):

@@ -2,11 +2,8 @@
 
 from __future__ import annotations
 
-import doctest
-
 import pytest
 
-from spectrinsic.gt_export import names
 from spectrinsic.gt_export.names import camera_slug, slug
 
 
@@ -29,8 +26,3 @@ def test_camera_slug_of_the_sensor_set_and_of_its_layer_key_agree():
     # from the layer key "<key>": the same slug, so SC4_<slug> matches camera-<slug>
     assert camera_slug("camera:Nikon 5100 (NPL)") == camera_slug("Nikon 5100 (NPL)") == "nikon-5100-npl"
     assert camera_slug("camera:") == "camera"
-
-
-def test_docstring_examples():
-    result = doctest.testmod(names)
-    assert result.attempted > 0 and result.failed == 0

@@ -138,3 +138,17 @@ def test_export_verb_writes_shards_and_rejects_bad_input(built, tmp_path_factory
     assert sorted(item["sample_id"] for item in shard_dataset(out)) == ["a-one", "b-two"]
     assert main(["-q", "export", str(out), "--out", str(out / "x")]) == 2
     assert "no manifest.json" in capsys.readouterr().err
+
+
+def test_a_shard_with_flipped_bytes_is_refused_before_any_item(built, tmp_path_factory):
+    """8 bytes flipped inside a shard's data (as in the issue: a depth read back as 9.5e14)."""
+    out = tmp_path_factory.mktemp("shards")
+    write_shards(built, out, samples_per_shard=1)
+    assert len(list(shard_dataset(out))) == 2  # intact: every item
+    shard = sorted(out.glob("*.tar"))[0]
+    data = bytearray(shard.read_bytes())
+    middle = len(data) // 2
+    data[middle:middle + 8] = bytes(b ^ 0xFF for b in data[middle:middle + 8])
+    shard.write_bytes(bytes(data))
+    with pytest.raises(DatasetError, match=f"{shard.name}: does not match its SHA-256 in {SHARD_INDEX}"):
+        shard_dataset(out)

@@ -178,11 +178,13 @@ def test_manifest_hashes_every_file_and_records_provenance(built, config):
 
 
 def test_dataset_card_describes_every_layer(built):
+    import html
+
     card = (built / "DATASET.md").read_text()
     meta = json.loads((built / "b-two" / "meta.json").read_text())
     for key, record in meta["layers"].items():
         assert f"`{key}`" in card
-        assert record["units"] in card
+        assert html.escape(record["units"], quote=False) in card  # "L<i>" is not an <i> tag
     assert "linear" in card and "D65" in card and "load_sample" in card
 
 
@@ -201,7 +203,7 @@ def test_torch_adapter_without_torch_says_what_to_install(built, monkeypatch):
 def test_meta_json_floats_carry_at_most_the_stated_digits(tmp_path, two_light_sample, config):
     """Fitted matrices and colours are rounded (issue 9, point 10), so BLAS's last bits never
     reach the file; the rounding keeps 12 significant digits, far above their accuracy."""
-    from spectrinsic.gt_export.writer import META_DIGITS
+    from spectrinsic.gt_export.sample import META_DIGITS
 
     scene, result = two_light_sample
     folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=3)
@@ -256,12 +258,13 @@ def test_light_records_carry_only_the_fields_of_their_kind(tmp_path, two_light_s
 
 def test_dataset_card_shows_the_diversity_figure(built):
     from spectrinsic.gt_export.diversity import diversity_figure, diversity_stats
-    from spectrinsic.gt_export.writer import _read_meta, sample_dirs
+    from spectrinsic.gt_export.sample import sample_dirs
+    from spectrinsic.gt_export.sample_meta import read_meta
 
     assert "diversity.png" in (built / "DATASET.md").read_text() and (built / "diversity.png").is_file()
     samples = sample_dirs(built)
-    stats = diversity_stats(samples, [_read_meta(s) for s in samples])
-    n_lights = sum(len(_read_meta(s)["lights"]) for s in samples)
+    stats = diversity_stats(samples, [read_meta(s) for s in samples])
+    n_lights = sum(len(read_meta(s).lights) for s in samples)
     assert len(stats["luminance_decades"]) == len(samples) and len(stats["light_cct"]) == n_lights
     assert all(1000 < t < 25000 for t in stats["light_cct"])
     assert len(diversity_figure(stats).axes) == 6

@@ -73,6 +73,44 @@ def test_a_corrupt_sample_is_rerendered_not_resumed(copy, built, corrupt, caplog
     assert _bytes(copy) == _bytes(built)  # the same pixels as before the damage
 
 
+def test_a_bit_flipped_key_in_meta_json_is_named_then_rerendered(copy, built, capsys, caplog):
+    """"median" -> "mediaN" (one bit): check names the file and the field in one line, and a
+    rerun re-renders the sample (it used to raise KeyError in both)."""
+    meta = copy / IDS[0] / "meta.json"
+    text = meta.read_text(encoding="utf-8")
+    assert '"median"' in text
+    meta.write_text(text.replace('"median"', '"mediaN"', 1), encoding="utf-8")
+    rc = main(["-q", "check", str(copy)])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1 and "Traceback" not in err
+    assert str(meta) in err and "noise.image.median: missing" in err
+    with caplog.at_level(logging.WARNING, logger="spectrinsic.pipeline.dataset"):
+        report = build_dataset(copy, CONFIG, only=ONLY)
+    assert [o.sample_id for o in report.built] == [IDS[0]]
+    assert any(IDS[0] in r.message and "median" in r.message and "re-rendering" in r.message
+               for r in caplog.records)
+    assert check_dataset(copy) == []
+    assert _bytes(copy) == _bytes(built)
+
+
+def test_an_edited_digit_of_a_fitted_matrix_is_rerendered_not_blessed(copy, built, caplog):
+    """One digit of ``matrices`` changed by hand: check fails, a rerun re-renders the sample
+    (it used to skip it and write the edited file's hash into manifest.json), check passes."""
+    meta = copy / IDS[0] / "meta.json"
+    text = meta.read_text(encoding="utf-8")
+    start = text.index('"matrices"')
+    digit = next(i for i in range(start, len(text)) if text[i] in "123456789")
+    meta.write_text(text[:digit] + str(int(text[digit]) % 9 + 1) + text[digit + 1:], encoding="utf-8")
+    assert any(p.startswith(f"{IDS[0]}: meta.json does not match its seal") for p in check_dataset(copy))
+    with caplog.at_level(logging.WARNING, logger="spectrinsic.pipeline.dataset"):
+        report = build_dataset(copy, CONFIG, only=ONLY)
+    assert [o.sample_id for o in report.built] == [IDS[0]]
+    assert any(IDS[0] in r.message and "seal" in r.message and "re-rendering" in r.message
+               for r in caplog.records)
+    assert check_dataset(copy) == []
+    assert _bytes(copy) == _bytes(built)
+
+
 def test_a_rerun_with_another_config_is_refused_then_rebuilt_with_rebuild(copy, capsys):
     before = _bytes(copy)
     rc = main([*CLI[:-2], "--spp", "4", "--only", IDS[0], "--out", str(copy)])
@@ -133,12 +171,12 @@ def test_a_full_disk_stops_the_build_in_one_line_naming_the_file(tmp_path, monke
 
 
 def test_when_every_sample_fails_failed_lines_and_no_manifest(tmp_path, monkeypatch, capsys):
-    import spectrinsic.render as render
+    import spectrinsic.pipeline.dataset as pipeline_dataset
 
-    def failing(scene, **kwargs):
+    def failing(scene, settings, **kwargs):
         raise RuntimeError(f"simulated failure of {scene.name}")
 
-    monkeypatch.setattr(render, "render_batches", failing)
+    monkeypatch.setattr(pipeline_dataset, "render_batches", failing)
     out = tmp_path / "ds"
     rc = main([*CLI, "--out", str(out)])
     captured = capsys.readouterr()

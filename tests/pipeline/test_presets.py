@@ -7,20 +7,20 @@ import json
 
 import pytest
 
-from spectrinsic.errors import SpectrinsicError
+from spectrinsic.errors import DatasetError, SpectrinsicError
 from spectrinsic.pipeline.presets import PRESETS, DatasetConfig, get_preset, hashed_versions
 
 
 def test_presets_exist_and_scale_up():
     assert list(PRESETS) == ["preview", "default", "paper"]
-    pixels_spp = [c.width * c.height * c.spp for c in PRESETS.values()]
+    pixels_spp = [c.width * c.height * c.render.spp for c in PRESETS.values()]
     assert pixels_spp == sorted(pixels_spp) and len(set(pixels_spp)) == 3
 
 
 def test_default_preset_renders_what_the_ground_truth_needs():
     cfg = get_preset("default")
-    assert set(cfg.modes) == {"spectral", "rgb3", "rgb6", "bands31"}
-    assert cfg.per_light  # illuminant map of two-light scenes
+    assert set(cfg.render.modes) == {"spectral", "rgb3", "rgb6", "bands31"}
+    assert cfg.render.per_light  # illuminant map of two-light scenes
     assert cfg.resolved_cameras()  # camera views need the bands31 cube
 
 
@@ -44,7 +44,7 @@ def test_every_registered_render_mode_validates():
 
     assert "gauss3" in RENDER_MODES
     cfg = get_preset("preview").with_options(modes=tuple(RENDER_MODES), share_mode="gauss3")
-    assert cfg.modes == tuple(RENDER_MODES) and cfg.share_mode == "gauss3"
+    assert cfg.render.modes == tuple(RENDER_MODES) and cfg.render.share_mode == "gauss3"
     with pytest.raises(SpectrinsicError, match="did you mean 'gauss3'"):
         get_preset("preview").with_options(modes=("gaus3",))
 
@@ -92,12 +92,32 @@ def test_config_hash_ignores_versions_that_do_not_change_pixels(monkeypatch):
 def test_hash_changes_with_output_settings_only():
     base = get_preset("preview")
     assert base.config_hash() == get_preset("preview").config_hash()
-    assert base.with_options(spp=base.spp + base.batches).config_hash() != base.config_hash()
+    assert base.with_options(spp=base.render.spp + base.render.batches).config_hash() != base.config_hash()
     assert base.with_options(seed=1).config_hash() != base.config_hash()
     assert base.with_options(modes=("rgb3",)).config_hash() != base.config_hash()
 
 
 def test_config_is_frozen():
-    cfg = DatasetConfig(preset="x", width=8, height=8, spp=1)
+    cfg = DatasetConfig.from_settings("x", width=8, height=8, spp=1)
     with pytest.raises(AttributeError):
-        cfg.spp = 2  # type: ignore[misc]
+        cfg.render.spp = 2  # type: ignore[misc]
+    with pytest.raises(AttributeError):
+        cfg.width = 2  # type: ignore[misc]
+
+
+@pytest.mark.parametrize("name", ["preview", "default", "paper"])
+def test_the_written_record_rebuilds_the_same_config(name):
+    """The flat settings a sample records (``meta.json``, manifest) give back the config with
+    its embedded render settings: no setting is lost between the record and the renderer."""
+    cfg = get_preset(name, seed=3).with_options(direct=True, noise_target=0.05)
+    record = cfg.settings()
+    rebuilt = DatasetConfig.from_settings(cfg.preset, **{**record, "cameras": cfg.cameras})
+    assert rebuilt == cfg and rebuilt.config_hash() == cfg.config_hash()
+    assert rebuilt.render.spp == record["spp"] and rebuilt.render.batch_spp * record["batches"] == record["spp"]
+
+
+def test_render_settings_errors_read_as_dataset_settings():
+    with pytest.raises(DatasetError, match="dataset setting spp=3 with batches=2"):
+        get_preset("preview").with_options(spp=3)
+    with pytest.raises(DatasetError, match="unknown dataset setting.*'aovs'"):
+        get_preset("preview").with_options(aovs=False)

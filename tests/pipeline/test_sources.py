@@ -16,8 +16,8 @@ from spectrinsic.pipeline.presets import DatasetConfig
 from spectrinsic.pipeline.sources import files_source, generator_source
 from spectrinsic.scenes import load_scene
 
-TINY = DatasetConfig(preset="tiny-test", width=8, height=8, spp=2, max_depth=3,
-                     modes=("spectral", "rgb3"), per_light=True, seed=4)
+TINY = DatasetConfig.from_settings("tiny-test", width=8, height=8, spp=2, max_depth=3,
+                                   modes=("spectral", "rgb3"), per_light=True, seed=4)
 #: Layers every sample carries at this config (a library sample's, from gt_export).
 LAYERS = {"image", "reflectance", "shading", "residual", "illuminant", "light_share", "depth",
           "normals", "material_id", "object_id", "mask", "shading_grey", "shading_ratio"}

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from spectrinsic.render import mode_names, render_scene
+from spectrinsic.render import RenderSettings, mode_names, render_scene
 from spectrinsic.scenes import library
 
 #: Small enough to keep the whole library under a minute on 2 cores.
@@ -21,7 +21,7 @@ SIZE, SPP = 12, 1
 def test_library_scene_renders_in_every_mode(name):
     scene = library.build(name, view=library.n_views(name) - 1, condition="two-colour-b", seed=0,
                           width=SIZE, height=SIZE)
-    result = render_scene(scene, modes=mode_names(), spp=SPP, seed=1, max_depth=4, aovs=True)
+    result = render_scene(scene, RenderSettings(SPP, modes=mode_names(), max_depth=4, aovs=True), seed=1)
     assert set(result.images) == set(mode_names())
     for mode, xyz in result.images.items():
         assert xyz.shape == (SIZE, SIZE, 3), mode

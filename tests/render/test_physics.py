@@ -10,8 +10,10 @@ import numpy as np
 import pytest
 
 from spectrinsic.render import (
+    RenderSettings,
     channel_values,
     get_mode,
+    render_batches,
     render_diagonal,
     render_scene,
     to_xyz_matrix,
@@ -49,7 +51,7 @@ def _plane_prediction(reflectance: str, light: str, tilt_deg: float, sensors: st
 def test_plane_spectral_reference_is_analytic(make_plane, reflectance, light):
     """A diffuse plane under a directional light renders ∫ρ E S cosθ/π within noise."""
     scene = make_plane(reflectance, light, tilt_deg=30.0, size=16)
-    result = render_scene(scene, modes=("spectral",), spp=256, seed=1, aovs=False)
+    result = render_scene(scene, RenderSettings(256, modes=("spectral",), aovs=False), seed=1)
     pixels = result.images["spectral"].reshape(-1, 3).astype(np.float64)
     expected = _plane_prediction(reflectance, light, 30.0, "cie1931")
     stderr = pixels.std(axis=0, ddof=1) / np.sqrt(len(pixels))
@@ -61,7 +63,7 @@ def test_plane_diagonal_renders_are_eq_5_2(make_plane):
     """Diagonal passes on the plane have no noise and equal (∫ρS/∫S)(∫E S) cosθ/π exactly."""
     reflectance, light, tilt = "munsell:5R 5/12", "planck:2800K", 30.0
     scene = make_plane(reflectance, light, tilt_deg=tilt, size=8)
-    result = render_scene(scene, modes=("rgb3", "bands31"), spp=4, seed=1, aovs=False)
+    result = render_scene(scene, RenderSettings(4, modes=("rgb3", "bands31"), aovs=False), seed=1)
     rho, e = get_spectrum(reflectance).on(WL), get_spectrum(light).on(WL)
     for mode in ("rgb3", "bands31"):
         s = get_sensors(get_mode(mode).sensors).on(WL)
@@ -82,8 +84,8 @@ def test_cube_agrees_with_spectral_reference(make_room):
     scene = make_room(lights=(("point", "planck:3500K", 1.5), ("area", "daylight:6500K", 3.0)), size=24)
     # the spectral pass costs about one RGB pass but is much noisier (wavelength sampling, heavy
     # tails): it gets 8x the samples of the 11-pass cube
-    spec = [render_scene(scene, modes=("spectral",), spp=2048, seed=s, aovs=False).images["spectral"] for s in (1, 2)]
-    cube = [render_scene(scene, modes=("bands31",), spp=256, seed=s, aovs=False).images["bands31"] for s in (1, 2)]
+    spec = [render_scene(scene, RenderSettings(2048, modes=("spectral",), aovs=False), seed=s).images["spectral"] for s in (1, 2)]
+    cube = [render_scene(scene, RenderSettings(256, modes=("bands31",), aovs=False), seed=s).images["bands31"] for s in (1, 2)]
     spec = [a.astype(np.float64) for a in spec]
     cube = [a.astype(np.float64) for a in cube]
     spec_mean, cube_mean = (spec[0] + spec[1]) / 2, (cube[0] + cube[1]) / 2
@@ -111,7 +113,7 @@ def test_common_random_numbers(make_room):
 def test_interreflections_carry_energy(make_room):
     """3(d): in a closed room the full render carries more energy than direct light alone."""
     scene = make_room(size=16)
-    result = render_scene(scene, modes=("rgb3",), spp=16, seed=3, direct=True, aovs=False)
+    result = render_scene(scene, RenderSettings(16, modes=("rgb3",), direct=True, aovs=False), seed=3)
     full, one = result.images["rgb3"], result.direct["rgb3"]
     r = result.energy_ratio("rgb3")
     assert np.all(full >= one - 1e-6), "with shared paths a longer path depth only adds light"
@@ -122,13 +124,13 @@ def test_flat_materials_make_modes_agree(make_room):
     """3(e): all materials spectrally flat -> 3-, 6- and 31-channel renders agree."""
     flat = tuple(f"flat:{v}" for v in (0.2, 0.4, 0.6, 0.8, 0.5, 0.5))
     scene = make_room(wall_spectra=flat, cube_spectrum="flat:0.3", size=16)
-    result = render_scene(scene, modes=("rgb3", "rgb6", "bands31"), spp=8, seed=5, aovs=False)
+    result = render_scene(scene, RenderSettings(8, modes=("rgb3", "rgb6", "bands31"), aovs=False), seed=5)
     ref = result.images["rgb3"].astype(np.float64)
     for mode, tol in (("bands31", FLAT_BANDS_TOL), ("rgb6", FLAT_RGB6_TOL)):
         err = np.linalg.norm(result.images[mode] - ref, axis=-1) / np.linalg.norm(ref, axis=-1)
         assert float(err.max()) < tol, (mode, float(err.max()))
     # control: coloured materials break the agreement
-    coloured = render_scene(make_room(size=16), modes=("rgb3", "bands31"), spp=8, seed=5, aovs=False)
+    coloured = render_scene(make_room(size=16), RenderSettings(8, modes=("rgb3", "bands31"), aovs=False), seed=5)
     ref = coloured.images["bands31"].astype(np.float64)
     err = np.linalg.norm(coloured.images["rgb3"] - ref, axis=-1) / np.linalg.norm(ref, axis=-1)
     assert float(err.max()) > 10 * FLAT_BANDS_TOL
@@ -137,8 +139,8 @@ def test_flat_materials_make_modes_agree(make_room):
 def test_per_light_renders_sum_to_full_render(make_room):
     """One scene per light; their sum is the image and matches a render of all lights at once."""
     scene = make_room(size=16)
-    split = render_scene(scene, modes=("rgb3",), spp=128, seed=11, per_light=True, aovs=False)
-    whole = render_scene(scene, modes=("rgb3",), spp=128, seed=12, aovs=False)
+    split = render_scene(scene, RenderSettings(128, modes=("rgb3",), per_light=True, aovs=False), seed=11)
+    whole = render_scene(scene, RenderSettings(128, modes=("rgb3",), aovs=False), seed=12)
     assert len(split.per_light) == 2
     total = split.per_light[0]["rgb3"].astype(np.float64) + split.per_light[1]["rgb3"]
     np.testing.assert_allclose(split.images["rgb3"], total, rtol=FLOAT32_RTOL, atol=1e-6)
@@ -155,3 +157,19 @@ def test_to_xyz_uses_the_scene_lights_for_rgb6(make_plane):
     a = to_xyz_matrix(get_mode("rgb6"), make_plane("flat:0.5", "planck:2800K"))
     b = to_xyz_matrix(get_mode("rgb6"), make_plane("flat:0.5", "daylight:6500K"))
     assert a.shape == (3, 6) and not np.allclose(a, b)
+
+
+def test_adaptive_batches_stop_at_the_target_or_the_cap(make_room):
+    """--noise-target: more batches only while the measured noise is above the target."""
+    from spectrinsic.render import image_noise
+
+    scene = make_room(size=12)
+    settings = RenderSettings(4, modes=("rgb3",), batches=2, aovs=False, max_batches=3)
+    capped = render_batches(scene, settings.with_options(noise_target=1e-9), seed=1)
+    assert capped.meta["batches"] == 3 and len(capped.batch_raw) == 3
+    assert capped.meta["noise_target"]["reached"] > 1e-9
+    easy = render_batches(scene, settings.with_options(noise_target=0.99), seed=1)
+    assert easy.meta["batches"] == 2
+    assert easy.meta["noise_target"]["reached"] == pytest.approx(
+        image_noise([render_scene(scene, RenderSettings(2, modes=("rgb3",), aovs=False), seed=s)
+                     for s in easy.meta["batch_seeds"]]))

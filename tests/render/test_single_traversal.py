@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from spectrinsic.errors import RenderError
+from spectrinsic.pipeline.presets import get_preset
 from spectrinsic.render import (
     channel_values,
     count_passes,
@@ -20,7 +21,8 @@ from spectrinsic.render import (
     render_diagonal,
     render_scene,
 )
-from spectrinsic.render.single import render_transport
+from spectrinsic.render.settings import RenderSettings
+from spectrinsic.render.single import render_traversal
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import get_sensors
 
@@ -42,10 +44,11 @@ def test_single_traversal_equals_the_passes(make_room):
     """Same seed and spp: every band of every diagonal mode, full and direct-only, equals the
     ⌈K/3⌉ passes (14 of them) to float rounding; the spectral pass is untouched."""
     scene = make_room(size=24)
-    kw = dict(modes=("spectral", *DIAGONAL), spp=4, seed=5, per_light=True, per_light_modes=("rgb3",), direct=True)
-    calls = {"passes": [], "single": []}
+    base = RenderSettings(4, modes=("spectral", *DIAGONAL), per_light=True, share_mode="rgb3", direct=True)
+    calls: dict[str, list[int]] = {"passes": [], "single": []}
+    settings = {name: base.with_options(integrator=name) for name in calls}
     results = {
-        name: render_scene(scene, integrator=name, progress=calls[name].append, **kw) for name in calls
+        name: render_scene(scene, settings[name], seed=5, progress=calls[name].append) for name in calls
     }
     old, new = results["passes"], results["single"]
     for mode in DIAGONAL:
@@ -57,9 +60,8 @@ def test_single_traversal_equals_the_passes(make_room):
     # two traversals (full with the first-hit maps, and direct-only) replace 2 x (1 + 2 + 11)
     # diagonal passes, 2 per-light passes and 3 coverage passes; the spectral reference keeps
     # its 2. The progress calls are what count_passes predicts.
-    options = {k: v for k, v in kw.items() if k not in ("spp", "seed")}
     for name, seen in calls.items():
-        assert len(seen) == count_passes(scene, integrator=name, **options)
+        assert len(seen) == count_passes(scene, settings[name])
     assert (len(calls["passes"]), len(calls["single"])) == (2 + 2 * 14 + 2 + 3, 2 + 2)
     assert new.meta["integrator"] == "single" and new.meta["timings"]["single"]["passes"] == 2
     # the first-hit maps see the same camera rays as the coverage passes
@@ -68,11 +70,11 @@ def test_single_traversal_equals_the_passes(make_room):
     assert not old.transport
 
 
-def test_render_transport_matches_render_diagonal(make_room):
+def test_render_traversal_matches_render_diagonal(make_room):
     """Lower level: the transport times the lights' channel values is render_diagonal's image."""
     scene = make_room(size=12)
     values = [channel_values(scene, get_sensors(get_mode(m).sensors)) for m in DIAGONAL]
-    outs, aovs, seconds, _ = render_transport(scene, values, spp=8, seed=9)
+    outs, aovs, seconds, _ = render_traversal(scene, values, spp=8, seed=9)
     passes = render_diagonal(scene, values, spp=8, seed=9)
     assert len(seconds) == 1 and not aovs
     for out, ref, v in zip(outs, passes, values, strict=True):
@@ -84,8 +86,9 @@ def test_per_light_split_sums_to_the_image(make_room):
     """Each light's image is its share of the one render: the shares sum to the image exactly,
     and each share is an unbiased estimate of the light alone (a separate one-light render)."""
     scene = make_room(size=16)
-    new = render_scene(scene, modes=DIAGONAL, spp=64, seed=11, per_light=True, aovs=False, integrator="single")
-    old = render_scene(scene, modes=("rgb3",), spp=64, seed=12, per_light=True, aovs=False, integrator="passes")
+    new = render_scene(scene, RenderSettings(64, modes=DIAGONAL, per_light=True, aovs=False, integrator="single"), seed=11)
+    old = render_scene(scene, RenderSettings(64, modes=("rgb3",), per_light=True, aovs=False, integrator="passes"),
+                       seed=12)
     for mode in DIAGONAL:
         total = sum(p[mode].astype(np.float64) for p in new.per_light)
         _close(total, new.images[mode])
@@ -101,7 +104,8 @@ def test_per_light_split_sums_to_the_image(make_room):
 
 def test_batches_average_the_transport(make_room):
     scene = make_room(size=8)
-    parts = [render_scene(scene, modes=("rgb3",), spp=2, seed=s, aovs=False, integrator="single") for s in (1, 2)]
+    parts = [render_scene(scene, RenderSettings(2, modes=("rgb3",), aovs=False, integrator="single"), seed=s)
+             for s in (1, 2)]
     merged = merge_batches(parts)
     np.testing.assert_allclose(merged.transport["rgb3"], (parts[0].transport["rgb3"].astype(np.float64)
                                                           + parts[1].transport["rgb3"]) / 2, rtol=1e-6)
@@ -111,7 +115,7 @@ def test_plane_under_directional_lights_is_exact(make_plane):
     """One bounce under a directional light has no noise: every band is ρ_k E_k cosθ/π."""
     tilt = 30.0
     scene = make_plane("munsell:5R 5/12", "planck:2800K", tilt_deg=tilt, size=8)
-    result = render_scene(scene, modes=DIAGONAL, spp=4, seed=1, aovs=False, integrator="single")
+    result = render_scene(scene, RenderSettings(4, modes=DIAGONAL, aovs=False, integrator="single"), seed=1)
     for mode in DIAGONAL:
         v = channel_values(scene, get_sensors(get_mode(mode).sensors))
         expected = v.materials[0] * v.lights[0] * np.cos(np.radians(tilt)) / np.pi
@@ -141,7 +145,7 @@ def test_plane_under_an_area_light_is_the_view_factor():
         # a narrow view of the point under the light's centre, from beside the light
         camera=Camera(origin=(0, -0.6, 0.25), target=(0, 0, 0), up=(0, 0, 1), fov_deg=1.0, width=8, height=8),
     )
-    result = render_scene(scene, modes=("bands31",), spp=256, seed=3, aovs=False, integrator="single")
+    result = render_scene(scene, RenderSettings(256, modes=("bands31",), aovs=False, integrator="single"), seed=3)
     v = channel_values(scene, get_sensors(get_mode("bands31").sensors))
     expected = v.materials[0] * v.lights[0] * _parallel_rectangle_factor(size, size, height)
     pixels = result.raw["bands31"].reshape(-1, 31).astype(np.float64)
@@ -150,6 +154,15 @@ def test_plane_under_an_area_light_is_the_view_factor():
     assert np.all(np.abs(pixels.mean(axis=0) - expected) <= N_SIGMA * stderr + 1e-3 * expected)
 
 
-def test_unknown_integrator_is_one_line(make_plane):
-    with pytest.raises(RenderError, match="integrator 'one-pass'.*passes.*single"):
-        render_scene(make_plane("flat:0.5", "cie:D65"), modes=("rgb3",), spp=1, seed=0, integrator="one-pass")
+def test_unknown_integrator_is_one_line():
+    with pytest.raises(RenderError, match="integrator='one-pass'; expected one of passes, single"):
+        RenderSettings(1, modes=("rgb3",), integrator="one-pass")
+
+
+def test_integrator_is_a_render_setting_not_hashed():
+    """The dataset config carries the choice to every sample's render; both integrators give
+    the same pixels to float rounding, so the config hash does not change with it."""
+    config = get_preset("preview")
+    passes = config.with_options(integrator="passes")
+    assert (config.render.integrator, passes.render.integrator) == ("single", "passes")
+    assert passes.config_hash() == config.config_hash()

@@ -6,7 +6,13 @@ import numpy as np
 import pytest
 
 from spectrinsic.errors import SceneError
-from spectrinsic.render import render_aovs, render_scene, scene_to_mitsuba, variant_scope
+from spectrinsic.render import (
+    RenderSettings,
+    render_aovs,
+    render_scene,
+    scene_to_mitsuba,
+    variant_scope,
+)
 from spectrinsic.render.translate import (
     hdr_film,
     path_integrator,
@@ -80,7 +86,7 @@ def test_camera_is_not_mirrored_and_area_light_points_down():
     aovs, _ = render_aovs(_marker_scene(1.2), spp=16, seed=0)
     ys, xs = np.nonzero(aovs["material_id"] == 1)
     assert xs.size > 0 and xs.mean() > 16, "a patch at +x (camera right) must appear in the right half"
-    image = render_scene(_marker_scene(1.2), modes=("rgb3",), spp=16, seed=0, aovs=False).images["rgb3"]
+    image = render_scene(_marker_scene(1.2), RenderSettings(16, modes=("rgb3",), aovs=False), seed=0).images["rgb3"]
     assert float(image[..., 1].mean()) > 0.0, "an area light facing the floor lights it"
 
 
@@ -107,7 +113,7 @@ def test_plane_aovs(make_plane):
 def test_room_coverage_partitions_each_pixel(make_room, integrator, coverage_passes):
     """From the coverage passes (3 for 7 surfaces) or the traversal's first hits (none)."""
     scene = make_room(size=16)
-    result = render_scene(scene, modes=("rgb3",), spp=32, seed=2, integrator=integrator)
+    result = render_scene(scene, RenderSettings(32, modes=("rgb3",), integrator=integrator), seed=2)
     cov = result.aovs["coverage"]
     assert cov.shape == (16, 16, len(scene.materials))
     # a closed room: every sample hits a material or the (black) area light

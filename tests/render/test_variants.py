@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from spectrinsic.errors import RenderError, SpectrinsicError, SpectrinsicWarning
-from spectrinsic.render import variants
+from spectrinsic.render import RenderSettings, variants
 
 
 @pytest.mark.parametrize(
@@ -105,8 +105,8 @@ def test_scalar_variant_renders_the_same_deterministic_plane(make_plane):
     from spectrinsic.render import render_scene
 
     scene = make_plane("munsell:5R 5/12", "planck:2800K", tilt_deg=30.0, size=4)
-    scalar = render_scene(scene, modes=("rgb3",), spp=2, seed=0, variant="scalar", aovs=False)
-    best = render_scene(scene, modes=("rgb3",), spp=2, seed=0, aovs=False)
+    scalar = render_scene(scene, RenderSettings(2, modes=("rgb3",), variant="scalar", aovs=False), seed=0)
+    best = render_scene(scene, RenderSettings(2, modes=("rgb3",), aovs=False), seed=0)
     assert scalar.meta["variants"]["rgb3"] == "scalar_rgb"
     np.testing.assert_allclose(scalar.images["rgb3"], best.images["rgb3"], rtol=1e-5)
 

@@ -151,13 +151,3 @@ def test_objects_rest_on_the_ground_and_are_modest(name):
     assert part.vertices[:, 2].min() == pytest.approx(0.0, abs=1e-9)
     assert len(part.faces) < 12_000
     assert volume(part) > 0
-
-
-def test_docstring_examples():
-    import doctest
-
-    from spectrinsic.scenes import validate
-
-    for module in (g, validate):
-        result = doctest.testmod(module)
-        assert result.attempted > 0 and result.failed == 0

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import doctest
-
 import pytest
 
 from spectrinsic.errors import DatasetError
@@ -44,11 +42,3 @@ def test_sample_id_is_a_frozen_record():
     with pytest.raises(AttributeError):
         sid.view = 1  # type: ignore[misc]
     assert sid == SampleId("obj-vase", 0, "white") and hash(sid) == hash(SampleId("obj-vase", 0, "white"))
-
-
-def test_docstring_examples():
-    from spectrinsic.scenes import model, sample_id
-
-    for module in (sample_id, model):
-        result = doctest.testmod(module)
-        assert result.attempted > 0 and result.failed == 0

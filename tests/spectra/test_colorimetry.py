@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import colour
 import numpy as np
 import pytest
@@ -148,15 +150,57 @@ def test_fits_and_responses_do_not_depend_on_blas_threads(tmp_path):
         "rho = family_values('munsell', wl)\n"
         "q = responses(rho, get_sensors('srgb').on(wl), wl)\n"
         "p = responses(rho, get_sensors('gaussian:6@400-700').on(wl), wl)\n"
-        "out = np.concatenate([fit_matrix(q, q[:, ::-1] ** 1.1).ravel(), fit_projection(p, q).ravel(), q.ravel()])\n"
+        "out = np.concatenate([fit_matrix(q, np.abs(q[:, ::-1]) ** 1.1).ravel(), fit_projection(p, q).ravel(), q.ravel()])\n"
         "print(out.tobytes().hex())\n"
     )
     outputs = set()
-    for threads in ("1", "2"):
-        env = {**__import__("os").environ, "OPENBLAS_NUM_THREADS": threads, "OMP_NUM_THREADS": threads}
+    for env in _blas_environments():
         run = subprocess.run([sys.executable, "-P", str(script)], capture_output=True, text=True,
                              env=env, check=True)
         outputs.add(run.stdout)
+    assert len(outputs) == 1
+
+
+def _blas_environments() -> list[dict[str, str]]:
+    """This process's environment with 1 and 2 BLAS threads, and with OpenBLAS's CPU kernel
+    forced to Haswell and left to its own choice (some CI machines set it), where the CPU can
+    run Haswell's AVX2 kernels."""
+    import os
+
+    base = {k: v for k, v in os.environ.items() if not k.startswith("OPENBLAS_")}
+    envs = [{**base, "OPENBLAS_NUM_THREADS": n, "OMP_NUM_THREADS": n} for n in ("1", "2")]
+    cpu = Path("/proc/cpuinfo")
+    if cpu.is_file() and " avx2" in cpu.read_text():
+        envs.append({**base, "OPENBLAS_CORETYPE": "Haswell", "OPENBLAS_NUM_THREADS": "2"})
+    return envs
+
+
+def test_rank_deficient_fit_is_the_minimum_norm_solution_under_every_blas_kernel(tmp_path):
+    """Exactly rank-deficient responses (flat greys seen by 6 sensors are rank 1) get one
+    defined answer, the minimum-norm least-squares solution (independent reference: numpy's
+    SVD ``lstsq``), bit-identical whatever BLAS kernel or thread count the process runs."""
+    import subprocess
+    import sys
+
+    from spectrinsic.spectra import fit_projection
+
+    rng = np.random.default_rng(5)
+    greys = np.linspace(0.15, 0.95, 12)[:, None]
+    a = greys * rng.random(6)        # every row a multiple of one 6-sensor response: rank 1
+    b = greys * rng.random(3)
+    ref, *_ = np.linalg.lstsq(a, b, rcond=1e-8)
+    np.testing.assert_allclose(fit_projection(a, b), ref.T, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(a @ fit_projection(a, b).T, b, rtol=1e-12)
+    script = tmp_path / "rank.py"
+    script.write_text(
+        "import numpy as np\n"
+        "from spectrinsic.spectra import fit_projection\n"
+        "rng = np.random.default_rng(5); g = np.linspace(0.15, 0.95, 12)[:, None]\n"
+        "a = g * rng.random(6); b = g * rng.random(3)\n"
+        "print(fit_projection(a, b).tobytes().hex())\n"
+    )
+    outputs = {subprocess.run([sys.executable, "-P", str(script)], capture_output=True, text=True,
+                              env=env, check=True).stdout for env in _blas_environments()}
     assert len(outputs) == 1
 
 

@@ -10,7 +10,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from spectrinsic.decompose import colour_naming
 from spectrinsic.spectra import colorimetry, illuminants, io, reflectances, registry, sensors
 from spectrinsic.spectra.colourspace import srgb_matrices
 
@@ -120,9 +119,3 @@ def test_cached_data_directory_tables_are_read_only(data_dir: Path):
     _frozen(wl, curves)
     with pytest.raises(TypeError):
         cams["new"] = (wl, curves)  # type: ignore[index]
-
-
-def test_cached_colour_naming_tables_are_read_only():
-    params = colour_naming.tse_parameters()
-    _frozen(params.chromatic, params.present, params.achromatic)
-    _frozen(colour_naming.appendix_a_labels(), colour_naming.label_centroids())

@@ -41,7 +41,15 @@ from spectrinsic.studies.rendering.compute import (
     valid_pixels,
 )
 from spectrinsic.studies.rendering.plot import error_figure
-from spectrinsic.studies.rendering.report import format_rendering, run_rendering_study
+from spectrinsic.studies.rendering.report import (
+    RenderingResult,
+    RenderingSettings,
+    format_rendering,
+    rendering_payload,
+    run_rendering,
+    run_rendering_study,
+    write_rendering_outputs,
+)
 
 __all__ = [
     "QUALITIES",
@@ -56,6 +64,11 @@ __all__ = [
     "valid_pixels",
     "error_stats",
     "evaluate_sample",
+    "RenderingSettings",
+    "RenderingResult",
+    "run_rendering",
+    "rendering_payload",
+    "write_rendering_outputs",
     "run_rendering_study",
     "format_rendering",
     "error_figure",

@@ -16,7 +16,12 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import SceneError, StudyError, validate_choice
+from spectrinsic.render import render_scene
+from spectrinsic.render.settings import RenderSettings
+from spectrinsic.rng import seed_from_key
+from spectrinsic.scenes import library
 from spectrinsic.scenes.library import CONDITIONS
+from spectrinsic.scenes.sample_id import SampleId
 from spectrinsic.spectra import relative_error
 
 __all__ = [
@@ -48,6 +53,12 @@ class StudyQuality:
     width: int
     height: int
     spp: int
+
+    def render_settings(self, variant: str | None = None) -> RenderSettings:
+        """One batch of :attr:`spp` samples of the compared modes and the reference, path depth
+        :data:`MAX_DEPTH`, the reference also direct-only (for r of Eq. 5.8), with AOVs."""
+        return RenderSettings(self.spp, modes=(*COMPARED_MODES, REFERENCE_MODE), max_depth=MAX_DEPTH,
+                              variant=variant, direct=(REFERENCE_MODE,), aovs=True)
 
 
 #: Quality presets; "default" runs in about 5 minutes on 2 shared cores.
@@ -94,8 +105,6 @@ def samples(
 ) -> Iterator[tuple[str, int, str]]:
     """``(scene, view, condition)`` of every sample: each complex scene (or *scenes*), each of
     its views (or *views*), each condition (validated against the library's)."""
-    from spectrinsic.scenes import library
-
     for condition in conditions:
         validate_choice(condition, CONDITIONS, "illumination condition", error=SceneError)
     names = list(scenes) if scenes is not None else library.scene_names("complex")
@@ -131,19 +140,12 @@ def evaluate_sample(
     The row holds, per compared mode, the mean, s.d. and max of ε in percent, the energy ratio
     r (Eq. 5.8) of the reference, the number of evaluated pixels and the render time (s).
     """
-    from spectrinsic.render import render_scene
-    from spectrinsic.rng import seed_from_key
-    from spectrinsic.scenes import library
-    from spectrinsic.scenes.sample_id import SampleId
-
     sample = str(SampleId(name, view, condition))
     scene = library.build(name, view=view, condition=condition, seed=seed, width=quality.width,
                           height=quality.height)
     t0 = time.perf_counter()
-    result = render_scene(
-        scene, modes=(*COMPARED_MODES, REFERENCE_MODE), spp=quality.spp, seed=seed_from_key(seed, sample),
-        max_depth=MAX_DEPTH, variant=variant, direct=(REFERENCE_MODE,), aovs=True, data_dir=data_dir,
-    )
+    result = render_scene(scene, quality.render_settings(variant), seed=seed_from_key(seed, sample),
+                          data_dir=data_dir)
     seconds = time.perf_counter() - t0
     ref = result.images[REFERENCE_MODE]
     valid = valid_pixels(ref, result.aovs["mask"])

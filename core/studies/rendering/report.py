@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +18,7 @@ from spectrinsic.studies.rendering.compute import (
     REFERENCE_MODE,
     STUDY_CONDITIONS,
     THESIS_MEAN_R,
+    SampleResult,
     evaluate_sample,
     samples,
     study_quality,
@@ -26,7 +27,8 @@ from spectrinsic.studies.rendering.compute import (
 from spectrinsic.studies.rendering.plot import error_figure
 from spectrinsic.typing import StepProgress
 
-__all__ = ["run_rendering_study", "format_rendering"]
+__all__ = ["RenderingSettings", "RenderingResult", "run_rendering", "rendering_payload",
+           "write_rendering_outputs", "run_rendering_study", "format_rendering"]
 
 #: Resolution of the per-sample figures, dots per inch.
 DPI = 90
@@ -43,6 +45,102 @@ def _definitions() -> dict[str, Any]:
     }
 
 
+@dataclass(frozen=True)
+class RenderingSettings:
+    """What the rendering study renders.
+
+    Attributes
+    ----------
+    quality
+        One of :data:`~spectrinsic.studies.rendering.compute.QUALITIES`.
+    seed
+        Root seed of the illuminant draws (:func:`spectrinsic.scenes.library.build`) and of the
+        sampler (offset per sample).
+    scenes, views
+        Subsets (default: every complex scene, every view).
+    conditions
+        Illumination conditions of the library (default: its two-light ones).
+    variant
+        Mitsuba variant or backend (default: the best usable).
+    """
+
+    quality: str = "default"
+    seed: int = DEFAULT_SEED
+    scenes: tuple[str, ...] | None = None
+    views: tuple[int, ...] | None = None
+    conditions: tuple[str, ...] = STUDY_CONDITIONS
+    variant: str | None = None
+
+
+@dataclass(frozen=True)
+class RenderingResult:
+    """The study's numbers and, per sample, the images its figure shows."""
+
+    settings: RenderingSettings
+    samples: tuple[SampleResult, ...]
+    seconds: float
+
+
+def run_rendering(
+    settings: RenderingSettings, *, data_dir: str | None = None, progress: StepProgress | None = None,
+) -> RenderingResult:
+    """Render every sample of *settings* in every compared mode and the reference; no files.
+    *progress* is called once per rendered sample with its id."""
+    q = study_quality(settings.quality)
+    found: list[SampleResult] = []
+    started = time.perf_counter()
+    for name, view, condition in samples(settings.scenes, settings.views, settings.conditions):
+        found.append(evaluate_sample(name, view, condition, quality=q, seed=settings.seed,
+                                     variant=settings.variant, data_dir=data_dir))
+        if progress is not None:
+            progress(found[-1].sample)
+    return RenderingResult(settings, tuple(found), time.perf_counter() - started)
+
+
+def rendering_payload(result: RenderingResult) -> dict[str, Any]:
+    """What ``rendering.json`` holds: ``rows`` (one per scene, view and condition),
+    ``summary``, ``settings``, ``definitions``, ``provenance`` (``paths`` added by the writer)."""
+    s = result.settings
+    rows = [r.row for r in result.samples]
+    totals = summary(rows)
+    totals["seconds_total"] = result.seconds
+    return {
+        "study": "rendering",
+        "rows": rows,
+        "summary": totals,
+        "settings": {**asdict(study_quality(s.quality)), "quality": s.quality, "seed": s.seed,
+                     "max_depth": MAX_DEPTH, "reference": REFERENCE_MODE,
+                     "compared": list(COMPARED_MODES), "conditions": list(s.conditions),
+                     "dark_fraction": DARK_FRACTION},
+        "definitions": _definitions(),
+        "provenance": provenance(),
+    }
+
+
+def write_rendering_outputs(result: RenderingResult, out_dir: Path) -> dict[str, Path]:
+    """Write ``rendering.json``, ``rendering.csv`` and ``rendering/<sample>.png`` into *out_dir*;
+    the paths of the first two."""
+    paths = _write(result, Path(out_dir))["paths"]
+    return {"json": Path(paths["json"]), "csv": Path(paths["csv"])}
+
+
+def _write(result: RenderingResult, out_dir: Path) -> dict[str, Any]:
+    """Write the study's files; the payload of ``rendering.json``."""
+    figures: list[str] = []
+    for found in result.samples:
+        path = out_dir / "rendering" / f"{found.sample}.png"
+        path.parent.mkdir(parents=True, exist_ok=True)
+        error_figure(found.sample.replace("__", "  "), found.reference, found.errors).savefig(path, dpi=DPI)
+        figures.append(str(path))
+    payload = rendering_payload(result)
+    json_path = out_dir / "rendering.json"
+    csv_path = out_dir / "rendering.csv"
+    payload["paths"] = {"json": str(json_path), "csv": str(csv_path), "figures": figures}
+    write_json(json_path, json_safe(payload))
+    write_csv(csv_path, payload["rows"])
+    return payload
+
+
 def run_rendering_study(
     out_dir: Path,
     *,
@@ -55,62 +153,18 @@ def run_rendering_study(
     conditions: Sequence[str] = STUDY_CONDITIONS,
     variant: str | None = None,
 ) -> dict[str, Any]:
-    """Render the complex scenes and write ``rendering.json``, ``rendering.csv`` and error maps.
-
-    Parameters
-    ----------
-    out_dir
-        Folder for ``rendering.json``, ``rendering.csv`` and ``rendering/<sample>.png``.
-    quality
-        One of :data:`~spectrinsic.studies.rendering.compute.QUALITIES`.
-    progress
-        Called once per rendered sample with its id (e.g. a tqdm step).
-    seed
-        Root seed of the illuminant draws (:func:`spectrinsic.scenes.library.build`) and of the
-        sampler (offset per sample).
-    scenes, views
-        Subsets (default: every complex scene, every view).
-    conditions
-        Illumination conditions of the library (default: its two-light ones).
+    """Render the complex scenes and write ``rendering.json``, ``rendering.csv`` and error maps
+    (:func:`run_rendering` then :func:`write_rendering_outputs`; parameters are the fields of
+    :class:`RenderingSettings`).
 
     Returns
     -------
-    The payload written to ``rendering.json``: ``rows`` (one per scene, view and condition),
-    ``summary``, ``settings``, ``definitions``, ``provenance``, ``paths``.
+    The payload written to ``rendering.json``: ``rows``, ``summary``, ``settings``,
+    ``definitions``, ``provenance``, ``paths``.
     """
-    q = study_quality(quality)
-    out_dir = Path(out_dir)
-    rows: list[dict[str, Any]] = []
-    figures: list[str] = []
-    started = time.perf_counter()
-    for name, view, condition in samples(scenes, views, conditions):
-        found = evaluate_sample(name, view, condition, quality=q, seed=seed, variant=variant,
-                                data_dir=data_dir)
-        rows.append(found.row)
-        path = out_dir / "rendering" / f"{found.sample}.png"
-        path.parent.mkdir(parents=True, exist_ok=True)
-        error_figure(found.sample.replace("__", "  "), found.reference, found.errors).savefig(path, dpi=DPI)
-        figures.append(str(path))
-        if progress is not None:
-            progress(found.sample)
-    totals = summary(rows)
-    totals["seconds_total"] = time.perf_counter() - started
-    payload: dict[str, Any] = {
-        "study": "rendering",
-        "rows": rows,
-        "summary": totals,
-        "settings": {**asdict(q), "quality": quality, "seed": seed, "max_depth": MAX_DEPTH,
-                     "reference": REFERENCE_MODE, "compared": list(COMPARED_MODES),
-                     "conditions": list(conditions), "dark_fraction": DARK_FRACTION},
-        "definitions": _definitions(),
-        "provenance": provenance(),
-    }
-    json_path = out_dir / "rendering.json"
-    csv_path = out_dir / "rendering.csv"
-    payload["paths"] = {"json": str(json_path), "csv": str(csv_path), "figures": figures}
-    write_json(json_path, json_safe(payload))
-    write_csv(csv_path, rows)
-    return payload
+    settings = RenderingSettings(quality, seed, None if scenes is None else tuple(scenes),
+                                 None if views is None else tuple(views), tuple(conditions), variant)
+    return _write(run_rendering(settings, data_dir=data_dir, progress=progress), Path(out_dir))
 
 
 def format_rendering(payload: dict[str, Any]) -> str:

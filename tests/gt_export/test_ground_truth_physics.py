@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from spectrinsic.gt_export.layers import compute_ground_truth, identities
-from spectrinsic.render import render_batches, render_scene
+from spectrinsic.render import RenderSettings, render_batches, render_scene
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as WL
 from spectrinsic.spectra import get_sensors, get_spectrum, responses, xyz_to_linear_srgb
@@ -60,7 +60,8 @@ def _corner_scene(grey: str = "flat:0.8", wall: str = "munsell:5R 5/12", size: i
 
 
 def _gt(scene: Scene, **render: object):
-    result = render_scene(scene, modes=("bands31",), seed=3, **{"spp": 16, "max_depth": 3, **render})
+    settings = RenderSettings(**{"spp": 16, "max_depth": 3, "modes": ("bands31",), **render})
+    result = render_scene(scene, settings, seed=3)
     return compute_ground_truth(scene, result), result
 
 
@@ -123,8 +124,8 @@ def test_c_swapping_a_material_leaves_its_shading_and_changes_its_image():
 def test_d_e_identity_and_shading_sign_in_a_room_with_interreflections(make_room):
     """(d) image = reflectance ∘ shading + residual to float precision; (e) shading ≥ 0, finite."""
     scene = make_room(size=20)
-    result = render_batches(scene, batches=2, modes=("bands31", "rgb3"), spp=4, seed=5,
-                            per_light=True, per_light_modes=("rgb3",))
+    result = render_batches(scene, RenderSettings(8, batches=2, modes=("bands31", "rgb3"),
+                                                  per_light=True, share_mode="rgb3"), seed=5)
     gt = compute_ground_truth(scene, result, cameras=("camera:Nikon 5100 (NPL)",), denoise=True)
     for ident in identities(gt):
         image, refl, shading, res = (gt.layers[ident[k]].data.astype(np.float64)
@@ -146,9 +147,10 @@ def test_d_e_identity_and_shading_sign_in_a_room_with_interreflections(make_room
 def noisy_and_converged(make_room):
     """A room at 2 batches × 8 spp, and the same room at 16× the spp as the reference."""
     scene = make_room(size=40)
-    options = dict(modes=("bands31",), max_depth=4, per_light=True, per_light_modes=("rgb3",))
-    noisy = render_batches(scene, batches=2, spp=8, seed=11, **options)
-    reference = render_batches(scene, batches=4, spp=64, seed=99, **options)
+    settings = RenderSettings(16, batches=2, modes=("bands31",), max_depth=4, per_light=True,
+                              share_mode="rgb3")
+    noisy = render_batches(scene, settings, seed=11)
+    reference = render_batches(scene, settings.with_options(spp=256, batches=4), seed=99)
     return scene, noisy, reference
 
 
@@ -183,22 +185,6 @@ def test_h_denoised_shading_is_closer_to_the_converged_render(noisy_and_converge
     denoised = _relative_error(gt.layers["shading"].data, ref.layers["shading"].data, valid)
     assert np.median(denoised) < 0.7 * np.median(raw)
     assert "shading" in gt.denoised and "shading_raw" not in gt.denoised
-
-
-def test_adaptive_batches_stop_at_the_target_or_the_cap(make_room):
-    """--noise-target: more batches only while the measured noise is above the target."""
-    from spectrinsic.render import image_noise
-
-    scene = make_room(size=12)
-    options = dict(modes=("rgb3",), spp=2, seed=1, batches=2, aovs=False)
-    capped = render_batches(scene, noise_target=1e-9, max_batches=3, **options)
-    assert capped.meta["batches"] == 3 and len(capped.batch_raw) == 3
-    assert capped.meta["noise_target"]["reached"] > 1e-9
-    easy = render_batches(scene, noise_target=0.99, max_batches=3, **options)
-    assert easy.meta["batches"] == 2
-    assert easy.meta["noise_target"]["reached"] == pytest.approx(
-        image_noise([render_scene(scene, modes=("rgb3",), spp=2, seed=s, aovs=False)
-                     for s in easy.meta["batch_seeds"]]))
 
 
 def test_residual_vanishes_on_a_flat_grey_and_not_on_a_saturated_chip():

@@ -1,0 +1,89 @@
+"""Ctrl-C that reaches Python while Mitsuba renders.
+
+Mitsuba's Python binding of ``mi.render`` installs its own SIGINT handler for the length of the
+call ("Received interrupt signal, winding down..") and restores the previous one afterwards. An
+interrupt that lands mid-render is consumed there: the render returns early or fails, and Python
+never sees a ``KeyboardInterrupt``, so a serial build either ran to the end (rc 0) or reported one
+failed sample and went on (rc 1).
+
+:func:`interrupts_reach_python` takes SIGINT away from signal *handlers* altogether: the calling
+(main) thread blocks it, so every thread started afterwards (Dr.Jit's and OIDN's pools, tqdm's
+monitor) inherits the block, and one watcher thread receives it synchronously with
+:func:`signal.sigwait`. A handler installed by a library is never run for a blocked signal; the
+watcher turns each SIGINT into :func:`_thread.interrupt_main`, which raises ``KeyboardInterrupt``
+in the main thread as soon as it runs Python again, and records it (:func:`requested`).
+
+The record is what makes the stop certain: Dr.Jit's ``custom`` operation, through which
+``mi.render`` runs, re-raises a ``KeyboardInterrupt`` from inside a render as a ``RuntimeError``,
+and a task runner that survives failed items would then go on. Long loops call
+:func:`raise_if_requested` between their steps (passes, samples), so a build stops within one
+render pass of the Ctrl-C (a pass of a default sample takes well under a second).
+
+Child processes inherit the blocked mask (they are stopped by their parent, see
+:mod:`spectrinsic.pipeline.executors`). Only POSIX systems have per-thread signal masks;
+elsewhere the context manager does nothing.
+"""
+
+from __future__ import annotations
+
+import _thread
+import signal
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+__all__ = ["interrupts_reach_python", "requested", "raise_if_requested"]
+
+_SIGINT = {signal.SIGINT}
+_watcher_lock = threading.Lock()
+_watcher: threading.Thread | None = None
+_requested = threading.Event()
+
+
+def requested() -> bool:
+    """Whether a Ctrl-C arrived within the current :func:`interrupts_reach_python` block."""
+    return _requested.is_set()
+
+
+def raise_if_requested() -> None:
+    """Raise ``KeyboardInterrupt`` if a Ctrl-C arrived, wherever Python saw it (or lost it)."""
+    if _requested.is_set():
+        raise KeyboardInterrupt
+
+
+@contextmanager
+def interrupts_reach_python() -> Iterator[None]:
+    """Within the block, Ctrl-C raises ``KeyboardInterrupt`` in the main thread even while a
+    library (Mitsuba) has its own SIGINT handler installed. Restores the signal mask on exit.
+
+    Call it in the main thread before any thread is started, so that all of them inherit the
+    block (threads started earlier could still receive SIGINT and run a library's handler).
+    """
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGINT)
+    _requested.clear()
+    try:
+        _start_watcher()
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        _requested.clear()
+
+
+def _start_watcher() -> None:
+    """Start the one SIGINT watcher of this process (a daemon thread), if not yet running."""
+    global _watcher
+    with _watcher_lock:
+        if _watcher is None:
+            _watcher = threading.Thread(target=_watch, name="spectrinsic-sigint", daemon=True)
+            _watcher.start()
+
+
+def _watch() -> None:
+    """Receive each SIGINT, record it and raise ``KeyboardInterrupt`` in the main thread."""
+    while True:
+        signal.sigwait(_SIGINT)
+        _requested.set()
+        _thread.interrupt_main(signal.SIGINT)

@@ -1,0 +1,152 @@
+"""Every family together: :func:`compute_ground_truth` and the identities the layers satisfy.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export import irradiance as irr
+from spectrinsic.gt_export.denoise import denoise_white_radiance
+from spectrinsic.gt_export.layers.cameras import camera_layers, matrices_of
+from spectrinsic.gt_export.layers.geometry import coverage_of, geometry_layers
+from spectrinsic.gt_export.layers.images import cube_layer, image_layers
+from spectrinsic.gt_export.layers.imaging import coverage_weighted
+from spectrinsic.gt_export.layers.intrinsics import (
+    clipping_of,
+    from_denoised,
+    intrinsic_layers,
+    noise_of,
+    srgb_of,
+    srgb_white,
+    white_radiance,
+)
+from spectrinsic.gt_export.layers.lights import light_records, share_layers
+from spectrinsic.gt_export.layers.records import (
+    RGB,
+    GroundTruth,
+    RenderRecord,
+    SampleInputs,
+    aov,
+    camera_key,
+    cube_sensor_name,
+    grid,
+    make_layer,
+    reference_mode,
+)
+from spectrinsic.gt_export.layers.spectral import camera_curves
+from spectrinsic.scenes.model import Scene
+from spectrinsic.spectra import absolute_reflectance, get_sensors, get_spectrum
+
+# Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
+
+__all__ = ["compute_ground_truth", "identities"]
+
+
+def _sample(scene: Scene, result: Any, data_dir: Any) -> SampleInputs:
+    wl = grid()
+    rho = (np.stack([get_spectrum(m.spectrum, data_dir=data_dir).on(wl) for m in scene.materials])
+           if scene.materials else np.zeros((0, wl.size)))
+    return SampleInputs(scene, result, reference_mode(result), wl, rho,
+                   get_spectrum("cie:D65").on(wl), data_dir)
+
+
+def compute_ground_truth(
+    scene: Scene,
+    result: RenderRecord,
+    *,
+    cameras: Sequence[str] = (),
+    write_cube: bool = False,
+    denoise: bool = False,
+    denoise_quality: str = "fast",
+    data_dir: Any = None,
+    training: np.ndarray | None = None,
+) -> GroundTruth:
+    """Compute every ground-truth layer of one rendered sample.
+
+    Parameters
+    ----------
+    scene
+        The scene that was rendered (names every material and light spectrum).
+    result
+        The render (:class:`RenderRecord`).
+    cameras
+        Sensor-set names (``"camera:Nikon 5100 (NPL)"``); each adds an image integrated from
+        the 31-band cube, a relative reflectance, shading, residual and illuminant in that
+        camera's RGB.
+    write_cube
+        Add the raw multispectral cube as layer ``cube``.
+    denoise
+        Denoise the white-surface radiance with OIDN (:mod:`~spectrinsic.gt_export.denoise`):
+        ``shading``, ``residual``, ``illuminant``, ``shading_grey`` and the camera shading
+        come from it, ``image_denoised = reflectance ∘ shading + residual`` is rebuilt from it,
+        and the raw ``shading_raw``/``residual_raw`` are kept beside ``image``.
+    denoise_quality
+        OIDN quality, ``"fast"`` (the dataset's, :data:`~spectrinsic.gt_export.denoise.DENOISE_QUALITY`)
+        or ``"high"``.
+    training
+        ``(N, 471)`` reflectances on the 1 nm grid for the matrix fits (default: all Munsell chips).
+    """
+    s = _sample(scene, result, data_dir)
+    layers = image_layers(s)
+    image = layers[0].data.astype(np.float64)
+    coverage, mask = coverage_of(s, (image.shape[0], image.shape[1]))
+    layers += geometry_layers(s, mask)
+    names = [m.spectrum for m in scene.materials]
+    reflectance = coverage_weighted(
+        coverage, absolute_reflectance(names, data_dir=data_dir) if names else np.zeros((0, 3)))
+    layers.append(make_layer("reflectance", reflectance, RGB,
+                         "dimensionless absolute reflectance, linear sRGB under D65 (perfect white = 1); "
+                         "box-filtered by pixel coverage, 0 for background", "intrinsics"))
+    w_raw = white_radiance(s, coverage)
+    w = w_raw
+    if denoise:
+        w = denoise_white_radiance(w_raw, aov(result, "normals"), quality=denoise_quality)
+    layers += intrinsic_layers(s, w_raw, w, image, reflectance, denoised=denoise)
+    noise_maps, noise = noise_of(s, w_raw)
+    light_maps, shares = share_layers(s, w, mask)
+    layers += noise_maps + light_maps
+    spaces: dict[str, np.ndarray] = {"srgb": get_sensors("srgb").on(s.wl)}
+    spaces.update({cam: camera_curves(cam, s.wl, data_dir=data_dir) for cam in cameras})
+    if cameras and "bands31" not in result.raw:
+        raise DatasetError(
+            "camera images need the 31-band cube (render mode 'bands31'); render it or pass cameras=()"
+        )
+    for cam in cameras:
+        layers += camera_layers(s, cam, spaces[cam], coverage, w, denoised=denoise)
+    cube_name = cube_sensor_name(result) if "bands31" in result.raw else None
+    if write_cube:
+        layers.append(cube_layer(s, cube_name))
+    return GroundTruth(
+        layers={layer.name: layer for layer in layers},
+        lights=light_records(s, shares, spaces, cameras),
+        materials={str(i): n for i, n in enumerate(names)},
+        matrices=matrices_of(s, shares, spaces, training),
+        reference_mode=s.ref,
+        cameras=tuple(cameras),
+        cube_sensors=cube_name,
+        denoised=tuple(sorted(layer.name for layer in layers if denoise and from_denoised(layer.name))),
+        noise=noise,
+        clipping=clipping_of(srgb_of(w) / srgb_white(s), w.valid & (irr.luminance_of(w) > 0)),
+    )
+
+
+def identities(gt: GroundTruth) -> list[dict[str, str]]:
+    """The exact identities the layers satisfy: ``image = reflectance ∘ shading + residual``
+    per sensor space (and on the raw layers when denoised); recorded in ``meta.json``."""
+    out = []
+    denoised = "image_denoised" in gt.layers
+    out.append({"image": "image_denoised" if denoised else "image", "reflectance": "reflectance",
+                "shading": "shading", "residual": "residual"})
+    if denoised:
+        out.append({"image": "image", "reflectance": "reflectance", "shading": "shading_raw",
+                    "residual": "residual_raw"})
+    for cam in gt.cameras:
+        key = camera_key(cam)
+        image = f"image_camera_denoised/{key}" if denoised else f"image_camera/{key}"
+        out.append({"image": image, "reflectance": f"reflectance_camera/{key}",
+                    "shading": f"shading_camera/{key}", "residual": f"residual_camera/{key}"})
+    return out

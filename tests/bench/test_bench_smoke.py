@@ -1,0 +1,38 @@
+"""``make bench`` at the tiniest size: every step of the render and decomposer benchmarks runs
+and writes the JSON it promises (the numbers are meaningless at this size; ``make bench``
+measures them)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from spectrinsic import bench
+from spectrinsic.bench import decompose as bench_decompose
+from spectrinsic.bench import render as bench_render
+
+
+@pytest.fixture
+def tiny(monkeypatch):
+    """The benchmarks' sizes cut to a few pixels and samples."""
+    for name, value in {"SIZE": 8, "SPP": 1, "OVERHEAD_SIZE": 8, "OVERHEAD_SPP": 1, "REPEATS": 1,
+                        "TRUTH_FACTOR": 2}.items():
+        monkeypatch.setattr(bench_render, name, value)
+    monkeypatch.setattr(bench_decompose, "SIZE", 32)  # LMSE needs a 20-pixel window
+
+
+@pytest.mark.slow
+def test_render_and_decompose_benchmarks_write_their_results(tiny, tmp_path, capsys):
+    assert bench.main(["--out", str(tmp_path), "--only", "render", "decompose"]) == 0
+    render = json.loads((tmp_path / "bench_render.json").read_text())
+    assert set(render["passes"]) == set(bench_render.MODES) | {"aovs"}
+    assert render["passes"]["bands31"] == 11 and render["passes"]["rgb3"] == 1
+    assert all(v > 0 for v in render["seconds_per_pass"].values())
+    assert render["equal_time"]["bands31_spp"] == 1 and "8x8" in render["scene"]
+    decomposers = json.loads((tmp_path / "bench_decompose.json").read_text())
+    assert {"names-shades", "colour-retinex"} <= set(decomposers["methods"])
+    assert all(m["reflectance_lmse"] >= 0 for m in decomposers["methods"].values())
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert set(summary) == {"bench_render", "bench_decompose"}
+    assert "bench_render:" in capsys.readouterr().out

@@ -1,0 +1,46 @@
+"""Eq. 3.10's bounded least squares: the active-set solver against scipy's bounded LSMR."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from scipy.optimize import lsq_linear
+
+from spectrinsic.decompose.coherence import bounded_minimum, global_coherence
+
+
+def _ratio_rows(rng, n: int, n_pairs: int) -> sp.csr_matrix:
+    """Rows ``s (a_i x_i - a_j x_j)`` with positive ``a``, as global_coherence builds them."""
+    i = rng.integers(0, n, n_pairs)
+    j = (i + rng.integers(1, n, n_pairs)) % n
+    a_i, a_j, s = rng.uniform(0.05, 1.0, (3, n_pairs))
+    rows = np.repeat(np.arange(n_pairs), 2)
+    cols = np.stack([i, j], axis=1).ravel()
+    vals = np.stack([s * a_i, -s * a_j], axis=1).ravel()
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n_pairs, n))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_active_set_reaches_the_bounded_least_squares_minimum(seed):
+    rng = np.random.default_rng(seed)
+    a = _ratio_rows(rng, n=60, n_pairs=150)
+    ours = bounded_minimum(a)
+    ref = lsq_linear(a.toarray(), np.zeros(a.shape[0]), bounds=(1.0, np.inf), method="bvls",
+                     tol=1e-14, max_iter=10000).x
+    assert ours.min() >= 1.0 - 1e-12
+    assert np.sum((a @ ours) ** 2) <= np.sum((a @ ref) ** 2) * (1 + 1e-9) + 1e-15
+    np.testing.assert_allclose(ours, ref, rtol=1e-6)
+
+
+def test_a_region_without_neighbours_keeps_scale_one():
+    rng = np.random.default_rng(3)
+    a = sp.hstack([_ratio_rows(rng, n=10, n_pairs=30), sp.csr_matrix((30, 1))]).tocsr()
+    assert bounded_minimum(a)[-1] == 1.0
+
+
+def test_coherence_scales_a_two_region_image_to_the_image_ratio():
+    regions = np.array([[1, 1, 2, 2]] * 3)
+    image = np.where(regions == 1, 0.2, 0.8)
+    lam = global_coherence(regions, np.array([0.0, 0.5, 0.5]), image)
+    assert lam[2] / lam[1] == pytest.approx(4.0, rel=1e-9) and lam[1:].min() == 1.0

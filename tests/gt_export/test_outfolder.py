@@ -1,0 +1,142 @@
+"""One --out rule for every writing verb, and the advisory lock that keeps two runs apart
+(issue 17, items 3 and 4). The lock is tested with a second process holding it."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from spectrinsic.cli import main
+from spectrinsic.errors import DatasetError, FolderLockedError
+from spectrinsic.gt_export.outfolder import (
+    LOCK_NAME,
+    OUTPUT_MARKER,
+    check_output_folder,
+    folder_lock,
+    output_folder,
+)
+
+#: Longest wait for the helper process to take the lock, seconds.
+HOLDER_START_S = 60.0
+
+
+def _marker(out: Path) -> dict:
+    return json.loads((out / OUTPUT_MARKER).read_text())
+
+
+def test_an_output_folder_records_what_it_wrote_and_accepts_itself_again(tmp_path):
+    out = tmp_path / "results"
+    with output_folder(out):
+        (out / "a.csv").write_text("x")
+        (out / "figures").mkdir()
+        (out / "figures" / "b.png").write_bytes(b"png")
+        assert _marker(out)["writing"]["pid"] == os.getpid()  # says a run is writing
+    assert _marker(out) == {"spectrinsic_output": 1, "files": ["a.csv", "figures/b.png"], "writing": None}
+    assert not (out / LOCK_NAME).exists()
+    check_output_folder(out)  # its own folder: a second run may write again
+    with output_folder(out):
+        (out / "c.json").write_text("{}")
+    assert _marker(out)["files"] == ["a.csv", "c.json", "figures/b.png"]
+
+
+def test_a_users_file_in_an_own_folder_stops_the_next_run_and_is_kept(tmp_path):
+    out = tmp_path / "results"
+    with output_folder(out):
+        (out / "a.csv").write_text("x")
+    (out / "figures").mkdir()
+    (out / "figures" / "mine.txt").write_text("mine")
+    with pytest.raises(DatasetError, match="figures/mine.txt"):
+        check_output_folder(out)
+    assert (out / "figures" / "mine.txt").read_text() == "mine"
+
+
+def test_files_written_before_an_interrupt_are_recorded(tmp_path):
+    out = tmp_path / "results"
+    with pytest.raises(KeyboardInterrupt), output_folder(out):
+        (out / "half.csv").write_text("x")
+        raise KeyboardInterrupt
+    assert _marker(out)["files"] == ["half.csv"] and _marker(out)["writing"] is None
+    check_output_folder(out)
+
+
+def test_nested_own_folders_are_not_foreign(tmp_path):
+    """``study --out results`` beside ``evaluate --out results/evaluation``."""
+    with output_folder(tmp_path / "results" / "evaluation"):
+        (tmp_path / "results" / "evaluation" / "scores.csv").write_text("x")
+    with output_folder(tmp_path / "results"):
+        (tmp_path / "results" / "photometric.json").write_text("{}")
+    assert _marker(tmp_path / "results")["files"] == ["photometric.json"]
+
+
+def test_a_refused_run_under_the_lock_leaves_no_folder(tmp_path):
+    with pytest.raises(RuntimeError), folder_lock(tmp_path / "a" / "b"):
+        raise RuntimeError("refused")
+    assert list(tmp_path.iterdir()) == []
+
+
+def _hold_lock(folder: Path) -> subprocess.Popen:
+    """A second process holding *folder*'s lock until its stdin closes."""
+    code = ("import sys; from pathlib import Path; from spectrinsic.gt_export.outfolder import folder_lock\n"
+            f"with folder_lock(Path({str(folder)!r})):\n"
+            "    print('held', flush=True); sys.stdin.read()\n")
+    proc = subprocess.Popen([sys.executable, "-P", "-c", code], stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + HOLDER_START_S
+    assert proc.stdout is not None and proc.stdout.readline().strip() == "held"
+    assert time.monotonic() < deadline
+    return proc
+
+
+def _release(proc: subprocess.Popen) -> None:
+    assert proc.stdin is not None
+    proc.stdin.close()
+    assert proc.wait(timeout=HOLDER_START_S) == 0
+
+
+def test_a_second_process_is_refused_with_the_holders_pid_host_and_start(tmp_path):
+    folder = tmp_path / "ds"
+    proc = _hold_lock(folder)
+    try:
+        with pytest.raises(FolderLockedError) as info, folder_lock(folder):
+            pass
+        message = str(info.value)
+        assert f"pid {proc.pid} on " in message and "started 20" in message and "UTC" in message
+    finally:
+        _release(proc)
+    with folder_lock(folder):  # released when the holder ended
+        pass
+
+
+@pytest.mark.parametrize("verb", ["dataset", "export", "render", "study"])
+def test_every_writing_verb_refuses_a_held_folder_in_one_line_before_any_work(tmp_path, capsys, verb):
+    out = tmp_path / "out"
+    proc = _hold_lock(out)
+    try:
+        argv = {
+            "dataset": ["dataset", "--preset", "preview", "--resolution", "16x16", "--spp", "2",
+                        "--only", "obj-apple__v0__white"],
+            "export": ["export", str(_dataset(tmp_path))],
+            "render": ["render", "obj-apple", "--width", "16", "--height", "16"],
+            "study": ["study", "reconstruction-error"],
+        }[verb]
+        rc = main(["-q", *argv, "--out", str(out)])
+        err = capsys.readouterr().err.strip()
+    finally:
+        _release(proc)
+    assert rc == 2 and len(err.splitlines()) == 1, err
+    assert "in use by another spectrinsic run" in err and f"pid {proc.pid}" in err
+    assert not out.exists()  # the holder removed its lock file and folder; the refused run made nothing
+
+
+def _dataset(tmp: Path) -> Path:
+    """A folder export takes as a dataset (a manifest) without any sample."""
+    root = tmp / "ds"
+    root.mkdir()
+    (root / "manifest.json").write_text(json.dumps({"format_version": 1, "config_hash": "h"}))
+    return root
