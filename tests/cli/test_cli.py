@@ -42,7 +42,7 @@ def test_every_registered_command_has_help():
     of this test, ``description or format_help()``, could not fail: format_help is never empty)."""
     parser = build_parser()
     sub = next(a for a in parser._actions if a.dest == "command")
-    assert set(sub.choices) == {"info", "render", "dataset", "check", "export", "study", "evaluate"}
+    assert set(sub.choices) == {"info", "render", "dataset", "check", "export", "study", "evaluate", "list"}
     listed = {a.dest: a.help for a in sub._choices_actions}
     for name, p in sub.choices.items():
         assert listed.get(name), f"{name}: no help line in `spectrinsic --help`"
