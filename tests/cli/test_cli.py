@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 
@@ -86,3 +87,17 @@ def test_render_reads_a_mesh_file_as_dataset_scenes_does(tmp_path, capsys):
     assert [m["spectrum"] for m in meta["scene"]["materials"]] == ["munsell:5R 4/14"]
     assert (meta["scene"]["camera"]["width"], meta["scene"]["camera"]["height"]) == (8, 6)
     assert (out / "rgb3.exr").is_file()
+
+
+@pytest.mark.parametrize(("integrator", "diagonal_passes"), [("passes", 1 + 11), ("single", 0)])
+def test_render_integrator_option_reaches_the_render(tmp_path, capsys, integrator, diagonal_passes):
+    """``--integrator`` is a render setting: the passes render rgb3 in 1 pass and bands31 in 11;
+    the traversal renders both (and the AOVs) in one, reported on its own line."""
+    out = tmp_path / integrator
+    rc = main(["-q", "render", "obj-box", "--out", str(out), "--modes", "rgb3,bands31", "--spp", "1",
+               "--width", "8", "--height", "8", "--integrator", integrator])
+    assert rc == 0
+    meta = json.loads((out / "meta.json").read_text())
+    assert meta["integrator"] == integrator
+    assert meta["timings"]["rgb3"]["passes"] + meta["timings"]["bands31"]["passes"] == diagonal_passes
+    assert ("traversal" in capsys.readouterr().out) == (integrator == "single")
