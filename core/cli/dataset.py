@@ -17,6 +17,7 @@ from spectrinsic.pipeline.executors import check_scheduler, choose_executor
 from spectrinsic.pipeline.presets import PRESETS, DatasetConfig, get_preset, preset_names
 from spectrinsic.pipeline.sources import files_source, generator_source
 from spectrinsic.render.budget import check_render_size
+from spectrinsic.render.settings import INTEGRATORS
 from spectrinsic.scenes.sources import FileSource
 from spectrinsic.scenes.yaml_limits import load_yaml_file
 from spectrinsic.spectra import get_spectrum
@@ -114,6 +115,9 @@ def _add_quality_options(p: Any) -> None:
                    help="cap of the adaptive batches (default 4 x batches)")
     p.add_argument("--direct", action="store_true",
                    help="also render direct light only, to record the energy ratio r per sample")
+    p.add_argument("--integrator", choices=INTEGRATORS, default=None,
+                   help="diagonal modes from one traversal (single, the default) or the passes; "
+                        "same pixels to float rounding, so not part of the config hash")
     p.add_argument("--no-denoise", action="store_true",
                    help="keep shading from the raw Monte Carlo irradiance (no OIDN)")
     p.add_argument(
@@ -196,6 +200,8 @@ def _overrides(args: argparse.Namespace) -> dict[str, Any]:
         changes["noise_target"] = args.noise_target
     if args.max_batches is not None:
         changes["max_batches"] = args.max_batches
+    if args.integrator is not None:
+        changes["integrator"] = args.integrator
     if args.resolution is not None:
         w, sep, h = args.resolution.lower().partition("x")
         if not (sep and w.isdigit() and h.isdigit() and int(w) > 0 and int(h) > 0):

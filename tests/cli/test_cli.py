@@ -9,6 +9,7 @@ import sys
 import pytest
 
 from spectrinsic.cli import build_parser, main
+from spectrinsic.cli.dataset import config_from_args
 
 
 def test_help_lists_commands(capsys):
@@ -101,3 +102,13 @@ def test_render_integrator_option_reaches_the_render(tmp_path, capsys, integrato
     assert meta["integrator"] == integrator
     assert meta["timings"]["rgb3"]["passes"] + meta["timings"]["bands31"]["passes"] == diagonal_passes
     assert ("traversal" in capsys.readouterr().out) == (integrator == "single")
+
+
+def test_dataset_integrator_option_is_a_render_setting_outside_the_hash(tmp_path):
+    """``dataset --integrator passes`` reaches every sample's render settings; the config hash
+    (which decides whether a folder's samples are reused) is the default's."""
+    parse = build_parser().parse_args
+    default = config_from_args(parse(["dataset", "--out", str(tmp_path)]))
+    passes = config_from_args(parse(["dataset", "--out", str(tmp_path), "--integrator", "passes"]))
+    assert (default.render.integrator, passes.render.integrator) == ("single", "passes")
+    assert passes.config_hash() == default.config_hash()
