@@ -11,6 +11,9 @@ Nothing is imported from Mitsuba when this package is imported; variants are cho
 - :mod:`~spectrinsic.render.passes`: the passes themselves, for any sensor set.
 - :mod:`~spectrinsic.render.transport`: each light's band transport (:func:`render_transport`)
   and renders under any light spectra composed from it, for exact relighting.
+- :mod:`~spectrinsic.render.single` and :mod:`~spectrinsic.render.integrator`: every diagonal
+  mode, band and light in one path traversal (``RenderSettings(integrator="single")``, the
+  default), with the per-light band transport (``RenderResult.transport``).
 - :func:`scene_to_mitsuba`: the one translation of a scene into a Mitsuba dict.
 """
 

@@ -33,6 +33,7 @@ __all__ = [
     "render_spectral",
     "render_aovs",
     "AOV_NAMES",
+    "assemble_aovs",
 ]
 
 logger = logging.getLogger(__name__)
@@ -340,7 +341,7 @@ def render_aovs(
                 depth_sum, normal_sum = image[..., 0].astype(np.float64), image[..., 1:4].astype(np.float64)
             block = surfaces[3 * p: 3 * p + 3]
             cover[..., 3 * p: 3 * p + len(block)] = image[..., 4: 4 + len(block)]
-    return _assemble_aovs(scene, surfaces, cover, depth_sum, normal_sum), tuple(seconds)
+    return assemble_aovs(scene, surfaces, cover, depth_sum, normal_sum), tuple(seconds)
 
 
 def _majority(coverage: np.ndarray) -> np.ndarray:
@@ -352,13 +353,16 @@ def _majority(coverage: np.ndarray) -> np.ndarray:
     return np.where(winner == coverage.shape[-1], -1, winner).astype(np.int32)
 
 
-def _assemble_aovs(
+def assemble_aovs(
     scene: Scene,
     surfaces: Sequence[tr.Surface],
     cover: np.ndarray,
     depth_sum: np.ndarray | None,
     normal_sum: np.ndarray | None,
 ) -> dict[str, np.ndarray]:
+    """The maps :func:`render_aovs` returns, from the box-filtered per-surface coverage
+    ``(H, W, S)``, ray distance ``(H, W)`` and shading normal ``(H, W, 3)`` of the camera rays'
+    first hits (0 where they miss)."""
     h, w = cover.shape[:2]
     n_mat = len(scene.materials)
     material_cov = np.zeros((h, w, n_mat))

@@ -27,6 +27,7 @@ from spectrinsic.render.passes import (
 )
 from spectrinsic.render.result import RenderResult
 from spectrinsic.render.settings import DEFAULT_MODES, RenderSettings
+from spectrinsic.render.single import SingleTraversal, render_jobs, resolve_integrator
 from spectrinsic.render.translate import prepare_geometry, surfaces
 from spectrinsic.render.variants import choose_variant, import_mitsuba, variant_scope
 from spectrinsic.rng import seed_from_key
@@ -73,12 +74,18 @@ def count_passes(scene: Scene, settings: RenderSettings, *, data_dir: str | None
     wanted = _direct_modes(direct, objs)
     split = per_light and per_light_modes is not None
     groups = len(scene.lights) if per_light and not split else 1
-    colour = sum(n_passes(m, data_dir=data_dir) * (2 if m.name in wanted else 1) for m in objs)
     share_modes = _modes(per_light_modes) if per_light and per_light_modes is not None else []
+    single = resolve_integrator(settings.integrator, settings.variant) == "single" and any(
+        m.kind == "diagonal" for m in objs + share_modes)
+    diagonal = 0
+    if single:  # every diagonal mode and the AOVs: one traversal (+1 direct-only)
+        diagonal = 1 + any(m.kind == "diagonal" and m.name in wanted for m in objs)
+        objs, share_modes = [m for m in objs if m.kind != "diagonal"], [m for m in share_modes if m.kind != "diagonal"]
+    colour = sum(n_passes(m, data_dir=data_dir) * (2 if m.name in wanted else 1) for m in objs)
     shares = sum(n_passes(m, data_dir=data_dir) for m in share_modes)
 
-    aov_passes = max(1, -(-len(surfaces(scene)) // 3)) if aovs else 0
-    return groups * colour + len(scene.lights) * shares + aov_passes
+    aov_passes = max(1, -(-len(surfaces(scene)) // 3)) if aovs and not single else 0
+    return diagonal + groups * colour + len(scene.lights) * shares + aov_passes
 
 
 def _sum_direct(parts: Sequence[np.ndarray | None]) -> np.ndarray:
@@ -102,13 +109,16 @@ class _Job:
 def _run_jobs(
     scene: Scene, jobs: Sequence[_Job], *, wanted: set[str], spp: int, seed: int, max_depth: int,
     variant: str | None, aovs: bool, progress: PassProgress | None, data_dir: str | None,
-) -> tuple[list[dict[str, PassOutput]], dict[str, np.ndarray], tuple[float, ...]]:
+    integrator: str = "passes",
+) -> tuple[list[dict[str, PassOutput]], dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
     """Every pass of *jobs*, grouped by Mitsuba variant, plus the AOVs.
 
     Each switch between the RGB and the spectral variant reloads Mitsuba's Python modules
     (~0.1 s), so every RGB-variant pass (all diagonal modes of every job, then the AOVs) runs in
     one scope and every spectral pass in another. Passes do not depend on each other's order:
-    each sets its own values, seed and spp.
+    each sets its own values, seed and spp. With ``integrator="single"`` the diagonal modes of
+    every job come from one band-path traversal
+    (:func:`spectrinsic.render.single.render_jobs`).
     """
     geometry = prepare_geometry(scene)
     outputs: list[dict[str, PassOutput]] = [{} for _ in jobs]
@@ -116,10 +126,20 @@ def _run_jobs(
     aov_seconds: tuple[float, ...] = ()
     common: dict[str, Any] = dict(spp=spp, seed=seed, max_depth=max_depth, progress=progress,
                                   geometry=geometry)
-    if aovs or any(m.kind == "diagonal" for job in jobs for m in job.modes):
+    single = SingleTraversal({}, ())
+    if not any(m.kind == "diagonal" for job in jobs for m in job.modes):
+        integrator = "passes"  # nothing to trace: the AOVs come from their own passes
+    if aovs or integrator == "single" or any(m.kind == "diagonal" for job in jobs for m in job.modes):
         rgb_variant = choose_variant("rgb", variant)
         with variant_scope(rgb_variant):
-            for out, job in zip(outputs, jobs, strict=True):
+            if integrator == "single":
+                parts, single = render_jobs(
+                    scene, [(j.modes, j.group, j.with_direct) for j in jobs], wanted=wanted,
+                    variant=rgb_variant, data_dir=data_dir, aovs=aovs, **common)
+                aov_maps = single.aovs
+                for out, part in zip(outputs, parts, strict=True):
+                    out.update(part)
+            for out, job in zip(outputs, jobs, strict=True) if integrator == "passes" else ():
                 diagonal = [m for m in job.modes if m.kind == "diagonal"]
                 if not diagonal:
                     continue
@@ -129,7 +149,7 @@ def _run_jobs(
                     scene, values, direct=[job.with_direct and m.name in wanted for m in diagonal],
                     active_lights=job.group, variant=rgb_variant, **common,
                 ), strict=True))
-            if aovs:
+            if aovs and integrator == "passes":
                 aov_maps, aov_seconds = render_aovs(scene, spp=spp, seed=seed, variant=rgb_variant,
                                                     progress=progress, geometry=geometry)
     if any(m.kind == "spectral" for job in jobs for m in job.modes):
@@ -143,7 +163,7 @@ def _run_jobs(
                         active_lights=job.group, variant=spectral_variant, data_dir=data_dir,
                         **common,
                     )
-    return outputs, aov_maps, aov_seconds
+    return outputs, aov_maps, aov_seconds, single
 
 
 def render_scene(
@@ -167,7 +187,11 @@ def render_scene(
     ----------
     settings
         Modes, samples, path depth, variant, per-light, direct and AOV choices
-        (:class:`~spectrinsic.render.settings.RenderSettings`).
+        (:class:`~spectrinsic.render.settings.RenderSettings`), and the integrator of the
+        diagonal modes: ``"passes"``, ⌈K/3⌉ RGB passes per mode and one scene per light;
+        ``"single"`` (default), one traversal for every diagonal mode, band and light
+        (:mod:`spectrinsic.render.single`): the same images to float rounding, per-light
+        images that are exact shares of the full render, and ``RenderResult.transport``.
     seed
         Sampler seed, shared by every pass.
     progress
@@ -182,15 +206,16 @@ def render_scene(
                                               settings.variant)
     objs = _modes(modes)
     wanted = _direct_modes(direct, objs)
+    integrator = resolve_integrator(settings.integrator, variant)
     matrices = {m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in objs}
     lights = [[j] for j in range(len(scene.lights))]
     split = per_light and per_light_modes is not None
     share = _modes(per_light_modes) if per_light and per_light_modes is not None else []
     main = [_Job(tuple(objs), g) for g in (lights if per_light and not split else [None])]
     jobs = main + [_Job(tuple(share), g, with_direct=False) for g in lights] if split else main
-    outputs, aov_maps, aov_seconds = _run_jobs(
+    outputs, aov_maps, aov_seconds, single = _run_jobs(
         scene, jobs, wanted=wanted, spp=spp, seed=seed, max_depth=max_depth, variant=variant,
-        aovs=aovs, progress=progress, data_dir=data_dir,
+        aovs=aovs, progress=progress, data_dir=data_dir, integrator=integrator,
     )
     main_out, share_out = outputs[:len(main)], outputs[len(main):]
     timings: dict[str, list[float]] = {m.name: [] for m in objs + share}
@@ -215,12 +240,16 @@ def render_scene(
     }
     if aovs:
         timings["aovs"] = list(aov_seconds)
+    if single.seconds:
+        timings["single"] = list(single.seconds)
     meta = _render_meta(scene, objs, matrices, variants, timings, spp=spp, seed=seed,
                         max_depth=max_depth, per_light=per_light, wanted=wanted, data_dir=data_dir)
     meta["per_light_modes"] = [m.name for m in share] if split else (names if per_light else [])
+    meta["integrator"] = integrator
     logger.debug("rendered %s: %s", scene.name, {k: v["seconds"] for k, v in meta["timings"].items()})
     return RenderResult(images=images, raw=raw, per_light=per_light_images, direct=direct_images,
-                        aovs=aov_maps, meta=meta)
+                        aovs=aov_maps, meta=meta,
+                        transport={n: t.transport for n, t in single.transport.items()})
 
 
 def _render_meta(
@@ -380,6 +409,7 @@ def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
                         for i, pl in enumerate(first.per_light)),
         direct={m: _mean([r.direct[m] for r in results]) for m in first.direct},
         aovs=_merge_aovs([r.aovs for r in results]),
+        transport={m: _mean([r.transport[m] for r in results]) for m in first.transport},
         meta=meta,
         batch_raw=tuple(dict(r.raw) for r in results),
     )

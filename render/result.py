@@ -42,6 +42,11 @@ class RenderResult:
         float32 raw channels of that batch alone; ``raw`` is their mean. Empty for a single
         batch. Inside a batch every mode shares its paths; batches have independent seeds, so
         their spread measures the Monte Carlo noise.
+    transport
+        With the single-traversal integrator, mode -> ``(L, H, W, K)`` float32 per-light band
+        transport for unit emission (:class:`spectrinsic.render.single.TransportOutput`):
+        ``raw[mode][..., k] = Σ_l E_{l,k} transport[mode][l, ..., k]``, with E the lights'
+        channel values (:func:`spectrinsic.render.modes.channel_values`). Empty otherwise.
     """
 
     images: dict[str, np.ndarray]
@@ -51,6 +56,7 @@ class RenderResult:
     aovs: dict[str, np.ndarray] = field(default_factory=dict)
     meta: dict[str, Any] = field(default_factory=dict)
     batch_raw: tuple[dict[str, np.ndarray], ...] = ()
+    transport: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def shape(self) -> tuple[int, int]:

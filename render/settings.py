@@ -14,11 +14,18 @@ from typing import Any
 
 from spectrinsic.errors import RenderError
 
-__all__ = ["DEFAULT_MODES", "RenderSettings"]
+__all__ = ["DEFAULT_INTEGRATOR", "DEFAULT_MODES", "INTEGRATORS", "RenderSettings"]
 
 #: Every colour mode: the spectral Monte Carlo reference and the 3-, 6- and 31-channel
 #: diagonal renders (:data:`spectrinsic.render.modes.RENDER_MODES`).
 DEFAULT_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
+#: How the diagonal modes are rendered: ``"passes"``, ⌈K/3⌉ RGB passes per mode and one scene
+#: per light (:mod:`spectrinsic.render.passes`); ``"single"``, every diagonal mode, band and
+#: light from one path traversal (:mod:`spectrinsic.render.single`).
+INTEGRATORS: tuple[str, ...] = ("passes", "single")
+#: The traversal: the same images to float rounding, per-light images that are exact shares
+#: of the full render, fewer Mitsuba passes.
+DEFAULT_INTEGRATOR = "single"
 
 
 def _positive(name: str, value: Any) -> None:
@@ -62,6 +69,11 @@ class RenderSettings:
         is above this fraction (e.g. 0.02), up to *max_batches*.
     max_batches
         Cap of the adaptive batches (``None``: ``4 * batches``).
+    integrator
+        How the diagonal modes are rendered, one of :data:`INTEGRATORS`; ``"single"`` falls
+        back to ``"passes"`` on a scalar variant
+        (:func:`spectrinsic.render.single.resolve_integrator`). Not hashed by a dataset
+        config: both give the same pixels to float rounding.
 
     >>> s = RenderSettings(8, modes=("rgb3",), batches=2)
     >>> s.batch_spp, s.with_options(spp=16).batch_spp
@@ -83,6 +95,7 @@ class RenderSettings:
     batches: int = 1
     noise_target: float | None = None
     max_batches: int | None = None
+    integrator: str = DEFAULT_INTEGRATOR
 
     def __post_init__(self) -> None:
         # lists from JSON or the command line become tuples, so settings stay hashable records
@@ -102,6 +115,9 @@ class RenderSettings:
                                              or self.max_batches < self.batches):
             raise RenderError(f"render setting max_batches={self.max_batches!r}; expected an "
                               f"integer >= batches ({self.batches})")
+        if self.integrator not in INTEGRATORS:
+            raise RenderError(f"render setting integrator={self.integrator!r}; expected one of "
+                              f"{', '.join(INTEGRATORS)}")
 
     @property
     def batch_spp(self) -> int:

@@ -17,6 +17,7 @@ from spectrinsic.pipeline.executors import check_scheduler, choose_executor
 from spectrinsic.pipeline.presets import PRESETS, DatasetConfig, get_preset, preset_names
 from spectrinsic.pipeline.sources import files_source, generator_source
 from spectrinsic.render.budget import check_render_size
+from spectrinsic.render.settings import INTEGRATORS
 from spectrinsic.scenes.sources import FileSource
 from spectrinsic.scenes.yaml_limits import load_yaml_file
 from spectrinsic.spectra import get_spectrum
@@ -121,6 +122,9 @@ def _add_quality_options(p: Any) -> None:
     p.add_argument("--relight", type=int, default=None, metavar="N",
                    help="with --store-transport: also write N relit variants of every sample "
                         "(<id>-relitK, random light spectra, seeded)")
+    p.add_argument("--integrator", choices=INTEGRATORS, default=None,
+                   help="diagonal modes from one traversal (single, the default) or the passes; "
+                        "same pixels to float rounding, so not part of the config hash")
     p.add_argument("--no-denoise", action="store_true",
                    help="keep shading from the raw Monte Carlo irradiance (no OIDN)")
     p.add_argument(
@@ -186,34 +190,42 @@ def _source(args: argparse.Namespace) -> str | None:
     return None
 
 
+#: Options copied into the config as they are when given (option dest -> config key).
+_VALUE_OPTIONS: tuple[tuple[str, str], ...] = (
+    ("spp", "spp"), ("batches", "batches"), ("relight", "relight"), ("noise_target", "noise_target"),
+    ("max_batches", "max_batches"), ("integrator", "integrator"),
+)
+#: Switches and the config value each sets when given (option dest -> (config key, value)).
+_SWITCHES: tuple[tuple[str, str, bool], ...] = (
+    ("no_denoise", "denoise", False), ("direct", "direct", True),
+    ("store_transport", "store_transport", True),
+)
+
+
 def _overrides(args: argparse.Namespace) -> dict[str, Any]:
+    """The config changes the options ask for (getattr: ``render --ground-truth`` builds its
+    own namespace of dataset options, without some of them)."""
     changes: dict[str, Any] = {}
     source = _source(args)
     if source is not None:
         changes["source"] = source
-    if args.spp is not None:
-        changes["spp"] = args.spp
-    if args.batches is not None:
-        changes["batches"] = args.batches
-    if args.no_denoise:
-        changes["denoise"] = False
-    if args.direct:
-        changes["direct"] = True
-    # getattr: `render --ground-truth` builds its own namespace of dataset options
-    if getattr(args, "store_transport", False):
-        changes["store_transport"] = True
-    if getattr(args, "relight", None) is not None:
-        changes["relight"] = args.relight
-    if args.noise_target is not None:
-        changes["noise_target"] = args.noise_target
-    if args.max_batches is not None:
-        changes["max_batches"] = args.max_batches
+    for dest, key in _VALUE_OPTIONS:
+        if getattr(args, dest, None) is not None:
+            changes[key] = getattr(args, dest)
+    for dest, key, value in _SWITCHES:
+        if getattr(args, dest, False):
+            changes[key] = value
     if args.resolution is not None:
-        w, sep, h = args.resolution.lower().partition("x")
-        if not (sep and w.isdigit() and h.isdigit() and int(w) > 0 and int(h) > 0):
-            raise DatasetError(f"--resolution {args.resolution!r}; expected WIDTHxHEIGHT of positive integers, e.g. 256x256")
-        changes["width"], changes["height"] = int(w), int(h)
+        changes["width"], changes["height"] = _resolution(args.resolution)
     return changes
+
+
+def _resolution(text: str) -> tuple[int, int]:
+    """``WIDTHxHEIGHT`` as two positive integers."""
+    w, sep, h = text.lower().partition("x")
+    if not (sep and w.isdigit() and h.isdigit() and int(w) > 0 and int(h) > 0):
+        raise DatasetError(f"--resolution {text!r}; expected WIDTHxHEIGHT of positive integers, e.g. 256x256")
+    return int(w), int(h)
 
 
 def preflight(

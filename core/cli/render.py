@@ -36,6 +36,7 @@ from spectrinsic.render import (
 )
 from spectrinsic.render.budget import check_render_size
 from spectrinsic.render.modes import RENDER_MODES
+from spectrinsic.render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
 from spectrinsic.render.settings import DEFAULT_MODES as RENDER_DEFAULT_MODES
 from spectrinsic.scenes import library
 from spectrinsic.scenes.model import Scene, scene_to_dict
@@ -84,6 +85,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--per-light", action="store_true", help="also write one image per light")
     p.add_argument("--direct", action="store_true", help="also write direct-light-only images")
     p.add_argument("--no-aovs", action="store_true", help="skip coverage/id/depth/normal maps")
+    p.add_argument("--integrator", choices=INTEGRATORS, default=DEFAULT_INTEGRATOR,
+                   help="diagonal modes from one traversal (single) or K/3 passes per mode and "
+                        f"one scene per light (passes); same images (default: {DEFAULT_INTEGRATOR})")
     p.add_argument("--ground-truth", action="store_true",
                    help="write every ground-truth layer instead of raw passes: a one-sample dataset "
                         "built by the same path as `spectrinsic dataset --scenes` (uses --preset)")
@@ -188,7 +192,8 @@ def _render_settings(args: argparse.Namespace, modes: list[str]) -> RenderSettin
     """The render settings the options give (defaults: the default preset's spp and depth)."""
     spp = get_preset("default").render.spp if args.spp is None else args.spp
     return RenderSettings(spp, modes=tuple(modes), max_depth=args.max_depth, variant=args.variant,
-                          per_light=args.per_light, direct=args.direct, aovs=not args.no_aovs)
+                          per_light=args.per_light, direct=args.direct, aovs=not args.no_aovs,
+                          integrator=args.integrator)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -225,5 +230,8 @@ def run(args: argparse.Namespace) -> int:
     timings = result.meta["timings"]
     for mode in result.images:
         print(f"{mode:<9} {timings[mode]['passes']:>3} passes {timings[mode]['seconds']:7.2f} s  -> {paths[mode]}")
+    if "single" in timings:  # every diagonal mode (and the AOVs) from one traversal
+        print(f"{'traversal':<9} {timings['single']['passes']:>3} passes {timings['single']['seconds']:7.2f} s  "
+              "(all diagonal modes and lights)")
     print(f"wrote {paths['meta']}")
     return 0

@@ -37,7 +37,9 @@ _STANDARD_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
 #: Version of spectrinsic's own computation of pixels and ground truth. Bump it whenever a
 #: change alters any written value (a new or changed layer, formula, sampling or file layout),
 #: so existing datasets are rebuilt; a release that changes none keeps old datasets valid.
-PIXELS_VERSION = 2
+#: 3: diagonal modes from one band-path traversal; per-light images are shares of the full
+#: render (render/single.py), not one render per light.
+PIXELS_VERSION = 3
 #: What of the installed software changes pixels, hence enters the config hash, and how much
 #: of its version: the renderer exactly (its sampling changes between patch releases);
 #: colour-science's data tables (CMFs, illuminants, cameras) by minor release; numpy by major
@@ -62,9 +64,10 @@ def hashed_versions() -> dict[str, str]:
 #: 1-pass ``rgb3`` mode, and the AOVs the ground truth is computed from.
 DATASET_RENDER: dict[str, Any] = {"modes": _STANDARD_MODES, "per_light": True, "share_mode": "rgb3",
                                   "aovs": True}
-#: Settings of :class:`RenderSettings` a dataset config records (flat, beside its own).
+#: Settings of :class:`RenderSettings` a dataset config takes (flat, beside its own); all but
+#: ``integrator`` are recorded and hashed (:meth:`DatasetConfig.settings`).
 RENDER_KEYS: tuple[str, ...] = ("spp", "max_depth", "modes", "per_light", "direct", "batches",
-                                "share_mode", "noise_target", "max_batches", "variant")
+                                "share_mode", "noise_target", "max_batches", "variant", "integrator")
 
 
 @dataclass(frozen=True)

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 
 import pytest
 
 from spectrinsic.cli import _COMMANDS, build_parser, main
+from spectrinsic.cli.dataset import config_from_args
 
 
 def test_help_lists_commands(capsys):
@@ -87,3 +89,27 @@ def test_render_reads_a_mesh_file_as_dataset_scenes_does(tmp_path, capsys):
     assert [m["spectrum"] for m in meta["scene"]["materials"]] == ["munsell:5R 4/14"]
     assert (meta["scene"]["camera"]["width"], meta["scene"]["camera"]["height"]) == (8, 6)
     assert (out / "rgb3.exr").is_file()
+
+
+@pytest.mark.parametrize(("integrator", "diagonal_passes"), [("passes", 1 + 11), ("single", 0)])
+def test_render_integrator_option_reaches_the_render(tmp_path, capsys, integrator, diagonal_passes):
+    """``--integrator`` is a render setting: the passes render rgb3 in 1 pass and bands31 in 11;
+    the traversal renders both (and the AOVs) in one, reported on its own line."""
+    out = tmp_path / integrator
+    rc = main(["-q", "render", "obj-box", "--out", str(out), "--modes", "rgb3,bands31", "--spp", "1",
+               "--width", "8", "--height", "8", "--integrator", integrator])
+    assert rc == 0
+    meta = json.loads((out / "meta.json").read_text())
+    assert meta["integrator"] == integrator
+    assert meta["timings"]["rgb3"]["passes"] + meta["timings"]["bands31"]["passes"] == diagonal_passes
+    assert ("traversal" in capsys.readouterr().out) == (integrator == "single")
+
+
+def test_dataset_integrator_option_is_a_render_setting_outside_the_hash(tmp_path):
+    """``dataset --integrator passes`` reaches every sample's render settings; the config hash
+    (which decides whether a folder's samples are reused) is the default's."""
+    parse = build_parser().parse_args
+    default = config_from_args(parse(["dataset", "--out", str(tmp_path)]))
+    passes = config_from_args(parse(["dataset", "--out", str(tmp_path), "--integrator", "passes"]))
+    assert (default.render.integrator, passes.render.integrator) == ("single", "passes")
+    assert passes.config_hash() == default.config_hash()

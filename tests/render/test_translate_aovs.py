@@ -109,9 +109,11 @@ def test_plane_aovs(make_plane):
     assert float(aovs["depth"][0, 0]) > float(aovs["depth"][4, 4])
 
 
-def test_room_coverage_partitions_each_pixel(make_room):
+@pytest.mark.parametrize(("integrator", "coverage_passes"), [("passes", 3), ("single", 0)])
+def test_room_coverage_partitions_each_pixel(make_room, integrator, coverage_passes):
+    """From the coverage passes (3 for 7 surfaces) or the traversal's first hits (none)."""
     scene = make_room(size=16)
-    result = render_scene(scene, RenderSettings(32, modes=("rgb3",)), seed=2)
+    result = render_scene(scene, RenderSettings(32, modes=("rgb3",), integrator=integrator), seed=2)
     cov = result.aovs["coverage"]
     assert cov.shape == (16, 16, len(scene.materials))
     # a closed room: every sample hits a material or the (black) area light
@@ -124,7 +126,7 @@ def test_room_coverage_partitions_each_pixel(make_room):
     picked = np.take_along_axis(cov, np.maximum(ids, 0)[..., None], axis=-1)[..., 0]
     assert np.all(picked[inside] >= cov.max(axis=-1)[inside] - FLOAT32_ATOL)
     assert set(np.unique(result.aovs["object_id"])) <= {-1, 0, 1} and 1 in result.aovs["object_id"]
-    assert result.meta["timings"]["aovs"]["passes"] == 3
+    assert result.meta["timings"]["aovs"]["passes"] == coverage_passes
 
 
 def test_every_light_kind_of_the_scene_model_translates(make_plane):

@@ -29,7 +29,10 @@ def test_render_command_writes_named_float32_channels(tmp_path, capsys):
     np.testing.assert_array_equal(layers["raw"], layers["xyz"])
     meta = json.loads((out / "meta.json").read_text())
     assert meta["spp"] == 4 and meta["scene"]["metadata"]["condition"] == "two-colour-a"
-    assert meta["timings"]["bands31"]["passes"] == 22
+    # both modes, full and direct-only, and the AOVs: two traversals instead of 2 x (1 + 11)
+    # passes and the coverage passes
+    assert meta["integrator"] == "single" and meta["timings"]["single"]["passes"] == 2
+    assert meta["timings"]["bands31"]["passes"] == 0
     assert "bands31" in capsys.readouterr().out
 
 

@@ -1,0 +1,273 @@
+"""Every diagonal mode of one scene in a single path traversal, split by light.
+
+The counterpart of :func:`spectrinsic.render.passes.render_diagonal` (⌈K/3⌉ RGB passes per
+mode, one scene per light subset) built on the band-path integrator of
+:mod:`spectrinsic.render.integrator`: the bands of every value set are stacked into one table
+(K = 3 + 6 + 31 = 40 for the default modes) and traced once, with every light on. Because the
+passes trace identical paths (same seed and spp, Russian roulette off), the images are those of
+the passes to float rounding; each light's image is its exact share of that render (the
+per-light images sum to the total), not a separate render with the other lights removed.
+The coverage, ids, depth and normals of :func:`~spectrinsic.render.passes.render_aovs` come
+from the same traversal's camera rays (their first hits), so no coverage passes are needed.
+
+Cost, measured on ``room-living__v1__two-colour-a`` at the default preset (256², 2 batches of
+8 spp, 2 lights, 25 surfaces): see ``make bench`` (``bench_traversal.json``).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from spectrinsic.errors import RenderError, SceneError, validate_choice
+from spectrinsic.interrupts import raise_if_requested
+from spectrinsic.render import translate as tr
+from spectrinsic.render.integrator import BandTables, band_path, first_hit_channels
+from spectrinsic.render.modes import ChannelValues, RenderMode, channel_values
+from spectrinsic.render.passes import DIRECT_DEPTH, PassOutput, PassProgress, assemble_aovs
+from spectrinsic.render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
+from spectrinsic.render.variants import choose_variant, variant_scope
+from spectrinsic.scenes.model import Scene
+from spectrinsic.spectra import get_sensors
+
+__all__ = [
+    "TransportOutput",
+    "SingleTraversal",
+    "render_traversal",
+    "render_jobs",
+    "light_of_emitters",
+    "single_traversal_runs",
+    "resolve_integrator",
+]
+
+
+@dataclass(frozen=True, eq=False)
+class TransportOutput:
+    """Per-light band transport of one value set from one traversal.
+
+    Attributes
+    ----------
+    transport
+        ``(L, H, W, K)`` float32: light l's contribution to channel k for unit emission in
+        every band (``∫ radiance S_k`` per unit ``E_{l,k}``); the diagonal image is
+        ``Σ_l E_{l,k} · transport[l, ..., k]``.
+    direct
+        The same for direct light only (path depth 2), or ``None`` when not asked for.
+    emission
+        ``(L, K)`` float64 the lights' channel values ``E_{l,k}`` (:class:`ChannelValues`).
+    """
+
+    transport: np.ndarray
+    direct: np.ndarray | None
+    emission: np.ndarray
+
+    def per_light(self, *, direct: bool = False) -> np.ndarray:
+        """``(L, H, W, K)`` float32 each light's image: ``E_{l,k} · transport``."""
+        t = self.direct if direct else self.transport
+        if t is None:
+            raise RenderError("no direct-only transport was rendered")
+        return (t.astype(np.float64) * self.emission[:, None, None, :]).astype(np.float32)
+
+    def image(self, lights: Sequence[int] | None = None, *, direct: bool = False) -> np.ndarray:
+        """``(H, W, K)`` float32 image of the *lights* (default all): the sum of their shares."""
+        parts = self.per_light(direct=direct)
+        chosen = range(parts.shape[0]) if lights is None else [int(j) for j in lights]
+        return np.sum(parts[list(chosen)], axis=0, dtype=np.float64).astype(np.float32)
+
+
+def single_traversal_runs(variant: str | None) -> bool:
+    """Whether the band-path traversal runs with *variant*'s RGB variant: a JIT one (LLVM or
+    CUDA), where Dr.Jit traces it into one kernel. On a scalar variant a Python integrator
+    would run once per sample, so :func:`spectrinsic.render.render_scene` uses the passes."""
+    return not choose_variant("rgb", variant).startswith("scalar")
+
+
+def resolve_integrator(name: str | None, variant: str | None = None) -> str:
+    """*name* checked against :data:`~spectrinsic.render.settings.INTEGRATORS` (``None``:
+    :data:`~spectrinsic.render.settings.DEFAULT_INTEGRATOR`);
+    ``"passes"`` where the traversal does not run (:func:`single_traversal_runs`)."""
+    chosen = DEFAULT_INTEGRATOR if name is None else validate_choice(name, INTEGRATORS, "integrator", error=RenderError)
+    return chosen if chosen == "passes" or single_traversal_runs(variant) else "passes"
+
+
+def light_of_emitters(mi: Any, loaded: Any) -> dict[int, int]:
+    """``{emitter registry id: scene light index}`` of a scene translated by
+    :func:`~spectrinsic.render.translate.scene_to_mitsuba` (ids ``light_<i>``; an area
+    emitter is named by its rectangle)."""
+    import drjit as dr
+
+    emitters = list(loaded.emitters())
+    if not emitters:
+        return {}
+    ids = np.array(dr.reinterpret_array(mi.UInt32, mi.EmitterPtr(emitters)), np.int64)
+    out = {}
+    for eid, emitter in zip(ids, emitters, strict=True):
+        shape = emitter.get_shape()
+        key = shape.id() if shape is not None else emitter.id()
+        prefix = tr.light_key(0)[:-1]
+        if not key.startswith(prefix) or not key[len(prefix):].isdigit():
+            raise RenderError(f"emitter {key!r} is not one of the scene's lights ({prefix}<i>)")
+        out[int(eid)] = int(key[len(prefix):])
+    return out
+
+
+def _tables(scene: Scene, value_sets: Sequence[ChannelValues], emitters: dict[int, int], aovs: bool) -> BandTables:
+    bands = np.concatenate([np.asarray(v.materials, float) for v in value_sets], axis=1)
+    albedo = np.vstack([bands, np.zeros((1, bands.shape[1]))])  # last row: black
+    surfaces = tr.surfaces(scene)
+    rows = {s.key: s.material for s in surfaces if s.material >= 0}
+    return BandTables(albedo=albedo, shape_rows=rows, emitter_lights=emitters, n_lights=len(scene.lights),
+                      shape_surfaces={s.key: i for i, s in enumerate(surfaces)} if aovs else {})
+
+
+def _render(mi: Any, loaded: Any, integrator: Any, *, spp: int, seed: int, n: int) -> tuple[np.ndarray, float]:
+    raise_if_requested()  # Ctrl-C stops a build within one render
+    start = time.perf_counter()
+    try:
+        image = np.array(mi.render(loaded, spp=int(spp), seed=int(seed), integrator=integrator), dtype=np.float32)
+    except RuntimeError as exc:
+        raise_if_requested()  # Dr.Jit re-raises a Ctrl-C inside the render as RuntimeError
+        raise RenderError(f"Mitsuba render failed: {exc}") from exc
+    raise_if_requested()  # Mitsuba's own SIGINT handler may have cut the render short
+    if image.shape[-1] < n:
+        raise RenderError(f"band-path render returned {image.shape[-1]} channels; expected at least {n}")
+    return image[..., image.shape[-1] - n:], time.perf_counter() - start
+
+
+def render_traversal(
+    scene: Scene,
+    value_sets: Sequence[ChannelValues],
+    *,
+    spp: int,
+    seed: int,
+    max_depth: int = 8,
+    direct: bool = False,
+    aovs: bool = False,
+    variant: str | None = None,
+    progress: PassProgress | None = None,
+    geometry: Sequence[tr.SurfaceGeometry] | None = None,
+) -> tuple[list[TransportOutput], dict[str, np.ndarray], tuple[float, ...], str]:
+    """Per-light band transport of every value set, in one traversal (two with *direct*).
+
+    Parameters
+    ----------
+    value_sets
+        Channel values (:func:`spectrinsic.render.modes.channel_values`) of each diagonal mode;
+        their bands are traced together.
+    direct
+        Also trace direct light only (path depth 2), for the energy ratio r of Eq. 5.8.
+    aovs
+        Also take coverage, ids, depth and normals from the camera rays' first hits, as
+        :func:`~spectrinsic.render.passes.render_aovs` computes them from the same samples.
+
+    Returns
+    -------
+    outputs
+        One :class:`TransportOutput` per value set.
+    aov_maps
+        The maps of :func:`~spectrinsic.render.passes.render_aovs` (empty without *aovs*).
+    seconds
+        Wall-clock seconds of each traversal.
+    variant
+        The Mitsuba variant used.
+    """
+    if int(spp) < 1 or int(max_depth) < 1:
+        raise SceneError(f"spp {spp}, max_depth {max_depth}: expected at least 1 each")
+    if not scene.lights:
+        raise SceneError(f"scene {scene.name!r} has no lights: nothing to render")
+    if not value_sets:
+        raise SceneError("render_traversal: expected at least one set of channel values")
+    widths = [np.asarray(v.materials).shape[1] for v in value_sets]
+    n_bands, n_lights = sum(widths), len(scene.lights)
+    chosen = choose_variant("rgb", variant)
+    h, w = scene.camera.height, scene.camera.width
+    white = tr.rgb_spectrum([1.0, 1.0, 1.0])
+    with variant_scope(chosen) as mi:
+        loaded = mi.load_dict(tr.scene_to_mitsuba(
+            scene, materials=[white] * len(scene.materials), lights=[white] * n_lights,
+            film=tr.hdr_film(w, h), integrator=tr.path_integrator(max_depth), sample_count=spp,
+            geometry=geometry,
+        ))
+        tables = _tables(scene, value_sets, light_of_emitters(mi, loaded), aovs)
+        depths = [int(max_depth)] + ([DIRECT_DEPTH] if direct else [])
+        images, seconds, first = [], [], np.zeros((h, w, 0), np.float32)
+        for depth in depths:
+            n_surfaces = len(tables.shape_surfaces) if depth == depths[0] else 0
+            integrator = band_path(mi, max_depth=depth, n_bands=n_bands, n_lights=n_lights, n_surfaces=n_surfaces)
+            integrator.set_tables(loaded, tables if n_surfaces else replace(tables, shape_surfaces={}))
+            n_first = len(first_hit_channels(n_surfaces))
+            image, dt = _render(mi, loaded, integrator, spp=spp, seed=seed, n=n_bands * n_lights + n_first)
+            first = image[..., n_bands * n_lights:] if n_surfaces else first
+            images.append(image[..., :n_bands * n_lights].reshape(h, w, n_lights, n_bands).transpose(2, 0, 1, 3))
+            seconds.append(dt)
+            if progress is not None:
+                progress(1)
+    edges = np.cumsum([0, *widths])
+    outputs = [
+        TransportOutput(
+            transport=np.ascontiguousarray(images[0][..., a:b]),
+            direct=np.ascontiguousarray(images[1][..., a:b]) if direct else None,
+            emission=np.asarray(v.lights, float),
+        )
+        for v, a, b in zip(value_sets, edges[:-1], edges[1:], strict=True)
+    ]
+    aov_maps = assemble_aovs(scene, tr.surfaces(scene), first[..., :-4], first[..., -4], first[..., -3:]) if aovs else {}
+    return outputs, aov_maps, tuple(seconds), chosen
+
+
+@dataclass(frozen=True, eq=False)
+class SingleTraversal:
+    """The transport of every diagonal mode from :func:`render_jobs`, and its seconds."""
+
+    transport: dict[str, TransportOutput]
+    seconds: tuple[float, ...]
+    #: First-hit maps (:func:`~spectrinsic.render.passes.render_aovs`'s), when asked for.
+    aovs: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+def render_jobs(
+    scene: Scene,
+    jobs: Sequence[tuple[Sequence[RenderMode], Sequence[int] | None, bool]],
+    *,
+    wanted: set[str],
+    spp: int,
+    seed: int,
+    max_depth: int,
+    variant: str | None,
+    progress: PassProgress | None,
+    geometry: Sequence[tr.SurfaceGeometry] | None,
+    data_dir: str | None,
+    aovs: bool = False,
+) -> tuple[list[dict[str, PassOutput]], SingleTraversal]:
+    """The diagonal images of every job ``(modes, lights or None for all, with_direct)`` from
+    one traversal: each job's image of a mode is the sum of its lights' shares.
+
+    Drop-in for rendering each job's diagonal modes with
+    :func:`~spectrinsic.render.passes.render_diagonal`; a direct-only image is made for the
+    modes in *wanted* of the jobs that ask for one. With *aovs*, the first-hit maps come from
+    the same traversal (drop-in for :func:`~spectrinsic.render.passes.render_aovs`). The jobs
+    must hold at least one diagonal mode.
+    """
+    diagonal = list({m.name: m for modes, _, _ in jobs for m in modes if m.kind == "diagonal"}.values())
+    want_direct = any(flag and m.name in wanted for modes, _, flag in jobs for m in modes if m.kind == "diagonal")
+    values = [channel_values(scene, get_sensors(m.sensors, data_dir=data_dir), data_dir=data_dir) for m in diagonal]
+    outs, aov_maps, seconds, chosen = render_traversal(
+        scene, values, spp=spp, seed=seed, max_depth=max_depth, direct=want_direct, aovs=aovs,
+        variant=variant, progress=progress, geometry=geometry)
+    transport = {m.name: o for m, o in zip(diagonal, outs, strict=True)}
+    parts = []
+    for modes, group, flag in jobs:
+        part = {}
+        for m in (m for m in modes if m.kind == "diagonal"):
+            t = transport[m.name]
+            part[m.name] = PassOutput(
+                image=t.image(group),
+                direct=t.image(group, direct=True) if flag and m.name in wanted else None,
+                seconds=(), variant=chosen,
+            )
+        parts.append(part)
+    return parts, SingleTraversal(transport, seconds, aov_maps)
