@@ -69,7 +69,7 @@ evaluate: $(PKG) ## run the bundled decomposers on DATASET (default: data/datase
 bench: $(PKG) ## benchmarks, written as JSON under bench/
 	$(PY) -m spectrinsic.bench --out bench
 
-lint: $(PKG) ## ruff and mypy
+lint: $(PKG) ## ruff (the package folders and tests/) and mypy; .ci/run runs it before the tests
 	$(BIN)/ruff check $(PACKAGES) tests
 	$(BIN)/mypy -p spectrinsic
 

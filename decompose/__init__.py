@@ -19,24 +19,22 @@ from spectrinsic.decompose.colour_naming import (
 from spectrinsic.decompose.decomposition import Decomposer, Decomposition
 from spectrinsic.decompose.evaluate import EvaluationResult, Score, evaluate, evaluate_sample
 from spectrinsic.decompose.judgements import Judgements, sample_judgements
-from spectrinsic.decompose.metrics import (
-    METRICS,
-    Metric,
-    almse,
+from spectrinsic.decompose.metrics import METRICS, Metric, compute_metrics, get_metric, whdr
+from spectrinsic.decompose.metrics_colour import (
     angular_error_mean,
     angular_error_median,
-    compute_metrics,
-    correlation,
-    dssim,
-    get_metric,
-    lmse,
-    local_correlation,
-    mit_score,
     reflectance_chromaticity_error,
     reflectance_intensity_error,
     shading_chromaticity_error,
+)
+from spectrinsic.decompose.metrics_scale import (
+    almse,
+    correlation,
+    dssim,
+    lmse,
+    local_correlation,
+    mit_score,
     si_mse,
-    whdr,
 )
 from spectrinsic.decompose.photometric import SCENARIOS, photometric_correction
 from spectrinsic.decompose.predictions import PredictionFiles, Predictions, write_predictions

@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.decompose.decomposition import Decomposition
-from spectrinsic.decompose.metrics import almse, correlation, lmse, si_mse
+from spectrinsic.decompose.metrics_scale import almse, correlation, lmse, si_mse
 from spectrinsic.errors import DatasetError
 from spectrinsic.results import write_csv
 

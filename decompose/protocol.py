@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.decompose.decomposition import Decomposition
-from spectrinsic.decompose.metrics import lmse
+from spectrinsic.decompose.metrics_scale import lmse
 from spectrinsic.errors import SpectrinsicError
 from spectrinsic.scenes.sample_id import SampleId
 

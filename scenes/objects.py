@@ -1,6 +1,6 @@
 """A catalogue of painted objects like those of the MIT intrinsic-images dataset.
 
-Each builder returns one closed :class:`~spectrinsic.scenes.geometry.Part` resting on the plane
+Each builder returns one closed :class:`~spectrinsic.scenes.parts.Part` resting on the plane
 z = 0, centred on the z axis, sized like the real object (metres, +y away from a viewer in
 front). Shape complexity and colour distribution vary on purpose (thesis Figs. 5.6-5.7): a
 one-colour animal, striped and banded surfaces of revolution, a patched apple, a printed box
@@ -18,22 +18,16 @@ from collections.abc import Callable
 
 import numpy as np
 
-from spectrinsic.scenes.geometry import (
-    Part,
-    bands,
+from spectrinsic.scenes.painting import bands, patches, printed, stripes
+from spectrinsic.scenes.parts import Part, deformed, merge, moved
+from spectrinsic.scenes.primitives import (
     box,
     capsule,
     cone,
     cylinder,
-    deformed,
     ellipsoid,
-    merge,
-    moved,
-    patches,
-    printed,
     revolve,
     sphere,
-    stripes,
     torus,
 )
 

@@ -17,9 +17,9 @@ from pathlib import Path
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes.blender import load_blend
 from spectrinsic.scenes.generators import GeneratorOptions, generate
-from spectrinsic.scenes.io import load_scene
 from spectrinsic.scenes.meshes import MESH_SUFFIXES, load_mesh_scene
 from spectrinsic.scenes.model import Scene
+from spectrinsic.scenes.scene_reader import load_scene
 
 __all__ = ["GeneratedSource", "FileSource", "scene_file_kind", "is_scene_file", "load_scene_file",
            "FILE_SIZE"]

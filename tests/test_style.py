@@ -7,6 +7,9 @@ from pathlib import Path
 
 #: The longest function body allowed, in source lines, not counting its docstring.
 MAX_BODY_LINES = 60
+#: The most lines a module of the package may hold (STYLE.md: no god modules); a module that
+#: grows past it is split into modules named for what they hold.
+MAX_MODULE_LINES = 450
 #: The folders that make up the installed package (see pyproject's ``package-dir``).
 PACKAGE_FOLDERS = ("core", "spectra", "scenes", "render", "gt_export", "decompose")
 
@@ -73,6 +76,36 @@ def test_no_function_body_is_over_sixty_lines(repo_root: Path):
     assert not offenders, (
         f"functions with more than {MAX_BODY_LINES} body lines; split them into named steps:\n"
         + "\n".join(offenders)
+    )
+
+
+def long_modules(root: Path, limit: int = MAX_MODULE_LINES) -> list[str]:
+    """``"<path> (<n> lines)"`` for every module under the package folders of *root* that holds
+    more than *limit* lines."""
+    found = []
+    for folder in PACKAGE_FOLDERS:
+        for path in sorted((root / folder).rglob("*.py")):
+            n = len(path.read_text(encoding="utf-8").splitlines())
+            if n > limit:
+                found.append(f"{path.relative_to(root)} ({n} lines)")
+    return found
+
+
+def test_the_module_checker_counts_lines_in_every_package_folder(tmp_path: Path):
+    for folder in PACKAGE_FOLDERS:
+        (tmp_path / folder / "sub").mkdir(parents=True)
+        (tmp_path / folder / "ok.py").write_text("x = 1\n" * MAX_MODULE_LINES)
+    (tmp_path / "scenes" / "sub" / "big.py").write_text("x = 1\n" * (MAX_MODULE_LINES + 1))
+    (tmp_path / "tests").mkdir()
+    (tmp_path / "tests" / "big_test.py").write_text("x = 1\n" * 1000)  # not a package folder
+    assert long_modules(tmp_path) == [f"scenes/sub/big.py ({MAX_MODULE_LINES + 1} lines)"]
+
+
+def test_no_module_is_over_450_lines(repo_root: Path):
+    offenders = long_modules(repo_root)
+    assert not offenders, (
+        f"modules with more than {MAX_MODULE_LINES} lines; split them into modules named for "
+        "what they hold:\n" + "\n".join(offenders)
     )
 
 

@@ -15,7 +15,7 @@ import tracemalloc
 from pathlib import Path
 from typing import Any
 
-from spectrinsic.decompose.metrics import lmse
+from spectrinsic.decompose.metrics_scale import lmse
 from spectrinsic.decompose.registry import DECOMPOSERS, get_decomposer
 from spectrinsic.decompose.synthetic import mondrian
 

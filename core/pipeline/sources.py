@@ -31,8 +31,8 @@ from spectrinsic.scenes.generators import (
     generated_family,
     generated_scene_name,
 )
-from spectrinsic.scenes.io import save_scene
 from spectrinsic.scenes.sample_id import SampleId
+from spectrinsic.scenes.scene_writer import save_scene
 from spectrinsic.scenes.sources import FileSource, GeneratedSource, scene_file_kind
 from spectrinsic.spectra import list_spectra
 

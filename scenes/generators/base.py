@@ -15,11 +15,11 @@ from typing import Any
 
 import numpy as np
 
-from spectrinsic.scenes import geometry as g
 from spectrinsic.scenes.generators.camera import is_free, sample_camera
 from spectrinsic.scenes.generators.lights import FAMILIES, LightVolume, draw_lights
 from spectrinsic.scenes.generators.materials import MaterialDistribution
 from spectrinsic.scenes.model import Mesh, Scene
+from spectrinsic.scenes.parts import Part, to_meshes
 
 __all__ = ["GeneratorOptions", "Layout", "assemble", "family_of", "scene_rngs"]
 
@@ -76,7 +76,7 @@ class Layout:
         What the generator drew (recorded in the scene's metadata).
     """
 
-    parts: tuple[tuple[str, g.Part], ...]
+    parts: tuple[tuple[str, Part], ...]
     lights: LightVolume
     propose_camera: Callable[[np.random.Generator], tuple[np.ndarray, np.ndarray, float]]
     info: dict[str, Any]
@@ -101,7 +101,7 @@ def _is_object(mesh: Mesh) -> bool:
 def assemble(name: str, layout: Layout, seed: int, view: int, options: GeneratorOptions,
              rngs: dict[str, np.random.Generator]) -> Scene:
     """The scene of *layout* seen from camera *view*, with the lights of its family."""
-    meshes, materials = g.to_meshes(layout.parts)
+    meshes, materials = to_meshes(layout.parts)
     family = family_of(seed)
     lights = draw_lights(rngs["lights"], family, layout.lights,
                          free=lambda p: is_free(meshes, p), sfu=options.sfu_illuminants,

@@ -6,28 +6,29 @@ import math
 
 import numpy as np
 
-from spectrinsic.scenes import geometry as g
 from spectrinsic.scenes.generators.base import GeneratorOptions, Layout
 from spectrinsic.scenes.generators.camera import Footprints
 from spectrinsic.scenes.generators.lights import LightVolume
 from spectrinsic.scenes.generators.materials import MaterialDistribution, draw_reflectance
 from spectrinsic.scenes.generators.shapes import draw_object
+from spectrinsic.scenes.parts import Part, moved
+from spectrinsic.scenes.primitives import box
 
 __all__ = ["objects_on_ground"]
 
 
-def _ground(rng: np.random.Generator) -> g.Part:
+def _ground(rng: np.random.Generator) -> Part:
     """A large thin slab whose top is z = 0, spectrally flat grey or a low-chroma chip."""
     grey = rng.random() < 0.5
     spectrum = (f"flat:{rng.uniform(0.2, 0.8):.2f}" if grey
                 else draw_reflectance(rng, MaterialDistribution((3, 8), (0, 4))))
-    return g.box((12.0, 12.0, 0.05), spectrum, center=(0, 0, -0.025), divisions=(12, 12, 1))
+    return box((12.0, 12.0, 0.05), spectrum, center=(0, 0, -0.025), divisions=(12, 12, 1))
 
 
-def _place(rng: np.random.Generator, options: GeneratorOptions) -> tuple[list[tuple[str, g.Part]], list[str]]:
+def _place(rng: np.random.Generator, options: GeneratorOptions) -> tuple[list[tuple[str, Part]], list[str]]:
     """Objects at random spots within 0.35 m of the origin, footprints not overlapping."""
     floor = Footprints([])
-    parts: list[tuple[str, g.Part]] = []
+    parts: list[tuple[str, Part]] = []
     patterns: list[str] = []
     for i in range(int(rng.integers(1, 6))):
         shape, part, pattern, half = draw_object(rng, options.materials, options.sfu_reflectances)
@@ -35,7 +36,7 @@ def _place(rng: np.random.Generator, options: GeneratorOptions) -> tuple[list[tu
         for _ in range(30):
             centre = rng.uniform(-0.35, 0.35, 2)
             if floor.try_add(centre, half):
-                parts.append((f"{shape}-{i}", g.moved(part, translate=(centre[0], centre[1], 0.0))))
+                parts.append((f"{shape}-{i}", moved(part, translate=(centre[0], centre[1], 0.0))))
                 break
     return parts, patterns
 

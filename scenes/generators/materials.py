@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from spectrinsic.errors import SceneError
-from spectrinsic.scenes import geometry as g
+from spectrinsic.scenes.painting import patches, printed, stripes
+from spectrinsic.scenes.parts import Part
 from spectrinsic.spectra import list_spectra
 
 __all__ = [
@@ -103,42 +104,42 @@ def draw_palette(
     return names
 
 
-def _labelled(part: g.Part, palette: Sequence[str], index: np.ndarray) -> g.Part:
+def _labelled(part: Part, palette: Sequence[str], index: np.ndarray) -> Part:
     """*part* repainted: face f takes ``palette[index[f] % len(palette)]``."""
     names = tuple(dict.fromkeys(palette))
     lookup = np.array([names.index(p) for p in palette], dtype=np.int64)
     labels = lookup[np.asarray(index, dtype=np.int64) % len(palette)]
     used, labels = np.unique(labels, return_inverse=True)
-    return g.Part(part.vertices, part.faces, labels.astype(np.int64),
+    return Part(part.vertices, part.faces, labels.astype(np.int64),
                   tuple(names[i] for i in used))
 
 
-def _extent(part: g.Part) -> np.ndarray:
+def _extent(part: Part) -> np.ndarray:
     return np.maximum(np.ptp(part.vertices, axis=0), 1e-6)
 
 
-def _stripes(part: g.Part, rng: np.random.Generator, palette: Sequence[str]) -> g.Part:
+def _stripes(part: Part, rng: np.random.Generator, palette: Sequence[str]) -> Part:
     axis = int(rng.integers(3))
     width = float(_extent(part)[axis]) / rng.uniform(2, 8)
-    return g.stripes(part, list(palette), axis=axis, width=width, offset=float(rng.uniform(0, width)))
+    return stripes(part, list(palette), axis=axis, width=width, offset=float(rng.uniform(0, width)))
 
 
-def _checkers(part: g.Part, rng: np.random.Generator, palette: Sequence[str]) -> g.Part:
+def _checkers(part: Part, rng: np.random.Generator, palette: Sequence[str]) -> Part:
     cell = float(_extent(part).max()) / rng.uniform(2, 6)
     k = np.floor((part.centroids - part.vertices.min(axis=0)) / cell).astype(np.int64)
     return _labelled(part, palette, k.sum(axis=1))
 
 
-def _patches(part: g.Part, rng: np.random.Generator, palette: Sequence[str]) -> g.Part:
+def _patches(part: Part, rng: np.random.Generator, palette: Sequence[str]) -> Part:
     out = _labelled(part, palette[:1], np.zeros(len(part.faces)))
     centres = part.centroids[rng.integers(len(part.faces), size=int(rng.integers(1, 5)))]
     radius = float(_extent(part).max()) * rng.uniform(0.1, 0.3)
     for i, c in enumerate(centres):
-        out = g.patches(out, palette[1 + i % max(1, len(palette) - 1)], [c], radius)
+        out = patches(out, palette[1 + i % max(1, len(palette) - 1)], [c], radius)
     return out
 
 
-def _noise(part: g.Part, rng: np.random.Generator, palette: Sequence[str]) -> g.Part:
+def _noise(part: Part, rng: np.random.Generator, palette: Sequence[str]) -> Part:
     """A Voronoi partition of the surface around random seed points (a noise-like partition)."""
     lo, hi = part.vertices.min(axis=0), part.vertices.max(axis=0)
     seeds = rng.uniform(lo, hi, size=(int(rng.integers(3, 12)), 3))
@@ -146,7 +147,7 @@ def _noise(part: g.Part, rng: np.random.Generator, palette: Sequence[str]) -> g.
     return _labelled(part, palette, cell)
 
 
-def _label(part: g.Part, rng: np.random.Generator, palette: Sequence[str]) -> g.Part:
+def _label(part: Part, rng: np.random.Generator, palette: Sequence[str]) -> Part:
     """A printed-paper-like label on the side facing -y: random ink rows on the base colour."""
     lo, hi = part.vertices.min(axis=0), part.vertices.max(axis=0)
     cols, nrows = int(rng.integers(4, 10)), int(rng.integers(3, 8))
@@ -155,12 +156,12 @@ def _label(part: g.Part, rng: np.random.Generator, palette: Sequence[str]) -> g.
     keys = [*legend, ".", "."]
     rows = ["".join(keys[int(k)] for k in rng.integers(len(keys), size=cols)) for _ in range(nrows)]
     base = _labelled(part, palette[:1], np.zeros(len(part.faces)))
-    return g.printed(base, rows, legend, origin=(float(lo[0]), float(lo[2])), cell=cell,
+    return printed(base, rows, legend, origin=(float(lo[0]), float(lo[2])), cell=cell,
                      axes=(0, 2), facing=(0, -1, 0))
 
 
 #: Pattern painters by name: ``(part, rng, palette) -> part``.
-PATTERNS: dict[str, Callable[[g.Part, np.random.Generator, Sequence[str]], g.Part]] = {
+PATTERNS: dict[str, Callable[[Part, np.random.Generator, Sequence[str]], Part]] = {
     "stripes": _stripes,
     "checkers": _checkers,
     "patches": _patches,
@@ -170,8 +171,8 @@ PATTERNS: dict[str, Callable[[g.Part, np.random.Generator, Sequence[str]], g.Par
 
 
 def paint(
-    part: g.Part, rng: np.random.Generator, dist: MaterialDistribution, sfu: Sequence[str] = ()
-) -> tuple[g.Part, str]:
+    part: Part, rng: np.random.Generator, dist: MaterialDistribution, sfu: Sequence[str] = ()
+) -> tuple[Part, str]:
     """Paint *part*: one reflectance, or with ``dist.pattern_probability`` a pattern of 2-4.
 
     Returns

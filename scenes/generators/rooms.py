@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from spectrinsic.scenes import geometry as g
+from spectrinsic.scenes.furniture import chair, shelf, table
 from spectrinsic.scenes.generators.base import GeneratorOptions, Layout
 from spectrinsic.scenes.generators.camera import Footprints
 from spectrinsic.scenes.generators.lights import LightVolume
@@ -18,6 +18,8 @@ from spectrinsic.scenes.generators.materials import (
 )
 from spectrinsic.scenes.generators.shapes import draw_object
 from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_KINDS
+from spectrinsic.scenes.parts import Part, merge, moved
+from spectrinsic.scenes.primitives import box
 
 __all__ = ["rooms"]
 
@@ -29,13 +31,13 @@ _AIMED_KINDS = tuple(k for k in _PLACED_KINDS if "direction" in LIGHT_FIELDS[k])
 _T = 0.1  # wall thickness, m
 
 
-def _slab(lo: np.ndarray, hi: np.ndarray, spectrum: str) -> g.Part:
+def _slab(lo: np.ndarray, hi: np.ndarray, spectrum: str) -> Part:
     size = np.maximum(hi - lo, 1e-3)
     div = tuple(max(1, int(round(s * 2))) for s in size)
-    return g.box(tuple(size), spectrum, center=tuple((lo + hi) / 2), divisions=div)
+    return box(tuple(size), spectrum, center=tuple((lo + hi) / 2), divisions=div)
 
 
-def _wall(key: str, size: tuple[float, float, float], spectrum: str, hole: tuple[float, ...] | None) -> g.Part:
+def _wall(key: str, size: tuple[float, float, float], spectrum: str, hole: tuple[float, ...] | None) -> Part:
     """Wall *key* of the room ``[0,w]x[0,d]x[0,h]``, with an optional opening ``(a, b, c, e)``:
     along-wall interval [a, b] (fraction of its length) and height interval [c, e] (m)."""
     w, d, h = size
@@ -53,10 +55,10 @@ def _wall(key: str, size: tuple[float, float, float], spectrum: str, hole: tuple
         lo[axis], hi[axis], lo[2], hi[2] = a, b, c, e
         if b - a > 1e-3 and e - c > 1e-3:
             pieces.append(_slab(lo.copy(), hi.copy(), spectrum))
-    return g.merge(*pieces)
+    return merge(*pieces)
 
 
-def _shell(rng: np.random.Generator, size: tuple[float, float, float]) -> tuple[list[tuple[str, g.Part]], dict]:
+def _shell(rng: np.random.Generator, size: tuple[float, float, float]) -> tuple[list[tuple[str, Part]], dict]:
     w, d, h = size
     # half the rooms have light, low-chroma walls (strong interreflection: low r), the others
     # any walls; with missing walls and ceilings this spreads r
@@ -82,7 +84,7 @@ def _shell(rng: np.random.Generator, size: tuple[float, float, float]) -> tuple[
 
 
 def _furniture(rng: np.random.Generator, size: tuple[float, float, float], floor: Footprints,
-               dist: MaterialDistribution) -> tuple[list[tuple[str, g.Part]], list[tuple[np.ndarray, np.ndarray, float]]]:
+               dist: MaterialDistribution) -> tuple[list[tuple[str, Part]], list[tuple[np.ndarray, np.ndarray, float]]]:
     """Tables, shelves, chairs and cabinets on the floor; returns them and the table tops
     ``(lo_xy, hi_xy, z)`` objects may rest on."""
     w, d, _ = size
@@ -93,21 +95,21 @@ def _furniture(rng: np.random.Generator, size: tuple[float, float, float], floor
         spectrum = draw_reflectance(rng, dist)
         if kind == "table":
             tw, td, th = rng.uniform(0.6, 1.4), rng.uniform(0.5, 0.9), rng.uniform(0.45, 0.8)
-            part = g.table(tw, td, th, spectrum)
+            part = table(tw, td, th, spectrum)
         elif kind == "shelf":
             tw, td, th = rng.uniform(0.6, 1.2), rng.uniform(0.3, 0.45), rng.uniform(0.8, 1.8)
-            part = g.shelf(tw, td, th, spectrum, boards=int(rng.integers(2, 5)))
+            part = shelf(tw, td, th, spectrum, boards=int(rng.integers(2, 5)))
         elif kind == "chair":
             tw = rng.uniform(0.38, 0.5)
-            part = g.chair(tw, rng.uniform(0.4, 0.5), spectrum, facing_deg=float(rng.choice([0, 90, 180, 270])))
+            part = chair(tw, rng.uniform(0.4, 0.5), spectrum, facing_deg=float(rng.choice([0, 90, 180, 270])))
         else:
             tw, td, th = rng.uniform(0.4, 1.0), rng.uniform(0.3, 0.6), rng.uniform(0.4, 1.0)
-            part = g.box((tw, td, th), spectrum, center=(0, 0, th / 2), divisions=(3, 3, 3))
+            part = box((tw, td, th), spectrum, center=(0, 0, th / 2), divisions=(3, 3, 3))
         half = np.ptp(part.vertices[:, :2], axis=0) / 2
         for _ in range(30):
             c = rng.uniform([0.05 + half[0], 0.05 + half[1]], [w - 0.05 - half[0], d - 0.05 - half[1]])
             if floor.try_add(c, half, gap=0.05):
-                parts.append((f"{kind}-{i}", g.moved(part, translate=(c[0], c[1], 0.0))))
+                parts.append((f"{kind}-{i}", moved(part, translate=(c[0], c[1], 0.0))))
                 if kind in ("table", "cabinet"):
                     top = float(part.vertices[:, 2].max())
                     tops.append((c - half + 0.04, c + half - 0.04, top))
@@ -116,10 +118,10 @@ def _furniture(rng: np.random.Generator, size: tuple[float, float, float], floor
 
 
 def _objects(rng: np.random.Generator, size: tuple[float, float, float], floor: Footprints,
-             tops: list[tuple[np.ndarray, np.ndarray, float]], options: GeneratorOptions) -> tuple[list[tuple[str, g.Part]], list[str]]:
+             tops: list[tuple[np.ndarray, np.ndarray, float]], options: GeneratorOptions) -> tuple[list[tuple[str, Part]], list[str]]:
     """2-8 objects resting on table tops (preferred) or the floor, without overlaps."""
     w, d, _ = size
-    parts: list[tuple[str, g.Part]] = []
+    parts: list[tuple[str, Part]] = []
     patterns: list[str] = []
     supports = [(lo, hi, z, Footprints([])) for lo, hi, z in tops]
     supports.append((np.array([0.1, 0.1]), np.array([w - 0.1, d - 0.1]), 0.0, floor))
@@ -132,7 +134,7 @@ def _objects(rng: np.random.Generator, size: tuple[float, float, float], floor: 
                 continue
             c = rng.uniform(lo + half, hi - half)
             if taken.try_add(c, half):
-                parts.append((f"{shape}-{i}", g.moved(part, translate=(c[0], c[1], z))))
+                parts.append((f"{shape}-{i}", moved(part, translate=(c[0], c[1], z))))
                 break
     return parts, patterns
 

@@ -2,7 +2,7 @@
 with random scale, proportions and subdivision, standing on z = 0 and centred on the z axis.
 
 Every builder takes an explicit :class:`numpy.random.Generator` and a base reflectance name,
-and returns a closed :class:`~spectrinsic.scenes.geometry.Part`. Units: metres, degrees.
+and returns a closed :class:`~spectrinsic.scenes.parts.Part`. Units: metres, degrees.
 """
 
 from __future__ import annotations
@@ -11,55 +11,56 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from spectrinsic.scenes import geometry as g
 from spectrinsic.scenes.generators.materials import MaterialDistribution, paint
 from spectrinsic.scenes.objects import OBJECTS
+from spectrinsic.scenes.parts import Part, moved
+from spectrinsic.scenes.primitives import box, capsule, cone, cylinder, ellipsoid, revolve, torus
 
 __all__ = ["SHAPES", "shape_names", "make_shape", "draw_object", "on_ground"]
 
-Builder = Callable[[np.random.Generator, str], g.Part]
+Builder = Callable[[np.random.Generator, str], Part]
 
 
-def on_ground(part: g.Part) -> g.Part:
+def on_ground(part: Part) -> Part:
     """Move *part* so that its lowest point is on z = 0 and its footprint is centred at 0."""
     lo, hi = part.vertices.min(axis=0), part.vertices.max(axis=0)
-    return g.moved(part, translate=(-(lo[0] + hi[0]) / 2, -(lo[1] + hi[1]) / 2, -lo[2]))
+    return moved(part, translate=(-(lo[0] + hi[0]) / 2, -(lo[1] + hi[1]) / 2, -lo[2]))
 
 
-def _block(rng: np.random.Generator, spectrum: str) -> g.Part:
+def _block(rng: np.random.Generator, spectrum: str) -> Part:
     size = rng.uniform(0.06, 0.25, 3)
     div = tuple(int(d) for d in rng.integers(2, 7, 3))
-    return g.box(tuple(size), spectrum, center=(0, 0, size[2] / 2), divisions=div)
+    return box(tuple(size), spectrum, center=(0, 0, size[2] / 2), divisions=div)
 
 
-def _pillar(rng: np.random.Generator, spectrum: str) -> g.Part:
+def _pillar(rng: np.random.Generator, spectrum: str) -> Part:
     r, h = rng.uniform(0.03, 0.09), rng.uniform(0.08, 0.3)
-    return g.cylinder(r, h, spectrum, sections=int(rng.integers(8, 33)), rings=int(rng.integers(2, 8)))
+    return cylinder(r, h, spectrum, sections=int(rng.integers(8, 33)), rings=int(rng.integers(2, 8)))
 
 
-def _ball(rng: np.random.Generator, spectrum: str) -> g.Part:
+def _ball(rng: np.random.Generator, spectrum: str) -> Part:
     radii = rng.uniform(0.03, 0.1) * rng.uniform(0.7, 1.3, 3)
-    return g.ellipsoid(tuple(radii), spectrum, subdivisions=int(rng.integers(1, 4)))
+    return ellipsoid(tuple(radii), spectrum, subdivisions=int(rng.integers(1, 4)))
 
 
-def _cone(rng: np.random.Generator, spectrum: str) -> g.Part:
-    return g.cone(rng.uniform(0.03, 0.1), rng.uniform(0.06, 0.25), spectrum,
+def _cone(rng: np.random.Generator, spectrum: str) -> Part:
+    return cone(rng.uniform(0.03, 0.1), rng.uniform(0.06, 0.25), spectrum,
                   sections=int(rng.integers(6, 33)))
 
 
-def _capsule(rng: np.random.Generator, spectrum: str) -> g.Part:
-    part = g.capsule(rng.uniform(0.02, 0.06), rng.uniform(0.04, 0.2), spectrum,
+def _capsule(rng: np.random.Generator, spectrum: str) -> Part:
+    part = capsule(rng.uniform(0.02, 0.06), rng.uniform(0.04, 0.2), spectrum,
                      sections=int(rng.integers(8, 25)))
-    return g.moved(part, rotate_deg=(90.0 * int(rng.integers(0, 2)), 0, 0))
+    return moved(part, rotate_deg=(90.0 * int(rng.integers(0, 2)), 0, 0))
 
 
-def _ring(rng: np.random.Generator, spectrum: str) -> g.Part:
+def _ring(rng: np.random.Generator, spectrum: str) -> Part:
     major = rng.uniform(0.04, 0.1)
-    return g.torus(major, major * rng.uniform(0.15, 0.45), spectrum,
+    return torus(major, major * rng.uniform(0.15, 0.45), spectrum,
                    major_sections=int(rng.integers(12, 33)), minor_sections=int(rng.integers(6, 13)))
 
 
-def _vessel(rng: np.random.Generator, spectrum: str) -> g.Part:
+def _vessel(rng: np.random.Generator, spectrum: str) -> Part:
     """A bowl or pot: a surface of revolution with a cavity (concave, interreflections)."""
     height, radius = rng.uniform(0.05, 0.2), rng.uniform(0.04, 0.1)
     z = np.linspace(0.0, height, int(rng.integers(6, 14)))
@@ -68,13 +69,13 @@ def _vessel(rng: np.random.Generator, spectrum: str) -> g.Part:
     wall = 0.12 * radius
     inner = [(ri - wall, zi) for ri, zi in zip(r[::-1], z[::-1], strict=True) if zi >= wall]
     profile = [(0.0, 0.0), *zip(r, z, strict=True), *inner, (0.0, wall)]
-    return g.revolve(profile, spectrum, sections=int(rng.integers(12, 37)))
+    return revolve(profile, spectrum, sections=int(rng.integers(12, 37)))
 
 
 def _library(key: str) -> Builder:
-    def build(rng: np.random.Generator, spectrum: str) -> g.Part:
+    def build(rng: np.random.Generator, spectrum: str) -> Part:
         stretch = rng.uniform(0.8, 1.25, 3)
-        return g.moved(OBJECTS[key](), scale=tuple(float(rng.uniform(0.8, 2.0)) * stretch))
+        return moved(OBJECTS[key](), scale=tuple(float(rng.uniform(0.8, 2.0)) * stretch))
 
     build.__doc__ = f"The library's {key!r} with random scale and proportions (its own paint)."
     return build
@@ -98,16 +99,16 @@ def shape_names() -> list[str]:
     return list(SHAPES)
 
 
-def make_shape(name: str, rng: np.random.Generator, spectrum: str) -> g.Part:
+def make_shape(name: str, rng: np.random.Generator, spectrum: str) -> Part:
     """Build shape *name* with random parameters from *rng*, resting on z = 0, upright or
     turned about z by a random angle (degrees)."""
     part = SHAPES[name](rng, spectrum)
-    return on_ground(g.moved(part, rotate_deg=(0, 0, float(rng.uniform(0, 360)))))
+    return on_ground(moved(part, rotate_deg=(0, 0, float(rng.uniform(0, 360)))))
 
 
 def draw_object(
     rng: np.random.Generator, materials: MaterialDistribution, sfu: Sequence[str] = ()
-) -> tuple[str, g.Part, str | None, np.ndarray]:
+) -> tuple[str, Part, str | None, np.ndarray]:
     """A random shape, painted from *materials* (library objects keep their own paint).
 
     Returns

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from spectrinsic.decompose import DECOMPOSERS, decompose, get_decomposer
-from spectrinsic.decompose.metrics import lmse
+from spectrinsic.decompose.metrics_scale import lmse
 from spectrinsic.decompose.names_shades import NamesAndShades, global_coherence
 from spectrinsic.decompose.retinex import log_gradients, poisson_solve
 from spectrinsic.decompose.synthetic import mondrian

@@ -9,6 +9,8 @@ import pytest
 from skimage.metrics import structural_similarity
 
 from spectrinsic.decompose import metrics as M
+from spectrinsic.decompose import metrics_colour as MC
+from spectrinsic.decompose import metrics_scale as MS
 from spectrinsic.decompose._validation import ImageShapeError
 from spectrinsic.decompose.judgements import (
     DARKER_1,
@@ -69,10 +71,10 @@ def test_lmse_hand_computed_two_windows():
     truth = np.ones((20, 30))
     estimate = np.where(np.arange(30) < 15, 1.0, 2.0)[None, :].repeat(20, axis=0)
     expected = (300 / 7 + 300 / 13) / 800  # = 15/182
-    assert M.lmse(truth, estimate) == pytest.approx(expected, rel=EXACT)
+    assert MS.lmse(truth, estimate) == pytest.approx(expected, rel=EXACT)
     # colour copies of the same grey image give the same value with one alpha per window
     colour = np.repeat(estimate[:, :, None], 3, axis=2)
-    assert M.lmse(np.ones((20, 30, 3)), colour) == pytest.approx(expected, rel=EXACT)
+    assert MS.lmse(np.ones((20, 30, 3)), colour) == pytest.approx(expected, rel=EXACT)
 
 
 def test_lmse_window_straddling_the_mask():
@@ -85,26 +87,26 @@ def test_lmse_window_straddling_the_mask():
     truth[:, 25:] = 123.0
     estimate[:, 25:] = -7.0
     expected = (300 / 7 + 200 / 9) / (400 + 300)
-    assert M.lmse(truth, estimate, mask=mask) == pytest.approx(expected, rel=EXACT)
+    assert MS.lmse(truth, estimate, mask=mask) == pytest.approx(expected, rel=EXACT)
 
 
 def test_mit_score_averages_shading_and_reflectance(pair):
     truth, estimate = pair
     s, r = truth[..., 0], truth
     es, er = estimate[..., 0], estimate
-    assert M.mit_score(s, r, es, er) == pytest.approx(
-        0.5 * M.lmse(s, es) + 0.5 * M.lmse(r, er), rel=EXACT
+    assert MS.mit_score(s, r, es, er) == pytest.approx(
+        0.5 * MS.lmse(s, es) + 0.5 * MS.lmse(r, er), rel=EXACT
     )
 
 
 def test_si_mse_closed_form():
     # truth (1, 2), estimate (1, 1): alpha = 3/2, residual (1-1.5)^2 + (2-1.5)^2 = 0.5 over 2.
-    assert M.si_mse(np.array([[1.0, 2.0]]), np.array([[1.0, 1.0]])) == pytest.approx(0.25)
+    assert MS.si_mse(np.array([[1.0, 2.0]]), np.array([[1.0, 1.0]])) == pytest.approx(0.25)
 
 
 def test_correlation_matches_numpy(pair):
     truth, estimate = pair
-    assert M.correlation(truth, estimate) == pytest.approx(
+    assert MS.correlation(truth, estimate) == pytest.approx(
         np.corrcoef(truth.ravel(), estimate.ravel())[0, 1], rel=1e-12
     )
 
@@ -112,10 +114,10 @@ def test_correlation_matches_numpy(pair):
 def test_dssim_equals_scikit_image(pair):
     truth, estimate = pair
     ssim = structural_similarity(truth, estimate, data_range=1.0, channel_axis=-1)
-    value = M.dssim(truth, estimate, data_range=1.0, fit_scale=False)
+    value = MS.dssim(truth, estimate, data_range=1.0, fit_scale=False)
     assert value == pytest.approx((1.0 - ssim) / 2.0, rel=EXACT)
     grey = structural_similarity(truth[..., 1], estimate[..., 1], data_range=1.0)
-    assert M.dssim(truth[..., 1], estimate[..., 1], data_range=1.0, fit_scale=False) == (
+    assert MS.dssim(truth[..., 1], estimate[..., 1], data_range=1.0, fit_scale=False) == (
         pytest.approx((1.0 - grey) / 2.0, rel=EXACT)
     )
 
@@ -155,19 +157,19 @@ def test_angular_error_stats():
     estimate = np.ones((2, 2, 3))
     estimate[0, 0] = [1.0, 0.0, 0.0]  # angle to (1,1,1): acos(1/sqrt(3)) = 54.7356 deg
     angle = np.degrees(np.arccos(1 / np.sqrt(3)))
-    assert M.angular_error_mean(truth, estimate) == pytest.approx(angle / 4)
-    assert M.angular_error_median(truth, estimate) == pytest.approx(0.0)
+    assert MC.angular_error_mean(truth, estimate) == pytest.approx(angle / 4)
+    assert MC.angular_error_median(truth, estimate) == pytest.approx(0.0)
 
 
 def test_shape_checks_and_registry():
     with pytest.raises(ImageShapeError, match="differs"):
-        M.lmse(np.ones((30, 30)), np.ones((30, 31)))
+        MS.lmse(np.ones((30, 30)), np.ones((30, 31)))
     with pytest.raises(ImageShapeError, match="mask must have shape"):
-        M.lmse(np.ones((30, 30)), np.ones((30, 30)), mask=np.ones((3, 3), bool))
+        MS.lmse(np.ones((30, 30)), np.ones((30, 30)), mask=np.ones((3, 3), bool))
     with pytest.raises(ImageShapeError, match="smaller than"):
-        M.lmse(np.ones((10, 10)), np.ones((10, 10)))
+        MS.lmse(np.ones((10, 10)), np.ones((10, 10)))
     with pytest.raises(ImageShapeError, match="NaN"):
-        M.si_mse(np.full((4, 4), np.nan), np.ones((4, 4)))
+        MS.si_mse(np.full((4, 4), np.nan), np.ones((4, 4)))
     with pytest.raises(SpectrinsicError, match="did you mean 'lmse'"):
         M.get_metric("lmsee")
     assert M.get_metric("lmse").equation == "Eq. 2.5"
@@ -196,9 +198,9 @@ def test_shading_chromaticity_error_hand_computed():
     truth, estimate, mask = _shading_case()
     # scored pixels: (0,0) 54.74, (0,1) 0, (0,2) 90, (1,2) 0
     expected_mean = (PRIMARY_TO_GREY_DEG + 0.0 + 90.0 + 0.0) / 4.0
-    value = M.shading_chromaticity_error(truth, estimate, mask=mask)
+    value = MC.shading_chromaticity_error(truth, estimate, mask=mask)
     assert value == pytest.approx(expected_mean, abs=ANGLE_ROUNDOFF_DEG)
-    median = M.shading_chromaticity_error(truth, estimate, mask=mask, statistic="median")
+    median = MC.shading_chromaticity_error(truth, estimate, mask=mask, statistic="median")
     assert median == pytest.approx(PRIMARY_TO_GREY_DEG / 2.0, abs=ANGLE_ROUNDOFF_DEG)
 
 
@@ -206,18 +208,18 @@ def test_shading_chromaticity_error_scores_grey_shading_as_white_light():
     truth = np.zeros((4, 4, 3))
     truth[..., 0] = 2.0  # red light everywhere
     grey = np.full((4, 4), 0.3)
-    value = M.shading_chromaticity_error(truth, grey)
+    value = MC.shading_chromaticity_error(truth, grey)
     assert value == pytest.approx(PRIMARY_TO_GREY_DEG, abs=ANGLE_ROUNDOFF_DEG)
-    assert M.shading_chromaticity_error(truth, 5.0 * truth) == pytest.approx(0.0, abs=1e-6)
+    assert MC.shading_chromaticity_error(truth, 5.0 * truth) == pytest.approx(0.0, abs=1e-6)
 
 
 def test_shading_chromaticity_error_rejects_bad_input():
     with pytest.raises(ImageShapeError, match="differs from truth shape"):
-        M.shading_chromaticity_error(np.ones((4, 4, 3)), np.ones((4, 5, 3)))
+        MC.shading_chromaticity_error(np.ones((4, 4, 3)), np.ones((4, 5, 3)))
     with pytest.raises(ImageShapeError, match="colour or"):
-        M.shading_chromaticity_error(np.ones((4, 4, 2)), np.ones((4, 4, 2)))
+        MC.shading_chromaticity_error(np.ones((4, 4, 2)), np.ones((4, 4, 2)))
     with pytest.raises(SpectrinsicError, match="statistic"):
-        M.shading_chromaticity_error(np.ones((4, 4, 3)), np.ones((4, 4, 3)), statistic="max")
+        MC.shading_chromaticity_error(np.ones((4, 4, 3)), np.ones((4, 4, 3)), statistic="max")
 
 
 def test_reflectance_intensity_error_hand_computed():
@@ -225,11 +227,11 @@ def test_reflectance_intensity_error_hand_computed():
     # residual (1-2)^2 + 0 + (3-2)^2 = 2, energy 1 + 4 + 9 = 14.
     truth = np.array([1.0, 2.0, 3.0])[None, :, None] * np.ones((1, 3, 3))
     flat = np.full((1, 3, 3), 0.4)
-    assert M.reflectance_intensity_error(truth, flat) == pytest.approx(2.0 / 14.0, abs=EXACT)
+    assert MC.reflectance_intensity_error(truth, flat) == pytest.approx(2.0 / 14.0, abs=EXACT)
     mask = np.array([[True, False, True]])  # intensities 1 and 3: alpha 2, residual 2, energy 10
-    assert M.reflectance_intensity_error(truth, flat, mask=mask) == pytest.approx(0.2, abs=EXACT)
+    assert MC.reflectance_intensity_error(truth, flat, mask=mask) == pytest.approx(0.2, abs=EXACT)
     with pytest.raises(ImageShapeError, match="masked truth is zero"):
-        M.reflectance_intensity_error(np.zeros((2, 2, 3)), np.ones((2, 2, 3)))
+        MC.reflectance_intensity_error(np.zeros((2, 2, 3)), np.ones((2, 2, 3)))
 
 
 def test_maw_split_separates_colour_from_lightness():
@@ -237,19 +239,19 @@ def test_maw_split_separates_colour_from_lightness():
     recoloured = np.broadcast_to(np.array([1.5, 0.5, 1.0]), (3, 3, 3))  # same channel mean
     # (1,1,1).(1.5,0.5,1) = 3; |.| = sqrt(3) sqrt(3.5)
     angle = math.degrees(math.acos(3.0 / math.sqrt(3.0 * 3.5)))
-    assert M.reflectance_intensity_error(truth, recoloured) == pytest.approx(0.0, abs=EXACT)
-    assert M.reflectance_chromaticity_error(truth, recoloured) == pytest.approx(
+    assert MC.reflectance_intensity_error(truth, recoloured) == pytest.approx(0.0, abs=EXACT)
+    assert MC.reflectance_chromaticity_error(truth, recoloured) == pytest.approx(
         angle, abs=ANGLE_ROUNDOFF_DEG)
     darker = truth.copy()
     darker[0] *= 0.5  # lightness change, colour kept
-    assert M.reflectance_chromaticity_error(truth, darker) == pytest.approx(
+    assert MC.reflectance_chromaticity_error(truth, darker) == pytest.approx(
         0.0, abs=ANGLE_ROUNDOFF_DEG)
     # intensities 1 (6 px) and 0.5 (3 px) against 1: alpha = 7.5/9, see the formula above
     t = np.array([1.0] * 6 + [1.0] * 3)
     e = np.array([1.0] * 6 + [0.5] * 3)
     alpha = (t * e).sum() / (e * e).sum()
     expected = ((t - alpha * e) ** 2).sum() / (t * t).sum()
-    assert M.reflectance_intensity_error(darker, truth) > 0.0
-    assert M.reflectance_intensity_error(truth, darker) == pytest.approx(expected, abs=EXACT)
+    assert MC.reflectance_intensity_error(darker, truth) > 0.0
+    assert MC.reflectance_intensity_error(truth, darker) == pytest.approx(expected, abs=EXACT)
     with pytest.raises(ImageShapeError, match="needs .H, W, 3. images"):
-        M.reflectance_chromaticity_error(np.ones((3, 3)), np.ones((3, 3)))
+        MC.reflectance_chromaticity_error(np.ones((3, 3)), np.ones((3, 3)))

@@ -8,22 +8,34 @@ import numpy as np
 import pytest
 
 from spectrinsic.errors import SceneError
-from spectrinsic.scenes import geometry as g
+from spectrinsic.scenes.furniture import chair, room, shelf, table
 from spectrinsic.scenes.objects import OBJECTS
+from spectrinsic.scenes.painting import bands, patches, printed, stripes
+from spectrinsic.scenes.parts import Part, moved, to_meshes
+from spectrinsic.scenes.primitives import (
+    box,
+    capsule,
+    cone,
+    cylinder,
+    ellipsoid,
+    revolve,
+    sphere,
+    torus,
+)
 from spectrinsic.scenes.validate import is_closed
 
 #: Volumes of exact polyhedra (boxes, prisms) agree to rounding only.
 EXACT = 1e-12
 
 
-def volume(part: g.Part) -> float:
+def volume(part: Part) -> float:
     """Signed volume by the divergence theorem: positive iff the normals point outwards."""
     tri = part.vertices[part.faces]
     return float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6)
 
 
 def test_box_is_closed_with_exact_volume_and_grid_faces():
-    part = g.box((1.0, 2.0, 3.0), "flat:0.5", center=(1, 1, 1), divisions=(2, 3, 4))
+    part = box((1.0, 2.0, 3.0), "flat:0.5", center=(1, 1, 1), divisions=(2, 3, 4))
     assert is_closed(part.faces)
     assert volume(part) == pytest.approx(6.0, rel=EXACT)
     # 2 triangles per grid cell on each pair of opposite faces
@@ -35,7 +47,7 @@ def test_box_is_closed_with_exact_volume_and_grid_faces():
 def test_cylinder_volume_is_the_prism_volume(sections):
     # a revolved rectangle is a prism over a regular polygon of area n/2 r^2 sin(2 pi / n)
     r, h = 0.3, 1.2
-    part = g.cylinder(r, h, "flat:0.5", sections=sections, rings=3)
+    part = cylinder(r, h, "flat:0.5", sections=sections, rings=3)
     assert is_closed(part.faces)
     assert volume(part) == pytest.approx(
         sections / 2 * r**2 * math.sin(2 * math.pi / sections) * h, rel=EXACT
@@ -44,14 +56,14 @@ def test_cylinder_volume_is_the_prism_volume(sections):
 
 def test_primitives_are_closed_and_outward():
     parts = [
-        g.sphere(0.5, "flat:0.5"),
-        g.ellipsoid((0.5, 0.2, 0.1), "flat:0.5"),
-        g.cone(0.3, 0.5, "flat:0.5"),
-        g.capsule(0.2, 0.5, "flat:0.5"),
-        g.torus(0.5, 0.1, "flat:0.5"),
-        g.table(1.0, 0.6, 0.7, "flat:0.5"),
-        g.shelf(1.0, 0.4, 1.5, "flat:0.5"),
-        g.chair(0.45, 0.45, "flat:0.5", facing_deg=30),
+        sphere(0.5, "flat:0.5"),
+        ellipsoid((0.5, 0.2, 0.1), "flat:0.5"),
+        cone(0.3, 0.5, "flat:0.5"),
+        capsule(0.2, 0.5, "flat:0.5"),
+        torus(0.5, 0.1, "flat:0.5"),
+        table(1.0, 0.6, 0.7, "flat:0.5"),
+        shelf(1.0, 0.4, 1.5, "flat:0.5"),
+        chair(0.45, 0.45, "flat:0.5", facing_deg=30),
     ]
     for part in parts:
         assert is_closed(part.faces)
@@ -60,14 +72,14 @@ def test_primitives_are_closed_and_outward():
 
 def test_sphere_volume_approaches_analytic():
     # an inscribed icosphere of 5120 faces loses < 0.5 % of the ball's volume
-    assert volume(g.sphere(1.0, "flat:0.5", subdivisions=4)) == pytest.approx(
+    assert volume(sphere(1.0, "flat:0.5", subdivisions=4)) == pytest.approx(
         4 / 3 * math.pi, rel=5e-3
     )
 
 
 def test_revolve_paints_profile_segments_exactly():
     profile = [(0, 0), (1, 0), (1, 1), (1, 2), (0, 2)]
-    part = g.revolve(profile, ["flat:0.1", "flat:0.2", "flat:0.3", "flat:0.4"], sections=8)
+    part = revolve(profile, ["flat:0.1", "flat:0.2", "flat:0.3", "flat:0.4"], sections=8)
     z = part.centroids[:, 2]
     spectra = part.face_spectra
     assert set(spectra[z == 0]) == {"flat:0.1"}
@@ -78,27 +90,27 @@ def test_revolve_paints_profile_segments_exactly():
 
 def test_revolve_rejects_profiles_off_the_axis():
     with pytest.raises(SceneError, match="axis"):
-        g.revolve([(0.1, 0), (1, 0), (0, 1)], "flat:0.5")
+        revolve([(0.1, 0), (1, 0), (0, 1)], "flat:0.5")
 
 
 def test_bands_stripes_patches_and_print_follow_centroids():
-    part = g.box((1, 1, 1), "flat:0.5", divisions=(4, 4, 4))
+    part = box((1, 1, 1), "flat:0.5", divisions=(4, 4, 4))
     c = part.centroids
-    banded = g.bands(part, ["flat:0.1", None, "flat:0.9"], axis=2, edges=[-0.25, 0.25])
+    banded = bands(part, ["flat:0.1", None, "flat:0.9"], axis=2, edges=[-0.25, 0.25])
     s = banded.face_spectra
     assert set(s[c[:, 2] < -0.25]) == {"flat:0.1"}
     assert set(s[(c[:, 2] > -0.25) & (c[:, 2] < 0.25)]) == {"flat:0.5"}
     assert set(s[c[:, 2] > 0.25]) == {"flat:0.9"}
 
-    striped = g.stripes(part, ["flat:0.1", "flat:0.2"], axis=0, width=0.25, offset=-0.5)
+    striped = stripes(part, ["flat:0.1", "flat:0.2"], axis=0, width=0.25, offset=-0.5)
     k = np.floor((c[:, 0] + 0.5) / 0.25).astype(int) % 2
     assert np.array_equal(striped.face_spectra == "flat:0.2", k == 1)
 
-    patched = g.patches(part, "flat:0.1", [(0.5, 0.0, 0.0)], 0.2)
+    patched = patches(part, "flat:0.1", [(0.5, 0.0, 0.0)], 0.2)
     near = np.linalg.norm(c - [0.5, 0, 0], axis=1) <= 0.2
     assert near.any() and np.array_equal(patched.face_spectra == "flat:0.1", near)
 
-    inked = g.printed(part, ["X.", ".X"], {"X": "flat:0.1"}, origin=(-0.5, -0.5), cell=0.25)
+    inked = printed(part, ["X.", ".X"], {"X": "flat:0.1"}, origin=(-0.5, -0.5), cell=0.25)
     top = part.normals[:, 2] > 0.9
     col = np.floor((c[:, 0] + 0.5) / 0.25)
     row = 1 - np.floor((c[:, 1] + 0.5) / 0.25)
@@ -108,8 +120,8 @@ def test_bands_stripes_patches_and_print_follow_centroids():
 
 
 def test_moved_applies_scale_rotation_translation_in_order():
-    part = g.box((1, 1, 1), "flat:0.5")
-    out = g.moved(part, scale=(2, 1, 1), rotate_deg=(0, 0, 90), translate=(1, 2, 3))
+    part = box((1, 1, 1), "flat:0.5")
+    out = moved(part, scale=(2, 1, 1), rotate_deg=(0, 0, 90), translate=(1, 2, 3))
     # x-extent 2 becomes the y-extent after a quarter turn about z
     np.testing.assert_allclose(out.vertices.min(axis=0), [0.5, 1.0, 2.5], atol=1e-12)
     np.testing.assert_allclose(out.vertices.max(axis=0), [1.5, 3.0, 3.5], atol=1e-12)
@@ -117,11 +129,11 @@ def test_moved_applies_scale_rotation_translation_in_order():
 
 
 def test_merge_and_to_meshes_share_one_material_table():
-    a = g.box((1, 1, 1), "flat:0.1")
-    b = g.bands(
-        g.box((1, 1, 1), "flat:0.2", divisions=(1, 1, 2)), ["flat:0.1", None], axis=2, edges=[0.0]
+    a = box((1, 1, 1), "flat:0.1")
+    b = bands(
+        box((1, 1, 1), "flat:0.2", divisions=(1, 1, 2)), ["flat:0.1", None], axis=2, edges=[0.0]
     )
-    meshes, materials = g.to_meshes([("a", a), ("b", b)], first_object_id=5)
+    meshes, materials = to_meshes([("a", a), ("b", b)], first_object_id=5)
     assert [m.spectrum for m in materials] == ["flat:0.1", "flat:0.2"]
     assert [m.object_id for m in meshes] == [5, 6]
     assert set(meshes[0].face_materials) == {0}
@@ -131,7 +143,7 @@ def test_merge_and_to_meshes_share_one_material_table():
 
 
 def test_room_walls_enclose_free_air():
-    shell = g.room(
+    shell = room(
         (4, 3, 2.5),
         dict.fromkeys(("floor", "ceiling", "left", "right", "back", "front"), "flat:0.5"),
     )

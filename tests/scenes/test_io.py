@@ -13,8 +13,9 @@ import yaml
 
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes import library
-from spectrinsic.scenes.io import load_scene, save_scene
 from spectrinsic.scenes.model import Light, scene_hash
+from spectrinsic.scenes.scene_reader import load_scene
+from spectrinsic.scenes.scene_writer import save_scene
 
 SEED = 7
 
