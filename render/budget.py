@@ -8,19 +8,24 @@ process itself (Python, Mitsuba, the compiled kernels). It is calibrated to be a
 of the measured peak resident memory (``ru_maxrss``) of ``spectrinsic render obj-apple`` with
 the four default modes (73 values per pixel with the AOVs), spp 16, on the 2-core CI machine:
 
-=========  ==========  ==========
-size       measured    estimate
-=========  ==========  ==========
-8 x 8      277 MiB     448 MiB
-256 x 256  305 MiB     558 MiB
-512 x 512  488 MiB     886 MiB
-2048^2     5.0 GB      7.8 GB
-=========  ==========  ==========
+=========  ===========================  ==========
+size       measured                     estimate
+=========  ===========================  ==========
+8 x 8      277 MiB (passes)             1.0 GiB
+64 x 64    851 MiB (single, cold JIT)   1.1 GiB
+192 x 192  851 MiB (single, cold JIT)   1.1 GiB
+256 x 256  305 / 348 MiB (passes/single) 1.1 GiB
+512 x 512  488 / 608 MiB (passes/single) 1.4 GiB
+2048^2     5.0 GB (passes)              8.4 GB
+=========  ===========================  ==========
 
 (the 2048^2 figure from issue 17, where the former count, 684 B/pixel without the process,
-estimated 1.7 GiB). The samples per pixel do not matter: 256 x 256 at spp 64 peaked at 304 MiB,
-as Mitsuba's symbolic loops keep no per-sample state. So a size refused here could not have
-worked, and a size let through fits with the margin of the table.
+estimated 1.7 GiB). The single traversal (``RenderSettings.integrator="single"``) compiles one
+large kernel: a cold LLVM compile (a mode set not yet in Dr.Jit's kernel cache) peaks at about
+850 MiB whatever the size, which sets :data:`BASE_BYTES`. The samples per pixel do not matter:
+256 x 256 at spp 64 peaked at 304 MiB, as Mitsuba's symbolic loops keep no per-sample state. So
+a size refused here could not have worked, and a size let through fits with the margin of the
+table.
 """
 
 from __future__ import annotations
@@ -49,9 +54,10 @@ BYTES_PER_VALUE = 4
 #: arrays, the EXR encoder's buffers (fitted: 1120 B/pixel measured at 2048^2 for 73 values is
 #: 3.8 copies; 6 keeps the estimate above every measurement of the module's table).
 OVERHEAD_FACTOR = 6
-#: Resident memory of a render process before its first pixel (measured 277 MiB at 8 x 8 and
-#: 318 MiB at 64 x 64 with three modes; the margin covers other builds of the libraries).
-BASE_BYTES = 448 * 2**20
+#: Resident memory of a render process before its first pixel, a cold compile of the single
+#: traversal's kernel included (851 MiB measured at 64 x 64 and 192 x 192; 277 MiB at 8 x 8 with
+#: the passes); the margin covers other builds of the libraries.
+BASE_BYTES = 1024 * 2**20
 #: AOV values per pixel: coverage of up to 9 materials, 2 ids, depth, 3 normals, the mask.
 AOV_VALUES = 16
 #: Longest image side accepted at all (OpenEXR and Mitsuba films use 32-bit sizes).
