@@ -88,7 +88,8 @@ def _active(scene: Scene, active_lights: Sequence[int] | None) -> set[int]:
     return active
 
 
-def _timed_render(mi: Any, loaded: Any, *, spp: int, seed: int, integrator: Any = None) -> tuple[np.ndarray, float]:
+def timed_render(mi: Any, loaded: Any, *, spp: int, seed: int, integrator: Any = None) -> tuple[np.ndarray, float]:
+    """One ``mi.render`` as float32 and its seconds; a Ctrl-C stops the build within it."""
     raise_if_requested()
     start = time.perf_counter()
     try:
@@ -191,13 +192,13 @@ def render_diagonal(
                 for j in sorted(active):
                     _set_rgb(mi, params, tr.emission_key(scene, j, spectral=False), lights[j])
                 params.update()
-                image, dt = _timed_render(mi, loaded, spp=spp, seed=seed)
+                image, dt = timed_render(mi, loaded, spp=spp, seed=seed)
                 full.append(image)
                 seconds.append(dt)
                 if progress is not None:
                     progress(1)
                 if want_direct:
-                    image, dt = _timed_render(mi, loaded, spp=spp, seed=seed, integrator=direct_integrator)
+                    image, dt = timed_render(mi, loaded, spp=spp, seed=seed, integrator=direct_integrator)
                     direct_parts.append(image)
                     seconds.append(dt)
                     if progress is not None:
@@ -251,14 +252,14 @@ def render_spectral(
             geometry=geometry,
         )
         loaded = mi.load_dict(mitsuba_dict)
-        image, dt = _timed_render(mi, loaded, spp=spp, seed=seed)
+        image, dt = timed_render(mi, loaded, spp=spp, seed=seed)
         seconds = [dt]
         if progress is not None:
             progress(1)
         direct_image = None
         if direct:
             integrator = mi.load_dict(tr.path_integrator(DIRECT_DEPTH))
-            direct_image, dt = _timed_render(mi, loaded, spp=spp, seed=seed, integrator=integrator)
+            direct_image, dt = timed_render(mi, loaded, spp=spp, seed=seed, integrator=integrator)
             seconds.append(dt)
             if progress is not None:
                 progress(1)
@@ -331,7 +332,7 @@ def render_aovs(
                     onehot[i % 3] = 1.0
                 _set_rgb(mi, params, tr.reflectance_key(s, spectral=False), onehot)
             params.update()
-            image, dt = _timed_render(mi, loaded, spp=spp, seed=seed)
+            image, dt = timed_render(mi, loaded, spp=spp, seed=seed)
             seconds.append(dt)
             if progress is not None:
                 progress(1)

@@ -16,7 +16,6 @@ Cost, measured on ``room-living__v1__two-colour-a`` at the default preset (256²
 
 from __future__ import annotations
 
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -24,11 +23,16 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import RenderError, SceneError, validate_choice
-from spectrinsic.interrupts import raise_if_requested
 from spectrinsic.render import translate as tr
 from spectrinsic.render.integrator import BandTables, band_path, first_hit_channels
 from spectrinsic.render.modes import ChannelValues, RenderMode, channel_values
-from spectrinsic.render.passes import DIRECT_DEPTH, PassOutput, PassProgress, assemble_aovs
+from spectrinsic.render.passes import (
+    DIRECT_DEPTH,
+    PassOutput,
+    PassProgress,
+    assemble_aovs,
+    timed_render,
+)
 from spectrinsic.render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
 from spectrinsic.render.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Scene
@@ -125,17 +129,11 @@ def _tables(scene: Scene, value_sets: Sequence[ChannelValues], emitters: dict[in
 
 
 def _render(mi: Any, loaded: Any, integrator: Any, *, spp: int, seed: int, n: int) -> tuple[np.ndarray, float]:
-    raise_if_requested()  # Ctrl-C stops a build within one render
-    start = time.perf_counter()
-    try:
-        image = np.array(mi.render(loaded, spp=int(spp), seed=int(seed), integrator=integrator), dtype=np.float32)
-    except RuntimeError as exc:
-        raise_if_requested()  # Dr.Jit re-raises a Ctrl-C inside the render as RuntimeError
-        raise RenderError(f"Mitsuba render failed: {exc}") from exc
-    raise_if_requested()  # Mitsuba's own SIGINT handler may have cut the render short
+    """The traversal's last *n* AOV channels (the band transport) and the render's seconds."""
+    image, seconds = timed_render(mi, loaded, spp=spp, seed=seed, integrator=integrator)
     if image.shape[-1] < n:
         raise RenderError(f"band-path render returned {image.shape[-1]} channels; expected at least {n}")
-    return image[..., image.shape[-1] - n:], time.perf_counter() - start
+    return image[..., image.shape[-1] - n:], seconds
 
 
 def render_traversal(
