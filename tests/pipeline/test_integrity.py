@@ -201,9 +201,13 @@ def _workers(pid: int) -> list[int]:
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc to find the workers")
 def test_a_worker_killed_mid_write_leaves_a_clean_complete_set(tmp_path):
     """kill -9 of both pool workers while a sample is being written: the build re-runs their
-    samples, succeeds, and leaves no temporary; check passes."""
+    samples, succeeds, and leaves no temporary; check passes. Four samples on two workers: when
+    the first temporary appears the others are still queued, so the workers are alive to be
+    killed (with two samples the pool could finish and exit before the kill)."""
+    ids = (*IDS, "obj-cup__v0__white", "obj-deer__v0__white")
     out = tmp_path / "ds"
-    proc = subprocess.Popen([sys.executable, "-P", "-m", "spectrinsic", *CLI, "--workers", "2",
+    cli = [*CLI[:-1], ",".join(ids)]
+    proc = subprocess.Popen([sys.executable, "-P", "-m", "spectrinsic", *cli, "--workers", "2",
                              "--threads", "1", "--out", str(out)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + WAIT_S
@@ -218,6 +222,6 @@ def test_a_worker_killed_mid_write_leaves_a_clean_complete_set(tmp_path):
     stdout, stderr = proc.communicate(timeout=WAIT_S)
     assert killed, "no worker found to kill"
     assert proc.returncode == 0, stderr
-    assert "built 2, skipped 0, failed 0" in stdout
+    assert f"built {len(ids)}, skipped 0, failed 0" in stdout
     assert not list(out.glob(".spectrinsic-tmp-*"))
     assert check_dataset(out) == []
