@@ -17,19 +17,20 @@ is still a cycle (it only moves the failure from import time to the first call).
 from __future__ import annotations
 
 import ast
+import tomllib
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+#: Folder -> package, as packaged: ``pyproject.toml``'s ``package-dir`` is the one list
+#: (tests/test_packaging.py guards it against the folders on disk).
 FOLDERS = {
-    "core": "spectrinsic",
-    "spectra": "spectrinsic.spectra",
-    "scenes": "spectrinsic.scenes",
-    "render": "spectrinsic.render",
-    "gt_export": "spectrinsic.gt_export",
-    "decompose": "spectrinsic.decompose",
+    folder: package
+    for package, folder in tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"][
+        "package-dir"
+    ].items()
 }
 #: Top-level names that may be imported inside a function (see the module docstring).
 HEAVY = frozenset({
