@@ -182,34 +182,55 @@ def render_diagonal(
                              + [tr.emission_key(scene, j, spectral=False) for j in sorted(active)])
         direct_integrator = mi.load_dict(tr.path_integrator(DIRECT_DEPTH)) if any(flags) else None
         for values, want_direct in zip(value_sets, flags, strict=True):
-            k = values.materials.shape[1]
-            material_blocks = pad_to_passes(values.materials)
-            light_blocks = pad_to_passes(values.lights)
-            full, direct_parts, seconds = [], [], []
-            for mats, lights in zip(material_blocks, light_blocks, strict=True):
-                for s in surfaces:
-                    _set_rgb(mi, params, tr.reflectance_key(s, spectral=False), mats[s.material])
-                for j in sorted(active):
-                    _set_rgb(mi, params, tr.emission_key(scene, j, spectral=False), lights[j])
-                params.update()
-                image, dt = timed_render(mi, loaded, spp=spp, seed=seed)
-                full.append(image)
-                seconds.append(dt)
-                if progress is not None:
-                    progress(1)
-                if want_direct:
-                    image, dt = timed_render(mi, loaded, spp=spp, seed=seed, integrator=direct_integrator)
-                    direct_parts.append(image)
-                    seconds.append(dt)
-                    if progress is not None:
-                        progress(1)
-            outputs.append(PassOutput(
-                image=np.concatenate(full, axis=-1)[..., :k],
-                direct=np.concatenate(direct_parts, axis=-1)[..., :k] if want_direct else None,
-                seconds=tuple(seconds),
-                variant=chosen,
-            ))
+            passes = _DiagonalPasses(mi, loaded, params, direct_integrator, spp, seed, progress)
+            outputs.append(passes.render(scene, surfaces, sorted(active), values, want_direct, chosen))
     return outputs
+
+
+@dataclass(frozen=True)
+class _DiagonalPasses:
+    """One loaded RGB scene and what every diagonal pass on it shares (seed, spp, integrators)."""
+
+    mi: Any
+    loaded: Any
+    params: Any
+    direct_integrator: Any
+    spp: int
+    seed: int
+    progress: PassProgress | None
+
+    def _render(self, integrator: Any = None) -> tuple[np.ndarray, float]:
+        image, dt = timed_render(self.mi, self.loaded, spp=self.spp, seed=self.seed, integrator=integrator)
+        if self.progress is not None:
+            self.progress(1)
+        return image, dt
+
+    def render(
+        self, scene: Scene, surfaces: Sequence[tr.Surface], active: Sequence[int], values: ChannelValues,
+        want_direct: bool, variant: str,
+    ) -> PassOutput:
+        """The ⌈K/3⌉ RGB passes of one value set (and their direct-only twins), stacked to K."""
+        k = values.materials.shape[1]
+        full, direct_parts, seconds = [], [], []
+        for mats, lights in zip(pad_to_passes(values.materials), pad_to_passes(values.lights), strict=True):
+            for s in surfaces:
+                _set_rgb(self.mi, self.params, tr.reflectance_key(s, spectral=False), mats[s.material])
+            for j in active:
+                _set_rgb(self.mi, self.params, tr.emission_key(scene, j, spectral=False), lights[j])
+            self.params.update()
+            image, dt = self._render()
+            full.append(image)
+            seconds.append(dt)
+            if want_direct:
+                image, dt = self._render(self.direct_integrator)
+                direct_parts.append(image)
+                seconds.append(dt)
+        return PassOutput(
+            image=np.concatenate(full, axis=-1)[..., :k],
+            direct=np.concatenate(direct_parts, axis=-1)[..., :k] if want_direct else None,
+            seconds=tuple(seconds),
+            variant=variant,
+        )
 
 
 def render_spectral(
