@@ -259,6 +259,24 @@ def _sealed(f: JsonFields, meta: Mapping[str, Any], verify: bool) -> bool:
     return sealed
 
 
+def _size(f: JsonFields, value: object) -> tuple[int, int]:
+    size = tuple(f.integer(v, f"size[{i}]", low=1) for i, v in enumerate(f.sequence(value, "size")))
+    if len(size) != 2:
+        raise f.fail("size", "[height, width]", list(size))
+    return size[0], size[1]
+
+
+def _check_records(f: JsonFields, meta: Mapping[str, object]) -> None:
+    """The fields kept as plain JSON in :class:`SampleMeta` (``raw``): checked for type only."""
+    for name in ("matrices", "spectral_grid", "shading_clipping", "render"):
+        f.numeric_tree(f.mapping(meta[name], name), name)
+    for name in ("objects", "versions"):
+        for key, value in f.mapping(meta[name], name).items():
+            f.text(value, f"{name}.{key}")
+    f.texts(meta["denoised_layers"], "denoised_layers")
+    f.text(meta["scene_hash"], "scene_hash")
+
+
 def parse_meta(meta: object, path: Path, *, verify: bool = True) -> SampleMeta:
     """Validate a parsed ``meta.json`` (*path* names it in errors and locates its folder).
 
@@ -281,16 +299,8 @@ def parse_meta(meta: object, path: Path, *, verify: bool = True) -> SampleMeta:
         raise f.fail("sample_id", f"the folder's name {path.parent.name!r}", sample_id)
     layers = {key: _layer(f, rec, f"layers.{key}")
               for key, rec in f.mapping(meta["layers"], "layers").items()}
-    size = tuple(f.integer(v, f"size[{i}]", low=1) for i, v in enumerate(f.sequence(meta["size"], "size")))
-    if len(size) != 2:
-        raise f.fail("size", "[height, width]", list(size))
-    for name in ("matrices", "spectral_grid", "shading_clipping", "render"):
-        f.numeric_tree(f.mapping(meta[name], name), name)
-    for name in ("objects", "versions"):
-        for key, value in f.mapping(meta[name], name).items():
-            f.text(value, f"{name}.{key}")
-    f.texts(meta["denoised_layers"], "denoised_layers")
-    f.text(meta["scene_hash"], "scene_hash")
+    size = _size(f, meta["size"])
+    _check_records(f, meta)
     materials = f.mapping(meta["materials"], "materials")
     files, hashes = _files(f, meta)
     transport = None
@@ -302,7 +312,7 @@ def parse_meta(meta: object, path: Path, *, verify: bool = True) -> SampleMeta:
         path=path, format_version=version, sample_id=sample_id,
         scene=f.text(meta["scene"], "scene"), config_hash=f.text(meta["config_hash"], "config_hash"),
         seed=f.integer(meta["seed"], "seed"), variants=f.texts(meta["variants"], "variants"),
-        reference_mode=f.text(meta["reference_mode"], "reference_mode"), size=(size[0], size[1]),
+        reference_mode=f.text(meta["reference_mode"], "reference_mode"), size=size,
         scene_metadata=MappingProxyType(f.mapping(meta["scene_metadata"], "scene_metadata")),
         materials=MappingProxyType({k: f.text(v, f"materials.{k}") for k, v in materials.items()}),
         lights=tuple(_light(f, v, f"lights[{i}]") for i, v in enumerate(f.sequence(meta["lights"], "lights"))),
