@@ -10,6 +10,7 @@ import doctest
 import importlib
 import importlib.util
 import pkgutil
+import tomllib
 from pathlib import Path
 
 import colour  # noqa: F401  (its import sets numpy's legacy printing: done before any example)
@@ -18,8 +19,12 @@ import pytest
 
 import spectrinsic
 
-#: The source folders of the package (pyproject's ``package-dir``).
-FOLDERS = ("core", "spectra", "scenes", "render", "gt_export", "decompose")
+#: The source folders of the package: pyproject's ``package-dir`` (tests/test_packaging.py guards it).
+FOLDERS = tuple(
+    tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())["tool"][
+        "setuptools"
+    ]["package-dir"].values()
+)
 
 
 def _modules_with_examples() -> list[str]:
