@@ -37,7 +37,15 @@ from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import get_sensors
 from spectrinsic.spectra.reconstruction import relative_error
 
-__all__ = ["run", "CROP", "REFERENCE_SPP", "REFERENCE_BATCHES", "crop_reference", "edge_pixels", "shading_errors"]
+__all__ = [
+    "run",
+    "CROP",
+    "REFERENCE_SPP",
+    "REFERENCE_BATCHES",
+    "crop_reference",
+    "edge_pixels",
+    "shading_errors",
+]
 
 SCENE, VIEW, CONDITION = "room-living", 1, "white"
 #: ``(x, y, width, height)`` of the window in the 256² image (a wall, furniture and their edges).
@@ -49,27 +57,57 @@ REFERENCE_BATCHES = 8
 MODE = "bands31"
 
 
-def _window(scene: Scene, *, spp: int, seed: int, crop: tuple[int, int, int, int]) -> RenderResult:
+def _window(
+    scene: Scene, *, spp: int, seed: int, max_depth: int, crop: tuple[int, int, int, int]
+) -> RenderResult:
     """One batch of the 31-band cube and the first-hit maps of the *crop*, as a render result."""
     mode = get_mode(MODE)
     sensors = get_sensors(mode.sensors)
     (out,), aovs, seconds, variant = render_traversal(
-        scene, [channel_values(scene, sensors)], spp=spp, seed=seed, aovs=True, crop=crop)
+        scene,
+        [channel_values(scene, sensors)],
+        spp=spp,
+        seed=seed,
+        max_depth=max_depth,
+        aovs=True,
+        crop=crop,
+    )
     raw = out.image()
     matrix = to_xyz_matrix(mode, scene)
-    meta = {"spp": spp, "seed": seed, "sensors": {MODE: sensors.name}, "to_xyz": {MODE: matrix.tolist()},
-            "variants": {MODE: variant}, "timings": {"single": {"passes": 1, "seconds": seconds[0],
-                                                                "per_pass": list(seconds)}}}
-    return RenderResult(images={MODE: raw_to_xyz(raw, matrix)}, raw={MODE: raw}, aovs=aovs, meta=meta)
+    meta = {
+        "spp": spp,
+        "seed": seed,
+        "sensors": {MODE: sensors.name},
+        "to_xyz": {MODE: matrix.tolist()},
+        "variants": {MODE: variant},
+        "timings": {"single": {"passes": 1, "seconds": seconds[0], "per_pass": list(seconds)}},
+    }
+    return RenderResult(
+        images={MODE: raw_to_xyz(raw, matrix)}, raw={MODE: raw}, aovs=aovs, meta=meta
+    )
 
 
-def crop_reference(scene: Scene, *, spp: int = REFERENCE_SPP, batches: int = REFERENCE_BATCHES, seed: int = 7,
-                   crop: tuple[int, int, int, int] = CROP) -> tuple[Any, float]:
-    """Ground truth of the *crop* at *spp* (in *batches*), and its render seconds."""
+def crop_reference(
+    scene: Scene,
+    *,
+    spp: int = REFERENCE_SPP,
+    batches: int = REFERENCE_BATCHES,
+    seed: int = 7,
+    max_depth: int,
+    crop: tuple[int, int, int, int] = CROP,
+) -> tuple[Any, np.ndarray, float]:
+    """Ground truth of the *crop* at *spp* (in *batches*) with paths of *max_depth* (the
+    estimate's: a longer path adds light), its edge pixels (:func:`edge_pixels`) and its
+    render seconds."""
     start = time.perf_counter()
-    parts = [_window(scene, spp=spp // batches, seed=s, crop=crop) for s in batch_seeds(seed, batches)]
+    parts = [
+        _window(scene, spp=spp // batches, seed=s, max_depth=max_depth, crop=crop)
+        for s in batch_seeds(seed, batches)
+    ]
     seconds = time.perf_counter() - start
-    return compute_ground_truth(scene, merge_batches(parts), cameras=()), seconds
+    merged = merge_batches(parts)
+    edges = edge_pixels(merged.aovs["material_id"], merged.aovs["coverage"])
+    return compute_ground_truth(scene, merged, cameras=()), edges, seconds
 
 
 def edge_pixels(material_id: np.ndarray, coverage: np.ndarray) -> np.ndarray:
@@ -80,20 +118,25 @@ def edge_pixels(material_id: np.ndarray, coverage: np.ndarray) -> np.ndarray:
     differs = np.zeros((h, w), bool)
     for dy in range(3):
         for dx in range(3):
-            differs |= ids[dy:dy + h, dx:dx + w] != material_id
+            differs |= ids[dy : dy + h, dx : dx + w] != material_id
     return differs | (coverage.max(axis=-1) < 0.999)
 
 
-def shading_errors(estimate: np.ndarray, reference: np.ndarray, valid: np.ndarray,
-                   edges: np.ndarray) -> dict[str, float]:
+def shading_errors(
+    estimate: np.ndarray, reference: np.ndarray, valid: np.ndarray, edges: np.ndarray
+) -> dict[str, float]:
     """Median, p95 and RMS of the per-pixel relative error (Eq. 5.7) on *valid* pixels, and
     median/p95 on the edge and interior pixels among them."""
     err = relative_error(estimate, reference, where=valid)
 
     def summary(mask: np.ndarray) -> dict[str, float]:
         e = err[mask]
-        return {"median": float(np.median(e)), "p95": float(np.percentile(e, 95)),
-                "rms": float(np.sqrt(np.mean(e ** 2))), "pixels": int(mask.sum())}
+        return {
+            "median": float(np.median(e)),
+            "p95": float(np.percentile(e, 95)),
+            "rms": float(np.sqrt(np.mean(e**2))),
+            "pixels": int(mask.sum()),
+        }
 
     out = summary(valid)
     out["edges"] = summary(valid & edges)
@@ -103,7 +146,7 @@ def shading_errors(estimate: np.ndarray, reference: np.ndarray, valid: np.ndarra
 
 def _cut(layer: np.ndarray, crop: tuple[int, int, int, int]) -> np.ndarray:
     x, y, w, h = crop
-    return layer[y:y + h, x:x + w]
+    return layer[y : y + h, x : x + w]
 
 
 def run(out_dir: Path) -> dict[str, Any]:
@@ -114,24 +157,34 @@ def run(out_dir: Path) -> dict[str, Any]:
     start = time.perf_counter()
     noisy = render_batches(scene, cfg.render, seed=1)
     t_render = time.perf_counter() - start
-    ref, t_ref = crop_reference(scene)
+    ref, edges, t_ref = crop_reference(scene, max_depth=cfg.render.max_depth)
     s_ref = ref.layers["shading"].data
-    valid = (ref.layers["shading_grey"].data > 0)
-    edges = edge_pixels(ref.layers["material_id"].data, ref.layers["coverage"].data if "coverage" in ref.layers
-                        else np.ones(valid.shape + (1,)))
+    valid = ref.layers["shading_grey"].data > 0
     ref_noise = ref.layers["noise_shading_raw"].data[valid]
     scored: dict[str, Any] = {}
-    for name, kw in {"raw": {"denoise": False}, "stored_oidn_fast": {"denoise": True},
-                     "oidn_high": {"denoise": True, "denoise_quality": "high"}}.items():
+    for name, kw in {
+        "raw": {"denoise": False},
+        "stored_oidn_fast": {"denoise": True},
+        "oidn_high": {"denoise": True, "denoise_quality": "high"},
+    }.items():
         gt = compute_ground_truth(scene, noisy, cameras=(), **kw)
         key = "shading" if kw["denoise"] else "shading_raw"
         scored[name] = shading_errors(_cut(gt.layers[key].data, CROP), s_ref, valid, edges)
     return {
-        "scene": f"{SCENE} view {VIEW} {CONDITION}, {cfg.width}x{cfg.height}", "crop": list(CROP),
-        "estimate": {"spp": cfg.render.spp, "batches": cfg.render.batches, "render_seconds": t_render},
-        "reference": {"spp": REFERENCE_SPP, "batches": REFERENCE_BATCHES, "render_seconds": t_ref,
-                      "own_noise_median": float(np.median(ref_noise)),
-                      "own_noise_p95": float(np.percentile(ref_noise, 95))},
+        "scene": f"{SCENE} view {VIEW} {CONDITION}, {cfg.width}x{cfg.height}",
+        "crop": list(CROP),
+        "estimate": {
+            "spp": cfg.render.spp,
+            "batches": cfg.render.batches,
+            "render_seconds": t_render,
+        },
+        "reference": {
+            "spp": REFERENCE_SPP,
+            "batches": REFERENCE_BATCHES,
+            "render_seconds": t_ref,
+            "own_noise_median": float(np.median(ref_noise)),
+            "own_noise_p95": float(np.percentile(ref_noise, 95)),
+        },
         "shading": scored,
         "goal": {"median": 0.02, "p95": 0.08},
     }
