@@ -62,3 +62,14 @@ def test_shading_errors_summarise_the_relative_error_per_pixel():
     )  # 0.85 of the way
     assert out["interior"]["median"] == 0 and out["interior"]["pixels"] == 12
     assert out["rms"] == pytest.approx(np.sqrt(0.01 / 16), rel=1e-6)
+
+
+def test_the_references_own_noise_is_removed_in_quadrature():
+    ref = np.ones((2, 2, 3))
+    est = ref * np.array([1.05, 1.05, 1.05])[None, None]  # 5 % everywhere
+    se = np.full((2, 2), 0.03)
+    out = cr.shading_errors(est, ref, np.ones((2, 2), bool), np.zeros((2, 2), bool), se)
+    assert out["edges"]["pixels"] == 0 and out["edges"]["median"] is None
+    assert out["median"] == pytest.approx(0.05, rel=1e-6)
+    assert out["corrected"]["median"] == pytest.approx(0.04, rel=1e-6)  # sqrt(5² − 3²)
+    assert out["corrected"]["rms"] == pytest.approx(0.04, rel=1e-6)
