@@ -148,6 +148,7 @@ def render_traversal(
     variant: str | None = None,
     progress: PassProgress | None = None,
     geometry: Sequence[tr.SurfaceGeometry] | None = None,
+    crop: tuple[int, int, int, int] | None = None,
 ) -> tuple[list[TransportOutput], dict[str, np.ndarray], tuple[float, ...], str]:
     """Per-light band transport of every value set, in one traversal (two with *direct*).
 
@@ -161,6 +162,9 @@ def render_traversal(
     aovs
         Also take coverage, ids, depth and normals from the camera rays' first hits, as
         :func:`~spectrinsic.render.passes.render_aovs` computes them from the same samples.
+    crop
+        ``(x, y, width, height)``: render only that window of the image
+        (:func:`~spectrinsic.render.translate.hdr_film`); every map is the window's.
 
     Returns
     -------
@@ -182,12 +186,12 @@ def render_traversal(
     widths = [np.asarray(v.materials).shape[1] for v in value_sets]
     n_bands, n_lights = sum(widths), len(scene.lights)
     chosen = choose_variant("rgb", variant)
-    h, w = scene.camera.height, scene.camera.width
+    h, w = (scene.camera.height, scene.camera.width) if crop is None else (int(crop[3]), int(crop[2]))
     white = tr.rgb_spectrum([1.0, 1.0, 1.0])
     with variant_scope(chosen) as mi:
         loaded = mi.load_dict(tr.scene_to_mitsuba(
             scene, materials=[white] * len(scene.materials), lights=[white] * n_lights,
-            film=tr.hdr_film(w, h), integrator=tr.path_integrator(max_depth), sample_count=spp,
+            film=tr.hdr_film(scene.camera.width, scene.camera.height, crop), integrator=tr.path_integrator(max_depth), sample_count=spp,
             geometry=geometry,
         ))
         tables = _tables(scene, value_sets, light_of_emitters(mi, loaded), aovs)

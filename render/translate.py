@@ -132,12 +132,22 @@ def black_bsdf() -> dict[str, Any]:
     return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.0, 0.0, 0.0]}}}
 
 
-def hdr_film(width: int, height: int) -> dict[str, Any]:
-    """3-channel float32 film with a box filter (no blur across pixels: ground truth aligns)."""
-    return {
+def hdr_film(width: int, height: int, crop: tuple[int, int, int, int] | None = None) -> dict[str, Any]:
+    """3-channel float32 film with a box filter (no blur across pixels: ground truth aligns).
+
+    *crop* ``(x, y, width, height)`` in pixels renders only that window of the image (Mitsuba's
+    ``crop_offset_x/_y``, ``crop_width/_height``): its pixels are the full image's, at the cost
+    of the window's pixels alone (converged references of a detail)."""
+    film: dict[str, Any] = {
         "type": "hdrfilm", "width": int(width), "height": int(height), "pixel_format": "rgb",
         "component_format": "float32", "rfilter": {"type": "box"},
     }
+    if crop is not None:
+        x, y, cw, ch = (int(v) for v in crop)
+        if x < 0 or y < 0 or cw < 1 or ch < 1 or x + cw > width or y + ch > height:
+            raise SceneError(f"film crop {tuple(crop)}: expected (x, y, width, height) inside {width}x{height}")
+        film.update(crop_offset_x=x, crop_offset_y=y, crop_width=cw, crop_height=ch)
+    return film
 
 
 def spectral_film(width: int, height: int, curves: np.ndarray, wavelengths: np.ndarray) -> dict[str, Any]:

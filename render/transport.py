@@ -14,15 +14,20 @@ the mean of ``power · L`` over the band). Everything a sample derives from its 
 and camera layers built from it) then follows for any other light spectra and powers, by
 the same functions.
 
-The transport is rendered one light at a time (one scene load per light, as Mitsuba cannot
+Where the single traversal runs (``RenderSettings.integrator="single"``, the default on the
+JIT variants), the transport is the traversal's own per-light split
+(``RenderResult.transport``, per unit channel emission) times the flat unit spectrum's channel
+values: one traversal per batch for every mode and light, and a relit sample equals a direct
+``"single"`` render with the new spectra (same seed, spp and depth) to float32 rounding, since
+the traversal's paths do not depend on the light spectra. With ``integrator="passes"`` (and on
+a scalar variant) each light is rendered alone (one scene load per light, as Mitsuba cannot
 switch an emitter off), with the seed, sample count and path depth of the sample, so every
-light's paths are those of a direct per-light render: composing Eq. 1 with the very
-spectra of a render equals that render to float32 rounding (the multiplication by ``ē``
-happens after the path sum instead of inside it). The spectral Monte Carlo mode samples
-wavelengths and is not a band render; it cannot be relit.
+light's paths are those of a direct per-light render with the passes. Either way, composing
+Eq. 1 with the very spectra of a render equals that render to float32 rounding (the
+multiplication by ``ē`` happens after the path sum instead of inside it). The spectral Monte
+Carlo mode samples wavelengths and is not a band render; it cannot be relit.
 
-:func:`render_transport` is the one function that produces the transport; a single-traversal
-integrator can replace its body without changing the record.
+:func:`render_transport_batches` is the one function that produces a sample's transport.
 """
 
 from __future__ import annotations
@@ -47,6 +52,7 @@ from spectrinsic.render.passes import PassProgress, render_aovs, render_diagonal
 from spectrinsic.render.pipeline import batch_seeds, image_noise, merge_batches, render_scene
 from spectrinsic.render.result import RenderResult
 from spectrinsic.render.settings import RenderSettings
+from spectrinsic.render.single import resolve_integrator
 from spectrinsic.render.translate import prepare_geometry
 from spectrinsic.render.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Scene
@@ -84,7 +90,8 @@ class LightTransport:
     max_depth
         Longest path of the passes.
     seconds
-        Seconds of each Mitsuba pass, per mode (empty when read from a file).
+        Seconds of each Mitsuba pass, per mode, and under ``"single"`` those of the traversals
+        carrying every mode at once (empty when read from a file).
     """
 
     modes: tuple[str, ...]
@@ -243,11 +250,40 @@ def _join(diagonal: RenderResult, other: RenderResult | None, aovs: Mapping[str,
     )
 
 
+def _traversal_batch(
+    scene: Scene, settings: RenderSettings, seed: int, *, progress: PassProgress | None, data_dir: str | None,
+) -> tuple[dict[str, np.ndarray], RenderResult]:
+    """:func:`_batch` from one single traversal (:mod:`spectrinsic.render.single`), which
+    already splits every band by light: its transport ``T'_lk`` (per unit channel emission
+    ``E_lk``) times the flat unit spectrum's channel values ``∫S_k dλ`` is Eq. 1's ``T_lk``,
+    so no per-light pass is rendered. The same call renders the other modes and the AOVs from
+    the same pixel samples, as a direct render with ``integrator="single"`` does, so a relit
+    sample equals that render to float rounding."""
+    names = diagonal_mode_names(settings.modes)
+    direct = (tuple(m for m in settings.modes if m not in names) if settings.direct is True
+              else tuple(m for m in settings.direct or () if m not in names))
+    render = render_scene(scene, settings.with_options(per_light=False, share_mode=None, direct=direct, aovs=True),
+                          seed=seed, progress=progress, data_dir=data_dir)
+    flat = {m: _unit_values(scene, get_mode(m).sensors, data_dir).lights for m in names}
+    t = {m: (render.transport[m].astype(np.float64) * flat[m][:, None, None, :]).astype(np.float32)
+         for m in names}
+    base = {"max_depth": int(settings.max_depth), "variants": {m: render.meta["variants"][m] for m in names},
+            "timings": {m: render.meta["timings"][m] for m in names}}
+    diagonal = transport_result(t, scene, seed=seed, spp=settings.batch_spp, meta=base, data_dir=data_dir)
+    others = [m for m in dict.fromkeys(settings.modes) if m not in names]
+    other = replace(render, images={m: render.images[m] for m in others}, raw={m: render.raw[m] for m in others},
+                    transport={}) if others else None
+    return t, _join(diagonal, other, render.aovs, list(dict.fromkeys(settings.modes)))
+
+
 def _batch(
     scene: Scene, settings: RenderSettings, seed: int, *, progress: PassProgress | None, data_dir: str | None,
 ) -> tuple[dict[str, np.ndarray], RenderResult]:
     """Transport of one batch and the sample's render of that batch (other modes rendered
-    directly with every light on, the AOVs from the same pixel samples)."""
+    directly with every light on, the AOVs from the same pixel samples): from the single
+    traversal where it runs (:func:`_traversal_batch`), else one set of passes per light."""
+    if resolve_integrator(settings.integrator, settings.variant) == "single":
+        return _traversal_batch(scene, settings, seed, progress=progress, data_dir=data_dir)
     modes, spp, variant = settings.modes, settings.batch_spp, settings.variant
     names = diagonal_mode_names(modes)
     others = tuple(m for m in dict.fromkeys(modes) if m not in names)
@@ -304,7 +340,8 @@ def render_transport_batches(
     if noise_target is not None:
         merged.meta["noise_target"] = {"target": float(noise_target), "reached": reached, "max_batches": cap}
     names = diagonal_mode_names(modes)
-    seconds = {m: tuple(x for r in done for x in r[1].meta["timings"][m]["per_pass"]) for m in names}
+    seconds = {m: tuple(x for r in done for x in r[1].meta["timings"][m]["per_pass"])
+               for m in (*names, "single") if m in done[0][1].meta["timings"]}
     transport = LightTransport(
         modes=names, sensors={m: get_mode(m).sensors for m in names},
         batches=tuple(t for t, _ in done), seeds=tuple(int(s) for s in seeds[:len(done)]),

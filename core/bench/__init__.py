@@ -15,7 +15,7 @@ from pathlib import Path
 
 from spectrinsic.results import write_json
 
-BENCHMARKS = ("render", "dataset", "traversal", "decompose", "ground_truth", "relight")
+BENCHMARKS = ("render", "dataset", "traversal", "decompose", "ground_truth", "crop_reference", "relight")
 
 
 def main(argv: list[str] | None = None) -> int:

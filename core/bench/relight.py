@@ -3,8 +3,8 @@
 One two-light room of the default set (``room-living``, view 0, ``two-colour-a``) at the
 ``default`` preset (256², 2 batches × 8 spp, denoised, two cameras), in one run:
 
-* render seconds of the sample as the default build renders it (per-light ``rgb3`` shares),
-  and with ``--store-transport`` (every diagonal mode light by light, flat unit spectra);
+* render seconds of the sample as the default build renders it, and with ``--store-transport``
+  (the single traversal's own split by light, kept per batch: no extra render);
 * disk: bytes of ``transport.exr`` against the rest of the sample folder;
 * relighting seconds under new spectra, three ways: the relit raw channels and images alone
   (Eq. 1 and the XYZ maps, every batch), every layer in memory (``relit_layers``: OIDN,
@@ -78,7 +78,7 @@ def run(out_dir: Path) -> dict[str, Any]:
     _, plain_s = _timed(render_batches, scene, settings, seed=SEED)
     (transport, result), transport_s = _timed(render_transport_batches, scene, settings, seed=SEED)
     new_scene = relit_scene(scene, NEW_LIGHTS)
-    # every diagonal mode light by light, as the transport renders them
+    # every diagonal mode split by light, from the same traversal as the transport's
     light_by_light = settings.with_options(modes=diagonal_mode_names(settings.modes), per_light=True,
                                            share_mode=None, direct=False)
     direct, direct_s = _timed(render_batches, new_scene, light_by_light, seed=SEED)

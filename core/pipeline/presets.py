@@ -250,13 +250,17 @@ PRESETS: dict[str, DatasetConfig] = {
     ),
     # The thesis layout (68 samples) at 256² in <= 20 minutes on 2 cores: every render mode,
     # so the reference image is the 31-band cube and the 3-/6-sensor approximations carry error
-    # maps; two batches of 8 spp measure the noise. The denoised shading's median error
-    # against a 16x-spp reference is measured by make bench (bench_ground_truth.json).
+    # maps; two batches of 32 spp measure the noise. The single traversal's saved time buys
+    # 4x the samples of the last round's 2 x 8: the denoised room shading against a converged
+    # crop (make bench, bench_crop_reference.json) went from median 3.7 % / p95 18.5 % to
+    # 2.8 % / 14.9 % (1.6 % median with the reference's own 2.3 % noise removed); a sample of
+    # the costliest class takes 2.2x as long as at 16 spp, so the set's 434 s at 16 spp on an
+    # idle machine becomes about 16 minutes.
     "default": DatasetConfig.from_settings(
         "default",
         width=256,
         height=256,
-        spp=16,
+        spp=64,
         max_depth=6,
         per_light=True,
         batches=2,

@@ -18,7 +18,7 @@ from spectrinsic.gt_export import check_sample, export_sample, load_sample
 from spectrinsic.gt_export.relight import relight, relit_scene
 from spectrinsic.gt_export.relight_pool import RandomRelight, relit_layers
 from spectrinsic.gt_export.transport_file import TRANSPORT_NAME
-from spectrinsic.render import RenderSettings, render_batches
+from spectrinsic.render import RenderSettings, count_passes, render_batches
 from spectrinsic.render.transport import render_transport_batches
 
 #: Issue 20: a relit layer and the direct render's agree to float rounding, 1e-5 of the
@@ -27,10 +27,10 @@ RELIGHT_RTOL = 1e-5
 NEW_LIGHTS = {0: "cie:LED-RGB1", 1: "planck:3000K"}  # were planck:2800K, daylight:6500K
 MODES = ("spectral", "rgb3", "rgb6", "bands31")
 SEED = 11
-#: Two batches of 2 samples per pixel each.
-#: The transport is built from per-light passes, so the direct render it is compared with runs
-#: the same passes (the single traversal draws other random numbers).
-SETTINGS = RenderSettings(spp=4, modes=MODES, batches=2, max_depth=4, integrator="passes")
+#: Two batches of 2 samples per pixel each, the diagonal modes from the single traversal (the
+#: default): the transport is the traversal's own split by light, and the direct render it is
+#: compared with is another traversal with the new spectra (same seed, spp and depth).
+SETTINGS = RenderSettings(spp=4, modes=MODES, batches=2, max_depth=4)
 CONFIG = {"test": "relight"}
 
 
@@ -54,13 +54,14 @@ def _arrays(sample: dict) -> dict[str, np.ndarray]:
     return {k: v for k, v in sample.items() if isinstance(v, np.ndarray)}
 
 
-def test_relit_sample_equals_a_direct_render_with_the_new_spectra(built):
-    out, scene, sample = built
-    relit = relight(sample, NEW_LIGHTS, out / "relit__v0__two")
+def _relit_and_direct(out, scene, sample, settings: RenderSettings, tag: str) -> tuple[dict, dict]:
+    """The sample relit with :data:`NEW_LIGHTS`, and a direct render of the relit scene with
+    *settings* (light by light), both loaded; every layer compared within the tolerance."""
+    relit = relight(sample, NEW_LIGHTS, out / f"relit__v0__{tag}")
     assert check_sample(relit) == []
     new_scene = relit_scene(scene, NEW_LIGHTS)
-    direct = render_batches(new_scene, SETTINGS.with_options(modes=MODES[1:], per_light=True), seed=SEED)
-    reference = export_sample(out, new_scene, direct, sample_id="direct__v0__two", config=CONFIG,
+    direct = render_batches(new_scene, settings.with_options(modes=MODES[1:], per_light=True), seed=SEED)
+    reference = export_sample(out, new_scene, direct, sample_id=f"direct__v0__{tag}", config=CONFIG,
                               seed=SEED, denoise=True)
     a, b = _arrays(load_sample(relit)), _arrays(load_sample(reference))
     assert set(a) == set(b)
@@ -68,6 +69,30 @@ def test_relit_sample_equals_a_direct_render_with_the_new_spectra(built):
             "shading_camera/Nikon 5100 (NPL)", "image_rgb6", "error_rgb3"} <= set(a)
     errors = {k: _max_rel(a[k], b[k]) for k in a}
     assert max(errors.values()) <= RELIGHT_RTOL, {k: e for k, e in errors.items() if e > RELIGHT_RTOL}
+    return a, {"relit": relit, "reference": reference}
+
+
+def test_the_transport_comes_from_the_single_traversal_without_per_light_passes(make_room):
+    """One traversal per batch carries every mode and light, plus the spectral pass: the
+    transport costs the Mitsuba renders of a plain render (L x (1 + 2 + 11) + coverage
+    passes per batch before), and its diagonal images are that render's to float rounding."""
+    scene = make_room(size=8)
+    settings = SETTINGS.with_options(spp=2, batches=1)
+    calls: list[int] = []
+    transport, result = render_transport_batches(scene, settings, seed=SEED, progress=calls.append)
+    assert len(calls) == count_passes(scene, settings) == 2  # the traversal and the spectral pass
+    assert "single" in transport.seconds and result.meta["integrator"] == "single"
+    plain = render_batches(scene, settings, seed=SEED)
+    for mode in MODES[1:]:
+        np.testing.assert_allclose(result.raw[mode], plain.raw[mode], rtol=1e-5, atol=1e-7 * plain.raw[mode].max())
+    np.testing.assert_array_equal(result.images["spectral"], plain.images["spectral"])
+    np.testing.assert_array_equal(result.aovs["coverage"], plain.aovs["coverage"])
+
+
+def test_relit_sample_equals_a_direct_render_with_the_new_spectra(built):
+    out, scene, sample = built
+    a, paths = _relit_and_direct(out, scene, sample, SETTINGS, "two")
+    relit, reference = paths["relit"], paths["reference"]
     # the new lights really changed the image (the comparison is not between equal samples)
     before = load_sample(sample, layers=["image", "illuminant"])
     assert _max_rel(a["image"], before["image"]) > 0.05
@@ -79,6 +104,18 @@ def test_relit_sample_equals_a_direct_render_with_the_new_spectra(built):
         assert la["xy"] == pytest.approx(lb["xy"], rel=1e-12)
     assert meta_a["render"]["relit"]["from"] == "room__v0__two"
     assert meta_a["noise"]["batches"] == 2
+
+
+def test_relit_sample_equals_a_direct_render_with_the_passes(tmp_path, make_room):
+    """The transport from per-light passes (``integrator="passes"``, the scalar variants' way)
+    relights as exactly, against a direct render with the same passes."""
+    scene = make_room(size=12)
+    settings = SETTINGS.with_options(integrator="passes", spp=2)
+    transport, result = render_transport_batches(scene, settings, seed=SEED)
+    assert "single" not in transport.seconds and result.meta.get("integrator") != "single"
+    sample = export_sample(tmp_path, scene, result, sample_id="room__v0__passes", config=CONFIG,
+                           seed=SEED, denoise=True, transport=transport)
+    _relit_and_direct(tmp_path, scene, sample, settings, "passes")
 
 
 def test_relighting_with_the_own_spectra_gives_the_sample_back(built):

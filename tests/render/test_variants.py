@@ -168,3 +168,28 @@ def test_variant_scope_restores_on_errors_and_documents_the_first_scope():
     )
     assert _fresh(code) == ["None", "scalar_spectral", "scalar_spectral", "scalar_rgb",
                             "scalar_spectral"]
+
+
+def test_batches_switch_variants_once_each(monkeypatch, make_room):
+    """Every switch between the RGB and the spectral variant reloads Mitsuba's Python modules
+    (0.25 s on 2 cores), so the render pipeline runs the variant already active first and
+    leaves the last one active: two batches of a room in both kinds of mode switch twice
+    (four times before: each scope switched back on leaving)."""
+    from spectrinsic.render import render_batches
+
+    mi = variants.import_mitsuba()
+    mi.set_variant(variants.choose_variant("rgb"))  # as after any earlier render
+    switches: list[str] = []
+    real = mi.set_variant
+
+    def counted(name: str, *args: object) -> None:
+        if mi.variant() != name:
+            switches.append(name)
+        real(name, *args)
+
+    monkeypatch.setattr(mi, "set_variant", counted)
+    settings = RenderSettings(spp=2, modes=("spectral", "rgb3"), batches=2, max_depth=2)
+    result = render_batches(make_room(size=4), settings, seed=1)
+    assert len(switches) <= 2, switches
+    assert set(result.images) == {"spectral", "rgb3"}
+    assert result.meta["batches"] == 2
