@@ -209,5 +209,8 @@ def sample_dirs(dataset_dir: str | os.PathLike[str]) -> list[Path]:
     root = Path(dataset_dir)
     if not root.is_dir():
         raise DatasetError(f"dataset folder {str(root)!r} does not exist")
-    return sorted(p for p in root.iterdir()
-                  if p.is_dir() and not p.name.startswith(".") and (p / META_NAME).is_file())
+    return sorted(
+        p
+        for p in root.iterdir()
+        if p.is_dir() and not p.name.startswith(".") and (p / META_NAME).is_file()
+    )

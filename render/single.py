@@ -94,7 +94,11 @@ def resolve_integrator(name: str | None, variant: str | None = None) -> str:
     """*name* checked against :data:`~spectrinsic.render.settings.INTEGRATORS` (``None``:
     :data:`~spectrinsic.render.settings.DEFAULT_INTEGRATOR`);
     ``"passes"`` where the traversal does not run (:func:`single_traversal_runs`)."""
-    chosen = DEFAULT_INTEGRATOR if name is None else validate_choice(name, INTEGRATORS, "integrator", error=RenderError)
+    chosen = (
+        DEFAULT_INTEGRATOR
+        if name is None
+        else validate_choice(name, INTEGRATORS, "integrator", error=RenderError)
+    )
     return chosen if chosen == "passes" or single_traversal_runs(variant) else "passes"
 
 
@@ -113,27 +117,38 @@ def light_of_emitters(mi: Any, loaded: Any) -> dict[int, int]:
         shape = emitter.get_shape()
         key = shape.id() if shape is not None else emitter.id()
         prefix = tr.light_key(0)[:-1]
-        if not key.startswith(prefix) or not key[len(prefix):].isdigit():
+        if not key.startswith(prefix) or not key[len(prefix) :].isdigit():
             raise RenderError(f"emitter {key!r} is not one of the scene's lights ({prefix}<i>)")
-        out[int(eid)] = int(key[len(prefix):])
+        out[int(eid)] = int(key[len(prefix) :])
     return out
 
 
-def _tables(scene: Scene, value_sets: Sequence[ChannelValues], emitters: dict[int, int], aovs: bool) -> BandTables:
+def _tables(
+    scene: Scene, value_sets: Sequence[ChannelValues], emitters: dict[int, int], aovs: bool
+) -> BandTables:
     bands = np.concatenate([np.asarray(v.materials, float) for v in value_sets], axis=1)
     albedo = np.vstack([bands, np.zeros((1, bands.shape[1]))])  # last row: black
     surfaces = tr.surfaces(scene)
     rows = {s.key: s.material for s in surfaces if s.material >= 0}
-    return BandTables(albedo=albedo, shape_rows=rows, emitter_lights=emitters, n_lights=len(scene.lights),
-                      shape_surfaces={s.key: i for i, s in enumerate(surfaces)} if aovs else {})
+    return BandTables(
+        albedo=albedo,
+        shape_rows=rows,
+        emitter_lights=emitters,
+        n_lights=len(scene.lights),
+        shape_surfaces={s.key: i for i, s in enumerate(surfaces)} if aovs else {},
+    )
 
 
-def _render(mi: Any, loaded: Any, integrator: Any, *, spp: int, seed: int, n: int) -> tuple[np.ndarray, float]:
+def _render(
+    mi: Any, loaded: Any, integrator: Any, *, spp: int, seed: int, n: int
+) -> tuple[np.ndarray, float]:
     """The traversal's last *n* AOV channels (the band transport) and the render's seconds."""
     image, seconds = timed_render(mi, loaded, spp=spp, seed=seed, integrator=integrator)
     if image.shape[-1] < n:
-        raise RenderError(f"band-path render returned {image.shape[-1]} channels; expected at least {n}")
-    return image[..., image.shape[-1] - n:], seconds
+        raise RenderError(
+            f"band-path render returned {image.shape[-1]} channels; expected at least {n}"
+        )
+    return image[..., image.shape[-1] - n :], seconds
 
 
 def render_traversal(
@@ -186,25 +201,43 @@ def render_traversal(
     widths = [np.asarray(v.materials).shape[1] for v in value_sets]
     n_bands, n_lights = sum(widths), len(scene.lights)
     chosen = choose_variant("rgb", variant)
-    h, w = (scene.camera.height, scene.camera.width) if crop is None else (int(crop[3]), int(crop[2]))
+    h, w = (
+        (scene.camera.height, scene.camera.width) if crop is None else (int(crop[3]), int(crop[2]))
+    )
     white = tr.rgb_spectrum([1.0, 1.0, 1.0])
     with variant_scope(chosen) as mi:
-        loaded = mi.load_dict(tr.scene_to_mitsuba(
-            scene, materials=[white] * len(scene.materials), lights=[white] * n_lights,
-            film=tr.hdr_film(scene.camera.width, scene.camera.height, crop), integrator=tr.path_integrator(max_depth), sample_count=spp,
-            geometry=geometry,
-        ))
+        loaded = mi.load_dict(
+            tr.scene_to_mitsuba(
+                scene,
+                materials=[white] * len(scene.materials),
+                lights=[white] * n_lights,
+                film=tr.hdr_film(scene.camera.width, scene.camera.height, crop),
+                integrator=tr.path_integrator(max_depth),
+                sample_count=spp,
+                geometry=geometry,
+            )
+        )
         tables = _tables(scene, value_sets, light_of_emitters(mi, loaded), aovs)
         depths = [int(max_depth)] + ([DIRECT_DEPTH] if direct else [])
         images, seconds, first = [], [], np.zeros((h, w, 0), np.float32)
         for depth in depths:
             n_surfaces = len(tables.shape_surfaces) if depth == depths[0] else 0
-            integrator = band_path(mi, max_depth=depth, n_bands=n_bands, n_lights=n_lights, n_surfaces=n_surfaces)
-            integrator.set_tables(loaded, tables if n_surfaces else replace(tables, shape_surfaces={}))
+            integrator = band_path(
+                mi, max_depth=depth, n_bands=n_bands, n_lights=n_lights, n_surfaces=n_surfaces
+            )
+            integrator.set_tables(
+                loaded, tables if n_surfaces else replace(tables, shape_surfaces={})
+            )
             n_first = len(first_hit_channels(n_surfaces))
-            image, dt = _render(mi, loaded, integrator, spp=spp, seed=seed, n=n_bands * n_lights + n_first)
-            first = image[..., n_bands * n_lights:] if n_surfaces else first
-            images.append(image[..., :n_bands * n_lights].reshape(h, w, n_lights, n_bands).transpose(2, 0, 1, 3))
+            image, dt = _render(
+                mi, loaded, integrator, spp=spp, seed=seed, n=n_bands * n_lights + n_first
+            )
+            first = image[..., n_bands * n_lights :] if n_surfaces else first
+            images.append(
+                image[..., : n_bands * n_lights]
+                .reshape(h, w, n_lights, n_bands)
+                .transpose(2, 0, 1, 3)
+            )
             seconds.append(dt)
             if progress is not None:
                 progress(1)
@@ -217,7 +250,11 @@ def render_traversal(
         )
         for v, a, b in zip(value_sets, edges[:-1], edges[1:], strict=True)
     ]
-    aov_maps = assemble_aovs(scene, tr.surfaces(scene), first[..., :-4], first[..., -4], first[..., -3:]) if aovs else {}
+    aov_maps = (
+        assemble_aovs(scene, tr.surfaces(scene), first[..., :-4], first[..., -4], first[..., -3:])
+        if aovs
+        else {}
+    )
     return outputs, aov_maps, tuple(seconds), chosen
 
 
@@ -254,12 +291,28 @@ def render_jobs(
     the same traversal (drop-in for :func:`~spectrinsic.render.passes.render_aovs`). The jobs
     must hold at least one diagonal mode.
     """
-    diagonal = list({m.name: m for modes, _, _ in jobs for m in modes if m.kind == "diagonal"}.values())
-    want_direct = any(flag and m.name in wanted for modes, _, flag in jobs for m in modes if m.kind == "diagonal")
-    values = [channel_values(scene, get_sensors(m.sensors, data_dir=data_dir), data_dir=data_dir) for m in diagonal]
+    diagonal = list(
+        {m.name: m for modes, _, _ in jobs for m in modes if m.kind == "diagonal"}.values()
+    )
+    want_direct = any(
+        flag and m.name in wanted for modes, _, flag in jobs for m in modes if m.kind == "diagonal"
+    )
+    values = [
+        channel_values(scene, get_sensors(m.sensors, data_dir=data_dir), data_dir=data_dir)
+        for m in diagonal
+    ]
     outs, aov_maps, seconds, chosen = render_traversal(
-        scene, values, spp=spp, seed=seed, max_depth=max_depth, direct=want_direct, aovs=aovs,
-        variant=variant, progress=progress, geometry=geometry)
+        scene,
+        values,
+        spp=spp,
+        seed=seed,
+        max_depth=max_depth,
+        direct=want_direct,
+        aovs=aovs,
+        variant=variant,
+        progress=progress,
+        geometry=geometry,
+    )
     transport = {m.name: o for m, o in zip(diagonal, outs, strict=True)}
     parts = []
     for modes, group, flag in jobs:
@@ -269,7 +322,8 @@ def render_jobs(
             part[m.name] = PassOutput(
                 image=t.image(group),
                 direct=t.image(group, direct=True) if flag and m.name in wanted else None,
-                seconds=(), variant=chosen,
+                seconds=(),
+                variant=chosen,
             )
         parts.append(part)
     return parts, SingleTraversal(transport, seconds, aov_maps)

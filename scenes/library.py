@@ -145,8 +145,9 @@ def condition_illuminants(name: str, condition: str, *, seed: int) -> tuple[str,
 def _power(spot: LightSpot, direction: np.ndarray, focus: np.ndarray, irradiance: float) -> float:
     """Power giving *irradiance* at *focus* on a surface facing the light
     (:func:`spectrinsic.scenes.model.light_power`)."""
-    return light_power(spot.kind, np.asarray(spot.position, float), direction, focus, spot.size,
-                       irradiance)
+    return light_power(
+        spot.kind, np.asarray(spot.position, float), direction, focus, spot.size, irradiance
+    )
 
 
 def _check_view(name: str, view: int) -> None:
