@@ -28,9 +28,9 @@ import numpy as np
 from spectrinsic.gt_export.layers import compute_ground_truth
 from spectrinsic.pipeline.presets import get_preset
 from spectrinsic.render import render_batches
+from spectrinsic.render.batches import batch_seeds, merge_batches
 from spectrinsic.render.modes import channel_values, get_mode, raw_to_xyz, to_xyz_matrix
 from spectrinsic.render.result import RenderResult
-from spectrinsic.render.scene_render import batch_seeds, merge_batches
 from spectrinsic.render.single import render_traversal
 from spectrinsic.scenes.library import build
 from spectrinsic.scenes.model import Scene

@@ -105,10 +105,10 @@ def run(args: argparse.Namespace) -> int:
     with folder_lock(parent):
         out = relight(
             sample,
-            lights,
+            lights,  # type: ignore[arg-type]
             args.out,
-            powers=powers,
-            data_dir=args.data_dir,  # type: ignore[arg-type]
+            powers=powers,  # type: ignore[arg-type]
+            data_dir=args.data_dir,
             keep_transport=args.keep_transport,
         )
     if not args.quiet:

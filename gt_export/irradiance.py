@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from spectrinsic.errors import DatasetError
-from spectrinsic.render.scene_render import relative_standard_error
+from spectrinsic.render.batches import relative_standard_error
 
 __all__ = [
     "COVERAGE_MIN",

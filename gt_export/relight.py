@@ -36,8 +36,8 @@ from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, file_sha256
 from spectrinsic.gt_export.sample_meta import read_meta
 from spectrinsic.gt_export.transport_file import read_transport
 from spectrinsic.gt_export.writer import export_sample
+from spectrinsic.render.batches import merge_batches
 from spectrinsic.render.result import RenderResult
-from spectrinsic.render.scene_render import merge_batches
 from spectrinsic.render.transport import LightTransport, transport_result
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import get_spectrum

@@ -17,6 +17,13 @@ Nothing is imported from Mitsuba when this package is imported; variants are cho
 - :func:`scene_to_mitsuba`: the one translation of a scene into a Mitsuba dict.
 """
 
+from spectrinsic.render.batches import (
+    batch_seeds,
+    image_noise,
+    merge_batches,
+    relative_standard_error,
+    render_batches,
+)
 from spectrinsic.render.modes import (
     RENDER_MODES,
     RenderMode,
@@ -27,15 +34,7 @@ from spectrinsic.render.modes import (
 )
 from spectrinsic.render.passes import render_aovs, render_diagonal, render_spectral
 from spectrinsic.render.result import RenderResult
-from spectrinsic.render.scene_render import (
-    batch_seeds,
-    count_passes,
-    image_noise,
-    merge_batches,
-    relative_standard_error,
-    render_batches,
-    render_scene,
-)
+from spectrinsic.render.scene_render import count_passes, render_scene
 from spectrinsic.render.settings import DEFAULT_MODES, RenderSettings
 from spectrinsic.render.translate import scene_to_mitsuba
 from spectrinsic.render.transport import LightTransport, render_transport, render_transport_batches

@@ -25,23 +25,17 @@ from spectrinsic.render.passes import (
     render_diagonal,
     render_spectral,
 )
-from spectrinsic.render.result import RenderResult
+from spectrinsic.render.result import RenderResult, render_meta
 from spectrinsic.render.settings import DEFAULT_MODES, RenderSettings
 from spectrinsic.render.single import SingleTraversal, render_jobs, resolve_integrator
 from spectrinsic.render.translate import prepare_geometry, surfaces
 from spectrinsic.render.variants import choose_variant, import_mitsuba, variant_scope
-from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.model import Scene
-from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
+from spectrinsic.spectra import get_sensors
 
 __all__ = [
     "DEFAULT_MODES",
     "render_scene",
-    "render_batches",
-    "batch_seeds",
-    "merge_batches",
-    "image_noise",
-    "relative_standard_error",
     "count_passes",
 ]
 
@@ -296,289 +290,132 @@ def render_scene(
     -------
     RenderResult
     """
-    modes, spp, max_depth, per_light = (
-        settings.modes,
-        settings.batch_spp,
-        settings.max_depth,
-        settings.per_light,
-    )
-    per_light_modes, direct, aovs, variant = (
-        settings.per_light_modes,
-        settings.direct,
-        settings.aovs,
-        settings.variant,
-    )
-    objs = _modes(modes)
-    wanted = _direct_modes(direct, objs)
-    integrator = resolve_integrator(settings.integrator, variant)
-    matrices = {m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in objs}
-    lights = [[j] for j in range(len(scene.lights))]
-    split = per_light and per_light_modes is not None
-    share = _modes(per_light_modes) if per_light and per_light_modes is not None else []
-    main = [_Job(tuple(objs), g) for g in (lights if per_light and not split else [None])]
-    jobs = main + [_Job(tuple(share), g, with_direct=False) for g in lights] if split else main
+    plan = _plan(scene, settings, data_dir)
     outputs, aov_maps, aov_seconds, single = _run_jobs(
         scene,
-        jobs,
-        wanted=wanted,
-        spp=spp,
+        plan.jobs,
+        wanted=plan.wanted,
+        spp=settings.batch_spp,
         seed=seed,
-        max_depth=max_depth,
-        variant=variant,
-        aovs=aovs,
+        max_depth=settings.max_depth,
+        variant=settings.variant,
+        aovs=settings.aovs,
         progress=progress,
         data_dir=data_dir,
-        integrator=integrator,
+        integrator=plan.integrator,
     )
-    main_out, share_out = outputs[: len(main)], outputs[len(main) :]
-    timings: dict[str, list[float]] = {m.name: [] for m in objs + share}
+    timings: dict[str, list[float]] = {m.name: [] for m in plan.objs + plan.share}
     variants: dict[str, str] = {}
     for out in outputs:
         for name, o in out.items():
             timings[name].extend(o.seconds)
             variants[name] = o.variant
-    names = [m.name for m in objs]
+    if settings.aovs:
+        timings["aovs"] = list(aov_seconds)
+    if single.seconds:
+        timings["single"] = list(single.seconds)
+    meta = render_meta(
+        scene,
+        plan.objs,
+        plan.matrices,
+        variants,
+        timings,
+        spp=settings.batch_spp,
+        seed=seed,
+        max_depth=settings.max_depth,
+        per_light=settings.per_light,
+        wanted=plan.wanted,
+        data_dir=data_dir,
+    )
+    names = [m.name for m in plan.objs]
+    meta["per_light_modes"] = (
+        [m.name for m in plan.share] if plan.split else (names if settings.per_light else [])
+    )
+    meta["integrator"] = plan.integrator
+    logger.debug(
+        "rendered %s: %s", scene.name, {k: v["seconds"] for k, v in meta["timings"].items()}
+    )
+    return _assemble(scene, plan, outputs, aov_maps, single, meta, data_dir=data_dir)
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """What :func:`render_scene` renders: the modes, their XYZ matrices and the jobs.
+
+    ``jobs[:n_main]`` render every mode (all lights, or one light each with ``per_light`` and
+    no separate share modes); the rest render the share modes light by light (``split``).
+    """
+
+    objs: list[RenderMode]
+    share: list[RenderMode]
+    wanted: set[str]
+    integrator: str
+    matrices: dict[str, np.ndarray]
+    split: bool
+    per_light: bool
+    jobs: list[_Job]
+    n_main: int
+
+
+def _plan(scene: Scene, settings: RenderSettings, data_dir: str | None) -> _Plan:
+    objs = _modes(settings.modes)
+    per_light, per_light_modes = settings.per_light, settings.per_light_modes
+    lights = [[j] for j in range(len(scene.lights))]
+    split = per_light and per_light_modes is not None
+    share = _modes(per_light_modes) if split and per_light_modes is not None else []
+    main = [_Job(tuple(objs), g) for g in (lights if per_light and not split else [None])]
+    jobs = main + [_Job(tuple(share), g, with_direct=False) for g in lights] if split else main
+    return _Plan(
+        objs=objs,
+        share=share,
+        wanted=_direct_modes(settings.direct, objs),
+        integrator=resolve_integrator(settings.integrator, settings.variant),
+        matrices={m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in objs},
+        split=split,
+        per_light=per_light,
+        jobs=jobs,
+        n_main=len(main),
+    )
+
+
+def _assemble(
+    scene: Scene,
+    plan: _Plan,
+    outputs: Sequence[dict[str, PassOutput]],
+    aov_maps: dict[str, np.ndarray],
+    single: SingleTraversal,
+    meta: dict[str, Any],
+    *,
+    data_dir: str | None,
+) -> RenderResult:
+    """The XYZ images of the jobs' raw outputs: totals, per-light shares and direct light."""
+    main_out, share_out = outputs[: plan.n_main], outputs[plan.n_main :]
+    names = [m.name for m in plan.objs]
+    matrices = plan.matrices
     raw = {
         n: np.sum([g[n].image for g in main_out], axis=0, dtype=np.float64).astype(np.float32)
         for n in names
     }
-    images = {n: raw_to_xyz(raw[n], matrices[n]) for n in names}
-    if split:
-        share_xyz = {m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in share}
+    per_light_images: tuple[dict[str, np.ndarray], ...] = ()
+    if plan.split:
+        share_xyz = {m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in plan.share}
         per_light_images = tuple(
             {n: raw_to_xyz(g[n].image, share_xyz[n]) for n in share_xyz} for g in share_out
         )
-    elif per_light:
+    elif plan.per_light:
         per_light_images = tuple(
             {n: raw_to_xyz(g[n].image, matrices[n]) for n in names} for g in main_out
         )
-    else:
-        per_light_images = ()
-    direct_images = {
-        n: raw_to_xyz(_sum_direct([g[n].direct for g in main_out]), matrices[n])
-        for n in names
-        if n in wanted
-    }
-    if aovs:
-        timings["aovs"] = list(aov_seconds)
-    if single.seconds:
-        timings["single"] = list(single.seconds)
-    meta = _render_meta(
-        scene,
-        objs,
-        matrices,
-        variants,
-        timings,
-        spp=spp,
-        seed=seed,
-        max_depth=max_depth,
-        per_light=per_light,
-        wanted=wanted,
-        data_dir=data_dir,
-    )
-    meta["per_light_modes"] = [m.name for m in share] if split else (names if per_light else [])
-    meta["integrator"] = integrator
-    logger.debug(
-        "rendered %s: %s", scene.name, {k: v["seconds"] for k, v in meta["timings"].items()}
-    )
     return RenderResult(
-        images=images,
+        images={n: raw_to_xyz(raw[n], matrices[n]) for n in names},
         raw=raw,
         per_light=per_light_images,
-        direct=direct_images,
+        direct={
+            n: raw_to_xyz(_sum_direct([g[n].direct for g in main_out]), matrices[n])
+            for n in names
+            if n in plan.wanted
+        },
         aovs=aov_maps,
         meta=meta,
         transport={n: t.transport for n, t in single.transport.items()},
-    )
-
-
-def _render_meta(
-    scene: Scene,
-    objs: Sequence[RenderMode],
-    matrices: dict[str, np.ndarray],
-    variants: dict[str, str],
-    timings: dict[str, list[float]],
-    *,
-    spp: int,
-    seed: int,
-    max_depth: int,
-    per_light: bool,
-    wanted: set[str],
-    data_dir: str | None,
-) -> dict[str, Any]:
-    names = [m.name for m in objs]
-    return {
-        "mitsuba": import_mitsuba().__version__,
-        "variants": variants,
-        "spp": int(spp),
-        "seed": int(seed),
-        "max_depth": int(max_depth),
-        "modes": names,
-        "sensors": {m.name: get_sensors(m.sensors, data_dir=data_dir).name for m in objs},
-        "to_xyz": {n: np.asarray(matrices[n]).tolist() for n in names},
-        "wavelengths": {
-            "start": float(COLORIMETRIC_WAVELENGTHS[0]),
-            "end": float(COLORIMETRIC_WAVELENGTHS[-1]),
-            "step": float(COLORIMETRIC_WAVELENGTHS[1] - COLORIMETRIC_WAVELENGTHS[0]),
-            "unit": "nm",
-        },
-        "per_light": bool(per_light),
-        "direct_modes": sorted(wanted),
-        "timings": {
-            k: {"passes": len(v), "seconds": float(sum(v)), "per_pass": [float(x) for x in v]}
-            for k, v in timings.items()
-        },
-        "units": "XYZ = integral of radiance times CIE 1931 CMF over nm; raw = integral of radiance times S_k",
-    }
-
-
-def batch_seeds(seed: int, batches: int) -> list[int]:
-    """Sampler seeds of *batches* independent batches: the sample's own seed first (so one
-    batch is exactly :func:`render_scene`), then seeds derived from it by key."""
-    if isinstance(batches, bool) or not isinstance(batches, int) or batches < 1:
-        raise SceneError(f"batches {batches!r}: expected a positive integer")
-    return [int(seed)] + [seed_from_key(int(seed), f"batch-{b}") for b in range(1, batches)]
-
-
-def render_batches(
-    scene: Scene,
-    settings: RenderSettings,
-    *,
-    seed: int,
-    progress: PassProgress | None = None,
-    data_dir: str | None = None,
-) -> RenderResult:
-    """:func:`render_scene` as ``settings.batches`` independent batches, merged.
-
-    Inside a batch every mode and the AOVs share seed and paths (common random numbers); the
-    batches differ only in their seed (:func:`batch_seeds`), so the spread between them is a
-    direct estimate of the Monte Carlo error of their mean (the noise budget of the ground
-    truth).
-
-    Adaptive sampling: with ``settings.noise_target``, batches are added one at a time while
-    the median relative standard error of the image (:func:`image_noise`) is above it, up to
-    ``settings.max_batches`` (default ``4 * batches``). ``meta["noise_target"]`` records the
-    target and the median reached.
-    """
-    batches, noise_target = settings.batches, settings.noise_target
-    cap = max(batches, settings.max_batches if settings.max_batches is not None else 4 * batches)
-    seeds = batch_seeds(seed, cap if noise_target is not None else batches)
-
-    def one(s: int) -> RenderResult:
-        return render_scene(scene, settings, seed=s, progress=progress, data_dir=data_dir)
-
-    results = [one(s) for s in seeds[:batches]]
-    reached = image_noise(results) if noise_target is not None else None
-    while (
-        reached is not None
-        and noise_target is not None
-        and reached > noise_target
-        and len(results) < cap
-    ):
-        results.append(one(seeds[len(results)]))
-        reached = image_noise(results)
-    merged = merge_batches(results)
-    if noise_target is not None:
-        merged.meta["noise_target"] = {
-            "target": float(noise_target),
-            "reached": reached,
-            "max_batches": cap,
-        }
-    return merged
-
-
-def relative_standard_error(batches: Sequence[np.ndarray], valid: np.ndarray) -> np.ndarray:
-    """Per-pixel relative standard error of the mean of independent batch estimates.
-
-    ``se = sqrt(Σ_b ‖x_b − x̄‖² / (B (B − 1)))`` over channels, divided by ``‖x̄‖``; 0 where
-    not *valid* or where ``‖x̄‖`` is below 1e-3 of its 99th percentile (unlit).
-
-    Parameters
-    ----------
-    batches
-        ``B >= 2`` arrays ``(H, W, C)``, one estimate per independent batch.
-    """
-    stack = np.stack([np.asarray(b, np.float64) for b in batches])
-    if stack.shape[0] < 2:
-        raise RenderError("a noise estimate needs at least two independent batches")
-    mean = stack.mean(axis=0)
-    b = stack.shape[0]
-    se = np.sqrt(((stack - mean) ** 2).sum(axis=(0, -1)) / (b * (b - 1)))
-    norm = np.linalg.norm(mean, axis=-1)
-    positive = norm[valid & (norm > 0)]
-    floor = 1e-3 * np.percentile(positive, 99) if positive.size else np.inf
-    ok = valid & (norm > floor)
-    return np.where(ok, se / np.where(ok, norm, 1.0), 0.0)
-
-
-def image_noise(results: Sequence[RenderResult]) -> float | None:
-    """Median over lit pixels of the relative standard error of the mean image (XYZ of the
-    31-band cube, else of the first mode), from independent batch renders; ``None`` for fewer
-    than two."""
-    if len(results) < 2:
-        return None
-    images = results[0].images
-    mode = "bands31" if "bands31" in images else next(iter(images))
-    stack = [np.asarray(r.images[mode], np.float64) for r in results]
-    rel = relative_standard_error(stack, np.ones(stack[0].shape[:2], bool))
-    return float(np.median(rel[rel > 0])) if (rel > 0).any() else 0.0
-
-
-def _mean(arrays: Sequence[np.ndarray]) -> np.ndarray:
-    return np.mean(np.stack(arrays), axis=0, dtype=np.float64).astype(np.float32)
-
-
-def _merge_aovs(parts: Sequence[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
-    """Coverage, depth and normals averaged over the batches (each batch's AOVs saw that
-    batch's own pixel samples); the integer maps and the mask are those of the first batch."""
-    if not parts or not parts[0]:
-        return {}
-    merged = dict(parts[0])
-    for key in ("coverage", "depth", "normals"):
-        if key in merged:
-            merged[key] = _mean([p[key] for p in parts])
-    if "normals" in merged:
-        n = merged["normals"].astype(np.float64)
-        length = np.linalg.norm(n, axis=-1, keepdims=True)
-        merged["normals"] = np.divide(n, length, out=np.zeros_like(n), where=length > 1e-6).astype(
-            np.float32
-        )
-    return merged
-
-
-def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
-    """The mean of independent batch renders of one scene, keeping each batch's raw channels."""
-    if not results:
-        raise RenderError("no batches to merge")
-    if len(results) == 1:
-        return results[0]
-    first = results[0]
-    modes = list(first.images)
-    meta = dict(first.meta)
-    meta.update(
-        spp=int(first.meta["spp"]) * len(results),
-        batches=len(results),
-        batch_spp=int(first.meta["spp"]),
-        batch_seeds=[int(r.meta["seed"]) for r in results],
-        timings={
-            k: {
-                "passes": sum(r.meta["timings"][k]["passes"] for r in results),
-                "seconds": sum(r.meta["timings"][k]["seconds"] for r in results),
-                "per_pass": [x for r in results for x in r.meta["timings"][k]["per_pass"]],
-            }
-            for k in first.meta["timings"]
-        },
-    )
-    return RenderResult(
-        images={m: _mean([r.images[m] for r in results]) for m in modes},
-        raw={m: _mean([r.raw[m] for r in results]) for m in first.raw},
-        per_light=tuple(
-            {m: _mean([r.per_light[i][m] for r in results]) for m in pl}
-            for i, pl in enumerate(first.per_light)
-        ),
-        direct={m: _mean([r.direct[m] for r in results]) for m in first.direct},
-        aovs=_merge_aovs([r.aovs for r in results]),
-        transport={m: _mean([r.transport[m] for r in results]) for m in first.transport},
-        meta=meta,
-        batch_raw=tuple(dict(r.raw) for r in results),
     )

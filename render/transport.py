@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import RenderError, SceneError
+from spectrinsic.render.batches import batch_seeds, image_noise, merge_batches
 from spectrinsic.render.modes import (
     ChannelValues,
     channel_values,
@@ -50,7 +51,7 @@ from spectrinsic.render.modes import (
 )
 from spectrinsic.render.passes import PassProgress, render_aovs, render_diagonal
 from spectrinsic.render.result import RenderResult
-from spectrinsic.render.scene_render import batch_seeds, image_noise, merge_batches, render_scene
+from spectrinsic.render.scene_render import render_scene
 from spectrinsic.render.settings import RenderSettings
 from spectrinsic.render.single import resolve_integrator
 from spectrinsic.render.translate import prepare_geometry

@@ -170,8 +170,8 @@ def _frame(vertices: np.ndarray, width: int, height: int) -> tuple[Camera, Light
         kind="point",
         spectrum="cie:D65",
         power=_IRRADIANCE * d2,
-        position=tuple(float(x) for x in light_pos),
-    )  # type: ignore[arg-type]
+        position=tuple(float(x) for x in light_pos),  # type: ignore[arg-type]
+    )
     return camera, light
 
 

@@ -187,12 +187,13 @@ def _check_spectrum(
     found = cache[name]
     if isinstance(found, SpectrinsicError):
         raise _fail(source, field, str(found)) from found
-    if getattr(found, "kind", kind) != kind:
+    found_kind = getattr(found, "kind", kind)
+    if found_kind != kind:
         raise _fail(
             source,
             field,
-            f"{name!r} is {with_article(found.kind)} spectrum; expected {with_article(kind)}",
-        )  # type: ignore[attr-defined]
+            f"{name!r} is {with_article(found_kind)} spectrum; expected {with_article(kind)}",
+        )
 
 
 def _check_area(v: np.ndarray, f: np.ndarray, source: str, where: str) -> None:

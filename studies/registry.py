@@ -139,8 +139,10 @@ class _Photometric:
 
     def settings(self, options: StudyOptions) -> PhotometricSettings:
         return PhotometricSettings(
-            seed=options.seed, include_ie=options.include_ie, camera_balance=options.camera_balance
-        )  # type: ignore[arg-type]
+            seed=options.seed,
+            include_ie=options.include_ie,
+            camera_balance=options.camera_balance,  # type: ignore[arg-type]
+        )
 
     def run(
         self, settings: PhotometricSettings, *, data_dir: str | None, progress: StepProgress | None

@@ -82,8 +82,8 @@ def objects_on_ground(rng: np.random.Generator, options: GeneratorOptions) -> La
     volume = LightVolume(
         lo=(centre[0] - d, centre[1] - d, hi[2] + radius),
         hi=(centre[0] + d, centre[1] + d, hi[2] + d),
-        focus=tuple(float(x) for x in centre),
-    )  # type: ignore[arg-type]
+        focus=tuple(float(x) for x in centre),  # type: ignore[arg-type]
+    )
     info = {
         "generator": "objects-on-ground",
         "n_objects": len(objects),

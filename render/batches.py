@@ -1,0 +1,181 @@
+"""Independent batches of one scene's render: their seeds, their mean and their spread.
+
+Inside a batch every mode shares seed and paths (:func:`~spectrinsic.render.scene_render.render_scene`);
+the batches differ only in their seed, so the spread between them is a direct estimate of the
+Monte Carlo error of their mean (the noise budget of the ground truth, and the adaptive
+sampling of ``RenderSettings.noise_target``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from spectrinsic.errors import RenderError, SceneError
+from spectrinsic.render.passes import PassProgress
+from spectrinsic.render.result import RenderResult
+from spectrinsic.render.scene_render import render_scene
+from spectrinsic.render.settings import RenderSettings
+from spectrinsic.rng import seed_from_key
+from spectrinsic.scenes.model import Scene
+
+__all__ = [
+    "batch_seeds",
+    "render_batches",
+    "relative_standard_error",
+    "image_noise",
+    "merge_batches",
+]
+
+
+def batch_seeds(seed: int, batches: int) -> list[int]:
+    """Sampler seeds of *batches* independent batches: the sample's own seed first (so one
+    batch is exactly :func:`render_scene`), then seeds derived from it by key."""
+    if isinstance(batches, bool) or not isinstance(batches, int) or batches < 1:
+        raise SceneError(f"batches {batches!r}: expected a positive integer")
+    return [int(seed)] + [seed_from_key(int(seed), f"batch-{b}") for b in range(1, batches)]
+
+
+def render_batches(
+    scene: Scene,
+    settings: RenderSettings,
+    *,
+    seed: int,
+    progress: PassProgress | None = None,
+    data_dir: str | None = None,
+) -> RenderResult:
+    """:func:`render_scene` as ``settings.batches`` independent batches, merged.
+
+    Inside a batch every mode and the AOVs share seed and paths (common random numbers); the
+    batches differ only in their seed (:func:`batch_seeds`), so the spread between them is a
+    direct estimate of the Monte Carlo error of their mean (the noise budget of the ground
+    truth).
+
+    Adaptive sampling: with ``settings.noise_target``, batches are added one at a time while
+    the median relative standard error of the image (:func:`image_noise`) is above it, up to
+    ``settings.max_batches`` (default ``4 * batches``). ``meta["noise_target"]`` records the
+    target and the median reached.
+    """
+    batches, noise_target = settings.batches, settings.noise_target
+    cap = max(batches, settings.max_batches if settings.max_batches is not None else 4 * batches)
+    seeds = batch_seeds(seed, cap if noise_target is not None else batches)
+
+    def one(s: int) -> RenderResult:
+        return render_scene(scene, settings, seed=s, progress=progress, data_dir=data_dir)
+
+    results = [one(s) for s in seeds[:batches]]
+    reached = image_noise(results) if noise_target is not None else None
+    while (
+        reached is not None
+        and noise_target is not None
+        and reached > noise_target
+        and len(results) < cap
+    ):
+        results.append(one(seeds[len(results)]))
+        reached = image_noise(results)
+    merged = merge_batches(results)
+    if noise_target is not None:
+        merged.meta["noise_target"] = {
+            "target": float(noise_target),
+            "reached": reached,
+            "max_batches": cap,
+        }
+    return merged
+
+
+def relative_standard_error(batches: Sequence[np.ndarray], valid: np.ndarray) -> np.ndarray:
+    """Per-pixel relative standard error of the mean of independent batch estimates.
+
+    ``se = sqrt(Σ_b ‖x_b − x̄‖² / (B (B − 1)))`` over channels, divided by ``‖x̄‖``; 0 where
+    not *valid* or where ``‖x̄‖`` is below 1e-3 of its 99th percentile (unlit).
+
+    Parameters
+    ----------
+    batches
+        ``B >= 2`` arrays ``(H, W, C)``, one estimate per independent batch.
+    """
+    stack = np.stack([np.asarray(b, np.float64) for b in batches])
+    if stack.shape[0] < 2:
+        raise RenderError("a noise estimate needs at least two independent batches")
+    mean = stack.mean(axis=0)
+    b = stack.shape[0]
+    se = np.sqrt(((stack - mean) ** 2).sum(axis=(0, -1)) / (b * (b - 1)))
+    norm = np.linalg.norm(mean, axis=-1)
+    positive = norm[valid & (norm > 0)]
+    floor = 1e-3 * np.percentile(positive, 99) if positive.size else np.inf
+    ok = valid & (norm > floor)
+    return np.where(ok, se / np.where(ok, norm, 1.0), 0.0)
+
+
+def image_noise(results: Sequence[RenderResult]) -> float | None:
+    """Median over lit pixels of the relative standard error of the mean image (XYZ of the
+    31-band cube, else of the first mode), from independent batch renders; ``None`` for fewer
+    than two."""
+    if len(results) < 2:
+        return None
+    images = results[0].images
+    mode = "bands31" if "bands31" in images else next(iter(images))
+    stack = [np.asarray(r.images[mode], np.float64) for r in results]
+    rel = relative_standard_error(stack, np.ones(stack[0].shape[:2], bool))
+    return float(np.median(rel[rel > 0])) if (rel > 0).any() else 0.0
+
+
+def _mean(arrays: Sequence[np.ndarray]) -> np.ndarray:
+    return np.mean(np.stack(arrays), axis=0, dtype=np.float64).astype(np.float32)
+
+
+def _merge_aovs(parts: Sequence[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
+    """Coverage, depth and normals averaged over the batches (each batch's AOVs saw that
+    batch's own pixel samples); the integer maps and the mask are those of the first batch."""
+    if not parts or not parts[0]:
+        return {}
+    merged = dict(parts[0])
+    for key in ("coverage", "depth", "normals"):
+        if key in merged:
+            merged[key] = _mean([p[key] for p in parts])
+    if "normals" in merged:
+        n = merged["normals"].astype(np.float64)
+        length = np.linalg.norm(n, axis=-1, keepdims=True)
+        merged["normals"] = np.divide(n, length, out=np.zeros_like(n), where=length > 1e-6).astype(
+            np.float32
+        )
+    return merged
+
+
+def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
+    """The mean of independent batch renders of one scene, keeping each batch's raw channels."""
+    if not results:
+        raise RenderError("no batches to merge")
+    if len(results) == 1:
+        return results[0]
+    first = results[0]
+    modes = list(first.images)
+    meta = dict(first.meta)
+    meta.update(
+        spp=int(first.meta["spp"]) * len(results),
+        batches=len(results),
+        batch_spp=int(first.meta["spp"]),
+        batch_seeds=[int(r.meta["seed"]) for r in results],
+        timings={
+            k: {
+                "passes": sum(r.meta["timings"][k]["passes"] for r in results),
+                "seconds": sum(r.meta["timings"][k]["seconds"] for r in results),
+                "per_pass": [x for r in results for x in r.meta["timings"][k]["per_pass"]],
+            }
+            for k in first.meta["timings"]
+        },
+    )
+    return RenderResult(
+        images={m: _mean([r.images[m] for r in results]) for m in modes},
+        raw={m: _mean([r.raw[m] for r in results]) for m in first.raw},
+        per_light=tuple(
+            {m: _mean([r.per_light[i][m] for r in results]) for m in pl}
+            for i, pl in enumerate(first.per_light)
+        ),
+        direct={m: _mean([r.direct[m] for r in results]) for m in first.direct},
+        aovs=_merge_aovs([r.aovs for r in results]),
+        transport={m: _mean([r.transport[m] for r in results]) for m in first.transport},
+        meta=meta,
+        batch_raw=tuple(dict(r.raw) for r in results),
+    )
