@@ -32,7 +32,8 @@ from spectrinsic.gt_export.relight_pool import relit_layers
 from spectrinsic.gt_export.transport_file import TRANSPORT_NAME
 from spectrinsic.pipeline.presets import get_preset
 from spectrinsic.render import render_batches
-from spectrinsic.render.transport import diagonal_mode_names, render_transport_batches
+from spectrinsic.render.light_transport import diagonal_mode_names
+from spectrinsic.render.transport import render_transport_batches
 from spectrinsic.scenes.library import build
 
 SCENE, VIEW, CONDITION = "room-living", 0, "two-colour-a"

@@ -2,7 +2,7 @@
 
 Every layer of a sample is a function of its raw band channels, and those are linear in every
 light's band values (:mod:`spectrinsic.render.transport`, Eq. 1). So a sample under new light
-spectra (and powers) is its transport composed with them (:func:`~spectrinsic.render.transport.transport_result`,
+spectra (and powers) is its transport composed with them (:func:`~spectrinsic.render.light_transport.transport_result`,
 batch by batch, merged as a render's batches are), and every ground-truth layer is then
 computed by :func:`~spectrinsic.gt_export.layers.compute_ground_truth` and written by
 :func:`~spectrinsic.gt_export.writer.export_sample`, the very functions that made the sample:
@@ -37,8 +37,8 @@ from spectrinsic.gt_export.sample_meta import read_meta
 from spectrinsic.gt_export.transport_file import read_transport
 from spectrinsic.gt_export.writer import export_sample
 from spectrinsic.render.batches import merge_batches
+from spectrinsic.render.light_transport import LightTransport, transport_result
 from spectrinsic.render.result import RenderResult
-from spectrinsic.render.transport import LightTransport, transport_result
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import get_spectrum
 

@@ -27,7 +27,7 @@ import numpy as np
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.exr import read_exr, write_exr
 from spectrinsic.gt_export.sample import TRANSPORT_NAME
-from spectrinsic.render.transport import LightTransport
+from spectrinsic.render.light_transport import LightTransport
 from spectrinsic.spectra import get_sensors
 
 __all__ = [

@@ -61,7 +61,7 @@ from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene
 from spectrinsic.spectra import DEFAULT_WAVELENGTHS, get_spectrum
 
 if TYPE_CHECKING:
-    from spectrinsic.render.transport import LightTransport
+    from spectrinsic.render.light_transport import LightTransport
 
 __all__ = [
     "DEFAULT_CAMERAS",
@@ -266,7 +266,7 @@ def export_sample(
     data_dir
         Spectral data directory (for ``sfu:``/data-directory cameras).
     transport
-        A :class:`~spectrinsic.render.transport.LightTransport` of this render to store as
+        A :class:`~spectrinsic.render.light_transport.LightTransport` of this render to store as
         ``transport.exr`` (:mod:`~spectrinsic.gt_export.transport_file`), for exact
         relighting (:func:`spectrinsic.gt_export.relight.relight`).
 

@@ -16,9 +16,9 @@ from spectrinsic import provenance
 from spectrinsic.errors import DatasetError, RenderError, validate_choice
 from spectrinsic.gt_export import DEFAULT_CAMERAS
 from spectrinsic.gt_export.sample import config_hash
+from spectrinsic.render.light_transport import diagonal_mode_names
 from spectrinsic.render.modes import RENDER_MODES
 from spectrinsic.render.settings import RenderSettings
-from spectrinsic.render.transport import diagonal_mode_names
 
 __all__ = [
     "DatasetConfig",

@@ -17,6 +17,7 @@ Nothing is imported from Mitsuba when this package is imported; variants are cho
 - :func:`scene_to_mitsuba`: the one translation of a scene into a Mitsuba dict.
 """
 
+from spectrinsic.render.aovs import render_aovs
 from spectrinsic.render.batches import (
     batch_seeds,
     image_noise,
@@ -24,6 +25,7 @@ from spectrinsic.render.batches import (
     relative_standard_error,
     render_batches,
 )
+from spectrinsic.render.light_transport import LightTransport
 from spectrinsic.render.modes import (
     RENDER_MODES,
     RenderMode,
@@ -32,12 +34,12 @@ from spectrinsic.render.modes import (
     mode_names,
     to_xyz_matrix,
 )
-from spectrinsic.render.passes import render_aovs, render_diagonal, render_spectral
+from spectrinsic.render.passes import render_diagonal, render_spectral
 from spectrinsic.render.result import RenderResult
 from spectrinsic.render.scene_render import count_passes, render_scene
 from spectrinsic.render.settings import DEFAULT_MODES, RenderSettings
 from spectrinsic.render.translate import scene_to_mitsuba
-from spectrinsic.render.transport import LightTransport, render_transport, render_transport_batches
+from spectrinsic.render.transport import render_transport, render_transport_batches
 from spectrinsic.render.variants import (
     available_variants,
     choose_variant,

@@ -37,7 +37,7 @@ class RenderResult:
     aovs
         ``coverage`` ``(H, W, M)`` float32, ``material_id`` / ``object_id`` ``(H, W)`` int32 (-1
         background), ``depth`` ``(H, W)`` float32, ``normals`` ``(H, W, 3)`` float32, ``mask``
-        ``(H, W)`` bool; see :func:`spectrinsic.render.passes.render_aovs` (empty unless asked).
+        ``(H, W)`` bool; see :func:`spectrinsic.render.aovs.render_aovs` (empty unless asked).
     meta
         Variants, spp, seed, max_depth, sensors and XYZ matrices per mode, wavelength grid,
         timings (seconds per pass), Mitsuba version; with batches also ``batches``,

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import RenderError, SceneError
+from spectrinsic.render.aovs import render_aovs
 from spectrinsic.render.modes import (
     RenderMode,
     channel_values,
@@ -21,7 +22,6 @@ from spectrinsic.render.modes import (
 from spectrinsic.render.passes import (
     PassOutput,
     PassProgress,
-    render_aovs,
     render_diagonal,
     render_spectral,
 )

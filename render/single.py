@@ -7,7 +7,7 @@ mode, one scene per light subset) built on the band-path integrator of
 passes trace identical paths (same seed and spp, Russian roulette off), the images are those of
 the passes to float rounding; each light's image is its exact share of that render (the
 per-light images sum to the total), not a separate render with the other lights removed.
-The coverage, ids, depth and normals of :func:`~spectrinsic.render.passes.render_aovs` come
+The coverage, ids, depth and normals of :func:`~spectrinsic.render.aovs.render_aovs` come
 from the same traversal's camera rays (their first hits), so no coverage passes are needed.
 
 Cost, measured on ``room-living__v1__two-colour-a`` at the default preset (256², 2 batches of
@@ -24,13 +24,13 @@ import numpy as np
 
 from spectrinsic.errors import RenderError, SceneError, validate_choice
 from spectrinsic.render import translate as tr
+from spectrinsic.render.aovs import assemble_aovs
 from spectrinsic.render.integrator import BandTables, band_path, first_hit_channels
 from spectrinsic.render.modes import ChannelValues, RenderMode, channel_values
 from spectrinsic.render.passes import (
     DIRECT_DEPTH,
     PassOutput,
     PassProgress,
-    assemble_aovs,
     timed_render,
 )
 from spectrinsic.render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
@@ -176,7 +176,7 @@ def render_traversal(
         Also trace direct light only (path depth 2), for the energy ratio r of Eq. 5.8.
     aovs
         Also take coverage, ids, depth and normals from the camera rays' first hits, as
-        :func:`~spectrinsic.render.passes.render_aovs` computes them from the same samples.
+        :func:`~spectrinsic.render.aovs.render_aovs` computes them from the same samples.
     crop
         ``(x, y, width, height)``: render only that window of the image
         (:func:`~spectrinsic.render.translate.hdr_film`); every map is the window's.
@@ -186,7 +186,7 @@ def render_traversal(
     outputs
         One :class:`TransportOutput` per value set.
     aov_maps
-        The maps of :func:`~spectrinsic.render.passes.render_aovs` (empty without *aovs*).
+        The maps of :func:`~spectrinsic.render.aovs.render_aovs` (empty without *aovs*).
     seconds
         Wall-clock seconds of each traversal.
     variant
@@ -264,7 +264,7 @@ class SingleTraversal:
 
     transport: dict[str, TransportOutput]
     seconds: tuple[float, ...]
-    #: First-hit maps (:func:`~spectrinsic.render.passes.render_aovs`'s), when asked for.
+    #: First-hit maps (:func:`~spectrinsic.render.aovs.render_aovs`'s), when asked for.
     aovs: dict[str, np.ndarray] = field(default_factory=dict)
 
 
@@ -288,7 +288,7 @@ def render_jobs(
     Drop-in for rendering each job's diagonal modes with
     :func:`~spectrinsic.render.passes.render_diagonal`; a direct-only image is made for the
     modes in *wanted* of the jobs that ask for one. With *aovs*, the first-hit maps come from
-    the same traversal (drop-in for :func:`~spectrinsic.render.passes.render_aovs`). The jobs
+    the same traversal (drop-in for :func:`~spectrinsic.render.aovs.render_aovs`). The jobs
     must hold at least one diagonal mode.
     """
     diagonal = list(
