@@ -32,9 +32,11 @@ from spectrinsic.gt_export.relight_pool import relit_layers
 from spectrinsic.gt_export.transport_file import TRANSPORT_NAME
 from spectrinsic.pipeline.presets import get_preset
 from spectrinsic.render import render_batches
-from spectrinsic.render.light_transport import diagonal_mode_names
+from spectrinsic.render.light_transport import LightTransport, diagonal_mode_names
+from spectrinsic.render.settings import RenderSettings
 from spectrinsic.render.transport import render_transport_batches
 from spectrinsic.scenes.library import build
+from spectrinsic.scenes.model import Scene
 
 SCENE, VIEW, CONDITION = "room-living", 0, "two-colour-a"
 NEW_LIGHTS = {0: "cie:LED-RGB1", 1: "planck:3000K"}
@@ -69,40 +71,21 @@ def _max_errors(a: dict[str, Any], b: dict[str, Any]) -> dict[str, float]:
     return out
 
 
-def run(out_dir: Path) -> dict[str, Any]:
+def _record(
+    scene: Scene,
+    settings: RenderSettings,
+    transport: LightTransport,
+    render_s: tuple[float, float, float],
+    relight_s: tuple[float, float, float],
+    disk: tuple[int, int],
+    errors: dict[str, float],
+) -> dict[str, Any]:
+    """The JSON record: render seconds (plain, with transport, direct with the new spectra),
+    relight seconds (images, all layers, a folder), bytes (transport, the rest) and exactness."""
     cfg = get_preset("default")
-    scene = build(SCENE, view=VIEW, condition=CONDITION, seed=0, width=cfg.width, height=cfg.height)
-    settings = cfg.render
-    small = dataclasses.replace(
-        scene, camera=dataclasses.replace(scene.camera, width=32, height=32)
-    )
-    render_batches(
-        small, settings.with_options(batches=1, spp=settings.batch_spp), seed=SEED
-    )  # warm-up: compile kernels
-    _, plain_s = _timed(render_batches, scene, settings, seed=SEED)
-    (transport, result), transport_s = _timed(render_transport_batches, scene, settings, seed=SEED)
-    new_scene = relit_scene(scene, NEW_LIGHTS)
-    # every diagonal mode split by light, from the same traversal as the transport's
-    light_by_light = settings.with_options(
-        modes=diagonal_mode_names(settings.modes), per_light=True, share_mode=None, direct=False
-    )
-    direct, direct_s = _timed(render_batches, new_scene, light_by_light, seed=SEED)
-    cameras = cfg.resolved_cameras()
-    with tempfile.TemporaryDirectory(dir=out_dir) as tmp:
-        root = Path(tmp)
-        common: dict[str, Any] = dict(
-            config=cfg.to_dict(), seed=SEED, cameras=cameras, denoise=cfg.denoise
-        )
-        sample = export_sample(
-            root, scene, result, sample_id="source__v0__x", transport=transport, **common
-        )
-        reference = export_sample(root, new_scene, direct, sample_id="direct__v0__x", **common)
-        _, compose_s = _timed(_compose_only, sample)
-        _, layers_s = _timed(relit_layers, sample, NEW_LIGHTS)
-        relit, folder_s = _timed(relight, sample, NEW_LIGHTS, root / "relit__v0__x")
-        errors = _max_errors(load_sample(relit), load_sample(reference))
-        transport_bytes = (sample / TRANSPORT_NAME).stat().st_size
-        rest_bytes = _folder_bytes(sample, skip=TRANSPORT_NAME)
+    plain_s, transport_s, direct_s = render_s
+    compose_s, layers_s, folder_s = relight_s
+    transport_bytes, rest_bytes = disk
     worst = max(errors, key=errors.__getitem__)
     return {
         "scene": f"{SCENE}__v{VIEW}__{CONDITION}",
@@ -142,3 +125,48 @@ def run(out_dir: Path) -> dict[str, Any]:
             "met": errors[worst] <= EXACT_GOAL,
         },
     }
+
+
+def run(out_dir: Path) -> dict[str, Any]:
+    cfg = get_preset("default")
+    scene = build(SCENE, view=VIEW, condition=CONDITION, seed=0, width=cfg.width, height=cfg.height)
+    settings = cfg.render
+    small = dataclasses.replace(
+        scene, camera=dataclasses.replace(scene.camera, width=32, height=32)
+    )
+    render_batches(
+        small, settings.with_options(batches=1, spp=settings.batch_spp), seed=SEED
+    )  # warm-up: compile kernels
+    _, plain_s = _timed(render_batches, scene, settings, seed=SEED)
+    (transport, result), transport_s = _timed(render_transport_batches, scene, settings, seed=SEED)
+    new_scene = relit_scene(scene, NEW_LIGHTS)
+    # every diagonal mode split by light, from the same traversal as the transport's
+    light_by_light = settings.with_options(
+        modes=diagonal_mode_names(settings.modes), per_light=True, share_mode=None, direct=False
+    )
+    direct, direct_s = _timed(render_batches, new_scene, light_by_light, seed=SEED)
+    cameras = cfg.resolved_cameras()
+    with tempfile.TemporaryDirectory(dir=out_dir) as tmp:
+        root = Path(tmp)
+        common: dict[str, Any] = dict(
+            config=cfg.to_dict(), seed=SEED, cameras=cameras, denoise=cfg.denoise
+        )
+        sample = export_sample(
+            root, scene, result, sample_id="source__v0__x", transport=transport, **common
+        )
+        reference = export_sample(root, new_scene, direct, sample_id="direct__v0__x", **common)
+        _, compose_s = _timed(_compose_only, sample)
+        _, layers_s = _timed(relit_layers, sample, NEW_LIGHTS)
+        relit, folder_s = _timed(relight, sample, NEW_LIGHTS, root / "relit__v0__x")
+        errors = _max_errors(load_sample(relit), load_sample(reference))
+        transport_bytes = (sample / TRANSPORT_NAME).stat().st_size
+        rest_bytes = _folder_bytes(sample, skip=TRANSPORT_NAME)
+    return _record(
+        scene,
+        settings,
+        transport,
+        (plain_s, transport_s, direct_s),
+        (compose_s, layers_s, folder_s),
+        (transport_bytes, rest_bytes),
+        errors,
+    )
