@@ -243,9 +243,10 @@ def mitsuba_ior_dir() -> Path:
     """Folder of the spectral ``<name>.eta.spd`` / ``<name>.k.spd`` tables shipped inside the
     installed ``mitsuba`` package (``data/ior``), found without importing Mitsuba."""
     spec = importlib.util.find_spec("mitsuba")
-    if spec is None or not spec.submodule_search_locations:
+    if spec is None or spec.origin is None:
         raise DataDirectoryError("the 'mitsuba' package (which ships the conductor η/k tables) is not installed")
-    return Path(next(iter(spec.submodule_search_locations)), "data", "ior")
+    # the package's folder (once a variant is set, the spec is that of Mitsuba's alias module in it)
+    return Path(spec.origin).parent / "data" / "ior"
 
 
 @functools.lru_cache(maxsize=64)
