@@ -36,7 +36,6 @@ import numpy as np
 
 from spectrinsic.errors import RenderError, SpectralDataError, validate_choice
 from spectrinsic.scenes.model import Scene
-from spectrinsic.spectra.conductors import FRESNEL_NODES, fresnel_table
 from spectrinsic.spectra import (
     COLORIMETRIC_WAVELENGTHS,
     SensorSet,
@@ -47,6 +46,7 @@ from spectrinsic.spectra import (
     get_spectrum,
     responses,
 )
+from spectrinsic.spectra.conductors import FRESNEL_NODES, fresnel_table
 from spectrinsic.typing import Wavelengths
 
 __all__ = [
