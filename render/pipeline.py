@@ -207,6 +207,10 @@ def render_scene(
     objs = _modes(modes)
     wanted = _direct_modes(direct, objs)
     integrator = resolve_integrator(settings.integrator, variant)
+    if integrator == "passes" and any(m.glossy for m in scene.materials) and any(
+            m.kind == "diagonal" for m in objs):
+        raise RenderError(f"scene {scene.name!r} has glossy materials: diagonal modes render them only with "
+                          "integrator 'single' on a JIT (LLVM/CUDA) variant; spectral modes render them either way")
     matrices = {m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in objs}
     lights = [[j] for j in range(len(scene.lights))]
     split = per_light and per_light_modes is not None
@@ -249,7 +253,18 @@ def render_scene(
     logger.debug("rendered %s: %s", scene.name, {k: v["seconds"] for k, v in meta["timings"].items()})
     return RenderResult(images=images, raw=raw, per_light=per_light_images, direct=direct_images,
                         aovs=aov_maps, meta=meta,
-                        transport={n: t.transport for n, t in single.transport.items()})
+                        transport={n: t.transport for n, t in single.transport.items()},
+                        specular=_specular_raw(single))
+
+
+def _specular_raw(single: SingleTraversal) -> dict[str, np.ndarray]:
+    """Mode -> raw specular channels of every light (glossy scenes)."""
+    out = {}
+    for name, t in single.transport.items():
+        image = t.specular_image()
+        if image is not None:
+            out[name] = image
+    return out
 
 
 def _render_meta(
@@ -410,6 +425,7 @@ def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
         direct={m: _mean([r.direct[m] for r in results]) for m in first.direct},
         aovs=_merge_aovs([r.aovs for r in results]),
         transport={m: _mean([r.transport[m] for r in results]) for m in first.transport},
+        specular={m: _mean([r.specular[m] for r in results]) for m in first.specular},
         meta=meta,
         batch_raw=tuple(dict(r.raw) for r in results),
     )
