@@ -63,16 +63,18 @@ class GlossKernel(_Kernel):
     """:class:`~spectrinsic.render.integrator._Kernel` with (G1) band factors and the
     specular accumulators (module docstring); same sampler calls, in the same order."""
 
-    def lobes(
-        self, si: Any, bsdf: Any, wo: Any, full: Any, delta: Any, active: Any
-    ) -> tuple[Any, Any]:
-        """``a = f_d / f`` at local direction *wo* (*full*: ``f``; 0 where *delta*) and
-        ``μ = |wi · h|``."""
+    def lobes(self, si: Any, bsdf: Any, wo: Any, delta: Any, active: Any) -> tuple[Any, Any]:
+        """``a = f_d / f`` at local direction *wo* (0 where *delta*; exactly 1 for a BSDF
+        without non-diffuse lobes) and ``μ = |wi · h|``."""
         mi, dr = self.mi, self.dr
-        ctx = mi.BSDFContext(mi.TransportMode.Radiance, mi.BSDFFlags.Diffuse)
-        diffuse = bsdf.eval(ctx, si, wo, active)[0]
-        a = dr.select(full > 0.0, diffuse / full, 1.0)
-        a = dr.select(delta, 0.0, dr.clip(a, 0.0, 1.0))
+        diffuse = bsdf.eval(
+            mi.BSDFContext(mi.TransportMode.Radiance, mi.BSDFFlags.Diffuse), si, wo, active
+        )[0]
+        full = bsdf.eval(mi.BSDFContext(), si, wo, active)[0]
+        a = dr.clip(dr.select(full > 0.0, diffuse / full, 1.0), 0.0, 1.0)
+        flags = bsdf.flags()
+        matte = ~(mi.has_flag(flags, mi.BSDFFlags.Glossy) | mi.has_flag(flags, mi.BSDFFlags.Delta))
+        a = dr.select(matte, 1.0, dr.select(delta, 0.0, a))
         h = si.wi + wo
         norm = dr.norm(h)
         mu = dr.select(norm > 0.0, dr.abs(dr.dot(si.wi, h)) / norm, 1.0)
@@ -116,10 +118,9 @@ class GlossKernel(_Kernel):
         )
         mis_em = dr.select(ds.delta, 1.0, _mis_weight(dr, mi, ds.pdf, bsdf_pdf))
         nee = bsdf_val[0] * em_weight[0] * mis_em
-        em_lobes = self.lobes(si, bsdf, wo_em, bsdf_val[0], mi.Bool(False), active_em)
+        em_lobes = self.lobes(si, bsdf, wo_em, mi.Bool(False), active_em)
         delta = mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
-        full = bsdf.eval(mi.BSDFContext(), si, bsdf_sample.wo, active_next)[0]
-        bs_lobes = self.lobes(si, bsdf, bsdf_sample.wo, full, delta, active_next)
+        bs_lobes = self.lobes(si, bsdf, bsdf_sample.wo, delta, active_next)
         return (
             self.light_of(ds.emitter, active_em),
             nee,
