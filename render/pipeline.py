@@ -254,16 +254,17 @@ def render_scene(
     return RenderResult(images=images, raw=raw, per_light=per_light_images, direct=direct_images,
                         aovs=aov_maps, meta=meta,
                         transport={n: t.transport for n, t in single.transport.items()},
-                        specular=_specular_raw(single))
+                        specular=_specular_raw(single, [job.group for job in main]))
 
 
-def _specular_raw(single: SingleTraversal) -> dict[str, np.ndarray]:
-    """Mode -> raw specular channels of every light (glossy scenes)."""
+def _specular_raw(single: SingleTraversal, groups: Sequence[Sequence[int] | None]) -> dict[str, np.ndarray]:
+    """Mode -> raw specular channels (glossy scenes), summed over the light *groups* of the
+    main jobs exactly as ``raw`` is, so ``raw − specular`` is exactly 0 where all is specular."""
     out = {}
     for name, t in single.transport.items():
-        image = t.specular_image()
-        if image is not None:
-            out[name] = image
+        if t.specular is not None:
+            parts = [t.specular_image(g) for g in groups]
+            out[name] = np.sum(parts, axis=0, dtype=np.float64).astype(np.float32)
     return out
 
 

@@ -75,12 +75,15 @@ class TransportOutput:
     emission: np.ndarray
     specular: np.ndarray | None = None
 
-    def specular_image(self) -> np.ndarray | None:
-        """``(H, W, K)`` float32 ``Σ_l E_{l,k} specular[l, ..., k]``, or ``None`` if matte."""
+    def specular_image(self, lights: Sequence[int] | None = None) -> np.ndarray | None:
+        """``(H, W, K)`` float32 specular image of the *lights* (default all), summed as
+        :meth:`image` sums the transport (so both agree bit for bit where all light is
+        specular), or ``None`` for a matte scene."""
         if self.specular is None:
             return None
-        parts = self.specular.astype(np.float64) * self.emission[:, None, None, :]
-        return np.sum(parts, axis=0).astype(np.float32)
+        parts = (self.specular.astype(np.float64) * self.emission[:, None, None, :]).astype(np.float32)
+        chosen = range(parts.shape[0]) if lights is None else [int(j) for j in lights]
+        return np.sum(parts[list(chosen)], axis=0, dtype=np.float64).astype(np.float32)
 
     def per_light(self, *, direct: bool = False) -> np.ndarray:
         """``(L, H, W, K)`` float32 each light's image: ``E_{l,k} · transport``."""
