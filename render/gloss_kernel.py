@@ -131,7 +131,7 @@ class GlossKernel(_Kernel):
             bs_lobes,
         )
 
-    def body(
+    def gloss_body(
         self,
         sampler: Any,
         ray: Any,
@@ -147,6 +147,7 @@ class GlossKernel(_Kernel):
         sbands: list,
         sacc: list,
     ) -> tuple:
+        """:meth:`_Kernel.body` with the (G1) factors and the specular throughput and accumulators."""
         mi, dr = self.mi, self.dr
         si = self.scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=depth == 0)
         first = self.first_hit(si, depth, first)
@@ -158,8 +159,8 @@ class GlossKernel(_Kernel):
             sampler, si, si.bsdf(ray), active_next
         )
         rho, row, valid, now = self.albedo(si), self.row(si), si.is_valid(), depth == 0
-        c_em, s_em = self.factors(rho, row, *em_lobes, valid)
-        c_bs, s_bs = self.factors(rho, row, *bs_lobes, valid)
+        c_em, s_em = self.factors(rho, row, em_lobes[0], em_lobes[1], valid)
+        c_bs, s_bs = self.factors(rho, row, bs_lobes[0], bs_lobes[1], valid)
         # the first vertex starts the specular throughput; later ones scale it as the total
         s_nee = [
             dr.select(now, b * s, sb * c)
@@ -216,7 +217,7 @@ class GlossKernel(_Kernel):
             [mi.Float(0.0) for _ in range(k * self.it.n_lights)],
         )
         state = dr.while_loop(
-            state, lambda *s: s[10], self.body, label="spectrinsic band path (glossy)"
+            state, lambda *s: s[10], self.gloss_body, label="spectrinsic band path (glossy)"
         )
         out = list(state[5]) + list(state[12])
         if self.it.n_surfaces:

@@ -263,7 +263,7 @@ def _specular_raw(single: SingleTraversal, groups: Sequence[Sequence[int] | None
     out = {}
     for name, t in single.transport.items():
         if t.specular is not None:
-            parts = [t.specular_image(g) for g in groups]
+            parts = [p for g in groups if (p := t.specular_image(g)) is not None]
             out[name] = np.sum(parts, axis=0, dtype=np.float64).astype(np.float32)
     return out
 
