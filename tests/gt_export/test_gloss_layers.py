@@ -105,3 +105,37 @@ def test_a_glossy_sample_passes_the_check_and_a_broken_specular_does_not(glossy_
     write_exr(path, arrays, channel_names=order)
     problems = " ".join(check_dataset(tmp_path))
     assert "specular" in problems
+
+
+#: The issue's bound on the metal's specular hue (CIELAB hue angle, degrees).
+HUE_TOL_DEG = 1.0
+
+
+@pytest.mark.parametrize("metal", ["Au", "Cu"])
+def test_b_metal_sample_reflectance_is_zero_and_specular_has_the_hue_of_f0(metal):
+    """(b) A smooth metal seen along its normal under a D65 sky: ``reflectance`` 0 and the
+    ``specular`` layer's CIELAB hue that of ∫ F₀(λ) D65(λ) x̄ȳz̄ dλ, F₀ from Mitsuba's η/k files
+    read here (within 1°; chromatic metals: a near-neutral one such as Al has no stable hue)."""
+    import colour
+
+    from spectrinsic.render import render_scene
+    from spectrinsic.scenes.model import Camera, Light, Mesh, Scene
+    from spectrinsic.spectra import get_sensors, get_spectrum, linear_srgb_to_xyz
+    from spectrinsic.spectra.io import mitsuba_ior_dir
+
+    v = np.array([[-50.0, -50, 0], [50, -50, 0], [50, 50, 0], [-50, 50, 0]])
+    sky = Light("area", "cie:D65", 1.0, position=(0, 0, 3.0), direction=(0, 0, -1), size=(400.0, 400.0))
+    camera = Camera(origin=(0.0, 0.0, 2.0), target=(0, 0, 0), up=(0, 1, 0), fov_deg=4, width=6, height=6)
+    scene = Scene("metal", (Mesh("plane", v, np.array([[0, 1, 2], [0, 2, 3]]), np.zeros(2, np.int64), 0),),
+                  (Material("metal", "flat:0", kind="conductor", metal=metal),), (sky,), camera)
+    gt = compute_ground_truth(scene, render_scene(scene, RenderSettings(2, modes=("bands31",), max_depth=3), seed=1))
+    assert np.all(gt.layers["reflectance"].data == 0.0) and np.all(gt.layers["metallic"].data == 1.0)
+    wl = np.arange(360.0, 831.0)
+    eta, k = (np.loadtxt(mitsuba_ior_dir() / f"{metal}.{p}.spd", comments="#") for p in ("eta", "k"))
+    n, kk = np.interp(wl, eta[:, 0], eta[:, 1]), np.interp(wl, k[:, 0], k[:, 1])
+    f0 = ((n - 1) ** 2 + kk**2) / ((n + 1) ** 2 + kk**2)
+    expected = get_sensors("cie1931").on(wl) @ (f0 * get_spectrum("cie:D65").on(wl))
+    got = linear_srgb_to_xyz(gt.layers["specular"].data.reshape(-1, 3).mean(axis=0))
+    white = colour.CCS_ILLUMINANTS["CIE 1931 2 Degree Standard Observer"]["D65"]
+    hue = [float(colour.Lab_to_LCHab(colour.XYZ_to_Lab(x / x[1] * 0.5, white))[2]) for x in (got, expected)]
+    assert abs((hue[0] - hue[1] + 180.0) % 360.0 - 180.0) <= HUE_TOL_DEG, hue
