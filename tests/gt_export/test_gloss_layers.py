@@ -96,6 +96,9 @@ def test_a_glossy_sample_passes_the_check_and_a_broken_specular_does_not(glossy_
     export_sample(tmp_path, scene, result, sample_id="g", config=config, seed=5)
     write_manifest(tmp_path, config)
     assert check_dataset(tmp_path) == []
+    from spectrinsic.gt_export.relight import read_sample_scene
+
+    assert read_sample_scene(tmp_path / "g").materials == scene.materials  # gloss kept in scene.json
     path = tmp_path / "g" / "intrinsics.exr"
     import json
 
