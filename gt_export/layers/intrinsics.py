@@ -29,6 +29,12 @@ from spectrinsic.spectra import white_normalised_responses as canonical_response
 __all__ = ["white_radiance", "srgb_white", "srgb_of", "shading_set", "intrinsic_layers", "noise_of", "clipping_of", "from_denoised"]
 
 
+_RESIDUAL_UNITS = ("image − reflectance ∘ shading (render units): spectral non-commutativity and "
+                   "out-of-gamut light; the image itself where no surface")
+_RESIDUAL_UNITS_GLOSSY = ("image − reflectance ∘ shading − specular (render units): spectral "
+                          "non-commutativity and out-of-gamut light; the image less specular where no surface")
+
+
 def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
     """``W = E/π`` from the reference render, Eq. 1 of
     :mod:`~spectrinsic.gt_export.irradiance`, with the band albedos the renderer used."""
@@ -67,9 +73,7 @@ def shading_set(
                "(render units, relative to that space's white under D65; ≥ 0, 0 where no surface)",
                group, nonnegative=True),
         make_layer(names[1], irr.residual(image, reflectance, shading, specular), RGB,
-               "image − reflectance ∘ shading − specular (render units; specular 0 in matte "
-               "scenes): spectral non-commutativity and out-of-gamut light; the image itself "
-               "(less specular) where no surface", group),
+               _RESIDUAL_UNITS if specular is None else _RESIDUAL_UNITS_GLOSSY, group),
     ]
     if len(names) > 2:
         layers.append(make_layer(names[2], irr.unit_luminance(shading, grey), RGB,
@@ -94,7 +98,8 @@ def intrinsic_layers(
         used = used if specular is None else used + specular
         out.append(make_layer("image_denoised", used, RGB,
                           UNITS_IMAGE + "; rebuilt as reflectance-weighted denoised white-surface "
-                          "radiance (the raw image where no surface), plus the raw specular layer", "image"))
+                          "radiance (the raw image where no surface)"
+                          + ("" if specular is None else ", plus the raw specular layer"), "image"))
         out += shading_set(w_raw, srgb_of(w_raw), white, image, reflectance, space="linear sRGB",
                             names=("shading_raw", "residual_raw"), group="intrinsics", specular=specular)
     out += shading_set(w, srgb_of(w), white, used, reflectance, space="linear sRGB",
