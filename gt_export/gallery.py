@@ -48,8 +48,8 @@ __all__ = ["build_gallery", "contact_sheet", "gallery_index", "GALLERY_DIRS", "G
 GALLERY_LAYERS: tuple[str, ...] = (
     "image", "image_denoised", "image_rgb3", "image_rgb6", "image_spectral", "reflectance",
     "shading", "shading_raw", "shading_grey", "shading_ratio", "residual", "residual_raw",
-    "illuminant", "error_rgb3", "error_rgb6", "error_spectral", "noise_image", "noise_shading_raw",
-    "depth", "normals", "material_id", "object_id", "mask",
+    "specular", "illuminant", "error_rgb3", "error_rgb6", "error_spectral", "noise_image", "noise_shading_raw",
+    "depth", "normals", "material_id", "object_id", "mask", "non_diffuse", "metallic", "roughness",
 )
 #: The JavaScript variable ``gallery-index.js`` assigns the index to.
 INDEX_VARIABLE = "SPECTRINSIC_GALLERY"

@@ -39,7 +39,7 @@ from spectrinsic.gt_export.writer import export_sample
 from spectrinsic.render.pipeline import merge_batches
 from spectrinsic.render.result import RenderResult
 from spectrinsic.render.transport import LightTransport, transport_result
-from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
+from spectrinsic.scenes.model import GLOSS_FIELDS, Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import get_spectrum
 
 __all__ = ["RelitSample", "read_sample_scene", "relit_scene", "relit_render", "relight", "check_light_spectra"]
@@ -95,7 +95,8 @@ def read_sample_scene(sample_dir: str | os.PathLike[str]) -> Scene:
                             faces=np.asarray(m["faces"], np.int64).reshape(-1, 3),
                             face_materials=np.asarray(m["face_materials"], np.int64).reshape(-1),
                             object_id=int(m["object_id"])) for m in data["meshes"])
-        materials = tuple(Material(str(m["name"]), str(m["spectrum"])) for m in data["materials"])
+        materials = tuple(Material(str(m["name"]), str(m["spectrum"]), **{k: m[k] for k in GLOSS_FIELDS if k in m})
+                          for m in data["materials"])
         lights = tuple(Light(**_fields(x)) for x in data["lights"])
         camera = Camera(**_fields(data["camera"]))
         metadata = data.get("metadata") or {}

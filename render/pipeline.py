@@ -234,6 +234,10 @@ def render_scene(
     objs = _modes(modes)
     wanted = _direct_modes(direct, objs)
     integrator = resolve_integrator(settings.integrator, variant)
+    if integrator == "passes" and any(m.glossy for m in scene.materials) and any(
+            m.kind == "diagonal" for m in objs):
+        raise RenderError(f"scene {scene.name!r} has glossy materials: diagonal modes render them only with "
+                          "integrator 'single' on a JIT (LLVM/CUDA) variant; spectral modes render them either way")
     matrices = {m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in objs}
     lights = [[j] for j in range(len(scene.lights))]
     split = per_light and per_light_modes is not None
@@ -276,7 +280,19 @@ def render_scene(
     logger.debug("rendered %s: %s", scene.name, {k: v["seconds"] for k, v in meta["timings"].items()})
     return RenderResult(images=images, raw=raw, per_light=per_light_images, direct=direct_images,
                         aovs=aov_maps, meta=meta,
-                        transport={n: t.transport for n, t in single.transport.items()})
+                        transport={n: t.transport for n, t in single.transport.items()},
+                        specular=_specular_raw(single, [job.group for job in main]))
+
+
+def _specular_raw(single: SingleTraversal, groups: Sequence[Sequence[int] | None]) -> dict[str, np.ndarray]:
+    """Mode -> raw specular channels (glossy scenes), summed over the light *groups* of the
+    main jobs exactly as ``raw`` is, so ``raw − specular`` is exactly 0 where all is specular."""
+    out = {}
+    for name, t in single.transport.items():
+        if t.specular is not None:
+            parts = [p for g in groups if (p := t.specular_image(g)) is not None]
+            out[name] = np.sum(parts, axis=0, dtype=np.float64).astype(np.float32)
+    return out
 
 
 def _render_meta(
@@ -437,6 +453,7 @@ def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
         direct={m: _mean([r.direct[m] for r in results]) for m in first.direct},
         aovs=_merge_aovs([r.aovs for r in results]),
         transport={m: _mean([r.transport[m] for r in results]) for m in first.transport},
+        specular={m: _mean([r.specular[m] for r in results]) for m in first.specular},
         meta=meta,
         batch_raw=tuple(dict(r.raw) for r in results),
     )

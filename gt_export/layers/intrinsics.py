@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.gt_export import irradiance as irr
+from spectrinsic.gt_export.layers.gloss import diffuse_raw
 from spectrinsic.gt_export.layers.imaging import shading_ratio
 from spectrinsic.gt_export.layers.records import (
     REFLECTANCE_FLOOR,
@@ -28,6 +29,12 @@ from spectrinsic.spectra import white_normalised_responses as canonical_response
 __all__ = ["white_radiance", "srgb_white", "srgb_of", "shading_set", "intrinsic_layers", "noise_of", "clipping_of", "from_denoised"]
 
 
+_RESIDUAL_UNITS = ("image − reflectance ∘ shading (render units): spectral non-commutativity and "
+                   "out-of-gamut light; the image itself where no surface")
+_RESIDUAL_UNITS_GLOSSY = ("image − reflectance ∘ shading − specular (render units): spectral "
+                          "non-commutativity and out-of-gamut light; the image less specular where no surface")
+
+
 def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
     """``W = E/π`` from the reference render, Eq. 1 of
     :mod:`~spectrinsic.gt_export.irradiance`, with the band albedos the renderer used."""
@@ -39,7 +46,8 @@ def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
     to_xyz = (np.asarray(matrices[s.ref], float) if s.ref in matrices
               else to_xyz_matrix(mode, s.scene, data_dir=s.data_dir))
     raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
-    return irr.white_radiance(raw, coverage, albedos, to_xyz, mode=s.ref)
+    # W of the first hits' diffuse lobes only: the specular part is its own layer
+    return irr.white_radiance(diffuse_raw(s, raw), coverage, albedos, to_xyz, mode=s.ref)
 
 
 def srgb_white(s: SampleInputs) -> np.ndarray:
@@ -53,9 +61,10 @@ def srgb_of(w: irr.WhiteRadiance) -> np.ndarray:
 def shading_set(
     w: irr.WhiteRadiance, colour: np.ndarray, white: np.ndarray, image: np.ndarray,
     reflectance: np.ndarray, *, names: tuple[str, ...], group: str, space: str,
+    specular: np.ndarray | None = None,
 ) -> list[Layer]:
     """``shading``, ``residual`` and, if a third name is given, ``illuminant`` of one sensor
-    space from ``W``'s colour."""
+    space from ``W``'s colour (the residual less *specular*, if given)."""
     shading = irr.relative_shading(colour, white, w.valid)
     grey = irr.luminance_of(w)
     layers = [
@@ -63,9 +72,8 @@ def shading_set(
                f"shading-illumination: {space} of the light a perfect white would reflect here "
                "(render units, relative to that space's white under D65; ≥ 0, 0 where no surface)",
                group, nonnegative=True),
-        make_layer(names[1], irr.residual(image, reflectance, shading), RGB,
-               "image − reflectance ∘ shading (render units): spectral non-commutativity and "
-               "out-of-gamut light; the image itself where no surface", group),
+        make_layer(names[1], irr.residual(image, reflectance, shading, specular), RGB,
+               _RESIDUAL_UNITS if specular is None else _RESIDUAL_UNITS_GLOSSY, group),
     ]
     if len(names) > 2:
         layers.append(make_layer(names[2], irr.unit_luminance(shading, grey), RGB,
@@ -76,23 +84,26 @@ def shading_set(
 
 def intrinsic_layers(
     s: SampleInputs, w_raw: irr.WhiteRadiance, w: irr.WhiteRadiance, image: np.ndarray,
-    reflectance: np.ndarray, *, denoised: bool,
+    reflectance: np.ndarray, *, denoised: bool, specular: np.ndarray | None = None,
 ) -> list[Layer]:
-    """sRGB shading, residual, grey shading and illuminant (from the denoised ``W`` if asked,
-    with ``image_denoised`` rebuilt from it and the raw ``shading_raw``/``residual_raw``)."""
+    """sRGB shading, residual and illuminant (from the denoised ``W`` if asked, with
+    ``image_denoised`` rebuilt from it plus the raw *specular*, and the raw ``shading_raw``/
+    ``residual_raw``), grey shading and ratio shading."""
     white = srgb_white(s)
     used = image
     out: list[Layer] = []
     if denoised:
         raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
-        used = xyz_to_linear_srgb(np.einsum("hwk,ck->hwc", irr.recompose(w, raw), w.to_xyz))
+        used = xyz_to_linear_srgb(np.einsum("hwk,ck->hwc", irr.recompose(w, diffuse_raw(s, raw)), w.to_xyz))
+        used = used if specular is None else used + specular
         out.append(make_layer("image_denoised", used, RGB,
                           UNITS_IMAGE + "; rebuilt as reflectance-weighted denoised white-surface "
-                          "radiance (the raw image where no surface)", "image"))
+                          "radiance (the raw image where no surface)"
+                          + ("" if specular is None else ", plus the raw specular layer"), "image"))
         out += shading_set(w_raw, srgb_of(w_raw), white, image, reflectance, space="linear sRGB",
-                            names=("shading_raw", "residual_raw"), group="intrinsics")
+                            names=("shading_raw", "residual_raw"), group="intrinsics", specular=specular)
     out += shading_set(w, srgb_of(w), white, used, reflectance, space="linear sRGB",
-                        names=("shading", "residual", "illuminant"), group="intrinsics")
+                        names=("shading", "residual", "illuminant"), group="intrinsics", specular=specular)
     out.append(make_layer("shading_grey", irr.luminance_of(w), ("Y",),
                       "luminance Y of the light a perfect white would reflect (render units)",
                       "intrinsics", nonnegative=True))
