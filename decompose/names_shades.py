@@ -215,9 +215,16 @@ class NamesAndShades:
         ``mu = 1/3``, ``gamma/alpha = 100``, ``gamma/beta = 2``, label-centroid colours, regions
         of equal label only, no colour constancy, alpha-expansion to convergence.
         """
-        return cls(gamma_over_alpha=100.0, gamma_over_beta=2.0, mu=1.0 / 3.0,
-                   reflectance_colour="label-centroid", split_by_ridge=False,
-                   colour_constancy="none", expansion_cycles=-1, name="names-shades-thesis")
+        return cls(
+            gamma_over_alpha=100.0,
+            gamma_over_beta=2.0,
+            mu=1.0 / 3.0,
+            reflectance_colour="label-centroid",
+            split_by_ridge=False,
+            colour_constancy="none",
+            expansion_cycles=-1,
+            name="names-shades-thesis",
+        )
 
     def __call__(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Decomposition:
         """Decompose a linear ``(H, W, 3)`` image into reflectance and shading.
@@ -230,7 +237,9 @@ class NamesAndShades:
     def labelling(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Labelling:
         """Steps 1-3 (names, shades, MRF) of a linear ``(H, W, 3)`` image (:class:`Labelling`)."""
         validate_choice(
-            self.reflectance_colour, ("label-centroid", "region-mean"), "reflectance_colour",
+            self.reflectance_colour,
+            ("label-centroid", "region-mean"),
+            "reflectance_colour",
             error=DecomposeError,
         )
         gco = _import_gco()
@@ -265,8 +274,9 @@ class NamesAndShades:
         """
         t3 = time.perf_counter()
         m, linear = stages.mask, stages.linear
-        regions, colours = self._regions(m, stages.labels, stages.candidates, stages.shades,
-                                         stages.pixels)
+        regions, colours = self._regions(
+            m, stages.labels, stages.candidates, stages.shades, stages.pixels
+        )
         n_regions = int(regions.max())
         if self.global_coherence:
             lam = global_coherence(regions, colours.mean(axis=1), linear.mean(axis=2))
@@ -309,15 +319,17 @@ class NamesAndShades:
         Eq. 3.4 by alpha-expansion; the observations themselves if there is nothing to cut."""
         unary = self.mu * distance[y]
         if distance.shape[0] > 1 and edges.shape[0] > 0:
-            return np.asarray(gco.cut_general_graph(
-                edges,
-                (1.0 - self.mu) * weights,
-                unary,
-                distance,
-                n_iter=self.expansion_cycles,
-                algorithm="expansion",
-                init_labels=y.astype(np.int32),
-            ))
+            return np.asarray(
+                gco.cut_general_graph(
+                    edges,
+                    (1.0 - self.mu) * weights,
+                    unary,
+                    distance,
+                    n_iter=self.expansion_cycles,
+                    algorithm="expansion",
+                    init_labels=y.astype(np.int32),
+                )
+            )
         return np.asarray(y)
 
     def _regions(
@@ -340,10 +352,16 @@ class NamesAndShades:
         n_regions = int(regions.max())
         region_of_pixel = regions[m]
         counts = np.bincount(region_of_pixel, minlength=n_regions + 1).astype(np.float64)
-        mean_colour = np.stack(
-            [np.bincount(region_of_pixel, weights=pixels[:, c], minlength=n_regions + 1)
-             for c in range(3)], axis=1,
-        ) / np.maximum(counts, 1.0)[:, None]
+        mean_colour = (
+            np.stack(
+                [
+                    np.bincount(region_of_pixel, weights=pixels[:, c], minlength=n_regions + 1)
+                    for c in range(3)
+                ],
+                axis=1,
+            )
+            / np.maximum(counts, 1.0)[:, None]
+        )
         region_label = np.zeros(n_regions + 1, dtype=np.int64)
         region_label[region_of_pixel] = candidates[labels]
         if self.reflectance_colour == "label-centroid":
