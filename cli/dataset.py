@@ -10,7 +10,7 @@ from typing import Any
 
 from tqdm import tqdm
 
-from spectrinsic.errors import DatasetError, SpectrinsicError
+from spectrinsic.errors import DatasetError, SceneError, SpectrinsicError
 from spectrinsic.gt_export.integrity import check_build_folder
 from spectrinsic.pipeline.dataset import SampleFailure, build_dataset
 from spectrinsic.pipeline.executors import check_scheduler, choose_executor
@@ -18,6 +18,7 @@ from spectrinsic.pipeline.presets import PRESETS, DatasetConfig, get_preset, pre
 from spectrinsic.pipeline.source_plan import files_source, generator_source
 from spectrinsic.render.budget import check_render_size
 from spectrinsic.render.settings import INTEGRATORS
+from spectrinsic.scenes.generators import GlossDistribution
 from spectrinsic.scenes.sources import FileSource
 from spectrinsic.scenes.yaml_limits import load_yaml_file
 from spectrinsic.spectra import get_spectrum
@@ -205,6 +206,26 @@ def _add_source_options(src: Any) -> None:
         help="also draw SFU reflectances and illuminants (needs --data-dir)",
     )
     src.add_argument(
+        "--glossy",
+        type=float,
+        default=0.0,
+        metavar="F",
+        help="fraction of generated materials made coated/glossy (plastic) (0)",
+    )
+    src.add_argument(
+        "--metallic",
+        type=float,
+        default=0.0,
+        metavar="F",
+        help="fraction of generated materials made metal (Ag, Al, Au, Cu, Cr) (0)",
+    )
+    src.add_argument(
+        "--roughness-range",
+        default="0,0.3",
+        metavar="LO,HI",
+        help="GGX roughness range of glossy and metal materials (0,0.3)",
+    )
+    src.add_argument(
         "--scenes",
         nargs="+",
         metavar="PATH",
@@ -255,6 +276,12 @@ def _source(args: argparse.Namespace) -> str | None:
     if args.generator and args.scenes:
         raise DatasetError("--generator and --scenes exclude each other; give one")
     if args.generator:
+        try:
+            gloss = GlossDistribution(
+                args.glossy, args.metallic, _range("--roughness-range", args.roughness_range)
+            )
+        except SceneError as exc:
+            raise DatasetError(f"--glossy/--metallic/--roughness-range: {exc}") from None
         return generator_source(
             args.generator,
             args.count,
@@ -262,6 +289,7 @@ def _source(args: argparse.Namespace) -> str | None:
             sfu=args.sfu,
             value_range=_range("--value-range", args.value_range),
             chroma_range=_range("--chroma-range", args.chroma_range),
+            gloss=gloss,
         )
     if args.scenes:
         return files_source(

@@ -95,12 +95,21 @@ def _identity_problems(
     out = []
     for ident in identities:
         keys = [ident.image, ident.reflectance, ident.shading, ident.residual]
+        keys += [ident.specular] if ident.specular else []
         missing = [k for k in keys if k not in data]
         if missing:
             out.append(f"identity {keys}: layer(s) {missing} missing")
             continue
+        # the specular layer, where there is one, is one more term beside the residual
+        rest = data[keys[3]].astype(np.float64) + (
+            data[keys[4]].astype(np.float64) if len(keys) > 4 else 0.0
+        )
         issue = _identity_problem(
-            *(data[k] for k in keys), names=f"{keys[0]} != {keys[1]} * {keys[2]} + {keys[3]}"
+            data[keys[0]],
+            data[keys[1]],
+            data[keys[2]],
+            rest,
+            names=f"{keys[0]} != {keys[1]} * {keys[2]} + " + " + ".join(keys[3:]),
         )
         if issue:
             out.append(f"{keys[0]}: {issue}")

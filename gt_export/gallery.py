@@ -64,6 +64,7 @@ GALLERY_LAYERS: tuple[str, ...] = (
     "shading_ratio",
     "residual",
     "residual_raw",
+    "specular",
     "illuminant",
     "error_rgb3",
     "error_rgb6",
@@ -75,6 +76,9 @@ GALLERY_LAYERS: tuple[str, ...] = (
     "material_id",
     "object_id",
     "mask",
+    "non_diffuse",
+    "metallic",
+    "roughness",
 )
 #: The JavaScript variable ``gallery-index.js`` assigns the index to.
 INDEX_VARIABLE = "SPECTRINSIC_GALLERY"

@@ -177,16 +177,23 @@ def unit_luminance(shading: np.ndarray, grey: np.ndarray) -> np.ndarray:
     return np.where(lit[..., None], shading / np.where(lit, grey, 1.0)[..., None], 0.0)
 
 
-def residual(image: np.ndarray, reflectance: np.ndarray, shading: np.ndarray) -> np.ndarray:
-    """``image − reflectance ∘ shading``, so ``image = reflectance ∘ shading + residual``.
+def residual(
+    image: np.ndarray,
+    reflectance: np.ndarray,
+    shading: np.ndarray,
+    specular: np.ndarray | None = None,
+) -> np.ndarray:
+    """``image − reflectance ∘ shading [− specular]``, so ``image = reflectance ∘ shading
+    [+ specular] + residual``.
 
     Computed from the float32 values that are stored, in float64, so the identity holds on
     the stored layers to float32 rounding of the residual alone.
     """
     f32 = np.float32
-    return np.asarray(image, f32).astype(np.float64) - np.asarray(reflectance, f32).astype(
+    out = np.asarray(image, f32).astype(np.float64) - np.asarray(reflectance, f32).astype(
         np.float64
     ) * np.asarray(shading, f32).astype(np.float64)
+    return out if specular is None else out - np.asarray(specular, f32).astype(np.float64)
 
 
 def recompose(radiance: WhiteRadiance, raw: np.ndarray) -> np.ndarray:

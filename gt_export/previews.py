@@ -27,7 +27,7 @@ Preview = tuple[np.ndarray, dict[str, Any]]
 
 #: Layers that share one exposure per sample, so brightness differences between them are real:
 #: every image mode and camera image uses ``image``'s, every shading ``shading``'s.
-_EXPOSURE_OF = (("image", "image"), ("shading", "shading"))
+_EXPOSURE_OF = (("image", "image"), ("shading", "shading"), ("specular", "image"))
 
 
 def _srgb(data: np.ndarray, scale: float) -> Preview:
@@ -80,6 +80,11 @@ def _residual_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
     return preview, {**encoding, "of": "‖residual‖ / ‖image‖"}
 
 
+def _unit_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
+    """Maps in [0, 1] (``non_diffuse``, ``metallic``, ``roughness``)."""
+    return _colormap(layer.data, 0.0, 1.0, cmap="viridis")
+
+
 def _noise_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
     return _colormap(layer.data, 0.0, 0.2)
 
@@ -124,6 +129,10 @@ _PREVIEWS: tuple[tuple[str, Callable[[Layer, Mapping[str, Layer]], Preview]], ..
     ("illuminant", _illuminant_preview),
     ("error_", _error_preview),
     ("residual", _residual_preview),
+    ("specular", _colour_preview),
+    ("non_diffuse", _unit_preview),
+    ("metallic", _unit_preview),
+    ("roughness", _unit_preview),
     ("noise_", _noise_preview),
     ("depth", _depth_preview),
     ("normals", _normals_preview),

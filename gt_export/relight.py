@@ -39,7 +39,7 @@ from spectrinsic.gt_export.writer import export_sample
 from spectrinsic.render.batches import merge_batches
 from spectrinsic.render.light_transport import LightTransport, transport_result
 from spectrinsic.render.result import RenderResult
-from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
+from spectrinsic.scenes.model import GLOSS_FIELDS, Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import get_spectrum
 
 __all__ = [
@@ -108,7 +108,12 @@ def read_sample_scene(sample_dir: str | os.PathLike[str]) -> Scene:
             )
             for m in data["meshes"]
         )
-        materials = tuple(Material(str(m["name"]), str(m["spectrum"])) for m in data["materials"])
+        materials = tuple(
+            Material(
+                str(m["name"]), str(m["spectrum"]), **{k: m[k] for k in GLOSS_FIELDS if k in m}
+            )
+            for m in data["materials"]
+        )
         lights = tuple(Light(**_fields(x)) for x in data["lights"])
         camera = Camera(**_fields(data["camera"]))
         metadata = data.get("metadata") or {}

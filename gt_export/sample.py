@@ -88,7 +88,13 @@ def plain_data(value: Any, digits: int | None = None) -> Any:
     {'a': 0.5, 'b': [1, 2], 'c': 0.333}
     """
     if is_dataclass(value) and not isinstance(value, type):
-        return {f.name: plain_data(getattr(value, f.name), digits) for f in fields(value)}
+        # fields marked omit_default (a material's gloss) are left out at their defaults, as
+        # scene_to_dict does, so matte scenes are written as before they existed
+        return {
+            f.name: plain_data(getattr(value, f.name), digits)
+            for f in fields(value)
+            if not (f.metadata.get("omit_default") and getattr(value, f.name) == f.default)
+        }
     if isinstance(value, Mapping):
         return {str(k): plain_data(v, digits) for k, v in value.items()}
     if isinstance(value, np.ndarray):

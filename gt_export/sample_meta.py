@@ -153,12 +153,14 @@ class LightEntry:
 
 @dataclass(frozen=True)
 class Identity:
-    """``image = reflectance ∘ shading + residual``, by layer key."""
+    """``image = reflectance ∘ shading [+ specular] + residual``, by layer key (``specular``
+    only in samples of glossy scenes)."""
 
     image: str
     reflectance: str
     shading: str
     residual: str
+    specular: str | None = None
 
 
 @dataclass(frozen=True)
@@ -270,9 +272,10 @@ def _identity(
     f: JsonFields, ident: object, name: str, layers: Mapping[str, LayerRecord]
 ) -> Identity:
     ident = f.mapping(ident, name)
-    f.exact_keys(ident, name, frozenset(_IDENTITY_FIELDS))
-    keys = [f.text(ident[k], f"{name}.{k}") for k in _IDENTITY_FIELDS]
-    for k, key in zip(_IDENTITY_FIELDS, keys, strict=True):
+    fields = _IDENTITY_FIELDS + (("specular",) if "specular" in ident else ())
+    f.exact_keys(ident, name, frozenset(fields))
+    keys = [f.text(ident[k], f"{name}.{k}") for k in fields]
+    for k, key in zip(fields, keys, strict=True):
         if key not in layers:
             raise f.fail(f"{name}.{k}", "a layer of this sample", key)
     return Identity(*keys)

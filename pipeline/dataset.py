@@ -50,7 +50,7 @@ from spectrinsic.pipeline.source_plan import plan_source_samples, save_generated
 from spectrinsic.pipeline.tasks import SampleFailure, SampleOutcome, SampleTask
 from spectrinsic.render import render_batches, set_thread_count
 from spectrinsic.render.transport import render_transport_batches
-from spectrinsic.scenes.library import build, default_samples
+from spectrinsic.scenes.library import build, default_samples, glossy_samples
 from spectrinsic.scenes.sources import GeneratedSource
 
 __all__ = [
@@ -129,7 +129,8 @@ def plan_samples(
     ----------
     only
         Glob pattern(s) on the sample id (``"obj-*"``, ``"*__white"``); a string may hold
-        several separated by commas. ``None`` keeps every sample.
+        several separated by commas. ``None`` keeps every sample. A pattern holding
+        ``glossy`` also selects among the glossy variants (``room-living-glossy__v0__white``).
 
     Raises
     ------
@@ -153,9 +154,16 @@ def plan_samples(
             render_threads=render_threads,
             data_dir=None if data_dir is None else str(data_dir),
         )
-        for sid in default_samples()
+        for sid in default_samples() + (glossy_samples() if _asks_glossy(only) else [])
     ]
     return select_samples(tasks, only)
+
+
+def _asks_glossy(only: Sequence[str] | str | None) -> bool:
+    """Whether an *only* pattern names the library's glossy variants (``*-glossy*``), which the
+    default layout leaves out."""
+    patterns = only.split(",") if isinstance(only, str) else list(only or ())
+    return any("glossy" in p for p in patterns)
 
 
 def select_samples(
@@ -190,6 +198,11 @@ def build_sample(task: SampleTask) -> SampleOutcome:
     scene = _task_scene(task)
     t_render = time.perf_counter()
     transport = None
+    if cfg.store_transport and any(m.glossy for m in scene.materials):
+        raise DatasetError(
+            f"{task.sample_id}: --store-transport relights matte scenes only; this scene has "
+            "glossy materials, whose specular part the stored transport does not split"
+        )
     if cfg.store_transport:  # diagonal modes light by light, kept per light for relighting
         transport, result = render_transport_batches(
             scene, cfg.render, seed=task.seed, data_dir=task.data_dir

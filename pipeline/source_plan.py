@@ -20,13 +20,14 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from spectrinsic.errors import DatasetError, validate_choice
+from spectrinsic.errors import DatasetError, SceneError, validate_choice
 from spectrinsic.gt_export.sample import file_sha256
 from spectrinsic.pipeline.presets import DatasetConfig
 from spectrinsic.pipeline.tasks import SampleTask
 from spectrinsic.scenes.generators import (
     GENERATORS,
     GeneratorOptions,
+    GlossDistribution,
     MaterialDistribution,
     generated_family,
     generated_scene_name,
@@ -62,8 +63,10 @@ def generator_source(
     chroma_range: Sequence[float] = (0.0, 16.0),
     min_coverage: float = 0.15,
     sfu: bool = False,
+    gloss: GlossDistribution | None = None,
 ) -> str:
-    """The canonical ``source`` JSON of a generated set (validated)."""
+    """The canonical ``source`` JSON of a generated set (validated); *gloss* enters it only
+    when active, so matte sets keep their source and config hash."""
     validate_choice(generator, GENERATORS, "scene generator", error=DatasetError)
     if not (1 <= count <= MAX_COUNT and 1 <= views <= MAX_VIEWS):
         raise DatasetError(
@@ -79,6 +82,12 @@ def generator_source(
         "min_coverage": float(min_coverage),
         "sfu": bool(sfu),
     }
+    if gloss is not None and gloss.active:
+        spec["gloss"] = {
+            "glossy": float(gloss.glossy_fraction),
+            "metallic": float(gloss.metal_fraction),
+            "roughness_range": [float(v) for v in gloss.roughness_range],
+        }
     return json.dumps(spec, sort_keys=True)
 
 
@@ -120,6 +129,15 @@ def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir:
     dist = MaterialDistribution(
         tuple(spec["value_range"]), tuple(spec["chroma_range"]), sfu_fraction=0.5 if sfu_r else 0.0
     )
+    g = spec.get("gloss") or {}
+    try:
+        gloss = GlossDistribution(
+            float(g.get("glossy", 0.0)),
+            float(g.get("metallic", 0.0)),
+            tuple(g.get("roughness_range", (0.0, 0.3))),
+        )  # type: ignore[arg-type]
+    except (SceneError, TypeError, ValueError) as exc:
+        raise DatasetError(f"source gloss {g!r}: {exc}") from exc
     return GeneratorOptions(
         width=config.width,
         height=config.height,
@@ -128,6 +146,7 @@ def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir:
         min_coverage=float(spec["min_coverage"]),
         sfu_reflectances=sfu_r,
         sfu_illuminants=sfu_i,
+        gloss=gloss,
     )
 
 

@@ -176,6 +176,7 @@ def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
         direct={m: _mean([r.direct[m] for r in results]) for m in first.direct},
         aovs=_merge_aovs([r.aovs for r in results]),
         transport={m: _mean([r.transport[m] for r in results]) for m in first.transport},
+        specular={m: _mean([r.specular[m] for r in results]) for m in first.specular},
         meta=meta,
         batch_raw=tuple(dict(r.raw) for r in results),
     )

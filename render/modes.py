@@ -47,6 +47,7 @@ from spectrinsic.spectra import (
     get_spectrum,
     responses,
 )
+from spectrinsic.spectra.conductors import FRESNEL_NODES, fresnel_table
 
 __all__ = [
     "RenderMode",
@@ -166,10 +167,15 @@ class ChannelValues:
         ``(M, K)`` float64 ``∫ρ_m S_k / ∫S_k`` in [0, 1] for reflectances in [0, 1].
     lights
         ``(L, K)`` float64 ``power_l ∫L_l S_k dλ`` (λ in nm).
+    specular
+        ``(M, N, K)`` float64 band factors of each material's non-diffuse lobe at N cosines
+        (:func:`spectrinsic.spectra.conductors.fresnel_table` for a conductor, 1 otherwise),
+        when the scene has glossy materials; ``None`` otherwise.
     """
 
     materials: np.ndarray
     lights: np.ndarray
+    specular: np.ndarray | None = None
 
 
 def light_spectra(
@@ -224,6 +230,19 @@ def channel_values(
         lights=responses(emission, curves, wavelengths)
         if len(emission)
         else np.zeros((0, sensors.n)),
+        specular=_specular(scene, curves, wavelengths)
+        if any(m.glossy for m in scene.materials)
+        else None,
+    )
+
+
+def _specular(scene: Scene, curves: np.ndarray, wavelengths: Wavelengths) -> np.ndarray:
+    ones = np.ones((FRESNEL_NODES, curves.shape[0]))
+    return np.stack(
+        [
+            fresnel_table(m.metal, curves, wavelengths) if m.kind == "conductor" else ones
+            for m in scene.materials
+        ]
     )
 
 

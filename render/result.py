@@ -52,6 +52,12 @@ class RenderResult:
         transport for unit emission (:class:`spectrinsic.render.single.TransportOutput`):
         ``raw[mode][..., k] = Σ_l E_{l,k} transport[mode][l, ..., k]``, with E the lights'
         channel values (:func:`spectrinsic.render.modes.channel_values`). Empty otherwise.
+    specular
+        Scenes with glossy materials, single traversal: mode -> ``(H, W, K)`` float32 raw
+        channels of the light the camera rays' first hits return through their non-diffuse
+        lobes (coat reflection, metal), with everything those lobes reflect
+        (:mod:`spectrinsic.render.gloss_kernel`); a part of ``raw[mode]``. Empty for matte
+        scenes, where it is 0.
     """
 
     images: dict[str, np.ndarray]
@@ -62,6 +68,7 @@ class RenderResult:
     meta: dict[str, Any] = field(default_factory=dict)
     batch_raw: tuple[dict[str, np.ndarray], ...] = ()
     transport: dict[str, np.ndarray] = field(default_factory=dict)
+    specular: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def shape(self) -> tuple[int, int]:

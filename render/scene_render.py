@@ -365,11 +365,21 @@ def _plan(scene: Scene, settings: RenderSettings, data_dir: str | None) -> _Plan
     share = _modes(per_light_modes) if split and per_light_modes is not None else []
     main = [_Job(tuple(objs), g) for g in (lights if per_light and not split else [None])]
     jobs = main + [_Job(tuple(share), g, with_direct=False) for g in lights] if split else main
+    integrator = resolve_integrator(settings.integrator, settings.variant)
+    if (
+        integrator == "passes"
+        and any(m.glossy for m in scene.materials)
+        and any(m.kind == "diagonal" for m in objs)
+    ):
+        raise RenderError(
+            f"scene {scene.name!r} has glossy materials: diagonal modes render them only with "
+            "integrator 'single' on a JIT (LLVM/CUDA) variant; spectral modes render them either way"
+        )
     return _Plan(
         objs=objs,
         share=share,
         wanted=_direct_modes(settings.direct, objs),
-        integrator=resolve_integrator(settings.integrator, settings.variant),
+        integrator=integrator,
         matrices={m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in objs},
         split=split,
         per_light=per_light,
@@ -418,4 +428,18 @@ def _assemble(
         aovs=aov_maps,
         meta=meta,
         transport={n: t.transport for n, t in single.transport.items()},
+        specular=_specular_raw(single, [job.group for job in plan.jobs[: plan.n_main]]),
     )
+
+
+def _specular_raw(
+    single: SingleTraversal, groups: Sequence[Sequence[int] | None]
+) -> dict[str, np.ndarray]:
+    """Mode -> raw specular channels (glossy scenes), summed over the light *groups* of the
+    main jobs exactly as ``raw`` is, so ``raw − specular`` is exactly 0 where all is specular."""
+    out = {}
+    for name, t in single.transport.items():
+        if t.specular is not None:
+            parts = [p for g in groups if (p := t.specular_image(g)) is not None]
+            out[name] = np.sum(parts, axis=0, dtype=np.float64).astype(np.float32)
+    return out

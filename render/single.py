@@ -25,6 +25,7 @@ import numpy as np
 from spectrinsic.errors import RenderError, SceneError, validate_choice
 from spectrinsic.render import translate as tr
 from spectrinsic.render.aovs import assemble_aovs
+from spectrinsic.render.gloss_kernel import gloss_path
 from spectrinsic.render.integrator import BandTables, band_path, first_hit_channels
 from spectrinsic.render.modes import ChannelValues, RenderMode, channel_values
 from spectrinsic.render.passes import (
@@ -63,11 +64,28 @@ class TransportOutput:
         The same for direct light only (path depth 2), or ``None`` when not asked for.
     emission
         ``(L, K)`` float64 the lights' channel values ``E_{l,k}`` (:class:`ChannelValues`).
+    specular
+        ``(L, H, W, K)`` float32 the part of :attr:`transport` whose first camera-ray vertex
+        went through a non-diffuse lobe (:mod:`spectrinsic.render.gloss_kernel`), for scenes
+        with glossy materials; ``None`` for matte scenes (where it is 0).
     """
 
     transport: np.ndarray
     direct: np.ndarray | None
     emission: np.ndarray
+    specular: np.ndarray | None = None
+
+    def specular_image(self, lights: Sequence[int] | None = None) -> np.ndarray | None:
+        """``(H, W, K)`` float32 specular image of the *lights* (default all), summed as
+        :meth:`image` sums the transport (so both agree bit for bit where all light is
+        specular), or ``None`` for a matte scene."""
+        if self.specular is None:
+            return None
+        parts = (self.specular.astype(np.float64) * self.emission[:, None, None, :]).astype(
+            np.float32
+        )
+        chosen = range(parts.shape[0]) if lights is None else [int(j) for j in lights]
+        return np.sum(parts[list(chosen)], axis=0, dtype=np.float64).astype(np.float32)
 
     def per_light(self, *, direct: bool = False) -> np.ndarray:
         """``(L, H, W, K)`` float32 each light's image: ``E_{l,k} · transport``."""
@@ -139,6 +157,18 @@ def _tables(
     )
 
 
+def _specular_table(scene: Scene, value_sets: Sequence[ChannelValues]) -> np.ndarray:
+    """``(M + 1, N, K)`` band factors of the non-diffuse lobes of every material (the value
+    sets' tables side by side over bands; the last row, black, all ones)."""
+    tables = [np.asarray(v.specular, float) for v in value_sets if v.specular is not None]
+    if len(tables) != len(value_sets):
+        raise RenderError(
+            f"scene {scene.name!r} has glossy materials but its channel values carry no specular tables"
+        )
+    table = np.concatenate(tables, axis=2)
+    return np.concatenate([table, np.ones((1, *table.shape[1:]))], axis=0)
+
+
 def _render(
     mi: Any, loaded: Any, integrator: Any, *, spp: int, seed: int, n: int
 ) -> tuple[np.ndarray, float]:
@@ -205,6 +235,8 @@ def render_traversal(
         (scene.camera.height, scene.camera.width) if crop is None else (int(crop[3]), int(crop[2]))
     )
     white = tr.rgb_spectrum([1.0, 1.0, 1.0])
+    glossy = any(m.glossy for m in scene.materials)
+    n_spec = n_bands * n_lights if glossy else 0
     with variant_scope(chosen) as mi:
         loaded = mi.load_dict(
             tr.scene_to_mitsuba(
@@ -215,29 +247,36 @@ def render_traversal(
                 integrator=tr.path_integrator(max_depth),
                 sample_count=spp,
                 geometry=geometry,
+                white_metal=True,
             )
         )
         tables = _tables(scene, value_sets, light_of_emitters(mi, loaded), aovs)
         depths = [int(max_depth)] + ([DIRECT_DEPTH] if direct else [])
-        images, seconds, first = [], [], np.zeros((h, w, 0), np.float32)
+        images, specular, seconds, first = [], None, [], np.zeros((h, w, 0), np.float32)
         for depth in depths:
             n_surfaces = len(tables.shape_surfaces) if depth == depths[0] else 0
-            integrator = band_path(
+            make = gloss_path if glossy else band_path
+            integrator = make(
                 mi, max_depth=depth, n_bands=n_bands, n_lights=n_lights, n_surfaces=n_surfaces
             )
             integrator.set_tables(
                 loaded, tables if n_surfaces else replace(tables, shape_surfaces={})
             )
+            if glossy:
+                integrator.set_specular(_specular_table(scene, value_sets))
             n_first = len(first_hit_channels(n_surfaces))
+            n_t = n_bands * n_lights
             image, dt = _render(
-                mi, loaded, integrator, spp=spp, seed=seed, n=n_bands * n_lights + n_first
+                mi, loaded, integrator, spp=spp, seed=seed, n=n_t + n_spec + n_first
             )
-            first = image[..., n_bands * n_lights :] if n_surfaces else first
-            images.append(
-                image[..., : n_bands * n_lights]
-                .reshape(h, w, n_lights, n_bands)
-                .transpose(2, 0, 1, 3)
-            )
+            first = image[..., n_t + n_spec :] if n_surfaces else first
+            images.append(image[..., :n_t].reshape(h, w, n_lights, n_bands).transpose(2, 0, 1, 3))
+            if glossy and depth == depths[0]:
+                specular = (
+                    image[..., n_t : n_t + n_spec]
+                    .reshape(h, w, n_lights, n_bands)
+                    .transpose(2, 0, 1, 3)
+                )
             seconds.append(dt)
             if progress is not None:
                 progress(1)
@@ -247,6 +286,7 @@ def render_traversal(
             transport=np.ascontiguousarray(images[0][..., a:b]),
             direct=np.ascontiguousarray(images[1][..., a:b]) if direct else None,
             emission=np.asarray(v.lights, float),
+            specular=None if specular is None else np.ascontiguousarray(specular[..., a:b]),
         )
         for v, a, b in zip(value_sets, edges[:-1], edges[1:], strict=True)
     ]

@@ -7,7 +7,9 @@ spectrum dicts (:func:`rgb_spectrum` for the channel values of a diagonal pass,
 Naming, which :mod:`spectrinsic.render.passes` relies on to update parameters between passes:
 
 * each mesh is split by material into shapes ``surf_<mesh>_<material>``, each with its own
-  two-sided Lambertian BSDF (``<id>.bsdf.brdf_0.reflectance``);
+  two-sided BSDF: Lambertian (``<id>.bsdf.brdf_0.reflectance``), or for a glossy material
+  (:func:`material_bsdf`) Mitsuba's ``plastic``/``roughplastic`` (the reflectance is the
+  ``diffuse_reflectance`` under the coat) or ``conductor``/``roughconductor``;
 * light ``i`` is ``light_<i>``; an area light is a rectangle shape with an ``area`` emitter and a
   black two-sided BSDF, so it occludes and reflects nothing.
 
@@ -26,7 +28,7 @@ import numpy as np
 
 from spectrinsic.errors import SceneError
 from spectrinsic.render.variants import import_mitsuba
-from spectrinsic.scenes.model import Light, Scene, unknown_light_kind
+from spectrinsic.scenes.model import Light, Material, Scene, unknown_light_kind
 
 __all__ = [
     "CREASE_ANGLE_DEG",
@@ -34,6 +36,7 @@ __all__ = [
     "surfaces",
     "light_key",
     "reflectance_key",
+    "material_bsdf",
     "emission_key",
     "rgb_spectrum",
     "regular_spectrum",
@@ -278,6 +281,40 @@ def _lambertian(reflectance: Mapping) -> dict[str, Any]:
     return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": dict(reflectance)}}
 
 
+def material_bsdf(
+    material: Material, reflectance: Mapping, *, white_metal: bool = False
+) -> dict[str, Any]:
+    """The two-sided Mitsuba BSDF of *material* with diffuse *reflectance*.
+
+    ``plastic``: Mitsuba's ``plastic`` (smooth) or ``roughplastic`` (GGX, α = roughness) with
+    the linear diffuse term (``nonlinear: false``, so the diffuse lobe is proportional to the
+    base reflectance) and ``int_ior`` = the coat's index over air. ``conductor``: Mitsuba's
+    ``conductor``/``roughconductor`` with its measured η/k of ``material.metal``, or with
+    *white_metal* a perfect mirror (``material: none``, F = 1) whose Fresnel factor the band
+    integrator applies per band. Lambertian otherwise.
+    """
+    if material.kind == "diffuse":
+        return _lambertian(reflectance)
+    rough = material.roughness > 0.0
+    bsdf: dict[str, Any]
+    if material.kind == "plastic":
+        bsdf = {
+            "type": "roughplastic" if rough else "plastic",
+            "diffuse_reflectance": dict(reflectance),
+            "int_ior": float(material.ior),
+            "ext_ior": 1.0,
+            "nonlinear": False,
+        }
+    else:
+        bsdf = {
+            "type": "roughconductor" if rough else "conductor",
+            "material": "none" if white_metal else material.metal,
+        }
+    if rough:
+        bsdf |= {"distribution": "ggx", "alpha": float(material.roughness)}
+    return {"type": "twosided", "bsdf": bsdf}
+
+
 def _look_at(mi: Any, origin: Sequence[float], direction: Sequence[float], what: str) -> Any:
     d = np.asarray(direction, float)
     if not np.linalg.norm(d) > 0:
@@ -396,6 +433,7 @@ def scene_to_mitsuba(
     sample_count: int,
     crease_deg: float = CREASE_ANGLE_DEG,
     geometry: Sequence[SurfaceGeometry] | None = None,
+    white_metal: bool = False,
 ) -> dict[str, Any]:
     """Translate *scene* into a dict for ``mitsuba.load_dict``.
 
@@ -417,6 +455,8 @@ def scene_to_mitsuba(
         Samples per pixel of the sensor's sampler.
     geometry
         :func:`prepare_geometry` of *scene*, if already computed.
+    white_metal
+        Metals as perfect mirrors (:func:`material_bsdf`), for the band integrator.
     """
     mi = import_mitsuba()
     if len(materials) != len(scene.materials) or len(lights) != len(scene.lights):
@@ -430,9 +470,10 @@ def scene_to_mitsuba(
         "sensor": _camera(mi, scene, film, sample_count),
     }
     for part in prepare_geometry(scene, crease_deg) if geometry is None else geometry:
-        out[part.key] = _mitsuba_mesh(
-            mi, part.key, part.corners, part.normals, _lambertian(materials[part.material])
+        bsdf = material_bsdf(
+            scene.materials[part.material], materials[part.material], white_metal=white_metal
         )
+        out[part.key] = _mitsuba_mesh(mi, part.key, part.corners, part.normals, bsdf)
     for j, (light, emission) in enumerate(zip(scene.lights, lights, strict=True)):
         entry = _light(mi, light, emission, f"scene {scene.name!r} light {j} ({light.name})")
         if entry is not None:

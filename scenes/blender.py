@@ -13,10 +13,14 @@ converts, in world space:
   Powers are converted from Blender's watts: point and spot radiant intensity ``P / 4π``, area
   radiance ``P / (π A)`` (one-sided Lambertian), sun irradiance = strength.
 
-Each material becomes a Lambertian material named after the Blender material, with its
-reflectance spectrum chosen by, in order: the *materials* mapping passed in, the material's
-custom property ``"spectrum"``, or the material's own name (name a material
-``"munsell:5R 4/14"`` and nothing else is needed).
+Each material becomes a material named after the Blender material, with its reflectance
+spectrum chosen by, in order: the *materials* mapping passed in, the material's custom property
+``"spectrum"``, or the material's own name (name a material ``"munsell:5R 4/14"`` and nothing
+else is needed). A Principled BSDF node sets the gloss (:func:`principled_gloss`): Metallic
+≥ 0.5 makes a metal (``conductor``, η/k of the custom property ``"metal"``, default ``Al``; no
+spectrum needed), else Roughness < 0.5 a coated diffuse (``plastic``, the node's IOR); GGX α is
+Roughness² (Blender's convention). Everything else of the node (base colour, coat, sheen,
+subsurface, transmission, emission, textures) is ignored; other materials are Lambertian.
 
 Opening a file replaces the data of the running ``bpy`` session (Blender has one global state).
 """
@@ -33,16 +37,20 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import MissingDependencyError, SceneError, SpectrinsicError, with_article
+from spectrinsic.scenes.materials import IOR_RANGE, METAL_SPECTRUM, material_problem
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.scenes.validate import validate_scene
 from spectrinsic.spectra import get_spectrum
 
-__all__ = ["load_blend", "SPECTRUM_PROPERTY"]
+__all__ = ["load_blend", "SPECTRUM_PROPERTY", "METAL_PROPERTY", "principled_gloss"]
 
 log = logging.getLogger(__name__)
 
 #: Custom property naming a material's or a light's spectrum.
 SPECTRUM_PROPERTY = "spectrum"
+#: Custom property of a metallic material naming its conductor (Mitsuba η/k table), and the default.
+METAL_PROPERTY = "metal"
+DEFAULT_METAL = "Al"
 _MESH_LIKE = {"MESH", "CURVE", "SURFACE", "META", "FONT"}
 
 
@@ -59,6 +67,32 @@ def _require_bpy() -> Any:
 
 def _matrix(obj: Any) -> np.ndarray:
     return np.array([list(row) for row in obj.matrix_world], dtype=np.float64)
+
+
+def principled_gloss(mat: Any) -> dict[str, Any]:
+    """Gloss fields of :class:`Material` from *mat*'s first Principled BSDF node (module
+    docstring); ``{}`` (Lambertian) without one or when it is matte."""
+    tree = getattr(mat, "node_tree", None)
+    node = (
+        next((n for n in tree.nodes if n.type == "BSDF_PRINCIPLED"), None)
+        if tree is not None
+        else None
+    )
+    if node is None:
+        return {}
+    rough = float(node.inputs["Roughness"].default_value)
+    alpha = min(max(rough, 0.0), 1.0) ** 2
+    if float(node.inputs["Metallic"].default_value) >= 0.5:
+        metal = str(mat[METAL_PROPERTY]) if METAL_PROPERTY in mat.keys() else DEFAULT_METAL
+        return {"kind": "conductor", "metal": metal, "roughness": alpha}
+    if rough < 0.5:
+        ior = float(node.inputs["IOR"].default_value) if "IOR" in node.inputs else 1.5
+        return {
+            "kind": "plastic",
+            "roughness": alpha,
+            "ior": min(max(ior, IOR_RANGE[0] + 1e-3), IOR_RANGE[1]),
+        }
+    return {}
 
 
 def _prop(*owners: Any) -> str | None:
@@ -217,6 +251,13 @@ class _MaterialTable:
         else:
             name = mat.name
             spectrum = self.mapping.get(name) or _prop(mat) or name
+        gloss = principled_gloss(mat) if mat is not None else {}
+        if name not in self.table and gloss.get("kind") == "conductor":
+            material = Material(name=name, spectrum=METAL_SPECTRUM, **gloss)
+            problem = material_problem(material)
+            if problem:
+                raise SceneError(f"{self.source}: material {name!r}: {problem}")
+            self.table[name] = material
         if name not in self.table:
             _check_spectrum(
                 self.source,
@@ -227,7 +268,7 @@ class _MaterialTable:
                 f"or pass materials={{{name!r}: ...}}",
                 self.data_dir,
             )
-            self.table[name] = Material(name=name, spectrum=spectrum)
+            self.table[name] = Material(name=name, spectrum=spectrum, **gloss)
         return list(self.table).index(name)
 
 

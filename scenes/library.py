@@ -40,6 +40,7 @@ import numpy as np
 from spectrinsic.errors import SceneError, validate_choice
 from spectrinsic.rng import generator, seed_from_key
 from spectrinsic.scenes.layouts import ROOM_LAYOUTS, Layout, LightSpot, object_layout
+from spectrinsic.scenes.library_gloss import GLOSSY_SUFFIX, base_name, glossy_variant
 from spectrinsic.scenes.model import Camera, Light, Scene, light_power
 from spectrinsic.scenes.objects import OBJECTS
 from spectrinsic.scenes.parts import to_meshes
@@ -57,6 +58,7 @@ __all__ = [
     "build",
     "condition_illuminants",
     "default_samples",
+    "glossy_samples",
 ]
 
 CONDITIONS: tuple[str, ...] = ("white", "one-colour", "two-colour-a", "two-colour-b")
@@ -84,20 +86,25 @@ _OBJECT_SCENES = {f"obj-{key}": key for key in OBJECTS}
 
 
 def scene_names(kind: str | None = None) -> list[str]:
-    """Library scene names: ``kind`` None (all), ``"object"`` (8) or ``"complex"`` (3)."""
+    """Library scene names: ``kind`` None (the thesis' 11), ``"object"`` (8), ``"complex"`` (3)
+    or ``"glossy"`` (the 11 glossy variants, :mod:`~spectrinsic.scenes.library_gloss`)."""
     if kind is None:
         return [*_OBJECT_SCENES, *ROOM_LAYOUTS]
-    validate_choice(kind, ("object", "complex"), "library scene kind", error=SceneError)
+    validate_choice(kind, ("object", "complex", "glossy"), "library scene kind", error=SceneError)
+    if kind == "glossy":
+        return [n + GLOSSY_SUFFIX for n in scene_names()]
     return list(_OBJECT_SCENES) if kind == "object" else list(ROOM_LAYOUTS)
 
 
 def _check_name(name: str) -> str:
-    return validate_choice(name, scene_names(), "library scene", error=SceneError)
+    return validate_choice(
+        name, scene_names() + scene_names("glossy"), "library scene", error=SceneError
+    )
 
 
 def n_views(name: str) -> int:
     """Number of camera viewpoints of scene *name*: 1 for objects, 3 for complex scenes."""
-    return 1 if _check_name(name) in _OBJECT_SCENES else 3
+    return 1 if base_name(_check_name(name)) in _OBJECT_SCENES else 3
 
 
 def _layout(name: str) -> Layout:
@@ -237,6 +244,18 @@ def build(
         "illuminants"}``.
     """
     _check_view(name, view)
+    if name != base_name(name):  # a glossy variant: its matte scene, lights and draws included
+        return glossy_variant(
+            build(
+                base_name(name),
+                view=view,
+                condition=condition,
+                seed=seed,
+                width=width,
+                height=height,
+            ),
+            base_name(name),
+        )
     illuminants = condition_illuminants(name, condition, seed=seed)
     layout = _layout(name)
     meshes, materials = to_meshes(layout.parts)
@@ -273,3 +292,9 @@ def default_samples() -> list[SampleId]:
         for view in range(n_views(name))
         for condition in CONDITIONS
     ]
+
+
+def glossy_samples() -> list[SampleId]:
+    """Every (scene, view, condition) of the glossy variants (``<scene>-glossy``), not part of
+    the thesis layout: 68 more samples, each the glossy twin of a default one."""
+    return [SampleId(s.scene + GLOSSY_SUFFIX, s.view, s.condition) for s in default_samples()]

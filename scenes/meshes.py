@@ -5,6 +5,12 @@ A mesh file carries geometry and material names but no spectra, lights or camera
 material name must be in the map (or a default spectrum is given), and the scene gets a framing
 camera and one CIE D65 point light above it, so any mesh renders with full ground truth. Only
 the named file is read (no textures, no referenced files outside its folder are needed).
+
+A glTF material's ``pbrMetallicRoughness`` factors set the gloss as for ``.blend`` files: metallic
+≥ 0.5 makes a metal (``conductor``, Al: the factors name no metal; no spectrum needed), else
+roughness < 0.5 a coated diffuse (``plastic``, η = 1.5); GGX α = roughness². Absent factors
+count as matte (not glTF's default of 1), so files without them import as before; base colour,
+textures and every other material field are ignored.
 """
 
 from __future__ import annotations
@@ -20,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import SceneError
+from spectrinsic.scenes.materials import METAL_SPECTRUM
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.scenes.validate import validate_scene
 
@@ -124,9 +131,21 @@ def check_mesh_size(path: Path) -> None:
         )
 
 
-def _geometries(path: Path) -> list[tuple[str, str, np.ndarray, np.ndarray]]:
-    """``(geometry name, material name, vertices, faces)`` of every triangle mesh in the file,
-    in world space, sorted by geometry name (file order is not stable across formats)."""
+def _pbr_gloss(material: Any) -> dict[str, Any]:
+    """Gloss fields of :class:`Material` from a trimesh PBR material (module docstring)."""
+    metallic = getattr(material, "metallicFactor", None)
+    roughness = getattr(material, "roughnessFactor", None)
+    alpha = min(max(float(roughness), 0.0), 1.0) ** 2 if roughness is not None else 1.0
+    if metallic is not None and float(metallic) >= 0.5:
+        return {"kind": "conductor", "metal": "Al", "roughness": alpha}
+    if roughness is not None and float(roughness) < 0.5:
+        return {"kind": "plastic", "roughness": alpha}
+    return {}
+
+
+def _geometries(path: Path) -> list[tuple[str, str, np.ndarray, np.ndarray, dict[str, Any]]]:
+    """``(geometry name, material name, vertices, faces, gloss)`` of every triangle mesh in the
+    file, in world space, sorted by geometry name (file order is not stable across formats)."""
     import trimesh
 
     check_mesh_size(path)
@@ -143,8 +162,9 @@ def _geometries(path: Path) -> list[tuple[str, str, np.ndarray, np.ndarray]]:
             continue
         verts = np.asarray(geom.vertices, dtype=np.float64)
         verts = verts @ np.asarray(matrix)[:3, :3].T + np.asarray(matrix)[:3, 3]
-        material = getattr(getattr(geom.visual, "material", None), "name", None) or str(key)
-        out.append((str(node), str(material), verts, faces))
+        pbr = getattr(geom.visual, "material", None)
+        material = getattr(pbr, "name", None) or str(key)
+        out.append((str(node), str(material), verts, faces, _pbr_gloss(pbr)))
     if not out:
         raise SceneError(f"{path}: holds no triangles")
     return out
@@ -205,24 +225,28 @@ def load_mesh_scene(
     """
     path = Path(path)
     geoms = _geometries(path)
-    names: list[str] = []
+    table: dict[str, Material] = {}  # matte materials keep their spectrum's name
     meshes = []
-    for i, (node, material, verts, faces) in enumerate(geoms):
-        spectrum = materials.get(material, default_spectrum)
+    for i, (node, material, verts, faces, gloss) in enumerate(geoms):
+        spectrum = (
+            METAL_SPECTRUM
+            if gloss.get("kind") == "conductor"
+            else materials.get(material, default_spectrum)
+        )
         if spectrum is None:
             known = sorted({g[1] for g in geoms})
             raise SceneError(
                 f"{path}: material {material!r} is not in the material map; the file's "
                 f"materials are {known}"
             )
-        if spectrum not in names:
-            names.append(spectrum)
+        name = f"{spectrum} ({material})" if gloss else spectrum
+        table.setdefault(name, Material(name=name, spectrum=spectrum, **gloss))
         meshes.append(
             Mesh(
                 name=f"{node}",
                 vertices=verts,
                 faces=faces,
-                face_materials=np.full(len(faces), names.index(spectrum), dtype=np.int64),
+                face_materials=np.full(len(faces), list(table).index(name), dtype=np.int64),
                 object_id=i,
             )
         )
@@ -230,7 +254,7 @@ def load_mesh_scene(
     scene = Scene(
         name=path.stem,
         meshes=tuple(meshes),
-        materials=tuple(Material(name=n, spectrum=n) for n in names),
+        materials=tuple(table.values()),
         lights=(light,),
         camera=camera,
         metadata={"source": path.name},

@@ -7,7 +7,8 @@ compared, hashed (:func:`scene_hash`) and written as JSON (:func:`scene_to_dict`
 rendered sample. Only :mod:`spectrinsic.render` translates a scene into a Mitsuba dict.
 
 Units: lengths in scene units (metres by convention), angles in degrees, wavelengths in nm.
-All materials are Lambertian (as in the thesis dataset).
+Materials are Lambertian by default (as in the thesis dataset); a material may instead be a
+coated diffuse (``plastic``) or a metal (``conductor``), smooth or rough (:class:`Material`).
 """
 
 from __future__ import annotations
@@ -24,6 +25,9 @@ from spectrinsic.errors import did_you_mean
 
 __all__ = [
     "Material",
+    "MaterialKind",
+    "MATERIAL_KINDS",
+    "GLOSS_FIELDS",
     "Mesh",
     "Light",
     "Camera",
@@ -60,20 +64,51 @@ LIGHT_PLACEMENT: tuple[str, ...] = tuple(
 LIGHT_DEFAULTED: tuple[str, ...] = ("cutoff_deg",)
 
 
+MaterialKind = Literal["diffuse", "plastic", "conductor"]
+#: Material kinds: Lambertian; a diffuse base under a dielectric coat (Mitsuba ``plastic`` /
+#: ``roughplastic``); a metal (``conductor`` / ``roughconductor``).
+MATERIAL_KINDS: tuple[MaterialKind, ...] = ("diffuse", "plastic", "conductor")
+#: The optional fields of :class:`Material`; at their defaults they are left out of
+#: :func:`scene_to_dict`, so a matte scene's record and hash are those of before they existed.
+GLOSS_FIELDS = ("kind", "roughness", "ior", "metal")
+_OPTIONAL = {"omit_default": True}
+
+
 @dataclass(frozen=True)
 class Material:
-    """A Lambertian material whose reflectance is the spectrum called *spectrum*.
+    """A material: Lambertian (default), coated diffuse or metal.
 
     Attributes
     ----------
     name
         Human-readable name (``"wall"``, ``"stripe 2"``).
     spectrum
-        Registry name of a reflectance spectrum, e.g. ``"munsell:5R 4/14"``.
+        Registry name of the diffuse reflectance spectrum, e.g. ``"munsell:5R 4/14"`` (the base
+        under the coat of a ``plastic``; ``"flat:0"`` for a ``conductor``, which has no diffuse
+        lobe).
+    kind
+        One of :data:`MATERIAL_KINDS`.
+    roughness
+        GGX α of the coat or metal surface (dimensionless, 0 = smooth, i.e. a delta lobe);
+        ignored for ``diffuse``.
+    ior
+        Index of refraction of a ``plastic``'s coat (the base medium has index 1).
+    metal
+        Name of a conductor whose measured η/k Mitsuba ships (``Au``, ``Cu``, ``Al``, ``Ag``...),
+        for ``conductor``.
     """
 
     name: str
     spectrum: str
+    kind: MaterialKind = field(default="diffuse", metadata=_OPTIONAL)
+    roughness: float = field(default=0.0, metadata=_OPTIONAL)
+    ior: float = field(default=1.5, metadata=_OPTIONAL)
+    metal: str = field(default="", metadata=_OPTIONAL)
+
+    @property
+    def glossy(self) -> bool:
+        """Whether the material has a non-diffuse lobe."""
+        return self.kind != "diffuse"
 
 
 @dataclass(frozen=True, eq=False)
@@ -246,7 +281,11 @@ class Scene:
 
 def _plain(value: Any) -> Any:
     if is_dataclass(value) and not isinstance(value, type):
-        return {f.name: _plain(getattr(value, f.name)) for f in fields(value)}
+        return {
+            f.name: _plain(getattr(value, f.name))
+            for f in fields(value)
+            if not (f.metadata.get("omit_default") and getattr(value, f.name) == f.default)
+        }
     if isinstance(value, np.ndarray):
         return value.tolist()
     if isinstance(value, (tuple, list)):

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import SceneError, did_you_mean, with_article
+from spectrinsic.scenes.materials import parse_material
 from spectrinsic.scenes.model import (
     LIGHT_DEFAULTED,
     LIGHT_FIELDS,
@@ -351,12 +352,16 @@ def scene_from_dict(data: Any, *, base: str | os.PathLike[str], source: str = "<
 def _materials(doc: _Doc, mats: Any) -> tuple[Material, ...]:
     if not isinstance(mats, dict) or not mats:
         raise doc.fail(
-            "materials", "expected a non-empty mapping of material name -> spectrum name"
+            "materials",
+            "expected a non-empty mapping of material name -> spectrum name or material",
         )
-    return tuple(
-        Material(name=doc.string(k, "materials"), spectrum=doc.string(v, f"materials.{k}"))
-        for k, v in mats.items()
-    )
+    out = []
+    for k, v in mats.items():
+        parsed = parse_material(doc.string(k, "materials"), v)
+        if isinstance(parsed, str):
+            raise doc.fail(f"materials.{k}", parsed)
+        out.append(parsed)
+    return tuple(out)
 
 
 def _entries(doc: _Doc, data: dict, key: str) -> list[Any]:

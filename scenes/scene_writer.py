@@ -19,6 +19,7 @@ import numpy as np
 import yaml
 
 from spectrinsic.errors import SceneError
+from spectrinsic.scenes.materials import material_entry
 from spectrinsic.scenes.model import Light, Scene, scene_to_dict
 from spectrinsic.scenes.scene_format import FORMAT_VERSION
 
@@ -84,7 +85,7 @@ def scene_to_yaml_dict(scene: Scene, mesh_files: Mapping[str, str] | None = None
     doc: dict[str, Any] = {
         "format": FORMAT_VERSION,
         "name": scene.name,
-        "materials": {m.name: m.spectrum for m in scene.materials},
+        "materials": {m.name: material_entry(m) for m in scene.materials},
         "meshes": meshes,
         "lights": lights,
         "camera": cam,

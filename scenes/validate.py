@@ -26,6 +26,7 @@ from typing import TypeVar
 import numpy as np
 
 from spectrinsic.errors import SceneError, SpectrinsicError, with_article
+from spectrinsic.scenes.materials import material_problem
 from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_KINDS, Scene, unknown_light_kind
 from spectrinsic.spectra import get_spectrum
 
@@ -83,6 +84,14 @@ class Problems:
 
 def _fail(source: str, field: str, problem: str) -> SceneError:
     return SceneError(f"{source}: {field}: {problem}")
+
+
+def _check_materials(scene: Scene, source: str) -> None:
+    """Gloss parameters of every material (:func:`~spectrinsic.scenes.materials.material_problem`)."""
+    for i, mat in enumerate(scene.materials):
+        problem = material_problem(mat)
+        if problem:
+            raise _fail(source, f"materials[{i}] ({mat.name!r})", problem)
 
 
 def winding_numbers(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -419,7 +428,7 @@ def validate_scene(
     """
     source = source or f"scene {scene.name!r}"
     problems = Problems(source)
-    for check in (_check_meshes, _check_lights, _check_camera):
+    for check in (_check_meshes, _check_lights, _check_camera, _check_materials):
         problems.get(check, scene, source)
     if check_spectra:
         cache: dict[str, object] = {}

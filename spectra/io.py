@@ -251,3 +251,35 @@ def read_user_csv(path: str | os.PathLike[str], *, kind: str) -> Table:
             f"{path}: expected at least one {kind} column after the wavelengths"
         )
     return table
+
+
+def mitsuba_ior_dir() -> Path:
+    """Folder of the spectral ``<name>.eta.spd`` / ``<name>.k.spd`` tables shipped inside the
+    installed ``mitsuba`` package (``data/ior``), found without importing Mitsuba."""
+    spec = importlib.util.find_spec("mitsuba")
+    if spec is None or spec.origin is None:
+        raise DataDirectoryError(
+            "the 'mitsuba' package (which ships the conductor η/k tables) is not installed"
+        )
+    # the package's folder (once a variant is set, the spec is that of Mitsuba's alias module in it)
+    return Path(spec.origin).parent / "data" / "ior"
+
+
+@functools.lru_cache(maxsize=64)
+def read_conductor_ior(name: str) -> Table:
+    """Mitsuba's measured complex index of refraction of conductor *name* (``Au``, ``Cu``...):
+    a read-only table with wavelengths in nm and values ``(2, N)`` = (η, k), both read from
+    the two ``.spd`` files (first column: wavelength in nm, second: value) on η's grid."""
+    folder = mitsuba_ior_dir()
+    columns = []
+    for part in ("eta", "k"):
+        path = folder / f"{name}.{part}.spd"
+        if not path.is_file():
+            raise SpectralDataError(f"conductor {name!r}: no table {str(path)!r} in Mitsuba's data")
+        columns.append(np.loadtxt(path, comments="#", dtype=float, ndmin=2))
+    eta, k = columns
+    wl = eta[:, 0]
+    k_on_eta = np.interp(wl, k[:, 0], k[:, 1])
+    return _read_only(
+        Table(wavelengths=wl, values=np.stack([eta[:, 1], k_on_eta]), labels=("eta", "k"))
+    )

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.gt_export import irradiance as irr
+from spectrinsic.gt_export.layers.gloss import diffuse_raw
 from spectrinsic.gt_export.layers.imaging import coverage_weighted
 from spectrinsic.gt_export.layers.intrinsics import shading_set
 from spectrinsic.gt_export.layers.records import (
@@ -68,9 +69,22 @@ def camera_layers(
             nonnegative=True,
         ),
     ]
+    spec = (getattr(s.result, "specular", None) or {}).get("bands31")
+    specular = None if spec is None else np.asarray(spec, float) @ weights.T
+    if specular is not None:
+        out.append(
+            make_layer(
+                f"specular_camera/{key}",
+                specular,
+                RGB,
+                UNITS_CAMERA + "; the specular layer in camera RGB",
+                slug,
+            )
+        )
     used = image
     if denoised:
-        used = irr.recompose(w, s.result.raw["bands31"]) @ weights.T
+        used = irr.recompose(w, diffuse_raw(s, s.result.raw["bands31"])) @ weights.T
+        used = used if specular is None else used + specular
         out.append(
             make_layer(
                 f"image_camera_denoised/{key}",
@@ -82,7 +96,15 @@ def camera_layers(
         )
     names = (f"shading_camera/{key}", f"residual_camera/{key}", f"illuminant_camera/{key}")
     return out + shading_set(
-        w, w.bands @ weights.T, white, used, refl, names=names, group=slug, space="camera RGB"
+        w,
+        w.bands @ weights.T,
+        white,
+        used,
+        refl,
+        names=names,
+        group=slug,
+        space="camera RGB",
+        specular=specular,
     )
 
 

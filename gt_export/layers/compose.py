@@ -12,6 +12,7 @@ from spectrinsic.gt_export import irradiance as irr
 from spectrinsic.gt_export.denoise import denoise_white_radiance
 from spectrinsic.gt_export.layers.cameras import camera_layers, matrices_of
 from spectrinsic.gt_export.layers.geometry import coverage_of, geometry_layers
+from spectrinsic.gt_export.layers.gloss import gloss_layers, specular_srgb
 from spectrinsic.gt_export.layers.images import cube_layer, image_layers
 from spectrinsic.gt_export.layers.imaging import coverage_weighted
 from spectrinsic.gt_export.layers.intrinsics import (
@@ -116,7 +117,9 @@ def compute_ground_truth(
     w = w_raw
     if denoise:
         w = denoise_white_radiance(w_raw, aov(result, "normals"), quality=denoise_quality)
-    layers += intrinsic_layers(s, w_raw, w, image, reflectance, denoised=denoise)
+    specular = specular_srgb(s, w_raw.to_xyz)
+    layers += intrinsic_layers(s, w_raw, w, image, reflectance, denoised=denoise, specular=specular)
+    layers += gloss_layers(s, coverage, specular)
     noise_maps, noise = noise_of(s, w_raw)
     light_maps, shares = share_layers(s, w, mask)
     layers += noise_maps + light_maps
@@ -148,10 +151,13 @@ def compute_ground_truth(
 
 
 def identities(gt: GroundTruth) -> list[dict[str, str]]:
-    """The exact identities the layers satisfy: ``image = reflectance ∘ shading + residual``
-    per sensor space (and on the raw layers when denoised); recorded in ``meta.json``."""
+    """The exact identities the layers satisfy: ``image = reflectance ∘ shading [+ specular] +
+    residual`` per sensor space (and on the raw layers when denoised), the specular term only in
+    glossy scenes; recorded in ``meta.json``."""
     out = []
     denoised = "image_denoised" in gt.layers
+    glossy = "specular" in gt.layers
+    spec = {"specular": "specular"} if glossy else {}
     out.append(
         {
             "image": "image_denoised" if denoised else "image",
@@ -159,6 +165,7 @@ def identities(gt: GroundTruth) -> list[dict[str, str]]:
             "shading": "shading",
             "residual": "residual",
         }
+        | spec
     )
     if denoised:
         out.append(
@@ -168,6 +175,7 @@ def identities(gt: GroundTruth) -> list[dict[str, str]]:
                 "shading": "shading_raw",
                 "residual": "residual_raw",
             }
+            | spec
         )
     for cam in gt.cameras:
         key = camera_key(cam)
@@ -179,5 +187,6 @@ def identities(gt: GroundTruth) -> list[dict[str, str]]:
                 "shading": f"shading_camera/{key}",
                 "residual": f"residual_camera/{key}",
             }
+            | ({"specular": f"specular_camera/{key}"} if glossy else {})
         )
     return out

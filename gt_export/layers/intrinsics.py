@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.gt_export import irradiance as irr
+from spectrinsic.gt_export.layers.gloss import diffuse_raw
 from spectrinsic.gt_export.layers.imaging import shading_ratio
 from spectrinsic.gt_export.layers.records import (
     REFLECTANCE_FLOOR,
@@ -37,6 +38,16 @@ __all__ = [
 ]
 
 
+_RESIDUAL_UNITS = (
+    "image − reflectance ∘ shading (render units): spectral non-commutativity and "
+    "out-of-gamut light; the image itself where no surface"
+)
+_RESIDUAL_UNITS_GLOSSY = (
+    "image − reflectance ∘ shading − specular (render units): spectral "
+    "non-commutativity and out-of-gamut light; the image less specular where no surface"
+)
+
+
 def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
     """``W = E/π`` from the reference render, Eq. 1 of
     :mod:`~spectrinsic.gt_export.irradiance`, with the band albedos the renderer used."""
@@ -52,7 +63,8 @@ def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
         else to_xyz_matrix(mode, s.scene, data_dir=s.data_dir)
     )
     raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
-    return irr.white_radiance(raw, coverage, albedos, to_xyz, mode=s.ref)
+    # W of the first hits' diffuse lobes only: the specular part is its own layer
+    return irr.white_radiance(diffuse_raw(s, raw), coverage, albedos, to_xyz, mode=s.ref)
 
 
 def srgb_white(s: SampleInputs) -> np.ndarray:
@@ -73,9 +85,10 @@ def shading_set(
     names: tuple[str, ...],
     group: str,
     space: str,
+    specular: np.ndarray | None = None,
 ) -> list[Layer]:
     """``shading``, ``residual`` and, if a third name is given, ``illuminant`` of one sensor
-    space from ``W``'s colour."""
+    space from ``W``'s colour (the residual less *specular*, if given)."""
     shading = irr.relative_shading(colour, white, w.valid)
     grey = irr.luminance_of(w)
     layers = [
@@ -90,10 +103,9 @@ def shading_set(
         ),
         make_layer(
             names[1],
-            irr.residual(image, reflectance, shading),
+            irr.residual(image, reflectance, shading, specular),
             RGB,
-            "image − reflectance ∘ shading (render units): spectral non-commutativity and "
-            "out-of-gamut light; the image itself where no surface",
+            _RESIDUAL_UNITS if specular is None else _RESIDUAL_UNITS_GLOSSY,
             group,
         ),
     ]
@@ -120,22 +132,28 @@ def intrinsic_layers(
     reflectance: np.ndarray,
     *,
     denoised: bool,
+    specular: np.ndarray | None = None,
 ) -> list[Layer]:
-    """sRGB shading, residual, grey shading and illuminant (from the denoised ``W`` if asked,
-    with ``image_denoised`` rebuilt from it and the raw ``shading_raw``/``residual_raw``)."""
+    """sRGB shading, residual and illuminant (from the denoised ``W`` if asked, with
+    ``image_denoised`` rebuilt from it plus the raw *specular*, and the raw ``shading_raw``/
+    ``residual_raw``), grey shading and ratio shading."""
     white = srgb_white(s)
     used = image
     out: list[Layer] = []
     if denoised:
         raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
-        used = xyz_to_linear_srgb(np.einsum("hwk,ck->hwc", irr.recompose(w, raw), w.to_xyz))
+        used = xyz_to_linear_srgb(
+            np.einsum("hwk,ck->hwc", irr.recompose(w, diffuse_raw(s, raw)), w.to_xyz)
+        )
+        used = used if specular is None else used + specular
         out.append(
             make_layer(
                 "image_denoised",
                 used,
                 RGB,
                 UNITS_IMAGE + "; rebuilt as reflectance-weighted denoised white-surface "
-                "radiance (the raw image where no surface)",
+                "radiance (the raw image where no surface)"
+                + ("" if specular is None else ", plus the raw specular layer"),
                 "image",
             )
         )
@@ -148,6 +166,7 @@ def intrinsic_layers(
             space="linear sRGB",
             names=("shading_raw", "residual_raw"),
             group="intrinsics",
+            specular=specular,
         )
     out += shading_set(
         w,
@@ -158,6 +177,7 @@ def intrinsic_layers(
         space="linear sRGB",
         names=("shading", "residual", "illuminant"),
         group="intrinsics",
+        specular=specular,
     )
     out.append(
         make_layer(

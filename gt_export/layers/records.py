@@ -169,9 +169,12 @@ def aov(result: Any, name: str) -> np.ndarray | None:
 
 
 def reference_mode(result: Any) -> str:
-    """The render mode whose image is the reference ``image`` (first of :data:`REFERENCE_MODES`)."""
+    """The render mode whose image is the reference ``image`` (first of :data:`REFERENCE_MODES`;
+    for a glossy scene, first of those whose specular part was rendered)."""
+    # with glossy materials, the first mode whose specular part was rendered (a diagonal one)
+    split = getattr(result, "specular", None) or {}
     for mode in REFERENCE_MODES:
-        if mode in result.images:
+        if mode in result.images and (not split or mode in split):
             return mode
     if result.images:
         return sorted(result.images)[0]

@@ -24,6 +24,7 @@ from spectrinsic.scenes.generators.base import (
     family_of,
     scene_rngs,
 )
+from spectrinsic.scenes.generators.gloss import GlossDistribution, apply_gloss
 from spectrinsic.scenes.generators.ground import objects_on_ground
 from spectrinsic.scenes.generators.materials import MaterialDistribution
 from spectrinsic.scenes.generators.rooms import rooms
@@ -33,6 +34,7 @@ __all__ = [
     "GENERATORS",
     "GeneratorOptions",
     "MaterialDistribution",
+    "GlossDistribution",
     "generator_names",
     "generated_scene_name",
     "generated_scene_seed",
@@ -112,6 +114,7 @@ def generate(
         except SceneError as exc:  # this layout cannot be lit or seen: draw another
             problems.append(str(exc))
             continue
+        scene = apply_gloss(scene, options.gloss, seed)
         if attempt == 0:
             return scene
         return replace(scene, metadata={**scene.metadata, "layout_attempt": attempt})

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.scenes.generators.camera import is_free, sample_camera
+from spectrinsic.scenes.generators.gloss import GlossDistribution
 from spectrinsic.scenes.generators.lights import FAMILIES, LightVolume, draw_lights
 from spectrinsic.scenes.generators.materials import MaterialDistribution
 from spectrinsic.scenes.model import Mesh, Scene
@@ -45,6 +46,8 @@ class GeneratorOptions:
         Most lights per scene (1-4).
     sfu_reflectances, sfu_illuminants
         SFU names to draw from (empty when no data directory is configured).
+    gloss
+        Fractions of glossy and metal materials and their roughness range (default: none).
     data_dir
         Spectral data directory (for ``sfu`` chromaticities).
     """
@@ -58,6 +61,7 @@ class GeneratorOptions:
     sfu_reflectances: tuple[str, ...] = ()
     sfu_illuminants: tuple[str, ...] = ()
     data_dir: str | None = None
+    gloss: GlossDistribution = field(default_factory=GlossDistribution)
 
 
 @dataclass(frozen=True)

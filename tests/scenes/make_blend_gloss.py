@@ -1,0 +1,52 @@
+"""Build a .blend with Principled BSDF materials for tests/scenes/test_blender_gloss.py
+(run in a subprocess: bpy state is global).
+
+Usage: python make_blend_gloss.py -- OUT.blend
+
+Three quads side by side: "Copper" (Metallic 1, Roughness 0.3, custom property metal = "Cu"),
+"munsell:5R 4/14" (Metallic 0, Roughness 0.2, IOR 1.45) and "flat:0.5" (Roughness 0.8); a
+camera above and a sun.
+"""
+
+import sys
+
+import bpy
+
+out = sys.argv[-1]
+bpy.ops.wm.read_factory_settings(use_empty=True)
+scene = bpy.context.scene
+
+
+def principled(name, metallic, roughness, ior=1.5):
+    m = bpy.data.materials.new(name)
+    m.use_nodes = True
+    node = next(n for n in m.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+    node.inputs["Metallic"].default_value = metallic
+    node.inputs["Roughness"].default_value = roughness
+    node.inputs["IOR"].default_value = ior
+    return m
+
+
+copper = principled("Copper", 1.0, 0.3)
+copper["metal"] = "Cu"
+mats = [copper, principled("munsell:5R 4/14", 0.0, 0.2, 1.45), principled("flat:0.5", 0.0, 0.8)]
+for i, mat in enumerate(mats):
+    me = bpy.data.meshes.new(f"quad{i}")
+    x = 2.0 * i - 2.0
+    me.from_pydata(
+        [(x - 1, -1, 0), (x + 1, -1, 0), (x + 1, 1, 0), (x - 1, 1, 0)], [], [(0, 1, 2, 3)]
+    )
+    me.update()
+    obj = bpy.data.objects.new(f"Quad{i}", me)
+    obj.data.materials.append(mat)
+    scene.collection.objects.link(obj)
+
+cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+cam.location = (0.0, 0.0, 8.0)
+scene.collection.objects.link(cam)
+scene.camera = cam
+scene.render.resolution_x, scene.render.resolution_y = 32, 16
+sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+sun.data.energy = 2.0
+scene.collection.objects.link(sun)
+bpy.ops.wm.save_as_mainfile(filepath=out)

@@ -1,0 +1,47 @@
+"""The mesh importer maps glTF pbrMetallicRoughness factors to glossy materials."""
+
+from __future__ import annotations
+
+import pytest
+import trimesh
+from trimesh.visual.material import PBRMaterial
+
+from spectrinsic.scenes.meshes import load_mesh_scene
+
+
+def _box(name: str, offset: float, material: PBRMaterial | None) -> trimesh.Trimesh:
+    box = trimesh.creation.box((1.0, 1.0, 1.0))
+    box.apply_translation((offset, 0.0, 0.5))
+    if material is not None:
+        box.visual = trimesh.visual.TextureVisuals(material=material)
+    box.metadata["name"] = name
+    return box
+
+
+def test_gltf_metallic_roughness_factors(tmp_path):
+    scene = trimesh.Scene()
+    scene.add_geometry(
+        _box("a", -1.5, PBRMaterial(name="steel", metallicFactor=1.0, roughnessFactor=0.3)), "a"
+    )
+    scene.add_geometry(
+        _box("b", 0.0, PBRMaterial(name="lacquer", metallicFactor=0.0, roughnessFactor=0.2)), "b"
+    )
+    scene.add_geometry(
+        _box("c", 1.5, PBRMaterial(name="clay", metallicFactor=0.0, roughnessFactor=0.9)), "c"
+    )
+    path = tmp_path / "three.glb"
+    scene.export(path)
+    loaded = load_mesh_scene(
+        path, materials={"lacquer": "munsell:5R 4/14", "clay": "flat:0.5"}, width=16, height=16
+    )
+    by_kind = {m.kind: m for m in loaded.materials}
+    assert set(by_kind) == {"conductor", "plastic", "diffuse"}
+    assert by_kind["conductor"].metal == "Al" and by_kind["conductor"].roughness == pytest.approx(
+        0.09, rel=1e-5
+    )
+    assert by_kind["plastic"].spectrum == "munsell:5R 4/14" and by_kind[
+        "plastic"
+    ].roughness == pytest.approx(0.04)
+    assert (
+        by_kind["diffuse"].name == "flat:0.5"
+    )  # matte materials are named after their spectrum, as before
