@@ -66,7 +66,7 @@ from spectrinsic.decompose.colour_naming import (
 )
 from spectrinsic.decompose.constancy import discount_illuminant
 from spectrinsic.decompose.decomposition import Decomposition, finish, prepare_input
-from spectrinsic.decompose.ridges import ColourShades, colour_shades
+from spectrinsic.decompose.ridges import RIDGE_DETECTORS, ColourShades, colour_shades
 from spectrinsic.errors import DecomposeError, MissingDependencyError, validate_choice
 from spectrinsic.spectra.colorimetry import decode_srgb as _srgb_decode
 from spectrinsic.spectra.colorimetry import encode_srgb as _srgb_encode
@@ -167,7 +167,13 @@ class NamesAndShades:
     parallel_threshold_deg
         ``thr`` of sec. 3.3.2: steps within this angle of the ridge are parallel (Case C).
     bins, sigma
-        Colour-histogram resolution and smoothing of the colour-shade descriptor.
+        Colour-histogram resolution and smoothing (derivative scale) of the colour-shade
+        descriptor, in bins.
+    ridge_detector, creaseness
+        Ridge detector of the colour-shade descriptor (:data:`spectrinsic.decompose.ridges.
+        RIDGE_DETECTORS`: ``"rad"``, RAD's MLSEC-ST creaseness, thinning and pruning, as the
+        thesis cites; ``"hessian"``, the earlier pragmatic detector) and RAD's creaseness
+        threshold.
     global_coherence
         Apply sec. 3.4 (off reproduces Fig. 3.7(c)).
     reflectance_colour
@@ -197,6 +203,8 @@ class NamesAndShades:
     parallel_threshold_deg: float = 30.0
     bins: int = 64
     sigma: float = 1.0
+    ridge_detector: str = "hessian"
+    creaseness: float = 1.0
     global_coherence: bool = True
     reflectance_colour: Literal["label-centroid", "region-mean"] = "region-mean"
     split_by_ridge: bool = True
@@ -217,7 +225,8 @@ class NamesAndShades:
         """
         return cls(gamma_over_alpha=100.0, gamma_over_beta=2.0, mu=1.0 / 3.0,
                    reflectance_colour="label-centroid", split_by_ridge=False,
-                   colour_constancy="none", expansion_cycles=-1, name="names-shades-thesis")
+                   colour_constancy="none", expansion_cycles=-1, ridge_detector="rad",
+                   name="names-shades-thesis")
 
     def __call__(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Decomposition:
         """Decompose a linear ``(H, W, 3)`` image into reflectance and shading.
@@ -233,6 +242,8 @@ class NamesAndShades:
             self.reflectance_colour, ("label-centroid", "region-mean"), "reflectance_colour",
             error=DecomposeError,
         )
+        validate_choice(self.ridge_detector, RIDGE_DETECTORS, "ridge_detector",
+                        error=DecomposeError)
         gco = _import_gco()
         t0 = time.perf_counter()
         img, m = prepare_input(image, mask)
@@ -246,7 +257,8 @@ class NamesAndShades:
 
         # 2. colour shades on the log image
         log_colours = np.log(np.maximum(pixels, _LOG_FLOOR))
-        shades = colour_shades(log_colours, bins=self.bins, sigma=self.sigma)
+        shades = colour_shades(log_colours, bins=self.bins, sigma=self.sigma,
+                               detector=self.ridge_detector, creaseness=self.creaseness)
         t2 = time.perf_counter()
 
         # 3. MRF (Eq. 3.4) by alpha-expansion

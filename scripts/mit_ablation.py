@@ -32,10 +32,22 @@ from spectrinsic.decompose.registry import get_decomposer
 
 #: Parameters of steps 1-3 (each point runs the MRF). gamma's absolute scale is not in the
 #: thesis (only gamma/alpha = 100, gamma/beta = 2 and mu = 1/3 are); gamma/alpha = 10 was the
-#: rendered-set protocol's choice.
-MRF_GRID = {"gamma": [1.0, 3.0, 10.0, 30.0], "gamma_over_alpha": [10.0, 100.0]}
-MRF_POINTS = [{"gamma": g, "gamma_over_alpha": 100.0} for g in MRF_GRID["gamma"]] + [
-    {"gamma": 1.0, "gamma_over_alpha": 10.0}, {"gamma": 10.0, "gamma_over_alpha": 10.0}]
+#: rendered-set protocol's choice. The ridge detector (sec. 3.2.2): "hessian" (round 1) or
+#: "rad" (RAD's MLSEC-ST creaseness, thinning, pruning) at creaseness/sigma (1.0, 1) or (1.5, 2).
+HESSIAN = {"ridge_detector": "hessian", "creaseness": 1.0, "sigma": 1.0}
+RAD = {"ridge_detector": "rad", "creaseness": 1.5, "sigma": 2.0}
+RAD_FINE = {"ridge_detector": "rad", "creaseness": 1.0, "sigma": 1.0}
+MRF_GRID = {"gamma": [1.0, 3.0, 10.0, 30.0], "gamma_over_alpha": [10.0, 100.0],
+            "ridge_detector": ["hessian", "rad"], "creaseness": [1.0, 1.5], "sigma": [1.0, 2.0]}
+#: Round 1 (scripts/mit_ablation.json, before the RAD detector): the hessian points.
+HESSIAN_POINTS = [{"gamma": g, "gamma_over_alpha": 100.0, **HESSIAN} for g in (1.0, 3.0, 10.0, 30.0)
+                  ] + [{"gamma": g, "gamma_over_alpha": 10.0, **HESSIAN} for g in (1.0, 10.0)]
+#: Round 2 (scripts/mit_ablation_rad.json): the RAD points.
+MRF_POINTS = [{"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD},
+              {"gamma": 1.0, "gamma_over_alpha": 100.0, **RAD},
+              {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD},
+              {"gamma": 10.0, "gamma_over_alpha": 100.0, **RAD},
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD_FINE}]
 #: Parameters of steps 4-5 (run on each labelling).
 POST_GRID = {"reflectance_colour": ["label-centroid", "region-mean"],
              "split_by_ridge": [False, True]}
@@ -62,7 +74,7 @@ def key(point: dict) -> str:
     return json.dumps(point, sort_keys=True)
 
 
-def run(mit_dir: Path, names: list[str] | None) -> dict:
+def run(mit_dir: Path, names: list[str] | None, with_extra: bool = False) -> dict:
     base = dataclasses.replace(NamesAndShades.thesis(), expansion_cycles=2)
     scores: dict[str, dict[str, dict]] = {}
     seconds: dict[str, float] = {}
@@ -84,7 +96,7 @@ def run(mit_dir: Path, names: list[str] | None) -> dict:
                                             colour_constancy=constancy)
                     scores.setdefault(key(point), {})[obj.name] = {
                         **mit_measures(obj, result), "regions": plain.info["regions"]}
-        for label, change in EXTRA.items():
+        for label, change in (EXTRA.items() if with_extra else ()):
             method = dataclasses.replace(NamesAndShades.thesis(), **change)
             result = method(obj.image, obj.mask)
             scores.setdefault(label, {})[obj.name] = {
@@ -141,6 +153,8 @@ def merge(parts: list[Path]) -> dict:
     for part in parts:
         data = json.loads(part.read_text())
         for k, per_object in data["scores"].items():
+            if k.startswith("{") and "ridge_detector" not in k:  # round 1: the hessian detector
+                k = key({**json.loads(k), **HESSIAN})
             report["scores"].setdefault(k, {}).update(per_object)
         report["labelling_seconds"].update(data["labelling_seconds"])
     report["choice"] = choose(report["scores"])
