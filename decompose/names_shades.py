@@ -4,7 +4,8 @@ Pipeline (Fig. 3.4):
 
 1. **Colour names** (sec. 3.2.1): Benavente et al.'s memberships over the 11 basic terms,
    discretised to the Appendix A labels (:mod:`spectrinsic.decompose.colour_naming`).
-2. **Colour shades** (sec. 3.2.2): ridges of the distribution of the log image's colours
+2. **Colour shades** (sec. 3.2.2): RAD ridges (MLSEC-ST creaseness, thinning, pruning) of the
+   distribution of the log image's colours
    (:mod:`spectrinsic.decompose.ridges`; "we apply a logarithm to the input image before obtaining
    its color-shade descriptor", sec. 3.5).
 3. **MRF** (sec. 3.3, Eq. 3.4): ``E(x) = mu sum_i |x_i - y_i|_1 + (1 - mu) sum_ij w_ij |x_i - x_j|_1``
@@ -202,9 +203,9 @@ class NamesAndShades:
     gamma_over_beta: float = 2.0
     parallel_threshold_deg: float = 30.0
     bins: int = 64
-    sigma: float = 1.0
-    ridge_detector: str = "hessian"
-    creaseness: float = 1.0
+    sigma: float = 2.0
+    ridge_detector: str = "rad"
+    creaseness: float = 1.5
     global_coherence: bool = True
     reflectance_colour: Literal["label-centroid", "region-mean"] = "region-mean"
     split_by_ridge: bool = True

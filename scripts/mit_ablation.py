@@ -1,7 +1,8 @@
 """Names-and-shades on the MIT development half: each deviation from the thesis on and off.
 
-Usage: python -P scripts/mit_ablation.py MIT_DIR OUT.json [OBJECT ...]   (score; all objects
-       by default, several runs on disjoint objects can share the 2 cores)
+Usage: python -P scripts/mit_ablation.py MIT_DIR OUT.json [--points=I,J] [OBJECT ...]
+       (score the MRF_POINTS given by index, all by default; all objects by default, several
+       runs on disjoint objects can share the 2 cores)
        python -P scripts/mit_ablation.py --merge OUT.json DOC.md PART.json ...
 
 For every object of MIT_DIR (the development half, ``$SPECTRINSIC_DATA/mit_intrinsic_dev``)
@@ -37,8 +38,9 @@ from spectrinsic.decompose.registry import get_decomposer
 HESSIAN = {"ridge_detector": "hessian", "creaseness": 1.0, "sigma": 1.0}
 RAD = {"ridge_detector": "rad", "creaseness": 1.5, "sigma": 2.0}
 RAD_FINE = {"ridge_detector": "rad", "creaseness": 1.0, "sigma": 1.0}
-MRF_GRID = {"gamma": [1.0, 3.0, 10.0, 30.0], "gamma_over_alpha": [10.0, 100.0],
-            "ridge_detector": ["hessian", "rad"], "creaseness": [1.0, 1.5], "sigma": [1.0, 2.0]}
+MRF_GRID = {"gamma": [0.3, 1.0, 3.0, 10.0, 30.0], "gamma_over_alpha": [10.0, 100.0],
+            "ridge_detector": ["hessian", "rad"], "creaseness": [1.0, 1.5],
+            "sigma": [1.0, 2.0, 3.0]}
 #: Round 1 (scripts/mit_ablation.json, before the RAD detector): the hessian points.
 HESSIAN_POINTS = [{"gamma": g, "gamma_over_alpha": 100.0, **HESSIAN} for g in (1.0, 3.0, 10.0, 30.0)
                   ] + [{"gamma": g, "gamma_over_alpha": 10.0, **HESSIAN} for g in (1.0, 10.0)]
@@ -47,7 +49,10 @@ MRF_POINTS = [{"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD},
               {"gamma": 1.0, "gamma_over_alpha": 100.0, **RAD},
               {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD},
               {"gamma": 10.0, "gamma_over_alpha": 100.0, **RAD},
-              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD_FINE}]
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD_FINE},
+              # round 2b (the chosen point lay on the grid's edge: gamma 1, sigma 2)
+              {"gamma": 0.3, "gamma_over_alpha": 10.0, **RAD},
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "sigma": 3.0}]
 #: Parameters of steps 4-5 (run on each labelling).
 POST_GRID = {"reflectance_colour": ["label-centroid", "region-mean"],
              "split_by_ridge": [False, True]}
@@ -74,7 +79,8 @@ def key(point: dict) -> str:
     return json.dumps(point, sort_keys=True)
 
 
-def run(mit_dir: Path, names: list[str] | None, with_extra: bool = False) -> dict:
+def run(mit_dir: Path, names: list[str] | None, points: list[dict], with_extra: bool = False
+        ) -> dict:
     base = dataclasses.replace(NamesAndShades.thesis(), expansion_cycles=2)
     scores: dict[str, dict[str, dict]] = {}
     seconds: dict[str, float] = {}
@@ -83,7 +89,7 @@ def run(mit_dir: Path, names: list[str] | None, with_extra: bool = False) -> dic
         for name in REFERENCES:
             scores.setdefault(name, {})[obj.name] = mit_measures(obj, get_decomposer(name)(
                 obj.image, obj.mask))
-        for mrf in MRF_POINTS:
+        for mrf in points:
             method = dataclasses.replace(base, **mrf)
             t0 = time.perf_counter()
             labelling = method.labelling(obj.image, obj.mask)
@@ -124,27 +130,41 @@ def row(name: str, per_object: dict, baseline: dict) -> str:
             f"{means['almse']:.4f} | {wins}/{len(per_object)} |")
 
 
+#: The thesis' settings (NamesAndShades.thesis(), 2 expansion cycles) with each detector.
+THESIS = {"gamma": 1.0, "gamma_over_alpha": 100.0, "reflectance_colour": "label-centroid",
+          "split_by_ridge": False, "colour_constancy": "none"}
+#: The round-1 defaults (hessian ridges), the reference for "before".
+ROUND_1 = {"gamma": 1.0, "gamma_over_alpha": 10.0, "reflectance_colour": "region-mean",
+           "split_by_ridge": True, "colour_constancy": "grey-world", **HESSIAN}
+
+
+def variations(label: str, centre: dict, s: dict, base: dict) -> list[str]:
+    """One row per grid value that differs from *centre* in one parameter (where scored)."""
+    lines = []
+    for p, values in {**MRF_GRID, **POST_GRID, "colour_constancy": CONSTANCY}.items():
+        for v in values:
+            if v != centre[p] and key({**centre, p: v}) in s:
+                lines.append(row(f"{label}, {p} = {v}", s[key({**centre, p: v})], base))
+    return lines
+
+
 def markdown(report: dict) -> str:
     s, chosen = report["scores"], report["choice"]["chosen"]
-    thesis = {"gamma": 1.0, "gamma_over_alpha": 100.0, "reflectance_colour": "label-centroid",
-              "split_by_ridge": False, "colour_constancy": "none"}
     lines = ["| setting | MIT LMSE | Corr | MSE | aLMSE | beats baseline |",
              "|---|---|---|---|---|---|"]
     base = s["image-as-reflectance"]
     for name in REFERENCES:
         lines.append(row(name, s[name], base))
-    lines.append(row("thesis (2 expansion cycles)", s[key(thesis)], base))
+    for label, ridges in (("thesis, hessian ridges (round 1)", HESSIAN),
+                          ("thesis, RAD ridges", RAD)):
+        lines.append(row(label, s[key({**THESIS, **ridges})], base))
     for label in EXTRA:
-        lines.append(row(label, s[label], base))
-    for p, values in {**MRF_GRID, **POST_GRID, "colour_constancy": CONSTANCY}.items():
-        for v in values:
-            if v != thesis[p] and key({**thesis, p: v}) in s:
-                lines.append(row(f"thesis, {p} = {v}", s[key({**thesis, p: v})], base))
+        if label in s:
+            lines.append(row(f"{label} (hessian ridges)", s[label], base))
+    lines += variations("thesis, RAD ridges", {**THESIS, **RAD}, s, base)
+    lines.append(row("round-1 defaults (hessian ridges)", s[key(ROUND_1)], base))
     lines.append(row(f"**chosen**: {chosen}", s[key(chosen)], base))
-    for p, values in {**MRF_GRID, **POST_GRID, "colour_constancy": CONSTANCY}.items():
-        for v in values:
-            if v != chosen[p] and key({**chosen, p: v}) in s:
-                lines.append(row(f"chosen, {p} = {v}", s[key({**chosen, p: v})], base))
+    lines += variations("chosen", chosen, s, base)
     return "\n".join(lines) + "\n"
 
 
@@ -164,11 +184,10 @@ def merge(parts: list[Path]) -> dict:
 def per_object(report: dict) -> str:
     """LMSE per object: the thesis' reported value beside ours (thesis settings and chosen)."""
     s, chosen = report["scores"], report["choice"]["chosen"]
-    thesis = key({"gamma": 1.0, "gamma_over_alpha": 100.0, "reflectance_colour": "label-centroid",
-                  "split_by_ridge": False, "colour_constancy": "none"})
     columns = {"thesis Table 3.5": None, "image-as-reflectance": "image-as-reflectance",
-               "colour-retinex": "colour-retinex", "ours, thesis settings": thesis,
-               "ours, chosen": key(chosen)}
+               "colour-retinex": "colour-retinex",
+               "ours, thesis settings, RAD": key({**THESIS, **RAD}),
+               "ours, round-1 defaults": key(ROUND_1), "ours, chosen": key(chosen)}
     lines = ["| object | " + " | ".join(columns) + " |", "|---" * (len(columns) + 1) + "|"]
     objects = sorted(o for o in THESIS_TABLES_3_4_3_5 if o in s["colour-retinex"])
     for obj in objects:
@@ -192,8 +211,12 @@ def main(argv: list[str]) -> int:
         print(table)
         print(json.dumps(report["choice"], indent=1))
         return 0
+    chosen = [a for a in argv if a.startswith("--points=")]  # indices into MRF_POINTS
+    argv = [a for a in argv if a not in chosen]
+    points = ([MRF_POINTS[int(i)] for i in chosen[0].split("=", 1)[1].split(",")] if chosen
+              else MRF_POINTS)
     mit_dir, target = Path(argv[0]), Path(argv[1])
-    report = run(mit_dir, argv[2:] or None)
+    report = run(mit_dir, argv[2:] or None, points)
     target.write_text(json.dumps(report, indent=1, sort_keys=True) + "\n")
     return 0
 
