@@ -39,8 +39,8 @@ HESSIAN = {"ridge_detector": "hessian", "creaseness": 1.0, "sigma": 1.0}
 RAD = {"ridge_detector": "rad", "creaseness": 1.5, "sigma": 2.0}
 RAD_FINE = {"ridge_detector": "rad", "creaseness": 1.0, "sigma": 1.0}
 MRF_GRID = {"gamma": [0.3, 1.0, 3.0, 10.0, 30.0], "gamma_over_alpha": [10.0, 100.0],
-            "ridge_detector": ["hessian", "rad"], "creaseness": [1.0, 1.5],
-            "sigma": [1.0, 2.0, 3.0]}
+            "ridge_detector": ["hessian", "rad"], "creaseness": [1.0, 1.25, 1.5],
+            "sigma": [1.0, 1.5, 2.0, 3.0]}
 #: Round 1 (before the RAD detector): the hessian points. scripts/mit_ablation.json holds
 #: both rounds (round 1's keys, which lack the detector, are read as HESSIAN by merge()).
 HESSIAN_POINTS = [{"gamma": g, "gamma_over_alpha": 100.0, **HESSIAN} for g in (1.0, 3.0, 10.0, 30.0)
@@ -53,7 +53,10 @@ MRF_POINTS = [{"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD},
               {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD_FINE},
               # round 2b (the chosen point lay on the grid's edge: gamma 1, sigma 2)
               {"gamma": 0.3, "gamma_over_alpha": 10.0, **RAD},
-              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "sigma": 3.0}]
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "sigma": 3.0},
+              # round 2c (between the connected web of 1.0 and the chosen 1.5; sigma 1.5)
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "creaseness": 1.25},
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "sigma": 1.5}]
 #: Parameters of steps 4-5 (run on each labelling).
 POST_GRID = {"reflectance_colour": ["label-centroid", "region-mean"],
              "split_by_ridge": [False, True]}
