@@ -42,8 +42,14 @@ from spectrinsic.gt_export.exr import exr_size, read_exr, write_exr
 from spectrinsic.gt_export.png import PNG16_MAX, png_size, read_png16, write_png16
 from spectrinsic.spectra.colorimetry import decode_srgb, encode_srgb
 
-__all__ = ["PNG_ENCODINGS", "PREDICTION_FORMATS", "Predictions", "PredictionFiles", "read_layer",
-           "write_predictions"]
+__all__ = [
+    "PNG_ENCODINGS",
+    "PREDICTION_FORMATS",
+    "Predictions",
+    "PredictionFiles",
+    "read_layer",
+    "write_predictions",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -82,14 +88,20 @@ def _check_header_size(path: Path, layer: str, shape: tuple[int, int]) -> None:
     else:
         (height, width), channels = png_size(path), 0
     if (height, width) != tuple(shape):
-        raise DatasetError(f"{path}: expected a {layer} image of shape {(*shape, 3)}; its header "
-                           f"declares {width}x{height} pixels (refused before decoding)")
+        raise DatasetError(
+            f"{path}: expected a {layer} image of shape {(*shape, 3)}; its header "
+            f"declares {width}x{height} pixels (refused before decoding)"
+        )
     if channels > MAX_CHANNELS:
-        raise DatasetError(f"{path}: its header declares {channels} channels; expected a {layer} "
-                           f"image of at most {MAX_CHANNELS}")
+        raise DatasetError(
+            f"{path}: its header declares {channels} channels; expected a {layer} "
+            f"image of at most {MAX_CHANNELS}"
+        )
 
 
-def read_layer(folder: Path, layer: str, shape: tuple[int, int], *, encoding: str) -> np.ndarray | None:
+def read_layer(
+    folder: Path, layer: str, shape: tuple[int, int], *, encoding: str
+) -> np.ndarray | None:
     """Read ``folder/<layer>.exr`` (else ``.png``) as float64 ``(H, W, 3)``; None when absent.
 
     A grey shading (one channel) is repeated to 3 channels. Raises :class:`DatasetError` for a
@@ -180,8 +192,11 @@ class Predictions:
         if shad is None:
             return finish(img, refl, mask, {"source": str(folder)})
         m = mask[:, :, None]
-        return Decomposition(np.where(m, refl, 0.0).astype(np.float32),
-                             np.where(m, shad, 0.0).astype(np.float32), {"source": str(folder)})
+        return Decomposition(
+            np.where(m, refl, 0.0).astype(np.float32),
+            np.where(m, shad, 0.0).astype(np.float32),
+            {"source": str(folder)},
+        )
 
 
 @dataclass(frozen=True)
@@ -206,10 +221,18 @@ class PredictionFiles:
 
 def _plain_name(value: str, what: str) -> str:
     """*value* if it is one folder name (no separator, not ``.``/``..``), else a DatasetError."""
-    if not isinstance(value, str) or not value or value in (".", "..") or "/" in value \
-            or "\\" in value or os.sep in value:
-        raise DatasetError(f"write_predictions: {what} {value!r}; expected one folder name, "
-                           "e.g. 'room-living__v1__white'")
+    if (
+        not isinstance(value, str)
+        or not value
+        or value in (".", "..")
+        or "/" in value
+        or "\\" in value
+        or os.sep in value
+    ):
+        raise DatasetError(
+            f"write_predictions: {what} {value!r}; expected one folder name, "
+            "e.g. 'room-living__v1__white'"
+        )
     return value
 
 
@@ -219,8 +242,10 @@ def _layer_values(layer: str, values: np.ndarray) -> np.ndarray:
     if arr.ndim == 3 and arr.shape[2] == 1 and layer == "shading":
         arr = arr[:, :, 0]
     if not (arr.ndim == 3 and arr.shape[2] == 3) and not (arr.ndim == 2 and layer == "shading"):
-        raise DatasetError(f"write_predictions: {layer} of shape {arr.shape}; expected (H, W, 3)"
-                           + (" or (H, W)" if layer == "shading" else ""))
+        raise DatasetError(
+            f"write_predictions: {layer} of shape {arr.shape}; expected (H, W, 3)"
+            + (" or (H, W)" if layer == "shading" else "")
+        )
     if not np.all(np.isfinite(arr)):
         raise DatasetError(f"write_predictions: {layer} contains NaN or Inf values")
     return arr
@@ -289,7 +314,9 @@ def write_predictions(
     """
     validate_choice(fmt, PREDICTION_FORMATS, "predictions format", error=DatasetError)
     validate_choice(encoding, PNG_ENCODINGS, "PNG encoding", error=DatasetError)
-    layers = {k: v for k, v in (("reflectance", reflectance), ("shading", shading)) if v is not None}
+    layers = {
+        k: v for k, v in (("reflectance", reflectance), ("shading", shading)) if v is not None
+    }
     if not layers:
         raise DatasetError("write_predictions: give reflectance, shading or both")
     folder = Path(root) / _plain_name(sample_id, "sample id")
@@ -301,14 +328,16 @@ def write_predictions(
         if target.exists() and not overwrite:
             raise DatasetError(f"{target} exists; pass overwrite=True to replace it")
         if fmt == "png" and hider.exists():
-            raise DatasetError(f"{hider} exists and the reader prefers it to {target.name}; "
-                               "remove it or write EXR")
+            raise DatasetError(
+                f"{hider} exists and the reader prefers it to {target.name}; remove it or write EXR"
+            )
     folder.mkdir(parents=True, exist_ok=True)
     return PredictionFiles(folder, *_write_layers(folder, arrays, fmt, encoding))
 
 
-def _write_layers(folder: Path, arrays: Mapping[str, np.ndarray], fmt: str,
-                  encoding: str) -> tuple[dict[str, Path], dict[str, float]]:
+def _write_layers(
+    folder: Path, arrays: Mapping[str, np.ndarray], fmt: str, encoding: str
+) -> tuple[dict[str, Path], dict[str, float]]:
     files, scales = {}, {}
     for name, arr in arrays.items():
         if fmt == "exr":

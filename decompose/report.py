@@ -107,7 +107,9 @@ def scenario_table(scores: Iterable[Score], *, metric: str = "lmse") -> list[dic
 #: Thesis Table 3.2's columns: (key, metric, header); each the mean over samples of
 #: ``(shading_grey + reflectance_grey) / 2``.
 TABLE_3_2_COLUMNS: tuple[tuple[str, str, str], ...] = (
-    ("corr", "corr", "Corr."), ("mse", "si_mse", "MSE"), ("lmse", "lmse", "LMSE"),
+    ("corr", "corr", "Corr."),
+    ("mse", "si_mse", "MSE"),
+    ("lmse", "lmse", "LMSE"),
     ("almse", "almse", "aLMSE"),
 )
 
@@ -146,7 +148,8 @@ def method_parameters(methods: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
     for name, method in methods.items():
         params = (
             {f.name: getattr(method, f.name) for f in dataclasses.fields(method)}
-            if dataclasses.is_dataclass(method) else {}
+            if dataclasses.is_dataclass(method)
+            else {}
         )
         out[name] = {
             "class": f"{type(method).__module__}.{type(method).__qualname__}",
@@ -170,7 +173,10 @@ def _markdown(rows: list[dict[str, Any]], columns: Sequence[str], headers: Seque
 
 
 def _condition_files(
-    out: Path, stem: str, title: str, rows: list[dict[str, Any]],
+    out: Path,
+    stem: str,
+    title: str,
+    rows: list[dict[str, Any]],
     columns: Sequence[tuple[str, str, str, str]],
 ) -> dict[str, Path]:
     keys = [f"{prefix}_{g}" for prefix, *_ in columns for g in _GROUP_ORDER]
@@ -178,8 +184,10 @@ def _condition_files(
     layers = sorted({layer for _, layer, _, _ in columns})
     md = [f"# {title}", "", "Mean over samples; sRGB input. Layers scored:", ""]
     md += [f"* `{layer}`: {SCORED_LAYERS[layer]}" for layer in layers]
-    md += [f"* {header}: metric `{metric}` ({METRICS[metric].equation}) of `{layer}`"
-           for _, layer, metric, header in columns]
+    md += [
+        f"* {header}: metric `{metric}` ({METRICS[metric].equation}) of `{layer}`"
+        for _, layer, metric, header in columns
+    ]
     md.append("")
     headers = ["method"] + [f"{h} {g}" for *_, h in columns for g in _GROUP_ORDER]
     for kind, name in _KINDS.items():
@@ -193,9 +201,16 @@ def _condition_files(
 def _report_md(
     methods: Mapping[str, Any], inputs: Sequence[str], n_samples: int, files: Mapping[str, Path]
 ) -> str:
-    md = ["# Evaluation report", "", f"{n_samples} samples. Input decomposed: "
-          + ", ".join(f"`{k}`" for k in inputs)
-          + f" (the first of {list(INPUT_LAYERS)} each sample has).", "", "## Layers scored", ""]
+    md = [
+        "# Evaluation report",
+        "",
+        f"{n_samples} samples. Input decomposed: "
+        + ", ".join(f"`{k}`" for k in inputs)
+        + f" (the first of {list(INPUT_LAYERS)} each sample has).",
+        "",
+        "## Layers scored",
+        "",
+    ]
     md += [f"* `{layer}`: {text}" for layer, text in SCORED_LAYERS.items()]
     md += ["", "## Methods and parameters", ""]
     for name, record in method_parameters(methods).items():
@@ -217,35 +232,67 @@ def write_report(
 ) -> dict[str, Path]:
     """Write ``scores.csv``, the condition and scenario tables, ``methods.json`` and ``REPORT.md``."""
     files: dict[str, Path] = {"scores": out / "scores.csv"}
-    _write_csv(files["scores"], [
-        {"sample": s.sample, "method": s.method, "scenario": s.scenario, "layer": s.layer,
-         "metric": s.metric, "value": s.value} for s in scores
-    ], ("sample", "method", "scenario", "layer", "metric", "value"))
-    files.update(_condition_files(
-        out, "lmse_by_condition", "LMSE by lighting condition (like thesis Tables 5.3 and 5.4)",
-        condition_table(scores, samples, columns=LMSE_COLUMNS), LMSE_COLUMNS))
-    files.update(_condition_files(
-        out, "colour_by_condition", "Coloured-shading metrics by lighting condition",
-        condition_table(scores, samples, columns=COLOUR_COLUMNS), COLOUR_COLUMNS))
+    _write_csv(
+        files["scores"],
+        [
+            {
+                "sample": s.sample,
+                "method": s.method,
+                "scenario": s.scenario,
+                "layer": s.layer,
+                "metric": s.metric,
+                "value": s.value,
+            }
+            for s in scores
+        ],
+        ("sample", "method", "scenario", "layer", "metric", "value"),
+    )
+    files.update(
+        _condition_files(
+            out,
+            "lmse_by_condition",
+            "LMSE by lighting condition (like thesis Tables 5.3 and 5.4)",
+            condition_table(scores, samples, columns=LMSE_COLUMNS),
+            LMSE_COLUMNS,
+        )
+    )
+    files.update(
+        _condition_files(
+            out,
+            "colour_by_condition",
+            "Coloured-shading metrics by lighting condition",
+            condition_table(scores, samples, columns=COLOUR_COLUMNS),
+            COLOUR_COLUMNS,
+        )
+    )
     scen_rows = scenario_table(scores)
     scen_cols = ["camera", "method", *_PHOTOMETRIC]
     _write_csv(out / "lmse_by_scenario.csv", scen_rows, scen_cols)
     md = ["# Reflectance LMSE by photometric scenario (like thesis Table 5.1)", ""]
-    md += [_markdown(scen_rows, scen_cols, scen_cols) if scen_rows
-           else "No camera renderings scored: Table 5.1 needs `image_camera/<name>`."]
+    md += [
+        _markdown(scen_rows, scen_cols, scen_cols)
+        if scen_rows
+        else "No camera renderings scored: Table 5.1 needs `image_camera/<name>`."
+    ]
     (out / "lmse_by_scenario.md").write_text("\n".join(md) + "\n", encoding="utf-8")
     files.update(scenario_csv=out / "lmse_by_scenario.csv", scenario_md=out / "lmse_by_scenario.md")
     t32 = table_3_2(scores, samples)
     cols = ["method", "lighting", *(k for k, _, _ in TABLE_3_2_COLUMNS)]
     _write_csv(out / "table_3_2_objects.csv", t32, cols)
-    md = ["# Single objects, like thesis Table 3.2 (MIT-20)", "",
-          "Mean over samples of (grey shading + grey reflectance) / 2, grey = mean over "
-          "channels, as the thesis (sec. 3.5); MSE is the scale-invariant MSE (Eq. 2.4).", "",
-          _markdown(t32, cols, ["method", "light", *(h for _, _, h in TABLE_3_2_COLUMNS)]) if t32
-          else "No single-object samples scored."]
+    md = [
+        "# Single objects, like thesis Table 3.2 (MIT-20)",
+        "",
+        "Mean over samples of (grey shading + grey reflectance) / 2, grey = mean over "
+        "channels, as the thesis (sec. 3.5); MSE is the scale-invariant MSE (Eq. 2.4).",
+        "",
+        _markdown(t32, cols, ["method", "light", *(h for _, _, h in TABLE_3_2_COLUMNS)])
+        if t32
+        else "No single-object samples scored.",
+    ]
     (out / "table_3_2_objects.md").write_text("\n".join(md) + "\n", encoding="utf-8")
-    files.update(table_3_2_csv=out / "table_3_2_objects.csv",
-                 table_3_2_md=out / "table_3_2_objects.md")
+    files.update(
+        table_3_2_csv=out / "table_3_2_objects.csv", table_3_2_md=out / "table_3_2_objects.md"
+    )
     files["methods"] = out / "methods.json"
     write_json(files["methods"], method_parameters(methods), strict=False, default=str, end="")
     files["report"] = out / "REPORT.md"

@@ -45,28 +45,35 @@ def _diversity_section(root: Path, samples: Sequence[Path], metas: Sequence[Samp
         write_diversity(root, samples, metas)
     splits = splits_by_scene({m.sample_id: m.scene for m in metas})
     counts = ", ".join(f"{k} {len(v)}" for k, v in splits.items())
-    return (f"\n## Splits and diversity\n\nSplits by scene (no scene in two splits; "
-            f"`manifest.json[\"splits\"]`): {counts} samples.\n\n"
-            f"![r, light CCT and xy, materials per image, object coverage, luminance range]"
-            f"({DIVERSITY_NAME})\n")
+    return (
+        f"\n## Splits and diversity\n\nSplits by scene (no scene in two splits; "
+        f'`manifest.json["splits"]`): {counts} samples.\n\n'
+        f"![r, light CCT and xy, materials per image, object coverage, luminance range]"
+        f"({DIVERSITY_NAME})\n"
+    )
 
 
 def _noise_table(summary: Mapping[str, Any]) -> str:
     if not summary:
         return "Rendered as a single batch: no noise estimate (build with `batches` ≥ 2)."
-    lines = ["Relative standard error of the raw Monte Carlo layers, per pixel, from the spread of "
-             "independent batches (the denoised layers are measured against converged renders "
-             "in `make bench`). Per sample: median, 95th percentile and RMS over its pixels; with two "
-             "batches a pixel's estimate has one degree of freedom, so the RMS is the unbiased "
-             "figure and the median reads about 0.67 of it.", "",
-             "| layer | scenes | samples | median of medians | median of p95 | median of RMS | worst median (sample) |",
-             "|---|---|---|---|---|---|---|"]
+    lines = [
+        "Relative standard error of the raw Monte Carlo layers, per pixel, from the spread of "
+        "independent batches (the denoised layers are measured against converged renders "
+        "in `make bench`). Per sample: median, 95th percentile and RMS over its pixels; with two "
+        "batches a pixel's estimate has one degree of freedom, so the RMS is the unbiased "
+        "figure and the median reads about 0.67 of it.",
+        "",
+        "| layer | scenes | samples | median of medians | median of p95 | median of RMS | worst median (sample) |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for layer, kinds in sorted(summary.items()):
         for kind, row in sorted(kinds.items()):
-            lines.append(f"| `{layer}` | {_text(kind)} | {row['samples']} | {100 * row['median_of_medians']:.1f} % "
-                         f"| {100 * row['median_of_p95']:.1f} % | {100 * row['median_of_rms']:.1f} % "
-                         f"| {100 * row['worst_median']:.1f} % "
-                         f"(`{row['worst_sample']}`) |")
+            lines.append(
+                f"| `{layer}` | {_text(kind)} | {row['samples']} | {100 * row['median_of_medians']:.1f} % "
+                f"| {100 * row['median_of_p95']:.1f} % | {100 * row['median_of_rms']:.1f} % "
+                f"| {100 * row['worst_median']:.1f} % "
+                f"(`{row['worst_sample']}`) |"
+            )
     return "\n".join(lines)
 
 

@@ -44,7 +44,9 @@ def _luminance_decades(image: np.ndarray, mask: np.ndarray | None) -> float:
     return float(np.log10(max(hi, 1e-12) / max(lo, 1e-12)))
 
 
-def diversity_stats(sample_dirs: Sequence[Path], metas: Sequence[SampleMeta]) -> dict[str, list[Any]]:
+def diversity_stats(
+    sample_dirs: Sequence[Path], metas: Sequence[SampleMeta]
+) -> dict[str, list[Any]]:
     """Per-sample statistics (lists aligned with *sample_dirs*; ``r`` only where recorded).
 
     Returns
@@ -54,8 +56,10 @@ def diversity_stats(sample_dirs: Sequence[Path], metas: Sequence[SampleMeta]) ->
         ``n_materials``, ``material_srgb`` (linear sRGB of each material under D65, if
         recorded), ``coverage`` (fraction), ``luminance_decades`` (log10 of p99/p1).
     """
-    out: dict[str, list[Any]] = {k: [] for k in ("r", "light_xy", "light_cct", "n_materials",
-                                                 "coverage", "luminance_decades")}
+    out: dict[str, list[Any]] = {
+        k: []
+        for k in ("r", "light_xy", "light_cct", "n_materials", "coverage", "luminance_decades")
+    }
     for folder, meta in zip(sample_dirs, metas, strict=True):
         extra = meta.scene_metadata
         if isinstance(extra.get("energy_ratio_r"), float) and np.isfinite(extra["energy_ratio_r"]):
@@ -77,11 +81,13 @@ def diversity_figure(stats: Mapping[str, Sequence[Any]]) -> Any:
 
     fig = Figure(figsize=(12, 7), layout="constrained")
     axes = fig.subplots(2, 3).ravel()
-    panels = [("r", "energy ratio r (direct / total)", "needs a build with --direct"),
-              ("light_cct", "light CCT (K, McCamy)", "no lights"),
-              ("n_materials", "materials per image", "no materials"),
-              ("coverage", "object coverage of the camera", "library scenes: not recorded"),
-              ("luminance_decades", "luminance range, log10(p99/p1)", "no images")]
+    panels = [
+        ("r", "energy ratio r (direct / total)", "needs a build with --direct"),
+        ("light_cct", "light CCT (K, McCamy)", "no lights"),
+        ("n_materials", "materials per image", "no materials"),
+        ("coverage", "object coverage of the camera", "library scenes: not recorded"),
+        ("luminance_decades", "luminance range, log10(p99/p1)", "no images"),
+    ]
     for ax, (key, title, empty) in zip(axes[[0, 1, 3, 4, 5]], panels, strict=True):
         values = list(stats.get(key, []))
         ax.set_title(title, fontsize=10)
@@ -92,12 +98,19 @@ def diversity_figure(stats: Mapping[str, Sequence[Any]]) -> Any:
     ax = axes[2]
     xy = np.asarray(stats.get("light_xy", []), float).reshape(-1, 2)
     ax.scatter(xy[:, 0], xy[:, 1], s=12, c="k")
-    ax.set(title="light chromaticities (CIE 1931 xy)", xlabel="x", ylabel="y", xlim=(0.2, 0.6), ylim=(0.2, 0.5))
+    ax.set(
+        title="light chromaticities (CIE 1931 xy)",
+        xlabel="x",
+        ylabel="y",
+        xlim=(0.2, 0.6),
+        ylim=(0.2, 0.5),
+    )
     return fig
 
 
-def write_diversity(dataset_dir: str | os.PathLike[str], sample_dirs: Sequence[Path],
-                    metas: Sequence[SampleMeta]) -> Path:
+def write_diversity(
+    dataset_dir: str | os.PathLike[str], sample_dirs: Sequence[Path], metas: Sequence[SampleMeta]
+) -> Path:
     """Compute the statistics and save the figure as ``<dataset>/diversity.png``."""
     path = Path(dataset_dir) / DIVERSITY_NAME
     diversity_figure(diversity_stats(sample_dirs, metas)).savefig(path, dpi=90)

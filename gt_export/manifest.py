@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from spectrinsic.config import resolve_data_dir
+from spectrinsic.data_dir import resolve_data_dir
 from spectrinsic.errors import DatasetError, SampleMetaError
 from spectrinsic.gt_export.integrity import guarded_write
 from spectrinsic.gt_export.json_fields import JsonFields, load_json
@@ -65,7 +65,7 @@ def _spectral_provenance(metas: Sequence[SampleMeta], data_dir: Any) -> dict[str
         "spectra_used": sorted(used),
         "munsell": f"Munsell1269.dat from luxpy {versions['luxpy']} (Parkkinen et al. 1989)",
         "cie_and_cameras": f"colour-science {versions['colour-science']} (CIE 1931 2°, "
-                           "CIE illuminants, NPL camera sensitivities)",
+        "CIE illuminants, NPL camera sensitivities)",
         "ground_truth_grid": "360-830 nm at 1 nm",
     }
     root = resolve_data_dir(data_dir)
@@ -179,10 +179,12 @@ def noise_summary(metas: Sequence[SampleMeta]) -> dict[str, Any]:
         for kind, rows in kinds.items():
             worst = max(rows)
             summary.setdefault(layer, {})[kind] = {
-                "samples": len(rows), "median_of_medians": float(np.median([r[0] for r in rows])),
+                "samples": len(rows),
+                "median_of_medians": float(np.median([r[0] for r in rows])),
                 "median_of_p95": float(np.median([r[1] for r in rows])),
                 "median_of_rms": float(np.median([r[2] for r in rows])),
-                "worst_median": float(worst[0]), "worst_sample": worst[3],
+                "worst_median": float(worst[0]),
+                "worst_sample": worst[3],
             }
     return summary
 
@@ -206,14 +208,16 @@ class ManifestRecord:
     raw: Mapping[str, Any] = field(repr=False)
 
 
-def _manifest_samples(f: JsonFields, root: Path, listed: Mapping[str, Any]) -> dict[str, dict[str, str]]:
+def _manifest_samples(
+    f: JsonFields, root: Path, listed: Mapping[str, Any]
+) -> dict[str, dict[str, str]]:
     out = {}
     for name, record in listed.items():
         files = record.get("files", {}) if isinstance(record, dict) else None
         if not isinstance(files, dict):
             raise f.fail(f"samples.{name}", "an object with a 'files' object", record)
         for rel, digest in files.items():
-            inside = rel.startswith(f"{name}/") and confined_path(root / name, rel[len(name) + 1:])
+            inside = rel.startswith(f"{name}/") and confined_path(root / name, rel[len(name) + 1 :])
             if not inside:
                 raise f.fail(f"samples.{name}.files", f"paths inside {name}/", rel)
             f.text(digest, f"samples.{name}.files.{rel}")
@@ -242,7 +246,10 @@ def read_manifest(dataset_dir: str | os.PathLike[str]) -> ManifestRecord | None:
         splits[split] = list(f.texts(ids, f"splits.{split}"))
     chash = manifest.get("config_hash")
     return ManifestRecord(
-        path=path, config_hash=f.text(chash, "config_hash", optional=True), splits=splits,
+        path=path,
+        config_hash=f.text(chash, "config_hash", optional=True),
+        splits=splits,
         sample_hashes=MappingProxyType({k: v.get("config_hash", chash) for k, v in listed.items()}),
-        sample_files=MappingProxyType(files), raw=MappingProxyType(manifest),
+        sample_files=MappingProxyType(files),
+        raw=MappingProxyType(manifest),
     )

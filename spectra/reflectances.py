@@ -32,7 +32,9 @@ MUNSELL_SOURCE = (
     "via luxpy's Munsell1269.dat"
 )
 SFU_SOURCE = "Barnard, Martin, Funt & Coath, Color Res. Appl. 27(3):147-151, 2002"
-_NOTATION = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*([A-Z]{1,2})\s+(\d+(?:\.\d+)?)\s*/\s*(\d+(?:\.\d+)?)\s*$")
+_NOTATION = re.compile(
+    r"^\s*(\d+(?:\.\d+)?)\s*([A-Z]{1,2})\s+(\d+(?:\.\d+)?)\s*/\s*(\d+(?:\.\d+)?)\s*$"
+)
 
 
 def _fmt(x: float) -> str:
@@ -72,7 +74,9 @@ def munsell(key: str) -> Spectrum:
             )
     else:
         m = _NOTATION.match(key.upper())
-        canonical = _canonical(m.group(1) + m.group(2), float(m.group(3)), float(m.group(4))) if m else key
+        canonical = (
+            _canonical(m.group(1) + m.group(2), float(m.group(3)), float(m.group(4))) if m else key
+        )
         index = _munsell_index()
         if canonical not in index:
             raise SpectrumNotFoundError(
@@ -97,13 +101,14 @@ def colorchecker(key: str) -> Spectrum:
 
     sds = colour.SDS_COLOURCHECKERS["BabelColor Average"]
     if key not in sds:
-        raise SpectrumNotFoundError(
-            f"unknown ColorChecker patch {key!r}" + did_you_mean(key, sds)
-        )
+        raise SpectrumNotFoundError(f"unknown ColorChecker patch {key!r}" + did_you_mean(key, sds))
     sd = sds[key]
     return Spectrum(
-        f"colorchecker:{key}", "reflectance", np.asarray(sd.wavelengths, float),
-        np.asarray(sd.values, float), "BabelColor average ColorChecker (colour-science)",
+        f"colorchecker:{key}",
+        "reflectance",
+        np.asarray(sd.wavelengths, float),
+        np.asarray(sd.values, float),
+        "BabelColor average ColorChecker (colour-science)",
     )
 
 
@@ -132,7 +137,9 @@ def sfu_reflectance(key: str, data_dir: str | None = None) -> Spectrum:
     values = table.values[col]
     nz = np.flatnonzero(values > 0)
     lo, hi = (int(nz[0]), int(nz[-1]) + 1) if nz.size else (0, values.size)
-    return Spectrum(f"sfu:{key.strip()}", "reflectance", table.wavelengths[lo:hi], values[lo:hi], SFU_SOURCE)
+    return Spectrum(
+        f"sfu:{key.strip()}", "reflectance", table.wavelengths[lo:hi], values[lo:hi], SFU_SOURCE
+    )
 
 
 def flat(key: str) -> Spectrum:

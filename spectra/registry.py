@@ -30,7 +30,7 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from spectrinsic.config import resolve_data_dir
+from spectrinsic.data_dir import resolve_data_dir
 from spectrinsic.errors import SpectrumNotFoundError, did_you_mean
 from spectrinsic.spectra import illuminants, io, reflectances, sensors
 from spectrinsic.spectra.records import SensorSet, Spectrum
@@ -46,8 +46,6 @@ __all__ = [
 ]
 
 DataDir = str | os.PathLike[str] | None
-
-
 
 
 #: family -> loader(key, data_dir)
@@ -89,7 +87,9 @@ SENSOR_FAMILIES: dict[str, Callable[[str, str | None], SensorSet]] = {
 
 def _split(name: str, families: Mapping[str, object], what: str) -> tuple[str, str]:
     if not isinstance(name, str) or not name.strip():
-        raise SpectrumNotFoundError(f"{what} name {name!r}: expected 'family:key', e.g. 'munsell:5R 4/14'")
+        raise SpectrumNotFoundError(
+            f"{what} name {name!r}: expected 'family:key', e.g. 'munsell:5R 4/14'"
+        )
     family, sep, key = name.strip().partition(":")
     family = family.strip().lower()
     if family not in families:

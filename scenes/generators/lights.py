@@ -30,8 +30,17 @@ from spectrinsic.spectra import get_sensors, get_spectrum, responses, xyz_to_xy
 __all__ = ["FAMILIES", "LightVolume", "draw_illuminant", "draw_lights"]
 
 FAMILIES: tuple[str, ...] = ("white", "one-colour", "two-colour")
-_LEDS = ("cie:LED-B1", "cie:LED-B2", "cie:LED-B3", "cie:LED-B4", "cie:LED-B5", "cie:LED-BH1",
-         "cie:LED-RGB1", "cie:LED-V1", "cie:LED-V2")
+_LEDS = (
+    "cie:LED-B1",
+    "cie:LED-B2",
+    "cie:LED-B3",
+    "cie:LED-B4",
+    "cie:LED-B5",
+    "cie:LED-BH1",
+    "cie:LED-RGB1",
+    "cie:LED-V1",
+    "cie:LED-V2",
+)
 _FLUORESCENTS = tuple(f"cie:FL{i}" for i in range(1, 13))
 
 
@@ -78,8 +87,9 @@ def _far(a: str, b: str, data_dir: str | None) -> bool:
     return math.dist(_xy(a, data_dir), _xy(b, data_dir)) >= MIN_XY_DISTANCE
 
 
-def _family_spectra(family: str, n: int, rng: np.random.Generator, sfu: Sequence[str],
-                    data_dir: str | None) -> list[str]:
+def _family_spectra(
+    family: str, n: int, rng: np.random.Generator, sfu: Sequence[str], data_dir: str | None
+) -> list[str]:
     """The spectrum of each of *n* lights of a condition *family*."""
     if family == "white":
         return [WHITE] * n
@@ -93,15 +103,27 @@ def _family_spectra(family: str, n: int, rng: np.random.Generator, sfu: Sequence
     raise SceneError(f"could not draw distinct coloured illuminants for {family!r}")
 
 
-def _one_light(i: int, kind: LightKind, spectrum: str, position: np.ndarray,
-               volume: LightVolume, share: float, rng: np.random.Generator) -> Light:
+def _one_light(
+    i: int,
+    kind: LightKind,
+    spectrum: str,
+    position: np.ndarray,
+    volume: LightVolume,
+    share: float,
+    rng: np.random.Generator,
+) -> Light:
     focus = np.asarray(volume.focus, float)
     direction = focus - position
     direction /= np.linalg.norm(direction)
     size = (float(rng.uniform(0.2, 0.8)), float(rng.uniform(0.2, 0.8)))
-    power = light_power(kind, position, direction, focus, size, share) * float(rng.uniform(0.5, 2.0))
-    placement: dict[str, object] = {"position": tuple(float(x) for x in position),
-                                    "direction": tuple(float(x) for x in direction), "size": size}
+    power = light_power(kind, position, direction, focus, size, share) * float(
+        rng.uniform(0.5, 2.0)
+    )
+    placement: dict[str, object] = {
+        "position": tuple(float(x) for x in position),
+        "direction": tuple(float(x) for x in direction),
+        "size": size,
+    }
     if "cutoff_deg" in LIGHT_FIELDS[kind]:  # drawn only for the kinds that have a cone
         placement["cutoff_deg"] = float(rng.uniform(25.0, 60.0))
     return make_light(kind, spectrum, power, name=f"light{i}", **placement)

@@ -62,7 +62,9 @@ class MaterialDistribution:
                 raise SceneError(f"material distribution {name}={(lo, hi)}; expected low <= high")
         for name in ("sfu_fraction", "pattern_probability"):
             if not 0.0 <= getattr(self, name) <= 1.0:
-                raise SceneError(f"material distribution {name}={getattr(self, name)}; expected 0..1")
+                raise SceneError(
+                    f"material distribution {name}={getattr(self, name)}; expected 0..1"
+                )
 
 
 @functools.lru_cache(maxsize=1)
@@ -85,8 +87,10 @@ def draw_reflectance(
     (v0, v1), (c0, c1) = dist.value_range, dist.chroma_range
     pool = [n for n, v, c in munsell_chips() if v0 <= v <= v1 and c0 <= c <= c1]
     if not pool:
-        raise SceneError(f"no Munsell chip has value in {dist.value_range} and chroma in "
-                         f"{dist.chroma_range}; widen the ranges")
+        raise SceneError(
+            f"no Munsell chip has value in {dist.value_range} and chroma in "
+            f"{dist.chroma_range}; widen the ranges"
+        )
     return pool[int(rng.integers(len(pool)))]
 
 
@@ -110,8 +114,7 @@ def _labelled(part: Part, palette: Sequence[str], index: np.ndarray) -> Part:
     lookup = np.array([names.index(p) for p in palette], dtype=np.int64)
     labels = lookup[np.asarray(index, dtype=np.int64) % len(palette)]
     used, labels = np.unique(labels, return_inverse=True)
-    return Part(part.vertices, part.faces, labels.astype(np.int64),
-                  tuple(names[i] for i in used))
+    return Part(part.vertices, part.faces, labels.astype(np.int64), tuple(names[i] for i in used))
 
 
 def _extent(part: Part) -> np.ndarray:
@@ -156,8 +159,15 @@ def _label(part: Part, rng: np.random.Generator, palette: Sequence[str]) -> Part
     keys = [*legend, ".", "."]
     rows = ["".join(keys[int(k)] for k in rng.integers(len(keys), size=cols)) for _ in range(nrows)]
     base = _labelled(part, palette[:1], np.zeros(len(part.faces)))
-    return printed(base, rows, legend, origin=(float(lo[0]), float(lo[2])), cell=cell,
-                     axes=(0, 2), facing=(0, -1, 0))
+    return printed(
+        base,
+        rows,
+        legend,
+        origin=(float(lo[0]), float(lo[2])),
+        cell=cell,
+        axes=(0, 2),
+        facing=(0, -1, 0),
+    )
 
 
 #: Pattern painters by name: ``(part, rng, palette) -> part``.
@@ -181,7 +191,9 @@ def paint(
         The painted part and the pattern's name (``"plain"`` for one spectrum).
     """
     if rng.random() >= dist.pattern_probability:
-        return _labelled(part, [draw_reflectance(rng, dist, sfu)], np.zeros(len(part.faces))), "plain"
+        return _labelled(
+            part, [draw_reflectance(rng, dist, sfu)], np.zeros(len(part.faces))
+        ), "plain"
     names = list(PATTERNS)
     pattern = names[int(rng.integers(len(names)))]
     palette = draw_palette(rng, dist, int(rng.integers(2, 5)), sfu)

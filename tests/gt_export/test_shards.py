@@ -148,7 +148,9 @@ def test_a_shard_with_flipped_bytes_is_refused_before_any_item(built, tmp_path_f
     shard = sorted(out.glob("*.tar"))[0]
     data = bytearray(shard.read_bytes())
     middle = len(data) // 2
-    data[middle:middle + 8] = bytes(b ^ 0xFF for b in data[middle:middle + 8])
+    data[middle : middle + 8] = bytes(b ^ 0xFF for b in data[middle : middle + 8])
     shard.write_bytes(bytes(data))
-    with pytest.raises(DatasetError, match=f"{shard.name}: does not match its SHA-256 in {SHARD_INDEX}"):
+    with pytest.raises(
+        DatasetError, match=f"{shard.name}: does not match its SHA-256 in {SHARD_INDEX}"
+    ):
         shard_dataset(out)
