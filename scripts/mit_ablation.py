@@ -1,7 +1,8 @@
 """Names-and-shades on the MIT development half: each deviation from the thesis on and off.
 
-Usage: python -P scripts/mit_ablation.py MIT_DIR OUT.json [OBJECT ...]   (score; all objects
-       by default, several runs on disjoint objects can share the 2 cores)
+Usage: python -P scripts/mit_ablation.py MIT_DIR OUT.json [--points=I,J] [OBJECT ...]
+       (score the MRF_POINTS given by index, all by default; all objects by default, several
+       runs on disjoint objects can share the 2 cores)
        python -P scripts/mit_ablation.py --merge OUT.json DOC.md PART.json ...
 
 For every object of MIT_DIR (the development half, ``$SPECTRINSIC_DATA/mit_intrinsic_dev``)
@@ -32,10 +33,30 @@ from spectrinsic.decompose.registry import get_decomposer
 
 #: Parameters of steps 1-3 (each point runs the MRF). gamma's absolute scale is not in the
 #: thesis (only gamma/alpha = 100, gamma/beta = 2 and mu = 1/3 are); gamma/alpha = 10 was the
-#: rendered-set protocol's choice.
-MRF_GRID = {"gamma": [1.0, 3.0, 10.0, 30.0], "gamma_over_alpha": [10.0, 100.0]}
-MRF_POINTS = [{"gamma": g, "gamma_over_alpha": 100.0} for g in MRF_GRID["gamma"]] + [
-    {"gamma": 1.0, "gamma_over_alpha": 10.0}, {"gamma": 10.0, "gamma_over_alpha": 10.0}]
+#: rendered-set protocol's choice. The ridge detector (sec. 3.2.2): "hessian" (round 1) or
+#: "rad" (RAD's MLSEC-ST creaseness, thinning, pruning) at creaseness/sigma (1.0, 1) or (1.5, 2).
+HESSIAN = {"ridge_detector": "hessian", "creaseness": 1.0, "sigma": 1.0}
+RAD = {"ridge_detector": "rad", "creaseness": 1.5, "sigma": 2.0}
+RAD_FINE = {"ridge_detector": "rad", "creaseness": 1.0, "sigma": 1.0}
+MRF_GRID = {"gamma": [0.3, 1.0, 3.0, 10.0, 30.0], "gamma_over_alpha": [10.0, 100.0],
+            "ridge_detector": ["hessian", "rad"], "creaseness": [1.0, 1.25, 1.5],
+            "sigma": [1.0, 1.5, 2.0, 3.0]}
+#: Round 1 (before the RAD detector): the hessian points. scripts/mit_ablation.json holds
+#: both rounds (round 1's keys, which lack the detector, are read as HESSIAN by merge()).
+HESSIAN_POINTS = [{"gamma": g, "gamma_over_alpha": 100.0, **HESSIAN} for g in (1.0, 3.0, 10.0, 30.0)
+                  ] + [{"gamma": g, "gamma_over_alpha": 10.0, **HESSIAN} for g in (1.0, 10.0)]
+#: Round 2: the RAD points.
+MRF_POINTS = [{"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD},
+              {"gamma": 1.0, "gamma_over_alpha": 100.0, **RAD},
+              {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD},
+              {"gamma": 10.0, "gamma_over_alpha": 100.0, **RAD},
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD_FINE},
+              # round 2b (the chosen point lay on the grid's edge: gamma 1, sigma 2)
+              {"gamma": 0.3, "gamma_over_alpha": 10.0, **RAD},
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "sigma": 3.0},
+              # round 2c (between the connected web of 1.0 and the chosen 1.5; sigma 1.5)
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "creaseness": 1.25},
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "sigma": 1.5}]
 #: Parameters of steps 4-5 (run on each labelling).
 POST_GRID = {"reflectance_colour": ["label-centroid", "region-mean"],
              "split_by_ridge": [False, True]}
@@ -62,7 +83,8 @@ def key(point: dict) -> str:
     return json.dumps(point, sort_keys=True)
 
 
-def run(mit_dir: Path, names: list[str] | None) -> dict:
+def run(mit_dir: Path, names: list[str] | None, points: list[dict], with_extra: bool = False
+        ) -> dict:
     base = dataclasses.replace(NamesAndShades.thesis(), expansion_cycles=2)
     scores: dict[str, dict[str, dict]] = {}
     seconds: dict[str, float] = {}
@@ -71,7 +93,7 @@ def run(mit_dir: Path, names: list[str] | None) -> dict:
         for name in REFERENCES:
             scores.setdefault(name, {})[obj.name] = mit_measures(obj, get_decomposer(name)(
                 obj.image, obj.mask))
-        for mrf in MRF_POINTS:
+        for mrf in points:
             method = dataclasses.replace(base, **mrf)
             t0 = time.perf_counter()
             labelling = method.labelling(obj.image, obj.mask)
@@ -84,7 +106,7 @@ def run(mit_dir: Path, names: list[str] | None) -> dict:
                                             colour_constancy=constancy)
                     scores.setdefault(key(point), {})[obj.name] = {
                         **mit_measures(obj, result), "regions": plain.info["regions"]}
-        for label, change in EXTRA.items():
+        for label, change in (EXTRA.items() if with_extra else ()):
             method = dataclasses.replace(NamesAndShades.thesis(), **change)
             result = method(obj.image, obj.mask)
             scores.setdefault(label, {})[obj.name] = {
@@ -112,27 +134,44 @@ def row(name: str, per_object: dict, baseline: dict) -> str:
             f"{means['almse']:.4f} | {wins}/{len(per_object)} |")
 
 
+#: The thesis' settings (NamesAndShades.thesis(), 2 expansion cycles) with each detector.
+THESIS = {"gamma": 1.0, "gamma_over_alpha": 100.0, "reflectance_colour": "label-centroid",
+          "split_by_ridge": False, "colour_constancy": "none"}
+#: The round-1 defaults (hessian ridges), the reference for "before".
+ROUND_1 = {"gamma": 1.0, "gamma_over_alpha": 10.0, "reflectance_colour": "region-mean",
+           "split_by_ridge": True, "colour_constancy": "grey-world", **HESSIAN}
+
+
+def variations(label: str, centre: dict, s: dict, base: dict) -> list[str]:
+    """One row per grid value that differs from *centre* in one parameter (where scored)."""
+    lines = []
+    for p, values in {**MRF_GRID, **POST_GRID, "colour_constancy": CONSTANCY}.items():
+        for v in values:
+            if v != centre[p] and key({**centre, p: v}) in s:
+                lines.append(row(f"{label}, {p} = {v}", s[key({**centre, p: v})], base))
+    return lines
+
+
 def markdown(report: dict) -> str:
     s, chosen = report["scores"], report["choice"]["chosen"]
-    thesis = {"gamma": 1.0, "gamma_over_alpha": 100.0, "reflectance_colour": "label-centroid",
-              "split_by_ridge": False, "colour_constancy": "none"}
     lines = ["| setting | MIT LMSE | Corr | MSE | aLMSE | beats baseline |",
              "|---|---|---|---|---|---|"]
     base = s["image-as-reflectance"]
     for name in REFERENCES:
         lines.append(row(name, s[name], base))
-    lines.append(row("thesis (2 expansion cycles)", s[key(thesis)], base))
+    for label, ridges in (("thesis, hessian ridges (round 1)", HESSIAN),
+                          ("thesis, RAD ridges", RAD)):
+        lines.append(row(label, s[key({**THESIS, **ridges})], base))
     for label in EXTRA:
-        lines.append(row(label, s[label], base))
-    for p, values in {**MRF_GRID, **POST_GRID, "colour_constancy": CONSTANCY}.items():
-        for v in values:
-            if v != thesis[p] and key({**thesis, p: v}) in s:
-                lines.append(row(f"thesis, {p} = {v}", s[key({**thesis, p: v})], base))
+        if label in s:
+            lines.append(row(f"{label} (hessian ridges)", s[label], base))
+    lines += variations("thesis, RAD ridges", {**THESIS, **RAD}, s, base)
+    lines.append(row("round-1 defaults (hessian ridges)", s[key(ROUND_1)], base))
     lines.append(row(f"**chosen**: {chosen}", s[key(chosen)], base))
-    for p, values in {**MRF_GRID, **POST_GRID, "colour_constancy": CONSTANCY}.items():
-        for v in values:
-            if v != chosen[p] and key({**chosen, p: v}) in s:
-                lines.append(row(f"chosen, {p} = {v}", s[key({**chosen, p: v})], base))
+    lines += variations("chosen", chosen, s, base)
+    if key({**chosen, **RAD_FINE}) in s:
+        lines.append(row("chosen, RAD creaseness 1.0 and sigma 1", s[key({**chosen, **RAD_FINE})],
+                         base))
     return "\n".join(lines) + "\n"
 
 
@@ -141,6 +180,8 @@ def merge(parts: list[Path]) -> dict:
     for part in parts:
         data = json.loads(part.read_text())
         for k, per_object in data["scores"].items():
+            if k.startswith("{") and "ridge_detector" not in k:  # round 1: the hessian detector
+                k = key({**json.loads(k), **HESSIAN})
             report["scores"].setdefault(k, {}).update(per_object)
         report["labelling_seconds"].update(data["labelling_seconds"])
     report["choice"] = choose(report["scores"])
@@ -150,11 +191,10 @@ def merge(parts: list[Path]) -> dict:
 def per_object(report: dict) -> str:
     """LMSE per object: the thesis' reported value beside ours (thesis settings and chosen)."""
     s, chosen = report["scores"], report["choice"]["chosen"]
-    thesis = key({"gamma": 1.0, "gamma_over_alpha": 100.0, "reflectance_colour": "label-centroid",
-                  "split_by_ridge": False, "colour_constancy": "none"})
     columns = {"thesis Table 3.5": None, "image-as-reflectance": "image-as-reflectance",
-               "colour-retinex": "colour-retinex", "ours, thesis settings": thesis,
-               "ours, chosen": key(chosen)}
+               "colour-retinex": "colour-retinex",
+               "ours, thesis settings, RAD": key({**THESIS, **RAD}),
+               "ours, round-1 defaults": key(ROUND_1), "ours, chosen": key(chosen)}
     lines = ["| object | " + " | ".join(columns) + " |", "|---" * (len(columns) + 1) + "|"]
     objects = sorted(o for o in THESIS_TABLES_3_4_3_5 if o in s["colour-retinex"])
     for obj in objects:
@@ -178,8 +218,12 @@ def main(argv: list[str]) -> int:
         print(table)
         print(json.dumps(report["choice"], indent=1))
         return 0
+    chosen = [a for a in argv if a.startswith("--points=")]  # indices into MRF_POINTS
+    argv = [a for a in argv if a not in chosen]
+    points = ([MRF_POINTS[int(i)] for i in chosen[0].split("=", 1)[1].split(",")] if chosen
+              else MRF_POINTS)
     mit_dir, target = Path(argv[0]), Path(argv[1])
-    report = run(mit_dir, argv[2:] or None)
+    report = run(mit_dir, argv[2:] or None, points)
     target.write_text(json.dumps(report, indent=1, sort_keys=True) + "\n")
     return 0
 

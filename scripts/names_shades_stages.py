@@ -83,14 +83,14 @@ def ridge_figure(stages, path: Path, title: str) -> None:
     logc = np.log(np.maximum(stages.pixels, 1.0 / 255.0))
     rng = np.random.default_rng(0)
     pick = rng.choice(logc.shape[0], size=min(4000, logc.shape[0]), replace=False)
-    points, ridge_of = np.unique(np.c_[shades.projection, shades.ridge], axis=0, return_index=True)
-    colours = random_colours(shades.ridge)
+    palette = random_colours(np.arange(shades.n_ridges))
+    colours = palette[shades.ridge]
     fig = plt.figure(figsize=(7.8, 2.6))
     ax = fig.add_subplot(1, 3, 1, projection="3d")
     ax.scatter(*logc[pick].T, s=1, c=np.clip(np.exp(logc[pick]), 0, 1), alpha=0.5)
     ax.set_title("log colours (Fig. 3.3b)", fontsize=8)
     ax2 = fig.add_subplot(1, 3, 2, projection="3d")
-    ax2.scatter(*points[:, :3].T, s=3, c=colours[ridge_of])
+    ax2.scatter(*shades.ridge_points.T, s=3, c=palette[shades.ridge_of_point])
     ax2.set_title(f"{shades.n_ridges} ridges (Fig. 3.3c)", fontsize=8)
     for a in (ax, ax2):
         a.set_xlabel("log R", fontsize=6)
