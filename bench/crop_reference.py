@@ -2,7 +2,7 @@
 
 A converged reference of a whole 256² room costs hours; one of a 64 × 64 window of it costs
 16 × less per sample per pixel. The window is rendered with the film's crop
-(:func:`spectrinsic.render.translate.hdr_film`) by the single traversal, at
+(:func:`spectrinsic.render.plugins.hdr_film`) by the single traversal, at
 :data:`REFERENCE_SPP` samples per pixel in :data:`REFERENCE_BATCHES` independent batches, and
 its shading is computed by the very functions of the ground truth
 (:func:`spectrinsic.gt_export.layers.compute_ground_truth` on the window's render): its pixels

@@ -27,6 +27,7 @@ import numpy as np
 from spectrinsic.render import RenderSettings, channel_values, get_mode, render_scene
 from spectrinsic.render import translate as tr
 from spectrinsic.render.modes import RENDER_MODES
+from spectrinsic.render.plugins import hdr_film, path_integrator, rgb_spectrum
 from spectrinsic.render.translate import prepare_geometry
 from spectrinsic.render.variants import choose_variant, variant_report, variant_scope
 from spectrinsic.scenes import library
@@ -57,10 +58,10 @@ def _bare_seconds(scene: Any, spp: int) -> float:
     with variant_scope(choose_variant("rgb")) as mi:
         mitsuba_dict = tr.scene_to_mitsuba(
             scene,
-            materials=[tr.rgb_spectrum(v) for v in np.clip(values.materials, 0, 1)],
-            lights=[tr.rgb_spectrum(v) for v in values.lights],
-            film=tr.hdr_film(scene.camera.width, scene.camera.height),
-            integrator=tr.path_integrator(8),
+            materials=[rgb_spectrum(v) for v in np.clip(values.materials, 0, 1)],
+            lights=[rgb_spectrum(v) for v in values.lights],
+            film=hdr_film(scene.camera.width, scene.camera.height),
+            integrator=path_integrator(8),
             sample_count=spp,
         )
         start = time.perf_counter()

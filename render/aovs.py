@@ -16,6 +16,7 @@ from spectrinsic.render.passes import (
     set_rgb,
     timed_render,
 )
+from spectrinsic.render.plugins import aov_integrator, hdr_film, rgb_spectrum
 from spectrinsic.render.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Scene
 
@@ -60,13 +61,13 @@ def render_aovs(
     cover = np.zeros((h, w, len(surfaces)), np.float64)
     seconds = []
     with variant_scope(chosen) as mi:
-        zero = tr.rgb_spectrum([0.0, 0.0, 0.0])
+        zero = rgb_spectrum([0.0, 0.0, 0.0])
         mitsuba_dict = tr.scene_to_mitsuba(
             scene,
             materials=[zero] * len(scene.materials),
             lights=[placeholder_light(j) for j in range(len(scene.lights))],
-            film=tr.hdr_film(w, h),
-            integrator=tr.aov_integrator(),
+            film=hdr_film(w, h),
+            integrator=aov_integrator(),
             sample_count=spp,
             geometry=geometry,
         )

@@ -21,6 +21,13 @@ from spectrinsic.errors import RenderError, SceneError
 from spectrinsic.interrupts import raise_if_requested
 from spectrinsic.render import translate as tr
 from spectrinsic.render.modes import ChannelValues, light_spectra, pad_to_passes
+from spectrinsic.render.plugins import (
+    hdr_film,
+    path_integrator,
+    regular_spectrum,
+    rgb_spectrum,
+    spectral_film,
+)
 from spectrinsic.render.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, SensorSet, get_spectrum
@@ -108,7 +115,7 @@ def timed_render(
 def placeholder_light(index: int) -> dict[str, Any]:
     """Distinct emission per light at load time (identical dicts could be merged into one
     shared object); every pass sets the real values before rendering."""
-    return tr.rgb_spectrum([1.0 + index, 1.0, 1.0])
+    return rgb_spectrum([1.0 + index, 1.0, 1.0])
 
 
 def scene_parameters(mi: Any, loaded: Any, keys: Sequence[str]) -> Any:
@@ -176,12 +183,12 @@ def render_diagonal(
         mitsuba_dict = tr.scene_to_mitsuba(
             scene,
             # placeholders: every pass sets its own values before rendering
-            materials=[tr.rgb_spectrum([0.0, 0.0, 0.0])] * len(scene.materials),
+            materials=[rgb_spectrum([0.0, 0.0, 0.0])] * len(scene.materials),
             lights=[
                 placeholder_light(j) if j in active else None for j in range(len(scene.lights))
             ],
-            film=tr.hdr_film(scene.camera.width, scene.camera.height),
-            integrator=tr.path_integrator(max_depth),
+            film=hdr_film(scene.camera.width, scene.camera.height),
+            integrator=path_integrator(max_depth),
             sample_count=spp,
             geometry=geometry,
         )
@@ -192,7 +199,7 @@ def render_diagonal(
             [tr.reflectance_key(s, spectral=False) for s in surfaces]
             + [tr.emission_key(scene, j, spectral=False) for j in sorted(active)],
         )
-        direct_integrator = mi.load_dict(tr.path_integrator(DIRECT_DEPTH)) if any(flags) else None
+        direct_integrator = mi.load_dict(path_integrator(DIRECT_DEPTH)) if any(flags) else None
         for values, want_direct in zip(value_sets, flags, strict=True):
             passes = _DiagonalPasses(mi, loaded, params, direct_integrator, spp, seed, progress)
             outputs.append(
@@ -292,15 +299,15 @@ def render_spectral(
         mitsuba_dict = tr.scene_to_mitsuba(
             scene,
             materials=[
-                tr.regular_spectrum(get_spectrum(m.spectrum, data_dir=data_dir).on(wl), wl)
+                regular_spectrum(get_spectrum(m.spectrum, data_dir=data_dir).on(wl), wl)
                 for m in scene.materials
             ],
             lights=[
-                tr.regular_spectrum(emission[j], wl) if j in active else None
+                regular_spectrum(emission[j], wl) if j in active else None
                 for j in range(len(scene.lights))
             ],
-            film=tr.spectral_film(scene.camera.width, scene.camera.height, sensors.on(wl), wl),
-            integrator=tr.path_integrator(max_depth),
+            film=spectral_film(scene.camera.width, scene.camera.height, sensors.on(wl), wl),
+            integrator=path_integrator(max_depth),
             sample_count=spp,
             geometry=geometry,
         )
@@ -311,7 +318,7 @@ def render_spectral(
             progress(1)
         direct_image = None
         if direct:
-            integrator = mi.load_dict(tr.path_integrator(DIRECT_DEPTH))
+            integrator = mi.load_dict(path_integrator(DIRECT_DEPTH))
             direct_image, dt = timed_render(mi, loaded, spp=spp, seed=seed, integrator=integrator)
             seconds.append(dt)
             if progress is not None:

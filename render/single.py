@@ -34,6 +34,7 @@ from spectrinsic.render.passes import (
     PassProgress,
     timed_render,
 )
+from spectrinsic.render.plugins import hdr_film, path_integrator, rgb_spectrum
 from spectrinsic.render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
 from spectrinsic.render.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Scene
@@ -181,6 +182,85 @@ def _render(
     return image[..., image.shape[-1] - n :], seconds
 
 
+@dataclass(frozen=True)
+class _Dims:
+    """Image height and width, bands K, lights L, and whether the scene has glossy materials."""
+
+    h: int
+    w: int
+    n_bands: int
+    n_lights: int
+    glossy: bool
+
+
+@dataclass(frozen=True, eq=False)
+class _Traced:
+    """One traversal: transport ``(L, H, W, K)``, the first hit's non-diffuse part (glossy
+    scenes, same shape), the first-hit maps (first traversal with surfaces) and its seconds."""
+
+    transport: np.ndarray
+    specular: np.ndarray | None
+    first: np.ndarray | None
+    seconds: float
+
+
+def _trace(
+    mi: Any,
+    loaded: Any,
+    tables: BandTables,
+    dims: _Dims,
+    spec_table: np.ndarray | None,
+    *,
+    depth: int,
+    first: bool,
+    spp: int,
+    seed: int,
+) -> _Traced:
+    """One traversal at path *depth*; the *first* one also takes the first-hit maps."""
+    n_surfaces = len(tables.shape_surfaces) if first else 0
+    make = gloss_path if dims.glossy else band_path
+    integrator = make(
+        mi, max_depth=depth, n_bands=dims.n_bands, n_lights=dims.n_lights, n_surfaces=n_surfaces
+    )
+    integrator.set_tables(loaded, tables if n_surfaces else replace(tables, shape_surfaces={}))
+    if spec_table is not None:
+        integrator.set_specular(spec_table)
+    n_t = dims.n_bands * dims.n_lights
+    n_spec = n_t if dims.glossy else 0
+    n_first = len(first_hit_channels(n_surfaces))
+    image, dt = _render(mi, loaded, integrator, spp=spp, seed=seed, n=n_t + n_spec + n_first)
+
+    def per_light(channels: np.ndarray) -> np.ndarray:
+        return channels.reshape(dims.h, dims.w, dims.n_lights, dims.n_bands).transpose(2, 0, 1, 3)
+
+    return _Traced(
+        transport=per_light(image[..., :n_t]),
+        specular=per_light(image[..., n_t : n_t + n_spec]) if dims.glossy and first else None,
+        first=image[..., n_t + n_spec :] if n_surfaces else None,
+        seconds=dt,
+    )
+
+
+def _outputs(
+    value_sets: Sequence[ChannelValues],
+    widths: Sequence[int],
+    traced: Sequence[_Traced],
+    direct: bool,
+) -> list[TransportOutput]:
+    """The traversals' bands cut back into one :class:`TransportOutput` per value set."""
+    edges = np.cumsum([0, *widths])
+    specular = traced[0].specular
+    return [
+        TransportOutput(
+            transport=np.ascontiguousarray(traced[0].transport[..., a:b]),
+            direct=np.ascontiguousarray(traced[1].transport[..., a:b]) if direct else None,
+            emission=np.asarray(v.lights, float),
+            specular=None if specular is None else np.ascontiguousarray(specular[..., a:b]),
+        )
+        for v, a, b in zip(value_sets, edges[:-1], edges[1:], strict=True)
+    ]
+
+
 def render_traversal(
     scene: Scene,
     value_sets: Sequence[ChannelValues],
@@ -209,7 +289,7 @@ def render_traversal(
         :func:`~spectrinsic.render.aovs.render_aovs` computes them from the same samples.
     crop
         ``(x, y, width, height)``: render only that window of the image
-        (:func:`~spectrinsic.render.translate.hdr_film`); every map is the window's.
+        (:func:`~spectrinsic.render.plugins.hdr_film`); every map is the window's.
 
     Returns
     -------
@@ -234,67 +314,50 @@ def render_traversal(
     h, w = (
         (scene.camera.height, scene.camera.width) if crop is None else (int(crop[3]), int(crop[2]))
     )
-    white = tr.rgb_spectrum([1.0, 1.0, 1.0])
+    white = rgb_spectrum([1.0, 1.0, 1.0])
     glossy = any(m.glossy for m in scene.materials)
-    n_spec = n_bands * n_lights if glossy else 0
     with variant_scope(chosen) as mi:
         loaded = mi.load_dict(
             tr.scene_to_mitsuba(
                 scene,
                 materials=[white] * len(scene.materials),
                 lights=[white] * n_lights,
-                film=tr.hdr_film(scene.camera.width, scene.camera.height, crop),
-                integrator=tr.path_integrator(max_depth),
+                film=hdr_film(scene.camera.width, scene.camera.height, crop),
+                integrator=path_integrator(max_depth),
                 sample_count=spp,
                 geometry=geometry,
                 white_metal=True,
             )
         )
         tables = _tables(scene, value_sets, light_of_emitters(mi, loaded), aovs)
-        depths = [int(max_depth)] + ([DIRECT_DEPTH] if direct else [])
-        images, specular, seconds, first = [], None, [], np.zeros((h, w, 0), np.float32)
-        for depth in depths:
-            n_surfaces = len(tables.shape_surfaces) if depth == depths[0] else 0
-            make = gloss_path if glossy else band_path
-            integrator = make(
-                mi, max_depth=depth, n_bands=n_bands, n_lights=n_lights, n_surfaces=n_surfaces
-            )
-            integrator.set_tables(
-                loaded, tables if n_surfaces else replace(tables, shape_surfaces={})
-            )
-            if glossy:
-                integrator.set_specular(_specular_table(scene, value_sets))
-            n_first = len(first_hit_channels(n_surfaces))
-            n_t = n_bands * n_lights
-            image, dt = _render(
-                mi, loaded, integrator, spp=spp, seed=seed, n=n_t + n_spec + n_first
-            )
-            first = image[..., n_t + n_spec :] if n_surfaces else first
-            images.append(image[..., :n_t].reshape(h, w, n_lights, n_bands).transpose(2, 0, 1, 3))
-            if glossy and depth == depths[0]:
-                specular = (
-                    image[..., n_t : n_t + n_spec]
-                    .reshape(h, w, n_lights, n_bands)
-                    .transpose(2, 0, 1, 3)
+        dims = _Dims(h, w, n_bands, n_lights, glossy)
+        spec_table = _specular_table(scene, value_sets) if glossy else None
+        traced: list[_Traced] = []
+        for depth in [int(max_depth)] + ([DIRECT_DEPTH] if direct else []):
+            first = not traced
+            traced.append(
+                _trace(
+                    mi,
+                    loaded,
+                    tables,
+                    dims,
+                    spec_table,
+                    depth=depth,
+                    first=first,
+                    spp=spp,
+                    seed=seed,
                 )
-            seconds.append(dt)
+            )
             if progress is not None:
                 progress(1)
-    edges = np.cumsum([0, *widths])
-    outputs = [
-        TransportOutput(
-            transport=np.ascontiguousarray(images[0][..., a:b]),
-            direct=np.ascontiguousarray(images[1][..., a:b]) if direct else None,
-            emission=np.asarray(v.lights, float),
-            specular=None if specular is None else np.ascontiguousarray(specular[..., a:b]),
-        )
-        for v, a, b in zip(value_sets, edges[:-1], edges[1:], strict=True)
-    ]
+    outputs = _outputs(value_sets, widths, traced, direct)
+    hits = traced[0].first
     aov_maps = (
-        assemble_aovs(scene, tr.surfaces(scene), first[..., :-4], first[..., -4], first[..., -3:])
-        if aovs
+        assemble_aovs(scene, tr.surfaces(scene), hits[..., :-4], hits[..., -4], hits[..., -3:])
+        if aovs and hits is not None
         else {}
     )
+    seconds = [t.seconds for t in traced]
     return outputs, aov_maps, tuple(seconds), chosen
 
 

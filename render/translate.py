@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import SceneError
+from spectrinsic.render.plugins import black_bsdf
 from spectrinsic.render.variants import import_mitsuba
 from spectrinsic.scenes.model import Light, Material, Scene, unknown_light_kind
 
@@ -38,13 +39,6 @@ __all__ = [
     "reflectance_key",
     "material_bsdf",
     "emission_key",
-    "rgb_spectrum",
-    "regular_spectrum",
-    "black_bsdf",
-    "hdr_film",
-    "spectral_film",
-    "path_integrator",
-    "aov_integrator",
     "smooth_corner_normals",
     "SurfaceGeometry",
     "prepare_geometry",
@@ -112,98 +106,6 @@ def emission_key(scene: Scene, index: int, *, spectral: bool) -> str:
     light = scene.lights[index]
     prefix = f"{light_key(index)}.emitter." if light.kind == "area" else f"{light_key(index)}."
     return prefix + _EMISSION_PARAM[light.kind] + (".values" if spectral else ".value")
-
-
-def rgb_spectrum(values: Sequence[float]) -> dict[str, Any]:
-    """A 3-channel value for an RGB variant (a diagonal pass's channel values, unclamped)."""
-    v = np.asarray(values, float)
-    if v.shape != (3,) or not np.all(np.isfinite(v)):
-        raise SceneError(f"channel values {values!r}: expected 3 finite numbers")
-    return {"type": "rgb", "value": [float(x) for x in v]}
-
-
-def regular_spectrum(values: np.ndarray, wavelengths: np.ndarray) -> dict[str, Any]:
-    """A spectrum for the spectral variant: *values* on *wavelengths* (nm), linearly interpolated.
-
-    Uses Mitsuba's ``regular`` plugin on an evenly spaced grid, ``irregular`` otherwise.
-    """
-    wl = np.asarray(wavelengths, float)
-    v = np.asarray(values, float)
-    text = ", ".join(f"{x:.9g}" for x in v)
-    if np.allclose(np.diff(wl), wl[1] - wl[0]):
-        return {
-            "type": "regular",
-            "wavelength_min": float(wl[0]),
-            "wavelength_max": float(wl[-1]),
-            "values": text,
-        }
-    return {"type": "irregular", "wavelengths": ", ".join(f"{x:.9g}" for x in wl), "values": text}
-
-
-def black_bsdf() -> dict[str, Any]:
-    """Two-sided black Lambertian BSDF (area-light geometry)."""
-    return {
-        "type": "twosided",
-        "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.0, 0.0, 0.0]}},
-    }
-
-
-def hdr_film(
-    width: int, height: int, crop: tuple[int, int, int, int] | None = None
-) -> dict[str, Any]:
-    """3-channel float32 film with a box filter (no blur across pixels: ground truth aligns).
-
-    *crop* ``(x, y, width, height)`` in pixels renders only that window of the image (Mitsuba's
-    ``crop_offset_x/_y``, ``crop_width/_height``): its pixels are the full image's, at the cost
-    of the window's pixels alone (converged references of a detail)."""
-    film: dict[str, Any] = {
-        "type": "hdrfilm",
-        "width": int(width),
-        "height": int(height),
-        "pixel_format": "rgb",
-        "component_format": "float32",
-        "rfilter": {"type": "box"},
-    }
-    if crop is not None:
-        x, y, cw, ch = (int(v) for v in crop)
-        if x < 0 or y < 0 or cw < 1 or ch < 1 or x + cw > width or y + ch > height:
-            raise SceneError(
-                f"film crop {tuple(crop)}: expected (x, y, width, height) inside {width}x{height}"
-            )
-        film.update(crop_offset_x=x, crop_offset_y=y, crop_width=cw, crop_height=ch)
-    return film
-
-
-def spectral_film(
-    width: int, height: int, curves: np.ndarray, wavelengths: np.ndarray
-) -> dict[str, Any]:
-    """``specfilm`` whose bands are *curves* ``(K, W)``: channel k is ``∫ L S_k dλ`` (nm).
-
-    Bands are named ``s00``, ``s01``, ... so their order survives any sorting by name.
-    """
-    film: dict[str, Any] = {
-        "type": "specfilm",
-        "width": int(width),
-        "height": int(height),
-        "component_format": "float32",
-        "rfilter": {"type": "box"},
-    }
-    for k, curve in enumerate(np.asarray(curves, float)):
-        film[f"s{k:02d}"] = regular_spectrum(np.clip(curve, 0.0, None), wavelengths)
-    return film
-
-
-def path_integrator(max_depth: int) -> dict[str, Any]:
-    """Path tracer with Russian roulette off (``rr_depth`` > ``max_depth``): passes that share a
-    seed and sample count then trace identical paths (common random numbers)."""
-    if max_depth < 1:
-        raise SceneError(f"max_depth {max_depth}: expected >= 1 (2 = direct light only)")
-    return {"type": "path", "max_depth": int(max_depth), "rr_depth": int(max_depth) + 1}
-
-
-def aov_integrator() -> dict[str, Any]:
-    """AOV integrator: ray distance, shading normal and the BSDF's diffuse reflectance."""
-    return {"type": "aov", "aovs": "dd:depth,nn:sh_normal,alb:albedo"}
 
 
 def smooth_corner_normals(

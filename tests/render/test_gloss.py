@@ -15,6 +15,7 @@ from spectrinsic.render import channel_values
 from spectrinsic.render import translate as tr
 from spectrinsic.render.gloss_kernel import gloss_path
 from spectrinsic.render.integrator import band_path
+from spectrinsic.render.plugins import hdr_film, path_integrator, rgb_spectrum
 from spectrinsic.render.single import _tables, light_of_emitters, render_traversal
 from spectrinsic.render.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
@@ -171,7 +172,7 @@ def test_e_gloss_kernel_on_a_matte_scene_is_the_band_path(make_room):
     apart) and its specular part is exactly 0."""
     scene = make_room(size=10)
     values = channel_values(scene, get_sensors("gaussian:6"))
-    white = tr.rgb_spectrum([1.0, 1.0, 1.0])
+    white = rgb_spectrum([1.0, 1.0, 1.0])
     images = []
     with variant_scope(choose_variant("rgb", None)) as mi:
         loaded = mi.load_dict(
@@ -179,8 +180,8 @@ def test_e_gloss_kernel_on_a_matte_scene_is_the_band_path(make_room):
                 scene,
                 materials=[white] * len(scene.materials),
                 lights=[white] * len(scene.lights),
-                film=tr.hdr_film(10, 10),
-                integrator=tr.path_integrator(4),
+                film=hdr_film(10, 10),
+                integrator=path_integrator(4),
                 sample_count=4,
             )
         )
