@@ -124,6 +124,48 @@ def shading_set(
     return layers
 
 
+def _denoised_image(
+    s: SampleInputs,
+    w_raw: irr.WhiteRadiance,
+    w: irr.WhiteRadiance,
+    image: np.ndarray,
+    reflectance: np.ndarray,
+    specular: np.ndarray | None,
+) -> tuple[np.ndarray, list[Layer]]:
+    """``image_denoised`` (the reflectance-weighted denoised ``W`` plus the raw *specular*) and
+    the raw shading and residual it replaces, ``shading_raw``/``residual_raw``."""
+    white = srgb_white(s)
+    out: list[Layer] = []
+    raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
+    used = xyz_to_linear_srgb(
+        np.einsum("hwk,ck->hwc", irr.recompose(w, diffuse_raw(s, raw)), w.to_xyz)
+    )
+    used = used if specular is None else used + specular
+    out.append(
+        make_layer(
+            "image_denoised",
+            used,
+            RGB,
+            UNITS_IMAGE + "; rebuilt as reflectance-weighted denoised white-surface "
+            "radiance (the raw image where no surface)"
+            + ("" if specular is None else ", plus the raw specular layer"),
+            "image",
+        )
+    )
+    out += shading_set(
+        w_raw,
+        srgb_of(w_raw),
+        white,
+        image,
+        reflectance,
+        space="linear sRGB",
+        names=("shading_raw", "residual_raw"),
+        group="intrinsics",
+        specular=specular,
+    )
+    return used, out
+
+
 def intrinsic_layers(
     s: SampleInputs,
     w_raw: irr.WhiteRadiance,
@@ -141,33 +183,8 @@ def intrinsic_layers(
     used = image
     out: list[Layer] = []
     if denoised:
-        raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
-        used = xyz_to_linear_srgb(
-            np.einsum("hwk,ck->hwc", irr.recompose(w, diffuse_raw(s, raw)), w.to_xyz)
-        )
-        used = used if specular is None else used + specular
-        out.append(
-            make_layer(
-                "image_denoised",
-                used,
-                RGB,
-                UNITS_IMAGE + "; rebuilt as reflectance-weighted denoised white-surface "
-                "radiance (the raw image where no surface)"
-                + ("" if specular is None else ", plus the raw specular layer"),
-                "image",
-            )
-        )
-        out += shading_set(
-            w_raw,
-            srgb_of(w_raw),
-            white,
-            image,
-            reflectance,
-            space="linear sRGB",
-            names=("shading_raw", "residual_raw"),
-            group="intrinsics",
-            specular=specular,
-        )
+        used, denoised_layers = _denoised_image(s, w_raw, w, image, reflectance, specular)
+        out += denoised_layers
     out += shading_set(
         w,
         srgb_of(w),
