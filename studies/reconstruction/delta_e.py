@@ -132,12 +132,22 @@ def _fit(
     )
 
 
+def _project(values: np.ndarray, proj: np.ndarray) -> np.ndarray:
+    """``values @ proj.T`` summed term by term in a fixed order: a BLAS product's last bits
+    depend on its kernel, threads and the operands' memory alignment, and these numbers are
+    written to files (``(N, n) x (3, n) -> (N, 3)``)."""
+    out = values[:, 0, None] * proj[None, :, 0]
+    for k in range(1, proj.shape[1]):
+        out = out + values[:, k, None] * proj[None, :, k]
+    return out
+
+
 def _one_bounce(fit: _Fit) -> dict[str, np.ndarray]:
     """ΔE2000 per surface of each method for one bounce."""
     lab_1 = _cie_lab(fit.xyz_1)
     return {
-        "two-pass": _delta_e(lab_1, _cie_lab((fit.s6_f * fit.s6_l) @ fit.proj.T)),
-        "projection-only": _delta_e(lab_1, _cie_lab(fit.p6 @ fit.proj.T)),
+        "two-pass": _delta_e(lab_1, _cie_lab(_project(fit.s6_f * fit.s6_l, fit.proj))),
+        "projection-only": _delta_e(lab_1, _cie_lab(_project(fit.p6, fit.proj))),
         "cie1931-diagonal": _delta_e(lab_1, _cie_lab(fit.cm_f * fit.cm_l)),
     }
 
@@ -164,8 +174,8 @@ def _two_bounce(
         exact = exact / fit.norm
         lab_exact = _cie_lab(exact[:, :3])
         for method, approx in (
-            ("projection-only", exact[:, 3:] @ fit.proj.T),
-            ("two-pass", (fit.s6_f[i] * fit.s6_f[j] * fit.s6_l) @ fit.proj.T),
+            ("projection-only", _project(exact[:, 3:], fit.proj)),
+            ("two-pass", _project(fit.s6_f[i] * fit.s6_f[j] * fit.s6_l, fit.proj)),
             ("cie1931-diagonal", fit.cm_f[i] * fit.cm_f[j] * fit.cm_l),
         ):
             found[method].append(ordered_pairs(_delta_e(lab_exact, _cie_lab(approx)), i, j))

@@ -13,12 +13,8 @@ from spectrinsic.render import (
     scene_to_mitsuba,
     variant_scope,
 )
-from spectrinsic.render.translate import (
-    hdr_film,
-    path_integrator,
-    rgb_spectrum,
-    smooth_corner_normals,
-)
+from spectrinsic.render.plugins import hdr_film, path_integrator, rgb_spectrum
+from spectrinsic.render.translate import smooth_corner_normals
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 
 #: float32 round-off.
