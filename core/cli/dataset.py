@@ -12,6 +12,7 @@ from tqdm import tqdm
 
 from spectrinsic.errors import DatasetError, SpectrinsicError
 from spectrinsic.gt_export.integrity import check_build_folder
+from spectrinsic.gt_export.manifest import SPLIT_FRACTIONS
 from spectrinsic.pipeline.dataset import SampleFailure, build_dataset
 from spectrinsic.pipeline.executors import check_scheduler, choose_executor
 from spectrinsic.pipeline.presets import PRESETS, DatasetConfig, get_preset, preset_names
@@ -55,6 +56,11 @@ def register(subparsers: Any) -> None:
     _add_build_options(p)
     _add_quality_options(p)
     _add_source_options(p.add_argument_group("scene source (default: the built-in library layout)"))
+    p.add_argument(
+        "--split-fractions", default=None, metavar="TRAIN,VAL,TEST",
+        help="shares of the scenes in the train, val and test splits (0.8,0.1,0.1); from 3 "
+             "scenes on every split holds a scene; not hashed (a resume rewrites the manifest)",
+    )
     p.add_argument(
         "--rebuild",
         action="store_true",
@@ -217,7 +223,20 @@ def _overrides(args: argparse.Namespace) -> dict[str, Any]:
             changes[key] = value
     if args.resolution is not None:
         changes["width"], changes["height"] = _resolution(args.resolution)
+    if getattr(args, "split_fractions", None) is not None:
+        changes["split_fractions"] = _split_fractions(args.split_fractions)
     return changes
+
+
+def _split_fractions(text: str) -> tuple[tuple[str, float], ...]:
+    """``TRAIN,VAL,TEST`` shares (each > 0, summing to 1; checked by the config)."""
+    try:
+        shares = [float(v) for v in text.split(",")]
+    except ValueError:
+        shares = []
+    if len(shares) != len(SPLIT_FRACTIONS):
+        raise DatasetError(f"--split-fractions {text!r}; expected TRAIN,VAL,TEST shares, e.g. 0.8,0.1,0.1")
+    return tuple((name, v) for (name, _), v in zip(SPLIT_FRACTIONS, shares, strict=True))
 
 
 def _resolution(text: str) -> tuple[int, int]:

@@ -433,7 +433,7 @@ def finalize_dataset(
     if not sample_dirs(out):
         return {}
     cfg = config.to_dict()
-    manifest = write_manifest(out, cfg, data_dir=data_dir)
+    manifest = write_manifest(out, cfg, data_dir=data_dir, split_fractions=config.split_fractions)
     card = write_dataset_card(out, cfg)
     gallery = build_gallery(out)
     return {"manifest": str(manifest), "card": str(card), "gallery": str(gallery)}
