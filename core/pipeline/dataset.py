@@ -221,7 +221,7 @@ def _task_scene(task: SampleTask) -> Any:
 
     scene = task.source.build(task.data_dir)
     if isinstance(task.source, GeneratedSource):
-        save_generated(task.out_dir, task.sample_id, scene)
+        save_generated(task.out_dir, task.sample_id, scene, task.seed)
     return scene
 
 
