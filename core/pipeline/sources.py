@@ -103,7 +103,7 @@ def files_source(paths: Sequence[str | os.PathLike[str]], *,
 def saved_sample(path: str | os.PathLike[str]) -> tuple[SampleId, int] | None:
     """The sample a generated build saved this YAML scene for (``metadata.sample``: id and
     seed), or ``None`` for any other scene file. A malformed record is a one-line error."""
-    if scene_file_kind(path) != "yaml":
+    if scene_file_kind(Path(path)) != "yaml":
         return None
     doc = load_yaml_file(Path(path))
     meta = doc.get("metadata") if isinstance(doc, dict) else None
