@@ -17,7 +17,8 @@ Predictions`, a user's estimates read from files. For each sample and method:
 
 Outputs in ``out_dir`` (:func:`spectrinsic.decompose.report.write_report`): ``scores.csv``
 (sample, method, scenario, layer, metric, value), the condition tables like Tables 5.3/5.4,
-the scenario table like Table 5.1, ``REPORT.md`` (input, layers, methods and their parameters),
+the scenario table like Table 5.1, ``summary.png`` (method x condition), ``REPORT.md`` (every
+table's numbers inline, abbreviations, the summary figure, methods and their parameters),
 ``figures/<sample>.png`` and ``estimates/<method>/<scenario>/<sample>/{reflectance,shading}.exr``
 (the predictions layout, so an estimates folder can be scored again with ``--predictions``).
 """

@@ -19,7 +19,12 @@ from typing import Any
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.diversity import DIVERSITY_NAME, write_diversity
 from spectrinsic.gt_export.integrity import guarded_write
-from spectrinsic.gt_export.manifest import noise_summary, splits_by_scene, variants_of
+from spectrinsic.gt_export.manifest import (
+    noise_summary,
+    read_manifest,
+    splits_by_scene,
+    variants_of,
+)
 from spectrinsic.gt_export.sample import CARD_NAME, META_NAME, config_hash, plain_data, sample_dirs
 from spectrinsic.gt_export.sample_meta import LayerRecord, SampleMeta, read_meta
 from spectrinsic.provenance import software_versions
@@ -43,10 +48,14 @@ def _diversity_section(root: Path, samples: Sequence[Path], metas: Sequence[Samp
     newest = max((s / META_NAME).stat().st_mtime_ns for s in samples)
     if not figure.is_file() or figure.stat().st_mtime_ns < newest:  # a resumed build: keep it
         write_diversity(root, samples, metas)
-    splits = splits_by_scene({m.sample_id: m.scene for m in metas})
-    counts = ", ".join(f"{k} {len(v)}" for k, v in splits.items())
+    manifest = read_manifest(root)  # the splits the build wrote (its --split-fractions)
+    scenes = {m.sample_id: m.scene for m in metas}
+    splits = manifest.splits if manifest is not None and manifest.splits else splits_by_scene(scenes)
+    counts = ", ".join(f"{k} {len(v)} samples ({len({scenes[i] for i in v if i in scenes})} scenes)"
+                       for k, v in splits.items())
     return (f"\n## Splits and diversity\n\nSplits by scene (no scene in two splits; "
-            f"`manifest.json[\"splits\"]`): {counts} samples.\n\n"
+            f"`manifest.json[\"splits\"]`; every split holds a scene from as many scenes as "
+            f"splits on): {counts}.\n\n"
             f"![r, light CCT and xy, materials per image, object coverage, luminance range]"
             f"({DIVERSITY_NAME})\n")
 

@@ -125,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
     for key in ("lmse_by_condition_md", "colour_by_condition_md", "scenario_md"):
         print(result.files[key].read_text(encoding="utf-8"))
     print(f"{len(result.scores)} scores for {len(folders)} samples in {args.out} "
-          f"(REPORT.md, scores.csv, tables, figures/, estimates/)")
+          f"(REPORT.md with every table and summary.png, scores.csv, figures/, estimates/)")
     return 0
 
 

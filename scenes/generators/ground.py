@@ -67,7 +67,7 @@ def objects_on_ground(rng: np.random.Generator, options: GeneratorOptions) -> La
     volume = LightVolume(lo=(centre[0] - d, centre[1] - d, hi[2] + radius),
                          hi=(centre[0] + d, centre[1] + d, hi[2] + d),
                          focus=tuple(float(x) for x in centre))  # type: ignore[arg-type]
-    info = {"generator": "objects-on-ground", "n_objects": len(objects),
+    info = {"generator": "objects-on-ground", "kind": "object", "n_objects": len(objects),
             "shapes": [n.rsplit("-", 1)[0] for n, _ in objects], "patterns": patterns}
     return Layout(parts=(*objects, ("ground", _ground(rng))), lights=volume,
                   propose_camera=propose, info=info)

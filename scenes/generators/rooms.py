@@ -173,7 +173,7 @@ def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
         return origin, target, float(r.uniform(50, 75))
 
     volume, lighting = _light_volume(rng, size, openness)
-    info = {"generator": "rooms", "room_size": list(size), **openness, "lighting": lighting,
+    info = {"generator": "rooms", "kind": "complex", "room_size": list(size), **openness, "lighting": lighting,
             "n_furniture": len(furniture), "n_objects": len(objects),
             "shapes": [n.rsplit("-", 1)[0] for n, _ in objects], "patterns": patterns}
     return Layout(parts=(*shell, *furniture, *objects), lights=volume, propose_camera=propose,
