@@ -20,7 +20,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from spectrinsic.errors import DatasetError, validate_choice
+from spectrinsic.errors import DatasetError, SceneError, validate_choice
 from spectrinsic.gt_export.sample import file_sha256
 from spectrinsic.pipeline.presets import DatasetConfig
 from spectrinsic.pipeline.tasks import SampleTask
@@ -31,6 +31,8 @@ from spectrinsic.scenes.generators import (
     generated_family,
     generated_scene_name,
 )
+from spectrinsic.scenes.generators.lights import check_saturation
+from spectrinsic.scenes.generators.materials import check_ranges
 from spectrinsic.scenes.sample_id import SampleId
 from spectrinsic.scenes.scene_writer import save_scene
 from spectrinsic.scenes.sources import FileSource, GeneratedSource, scene_file_kind
@@ -50,9 +52,21 @@ MAX_VIEWS = 64
 def generator_source(generator: str, count: int, *, views: int = 1,
                      value_range: Sequence[float] = (2.0, 9.0),
                      chroma_range: Sequence[float] = (0.0, 16.0),
-                     min_coverage: float = 0.15, sfu: bool = False) -> str:
-    """The canonical ``source`` JSON of a generated set (validated)."""
+                     min_coverage: float = 0.15, sfu: bool = False,
+                     light_saturation: Sequence[float] | None = None) -> str:
+    """The canonical ``source`` JSON of a generated set (validated: an impossible range is
+    refused here, before any scene is planned)."""
     validate_choice(generator, GENERATORS, "scene generator", error=DatasetError)
+    try:
+        check_ranges((float(value_range[0]), float(value_range[1])),
+                     (float(chroma_range[0]), float(chroma_range[1])))
+    except SceneError as exc:
+        raise DatasetError(f"--value-range / --chroma-range: {exc}") from None
+    try:
+        if light_saturation is not None:
+            check_saturation((float(light_saturation[0]), float(light_saturation[1])))
+    except SceneError as exc:
+        raise DatasetError(f"--light-saturation: {exc}") from None
     if not (1 <= count <= MAX_COUNT and 1 <= views <= MAX_VIEWS):
         raise DatasetError(f"--count {count} / --views {views}; expected whole numbers from 1 to "
                            f"{MAX_COUNT} scenes and 1 to {MAX_VIEWS} views")
@@ -60,6 +74,8 @@ def generator_source(generator: str, count: int, *, views: int = 1,
             "value_range": [float(v) for v in value_range],
             "chroma_range": [float(c) for c in chroma_range],
             "min_coverage": float(min_coverage), "sfu": bool(sfu)}
+    if light_saturation is not None:  # absent when not given: older configs keep their hash
+        spec["light_saturation"] = [float(v) for v in light_saturation]
     return json.dumps(spec, sort_keys=True)
 
 
@@ -94,9 +110,11 @@ def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir:
             raise DatasetError(f"--sfu needs the SFU data directory (--data-dir): {exc}") from exc
     dist = MaterialDistribution(tuple(spec["value_range"]), tuple(spec["chroma_range"]),
                                 sfu_fraction=0.5 if sfu_r else 0.0)
+    saturation = spec.get("light_saturation")
     return GeneratorOptions(width=config.width, height=config.height, views=int(spec["views"]),
                             materials=dist, min_coverage=float(spec["min_coverage"]),
-                            sfu_reflectances=sfu_r, sfu_illuminants=sfu_i)
+                            sfu_reflectances=sfu_r, sfu_illuminants=sfu_i,
+                            light_saturation=None if saturation is None else tuple(saturation))
 
 
 def plan_source_samples(out: str, config: DatasetConfig, *, data_dir: str | None,

@@ -47,6 +47,8 @@ class GeneratorOptions:
         SFU names to draw from (empty when no data directory is configured).
     data_dir
         Spectral data directory (for ``sfu`` chromaticities).
+    light_saturation
+        ``(lo, hi)``: |Duv| range (Ohno 2013) of the coloured families' lights; None: any.
     """
 
     width: int
@@ -58,6 +60,7 @@ class GeneratorOptions:
     sfu_reflectances: tuple[str, ...] = ()
     sfu_illuminants: tuple[str, ...] = ()
     data_dir: str | None = None
+    light_saturation: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -105,7 +108,8 @@ def assemble(name: str, layout: Layout, seed: int, view: int, options: Generator
     family = family_of(seed)
     lights = draw_lights(rngs["lights"], family, layout.lights,
                          free=lambda p: is_free(meshes, p), sfu=options.sfu_illuminants,
-                         data_dir=options.data_dir, max_lights=options.max_lights)
+                         data_dir=options.data_dir, max_lights=options.max_lights,
+                         saturation=options.light_saturation)
     # Views 0..views-1 are drawn in order, so view k is the same in any build, and all of them
     # must pass for the layout to be used (every view of a scene shows one layout).
     for k in range(max(view + 1, options.views)):

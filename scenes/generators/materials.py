@@ -25,6 +25,10 @@ __all__ = [
     "MaterialDistribution",
     "PATTERNS",
     "munsell_chips",
+    "check_ranges",
+    "within",
+    "obeys",
+    "repaint_outside",
     "draw_reflectance",
     "draw_palette",
     "paint",
@@ -76,14 +80,60 @@ def munsell_chips() -> tuple[tuple[str, float, float], ...]:
     return tuple(out)
 
 
+def _pool(value_range: tuple[float, float], chroma_range: tuple[float, float]) -> list[str]:
+    (v0, v1), (c0, c1) = value_range, chroma_range
+    return [n for n, v, c in munsell_chips() if v0 <= v <= v1 and c0 <= c <= c1]
+
+
+def check_ranges(value_range: tuple[float, float], chroma_range: tuple[float, float]) -> None:
+    """Refuse Munsell ranges that hold no matte chip (raises :class:`SceneError`, one line)."""
+    if not value_range[0] <= value_range[1] or not chroma_range[0] <= chroma_range[1]:
+        raise SceneError(f"value range {value_range} / chroma range {chroma_range}; expected LO <= HI")
+    if not _pool(value_range, chroma_range):
+        raise SceneError(
+            f"no Munsell chip has value in {value_range[0]:g}-{value_range[1]:g} and chroma in "
+            f"{chroma_range[0]:g}-{chroma_range[1]:g}; the matte chips span value 2.5-9 and "
+            "chroma 1-14"
+        )
+
+
+def within(preferred: MaterialDistribution, user: MaterialDistribution) -> MaterialDistribution:
+    """*preferred* (a generator's own taste, e.g. light walls) narrowed to the *user*'s ranges;
+    the user's ranges alone where the two share no chip. Either way every chip drawn obeys the
+    user's ``--value-range`` / ``--chroma-range``."""
+    v = (max(preferred.value_range[0], user.value_range[0]), min(preferred.value_range[1], user.value_range[1]))
+    c = (max(preferred.chroma_range[0], user.chroma_range[0]), min(preferred.chroma_range[1], user.chroma_range[1]))
+    if v[0] <= v[1] and c[0] <= c[1] and _pool(v, c):
+        return MaterialDistribution(v, c, preferred.sfu_fraction, preferred.pattern_probability)
+    return MaterialDistribution(user.value_range, user.chroma_range, preferred.sfu_fraction,
+                                preferred.pattern_probability)
+
+
+def obeys(name: str, dist: MaterialDistribution) -> bool:
+    """Whether *name* is a Munsell chip inside *dist*'s value and chroma ranges."""
+    return name in _pool_set(dist.value_range, dist.chroma_range)
+
+
+@functools.lru_cache(maxsize=32)
+def _pool_set(value_range: tuple[float, float], chroma_range: tuple[float, float]) -> frozenset[str]:
+    return frozenset(_pool(value_range, chroma_range))
+
+
+def repaint_outside(part: Part, rng: np.random.Generator, dist: MaterialDistribution) -> Part:
+    """*part* with every palette entry outside *dist* (not a chip in its ranges) replaced by a
+    chip drawn from *dist*; the regions keep their shapes (library objects keep their look
+    where the ranges allow it)."""
+    palette = tuple(n if obeys(n, dist) else draw_reflectance(rng, dist) for n in part.palette)
+    return Part(part.vertices, part.faces, part.labels, palette)
+
+
 def draw_reflectance(
     rng: np.random.Generator, dist: MaterialDistribution, sfu: Sequence[str] = ()
 ) -> str:
     """One reflectance name drawn from *dist* (Munsell, or SFU with ``dist.sfu_fraction``)."""
     if sfu and rng.random() < dist.sfu_fraction:
         return sfu[int(rng.integers(len(sfu)))]
-    (v0, v1), (c0, c1) = dist.value_range, dist.chroma_range
-    pool = [n for n, v, c in munsell_chips() if v0 <= v <= v1 and c0 <= c <= c1]
+    pool = _pool(dist.value_range, dist.chroma_range)
     if not pool:
         raise SceneError(f"no Munsell chip has value in {dist.value_range} and chroma in "
                          f"{dist.chroma_range}; widen the ranges")

@@ -15,6 +15,7 @@ from spectrinsic.scenes.generators.lights import LightVolume
 from spectrinsic.scenes.generators.materials import (
     MaterialDistribution,
     draw_reflectance,
+    within,
 )
 from spectrinsic.scenes.generators.shapes import draw_object
 from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_KINDS
@@ -58,12 +59,14 @@ def _wall(key: str, size: tuple[float, float, float], spectrum: str, hole: tuple
     return merge(*pieces)
 
 
-def _shell(rng: np.random.Generator, size: tuple[float, float, float]) -> tuple[list[tuple[str, Part]], dict]:
+def _shell(rng: np.random.Generator, size: tuple[float, float, float],
+           user: MaterialDistribution) -> tuple[list[tuple[str, Part]], dict]:
     w, d, h = size
     # half the rooms have light, low-chroma walls (strong interreflection: low r), the others
     # any walls; with missing walls and ceilings this spreads r
     bright = rng.random() < 0.5
-    walls = MaterialDistribution((7.0, 9.5), (0.0, 4.0)) if bright else MaterialDistribution((2.0, 9.0), (0.0, 10.0))
+    walls = within(MaterialDistribution((7.0, 9.5), (0.0, 4.0)) if bright
+                   else MaterialDistribution((2.0, 9.0), (0.0, 10.0)), user)
     missing = [k for k in _WALLS if k != "back" and rng.random() < 0.3]
     ceiling = rng.random() >= 0.35
     parts = [("floor", _slab(np.array([-_T, -_T, -_T]), np.array([w + _T, d + _T, 0.0]),
@@ -161,9 +164,10 @@ def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
     """Lay out a generated room (see the module docstring)."""
     size = (float(rng.uniform(2.5, 6.0)), float(rng.uniform(2.5, 6.0)), float(rng.uniform(2.3, 3.2)))
     w, d, h = size
-    shell, openness = _shell(rng, size)
+    shell, openness = _shell(rng, size, options.materials)
     floor = Footprints([])
-    furniture, tops = _furniture(rng, size, floor, MaterialDistribution((2, 8), (0, 12)))
+    furniture, tops = _furniture(rng, size, floor,
+                                 within(MaterialDistribution((2, 8), (0, 12)), options.materials))
     objects, patterns = _objects(rng, size, floor, tops, options)
     targets = [p.vertices.mean(axis=0) for _, p in objects + furniture] or [np.array([w / 2, d / 2, 0.5])]
 

@@ -1,0 +1,134 @@
+"""Generated worlds that exercise colour (issue 22): saturated and mixed lights, two-colour
+pairs people can tell apart, and material ranges every generator obeys. No rendering."""
+
+import math
+
+import colour
+import numpy as np
+import pytest
+
+from spectrinsic.errors import SceneError, SpectrumNotFoundError
+from spectrinsic.scenes.generators import (
+    GeneratorOptions,
+    MaterialDistribution,
+    generate,
+    generated_scene_seed,
+)
+from spectrinsic.scenes.generators.base import family_of, scene_rngs
+from spectrinsic.scenes.generators.lights import (
+    TWO_COLOUR_XY,
+    LightVolume,
+    check_saturation,
+    draw_lights,
+)
+from spectrinsic.scenes.generators.materials import check_ranges, munsell_chips
+from spectrinsic.spectra import get_spectrum
+from spectrinsic.spectra.coloured_lights import FILTER_FLOOR, filter_transmission
+
+_VOLUME = LightVolume(lo=(0, 0, 1), hi=(1, 1, 2), focus=(0.5, 0.5, 0))
+#: Scenes of the done-when set (``--count 200``).
+COUNT = 200
+
+
+def _xy_duv(name):
+    """Independent colorimetry: colour-science's own sd_to_XYZ and Ohno 2013 Duv."""
+    spd = get_spectrum(name)
+    sd = colour.SpectralDistribution(dict(zip(spd.wavelengths, spd.values, strict=True)))
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+    xy = colour.XYZ_to_xy(colour.sd_to_XYZ(sd.copy().align(cmfs.shape), cmfs, method="Integration"))
+    duv = colour.temperature.uv_to_CCT_Ohno2013(colour.xy_to_UCS_uv(xy))[1]
+    return np.asarray(xy, float), float(duv)
+
+
+def _set_lights(generator, saturation=None):
+    """The lights of scenes 0..COUNT-1 of a generated set, as :func:`generate` draws them (the
+    lights have their own child seed: geometry and camera do not change them)."""
+    for i in range(COUNT):
+        seed = generated_scene_seed(0, generator, i)
+        family = family_of(seed)
+        lights = draw_lights(
+            scene_rngs(seed)["lights"], family, _VOLUME, free=lambda p: True, saturation=saturation
+        )
+        yield family, lights
+
+
+@pytest.mark.parametrize("generator", ["rooms", "objects-on-ground"])
+def test_a_third_of_coloured_lights_are_tinted_and_two_colours_are_far_apart(generator):
+    duv, pairs = [], []
+    for family, lights in _set_lights(generator):
+        if family == "white":
+            continue
+        names = sorted({light.spectrum for light in lights})
+        measured = {n: _xy_duv(n) for n in names}
+        duv += [abs(measured[light.spectrum][1]) for light in lights]
+        if family == "two-colour":
+            assert len(names) == 2, names
+            pairs.append(float(np.linalg.norm(measured[names[0]][0] - measured[names[1]][0])))
+    assert np.mean(np.array(duv) >= 0.02) >= 1 / 3, np.mean(np.array(duv) >= 0.02)
+    assert pairs and min(pairs) >= TWO_COLOUR_XY, min(pairs)
+
+
+def test_light_saturation_range_keeps_only_lights_in_it():
+    seen = 0
+    for family, lights in list(_set_lights("rooms", saturation=(0.05, 0.3)))[:60]:
+        for light in lights if family != "white" else ():
+            assert 0.05 - 1e-4 <= abs(_xy_duv(light.spectrum)[1]) <= 0.3 + 1e-4, light.spectrum
+            seen += 1
+    assert seen > 20
+
+
+@pytest.mark.parametrize("bad", [(0.2, 0.3), (0.05, 0.01), (-0.1, 0.1)])
+def test_impossible_light_saturation_is_refused(bad):
+    with pytest.raises(SceneError, match="light saturation"):
+        check_saturation(bad)
+
+
+def test_led_spectra_peak_where_asked_and_mix_their_terms():
+    wl = np.arange(380.0, 781.0)
+    one = get_spectrum("led:460/20").on(wl)
+    assert wl[one.argmax()] == pytest.approx(460, abs=1)
+    assert one[np.abs(wl - 460) > 40].max() < 0.02 * one.max()  # narrow band
+    mix = get_spectrum("led:630/20@1+530/30@0.5").on(wl)
+    # Ohno's LED shape peaks at 1, so the peak ratio is the ratio asked for
+    assert mix[wl == 530][0] / mix[wl == 630][0] == pytest.approx(0.5, rel=0.02)
+    with pytest.raises(SpectrumNotFoundError, match="PEAK/FWHM"):
+        get_spectrum("led:blue")
+
+
+def test_filtered_lamp_is_lamp_times_filter_transmission():
+    lamp, out = get_spectrum("planck:3200K"), get_spectrum("filtered:planck:3200K|bandpass:520/80")
+    wl = np.asarray(lamp.wavelengths)
+    ratio = out.values / lamp.values
+    t = filter_transmission("bandpass:520/80", wl)
+    assert np.allclose(ratio / ratio.max(), t / t.max(), rtol=1e-9)
+    assert t.min() == pytest.approx(FILTER_FLOOR, abs=1e-6) and t.max() == pytest.approx(
+        1.0, abs=1e-6
+    )
+    # half transmission at centre +- FWHM/2, and a long-pass rises through its edge
+    half = (filter_transmission("bandpass:520/80", np.array([480.0, 560.0])) - FILTER_FLOOR) / (
+        1 - FILTER_FLOOR
+    )
+    assert np.allclose(half, 0.5)
+    lp = filter_transmission("longpass:600/30", np.array([585.0, 600.0, 615.0]))
+    assert lp[0] < 0.2 < lp[1] < 0.8 < lp[2]
+    green = _xy_duv("filtered:planck:3200K|bandpass:520/80")
+    assert green[1] > 0.05 and math.dist(green[0], (0.3127, 0.329)) > 0.2
+
+
+@pytest.mark.parametrize("generator", ["rooms", "objects-on-ground"])
+def test_chroma_range_is_obeyed_by_every_material_of_both_generators(generator):
+    dist = MaterialDistribution(value_range=(2.0, 9.0), chroma_range=(2.0, 4.0))
+    options = GeneratorOptions(width=16, height=16, materials=dist)
+    chips = {n: (v, c) for n, v, c in munsell_chips()}
+    used = set()
+    for index in range(3):
+        scene = generate(generator, root_seed=5, index=index, view=0, options=options)
+        used |= {m.spectrum for m in scene.materials}
+    assert len(used) > 5
+    assert all(n in chips and 2.0 <= chips[n][1] <= 4.0 for n in used), sorted(used)
+
+
+def test_a_range_with_no_chip_is_refused_in_one_line():
+    with pytest.raises(SceneError, match="chroma in 50-60") as err:
+        check_ranges((2.0, 9.0), (50.0, 60.0))
+    assert "\n" not in str(err.value)
