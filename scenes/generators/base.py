@@ -77,12 +77,16 @@ class Layout:
         ``rng -> (origin, target, fov_deg)``: one camera proposal.
     info
         What the generator drew (recorded in the scene's metadata).
+    min_coverage
+        The generator's own least object coverage of a view (rooms frame furniture); the
+        camera must pass the larger of this and ``options.min_coverage``.
     """
 
     parts: tuple[tuple[str, Part], ...]
     lights: LightVolume
     propose_camera: Callable[[np.random.Generator], tuple[np.ndarray, np.ndarray, float]]
     info: dict[str, Any]
+    min_coverage: float = 0.0
 
 
 def scene_rngs(seed: int) -> dict[str, np.random.Generator]:
@@ -115,7 +119,8 @@ def assemble(name: str, layout: Layout, seed: int, view: int, options: Generator
     for k in range(max(view + 1, options.views)):
         drawn = sample_camera(rngs["camera"], meshes, layout.propose_camera,
                               width=options.width, height=options.height,
-                              is_object=_is_object, min_coverage=options.min_coverage,
+                              is_object=_is_object,
+                              min_coverage=max(options.min_coverage, layout.min_coverage),
                               name=f"view{k}")
         if k == view:
             camera, cov = drawn

@@ -132,3 +132,48 @@ def test_a_range_with_no_chip_is_refused_in_one_line():
     with pytest.raises(SceneError, match="chroma in 50-60") as err:
         check_ranges((2.0, 9.0), (50.0, 60.0))
     assert "\n" not in str(err.value)
+
+
+#: Rays per side for the framing measurement: finer than the generator's own 12 x 12 check.
+_FRAMING_GRID = 24
+
+
+def test_room_views_frame_furniture_and_objects():
+    """>= 90 % of room views have >= 30 % of their rays (24 x 24, as pixels) on furniture and
+    objects, measured independently of the generator's coarser check."""
+    from spectrinsic.scenes.generators.camera import first_hits
+    from spectrinsic.scenes.validate import camera_rays
+
+    options = GeneratorOptions(width=32, height=24)
+    fractions = []
+    for index in range(10):
+        scene = generate("rooms", root_seed=3, index=index, view=0, options=options)
+        c = scene.camera
+        o, d = camera_rays(c.origin, c.target, c.up, c.fov_deg, c.width, c.height, n=_FRAMING_GRID)
+        hit = first_hits(scene.meshes, o, d)
+        furnished = np.array(
+            [not m.name.startswith(("wall-", "floor", "ceiling")) for m in scene.meshes] + [False]
+        )
+        fractions.append(float(furnished[hit].mean()))
+    assert np.mean(np.array(fractions) >= 0.3) >= 0.9, fractions
+
+
+def test_rooms_have_furniture_beyond_boxes_and_objects_on_shelves():
+    options = GeneratorOptions(width=16, height=16)
+    kinds, on_boards = set(), 0
+    for index in range(8):
+        scene = generate("rooms", root_seed=4, index=index, view=0, options=options)
+        kinds |= {m.name.rsplit("-", 1)[0] for m in scene.meshes}
+        shelves = [m for m in scene.meshes if m.name.startswith("shelf")]
+        for m in scene.meshes:
+            z0, lo, hi = (
+                float(m.vertices[:, 2].min()),
+                m.vertices.min(axis=0),
+                m.vertices.max(axis=0),
+            )
+            for s in shelves:
+                slo, shi = s.vertices.min(axis=0), s.vertices.max(axis=0)
+                inside = np.all(lo[:2] >= slo[:2]) and np.all(hi[:2] <= shi[:2])
+                on_boards += bool(m is not s and inside and 0.01 < z0 < shi[2] - 0.01)
+    assert {"round-table", "sofa", "lamp"} & kinds, kinds
+    assert on_boards > 0
