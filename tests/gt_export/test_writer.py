@@ -267,4 +267,5 @@ def test_dataset_card_shows_the_diversity_figure(built):
     n_lights = sum(len(read_meta(s).lights) for s in samples)
     assert len(stats["luminance_decades"]) == len(samples) and len(stats["light_cct"]) == n_lights
     assert all(1000 < t < 25000 for t in stats["light_cct"])
-    assert len(diversity_figure(stats).axes) == 6
+    assert len(stats["samples"]) == len(samples) and len(stats["material_chroma"]) >= len(samples)
+    assert len(diversity_figure(stats).axes) == 8
