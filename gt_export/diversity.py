@@ -24,7 +24,7 @@ from spectrinsic.gt_export.layers import luminance
 from spectrinsic.gt_export.loader import load_sample
 from spectrinsic.gt_export.sample_meta import SampleMeta
 
-__all__ = ["DIVERSITY_NAME", "diversity_stats", "diversity_figure", "write_diversity"]
+__all__ = ["DIVERSITY_NAME", "diversity_stats", "diversity_figure", "spread_record", "write_diversity"]
 
 DIVERSITY_NAME = "diversity.png"
 #: Luminance percentiles whose ratio is the "luminance range" (decades).
@@ -46,6 +46,16 @@ def _luminance_decades(image: np.ndarray, mask: np.ndarray | None) -> float:
         return 0.0
     lo, hi = np.percentile(y, _RANGE_PERCENTILES)
     return float(np.log10(max(hi, 1e-12) / max(lo, 1e-12)))
+
+
+def spread_record(meta: SampleMeta) -> dict[str, Any]:
+    """One sample's record for :func:`~spectrinsic.gt_export.colour_spread.spread_summary`."""
+    extra = meta.scene_metadata
+    return {"lights": [tuple(light.xy) for light in meta.lights],
+            "materials": list(meta.materials.values()),
+            "patterned": len(extra.get("patterns", [])),
+            "objects": int(extra.get("n_objects", 0) or 0),
+            "coverage": extra.get("object_coverage")}
 
 
 def diversity_stats(sample_dirs: Sequence[Path], metas: Sequence[SampleMeta]) -> dict[str, list[Any]]:
@@ -71,11 +81,7 @@ def diversity_stats(sample_dirs: Sequence[Path], metas: Sequence[SampleMeta]) ->
             out["light_cct"].append(_cct(light.xy))
         out["n_materials"].append(len(meta.materials))
         out["material_chroma"] += [material_chroma(n) for n in meta.materials.values()]
-        out["samples"].append({"lights": [tuple(light.xy) for light in meta.lights],
-                               "materials": list(meta.materials.values()),
-                               "patterned": len(extra.get("patterns", [])),
-                               "objects": int(extra.get("n_objects", 0) or 0),
-                               "coverage": extra.get("object_coverage")})
+        out["samples"].append(spread_record(meta))
         if isinstance(extra.get("object_coverage"), float):
             out["coverage"].append(extra["object_coverage"])
         sample = load_sample(folder, layers=[k for k in ("image", "mask") if k in meta.layers])

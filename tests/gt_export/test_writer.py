@@ -261,7 +261,9 @@ def test_dataset_card_shows_the_diversity_figure(built):
     from spectrinsic.gt_export.sample import sample_dirs
     from spectrinsic.gt_export.sample_meta import read_meta
 
-    assert "diversity.png" in (built / "DATASET.md").read_text() and (built / "diversity.png").is_file()
+    card = (built / "DATASET.md").read_text()
+    assert "diversity.png" in card and (built / "diversity.png").is_file()
+    assert "Colour spread: lights cover" in card and "nan" not in card
     samples = sample_dirs(built)
     stats = diversity_stats(samples, [read_meta(s) for s in samples])
     n_lights = sum(len(read_meta(s).lights) for s in samples)
