@@ -177,3 +177,21 @@ def test_rooms_have_furniture_beyond_boxes_and_objects_on_shelves():
                 on_boards += bool(m is not s and inside and 0.01 < z0 < shi[2] - 0.01)
     assert {"round-table", "sofa", "lamp"} & kinds, kinds
     assert on_boards > 0
+
+
+def test_sfu_lamps_behind_filters_with_a_data_directory(data_dir):
+    from spectrinsic.scenes.generators.lights import draw_illuminant
+    from spectrinsic.spectra import list_spectra
+
+    sfu = tuple(list_spectra("sfu-illum", data_dir=data_dir))
+    rng = np.random.default_rng(0)
+    drawn = [draw_illuminant(rng, sfu, saturated=True) for _ in range(300)]
+    filtered_sfu = [n for n in drawn if n.startswith("filtered:sfu-illum:")]
+    assert filtered_sfu
+    name = filtered_sfu[0]
+    lamp_name, spec = name.removeprefix("filtered:").rsplit("|", 1)
+    lamp, out = get_spectrum(lamp_name, data_dir=data_dir), get_spectrum(name, data_dir=data_dir)
+    ratio = out.values / np.where(lamp.values > 0, lamp.values, np.nan)
+    t = filter_transmission(spec, np.asarray(lamp.wavelengths))
+    ok = np.isfinite(ratio)
+    assert np.allclose(ratio[ok] / t[ok], (ratio[ok] / t[ok])[0], rtol=1e-9)
