@@ -46,6 +46,10 @@ _SAFE = re.compile(r"[^A-Za-z0-9._-]+")
 #: Most generated scenes and cameras per scene in one dataset: planning is O(count x views)
 #: before the first render, and 10^5 scenes already take days to render on a workstation.
 MAX_COUNT = 100_000
+#: Version of what the generators draw for a seed, part of the config: a set built by an older
+#: version (other light pools, furniture, framing) asks for ``--rebuild`` instead of mixing.
+#: 2: saturated lights, ranges obeyed by every material, framed rooms (issue 22).
+GENERATOR_VERSION = 2
 MAX_VIEWS = 64
 
 
@@ -73,7 +77,8 @@ def generator_source(generator: str, count: int, *, views: int = 1,
     spec = {"generator": generator, "count": int(count), "views": int(views),
             "value_range": [float(v) for v in value_range],
             "chroma_range": [float(c) for c in chroma_range],
-            "min_coverage": float(min_coverage), "sfu": bool(sfu)}
+            "min_coverage": float(min_coverage), "sfu": bool(sfu),
+            "generator_version": GENERATOR_VERSION}
     if light_saturation is not None:  # absent when not given: older configs keep their hash
         spec["light_saturation"] = [float(v) for v in light_saturation]
     return json.dumps(spec, sort_keys=True)
