@@ -122,8 +122,8 @@ def diversity_figure(stats: Mapping[str, Sequence[Any]]) -> Any:
     ax = axes[3]
     d65 = np.linalg.norm(xy - np.array([0.31271, 0.32902]), axis=1) if len(xy) else []
     ax.hist(d65, bins=20, color="0.35")
-    ax.set_title(f"light xy distance from D65 (tinted |Duv|>=0.02: {summary['tinted_fraction']:.0%}; "
-                 f"pairs min {summary['pair_distance_min']:.3f})", fontsize=9)
+    ax.set_title(f"light xy distance from D65\n(tinted, |Duv| >= 0.02: {summary['tinted_fraction']:.0%}; "
+                 f"pairs >= {summary['pair_distance_min']:.3f} apart)", fontsize=9)
     return fig
 
 
