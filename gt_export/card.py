@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export.colour_spread import spread_summary
+from spectrinsic.gt_export.colour_spread import shown, spread_summary
 from spectrinsic.gt_export.diversity import DIVERSITY_NAME, spread_record, write_diversity
 from spectrinsic.gt_export.integrity import guarded_write
 from spectrinsic.gt_export.manifest import noise_summary, splits_by_scene, variants_of
@@ -38,11 +38,6 @@ def _text(value: object) -> str:
     return html.escape(str(value), quote=False)
 
 
-def _fig(value: float, fmt: str) -> str:
-    """*value* formatted, or ``n/a`` where the set has nothing to measure (NaN)."""
-    return "n/a" if value != value else format(value, fmt)
-
-
 def _diversity_section(root: Path, samples: Sequence[Path], metas: Sequence[SampleMeta]) -> str:
     """The card's diversity section: splits by scene and ``diversity.png`` (written here)."""
     figure = root / DIVERSITY_NAME
@@ -54,13 +49,13 @@ def _diversity_section(root: Path, samples: Sequence[Path], metas: Sequence[Samp
     spread = spread_summary([spread_record(m) for m in metas])
     return (f"\n## Splits and diversity\n\nSplits by scene (no scene in two splits; "
             f"`manifest.json[\"splits\"]`): {counts} samples.\n\n"
-            f"Colour spread: lights cover {_fig(spread['xy_hull_area'], '.3f')} of CIE 1931 xy (hull area), "
-            f"{_fig(spread['d65_distance_median'], '.3f')} median xy distance from D65, "
-            f"{_fig(spread['tinted_fraction'], '.0%')} of non-D65 lights tinted (|Duv| >= 0.02, Ohno 2013), "
-            f"paired lights at least {_fig(spread['pair_distance_min'], '.3f')} apart in xy; material chroma "
-            f"C*ab median {_fig(spread['chroma_median'], '.1f')} (p90 {_fig(spread['chroma_p90'], '.1f')}); "
-            f"{_fig(spread['patterned_fraction'], '.0%')} of generated objects patterned, "
-            f"{_fig(spread['framed_fraction'], '.0%')} of views framed (>= 30 % objects).\n\n"
+            f"Colour spread: lights cover {shown(spread['xy_hull_area'], '.3f')} of CIE 1931 xy (hull area), "
+            f"{shown(spread['d65_distance_median'], '.3f')} median xy distance from D65, "
+            f"{shown(spread['tinted_fraction'], '.0%')} of non-D65 lights tinted (|Duv| >= 0.02, Ohno 2013), "
+            f"paired lights at least {shown(spread['pair_distance_min'], '.3f')} apart in xy; material chroma "
+            f"C*ab median {shown(spread['chroma_median'], '.1f')} (p90 {shown(spread['chroma_p90'], '.1f')}); "
+            f"{shown(spread['patterned_fraction'], '.0%')} of generated objects patterned, "
+            f"{shown(spread['framed_fraction'], '.0%')} of views framed (>= 30 % objects).\n\n"
             f"![r, light CCT and xy, materials per image, object coverage, luminance range]"
             f"({DIVERSITY_NAME})\n")
 

@@ -24,6 +24,7 @@ import numpy as np
 from spectrinsic.spectra import get_sensors, get_spectrum, responses, xy_to_duv, xyz_to_xy
 
 __all__ = [
+    "shown",
     "D65_XY",
     "FRAMED",
     "TINTED_DUV",
@@ -93,6 +94,11 @@ def hull_area(points: np.ndarray) -> float:
     return 0.5 * abs(
         sum(a[0] * b[1] - b[0] * a[1] for a, b in zip(ring, ring[1:] + ring[:1], strict=True))
     )
+
+
+def shown(value: float, fmt: str) -> str:
+    """A figure *value* formatted with *fmt*, or ``n/a`` where the set had nothing to measure."""
+    return "n/a" if math.isnan(value) else format(value, fmt)
 
 
 def spread_summary(samples: Sequence[Mapping[str, Any]]) -> dict[str, float]:

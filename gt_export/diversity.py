@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from spectrinsic.gt_export.colour_spread import material_chroma, spread_summary
+from spectrinsic.gt_export.colour_spread import material_chroma, shown, spread_summary
 from spectrinsic.gt_export.layers import luminance
 from spectrinsic.gt_export.loader import load_sample
 from spectrinsic.gt_export.sample_meta import SampleMeta
@@ -99,9 +99,9 @@ def diversity_figure(stats: Mapping[str, Sequence[Any]]) -> Any:
     panels = [("r", "energy ratio r (direct / total)", "needs a build with --direct"),
               ("light_cct", "light CCT (K, McCamy)", "no lights"),
               ("n_materials", "materials per image", "no materials"),
-              ("material_chroma", f"material chroma C*ab (median {summary['chroma_median']:.1f})",
+              ("material_chroma", f"material chroma C*ab (median {shown(summary['chroma_median'], '.1f')})",
                "no materials"),
-              ("coverage", f"object coverage (framed {summary['framed_fraction']:.0%})",
+              ("coverage", f"object coverage (framed {shown(summary['framed_fraction'], '.0%')})",
                "library scenes: not recorded"),
               ("luminance_decades", "luminance range, log10(p99/p1)", "no images")]
     for ax, (key, title, empty) in zip(axes[[0, 1, 4, 5, 6, 7]], panels, strict=True):
@@ -116,14 +116,14 @@ def diversity_figure(stats: Mapping[str, Sequence[Any]]) -> Any:
     ax.scatter(xy[:, 0], xy[:, 1], s=12, c="k")
     ax.plot(*_planckian_xy(), color="tab:orange", lw=1, label="Planckian 1000-25000 K")
     ax.scatter([0.31271], [0.32902], marker="+", s=80, c="tab:red", label="D65")
-    ax.set(title=f"light xy (hull area {summary['xy_hull_area']:.3f})", xlabel="x", ylabel="y",
+    ax.set(title=f"light xy (hull area {shown(summary['xy_hull_area'], '.3f')})", xlabel="x", ylabel="y",
            xlim=(0.0, 0.75), ylim=(0.0, 0.85))
     ax.legend(fontsize=7)
     ax = axes[3]
     d65 = np.linalg.norm(xy - np.array([0.31271, 0.32902]), axis=1) if len(xy) else []
     ax.hist(d65, bins=20, color="0.35")
-    ax.set_title(f"light xy distance from D65\n(tinted, |Duv| >= 0.02: {summary['tinted_fraction']:.0%}; "
-                 f"pairs >= {summary['pair_distance_min']:.3f} apart)", fontsize=9)
+    ax.set_title(f"light xy distance from D65\n(tinted, |Duv| >= 0.02: {shown(summary['tinted_fraction'], '.0%')}; "
+                 f"pairs >= {shown(summary['pair_distance_min'], '.3f')} apart)", fontsize=9)
     return fig
 
 
