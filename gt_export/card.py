@@ -54,7 +54,8 @@ def _diversity_section(root: Path, samples: Sequence[Path], metas: Sequence[Samp
             f"{shown(spread['tinted_fraction'], '.0%')} of non-D65 lights tinted (|Duv| >= 0.02, Ohno 2013), "
             f"paired lights at least {shown(spread['pair_distance_min'], '.3f')} apart in xy; material chroma "
             f"C*ab median {shown(spread['chroma_median'], '.1f')} (p90 {shown(spread['chroma_p90'], '.1f')}); "
-            f"{shown(spread['patterned_fraction'], '.0%')} of generated objects patterned, "
+            f"{shown(spread['patterned_fraction'], '.0%')} of generated objects patterned "
+            f"({shown(spread['textured_fraction'], '.0%')} spectrally textured), "
             f"{shown(spread['framed_fraction'], '.0%')} of views framed (>= 30 % objects).\n\n"
             f"![r, light CCT and xy, materials per image, object coverage, luminance range]"
             f"({DIVERSITY_NAME})\n")

@@ -111,7 +111,8 @@ def spread_summary(samples: Sequence[Mapping[str, Any]]) -> dict[str, float]:
         ``xy_hull_area``, ``d65_distance_median``/``_max`` (xy), ``tinted_fraction`` (|Duv| >=
         TINTED_DUV among non-D65 lights), ``pair_distance_min``/``_median`` (largest xy distance
         within each sample of >= 2 distinct lights), ``chroma_median``/``_p90`` (C*ab),
-        ``patterned_fraction`` of objects, ``framed_fraction`` of views with a coverage.
+        ``patterned_fraction`` and ``textured_fraction`` (spectral textures) of objects,
+        ``framed_fraction`` of views with a coverage.
     """
     xy = np.array([p for s in samples for p in s["lights"]], float).reshape(-1, 2)
     d65 = np.linalg.norm(xy - np.array(D65_XY), axis=1)
@@ -140,6 +141,9 @@ def spread_summary(samples: Sequence[Mapping[str, Any]]) -> dict[str, float]:
         "chroma_median": stat(chroma, np.median),
         "chroma_p90": stat(chroma, lambda v: np.percentile(v, 90)),
         "patterned_fraction": sum(int(s.get("patterned", 0)) for s in samples) / objects
+        if objects
+        else float("nan"),
+        "textured_fraction": sum(int(s.get("textured", 0)) for s in samples) / objects
         if objects
         else float("nan"),
         "framed_fraction": stat(np.array(covs) >= FRAMED, np.mean),

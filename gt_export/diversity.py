@@ -54,6 +54,7 @@ def spread_record(meta: SampleMeta) -> dict[str, Any]:
     return {"lights": [tuple(light.xy) for light in meta.lights],
             "materials": list(meta.materials.values()),
             "patterned": len(extra.get("patterns", [])),
+            "textured": list(extra.get("patterns", [])).count("texture"),
             "objects": int(extra.get("n_objects", 0) or 0),
             "coverage": extra.get("object_coverage")}
 

@@ -3,8 +3,9 @@
 Materials are drawn from the 1269 matte Munsell chips (and the SFU reflectances when a data
 directory is configured), with a controllable distribution of Munsell value and chroma
 (:class:`MaterialDistribution`). Patterns (:data:`PATTERNS`: stripes, checkers, patches,
-printed labels, noise partitions) repaint faces by their centroids, so every region is still
-one exact spectrum (no texture filtering).
+printed labels, noise partitions, spectral textures) repaint faces by their centroids, so every
+region is still one exact spectrum (no texture filtering); a spectral texture varies smoothly
+from face to face as convex mixes of three reflectances (``mix:`` spectra).
 """
 
 from __future__ import annotations
@@ -210,6 +211,41 @@ def _label(part: Part, rng: np.random.Generator, palette: Sequence[str]) -> Part
                      axes=(0, 2), facing=(0, -1, 0))
 
 
+#: Steps of a spectral texture's mixing weights (1/8: at most 45 mixes of three reflectances).
+TEXTURE_STEPS = 8
+
+
+def _quantised(weights: np.ndarray, steps: int) -> np.ndarray:
+    """Rows of *weights* (summing to 1) as whole multiples of 1/steps still summing to 1
+    (largest remainders get the spare steps)."""
+    scaled = weights * steps
+    out = np.floor(scaled).astype(np.int64)
+    spare = steps - out.sum(axis=1)
+    order = np.argsort(-(scaled - out), axis=1)
+    for j in range(weights.shape[1]):
+        out[np.arange(len(out)), order[:, j]] += (spare > j).astype(np.int64)
+    return out
+
+
+def _texture(part: Part, rng: np.random.Generator, palette: Sequence[str]) -> Part:
+    """A spectral texture: every face (texel) is a convex mix ``mix:w1*A+w2*B+w3*C`` of up to
+    three palette reflectances, so it is a valid reflectance in [0, 1]; the weights vary
+    smoothly over the surface (softmax of random low-frequency sinusoids of the position),
+    quantised to 1/TEXTURE_STEPS. Each texel stays one exact spectrum."""
+    bases = list(dict.fromkeys(palette))[:3]
+    p = (part.centroids - part.vertices.min(axis=0)) / float(_extent(part).max())
+    fields = [np.sin(2 * np.pi * p @ rng.uniform(0.3, 1.5, 3) + rng.uniform(0, 2 * np.pi)) for _ in bases]
+    raw = np.exp(2.0 * np.stack(fields, axis=1))
+    steps = _quantised(raw / raw.sum(axis=1, keepdims=True), TEXTURE_STEPS)
+    rows, index = np.unique(steps, axis=0, return_inverse=True)
+    names = []
+    for row in rows:
+        terms = [(int(k), b) for k, b in zip(row, bases, strict=True) if k > 0]
+        names.append(terms[0][1] if len(terms) == 1 else
+                     "mix:" + "+".join(f"{k / TEXTURE_STEPS:g}*{b}" for k, b in terms))
+    return _labelled(part, names, np.asarray(index).ravel())
+
+
 #: Pattern painters by name: ``(part, rng, palette) -> part``.
 PATTERNS: dict[str, Callable[[Part, np.random.Generator, Sequence[str]], Part]] = {
     "stripes": _stripes,
@@ -217,6 +253,7 @@ PATTERNS: dict[str, Callable[[Part, np.random.Generator, Sequence[str]], Part]] 
     "patches": _patches,
     "noise": _noise,
     "label": _label,
+    "texture": _texture,
 }
 
 

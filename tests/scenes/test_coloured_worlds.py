@@ -125,7 +125,10 @@ def test_chroma_range_is_obeyed_by_every_material_of_both_generators(generator):
         scene = generate(generator, root_seed=5, index=index, view=0, options=options)
         used |= {m.spectrum for m in scene.materials}
     assert len(used) > 5
-    assert all(n in chips and 2.0 <= chips[n][1] <= 4.0 for n in used), sorted(used)
+    # a spectral texture's texels are convex mixes of chips drawn in the range
+    bases = {b.split("*", 1)[1] for n in used if n.startswith("mix:") for b in n[4:].split("+")}
+    flat = {n for n in used if not n.startswith("mix:")} | bases
+    assert all(n in chips and 2.0 <= chips[n][1] <= 4.0 for n in flat), sorted(flat)
 
 
 def test_a_range_with_no_chip_is_refused_in_one_line():
@@ -195,3 +198,45 @@ def test_sfu_lamps_behind_filters_with_a_data_directory(data_dir):
     t = filter_transmission(spec, np.asarray(lamp.wavelengths))
     ok = np.isfinite(ratio)
     assert np.allclose(ratio[ok] / t[ok], (ratio[ok] / t[ok])[0], rtol=1e-9)
+
+
+def test_spectral_texture_texels_are_valid_mixes_integrated_as_colour_science_does():
+    from spectrinsic.scenes.generators.materials import PATTERNS, TEXTURE_STEPS, draw_palette
+    from spectrinsic.scenes.generators.shapes import make_shape
+    from spectrinsic.spectra import get_sensors, responses
+
+    rng = np.random.default_rng(2)
+    part = make_shape("ball", rng, "flat:0.5")
+    palette = draw_palette(rng, MaterialDistribution(), 3)
+    textured = PATTERNS["texture"](part, rng, palette)
+    assert len(textured.palette) >= 5  # the weights vary over the surface
+    cmf = get_sensors("cie1931")
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+    for name in textured.palette:
+        spd = get_spectrum(name)
+        assert spd.values.min() >= 0.0 and spd.values.max() <= 1.0
+        terms = (
+            [t.split("*", 1) for t in name[4:].split("+")]
+            if name.startswith("mix:")
+            else [["1", name]]
+        )
+        weights = [float(w) for w, _ in terms]
+        assert sum(weights) == pytest.approx(1.0) and all(
+            w * TEXTURE_STEPS == round(w * TEXTURE_STEPS) for w in weights
+        )
+        # independent: colour-science's own arithmetic and integration of the texel spectrum
+        sds = [
+            colour.SpectralDistribution(
+                dict(zip(get_spectrum(b).wavelengths, get_spectrum(b).values, strict=True))
+            )
+            for _, b in terms
+        ]
+        texel = sds[0] * weights[0]
+        for w, sd in zip(weights[1:], sds[1:], strict=True):
+            texel = texel + sd * w
+        texel = texel.copy().align(cmfs.shape, extrapolator_kwargs={"method": "Constant"})
+        expected = colour.sd_to_XYZ(texel, cmfs, method="Integration", k=1.0)
+        got = responses(spd.on(cmf.wavelengths), cmf.curves, cmf.wavelengths)
+        assert np.allclose(
+            got / np.sum(cmf.curves[1]), expected / np.sum(cmfs.values[:, 1]), atol=1e-4
+        ), name
