@@ -153,6 +153,10 @@ def _add_source_options(src: Any) -> None:
                      help="Munsell value range of generated materials (2,9)")
     src.add_argument("--chroma-range", default="0,16", metavar="LO,HI",
                      help="Munsell chroma range of generated materials (0,16)")
+    src.add_argument("--light-saturation", default=None, metavar="LO,HI",
+                     help="keep only coloured lights whose |Duv| (Ohno 2013: CIE 1960 uv distance "
+                          "from the Planckian locus) is in LO,HI; 0.02 is visibly tinted, at most "
+                          "0.15 for LO (default: any, 60%% from saturated LEDs and filtered lamps)")
     src.add_argument("--sfu", action="store_true",
                      help="also draw SFU reflectances and illuminants (needs --data-dir)")
     src.add_argument("--glossy", type=float, default=0.0, metavar="F",
@@ -205,7 +209,9 @@ def _source(args: argparse.Namespace) -> str | None:
             raise DatasetError(f"--glossy/--metallic/--roughness-range: {exc}") from None
         return generator_source(args.generator, args.count, views=args.views, sfu=args.sfu,
                                 value_range=_range("--value-range", args.value_range),
-                                chroma_range=_range("--chroma-range", args.chroma_range), gloss=gloss)
+                                chroma_range=_range("--chroma-range", args.chroma_range), gloss=gloss,
+                                light_saturation=None if args.light_saturation is None
+                                else _range("--light-saturation", args.light_saturation))
     if args.scenes:
         size = None if args.resolution is None else parse_resolution(args.resolution)
         return files_source(args.scenes, materials=material_map(args.material_map),

@@ -36,6 +36,8 @@ from spectrinsic.scenes.generators import (
     generated_family,
     generated_scene_name,
 )
+from spectrinsic.scenes.generators.lights import check_saturation
+from spectrinsic.scenes.generators.materials import check_ranges
 from spectrinsic.scenes.model import Scene
 from spectrinsic.scenes.sample_id import SampleId
 from spectrinsic.scenes.scene_writer import save_scene
@@ -52,6 +54,10 @@ _SAFE = re.compile(r"[^A-Za-z0-9._-]+")
 #: Most generated scenes and cameras per scene in one dataset: planning is O(count x views)
 #: before the first render, and 10^5 scenes already take days to render on a workstation.
 MAX_COUNT = 100_000
+#: Version of what the generators draw for a seed, part of the config: a set built by an older
+#: version (other light pools, furniture, framing) asks for ``--rebuild`` instead of mixing.
+#: 2: saturated lights, ranges obeyed by every material, framed rooms (issue 22).
+GENERATOR_VERSION = 2
 MAX_VIEWS = 64
 
 
@@ -59,20 +65,35 @@ def generator_source(generator: str, count: int, *, views: int = 1,
                      value_range: Sequence[float] = (2.0, 9.0),
                      chroma_range: Sequence[float] = (0.0, 16.0),
                      min_coverage: float = 0.15, sfu: bool = False,
-                     gloss: GlossDistribution | None = None) -> str:
-    """The canonical ``source`` JSON of a generated set (validated); *gloss* enters it only
-    when active, so matte sets keep their source and config hash."""
+                     gloss: GlossDistribution | None = None,
+                     light_saturation: Sequence[float] | None = None) -> str:
+    """The canonical ``source`` JSON of a generated set (validated: an impossible range is
+    refused here, before any scene is planned); *gloss* and *light_saturation* enter it only
+    when given, so matte sets and older configs keep their source and config hash."""
     validate_choice(generator, GENERATORS, "scene generator", error=DatasetError)
+    try:
+        check_ranges((float(value_range[0]), float(value_range[1])),
+                     (float(chroma_range[0]), float(chroma_range[1])))
+    except SceneError as exc:
+        raise DatasetError(f"--value-range / --chroma-range: {exc}") from None
+    try:
+        if light_saturation is not None:
+            check_saturation((float(light_saturation[0]), float(light_saturation[1])))
+    except SceneError as exc:
+        raise DatasetError(f"--light-saturation: {exc}") from None
     if not (1 <= count <= MAX_COUNT and 1 <= views <= MAX_VIEWS):
         raise DatasetError(f"--count {count} / --views {views}; expected whole numbers from 1 to "
                            f"{MAX_COUNT} scenes and 1 to {MAX_VIEWS} views")
     spec = {"generator": generator, "count": int(count), "views": int(views),
             "value_range": [float(v) for v in value_range],
             "chroma_range": [float(c) for c in chroma_range],
-            "min_coverage": float(min_coverage), "sfu": bool(sfu)}
+            "min_coverage": float(min_coverage), "sfu": bool(sfu),
+            "generator_version": GENERATOR_VERSION}
     if gloss is not None and gloss.active:
         spec["gloss"] = {"glossy": float(gloss.glossy_fraction), "metallic": float(gloss.metal_fraction),
                          "roughness_range": [float(v) for v in gloss.roughness_range]}
+    if light_saturation is not None:  # absent when not given: older configs keep their hash
+        spec["light_saturation"] = [float(v) for v in light_saturation]
     return json.dumps(spec, sort_keys=True)
 
 
@@ -154,9 +175,11 @@ def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir:
                                   tuple(g.get("roughness_range", (0.0, 0.3))))  # type: ignore[arg-type]
     except (SceneError, TypeError, ValueError) as exc:
         raise DatasetError(f"source gloss {g!r}: {exc}") from exc
+    saturation = spec.get("light_saturation")
     return GeneratorOptions(width=config.width, height=config.height, views=int(spec["views"]),
                             materials=dist, min_coverage=float(spec["min_coverage"]),
-                            sfu_reflectances=sfu_r, sfu_illuminants=sfu_i, gloss=gloss)
+                            sfu_reflectances=sfu_r, sfu_illuminants=sfu_i, gloss=gloss,
+                            light_saturation=None if saturation is None else tuple(saturation))
 
 
 def plan_source_samples(out: str, config: DatasetConfig, *, data_dir: str | None,

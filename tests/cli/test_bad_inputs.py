@@ -310,6 +310,11 @@ CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
     # --- item 7: bounded inputs
     ("dataset-count-huge", lambda t: ["dataset", "--generator", "rooms", "--count", "100000000",
                                       "--out", str(t / "new")], "--count 100000000"),
+    ("dataset-chroma-range-impossible", lambda t: ["dataset", "--generator", "objects-on-ground",
+                                                   "--chroma-range", "50,60", "--out", str(t / "new")],
+     "chroma in 50-60"),
+    ("dataset-light-saturation-impossible", lambda t: ["dataset", "--generator", "rooms", "--light-saturation",
+                                                       "0.4,0.5", "--out", str(t / "new")], "--light-saturation"),
     ("ply-million-vertices", lambda t: ["render", _scene(t, _ply_header(10**6, 1), "big.ply"), "--material-map",
                                         _scene(t, 'big.ply: "flat:0.5"\n', "map.yaml"), "--out", str(t / "o")],
      "1,000,000 vertices"),
