@@ -171,12 +171,12 @@ def _markdown(rows: list[dict[str, Any]], columns: Sequence[str], headers: Seque
 
 def _condition_files(
     out: Path, stem: str, title: str, rows: list[dict[str, Any]],
-    columns: Sequence[tuple[str, str, str, str]],
+    columns: Sequence[tuple[str, str, str, str]], note: str = "",
 ) -> dict[str, Path]:
     keys = [f"{prefix}_{g}" for prefix, *_ in columns for g in _GROUP_ORDER]
     _write_csv(out / f"{stem}.csv", rows, ["scene_kind", "method", *keys])
     layers = sorted({layer for _, layer, _, _ in columns})
-    md = [f"# {title}", "", "Mean over samples; sRGB input. Layers scored:", ""]
+    md = [*_titled(title, note), "Mean over samples; sRGB input. Layers scored:", ""]
     md += [f"* `{layer}`: {SCORED_LAYERS[layer]}" for layer in layers]
     md += [f"* {header}: metric `{metric}` ({METRICS[metric].equation}) of `{layer}`"
            for _, layer, metric, header in columns]
@@ -190,10 +190,16 @@ def _condition_files(
     return {f"{stem}_csv": out / f"{stem}.csv", f"{stem}_md": out / f"{stem}.md"}
 
 
+def _titled(title: str, note: str) -> list[str]:
+    """A markdown title and, when there is one, the evaluation target's note below it."""
+    return [f"# {title}", "", note, ""] if note else [f"# {title}", ""]
+
+
 def _report_md(
-    methods: Mapping[str, Any], inputs: Sequence[str], n_samples: int, files: Mapping[str, Path]
+    methods: Mapping[str, Any], inputs: Sequence[str], n_samples: int, files: Mapping[str, Path],
+    note: str = "",
 ) -> str:
-    md = ["# Evaluation report", "", f"{n_samples} samples. Input decomposed: "
+    md = [*_titled("Evaluation report", note), f"{n_samples} samples. Input decomposed: "
           + ", ".join(f"`{k}`" for k in inputs)
           + f" (the first of {list(INPUT_LAYERS)} each sample has).", "", "## Layers scored", ""]
     md += [f"* `{layer}`: {text}" for layer, text in SCORED_LAYERS.items()]
@@ -214,8 +220,12 @@ def write_report(
     samples: Mapping[str, tuple[str, str]],
     methods: Mapping[str, Any],
     inputs: Sequence[str],
+    note: str = "",
 ) -> dict[str, Path]:
-    """Write ``scores.csv``, the condition and scenario tables, ``methods.json`` and ``REPORT.md``."""
+    """Write ``scores.csv``, the condition and scenario tables, ``methods.json`` and ``REPORT.md``.
+
+    *note* (:func:`spectrinsic.decompose.targets.target_note`) is printed under every title.
+    """
     files: dict[str, Path] = {"scores": out / "scores.csv"}
     _write_csv(files["scores"], [
         {"sample": s.sample, "method": s.method, "scenario": s.scenario, "layer": s.layer,
@@ -223,14 +233,14 @@ def write_report(
     ], ("sample", "method", "scenario", "layer", "metric", "value"))
     files.update(_condition_files(
         out, "lmse_by_condition", "LMSE by lighting condition (like thesis Tables 5.3 and 5.4)",
-        condition_table(scores, samples, columns=LMSE_COLUMNS), LMSE_COLUMNS))
+        condition_table(scores, samples, columns=LMSE_COLUMNS), LMSE_COLUMNS, note))
     files.update(_condition_files(
         out, "colour_by_condition", "Coloured-shading metrics by lighting condition",
-        condition_table(scores, samples, columns=COLOUR_COLUMNS), COLOUR_COLUMNS))
+        condition_table(scores, samples, columns=COLOUR_COLUMNS), COLOUR_COLUMNS, note))
     scen_rows = scenario_table(scores)
     scen_cols = ["camera", "method", *_PHOTOMETRIC]
     _write_csv(out / "lmse_by_scenario.csv", scen_rows, scen_cols)
-    md = ["# Reflectance LMSE by photometric scenario (like thesis Table 5.1)", ""]
+    md = _titled("Reflectance LMSE by photometric scenario (like thesis Table 5.1)", note)
     md += [_markdown(scen_rows, scen_cols, scen_cols) if scen_rows
            else "No camera renderings scored: Table 5.1 needs `image_camera/<name>`."]
     (out / "lmse_by_scenario.md").write_text("\n".join(md) + "\n", encoding="utf-8")
@@ -238,7 +248,7 @@ def write_report(
     t32 = table_3_2(scores, samples)
     cols = ["method", "lighting", *(k for k, _, _ in TABLE_3_2_COLUMNS)]
     _write_csv(out / "table_3_2_objects.csv", t32, cols)
-    md = ["# Single objects, like thesis Table 3.2 (MIT-20)", "",
+    md = [*_titled("Single objects, like thesis Table 3.2 (MIT-20)", note),
           "Mean over samples of (grey shading + grey reflectance) / 2, grey = mean over "
           "channels, as the thesis (sec. 3.5); MSE is the scale-invariant MSE (Eq. 2.4).", "",
           _markdown(t32, cols, ["method", "light", *(h for _, _, h in TABLE_3_2_COLUMNS)]) if t32
@@ -249,5 +259,5 @@ def write_report(
     files["methods"] = out / "methods.json"
     write_json(files["methods"], method_parameters(methods), strict=False, default=str, end="")
     files["report"] = out / "REPORT.md"
-    files["report"].write_text(_report_md(methods, inputs, len(samples), files), encoding="utf-8")
+    files["report"].write_text(_report_md(methods, inputs, len(samples), files, note), encoding="utf-8")
     return files
