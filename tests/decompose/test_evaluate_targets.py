@@ -55,7 +55,8 @@ def _run(sample, out, preds: dict[str, Predictions], target: str) -> dict:
 
 def test_the_diffuse_image_is_reflectance_times_shading_plus_residual(dataset):
     """The diffuse target is ``image − specular = reflectance ∘ shading + residual`` (the
-    sample's own identity), and it differs from the full image where the floor and mirror shine."""
+    sample's own identity, in sRGB and per camera), and it differs from the full image where the
+    floor and mirror shine."""
     _, s = dataset
     image = input_image(s)[1]
     diffuse = target_image(s, image, "diffuse")
@@ -63,6 +64,18 @@ def test_the_diffuse_image_is_reflectance_times_shading_plus_residual(dataset):
     tol = FLOAT32_RTOL * np.abs(image).max()
     np.testing.assert_allclose(diffuse, rebuilt, rtol=FLOAT32_RTOL, atol=tol)
     assert np.abs(image - diffuse).max() > 0.1 * np.abs(image).max()
+    cam = next(k.split("/", 1)[1] for k in s if k.startswith("specular_camera/"))
+    image_cam = input_image(s, cam)[1]
+    rebuilt_cam = (
+        np.asarray(s[f"reflectance_camera/{cam}"], np.float64) * s[f"shading_camera/{cam}"]
+        + s[f"residual_camera/{cam}"]
+    )
+    np.testing.assert_allclose(
+        target_image(s, image_cam, "diffuse", cam),
+        rebuilt_cam,
+        rtol=FLOAT32_RTOL,
+        atol=FLOAT32_RTOL * np.abs(image_cam).max(),
+    )
     assert target_image(s, image, "full") is image
     with pytest.raises(DatasetError, match="evaluation target"):
         target_image(s, image, "specular")
