@@ -174,12 +174,12 @@ def _markdown(rows: list[dict[str, Any]], columns: Sequence[str], headers: Seque
 
 def _condition_files(
     out: Path, stem: str, title: str, rows: list[dict[str, Any]],
-    columns: Sequence[tuple[str, str, str, str]],
+    columns: Sequence[tuple[str, str, str, str]], note: str = "",
 ) -> dict[str, Path]:
     keys = [f"{prefix}_{g}" for prefix, *_ in columns for g in _GROUP_ORDER]
     _write_csv(out / f"{stem}.csv", rows, ["scene_kind", "method", *keys])
     layers = sorted({layer for _, layer, _, _ in columns})
-    md = [f"# {title}", "", "Mean over samples; sRGB input. Layers scored:", ""]
+    md = [*_titled(title, note), "Mean over samples; sRGB input. Layers scored:", ""]
     md += [f"* `{layer}`: {SCORED_LAYERS[layer]}" for layer in layers]
     md += [f"* {header}: metric `{metric}` ({METRICS[metric].equation}) of `{layer}`"
            for _, layer, metric, header in columns]
@@ -236,9 +236,16 @@ def _kind_tables(label: str, rows: Sequence[Mapping[str, Any]], columns: list[Co
     return md or ["No samples scored.", ""]
 
 
-def _intro(methods: Mapping[str, Any], inputs: Sequence[str], samples: Mapping[str, tuple[str, str]]) -> list[str]:
+def _titled(title: str, note: str) -> list[str]:
+    """A markdown title and, when there is one, the evaluation target's note below it."""
+    return [f"# {title}", "", note, ""] if note else [f"# {title}", ""]
+
+
+def _intro(
+    methods: Mapping[str, Any], inputs: Sequence[str], samples: Mapping[str, tuple[str, str]], note: str
+) -> list[str]:
     kinds = [k for k, _ in samples.values()]
-    return ["# Evaluation report", "",
+    return [*_titled("Evaluation report", note),
             f"{len(samples)} samples ({kinds.count('object')} single objects, "
             f"{kinds.count('complex')} complex-scene views); input decomposed: "
             + ", ".join(f"`{k}`" for k in inputs) + f" (the first of {list(INPUT_LAYERS)} each "
@@ -249,11 +256,11 @@ def _intro(methods: Mapping[str, Any], inputs: Sequence[str], samples: Mapping[s
 
 def _report_md(
     methods: Mapping[str, Any], inputs: Sequence[str], samples: Mapping[str, tuple[str, str]],
-    tables: Mapping[str, list[dict[str, Any]]], files: Mapping[str, Path],
+    tables: Mapping[str, list[dict[str, Any]]], files: Mapping[str, Path], note: str = "",
 ) -> str:
     summary = tables["summary"]
     conds = [k for k in (summary[0] if summary else {}) if k != "method"]
-    md = _intro(methods, inputs, samples)
+    md = _intro(methods, inputs, samples, note)
     md += ["## Summary: reflectance LMSE by method and lighting condition", ""]
     md += [markdown_table(summary, [Column("method", "method"), *(Column(c, c, "lower") for c in conds)]),
            "", f"![Reflectance LMSE, method x lighting condition]({SUMMARY_FIGURE})", ""] if summary \
@@ -299,17 +306,51 @@ def _methods_md(methods: Mapping[str, Any]) -> list[str]:
     return md + [""]
 
 
+def _scenario_files(out: Path, rows: list[dict[str, Any]], note: str) -> dict[str, Path]:
+    cols = ["camera", "method", *_PHOTOMETRIC]
+    _write_csv(out / "lmse_by_scenario.csv", rows, cols)
+    md = _titled("Reflectance LMSE by photometric scenario (like thesis Table 5.1)", note)
+    md += [_markdown(rows, cols, cols) if rows
+           else "No camera renderings scored: Table 5.1 needs `image_camera/<name>`."]
+    (out / "lmse_by_scenario.md").write_text("\n".join(md) + "\n", encoding="utf-8")
+    return {"scenario_csv": out / "lmse_by_scenario.csv", "scenario_md": out / "lmse_by_scenario.md"}
+
+
+def _t32_files(out: Path, t32: list[dict[str, Any]], note: str) -> dict[str, Path]:
+    cols = ["method", "lighting", *(k for k, _, _ in TABLE_3_2_COLUMNS)]
+    _write_csv(out / "table_3_2_objects.csv", t32, cols)
+    md = [*_titled("Single objects, like thesis Table 3.2 (MIT-20)", note),
+          "Mean over samples of (grey shading + grey reflectance) / 2, grey = mean over "
+          "channels, as the thesis (sec. 3.5); MSE is the scale-invariant MSE (Eq. 2.4).", "",
+          _markdown(t32, cols, ["method", "light", *(h for _, _, h in TABLE_3_2_COLUMNS)]) if t32
+          else "No single-object samples scored."]
+    (out / "table_3_2_objects.md").write_text("\n".join(md) + "\n", encoding="utf-8")
+    return {"table_3_2_csv": out / "table_3_2_objects.csv", "table_3_2_md": out / "table_3_2_objects.md"}
+
+
+def _summary_files(out: Path, summary: list[dict[str, Any]]) -> dict[str, Path]:
+    if not summary:
+        return {}
+    conds = [k for k in summary[0] if k != "method"]
+    _write_csv(out / "summary_by_condition.csv", summary, ["method", *conds])
+    summary_heatmap(out / SUMMARY_FIGURE, summary, conds,
+                    title="Reflectance LMSE (lower is better), mean over samples")
+    return {"summary_csv": out / "summary_by_condition.csv"}
+
+
 def write_report(
     out: Path,
     scores: Sequence[Score],
     samples: Mapping[str, tuple[str, str]],
     methods: Mapping[str, Any],
     inputs: Sequence[str],
+    note: str = "",
 ) -> dict[str, Path]:
     """Write ``scores.csv``, the summary, condition and scenario tables, ``methods.json``, the
     summary figure (:data:`~spectrinsic.decompose.report_figure.SUMMARY_FIGURE`) and
     ``REPORT.md``, which holds every table's numbers inline
-    (:mod:`spectrinsic.decompose.report_md`)."""
+    (:mod:`spectrinsic.decompose.report_md`). *note*
+    (:func:`spectrinsic.decompose.targets.target_note`) is printed under every title."""
     files: dict[str, Path] = {"scores": out / "scores.csv"}
     _write_csv(files["scores"], [
         {"sample": s.sample, "method": s.method, "scenario": s.scenario, "layer": s.layer,
@@ -319,39 +360,17 @@ def write_report(
               "lmse": condition_table(scores, samples, columns=LMSE_COLUMNS),
               "colour": condition_table(scores, samples, columns=COLOUR_COLUMNS),
               "scenario": scenario_table(scores), "t32": table_3_2(scores, samples)}
-    if tables["summary"]:
-        conds = [k for k in tables["summary"][0] if k != "method"]
-        _write_csv(out / "summary_by_condition.csv", tables["summary"], ["method", *conds])
-        files["summary_csv"] = out / "summary_by_condition.csv"
-        summary_heatmap(out / SUMMARY_FIGURE, tables["summary"], conds,
-                        title="Reflectance LMSE (lower is better), mean over samples")
+    files.update(_summary_files(out, tables["summary"]))
     files.update(_condition_files(
         out, "lmse_by_condition", "LMSE by lighting condition (like thesis Tables 5.3 and 5.4)",
-        tables["lmse"], LMSE_COLUMNS))
+        tables["lmse"], LMSE_COLUMNS, note))
     files.update(_condition_files(
         out, "colour_by_condition", "Coloured-shading metrics by lighting condition",
-        tables["colour"], COLOUR_COLUMNS))
-    scen_rows = tables["scenario"]
-    scen_cols = ["camera", "method", *_PHOTOMETRIC]
-    _write_csv(out / "lmse_by_scenario.csv", scen_rows, scen_cols)
-    md = ["# Reflectance LMSE by photometric scenario (like thesis Table 5.1)", ""]
-    md += [_markdown(scen_rows, scen_cols, scen_cols) if scen_rows
-           else "No camera renderings scored: Table 5.1 needs `image_camera/<name>`."]
-    (out / "lmse_by_scenario.md").write_text("\n".join(md) + "\n", encoding="utf-8")
-    files.update(scenario_csv=out / "lmse_by_scenario.csv", scenario_md=out / "lmse_by_scenario.md")
-    t32 = tables["t32"]
-    cols = ["method", "lighting", *(k for k, _, _ in TABLE_3_2_COLUMNS)]
-    _write_csv(out / "table_3_2_objects.csv", t32, cols)
-    md = ["# Single objects, like thesis Table 3.2 (MIT-20)", "",
-          "Mean over samples of (grey shading + grey reflectance) / 2, grey = mean over "
-          "channels, as the thesis (sec. 3.5); MSE is the scale-invariant MSE (Eq. 2.4).", "",
-          _markdown(t32, cols, ["method", "light", *(h for _, _, h in TABLE_3_2_COLUMNS)]) if t32
-          else "No single-object samples scored."]
-    (out / "table_3_2_objects.md").write_text("\n".join(md) + "\n", encoding="utf-8")
-    files.update(table_3_2_csv=out / "table_3_2_objects.csv",
-                 table_3_2_md=out / "table_3_2_objects.md")
+        tables["colour"], COLOUR_COLUMNS, note))
+    files.update(_scenario_files(out, tables["scenario"], note))
+    files.update(_t32_files(out, tables["t32"], note))
     files["methods"] = out / "methods.json"
     write_json(files["methods"], method_parameters(methods), strict=False, default=str, end="")
     files["report"] = out / "REPORT.md"
-    files["report"].write_text(_report_md(methods, inputs, samples, tables, files), encoding="utf-8")
+    files["report"].write_text(_report_md(methods, inputs, samples, tables, files, note), encoding="utf-8")
     return files

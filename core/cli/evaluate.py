@@ -14,6 +14,7 @@ from spectrinsic.decompose.evaluate import evaluate
 from spectrinsic.decompose.mit import evaluate_mit, mit_folder_objects
 from spectrinsic.decompose.predictions import Predictions
 from spectrinsic.decompose.registry import available_decomposers, get_decomposer
+from spectrinsic.decompose.targets import TARGETS
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.loader import load_sample
 from spectrinsic.gt_export.outfolder import output_folder
@@ -61,6 +62,10 @@ def register(subparsers: Any) -> None:
     p.add_argument("--samples", metavar="GLOB", default=None,
                    help="only samples whose id matches one of these comma-separated patterns "
                         "(e.g. 'obj-*')")
+    p.add_argument("--target", choices=TARGETS, default="full",
+                   help="image the methods decompose: the full image, or the diffuse image "
+                        "(image - specular) of glossy samples (full); see "
+                        "spectrinsic.decompose.targets")
     p.add_argument("--seed", type=int, default=0, help="root seed of the WHDR judgements (0)")
     p.add_argument("--no-cameras", action="store_true",
                    help="skip the photometric scenarios on camera renderings (Table 5.1)")
@@ -141,7 +146,7 @@ def _evaluate(args: argparse.Namespace, folders: list[Path], methods: dict[str, 
         result = evaluate(
             (load_sample(f) for f in folders), args.out, methods=methods, seed=args.seed,
             cameras=not args.no_cameras, figures=not args.no_figures,
-            save_estimates=not args.no_estimates, progress=progress,
+            save_estimates=not args.no_estimates, progress=progress, target=args.target,
         )
     finally:
         bar.close()
