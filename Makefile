@@ -5,10 +5,10 @@ BIN      := $(VENV)/bin
 PY       := $(BIN)/python -P
 DEPS     := $(VENV)/.deps-installed
 PKG      := $(VENV)/.pkg-installed
-PACKAGES := core spectra scenes render gt_export decompose
+PACKAGES := core spectra scenes render gt_export decompose pipeline studies bench cli
 # Adding or removing a module changes its folder's mtime: strict editable installs only link
 # the files present at install time, so the package is relinked then.
-PKG_DIRS := $(shell find $(PACKAGES) -type d -not -name __pycache__ 2>/dev/null)
+PKG_DIRS := $(shell find $(addprefix $(CURDIR)/,$(PACKAGES)) -type d -not -name __pycache__ 2>/dev/null)
 # Optional: OUT, PRESET, DATASET, DATA_DIR (spectral data directory, default ../shared/data if present)
 DATA_DIR ?= $(abspath $(firstword $(wildcard ../shared/data)))
 export PYTHONSAFEPATH := 1
@@ -66,11 +66,12 @@ evaluate: $(PKG) ## run the bundled decomposers on DATASET (default: data/datase
 	fi; \
 	$(BIN)/spectrinsic evaluate --dataset "$$dataset" --out results/evaluation
 
-bench: $(PKG) ## benchmarks, written as JSON under bench/
-	$(PY) -m spectrinsic.bench --out bench
+bench: $(PKG) ## benchmarks, written as JSON under results/bench/
+	$(PY) -m spectrinsic.bench --out results/bench
 
-lint: $(PKG) ## ruff (the package folders and tests/) and mypy; .ci/run runs it before the tests
+lint: $(PKG) ## ruff's rules and formatter check (the package folders and tests/) and mypy; .ci/run runs it before the tests
 	$(BIN)/ruff check $(PACKAGES) tests
+	$(BIN)/ruff format --check $(PACKAGES) tests
 	$(BIN)/mypy -p spectrinsic
 
 info: $(PKG) ## versions, usable Mitsuba variants, data directories

@@ -59,7 +59,10 @@ def interrupts_reach_python() -> Iterator[None]:
     Call it in the main thread before any thread is started, so that all of them inherit the
     block (threads started earlier could still receive SIGINT and run a library's handler).
     """
-    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+    if (
+        not hasattr(signal, "pthread_sigmask")
+        or threading.current_thread() is not threading.main_thread()
+    ):
         yield
         return
     previous = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGINT)

@@ -16,8 +16,19 @@ __all__ = ["DISTRIBUTIONS", "software_versions", "git_commit", "provenance"]
 
 #: Distributions whose versions shape spectrinsic's outputs.
 DISTRIBUTIONS: tuple[str, ...] = (
-    "spectrinsic", "numpy", "scipy", "colour-science", "luxpy", "mitsuba", "drjit", "OpenEXR",
-    "trimesh", "scikit-image", "gco-wrapper", "matplotlib", "pillow",
+    "spectrinsic",
+    "numpy",
+    "scipy",
+    "colour-science",
+    "luxpy",
+    "mitsuba",
+    "drjit",
+    "OpenEXR",
+    "trimesh",
+    "scikit-image",
+    "gco-wrapper",
+    "matplotlib",
+    "pillow",
 )
 
 
@@ -39,8 +50,12 @@ def git_commit() -> str | None:
     """The commit of the source tree spectrinsic runs from, or None outside a git checkout."""
     try:
         sha = subprocess.run(
-            ["git", "rev-parse", "HEAD"], cwd=Path(__file__).resolve().parent,
-            capture_output=True, text=True, timeout=5, check=False,
+            ["git", "rev-parse", "HEAD"],
+            cwd=Path(__file__).resolve().parent,
+            capture_output=True,
+            text=True,
+            timeout=5,
+            check=False,
         ).stdout.strip()
     except (OSError, subprocess.SubprocessError):
         return None

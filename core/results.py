@@ -75,7 +75,10 @@ def write_csv(
         writer.writeheader()
         for row in rows:
             if float_format is not None:
-                row = {k: (format(v, float_format) if isinstance(v, float) else v) for k, v in row.items()}
+                row = {
+                    k: (format(v, float_format) if isinstance(v, float) else v)
+                    for k, v in row.items()
+                }
             writer.writerow(row)
     return path
 

@@ -33,8 +33,10 @@ def grid_edges(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     index[mask] = np.arange(int(mask.sum()))
     pix = np.arange(h * w).reshape(h, w)
     pairs, flats = [], []
-    for a, b in (((slice(0, -1), slice(None)), (slice(1, None), slice(None))),
-                 ((slice(None), slice(0, -1)), (slice(None), slice(1, None)))):
+    for a, b in (
+        ((slice(0, -1), slice(None)), (slice(1, None), slice(None))),
+        ((slice(None), slice(0, -1)), (slice(None), slice(1, None))),
+    ):
         ok = (index[a] >= 0) & (index[b] >= 0)
         pairs.append(np.stack([index[a][ok], index[b][ok]], axis=1))
         flats.append(np.stack([pix[a][ok], pix[b][ok]], axis=1))
@@ -157,6 +159,5 @@ def bounded_minimum(a) -> np.ndarray:
 def _bounded_lsmr(a) -> np.ndarray:
     from scipy.optimize import lsq_linear
 
-    result = lsq_linear(a, np.zeros(a.shape[0]), bounds=(1.0, np.inf), lsq_solver="lsmr",
-                        tol=1e-10)
+    result = lsq_linear(a, np.zeros(a.shape[0]), bounds=(1.0, np.inf), lsq_solver="lsmr", tol=1e-10)
     return np.where(np.isfinite(result.x), result.x, 1.0)

@@ -39,7 +39,17 @@ __all__ = [
 
 #: The 11 basic colour terms, in the order of the thesis' set N (section 3.2.1).
 COLOUR_NAMES: tuple[str, ...] = (
-    "black", "white", "red", "green", "yellow", "blue", "brown", "purple", "orange", "pink", "grey",
+    "black",
+    "white",
+    "red",
+    "green",
+    "yellow",
+    "blue",
+    "brown",
+    "purple",
+    "orange",
+    "pink",
+    "grey",
 )
 _CHROMATIC = ("red", "orange", "brown", "yellow", "green", "blue", "purple", "pink")
 #: Upper L* bounds of the 6 lightness levels of the model (level k: thr[k-1] < L* <= thr[k]).
@@ -101,7 +111,9 @@ def tse_parameters() -> TSEParameters:
 def _check_rgb(values: npt.ArrayLike, what: str) -> npt.NDArray[np.float64]:
     arr = np.asarray(values, dtype=np.float64)
     if arr.ndim < 1 or arr.shape[-1] != 3:
-        raise SpectrinsicError(f"{what} must have a last axis of 3 (R, G, B); got shape {arr.shape}")
+        raise SpectrinsicError(
+            f"{what} must have a last axis of 3 (R, G, B); got shape {arr.shape}"
+        )
     return arr
 
 

@@ -81,5 +81,6 @@ def with_constancy(
     """*result* (made with ``colour_constancy="none"``) as the method would give it with
     *colour_constancy*: the reflectance divided by the light colour, ``shading = image / R``."""
     refl, light = discount_illuminant(
-        np.asarray(result.reflectance, np.float64), image, mask, colour_constancy)
+        np.asarray(result.reflectance, np.float64), image, mask, colour_constancy
+    )
     return finish(np.clip(image, 0.0, None), refl, mask, {**result.info, "light_colour": light})

@@ -176,8 +176,9 @@ def _camera_inputs(sample: Mapping[str, Any], target: str) -> list[tuple[str, st
         }
         for scenario in _PHOTOMETRIC:
             if not available[scenario]:
-                logger.info("sample %s, camera %s: no matrices for %s", _sample_id(sample),
-                            camera, scenario)
+                logger.info(
+                    "sample %s, camera %s: no matrices for %s", _sample_id(sample), camera, scenario
+                )
                 continue
             light = light_cam if scenario == "SC1" else light_srgb
             corrected = photometric_correction(
@@ -214,8 +215,9 @@ def input_image(sample: Mapping[str, Any], camera: str | None = None) -> tuple[s
     For a camera, ``image_camera_denoised/<camera>`` else ``image_camera/<camera>``.
     Returns ``(layer key, float64 array)``.
     """
-    keys = [f"{k.replace('image', 'image_camera', 1)}/{camera}" if camera else k
-            for k in INPUT_LAYERS]
+    keys = [
+        f"{k.replace('image', 'image_camera', 1)}/{camera}" if camera else k for k in INPUT_LAYERS
+    ]
     for key in keys:
         if key in sample:
             return key, np.asarray(sample[key], dtype=np.float64)
@@ -229,15 +231,23 @@ def layer_metrics(layer: str, metrics: Sequence[str] | None = None) -> list[str]
     """
     if layer == "reflectance" and metrics is not None:
         return [get_metric(n).name for n in metrics]
-    defaults = {"shading_grey": _SHADING_GREY_METRICS, "shading": _SHADING_COLOUR_METRICS,
-                "reflectance_grey": _REFLECTANCE_GREY_METRICS, SPECULAR_LAYER: SPECULAR_METRICS}
+    defaults = {
+        "shading_grey": _SHADING_GREY_METRICS,
+        "shading": _SHADING_COLOUR_METRICS,
+        "reflectance_grey": _REFLECTANCE_GREY_METRICS,
+        SPECULAR_LAYER: SPECULAR_METRICS,
+    }
     if layer in defaults:
         return list(defaults[layer])
     return [n for n, m in METRICS.items() if layer in m.layers]
 
 
 def _estimate(
-    method: Decomposer | Predictions, sid: str, scenario: str, image: np.ndarray, mask: np.ndarray,
+    method: Decomposer | Predictions,
+    sid: str,
+    scenario: str,
+    image: np.ndarray,
+    mask: np.ndarray,
     target: str,
 ) -> Decomposition | None:
     if isinstance(method, Predictions):  # a predicted specular is in the full image only
@@ -262,27 +272,42 @@ def _truth(sample: Mapping[str, Any], seed: int, n_judgements: int) -> _Truth:
     grey = sample.get("shading_grey")
     mask = evaluation_mask(sample)
     judgements = sample_judgements(
-        reflectance, seed=seed_from_key(seed, sid), n_pairs=n_judgements, mask=mask,
-        material_ids=_material_ids(sample), delta=WHDR_DELTA,
+        reflectance,
+        seed=seed_from_key(seed, sid),
+        n_pairs=n_judgements,
+        mask=mask,
+        material_ids=_material_ids(sample),
+        delta=WHDR_DELTA,
     )
-    layers = {"reflectance": reflectance, "shading": colour,
-              "shading_grey": _grey(colour if grey is None else grey),
-              "reflectance_grey": _grey(reflectance)}
+    layers = {
+        "reflectance": reflectance,
+        "shading": colour,
+        "shading_grey": _grey(colour if grey is None else grey),
+        "reflectance_grey": _grey(reflectance),
+    }
     if SPECULAR_LAYER in sample:
         layers[SPECULAR_LAYER] = np.asarray(sample[SPECULAR_LAYER], dtype=np.float64)
     return _Truth(sid, mask, layers, judgements)
 
 
 def _score(
-    truth: _Truth, result: Decomposition, method: str, scenario: str, names: Sequence[str],
-    camera: str = "", photometric: str = "",
+    truth: _Truth,
+    result: Decomposition,
+    method: str,
+    scenario: str,
+    names: Sequence[str],
+    camera: str = "",
+    photometric: str = "",
 ) -> list[Score]:
     """Scores of one estimate: reflectance always, shading (grey and colour) for sRGB input."""
     extra = {"camera": camera, "photometric": photometric}
     estimates = {"reflectance": result.reflectance}
     if scenario == "srgb":
-        estimates.update(shading=result.shading, shading_grey=_grey(result.shading),
-                         reflectance_grey=_grey(result.reflectance))
+        estimates.update(
+            shading=result.shading,
+            shading_grey=_grey(result.shading),
+            reflectance_grey=_grey(result.reflectance),
+        )
         if result.specular is not None and SPECULAR_LAYER in truth.layers:
             estimates[SPECULAR_LAYER] = result.specular
     out = []
@@ -290,8 +315,17 @@ def _score(
         which = names if layer == "reflectance" else layer_metrics(layer)
         for metric, value in _layer_scores(truth.layers[layer], est, truth.mask, which).items():
             out.append(Score(truth.sid, method, scenario, layer, metric, value, **extra))
-    out.append(Score(truth.sid, method, scenario, "reflectance", "whdr",
-                     whdr(result.reflectance, truth.judgements), **extra))
+    out.append(
+        Score(
+            truth.sid,
+            method,
+            scenario,
+            "reflectance",
+            "whdr",
+            whdr(result.reflectance, truth.judgements),
+            **extra,
+        )
+    )
     return out
 
 
@@ -335,8 +369,10 @@ def evaluate_sample(
     image = target_image(sample, input_image(sample)[1], target)
     inputs: list[tuple[str, str, str, np.ndarray]] = [("srgb", "", "", image)]
     if cameras:
-        inputs += [(f"{sc}_{camera_slug(cam)}", cam, sc, img)
-                   for cam, sc, img in _camera_inputs(sample, target)]
+        inputs += [
+            (f"{sc}_{camera_slug(cam)}", cam, sc, img)
+            for cam, sc, img in _camera_inputs(sample, target)
+        ]
     scores: list[Score] = []
     figure_rows: list[tuple[str, Decomposition]] = []
     for method, decomposer in methods.items():
@@ -350,8 +386,14 @@ def evaluate_sample(
             if save_estimates and out_dir is not None and not isinstance(decomposer, Predictions):
                 _write_estimate(Path(out_dir) / "estimates" / method / scenario / truth.sid, result)
     if out_dir is not None and figure:
-        _figure(Path(out_dir) / "figures" / f"{truth.sid}.png", truth.sid, inputs[0][3],
-                truth.layers["reflectance"], truth.layers["shading"], figure_rows)
+        _figure(
+            Path(out_dir) / "figures" / f"{truth.sid}.png",
+            truth.sid,
+            inputs[0][3],
+            truth.layers["reflectance"],
+            truth.layers["shading"],
+            figure_rows,
+        )
     return scores
 
 
@@ -372,8 +414,9 @@ def _figure(path: Path, sid: str, image, reflectance, shading, rows) -> None:
     fig = Figure(figsize=(7.5, 2.4 * len(panels)))
     axes = fig.subplots(len(panels), 3, squeeze=False)
     for row, (label, img, refl, shad) in enumerate(panels):
-        for col, (title, data) in enumerate((("input", img), ("reflectance", refl),
-                                             ("shading", shad))):
+        for col, (title, data) in enumerate(
+            (("input", img), ("reflectance", refl), ("shading", shad))
+        ):
             ax = axes[row, col]
             ax.set_axis_off()
             if data is not None:
@@ -437,14 +480,22 @@ def evaluate(
         samples_info[sid] = (sample_kind(sample), sample_condition(sample))
         inputs.add(input_image(sample)[0])
         scores += evaluate_sample(
-            sample, methods, seed=seed, metrics=metrics, n_judgements=n_judgements,
-            out_dir=out, cameras=cameras, figure=figures, save_estimates=save_estimates,
+            sample,
+            methods,
+            seed=seed,
+            metrics=metrics,
+            n_judgements=n_judgements,
+            out_dir=out,
+            cameras=cameras,
+            figure=figures,
+            save_estimates=save_estimates,
             target=target,
         )
         if progress is not None:
             progress(sid)
     if not scores:
         raise DatasetError("no samples to evaluate")
-    files = write_report(out, scores, samples_info, methods, sorted(inputs),
-                         note=target_note(target, glossy))
+    files = write_report(
+        out, scores, samples_info, methods, sorted(inputs), note=target_note(target, glossy)
+    )
     return EvaluationResult(tuple(scores), files)

@@ -53,9 +53,7 @@ logger = logging.getLogger(__name__)
 WHDR_DELTA = 0.10
 
 
-def whdr(
-    reflectance: npt.ArrayLike, judgements: Judgements, *, delta: float = WHDR_DELTA
-) -> float:
+def whdr(reflectance: npt.ArrayLike, judgements: Judgements, *, delta: float = WHDR_DELTA) -> float:
     """Weighted human disagreement rate, thesis Eqs. 2.12-2.13 (Bell et al. 2014).
 
     Each judgement compares points 1 and 2; the estimate predicts ``1`` (point 1 darker) when
@@ -121,14 +119,31 @@ METRICS: Mapping[str, Metric] = {
         Metric("lcorr", local_correlation, "Eq. 2.8", "higher", True),
         Metric("dssim", dssim, "Eq. 2.11", "lower", True),
         Metric("angular_mean", angular_error_mean, "Eq. 4.31", "lower", True, ("reflectance",)),
-        Metric("angular_median", angular_error_median, "Eq. 4.31", "lower", True,
-               ("reflectance",)),
-        Metric("intensity_error", reflectance_intensity_error, "MAW intensity (Wu et al. 2023)",
-               "lower", True, ("reflectance",)),
-        Metric("chromaticity_error", reflectance_chromaticity_error,
-               "MAW chromaticity (Wu et al. 2023), Eq. 4.31", "lower", True, ("reflectance",)),
-        Metric("shading_chromaticity", shading_chromaticity_error, "Eq. 4.31 on shading",
-               "lower", True, ("shading",)),
+        Metric("angular_median", angular_error_median, "Eq. 4.31", "lower", True, ("reflectance",)),
+        Metric(
+            "intensity_error",
+            reflectance_intensity_error,
+            "MAW intensity (Wu et al. 2023)",
+            "lower",
+            True,
+            ("reflectance",),
+        ),
+        Metric(
+            "chromaticity_error",
+            reflectance_chromaticity_error,
+            "MAW chromaticity (Wu et al. 2023), Eq. 4.31",
+            "lower",
+            True,
+            ("reflectance",),
+        ),
+        Metric(
+            "shading_chromaticity",
+            shading_chromaticity_error,
+            "Eq. 4.31 on shading",
+            "lower",
+            True,
+            ("shading",),
+        ),
     )
 }
 

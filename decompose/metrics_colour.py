@@ -177,5 +177,7 @@ def reflectance_chromaticity_error(
     """
     t, e, m = image_pair(truth, estimate, mask)
     if t.shape[2] != 3:
-        raise ImageShapeError(f"reflectance chromaticity error needs (H, W, 3) images; got {t.shape}")
+        raise ImageShapeError(
+            f"reflectance chromaticity error needs (H, W, 3) images; got {t.shape}"
+        )
     return shading_chromaticity_error(t, e, mask=m, statistic=statistic)

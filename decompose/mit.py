@@ -128,14 +128,17 @@ def load_mit_object(path: Path) -> MitObject:
         raise DatasetError(f"MIT object {str(path)!r} is not a readable .npz: {exc}") from exc
     missing = [k for k in ARRAYS if k not in arrays]
     if missing:
-        raise DatasetError(f"MIT object {str(path)!r} lacks {', '.join(missing)} "
-                           f"(expected {', '.join(ARRAYS)})")
+        raise DatasetError(
+            f"MIT object {str(path)!r} lacks {', '.join(missing)} (expected {', '.join(ARRAYS)})"
+        )
     shape = arrays["mask"].shape
     for key, rank in ARRAYS.items():
         a = arrays[key]
         if a.ndim != rank or a.shape[:2] != shape or (rank == 3 and a.shape[2] != 3):
-            raise DatasetError(f"MIT object {str(path)!r}: {key} has shape {a.shape}; expected "
-                               f"{shape + ((3,) if rank == 3 else ())}")
+            raise DatasetError(
+                f"MIT object {str(path)!r}: {key} has shape {a.shape}; expected "
+                f"{shape + ((3,) if rank == 3 else ())}"
+            )
     mask = arrays["mask"].astype(bool)
     if not mask.any():
         raise DatasetError(f"MIT object {str(path)!r}: the mask selects no pixel")
@@ -143,8 +146,13 @@ def load_mit_object(path: Path) -> MitObject:
     def unit(a: np.ndarray) -> np.ndarray:
         return np.asarray(a, dtype=np.float64) / _FULL_SCALE
 
-    return MitObject(path.stem, unit(arrays["diffuse"]), unit(arrays["reflectance"]),
-                     unit(arrays["shading"]), mask)
+    return MitObject(
+        path.stem,
+        unit(arrays["diffuse"]),
+        unit(arrays["reflectance"]),
+        unit(arrays["shading"]),
+        mask,
+    )
 
 
 def mit_folder_objects(folder: Path, patterns: Iterable[str] | None = None) -> list[Path]:
@@ -156,8 +164,10 @@ def mit_folder_objects(folder: Path, patterns: Iterable[str] | None = None) -> l
     """
     folder = Path(folder)
     if not folder.is_dir():
-        raise DatasetError(f"MIT folder {str(folder)!r} does not exist (expected a folder of "
-                           f"<object>.npz files, e.g. $SPECTRINSIC_DATA/mit_intrinsic_dev)")
+        raise DatasetError(
+            f"MIT folder {str(folder)!r} does not exist (expected a folder of "
+            f"<object>.npz files, e.g. $SPECTRINSIC_DATA/mit_intrinsic_dev)"
+        )
     files = sorted(p for p in folder.glob("*.npz") if p.is_file())
     if not files:
         raise DatasetError(f"MIT folder {str(folder)!r} holds no <object>.npz file")
@@ -166,8 +176,10 @@ def mit_folder_objects(folder: Path, patterns: Iterable[str] | None = None) -> l
     globs = list(patterns)
     chosen = [p for p in files if any(fnmatch.fnmatchcase(p.stem, g) for g in globs)]
     if not chosen:
-        raise DatasetError(f"no object of MIT folder {str(folder)!r} matches "
-                           f"{', '.join(globs)}; it holds {', '.join(p.stem for p in files)}")
+        raise DatasetError(
+            f"no object of MIT folder {str(folder)!r} matches "
+            f"{', '.join(globs)}; it holds {', '.join(p.stem for p in files)}"
+        )
     return chosen
 
 
@@ -182,8 +194,10 @@ def mit_measures(obj: MitObject, result: Decomposition) -> dict[str, float]:
     m = obj.mask
     pairs = {
         "shading": (obj.shading, np.asarray(result.shading, np.float64).mean(axis=2)),
-        "reflectance": (obj.reflectance.mean(axis=2),
-                        np.asarray(result.reflectance, np.float64).mean(axis=2)),
+        "reflectance": (
+            obj.reflectance.mean(axis=2),
+            np.asarray(result.reflectance, np.float64).mean(axis=2),
+        ),
     }
     out: dict[str, float] = {}
     for layer, (truth, raw) in pairs.items():
@@ -248,7 +262,8 @@ def mit_table(scores: Iterable[MitScore]) -> list[dict[str, Any]]:
             row[measure] = float(np.mean(finite)) if finite else float("nan")
         if baseline is not None:
             row["beats_baseline"] = sum(
-                1 for o, v in objects.items() if o in baseline and v["lmse"] < baseline[o]["lmse"])
+                1 for o, v in objects.items() if o in baseline and v["lmse"] < baseline[o]["lmse"]
+            )
         rows.append(row)
     return rows
 
@@ -266,8 +281,9 @@ def evaluate_mit(
 
     scores = list(score_mit(files, methods, progress=progress))
     out = Path(out)
-    per_object = [{"method": s.method, "object": s.obj, **s.values, "seconds": s.seconds}
-                  for s in scores]
+    per_object = [
+        {"method": s.method, "object": s.obj, **s.values, "seconds": s.seconds} for s in scores
+    ]
     rows = mit_table(scores)
     files_out = {
         "scores": write_csv(out / "mit_scores.csv", per_object, float_format=".6g"),
@@ -283,7 +299,9 @@ def mit_markdown(rows: Iterable[Mapping[str, Any]]) -> str:
     """Thesis Table 3.2 layout of :func:`mit_table` rows (LMSE is the MIT score)."""
     rows = list(rows)
     extra = any("beats_baseline" in r for r in rows)
-    head = "| method | objects | Corr. | MSE | LMSE | aLMSE |" + (" beats baseline |" if extra else "")
+    head = "| method | objects | Corr. | MSE | LMSE | aLMSE |" + (
+        " beats baseline |" if extra else ""
+    )
     lines = [head, "|---" * (head.count("|") - 1) + "|"]
     for r in rows:
         cells = [r["method"], str(r["objects"])] + [f"{r[m]:.4f}" for m in MEASURES]

@@ -231,10 +231,17 @@ class NamesAndShades:
         of equal label only, no colour constancy, alpha-expansion to convergence, RAD ridges
         (sec. 3.2.2; its creaseness and scale, which the thesis does not give, as the defaults).
         """
-        return cls(gamma_over_alpha=100.0, gamma_over_beta=2.0, mu=1.0 / 3.0,
-                   reflectance_colour="label-centroid", split_by_ridge=False,
-                   colour_constancy="none", expansion_cycles=-1, ridge_detector="rad",
-                   name="names-shades-thesis")
+        return cls(
+            gamma_over_alpha=100.0,
+            gamma_over_beta=2.0,
+            mu=1.0 / 3.0,
+            reflectance_colour="label-centroid",
+            split_by_ridge=False,
+            colour_constancy="none",
+            expansion_cycles=-1,
+            ridge_detector="rad",
+            name="names-shades-thesis",
+        )
 
     def __call__(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Decomposition:
         """Decompose a linear ``(H, W, 3)`` image into reflectance and shading.
@@ -247,11 +254,14 @@ class NamesAndShades:
     def labelling(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Labelling:
         """Steps 1-3 (names, shades, MRF) of a linear ``(H, W, 3)`` image (:class:`Labelling`)."""
         validate_choice(
-            self.reflectance_colour, ("label-centroid", "region-mean"), "reflectance_colour",
+            self.reflectance_colour,
+            ("label-centroid", "region-mean"),
+            "reflectance_colour",
             error=DecomposeError,
         )
-        validate_choice(self.ridge_detector, RIDGE_DETECTORS, "ridge_detector",
-                        error=DecomposeError)
+        validate_choice(
+            self.ridge_detector, RIDGE_DETECTORS, "ridge_detector", error=DecomposeError
+        )
         gco = _import_gco()
         t0 = time.perf_counter()
         img, m = prepare_input(image, mask)
@@ -265,8 +275,13 @@ class NamesAndShades:
 
         # 2. colour shades on the log image
         log_colours = np.log(np.maximum(pixels, _LOG_FLOOR))
-        shades = colour_shades(log_colours, bins=self.bins, sigma=self.sigma,
-                               detector=self.ridge_detector, creaseness=self.creaseness)
+        shades = colour_shades(
+            log_colours,
+            bins=self.bins,
+            sigma=self.sigma,
+            detector=self.ridge_detector,
+            creaseness=self.creaseness,
+        )
         t2 = time.perf_counter()
 
         # 3. MRF (Eq. 3.4) by alpha-expansion
@@ -285,8 +300,9 @@ class NamesAndShades:
         """
         t3 = time.perf_counter()
         m, linear = stages.mask, stages.linear
-        regions, colours = self._regions(m, stages.labels, stages.candidates, stages.shades,
-                                         stages.pixels)
+        regions, colours = self._regions(
+            m, stages.labels, stages.candidates, stages.shades, stages.pixels
+        )
         n_regions = int(regions.max())
         if self.global_coherence:
             lam = global_coherence(regions, colours.mean(axis=1), linear.mean(axis=2))
@@ -329,15 +345,17 @@ class NamesAndShades:
         Eq. 3.4 by alpha-expansion; the observations themselves if there is nothing to cut."""
         unary = self.mu * distance[y]
         if distance.shape[0] > 1 and edges.shape[0] > 0:
-            return np.asarray(gco.cut_general_graph(
-                edges,
-                (1.0 - self.mu) * weights,
-                unary,
-                distance,
-                n_iter=self.expansion_cycles,
-                algorithm="expansion",
-                init_labels=y.astype(np.int32),
-            ))
+            return np.asarray(
+                gco.cut_general_graph(
+                    edges,
+                    (1.0 - self.mu) * weights,
+                    unary,
+                    distance,
+                    n_iter=self.expansion_cycles,
+                    algorithm="expansion",
+                    init_labels=y.astype(np.int32),
+                )
+            )
         return np.asarray(y)
 
     def _regions(
@@ -360,10 +378,16 @@ class NamesAndShades:
         n_regions = int(regions.max())
         region_of_pixel = regions[m]
         counts = np.bincount(region_of_pixel, minlength=n_regions + 1).astype(np.float64)
-        mean_colour = np.stack(
-            [np.bincount(region_of_pixel, weights=pixels[:, c], minlength=n_regions + 1)
-             for c in range(3)], axis=1,
-        ) / np.maximum(counts, 1.0)[:, None]
+        mean_colour = (
+            np.stack(
+                [
+                    np.bincount(region_of_pixel, weights=pixels[:, c], minlength=n_regions + 1)
+                    for c in range(3)
+                ],
+                axis=1,
+            )
+            / np.maximum(counts, 1.0)[:, None]
+        )
         region_label = np.zeros(n_regions + 1, dtype=np.int64)
         region_label[region_of_pixel] = candidates[labels]
         if self.reflectance_colour == "label-centroid":

@@ -47,8 +47,14 @@ from spectrinsic.gt_export.exr import exr_size, read_exr, write_exr
 from spectrinsic.gt_export.png import PNG16_MAX, png_size, read_png16, write_png16
 from spectrinsic.spectra.colorimetry import decode_srgb, encode_srgb
 
-__all__ = ["PNG_ENCODINGS", "PREDICTION_FORMATS", "Predictions", "PredictionFiles", "read_layer",
-           "write_predictions"]
+__all__ = [
+    "PNG_ENCODINGS",
+    "PREDICTION_FORMATS",
+    "Predictions",
+    "PredictionFiles",
+    "read_layer",
+    "write_predictions",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -87,14 +93,20 @@ def _check_header_size(path: Path, layer: str, shape: tuple[int, int]) -> None:
     else:
         (height, width), channels = png_size(path), 0
     if (height, width) != tuple(shape):
-        raise DatasetError(f"{path}: expected a {layer} image of shape {(*shape, 3)}; its header "
-                           f"declares {width}x{height} pixels (refused before decoding)")
+        raise DatasetError(
+            f"{path}: expected a {layer} image of shape {(*shape, 3)}; its header "
+            f"declares {width}x{height} pixels (refused before decoding)"
+        )
     if channels > MAX_CHANNELS:
-        raise DatasetError(f"{path}: its header declares {channels} channels; expected a {layer} "
-                           f"image of at most {MAX_CHANNELS}")
+        raise DatasetError(
+            f"{path}: its header declares {channels} channels; expected a {layer} "
+            f"image of at most {MAX_CHANNELS}"
+        )
 
 
-def read_layer(folder: Path, layer: str, shape: tuple[int, int], *, encoding: str) -> np.ndarray | None:
+def read_layer(
+    folder: Path, layer: str, shape: tuple[int, int], *, encoding: str
+) -> np.ndarray | None:
     """Read ``folder/<layer>.exr`` (else ``.png``) as float64 ``(H, W, 3)``; None when absent.
 
     A grey shading (one channel) is repeated to 3 channels. Raises :class:`DatasetError` for a
@@ -158,7 +170,12 @@ class Predictions:
         return base if scenario == "srgb" else base / scenario
 
     def load(
-        self, sample_id: str, scenario: str, image: np.ndarray, mask: np.ndarray, *,
+        self,
+        sample_id: str,
+        scenario: str,
+        image: np.ndarray,
+        mask: np.ndarray,
+        *,
         subtract_specular: bool = True,
     ) -> Decomposition | None:
         """The estimate of one sample and scenario, completed from *image* (module docstring).
@@ -191,9 +208,12 @@ class Predictions:
         spec32 = None if spec is None else np.where(m, spec, 0.0).astype(np.float32)
         if shad is None:
             return replace(finish(img, refl, mask, {"source": str(folder)}), specular=spec32)
-        return Decomposition(np.where(m, refl, 0.0).astype(np.float32),
-                             np.where(m, shad, 0.0).astype(np.float32), {"source": str(folder)},
-                             spec32)
+        return Decomposition(
+            np.where(m, refl, 0.0).astype(np.float32),
+            np.where(m, shad, 0.0).astype(np.float32),
+            {"source": str(folder)},
+            spec32,
+        )
 
 
 @dataclass(frozen=True)
@@ -218,10 +238,18 @@ class PredictionFiles:
 
 def _plain_name(value: str, what: str) -> str:
     """*value* if it is one folder name (no separator, not ``.``/``..``), else a DatasetError."""
-    if not isinstance(value, str) or not value or value in (".", "..") or "/" in value \
-            or "\\" in value or os.sep in value:
-        raise DatasetError(f"write_predictions: {what} {value!r}; expected one folder name, "
-                           "e.g. 'room-living__v1__white'")
+    if (
+        not isinstance(value, str)
+        or not value
+        or value in (".", "..")
+        or "/" in value
+        or "\\" in value
+        or os.sep in value
+    ):
+        raise DatasetError(
+            f"write_predictions: {what} {value!r}; expected one folder name, "
+            "e.g. 'room-living__v1__white'"
+        )
     return value
 
 
@@ -231,8 +259,10 @@ def _layer_values(layer: str, values: np.ndarray) -> np.ndarray:
     if arr.ndim == 3 and arr.shape[2] == 1 and layer == "shading":
         arr = arr[:, :, 0]
     if not (arr.ndim == 3 and arr.shape[2] == 3) and not (arr.ndim == 2 and layer == "shading"):
-        raise DatasetError(f"write_predictions: {layer} of shape {arr.shape}; expected (H, W, 3)"
-                           + (" or (H, W)" if layer == "shading" else ""))
+        raise DatasetError(
+            f"write_predictions: {layer} of shape {arr.shape}; expected (H, W, 3)"
+            + (" or (H, W)" if layer == "shading" else "")
+        )
     if not np.all(np.isfinite(arr)):
         raise DatasetError(f"write_predictions: {layer} contains NaN or Inf values")
     return arr
@@ -320,14 +350,16 @@ def write_predictions(
         if target.exists() and not overwrite:
             raise DatasetError(f"{target} exists; pass overwrite=True to replace it")
         if fmt == "png" and hider.exists():
-            raise DatasetError(f"{hider} exists and the reader prefers it to {target.name}; "
-                               "remove it or write EXR")
+            raise DatasetError(
+                f"{hider} exists and the reader prefers it to {target.name}; remove it or write EXR"
+            )
     folder.mkdir(parents=True, exist_ok=True)
     return PredictionFiles(folder, *_write_layers(folder, arrays, fmt, encoding))
 
 
-def _write_layers(folder: Path, arrays: Mapping[str, np.ndarray], fmt: str,
-                  encoding: str) -> tuple[dict[str, Path], dict[str, float]]:
+def _write_layers(
+    folder: Path, arrays: Mapping[str, np.ndarray], fmt: str, encoding: str
+) -> tuple[dict[str, Path], dict[str, float]]:
     files, scales = {}, {}
     for name, arr in arrays.items():
         if fmt == "exr":

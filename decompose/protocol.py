@@ -27,8 +27,15 @@ from spectrinsic.decompose.metrics_scale import lmse
 from spectrinsic.errors import SpectrinsicError
 from spectrinsic.scenes.sample_id import SampleId
 
-__all__ = ["Fold", "HoldOutResult", "grid_points", "hold_one_out", "mit_sample_score",
-           "scene_group", "score_grid"]
+__all__ = [
+    "Fold",
+    "HoldOutResult",
+    "grid_points",
+    "hold_one_out",
+    "mit_sample_score",
+    "scene_group",
+    "score_grid",
+]
 
 #: A grid point: sorted ``(parameter, value)`` pairs (hashable).
 GridPoint = tuple[tuple[str, Any], ...]
@@ -44,8 +51,10 @@ def scene_group(sample_id: str) -> str:
 def grid_points(grid: Mapping[str, Sequence[Any]]) -> list[GridPoint]:
     """Every combination of the *grid*'s values, as sorted ``(name, value)`` tuples."""
     names = sorted(grid)
-    return [tuple(zip(names, values, strict=True))
-            for values in itertools.product(*(grid[n] for n in names))]
+    return [
+        tuple(zip(names, values, strict=True))
+        for values in itertools.product(*(grid[n] for n in names))
+    ]
 
 
 def mit_sample_score(sample: Mapping[str, Any], mask: np.ndarray, result: Decomposition) -> float:
@@ -76,7 +85,8 @@ def score_grid(
     extra = grid_points(post_grid) if post_grid else [()]
     decomposers = {p: make(**dict(p)) for p in points}
     table: dict[GridPoint, dict[str, float]] = {
-        tuple(sorted(p + e)): {} for p in points for e in extra}
+        tuple(sorted(p + e)): {} for p in points for e in extra
+    }
     for sid, sample, image, mask in samples:
         for p, decomposer in decomposers.items():
             result = decomposer(image, mask)

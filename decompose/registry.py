@@ -102,7 +102,8 @@ def _check_parameters(name: str, factory: Callable[..., Any], params: Mapping[st
     except (TypeError, ValueError):  # some builtins and extension types have none
         return
     accepted = [
-        p.name for p in signature.parameters.values()
+        p.name
+        for p in signature.parameters.values()
         if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
     ]
     if any(p.kind is p.VAR_KEYWORD for p in signature.parameters.values()):
@@ -132,8 +133,9 @@ def get_decomposer(name: str, **params: Any) -> Decomposer:
     _check_parameters(name, factory, params)
     decomposer = factory(**params)
     if not callable(decomposer):
-        raise PluginError(f"decomposer {name!r}: its factory returned a non-callable "
-                          f"{type(decomposer).__name__}")
+        raise PluginError(
+            f"decomposer {name!r}: its factory returned a non-callable {type(decomposer).__name__}"
+        )
     return decomposer
 
 

@@ -110,7 +110,9 @@ def scenario_table(scores: Iterable[Score], *, metric: str = "lmse") -> list[dic
 #: Thesis Table 3.2's columns: (key, metric, header); each the mean over samples of
 #: ``(shading_grey + reflectance_grey) / 2``.
 TABLE_3_2_COLUMNS: tuple[tuple[str, str, str], ...] = (
-    ("corr", "corr", "Corr."), ("mse", "si_mse", "MSE"), ("lmse", "lmse", "LMSE"),
+    ("corr", "corr", "Corr."),
+    ("mse", "si_mse", "MSE"),
+    ("lmse", "lmse", "LMSE"),
     ("almse", "almse", "aLMSE"),
 )
 
@@ -149,7 +151,8 @@ def method_parameters(methods: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
     for name, method in methods.items():
         params = (
             {f.name: getattr(method, f.name) for f in dataclasses.fields(method)}
-            if dataclasses.is_dataclass(method) else {}
+            if dataclasses.is_dataclass(method)
+            else {}
         )
         out[name] = {
             "class": f"{type(method).__module__}.{type(method).__qualname__}",
@@ -173,16 +176,22 @@ def _markdown(rows: list[dict[str, Any]], columns: Sequence[str], headers: Seque
 
 
 def _condition_files(
-    out: Path, stem: str, title: str, rows: list[dict[str, Any]],
-    columns: Sequence[tuple[str, str, str, str]], note: str = "",
+    out: Path,
+    stem: str,
+    title: str,
+    rows: list[dict[str, Any]],
+    columns: Sequence[tuple[str, str, str, str]],
+    note: str = "",
 ) -> dict[str, Path]:
     keys = [f"{prefix}_{g}" for prefix, *_ in columns for g in _GROUP_ORDER]
     _write_csv(out / f"{stem}.csv", rows, ["scene_kind", "method", *keys])
     layers = sorted({layer for _, layer, _, _ in columns})
     md = [*_titled(title, note), "Mean over samples; sRGB input. Layers scored:", ""]
     md += [f"* `{layer}`: {SCORED_LAYERS[layer]}" for layer in layers]
-    md += [f"* {header}: metric `{metric}` ({METRICS[metric].equation}) of `{layer}`"
-           for _, layer, metric, header in columns]
+    md += [
+        f"* {header}: metric `{metric}` ({METRICS[metric].equation}) of `{layer}`"
+        for _, layer, metric, header in columns
+    ]
     md.append("")
     headers = ["method"] + [f"{h} {g}" for *_, h in columns for g in _GROUP_ORDER]
     for kind, name in _KINDS.items():
@@ -193,7 +202,9 @@ def _condition_files(
     return {f"{stem}_csv": out / f"{stem}.csv", f"{stem}_md": out / f"{stem}.md"}
 
 
-def summary_table(scores: Iterable[Score], samples: Mapping[str, tuple[str, str]]) -> list[dict[str, Any]]:
+def summary_table(
+    scores: Iterable[Score], samples: Mapping[str, tuple[str, str]]
+) -> list[dict[str, Any]]:
     """Rows of the report's first table and summary figure: per method, the mean reflectance
     LMSE (sRGB input) over the samples of each lighting condition present, and over all."""
     per: dict[tuple[str, str], list[float]] = defaultdict(list)
@@ -202,13 +213,18 @@ def summary_table(scores: Iterable[Score], samples: Mapping[str, tuple[str, str]
             per[(s.method, samples[s.sample][1])].append(s.value)
             per[(s.method, "all")].append(s.value)
     conditions = [c for c in CONDITION_GROUPS if any(k[1] == c for k in per)]
-    return [{"method": m, **{c: _mean(per.get((m, c), [])) for c in (*conditions, "all")}}
-            for m in sorted({k[0] for k in per}, key=_method_order)]
+    return [
+        {"method": m, **{c: _mean(per.get((m, c), [])) for c in (*conditions, "all")}}
+        for m in sorted({k[0] for k in per}, key=_method_order)
+    ]
 
 
 def _group_columns(columns: Sequence[tuple[str, str, str, str]]) -> list[Column]:
-    return [Column(f"{prefix}_{g}", f"{header} {g}", METRICS[metric].better)
-            for prefix, _, metric, header in columns for g in _GROUP_ORDER]
+    return [
+        Column(f"{prefix}_{g}", f"{header} {g}", METRICS[metric].better)
+        for prefix, _, metric, header in columns
+        for g in _GROUP_ORDER
+    ]
 
 
 def _t32_pivot(t32: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
@@ -222,9 +238,12 @@ def _t32_pivot(t32: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
 
 def _t32_columns(keys: Sequence[str]) -> list[Column]:
     label = {"mse": "si-MSE"}
-    return [Column(f"{key}_{g}", f"{label.get(key, header)} {g}", METRICS[metric].better)
-            for key, metric, header in TABLE_3_2_COLUMNS if key in keys
-            for g in (*_GROUP_ORDER, "all")]
+    return [
+        Column(f"{key}_{g}", f"{label.get(key, header)} {g}", METRICS[metric].better)
+        for key, metric, header in TABLE_3_2_COLUMNS
+        if key in keys
+        for g in (*_GROUP_ORDER, "all")
+    ]
 
 
 def _kind_tables(label: str, rows: Sequence[Mapping[str, Any]], columns: list[Column]) -> list[str]:
@@ -242,42 +261,76 @@ def _titled(title: str, note: str) -> list[str]:
 
 
 def _intro(
-    methods: Mapping[str, Any], inputs: Sequence[str], samples: Mapping[str, tuple[str, str]], note: str
+    methods: Mapping[str, Any],
+    inputs: Sequence[str],
+    samples: Mapping[str, tuple[str, str]],
+    note: str,
 ) -> list[str]:
     kinds = [k for k, _ in samples.values()]
-    return [*_titled("Evaluation report", note),
-            f"{len(samples)} samples ({kinds.count('object')} single objects, "
-            f"{kinds.count('complex')} complex-scene views); input decomposed: "
-            + ", ".join(f"`{k}`" for k in inputs) + f" (the first of {list(INPUT_LAYERS)} each "
-            f"sample has); methods: {', '.join(methods)}. Every number is a mean over samples on "
-            "the sRGB input; the CSV files beside this report hold the same rows to 6 significant "
-            "digits.", ""]
+    return [
+        *_titled("Evaluation report", note),
+        f"{len(samples)} samples ({kinds.count('object')} single objects, "
+        f"{kinds.count('complex')} complex-scene views); input decomposed: "
+        + ", ".join(f"`{k}`" for k in inputs)
+        + f" (the first of {list(INPUT_LAYERS)} each "
+        f"sample has); methods: {', '.join(methods)}. Every number is a mean over samples on "
+        "the sRGB input; the CSV files beside this report hold the same rows to 6 significant "
+        "digits.",
+        "",
+    ]
 
 
 def _report_md(
-    methods: Mapping[str, Any], inputs: Sequence[str], samples: Mapping[str, tuple[str, str]],
-    tables: Mapping[str, list[dict[str, Any]]], files: Mapping[str, Path], note: str = "",
+    methods: Mapping[str, Any],
+    inputs: Sequence[str],
+    samples: Mapping[str, tuple[str, str]],
+    tables: Mapping[str, list[dict[str, Any]]],
+    files: Mapping[str, Path],
+    note: str = "",
 ) -> str:
     summary = tables["summary"]
     conds = [k for k in (summary[0] if summary else {}) if k != "method"]
     md = _intro(methods, inputs, samples, note)
     md += ["## Summary: reflectance LMSE by method and lighting condition", ""]
-    md += [markdown_table(summary, [Column("method", "method"), *(Column(c, c, "lower") for c in conds)]),
-           "", f"![Reflectance LMSE, method x lighting condition]({SUMMARY_FIGURE})", ""] if summary \
+    md += (
+        [
+            markdown_table(
+                summary, [Column("method", "method"), *(Column(c, c, "lower") for c in conds)]
+            ),
+            "",
+            f"![Reflectance LMSE, method x lighting condition]({SUMMARY_FIGURE})",
+            "",
+        ]
+        if summary
         else ["No reflectance LMSE scored (see `--metrics`).", ""]
+    )
     md += glossary_section()
     md += ["## LMSE by lighting group (like thesis Tables 5.3 and 5.4)", ""]
-    md += _kind_tables("LMSE", tables["lmse"], [Column("method", "method"), *_group_columns(LMSE_COLUMNS)])
+    md += _kind_tables(
+        "LMSE", tables["lmse"], [Column("method", "method"), *_group_columns(LMSE_COLUMNS)]
+    )
     md += ["## Coloured-shading metrics by lighting group", ""]
-    md += _kind_tables("Coloured shading", tables["colour"], [Column("method", "method"), *_group_columns(COLOUR_COLUMNS)])
+    md += _kind_tables(
+        "Coloured shading",
+        tables["colour"],
+        [Column("method", "method"), *_group_columns(COLOUR_COLUMNS)],
+    )
     pivot = _t32_pivot(tables["t32"])
-    note = ("Single objects; mean over samples of (grey shading + grey reflectance) / 2, grey = "
-            "mean over channels, as thesis sec. 3.5.")
-    for title, keys in (("scale-invariant global metrics (Corr., si-MSE)", ("corr", "mse")),
-                        ("local metrics (LMSE, aLMSE)", ("lmse", "almse"))):
+    note = (
+        "Single objects; mean over samples of (grey shading + grey reflectance) / 2, grey = "
+        "mean over channels, as thesis sec. 3.5."
+    )
+    for title, keys in (
+        ("scale-invariant global metrics (Corr., si-MSE)", ("corr", "mse")),
+        ("local metrics (LMSE, aLMSE)", ("lmse", "almse")),
+    ):
         md += [f"## Like thesis Table 3.2: {title}", "", note, ""]
-        md += [markdown_table(pivot, [Column("method", "method"), *_t32_columns(keys)]) if pivot
-               else "No single-object samples scored.", ""]
+        md += [
+            markdown_table(pivot, [Column("method", "method"), *_t32_columns(keys)])
+            if pivot
+            else "No single-object samples scored.",
+            "",
+        ]
     md += _scenario_md(tables["scenario"])
     md += _methods_md(methods)
     md += ["## Files", ""] + [f"* `{p.name}`" for p in files.values()]
@@ -291,7 +344,12 @@ def _scenario_md(rows: Sequence[Mapping[str, Any]]) -> list[str]:
         return md + ["No camera renderings scored: Table 5.1 needs `image_camera/<name>`.", ""]
     cols = [Column("method", "method"), *(Column(sc, sc, "lower") for sc in _PHOTOMETRIC)]
     for camera in sorted({r["camera"] for r in rows}):
-        md += [f"### Camera {camera}", "", markdown_table([r for r in rows if r["camera"] == camera], cols), ""]
+        md += [
+            f"### Camera {camera}",
+            "",
+            markdown_table([r for r in rows if r["camera"] == camera], cols),
+            "",
+        ]
     return md
 
 
@@ -310,22 +368,35 @@ def _scenario_files(out: Path, rows: list[dict[str, Any]], note: str) -> dict[st
     cols = ["camera", "method", *_PHOTOMETRIC]
     _write_csv(out / "lmse_by_scenario.csv", rows, cols)
     md = _titled("Reflectance LMSE by photometric scenario (like thesis Table 5.1)", note)
-    md += [_markdown(rows, cols, cols) if rows
-           else "No camera renderings scored: Table 5.1 needs `image_camera/<name>`."]
+    md += [
+        _markdown(rows, cols, cols)
+        if rows
+        else "No camera renderings scored: Table 5.1 needs `image_camera/<name>`."
+    ]
     (out / "lmse_by_scenario.md").write_text("\n".join(md) + "\n", encoding="utf-8")
-    return {"scenario_csv": out / "lmse_by_scenario.csv", "scenario_md": out / "lmse_by_scenario.md"}
+    return {
+        "scenario_csv": out / "lmse_by_scenario.csv",
+        "scenario_md": out / "lmse_by_scenario.md",
+    }
 
 
 def _t32_files(out: Path, t32: list[dict[str, Any]], note: str) -> dict[str, Path]:
     cols = ["method", "lighting", *(k for k, _, _ in TABLE_3_2_COLUMNS)]
     _write_csv(out / "table_3_2_objects.csv", t32, cols)
-    md = [*_titled("Single objects, like thesis Table 3.2 (MIT-20)", note),
-          "Mean over samples of (grey shading + grey reflectance) / 2, grey = mean over "
-          "channels, as the thesis (sec. 3.5); MSE is the scale-invariant MSE (Eq. 2.4).", "",
-          _markdown(t32, cols, ["method", "light", *(h for _, _, h in TABLE_3_2_COLUMNS)]) if t32
-          else "No single-object samples scored."]
+    md = [
+        *_titled("Single objects, like thesis Table 3.2 (MIT-20)", note),
+        "Mean over samples of (grey shading + grey reflectance) / 2, grey = mean over "
+        "channels, as the thesis (sec. 3.5); MSE is the scale-invariant MSE (Eq. 2.4).",
+        "",
+        _markdown(t32, cols, ["method", "light", *(h for _, _, h in TABLE_3_2_COLUMNS)])
+        if t32
+        else "No single-object samples scored.",
+    ]
     (out / "table_3_2_objects.md").write_text("\n".join(md) + "\n", encoding="utf-8")
-    return {"table_3_2_csv": out / "table_3_2_objects.csv", "table_3_2_md": out / "table_3_2_objects.md"}
+    return {
+        "table_3_2_csv": out / "table_3_2_objects.csv",
+        "table_3_2_md": out / "table_3_2_objects.md",
+    }
 
 
 def _summary_files(out: Path, summary: list[dict[str, Any]]) -> dict[str, Path]:
@@ -333,8 +404,12 @@ def _summary_files(out: Path, summary: list[dict[str, Any]]) -> dict[str, Path]:
         return {}
     conds = [k for k in summary[0] if k != "method"]
     _write_csv(out / "summary_by_condition.csv", summary, ["method", *conds])
-    summary_heatmap(out / SUMMARY_FIGURE, summary, conds,
-                    title="Reflectance LMSE (lower is better), mean over samples")
+    summary_heatmap(
+        out / SUMMARY_FIGURE,
+        summary,
+        conds,
+        title="Reflectance LMSE (lower is better), mean over samples",
+    )
     return {"summary_csv": out / "summary_by_condition.csv"}
 
 
@@ -352,25 +427,55 @@ def write_report(
     (:mod:`spectrinsic.decompose.report_md`). *note*
     (:func:`spectrinsic.decompose.targets.target_note`) is printed under every title."""
     files: dict[str, Path] = {"scores": out / "scores.csv"}
-    _write_csv(files["scores"], [
-        {"sample": s.sample, "method": s.method, "scenario": s.scenario, "layer": s.layer,
-         "metric": s.metric, "value": s.value} for s in scores
-    ], ("sample", "method", "scenario", "layer", "metric", "value"))
-    tables = {"summary": summary_table(scores, samples),
-              "lmse": condition_table(scores, samples, columns=LMSE_COLUMNS),
-              "colour": condition_table(scores, samples, columns=COLOUR_COLUMNS),
-              "scenario": scenario_table(scores), "t32": table_3_2(scores, samples)}
+    _write_csv(
+        files["scores"],
+        [
+            {
+                "sample": s.sample,
+                "method": s.method,
+                "scenario": s.scenario,
+                "layer": s.layer,
+                "metric": s.metric,
+                "value": s.value,
+            }
+            for s in scores
+        ],
+        ("sample", "method", "scenario", "layer", "metric", "value"),
+    )
+    tables = {
+        "summary": summary_table(scores, samples),
+        "lmse": condition_table(scores, samples, columns=LMSE_COLUMNS),
+        "colour": condition_table(scores, samples, columns=COLOUR_COLUMNS),
+        "scenario": scenario_table(scores),
+        "t32": table_3_2(scores, samples),
+    }
     files.update(_summary_files(out, tables["summary"]))
-    files.update(_condition_files(
-        out, "lmse_by_condition", "LMSE by lighting condition (like thesis Tables 5.3 and 5.4)",
-        tables["lmse"], LMSE_COLUMNS, note))
-    files.update(_condition_files(
-        out, "colour_by_condition", "Coloured-shading metrics by lighting condition",
-        tables["colour"], COLOUR_COLUMNS, note))
+    files.update(
+        _condition_files(
+            out,
+            "lmse_by_condition",
+            "LMSE by lighting condition (like thesis Tables 5.3 and 5.4)",
+            tables["lmse"],
+            LMSE_COLUMNS,
+            note,
+        )
+    )
+    files.update(
+        _condition_files(
+            out,
+            "colour_by_condition",
+            "Coloured-shading metrics by lighting condition",
+            tables["colour"],
+            COLOUR_COLUMNS,
+            note,
+        )
+    )
     files.update(_scenario_files(out, tables["scenario"], note))
     files.update(_t32_files(out, tables["t32"], note))
     files["methods"] = out / "methods.json"
     write_json(files["methods"], method_parameters(methods), strict=False, default=str, end="")
     files["report"] = out / "REPORT.md"
-    files["report"].write_text(_report_md(methods, inputs, samples, tables, files, note), encoding="utf-8")
+    files["report"].write_text(
+        _report_md(methods, inputs, samples, tables, files, note), encoding="utf-8"
+    )
     return files

@@ -142,7 +142,9 @@ class ColourRetinex:
     protocol: ClassVar[str] = PROTOCOL
 
     def __call__(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Decomposition:
-        validate_choice(self.shading_colour, ("grey", "colour"), "shading_colour", error=DecomposeError)
+        validate_choice(
+            self.shading_colour, ("grey", "colour"), "shading_colour", error=DecomposeError
+        )
         img, m = prepare_input(image, mask)
         scale = float(np.percentile(img[m].max(axis=1), 99.0))
         floor = _FLOOR * (scale if scale > 0.0 else 1.0)
@@ -164,6 +166,8 @@ class ColourRetinex:
             rx = np.where(kept[1], gx_grey, 0.0)
             raw = img / np.exp(grey_log - poisson_solve(ry, rx, m))[:, :, None]
         reflectance, light = discount_illuminant(raw, img, m, self.colour_constancy)
-        info = {"reflectance_edges": float((kept[0][m].mean() + kept[1][m].mean()) / 2.0),
-                "light_colour": light}
+        info = {
+            "reflectance_edges": float((kept[0][m].mean() + kept[1][m].mean()) / 2.0),
+            "light_colour": light,
+        }
         return finish(img, reflectance, m, info)

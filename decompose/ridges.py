@@ -139,8 +139,15 @@ def colour_shades(
         ridge_mask = _rad_ridges(grid.hist, density, sigma, min_density, creaseness)
     if not ridge_mask.any():
         diagonal = np.broadcast_to(_DIAGONAL, x.shape).copy()
-        return ColourShades(np.zeros(x.shape[0], np.int64), x.copy(), diagonal, 1, grid.width,
-                            x.mean(axis=0, keepdims=True), np.zeros(1, np.int64))
+        return ColourShades(
+            np.zeros(x.shape[0], np.int64),
+            x.copy(),
+            diagonal,
+            1,
+            grid.width,
+            x.mean(axis=0, keepdims=True),
+            np.zeros(1, np.int64),
+        )
     components, _ = ndimage.label(ridge_mask, structure=np.ones((3, 3, 3)))
     if detector == "rad":
         components = _prune(components, grid.index, min_share)
@@ -170,13 +177,15 @@ def _rad_ridges(
     from skimage.morphology import skeletonize
 
     orders = ((1, 0, 0), (0, 1, 0), (0, 0, 1))
-    grad = np.stack([ndimage.gaussian_filter(hist, sigma, order=o, mode="constant")
-                     for o in orders], axis=-1)
+    grad = np.stack(
+        [ndimage.gaussian_filter(hist, sigma, order=o, mode="constant") for o in orders], axis=-1
+    )
     tensor = np.empty(hist.shape + (3, 3))
     for a in range(3):
         for b in range(a, 3):
             tensor[..., a, b] = tensor[..., b, a] = ndimage.gaussian_filter(
-                grad[..., a] * grad[..., b], 2.0 * sigma, mode="constant")
+                grad[..., a] * grad[..., b], 2.0 * sigma, mode="constant"
+            )
     support = density >= min_density
     field = np.zeros(hist.shape + (3,))
     _, vecs = np.linalg.eigh(tensor[support])
@@ -278,6 +287,12 @@ def _describe(
     tangent = tangent_grid[near[:, 0], near[:, 1], near[:, 2]]
     projection = centre + ((x - centre) * tangent).sum(axis=1, keepdims=True) * tangent
     points = np.argwhere(ridge_mask)
-    return ColourShades(ridge, projection, tangent, int(ids.size), grid.width,
-                        grid.lo + (points - grid.pad) * grid.width,
-                        renumber[components[tuple(points.T)]])
+    return ColourShades(
+        ridge,
+        projection,
+        tangent,
+        int(ids.size),
+        grid.width,
+        grid.lo + (points - grid.pad) * grid.width,
+        renumber[components[tuple(points.T)]],
+    )

@@ -29,11 +29,11 @@ INPUT_LAYERS: tuple[str, ...] = ("image_denoised", "image")
 SCORED_LAYERS: dict[str, str] = {
     "reflectance": "`reflectance` (absolute, linear sRGB under D65) against the estimate, in colour",
     "shading_grey": "`shading_grey` (luminance Y of the irradiance) against the estimate's mean "
-                    "over channels (thesis sec. 5.2.5: grey shading)",
+    "over channels (thesis sec. 5.2.5: grey shading)",
     "shading": "`shading` (linear-sRGB colour of the irradiance, material-free) against the "
-               "estimate's coloured shading (`image / reflectance`)",
+    "estimate's coloured shading (`image / reflectance`)",
     "reflectance_grey": "mean over channels of `reflectance` against that of the estimate "
-                        "(thesis Tables 3.1/3.2: \"grayscale reflectances\")",
+    '(thesis Tables 3.1/3.2: "grayscale reflectances")',
 }
 
 

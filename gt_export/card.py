@@ -51,41 +51,52 @@ def _diversity_section(root: Path, samples: Sequence[Path], metas: Sequence[Samp
         write_diversity(root, samples, metas)
     manifest = read_manifest(root)  # the splits the build wrote (its --split-fractions)
     scenes = {m.sample_id: m.scene for m in metas}
-    splits = manifest.splits if manifest is not None and manifest.splits else splits_by_scene(scenes)
-    counts = ", ".join(f"{k} {len(v)} samples ({len({scenes[i] for i in v if i in scenes})} scenes)"
-                       for k, v in splits.items())
+    splits = (
+        manifest.splits if manifest is not None and manifest.splits else splits_by_scene(scenes)
+    )
+    counts = ", ".join(
+        f"{k} {len(v)} samples ({len({scenes[i] for i in v if i in scenes})} scenes)"
+        for k, v in splits.items()
+    )
     spread = spread_summary([spread_record(m) for m in metas])
-    return (f"\n## Splits and diversity\n\nSplits by scene (no scene in two splits; "
-            f"`manifest.json[\"splits\"]`; every split holds a scene from as many scenes as "
-            f"splits on): {counts}.\n\n"
-            f"Colour spread: lights cover {shown(spread['xy_hull_area'], '.3f')} of CIE 1931 xy (hull area), "
-            f"{shown(spread['d65_distance_median'], '.3f')} median xy distance from D65, "
-            f"{shown(spread['tinted_fraction'], '.0%')} of non-D65 lights tinted (|Duv| >= 0.02, Ohno 2013), "
-            f"paired lights at least {shown(spread['pair_distance_min'], '.3f')} apart in xy; material chroma "
-            f"C*ab median {shown(spread['chroma_median'], '.1f')} (p90 {shown(spread['chroma_p90'], '.1f')}); "
-            f"{shown(spread['patterned_fraction'], '.0%')} of generated objects patterned "
-            f"({shown(spread['textured_fraction'], '.0%')} spectrally textured), "
-            f"{shown(spread['framed_fraction'], '.0%')} of views framed (>= 30 % objects).\n\n"
-            f"![r, light CCT and xy, materials per image, object coverage, luminance range]"
-            f"({DIVERSITY_NAME})\n")
+    return (
+        f"\n## Splits and diversity\n\nSplits by scene (no scene in two splits; "
+        f'`manifest.json["splits"]`; every split holds a scene from as many scenes as '
+        f"splits on): {counts}.\n\n"
+        f"Colour spread: lights cover {shown(spread['xy_hull_area'], '.3f')} of CIE 1931 xy (hull area), "
+        f"{shown(spread['d65_distance_median'], '.3f')} median xy distance from D65, "
+        f"{shown(spread['tinted_fraction'], '.0%')} of non-D65 lights tinted (|Duv| >= 0.02, Ohno 2013), "
+        f"paired lights at least {shown(spread['pair_distance_min'], '.3f')} apart in xy; material chroma "
+        f"C*ab median {shown(spread['chroma_median'], '.1f')} (p90 {shown(spread['chroma_p90'], '.1f')}); "
+        f"{shown(spread['patterned_fraction'], '.0%')} of generated objects patterned "
+        f"({shown(spread['textured_fraction'], '.0%')} spectrally textured), "
+        f"{shown(spread['framed_fraction'], '.0%')} of views framed (>= 30 % objects).\n\n"
+        f"![r, light CCT and xy, materials per image, object coverage, luminance range]"
+        f"({DIVERSITY_NAME})\n"
+    )
 
 
 def _noise_table(summary: Mapping[str, Any]) -> str:
     if not summary:
         return "Rendered as a single batch: no noise estimate (build with `batches` ≥ 2)."
-    lines = ["Relative standard error of the raw Monte Carlo layers, per pixel, from the spread of "
-             "independent batches (the denoised layers are measured against converged renders "
-             "in `make bench`). Per sample: median, 95th percentile and RMS over its pixels; with two "
-             "batches a pixel's estimate has one degree of freedom, so the RMS is the unbiased "
-             "figure and the median reads about 0.67 of it.", "",
-             "| layer | scenes | samples | median of medians | median of p95 | median of RMS | worst median (sample) |",
-             "|---|---|---|---|---|---|---|"]
+    lines = [
+        "Relative standard error of the raw Monte Carlo layers, per pixel, from the spread of "
+        "independent batches (the denoised layers are measured against converged renders "
+        "in `make bench`). Per sample: median, 95th percentile and RMS over its pixels; with two "
+        "batches a pixel's estimate has one degree of freedom, so the RMS is the unbiased "
+        "figure and the median reads about 0.67 of it.",
+        "",
+        "| layer | scenes | samples | median of medians | median of p95 | median of RMS | worst median (sample) |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for layer, kinds in sorted(summary.items()):
         for kind, row in sorted(kinds.items()):
-            lines.append(f"| `{layer}` | {_text(kind)} | {row['samples']} | {100 * row['median_of_medians']:.1f} % "
-                         f"| {100 * row['median_of_p95']:.1f} % | {100 * row['median_of_rms']:.1f} % "
-                         f"| {100 * row['worst_median']:.1f} % "
-                         f"(`{row['worst_sample']}`) |")
+            lines.append(
+                f"| `{layer}` | {_text(kind)} | {row['samples']} | {100 * row['median_of_medians']:.1f} % "
+                f"| {100 * row['median_of_p95']:.1f} % | {100 * row['median_of_rms']:.1f} % "
+                f"| {100 * row['worst_median']:.1f} % "
+                f"(`{row['worst_sample']}`) |"
+            )
     return "\n".join(lines)
 
 

@@ -39,8 +39,15 @@ from spectrinsic.gt_export.sample import (
 )
 from spectrinsic.gt_export.sample_meta import Identity, LayerRecord, SampleMeta, read_meta
 
-__all__ = ["check_dataset", "check_sample", "noise_report", "IDENTITY_RTOL", "NOISE_THRESHOLD",
-           "NOISY", "TARGET_MISSED"]
+__all__ = [
+    "check_dataset",
+    "check_sample",
+    "noise_report",
+    "IDENTITY_RTOL",
+    "NOISE_THRESHOLD",
+    "NOISY",
+    "TARGET_MISSED",
+]
 
 #: Default flag of :func:`noise_report`: a sample whose raw shading has a median relative
 #: standard error above this is called noisy. Advisory: a preset promises no noise level
@@ -56,8 +63,12 @@ IDENTITY_RTOL = 4 * float(np.finfo(np.float32).eps)
 
 
 def _identity_problem(
-    image: np.ndarray, refl: np.ndarray, shad: np.ndarray, residual: np.ndarray | None = None,
-    *, names: str = "image != reflectance * shading",
+    image: np.ndarray,
+    refl: np.ndarray,
+    shad: np.ndarray,
+    residual: np.ndarray | None = None,
+    *,
+    names: str = "image != reflectance * shading",
 ) -> str | None:
     """``image = refl ∘ shad (+ residual)`` to float32 rounding, where reflectance is non-zero
     (everywhere when a residual is given)."""
@@ -71,12 +82,16 @@ def _identity_problem(
     bad = err > IDENTITY_RTOL * scale + np.finfo(np.float32).tiny
     if bad.any():
         worst = float((err / np.maximum(scale, np.finfo(np.float32).tiny)).max())
-        return (f"{names} at {int(bad.sum())} channel values "
-                f"(worst relative error {worst:.2e}, tolerance {IDENTITY_RTOL:.1e})")
+        return (
+            f"{names} at {int(bad.sum())} channel values "
+            f"(worst relative error {worst:.2e}, tolerance {IDENTITY_RTOL:.1e})"
+        )
     return None
 
 
-def _identity_problems(identities: tuple[Identity, ...], data: Mapping[str, np.ndarray]) -> list[str]:
+def _identity_problems(
+    identities: tuple[Identity, ...], data: Mapping[str, np.ndarray]
+) -> list[str]:
     out = []
     for ident in identities:
         keys = [ident.image, ident.reflectance, ident.shading, ident.residual]
@@ -86,14 +101,25 @@ def _identity_problems(identities: tuple[Identity, ...], data: Mapping[str, np.n
             out.append(f"identity {keys}: layer(s) {missing} missing")
             continue
         # the specular layer, where there is one, is one more term beside the residual
-        rest = data[keys[3]].astype(np.float64) + (data[keys[4]].astype(np.float64) if len(keys) > 4 else 0.0)
-        issue = _identity_problem(data[keys[0]], data[keys[1]], data[keys[2]], rest,
-                                  names=f"{keys[0]} != {keys[1]} * {keys[2]} + " + " + ".join(keys[3:]))
+        rest = data[keys[3]].astype(np.float64) + (
+            data[keys[4]].astype(np.float64) if len(keys) > 4 else 0.0
+        )
+        issue = _identity_problem(
+            data[keys[0]],
+            data[keys[1]],
+            data[keys[2]],
+            rest,
+            names=f"{keys[0]} != {keys[1]} * {keys[2]} + " + " + ".join(keys[3:]),
+        )
         if issue:
             out.append(f"{keys[0]}: {issue}")
     if all(k in data for k in ("image", "reflectance", "shading_ratio")):
-        issue = _identity_problem(data["image"], data["reflectance"], data["shading_ratio"],
-                                  names="image != reflectance * shading_ratio")
+        issue = _identity_problem(
+            data["image"],
+            data["reflectance"],
+            data["shading_ratio"],
+            names="image != reflectance * shading_ratio",
+        )
         if issue:
             out.append(f"image: {issue}")
     return out
@@ -121,8 +147,10 @@ def _file_problems(meta: SampleMeta) -> list[str]:
     """Listed files missing, or not matching the SHA-256 that ``meta.json`` records."""
     problems = []
     if meta.sealed is False:
-        problems.append(f"{META_NAME} does not match its seal ({SEAL_KEY}): edited or damaged "
-                        "after it was written")
+        problems.append(
+            f"{META_NAME} does not match its seal ({SEAL_KEY}): edited or damaged "
+            "after it was written"
+        )
     for rel in meta.files:
         if not (meta.folder / rel).is_file():
             problems.append(f"file {rel!r} listed in meta.json is missing")
@@ -172,7 +200,9 @@ def check_sample(sample: str | os.PathLike[str]) -> list[str]:
             problems.append(f"layer {required!r} is missing from meta.json")
     data = _layer_data(meta, problems)
     if not meta.identities:
-        problems.append("meta.json records no identities (image = reflectance * shading + residual)")
+        problems.append(
+            "meta.json records no identities (image = reflectance * shading + residual)"
+        )
     problems.extend(_identity_problems(meta.identities, data))
     return problems
 
@@ -195,7 +225,9 @@ def check_dataset(
     if not samples:
         problems.append("<dataset>: no sample folders with meta.json")
     for leftover in sorted(root.glob(f"{TMP_PREFIX}*")):
-        problems.append(f"<dataset>: leftover temporary {leftover.name!r} from an interrupted write")
+        problems.append(
+            f"<dataset>: leftover temporary {leftover.name!r} from an interrupted write"
+        )
     for sample in samples:
         problems.extend(f"{sample.name}: {p}" for p in check_sample(sample))
         if progress is not None:
@@ -214,12 +246,16 @@ def _config_problems(manifest: ManifestRecord, samples: list[Path]) -> list[str]
     for sample in samples:
         own = read_meta(sample, verify=False).config_hash
         if own != expected:
-            problems.append(f"{sample.name}: built with config hash {str(own)[:12]}, but "
-                            f"{MANIFEST_NAME} describes config hash {str(expected)[:12]}")
+            problems.append(
+                f"{sample.name}: built with config hash {str(own)[:12]}, but "
+                f"{MANIFEST_NAME} describes config hash {str(expected)[:12]}"
+            )
         recorded = manifest.sample_hashes.get(sample.name, expected)
         if recorded != expected:
-            problems.append(f"{sample.name}: {MANIFEST_NAME} lists it with config hash "
-                            f"{str(recorded)[:12]}, not the dataset's {str(expected)[:12]}")
+            problems.append(
+                f"{sample.name}: {MANIFEST_NAME} lists it with config hash "
+                f"{str(recorded)[:12]}, not the dataset's {str(expected)[:12]}"
+            )
     return problems
 
 
@@ -242,7 +278,9 @@ def _manifest_problems(root: Path, manifest: ManifestRecord, samples: list[Path]
             if not path.is_file():
                 problems.append(f"{name}: file {rel!r} from {MANIFEST_NAME} is missing")
             elif file_sha256(path) != digest:
-                problems.append(f"{name}: file {rel!r} does not match its SHA-256 in {MANIFEST_NAME}")
+                problems.append(
+                    f"{name}: file {rel!r} does not match its SHA-256 in {MANIFEST_NAME}"
+                )
     return problems
 
 
@@ -263,8 +301,10 @@ def noise_report(
         if not figures:
             lines.append(f"{sample.name}: no noise estimate (one batch)" + missed)
             continue
-        parts = [f"{k} median {100 * v.median:.1f} % p95 {100 * v.p95:.1f} %"
-                 for k, v in sorted(figures.items())]
+        parts = [
+            f"{k} median {100 * v.median:.1f} % p95 {100 * v.p95:.1f} %"
+            for k, v in sorted(figures.items())
+        ]
         shading = figures["shading_raw"].median if "shading_raw" in figures else 0.0
         if shading > threshold:
             flagged.append(sample.name)
@@ -280,7 +320,13 @@ def _missed_target(render: object) -> str:
     if not isinstance(record, Mapping):
         return ""
     target, reached = record.get("target"), record.get("reached")
-    if not isinstance(target, int | float) or not isinstance(reached, int | float) or reached <= target:
+    if (
+        not isinstance(target, int | float)
+        or not isinstance(reached, int | float)
+        or reached <= target
+    ):
         return ""
-    return (f"; {TARGET_MISSED} (image median {100 * reached:.1f} % above the config's "
-            f"noise_target {100 * target:.1f} % after {record.get('max_batches')} batches)")
+    return (
+        f"; {TARGET_MISSED} (image median {100 * reached:.1f} % above the config's "
+        f"noise_target {100 * target:.1f} % after {record.get('max_batches')} batches)"
+    )

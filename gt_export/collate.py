@@ -72,8 +72,11 @@ def _n_lights(share: np.ndarray, channel_first: bool) -> int:
 
 
 def _is_array_dict(value: Any) -> bool:
-    return isinstance(value, Mapping) and bool(value) and all(
-        isinstance(v, np.ndarray) for v in value.values())
+    return (
+        isinstance(value, Mapping)
+        and bool(value)
+        and all(isinstance(v, np.ndarray) for v in value.values())
+    )
 
 
 def _stack(key: str, values: Sequence[np.ndarray]) -> np.ndarray:
@@ -99,7 +102,9 @@ def _collate_key(key: str, values: list[Any]) -> Any:
 
 
 def collate_arrays(
-    items: Sequence[Mapping[str, Any]], *, max_lights: int | None = None,
+    items: Sequence[Mapping[str, Any]],
+    *,
+    max_lights: int | None = None,
     channel_first: bool | None = None,
 ) -> dict[str, Any]:
     """Collate numpy items into one batch (see the module docstring).
@@ -133,11 +138,14 @@ def collate_arrays(
     per_light = [k for k in PER_LIGHT_LAYERS if k in items[0]]
     batch: dict[str, Any] = {}
     if per_light:
-        counts = np.array([_n_lights(np.asarray(item[per_light[0]]), channel_first) for item in items])
+        counts = np.array(
+            [_n_lights(np.asarray(item[per_light[0]]), channel_first) for item in items]
+        )
         width = int(counts.max()) if max_lights is None else int(max_lights)
         for key in per_light:
-            batch[key] = _stack(key, [pad_lights(item[key], width, channel_first=channel_first)
-                                      for item in items])
+            batch[key] = _stack(
+                key, [pad_lights(item[key], width, channel_first=channel_first) for item in items]
+            )
         batch[LIGHT_MASK] = np.arange(width)[None, :] < counts[:, None]
     for key in keys:
         if key not in batch:
@@ -154,8 +162,11 @@ def _to_numpy(value: Any) -> Any:
 
 
 def _is_tensor_dict(value: Any) -> bool:
-    return isinstance(value, Mapping) and bool(value) and all(
-        hasattr(v, "detach") for v in value.values())
+    return (
+        isinstance(value, Mapping)
+        and bool(value)
+        and all(hasattr(v, "detach") for v in value.values())
+    )
 
 
 def _to_torch(value: Any, torch: Any) -> Any:

@@ -43,7 +43,9 @@ def denoise_rgb(
     oidn = _oidn()
     colour = np.ascontiguousarray(np.clip(colour, 0.0, None), np.float32)
     albedo = np.ones_like(colour)
-    normal = None if normals is None else np.ascontiguousarray(np.clip(normals, -1.0, 1.0), np.float32)
+    normal = (
+        None if normals is None else np.ascontiguousarray(np.clip(normals, -1.0, 1.0), np.float32)
+    )
     out = oidn.denoise(colour, albedo, normal, hdr=True, quality=quality)
     return np.clip(np.asarray(out, np.float64), 0.0, None)
 
@@ -56,6 +58,8 @@ def denoise_white_radiance(
     k = bands.shape[-1]
     padded = np.zeros(bands.shape[:-1] + (-(-k // 3) * 3,))
     padded[..., :k] = bands
-    blocks = [denoise_rgb(padded[..., i:i + 3], normals, quality=quality)
-              for i in range(0, padded.shape[-1], 3)]
+    blocks = [
+        denoise_rgb(padded[..., i : i + 3], normals, quality=quality)
+        for i in range(0, padded.shape[-1], 3)
+    ]
     return radiance.with_bands(np.concatenate(blocks, axis=-1)[..., :k])

@@ -24,7 +24,13 @@ from spectrinsic.gt_export.layers import luminance
 from spectrinsic.gt_export.loader import load_sample
 from spectrinsic.gt_export.sample_meta import SampleMeta
 
-__all__ = ["DIVERSITY_NAME", "diversity_stats", "diversity_figure", "spread_record", "write_diversity"]
+__all__ = [
+    "DIVERSITY_NAME",
+    "diversity_stats",
+    "diversity_figure",
+    "spread_record",
+    "write_diversity",
+]
 
 DIVERSITY_NAME = "diversity.png"
 #: Luminance percentiles whose ratio is the "luminance range" (decades).
@@ -51,15 +57,19 @@ def _luminance_decades(image: np.ndarray, mask: np.ndarray | None) -> float:
 def spread_record(meta: SampleMeta) -> dict[str, Any]:
     """One sample's record for :func:`~spectrinsic.gt_export.colour_spread.spread_summary`."""
     extra = meta.scene_metadata
-    return {"lights": [tuple(light.xy) for light in meta.lights],
-            "materials": list(meta.materials.values()),
-            "patterned": len(extra.get("patterns", [])),
-            "textured": list(extra.get("patterns", [])).count("texture"),
-            "objects": int(extra.get("n_objects", 0) or 0),
-            "coverage": extra.get("object_coverage")}
+    return {
+        "lights": [tuple(light.xy) for light in meta.lights],
+        "materials": list(meta.materials.values()),
+        "patterned": len(extra.get("patterns", [])),
+        "textured": list(extra.get("patterns", [])).count("texture"),
+        "objects": int(extra.get("n_objects", 0) or 0),
+        "coverage": extra.get("object_coverage"),
+    }
 
 
-def diversity_stats(sample_dirs: Sequence[Path], metas: Sequence[SampleMeta]) -> dict[str, list[Any]]:
+def diversity_stats(
+    sample_dirs: Sequence[Path], metas: Sequence[SampleMeta]
+) -> dict[str, list[Any]]:
     """Per-sample statistics (lists aligned with *sample_dirs*; ``r`` only where recorded).
 
     Returns
@@ -70,9 +80,19 @@ def diversity_stats(sample_dirs: Sequence[Path], metas: Sequence[SampleMeta]) ->
         (fraction), ``luminance_decades`` (log10 of p99/p1), and ``samples``: one record per
         sample for :func:`~spectrinsic.gt_export.colour_spread.spread_summary`.
     """
-    out: dict[str, list[Any]] = {k: [] for k in ("r", "light_xy", "light_cct", "n_materials",
-                                                 "material_chroma", "coverage", "luminance_decades",
-                                                 "samples")}
+    out: dict[str, list[Any]] = {
+        k: []
+        for k in (
+            "r",
+            "light_xy",
+            "light_cct",
+            "n_materials",
+            "material_chroma",
+            "coverage",
+            "luminance_decades",
+            "samples",
+        )
+    }
     for folder, meta in zip(sample_dirs, metas, strict=True):
         extra = meta.scene_metadata
         if isinstance(extra.get("energy_ratio_r"), float) and np.isfinite(extra["energy_ratio_r"]):
@@ -97,14 +117,22 @@ def diversity_figure(stats: Mapping[str, Sequence[Any]]) -> Any:
     fig = Figure(figsize=(16, 7), layout="constrained")
     axes = fig.subplots(2, 4).ravel()
     summary = spread_summary(list(stats.get("samples", [])))
-    panels = [("r", "energy ratio r (direct / total)", "needs a build with --direct"),
-              ("light_cct", "light CCT (K, McCamy)", "no lights"),
-              ("n_materials", "materials per image", "no materials"),
-              ("material_chroma", f"material chroma C*ab (median {shown(summary['chroma_median'], '.1f')})",
-               "no materials"),
-              ("coverage", f"object coverage (framed {shown(summary['framed_fraction'], '.0%')})",
-               "library scenes: not recorded"),
-              ("luminance_decades", "luminance range, log10(p99/p1)", "no images")]
+    panels = [
+        ("r", "energy ratio r (direct / total)", "needs a build with --direct"),
+        ("light_cct", "light CCT (K, McCamy)", "no lights"),
+        ("n_materials", "materials per image", "no materials"),
+        (
+            "material_chroma",
+            f"material chroma C*ab (median {shown(summary['chroma_median'], '.1f')})",
+            "no materials",
+        ),
+        (
+            "coverage",
+            f"object coverage (framed {shown(summary['framed_fraction'], '.0%')})",
+            "library scenes: not recorded",
+        ),
+        ("luminance_decades", "luminance range, log10(p99/p1)", "no images"),
+    ]
     for ax, (key, title, empty) in zip(axes[[0, 1, 4, 5, 6, 7]], panels, strict=True):
         values = list(stats.get(key, []))
         ax.set_title(title, fontsize=10)
@@ -117,27 +145,38 @@ def diversity_figure(stats: Mapping[str, Sequence[Any]]) -> Any:
     ax.scatter(xy[:, 0], xy[:, 1], s=12, c="k")
     ax.plot(*_planckian_xy(), color="tab:orange", lw=1, label="Planckian 1000-25000 K")
     ax.scatter([0.31271], [0.32902], marker="+", s=80, c="tab:red", label="D65")
-    ax.set(title=f"light xy (hull area {shown(summary['xy_hull_area'], '.3f')})", xlabel="x", ylabel="y",
-           xlim=(0.0, 0.75), ylim=(0.0, 0.85))
+    ax.set(
+        title=f"light xy (hull area {shown(summary['xy_hull_area'], '.3f')})",
+        xlabel="x",
+        ylabel="y",
+        xlim=(0.0, 0.75),
+        ylim=(0.0, 0.85),
+    )
     ax.legend(fontsize=7)
     ax = axes[3]
     d65 = np.linalg.norm(xy - np.array([0.31271, 0.32902]), axis=1) if len(xy) else []
     ax.hist(d65, bins=20, color="0.35")
-    ax.set_title(f"light xy distance from D65\n(tinted, |Duv| >= 0.02: {shown(summary['tinted_fraction'], '.0%')}; "
-                 f"pairs >= {shown(summary['pair_distance_min'], '.3f')} apart)", fontsize=9)
+    ax.set_title(
+        f"light xy distance from D65\n(tinted, |Duv| >= 0.02: {shown(summary['tinted_fraction'], '.0%')}; "
+        f"pairs >= {shown(summary['pair_distance_min'], '.3f')} apart)",
+        fontsize=9,
+    )
     return fig
 
 
 def _planckian_xy() -> tuple[np.ndarray, np.ndarray]:
     import colour
 
-    uv = colour.temperature.CCT_to_uv_Ohno2013(np.stack([np.geomspace(1000, 25000, 60), np.zeros(60)], -1))
+    uv = colour.temperature.CCT_to_uv_Ohno2013(
+        np.stack([np.geomspace(1000, 25000, 60), np.zeros(60)], -1)
+    )
     xy = colour.UCS_uv_to_xy(uv)
     return xy[:, 0], xy[:, 1]
 
 
-def write_diversity(dataset_dir: str | os.PathLike[str], sample_dirs: Sequence[Path],
-                    metas: Sequence[SampleMeta]) -> Path:
+def write_diversity(
+    dataset_dir: str | os.PathLike[str], sample_dirs: Sequence[Path], metas: Sequence[SampleMeta]
+) -> Path:
     """Compute the statistics and save the figure as ``<dataset>/diversity.png``."""
     path = Path(dataset_dir) / DIVERSITY_NAME
     diversity_figure(diversity_stats(sample_dirs, metas)).savefig(path, dpi=90)

@@ -45,8 +45,10 @@ def default_channel_names(n_channels: int) -> tuple[str, ...]:
 def _as_int32_bits(name: str, array: np.ndarray) -> np.ndarray:
     """An integer array as the uint32 bits of its int32 values (range-checked: exact or refused)."""
     if array.size and (array.min() < _INT32.min or array.max() > _INT32.max):
-        raise DatasetError(f"layer {name!r} holds integers beyond the 32-bit range "
-                           f"[{_INT32.min}, {_INT32.max}]; ids are stored as int32")
+        raise DatasetError(
+            f"layer {name!r} holds integers beyond the 32-bit range "
+            f"[{_INT32.min}, {_INT32.max}]; ids are stored as int32"
+        )
     return array.astype(np.int32).view(np.uint32)
 
 
@@ -109,7 +111,9 @@ def write_exr(
         if data.ndim == 2:
             data = data[..., None]
         if data.ndim != 3:
-            raise DatasetError(f"layer {name!r} has shape {data.shape}; expected (H, W) or (H, W, C)")
+            raise DatasetError(
+                f"layer {name!r} has shape {data.shape}; expected (H, W) or (H, W, C)"
+            )
         if shape is None:
             shape = (int(data.shape[0]), int(data.shape[1]))
         elif data.shape[:2] != shape:
@@ -161,10 +165,14 @@ def _channel_order(path: Path, text: object) -> dict[str, list[str]]:
         order = json.loads(str(text))
     except ValueError:
         order = None
-    if not (isinstance(order, dict) and all(isinstance(v, list) and all(isinstance(c, str) for c in v)
-                                            for v in order.values())):
-        raise DatasetError(f"EXR file {str(path)!r}: header attribute {CHANNELS_ATTRIBUTE!r} is not "
-                           "a JSON object of layer -> channel names")
+    if not (
+        isinstance(order, dict)
+        and all(isinstance(v, list) and all(isinstance(c, str) for c in v) for v in order.values())
+    ):
+        raise DatasetError(
+            f"EXR file {str(path)!r}: header attribute {CHANNELS_ATTRIBUTE!r} is not "
+            "a JSON object of layer -> channel names"
+        )
     return order
 
 
@@ -251,7 +259,9 @@ def read_exr(
         keys = [f"{layer}.{c}" if layer else c for c in names]
         missing = [k for k in keys if k not in pixels]
         if missing:
-            raise DatasetError(f"EXR file {str(path)!r} lacks channels {missing} of layer {layer!r}")
+            raise DatasetError(
+                f"EXR file {str(path)!r} lacks channels {missing} of layer {layer!r}"
+            )
         arrays = [_as_read(pixels[k], layer in int32) for k in keys]
         out[layer] = arrays[0] if len(arrays) == 1 else np.stack(arrays, axis=-1)
     return out

@@ -42,17 +42,47 @@ from spectrinsic.gt_export.sample_meta import SampleMeta, read_meta
 from spectrinsic.scenes.sample_id import SEPARATOR
 from spectrinsic.spectra import get_sensors, xyz_to_xy
 
-__all__ = ["build_gallery", "contact_sheet", "gallery_index", "scene_kind", "GALLERY_DIRS",
-           "GALLERY_LAYERS", "INDEX_VARIABLE"]
+__all__ = [
+    "build_gallery",
+    "contact_sheet",
+    "gallery_index",
+    "scene_kind",
+    "GALLERY_DIRS",
+    "GALLERY_LAYERS",
+    "INDEX_VARIABLE",
+]
 
 #: Layer order in the per-sample switcher (others follow in name order; camera views last).
 #: ``image_denoised`` (``reflectance * shading + residual``, what a method should decompose)
 #: comes first where a sample has it, so the page opens on it rather than the noisy render.
 GALLERY_LAYERS: tuple[str, ...] = (
-    "image_denoised", "image", "image_rgb3", "image_rgb6", "image_spectral", "reflectance",
-    "shading", "shading_raw", "shading_grey", "shading_ratio", "residual", "residual_raw",
-    "specular", "illuminant", "error_rgb3", "error_rgb6", "error_spectral", "noise_image", "noise_shading_raw",
-    "depth", "normals", "material_id", "object_id", "mask", "non_diffuse", "metallic", "roughness",
+    "image_denoised",
+    "image",
+    "image_rgb3",
+    "image_rgb6",
+    "image_spectral",
+    "reflectance",
+    "shading",
+    "shading_raw",
+    "shading_grey",
+    "shading_ratio",
+    "residual",
+    "residual_raw",
+    "specular",
+    "illuminant",
+    "error_rgb3",
+    "error_rgb6",
+    "error_spectral",
+    "noise_image",
+    "noise_shading_raw",
+    "depth",
+    "normals",
+    "material_id",
+    "object_id",
+    "mask",
+    "non_diffuse",
+    "metallic",
+    "roughness",
 )
 #: The JavaScript variable ``gallery-index.js`` assigns the index to.
 INDEX_VARIABLE = "SPECTRINSIC_GALLERY"
@@ -85,8 +115,10 @@ def _srgb_primaries() -> dict[str, list[float]]:
     import colour
 
     space = colour.RGB_COLOURSPACES["sRGB"]
-    return {"primaries": np.asarray(space.primaries, float).round(5).tolist(),
-            "white": np.asarray(space.whitepoint, float).round(5).tolist()}
+    return {
+        "primaries": np.asarray(space.primaries, float).round(5).tolist(),
+        "white": np.asarray(space.whitepoint, float).round(5).tolist(),
+    }
 
 
 def _colormap_luts(names: Iterable[str]) -> dict[str, list[list[int]]]:
@@ -124,24 +156,40 @@ def _sample_entry(sample: Path, meta: SampleMeta, split: str | None) -> dict[str
     records = meta.layers
     layers = {
         name: [f"{sample.name}/{records[name].preview}", records[name].preview_encoding]
-        for name in _layer_order(records) if records[name].preview
+        for name in _layer_order(records)
+        if records[name].preview
     }
     lights = [
-        {"name": light.name, "spectrum": light.spectrum, "kind": light.kind,
-         "xy": list(light.xy), "srgb": list(light.srgb), "share": light.share,
-         "spd": [float(f"{v:.{_SPD_DIGITS}g}") for v in light.spd]}
+        {
+            "name": light.name,
+            "spectrum": light.spectrum,
+            "kind": light.kind,
+            "xy": list(light.xy),
+            "srgb": list(light.srgb),
+            "share": light.share,
+            "spd": [float(f"{v:.{_SPD_DIGITS}g}") for v in light.spd],
+        }
         for light in meta.lights
     ]
     return {
-        "id": sample.name, "scene": meta.scene, "condition": smeta.get("condition"),
+        "id": sample.name,
+        "scene": meta.scene,
+        "condition": smeta.get("condition"),
         # generated scenes name their generator; the built-in library and user scenes do not
         "generator": smeta.get("generator") or ("library" if "library" in smeta else "own scene"),
-        "kind": scene_kind(meta), "split": split, "noise": _noise_figure(meta),
-        "first_layer": next(iter(layers), None), "light_shares": [light["share"] for light in lights],
-        "size": list(meta.size), "reference_mode": meta.reference_mode,
-        "layers": layers, "lights": lights,
-        "files": sorted({f"{sample.name}/{r.file}" for r in records.values()}
-                        | {f"{sample.name}/{META_NAME}", f"{sample.name}/{SCENE_NAME}"}),
+        "kind": scene_kind(meta),
+        "split": split,
+        "noise": _noise_figure(meta),
+        "first_layer": next(iter(layers), None),
+        "light_shares": [light["share"] for light in lights],
+        "size": list(meta.size),
+        "reference_mode": meta.reference_mode,
+        "layers": layers,
+        "lights": lights,
+        "files": sorted(
+            {f"{sample.name}/{r.file}" for r in records.values()}
+            | {f"{sample.name}/{META_NAME}", f"{sample.name}/{SCENE_NAME}"}
+        ),
     }
 
 
@@ -171,8 +219,15 @@ def _layer_info(metas: Sequence[SampleMeta]) -> dict[str, dict[str, Any]]:
     info: dict[str, dict[str, Any]] = {}
     for meta in metas:
         for name, rec in meta.layers.items():
-            info.setdefault(name, {"file": rec.file, "exr_layer": rec.exr_layer,
-                                   "channels": list(rec.channels), "units": rec.units})
+            info.setdefault(
+                name,
+                {
+                    "file": rec.file,
+                    "exr_layer": rec.exr_layer,
+                    "channels": list(rec.channels),
+                    "units": rec.units,
+                },
+            )
     return info
 
 
@@ -191,10 +246,16 @@ def gallery_index(dataset_dir: str | os.PathLike[str]) -> dict[str, Any]:
     manifest = read_manifest(root)
     split_of = _split_of(manifest.splits) if manifest is not None else {}
     metas = [read_meta(s) for s in samples]
-    entries = [_sample_entry(s, m, split_of.get(s.name)) for s, m in zip(samples, metas, strict=True)]
+    entries = [
+        _sample_entry(s, m, split_of.get(s.name)) for s, m in zip(samples, metas, strict=True)
+    ]
     _link_neighbours(entries)
-    cmaps = {enc["cmap"] for e in entries for _, enc in e["layers"].values()
-             if isinstance(enc, Mapping) and enc.get("kind") == "colormap"}
+    cmaps = {
+        enc["cmap"]
+        for e in entries
+        for _, enc in e["layers"].values()
+        if isinstance(enc, Mapping) and enc.get("kind") == "colormap"
+    }
     grid = metas[0].raw["spectral_grid"].get("lights_spd") or {}
     return {
         "title": f"spectrinsic dataset: {root.resolve().name}",
@@ -212,12 +273,16 @@ def gallery_index(dataset_dir: str | os.PathLike[str]) -> dict[str, Any]:
 
 def _summary_plots(root: Path) -> list[str]:
     """Summary plots in the dataset folder (PNG files other than the contact sheets)."""
-    found = {p.relative_to(root).as_posix() for pattern in _SUMMARY_GLOBS for p in root.glob(pattern)}
+    found = {
+        p.relative_to(root).as_posix() for pattern in _SUMMARY_GLOBS for p in root.glob(pattern)
+    }
     return sorted(f for f in found if not f.startswith("contact_sheet"))
 
 
 def contact_sheet(
-    dataset_dir: str | os.PathLike[str], *, out: str | os.PathLike[str] | None = None,
+    dataset_dir: str | os.PathLike[str],
+    *,
+    out: str | os.PathLike[str] | None = None,
     samples: Sequence[Path] | None = None,
 ) -> Path:
     """Tile the ``image`` preview of every sample (or of *samples*) with its id into one PNG.
@@ -229,7 +294,9 @@ def contact_sheet(
     root = Path(dataset_dir)
     samples = sample_dirs(root) if samples is None else list(samples)
     if not samples:
-        raise DatasetError(f"dataset folder {str(root)!r} has no complete samples for a contact sheet")
+        raise DatasetError(
+            f"dataset folder {str(root)!r} has no complete samples for a contact sheet"
+        )
     font = ImageFont.load_default()
     cols = min(COLUMNS, len(samples))
     rows = -(-len(samples) // cols)
@@ -246,7 +313,9 @@ def contact_sheet(
         x0, y0 = (i % cols) * TILE, (i // cols) * cell
         sheet.paste(tile, (x0 + (TILE - tile.width) // 2, y0 + (TILE - tile.height) // 2))
         for line_no, line in enumerate(_wrap(sample.name, draw, font)):
-            draw.text((x0 + 2, y0 + TILE + 1 + line_no * _CAPTION_HEIGHT), line, fill=(0, 0, 0), font=font)
+            draw.text(
+                (x0 + 2, y0 + TILE + 1 + line_no * _CAPTION_HEIGHT), line, fill=(0, 0, 0), font=font
+            )
     path = Path(out) if out is not None else root / "contact_sheet.png"
     with guarded_write(path):
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -311,15 +380,18 @@ def _write_pixel_scripts(root: Path, index: Mapping[str, Any]) -> None:
             old.unlink()
     for entry in index["samples"]:
         urls = {
-            name: "data:image/png;base64," + base64.b64encode((root / src).read_bytes()).decode("ascii")
+            name: "data:image/png;base64,"
+            + base64.b64encode((root / src).read_bytes()).decode("ascii")
             for name, (src, enc) in entry["layers"].items()
             if isinstance(enc, Mapping) and enc.get("kind") in ("srgb", "colormap")
         }
         rel = f"{_PIXELS_DIR}/{entry['id']}.js"
         target = root / rel
         if target.exists() and not _written_by_us(target):
-            raise DatasetError(f"{target}: not a gallery file spectrinsic wrote; move it away to "
-                               "rebuild the gallery")
+            raise DatasetError(
+                f"{target}: not a gallery file spectrinsic wrote; move it away to "
+                "rebuild the gallery"
+            )
         _write_text(target, f"{_PIXELS_HEAD}{json.dumps(entry['id'])}] = {json.dumps(urls)};\n")
         entry["pixels"] = rel
 
@@ -347,7 +419,8 @@ def build_gallery(
     for name in _STATIC:
         _write_text(root / name, read_template(name))
     page = string.Template(read_template("gallery.html")).substitute(
-        title=_escape(index["title"]), n_samples=len(index["samples"]))
+        title=_escape(index["title"]), n_samples=len(index["samples"])
+    )
     path = root / "index.html"
     _write_text(path, page)
     return path

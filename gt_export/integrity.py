@@ -143,7 +143,11 @@ def dataset_config_hash(root: Path) -> str | None:
             record = json.loads((root / name).read_text(encoding="utf-8"))
         except (OSError, ValueError):
             continue
-        if isinstance(record, dict) and key in record and isinstance(record.get("config_hash"), str):
+        if (
+            isinstance(record, dict)
+            and key in record
+            and isinstance(record.get("config_hash"), str)
+        ):
             return record["config_hash"]
     return None
 
@@ -160,8 +164,11 @@ def check_build_folder(root: Path, config_hash: str, *, rebuild: bool) -> str | 
         locked by another run, non-empty and not a spectrinsic dataset), or it was built with
         another config and *rebuild* is false.
     """
-    if check_out_folder(root, own=lambda p: dataset_config_hash(p) is not None,
-                        what=f"a spectrinsic dataset (no {MARKER_NAME} or {MANIFEST_NAME})"):
+    if check_out_folder(
+        root,
+        own=lambda p: dataset_config_hash(p) is not None,
+        what=f"a spectrinsic dataset (no {MARKER_NAME} or {MANIFEST_NAME})",
+    ):
         return None
     previous = dataset_config_hash(root)
     if previous is not None and previous != config_hash and not rebuild:
@@ -180,8 +187,10 @@ def write_marker(root: Path, config_hash: str) -> None:
         raise WriteError(f"--out {str(root)!r}: cannot create the folder ({exc.strerror})") from exc
     tmp = root / f"{TMP_PREFIX}{MARKER_NAME.lstrip('.')}"
     with guarded_write(root / MARKER_NAME):
-        tmp.write_text(json.dumps({"spectrinsic_dataset": 1, "config_hash": config_hash}) + "\n",
-                       encoding="utf-8")
+        tmp.write_text(
+            json.dumps({"spectrinsic_dataset": 1, "config_hash": config_hash}) + "\n",
+            encoding="utf-8",
+        )
         tmp.replace(root / MARKER_NAME)
 
 

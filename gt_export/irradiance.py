@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from spectrinsic.errors import DatasetError
-from spectrinsic.render.pipeline import relative_standard_error
+from spectrinsic.render.scene_render import relative_standard_error
 
 __all__ = [
     "COVERAGE_MIN",
@@ -92,8 +92,13 @@ class WhiteRadiance:
 
     def with_bands(self, bands: np.ndarray) -> WhiteRadiance:
         """The same record with other band values (a batch, or the denoised estimate)."""
-        return WhiteRadiance(self.mode, np.where(self.valid[..., None], bands, 0.0), self.albedo,
-                             self.valid, self.to_xyz)
+        return WhiteRadiance(
+            self.mode,
+            np.where(self.valid[..., None], bands, 0.0),
+            self.albedo,
+            self.valid,
+            self.to_xyz,
+        )
 
     def from_raw(self, raw: np.ndarray) -> WhiteRadiance:
         """``W`` of other raw channels of the same pixels (an independent batch), Eq. 1."""
@@ -172,8 +177,12 @@ def unit_luminance(shading: np.ndarray, grey: np.ndarray) -> np.ndarray:
     return np.where(lit[..., None], shading / np.where(lit, grey, 1.0)[..., None], 0.0)
 
 
-def residual(image: np.ndarray, reflectance: np.ndarray, shading: np.ndarray,
-             specular: np.ndarray | None = None) -> np.ndarray:
+def residual(
+    image: np.ndarray,
+    reflectance: np.ndarray,
+    shading: np.ndarray,
+    specular: np.ndarray | None = None,
+) -> np.ndarray:
     """``image − reflectance ∘ shading [− specular]``, so ``image = reflectance ∘ shading
     [+ specular] + residual``.
 
@@ -181,8 +190,9 @@ def residual(image: np.ndarray, reflectance: np.ndarray, shading: np.ndarray,
     the stored layers to float32 rounding of the residual alone.
     """
     f32 = np.float32
-    out = (np.asarray(image, f32).astype(np.float64)
-           - np.asarray(reflectance, f32).astype(np.float64) * np.asarray(shading, f32).astype(np.float64))
+    out = np.asarray(image, f32).astype(np.float64) - np.asarray(reflectance, f32).astype(
+        np.float64
+    ) * np.asarray(shading, f32).astype(np.float64)
     return out if specular is None else out - np.asarray(specular, f32).astype(np.float64)
 
 
@@ -213,5 +223,9 @@ def noise_figures(rel_se: np.ndarray, valid: np.ndarray) -> dict[str, float | in
     values = rel_se[valid & (rel_se > 0)]
     if not values.size:
         return {"median": 0.0, "p95": 0.0, "rms": 0.0, "pixels": 0}
-    return {"median": float(np.median(values)), "p95": float(np.percentile(values, 95)),
-            "rms": float(np.sqrt(np.mean(values ** 2))), "pixels": int(values.size)}
+    return {
+        "median": float(np.median(values)),
+        "p95": float(np.percentile(values, 95)),
+        "rms": float(np.sqrt(np.mean(values**2))),
+        "pixels": int(values.size),
+    }

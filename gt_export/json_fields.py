@@ -32,12 +32,19 @@ class JsonFields:
         got = "" if value is ... else f", got {_short(value)}"
         return SampleMetaError(f"{self.path}: {name}: expected {expected}{got}")
 
-    def exact_keys(self, obj: Mapping[str, Any], name: str, keys: frozenset[str],
-                   required: frozenset[str] | None = None) -> None:
+    def exact_keys(
+        self,
+        obj: Mapping[str, Any],
+        name: str,
+        keys: frozenset[str],
+        required: frozenset[str] | None = None,
+    ) -> None:
         for key in sorted((keys if required is None else required) - set(obj)):
             raise SampleMetaError(f"{self.path}: {_join(name, key)}: missing")
         for key in sorted(set(obj) - keys):
-            raise SampleMetaError(f"{self.path}: {_join(name, key)}: not a field spectrinsic writes")
+            raise SampleMetaError(
+                f"{self.path}: {_join(name, key)}: not a field spectrinsic writes"
+            )
 
     def mapping(self, value: object, name: str) -> Mapping[str, Any]:
         if not isinstance(value, dict):
@@ -57,7 +64,11 @@ class JsonFields:
         return value
 
     def number(self, value: object, name: str) -> float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, (int, float))
+            or not math.isfinite(value)
+        ):
             raise self.fail(name, "a finite number", value)
         return float(value)
 
@@ -70,7 +81,9 @@ class JsonFields:
         return tuple(self.text(v, f"{name}[{i}]") for i, v in enumerate(self.sequence(value, name)))
 
     def numbers(self, value: object, name: str) -> tuple[float, ...]:
-        return tuple(self.number(v, f"{name}[{i}]") for i, v in enumerate(self.sequence(value, name)))
+        return tuple(
+            self.number(v, f"{name}[{i}]") for i, v in enumerate(self.sequence(value, name))
+        )
 
     def inside(self, value: object, name: str) -> str:
         rel = self.text(value, name)

@@ -16,8 +16,14 @@ from spectrinsic.gt_export.png import EXPOSURE_PERCENTILE, exposure
 from spectrinsic.gt_export.sample import META_NAME, file_sha256, sample_dirs
 from spectrinsic.gt_export.sample_meta import SampleMeta, read_meta
 
-__all__ = ["load_sample", "load_dataset", "split_samples", "prepare_item", "torch_dataset",
-           "EXPOSURE_PERCENTILE"]
+__all__ = [
+    "load_sample",
+    "load_dataset",
+    "split_samples",
+    "prepare_item",
+    "torch_dataset",
+    "EXPOSURE_PERCENTILE",
+]
 
 _INT_LAYERS = ("material_id", "object_id")
 
@@ -28,8 +34,10 @@ def _verified(meta: SampleMeta, file: str) -> Path:
     if not path.is_file():
         raise DatasetError(f"{path}: listed in {META_NAME} but missing; the sample is incomplete")
     if file_sha256(path) != meta.hashes.get(file):
-        raise DatasetError(f"{path}: does not match its SHA-256 in {META_NAME}; the sample is "
-                           f"damaged (spectrinsic check finds every such file)")
+        raise DatasetError(
+            f"{path}: does not match its SHA-256 in {META_NAME}; the sample is "
+            f"damaged (spectrinsic check finds every such file)"
+        )
     return path
 
 
@@ -69,7 +77,9 @@ def load_sample(
     wanted = list(records) if layers is None else list(layers)
     unknown = [k for k in wanted if k not in records]
     if unknown:
-        raise DatasetError(f"sample {meta.sample_id!r} has no layers {unknown}; it has {sorted(records)}")
+        raise DatasetError(
+            f"sample {meta.sample_id!r} has no layers {unknown}; it has {sorted(records)}"
+        )
     by_file: dict[str, list[str]] = {}
     for key in wanted:
         by_file.setdefault(records[key].file, []).append(key)
@@ -94,7 +104,9 @@ def load_sample(
 
 
 def load_dataset(
-    dataset_dir: str | os.PathLike[str], *, layers: Sequence[str] | None = None,
+    dataset_dir: str | os.PathLike[str],
+    *,
+    layers: Sequence[str] | None = None,
     verify: bool = True,
 ) -> Iterator[dict[str, Any]]:
     """Iterate :func:`load_sample` over the complete samples of *dataset_dir*, sorted by id."""
@@ -162,7 +174,7 @@ def prepare_item(
         if crop[0] > h or crop[1] > w:
             raise DatasetError(f"crop {crop} is larger than the {h}x{w} sample")
         y0, x0 = int(rng.integers(h - crop[0] + 1)), int(rng.integers(w - crop[1] + 1))
-        arrays = {k: v[y0:y0 + crop[0], x0:x0 + crop[1]] for k, v in arrays.items()}
+        arrays = {k: v[y0 : y0 + crop[0], x0 : x0 + crop[1]] for k, v in arrays.items()}
     item: dict[str, Any] = {}
     for key, value in arrays.items():
         if normalize_exposure and key.startswith(EXPOSED_PREFIXES):
@@ -234,10 +246,13 @@ def torch_dataset(
                 sample = load_sample(folders[index], layers=wanted, verify=verify)
             else:
                 relit = relight(folders[index], index, self.epoch)
-                sample = {k: v for k, v in relit.items() if wanted is None or k in wanted or k == "meta"}
+                sample = {
+                    k: v for k, v in relit.items() if wanted is None or k in wanted or k == "meta"
+                }
             rng = None if seed is None else np.random.default_rng([seed, index])
-            item = tensors(prepare_item(sample, crop=crop, rng=rng,
-                                        normalize_exposure=normalize_exposure))
+            item = tensors(
+                prepare_item(sample, crop=crop, rng=rng, normalize_exposure=normalize_exposure)
+            )
             return transform(item) if transform is not None else item
 
     return SpectrinsicDataset()

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from spectrinsic.config import resolve_data_dir
+from spectrinsic.data_dir import resolve_data_dir
 from spectrinsic.errors import DatasetError, SampleMetaError
 from spectrinsic.gt_export.integrity import guarded_write
 from spectrinsic.gt_export.json_fields import JsonFields, load_json
@@ -71,7 +71,7 @@ def _spectral_provenance(metas: Sequence[SampleMeta], data_dir: Any) -> dict[str
         "spectra_used": sorted(used),
         "munsell": f"Munsell1269.dat from luxpy {versions['luxpy']} (Parkkinen et al. 1989)",
         "cie_and_cameras": f"colour-science {versions['colour-science']} (CIE 1931 2°, "
-                           "CIE illuminants, NPL camera sensitivities)",
+        "CIE illuminants, NPL camera sensitivities)",
         "ground_truth_grid": "360-830 nm at 1 nm",
     }
     root = resolve_data_dir(data_dir)
@@ -131,7 +131,9 @@ def write_manifest(
     return path
 
 
-def read_splits(dataset_dir: str | os.PathLike[str], split: str | None = None) -> dict[str, list[str]]:
+def read_splits(
+    dataset_dir: str | os.PathLike[str], split: str | None = None
+) -> dict[str, list[str]]:
     """``{split: [sample ids]}`` of a built dataset's manifest.
 
     With *split*, that split must exist and hold a sample: an unknown name or an empty split
@@ -151,7 +153,8 @@ def read_splits(dataset_dir: str | os.PathLike[str], split: str | None = None) -
         raise DatasetError(
             f"split {split!r} of {dataset_dir} is empty: the dataset has {n} scene(s) for "
             f"{len(record.splits)} splits (every split gets a scene from {len(record.splits)} "
-            "scenes on; build more scenes or choose other --split-fractions)")
+            "scenes on; build more scenes or choose other --split-fractions)"
+        )
     return record.splits
 
 
@@ -178,7 +181,10 @@ def check_split_fractions(fractions: SplitFractions) -> SplitFractions:
     shown = ", ".join(f"{n}={v:g}" for n, v in pairs)
     if not pairs or len(set(names)) != len(names) or not all(names):
         raise DatasetError(f"split fractions {shown or '(none)'}; expected distinct named splits")
-    if not all(np.isfinite(v) and v > 0 for _, v in pairs) or abs(sum(v for _, v in pairs) - 1) > 1e-6:
+    if (
+        not all(np.isfinite(v) and v > 0 for _, v in pairs)
+        or abs(sum(v for _, v in pairs) - 1) > 1e-6
+    ):
         raise DatasetError(f"split fractions {shown}; expected shares > 0 that sum to 1")
     return pairs
 
@@ -223,7 +229,7 @@ def splits_by_scene(
     owner: dict[str, str] = {}
     start = 0
     for name, count in split_counts(len(scenes), fractions).items():
-        owner.update({scene: name for scene in scenes[start:start + count]})
+        owner.update({scene: name for scene in scenes[start : start + count]})
         start += count
     out: dict[str, list[str]] = {name: [] for name, _ in fractions}
     for sample, scene in sorted(sample_scenes.items()):
@@ -245,10 +251,12 @@ def noise_summary(metas: Sequence[SampleMeta]) -> dict[str, Any]:
         for kind, rows in kinds.items():
             worst = max(rows)
             summary.setdefault(layer, {})[kind] = {
-                "samples": len(rows), "median_of_medians": float(np.median([r[0] for r in rows])),
+                "samples": len(rows),
+                "median_of_medians": float(np.median([r[0] for r in rows])),
                 "median_of_p95": float(np.median([r[1] for r in rows])),
                 "median_of_rms": float(np.median([r[2] for r in rows])),
-                "worst_median": float(worst[0]), "worst_sample": worst[3],
+                "worst_median": float(worst[0]),
+                "worst_sample": worst[3],
             }
     return summary
 
@@ -278,14 +286,16 @@ class ManifestRecord:
         return len({r.get("scene") for r in listed.values() if isinstance(r, dict)})
 
 
-def _manifest_samples(f: JsonFields, root: Path, listed: Mapping[str, Any]) -> dict[str, dict[str, str]]:
+def _manifest_samples(
+    f: JsonFields, root: Path, listed: Mapping[str, Any]
+) -> dict[str, dict[str, str]]:
     out = {}
     for name, record in listed.items():
         files = record.get("files", {}) if isinstance(record, dict) else None
         if not isinstance(files, dict):
             raise f.fail(f"samples.{name}", "an object with a 'files' object", record)
         for rel, digest in files.items():
-            inside = rel.startswith(f"{name}/") and confined_path(root / name, rel[len(name) + 1:])
+            inside = rel.startswith(f"{name}/") and confined_path(root / name, rel[len(name) + 1 :])
             if not inside:
                 raise f.fail(f"samples.{name}.files", f"paths inside {name}/", rel)
             f.text(digest, f"samples.{name}.files.{rel}")
@@ -314,7 +324,10 @@ def read_manifest(dataset_dir: str | os.PathLike[str]) -> ManifestRecord | None:
         splits[split] = list(f.texts(ids, f"splits.{split}"))
     chash = manifest.get("config_hash")
     return ManifestRecord(
-        path=path, config_hash=f.text(chash, "config_hash", optional=True), splits=splits,
+        path=path,
+        config_hash=f.text(chash, "config_hash", optional=True),
+        splits=splits,
         sample_hashes=MappingProxyType({k: v.get("config_hash", chash) for k, v in listed.items()}),
-        sample_files=MappingProxyType(files), raw=MappingProxyType(manifest),
+        sample_files=MappingProxyType(files),
+        raw=MappingProxyType(manifest),
     )

@@ -48,7 +48,10 @@ OUTPUT_MARKER = ".spectrinsic-output"
 #: Prefix of spectrinsic's temporaries (as in :mod:`spectrinsic.gt_export.integrity`).
 _TMP_PREFIX = ".spectrinsic-tmp-"
 #: Files whose presence makes a folder a dataset or a shard export (a folder of spectrinsic's).
-_DATASET_MARKERS = ((".spectrinsic-dataset", "spectrinsic_dataset"), ("manifest.json", "format_version"))
+_DATASET_MARKERS = (
+    (".spectrinsic-dataset", "spectrinsic_dataset"),
+    ("manifest.json", "format_version"),
+)
 _SHARD_INDEX = ("shards.json", "format")
 #: Folders whose lock this process holds: checks made under the lock must not probe it (a
 #: second ``flock`` on a new descriptor conflicts with the process's own lock).
@@ -80,16 +83,21 @@ def _is_dataset(folder: Path) -> bool:
 
 def _is_own_folder(folder: Path) -> bool:
     """A dataset, a shard export or an output folder of spectrinsic's."""
-    return (_is_dataset(folder) or _json_record(folder / _SHARD_INDEX[0], _SHARD_INDEX[1]) is not None
-            or _json_record(folder / OUTPUT_MARKER, "spectrinsic_output") is not None)
+    return (
+        _is_dataset(folder)
+        or _json_record(folder / _SHARD_INDEX[0], _SHARD_INDEX[1]) is not None
+        or _json_record(folder / OUTPUT_MARKER, "spectrinsic_output") is not None
+    )
 
 
 def _refuse_inside_dataset(root: Path, option: str) -> None:
     """A folder inside a dataset would become part of it (a ``meta.json`` reads as a sample)."""
     for parent in root.absolute().parents:
         if parent.is_dir() and _is_dataset(parent):
-            raise DatasetError(f"{option} {str(root)!r} lies inside the dataset folder {str(parent)!r}; "
-                               "choose a folder outside it")
+            raise DatasetError(
+                f"{option} {str(root)!r} lies inside the dataset folder {str(parent)!r}; "
+                "choose a folder outside it"
+            )
 
 
 def _require_writable(root: Path, option: str) -> None:
@@ -100,16 +108,18 @@ def _require_writable(root: Path, option: str) -> None:
         probe.mkdir()
         probe.rmdir()
     except OSError as exc:
-        raise WriteError(f"{option} {str(root)!r}: {str(existing)!r} is not writable "
-                         f"({exc.strerror or exc})") from None
+        raise WriteError(
+            f"{option} {str(root)!r}: {str(existing)!r} is not writable ({exc.strerror or exc})"
+        ) from None
 
 
 def _entries(root: Path) -> list[Path]:
     return sorted(p for p in root.iterdir() if p.name != LOCK_NAME)
 
 
-def check_out_folder(root: Path, *, own: Callable[[Path], bool], what: str,
-                     option: str = "--out") -> bool:
+def check_out_folder(
+    root: Path, *, own: Callable[[Path], bool], what: str, option: str = "--out"
+) -> bool:
     """Check that a verb may write into *root*; return True if it is new or empty.
 
     The one rule of every writing verb: *root* is a folder path (not a file, not below one),
@@ -128,8 +138,10 @@ def check_out_folder(root: Path, *, own: Callable[[Path], bool], what: str,
         _require_writable(root, option)
         return True
     if not own(root):
-        raise DatasetError(f"{option} {str(root)!r} is not empty and is not {what}, so it "
-                           "holds files spectrinsic did not write; choose a new or empty folder")
+        raise DatasetError(
+            f"{option} {str(root)!r} is not empty and is not {what}, so it "
+            "holds files spectrinsic did not write; choose a new or empty folder"
+        )
     _require_writable(root, option)
     return False
 
@@ -139,8 +151,11 @@ def check_out_folder(root: Path, *, own: Callable[[Path], bool], what: str,
 
 
 def _holder() -> dict[str, object]:
-    return {"pid": os.getpid(), "host": socket.gethostname(),
-            "started": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime())}
+    return {
+        "pid": os.getpid(),
+        "host": socket.gethostname(),
+        "started": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()),
+    }
 
 
 def _locked_message(root: Path, fd: int, option: str) -> str:
@@ -149,8 +164,10 @@ def _locked_message(root: Path, fd: int, option: str) -> str:
         who = f"pid {holder['pid']} on {holder['host']}, started {holder['started']}"
     except (OSError, ValueError, KeyError, TypeError):
         who = "its details are not written yet"
-    return (f"{option} {str(root)!r} is in use by another spectrinsic run ({who}); wait for it "
-            "to finish or choose another folder")
+    return (
+        f"{option} {str(root)!r} is in use by another spectrinsic run ({who}); wait for it "
+        "to finish or choose another folder"
+    )
 
 
 def check_unlocked(root: Path, option: str = "--out") -> None:
@@ -205,8 +222,9 @@ def folder_lock(root: Path, option: str = "--out") -> Iterator[None]:
         root.mkdir(parents=True, exist_ok=True)
         fd = _acquire(root, option)
     except OSError as exc:
-        raise WriteError(f"{option} {str(root)!r}: cannot create the folder's lock "
-                         f"({exc.strerror or exc})") from None
+        raise WriteError(
+            f"{option} {str(root)!r}: cannot create the folder's lock ({exc.strerror or exc})"
+        ) from None
     held = root.resolve()
     try:
         os.ftruncate(fd, 0)
@@ -233,8 +251,9 @@ def _files_below(root: Path) -> set[str]:
     found: set[str] = set()
     for dirpath, dirnames, filenames in os.walk(root):
         here = Path(dirpath)
-        dirnames[:] = sorted(d for d in dirnames
-                             if not d.startswith(_TMP_PREFIX) and not _is_own_folder(here / d))
+        dirnames[:] = sorted(
+            d for d in dirnames if not d.startswith(_TMP_PREFIX) and not _is_own_folder(here / d)
+        )
         for name in filenames:
             if name in (LOCK_NAME, OUTPUT_MARKER) or name.startswith(_TMP_PREFIX):
                 continue
@@ -271,16 +290,25 @@ def check_output_folder(root: Path, option: str = "--out") -> None:
         spectrinsic did not write.
     """
     # own: the marker's, or holding only other folders of spectrinsic's (results/evaluation)
-    if check_out_folder(root, own=lambda p: _marker(p) is not None or not _files_below(p), option=option,
-                        what=f"a spectrinsic output folder (no {OUTPUT_MARKER})"):
+    if check_out_folder(
+        root,
+        own=lambda p: _marker(p) is not None or not _files_below(p),
+        option=option,
+        what=f"a spectrinsic output folder (no {OUTPUT_MARKER})",
+    ):
         return
     foreign, died = _foreign(root)
     if foreign:
         more = f" and {len(foreign) - 1} more" if len(foreign) > 1 else ""
-        why = ("an earlier run was killed before it recorded its files"
-               if died else "spectrinsic did not write it")
-        raise DatasetError(f"{option} {str(root)!r} holds {foreign[0]!r}{more}, which is not "
-                           f"listed in {OUTPUT_MARKER} ({why}); move it away or choose another folder")
+        why = (
+            "an earlier run was killed before it recorded its files"
+            if died
+            else "spectrinsic did not write it"
+        )
+        raise DatasetError(
+            f"{option} {str(root)!r} holds {foreign[0]!r}{more}, which is not "
+            f"listed in {OUTPUT_MARKER} ({why}); move it away or choose another folder"
+        )
 
 
 def _write_marker(root: Path, files: set[str], writing: dict[str, object] | None) -> None:
@@ -290,7 +318,9 @@ def _write_marker(root: Path, files: set[str], writing: dict[str, object] | None
         tmp.write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
         tmp.replace(root / OUTPUT_MARKER)
     except OSError as exc:
-        raise WriteError(f"cannot write {str(root / OUTPUT_MARKER)!r}: {exc.strerror or exc}") from exc
+        raise WriteError(
+            f"cannot write {str(root / OUTPUT_MARKER)!r}: {exc.strerror or exc}"
+        ) from exc
 
 
 @contextlib.contextmanager

@@ -128,7 +128,9 @@ def write_png(path: str | os.PathLike[str], rgb8: np.ndarray) -> Path:
 
     rgb8 = np.asarray(rgb8)
     if rgb8.dtype != np.uint8 or rgb8.ndim not in (2, 3):
-        raise DatasetError(f"PNG {str(path)!r}: expected (H, W[, 3]) uint8, got {rgb8.dtype} {rgb8.shape}")
+        raise DatasetError(
+            f"PNG {str(path)!r}: expected (H, W[, 3]) uint8, got {rgb8.dtype} {rgb8.shape}"
+        )
     path = Path(path)
     with guarded_write(path):
         Image.fromarray(np.ascontiguousarray(rgb8)).save(path, format="PNG", optimize=False)
@@ -138,7 +140,11 @@ def write_png(path: str | os.PathLike[str], rgb8: np.ndarray) -> Path:
 def write_png16(path: str | os.PathLike[str], image: np.ndarray) -> Path:
     """Write ``(H, W)`` grey or ``(H, W, 3)`` RGB uint16 codes as a 16-bit PNG (pypng)."""
     codes = np.asarray(image)
-    if codes.dtype != np.uint16 or codes.ndim not in (2, 3) or (codes.ndim == 3 and codes.shape[2] != 3):
+    if (
+        codes.dtype != np.uint16
+        or codes.ndim not in (2, 3)
+        or (codes.ndim == 3 and codes.shape[2] != 3)
+    ):
         raise DatasetError(
             f"16-bit PNG {str(path)!r}: expected (H, W) or (H, W, 3) uint16, got {codes.dtype} {codes.shape}"
         )

@@ -52,10 +52,17 @@ def _grey_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
     return _srgb(np.repeat(layer.data[..., None], 3, axis=-1), png.exposure(layer.data))
 
 
-def _colormap(values: np.ndarray, vmin: float, vmax: float, cmap: str = "magma",
-              mask: np.ndarray | None = None) -> Preview:
-    return (png.false_colour(values, mask=mask, cmap=cmap, vmin=vmin, vmax=vmax),
-            {"kind": "colormap", "cmap": cmap, "vmin": float(vmin), "vmax": float(vmax)})
+def _colormap(
+    values: np.ndarray,
+    vmin: float,
+    vmax: float,
+    cmap: str = "magma",
+    mask: np.ndarray | None = None,
+) -> Preview:
+    return (
+        png.false_colour(values, mask=mask, cmap=cmap, vmin=vmin, vmax=vmax),
+        {"kind": "colormap", "cmap": cmap, "vmin": float(vmin), "vmax": float(vmax)},
+    )
 
 
 def _error_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
@@ -66,7 +73,9 @@ def _residual_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
     """Magnitude of the residual relative to the image: 0 (black) to 10 % (bright)."""
     base = layers.get(layer.name.replace("residual", "image", 1).replace("image_raw", "image"))
     norm = np.linalg.norm(base.data, axis=-1) if base is not None else np.ones(layer.data.shape[:2])
-    rel = np.divide(np.linalg.norm(layer.data, axis=-1), norm, out=np.zeros(norm.shape), where=norm > 0)
+    rel = np.divide(
+        np.linalg.norm(layer.data, axis=-1), norm, out=np.zeros(norm.shape), where=norm > 0
+    )
     preview, encoding = _colormap(rel, 0.0, 0.1)
     return preview, {**encoding, "of": "‖residual‖ / ‖image‖"}
 
@@ -87,7 +96,11 @@ def _mask_of(layers: Mapping[str, Layer]) -> np.ndarray | None:
 def _depth_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
     mask = _mask_of(layers)
     valid = layer.data[mask] if mask is not None else layer.data.ravel()
-    lo, hi = (float(np.percentile(valid, 1)), float(np.percentile(valid, 99))) if valid.size else (0.0, 1.0)
+    lo, hi = (
+        (float(np.percentile(valid, 1)), float(np.percentile(valid, 99)))
+        if valid.size
+        else (0.0, 1.0)
+    )
     return _colormap(layer.data, lo, hi, cmap="viridis", mask=mask)
 
 

@@ -36,13 +36,20 @@ from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, file_sha256
 from spectrinsic.gt_export.sample_meta import read_meta
 from spectrinsic.gt_export.transport_file import read_transport
 from spectrinsic.gt_export.writer import export_sample
-from spectrinsic.render.pipeline import merge_batches
 from spectrinsic.render.result import RenderResult
+from spectrinsic.render.scene_render import merge_batches
 from spectrinsic.render.transport import LightTransport, transport_result
 from spectrinsic.scenes.model import GLOSS_FIELDS, Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import get_spectrum
 
-__all__ = ["RelitSample", "read_sample_scene", "relit_scene", "relit_render", "relight", "check_light_spectra"]
+__all__ = [
+    "RelitSample",
+    "read_sample_scene",
+    "relit_scene",
+    "relit_render",
+    "relight",
+    "check_light_spectra",
+]
 
 #: AOV layers read back from ``geometry.exr`` (coverage comes from ``transport.exr``).
 _AOV_LAYERS = ("depth", "normals", "material_id", "object_id", "mask")
@@ -91,12 +98,22 @@ def read_sample_scene(sample_dir: str | os.PathLike[str]) -> Scene:
     except ValueError as exc:
         raise _fail(sample, f"not valid JSON ({exc})") from exc
     try:
-        meshes = tuple(Mesh(name=str(m["name"]), vertices=np.asarray(m["vertices"], np.float64).reshape(-1, 3),
-                            faces=np.asarray(m["faces"], np.int64).reshape(-1, 3),
-                            face_materials=np.asarray(m["face_materials"], np.int64).reshape(-1),
-                            object_id=int(m["object_id"])) for m in data["meshes"])
-        materials = tuple(Material(str(m["name"]), str(m["spectrum"]), **{k: m[k] for k in GLOSS_FIELDS if k in m})
-                          for m in data["materials"])
+        meshes = tuple(
+            Mesh(
+                name=str(m["name"]),
+                vertices=np.asarray(m["vertices"], np.float64).reshape(-1, 3),
+                faces=np.asarray(m["faces"], np.int64).reshape(-1, 3),
+                face_materials=np.asarray(m["face_materials"], np.int64).reshape(-1),
+                object_id=int(m["object_id"]),
+            )
+            for m in data["meshes"]
+        )
+        materials = tuple(
+            Material(
+                str(m["name"]), str(m["spectrum"]), **{k: m[k] for k in GLOSS_FIELDS if k in m}
+            )
+            for m in data["materials"]
+        )
         lights = tuple(Light(**_fields(x)) for x in data["lights"])
         camera = Camera(**_fields(data["camera"]))
         metadata = data.get("metadata") or {}
@@ -105,8 +122,9 @@ def read_sample_scene(sample_dir: str | os.PathLike[str]) -> Scene:
         raise _fail(sample, f"unexpected structure ({type(exc).__name__}: {exc})") from exc
 
 
-def check_light_spectra(lights: Mapping[int, str], n_lights: int, *, data_dir: Any = None,
-                        what: str = "light") -> None:
+def check_light_spectra(
+    lights: Mapping[int, str], n_lights: int, *, data_dir: Any = None, what: str = "light"
+) -> None:
     """Raise a one-line error unless every key is a light index below *n_lights* and every value
     names an illuminant of the spectra registry (with a did-you-mean for near misses)."""
     if not lights:
@@ -119,28 +137,42 @@ def check_light_spectra(lights: Mapping[int, str], n_lights: int, *, data_dir: A
         except SpectrinsicError as exc:
             raise DatasetError(f"{what} {index}={name}: {exc}") from None
         if spectrum.kind != "illuminant":
-            raise DatasetError(f"{what} {index}={name}: a {spectrum.kind} spectrum; expected an illuminant "
-                               "(planck:3000K, cie:LED-RGB1, daylight:6500K, ...)")
+            raise DatasetError(
+                f"{what} {index}={name}: a {spectrum.kind} spectrum; expected an illuminant "
+                "(planck:3000K, cie:LED-RGB1, daylight:6500K, ...)"
+            )
 
 
-def relit_scene(scene: Scene, lights: Mapping[int, str], powers: Mapping[int, float] | None = None,
-                *, source: str | None = None) -> Scene:
+def relit_scene(
+    scene: Scene,
+    lights: Mapping[int, str],
+    powers: Mapping[int, float] | None = None,
+    *,
+    source: str | None = None,
+) -> Scene:
     """*scene* with light i's spectrum ``lights[i]`` (and power ``powers[i]``); others kept.
     Its metadata names the source sample and drops the energy ratio r (not relit)."""
     powers = dict(powers or {})
     bad = [i for i, p in powers.items() if not (isinstance(p, int | float) and p > 0)]
     if bad:
-        raise DatasetError(f"light power {powers[bad[0]]!r} for light {bad[0]}: expected a positive number")
-    new = tuple(dataclasses.replace(li, spectrum=str(lights.get(i, li.spectrum)),
-                                    power=float(powers.get(i, li.power)))
-                for i, li in enumerate(scene.lights))
+        raise DatasetError(
+            f"light power {powers[bad[0]]!r} for light {bad[0]}: expected a positive number"
+        )
+    new = tuple(
+        dataclasses.replace(
+            li, spectrum=str(lights.get(i, li.spectrum)), power=float(powers.get(i, li.power))
+        )
+        for i, li in enumerate(scene.lights)
+    )
     metadata = {k: v for k, v in scene.metadata.items() if k != "energy_ratio_r"}
     if source is not None:
         metadata["relit_from"] = source
     return dataclasses.replace(scene, lights=new, metadata=metadata)
 
 
-def _render_meta(meta: Mapping[str, Any], transport: LightTransport, relit: Mapping[str, Any]) -> dict[str, Any]:
+def _render_meta(
+    meta: Mapping[str, Any], transport: LightTransport, relit: Mapping[str, Any]
+) -> dict[str, Any]:
     base = {k: v for k, v in (meta.get("render") or {}).items() if k not in _DROPPED_META}
     variants = base.get("variants") or {}
     base["variants"] = {m: v for m, v in variants.items() if m in transport.modes}
@@ -171,8 +203,10 @@ def _aovs(sample: Path, meta: Mapping[str, Any], coverage: np.ndarray) -> dict[s
 def _source_meta(sample: Path) -> dict[str, Any]:
     meta = dict(read_meta(sample).raw)  # SampleMetaError: one line naming the file and field
     if "transport" not in meta:
-        raise DatasetError(f"sample {sample.name!r} stores no per-light transport; build it with "
-                           "`spectrinsic dataset --store-transport` to relight it")
+        raise DatasetError(
+            f"sample {sample.name!r} stores no per-light transport; build it with "
+            "`spectrinsic dataset --store-transport` to relight it"
+        )
     return meta
 
 
@@ -204,13 +238,18 @@ def relit_render(
         raise DatasetError(f"--power {stray[0]!r}: the sample has lights 0..{n_lights - 1}")
     transport, coverage = read_transport(sample, meta["transport"])
     scene = relit_scene(read_sample_scene(sample), lights, powers, source=str(meta["sample_id"]))
-    relit = {"from": meta["sample_id"], "from_meta_sha256": file_sha256(sample / META_NAME),
-             "lights": {str(i): li.spectrum for i, li in enumerate(scene.lights)},
-             "powers": {str(i): li.power for i, li in enumerate(scene.lights)}}
+    relit = {
+        "from": meta["sample_id"],
+        "from_meta_sha256": file_sha256(sample / META_NAME),
+        "lights": {str(i): li.spectrum for i, li in enumerate(scene.lights)},
+        "powers": {str(i): li.power for i, li in enumerate(scene.lights)},
+    }
     base = _render_meta(meta, transport, relit)
     dd = None if data_dir is None else str(data_dir)
-    batches = [transport_result(b, scene, seed=s, spp=transport.spp, meta=base, data_dir=dd)
-               for b, s in zip(transport.batches, transport.seeds, strict=True)]
+    batches = [
+        transport_result(b, scene, seed=s, spp=transport.spp, meta=base, data_dir=dd)
+        for b, s in zip(transport.batches, transport.seeds, strict=True)
+    ]
     merged = merge_batches(batches)
     result = dataclasses.replace(merged, aovs=_aovs(sample, meta, coverage))
     return RelitSample(scene=scene, result=result, meta=meta, transport=transport)
@@ -263,8 +302,15 @@ def relight(
         out.rmdir()  # an empty --out is allowed, as for `dataset`; rmdir removes nothing else
     cameras = meta["transport"].get("cameras") or [f"camera:{c}" for c in meta.get("cameras", [])]
     return export_sample(
-        out.parent, relit.scene, relit.result, sample_id=out.name,
-        config={"config_hash": meta["config_hash"]}, seed=int(meta["seed"]), cameras=cameras,
-        write_cube="cube" in meta.get("layers", {}), denoise=bool(meta.get("denoised_layers")),
-        data_dir=data_dir, transport=relit.transport if keep_transport else None,
+        out.parent,
+        relit.scene,
+        relit.result,
+        sample_id=out.name,
+        config={"config_hash": meta["config_hash"]},
+        seed=int(meta["seed"]),
+        cameras=cameras,
+        write_cube="cube" in meta.get("layers", {}),
+        denoise=bool(meta.get("denoised_layers")),
+        data_dir=data_dir,
+        transport=relit.transport if keep_transport else None,
     )

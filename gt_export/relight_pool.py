@@ -33,15 +33,23 @@ from spectrinsic.gt_export.sample_meta import read_meta
 from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.generators.lights import draw_illuminant
 
-__all__ = ["RELIT_TAG", "draw_light_spectra", "relit_variant_id", "write_relit_variants",
-           "relit_problem", "relit_layers", "RandomRelight"]
+__all__ = [
+    "RELIT_TAG",
+    "draw_light_spectra",
+    "relit_variant_id",
+    "write_relit_variants",
+    "relit_problem",
+    "relit_layers",
+    "RandomRelight",
+]
 
 #: Separator between a sample id and the relit variant's number.
 RELIT_TAG = "-relit"
 
 
-def draw_light_spectra(n_lights: int, rng: np.random.Generator,
-                       pool: Sequence[str] | None = None) -> dict[int, str]:
+def draw_light_spectra(
+    n_lights: int, rng: np.random.Generator, pool: Sequence[str] | None = None
+) -> dict[int, str]:
     """``{light index: illuminant name}`` for *n_lights* lights, drawn with *rng* from *pool*
     (uniformly) or, without one, from the generators' illuminant families."""
     if pool is not None and not pool:
@@ -65,14 +73,21 @@ def _variant_lights(n_lights: int, k: int, seed: int) -> dict[int, str]:
     return draw_light_spectra(n_lights, rng)
 
 
-def write_relit_variants(sample_dir: str | os.PathLike[str], n: int, *, seed: int,
-                         data_dir: Any = None) -> list[Path]:
+def write_relit_variants(
+    sample_dir: str | os.PathLike[str], n: int, *, seed: int, data_dir: Any = None
+) -> list[Path]:
     """Write *n* relit variants of a sample that stores its transport, beside it."""
     sample = Path(sample_dir)
     n_lights = len(read_meta(sample).lights)
-    return [relight(sample, _variant_lights(n_lights, k, seed),
-                    sample.parent / relit_variant_id(sample.name, k), data_dir=data_dir)
-            for k in range(1, int(n) + 1)]
+    return [
+        relight(
+            sample,
+            _variant_lights(n_lights, k, seed),
+            sample.parent / relit_variant_id(sample.name, k),
+            data_dir=data_dir,
+        )
+        for k in range(1, int(n) + 1)
+    ]
 
 
 def relit_problem(sample_dir: str | os.PathLike[str], n: int, config_hash: str) -> str | None:
@@ -86,9 +101,15 @@ def relit_problem(sample_dir: str | os.PathLike[str], n: int, config_hash: str) 
     return None
 
 
-def relit_layers(sample_dir: str | os.PathLike[str], lights: Mapping[int, str], *,
-                 powers: Mapping[int, float] | None = None, data_dir: Any = None,
-                 denoise: bool | None = None, cameras: bool = True) -> dict[str, Any]:
+def relit_layers(
+    sample_dir: str | os.PathLike[str],
+    lights: Mapping[int, str],
+    *,
+    powers: Mapping[int, float] | None = None,
+    data_dir: Any = None,
+    denoise: bool | None = None,
+    cameras: bool = True,
+) -> dict[str, Any]:
     """Every layer of a sample under new light spectra, in memory, keyed as
     :func:`~spectrinsic.gt_export.loader.load_sample` returns them (``mask`` bool, ids int32
     under ``ids``, ``meta`` the source's ``meta.json`` with the new ``lights`` spectra).
@@ -101,7 +122,9 @@ def relit_layers(sample_dir: str | os.PathLike[str], lights: Mapping[int, str], 
     relit = relit_render(sample_dir, lights, powers=powers, data_dir=data_dir)
     meta = relit.meta
     gt = compute_ground_truth(
-        relit.scene, relit.result, cameras=(meta["transport"].get("cameras") or ()) if cameras else (),
+        relit.scene,
+        relit.result,
+        cameras=(meta["transport"].get("cameras") or ()) if cameras else (),
         write_cube="cube" in meta.get("layers", {}),
         denoise=bool(meta.get("denoised_layers")) if denoise is None else denoise,
         data_dir=data_dir,
@@ -116,8 +139,17 @@ def relit_layers(sample_dir: str | os.PathLike[str], lights: Mapping[int, str], 
             ids[key.removesuffix("_id")] = out[key]
     out["ids"] = ids
     new_meta = dict(meta)
-    new_meta["lights"] = [{"index": r.index, "spectrum": r.spectrum, "power": r.power, "share": r.share,
-                           "xy": r.xy, "srgb": r.srgb} for r in gt.lights]
+    new_meta["lights"] = [
+        {
+            "index": r.index,
+            "spectrum": r.spectrum,
+            "power": r.power,
+            "share": r.share,
+            "xy": r.xy,
+            "srgb": r.srgb,
+        }
+        for r in gt.lights
+    ]
     new_meta["relit"] = relit.result.meta["relit"]
     out["meta"] = new_meta
     return out
@@ -152,8 +184,11 @@ class RandomRelight:
         rng = np.random.default_rng([int(self.seed), int(epoch), int(index)])
         return draw_light_spectra(n_lights, rng, self.pool)
 
-    def __call__(self, sample_dir: str | os.PathLike[str], index: int, epoch: int = 0) -> dict[str, Any]:
+    def __call__(
+        self, sample_dir: str | os.PathLike[str], index: int, epoch: int = 0
+    ) -> dict[str, Any]:
         """Every layer of the sample in *sample_dir* under this item's random spectra."""
         lights = self.lights(len(read_meta(sample_dir).lights), index, epoch)
-        return relit_layers(sample_dir, lights, data_dir=self.data_dir, denoise=self.denoise,
-                            cameras=self.cameras)
+        return relit_layers(
+            sample_dir, lights, data_dir=self.data_dir, denoise=self.denoise, cameras=self.cameras
+        )

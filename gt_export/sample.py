@@ -90,8 +90,11 @@ def plain_data(value: Any, digits: int | None = None) -> Any:
     if is_dataclass(value) and not isinstance(value, type):
         # fields marked omit_default (a material's gloss) are left out at their defaults, as
         # scene_to_dict does, so matte scenes are written as before they existed
-        return {f.name: plain_data(getattr(value, f.name), digits) for f in fields(value)
-                if not (f.metadata.get("omit_default") and getattr(value, f.name) == f.default)}
+        return {
+            f.name: plain_data(getattr(value, f.name), digits)
+            for f in fields(value)
+            if not (f.metadata.get("omit_default") and getattr(value, f.name) == f.default)
+        }
     if isinstance(value, Mapping):
         return {str(k): plain_data(v, digits) for k, v in value.items()}
     if isinstance(value, np.ndarray):
@@ -212,5 +215,8 @@ def sample_dirs(dataset_dir: str | os.PathLike[str]) -> list[Path]:
     root = Path(dataset_dir)
     if not root.is_dir():
         raise DatasetError(f"dataset folder {str(root)!r} does not exist")
-    return sorted(p for p in root.iterdir()
-                  if p.is_dir() and not p.name.startswith(".") and (p / META_NAME).is_file())
+    return sorted(
+        p
+        for p in root.iterdir()
+        if p.is_dir() and not p.name.startswith(".") and (p / META_NAME).is_file()
+    )

@@ -51,17 +51,52 @@ __all__ = [
 ]
 
 #: Every top-level field of ``meta.json`` (format 3 adds :data:`SEAL_KEY`).
-META_FIELDS = frozenset({
-    "format_version", "sample_id", "scene", "scene_hash", "scene_metadata", "config_hash", "seed",
-    "variants", "render", "reference_mode", "size", "spectral_grid", "materials", "objects",
-    "lights", "cameras", "cube_sensors", "matrices", "layers", "identities", "denoised_layers",
-    "noise", "shading_clipping", "files", "versions", HASHES_KEY,
-})
+META_FIELDS = frozenset(
+    {
+        "format_version",
+        "sample_id",
+        "scene",
+        "scene_hash",
+        "scene_metadata",
+        "config_hash",
+        "seed",
+        "variants",
+        "render",
+        "reference_mode",
+        "size",
+        "spectral_grid",
+        "materials",
+        "objects",
+        "lights",
+        "cameras",
+        "cube_sensors",
+        "matrices",
+        "layers",
+        "identities",
+        "denoised_layers",
+        "noise",
+        "shading_clipping",
+        "files",
+        "versions",
+        HASHES_KEY,
+    }
+)
 #: Fields written only by some builds: ``transport`` (``dataset --store-transport``, the record
 #: of :func:`~spectrinsic.gt_export.transport_file.write_transport`).
 OPTIONAL_META_FIELDS = frozenset({"transport"})
-_LAYER_FIELDS = frozenset({"file", "exr_layer", "channels", "shape", "dtype", "units",
-                           "nonnegative", "preview", "preview_encoding"})
+_LAYER_FIELDS = frozenset(
+    {
+        "file",
+        "exr_layer",
+        "channels",
+        "shape",
+        "dtype",
+        "units",
+        "nonnegative",
+        "preview",
+        "preview_encoding",
+    }
+)
 _NOISE_FIELDS = frozenset({"median", "p95", "rms", "pixels"})
 #: Noise records of format 2 may lack ``rms`` (it then reads as the median).
 _NOISE_REQUIRED = frozenset({"median", "p95", "pixels"})
@@ -173,8 +208,10 @@ def _layer(f: JsonFields, rec: object, name: str) -> LayerRecord:
         if key not in rec:
             raise SampleMetaError(f"{f.path}: {name}.{key}: missing")
     f.exact_keys(rec, name, _LAYER_FIELDS)
-    shape = tuple(f.integer(v, f"{name}.shape[{i}]", low=1)
-                  for i, v in enumerate(f.sequence(rec["shape"], f"{name}.shape")))
+    shape = tuple(
+        f.integer(v, f"{name}.shape[{i}]", low=1)
+        for i, v in enumerate(f.sequence(rec["shape"], f"{name}.shape"))
+    )
     if len(shape) not in (2, 3):
         raise f.fail(f"{name}.shape", "(H, W) or (H, W, C)", list(shape))
     encoding = rec["preview_encoding"]
@@ -184,9 +221,12 @@ def _layer(f: JsonFields, rec: object, name: str) -> LayerRecord:
     if not isinstance(rec["nonnegative"], bool):
         raise f.fail(f"{name}.nonnegative", "true or false", rec["nonnegative"])
     return LayerRecord(
-        file=f.inside(rec["file"], f"{name}.file"), exr_layer=f.text(rec["exr_layer"], f"{name}.exr_layer"),
-        channels=f.texts(rec["channels"], f"{name}.channels"), shape=shape,
-        dtype=f.text(rec["dtype"], f"{name}.dtype"), units=f.text(rec["units"], f"{name}.units"),
+        file=f.inside(rec["file"], f"{name}.file"),
+        exr_layer=f.text(rec["exr_layer"], f"{name}.exr_layer"),
+        channels=f.texts(rec["channels"], f"{name}.channels"),
+        shape=shape,
+        dtype=f.text(rec["dtype"], f"{name}.dtype"),
+        units=f.text(rec["units"], f"{name}.units"),
         nonnegative=rec["nonnegative"],
         preview=None if preview is None else f.inside(preview, f"{name}.preview"),
         preview_encoding=encoding,
@@ -218,14 +258,19 @@ def _light(f: JsonFields, light: object, name: str) -> LightEntry:
     if len(xy) != 2:
         raise f.fail(f"{name}.xy", "two numbers", list(xy))
     return LightEntry(
-        name=f.text(light["name"], f"{name}.name"), kind=f.text(light["kind"], f"{name}.kind"),
-        spectrum=f.text(light["spectrum"], f"{name}.spectrum"), xy=(xy[0], xy[1]),
-        srgb=f.numbers(light["srgb"], f"{name}.srgb"), share=f.number(light["share"], f"{name}.share"),
+        name=f.text(light["name"], f"{name}.name"),
+        kind=f.text(light["kind"], f"{name}.kind"),
+        spectrum=f.text(light["spectrum"], f"{name}.spectrum"),
+        xy=(xy[0], xy[1]),
+        srgb=f.numbers(light["srgb"], f"{name}.srgb"),
+        share=f.number(light["share"], f"{name}.share"),
         spd=f.numbers(light["spd"], f"{name}.spd"),
     )
 
 
-def _identity(f: JsonFields, ident: object, name: str, layers: Mapping[str, LayerRecord]) -> Identity:
+def _identity(
+    f: JsonFields, ident: object, name: str, layers: Mapping[str, LayerRecord]
+) -> Identity:
     ident = f.mapping(ident, name)
     fields = _IDENTITY_FIELDS + (("specular",) if "specular" in ident else ())
     f.exact_keys(ident, name, frozenset(fields))
@@ -237,7 +282,9 @@ def _identity(f: JsonFields, ident: object, name: str, layers: Mapping[str, Laye
 
 
 def _files(f: JsonFields, meta: Mapping[str, Any]) -> tuple[tuple[str, ...], dict[str, str]]:
-    files = tuple(f.inside(rel, f"files[{i}]") for i, rel in enumerate(f.sequence(meta["files"], "files")))
+    files = tuple(
+        f.inside(rel, f"files[{i}]") for i, rel in enumerate(f.sequence(meta["files"], "files"))
+    )
     hashes = f.mapping(meta[HASHES_KEY], HASHES_KEY)
     if set(hashes) != set(files):
         odd = sorted(set(hashes) ^ set(files))[0]
@@ -257,8 +304,10 @@ def _sealed(f: JsonFields, meta: Mapping[str, Any], verify: bool) -> bool:
         raise f.fail(SEAL_KEY, "a SHA-256 hex digest", meta[SEAL_KEY])
     sealed = meta_seal(meta) == meta[SEAL_KEY]
     if verify and not sealed:
-        raise SampleMetaError(f"{f.path}: {SEAL_KEY}: the content does not match its seal "
-                              "(edited or damaged after it was written)")
+        raise SampleMetaError(
+            f"{f.path}: {SEAL_KEY}: the content does not match its seal "
+            "(edited or damaged after it was written)"
+        )
     return sealed
 
 
@@ -300,8 +349,10 @@ def parse_meta(meta: object, path: Path, *, verify: bool = True) -> SampleMeta:
     sample_id = f.text(meta["sample_id"], "sample_id")
     if sample_id != path.parent.name:
         raise f.fail("sample_id", f"the folder's name {path.parent.name!r}", sample_id)
-    layers = {key: _layer(f, rec, f"layers.{key}")
-              for key, rec in f.mapping(meta["layers"], "layers").items()}
+    layers = {
+        key: _layer(f, rec, f"layers.{key}")
+        for key, rec in f.mapping(meta["layers"], "layers").items()
+    }
     size = _size(f, meta["size"])
     _check_records(f, meta)
     materials = f.mapping(meta["materials"], "materials")
@@ -310,22 +361,36 @@ def parse_meta(meta: object, path: Path, *, verify: bool = True) -> SampleMeta:
     if "transport" in meta:
         transport = MappingProxyType(f.mapping(meta["transport"], "transport"))
         if TRANSPORT_NAME not in files:
-            raise f.fail("transport", "a record of a transport file the sample lists", dict(transport))
+            raise f.fail(
+                "transport", "a record of a transport file the sample lists", dict(transport)
+            )
     record = SampleMeta(
-        path=path, format_version=version, sample_id=sample_id,
-        scene=f.text(meta["scene"], "scene"), config_hash=f.text(meta["config_hash"], "config_hash"),
-        seed=f.integer(meta["seed"], "seed"), variants=f.texts(meta["variants"], "variants"),
-        reference_mode=f.text(meta["reference_mode"], "reference_mode"), size=size,
+        path=path,
+        format_version=version,
+        sample_id=sample_id,
+        scene=f.text(meta["scene"], "scene"),
+        config_hash=f.text(meta["config_hash"], "config_hash"),
+        seed=f.integer(meta["seed"], "seed"),
+        variants=f.texts(meta["variants"], "variants"),
+        reference_mode=f.text(meta["reference_mode"], "reference_mode"),
+        size=size,
         scene_metadata=MappingProxyType(f.mapping(meta["scene_metadata"], "scene_metadata")),
         materials=MappingProxyType({k: f.text(v, f"materials.{k}") for k, v in materials.items()}),
-        lights=tuple(_light(f, v, f"lights[{i}]") for i, v in enumerate(f.sequence(meta["lights"], "lights"))),
+        lights=tuple(
+            _light(f, v, f"lights[{i}]") for i, v in enumerate(f.sequence(meta["lights"], "lights"))
+        ),
         cameras=f.texts(meta["cameras"], "cameras"),
         cube_sensors=f.text(meta["cube_sensors"], "cube_sensors", optional=True),
         layers=MappingProxyType(layers),
-        identities=tuple(_identity(f, v, f"identities[{i}]", layers)
-                         for i, v in enumerate(f.sequence(meta["identities"], "identities"))),
+        identities=tuple(
+            _identity(f, v, f"identities[{i}]", layers)
+            for i, v in enumerate(f.sequence(meta["identities"], "identities"))
+        ),
         noise=MappingProxyType(_noise(f, meta["noise"])),
-        files=files, hashes=MappingProxyType(hashes), sealed=None, raw=MappingProxyType(meta),
+        files=files,
+        hashes=MappingProxyType(hashes),
+        sealed=None,
+        raw=MappingProxyType(meta),
         transport=transport,
     )
     # the seal last: a field that is wrong is named above; this catches what no schema can
@@ -380,4 +445,3 @@ def owned_files(folder: Path) -> frozenset[str] | None:
     if not isinstance(files, list) or not all(confined_path(folder, f) for f in files):
         return None
     return frozenset(files)
-

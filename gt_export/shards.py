@@ -37,7 +37,15 @@ from spectrinsic.gt_export.outfolder import LOCK_NAME, check_out_folder, folder_
 from spectrinsic.gt_export.sample import MANIFEST_NAME, META_NAME, TMP_PREFIX, file_sha256
 from spectrinsic.gt_export.sample_meta import meta_from_bytes
 
-__all__ = ["SHARD_INDEX", "KEY_SEPARATOR", "ShardSet", "check_shard_folder", "write_shards", "shard_urls", "shard_dataset"]
+__all__ = [
+    "SHARD_INDEX",
+    "KEY_SEPARATOR",
+    "ShardSet",
+    "check_shard_folder",
+    "write_shards",
+    "shard_urls",
+    "shard_dataset",
+]
 
 #: The export's index; written last, so its presence means every listed shard is complete.
 SHARD_INDEX = "shards.json"
@@ -71,7 +79,9 @@ def _webdataset() -> Any:
 def _member_name(layer: str) -> str:
     """``image_camera/Nikon D50`` -> ``image_camera~nikon d50.npy``."""
     if "." in layer or KEY_SEPARATOR in layer:
-        raise DatasetError(f"layer {layer!r}: a shard entry name may not contain '.' or {KEY_SEPARATOR!r}")
+        raise DatasetError(
+            f"layer {layer!r}: a shard entry name may not contain '.' or {KEY_SEPARATOR!r}"
+        )
     return layer.replace("/", KEY_SEPARATOR).lower() + ".npy"
 
 
@@ -79,7 +89,9 @@ def _entries(layers: set[str]) -> dict[str, str]:
     """Entry name -> layer key; two keys differing only in case cannot share a shard."""
     entries = {_member_name(k): k for k in sorted(layers)}
     if len(entries) != len(layers):
-        raise DatasetError(f"layers {sorted(layers)}: two differ only in case, which WebDataset merges")
+        raise DatasetError(
+            f"layers {sorted(layers)}: two differ only in case, which WebDataset merges"
+        )
     return entries
 
 
@@ -106,8 +118,12 @@ def check_shard_folder(out: Path, option: str = "--out") -> set[str]:
     """The files an earlier export of ours wrote in *out* (listed by its index, complete or
     interrupted); refuse a folder holding anything else, or one breaking the rule of every
     writing verb (:func:`~spectrinsic.gt_export.outfolder.check_out_folder`). Writes nothing."""
-    if check_out_folder(out, own=lambda p: (p / SHARD_INDEX).is_file(), option=option,
-                        what=f"an earlier shard export (no {SHARD_INDEX})"):
+    if check_out_folder(
+        out,
+        own=lambda p: (p / SHARD_INDEX).is_file(),
+        option=option,
+        what=f"an earlier shard export (no {SHARD_INDEX})",
+    ):
         return set()
     index_path = out / SHARD_INDEX
     try:
@@ -117,12 +133,17 @@ def check_shard_folder(out: Path, option: str = "--out") -> set[str]:
     if not isinstance(previous, dict) or previous.get("format") != _FORMAT:
         raise DatasetError(f"{index_path}: not a spectrinsic shard index")
     ours = set(previous.get("files", {}))
-    foreign = sorted(p.name for p in out.iterdir()
-                     if p.name not in ours | {SHARD_INDEX, LOCK_NAME} and not p.name.startswith(TMP_PREFIX))
+    foreign = sorted(
+        p.name
+        for p in out.iterdir()
+        if p.name not in ours | {SHARD_INDEX, LOCK_NAME} and not p.name.startswith(TMP_PREFIX)
+    )
     if foreign:
-        raise DatasetError(f"shard folder {str(out)!r} holds files spectrinsic did not write "
-                           f"({', '.join(foreign[:3])}{', ...' if len(foreign) > 3 else ''}); "
-                           "expected a new, empty or earlier shard folder")
+        raise DatasetError(
+            f"shard folder {str(out)!r} holds files spectrinsic did not write "
+            f"({', '.join(foreign[:3])}{', ...' if len(foreign) > 3 else ''}); "
+            "expected a new, empty or earlier shard folder"
+        )
     return ours
 
 
@@ -139,13 +160,20 @@ def _plan(source: Path, samples_per_shard: int) -> dict[str, dict[str, list[Path
     for split in list(splits) or [None]:
         folders = split_samples(source, split) if split is None or splits[split] else []
         label = split or "all"
-        plan[label] = {f"{label}-{i // samples_per_shard:06d}.tar": folders[i:i + samples_per_shard]
-                       for i in range(0, len(folders), samples_per_shard)}
+        plan[label] = {
+            f"{label}-{i // samples_per_shard:06d}.tar": folders[i : i + samples_per_shard]
+            for i in range(0, len(folders), samples_per_shard)
+        }
     return plan
 
 
-def _write_shard(out: Path, name: str, folders: Sequence[Path], layers: Sequence[str] | None,
-                 progress: Callable[[str], None] | None) -> set[str]:
+def _write_shard(
+    out: Path,
+    name: str,
+    folders: Sequence[Path],
+    layers: Sequence[str] | None,
+    progress: Callable[[str], None] | None,
+) -> set[str]:
     """Write one shard under a temporary name, then rename it; return the layer keys seen."""
     wds = _webdataset()
     tmp = out / f"{TMP_PREFIX}{name}"
@@ -205,33 +233,63 @@ def write_shards(
     source, out = Path(dataset_dir), Path(out_dir)
     check_shard_folder(out)
     with folder_lock(out):  # one export per folder; a second is refused, naming this one
-        return _write_locked(source, out, check_shard_folder(out), samples_per_shard, layers, progress)
+        return _write_locked(
+            source, out, check_shard_folder(out), samples_per_shard, layers, progress
+        )
 
 
-def _write_locked(source: Path, out: Path, ours: set[str], samples_per_shard: int,
-                  layers: Sequence[str] | None, progress: Callable[[str], None] | None) -> ShardSet:
+def _write_locked(
+    source: Path,
+    out: Path,
+    ours: set[str],
+    samples_per_shard: int,
+    layers: Sequence[str] | None,
+    progress: Callable[[str], None] | None,
+) -> ShardSet:
     """:func:`write_shards` once the folder's lock is held; *ours*: files of an earlier export."""
     plan = _plan(source, samples_per_shard)
     planned = {name for shards in plan.values() for name in shards}
-    base = {"format": _FORMAT, "version": _VERSION, "key_separator": KEY_SEPARATOR,
-            "config_hash": _manifest(source).get("config_hash"),
-            "n_scenes": len({r.get("scene") for r in (_manifest(source).get("samples") or {}).values()})}
+    base = {
+        "format": _FORMAT,
+        "version": _VERSION,
+        "key_separator": KEY_SEPARATOR,
+        "config_hash": _manifest(source).get("config_hash"),
+        "n_scenes": len(
+            {r.get("scene") for r in (_manifest(source).get("samples") or {}).values()}
+        ),
+    }
     # Before any shard: record every name this export may write, so a re-run after an
     # interruption knows them as its own (and nothing else in the folder is ever touched).
-    _write_index(out, {**base, "complete": False, "files": dict.fromkeys(sorted(ours | planned), "")})
+    _write_index(
+        out, {**base, "complete": False, "files": dict.fromkeys(sorted(ours | planned), "")}
+    )
     files: dict[str, str] = {}
     seen: set[str] = set()
     for shards in plan.values():
         for name, folders in shards.items():
             seen |= _write_shard(out, name, folders, layers, progress)
             files[name] = file_sha256(out / name)
-    _write_index(out, {**base, "complete": True, "entries": _entries(seen), "files": files,
-                       "splits": {k: {"shards": list(v), "samples": sum(map(len, v.values()))}
-                                  for k, v in plan.items()}})
+    _write_index(
+        out,
+        {
+            **base,
+            "complete": True,
+            "entries": _entries(seen),
+            "files": files,
+            "splits": {
+                k: {"shards": list(v), "samples": sum(map(len, v.values()))}
+                for k, v in plan.items()
+            },
+        },
+    )
     for stale in ours - planned:
         (out / stale).unlink(missing_ok=True)  # a shard an earlier export of ours wrote
-    return ShardSet(out, {k: tuple(v) for k, v in plan.items()},
-                    {k: sum(map(len, v.values())) for k, v in plan.items()}, tuple(sorted(seen)))
+    return ShardSet(
+        out,
+        {k: tuple(v) for k, v in plan.items()},
+        {k: sum(map(len, v.values())) for k, v in plan.items()},
+        tuple(sorted(seen)),
+    )
 
 
 def _index(out: Path) -> dict[str, Any]:
@@ -251,8 +309,10 @@ def shard_urls(out_dir: str | os.PathLike[str], split: str | None = None) -> lis
     if split is not None and split not in splits:
         raise DatasetError(f"split {split!r}; the shards have {sorted(splits)}")
     if split is not None and not splits[split]["samples"]:
-        raise DatasetError(f"split {split!r} of {out} is empty: the dataset had "
-                           f"{_index(out).get('n_scenes', '?')} scene(s) for {len(splits)} splits")
+        raise DatasetError(
+            f"split {split!r} of {out} is empty: the dataset had "
+            f"{_index(out).get('n_scenes', '?')} scene(s) for {len(splits)} splits"
+        )
     chosen = [split] if split is not None else sorted(splits)
     return [str(out / name) for s in chosen for name in splits[s]["shards"]]
 
@@ -265,7 +325,9 @@ def _decoder(entries: dict[str, str]) -> Callable[[dict[str, Any]], dict[str, An
         item: dict[str, Any] = {"sample_id": record["__key__"]}
         for entry, value in record.items():
             if entry in entries:
-                item[entries[entry]] = np.lib.format.read_array(io.BytesIO(value), allow_pickle=False)
+                item[entries[entry]] = np.lib.format.read_array(
+                    io.BytesIO(value), allow_pickle=False
+                )
             elif entry == META_NAME:
                 source = Path(str(record.get("__url__", "shard"))) / record["__key__"] / META_NAME
                 item["meta"] = dict(meta_from_bytes(value, source).raw)
@@ -281,11 +343,15 @@ def _verify_shards(urls: Sequence[str], index: dict[str, Any]) -> None:
         if not Path(url).is_file():
             raise DatasetError(f"{url}: listed in {SHARD_INDEX} but missing; export again")
         if file_sha256(url) != recorded.get(Path(url).name):
-            raise DatasetError(f"{url}: does not match its SHA-256 in {SHARD_INDEX}; the shard is "
-                               "damaged, export again")
+            raise DatasetError(
+                f"{url}: does not match its SHA-256 in {SHARD_INDEX}; the shard is "
+                "damaged, export again"
+            )
 
 
-def shard_dataset(out_dir: str | os.PathLike[str], split: str | None = None) -> Iterator[dict[str, Any]]:
+def shard_dataset(
+    out_dir: str | os.PathLike[str], split: str | None = None
+) -> Iterator[dict[str, Any]]:
     """A ``webdataset.WebDataset`` over the shards of *split*, each item decoded as
     :func:`load_sample` returns it (arrays ``(H, W[, C])`` under their layer keys, ``meta``)
     plus ``sample_id``; an empty split is a :class:`~spectrinsic.errors.DatasetError` naming it.

@@ -30,11 +30,19 @@ from spectrinsic.gt_export.sample import TRANSPORT_NAME
 from spectrinsic.render.transport import LightTransport
 from spectrinsic.spectra import get_sensors
 
-__all__ = ["TRANSPORT_NAME", "COVERAGE_LAYER", "transport_layer", "write_transport", "read_transport"]
+__all__ = [
+    "TRANSPORT_NAME",
+    "COVERAGE_LAYER",
+    "transport_layer",
+    "write_transport",
+    "read_transport",
+]
 
 COVERAGE_LAYER = "coverage"
-TRANSPORT_UNITS = ("raw channel ∫ radiance · S_k dλ (render units) of one light alone emitting the "
-                   "flat unit spectrum L(λ) = 1 at power 1; raw_k = Σ_l T_lk · power_l ∫L_l S_k dλ / ∫S_k dλ")
+TRANSPORT_UNITS = (
+    "raw channel ∫ radiance · S_k dλ (render units) of one light alone emitting the "
+    "flat unit spectrum L(λ) = 1 at power 1; raw_k = Σ_l T_lk · power_l ∫L_l S_k dλ / ∫S_k dλ"
+)
 
 
 def transport_layer(light: int, batch: int, mode: str) -> str:
@@ -46,11 +54,18 @@ def transport_layer(light: int, batch: int, mode: str) -> str:
     return f"L{int(light)}_b{int(batch)}_{mode}"
 
 
-def write_transport(folder: str | os.PathLike[str], transport: LightTransport, coverage: np.ndarray,
-                    *, sample_id: str) -> dict[str, Any]:
+def write_transport(
+    folder: str | os.PathLike[str],
+    transport: LightTransport,
+    coverage: np.ndarray,
+    *,
+    sample_id: str,
+) -> dict[str, Any]:
     """Write ``transport.exr`` into *folder*; return its ``meta.json["transport"]`` record."""
     layers: dict[str, np.ndarray] = {COVERAGE_LAYER: np.asarray(coverage, np.float32)}
-    names: dict[str, tuple[str, ...]] = {COVERAGE_LAYER: tuple(f"m{m}" for m in range(np.shape(coverage)[-1]))}
+    names: dict[str, tuple[str, ...]] = {
+        COVERAGE_LAYER: tuple(f"m{m}" for m in range(np.shape(coverage)[-1]))
+    }
     for b, batch in enumerate(transport.batches):
         for mode in transport.modes:
             channels = get_sensors(transport.sensors[mode]).channels
@@ -84,7 +99,9 @@ def _field(record: Any, key: str, kind: type | tuple[type, ...], where: str) -> 
     return value
 
 
-def read_transport(sample_dir: str | os.PathLike[str], record: Any) -> tuple[LightTransport, np.ndarray]:
+def read_transport(
+    sample_dir: str | os.PathLike[str], record: Any
+) -> tuple[LightTransport, np.ndarray]:
     """The transport and the ``(H, W, M)`` coverage stored in a sample (its ``meta.json``
     ``transport`` *record*), checked against the record before use."""
     folder = Path(sample_dir)
@@ -93,7 +110,11 @@ def read_transport(sample_dir: str | os.PathLike[str], record: Any) -> tuple[Lig
     sensors = _field(record, "sensors", dict, where)
     lights = _field(record, "lights", int, where)
     seeds = _field(record, "batch_seeds", list, where)
-    if _field(record, "file", str, where) != TRANSPORT_NAME or not modes or set(sensors) != set(modes):
+    if (
+        _field(record, "file", str, where) != TRANSPORT_NAME
+        or not modes
+        or set(sensors) != set(modes)
+    ):
         raise DatasetError(f"{where}: meta.json transport record is not spectrinsic's")
     arrays = read_exr(folder / TRANSPORT_NAME)
     batches = []
@@ -103,15 +124,20 @@ def read_transport(sample_dir: str | os.PathLike[str], record: Any) -> tuple[Lig
             keys = [transport_layer(j, b, mode) for j in range(lights)]
             missing = [k for k in keys if k not in arrays]
             if missing:
-                raise DatasetError(f"{folder / TRANSPORT_NAME}: lacks the transport layers {missing[:3]}")
+                raise DatasetError(
+                    f"{folder / TRANSPORT_NAME}: lacks the transport layers {missing[:3]}"
+                )
             batch[mode] = np.stack([np.atleast_3d(arrays[k]) for k in keys])
         batches.append(batch)
     if COVERAGE_LAYER not in arrays:
         raise DatasetError(f"{folder / TRANSPORT_NAME}: lacks the {COVERAGE_LAYER!r} layer")
     coverage = np.atleast_3d(arrays[COVERAGE_LAYER])
     transport = LightTransport(
-        modes=tuple(modes), sensors={str(k): str(v) for k, v in sensors.items()},
-        batches=tuple(batches), seeds=tuple(int(s) for s in seeds),
-        spp=_field(record, "batch_spp", int, where), max_depth=_field(record, "max_depth", int, where),
+        modes=tuple(modes),
+        sensors={str(k): str(v) for k, v in sensors.items()},
+        batches=tuple(batches),
+        seeds=tuple(int(s) for s in seeds),
+        spp=_field(record, "batch_spp", int, where),
+        max_depth=_field(record, "max_depth", int, where),
     )
     return transport, coverage

@@ -83,7 +83,9 @@ def _dump_json(path: Path, data: Any, *, compact: bool = False) -> None:
         path.write_text(canonical_json(data, compact=compact), encoding="utf-8")
 
 
-def _layer_records(gt: GroundTruth, previews: Mapping[str, tuple[str, dict[str, Any]]]) -> dict[str, Any]:
+def _layer_records(
+    gt: GroundTruth, previews: Mapping[str, tuple[str, dict[str, Any]]]
+) -> dict[str, Any]:
     return {
         layer.name: {
             "file": f"{layer.group}.exr",
@@ -101,11 +103,19 @@ def _layer_records(gt: GroundTruth, previews: Mapping[str, tuple[str, dict[str, 
 
 
 def _meta(
-    scene: Scene, result: Any, gt: GroundTruth, *, sample_id: str, config: Mapping[str, Any],
-    seed: int, previews: Mapping[str, tuple[str, dict[str, Any]]], files: Sequence[str],
+    scene: Scene,
+    result: Any,
+    gt: GroundTruth,
+    *,
+    sample_id: str,
+    config: Mapping[str, Any],
+    seed: int,
+    previews: Mapping[str, tuple[str, dict[str, Any]]],
+    files: Sequence[str],
 ) -> dict[str, Any]:
-    render_meta = {k: v for k, v in (getattr(result, "meta", None) or {}).items()
-                   if k not in _VOLATILE_META}
+    render_meta = {
+        k: v for k, v in (getattr(result, "meta", None) or {}).items() if k not in _VOLATILE_META
+    }
     lights = []
     for record in gt.lights:
         unused = set(LIGHT_PLACEMENT) - set(LIGHT_FIELDS[record.kind])
@@ -179,8 +189,15 @@ def _write_previews(folder: Path, gt: GroundTruth) -> dict[str, tuple[str, dict[
     return previews
 
 
-def _fill_folder(folder: Path, scene: Scene, result: Any, gt: GroundTruth, *,
-                 transport: LightTransport | None = None, **meta_kw: Any) -> None:
+def _fill_folder(
+    folder: Path,
+    scene: Scene,
+    result: Any,
+    gt: GroundTruth,
+    *,
+    transport: LightTransport | None = None,
+    **meta_kw: Any,
+) -> None:
     files = _write_layers(folder, gt, meta_kw["sample_id"])
     previews = _write_previews(folder, gt)
     files += [rel for rel, _ in previews.values()]
@@ -193,7 +210,9 @@ def _fill_folder(folder: Path, scene: Scene, result: Any, gt: GroundTruth, *,
     # and its own seal, so it can tell an intact meta.json
     record = None
     if transport is not None:  # the per-light transport, for exact relighting
-        record = write_transport(folder, transport, result.aovs["coverage"], sample_id=meta_kw["sample_id"])
+        record = write_transport(
+            folder, transport, result.aovs["coverage"], sample_id=meta_kw["sample_id"]
+        )
         record["cameras"] = list(gt.cameras)  # full sensor-set names, to relight the camera layers
         files.append(TRANSPORT_NAME)
     meta = _meta(scene, result, gt, previews=previews, files=files, **meta_kw)
@@ -262,14 +281,23 @@ def export_sample(
         raise DatasetError(f"sample id {sample_id!r}: expected a plain folder name")
     if cameras is None:
         cameras = DEFAULT_CAMERAS if "bands31" in (getattr(result, "raw", None) or {}) else ()
-    gt = compute_ground_truth(scene, result, cameras=cameras, write_cube=write_cube,
-                              denoise=denoise, data_dir=data_dir)
+    gt = compute_ground_truth(
+        scene, result, cameras=cameras, write_cube=write_cube, denoise=denoise, data_dir=data_dir
+    )
     final = out_dir / sample_id
     tmp = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{sample_id}-", dir=out_dir))
     try:
         tmp.chmod(0o755)
-        _fill_folder(tmp, scene, result, gt, sample_id=sample_id, config=config, seed=seed,
-                     transport=transport)
+        _fill_folder(
+            tmp,
+            scene,
+            result,
+            gt,
+            sample_id=sample_id,
+            config=config,
+            seed=seed,
+            transport=transport,
+        )
         _move_into_place(tmp, final, config_hash(config))
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)

@@ -26,7 +26,8 @@ from spectrinsic.render.modes import (
     to_xyz_matrix,
 )
 from spectrinsic.render.passes import render_aovs, render_diagonal, render_spectral
-from spectrinsic.render.pipeline import (
+from spectrinsic.render.result import RenderResult
+from spectrinsic.render.scene_render import (
     batch_seeds,
     count_passes,
     image_noise,
@@ -35,7 +36,6 @@ from spectrinsic.render.pipeline import (
     render_batches,
     render_scene,
 )
-from spectrinsic.render.result import RenderResult
 from spectrinsic.render.settings import DEFAULT_MODES, RenderSettings
 from spectrinsic.render.translate import scene_to_mitsuba
 from spectrinsic.render.transport import LightTransport, render_transport, render_transport_batches

@@ -99,8 +99,14 @@ def available_memory_bytes() -> int | None:
 
 
 def check_render_size(
-    width: int, height: int, settings: RenderSettings, *, what: str, processes: int = 1,
-    n_lights: int = 1, data_dir: str | None = None,
+    width: int,
+    height: int,
+    settings: RenderSettings,
+    *,
+    what: str,
+    processes: int = 1,
+    n_lights: int = 1,
+    data_dir: str | None = None,
 ) -> int:
     """Refuse a size that is not positive, too large, or cannot fit in memory; return the estimate.
 
@@ -122,8 +128,12 @@ def check_render_size(
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise RenderError(f"{what}: image {side} {value!r}; expected a positive integer")
         if value > MAX_SIDE:
-            raise RenderError(f"{what}: image {side} {value} exceeds the largest supported, {MAX_SIDE}")
-    need = processes * estimate_render_bytes(width, height, settings, n_lights=n_lights, data_dir=data_dir)
+            raise RenderError(
+                f"{what}: image {side} {value} exceeds the largest supported, {MAX_SIDE}"
+            )
+    need = processes * estimate_render_bytes(
+        width, height, settings, n_lights=n_lights, data_dir=data_dir
+    )
     have = available_memory_bytes()
     if have is not None and need > have:
         raise RenderError(

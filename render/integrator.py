@@ -36,8 +36,14 @@ import numpy as np
 from spectrinsic.errors import RenderError
 from spectrinsic.render.variants import import_mitsuba
 
-__all__ = ["INTEGRATOR_NAME", "BandTables", "band_path_class", "band_path", "transport_channels",
-           "first_hit_channels"]
+__all__ = [
+    "INTEGRATOR_NAME",
+    "BandTables",
+    "band_path_class",
+    "band_path",
+    "transport_channels",
+    "first_hit_channels",
+]
 
 #: Name the integrator is registered under (``mi.load_dict({"type": INTEGRATOR_NAME})``).
 INTEGRATOR_NAME = "spectrinsic_bandpath"
@@ -81,7 +87,12 @@ def first_hit_channels(n_surfaces: int) -> list[str]:
     ``sh_normal``); none without surfaces."""
     if n_surfaces == 0:
         return []
-    return [f"cov{i:03d}" for i in range(n_surfaces)] + ["depth", "normal.x", "normal.y", "normal.z"]
+    return [f"cov{i:03d}" for i in range(n_surfaces)] + [
+        "depth",
+        "normal.x",
+        "normal.y",
+        "normal.z",
+    ]
 
 
 def _mis_weight(dr: Any, mi: Any, pdf_a: Any, pdf_b: Any) -> Any:
@@ -95,8 +106,10 @@ def _band_max(dr: Any, bands: Sequence) -> Any:
     """Largest band value per lane (a balanced tree of ``dr.maximum``)."""
     values = list(bands)
     while len(values) > 1:
-        values = [dr.maximum(values[i], values[i + 1]) if i + 1 < len(values) else values[i]
-                  for i in range(0, len(values), 2)]
+        values = [
+            dr.maximum(values[i], values[i + 1]) if i + 1 < len(values) else values[i]
+            for i in range(0, len(values), 2)
+        ]
     return values[0]
 
 
@@ -106,7 +119,11 @@ def _lookups(mi: Any, dr: Any, scene: Any, tables: BandTables) -> tuple[Any, Any
     albedo = np.asarray(tables.albedo, np.float32)
     black, none = albedo.shape[0] - 1, len(tables.shape_surfaces)
     shapes = list(scene.shapes())
-    ids = np.array(dr.reinterpret_array(mi.UInt32, mi.ShapePtr(shapes)), np.int64) if shapes else np.zeros(0, np.int64)
+    ids = (
+        np.array(dr.reinterpret_array(mi.UInt32, mi.ShapePtr(shapes)), np.int64)
+        if shapes
+        else np.zeros(0, np.int64)
+    )
     rows = np.full(int(ids.max(initial=0)) + 1, black, np.uint32)
     surfaces = np.full(rows.size, none, np.uint32)
     for sid, shape in zip(ids, shapes, strict=True):
@@ -127,7 +144,12 @@ class _Kernel:
         self.mi, self.dr, self.it, self.scene = mi, dr, it, scene
 
     def light_of(self, emitter: Any, mask: Any) -> Any:
-        return self.dr.gather(self.mi.UInt32, self.it.emitter_lut, self.dr.reinterpret_array(self.mi.UInt32, emitter), mask)
+        return self.dr.gather(
+            self.mi.UInt32,
+            self.it.emitter_lut,
+            self.dr.reinterpret_array(self.mi.UInt32, emitter),
+            mask,
+        )
 
     def deposit(self, acc: list, light: Any, weight: Any, bands: Sequence, mask: Any) -> list:
         """``acc[l·K + k] += bands[k]·weight`` on the lanes whose light is l."""
@@ -138,13 +160,17 @@ class _Kernel:
                 out[j * k + b] = self.dr.fma(bands[b], w, out[j * k + b])
         return out
 
-    def emitter_hit(self, si: Any, prev_si: Any, prev_pdf: Any, prev_delta: Any) -> tuple[Any, Any, Any]:
+    def emitter_hit(
+        self, si: Any, prev_si: Any, prev_pdf: Any, prev_delta: Any
+    ) -> tuple[Any, Any, Any]:
         """Light, weight (radiance x BSDF-sampling MIS weight) and mask of an emitter hit."""
         mi, dr = self.mi, self.dr
         emitter = si.emitter(self.scene)
         hit = emitter != None  # noqa: E711 (a Dr.Jit pointer array, compared lane by lane)
         ds = mi.DirectionSample3f(self.scene, si=si, ref=prev_si)
-        em_pdf = dr.select(prev_delta, 0.0, self.scene.pdf_emitter_direction(prev_si, ds, ~prev_delta))
+        em_pdf = dr.select(
+            prev_delta, 0.0, self.scene.pdf_emitter_direction(prev_si, ds, ~prev_delta)
+        )
         radiance = emitter.eval(si, (prev_pdf > 0.0) & hit)[0]
         return self.light_of(emitter, hit), radiance * _mis_weight(dr, mi, prev_pdf, em_pdf), hit
 
@@ -156,7 +182,8 @@ class _Kernel:
         active_em &= ds.pdf != 0.0
         sample_1, sample_2 = sampler.next_1d(), sampler.next_2d()
         bsdf_val, bsdf_pdf, bsdf_sample, bsdf_weight = bsdf.eval_pdf_sample(
-            mi.BSDFContext(), si, si.to_local(ds.d), sample_1, sample_2)
+            mi.BSDFContext(), si, si.to_local(ds.d), sample_1, sample_2
+        )
         mis_em = dr.select(ds.delta, 1.0, _mis_weight(dr, mi, ds.pdf, bsdf_pdf))
         nee = bsdf_val[0] * em_weight[0] * mis_em
         return self.light_of(ds.emitter, active_em), nee, active_em, bsdf_sample, bsdf_weight[0]
@@ -165,7 +192,9 @@ class _Kernel:
         """ρ_k of the material of the shape hit (the black row elsewhere)."""
         mi, dr, k = self.mi, self.dr, self.it.n_bands
         valid = si.is_valid()
-        row = dr.gather(mi.UInt32, self.it.shape_lut, dr.reinterpret_array(mi.UInt32, si.shape), valid)
+        row = dr.gather(
+            mi.UInt32, self.it.shape_lut, dr.reinterpret_array(mi.UInt32, si.shape), valid
+        )
         return [dr.gather(mi.Float, self.it.albedo, row * k + b, valid) for b in range(k)]
 
     def roulette(self, sampler: Any, depth: Any, beta: Any, bands: Sequence) -> tuple[Any, Any]:
@@ -185,22 +214,41 @@ class _Kernel:
         if not self.it.n_surfaces:
             return first
         now, valid = depth == 0, si.is_valid()
-        surface = dr.gather(mi.UInt32, self.it.surface_lut, dr.reinterpret_array(mi.UInt32, si.shape), valid)
+        surface = dr.gather(
+            mi.UInt32, self.it.surface_lut, dr.reinterpret_array(mi.UInt32, si.shape), valid
+        )
         surface = dr.select(valid, surface, self.it.n_surfaces)
         distance = dr.select(valid, si.t, 0.0)
         normal = dr.select(valid, si.sh_frame.n, mi.Vector3f(0.0))
-        return (dr.select(now, surface, first[0]), dr.select(now, distance, first[1]),
-                dr.select(now, normal, first[2]))
+        return (
+            dr.select(now, surface, first[0]),
+            dr.select(now, distance, first[1]),
+            dr.select(now, normal, first[2]),
+        )
 
-    def body(self, sampler: Any, ray: Any, depth: Any, beta: Any, bands: list, acc: list,
-             prev_si: Any, prev_pdf: Any, prev_delta: Any, first: tuple, alive: Any) -> tuple:
+    def body(
+        self,
+        sampler: Any,
+        ray: Any,
+        depth: Any,
+        beta: Any,
+        bands: list,
+        acc: list,
+        prev_si: Any,
+        prev_pdf: Any,
+        prev_delta: Any,
+        first: tuple,
+        alive: Any,
+    ) -> tuple:
         mi, dr = self.mi, self.dr
         si = self.scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=depth == 0)
         first = self.first_hit(si, depth, first)
         light, weight, hit = self.emitter_hit(si, prev_si, prev_pdf, prev_delta)
         acc = self.deposit(acc, light, beta * weight, bands, hit)
         active_next = (depth + 1 < self.it.max_depth) & si.is_valid()
-        light, nee, active_em, bsdf_sample, bsdf_weight = self.vertex(sampler, si, si.bsdf(ray), active_next)
+        light, nee, active_em, bsdf_sample, bsdf_weight = self.vertex(
+            sampler, si, si.bsdf(ray), active_next
+        )
         bands = [b * rho for b, rho in zip(bands, self.albedo(si), strict=True)]
         acc = self.deposit(acc, light, beta * nee, bands, active_em)
         ray = si.spawn_ray(si.to_world(bsdf_sample.wo))
@@ -208,17 +256,38 @@ class _Kernel:
         depth = dr.select(si.is_valid(), depth + 1, depth)
         beta, go_on = self.roulette(sampler, depth, beta, bands)
         delta = mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
-        return (sampler, ray, depth, beta, bands, acc, mi.Interaction3f(si), bsdf_sample.pdf, delta,
-                first, active_next & go_on)
+        return (
+            sampler,
+            ray,
+            depth,
+            beta,
+            bands,
+            acc,
+            mi.Interaction3f(si),
+            bsdf_sample.pdf,
+            delta,
+            first,
+            active_next & go_on,
+        )
 
     def run(self, sampler: Any, ray: Any, active: Any) -> list:
         """The K·L accumulators of one wavefront of camera rays, then the first-hit maps
         (:func:`first_hit_channels`)."""
         mi, dr, k = self.mi, self.dr, self.it.n_bands
         first = (mi.UInt32(self.it.n_surfaces), mi.Float(0.0), mi.Vector3f(0.0))
-        state = (sampler, mi.Ray3f(ray), mi.UInt32(0), mi.Float(1.0), [mi.Float(1.0) for _ in range(k)],
-                 [mi.Float(0.0) for _ in range(k * self.it.n_lights)], dr.zeros(mi.Interaction3f),
-                 mi.Float(1.0), mi.Bool(True), first, mi.Bool(active))
+        state = (
+            sampler,
+            mi.Ray3f(ray),
+            mi.UInt32(0),
+            mi.Float(1.0),
+            [mi.Float(1.0) for _ in range(k)],
+            [mi.Float(0.0) for _ in range(k * self.it.n_lights)],
+            dr.zeros(mi.Interaction3f),
+            mi.Float(1.0),
+            mi.Bool(True),
+            first,
+            mi.Bool(active),
+        )
         state = dr.while_loop(state, lambda *s: s[-1], self.body, label="spectrinsic band path")
         out = list(state[5])
         if self.it.n_surfaces:
@@ -259,17 +328,33 @@ def band_path_class(variant: str) -> type:
         def set_tables(self, scene: Any, tables: BandTables) -> None:
             """Point the lookups at *tables* for the loaded *scene* (no recompilation)."""
             shape = np.shape(tables.albedo)
-            if (len(shape) != 2 or shape[1] != self.n_bands or tables.n_lights != self.n_lights
-                    or len(tables.shape_surfaces) != self.n_surfaces):
-                raise RenderError(f"band tables {shape} for {tables.n_lights} lights do not fit an "
-                                  f"integrator of {self.n_bands} bands and {self.n_lights} lights")
-            self.albedo, self.shape_lut, self.emitter_lut, self.surface_lut = _lookups(mi, dr, scene, tables)
+            if (
+                len(shape) != 2
+                or shape[1] != self.n_bands
+                or tables.n_lights != self.n_lights
+                or len(tables.shape_surfaces) != self.n_surfaces
+            ):
+                raise RenderError(
+                    f"band tables {shape} for {tables.n_lights} lights do not fit an "
+                    f"integrator of {self.n_bands} bands and {self.n_lights} lights"
+                )
+            self.albedo, self.shape_lut, self.emitter_lut, self.surface_lut = _lookups(
+                mi, dr, scene, tables
+            )
 
         def aov_names(self) -> list[str]:
-            return transport_channels(self.n_lights, self.n_bands) + first_hit_channels(self.n_surfaces)
+            return transport_channels(self.n_lights, self.n_bands) + first_hit_channels(
+                self.n_surfaces
+            )
 
-        def sample(self, scene: Any, sampler: Any, ray: Any, medium: Any = None, active: Any = True) -> tuple:
-            return mi.Spectrum(0.0), mi.Bool(True), _Kernel(mi, dr, self, scene).run(sampler, ray, active)
+        def sample(
+            self, scene: Any, sampler: Any, ray: Any, medium: Any = None, active: Any = True
+        ) -> tuple:
+            return (
+                mi.Spectrum(0.0),
+                mi.Bool(True),
+                _Kernel(mi, dr, self, scene).run(sampler, ray, active),
+            )
 
         def to_string(self) -> str:
             return f"BandPath[max_depth={self.max_depth}, n_bands={self.n_bands}, n_lights={self.n_lights}]"
@@ -282,5 +367,13 @@ def band_path(mi: Any, *, max_depth: int, n_bands: int, n_lights: int, n_surface
     """A :class:`BandPath` instance for the active variant (rr off: ``rr_depth`` > ``max_depth``),
     with first-hit maps of *n_surfaces* surfaces if not 0."""
     band_path_class(mi.variant())
-    return mi.load_dict({"type": INTEGRATOR_NAME, "max_depth": int(max_depth), "rr_depth": int(max_depth) + 1,
-                         "n_bands": int(n_bands), "n_lights": int(n_lights), "n_surfaces": int(n_surfaces)})
+    return mi.load_dict(
+        {
+            "type": INTEGRATOR_NAME,
+            "max_depth": int(max_depth),
+            "rr_depth": int(max_depth) + 1,
+            "n_bands": int(n_bands),
+            "n_lights": int(n_lights),
+            "n_surfaces": int(n_surfaces),
+        }
+    )

@@ -34,6 +34,7 @@ from typing import Literal
 
 import numpy as np
 
+from spectrinsic.arrays import Wavelengths
 from spectrinsic.errors import RenderError, SpectralDataError, validate_choice
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import (
@@ -47,7 +48,6 @@ from spectrinsic.spectra import (
     responses,
 )
 from spectrinsic.spectra.conductors import FRESNEL_NODES, fresnel_table
-from spectrinsic.typing import Wavelengths
 
 __all__ = [
     "RenderMode",
@@ -101,16 +101,41 @@ class RenderMode:
 RENDER_MODES: dict[str, RenderMode] = {
     m.name: m
     for m in (
-        RenderMode("spectral", "cie1931", "spectral", "identity",
-                   "spectral reference: Mitsuba spectral variant, specfilm with the CIE 1931 CMFs"),
-        RenderMode("rgb3", "cie1931", "diagonal", "identity",
-                   "3-channel diagonal render with the CIE 1931 CMFs as sensors"),
-        RenderMode("gauss3", "gaussian:3@400-700", "diagonal", "regression",
-                   "3 Gaussian sensors (the thesis' Table 5.2 set) in one RGB pass, regressed to XYZ"),
-        RenderMode("rgb6", "gaussian:6@400-700", "diagonal", "regression",
-                   "6 Gaussian sensors in two RGB passes, regressed to XYZ (thesis 5.2.3)"),
-        RenderMode("bands31", "bands:31@400-700", "diagonal", "integration",
-                   "31 box bands of 10 nm in 11 RGB passes, integrated against the CMFs"),
+        RenderMode(
+            "spectral",
+            "cie1931",
+            "spectral",
+            "identity",
+            "spectral reference: Mitsuba spectral variant, specfilm with the CIE 1931 CMFs",
+        ),
+        RenderMode(
+            "rgb3",
+            "cie1931",
+            "diagonal",
+            "identity",
+            "3-channel diagonal render with the CIE 1931 CMFs as sensors",
+        ),
+        RenderMode(
+            "gauss3",
+            "gaussian:3@400-700",
+            "diagonal",
+            "regression",
+            "3 Gaussian sensors (the thesis' Table 5.2 set) in one RGB pass, regressed to XYZ",
+        ),
+        RenderMode(
+            "rgb6",
+            "gaussian:6@400-700",
+            "diagonal",
+            "regression",
+            "6 Gaussian sensors in two RGB passes, regressed to XYZ (thesis 5.2.3)",
+        ),
+        RenderMode(
+            "bands31",
+            "bands:31@400-700",
+            "diagonal",
+            "integration",
+            "31 box bands of 10 nm in 11 RGB passes, integrated against the CMFs",
+        ),
     )
 }
 
@@ -154,18 +179,32 @@ class ChannelValues:
 
 
 def light_spectra(
-    scene: Scene, wavelengths: Wavelengths = COLORIMETRIC_WAVELENGTHS, *, data_dir: str | None = None
+    scene: Scene,
+    wavelengths: Wavelengths = COLORIMETRIC_WAVELENGTHS,
+    *,
+    data_dir: str | None = None,
 ) -> np.ndarray:
     """``(L, W)`` emitted spectra of the scene's lights: ``power · L(λ)`` on *wavelengths*."""
-    return np.stack(
-        [li.power * get_spectrum(li.spectrum, data_dir=data_dir).on(wavelengths) for li in scene.lights]
-    ) if scene.lights else np.zeros((0, np.size(wavelengths)))
+    return (
+        np.stack(
+            [
+                li.power * get_spectrum(li.spectrum, data_dir=data_dir).on(wavelengths)
+                for li in scene.lights
+            ]
+        )
+        if scene.lights
+        else np.zeros((0, np.size(wavelengths)))
+    )
 
 
 def _reflectances(scene: Scene, wavelengths: Wavelengths, data_dir: str | None) -> np.ndarray:
-    return np.stack(
-        [get_spectrum(m.spectrum, data_dir=data_dir).on(wavelengths) for m in scene.materials]
-    ) if scene.materials else np.zeros((0, np.size(wavelengths)))
+    return (
+        np.stack(
+            [get_spectrum(m.spectrum, data_dir=data_dir).on(wavelengths) for m in scene.materials]
+        )
+        if scene.materials
+        else np.zeros((0, np.size(wavelengths)))
+    )
 
 
 def channel_values(
@@ -185,16 +224,26 @@ def channel_values(
     rho = _reflectances(scene, wavelengths, data_dir)
     emission = light_spectra(scene, wavelengths, data_dir=data_dir)
     return ChannelValues(
-        materials=diagonal_values(rho, curves, wavelengths) if len(rho) else np.zeros((0, sensors.n)),
-        lights=responses(emission, curves, wavelengths) if len(emission) else np.zeros((0, sensors.n)),
-        specular=_specular(scene, curves, wavelengths) if any(m.glossy for m in scene.materials) else None,
+        materials=diagonal_values(rho, curves, wavelengths)
+        if len(rho)
+        else np.zeros((0, sensors.n)),
+        lights=responses(emission, curves, wavelengths)
+        if len(emission)
+        else np.zeros((0, sensors.n)),
+        specular=_specular(scene, curves, wavelengths)
+        if any(m.glossy for m in scene.materials)
+        else None,
     )
 
 
 def _specular(scene: Scene, curves: np.ndarray, wavelengths: Wavelengths) -> np.ndarray:
     ones = np.ones((FRESNEL_NODES, curves.shape[0]))
-    return np.stack([fresnel_table(m.metal, curves, wavelengths) if m.kind == "conductor" else ones
-                     for m in scene.materials])
+    return np.stack(
+        [
+            fresnel_table(m.metal, curves, wavelengths) if m.kind == "conductor" else ones
+            for m in scene.materials
+        ]
+    )
 
 
 def integration_matrix(
@@ -255,7 +304,11 @@ def regression_matrix(
         ``(J, W)`` spectra of the lights on *wavelengths*; each is normalised to unit maximum so
         every light weighs alike in the fit.
     """
-    rho = munsell_reflectances(wavelengths) if reflectances is None else np.asarray(reflectances, float)
+    rho = (
+        munsell_reflectances(wavelengths)
+        if reflectances is None
+        else np.asarray(reflectances, float)
+    )
     lights = np.atleast_2d(np.asarray(lights, float))
     if lights.shape[0] == 0:
         lights = np.ones((1, np.size(wavelengths)))
@@ -278,11 +331,15 @@ def to_xyz_matrix(
     xyz = get_sensors(XYZ_SENSORS)
     if mode.to_xyz == "identity":
         if sensors.n != 3:
-            raise SpectralDataError(f"mode {mode.name!r}: identity map to XYZ needs 3 sensors, got {sensors.n}")
+            raise SpectralDataError(
+                f"mode {mode.name!r}: identity map to XYZ needs 3 sensors, got {sensors.n}"
+            )
         return np.eye(3)
     if mode.to_xyz == "integration":
         return integration_matrix(sensors, xyz, wavelengths)
-    return regression_matrix(sensors, xyz, light_spectra(scene, wavelengths, data_dir=data_dir), wavelengths)
+    return regression_matrix(
+        sensors, xyz, light_spectra(scene, wavelengths, data_dir=data_dir), wavelengths
+    )
 
 
 def raw_to_xyz(raw: np.ndarray, matrix: np.ndarray) -> np.ndarray:
@@ -297,4 +354,4 @@ def pad_to_passes(values: np.ndarray) -> Sequence[np.ndarray]:
     blocks = -(-k // 3)
     padded = np.zeros((n, 3 * blocks))
     padded[:, :k] = values
-    return [padded[:, 3 * i: 3 * i + 3] for i in range(blocks)]
+    return [padded[:, 3 * i : 3 * i + 3] for i in range(blocks)]

@@ -78,7 +78,9 @@ def _check_render_args(scene: Scene, spp: int, max_depth: int) -> None:
 
 
 def _active(scene: Scene, active_lights: Sequence[int] | None) -> set[int]:
-    active = set(range(len(scene.lights))) if active_lights is None else {int(i) for i in active_lights}
+    active = (
+        set(range(len(scene.lights))) if active_lights is None else {int(i) for i in active_lights}
+    )
     bad = sorted(i for i in active if not 0 <= i < len(scene.lights))
     if bad or not active:
         raise SceneError(
@@ -88,12 +90,16 @@ def _active(scene: Scene, active_lights: Sequence[int] | None) -> set[int]:
     return active
 
 
-def timed_render(mi: Any, loaded: Any, *, spp: int, seed: int, integrator: Any = None) -> tuple[np.ndarray, float]:
+def timed_render(
+    mi: Any, loaded: Any, *, spp: int, seed: int, integrator: Any = None
+) -> tuple[np.ndarray, float]:
     """One ``mi.render`` as float32 and its seconds; a Ctrl-C stops the build within it."""
     raise_if_requested()
     start = time.perf_counter()
     try:
-        image = np.array(mi.render(loaded, spp=int(spp), seed=int(seed), integrator=integrator), dtype=np.float32)
+        image = np.array(
+            mi.render(loaded, spp=int(spp), seed=int(seed), integrator=integrator), dtype=np.float32
+        )
     except RuntimeError as exc:
         raise_if_requested()  # Dr.Jit re-raises a Ctrl-C inside the render as RuntimeError
         raise RenderError(f"Mitsuba render failed: {exc}") from exc
@@ -158,7 +164,9 @@ def render_diagonal(
     """
     _check_render_args(scene, spp, max_depth)
     active = _active(scene, active_lights)
-    flags = [bool(direct)] * len(value_sets) if isinstance(direct, bool) else [bool(d) for d in direct]
+    flags = (
+        [bool(direct)] * len(value_sets) if isinstance(direct, bool) else [bool(d) for d in direct]
+    )
     if len(flags) != len(value_sets):
         raise SceneError(f"direct flags {flags}: expected one per value set ({len(value_sets)})")
     if not value_sets:
@@ -178,12 +186,18 @@ def render_diagonal(
             geometry=geometry,
         )
         loaded = mi.load_dict(mitsuba_dict)
-        params = _parameters(mi, loaded, [tr.reflectance_key(s, spectral=False) for s in surfaces]
-                             + [tr.emission_key(scene, j, spectral=False) for j in sorted(active)])
+        params = _parameters(
+            mi,
+            loaded,
+            [tr.reflectance_key(s, spectral=False) for s in surfaces]
+            + [tr.emission_key(scene, j, spectral=False) for j in sorted(active)],
+        )
         direct_integrator = mi.load_dict(tr.path_integrator(DIRECT_DEPTH)) if any(flags) else None
         for values, want_direct in zip(value_sets, flags, strict=True):
             passes = _DiagonalPasses(mi, loaded, params, direct_integrator, spp, seed, progress)
-            outputs.append(passes.render(scene, surfaces, sorted(active), values, want_direct, chosen))
+            outputs.append(
+                passes.render(scene, surfaces, sorted(active), values, want_direct, chosen)
+            )
     return outputs
 
 
@@ -200,21 +214,32 @@ class _DiagonalPasses:
     progress: PassProgress | None
 
     def _render(self, integrator: Any = None) -> tuple[np.ndarray, float]:
-        image, dt = timed_render(self.mi, self.loaded, spp=self.spp, seed=self.seed, integrator=integrator)
+        image, dt = timed_render(
+            self.mi, self.loaded, spp=self.spp, seed=self.seed, integrator=integrator
+        )
         if self.progress is not None:
             self.progress(1)
         return image, dt
 
     def render(
-        self, scene: Scene, surfaces: Sequence[tr.Surface], active: Sequence[int], values: ChannelValues,
-        want_direct: bool, variant: str,
+        self,
+        scene: Scene,
+        surfaces: Sequence[tr.Surface],
+        active: Sequence[int],
+        values: ChannelValues,
+        want_direct: bool,
+        variant: str,
     ) -> PassOutput:
         """The ⌈K/3⌉ RGB passes of one value set (and their direct-only twins), stacked to K."""
         k = values.materials.shape[1]
         full, direct_parts, seconds = [], [], []
-        for mats, lights in zip(pad_to_passes(values.materials), pad_to_passes(values.lights), strict=True):
+        for mats, lights in zip(
+            pad_to_passes(values.materials), pad_to_passes(values.lights), strict=True
+        ):
             for s in surfaces:
-                _set_rgb(self.mi, self.params, tr.reflectance_key(s, spectral=False), mats[s.material])
+                _set_rgb(
+                    self.mi, self.params, tr.reflectance_key(s, spectral=False), mats[s.material]
+                )
             for j in active:
                 _set_rgb(self.mi, self.params, tr.emission_key(scene, j, spectral=False), lights[j])
             self.params.update()
@@ -258,15 +283,22 @@ def render_spectral(
     active = _active(scene, active_lights)
     wl = COLORIMETRIC_WAVELENGTHS
     if np.any(sensors.curves < 0):
-        raise SceneError(f"sensor set {sensors.name!r} has negative lobes; render 'cie1931' and convert instead")
+        raise SceneError(
+            f"sensor set {sensors.name!r} has negative lobes; render 'cie1931' and convert instead"
+        )
     chosen = choose_variant("spectral", variant)
     emission = light_spectra(scene, wl, data_dir=data_dir)
     with variant_scope(chosen) as mi:
         mitsuba_dict = tr.scene_to_mitsuba(
             scene,
-            materials=[tr.regular_spectrum(get_spectrum(m.spectrum, data_dir=data_dir).on(wl), wl)
-                       for m in scene.materials],
-            lights=[tr.regular_spectrum(emission[j], wl) if j in active else None for j in range(len(scene.lights))],
+            materials=[
+                tr.regular_spectrum(get_spectrum(m.spectrum, data_dir=data_dir).on(wl), wl)
+                for m in scene.materials
+            ],
+            lights=[
+                tr.regular_spectrum(emission[j], wl) if j in active else None
+                for j in range(len(scene.lights))
+            ],
             film=tr.spectral_film(scene.camera.width, scene.camera.height, sensors.on(wl), wl),
             integrator=tr.path_integrator(max_depth),
             sample_count=spp,
@@ -358,11 +390,16 @@ def render_aovs(
             if progress is not None:
                 progress(1)
             if image.shape[-1] != 7:
-                raise RenderError(f"AOV pass returned {image.shape[-1]} channels; expected 7 (depth, normal, albedo)")
+                raise RenderError(
+                    f"AOV pass returned {image.shape[-1]} channels; expected 7 (depth, normal, albedo)"
+                )
             if p == 0:
-                depth_sum, normal_sum = image[..., 0].astype(np.float64), image[..., 1:4].astype(np.float64)
-            block = surfaces[3 * p: 3 * p + 3]
-            cover[..., 3 * p: 3 * p + len(block)] = image[..., 4: 4 + len(block)]
+                depth_sum, normal_sum = (
+                    image[..., 0].astype(np.float64),
+                    image[..., 1:4].astype(np.float64),
+                )
+            block = surfaces[3 * p : 3 * p + 3]
+            cover[..., 3 * p : 3 * p + len(block)] = image[..., 4 : 4 + len(block)]
     return assemble_aovs(scene, surfaces, cover, depth_sum, normal_sum), tuple(seconds)
 
 
@@ -397,8 +434,14 @@ def assemble_aovs(
     hit = cover.sum(axis=-1)
     material_id = _majority(material_cov)
     winner = _majority(object_cov)
-    object_id = np.where(winner >= 0, np.asarray(object_ids + [-1], np.int64)[winner], -1).astype(np.int32)
-    depth = np.zeros((h, w)) if depth_sum is None else np.divide(depth_sum, hit, out=np.zeros((h, w)), where=hit > 1e-6)
+    object_id = np.where(winner >= 0, np.asarray(object_ids + [-1], np.int64)[winner], -1).astype(
+        np.int32
+    )
+    depth = (
+        np.zeros((h, w))
+        if depth_sum is None
+        else np.divide(depth_sum, hit, out=np.zeros((h, w)), where=hit > 1e-6)
+    )
     normals = np.zeros((h, w, 3)) if normal_sum is None else normal_sum
     length = np.linalg.norm(normals, axis=-1, keepdims=True)
     normals = np.divide(normals, length, out=np.zeros_like(normals), where=length > 1e-6)

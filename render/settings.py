@@ -105,19 +105,29 @@ class RenderSettings:
         for name in ("spp", "max_depth", "batches"):
             _positive(name, getattr(self, name))
         if self.spp % self.batches:
-            raise RenderError(f"render setting spp={self.spp} with batches={self.batches}; expected "
-                              "spp divisible by batches (each batch renders spp / batches samples)")
+            raise RenderError(
+                f"render setting spp={self.spp} with batches={self.batches}; expected "
+                "spp divisible by batches (each batch renders spp / batches samples)"
+            )
         if self.noise_target is not None and not (
-                isinstance(self.noise_target, int | float) and 0 < self.noise_target < 1):
-            raise RenderError(f"render setting noise_target={self.noise_target!r}; expected a "
-                              "fraction in (0, 1), e.g. 0.02")
-        if self.max_batches is not None and (not isinstance(self.max_batches, int)
-                                             or self.max_batches < self.batches):
-            raise RenderError(f"render setting max_batches={self.max_batches!r}; expected an "
-                              f"integer >= batches ({self.batches})")
+            isinstance(self.noise_target, int | float) and 0 < self.noise_target < 1
+        ):
+            raise RenderError(
+                f"render setting noise_target={self.noise_target!r}; expected a "
+                "fraction in (0, 1), e.g. 0.02"
+            )
+        if self.max_batches is not None and (
+            not isinstance(self.max_batches, int) or self.max_batches < self.batches
+        ):
+            raise RenderError(
+                f"render setting max_batches={self.max_batches!r}; expected an "
+                f"integer >= batches ({self.batches})"
+            )
         if self.integrator not in INTEGRATORS:
-            raise RenderError(f"render setting integrator={self.integrator!r}; expected one of "
-                              f"{', '.join(INTEGRATORS)}")
+            raise RenderError(
+                f"render setting integrator={self.integrator!r}; expected one of "
+                f"{', '.join(INTEGRATORS)}"
+            )
 
     @property
     def batch_spp(self) -> int:

@@ -81,7 +81,9 @@ class TransportOutput:
         specular), or ``None`` for a matte scene."""
         if self.specular is None:
             return None
-        parts = (self.specular.astype(np.float64) * self.emission[:, None, None, :]).astype(np.float32)
+        parts = (self.specular.astype(np.float64) * self.emission[:, None, None, :]).astype(
+            np.float32
+        )
         chosen = range(parts.shape[0]) if lights is None else [int(j) for j in lights]
         return np.sum(parts[list(chosen)], axis=0, dtype=np.float64).astype(np.float32)
 
@@ -110,7 +112,11 @@ def resolve_integrator(name: str | None, variant: str | None = None) -> str:
     """*name* checked against :data:`~spectrinsic.render.settings.INTEGRATORS` (``None``:
     :data:`~spectrinsic.render.settings.DEFAULT_INTEGRATOR`);
     ``"passes"`` where the traversal does not run (:func:`single_traversal_runs`)."""
-    chosen = DEFAULT_INTEGRATOR if name is None else validate_choice(name, INTEGRATORS, "integrator", error=RenderError)
+    chosen = (
+        DEFAULT_INTEGRATOR
+        if name is None
+        else validate_choice(name, INTEGRATORS, "integrator", error=RenderError)
+    )
     return chosen if chosen == "passes" or single_traversal_runs(variant) else "passes"
 
 
@@ -129,19 +135,26 @@ def light_of_emitters(mi: Any, loaded: Any) -> dict[int, int]:
         shape = emitter.get_shape()
         key = shape.id() if shape is not None else emitter.id()
         prefix = tr.light_key(0)[:-1]
-        if not key.startswith(prefix) or not key[len(prefix):].isdigit():
+        if not key.startswith(prefix) or not key[len(prefix) :].isdigit():
             raise RenderError(f"emitter {key!r} is not one of the scene's lights ({prefix}<i>)")
-        out[int(eid)] = int(key[len(prefix):])
+        out[int(eid)] = int(key[len(prefix) :])
     return out
 
 
-def _tables(scene: Scene, value_sets: Sequence[ChannelValues], emitters: dict[int, int], aovs: bool) -> BandTables:
+def _tables(
+    scene: Scene, value_sets: Sequence[ChannelValues], emitters: dict[int, int], aovs: bool
+) -> BandTables:
     bands = np.concatenate([np.asarray(v.materials, float) for v in value_sets], axis=1)
     albedo = np.vstack([bands, np.zeros((1, bands.shape[1]))])  # last row: black
     surfaces = tr.surfaces(scene)
     rows = {s.key: s.material for s in surfaces if s.material >= 0}
-    return BandTables(albedo=albedo, shape_rows=rows, emitter_lights=emitters, n_lights=len(scene.lights),
-                      shape_surfaces={s.key: i for i, s in enumerate(surfaces)} if aovs else {})
+    return BandTables(
+        albedo=albedo,
+        shape_rows=rows,
+        emitter_lights=emitters,
+        n_lights=len(scene.lights),
+        shape_surfaces={s.key: i for i, s in enumerate(surfaces)} if aovs else {},
+    )
 
 
 def _specular_table(scene: Scene, value_sets: Sequence[ChannelValues]) -> np.ndarray:
@@ -149,17 +162,23 @@ def _specular_table(scene: Scene, value_sets: Sequence[ChannelValues]) -> np.nda
     sets' tables side by side over bands; the last row, black, all ones)."""
     tables = [np.asarray(v.specular, float) for v in value_sets if v.specular is not None]
     if len(tables) != len(value_sets):
-        raise RenderError(f"scene {scene.name!r} has glossy materials but its channel values carry no specular tables")
+        raise RenderError(
+            f"scene {scene.name!r} has glossy materials but its channel values carry no specular tables"
+        )
     table = np.concatenate(tables, axis=2)
     return np.concatenate([table, np.ones((1, *table.shape[1:]))], axis=0)
 
 
-def _render(mi: Any, loaded: Any, integrator: Any, *, spp: int, seed: int, n: int) -> tuple[np.ndarray, float]:
+def _render(
+    mi: Any, loaded: Any, integrator: Any, *, spp: int, seed: int, n: int
+) -> tuple[np.ndarray, float]:
     """The traversal's last *n* AOV channels (the band transport) and the render's seconds."""
     image, seconds = timed_render(mi, loaded, spp=spp, seed=seed, integrator=integrator)
     if image.shape[-1] < n:
-        raise RenderError(f"band-path render returned {image.shape[-1]} channels; expected at least {n}")
-    return image[..., image.shape[-1] - n:], seconds
+        raise RenderError(
+            f"band-path render returned {image.shape[-1]} channels; expected at least {n}"
+        )
+    return image[..., image.shape[-1] - n :], seconds
 
 
 def render_traversal(
@@ -212,33 +231,52 @@ def render_traversal(
     widths = [np.asarray(v.materials).shape[1] for v in value_sets]
     n_bands, n_lights = sum(widths), len(scene.lights)
     chosen = choose_variant("rgb", variant)
-    h, w = (scene.camera.height, scene.camera.width) if crop is None else (int(crop[3]), int(crop[2]))
+    h, w = (
+        (scene.camera.height, scene.camera.width) if crop is None else (int(crop[3]), int(crop[2]))
+    )
     white = tr.rgb_spectrum([1.0, 1.0, 1.0])
     glossy = any(m.glossy for m in scene.materials)
     n_spec = n_bands * n_lights if glossy else 0
     with variant_scope(chosen) as mi:
-        loaded = mi.load_dict(tr.scene_to_mitsuba(
-            scene, materials=[white] * len(scene.materials), lights=[white] * n_lights,
-            film=tr.hdr_film(scene.camera.width, scene.camera.height, crop), integrator=tr.path_integrator(max_depth), sample_count=spp,
-            geometry=geometry, white_metal=True,
-        ))
+        loaded = mi.load_dict(
+            tr.scene_to_mitsuba(
+                scene,
+                materials=[white] * len(scene.materials),
+                lights=[white] * n_lights,
+                film=tr.hdr_film(scene.camera.width, scene.camera.height, crop),
+                integrator=tr.path_integrator(max_depth),
+                sample_count=spp,
+                geometry=geometry,
+                white_metal=True,
+            )
+        )
         tables = _tables(scene, value_sets, light_of_emitters(mi, loaded), aovs)
         depths = [int(max_depth)] + ([DIRECT_DEPTH] if direct else [])
         images, specular, seconds, first = [], None, [], np.zeros((h, w, 0), np.float32)
         for depth in depths:
             n_surfaces = len(tables.shape_surfaces) if depth == depths[0] else 0
             make = gloss_path if glossy else band_path
-            integrator = make(mi, max_depth=depth, n_bands=n_bands, n_lights=n_lights, n_surfaces=n_surfaces)
-            integrator.set_tables(loaded, tables if n_surfaces else replace(tables, shape_surfaces={}))
+            integrator = make(
+                mi, max_depth=depth, n_bands=n_bands, n_lights=n_lights, n_surfaces=n_surfaces
+            )
+            integrator.set_tables(
+                loaded, tables if n_surfaces else replace(tables, shape_surfaces={})
+            )
             if glossy:
                 integrator.set_specular(_specular_table(scene, value_sets))
             n_first = len(first_hit_channels(n_surfaces))
             n_t = n_bands * n_lights
-            image, dt = _render(mi, loaded, integrator, spp=spp, seed=seed, n=n_t + n_spec + n_first)
-            first = image[..., n_t + n_spec:] if n_surfaces else first
+            image, dt = _render(
+                mi, loaded, integrator, spp=spp, seed=seed, n=n_t + n_spec + n_first
+            )
+            first = image[..., n_t + n_spec :] if n_surfaces else first
             images.append(image[..., :n_t].reshape(h, w, n_lights, n_bands).transpose(2, 0, 1, 3))
             if glossy and depth == depths[0]:
-                specular = image[..., n_t:n_t + n_spec].reshape(h, w, n_lights, n_bands).transpose(2, 0, 1, 3)
+                specular = (
+                    image[..., n_t : n_t + n_spec]
+                    .reshape(h, w, n_lights, n_bands)
+                    .transpose(2, 0, 1, 3)
+                )
             seconds.append(dt)
             if progress is not None:
                 progress(1)
@@ -252,7 +290,11 @@ def render_traversal(
         )
         for v, a, b in zip(value_sets, edges[:-1], edges[1:], strict=True)
     ]
-    aov_maps = assemble_aovs(scene, tr.surfaces(scene), first[..., :-4], first[..., -4], first[..., -3:]) if aovs else {}
+    aov_maps = (
+        assemble_aovs(scene, tr.surfaces(scene), first[..., :-4], first[..., -4], first[..., -3:])
+        if aovs
+        else {}
+    )
     return outputs, aov_maps, tuple(seconds), chosen
 
 
@@ -289,12 +331,28 @@ def render_jobs(
     the same traversal (drop-in for :func:`~spectrinsic.render.passes.render_aovs`). The jobs
     must hold at least one diagonal mode.
     """
-    diagonal = list({m.name: m for modes, _, _ in jobs for m in modes if m.kind == "diagonal"}.values())
-    want_direct = any(flag and m.name in wanted for modes, _, flag in jobs for m in modes if m.kind == "diagonal")
-    values = [channel_values(scene, get_sensors(m.sensors, data_dir=data_dir), data_dir=data_dir) for m in diagonal]
+    diagonal = list(
+        {m.name: m for modes, _, _ in jobs for m in modes if m.kind == "diagonal"}.values()
+    )
+    want_direct = any(
+        flag and m.name in wanted for modes, _, flag in jobs for m in modes if m.kind == "diagonal"
+    )
+    values = [
+        channel_values(scene, get_sensors(m.sensors, data_dir=data_dir), data_dir=data_dir)
+        for m in diagonal
+    ]
     outs, aov_maps, seconds, chosen = render_traversal(
-        scene, values, spp=spp, seed=seed, max_depth=max_depth, direct=want_direct, aovs=aovs,
-        variant=variant, progress=progress, geometry=geometry)
+        scene,
+        values,
+        spp=spp,
+        seed=seed,
+        max_depth=max_depth,
+        direct=want_direct,
+        aovs=aovs,
+        variant=variant,
+        progress=progress,
+        geometry=geometry,
+    )
     transport = {m.name: o for m, o in zip(diagonal, outs, strict=True)}
     parts = []
     for modes, group, flag in jobs:
@@ -304,7 +362,8 @@ def render_jobs(
             part[m.name] = PassOutput(
                 image=t.image(group),
                 direct=t.image(group, direct=True) if flag and m.name in wanted else None,
-                seconds=(), variant=chosen,
+                seconds=(),
+                variant=chosen,
             )
         parts.append(part)
     return parts, SingleTraversal(transport, seconds, aov_maps)

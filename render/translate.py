@@ -55,7 +55,12 @@ __all__ = [
 CREASE_ANGLE_DEG = 30.0
 #: Emitter parameter holding the spectrum of each kind of
 #: :data:`spectrinsic.scenes.model.LIGHT_KINDS` in Mitsuba (the meaning of ``Light.power``).
-_EMISSION_PARAM = {"point": "intensity", "spot": "intensity", "directional": "irradiance", "area": "radiance"}
+_EMISSION_PARAM = {
+    "point": "intensity",
+    "spot": "intensity",
+    "directional": "irradiance",
+    "area": "radiance",
+}
 
 
 @dataclass(frozen=True)
@@ -126,41 +131,62 @@ def regular_spectrum(values: np.ndarray, wavelengths: np.ndarray) -> dict[str, A
     v = np.asarray(values, float)
     text = ", ".join(f"{x:.9g}" for x in v)
     if np.allclose(np.diff(wl), wl[1] - wl[0]):
-        return {"type": "regular", "wavelength_min": float(wl[0]), "wavelength_max": float(wl[-1]), "values": text}
+        return {
+            "type": "regular",
+            "wavelength_min": float(wl[0]),
+            "wavelength_max": float(wl[-1]),
+            "values": text,
+        }
     return {"type": "irregular", "wavelengths": ", ".join(f"{x:.9g}" for x in wl), "values": text}
 
 
 def black_bsdf() -> dict[str, Any]:
     """Two-sided black Lambertian BSDF (area-light geometry)."""
-    return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.0, 0.0, 0.0]}}}
+    return {
+        "type": "twosided",
+        "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.0, 0.0, 0.0]}},
+    }
 
 
-def hdr_film(width: int, height: int, crop: tuple[int, int, int, int] | None = None) -> dict[str, Any]:
+def hdr_film(
+    width: int, height: int, crop: tuple[int, int, int, int] | None = None
+) -> dict[str, Any]:
     """3-channel float32 film with a box filter (no blur across pixels: ground truth aligns).
 
     *crop* ``(x, y, width, height)`` in pixels renders only that window of the image (Mitsuba's
     ``crop_offset_x/_y``, ``crop_width/_height``): its pixels are the full image's, at the cost
     of the window's pixels alone (converged references of a detail)."""
     film: dict[str, Any] = {
-        "type": "hdrfilm", "width": int(width), "height": int(height), "pixel_format": "rgb",
-        "component_format": "float32", "rfilter": {"type": "box"},
+        "type": "hdrfilm",
+        "width": int(width),
+        "height": int(height),
+        "pixel_format": "rgb",
+        "component_format": "float32",
+        "rfilter": {"type": "box"},
     }
     if crop is not None:
         x, y, cw, ch = (int(v) for v in crop)
         if x < 0 or y < 0 or cw < 1 or ch < 1 or x + cw > width or y + ch > height:
-            raise SceneError(f"film crop {tuple(crop)}: expected (x, y, width, height) inside {width}x{height}")
+            raise SceneError(
+                f"film crop {tuple(crop)}: expected (x, y, width, height) inside {width}x{height}"
+            )
         film.update(crop_offset_x=x, crop_offset_y=y, crop_width=cw, crop_height=ch)
     return film
 
 
-def spectral_film(width: int, height: int, curves: np.ndarray, wavelengths: np.ndarray) -> dict[str, Any]:
+def spectral_film(
+    width: int, height: int, curves: np.ndarray, wavelengths: np.ndarray
+) -> dict[str, Any]:
     """``specfilm`` whose bands are *curves* ``(K, W)``: channel k is ``∫ L S_k dλ`` (nm).
 
     Bands are named ``s00``, ``s01``, ... so their order survives any sorting by name.
     """
     film: dict[str, Any] = {
-        "type": "specfilm", "width": int(width), "height": int(height),
-        "component_format": "float32", "rfilter": {"type": "box"},
+        "type": "specfilm",
+        "width": int(width),
+        "height": int(height),
+        "component_format": "float32",
+        "rfilter": {"type": "box"},
     }
     for k, curve in enumerate(np.asarray(curves, float)):
         film[f"s{k:02d}"] = regular_spectrum(np.clip(curve, 0.0, None), wavelengths)
@@ -205,26 +231,41 @@ def smooth_corner_normals(
     # each repeated once per corner of its vertex, and b over that vertex's corners. Built with
     # np.repeat rather than fancy indexing, which is the costly part on large meshes.
     per = np.repeat(counts, counts)  # pairs each sorted corner takes part in
-    b = np.repeat(starts, counts * counts) + (np.arange(per.sum()) - np.repeat(np.cumsum(per) - per, per))
+    b = np.repeat(starts, counts * counts) + (
+        np.arange(per.sum()) - np.repeat(np.cumsum(per) - per, per)
+    )
     fb = sorted_face[b]
     unit_a = np.repeat(unit[sorted_face], per, axis=0)
     keep = np.einsum("ij,ij->i", unit_a, unit[fb]) >= np.cos(np.radians(crease_deg))
     target, weights = np.repeat(order, per)[keep], cross[fb[keep]]
-    acc = np.stack([np.bincount(target, weights=weights[:, c], minlength=corner_vertex.size)
-                    for c in range(3)], axis=1).astype(np.float64)  # no pairs: bincount gives int
+    acc = np.stack(
+        [
+            np.bincount(target, weights=weights[:, c], minlength=corner_vertex.size)
+            for c in range(3)
+        ],
+        axis=1,
+    ).astype(np.float64)  # no pairs: bincount gives int
     norm = np.linalg.norm(acc, axis=1)
     out = np.divide(acc, norm[:, None], out=np.zeros_like(acc), where=norm[:, None] > 0)
     out[norm == 0] = (0.0, 0.0, 1.0)
     return out.reshape(len(f), 3, 3)
 
 
-def _mitsuba_mesh(mi: Any, name: str, corners: np.ndarray, normals: np.ndarray, bsdf: Mapping) -> Any:
+def _mitsuba_mesh(
+    mi: Any, name: str, corners: np.ndarray, normals: np.ndarray, bsdf: Mapping
+) -> Any:
     """An ``mi.Mesh`` with unshared vertices (one per face corner) and the given normals."""
     n_faces = corners.shape[0]
     props = mi.Properties()
     props["bsdf"] = mi.load_dict(dict(bsdf))
-    mesh = mi.Mesh(name, vertex_count=3 * n_faces, face_count=n_faces, has_vertex_normals=True,
-                   has_vertex_texcoords=False, props=props)
+    mesh = mi.Mesh(
+        name,
+        vertex_count=3 * n_faces,
+        face_count=n_faces,
+        has_vertex_normals=True,
+        has_vertex_texcoords=False,
+        props=props,
+    )
     params = mi.traverse(mesh)
     for key, array in (
         ("vertex_positions", corners.reshape(-1).astype(np.float32)),
@@ -240,7 +281,9 @@ def _lambertian(reflectance: Mapping) -> dict[str, Any]:
     return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": dict(reflectance)}}
 
 
-def material_bsdf(material: Material, reflectance: Mapping, *, white_metal: bool = False) -> dict[str, Any]:
+def material_bsdf(
+    material: Material, reflectance: Mapping, *, white_metal: bool = False
+) -> dict[str, Any]:
     """The two-sided Mitsuba BSDF of *material* with diffuse *reflectance*.
 
     ``plastic``: Mitsuba's ``plastic`` (smooth) or ``roughplastic`` (GGX, α = roughness) with
@@ -255,11 +298,18 @@ def material_bsdf(material: Material, reflectance: Mapping, *, white_metal: bool
     rough = material.roughness > 0.0
     bsdf: dict[str, Any]
     if material.kind == "plastic":
-        bsdf = {"type": "roughplastic" if rough else "plastic", "diffuse_reflectance": dict(reflectance),
-                "int_ior": float(material.ior), "ext_ior": 1.0, "nonlinear": False}
+        bsdf = {
+            "type": "roughplastic" if rough else "plastic",
+            "diffuse_reflectance": dict(reflectance),
+            "int_ior": float(material.ior),
+            "ext_ior": 1.0,
+            "nonlinear": False,
+        }
     else:
-        bsdf = {"type": "roughconductor" if rough else "conductor",
-                "material": "none" if white_metal else material.metal}
+        bsdf = {
+            "type": "roughconductor" if rough else "conductor",
+            "material": "none" if white_metal else material.metal,
+        }
     if rough:
         bsdf |= {"distribution": "ggx", "alpha": float(material.roughness)}
     return {"type": "twosided", "bsdf": bsdf}
@@ -272,25 +322,49 @@ def _look_at(mi: Any, origin: Sequence[float], direction: Sequence[float], what:
     d = d / np.linalg.norm(d)
     up = np.array([0.0, 0.0, 1.0]) if abs(d[2]) < 0.99 else np.array([0.0, 1.0, 0.0])
     o = np.asarray(origin, float)
-    return mi.ScalarTransform4f().look_at(origin=o.tolist(), target=(o + d).tolist(), up=up.tolist())
+    return mi.ScalarTransform4f().look_at(
+        origin=o.tolist(), target=(o + d).tolist(), up=up.tolist()
+    )
 
 
 def _light(mi: Any, light: Light, emission: Mapping | None, what: str) -> dict[str, Any] | None:
     if light.kind == "point":
-        return None if emission is None else {"type": "point", "position": list(map(float, light.position)),
-                                              "intensity": dict(emission)}
+        return (
+            None
+            if emission is None
+            else {
+                "type": "point",
+                "position": list(map(float, light.position)),
+                "intensity": dict(emission),
+            }
+        )
     if light.kind == "spot":
-        return None if emission is None else {
-            "type": "spot", "to_world": _look_at(mi, light.position, light.direction, what),
-            "cutoff_angle": float(light.cutoff_deg), "intensity": dict(emission)}
+        return (
+            None
+            if emission is None
+            else {
+                "type": "spot",
+                "to_world": _look_at(mi, light.position, light.direction, what),
+                "cutoff_angle": float(light.cutoff_deg),
+                "intensity": dict(emission),
+            }
+        )
     if light.kind == "directional":
-        return None if emission is None else {"type": "directional", "direction": list(map(float, light.direction)),
-                                              "irradiance": dict(emission)}
+        return (
+            None
+            if emission is None
+            else {
+                "type": "directional",
+                "direction": list(map(float, light.direction)),
+                "irradiance": dict(emission),
+            }
+        )
     if light.kind == "area":
         w, h = (float(s) for s in light.size)
         shape: dict[str, Any] = {
             "type": "rectangle",
-            "to_world": _look_at(mi, light.position, light.direction, what) @ mi.ScalarTransform4f().scale([w / 2, h / 2, 1.0]),
+            "to_world": _look_at(mi, light.position, light.direction, what)
+            @ mi.ScalarTransform4f().scale([w / 2, h / 2, 1.0]),
             # an instance, not a dict: load_dict merges identical dicts into one shared BSDF,
             # and every surface needs its own for the per-surface coverage passes
             "bsdf": mi.load_dict(black_bsdf()),
@@ -308,7 +382,9 @@ def _camera(mi: Any, scene: Scene, film: Mapping, sample_count: int) -> dict[str
         "fov": float(cam.fov_deg),
         "fov_axis": "x",
         "to_world": mi.ScalarTransform4f().look_at(
-            origin=list(map(float, cam.origin)), target=list(map(float, cam.target)), up=list(map(float, cam.up))
+            origin=list(map(float, cam.origin)),
+            target=list(map(float, cam.target)),
+            up=list(map(float, cam.up)),
         ),
         "film": dict(film),
         "sampler": {"type": "independent", "sample_count": int(sample_count)},
@@ -325,7 +401,9 @@ class SurfaceGeometry:
     normals: np.ndarray
 
 
-def prepare_geometry(scene: Scene, crease_deg: float = CREASE_ANGLE_DEG) -> tuple[SurfaceGeometry, ...]:
+def prepare_geometry(
+    scene: Scene, crease_deg: float = CREASE_ANGLE_DEG
+) -> tuple[SurfaceGeometry, ...]:
     """Split every mesh by material and compute its smoothed corner normals (pure numpy).
 
     :func:`scene_to_mitsuba` does this itself when not given the result; callers translating
@@ -339,7 +417,9 @@ def prepare_geometry(scene: Scene, crease_deg: float = CREASE_ANGLE_DEG) -> tupl
         face_materials = np.asarray(mesh.face_materials, np.int64)
         for m in np.unique(face_materials):
             sel = face_materials == m
-            out.append(SurfaceGeometry(f"surf_{index}_{int(m)}", int(m), corners[sel], normals[sel]))
+            out.append(
+                SurfaceGeometry(f"surf_{index}_{int(m)}", int(m), corners[sel], normals[sel])
+            )
     return tuple(out)
 
 
@@ -390,7 +470,9 @@ def scene_to_mitsuba(
         "sensor": _camera(mi, scene, film, sample_count),
     }
     for part in prepare_geometry(scene, crease_deg) if geometry is None else geometry:
-        bsdf = material_bsdf(scene.materials[part.material], materials[part.material], white_metal=white_metal)
+        bsdf = material_bsdf(
+            scene.materials[part.material], materials[part.material], white_metal=white_metal
+        )
         out[part.key] = _mitsuba_mesh(mi, part.key, part.corners, part.normals, bsdf)
     for j, (light, emission) in enumerate(zip(scene.lights, lights, strict=True)):
         entry = _light(mi, light, emission, f"scene {scene.name!r} light {j} ({light.name})")

@@ -49,8 +49,8 @@ from spectrinsic.render.modes import (
     to_xyz_matrix,
 )
 from spectrinsic.render.passes import PassProgress, render_aovs, render_diagonal
-from spectrinsic.render.pipeline import batch_seeds, image_noise, merge_batches, render_scene
 from spectrinsic.render.result import RenderResult
+from spectrinsic.render.scene_render import batch_seeds, image_noise, merge_batches, render_scene
 from spectrinsic.render.settings import RenderSettings
 from spectrinsic.render.single import resolve_integrator
 from spectrinsic.render.translate import prepare_geometry
@@ -107,8 +107,10 @@ class LightTransport:
             raise RenderError(f"transport: {len(self.batches)} batches for {len(self.seeds)} seeds")
         shapes = {a.shape[:3] for b in self.batches for a in b.values()}
         if len(shapes) != 1 or any(set(b) != set(self.modes) for b in self.batches):
-            raise RenderError(f"transport: every batch must hold modes {list(self.modes)} with "
-                              f"one (lights, height, width); got shapes {sorted(shapes)}")
+            raise RenderError(
+                f"transport: every batch must hold modes {list(self.modes)} with "
+                f"one (lights, height, width); got shapes {sorted(shapes)}"
+            )
 
     @property
     def n_lights(self) -> int:
@@ -138,8 +140,11 @@ def light_band_means(scene: Scene, sensors: str, *, data_dir: str | None = None)
     2.0
     """
     wl = COLORIMETRIC_WAVELENGTHS
-    return diagonal_values(light_spectra(scene, wl, data_dir=data_dir),
-                           get_sensors(sensors, data_dir=data_dir).on(wl), wl)
+    return diagonal_values(
+        light_spectra(scene, wl, data_dir=data_dir),
+        get_sensors(sensors, data_dir=data_dir).on(wl),
+        wl,
+    )
 
 
 def _unit_values(scene: Scene, sensors: str, data_dir: str | None) -> ChannelValues:
@@ -148,7 +153,9 @@ def _unit_values(scene: Scene, sensors: str, data_dir: str | None) -> ChannelVal
     wl = COLORIMETRIC_WAVELENGTHS
     curves = get_sensors(sensors, data_dir=data_dir).on(wl)
     flat = responses(np.ones(wl.size), curves, wl)
-    materials = channel_values(scene, get_sensors(sensors, data_dir=data_dir), data_dir=data_dir).materials
+    materials = channel_values(
+        scene, get_sensors(sensors, data_dir=data_dir), data_dir=data_dir
+    ).materials
     return ChannelValues(materials=materials, lights=np.tile(flat, (len(scene.lights), 1)))
 
 
@@ -167,10 +174,17 @@ def render_transport(
     ``settings.max_depth`` and Russian roulette off, so its paths are those of a per-light
     render with the same settings; only the diagonal ones of ``settings.modes`` are rendered.
     """
-    modes, spp, max_depth, variant = settings.modes, settings.batch_spp, settings.max_depth, settings.variant
+    modes, spp, max_depth, variant = (
+        settings.modes,
+        settings.batch_spp,
+        settings.max_depth,
+        settings.variant,
+    )
     names = diagonal_mode_names(modes)
     if not names:
-        raise SceneError(f"modes {list(modes)}: the transport needs a diagonal mode (rgb3, rgb6, bands31)")
+        raise SceneError(
+            f"modes {list(modes)}: the transport needs a diagonal mode (rgb3, rgb6, bands31)"
+        )
     if not scene.lights:
         raise SceneError(f"scene {scene.name!r} has no lights: no transport to render")
     sensors = [get_mode(m).sensors for m in names]
@@ -181,14 +195,24 @@ def render_transport(
     seconds: dict[str, list[float]] = {m: [] for m in names}
     with variant_scope(chosen):  # one scope: switching variants reloads Mitsuba's modules
         for j in range(len(scene.lights)):
-            outputs = render_diagonal(scene, values, spp=spp, seed=seed, max_depth=max_depth,
-                                      active_lights=[j], variant=chosen, progress=progress,
-                                      geometry=geometry)
+            outputs = render_diagonal(
+                scene,
+                values,
+                spp=spp,
+                seed=seed,
+                max_depth=max_depth,
+                active_lights=[j],
+                variant=chosen,
+                progress=progress,
+                geometry=geometry,
+            )
             for i, out in enumerate(outputs):
                 per_light[i].append(out.image)
                 seconds[names[i]].extend(out.seconds)
-    return ({m: np.stack(p).astype(np.float32) for m, p in zip(names, per_light, strict=True)},
-            {m: tuple(s) for m, s in seconds.items()})
+    return (
+        {m: np.stack(p).astype(np.float32) for m, p in zip(names, per_light, strict=True)},
+        {m: tuple(s) for m, s in seconds.items()},
+    )
 
 
 def transport_result(
@@ -213,9 +237,13 @@ def transport_result(
     matrices: dict[str, np.ndarray] = {}
     for mode, t in batch.items():
         if t.shape[0] != len(scene.lights):
-            raise RenderError(f"transport of {mode!r} has {t.shape[0]} lights; the scene has {len(scene.lights)}")
+            raise RenderError(
+                f"transport of {mode!r} has {t.shape[0]} lights; the scene has {len(scene.lights)}"
+            )
         means = light_band_means(scene, get_mode(mode).sensors, data_dir=data_dir)
-        parts = [(np.asarray(t[j], np.float64) * means[j]).astype(np.float32) for j in range(t.shape[0])]
+        parts = [
+            (np.asarray(t[j], np.float64) * means[j]).astype(np.float32) for j in range(t.shape[0])
+        ]
         raw[mode] = np.sum(parts, axis=0, dtype=np.float64).astype(np.float32)
         matrices[mode] = to_xyz_matrix(get_mode(mode), scene, data_dir=data_dir)
         images[mode] = raw_to_xyz(raw[mode], matrices[mode])
@@ -223,7 +251,11 @@ def transport_result(
             per_light[j][mode] = raw_to_xyz(part, matrices[mode])
     out_meta: dict[str, Any] = dict(meta or {})
     out_meta.update(
-        seed=int(seed), spp=int(spp), modes=list(batch), per_light=True, per_light_modes=list(batch),
+        seed=int(seed),
+        spp=int(spp),
+        modes=list(batch),
+        per_light=True,
+        per_light_modes=list(batch),
         sensors={m: get_mode(m).sensors for m in batch},
         to_xyz={m: np.asarray(v).tolist() for m, v in matrices.items()},
     )
@@ -231,8 +263,12 @@ def transport_result(
     return RenderResult(images=images, raw=raw, per_light=tuple(per_light), meta=out_meta)
 
 
-def _join(diagonal: RenderResult, other: RenderResult | None, aovs: Mapping[str, np.ndarray],
-          order: Sequence[str]) -> RenderResult:
+def _join(
+    diagonal: RenderResult,
+    other: RenderResult | None,
+    aovs: Mapping[str, np.ndarray],
+    order: Sequence[str],
+) -> RenderResult:
     """One batch: the composed diagonal modes with the directly rendered others and the AOVs,
     modes in the requested *order*."""
     if other is None:
@@ -241,17 +277,31 @@ def _join(diagonal: RenderResult, other: RenderResult | None, aovs: Mapping[str,
     for key in ("sensors", "to_xyz"):
         meta[key] = {**other.meta.get(key, {}), **diagonal.meta[key]}
     meta["timings"] = {**other.meta.get("timings", {}), **diagonal.meta["timings"]}
-    meta.update(modes=list(order), per_light=True, per_light_modes=diagonal.meta["per_light_modes"],
-                variants={**other.meta.get("variants", {}), **diagonal.meta.get("variants", {})})
+    meta.update(
+        modes=list(order),
+        per_light=True,
+        per_light_modes=diagonal.meta["per_light_modes"],
+        variants={**other.meta.get("variants", {}), **diagonal.meta.get("variants", {})},
+    )
     return RenderResult(
         images={m: {**other.images, **diagonal.images}[m] for m in order},
-        raw={m: {**other.raw, **diagonal.raw}[m] for m in order if m in {**other.raw, **diagonal.raw}},
-        per_light=diagonal.per_light, direct=dict(other.direct), aovs=dict(aovs), meta=meta,
+        raw={
+            m: {**other.raw, **diagonal.raw}[m] for m in order if m in {**other.raw, **diagonal.raw}
+        },
+        per_light=diagonal.per_light,
+        direct=dict(other.direct),
+        aovs=dict(aovs),
+        meta=meta,
     )
 
 
 def _traversal_batch(
-    scene: Scene, settings: RenderSettings, seed: int, *, progress: PassProgress | None, data_dir: str | None,
+    scene: Scene,
+    settings: RenderSettings,
+    seed: int,
+    *,
+    progress: PassProgress | None,
+    data_dir: str | None,
 ) -> tuple[dict[str, np.ndarray], RenderResult]:
     """:func:`_batch` from one single traversal (:mod:`spectrinsic.render.single`), which
     already splits every band by light: its transport ``T'_lk`` (per unit channel emission
@@ -260,24 +310,52 @@ def _traversal_batch(
     the same pixel samples, as a direct render with ``integrator="single"`` does, so a relit
     sample equals that render to float rounding."""
     names = diagonal_mode_names(settings.modes)
-    direct = (tuple(m for m in settings.modes if m not in names) if settings.direct is True
-              else tuple(m for m in settings.direct or () if m not in names))
-    render = render_scene(scene, settings.with_options(per_light=False, share_mode=None, direct=direct, aovs=True),
-                          seed=seed, progress=progress, data_dir=data_dir)
+    direct = (
+        tuple(m for m in settings.modes if m not in names)
+        if settings.direct is True
+        else tuple(m for m in settings.direct or () if m not in names)
+    )
+    render = render_scene(
+        scene,
+        settings.with_options(per_light=False, share_mode=None, direct=direct, aovs=True),
+        seed=seed,
+        progress=progress,
+        data_dir=data_dir,
+    )
     flat = {m: _unit_values(scene, get_mode(m).sensors, data_dir).lights for m in names}
-    t = {m: (render.transport[m].astype(np.float64) * flat[m][:, None, None, :]).astype(np.float32)
-         for m in names}
-    base = {"max_depth": int(settings.max_depth), "variants": {m: render.meta["variants"][m] for m in names},
-            "timings": {m: render.meta["timings"][m] for m in names}}
-    diagonal = transport_result(t, scene, seed=seed, spp=settings.batch_spp, meta=base, data_dir=data_dir)
+    t = {
+        m: (render.transport[m].astype(np.float64) * flat[m][:, None, None, :]).astype(np.float32)
+        for m in names
+    }
+    base = {
+        "max_depth": int(settings.max_depth),
+        "variants": {m: render.meta["variants"][m] for m in names},
+        "timings": {m: render.meta["timings"][m] for m in names},
+    }
+    diagonal = transport_result(
+        t, scene, seed=seed, spp=settings.batch_spp, meta=base, data_dir=data_dir
+    )
     others = [m for m in dict.fromkeys(settings.modes) if m not in names]
-    other = replace(render, images={m: render.images[m] for m in others}, raw={m: render.raw[m] for m in others},
-                    transport={}) if others else None
+    other = (
+        replace(
+            render,
+            images={m: render.images[m] for m in others},
+            raw={m: render.raw[m] for m in others},
+            transport={},
+        )
+        if others
+        else None
+    )
     return t, _join(diagonal, other, render.aovs, list(dict.fromkeys(settings.modes)))
 
 
 def _batch(
-    scene: Scene, settings: RenderSettings, seed: int, *, progress: PassProgress | None, data_dir: str | None,
+    scene: Scene,
+    settings: RenderSettings,
+    seed: int,
+    *,
+    progress: PassProgress | None,
+    data_dir: str | None,
 ) -> tuple[dict[str, np.ndarray], RenderResult]:
     """Transport of one batch and the sample's render of that batch (other modes rendered
     directly with every light on, the AOVs from the same pixel samples): from the single
@@ -289,21 +367,42 @@ def _batch(
     others = tuple(m for m in dict.fromkeys(modes) if m not in names)
     t, seconds = render_transport(scene, settings, seed=seed, progress=progress, data_dir=data_dir)
     rgb = choose_variant("rgb", variant)
-    timing = {m: {"passes": len(s), "seconds": float(sum(s)), "per_pass": list(s)} for m, s in seconds.items()}
-    base = {"max_depth": int(settings.max_depth), "timings": timing, "variants": dict.fromkeys(names, rgb)}
+    timing = {
+        m: {"passes": len(s), "seconds": float(sum(s)), "per_pass": list(s)}
+        for m, s in seconds.items()
+    }
+    base = {
+        "max_depth": int(settings.max_depth),
+        "timings": timing,
+        "variants": dict.fromkeys(names, rgb),
+    }
     diagonal = transport_result(t, scene, seed=seed, spp=spp, meta=base, data_dir=data_dir)
     other = None
     if others:
-        direct = settings.direct if isinstance(settings.direct, bool) else tuple(
-            m for m in settings.direct if m in others)
-        other = render_scene(scene, settings.with_options(modes=others, per_light=False, share_mode=None,
-                                                          direct=direct, aovs=True),
-                             seed=seed, progress=progress, data_dir=data_dir)
+        direct = (
+            settings.direct
+            if isinstance(settings.direct, bool)
+            else tuple(m for m in settings.direct if m in others)
+        )
+        other = render_scene(
+            scene,
+            settings.with_options(
+                modes=others, per_light=False, share_mode=None, direct=direct, aovs=True
+            ),
+            seed=seed,
+            progress=progress,
+            data_dir=data_dir,
+        )
         aovs = other.aovs
     else:
-        aovs, aov_seconds = render_aovs(scene, spp=spp, seed=seed, variant=variant, progress=progress)
-        timing["aovs"] = {"passes": len(aov_seconds), "seconds": float(sum(aov_seconds)),
-                          "per_pass": list(aov_seconds)}
+        aovs, aov_seconds = render_aovs(
+            scene, spp=spp, seed=seed, variant=variant, progress=progress
+        )
+        timing["aovs"] = {
+            "passes": len(aov_seconds),
+            "seconds": float(sum(aov_seconds)),
+            "per_pass": list(aov_seconds),
+        }
     return t, _join(diagonal, other, aovs, list(dict.fromkeys(modes)))
 
 
@@ -327,26 +426,48 @@ def render_transport_batches(
     """
     modes, batches, noise_target = settings.modes, settings.batches, settings.noise_target
     if settings.direct and not [m for m in modes if m not in diagonal_mode_names(modes)]:
-        raise SceneError("direct-only renders with the transport need the 'spectral' mode "
-                         "(the diagonal modes are composed, not rendered with every light)")
+        raise SceneError(
+            "direct-only renders with the transport need the 'spectral' mode "
+            "(the diagonal modes are composed, not rendered with every light)"
+        )
     cap = max(batches, settings.max_batches if settings.max_batches is not None else 4 * batches)
     seeds = batch_seeds(seed, cap if noise_target is not None else batches)
-    done = [_batch(scene, settings, s, progress=progress, data_dir=data_dir) for s in seeds[:batches]]
+    done = [
+        _batch(scene, settings, s, progress=progress, data_dir=data_dir) for s in seeds[:batches]
+    ]
     reached = image_noise([r for _, r in done]) if noise_target is not None else None
-    while reached is not None and noise_target is not None and reached > noise_target and len(done) < cap:
+    while (
+        reached is not None
+        and noise_target is not None
+        and reached > noise_target
+        and len(done) < cap
+    ):
         done.append(_batch(scene, settings, seeds[len(done)], progress=progress, data_dir=data_dir))
         reached = image_noise([r for _, r in done])
     merged = merge_batches([r for _, r in done])
     if noise_target is not None:
-        merged.meta["noise_target"] = {"target": float(noise_target), "reached": reached, "max_batches": cap}
+        merged.meta["noise_target"] = {
+            "target": float(noise_target),
+            "reached": reached,
+            "max_batches": cap,
+        }
     names = diagonal_mode_names(modes)
-    seconds = {m: tuple(x for r in done for x in r[1].meta["timings"][m]["per_pass"])
-               for m in (*names, "single") if m in done[0][1].meta["timings"]}
+    seconds = {
+        m: tuple(x for r in done for x in r[1].meta["timings"][m]["per_pass"])
+        for m in (*names, "single")
+        if m in done[0][1].meta["timings"]
+    }
     transport = LightTransport(
-        modes=names, sensors={m: get_mode(m).sensors for m in names},
-        batches=tuple(t for t, _ in done), seeds=tuple(int(s) for s in seeds[:len(done)]),
-        spp=int(settings.batch_spp), max_depth=int(settings.max_depth), seconds=seconds,
+        modes=names,
+        sensors={m: get_mode(m).sensors for m in names},
+        batches=tuple(t for t, _ in done),
+        seeds=tuple(int(s) for s in seeds[: len(done)]),
+        spp=int(settings.batch_spp),
+        max_depth=int(settings.max_depth),
+        seconds=seconds,
     )
     merged.meta["transport"] = {"modes": list(names), "batches": len(done)}
-    logger.debug("transport of %s: %d light(s), %d batch(es)", scene.name, transport.n_lights, len(done))
+    logger.debug(
+        "transport of %s: %d light(s), %d batch(es)", scene.name, transport.n_lights, len(done)
+    )
     return transport, merged

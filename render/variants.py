@@ -123,7 +123,11 @@ def find_libllvm(
                 if not (lib.suffix in (".so", ".dylib") or ".so." in lib.name) or not lib.exists():
                     continue
                 version = llvm_version_from_name(lib)
-                if version is not None and version >= min_version and (best is None or version > best[0]):
+                if (
+                    version is not None
+                    and version >= min_version
+                    and (best is None or version > best[0])
+                ):
                     best = (version, lib)
     return None if best is None else best[1]
 
@@ -214,7 +218,9 @@ def _llvm_suitable() -> bool:
     if not path:
         return False  # Dr.Jit would pick whatever libLLVM it finds: possibly 14/15, which crash
     version = llvm_version_from_name(path)
-    return version is None or version >= LLVM_MIN_VERSION  # an unversioned path set by the user is trusted
+    return (
+        version is None or version >= LLVM_MIN_VERSION
+    )  # an unversioned path set by the user is trusted
 
 
 def usable_backends() -> tuple[str, ...]:
@@ -275,7 +281,9 @@ def choose_variant(kind: VariantKind, requested: str | None = None) -> str:
             )
     variant = f"{BACKENDS[backend]}_{kind}"
     if variant not in mi.variants():
-        raise RenderError(f"this Mitsuba build lacks variant {variant!r}; it has {', '.join(mi.variants())}")
+        raise RenderError(
+            f"this Mitsuba build lacks variant {variant!r}; it has {', '.join(mi.variants())}"
+        )
     return variant
 
 
@@ -290,7 +298,9 @@ def available_variants() -> list[str]:
     mi = import_mitsuba()
     compiled = set(mi.variants())
     return [
-        f"{BACKENDS[b]}_{kind}" for b in usable_backends() for kind in ("rgb", "spectral")
+        f"{BACKENDS[b]}_{kind}"
+        for b in usable_backends()
+        for kind in ("rgb", "spectral")
         if f"{BACKENDS[b]}_{kind}" in compiled
     ]
 

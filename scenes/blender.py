@@ -73,7 +73,11 @@ def principled_gloss(mat: Any) -> dict[str, Any]:
     """Gloss fields of :class:`Material` from *mat*'s first Principled BSDF node (module
     docstring); ``{}`` (Lambertian) without one or when it is matte."""
     tree = getattr(mat, "node_tree", None)
-    node = next((n for n in tree.nodes if n.type == "BSDF_PRINCIPLED"), None) if tree is not None else None
+    node = (
+        next((n for n in tree.nodes if n.type == "BSDF_PRINCIPLED"), None)
+        if tree is not None
+        else None
+    )
     if node is None:
         return {}
     rough = float(node.inputs["Roughness"].default_value)
@@ -83,7 +87,11 @@ def principled_gloss(mat: Any) -> dict[str, Any]:
         return {"kind": "conductor", "metal": metal, "roughness": alpha}
     if rough < 0.5:
         ior = float(node.inputs["IOR"].default_value) if "IOR" in node.inputs else 1.5
-        return {"kind": "plastic", "roughness": alpha, "ior": min(max(ior, IOR_RANGE[0] + 1e-3), IOR_RANGE[1])}
+        return {
+            "kind": "plastic",
+            "roughness": alpha,
+            "ior": min(max(ior, IOR_RANGE[0] + 1e-3), IOR_RANGE[1]),
+        }
     return {}
 
 

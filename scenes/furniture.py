@@ -94,12 +94,21 @@ def sofa(width: float, depth: float, spectrum: str, *, seat: float = 0.42) -> Pa
     arm = 0.15
     cushions = max(1, int(round((width - 2 * arm) / 0.6)))
     cw = (width - 2 * arm) / cushions
-    parts = [box((width, depth, 0.25), spectrum, center=(0, 0, 0.125)),
-             box((width, 0.2, 0.8), spectrum, center=(0, depth / 2 - 0.1, 0.4))]
-    parts += [box((arm, depth, 0.6), spectrum, center=(sx * (width - arm) / 2, 0, 0.3)) for sx in (-1, 1)]
-    parts += [box((cw - 0.01, depth - 0.22, seat - 0.25), spectrum,
-                  center=(-width / 2 + arm + cw * (i + 0.5), -0.1, (0.25 + seat) / 2))
-              for i in range(cushions)]
+    parts = [
+        box((width, depth, 0.25), spectrum, center=(0, 0, 0.125)),
+        box((width, 0.2, 0.8), spectrum, center=(0, depth / 2 - 0.1, 0.4)),
+    ]
+    parts += [
+        box((arm, depth, 0.6), spectrum, center=(sx * (width - arm) / 2, 0, 0.3)) for sx in (-1, 1)
+    ]
+    parts += [
+        box(
+            (cw - 0.01, depth - 0.22, seat - 0.25),
+            spectrum,
+            center=(-width / 2 + arm + cw * (i + 0.5), -0.1, (0.25 + seat) / 2),
+        )
+        for i in range(cushions)
+    ]
     return merge(*parts)
 
 

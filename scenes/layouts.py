@@ -157,15 +157,11 @@ def _room_corner() -> Layout:
     parts += [
         (
             "cube-red",
-            box(
-                (0.5, 0.5, 0.5), _M + "5R 4/12", center=(0.3, d - 0.3, 0.25), divisions=(2, 2, 2)
-            ),
+            box((0.5, 0.5, 0.5), _M + "5R 4/12", center=(0.3, d - 0.3, 0.25), divisions=(2, 2, 2)),
         ),
         (
             "cube-blue",
-            box(
-                (0.4, 0.4, 0.4), _M + "5PB 5/10", center=(0.3, d - 0.3, 0.7), divisions=(2, 2, 2)
-            ),
+            box((0.4, 0.4, 0.4), _M + "5PB 5/10", center=(0.3, d - 0.3, 0.7), divisions=(2, 2, 2)),
         ),
         ("cube-purple", box((0.35, 0.35, 0.35), _M + "5P 4/10", center=(0.85, d - 0.25, 0.175))),
         (

@@ -97,7 +97,9 @@ def scene_names(kind: str | None = None) -> list[str]:
 
 
 def _check_name(name: str) -> str:
-    return validate_choice(name, scene_names() + scene_names("glossy"), "library scene", error=SceneError)
+    return validate_choice(
+        name, scene_names() + scene_names("glossy"), "library scene", error=SceneError
+    )
 
 
 def n_views(name: str) -> int:
@@ -150,8 +152,9 @@ def condition_illuminants(name: str, condition: str, *, seed: int) -> tuple[str,
 def _power(spot: LightSpot, direction: np.ndarray, focus: np.ndarray, irradiance: float) -> float:
     """Power giving *irradiance* at *focus* on a surface facing the light
     (:func:`spectrinsic.scenes.model.light_power`)."""
-    return light_power(spot.kind, np.asarray(spot.position, float), direction, focus, spot.size,
-                       irradiance)
+    return light_power(
+        spot.kind, np.asarray(spot.position, float), direction, focus, spot.size, irradiance
+    )
 
 
 def _check_view(name: str, view: int) -> None:
@@ -242,8 +245,17 @@ def build(
     """
     _check_view(name, view)
     if name != base_name(name):  # a glossy variant: its matte scene, lights and draws included
-        return glossy_variant(build(base_name(name), view=view, condition=condition, seed=seed,
-                                    width=width, height=height), base_name(name))
+        return glossy_variant(
+            build(
+                base_name(name),
+                view=view,
+                condition=condition,
+                seed=seed,
+                width=width,
+                height=height,
+            ),
+            base_name(name),
+        )
     illuminants = condition_illuminants(name, condition, seed=seed)
     layout = _layout(name)
     meshes, materials = to_meshes(layout.parts)

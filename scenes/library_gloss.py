@@ -34,12 +34,26 @@ class Gloss:
 
 #: Per complex scene, mesh name -> gloss; object scenes glaze their object (any non-ground mesh).
 GLOSSY_MESHES: dict[str, dict[str, Gloss]] = {
-    "room-living": {"wall-floor": Gloss(roughness=0.08), "table": Gloss(roughness=0.15), "cup": Gloss(),
-                    "vase": Gloss(), "box": Gloss("conductor", 0.1, metal="Au")},
-    "room-corner": {"wall-floor": Gloss(roughness=0.1), "cube-red": Gloss(),
-                    "cube-blue": Gloss("conductor", 0.2, metal="Al"), "cube-purple": Gloss("conductor", metal="Cu")},
-    "room-studio": {"wall-floor": Gloss(roughness=0.2), "desk": Gloss(roughness=0.1), "cup": Gloss(),
-                    "vase": Gloss(), "shelf": Gloss("conductor", 0.15, metal="Ag")},
+    "room-living": {
+        "wall-floor": Gloss(roughness=0.08),
+        "table": Gloss(roughness=0.15),
+        "cup": Gloss(),
+        "vase": Gloss(),
+        "box": Gloss("conductor", 0.1, metal="Au"),
+    },
+    "room-corner": {
+        "wall-floor": Gloss(roughness=0.1),
+        "cube-red": Gloss(),
+        "cube-blue": Gloss("conductor", 0.2, metal="Al"),
+        "cube-purple": Gloss("conductor", metal="Cu"),
+    },
+    "room-studio": {
+        "wall-floor": Gloss(roughness=0.2),
+        "desk": Gloss(roughness=0.1),
+        "cup": Gloss(),
+        "vase": Gloss(),
+        "shelf": Gloss("conductor", 0.15, metal="Ag"),
+    },
 }
 _GLAZE = Gloss(roughness=0.05)
 
@@ -51,8 +65,14 @@ def base_name(name: str) -> str:
 
 def _material(base: Material, gloss: Gloss, mesh: str) -> Material:
     spectrum = METAL_SPECTRUM if gloss.kind == "conductor" else base.spectrum
-    return Material(f"{base.name} ({mesh})", spectrum, kind=gloss.kind,  # type: ignore[arg-type]
-                    roughness=gloss.roughness, ior=gloss.ior, metal=gloss.metal)
+    return Material(
+        f"{base.name} ({mesh})",
+        spectrum,
+        kind=gloss.kind,  # type: ignore[arg-type]
+        roughness=gloss.roughness,
+        ior=gloss.ior,
+        metal=gloss.metal,
+    )
 
 
 def glossy_variant(scene: Scene, base: str) -> Scene:
@@ -61,7 +81,11 @@ def glossy_variant(scene: Scene, base: str) -> Scene:
     materials = list(scene.materials)
     meshes = []
     for mesh in scene.meshes:
-        gloss = table.get(mesh.name) if table is not None else (None if mesh.name == "ground" else _GLAZE)
+        gloss = (
+            table.get(mesh.name)
+            if table is not None
+            else (None if mesh.name == "ground" else _GLAZE)
+        )
         if gloss is None:
             meshes.append(mesh)
             continue
@@ -74,8 +98,14 @@ def glossy_variant(scene: Scene, base: str) -> Scene:
         meshes.append(Mesh(mesh.name, mesh.vertices, mesh.faces, new, mesh.object_id))
     used = sorted({int(m) for mesh in meshes for m in np.unique(mesh.face_materials)})
     index = {old: i for i, old in enumerate(used)}  # drop materials no face uses any more
-    meshes = [replace(m, face_materials=np.array([index[int(f)] for f in m.face_materials], np.int64))
-              for m in meshes]
-    return replace(scene, name=base + GLOSSY_SUFFIX, meshes=tuple(meshes),
-                   materials=tuple(materials[i] for i in used),
-                   metadata={**scene.metadata, "library": base + GLOSSY_SUFFIX, "glossy_of": base})
+    meshes = [
+        replace(m, face_materials=np.array([index[int(f)] for f in m.face_materials], np.int64))
+        for m in meshes
+    ]
+    return replace(
+        scene,
+        name=base + GLOSSY_SUFFIX,
+        meshes=tuple(meshes),
+        materials=tuple(materials[i] for i in used),
+        metadata={**scene.metadata, "library": base + GLOSSY_SUFFIX, "glossy_of": base},
+    )

@@ -30,7 +30,14 @@ from spectrinsic.scenes.materials import METAL_SPECTRUM
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.scenes.validate import validate_scene
 
-__all__ = ["MESH_SUFFIXES", "MAX_VERTICES", "MAX_FACES", "mesh_counts", "check_mesh_size", "load_mesh_scene"]
+__all__ = [
+    "MESH_SUFFIXES",
+    "MAX_VERTICES",
+    "MAX_FACES",
+    "mesh_counts",
+    "check_mesh_size",
+    "load_mesh_scene",
+]
 
 MESH_SUFFIXES = (".obj", ".ply", ".glb", ".gltf", ".stl", ".off")
 #: Largest mesh read, checked from the file's header before loading: loading takes about
@@ -46,7 +53,11 @@ def _ply_counts(head: bytes) -> tuple[int, int]:
     counts = {"vertex": 0, "face": 0}
     for line in head.split(b"end_header", 1)[0].splitlines():
         parts = line.split()
-        if len(parts) == 3 and parts[0] == b"element" and parts[1].decode("ascii", "replace") in counts:
+        if (
+            len(parts) == 3
+            and parts[0] == b"element"
+            and parts[1].decode("ascii", "replace") in counts
+        ):
             counts[parts[1].decode("ascii")] = int(parts[2])
     return counts["vertex"], counts["face"]
 
@@ -87,7 +98,11 @@ def mesh_counts(path: Path) -> tuple[int, int]:
             return _ply_counts(head)
         if suffix == ".off":
             words = b" ".join(line.split(b"#", 1)[0] for line in head.splitlines()).split()
-            return (int(words[1]), int(words[2])) if words[:1] == [b"OFF"] else (int(words[0]), int(words[1]))
+            return (
+                (int(words[1]), int(words[2]))
+                if words[:1] == [b"OFF"]
+                else (int(words[0]), int(words[1]))
+            )
         if suffix == ".stl" and not head.lstrip().startswith(b"solid"):
             faces = struct.unpack("<I", head[80:84])[0]
             return 3 * faces, faces
@@ -97,7 +112,7 @@ def mesh_counts(path: Path) -> tuple[int, int]:
             return _text_counts(path, b"v ", b"f ")
         if suffix == ".glb":
             length = struct.unpack("<I", head[12:16])[0]
-            return _gltf_vertices(json.loads(head[20:20 + length])), 0
+            return _gltf_vertices(json.loads(head[20 : 20 + length])), 0
         if suffix == ".gltf":
             return _gltf_vertices(json.loads(path.read_bytes())), 0
     except (ValueError, IndexError, struct.error, AttributeError):
@@ -110,8 +125,10 @@ def check_mesh_size(path: Path) -> None:
     :data:`MAX_FACES` faces, before it is loaded."""
     n_v, n_f = mesh_counts(path)
     if n_v > MAX_VERTICES or n_f > MAX_FACES:
-        raise SceneError(f"{path}: declares {n_v:,} vertices and {n_f:,} faces; meshes are limited to "
-                         f"{MAX_VERTICES:,} vertices and {MAX_FACES:,} faces (simplify it first)")
+        raise SceneError(
+            f"{path}: declares {n_v:,} vertices and {n_f:,} faces; meshes are limited to "
+            f"{MAX_VERTICES:,} vertices and {MAX_FACES:,} faces (simplify it first)"
+        )
 
 
 def _pbr_gloss(material: Any) -> dict[str, Any]:
@@ -161,12 +178,20 @@ def _frame(vertices: np.ndarray, width: int, height: int) -> tuple[Camera, Light
     direction /= np.linalg.norm(direction)
     origin = centre + direction * radius / math.sin(math.radians(fov) / 2) * 1.2
     light_pos = centre + np.array([-0.4, -0.6, 1.0]) * 3 * radius
-    camera = Camera(origin=tuple(float(x) for x in origin),  # type: ignore[arg-type]
-                    target=tuple(float(x) for x in centre),  # type: ignore[arg-type]
-                    fov_deg=fov, width=width, height=height)
+    camera = Camera(
+        origin=tuple(float(x) for x in origin),  # type: ignore[arg-type]
+        target=tuple(float(x) for x in centre),  # type: ignore[arg-type]
+        fov_deg=fov,
+        width=width,
+        height=height,
+    )
     d2 = float(np.sum((light_pos - centre) ** 2))
-    light = Light(kind="point", spectrum="cie:D65", power=_IRRADIANCE * d2,
-                  position=tuple(float(x) for x in light_pos))  # type: ignore[arg-type]
+    light = Light(
+        kind="point",
+        spectrum="cie:D65",
+        power=_IRRADIANCE * d2,
+        position=tuple(float(x) for x in light_pos),
+    )  # type: ignore[arg-type]
     return camera, light
 
 
@@ -203,17 +228,35 @@ def load_mesh_scene(
     table: dict[str, Material] = {}  # matte materials keep their spectrum's name
     meshes = []
     for i, (node, material, verts, faces, gloss) in enumerate(geoms):
-        spectrum = METAL_SPECTRUM if gloss.get("kind") == "conductor" else materials.get(material, default_spectrum)
+        spectrum = (
+            METAL_SPECTRUM
+            if gloss.get("kind") == "conductor"
+            else materials.get(material, default_spectrum)
+        )
         if spectrum is None:
             known = sorted({g[1] for g in geoms})
-            raise SceneError(f"{path}: material {material!r} is not in the material map; the file's "
-                             f"materials are {known}")
+            raise SceneError(
+                f"{path}: material {material!r} is not in the material map; the file's "
+                f"materials are {known}"
+            )
         name = f"{spectrum} ({material})" if gloss else spectrum
         table.setdefault(name, Material(name=name, spectrum=spectrum, **gloss))
-        meshes.append(Mesh(name=f"{node}", vertices=verts, faces=faces,
-                           face_materials=np.full(len(faces), list(table).index(name), dtype=np.int64),
-                           object_id=i))
+        meshes.append(
+            Mesh(
+                name=f"{node}",
+                vertices=verts,
+                faces=faces,
+                face_materials=np.full(len(faces), list(table).index(name), dtype=np.int64),
+                object_id=i,
+            )
+        )
     camera, light = _frame(np.concatenate([m.vertices for m in meshes]), width, height)
-    scene = Scene(name=path.stem, meshes=tuple(meshes), materials=tuple(table.values()), lights=(light,),
-                  camera=camera, metadata={"source": path.name})
+    scene = Scene(
+        name=path.stem,
+        meshes=tuple(meshes),
+        materials=tuple(table.values()),
+        lights=(light,),
+        camera=camera,
+        metadata={"source": path.name},
+    )
     return validate_scene(scene, source=str(path), data_dir=data_dir)

@@ -56,7 +56,9 @@ LIGHT_FIELDS: dict[str, tuple[str, ...]] = {
 #: The light kinds, in the table's order (``typing.get_args(LightKind)`` is the same).
 LIGHT_KINDS: tuple[LightKind, ...] = tuple(LIGHT_FIELDS)  # type: ignore[arg-type]
 #: Every placement field some kind uses (the union of :data:`LIGHT_FIELDS`).
-LIGHT_PLACEMENT: tuple[str, ...] = tuple(dict.fromkeys(f for fs in LIGHT_FIELDS.values() for f in fs))
+LIGHT_PLACEMENT: tuple[str, ...] = tuple(
+    dict.fromkeys(f for fs in LIGHT_FIELDS.values() for f in fs)
+)
 #: Placement fields with a default that a scene file may leave out (a spot's cone half-angle,
 #: :attr:`Light.cutoff_deg`).
 LIGHT_DEFAULTED: tuple[str, ...] = ("cutoff_deg",)
@@ -189,12 +191,14 @@ def unknown_light_kind(kind: object) -> str:
     >>> unknown_light_kind("spto")
     "unknown light kind 'spto'; expected one of point, spot, area, directional (did you mean 'spot'?)"
     """
-    return (f"unknown light kind {kind!r}; expected one of {', '.join(LIGHT_KINDS)}"
-            + did_you_mean(str(kind), LIGHT_KINDS))
+    return f"unknown light kind {kind!r}; expected one of {', '.join(LIGHT_KINDS)}" + did_you_mean(
+        str(kind), LIGHT_KINDS
+    )
 
 
-def make_light(kind: LightKind, spectrum: str, power: float, *, name: str = "light",
-               **placement: Any) -> Light:
+def make_light(
+    kind: LightKind, spectrum: str, power: float, *, name: str = "light", **placement: Any
+) -> Light:
     """A :class:`Light` of *kind* with only the placement fields its kind uses
     (:data:`LIGHT_FIELDS`) taken from *placement*; the others keep their defaults, so saved
     scenes and records stay tidy.
@@ -204,14 +208,22 @@ def make_light(kind: LightKind, spectrum: str, power: float, *, name: str = "lig
     """
     unknown = set(placement) - set(LIGHT_PLACEMENT)
     if unknown:
-        raise TypeError(f"make_light: unknown placement field(s) {sorted(unknown)}; "
-                        f"expected some of {list(LIGHT_PLACEMENT)}")
+        raise TypeError(
+            f"make_light: unknown placement field(s) {sorted(unknown)}; "
+            f"expected some of {list(LIGHT_PLACEMENT)}"
+        )
     used = {k: v for k, v in placement.items() if k in LIGHT_FIELDS[kind]}
     return Light(kind=kind, spectrum=spectrum, power=power, name=name, **used)
 
 
-def light_power(kind: str, position: np.ndarray, direction: np.ndarray, focus: np.ndarray,
-                size: tuple[float, float], irradiance: float) -> float:
+def light_power(
+    kind: str,
+    position: np.ndarray,
+    direction: np.ndarray,
+    focus: np.ndarray,
+    size: tuple[float, float],
+    irradiance: float,
+) -> float:
     """:attr:`Light.power` delivering *irradiance* at *focus* on a surface facing the light.
 
     Inverse square law for point and spot lights (power ``E d²``, a radiant intensity); an
@@ -269,8 +281,11 @@ class Scene:
 
 def _plain(value: Any) -> Any:
     if is_dataclass(value) and not isinstance(value, type):
-        return {f.name: _plain(getattr(value, f.name)) for f in fields(value)
-                if not (f.metadata.get("omit_default") and getattr(value, f.name) == f.default)}
+        return {
+            f.name: _plain(getattr(value, f.name))
+            for f in fields(value)
+            if not (f.metadata.get("omit_default") and getattr(value, f.name) == f.default)
+        }
     if isinstance(value, np.ndarray):
         return value.tolist()
     if isinstance(value, (tuple, list)):

@@ -37,7 +37,6 @@ def _from_trimesh(mesh, spectrum: str) -> Part:  # noqa: ANN001
     return _part(np.asarray(mesh.vertices), np.asarray(mesh.faces), spectrum)
 
 
-
 def box(
     extents: Sequence[float],
     spectrum: str,

@@ -75,12 +75,17 @@ class _Doc:
         problems = Problems(self.source)
         for key in value:
             if key not in allowed:
-                problems.get(self._raise, f"{field}.{key}" if field else str(key),
-                             f"unknown key; expected one of {', '.join(allowed)}"
-                             + did_you_mean(str(key), allowed))
+                problems.get(
+                    self._raise,
+                    f"{field}.{key}" if field else str(key),
+                    f"unknown key; expected one of {', '.join(allowed)}"
+                    + did_you_mean(str(key), allowed),
+                )
         for key in required:
             if key not in value:
-                problems.get(self._raise, f"{field}.{key}" if field else key, "missing required key")
+                problems.get(
+                    self._raise, f"{field}.{key}" if field else key, "missing required key"
+                )
         problems.raise_if_any()
         return value
 
@@ -312,15 +317,22 @@ def scene_from_dict(data: Any, *, base: str | os.PathLike[str], source: str = "<
         raise doc.fail("top level", f"expected a mapping, got {type(data).__name__}")
     problems.get(doc.mapping, data, "", _TOP, ("name", "materials", "meshes", "lights", "camera"))
     if data.get("format", FORMAT_VERSION) != FORMAT_VERSION:
-        problems.get(doc._raise, "format",
-                     f"unsupported format version {data['format']!r}; expected {FORMAT_VERSION}")
+        problems.get(
+            doc._raise,
+            "format",
+            f"unsupported format version {data['format']!r}; expected {FORMAT_VERSION}",
+        )
     materials = problems.get(_materials, doc, data.get("materials"))
     # without sound materials, every mesh would also report its material as unknown
     lookup = None if materials is None else {m.name: i for i, m in enumerate(materials)}
-    meshes = [problems.get(_mesh, doc, Path(base), m, i, lookup)
-              for i, m in enumerate(problems.get(_entries, doc, data, "meshes") or [])]
-    lights = [problems.get(_light, doc, x, i)
-              for i, x in enumerate(problems.get(_entries, doc, data, "lights") or [])]
+    meshes = [
+        problems.get(_mesh, doc, Path(base), m, i, lookup)
+        for i, m in enumerate(problems.get(_entries, doc, data, "meshes") or [])
+    ]
+    lights = [
+        problems.get(_light, doc, x, i)
+        for i, x in enumerate(problems.get(_entries, doc, data, "lights") or [])
+    ]
     camera = problems.get(_camera, doc, data["camera"]) if "camera" in data else None
     name = problems.get(doc.string, data.get("name"), "name") if "name" in data else None
     metadata = data.get("metadata", {}) or {}
@@ -340,7 +352,8 @@ def scene_from_dict(data: Any, *, base: str | os.PathLike[str], source: str = "<
 def _materials(doc: _Doc, mats: Any) -> tuple[Material, ...]:
     if not isinstance(mats, dict) or not mats:
         raise doc.fail(
-            "materials", "expected a non-empty mapping of material name -> spectrum name or material"
+            "materials",
+            "expected a non-empty mapping of material name -> spectrum name or material",
         )
     out = []
     for k, v in mats.items():
@@ -386,4 +399,3 @@ def load_scene(
     if validate:
         validate_scene(scene, source=source, data_dir=data_dir)
     return scene
-

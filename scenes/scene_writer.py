@@ -97,6 +97,7 @@ def scene_to_yaml_dict(scene: Scene, mesh_files: Mapping[str, str] | None = None
 
 def _dumper() -> type:
     """A SafeDumper writing rows of numbers (and other scalar lists) on one line each."""
+
     class Dumper(yaml.SafeDumper):
         pass
 

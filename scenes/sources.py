@@ -21,8 +21,14 @@ from spectrinsic.scenes.meshes import MESH_SUFFIXES, load_mesh_scene
 from spectrinsic.scenes.model import Scene
 from spectrinsic.scenes.scene_reader import load_scene
 
-__all__ = ["GeneratedSource", "FileSource", "scene_file_kind", "is_scene_file", "load_scene_file",
-           "FILE_SIZE"]
+__all__ = [
+    "GeneratedSource",
+    "FileSource",
+    "scene_file_kind",
+    "is_scene_file",
+    "load_scene_file",
+    "FILE_SIZE",
+]
 
 #: First bytes of every uncompressed ``.blend`` file.
 BLEND_MAGIC = b"BLENDER"
@@ -47,8 +53,13 @@ class GeneratedSource:
     def build(self, data_dir: str | None = None) -> Scene:
         """Generate the scene (deterministic: same record, same scene)."""
         options = dataclasses.replace(self.options, data_dir=data_dir)
-        return generate(self.generator, root_seed=self.root_seed, index=self.index,
-                        view=self.view, options=options)
+        return generate(
+            self.generator,
+            root_seed=self.root_seed,
+            index=self.index,
+            view=self.view,
+            options=options,
+        )
 
 
 def _compressed_blend(head: bytes, path: Path) -> bool:
@@ -91,8 +102,10 @@ def scene_file_kind(path: str | Path) -> str:
             return "blend"
     except OSError:
         pass
-    raise SceneError(f"scene file {str(p)!r}: expected .yaml/.yml, .blend (plain, gzip or zstd) "
-                     f"or a mesh ({', '.join(MESH_SUFFIXES)})")
+    raise SceneError(
+        f"scene file {str(p)!r}: expected .yaml/.yml, .blend (plain, gzip or zstd) "
+        f"or a mesh ({', '.join(MESH_SUFFIXES)})"
+    )
 
 
 def is_scene_file(argument: str | Path) -> bool:
@@ -132,16 +145,28 @@ def load_scene_file(
     mapping = dict(materials or {})
     given = width is not None or height is not None
     if kind == "mesh":
-        return load_mesh_scene(path, materials=mapping, width=width or FILE_SIZE,
-                               height=height or FILE_SIZE, default_spectrum=default_spectrum,
-                               data_dir=data_dir)
+        return load_mesh_scene(
+            path,
+            materials=mapping,
+            width=width or FILE_SIZE,
+            height=height or FILE_SIZE,
+            default_spectrum=default_spectrum,
+            data_dir=data_dir,
+        )
     if kind == "blend":
-        return load_blend(path, materials=mapping or None,
-                          resolution=(width or FILE_SIZE, height or FILE_SIZE) if given else None,
-                          default_spectrum=default_spectrum, data_dir=data_dir)
+        return load_blend(
+            path,
+            materials=mapping or None,
+            resolution=(width or FILE_SIZE, height or FILE_SIZE) if given else None,
+            default_spectrum=default_spectrum,
+            data_dir=data_dir,
+        )
     scene = load_scene(path, data_dir=data_dir)
-    camera = dataclasses.replace(scene.camera, width=scene.camera.width if width is None else width,
-                                 height=scene.camera.height if height is None else height)
+    camera = dataclasses.replace(
+        scene.camera,
+        width=scene.camera.width if width is None else width,
+        height=scene.camera.height if height is None else height,
+    )
     return dataclasses.replace(scene, camera=camera)
 
 
@@ -166,6 +191,11 @@ class FileSource:
 
     def build(self, data_dir: str | None = None) -> Scene:
         """Read and validate the file; one-line :class:`SceneError` naming it on bad input."""
-        return load_scene_file(self.path, width=self.width, height=self.height,
-                               materials=dict(self.materials),
-                               default_spectrum=self.default_spectrum, data_dir=data_dir)
+        return load_scene_file(
+            self.path,
+            width=self.width,
+            height=self.height,
+            materials=dict(self.materials),
+            default_spectrum=self.default_spectrum,
+            data_dir=data_dir,
+        )

@@ -77,7 +77,9 @@ class Problems:
         if len(self.messages) == 1:
             raise SceneError(f"{self.source}: {self.messages[0]}")
         if self.messages:
-            raise SceneError(f"{self.source}: {len(self.messages)} problems: " + "; ".join(self.messages))
+            raise SceneError(
+                f"{self.source}: {len(self.messages)} problems: " + "; ".join(self.messages)
+            )
 
 
 def _fail(source: str, field: str, problem: str) -> SceneError:
@@ -195,7 +197,11 @@ def _check_spectrum(
     if isinstance(found, SpectrinsicError):
         raise _fail(source, field, str(found)) from found
     if getattr(found, "kind", kind) != kind:
-        raise _fail(source, field, f"{name!r} is {with_article(found.kind)} spectrum; expected {with_article(kind)}")  # type: ignore[attr-defined]
+        raise _fail(
+            source,
+            field,
+            f"{name!r} is {with_article(found.kind)} spectrum; expected {with_article(kind)}",
+        )  # type: ignore[attr-defined]
 
 
 def _check_area(v: np.ndarray, f: np.ndarray, source: str, where: str) -> None:
@@ -203,8 +209,12 @@ def _check_area(v: np.ndarray, f: np.ndarray, source: str, where: str) -> None:
     normal to shade with)."""
     tri = v.astype(np.float64)[f]
     if not np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).any():
-        raise _fail(source, f"{where}.faces", f"all {len(f)} faces have zero area (collinear "
-                    "or repeated vertices); the mesh has no surface to render")
+        raise _fail(
+            source,
+            f"{where}.faces",
+            f"all {len(f)} faces have zero area (collinear "
+            "or repeated vertices); the mesh has no surface to render",
+        )
 
 
 def _check_meshes(scene: Scene, source: str) -> None:
@@ -422,11 +432,25 @@ def validate_scene(
     if check_spectra:
         cache: dict[str, object] = {}
         for i, mat in enumerate(scene.materials):
-            problems.get(_check_spectrum, source, f"materials[{i}] ({mat.name!r}).spectrum",
-                         mat.spectrum, "reflectance", data_dir, cache)
+            problems.get(
+                _check_spectrum,
+                source,
+                f"materials[{i}] ({mat.name!r}).spectrum",
+                mat.spectrum,
+                "reflectance",
+                data_dir,
+                cache,
+            )
         for i, light in enumerate(scene.lights):
-            problems.get(_check_spectrum, source, f"lights[{i}].spectrum", light.spectrum,
-                         "illuminant", data_dir, cache)
+            problems.get(
+                _check_spectrum,
+                source,
+                f"lights[{i}].spectrum",
+                light.spectrum,
+                "illuminant",
+                data_dir,
+                cache,
+            )
     if check_placement and not problems.messages:  # placement needs sound geometry
         problems.get(_check_placement, scene, source)
     problems.raise_if_any()

@@ -50,8 +50,10 @@ class _LimitedLoader(yaml.SafeLoader):
         try:
             if self._composed > MAX_NODES:
                 mark = self.peek_event().start_mark
-                raise SceneError(f"{self.source}: line {mark.line + 1}: more than {MAX_NODES:,} YAML "
-                                 "nodes; put large meshes in PLY files (FORMAT.md)")
+                raise SceneError(
+                    f"{self.source}: line {mark.line + 1}: more than {MAX_NODES:,} YAML "
+                    "nodes; put large meshes in PLY files (FORMAT.md)"
+                )
             if self._depth > MAX_DEPTH:
                 mark = self.peek_event().start_mark
                 raise SceneError(
@@ -94,8 +96,9 @@ def _expanded_size(node: yaml.Node, memo: dict[int, int], loader: _LimitedLoader
     if isinstance(node, yaml.SequenceNode):
         size += sum(_expanded_size(child, memo, loader) for child in node.value)
     elif isinstance(node, yaml.MappingNode):
-        size += sum(_expanded_size(k, memo, loader) + _expanded_size(v, memo, loader)
-                    for k, v in node.value)
+        size += sum(
+            _expanded_size(k, memo, loader) + _expanded_size(v, memo, loader) for k, v in node.value
+        )
     if size > MAX_NODES:
         raise loader._fail(
             node, f"aliases expand to more than {MAX_NODES:,} nodes; refusing (an alias bomb?)"
@@ -107,12 +110,16 @@ def _expanded_size(node: yaml.Node, memo: dict[int, int], loader: _LimitedLoader
 def load_yaml_text(text: str, source: str) -> Any:
     """Parse *text* with the limits above; *source* names it in errors."""
     if len(text) > MAX_YAML_BYTES:
-        raise SceneError(f"{source}: {len(text):,} characters; scene files are limited to "
-                         f"{MAX_YAML_BYTES:,} (put large meshes in PLY files)")
+        raise SceneError(
+            f"{source}: {len(text):,} characters; scene files are limited to "
+            f"{MAX_YAML_BYTES:,} (put large meshes in PLY files)"
+        )
     rough = text.count(",") + text.count("- ") + text.count(": ")
     if rough > MAX_NODES:  # composing them first would take minutes (pure-Python PyYAML)
-        raise SceneError(f"{source}: about {rough:,} YAML values (counted from commas, list items "
-                         f"and keys), more than {MAX_NODES:,}; put large meshes in PLY files (FORMAT.md)")
+        raise SceneError(
+            f"{source}: about {rough:,} YAML values (counted from commas, list items "
+            f"and keys), more than {MAX_NODES:,}; put large meshes in PLY files (FORMAT.md)"
+        )
     loader = _LimitedLoader(text, source)
     try:
         return loader.get_single_data()
@@ -134,8 +141,10 @@ def load_yaml_file(path: str | os.PathLike[str]) -> Any:
     try:
         size = path.stat().st_size
         if size > MAX_YAML_BYTES:
-            raise SceneError(f"{source}: {size:,} bytes; scene files are limited to "
-                             f"{MAX_YAML_BYTES:,} (put large meshes in PLY files)")
+            raise SceneError(
+                f"{source}: {size:,} bytes; scene files are limited to "
+                f"{MAX_YAML_BYTES:,} (put large meshes in PLY files)"
+            )
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise SceneError(f"{source}: cannot read scene file ({type(exc).__name__}: {exc})") from exc

@@ -11,12 +11,12 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from spectrinsic.arrays import Responses, SensorCurves, SpectralValues, Wavelengths
 from spectrinsic.errors import SpectralDataError
 from spectrinsic.spectra.colourspace import srgb_matrices
 from spectrinsic.spectra.grid import COLORIMETRIC_WAVELENGTHS, integration_weights
 from spectrinsic.spectra.records import Spectrum
 from spectrinsic.spectra.registry import get_sensors, get_spectrum
-from spectrinsic.typing import Responses, SensorCurves, SpectralValues, Wavelengths
 
 __all__ = [
     "XYZ_TO_LINEAR_SRGB",
@@ -87,7 +87,9 @@ def responses(spectra: SpectralValues, curves: SensorCurves, wavelengths: Wavele
     return np.einsum("...w,kw->...k", x * integration_weights(wl), s)
 
 
-def diagonal_values(spectra: SpectralValues, curves: SensorCurves, wavelengths: Wavelengths) -> Responses:
+def diagonal_values(
+    spectra: SpectralValues, curves: SensorCurves, wavelengths: Wavelengths
+) -> Responses:
     """Channel values of a K-channel diagonal render: ``∫ f S_k dλ / ∫ S_k dλ`` (Eq. 5.4, normalised).
 
     With material values from this function and light values ``∫ L S_k dλ`` (:func:`responses`),
@@ -138,7 +140,9 @@ def xy_to_duv(xy: np.ndarray) -> np.ndarray:
 
 
 def white_normalised_responses(
-    reflectances: SpectralValues, illuminant: SpectralValues, curves: SensorCurves,
+    reflectances: SpectralValues,
+    illuminant: SpectralValues,
+    curves: SensorCurves,
     wavelengths: Wavelengths,
 ) -> Responses:
     """Responses of reflectances under a light, scaled so the perfect white has luminance Y = 1.
@@ -204,8 +208,9 @@ def srgb_responses(
     ``p^{s,c}`` (Eq. 4.15), normalised like :func:`absolute_reflectance` but integrated on
     *wavelengths*. Linear: no transfer function.
     """
-    return white_normalised_responses(reflectances, illuminant, get_sensors("srgb").on(wavelengths),
-                                      wavelengths)
+    return white_normalised_responses(
+        reflectances, illuminant, get_sensors("srgb").on(wavelengths), wavelengths
+    )
 
 
 def encode_srgb(linear: np.ndarray) -> np.ndarray:
@@ -231,4 +236,6 @@ def decode_srgb(encoded: np.ndarray) -> np.ndarray:
     """
     import colour
 
-    return np.asarray(colour.cctf_decoding(np.clip(np.asarray(encoded, float), 0.0, 1.0), function="sRGB"), float)
+    return np.asarray(
+        colour.cctf_decoding(np.clip(np.asarray(encoded, float), 0.0, 1.0), function="sRGB"), float
+    )

@@ -18,10 +18,10 @@ import functools
 
 import numpy as np
 
+from spectrinsic.arrays import SensorCurves, Wavelengths
 from spectrinsic.errors import SpectralDataError, did_you_mean
 from spectrinsic.spectra.colorimetry import diagonal_values
 from spectrinsic.spectra.io import mitsuba_ior_dir, read_conductor_ior
-from spectrinsic.typing import SensorCurves, Wavelengths
 
 __all__ = [
     "FRESNEL_NODES",

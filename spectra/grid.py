@@ -13,8 +13,8 @@ from typing import Literal
 
 import numpy as np
 
+from spectrinsic.arrays import SpectralValues, Wavelengths
 from spectrinsic.errors import SpectralDataError
-from spectrinsic.typing import SpectralValues, Wavelengths
 
 __all__ = [
     "DEFAULT_WAVELENGTHS",
@@ -48,7 +48,9 @@ def validate_wavelengths(wavelengths: object, what: str = "wavelengths") -> Wave
     """Return *wavelengths* as a float64 array, or raise if empty or not strictly increasing."""
     wl = np.asarray(wavelengths, dtype=np.float64)
     if wl.ndim != 1 or wl.size < 2:
-        raise SpectralDataError(f"{what}: expected at least 2 wavelengths in nm, got shape {wl.shape}")
+        raise SpectralDataError(
+            f"{what}: expected at least 2 wavelengths in nm, got shape {wl.shape}"
+        )
     if not np.all(np.isfinite(wl)):
         raise SpectralDataError(f"{what}: wavelengths must be finite numbers (nm)")
     if not np.all(np.diff(wl) > 0):

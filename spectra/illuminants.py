@@ -44,7 +44,9 @@ ILLUMINANT_SETS: dict[str, tuple[str, ...]] = {
 
 def illuminant_set(name: str) -> tuple[str, ...]:
     """The 5 spectrum names of set ``"planckian"`` or ``"non-planckian"``."""
-    return ILLUMINANT_SETS[validate_choice(name, ILLUMINANT_SETS, "illuminant set", error=SpectrumNotFoundError)]
+    return ILLUMINANT_SETS[
+        validate_choice(name, ILLUMINANT_SETS, "illuminant set", error=SpectrumNotFoundError)
+    ]
 
 
 @functools.lru_cache(maxsize=1)
@@ -72,7 +74,9 @@ def normalise_illuminant(wavelengths: np.ndarray, values: np.ndarray) -> np.ndar
 
 def _illuminant(name: str, wl: np.ndarray, values: np.ndarray, source: str) -> Spectrum:
     wl = np.asarray(wl, float)
-    return Spectrum(name, "illuminant", wl, normalise_illuminant(wl, np.asarray(values, float)), source)
+    return Spectrum(
+        name, "illuminant", wl, normalise_illuminant(wl, np.asarray(values, float)), source
+    )
 
 
 def planck_law(wavelengths_nm: np.ndarray, temperature: float) -> np.ndarray:
@@ -96,7 +100,9 @@ def _kelvin(key: str, what: str) -> float:
     try:
         t = float(text)
     except ValueError:
-        raise SpectrumNotFoundError(f"{what} {key!r}: expected a temperature like '2800K'") from None
+        raise SpectrumNotFoundError(
+            f"{what} {key!r}: expected a temperature like '2800K'"
+        ) from None
     if not t > 0:
         raise SpectralDataError(f"{what} {key!r}: temperature must be > 0 K")
     return t
@@ -134,14 +140,16 @@ def _colour_dataset(table: str, key: str, family: str, what: str, source: str) -
 
 def cie_illuminant(key: str) -> Spectrum:
     """A CIE standard illuminant shipped by colour-science: A, D50, D65, FL1–FL12, LED-*, HP*..."""
-    return _colour_dataset("SDS_ILLUMINANTS", key, "cie", "CIE illuminant",
-                           "CIE illuminants via colour-science")
+    return _colour_dataset(
+        "SDS_ILLUMINANTS", key, "cie", "CIE illuminant", "CIE illuminants via colour-science"
+    )
 
 
 def light_source(key: str) -> Spectrum:
     """A measured light source from colour-science's ``SDS_LIGHT_SOURCES``."""
-    return _colour_dataset("SDS_LIGHT_SOURCES", key, "light", "light source",
-                           "colour-science SDS_LIGHT_SOURCES")
+    return _colour_dataset(
+        "SDS_LIGHT_SOURCES", key, "light", "light source", "colour-science SDS_LIGHT_SOURCES"
+    )
 
 
 def sfu_illuminant(key: str, data_dir: str | None = None) -> Spectrum:
@@ -154,6 +162,8 @@ def sfu_illuminant(key: str, data_dir: str | None = None) -> Spectrum:
         )
     i = table.labels.index(key)
     return _illuminant(
-        f"sfu-illum:{key}", table.wavelengths, table.values[i],
+        f"sfu-illum:{key}",
+        table.wavelengths,
+        table.values[i],
         "Barnard et al., Color Res. Appl. 27(3):147-151, 2002",
     )

@@ -24,7 +24,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from spectrinsic.config import require_data_file
+from spectrinsic.data_dir import require_data_file
 from spectrinsic.errors import DataDirectoryError, SpectralDataError
 from spectrinsic.spectra.grid import validate_wavelengths
 
@@ -63,7 +63,9 @@ def luxpy_data_file(*parts: str) -> Path:
     """
     spec = importlib.util.find_spec("luxpy")
     if spec is None or not spec.submodule_search_locations:
-        raise DataDirectoryError("the 'luxpy' package (which ships the Munsell spectra) is not installed")
+        raise DataDirectoryError(
+            "the 'luxpy' package (which ships the Munsell spectra) is not installed"
+        )
     path = Path(next(iter(spec.submodule_search_locations)), "data", *parts)
     if not path.is_file():
         raise DataDirectoryError(f"luxpy installation lacks the expected file {str(path)!r}")
@@ -114,7 +116,12 @@ def _first(mask: np.ndarray) -> tuple[int, int]:
 
 
 def _check_values(
-    path: Path, values: np.ndarray, empty: np.ndarray, labels: tuple[str, ...], *, missing: bool,
+    path: Path,
+    values: np.ndarray,
+    empty: np.ndarray,
+    labels: tuple[str, ...],
+    *,
+    missing: bool,
     maximum: float | None = None,
 ) -> None:
     """Every spectral value finite (empty cells aside when *missing*) and >= 0: reflectances,
@@ -176,13 +183,16 @@ def read_spectra_csv(
 def read_sfu_reflectances(data_dir: str | None) -> tuple[Table, tuple[tuple[str, int], ...]]:
     """The 1995 SFU reflectances (read-only, cached) and ``(group, index_in_group)`` per spectrum
     (1-based index)."""
-    table = read_spectra_csv(require_data_file("sfu_barnard2002/reflect_db_1995.csv", data_dir),
-                             maximum=1.0)
+    table = read_spectra_csv(
+        require_data_file("sfu_barnard2002/reflect_db_1995.csv", data_dir), maximum=1.0
+    )
     index_path = require_data_file("sfu_barnard2002/reflect_db_index.csv", data_dir)
     with index_path.open(newline="", encoding="utf-8") as fh:
         keys = tuple((r["group"], int(r["index_in_group"])) for r in csv.DictReader(fh))
     if len(keys) != table.values.shape[0]:
-        raise SpectralDataError(f"{index_path}: {len(keys)} rows for {table.values.shape[0]} spectra")
+        raise SpectralDataError(
+            f"{index_path}: {len(keys)} rows for {table.values.shape[0]} spectra"
+        )
     return _read_only(table), keys
 
 
@@ -192,7 +202,9 @@ def read_sfu_illuminants(data_dir: str | None) -> Table:
 
     Labels are the ids before any ``": name"`` suffix. The arrays are read-only (cached).
     """
-    a = read_spectra_csv(require_data_file("sfu_barnard2002/measured_with_sources_102.csv", data_dir))
+    a = read_spectra_csv(
+        require_data_file("sfu_barnard2002/measured_with_sources_102.csv", data_dir)
+    )
     b = read_spectra_csv(require_data_file("sfu_barnard2002/train_illum_87.csv", data_dir))
     if not np.array_equal(a.wavelengths, b.wavelengths):
         raise SpectralDataError("SFU illuminant files disagree in wavelengths")
@@ -235,7 +247,9 @@ def read_user_csv(path: str | os.PathLike[str], *, kind: str) -> Table:
         raise SpectralDataError(f"{kind} file {str(path)!r} does not exist")
     table = read_spectra_csv(path)
     if table.values.size == 0:
-        raise SpectralDataError(f"{path}: expected at least one {kind} column after the wavelengths")
+        raise SpectralDataError(
+            f"{path}: expected at least one {kind} column after the wavelengths"
+        )
     return table
 
 
@@ -244,7 +258,9 @@ def mitsuba_ior_dir() -> Path:
     installed ``mitsuba`` package (``data/ior``), found without importing Mitsuba."""
     spec = importlib.util.find_spec("mitsuba")
     if spec is None or spec.origin is None:
-        raise DataDirectoryError("the 'mitsuba' package (which ships the conductor η/k tables) is not installed")
+        raise DataDirectoryError(
+            "the 'mitsuba' package (which ships the conductor η/k tables) is not installed"
+        )
     # the package's folder (once a variant is set, the spec is that of Mitsuba's alias module in it)
     return Path(spec.origin).parent / "data" / "ior"
 
@@ -264,4 +280,6 @@ def read_conductor_ior(name: str) -> Table:
     eta, k = columns
     wl = eta[:, 0]
     k_on_eta = np.interp(wl, k[:, 0], k[:, 1])
-    return _read_only(Table(wavelengths=wl, values=np.stack([eta[:, 1], k_on_eta]), labels=("eta", "k")))
+    return _read_only(
+        Table(wavelengths=wl, values=np.stack([eta[:, 1], k_on_eta]), labels=("eta", "k"))
+    )

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from spectrinsic.arrays import Matrix3, SensorCurves, Wavelengths
 from spectrinsic.errors import SpectralDataError
-from spectrinsic.typing import Matrix3, SensorCurves, Wavelengths
 
 __all__ = [
     "ESTIMATE_SCENARIOS",
@@ -195,7 +195,11 @@ def _solve(m: np.ndarray, p: np.ndarray) -> np.ndarray:
 
 
 def scenario_estimates(
-    p: np.ndarray, p_c: np.ndarray, p_sc: np.ndarray, *, p_s: np.ndarray | None = None,
+    p: np.ndarray,
+    p_c: np.ndarray,
+    p_sc: np.ndarray,
+    *,
+    p_s: np.ndarray | None = None,
     sc3_light_space: str = "camera",
 ) -> dict[str, np.ndarray]:
     """Each scenario's estimate of the absolute reflectance ``p^{s,c}`` from ``p`` (Table 4.3).
@@ -236,7 +240,9 @@ def scenario_estimates(
     l_diag = fit_matrix(p_c, p, diagonal=True)
     if sc3_light_space == "srgb":
         if p_s is None:
-            raise SpectralDataError("sc3_light_space='srgb' needs the sRGB values under the scene light")
+            raise SpectralDataError(
+                "sc3_light_space='srgb' needs the sRGB values under the scene light"
+            )
         l_sc3 = fit_matrix(p_sc, p_s, diagonal=True)
     else:
         l_sc3 = l_diag

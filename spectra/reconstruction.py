@@ -18,8 +18,8 @@ from collections.abc import Iterator
 import numpy as np
 import numpy.typing as npt
 
+from spectrinsic.arrays import Mask, SensorCurves, SpectralValues, Wavelengths
 from spectrinsic.spectra.colorimetry import diagonal_values, responses
-from spectrinsic.typing import Mask, SensorCurves, SpectralValues, Wavelengths
 
 __all__ = [
     "relative_error",
@@ -86,8 +86,12 @@ def relative_error(
 
 
 def one_bounce_errors(
-    reflectances: SpectralValues, illuminant: SpectralValues, curves: SensorCurves,
-    wavelengths: Wavelengths, *, chip_threshold: float = 0.0,
+    reflectances: SpectralValues,
+    illuminant: SpectralValues,
+    curves: SensorCurves,
+    wavelengths: Wavelengths,
+    *,
+    chip_threshold: float = 0.0,
 ) -> npt.NDArray[np.float64]:
     """ε (Eq. 5.7, percent) of ``p̂ = f ∘ L`` (Eq. 5.3) against ``p = ∫ f L S`` (Eq. 4.9).
 
@@ -117,8 +121,14 @@ def one_bounce_errors(
 
 
 def pair_responses(
-    reflectances: SpectralValues, illuminant: SpectralValues, curves: SensorCurves,
-    wavelengths: Wavelengths, *, pair_threshold: float, include_self_pairs: bool, chunk_size: int,
+    reflectances: SpectralValues,
+    illuminant: SpectralValues,
+    curves: SensorCurves,
+    wavelengths: Wavelengths,
+    *,
+    pair_threshold: float,
+    include_self_pairs: bool,
+    chunk_size: int,
 ) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
     """Yield ``(i, j, exact, approx)`` for chunks of the kept unordered pairs ``i <= j``.
 
@@ -134,7 +144,11 @@ def pair_responses(
     s = np.asarray(curves, float)
     n, k = f.shape[0], s.shape[0]
     dl = np.gradient(np.asarray(wavelengths, float))
-    g = ((f * (illuminant * dl))[:, :, None] * s.T[None, :, :]).transpose(1, 0, 2).reshape(f.shape[1], n * k)
+    g = (
+        ((f * (illuminant * dl))[:, :, None] * s.T[None, :, :])
+        .transpose(1, 0, 2)
+        .reshape(f.shape[1], n * k)
+    )
     fs = diagonal_values(f, s, wavelengths)
     ls = responses(illuminant, s, wavelengths)
     mean_product = (f @ f.T) / f.shape[1]
@@ -146,7 +160,7 @@ def pair_responses(
         r, c = np.nonzero(keep)
         if r.size == 0:
             continue
-        exact = (f[rows] @ g[:, start * k:]).reshape(rows.size, cols.size, k)[r, c]
+        exact = (f[rows] @ g[:, start * k :]).reshape(rows.size, cols.size, k)[r, c]
         i, j = rows[r], cols[c]
         yield i, j, exact, fs[i] * fs[j] * ls
 
@@ -157,8 +171,13 @@ def ordered_pairs(values: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarra
 
 
 def two_bounce_errors(
-    reflectances: SpectralValues, illuminant: SpectralValues, curves: SensorCurves,
-    wavelengths: Wavelengths, *, pair_threshold: float = 0.0, include_self_pairs: bool = False,
+    reflectances: SpectralValues,
+    illuminant: SpectralValues,
+    curves: SensorCurves,
+    wavelengths: Wavelengths,
+    *,
+    pair_threshold: float = 0.0,
+    include_self_pairs: bool = False,
     chunk_size: int = 128,
 ) -> npt.NDArray[np.float64]:
     """ε (Eq. 5.7, percent) of ``f₂ ∘ f₁ ∘ L`` against ``∫ f₂ f₁ L S`` over ordered pairs.
@@ -170,8 +189,13 @@ def two_bounce_errors(
     """
     out = []
     for i, j, exact, approx in pair_responses(
-        reflectances, illuminant, curves, wavelengths, pair_threshold=pair_threshold,
-        include_self_pairs=include_self_pairs, chunk_size=chunk_size,
+        reflectances,
+        illuminant,
+        curves,
+        wavelengths,
+        pair_threshold=pair_threshold,
+        include_self_pairs=include_self_pairs,
+        chunk_size=chunk_size,
     ):
         out.append(ordered_pairs(relative_error(approx, exact, scale=100.0), i, j))
     return np.concatenate(out) if out else np.zeros(0)

@@ -7,9 +7,9 @@ from typing import Literal
 
 import numpy as np
 
+from spectrinsic.arrays import SensorCurves, SpectralValues, Wavelengths
 from spectrinsic.errors import SpectralDataError
 from spectrinsic.spectra.grid import resample
-from spectrinsic.typing import SensorCurves, SpectralValues, Wavelengths
 
 __all__ = ["Spectrum", "SensorSet", "SpectrumKind"]
 
@@ -98,7 +98,9 @@ class SensorSet:
 
     def __post_init__(self) -> None:
         if not np.isfinite(np.asarray(self.curves)).all():
-            raise SpectralDataError(f"sensor set {self.name!r} ({self.source}): NaN or inf in its curves")
+            raise SpectralDataError(
+                f"sensor set {self.name!r} ({self.source}): NaN or inf in its curves"
+            )
 
     @property
     def n(self) -> int:

@@ -33,7 +33,9 @@ MUNSELL_SOURCE = (
     "via luxpy's Munsell1269.dat"
 )
 SFU_SOURCE = "Barnard, Martin, Funt & Coath, Color Res. Appl. 27(3):147-151, 2002"
-_NOTATION = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*([A-Z]{1,2})\s+(\d+(?:\.\d+)?)\s*/\s*(\d+(?:\.\d+)?)\s*$")
+_NOTATION = re.compile(
+    r"^\s*(\d+(?:\.\d+)?)\s*([A-Z]{1,2})\s+(\d+(?:\.\d+)?)\s*/\s*(\d+(?:\.\d+)?)\s*$"
+)
 
 
 def _fmt(x: float) -> str:
@@ -73,7 +75,9 @@ def munsell(key: str) -> Spectrum:
             )
     else:
         m = _NOTATION.match(key.upper())
-        canonical = _canonical(m.group(1) + m.group(2), float(m.group(3)), float(m.group(4))) if m else key
+        canonical = (
+            _canonical(m.group(1) + m.group(2), float(m.group(3)), float(m.group(4))) if m else key
+        )
         index = _munsell_index()
         if canonical not in index:
             raise SpectrumNotFoundError(
@@ -98,13 +102,14 @@ def colorchecker(key: str) -> Spectrum:
 
     sds = colour.SDS_COLOURCHECKERS["BabelColor Average"]
     if key not in sds:
-        raise SpectrumNotFoundError(
-            f"unknown ColorChecker patch {key!r}" + did_you_mean(key, sds)
-        )
+        raise SpectrumNotFoundError(f"unknown ColorChecker patch {key!r}" + did_you_mean(key, sds))
     sd = sds[key]
     return Spectrum(
-        f"colorchecker:{key}", "reflectance", np.asarray(sd.wavelengths, float),
-        np.asarray(sd.values, float), "BabelColor average ColorChecker (colour-science)",
+        f"colorchecker:{key}",
+        "reflectance",
+        np.asarray(sd.wavelengths, float),
+        np.asarray(sd.values, float),
+        "BabelColor average ColorChecker (colour-science)",
     )
 
 
@@ -133,7 +138,9 @@ def sfu_reflectance(key: str, data_dir: str | None = None) -> Spectrum:
     values = table.values[col]
     nz = np.flatnonzero(values > 0)
     lo, hi = (int(nz[0]), int(nz[-1]) + 1) if nz.size else (0, values.size)
-    return Spectrum(f"sfu:{key.strip()}", "reflectance", table.wavelengths[lo:hi], values[lo:hi], SFU_SOURCE)
+    return Spectrum(
+        f"sfu:{key.strip()}", "reflectance", table.wavelengths[lo:hi], values[lo:hi], SFU_SOURCE
+    )
 
 
 def flat(key: str) -> Spectrum:
@@ -162,12 +169,18 @@ def mix(key: str, resolve: Callable[[str], Spectrum]) -> Spectrum:
         except ValueError:
             w = -1.0
         if not 0.0 <= w <= 1.0:
-            raise SpectrumNotFoundError(f"mixed reflectance {key!r}: expected WEIGHT*NAME+..., e.g. "
-                                        "'0.3*munsell:5R 4/14+0.7*munsell:5B 6/8'")
+            raise SpectrumNotFoundError(
+                f"mixed reflectance {key!r}: expected WEIGHT*NAME+..., e.g. "
+                "'0.3*munsell:5R 4/14+0.7*munsell:5B 6/8'"
+            )
         terms.append((w, resolve(name.strip())))
     if sum(w for w, _ in terms) > 1.0 + 1e-9 or any(sp.kind != "reflectance" for _, sp in terms):
-        raise SpectrumNotFoundError(f"mixed reflectance {key!r}: expected reflectances with weights summing to <= 1")
+        raise SpectrumNotFoundError(
+            f"mixed reflectance {key!r}: expected reflectances with weights summing to <= 1"
+        )
     wl = np.asarray(terms[0][1].wavelengths, float)
     values = np.clip(sum(w * sp.on(wl) for w, sp in terms), 0.0, 1.0)  # clip: float round-off only
     canonical = "+".join(f"{w:g}*{sp.name}" for w, sp in terms)
-    return Spectrum(f"mix:{canonical}", "reflectance", wl, values, "convex combination of reflectances")
+    return Spectrum(
+        f"mix:{canonical}", "reflectance", wl, values, "convex combination of reflectances"
+    )

@@ -33,7 +33,7 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from spectrinsic.config import resolve_data_dir
+from spectrinsic.data_dir import resolve_data_dir
 from spectrinsic.errors import SpectrumNotFoundError, did_you_mean
 from spectrinsic.spectra import coloured_lights, illuminants, io, reflectances, sensors
 from spectrinsic.spectra.records import SensorSet, Spectrum
@@ -51,8 +51,6 @@ __all__ = [
 DataDir = str | os.PathLike[str] | None
 
 
-
-
 #: family -> loader(key, data_dir)
 SPECTRUM_FAMILIES: dict[str, Callable[[str, str | None], Spectrum]] = {
     "munsell": lambda k, d: reflectances.munsell(k),
@@ -66,7 +64,9 @@ SPECTRUM_FAMILIES: dict[str, Callable[[str, str | None], Spectrum]] = {
     "sfu-illum": illuminants.sfu_illuminant,
     "mix": lambda k, d: reflectances.mix(k, lambda name: get_spectrum(name, data_dir=d)),
     "led": lambda k, d: coloured_lights.led(k),
-    "filtered": lambda k, d: coloured_lights.filtered(k, lambda lamp: get_spectrum(lamp, data_dir=d)),
+    "filtered": lambda k, d: coloured_lights.filtered(
+        k, lambda lamp: get_spectrum(lamp, data_dir=d)
+    ),
 }
 
 #: family -> example and source, the module table as data (``spectrinsic list spectra``).
@@ -98,7 +98,9 @@ SENSOR_FAMILIES: dict[str, Callable[[str, str | None], SensorSet]] = {
 
 def _split(name: str, families: Mapping[str, object], what: str) -> tuple[str, str]:
     if not isinstance(name, str) or not name.strip():
-        raise SpectrumNotFoundError(f"{what} name {name!r}: expected 'family:key', e.g. 'munsell:5R 4/14'")
+        raise SpectrumNotFoundError(
+            f"{what} name {name!r}: expected 'family:key', e.g. 'munsell:5R 4/14'"
+        )
     family, sep, key = name.strip().partition(":")
     family = family.strip().lower()
     if family not in families:

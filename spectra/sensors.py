@@ -11,7 +11,7 @@ import re
 
 import numpy as np
 
-from spectrinsic.config import resolve_data_dir
+from spectrinsic.data_dir import resolve_data_dir
 from spectrinsic.errors import SpectrumNotFoundError, did_you_mean
 from spectrinsic.spectra import io
 from spectrinsic.spectra.colourspace import srgb_matrices
@@ -56,7 +56,10 @@ def cie1931() -> SensorSet:
     for array in (wavelengths, curves):
         array.flags.writeable = False  # cached: shared by every caller
     return SensorSet(
-        "cie1931", ("X", "Y", "Z"), wavelengths, curves,
+        "cie1931",
+        ("X", "Y", "Z"),
+        wavelengths,
+        curves,
         "CIE 1931 2 degree observer (colour-science)",
     )
 
@@ -73,7 +76,10 @@ def srgb() -> SensorSet:
     curves = np.einsum("kj,jw->kw", srgb_matrices()[0], cmf.curves)
     curves.flags.writeable = False
     return SensorSet(
-        "srgb", ("R", "G", "B"), cmf.wavelengths, curves,
+        "srgb",
+        ("R", "G", "B"),
+        cmf.wavelengths,
+        curves,
         "linear sRGB from the CIE 1931 observer (IEC 61966-2-1)",
     )
 
@@ -81,7 +87,9 @@ def srgb() -> SensorSet:
 def _range(key: str, what: str) -> tuple[int, float, float]:
     m = _SPEC.match(key)
     if not m:
-        raise SpectrumNotFoundError(f"{what} {key!r}: expected 'N' or 'N@START-END' (nm), e.g. '6@400-700'")
+        raise SpectrumNotFoundError(
+            f"{what} {key!r}: expected 'N' or 'N@START-END' (nm), e.g. '6@400-700'"
+        )
     n = int(m.group(1))
     lo = float(m.group(2)) if m.group(2) else 400.0
     hi = float(m.group(3)) if m.group(3) else 700.0
@@ -91,7 +99,11 @@ def _range(key: str, what: str) -> tuple[int, float, float]:
 
 
 def gaussian_sensors(
-    n: int, start: float = 400.0, end: float = 700.0, *, sigma: float | None = None,
+    n: int,
+    start: float = 400.0,
+    end: float = 700.0,
+    *,
+    sigma: float | None = None,
     wavelengths: np.ndarray | None = None,
 ) -> SensorSet:
     """*n* Gaussian sensors centred in *n* equal bins of [start, end] nm.
@@ -103,11 +115,17 @@ def gaussian_sensors(
     width = (end - start) / n
     centres = start + width * (np.arange(n) + 0.5)
     sig = width / 4.0 if sigma is None else float(sigma)
-    wl = wavelength_grid(360.0, 830.0, 1.0) if wavelengths is None else np.asarray(wavelengths, float)
+    wl = (
+        wavelength_grid(360.0, 830.0, 1.0)
+        if wavelengths is None
+        else np.asarray(wavelengths, float)
+    )
     curves = np.exp(-0.5 * ((wl[None, :] - centres[:, None]) / sig) ** 2)
     curves /= (curves * np.gradient(wl)[None, :]).sum(axis=1, keepdims=True)
     name = f"gaussian:{n}@{start:g}-{end:g}"
-    return SensorSet(name, tuple(f"G{c:.0f}" for c in centres), wl, curves, "synthetic (thesis 5.2.3)")
+    return SensorSet(
+        name, tuple(f"G{c:.0f}" for c in centres), wl, curves, "synthetic (thesis 5.2.3)"
+    )
 
 
 def gaussian(key: str) -> SensorSet:
@@ -143,7 +161,8 @@ def _builtin_cameras() -> dict[str, tuple[np.ndarray, np.ndarray, str]]:
     out = {}
     for name, msds in colour.characterisation.MSDS_CAMERA_SENSITIVITIES.items():
         out[name] = (
-            np.asarray(msds.wavelengths, float), np.asarray(msds.values, float).T.copy(),
+            np.asarray(msds.wavelengths, float),
+            np.asarray(msds.values, float).T.copy(),
             "Darrodi et al. 2015 (NPL) via colour-science",
         )
     return out
@@ -170,7 +189,9 @@ def camera(key: str, data_dir: str | None = None) -> SensorSet:
     """A camera's R, G, B sensitivities by name, e.g. ``"Nikon 5100 (NPL)"`` or ``"Nikon D50"``."""
     cams = _all_cameras(data_dir)
     if key not in cams:
-        hint = "" if data_dir or len(cams) > 2 else " (more cameras with --data-dir/SPECTRINSIC_DATA)"
+        hint = (
+            "" if data_dir or len(cams) > 2 else " (more cameras with --data-dir/SPECTRINSIC_DATA)"
+        )
         raise SpectrumNotFoundError(f"unknown camera {key!r}" + did_you_mean(key, cams) + hint)
     wl, curves, source = cams[key]
     return SensorSet(f"camera:{key}", ("R", "G", "B"), wl, curves, source)
@@ -179,4 +200,6 @@ def camera(key: str, data_dir: str | None = None) -> SensorSet:
 def user_csv(path: str) -> SensorSet:
     """Sensors from a user CSV: ``wavelength_nm`` column, then one column per sensor (>= 0)."""
     table = io.read_user_csv(path, kind="sensitivity")
-    return SensorSet(f"csv:{path}", table.labels, table.wavelengths, table.values, f"user file {path}")
+    return SensorSet(
+        f"csv:{path}", table.labels, table.wavelengths, table.values, f"user file {path}"
+    )

@@ -47,9 +47,14 @@ def torch():
         import torch
 
         return torch
-    return pytest.importorskip("torch", reason="PyTorch is an optional extra: make test-torch installs it")
+    return pytest.importorskip(
+        "torch", reason="PyTorch is an optional extra: make test-torch installs it"
+    )
 
-def quad(corner: Sequence[float], u: Sequence[float], v: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
+
+def quad(
+    corner: Sequence[float], u: Sequence[float], v: Sequence[float]
+) -> tuple[np.ndarray, np.ndarray]:
     """Vertices (4, 3) and faces (2, 3) of the parallelogram corner + [0,1]u + [0,1]v."""
     c, a, b = (np.asarray(x, float) for x in (corner, u, v))
     return np.stack([c, c + a, c + a + b, c + b]), np.array([[0, 1, 2], [0, 2, 3]])
@@ -73,8 +78,12 @@ def plane_scene(
         name="plane",
         meshes=(Mesh("plane", vertices, faces, np.zeros(2, np.int64), object_id=0),),
         materials=(Material("plane", reflectance),),
-        lights=(Light("directional", light_spectrum, power, direction=(np.sin(t), 0.0, -np.cos(t))),),
-        camera=Camera(origin=(0, 0, 2), target=(0, 0, 0), up=(0, 1, 0), fov_deg=30, width=size, height=size),
+        lights=(
+            Light("directional", light_spectrum, power, direction=(np.sin(t), 0.0, -np.cos(t))),
+        ),
+        camera=Camera(
+            origin=(0, 0, 2), target=(0, 0, 0), up=(0, 1, 0), fov_deg=30, width=size, height=size
+        ),
     )
 
 
@@ -96,10 +105,18 @@ def _box(lo: Sequence[float], hi: Sequence[float]) -> tuple[np.ndarray, np.ndarr
 
 def box_room(
     wall_spectra: Sequence[str] = (
-        "munsell:5R 5/12", "munsell:5G 6/8", "munsell:5B 5/8", "munsell:5Y 8/10", "munsell:5Y 8/2", "munsell:5Y 8/2",
+        "munsell:5R 5/12",
+        "munsell:5G 6/8",
+        "munsell:5B 5/8",
+        "munsell:5Y 8/10",
+        "munsell:5Y 8/2",
+        "munsell:5Y 8/2",
     ),
     cube_spectrum: str = "munsell:5P 5/10",
-    lights: Sequence[tuple[str, str, float]] = (("point", "planck:2800K", 1.5), ("area", "daylight:6500K", 3.0)),
+    lights: Sequence[tuple[str, str, float]] = (
+        ("point", "planck:2800K", 1.5),
+        ("area", "daylight:6500K", 3.0),
+    ),
     size: int = 24,
 ) -> Scene:
     """A closed 2 m room with coloured walls (interreflections), a cube, and its lights.
@@ -109,14 +126,34 @@ def box_room(
     """
     room_v, room_f, room_side = _box((-1, -1, 0), (1, 1, 2))
     cube_v, cube_f, _ = _box((-0.3, -0.2, 0), (0.3, 0.4, 0.6))
-    materials = tuple(Material(f"wall{i}", s) for i, s in enumerate(wall_spectra)) + (Material("cube", cube_spectrum),)
+    materials = tuple(Material(f"wall{i}", s) for i, s in enumerate(wall_spectra)) + (
+        Material("cube", cube_spectrum),
+    )
     placed = []
     for i, (kind, spectrum, power) in enumerate(lights):
         if kind == "area":
-            placed.append(Light("area", spectrum, power, position=(0.3, -0.3, 1.95), direction=(0, 0, -1),
-                                size=(0.5, 0.5), name=f"light{i}"))
+            placed.append(
+                Light(
+                    "area",
+                    spectrum,
+                    power,
+                    position=(0.3, -0.3, 1.95),
+                    direction=(0, 0, -1),
+                    size=(0.5, 0.5),
+                    name=f"light{i}",
+                )
+            )
         else:
-            placed.append(Light(kind, spectrum, power, position=(-0.5, 0.5, 1.6), direction=(0, 0, -1), name=f"light{i}"))
+            placed.append(
+                Light(
+                    kind,
+                    spectrum,
+                    power,
+                    position=(-0.5, 0.5, 1.6),
+                    direction=(0, 0, -1),
+                    name=f"light{i}",
+                )
+            )
     return Scene(
         name="box-room",
         meshes=(
@@ -125,7 +162,14 @@ def box_room(
         ),
         materials=materials,
         lights=tuple(placed),
-        camera=Camera(origin=(0.0, -0.95, 1.2), target=(0.1, 0.5, 0.6), up=(0, 0, 1), fov_deg=75, width=size, height=size),
+        camera=Camera(
+            origin=(0.0, -0.95, 1.2),
+            target=(0.1, 0.5, 0.6),
+            up=(0, 0, 1),
+            fov_deg=75,
+            width=size,
+            height=size,
+        ),
     )
 
 

@@ -44,8 +44,12 @@ MODULES = _modules_with_examples()
 
 def test_every_source_file_with_examples_is_found(repo_root: Path):
     """The discovery by module name misses no file of the source tree that has examples."""
-    files = [p for folder in FOLDERS for p in (repo_root / folder).rglob("*.py")
-             if ">>>" in p.read_text(encoding="utf-8")]
+    files = [
+        p
+        for folder in FOLDERS
+        for p in (repo_root / folder).rglob("*.py")
+        if ">>>" in p.read_text(encoding="utf-8")
+    ]
     assert len(MODULES) == len(files) >= 11
 
 
@@ -56,7 +60,13 @@ def test_examples(name: str):
     # an array's repr depends on whether it was imported; examples are judged as numpy prints
     # by default (those of spectrinsic print lists, which read the same either way)
     with np.printoptions(legacy=False):
-        result = doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE,
-                                 report=True, verbose=False)
+        result = doctest.testmod(
+            module,
+            optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE,
+            report=True,
+            verbose=False,
+        )
     assert result.attempted > 0, f"{name}: no example ran"
-    assert result.failed == 0, f"{name}: {result.failed} of {result.attempted} examples failed (see above)"
+    assert result.failed == 0, (
+        f"{name}: {result.failed} of {result.attempted} examples failed (see above)"
+    )

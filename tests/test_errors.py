@@ -50,7 +50,9 @@ def _calls():
     ]
 
 
-@pytest.mark.parametrize(("what", "call", "error"), _calls(), ids=lambda x: x if isinstance(x, str) else "")
+@pytest.mark.parametrize(
+    ("what", "call", "error"), _calls(), ids=lambda x: x if isinstance(x, str) else ""
+)
 def test_unknown_names_raise_their_packages_error(what, call, error):
     with pytest.raises(error, match="unknown"):
         call()

@@ -28,15 +28,33 @@ ROOT = Path(__file__).resolve().parents[1]
 #: (tests/test_packaging.py guards it against the folders on disk).
 FOLDERS = {
     folder: package
-    for package, folder in tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"][
-        "package-dir"
-    ].items()
+    for package, folder in tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"][
+        "setuptools"
+    ]["package-dir"].items()
 }
 #: Top-level names that may be imported inside a function (see the module docstring).
-HEAVY = frozenset({
-    "mitsuba", "drjit", "bpy", "torch", "dask", "distributed", "selenium", "pyoidn", "webdataset",
-    "gco", "colour", "matplotlib", "scipy", "skimage", "trimesh", "zstandard", "OpenEXR", "PIL",
-})
+HEAVY = frozenset(
+    {
+        "mitsuba",
+        "drjit",
+        "bpy",
+        "torch",
+        "dask",
+        "distributed",
+        "selenium",
+        "pyoidn",
+        "webdataset",
+        "gco",
+        "colour",
+        "matplotlib",
+        "scipy",
+        "skimage",
+        "trimesh",
+        "zstandard",
+        "OpenEXR",
+        "PIL",
+    }
+)
 #: Cycles left to the work that owns the folder, as sorted module sets (none left).
 KNOWN_CYCLES: list[frozenset[str]] = []
 #: Folders whose function-level imports of light modules are left to the work that owns them,
@@ -154,7 +172,9 @@ def test_the_checker_finds_a_cycle_hidden_in_a_function(tmp_path):
     b.write_text("from . import a\n")
     graph = {"spectrinsic.a": set(), "spectrinsic.b": set()}
     for module, path in (("spectrinsic.a", a), ("spectrinsic.b", b)):
-        graph[module] = {n for n, _ in imports(module, path, set(graph)) if n in graph and n != module}
+        graph[module] = {
+            n for n, _ in imports(module, path, set(graph)) if n in graph and n != module
+        }
     assert cycles(graph) == [frozenset(graph)]
     assert list(imports("spectrinsic.a", a, set(graph))) == [("spectrinsic.b", True)]
 
@@ -181,8 +201,11 @@ def _folder(module: str) -> str:
 @pytest.mark.parametrize("folder", sorted(FOLDERS))
 def test_imports_inside_functions_are_only_heavy_optional_ones(folder):
     _, nested = import_graph()
-    wrong = [f"{m}: {name}" for m, name in nested
-             if _folder(m) == folder and name.split(".")[0] not in HEAVY]
+    wrong = [
+        f"{m}: {name}"
+        for m, name in nested
+        if _folder(m) == folder and name.split(".")[0] not in HEAVY
+    ]
     if folder in PENDING_FOLDERS:
         assert len(wrong) <= PENDING_FOLDERS[folder], "\n".join(wrong)
         return

@@ -24,7 +24,9 @@ def wait_for(predicate):
 
 def _run(body: str) -> str:
     script = PRELUDE + textwrap.dedent(body)
-    run = subprocess.run([sys.executable, "-P", "-c", script], capture_output=True, text=True, timeout=120)
+    run = subprocess.run(
+        [sys.executable, "-P", "-c", script], capture_output=True, text=True, timeout=120
+    )
     assert run.returncode == 0, run.stderr
     return run.stdout.strip()
 

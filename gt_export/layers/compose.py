@@ -1,5 +1,4 @@
-"""Every family together: :func:`compute_ground_truth` and the identities the layers satisfy.
-"""
+"""Every family together: :func:`compute_ground_truth` and the identities the layers satisfy."""
 
 from __future__ import annotations
 
@@ -49,10 +48,14 @@ __all__ = ["compute_ground_truth", "identities"]
 
 def _sample(scene: Scene, result: Any, data_dir: Any) -> SampleInputs:
     wl = grid()
-    rho = (np.stack([get_spectrum(m.spectrum, data_dir=data_dir).on(wl) for m in scene.materials])
-           if scene.materials else np.zeros((0, wl.size)))
-    return SampleInputs(scene, result, reference_mode(result), wl, rho,
-                   get_spectrum("cie:D65").on(wl), data_dir)
+    rho = (
+        np.stack([get_spectrum(m.spectrum, data_dir=data_dir).on(wl) for m in scene.materials])
+        if scene.materials
+        else np.zeros((0, wl.size))
+    )
+    return SampleInputs(
+        scene, result, reference_mode(result), wl, rho, get_spectrum("cie:D65").on(wl), data_dir
+    )
 
 
 def compute_ground_truth(
@@ -98,10 +101,18 @@ def compute_ground_truth(
     layers += geometry_layers(s, mask)
     names = [m.spectrum for m in scene.materials]
     reflectance = coverage_weighted(
-        coverage, absolute_reflectance(names, data_dir=data_dir) if names else np.zeros((0, 3)))
-    layers.append(make_layer("reflectance", reflectance, RGB,
-                         "dimensionless absolute reflectance, linear sRGB under D65 (perfect white = 1); "
-                         "box-filtered by pixel coverage, 0 for background", "intrinsics"))
+        coverage, absolute_reflectance(names, data_dir=data_dir) if names else np.zeros((0, 3))
+    )
+    layers.append(
+        make_layer(
+            "reflectance",
+            reflectance,
+            RGB,
+            "dimensionless absolute reflectance, linear sRGB under D65 (perfect white = 1); "
+            "box-filtered by pixel coverage, 0 for background",
+            "intrinsics",
+        )
+    )
     w_raw = white_radiance(s, coverage)
     w = w_raw
     if denoise:
@@ -131,7 +142,9 @@ def compute_ground_truth(
         reference_mode=s.ref,
         cameras=tuple(cameras),
         cube_sensors=cube_name,
-        denoised=tuple(sorted(layer.name for layer in layers if denoise and from_denoised(layer.name))),
+        denoised=tuple(
+            sorted(layer.name for layer in layers if denoise and from_denoised(layer.name))
+        ),
         noise=noise,
         clipping=clipping_of(srgb_of(w) / srgb_white(s), w.valid & (irr.luminance_of(w) > 0)),
     )
@@ -145,15 +158,35 @@ def identities(gt: GroundTruth) -> list[dict[str, str]]:
     denoised = "image_denoised" in gt.layers
     glossy = "specular" in gt.layers
     spec = {"specular": "specular"} if glossy else {}
-    out.append({"image": "image_denoised" if denoised else "image", "reflectance": "reflectance",
-                "shading": "shading", "residual": "residual"} | spec)
+    out.append(
+        {
+            "image": "image_denoised" if denoised else "image",
+            "reflectance": "reflectance",
+            "shading": "shading",
+            "residual": "residual",
+        }
+        | spec
+    )
     if denoised:
-        out.append({"image": "image", "reflectance": "reflectance", "shading": "shading_raw",
-                    "residual": "residual_raw"} | spec)
+        out.append(
+            {
+                "image": "image",
+                "reflectance": "reflectance",
+                "shading": "shading_raw",
+                "residual": "residual_raw",
+            }
+            | spec
+        )
     for cam in gt.cameras:
         key = camera_key(cam)
         image = f"image_camera_denoised/{key}" if denoised else f"image_camera/{key}"
-        out.append({"image": image, "reflectance": f"reflectance_camera/{key}",
-                    "shading": f"shading_camera/{key}", "residual": f"residual_camera/{key}"}
-                   | ({"specular": f"specular_camera/{key}"} if glossy else {}))
+        out.append(
+            {
+                "image": image,
+                "reflectance": f"reflectance_camera/{key}",
+                "shading": f"shading_camera/{key}",
+                "residual": f"residual_camera/{key}",
+            }
+            | ({"specular": f"specular_camera/{key}"} if glossy else {})
+        )
     return out

@@ -21,10 +21,18 @@ log = logging.getLogger(__name__)
 _GEOMETRY = (
     ("depth", ("Z",), "scene units, distance from the camera to the first hit (0: background)"),
     ("normals", ("X", "Y", "Z"), "world-space unit surface normals (0: background)"),
-    ("material_id", ("id",), "index into meta['materials'], int32 (an EXR UINT channel holding "
-     "the int32 bits); -1 background"),
-    ("object_id", ("id",), "object id of the scene meshes, int32 (an EXR UINT channel holding "
-     "the int32 bits); -1 background"),
+    (
+        "material_id",
+        ("id",),
+        "index into meta['materials'], int32 (an EXR UINT channel holding "
+        "the int32 bits); -1 background",
+    ),
+    (
+        "object_id",
+        ("id",),
+        "object id of the scene meshes, int32 (an EXR UINT channel holding "
+        "the int32 bits); -1 background",
+    ),
 )
 
 
@@ -55,8 +63,16 @@ def coverage_of(s: SampleInputs, shape: tuple[int, int]) -> tuple[np.ndarray, np
 
 
 def geometry_layers(s: SampleInputs, mask: np.ndarray) -> list[Layer]:
-    out = [make_layer("mask", mask, ("Y",), "1 where a surface covers the pixel centre, else 0",
-                  "geometry", nonnegative=True)]
+    out = [
+        make_layer(
+            "mask",
+            mask,
+            ("Y",),
+            "1 where a surface covers the pixel centre, else 0",
+            "geometry",
+            nonnegative=True,
+        )
+    ]
     for name, channels, units in _GEOMETRY:
         value = aov(s.result, name)
         if value is None:
@@ -64,5 +80,7 @@ def geometry_layers(s: SampleInputs, mask: np.ndarray) -> list[Layer]:
         if name in _ID_LAYERS:
             out.append(Layer(name, _ids(name, value), channels, units, "geometry"))
         else:
-            out.append(make_layer(name, value, channels, units, "geometry", nonnegative=name == "depth"))
+            out.append(
+                make_layer(name, value, channels, units, "geometry", nonnegative=name == "depth")
+            )
     return out

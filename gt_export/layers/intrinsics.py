@@ -26,13 +26,26 @@ from spectrinsic.spectra import get_sensors, xyz_to_linear_srgb
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 from spectrinsic.spectra import white_normalised_responses as canonical_responses
 
-__all__ = ["white_radiance", "srgb_white", "srgb_of", "shading_set", "intrinsic_layers", "noise_of", "clipping_of", "from_denoised"]
+__all__ = [
+    "white_radiance",
+    "srgb_white",
+    "srgb_of",
+    "shading_set",
+    "intrinsic_layers",
+    "noise_of",
+    "clipping_of",
+    "from_denoised",
+]
 
 
-_RESIDUAL_UNITS = ("image − reflectance ∘ shading (render units): spectral non-commutativity and "
-                   "out-of-gamut light; the image itself where no surface")
-_RESIDUAL_UNITS_GLOSSY = ("image − reflectance ∘ shading − specular (render units): spectral "
-                          "non-commutativity and out-of-gamut light; the image less specular where no surface")
+_RESIDUAL_UNITS = (
+    "image − reflectance ∘ shading (render units): spectral non-commutativity and "
+    "out-of-gamut light; the image itself where no surface"
+)
+_RESIDUAL_UNITS_GLOSSY = (
+    "image − reflectance ∘ shading − specular (render units): spectral "
+    "non-commutativity and out-of-gamut light; the image less specular where no surface"
+)
 
 
 def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
@@ -40,11 +53,15 @@ def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
     :mod:`~spectrinsic.gt_export.irradiance`, with the band albedos the renderer used."""
     mode = get_mode(s.ref)
     sensors = (s.result.meta or {}).get("sensors", {}).get(s.ref, mode.sensors)
-    albedos = channel_values(s.scene, get_sensors(sensors, data_dir=s.data_dir),
-                             data_dir=s.data_dir).materials
+    albedos = channel_values(
+        s.scene, get_sensors(sensors, data_dir=s.data_dir), data_dir=s.data_dir
+    ).materials
     matrices = (s.result.meta or {}).get("to_xyz", {})
-    to_xyz = (np.asarray(matrices[s.ref], float) if s.ref in matrices
-              else to_xyz_matrix(mode, s.scene, data_dir=s.data_dir))
+    to_xyz = (
+        np.asarray(matrices[s.ref], float)
+        if s.ref in matrices
+        else to_xyz_matrix(mode, s.scene, data_dir=s.data_dir)
+    )
     raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
     # W of the first hits' diffuse lobes only: the specular part is its own layer
     return irr.white_radiance(diffuse_raw(s, raw), coverage, albedos, to_xyz, mode=s.ref)
@@ -59,8 +76,15 @@ def srgb_of(w: irr.WhiteRadiance) -> np.ndarray:
 
 
 def shading_set(
-    w: irr.WhiteRadiance, colour: np.ndarray, white: np.ndarray, image: np.ndarray,
-    reflectance: np.ndarray, *, names: tuple[str, ...], group: str, space: str,
+    w: irr.WhiteRadiance,
+    colour: np.ndarray,
+    white: np.ndarray,
+    image: np.ndarray,
+    reflectance: np.ndarray,
+    *,
+    names: tuple[str, ...],
+    group: str,
+    space: str,
     specular: np.ndarray | None = None,
 ) -> list[Layer]:
     """``shading``, ``residual`` and, if a third name is given, ``illuminant`` of one sensor
@@ -68,23 +92,47 @@ def shading_set(
     shading = irr.relative_shading(colour, white, w.valid)
     grey = irr.luminance_of(w)
     layers = [
-        make_layer(names[0], shading, RGB,
-               f"shading-illumination: {space} of the light a perfect white would reflect here "
-               "(render units, relative to that space's white under D65; ≥ 0, 0 where no surface)",
-               group, nonnegative=True),
-        make_layer(names[1], irr.residual(image, reflectance, shading, specular), RGB,
-               _RESIDUAL_UNITS if specular is None else _RESIDUAL_UNITS_GLOSSY, group),
+        make_layer(
+            names[0],
+            shading,
+            RGB,
+            f"shading-illumination: {space} of the light a perfect white would reflect here "
+            "(render units, relative to that space's white under D65; ≥ 0, 0 where no surface)",
+            group,
+            nonnegative=True,
+        ),
+        make_layer(
+            names[1],
+            irr.residual(image, reflectance, shading, specular),
+            RGB,
+            _RESIDUAL_UNITS if specular is None else _RESIDUAL_UNITS_GLOSSY,
+            group,
+        ),
     ]
     if len(names) > 2:
-        layers.append(make_layer(names[2], irr.unit_luminance(shading, grey), RGB,
-                             f"{space} colour of the light arriving at unit luminance "
-                             "(D65 = (1, 1, 1)); 0 where none arrives", group, nonnegative=True))
+        layers.append(
+            make_layer(
+                names[2],
+                irr.unit_luminance(shading, grey),
+                RGB,
+                f"{space} colour of the light arriving at unit luminance "
+                "(D65 = (1, 1, 1)); 0 where none arrives",
+                group,
+                nonnegative=True,
+            )
+        )
     return layers
 
 
 def intrinsic_layers(
-    s: SampleInputs, w_raw: irr.WhiteRadiance, w: irr.WhiteRadiance, image: np.ndarray,
-    reflectance: np.ndarray, *, denoised: bool, specular: np.ndarray | None = None,
+    s: SampleInputs,
+    w_raw: irr.WhiteRadiance,
+    w: irr.WhiteRadiance,
+    image: np.ndarray,
+    reflectance: np.ndarray,
+    *,
+    denoised: bool,
+    specular: np.ndarray | None = None,
 ) -> list[Layer]:
     """sRGB shading, residual and illuminant (from the denoised ``W`` if asked, with
     ``image_denoised`` rebuilt from it plus the raw *specular*, and the raw ``shading_raw``/
@@ -94,23 +142,63 @@ def intrinsic_layers(
     out: list[Layer] = []
     if denoised:
         raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
-        used = xyz_to_linear_srgb(np.einsum("hwk,ck->hwc", irr.recompose(w, diffuse_raw(s, raw)), w.to_xyz))
+        used = xyz_to_linear_srgb(
+            np.einsum("hwk,ck->hwc", irr.recompose(w, diffuse_raw(s, raw)), w.to_xyz)
+        )
         used = used if specular is None else used + specular
-        out.append(make_layer("image_denoised", used, RGB,
-                          UNITS_IMAGE + "; rebuilt as reflectance-weighted denoised white-surface "
-                          "radiance (the raw image where no surface)"
-                          + ("" if specular is None else ", plus the raw specular layer"), "image"))
-        out += shading_set(w_raw, srgb_of(w_raw), white, image, reflectance, space="linear sRGB",
-                            names=("shading_raw", "residual_raw"), group="intrinsics", specular=specular)
-    out += shading_set(w, srgb_of(w), white, used, reflectance, space="linear sRGB",
-                        names=("shading", "residual", "illuminant"), group="intrinsics", specular=specular)
-    out.append(make_layer("shading_grey", irr.luminance_of(w), ("Y",),
-                      "luminance Y of the light a perfect white would reflect (render units)",
-                      "intrinsics", nonnegative=True))
-    out.append(make_layer("shading_ratio", shading_ratio(image, reflectance), RGB,
-                      "image / reflectance per channel (thesis Fig. 5.8; ill-conditioned where a "
-                      f"reflectance channel is small); 0 where |reflectance| <= {REFLECTANCE_FLOOR:g}",
-                      "intrinsics"))
+        out.append(
+            make_layer(
+                "image_denoised",
+                used,
+                RGB,
+                UNITS_IMAGE + "; rebuilt as reflectance-weighted denoised white-surface "
+                "radiance (the raw image where no surface)"
+                + ("" if specular is None else ", plus the raw specular layer"),
+                "image",
+            )
+        )
+        out += shading_set(
+            w_raw,
+            srgb_of(w_raw),
+            white,
+            image,
+            reflectance,
+            space="linear sRGB",
+            names=("shading_raw", "residual_raw"),
+            group="intrinsics",
+            specular=specular,
+        )
+    out += shading_set(
+        w,
+        srgb_of(w),
+        white,
+        used,
+        reflectance,
+        space="linear sRGB",
+        names=("shading", "residual", "illuminant"),
+        group="intrinsics",
+        specular=specular,
+    )
+    out.append(
+        make_layer(
+            "shading_grey",
+            irr.luminance_of(w),
+            ("Y",),
+            "luminance Y of the light a perfect white would reflect (render units)",
+            "intrinsics",
+            nonnegative=True,
+        )
+    )
+    out.append(
+        make_layer(
+            "shading_ratio",
+            shading_ratio(image, reflectance),
+            RGB,
+            "image / reflectance per channel (thesis Fig. 5.8; ill-conditioned where a "
+            f"reflectance channel is small); 0 where |reflectance| <= {REFLECTANCE_FLOOR:g}",
+            "intrinsics",
+        )
+    )
     return out
 
 
@@ -120,15 +208,28 @@ def noise_of(s: SampleInputs, w: irr.WhiteRadiance) -> tuple[list[Layer], dict[s
     if len(batches) < 2:
         return [], {}
     white = srgb_white(s)
-    images = [xyz_to_linear_srgb(np.einsum("hwk,ck->hwc", np.asarray(b, float), w.to_xyz)) for b in batches]
+    images = [
+        xyz_to_linear_srgb(np.einsum("hwk,ck->hwc", np.asarray(b, float), w.to_xyz))
+        for b in batches
+    ]
     shadings = [irr.relative_shading(srgb_of(w.from_raw(b)), white, w.valid) for b in batches]
     lit = w.valid
-    maps = {"image": irr.relative_standard_error(images, lit),
-            "shading_raw": irr.relative_standard_error(shadings, lit)}
-    layers = [make_layer(f"noise_{k}", v, ("Y",),
-                     f"relative standard error of the raw {k.removesuffix('_raw')} per pixel, "
-                     f"‖se‖₂/‖mean‖₂ over channels, from {len(batches)} independent batches",
-                     "noise", nonnegative=True) for k, v in maps.items()]
+    maps = {
+        "image": irr.relative_standard_error(images, lit),
+        "shading_raw": irr.relative_standard_error(shadings, lit),
+    }
+    layers = [
+        make_layer(
+            f"noise_{k}",
+            v,
+            ("Y",),
+            f"relative standard error of the raw {k.removesuffix('_raw')} per pixel, "
+            f"‖se‖₂/‖mean‖₂ over channels, from {len(batches)} independent batches",
+            "noise",
+            nonnegative=True,
+        )
+        for k, v in maps.items()
+    ]
     figures: dict[str, Any] = {k: irr.noise_figures(v, lit) for k, v in maps.items()}
     figures["batches"] = len(batches)
     return layers, figures
@@ -142,12 +243,24 @@ def clipping_of(colour: np.ndarray, lit: np.ndarray) -> dict[str, float]:
     clipped = np.linalg.norm(np.clip(values, None, 0.0), axis=-1)
     rel = clipped / np.maximum(np.linalg.norm(values, axis=-1), np.finfo(float).tiny)
     hit = clipped > 0
-    return {"pixels": float(hit.mean()), "mean": float(rel[hit].mean()) if hit.any() else 0.0,
-            "max": float(rel.max())}
+    return {
+        "pixels": float(hit.mean()),
+        "mean": float(rel[hit].mean()) if hit.any() else 0.0,
+        "max": float(rel.max()),
+    }
 
 
 def from_denoised(name: str) -> bool:
     base = name.split("/", 1)[0]
-    return base in ("image_denoised", "shading", "residual", "illuminant", "shading_grey",
-                    "light_share", "image_camera_denoised", "shading_camera", "residual_camera",
-                    "illuminant_camera")
+    return base in (
+        "image_denoised",
+        "shading",
+        "residual",
+        "illuminant",
+        "shading_grey",
+        "light_share",
+        "image_camera_denoised",
+        "shading_camera",
+        "residual_camera",
+        "illuminant_camera",
+    )

@@ -17,7 +17,27 @@ from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 
-__all__ = ["REFERENCE_MODES", "DEFAULT_CUBE_SENSORS", "REFLECTANCE_FLOOR", "ERROR_FLOOR", "TRAINING_FAMILY", "RenderRecord", "Layer", "LightRecord", "GroundTruth", "grid", "aov", "reference_mode", "cube_sensor_name", "camera_key", "UNITS_IMAGE", "UNITS_CAMERA", "RGB", "make_layer", "SampleInputs"]
+__all__ = [
+    "REFERENCE_MODES",
+    "DEFAULT_CUBE_SENSORS",
+    "REFLECTANCE_FLOOR",
+    "ERROR_FLOOR",
+    "TRAINING_FAMILY",
+    "RenderRecord",
+    "Layer",
+    "LightRecord",
+    "GroundTruth",
+    "grid",
+    "aov",
+    "reference_mode",
+    "cube_sensor_name",
+    "camera_key",
+    "UNITS_IMAGE",
+    "UNITS_CAMERA",
+    "RGB",
+    "make_layer",
+    "SampleInputs",
+]
 
 log = logging.getLogger(__name__)
 
@@ -173,7 +193,9 @@ def camera_key(name: str) -> str:
     return name.split(":", 1)[1] if name.startswith("camera:") else name
 
 
-UNITS_IMAGE = "relative radiance (render units), linear sRGB (IEC 61966-2-1, D65 white), from CIE XYZ"
+UNITS_IMAGE = (
+    "relative radiance (render units), linear sRGB (IEC 61966-2-1, D65 white), from CIE XYZ"
+)
 
 
 UNITS_CAMERA = (
@@ -185,9 +207,17 @@ UNITS_CAMERA = (
 RGB = ("R", "G", "B")
 
 
-def make_layer(name: str, data: np.ndarray, channels: Sequence[str], units: str, group: str,
-           nonnegative: bool = False) -> Layer:
-    return Layer(name, np.asarray(data, dtype=np.float32), tuple(channels), units, group, nonnegative)
+def make_layer(
+    name: str,
+    data: np.ndarray,
+    channels: Sequence[str],
+    units: str,
+    group: str,
+    nonnegative: bool = False,
+) -> Layer:
+    return Layer(
+        name, np.asarray(data, dtype=np.float32), tuple(channels), units, group, nonnegative
+    )
 
 
 @dataclass(frozen=True, eq=False)

@@ -32,7 +32,9 @@ def camera_curves(name: str, wavelengths: np.ndarray, *, data_dir: Any = None) -
     return curves / white.mean()
 
 
-def cube_to_sensors(cube_sensors: np.ndarray, curves: np.ndarray, wavelengths: np.ndarray) -> np.ndarray:
+def cube_to_sensors(
+    cube_sensors: np.ndarray, curves: np.ndarray, wavelengths: np.ndarray
+) -> np.ndarray:
     """``(K, B)`` weights ``A`` with ``S ≈ A @ bands`` (least squares on *wavelengths*).
 
     A band cube with values ``∫ L B_b dλ`` then gives ``∫ L S_k dλ ≈ Σ_b A_kb cube_b``; for

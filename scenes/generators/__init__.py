@@ -72,7 +72,9 @@ def generated_family(root_seed: int, generator: str, index: int) -> str:
     return family_of(generated_scene_seed(root_seed, generator, index))
 
 
-def generate(generator: str, *, root_seed: int, index: int, view: int, options: GeneratorOptions) -> Scene:
+def generate(
+    generator: str, *, root_seed: int, index: int, view: int, options: GeneratorOptions
+) -> Scene:
     """Generate scene *index* of *generator* seen from camera *view*.
 
     Parameters

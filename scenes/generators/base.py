@@ -96,8 +96,10 @@ class Layout:
 def scene_rngs(seed: int) -> dict[str, np.random.Generator]:
     """Independent generators for ``layout``, ``lights``, ``camera`` from the scene seed."""
     children = np.random.SeedSequence(seed).spawn(3)
-    return {k: np.random.default_rng(c) for k, c in zip(("layout", "lights", "camera"), children,
-                                                          strict=True)}
+    return {
+        k: np.random.default_rng(c)
+        for k, c in zip(("layout", "lights", "camera"), children, strict=True)
+    }
 
 
 def family_of(seed: int) -> str:
@@ -109,27 +111,51 @@ def _is_object(mesh: Mesh) -> bool:
     return not mesh.name.startswith(_BACKGROUND)
 
 
-def assemble(name: str, layout: Layout, seed: int, view: int, options: GeneratorOptions,
-             rngs: dict[str, np.random.Generator]) -> Scene:
+def assemble(
+    name: str,
+    layout: Layout,
+    seed: int,
+    view: int,
+    options: GeneratorOptions,
+    rngs: dict[str, np.random.Generator],
+) -> Scene:
     """The scene of *layout* seen from camera *view*, with the lights of its family."""
     meshes, materials = to_meshes(layout.parts)
     family = family_of(seed)
-    lights = draw_lights(rngs["lights"], family, layout.lights,
-                         free=lambda p: is_free(meshes, p), sfu=options.sfu_illuminants,
-                         data_dir=options.data_dir, max_lights=options.max_lights,
-                         saturation=options.light_saturation)
+    lights = draw_lights(
+        rngs["lights"],
+        family,
+        layout.lights,
+        free=lambda p: is_free(meshes, p),
+        sfu=options.sfu_illuminants,
+        data_dir=options.data_dir,
+        max_lights=options.max_lights,
+        saturation=options.light_saturation,
+    )
     # Views 0..views-1 are drawn in order, so view k is the same in any build, and all of them
     # must pass for the layout to be used (every view of a scene shows one layout).
     for k in range(max(view + 1, options.views)):
-        drawn = sample_camera(rngs["camera"], meshes, layout.propose_camera,
-                              width=options.width, height=options.height,
-                              is_object=_is_object,
-                              min_coverage=max(options.min_coverage, layout.min_coverage),
-                              name=f"view{k}")
+        drawn = sample_camera(
+            rngs["camera"],
+            meshes,
+            layout.propose_camera,
+            width=options.width,
+            height=options.height,
+            is_object=_is_object,
+            min_coverage=max(options.min_coverage, layout.min_coverage),
+            name=f"view{k}",
+        )
         if k == view:
             camera, cov = drawn
-    meta = {**layout.info, "generator_seed": int(seed), "view": int(view), "condition": family,
-            "object_coverage": cov, "illuminants": [light.spectrum for light in lights],
-            "light_kinds": [light.kind for light in lights]}
-    return Scene(name=name, meshes=meshes, materials=materials, lights=lights, camera=camera,
-                 metadata=meta)
+    meta = {
+        **layout.info,
+        "generator_seed": int(seed),
+        "view": int(view),
+        "condition": family,
+        "object_coverage": cov,
+        "illuminants": [light.spectrum for light in lights],
+        "light_kinds": [light.kind for light in lights],
+    }
+    return Scene(
+        name=name, meshes=meshes, materials=materials, lights=lights, camera=camera, metadata=meta
+    )

@@ -51,7 +51,11 @@ def first_hits(meshes: Sequence[Mesh], origins: np.ndarray, dirs: np.ndarray) ->
     best = np.full(len(origins), np.inf)
     hit = np.full(len(origins), -1)
     for s in range(0, len(tri), 4096):
-        t0, e1, e2 = tri[s:s + 4096, 0], tri[s:s + 4096, 1] - tri[s:s + 4096, 0], tri[s:s + 4096, 2] - tri[s:s + 4096, 0]
+        t0, e1, e2 = (
+            tri[s : s + 4096, 0],
+            tri[s : s + 4096, 1] - tri[s : s + 4096, 0],
+            tri[s : s + 4096, 2] - tri[s : s + 4096, 0],
+        )
         p = np.cross(dirs[:, None], e2[None])
         det = np.einsum("rfk,fk->rf", p, e1)
         ok = np.abs(det) > 1e-12
@@ -72,8 +76,15 @@ def first_hits(meshes: Sequence[Mesh], origins: np.ndarray, dirs: np.ndarray) ->
 
 def coverage(meshes: Sequence[Mesh], camera: Camera, is_object: Callable[[Mesh], bool]) -> float:
     """Fraction of a ``COVERAGE_GRID²`` ray grid of *camera* whose first hit is an object."""
-    o, d = camera_rays(camera.origin, camera.target, camera.up, camera.fov_deg,
-                       camera.width, camera.height, n=COVERAGE_GRID)
+    o, d = camera_rays(
+        camera.origin,
+        camera.target,
+        camera.up,
+        camera.fov_deg,
+        camera.width,
+        camera.height,
+        n=COVERAGE_GRID,
+    )
     hit = first_hits(meshes, o, d)
     flags = np.array([is_object(m) for m in meshes] + [False])
     return float(flags[hit].mean())
@@ -113,13 +124,24 @@ def sample_camera(
     best = 0.0
     for _ in range(tries):
         origin, target, fov = propose(rng)
-        if not math.isfinite(fov) or np.linalg.norm(target - origin) < 1e-3 or not is_free(meshes, origin):
+        if (
+            not math.isfinite(fov)
+            or np.linalg.norm(target - origin) < 1e-3
+            or not is_free(meshes, origin)
+        ):
             continue
-        cam = Camera(origin=tuple(float(x) for x in origin),  # type: ignore[arg-type]
-                     target=tuple(float(x) for x in target),  # type: ignore[arg-type]
-                     fov_deg=float(fov), width=width, height=height, name=name)
+        cam = Camera(
+            origin=tuple(float(x) for x in origin),  # type: ignore[arg-type]
+            target=tuple(float(x) for x in target),  # type: ignore[arg-type]
+            fov_deg=float(fov),
+            width=width,
+            height=height,
+            name=name,
+        )
         cov = coverage(meshes, cam, is_object)
         best = max(best, cov)
         if cov >= min_coverage:
             return cam, cov
-    raise SceneError(f"no camera of {tries} draws saw >= {min_coverage:.1%} objects (best {best:.1%})")
+    raise SceneError(
+        f"no camera of {tries} draws saw >= {min_coverage:.1%} objects (best {best:.1%})"
+    )

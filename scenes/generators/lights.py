@@ -57,8 +57,17 @@ FAMILIES: tuple[str, ...] = ("white", "one-colour", "two-colour")
 TWO_COLOUR_XY = 0.08
 #: Probability that a coloured light comes from the saturated pools (LEDs, filtered lamps).
 SATURATED_SHARE = 0.6
-_LEDS = ("cie:LED-B1", "cie:LED-B2", "cie:LED-B3", "cie:LED-B4", "cie:LED-B5", "cie:LED-BH1",
-         "cie:LED-RGB1", "cie:LED-V1", "cie:LED-V2")
+_LEDS = (
+    "cie:LED-B1",
+    "cie:LED-B2",
+    "cie:LED-B3",
+    "cie:LED-B4",
+    "cie:LED-B5",
+    "cie:LED-BH1",
+    "cie:LED-RGB1",
+    "cie:LED-V1",
+    "cie:LED-V2",
+)
 _FLUORESCENTS = tuple(f"cie:FL{i}" for i in range(1, 13))
 _LAMPS = ("cie:A", "cie:LED-B3", "cie:FL2", "planck:3000K", "planck:4500K", "daylight:6500K")
 #: Highest lower bound of a |Duv| range: about 1 in 6 saturated draws lies above 0.15, few
@@ -66,6 +75,7 @@ _LAMPS = ("cie:A", "cie:LED-B3", "cie:FL2", "planck:3000K", "planck:4500K", "day
 MAX_SATURATION_LOW = 0.15
 #: Most candidate draws for a family's coloured lights before the scene fails.
 _ATTEMPTS = 400
+
 
 @dataclass(frozen=True)
 class LightVolume:
@@ -100,8 +110,9 @@ def _rgb_led(r: np.random.Generator) -> str:
     peaks = (r.integers(615, 646), r.integers(510, 546), r.integers(445, 476))
     widths = r.integers(15, 36, 3)
     ratios = r.uniform(0.02, 1.0, 3).round(2)
-    return "led:" + "+".join(f"{int(p)}/{int(w)}@{a:g}" for p, w, a in zip(peaks, widths, ratios,
-                                                                        strict=True))
+    return "led:" + "+".join(
+        f"{int(p)}/{int(w)}@{a:g}" for p, w, a in zip(peaks, widths, ratios, strict=True)
+    )
 
 
 def _filtered(r: np.random.Generator, sfu: Sequence[str]) -> str:
@@ -123,8 +134,9 @@ def _saturated_draws(sfu: Sequence[str]) -> dict[str, Callable[[np.random.Genera
     return {"narrow-led": _narrow_led, "rgb-led": _rgb_led, "filtered": lambda r: _filtered(r, sfu)}
 
 
-def draw_illuminant(rng: np.random.Generator, sfu: Sequence[str] = (), *,
-                    saturated: bool = False) -> str:
+def draw_illuminant(
+    rng: np.random.Generator, sfu: Sequence[str] = (), *, saturated: bool = False
+) -> str:
     """One illuminant name: a pool drawn uniformly, then a member of it. The white pools are
     planck 2000-10000 K, daylight 4000-10000 K, white LED, fluorescent (SFU when *sfu* is
     given); with *saturated*, narrow-band LED, RGB-mix LED and filtered lamp."""
@@ -152,27 +164,42 @@ def check_saturation(saturation: tuple[float, float]) -> None:
     """Refuse a |Duv| range that no pool can fill (raises :class:`SceneError`, one line)."""
     lo, hi = saturation
     if not 0.0 <= lo <= hi or lo > MAX_SATURATION_LOW:
-        raise SceneError(f"light saturation {lo:g},{hi:g}: expected 0 <= LO <= HI and LO <= "
-                         f"{MAX_SATURATION_LOW:g} (|Duv|, Ohno 2013; 0.02 is visibly tinted)")
+        raise SceneError(
+            f"light saturation {lo:g},{hi:g}: expected 0 <= LO <= HI and LO <= "
+            f"{MAX_SATURATION_LOW:g} (|Duv|, Ohno 2013; 0.02 is visibly tinted)"
+        )
 
 
 def _apart(a: str, b: str, data_dir: str | None, least: float) -> bool:
     return math.dist(light_xy(a, data_dir), light_xy(b, data_dir)) >= least
 
 
-def _candidate(rng: np.random.Generator, sfu: Sequence[str], data_dir: str | None,
-               saturation: tuple[float, float] | None) -> str | None:
+def _candidate(
+    rng: np.random.Generator,
+    sfu: Sequence[str],
+    data_dir: str | None,
+    saturation: tuple[float, float] | None,
+) -> str | None:
     """A coloured light (>= MIN_XY_DISTANCE from D65, |Duv| in *saturation*), or None."""
     name = draw_illuminant(rng, sfu, saturated=bool(rng.random() < SATURATED_SHARE))
     if not _apart(name, WHITE, data_dir, MIN_XY_DISTANCE):
         return None
-    if saturation is not None and not saturation[0] <= abs(light_duv(name, data_dir)) <= saturation[1]:
+    if (
+        saturation is not None
+        and not saturation[0] <= abs(light_duv(name, data_dir)) <= saturation[1]
+    ):
         return None
     return name
 
 
-def _family_spectra(family: str, n: int, rng: np.random.Generator, sfu: Sequence[str],
-                    data_dir: str | None, saturation: tuple[float, float] | None = None) -> list[str]:
+def _family_spectra(
+    family: str,
+    n: int,
+    rng: np.random.Generator,
+    sfu: Sequence[str],
+    data_dir: str | None,
+    saturation: tuple[float, float] | None = None,
+) -> list[str]:
     """The spectrum of each of *n* lights of a condition *family*."""
     if family == "white":
         return [WHITE] * n
@@ -183,19 +210,33 @@ def _family_spectra(family: str, n: int, rng: np.random.Generator, sfu: Sequence
             coloured.append(name)
         if len(coloured) == (1 if family == "one-colour" else 2):
             return [coloured[i % len(coloured)] for i in range(n)]
-    raise SceneError(f"could not draw distinct coloured illuminants for {family!r}"
-                     + (f" with |Duv| in {saturation}" if saturation else ""))
+    raise SceneError(
+        f"could not draw distinct coloured illuminants for {family!r}"
+        + (f" with |Duv| in {saturation}" if saturation else "")
+    )
 
 
-def _one_light(i: int, kind: LightKind, spectrum: str, position: np.ndarray,
-               volume: LightVolume, share: float, rng: np.random.Generator) -> Light:
+def _one_light(
+    i: int,
+    kind: LightKind,
+    spectrum: str,
+    position: np.ndarray,
+    volume: LightVolume,
+    share: float,
+    rng: np.random.Generator,
+) -> Light:
     focus = np.asarray(volume.focus, float)
     direction = focus - position
     direction /= np.linalg.norm(direction)
     size = (float(rng.uniform(0.2, 0.8)), float(rng.uniform(0.2, 0.8)))
-    power = light_power(kind, position, direction, focus, size, share) * float(rng.uniform(0.5, 2.0))
-    placement: dict[str, object] = {"position": tuple(float(x) for x in position),
-                                    "direction": tuple(float(x) for x in direction), "size": size}
+    power = light_power(kind, position, direction, focus, size, share) * float(
+        rng.uniform(0.5, 2.0)
+    )
+    placement: dict[str, object] = {
+        "position": tuple(float(x) for x in position),
+        "direction": tuple(float(x) for x in direction),
+        "size": size,
+    }
     if "cutoff_deg" in LIGHT_FIELDS[kind]:  # drawn only for the kinds that have a cone
         placement["cutoff_deg"] = float(rng.uniform(25.0, 60.0))
     return make_light(kind, spectrum, power, name=f"light{i}", **placement)

@@ -67,7 +67,9 @@ class MaterialDistribution:
                 raise SceneError(f"material distribution {name}={(lo, hi)}; expected low <= high")
         for name in ("sfu_fraction", "pattern_probability"):
             if not 0.0 <= getattr(self, name) <= 1.0:
-                raise SceneError(f"material distribution {name}={getattr(self, name)}; expected 0..1")
+                raise SceneError(
+                    f"material distribution {name}={getattr(self, name)}; expected 0..1"
+                )
 
 
 @functools.lru_cache(maxsize=1)
@@ -89,7 +91,9 @@ def _pool(value_range: tuple[float, float], chroma_range: tuple[float, float]) -
 def check_ranges(value_range: tuple[float, float], chroma_range: tuple[float, float]) -> None:
     """Refuse Munsell ranges that hold no matte chip (raises :class:`SceneError`, one line)."""
     if not value_range[0] <= value_range[1] or not chroma_range[0] <= chroma_range[1]:
-        raise SceneError(f"value range {value_range} / chroma range {chroma_range}; expected LO <= HI")
+        raise SceneError(
+            f"value range {value_range} / chroma range {chroma_range}; expected LO <= HI"
+        )
     if not _pool(value_range, chroma_range):
         raise SceneError(
             f"no Munsell chip has value in {value_range[0]:g}-{value_range[1]:g} and chroma in "
@@ -102,12 +106,19 @@ def within(preferred: MaterialDistribution, user: MaterialDistribution) -> Mater
     """*preferred* (a generator's own taste, e.g. light walls) narrowed to the *user*'s ranges;
     the user's ranges alone where the two share no chip. Either way every chip drawn obeys the
     user's ``--value-range`` / ``--chroma-range``."""
-    v = (max(preferred.value_range[0], user.value_range[0]), min(preferred.value_range[1], user.value_range[1]))
-    c = (max(preferred.chroma_range[0], user.chroma_range[0]), min(preferred.chroma_range[1], user.chroma_range[1]))
+    v = (
+        max(preferred.value_range[0], user.value_range[0]),
+        min(preferred.value_range[1], user.value_range[1]),
+    )
+    c = (
+        max(preferred.chroma_range[0], user.chroma_range[0]),
+        min(preferred.chroma_range[1], user.chroma_range[1]),
+    )
     if v[0] <= v[1] and c[0] <= c[1] and _pool(v, c):
         return MaterialDistribution(v, c, preferred.sfu_fraction, preferred.pattern_probability)
-    return MaterialDistribution(user.value_range, user.chroma_range, preferred.sfu_fraction,
-                                preferred.pattern_probability)
+    return MaterialDistribution(
+        user.value_range, user.chroma_range, preferred.sfu_fraction, preferred.pattern_probability
+    )
 
 
 def obeys(name: str, dist: MaterialDistribution) -> bool:
@@ -116,7 +127,9 @@ def obeys(name: str, dist: MaterialDistribution) -> bool:
 
 
 @functools.lru_cache(maxsize=32)
-def _pool_set(value_range: tuple[float, float], chroma_range: tuple[float, float]) -> frozenset[str]:
+def _pool_set(
+    value_range: tuple[float, float], chroma_range: tuple[float, float]
+) -> frozenset[str]:
     return frozenset(_pool(value_range, chroma_range))
 
 
@@ -136,8 +149,10 @@ def draw_reflectance(
         return sfu[int(rng.integers(len(sfu)))]
     pool = _pool(dist.value_range, dist.chroma_range)
     if not pool:
-        raise SceneError(f"no Munsell chip has value in {dist.value_range} and chroma in "
-                         f"{dist.chroma_range}; widen the ranges")
+        raise SceneError(
+            f"no Munsell chip has value in {dist.value_range} and chroma in "
+            f"{dist.chroma_range}; widen the ranges"
+        )
     return pool[int(rng.integers(len(pool)))]
 
 
@@ -161,8 +176,7 @@ def _labelled(part: Part, palette: Sequence[str], index: np.ndarray) -> Part:
     lookup = np.array([names.index(p) for p in palette], dtype=np.int64)
     labels = lookup[np.asarray(index, dtype=np.int64) % len(palette)]
     used, labels = np.unique(labels, return_inverse=True)
-    return Part(part.vertices, part.faces, labels.astype(np.int64),
-                  tuple(names[i] for i in used))
+    return Part(part.vertices, part.faces, labels.astype(np.int64), tuple(names[i] for i in used))
 
 
 def _extent(part: Part) -> np.ndarray:
@@ -207,8 +221,15 @@ def _label(part: Part, rng: np.random.Generator, palette: Sequence[str]) -> Part
     keys = [*legend, ".", "."]
     rows = ["".join(keys[int(k)] for k in rng.integers(len(keys), size=cols)) for _ in range(nrows)]
     base = _labelled(part, palette[:1], np.zeros(len(part.faces)))
-    return printed(base, rows, legend, origin=(float(lo[0]), float(lo[2])), cell=cell,
-                     axes=(0, 2), facing=(0, -1, 0))
+    return printed(
+        base,
+        rows,
+        legend,
+        origin=(float(lo[0]), float(lo[2])),
+        cell=cell,
+        axes=(0, 2),
+        facing=(0, -1, 0),
+    )
 
 
 #: Steps of a spectral texture's mixing weights (1/8: at most 45 mixes of three reflectances).
@@ -234,15 +255,20 @@ def _texture(part: Part, rng: np.random.Generator, palette: Sequence[str]) -> Pa
     quantised to 1/TEXTURE_STEPS. Each texel stays one exact spectrum."""
     bases = list(dict.fromkeys(palette))[:3]
     p = (part.centroids - part.vertices.min(axis=0)) / float(_extent(part).max())
-    fields = [np.sin(2 * np.pi * p @ rng.uniform(0.3, 1.5, 3) + rng.uniform(0, 2 * np.pi)) for _ in bases]
+    fields = [
+        np.sin(2 * np.pi * p @ rng.uniform(0.3, 1.5, 3) + rng.uniform(0, 2 * np.pi)) for _ in bases
+    ]
     raw = np.exp(2.0 * np.stack(fields, axis=1))
     steps = _quantised(raw / raw.sum(axis=1, keepdims=True), TEXTURE_STEPS)
     rows, index = np.unique(steps, axis=0, return_inverse=True)
     names = []
     for row in rows:
         terms = [(int(k), b) for k, b in zip(row, bases, strict=True) if k > 0]
-        names.append(terms[0][1] if len(terms) == 1 else
-                     "mix:" + "+".join(f"{k / TEXTURE_STEPS:g}*{b}" for k, b in terms))
+        names.append(
+            terms[0][1]
+            if len(terms) == 1
+            else "mix:" + "+".join(f"{k / TEXTURE_STEPS:g}*{b}" for k, b in terms)
+        )
     return _labelled(part, names, np.asarray(index).ravel())
 
 
@@ -268,7 +294,9 @@ def paint(
         The painted part and the pattern's name (``"plain"`` for one spectrum).
     """
     if rng.random() >= dist.pattern_probability:
-        return _labelled(part, [draw_reflectance(rng, dist, sfu)], np.zeros(len(part.faces))), "plain"
+        return _labelled(
+            part, [draw_reflectance(rng, dist, sfu)], np.zeros(len(part.faces))
+        ), "plain"
     names = list(PATTERNS)
     pattern = names[int(rng.integers(len(names)))]
     palette = draw_palette(rng, dist, int(rng.integers(2, 5)), sfu)

@@ -52,7 +52,9 @@ def _slab(lo: np.ndarray, hi: np.ndarray, spectrum: str) -> Part:
     return box(tuple(size), spectrum, center=tuple((lo + hi) / 2), divisions=div)
 
 
-def _wall(key: str, size: tuple[float, float, float], spectrum: str, hole: tuple[float, ...] | None) -> Part:
+def _wall(
+    key: str, size: tuple[float, float, float], spectrum: str, hole: tuple[float, ...] | None
+) -> Part:
     """Wall *key* of the room ``[0,w]x[0,d]x[0,h]``, with an optional opening ``(a, b, c, e)``:
     along-wall interval [a, b] (fraction of its length) and height interval [c, e] (m)."""
     w, d, h = size
@@ -62,10 +64,16 @@ def _wall(key: str, size: tuple[float, float, float], spectrum: str, hole: tuple
     lo, hi = np.zeros(3), np.zeros(3)
     lo[1 - axis], hi[1 - axis] = normal_lo, normal_lo + _T
     pieces = []
-    spans = [(0.0, length, 0.0, h)] if hole is None else [
-        (0.0, hole[0] * length, 0.0, h), (hole[1] * length, length, 0.0, h),
-        (hole[0] * length, hole[1] * length, 0.0, hole[2]),
-        (hole[0] * length, hole[1] * length, hole[3], h)]
+    spans = (
+        [(0.0, length, 0.0, h)]
+        if hole is None
+        else [
+            (0.0, hole[0] * length, 0.0, h),
+            (hole[1] * length, length, 0.0, h),
+            (hole[0] * length, hole[1] * length, 0.0, hole[2]),
+            (hole[0] * length, hole[1] * length, hole[3], h),
+        ]
+    )
     for a, b, c, e in spans:
         lo[axis], hi[axis], lo[2], hi[2] = a, b, c, e
         if b - a > 1e-3 and e - c > 1e-3:
@@ -73,21 +81,42 @@ def _wall(key: str, size: tuple[float, float, float], spectrum: str, hole: tuple
     return merge(*pieces)
 
 
-def _shell(rng: np.random.Generator, size: tuple[float, float, float],
-           user: MaterialDistribution) -> tuple[list[tuple[str, Part]], dict]:
+def _shell(
+    rng: np.random.Generator, size: tuple[float, float, float], user: MaterialDistribution
+) -> tuple[list[tuple[str, Part]], dict]:
     w, d, h = size
     # half the rooms have light, low-chroma walls (strong interreflection: low r), the others
     # any walls; with missing walls and ceilings this spreads r
     bright = rng.random() < 0.5
-    walls = within(MaterialDistribution((7.0, 9.5), (0.0, 4.0)) if bright
-                   else MaterialDistribution((2.0, 9.0), (0.0, 10.0)), user)
+    walls = within(
+        MaterialDistribution((7.0, 9.5), (0.0, 4.0))
+        if bright
+        else MaterialDistribution((2.0, 9.0), (0.0, 10.0)),
+        user,
+    )
     missing = [k for k in _WALLS if k != "back" and rng.random() < 0.3]
     ceiling = rng.random() >= 0.35
-    parts = [("floor", _slab(np.array([-_T, -_T, -_T]), np.array([w + _T, d + _T, 0.0]),
-                             draw_reflectance(rng, walls)))]
+    parts = [
+        (
+            "floor",
+            _slab(
+                np.array([-_T, -_T, -_T]),
+                np.array([w + _T, d + _T, 0.0]),
+                draw_reflectance(rng, walls),
+            ),
+        )
+    ]
     if ceiling:
-        parts.append(("ceiling", _slab(np.array([-_T, -_T, h]), np.array([w + _T, d + _T, h + _T]),
-                                       draw_reflectance(rng, walls))))
+        parts.append(
+            (
+                "ceiling",
+                _slab(
+                    np.array([-_T, -_T, h]),
+                    np.array([w + _T, d + _T, h + _T]),
+                    draw_reflectance(rng, walls),
+                ),
+            )
+        )
     windows = 0
     for key in _WALLS:
         if key in missing:
@@ -95,15 +124,25 @@ def _shell(rng: np.random.Generator, size: tuple[float, float, float],
         hole = None
         if rng.random() < 0.4:
             a = rng.uniform(0.15, 0.5)
-            hole, windows = (a, a + rng.uniform(0.2, 0.4), rng.uniform(0.6, 1.0), rng.uniform(1.6, h - 0.2)), windows + 1
+            hole, windows = (
+                (a, a + rng.uniform(0.2, 0.4), rng.uniform(0.6, 1.0), rng.uniform(1.6, h - 0.2)),
+                windows + 1,
+            )
         parts.append((f"wall-{key}", _wall(key, size, draw_reflectance(rng, walls), hole)))
-    return parts, {"missing_walls": missing, "ceiling": ceiling, "windows": windows, "light_walls": bright}
+    return parts, {
+        "missing_walls": missing,
+        "ceiling": ceiling,
+        "windows": windows,
+        "light_walls": bright,
+    }
 
 
 Support = tuple[np.ndarray, np.ndarray, float, float]  # (lo_xy, hi_xy, z, free height above)
 
 
-def _piece(rng: np.random.Generator, kind: str, spectrum: str) -> tuple[Part, list[tuple[float, float]]]:
+def _piece(
+    rng: np.random.Generator, kind: str, spectrum: str
+) -> tuple[Part, list[tuple[float, float]]]:
     """One piece of furniture on z = 0 around the origin, and its supports ``(z, free height)``
     as fractions of its footprint's inner rectangle (tops of tables and cabinets, shelf boards)."""
     if kind == "table":
@@ -117,8 +156,12 @@ def _piece(rng: np.random.Generator, kind: str, spectrum: str) -> tuple[Part, li
         part = shelf(rng.uniform(0.6, 1.2), rng.uniform(0.3, 0.45), th, spectrum, boards=boards)
         return part, shelf_boards(th, boards)
     if kind == "chair":
-        return chair(rng.uniform(0.38, 0.5), rng.uniform(0.4, 0.5), spectrum,
-                     facing_deg=float(rng.choice([0, 90, 180, 270]))), []
+        return chair(
+            rng.uniform(0.38, 0.5),
+            rng.uniform(0.4, 0.5),
+            spectrum,
+            facing_deg=float(rng.choice([0, 90, 180, 270])),
+        ), []
     if kind == "sofa":
         return sofa(rng.uniform(1.2, 2.2), rng.uniform(0.75, 0.95), spectrum), []
     if kind == "lamp":
@@ -127,8 +170,12 @@ def _piece(rng: np.random.Generator, kind: str, spectrum: str) -> tuple[Part, li
     return box((tw, td, th), spectrum, center=(0, 0, th / 2), divisions=(3, 3, 3)), [(th, np.inf)]
 
 
-def _furniture(rng: np.random.Generator, size: tuple[float, float, float], floor: Footprints,
-               dist: MaterialDistribution) -> tuple[list[tuple[str, Part]], list[Support]]:
+def _furniture(
+    rng: np.random.Generator,
+    size: tuple[float, float, float],
+    floor: Footprints,
+    dist: MaterialDistribution,
+) -> tuple[list[tuple[str, Part]], list[Support]]:
     """Tables, shelves, chairs, sofas, lamps and cabinets on the floor; returns them and the
     surfaces objects may rest on (table tops, cabinet tops, shelf boards)."""
     w, d, _ = size
@@ -146,7 +193,9 @@ def _furniture(rng: np.random.Generator, size: tuple[float, float, float], floor
         if kind == "round-table":  # the square inside the round top
             inner_lo, inner_hi = lo * 0.7, hi * 0.7
         for _ in range(30):
-            c = rng.uniform([0.05 + half[0], 0.05 + half[1]], [w - 0.05 - half[0], d - 0.05 - half[1]])
+            c = rng.uniform(
+                [0.05 + half[0], 0.05 + half[1]], [w - 0.05 - half[0], d - 0.05 - half[1]]
+            )
             if floor.try_add(c, half, gap=0.05):
                 parts.append((f"{kind}-{i}", moved(part, translate=(c[0], c[1], 0.0))))
                 tops += [(c + inner_lo, c + inner_hi, z, room) for z, room in levels]
@@ -154,8 +203,13 @@ def _furniture(rng: np.random.Generator, size: tuple[float, float, float], floor
     return parts, tops
 
 
-def _objects(rng: np.random.Generator, size: tuple[float, float, float], floor: Footprints,
-             tops: list[Support], options: GeneratorOptions) -> tuple[list[tuple[str, Part]], list[str]]:
+def _objects(
+    rng: np.random.Generator,
+    size: tuple[float, float, float],
+    floor: Footprints,
+    tops: list[Support],
+    options: GeneratorOptions,
+) -> tuple[list[tuple[str, Part]], list[str]]:
     """3-10 objects resting on table tops and shelf boards (preferred) or the floor, without
     overlaps and below the board above."""
     w, d, _ = size
@@ -178,8 +232,9 @@ def _objects(rng: np.random.Generator, size: tuple[float, float, float], floor: 
     return parts, patterns
 
 
-def _light_volume(rng: np.random.Generator, size: tuple[float, float, float],
-                  openness: dict) -> tuple[LightVolume, str]:
+def _light_volume(
+    rng: np.random.Generator, size: tuple[float, float, float], openness: dict
+) -> tuple[LightVolume, str]:
     """Where the lights go, and whether they light the room ``"direct"`` or ``"indirect"``.
 
     Three in four light rooms with a ceiling are lit indirectly: spots and panels below the
@@ -189,21 +244,34 @@ def _light_volume(rng: np.random.Generator, size: tuple[float, float, float],
     """
     w, d, h = size
     if openness["ceiling"] and openness["light_walls"] and rng.random() < 0.75:
-        return LightVolume(lo=(0.4, 0.4, 0.35 * h), hi=(w - 0.4, d - 0.4, 0.6 * h),
-                           focus=(w / 2, d / 2, h), kinds=_AIMED_KINDS), "indirect"
-    return LightVolume(lo=(0.3, 0.3, 0.6 * h), hi=(w - 0.3, d - 0.3, h - 0.15),
-                       focus=(w / 2, d / 2, 0.6),
-                       kinds=_PLACED_KINDS if openness["ceiling"] else LIGHT_KINDS), "direct"
+        return LightVolume(
+            lo=(0.4, 0.4, 0.35 * h),
+            hi=(w - 0.4, d - 0.4, 0.6 * h),
+            focus=(w / 2, d / 2, h),
+            kinds=_AIMED_KINDS,
+        ), "indirect"
+    return LightVolume(
+        lo=(0.3, 0.3, 0.6 * h),
+        hi=(w - 0.3, d - 0.3, h - 0.15),
+        focus=(w / 2, d / 2, 0.6),
+        kinds=_PLACED_KINDS if openness["ceiling"] else LIGHT_KINDS,
+    ), "direct"
 
 
-def _framing(size: tuple[float, float, float],
-             parts: list[Part]) -> Callable[[np.random.Generator], tuple[np.ndarray, np.ndarray, float]]:
+def _framing(
+    size: tuple[float, float, float], parts: list[Part]
+) -> Callable[[np.random.Generator], tuple[np.ndarray, np.ndarray, float]]:
     """Camera proposals that frame one piece of furniture or object and its neighbours: the
     camera stands 1-1.7 times the distance at which the piece fills the field of view, at eye
     or seated height, looking at it from a random side (clipped to the room)."""
     w, d, h = size
-    spots = [((p.vertices.min(axis=0) + p.vertices.max(axis=0)) / 2,
-              max(float(np.linalg.norm(np.ptp(p.vertices, axis=0))) / 2, 0.15)) for p in parts]
+    spots = [
+        (
+            (p.vertices.min(axis=0) + p.vertices.max(axis=0)) / 2,
+            max(float(np.linalg.norm(np.ptp(p.vertices, axis=0))) / 2, 0.15),
+        )
+        for p in parts
+    ]
     spots = spots or [(np.array([w / 2, d / 2, 0.5]), 0.5)]
 
     def propose(r: np.random.Generator) -> tuple[np.ndarray, np.ndarray, float]:
@@ -221,17 +289,35 @@ def _framing(size: tuple[float, float, float],
 
 def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
     """Lay out a generated room (see the module docstring)."""
-    size = (float(rng.uniform(2.5, 6.0)), float(rng.uniform(2.5, 6.0)), float(rng.uniform(2.3, 3.2)))
+    size = (
+        float(rng.uniform(2.5, 6.0)),
+        float(rng.uniform(2.5, 6.0)),
+        float(rng.uniform(2.3, 3.2)),
+    )
     w, d, h = size
     shell, openness = _shell(rng, size, options.materials)
     floor = Footprints([])
-    furniture, tops = _furniture(rng, size, floor,
-                                 within(MaterialDistribution((2, 8), (0, 12)), options.materials))
+    furniture, tops = _furniture(
+        rng, size, floor, within(MaterialDistribution((2, 8), (0, 12)), options.materials)
+    )
     objects, patterns = _objects(rng, size, floor, tops, options)
     propose = _framing(size, [p for _, p in furniture + objects])
     volume, lighting = _light_volume(rng, size, openness)
-    info = {"generator": "rooms", "kind": "complex", "room_size": list(size), **openness, "lighting": lighting,
-            "n_furniture": len(furniture), "n_objects": len(objects),
-            "shapes": [n.rsplit("-", 1)[0] for n, _ in objects], "patterns": patterns}
-    return Layout(parts=(*shell, *furniture, *objects), lights=volume, propose_camera=propose,
-                  info=info, min_coverage=FRAMED_COVERAGE)
+    info = {
+        "generator": "rooms",
+        "kind": "complex",
+        "room_size": list(size),
+        **openness,
+        "lighting": lighting,
+        "n_furniture": len(furniture),
+        "n_objects": len(objects),
+        "shapes": [n.rsplit("-", 1)[0] for n, _ in objects],
+        "patterns": patterns,
+    }
+    return Layout(
+        parts=(*shell, *furniture, *objects),
+        lights=volume,
+        propose_camera=propose,
+        info=info,
+        min_coverage=FRAMED_COVERAGE,
+    )

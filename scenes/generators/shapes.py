@@ -35,7 +35,9 @@ def _block(rng: np.random.Generator, spectrum: str) -> Part:
 
 def _pillar(rng: np.random.Generator, spectrum: str) -> Part:
     r, h = rng.uniform(0.03, 0.09), rng.uniform(0.08, 0.3)
-    return cylinder(r, h, spectrum, sections=int(rng.integers(8, 33)), rings=int(rng.integers(2, 8)))
+    return cylinder(
+        r, h, spectrum, sections=int(rng.integers(8, 33)), rings=int(rng.integers(2, 8))
+    )
 
 
 def _ball(rng: np.random.Generator, spectrum: str) -> Part:
@@ -44,20 +46,27 @@ def _ball(rng: np.random.Generator, spectrum: str) -> Part:
 
 
 def _cone(rng: np.random.Generator, spectrum: str) -> Part:
-    return cone(rng.uniform(0.03, 0.1), rng.uniform(0.06, 0.25), spectrum,
-                  sections=int(rng.integers(6, 33)))
+    return cone(
+        rng.uniform(0.03, 0.1), rng.uniform(0.06, 0.25), spectrum, sections=int(rng.integers(6, 33))
+    )
 
 
 def _capsule(rng: np.random.Generator, spectrum: str) -> Part:
-    part = capsule(rng.uniform(0.02, 0.06), rng.uniform(0.04, 0.2), spectrum,
-                     sections=int(rng.integers(8, 25)))
+    part = capsule(
+        rng.uniform(0.02, 0.06), rng.uniform(0.04, 0.2), spectrum, sections=int(rng.integers(8, 25))
+    )
     return moved(part, rotate_deg=(90.0 * int(rng.integers(0, 2)), 0, 0))
 
 
 def _ring(rng: np.random.Generator, spectrum: str) -> Part:
     major = rng.uniform(0.04, 0.1)
-    return torus(major, major * rng.uniform(0.15, 0.45), spectrum,
-                   major_sections=int(rng.integers(12, 33)), minor_sections=int(rng.integers(6, 13)))
+    return torus(
+        major,
+        major * rng.uniform(0.15, 0.45),
+        spectrum,
+        major_sections=int(rng.integers(12, 33)),
+        minor_sections=int(rng.integers(6, 13)),
+    )
 
 
 def _vessel(rng: np.random.Generator, spectrum: str) -> Part:

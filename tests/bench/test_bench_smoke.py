@@ -16,8 +16,14 @@ from spectrinsic.bench import render as bench_render
 @pytest.fixture
 def tiny(monkeypatch):
     """The benchmarks' sizes cut to a few pixels and samples."""
-    for name, value in {"SIZE": 8, "SPP": 1, "OVERHEAD_SIZE": 8, "OVERHEAD_SPP": 1, "REPEATS": 1,
-                        "TRUTH_FACTOR": 2}.items():
+    for name, value in {
+        "SIZE": 8,
+        "SPP": 1,
+        "OVERHEAD_SIZE": 8,
+        "OVERHEAD_SPP": 1,
+        "REPEATS": 1,
+        "TRUTH_FACTOR": 2,
+    }.items():
         monkeypatch.setattr(bench_render, name, value)
     monkeypatch.setattr(bench_decompose, "SIZE", 32)  # LMSE needs a 20-pixel window
 

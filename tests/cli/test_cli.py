@@ -34,8 +34,12 @@ def test_bad_data_dir_is_one_line_error(tmp_path, capsys):
 
 def test_console_script_runs_in_a_fresh_interpreter():
     # -P: the repository root must never be on sys.path; the installed package is used.
-    out = subprocess.run([sys.executable, "-P", "-m", "spectrinsic", "--help"],
-                         capture_output=True, text=True, check=True).stdout
+    out = subprocess.run(
+        [sys.executable, "-P", "-m", "spectrinsic", "--help"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
     assert "spectrinsic" in out
 
 
@@ -82,8 +86,26 @@ def test_render_reads_a_mesh_file_as_dataset_scenes_does(tmp_path, capsys):
     obj.write_text("mtllib tri.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n")
     (tmp_path / "map.yaml").write_text("red: 'munsell:5R 4/14'\n")
     out = tmp_path / "out"
-    rc = main(["-q", "render", str(obj), "--material-map", str(tmp_path / "map.yaml"), "--out", str(out),
-               "--modes", "rgb3", "--spp", "1", "--width", "8", "--height", "6", "--no-aovs"])
+    rc = main(
+        [
+            "-q",
+            "render",
+            str(obj),
+            "--material-map",
+            str(tmp_path / "map.yaml"),
+            "--out",
+            str(out),
+            "--modes",
+            "rgb3",
+            "--spp",
+            "1",
+            "--width",
+            "8",
+            "--height",
+            "6",
+            "--no-aovs",
+        ]
+    )
     assert rc == 0, capsys.readouterr().err
     meta = json.loads((out / "meta.json").read_text())
     assert [m["spectrum"] for m in meta["scene"]["materials"]] == ["munsell:5R 4/14"]
@@ -96,12 +118,31 @@ def test_render_integrator_option_reaches_the_render(tmp_path, capsys, integrato
     """``--integrator`` is a render setting: the passes render rgb3 in 1 pass and bands31 in 11;
     the traversal renders both (and the AOVs) in one, reported on its own line."""
     out = tmp_path / integrator
-    rc = main(["-q", "render", "obj-box", "--out", str(out), "--modes", "rgb3,bands31", "--spp", "1",
-               "--width", "8", "--height", "8", "--integrator", integrator])
+    rc = main(
+        [
+            "-q",
+            "render",
+            "obj-box",
+            "--out",
+            str(out),
+            "--modes",
+            "rgb3,bands31",
+            "--spp",
+            "1",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--integrator",
+            integrator,
+        ]
+    )
     assert rc == 0
     meta = json.loads((out / "meta.json").read_text())
     assert meta["integrator"] == integrator
-    assert meta["timings"]["rgb3"]["passes"] + meta["timings"]["bands31"]["passes"] == diagonal_passes
+    assert (
+        meta["timings"]["rgb3"]["passes"] + meta["timings"]["bands31"]["passes"] == diagonal_passes
+    )
     assert ("traversal" in capsys.readouterr().out) == (integrator == "single")
 
 

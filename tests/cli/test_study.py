@@ -21,17 +21,34 @@ def test_reconstruction_error_cli_writes_table_and_extension(tmp_path, capsys, m
     monkeypatch.delenv("SPECTRINSIC_DATA", raising=False)
     assert main(["-q", "study", "reconstruction-error", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    assert "23.84 [23.84 +0.00]" in out  # 3 sensors, two bounces, max: thesis Table 5.2, and the difference
+    assert (
+        "23.84 [23.84 +0.00]" in out
+    )  # 3 sensors, two bounces, max: thesis Table 5.2, and the difference
     assert "note: skipped sfu" in out
-    for name in ("reconstruction_error.json", "reconstruction_error.csv", "reconstruction_error.png",
-                 "reconstruction_error_extended.json", "reconstruction_error_extended.csv",
-                 "reconstruction_error_delta_e.csv", "reconstruction_error_extended.png"):
+    for name in (
+        "reconstruction_error.json",
+        "reconstruction_error.csv",
+        "reconstruction_error.png",
+        "reconstruction_error_extended.json",
+        "reconstruction_error_extended.csv",
+        "reconstruction_error_delta_e.csv",
+        "reconstruction_error_extended.png",
+    ):
         assert (tmp_path / name).stat().st_size > 0, name
     doc = json.loads((tmp_path / "reconstruction_error.json").read_text())
     assert len(doc["rows"]) == 6
     assert {"n_sensors", "bounces", "mean_pct", "sd_pct", "max_pct"} <= set(doc["rows"][0])
-    for key in ("wavelength_start", "wavelength_end", "wavelength_step", "sigma_fraction",
-                "pair_threshold", "chip_threshold", "illuminant", "reflectances", "sensor_centres_nm"):
+    for key in (
+        "wavelength_start",
+        "wavelength_end",
+        "wavelength_step",
+        "sigma_fraction",
+        "pair_threshold",
+        "chip_threshold",
+        "illuminant",
+        "reflectances",
+        "sensor_centres_nm",
+    ):
         assert key in doc["settings"], key
     assert doc["settings"]["sensor_centres_nm"]["3"] == [450.0, 550.0, 650.0]
 

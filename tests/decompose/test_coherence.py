@@ -14,6 +14,7 @@ from spectrinsic.decompose.coherence import bounded_minimum, global_coherence
 @pytest.fixture(autouse=True)
 def _no_fallback(monkeypatch):
     """The active set must settle by itself on these problems, not hand over to LSMR."""
+
     def refuse(a):
         raise AssertionError("bounded_minimum fell back to LSMR")
 
@@ -36,8 +37,14 @@ def test_active_set_reaches_the_bounded_least_squares_minimum(seed):
     rng = np.random.default_rng(seed)
     a = _ratio_rows(rng, n=60, n_pairs=150)
     ours = bounded_minimum(a)
-    ref = lsq_linear(a.toarray(), np.zeros(a.shape[0]), bounds=(1.0, np.inf), method="bvls",
-                     tol=1e-14, max_iter=10000).x
+    ref = lsq_linear(
+        a.toarray(),
+        np.zeros(a.shape[0]),
+        bounds=(1.0, np.inf),
+        method="bvls",
+        tol=1e-14,
+        max_iter=10000,
+    ).x
     assert ours.min() >= 1.0 - 1e-12
     assert np.sum((a @ ours) ** 2) <= np.sum((a @ ref) ** 2) * (1 + 1e-9) + 1e-15
     np.testing.assert_allclose(ours, ref, rtol=1e-6)

@@ -18,17 +18,17 @@ from spectrinsic.decompose import colour_naming as cn
 #: "brown" (#A52A2A, a dark red). For those, "crimson", "royalblue" (= (65, 105, 225), which
 #: PROVENANCE lists as a blue) and "saddlebrown".
 FOCAL_SRGB8 = {
-    "black": (0, 0, 0),          # black
-    "white": (255, 255, 255),    # white
-    "red": (220, 20, 60),        # crimson
-    "green": (0, 128, 0),        # green
-    "yellow": (255, 255, 0),     # yellow
-    "blue": (65, 105, 225),      # royalblue
-    "brown": (139, 69, 19),      # saddlebrown
-    "purple": (128, 0, 128),     # purple
-    "orange": (255, 165, 0),     # orange
-    "pink": (255, 192, 203),     # pink
-    "grey": (128, 128, 128),     # grey
+    "black": (0, 0, 0),  # black
+    "white": (255, 255, 255),  # white
+    "red": (220, 20, 60),  # crimson
+    "green": (0, 128, 0),  # green
+    "yellow": (255, 255, 0),  # yellow
+    "blue": (65, 105, 225),  # royalblue
+    "brown": (139, 69, 19),  # saddlebrown
+    "purple": (128, 0, 128),  # purple
+    "orange": (255, 165, 0),  # orange
+    "pink": (255, 192, 203),  # pink
+    "grey": (128, 128, 128),  # grey
 }
 #: The raw model's memberships sum to >= 1; fuzzy chromatic sets overlap near the achromatic
 #: centre, reaching ~1.18 (measured on a 21^3 sRGB grid).

@@ -57,8 +57,12 @@ def test_scores_csv_and_progress(result):
     rows = list(csv.DictReader((out / "scores.csv").open()))
     assert set(rows[0]) == {"sample", "method", "scenario", "layer", "metric", "value"}
     assert {r["metric"] for r in rows if r["layer"] == "reflectance"} >= {"lmse", "whdr", "dssim"}
-    assert {r["scenario"] for r in rows} == {"srgb", "SC1_test-cam-npl", "SC3b_test-cam-npl",
-                                             "SC4_test-cam-npl"}
+    assert {r["scenario"] for r in rows} == {
+        "srgb",
+        "SC1_test-cam-npl",
+        "SC3b_test-cam-npl",
+        "SC4_test-cam-npl",
+    }
     assert len(rows) == len(res.scores)
 
 
@@ -129,14 +133,22 @@ def test_table_3_2_averages_grey_shading_and_grey_reflectance():
     from spectrinsic.decompose.evaluate import Score
     from spectrinsic.decompose.report import table_3_2
 
-    samples = {"obj-a__v0__white": ("object", "white"), "obj-b__v0__one-colour":
-               ("object", "one-colour"), "room__v0__white": ("complex", "white")}
+    samples = {
+        "obj-a__v0__white": ("object", "white"),
+        "obj-b__v0__one-colour": ("object", "one-colour"),
+        "room__v0__white": ("complex", "white"),
+    }
     scores = []
-    for sid, refl, shad in (("obj-a__v0__white", 0.2, 0.4), ("obj-b__v0__one-colour", 0.6, 0.0),
-                            ("room__v0__white", 9.0, 9.0)):
-        scores += [Score(sid, "m", "srgb", "reflectance_grey", "lmse", refl),
-                   Score(sid, "m", "srgb", "shading_grey", "lmse", shad),
-                   Score(sid, "m", "srgb", "reflectance", "lmse", 99.0)]
+    for sid, refl, shad in (
+        ("obj-a__v0__white", 0.2, 0.4),
+        ("obj-b__v0__one-colour", 0.6, 0.0),
+        ("room__v0__white", 9.0, 9.0),
+    ):
+        scores += [
+            Score(sid, "m", "srgb", "reflectance_grey", "lmse", refl),
+            Score(sid, "m", "srgb", "shading_grey", "lmse", shad),
+            Score(sid, "m", "srgb", "reflectance", "lmse", 99.0),
+        ]
     rows = {r["lighting"]: r for r in table_3_2(scores, samples)}
     assert rows["WL"]["lmse"] == pytest.approx(0.3)  # (0.2 + 0.4) / 2; the room is not an object
     assert rows["1L"]["lmse"] == pytest.approx(0.3)  # (0.6 + 0.0) / 2

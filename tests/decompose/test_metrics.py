@@ -40,12 +40,23 @@ def pair():
 @pytest.mark.parametrize("grey", [False, True])
 def test_identical_images_score_perfectly(pair, grey):
     truth = pair[0].mean(axis=2) if grey else pair[0]
-    names = [n for n in M.METRICS if not (grey and "reflectance" in M.METRICS[n].layers
-                                            and n.startswith(("angular", "chromaticity")))]
+    names = [
+        n
+        for n in M.METRICS
+        if not (
+            grey
+            and "reflectance" in M.METRICS[n].layers
+            and n.startswith(("angular", "chromaticity"))
+        )
+    ]
     scores = M.compute_metrics(truth, truth.copy(), names)
     for name, value in scores.items():
         expected = 1.0 if M.METRICS[name].better == "higher" else 0.0
-        tol = ANGLE_ROUNDOFF_DEG if "angular" in M.METRICS[name].equation or "4.31" in M.METRICS[name].equation else EXACT
+        tol = (
+            ANGLE_ROUNDOFF_DEG
+            if "angular" in M.METRICS[name].equation or "4.31" in M.METRICS[name].equation
+            else EXACT
+        )
         assert value == pytest.approx(expected, abs=tol), name
 
 
@@ -57,7 +68,11 @@ def test_scaled_estimate_scores_zero_on_scale_invariant_metrics(pair):
         assert metric.scale_invariant
         value = metric.func(truth, 3.7 * truth, mask=mask)
         expected = 1.0 if metric.better == "higher" else 0.0
-        tol = ANGLE_ROUNDOFF_DEG if "angular" in M.METRICS[name].equation or "4.31" in M.METRICS[name].equation else SCALED
+        tol = (
+            ANGLE_ROUNDOFF_DEG
+            if "angular" in M.METRICS[name].equation or "4.31" in M.METRICS[name].equation
+            else SCALED
+        )
         assert value == pytest.approx(expected, abs=tol), name
     judgements = sample_judgements(truth, seed=1, n_pairs=300, mask=mask)
     assert M.whdr(3.7 * truth, judgements) == 0.0
@@ -149,7 +164,9 @@ def test_sample_judgements_is_seeded_and_mixes_materials():
     assert np.all(i1[a.within] == i2[a.within]) and np.all(i1[~a.within] != i2[~a.within])
     assert np.all(a.labels[a.within] == EQUAL)  # flat materials: equal reflectance
     assert {DARKER_1, DARKER_2} <= set(a.labels[~a.within].tolist())
-    assert M.whdr(refl, a) == 0.0 and M.whdr(refl[..., ::-1] * 0 + rng.uniform(size=refl.shape), a) > 0
+    assert (
+        M.whdr(refl, a) == 0.0 and M.whdr(refl[..., ::-1] * 0 + rng.uniform(size=refl.shape), a) > 0
+    )
 
 
 def test_angular_error_stats():
@@ -241,11 +258,13 @@ def test_maw_split_separates_colour_from_lightness():
     angle = math.degrees(math.acos(3.0 / math.sqrt(3.0 * 3.5)))
     assert MC.reflectance_intensity_error(truth, recoloured) == pytest.approx(0.0, abs=EXACT)
     assert MC.reflectance_chromaticity_error(truth, recoloured) == pytest.approx(
-        angle, abs=ANGLE_ROUNDOFF_DEG)
+        angle, abs=ANGLE_ROUNDOFF_DEG
+    )
     darker = truth.copy()
     darker[0] *= 0.5  # lightness change, colour kept
     assert MC.reflectance_chromaticity_error(truth, darker) == pytest.approx(
-        0.0, abs=ANGLE_ROUNDOFF_DEG)
+        0.0, abs=ANGLE_ROUNDOFF_DEG
+    )
     # intensities 1 (6 px) and 0.5 (3 px) against 1: alpha = 7.5/9, see the formula above
     t = np.array([1.0] * 6 + [1.0] * 3)
     e = np.array([1.0] * 6 + [0.5] * 3)

@@ -41,9 +41,9 @@ def _local_error(correct, estimate, mask, window=20, shift=10):
     ssq = total = 0.0
     for i in range(0, correct.shape[0] - window + 1, shift):
         for j in range(0, correct.shape[1] - window + 1, shift):
-            c = correct[i:i + window, j:j + window]
-            e = estimate[i:i + window, j:j + window]
-            m = mask[i:i + window, j:j + window]
+            c = correct[i : i + window, j : j + window]
+            e = estimate[i : i + window, j : j + window]
+            m = mask[i : i + window, j : j + window]
             ssq += _ssq_error(c, e, m)
             total += np.sum(m * c**2)
     return ssq / total
@@ -62,8 +62,10 @@ def _reference_score(obj, result: Decomposition) -> float:
     shading = np.asarray(result.shading, float).mean(axis=2)
     refl = np.asarray(result.reflectance, float).mean(axis=2)
     true_refl = obj.reflectance.mean(axis=2) * m
-    return 0.5 * (_local_error(obj.shading * m, fitted(obj.shading * m, shading), m)
-                  + _local_error(true_refl, fitted(true_refl, refl), m))
+    return 0.5 * (
+        _local_error(obj.shading * m, fitted(obj.shading * m, shading), m)
+        + _local_error(true_refl, fitted(true_refl, refl), m)
+    )
 
 
 def _make_object(folder: Path, name: str, seed: int, shape=(60, 72)) -> None:
@@ -82,8 +84,13 @@ def _make_object(folder: Path, name: str, seed: int, shape=(60, 72)) -> None:
     def codes(a):
         return np.rint(np.clip(a, 0, 1) * 65535).astype(np.uint16)
 
-    np.savez(folder / f"{name}.npz", diffuse=codes(diffuse), reflectance=codes(reflectance),
-             shading=codes(shading), mask=mask)
+    np.savez(
+        folder / f"{name}.npz",
+        diffuse=codes(diffuse),
+        reflectance=codes(reflectance),
+        shading=codes(shading),
+        mask=mask,
+    )
 
 
 @pytest.fixture
@@ -114,7 +121,8 @@ def test_lmse_matches_grosse_loops_on_a_synthetic_folder(mit_folder, method):
         obj = load_mit_object(path)
         result = method(obj.image, obj.mask)
         assert mit_measures(obj, result)["lmse"] == pytest.approx(
-            _reference_score(obj, result), abs=1e-6)
+            _reference_score(obj, result), abs=1e-6
+        )
 
 
 def test_cli_scores_methods_and_predictions_on_an_mit_folder(mit_folder, tmp_path, capsys):
@@ -122,12 +130,24 @@ def test_cli_scores_methods_and_predictions_on_an_mit_folder(mit_folder, tmp_pat
     for path in mit_folder_objects(mit_folder):
         obj = load_mit_object(path)
         (preds / obj.name).mkdir(parents=True)
-        write_png16(preds / obj.name / "shading.png",
-                    np.rint(obj.shading * 65535).astype(np.uint16))
+        write_png16(
+            preds / obj.name / "shading.png", np.rint(obj.shading * 65535).astype(np.uint16)
+        )
     out = tmp_path / "out"
-    rc = main(["-q", "evaluate", "--mit", str(mit_folder), "--methods",
-               "image-as-reflectance,colour-retinex", "--predictions", f"truth={preds}",
-               "--out", str(out)])
+    rc = main(
+        [
+            "-q",
+            "evaluate",
+            "--mit",
+            str(mit_folder),
+            "--methods",
+            "image-as-reflectance,colour-retinex",
+            "--predictions",
+            f"truth={preds}",
+            "--out",
+            str(out),
+        ]
+    )
     assert rc == 0
     table = (out / "mit_table_3_2.md").read_text()
     assert "| colour-retinex | 2 |" in table and "| truth | 2 |" in table
@@ -140,14 +160,18 @@ def test_cli_scores_methods_and_predictions_on_an_mit_folder(mit_folder, tmp_pat
             continue
         method = ColourRetinex() if row["method"] == "colour-retinex" else ImageAsReflectance()
         assert float(row["lmse"]) == pytest.approx(
-            _reference_score(obj, method(obj.image, obj.mask)), abs=1e-6)
+            _reference_score(obj, method(obj.image, obj.mask)), abs=1e-6
+        )
     assert "MIT protocol on 2 objects" in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("make, expected", [
-    (lambda t: ["--mit", str(t / "absent")], "does not exist"),
-    (lambda t: ["--mit", str(t)], "holds no <object>.npz"),
-])
+@pytest.mark.parametrize(
+    "make, expected",
+    [
+        (lambda t: ["--mit", str(t / "absent")], "does not exist"),
+        (lambda t: ["--mit", str(t)], "holds no <object>.npz"),
+    ],
+)
 def test_bad_mit_folder_is_one_line_rc2(tmp_path, capsys, make, expected):
     rc = main(["-q", "evaluate", *make(tmp_path), "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err.strip()
@@ -164,8 +188,9 @@ def test_incomplete_object_file_is_named(tmp_path):
 def _mit_dev(data_dir: Path) -> Path:
     folder = data_dir / "mit_intrinsic_dev"
     if not folder.is_dir():
-        pytest.skip("MIT development half not in the data directory "
-                    "(SPECTRINSIC_DATA/mit_intrinsic_dev)")
+        pytest.skip(
+            "MIT development half not in the data directory (SPECTRINSIC_DATA/mit_intrinsic_dev)"
+        )
     return folder
 
 

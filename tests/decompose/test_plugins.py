@@ -45,8 +45,9 @@ def _install_dist(root, entries: dict[str, str]) -> None:
     (root / "toy_spectrinsic_plugin.py").write_text(TOY_MODULE)
     info = root / "toy_spectrinsic_plugin-0.1.dist-info"
     info.mkdir()
-    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: toy-spectrinsic-plugin\n"
-                                   "Version: 0.1\n")
+    (info / "METADATA").write_text(
+        "Metadata-Version: 2.1\nName: toy-spectrinsic-plugin\nVersion: 0.1\n"
+    )
     lines = "\n".join(f"{k} = {v}" for k, v in entries.items())
     (info / "entry_points.txt").write_text(f"[{ENTRY_POINT_GROUP}]\n{lines}\n")
 
@@ -68,13 +69,21 @@ def test_entry_point_adds_a_method_to_the_registry_and_the_tables(plugin_dir, tm
 
     samples = [_sample("obj-a__v0__white", 0, (1, 1, 1), False)]
     out = tmp_path / "evaluation"
-    evaluate(samples, out, methods=["image-as-reflectance", "toy-half"], seed=0,
-             cameras=False, figures=False, save_estimates=False)
+    evaluate(
+        samples,
+        out,
+        methods=["image-as-reflectance", "toy-half"],
+        seed=0,
+        cameras=False,
+        figures=False,
+        save_estimates=False,
+    )
     rows = {r["method"]: r for r in csv.DictReader((out / "lmse_by_condition.csv").open())}
     assert set(rows) == {"image-as-reflectance", "toy-half"}
     # image / 2 is the image up to scale: every scale-invariant score equals the baseline's
     assert float(rows["toy-half"]["reflectance_WL"]) == pytest.approx(
-        float(rows["image-as-reflectance"]["reflectance_WL"]), rel=1e-9)
+        float(rows["image-as-reflectance"]["reflectance_WL"]), rel=1e-9
+    )
     assert "toy-half" in (out / "REPORT.md").read_text()
 
 

@@ -47,13 +47,17 @@ def _write_baseline_as_files(root, result_dir):
 
 
 def test_predictions_folder_scores_exactly_like_the_builtin_baseline(tmp_path):
-    builtin = evaluate(_samples(), tmp_path / "builtin", methods=[BASELINE], seed=5,
-                       figures=False)
+    builtin = evaluate(_samples(), tmp_path / "builtin", methods=[BASELINE], seed=5, figures=False)
     root = tmp_path / "mine"
     _write_baseline_as_files(root, tmp_path / "builtin")
-    mine = evaluate(_samples(), tmp_path / "scored",
-                    methods={BASELINE: Predictions(root, name=BASELINE)}, seed=5, figures=False,
-                    save_estimates=False)
+    mine = evaluate(
+        _samples(),
+        tmp_path / "scored",
+        methods={BASELINE: Predictions(root, name=BASELINE)},
+        seed=5,
+        figures=False,
+        save_estimates=False,
+    )
 
     def key(s):
         return (s.sample, s.method, s.scenario, s.layer, s.metric)
@@ -64,8 +68,12 @@ def test_predictions_folder_scores_exactly_like_the_builtin_baseline(tmp_path):
     assert any(k[2].startswith("SC1_") for k in got)  # camera scenarios were scored too
     for k, v in expected.items():
         assert (math.isnan(v) and math.isnan(got[k])) or got[k] == v, k
-    for name in ("lmse_by_condition.csv", "colour_by_condition.csv", "lmse_by_scenario.csv",
-                 "table_3_2_objects.csv"):
+    for name in (
+        "lmse_by_condition.csv",
+        "colour_by_condition.csv",
+        "lmse_by_scenario.csv",
+        "table_3_2_objects.csv",
+    ):
         assert (tmp_path / "scored" / name).read_text() == (tmp_path / "builtin" / name).read_text()
     report = (tmp_path / "scored" / "REPORT.md").read_text()
     assert "predictions.Predictions" in report and "`shading_grey`" in report
@@ -106,8 +114,10 @@ def test_missing_and_bad_predictions_are_one_line_errors(tmp_path):
         Predictions(tmp_path / "nowhere")
     with pytest.raises(DatasetError, match="no reflectance or shading"):
         Predictions(tmp_path).load("obj-a__v0__white", "srgb", image, np.ones((48, 48), bool))
-    assert Predictions(tmp_path).load("obj-a__v0__white", "SC4_x", image,
-                                      np.ones((48, 48), bool)) is None
+    assert (
+        Predictions(tmp_path).load("obj-a__v0__white", "SC4_x", image, np.ones((48, 48), bool))
+        is None
+    )
     from PIL import Image
 
     (tmp_path / "s").mkdir()
@@ -122,15 +132,18 @@ def test_cli_predictions_options(tmp_path):
 
     (tmp_path / "mine").mkdir()
     args = build_parser().parse_args(
-        ["evaluate", "--predictions", f"ours={tmp_path / 'mine'}", "--png-encoding", "srgb"])
+        ["evaluate", "--predictions", f"ours={tmp_path / 'mine'}", "--png-encoding", "srgb"]
+    )
     methods = _methods(args)
     assert list(methods) == ["ours"]  # no bundled method unless --methods asks
     assert methods["ours"].encoding == "srgb" and methods["ours"].name == "ours"
     args = build_parser().parse_args(
-        ["evaluate", "--methods", BASELINE, "--predictions", str(tmp_path / "mine")])
+        ["evaluate", "--methods", BASELINE, "--predictions", str(tmp_path / "mine")]
+    )
     assert list(_methods(args)) == [BASELINE, "mine"]
     args = build_parser().parse_args(
-        ["evaluate", "--methods", BASELINE, "--predictions", f"{BASELINE}={tmp_path / 'mine'}"])
+        ["evaluate", "--methods", BASELINE, "--predictions", f"{BASELINE}={tmp_path / 'mine'}"]
+    )
     with pytest.raises(DatasetError, match="already used"):
         _methods(args)
 
@@ -141,11 +154,17 @@ def _png_declaring(path, width: int, height: int) -> None:
     import zlib
 
     def chunk(kind: bytes, data: bytes) -> bytes:
-        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+        return (
+            struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+        )
 
     ihdr = struct.pack(">IIBBBBB", width, height, 16, 2, 0, 0, 0)
-    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(bytes(64)))
-                     + chunk(b"IEND", b""))
+    path.write_bytes(
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", ihdr)
+        + chunk(b"IDAT", zlib.compress(bytes(64)))
+        + chunk(b"IEND", b"")
+    )
 
 
 def _exr_declaring(path, width: int, height: int) -> None:
@@ -157,7 +176,7 @@ def _exr_declaring(path, width: int, height: int) -> None:
     write_exr(path, {"reflectance": np.zeros((4, 4, 3), np.float32)})
     data = bytearray(path.read_bytes())
     at = data.index(b"dataWindow\x00box2i\x00") + len(b"dataWindow\x00box2i\x00") + 4
-    data[at:at + 16] = struct.pack("<iiii", 0, 0, width - 1, height - 1)
+    data[at : at + 16] = struct.pack("<iiii", 0, 0, width - 1, height - 1)
     path.write_bytes(bytes(data))
 
 

@@ -40,7 +40,10 @@ def test_hold_one_out_needs_two_groups_and_treats_nan_as_worst():
 
 
 def test_grid_points_and_groups():
-    assert grid_points({"b": [1, 2], "a": ["u"]}) == [(("a", "u"), ("b", 1)), (("a", "u"), ("b", 2))]
+    assert grid_points({"b": [1, 2], "a": ["u"]}) == [
+        (("a", "u"), ("b", 1)),
+        (("a", "u"), ("b", 2)),
+    ]
     assert scene_group("obj-apple__v0__two-colour-a") == "obj-apple"
 
 

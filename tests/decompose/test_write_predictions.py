@@ -20,14 +20,21 @@ SRGB_SLOPE = 2.4 / 1.055
 
 def _arrays(h=5, w=7, seed=0):
     rng = np.random.default_rng(seed)
-    return rng.uniform(0.0, 1.0, (h, w, 3)), rng.uniform(0.0, 6.0, (h, w, 3)), rng.uniform(0, 1, (h, w))
+    return (
+        rng.uniform(0.0, 1.0, (h, w, 3)),
+        rng.uniform(0.0, 6.0, (h, w, 3)),
+        rng.uniform(0, 1, (h, w)),
+    )
 
 
 def test_exr_round_trip_is_float32_exact(tmp_path):
     refl, shad, _ = _arrays()
     out = write_predictions(tmp_path, "s__v0__white", reflectance=refl, shading=shad)
     assert out.folder == tmp_path / "s__v0__white" and set(out.files) == {"reflectance", "shading"}
-    assert out.files["shading"].name == "shading.exr" and out.scales == {"reflectance": 1.0, "shading": 1.0}
+    assert out.files["shading"].name == "shading.exr" and out.scales == {
+        "reflectance": 1.0,
+        "shading": 1.0,
+    }
     for name, truth in (("reflectance", refl), ("shading", shad)):
         back = read_layer(out.folder, name, (5, 7), encoding="linear")
         np.testing.assert_array_equal(back, truth.astype(np.float32))
@@ -75,22 +82,42 @@ def test_refusals_are_one_line_errors_and_keep_files(tmp_path):
 @pytest.mark.parametrize("fmt", ["exr", "png"])
 def test_ground_truth_written_as_predictions_scores_perfectly(tmp_path, fmt):
     """End to end: the true layers, written by the helper, score LMSE 0 (to quantisation)."""
-    samples = [_sample("obj-a__v0__white", 0, (1, 1, 1), False),
-               _sample("room-b__v1__two-colour-a", 2, (0.7, 0.9, 1.0), False)]
+    samples = [
+        _sample("obj-a__v0__white", 0, (1, 1, 1), False),
+        _sample("room-b__v1__two-colour-a", 2, (0.7, 0.9, 1.0), False),
+    ]
     for s in samples:
-        write_predictions(tmp_path / "pred", s["meta"]["sample_id"], fmt=fmt,
-                          reflectance=s["reflectance"], shading=s["shading"])
-    result = evaluate(samples, tmp_path / "out", methods={"truth": Predictions(tmp_path / "pred")},
-                      seed=0, figures=False, save_estimates=False)
+        write_predictions(
+            tmp_path / "pred",
+            s["meta"]["sample_id"],
+            fmt=fmt,
+            reflectance=s["reflectance"],
+            shading=s["shading"],
+        )
+    result = evaluate(
+        samples,
+        tmp_path / "out",
+        methods={"truth": Predictions(tmp_path / "pred")},
+        seed=0,
+        figures=False,
+        save_estimates=False,
+    )
     lmse = [s.value for s in result.scores if s.metric == "lmse" and s.scenario == "srgb"]
     assert len(lmse) >= 4  # reflectance and shading of both samples
     assert max(lmse) <= (1e-12 if fmt == "exr" else 1e-6)
     # a method that is not the truth scores visibly worse through the same files
     s = samples[0]
-    write_predictions(tmp_path / "flat", s["meta"]["sample_id"],
-                      reflectance=np.ones_like(s["reflectance"]))
-    worse = evaluate(samples[:1], tmp_path / "out2", methods={"flat": Predictions(tmp_path / "flat")},
-                     seed=0, figures=False, save_estimates=False)
+    write_predictions(
+        tmp_path / "flat", s["meta"]["sample_id"], reflectance=np.ones_like(s["reflectance"])
+    )
+    worse = evaluate(
+        samples[:1],
+        tmp_path / "out2",
+        methods={"flat": Predictions(tmp_path / "flat")},
+        seed=0,
+        figures=False,
+        save_estimates=False,
+    )
     assert max(x.value for x in worse.scores if x.metric == "lmse") > 1e-3
     assert input_image(s)[1].shape == s["reflectance"].shape
 

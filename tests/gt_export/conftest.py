@@ -67,8 +67,13 @@ def make_scene(lights: tuple[str, ...] = ("planck:2800K",)) -> Scene:
         meshes=(mesh,),
         materials=tuple(Material(f"m{i}", s) for i, s in enumerate(MATERIALS)),
         lights=tuple(
-            Light(kind="point", spectrum=s, power=10.0 + i, position=(float(i), 0.0, 2.0),
-                  name=f"lamp{i}")
+            Light(
+                kind="point",
+                spectrum=s,
+                power=10.0 + i,
+                position=(float(i), 0.0, 2.0),
+                name=f"lamp{i}",
+            )
             for i, s in enumerate(lights)
         ),
         camera=Camera(origin=(0.0, -3.0, 1.0), target=(0.0, 0.0, 0.0), width=W, height=H),
@@ -98,8 +103,9 @@ def make_result(
     n_lights = len(scene.lights)
     if geometry is None:
         yy, xx = np.mgrid[0:H, 0:W] / max(H, W)
-        geometry = np.stack([0.2 + 0.8 * (xx if i % 2 == 0 else 1 - xx) * (0.5 + yy)
-                             for i in range(n_lights)])
+        geometry = np.stack(
+            [0.2 + 0.8 * (xx if i % 2 == 0 else 1 - xx) * (0.5 + yy) for i in range(n_lights)]
+        )
     cov = coverage_map()
     rho = np.stack([get_spectrum(m.spectrum).on(wl) for m in scene.materials])  # (M, W)
     spds = np.stack([get_spectrum(light.spectrum).on(wl) for light in scene.lights])  # (L, W)
@@ -113,8 +119,10 @@ def make_result(
     images = {}
     for mode in modes:
         images[mode] = (xyz * 1.02 if mode == "rgb3" else xyz).astype(np.float32)
-    per_light = tuple({m: (xyz_l[i] * (1.02 if m == "rgb3" else 1.0)).astype(np.float32)
-                       for m in modes} for i in range(n_lights))
+    per_light = tuple(
+        {m: (xyz_l[i] * (1.02 if m == "rgb3" else 1.0)).astype(np.float32) for m in modes}
+        for i in range(n_lights)
+    )
     coverage_sum = cov.sum(axis=-1)
     material_id = np.where(coverage_sum > 0, np.argmax(cov, axis=-1), -1).astype(np.int32)
     normals = np.zeros((H, W, 3), np.float32)
@@ -129,8 +137,12 @@ def make_result(
     }
     raw = {"bands31": cube.astype(np.float32)} if "bands31" in modes else {}
     meta = {
-        "variants": {"spectral": "synthetic", "bands31": "synthetic"}, "spp": 1, "seed": 0, "max_depth": 8,
-        "sensors": {"bands31": "bands:31@400-700"}, "timings": {"total": 0.123},
+        "variants": {"spectral": "synthetic", "bands31": "synthetic"},
+        "spp": 1,
+        "seed": 0,
+        "max_depth": 8,
+        "sensors": {"bands31": "bands:31@400-700"},
+        "timings": {"total": 0.123},
     }
     return FakeResult(images=images, raw=raw, per_light=per_light, aovs=aovs, meta=meta)
 
@@ -157,9 +169,15 @@ def synth() -> Any:
     """The builders above, for tests that need their own variants."""
     from types import SimpleNamespace
 
-    return SimpleNamespace(make_scene=make_scene, make_result=make_result,
-                           coverage_map=coverage_map, H=H, W=W, MATERIALS=MATERIALS,
-                           FakeResult=FakeResult)
+    return SimpleNamespace(
+        make_scene=make_scene,
+        make_result=make_result,
+        coverage_map=coverage_map,
+        H=H,
+        W=W,
+        MATERIALS=MATERIALS,
+        FakeResult=FakeResult,
+    )
 
 
 @pytest.fixture

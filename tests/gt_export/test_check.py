@@ -86,7 +86,11 @@ def test_cli_exit_status_and_report(built, capsys):
     (built / "one" / "scene.json").write_text("{}")
     assert main(["-q", "check", str(built)]) == 1
     out = capsys.readouterr().out
-    assert "one: 2 problem(s)" in out and "SHA-256 in meta.json" in out and "SHA-256 in manifest.json" in out
+    assert (
+        "one: 2 problem(s)" in out
+        and "SHA-256 in meta.json" in out
+        and "SHA-256 in manifest.json" in out
+    )
 
 
 def test_noise_from_two_batches_is_reported_and_flagged(tmp_path, synth, config):
@@ -101,7 +105,9 @@ def test_noise_from_two_batches_is_reported_and_flagged(tmp_path, synth, config)
     scene = synth.make_scene(("planck:2800K",))
     result = synth.make_result(scene)
     cube = result.raw["bands31"]
-    result = dataclasses.replace(result, batch_raw=({"bands31": cube * 1.1}, {"bands31": cube * 0.9}))
+    result = dataclasses.replace(
+        result, batch_raw=({"bands31": cube * 1.1}, {"bands31": cube * 0.9})
+    )
     folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=1)
     write_manifest(tmp_path, config)
     meta = json.loads((folder / "meta.json").read_text())

@@ -18,7 +18,9 @@ def test_pad_lights_keeps_the_real_channels_and_zeroes_the_rest():
     assert padded.shape == (4, 3, 4) and padded.dtype == np.float32
     assert np.array_equal(padded[:2], share) and not padded[2:].any()
     one = pad_lights(share[0], 3, channel_first=False)  # (H, W) is one light
-    assert one.shape == (3, 4, 3) and np.array_equal(one[..., 0], share[0]) and not one[..., 1:].any()
+    assert (
+        one.shape == (3, 4, 3) and np.array_equal(one[..., 0], share[0]) and not one[..., 1:].any()
+    )
     with pytest.raises(DatasetError, match="2 lights"):
         pad_lights(share, 1, channel_first=True)
 

@@ -23,7 +23,10 @@ def test_torch_dataset_batches_of_8_with_a_light_mask(built, torch):
     assert batch["image"].shape == (2, 3, 12, 16) and batch["image"].dtype == torch.float32
     assert batch["light_share"].shape == (2, 2, 12, 16)
     assert batch["light_mask"].tolist() == [[True, False], [True, True]]
-    assert batch["ids"]["object"].shape == (2, 1, 12, 16) and batch["ids"]["object"].dtype == torch.int32
+    assert (
+        batch["ids"]["object"].shape == (2, 1, 12, 16)
+        and batch["ids"]["object"].dtype == torch.int32
+    )
     for i in range(2):
         item = ds[i]
         assert torch.equal(batch["image"][i], item["image"])

@@ -25,8 +25,12 @@ def _random_layers(rng: np.random.Generator) -> dict[str, np.ndarray]:
 
 def test_round_trip_is_bit_exact(tmp_path):
     layers = _random_layers(np.random.default_rng(0))
-    path = write_exr(tmp_path / "a.exr", layers, channel_names={"depth": ("Z",)},
-                     attributes={"spectrinsic.sample": "s1"})
+    path = write_exr(
+        tmp_path / "a.exr",
+        layers,
+        channel_names={"depth": ("Z",)},
+        attributes={"spectrinsic.sample": "s1"},
+    )
     back = read_exr(path)
     assert set(back) == set(layers)
     for name, array in layers.items():
@@ -43,7 +47,9 @@ def test_channels_are_named_and_stored_as_float32(tmp_path):
     import OpenEXR
 
     rgb = np.arange(2 * 3 * 3, dtype=np.float32).reshape(2, 3, 3)
-    path = write_exr(tmp_path / "n.exr", {"normals": rgb}, channel_names={"normals": ("X", "Y", "Z")})
+    path = write_exr(
+        tmp_path / "n.exr", {"normals": rgb}, channel_names={"normals": ("X", "Y", "Z")}
+    )
     f = OpenEXR.File(str(path), separate_channels=True)
     channels = f.channels()
     assert sorted(channels) == ["normals.X", "normals.Y", "normals.Z"]

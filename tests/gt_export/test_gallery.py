@@ -21,7 +21,8 @@ HAVE_SELENIUM = importlib.util.find_spec("selenium") is not None
 needs_browser = pytest.mark.skipif(
     CHROMIUM is None or CHROMEDRIVER is None or not HAVE_SELENIUM,
     reason="headless Chromium, chromium-driver or selenium not installed (scripts/setup-system.sh "
-           "installs the Debian packages chromium and chromium-driver, `make setup` selenium)")
+    "installs the Debian packages chromium and chromium-driver, `make setup` selenium)",
+)
 #: Seconds the browser may take to show an element (it starts in ~1 s here).
 BROWSER_WAIT_S = 20
 #: Slack on top of a preview's stated precision (float32 EXR vs float64 decoding in the page).
@@ -36,10 +37,18 @@ def dataset(tmp_path, one_light_sample, two_light_sample, config):
     samples = {"one": one_light_sample, "two": two_light_sample, "three": one_light_sample}
     for sid, (scene, result) in samples.items():
         meta = {**scene.metadata, "condition": CONDITIONS[sid], "kind": "object"}
-        export_sample(tmp_path / "ds", dataclasses.replace(scene, metadata=meta), result,
-                      sample_id=sid, config=config, seed=1)
+        export_sample(
+            tmp_path / "ds",
+            dataclasses.replace(scene, metadata=meta),
+            result,
+            sample_id=sid,
+            config=config,
+            seed=1,
+        )
     root = tmp_path / "ds"
-    (root / "manifest.json").write_text(json.dumps({"splits": {"train": ["one", "two"], "test": ["three"]}}))
+    (root / "manifest.json").write_text(
+        json.dumps({"splits": {"train": ["one", "two"], "test": ["three"]}})
+    )
     return root
 
 
@@ -52,7 +61,7 @@ def _script_index(root: Path) -> dict:
     text = (root / "gallery-index.js").read_text()
     prefix = f"window.{INDEX_VARIABLE} = "
     assert text.startswith(prefix)
-    return json.loads(text[len(prefix):].rstrip().rstrip(";"))
+    return json.loads(text[len(prefix) :].rstrip().rstrip(";"))
 
 
 def test_index_records_every_sample_with_its_previews_and_encodings(gallery):
@@ -61,12 +70,18 @@ def test_index_records_every_sample_with_its_previews_and_encodings(gallery):
     assert _script_index(root) == index  # the page's script holds the same index
     assert [s["id"] for s in index["samples"]] == ["one", "three", "two"]
     by_id = {s["id"]: s for s in index["samples"]}
-    assert {s: by_id[s]["split"] for s in by_id} == {"one": "train", "two": "train", "three": "test"}
+    assert {s: by_id[s]["split"] for s in by_id} == {
+        "one": "train",
+        "two": "train",
+        "three": "test",
+    }
     assert index["splits"] == ["test", "train"]
     for sid, entry in by_id.items():
         meta = json.loads((root / sid / "meta.json").read_text())
         assert entry["condition"] == CONDITIONS[sid]
-        assert entry["generator"] == "own scene"  # the synthetic scenes name no library or generator
+        assert (
+            entry["generator"] == "own scene"
+        )  # the synthetic scenes name no library or generator
         for name, rec in meta["layers"].items():
             if rec["preview"]:
                 src, enc = entry["layers"][name]
@@ -76,7 +91,8 @@ def test_index_records_every_sample_with_its_previews_and_encodings(gallery):
         assert all((root / f).is_file() for f in entry["files"])
         pixels = (root / entry["pixels"]).read_text()
         assert pixels.count("data:image/png;base64,") == sum(
-            enc["kind"] != "categorical" for _, enc in entry["layers"].values())
+            enc["kind"] != "categorical" for _, enc in entry["layers"].values()
+        )
     for name, lut in index["colormaps"].items():
         assert len(lut) == 256, name
     # the locus starts in the violet corner (x≈0.17, y≈0.005) and passes near the green peak
@@ -114,8 +130,13 @@ def _driver(screenshots: Path, *, file_access: bool = False):
     from selenium.webdriver.chrome.service import Service
 
     options = webdriver.ChromeOptions()
-    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                "--window-size=1400,1000"):
+    for arg in (
+        "--headless=new",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-dev-shm-usage",
+        "--window-size=1400,1000",
+    ):
         options.add_argument(arg)
     if file_access:
         options.add_argument("--allow-file-access-from-files")
@@ -141,10 +162,14 @@ def _pixel_report(driver, element, dx: int, dy: int, layers: tuple[str, ...]) ->
         report = json.loads(d.find_element("id", "readout").get_attribute("data-report") or "{}")
         return report if set(layers) <= set(report.get("layers", {})) else False
 
-    return WebDriverWait(driver, BROWSER_WAIT_S).until(ready, driver.find_element("id", "readout").text)
+    return WebDriverWait(driver, BROWSER_WAIT_S).until(
+        ready, driver.find_element("id", "readout").text
+    )
 
 
-def _check_readout_against_exr(report: dict, root: Path, sample: str, layer: str, info: dict) -> int:
+def _check_readout_against_exr(
+    report: dict, root: Path, sample: str, layer: str, info: dict
+) -> int:
     """Assert the readout of *layer* matches the EXR pixel within its stated precision; return
     how many channels were inside the encoded range (and so compared to a value)."""
     exr = read_exr(root / sample / info["file"], layers=[info["exr_layer"]])[info["exr_layer"]]
@@ -195,21 +220,34 @@ def test_a_person_filters_opens_a_sample_and_reads_a_pixel(gallery, tmp_path):
         driver.find_element("id", "viewer").click()
         assert image.size["width"] == 2 * width
         viewer = driver.find_element("id", "viewer")
-        ActionChains(driver).key_down(Keys.SHIFT).click(viewer).key_up(Keys.SHIFT).perform()  # zoom out
+        ActionChains(driver).key_down(Keys.SHIFT).click(viewer).key_up(
+            Keys.SHIFT
+        ).perform()  # zoom out
         assert image.size["width"] == width
         assert len(driver.find_elements("css selector", "#lights circle.light-dot")) == 1
         # switch layers: A to the error map (a colour bar appears), back to the image
-        driver.find_element("css selector", '#layers button[data-layer="noise_image"], #layers button[data-layer="depth"]').click()
+        driver.find_element(
+            "css selector",
+            '#layers button[data-layer="noise_image"], #layers button[data-layer="depth"]',
+        ).click()
         assert driver.find_elements("css selector", "#colourbars canvas")
-        layer_a = driver.execute_script("return document.querySelector('#layers button.on').dataset.layer")
+        layer_a = driver.execute_script(
+            "return document.querySelector('#layers button.on').dataset.layer"
+        )
         assert image.get_attribute("src").endswith(f"previews/{layer_a}.png")
         driver.find_element("css selector", '#layers button[data-layer="image"]').click()
         Select(driver.find_element("id", "layer-b")).select_by_value("reflectance")
         # move the A/B slider: B's clip follows it
         slider = driver.find_element("id", "ab-slider")
-        before = driver.find_element("css selector", "#viewer img.b").value_of_css_property("clip-path")
-        ActionChains(driver).click_and_hold(slider).move_by_offset(-slider.size["width"] // 3, 0).release().perform()
-        after = driver.find_element("css selector", "#viewer img.b").value_of_css_property("clip-path")
+        before = driver.find_element("css selector", "#viewer img.b").value_of_css_property(
+            "clip-path"
+        )
+        ActionChains(driver).click_and_hold(slider).move_by_offset(
+            -slider.size["width"] // 3, 0
+        ).release().perform()
+        after = driver.find_element("css selector", "#viewer img.b").value_of_css_property(
+            "clip-path"
+        )
         assert before != after and float(slider.get_attribute("value")) < 40
         driver.save_screenshot(str(shots / "sample-ab.png"))
         # read pixels: the image and reflectance values match the EXR within the stated precision
@@ -226,10 +264,21 @@ def test_a_person_filters_opens_a_sample_and_reads_a_pixel(gallery, tmp_path):
         wait.until(lambda d: d.find_element("id", "sample").get_attribute("data-id") == "two")
         driver.find_element("css selector", '#layers button[data-layer="error_rgb3"]').click()
         image = driver.find_element("css selector", "#viewer img.a")
-        wait.until(lambda d: d.execute_script("return arguments[0].complete && arguments[0].naturalWidth", image))
-        compared = sum(_check_readout_against_exr(_pixel_report(driver, image, dx, dy, ("error_rgb3",)),
-                                                  root, "two", "error_rgb3", info["error_rgb3"])
-                       for dx, dy in ((-60, -40), (60, -40), (-60, 60), (60, 60)))
+        wait.until(
+            lambda d: d.execute_script(
+                "return arguments[0].complete && arguments[0].naturalWidth", image
+            )
+        )
+        compared = sum(
+            _check_readout_against_exr(
+                _pixel_report(driver, image, dx, dy, ("error_rgb3",)),
+                root,
+                "two",
+                "error_rgb3",
+                info["error_rgb3"],
+            )
+            for dx, dy in ((-60, -40), (60, -40), (-60, 60), (60, 60))
+        )
         assert compared >= 1
         assert _errors(driver) == []
     finally:
@@ -254,7 +303,8 @@ def test_the_readout_check_can_fail(gallery, tmp_path):
         from selenium.webdriver.support.ui import WebDriverWait
 
         WebDriverWait(driver, BROWSER_WAIT_S).until(
-            lambda d: d.execute_script("return arguments[0].naturalWidth", image) > 0)
+            lambda d: d.execute_script("return arguments[0].naturalWidth", image) > 0
+        )
         report = _pixel_report(driver, image, -60, -40, ("image",))
         assert report["source"] == "file"  # this browser may read the previews themselves
         with pytest.raises(AssertionError):
@@ -309,11 +359,21 @@ def denoised_gallery(tmp_path, one_light_sample, two_light_sample, config):
     """Two samples exported with the OIDN-denoised shading (so with ``image_denoised``) and one
     without, and their gallery."""
     root = tmp_path / "dn"
-    for sid, (scene, result), denoise in (("a", two_light_sample, True), ("b", one_light_sample, True),
-                                          ("c", one_light_sample, False)):
+    for sid, (scene, result), denoise in (
+        ("a", two_light_sample, True),
+        ("b", one_light_sample, True),
+        ("c", one_light_sample, False),
+    ):
         meta = {**scene.metadata, "condition": "white", "kind": "object"}
-        export_sample(root, dataclasses.replace(scene, metadata=meta), result, sample_id=sid,
-                      config=config, seed=1, denoise=denoise)
+        export_sample(
+            root,
+            dataclasses.replace(scene, metadata=meta),
+            result,
+            sample_id=sid,
+            config=config,
+            seed=1,
+            denoise=denoise,
+        )
     return build_gallery(root)
 
 
@@ -331,18 +391,33 @@ def test_index_opens_on_the_denoised_image_with_kind_shares_and_neighbours(denoi
         assert names[0] == entry["first_layer"] == first
         assert entry["kind"] == "object"
         assert entry["light_shares"] == [light["share"] for light in meta["lights"]]
-        assert sum(entry["light_shares"]) == pytest.approx(1.0, abs=1e-3)  # shares of the irradiance
+        assert sum(entry["light_shares"]) == pytest.approx(
+            1.0, abs=1e-3
+        )  # shares of the irradiance
         assert entry["prev"] == (ids[i - 1] if i else None)
         assert entry["next"] == (ids[i + 1] if i + 1 < len(ids) else None)
 
 
-@pytest.mark.parametrize(("metadata", "kind"), [({"generator": "rooms"}, "complex"),
-                                                ({"generator": "objects-on-ground"}, "object"),
-                                                ({}, "complex")])
-def test_a_sample_without_kind_metadata_still_has_a_kind(tmp_path, one_light_sample, config, metadata, kind):
+@pytest.mark.parametrize(
+    ("metadata", "kind"),
+    [
+        ({"generator": "rooms"}, "complex"),
+        ({"generator": "objects-on-ground"}, "object"),
+        ({}, "complex"),
+    ],
+)
+def test_a_sample_without_kind_metadata_still_has_a_kind(
+    tmp_path, one_light_sample, config, metadata, kind
+):
     scene, result = one_light_sample
-    export_sample(tmp_path / "ds", dataclasses.replace(scene, name="mine", metadata=metadata), result,
-                  sample_id="mine__v0__file", config=config, seed=1)
+    export_sample(
+        tmp_path / "ds",
+        dataclasses.replace(scene, name="mine", metadata=metadata),
+        result,
+        sample_id="mine__v0__file",
+        config=config,
+        seed=1,
+    )
     (entry,) = gallery_index(tmp_path / "ds")["samples"]
     assert entry["kind"] == kind and entry["light_shares"] and None not in entry["light_shares"]
 
@@ -367,10 +442,14 @@ def test_a_person_steps_between_samples_and_sees_every_layer(denoised_gallery, t
         tiles = driver.find_elements("css selector", "#layer-grid figure")
         assert [t.get_attribute("data-layer") for t in tiles] == list(first["layers"])
         tiles[-1].click()  # a tile shows its layer as A
-        assert image.get_attribute("src").endswith(first["layers"][list(first["layers"])[-1]][0].split("/", 1)[1])
+        assert image.get_attribute("src").endswith(
+            first["layers"][list(first["layers"])[-1]][0].split("/", 1)[1]
+        )
         assert not driver.find_elements("css selector", "a#prev-sample")  # the first has none
         driver.find_element("id", "next-sample").click()
-        wait.until(lambda d: d.find_element("id", "sample").get_attribute("data-id") == first["next"])
+        wait.until(
+            lambda d: d.find_element("id", "sample").get_attribute("data-id") == first["next"]
+        )
         driver.find_element("id", "prev-sample").click()
         wait.until(lambda d: d.find_element("id", "sample").get_attribute("data-id") == first["id"])
         assert _errors(driver) == []

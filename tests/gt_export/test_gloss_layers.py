@@ -98,7 +98,9 @@ def test_a_glossy_sample_passes_the_check_and_a_broken_specular_does_not(glossy_
     assert check_dataset(tmp_path) == []
     from spectrinsic.gt_export.relight import read_sample_scene
 
-    assert read_sample_scene(tmp_path / "g").materials == scene.materials  # gloss kept in scene.json
+    assert (
+        read_sample_scene(tmp_path / "g").materials == scene.materials
+    )  # gloss kept in scene.json
     path = tmp_path / "g" / "intrinsics.exr"
     import json
 
@@ -127,18 +129,36 @@ def test_b_metal_sample_reflectance_is_zero_and_specular_has_the_hue_of_f0(metal
     from spectrinsic.spectra.io import mitsuba_ior_dir
 
     v = np.array([[-50.0, -50, 0], [50, -50, 0], [50, 50, 0], [-50, 50, 0]])
-    sky = Light("area", "cie:D65", 1.0, position=(0, 0, 3.0), direction=(0, 0, -1), size=(400.0, 400.0))
-    camera = Camera(origin=(0.0, 0.0, 2.0), target=(0, 0, 0), up=(0, 1, 0), fov_deg=4, width=6, height=6)
-    scene = Scene("metal", (Mesh("plane", v, np.array([[0, 1, 2], [0, 2, 3]]), np.zeros(2, np.int64), 0),),
-                  (Material("metal", "flat:0", kind="conductor", metal=metal),), (sky,), camera)
-    gt = compute_ground_truth(scene, render_scene(scene, RenderSettings(2, modes=("bands31",), max_depth=3), seed=1))
-    assert np.all(gt.layers["reflectance"].data == 0.0) and np.all(gt.layers["metallic"].data == 1.0)
+    sky = Light(
+        "area", "cie:D65", 1.0, position=(0, 0, 3.0), direction=(0, 0, -1), size=(400.0, 400.0)
+    )
+    camera = Camera(
+        origin=(0.0, 0.0, 2.0), target=(0, 0, 0), up=(0, 1, 0), fov_deg=4, width=6, height=6
+    )
+    scene = Scene(
+        "metal",
+        (Mesh("plane", v, np.array([[0, 1, 2], [0, 2, 3]]), np.zeros(2, np.int64), 0),),
+        (Material("metal", "flat:0", kind="conductor", metal=metal),),
+        (sky,),
+        camera,
+    )
+    gt = compute_ground_truth(
+        scene, render_scene(scene, RenderSettings(2, modes=("bands31",), max_depth=3), seed=1)
+    )
+    assert np.all(gt.layers["reflectance"].data == 0.0) and np.all(
+        gt.layers["metallic"].data == 1.0
+    )
     wl = np.arange(360.0, 831.0)
-    eta, k = (np.loadtxt(mitsuba_ior_dir() / f"{metal}.{p}.spd", comments="#") for p in ("eta", "k"))
+    eta, k = (
+        np.loadtxt(mitsuba_ior_dir() / f"{metal}.{p}.spd", comments="#") for p in ("eta", "k")
+    )
     n, kk = np.interp(wl, eta[:, 0], eta[:, 1]), np.interp(wl, k[:, 0], k[:, 1])
     f0 = ((n - 1) ** 2 + kk**2) / ((n + 1) ** 2 + kk**2)
     expected = get_sensors("cie1931").on(wl) @ (f0 * get_spectrum("cie:D65").on(wl))
     got = linear_srgb_to_xyz(gt.layers["specular"].data.reshape(-1, 3).mean(axis=0))
     white = colour.CCS_ILLUMINANTS["CIE 1931 2 Degree Standard Observer"]["D65"]
-    hue = [float(colour.Lab_to_LCHab(colour.XYZ_to_Lab(x / x[1] * 0.5, white))[2]) for x in (got, expected)]
+    hue = [
+        float(colour.Lab_to_LCHab(colour.XYZ_to_Lab(x / x[1] * 0.5, white))[2])
+        for x in (got, expected)
+    ]
     assert abs((hue[0] - hue[1] + 180.0) % 360.0 - 180.0) <= HUE_TOL_DEG, hue

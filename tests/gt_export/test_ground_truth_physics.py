@@ -50,12 +50,20 @@ def _corner_scene(grey: str = "flat:0.8", wall: str = "munsell:5R 5/12", size: i
     wall_v, wall_f = _quad((0, 1, -3), (6, 0, 0), (0, 0, 6))
     return Scene(
         name="corner",
-        meshes=(Mesh("grey", grey_v, grey_f, np.zeros(2, np.int64), object_id=0),
-                Mesh("wall", wall_v, wall_f, np.ones(2, np.int64), object_id=1)),
+        meshes=(
+            Mesh("grey", grey_v, grey_f, np.zeros(2, np.int64), object_id=0),
+            Mesh("wall", wall_v, wall_f, np.ones(2, np.int64), object_id=1),
+        ),
         materials=(Material("grey", grey), Material("wall", wall)),
         lights=(Light("directional", "cie:D65", 5.0, direction=(0.0, 1.0, 0.0)),),
-        camera=Camera(origin=(1.0, -0.5, 0.0), target=(0.0, 0.2, 0.0), up=(0, 0, 1), fov_deg=20,
-                      width=size, height=size),
+        camera=Camera(
+            origin=(1.0, -0.5, 0.0),
+            target=(0.0, 0.2, 0.0),
+            up=(0, 0, 1),
+            fov_deg=20,
+            width=size,
+            height=size,
+        ),
     )
 
 
@@ -93,8 +101,9 @@ def test_b_f_a_grey_wall_lit_by_a_bounce_carries_the_bounce_colour():
     inside = _interior(gt)
     assert inside.sum() > 100
     rho = get_spectrum("munsell:5R 5/12").on(WL)
-    bounce = xyz_to_linear_srgb(responses(rho * get_spectrum("cie:D65").on(WL),
-                                          get_sensors("cie1931").on(WL), WL))
+    bounce = xyz_to_linear_srgb(
+        responses(rho * get_spectrum("cie:D65").on(WL), get_sensors("cie1931").on(WL), WL)
+    )
     assert _angle(gt.layers["illuminant"].data[inside], bounce).max() < BOUNCE_MAX_DEG
     shading = gt.layers["shading"].data[inside]
     assert _angle(shading, bounce).max() < BOUNCE_MAX_DEG
@@ -124,18 +133,30 @@ def test_c_swapping_a_material_leaves_its_shading_and_changes_its_image():
 def test_d_e_identity_and_shading_sign_in_a_room_with_interreflections(make_room):
     """(d) image = reflectance ∘ shading + residual to float precision; (e) shading ≥ 0, finite."""
     scene = make_room(size=20)
-    result = render_batches(scene, RenderSettings(8, batches=2, modes=("bands31", "rgb3"),
-                                                  per_light=True, share_mode="rgb3"), seed=5)
+    result = render_batches(
+        scene,
+        RenderSettings(8, batches=2, modes=("bands31", "rgb3"), per_light=True, share_mode="rgb3"),
+        seed=5,
+    )
     gt = compute_ground_truth(scene, result, cameras=("camera:Nikon 5100 (NPL)",), denoise=True)
     for ident in identities(gt):
-        image, refl, shading, res = (gt.layers[ident[k]].data.astype(np.float64)
-                                     for k in ("image", "reflectance", "shading", "residual"))
-        np.testing.assert_allclose(refl * shading + res, image, rtol=FLOAT32_RTOL,
-                                   atol=FLOAT32_RTOL * np.abs(image).max())
+        image, refl, shading, res = (
+            gt.layers[ident[k]].data.astype(np.float64)
+            for k in ("image", "reflectance", "shading", "residual")
+        )
+        np.testing.assert_allclose(
+            refl * shading + res, image, rtol=FLOAT32_RTOL, atol=FLOAT32_RTOL * np.abs(image).max()
+        )
     for name, layer in gt.layers.items():
         assert np.isfinite(layer.data).all(), name
-        if name.split("/")[0] in ("shading", "shading_raw", "shading_camera", "shading_grey",
-                                  "illuminant", "light_share"):
+        if name.split("/")[0] in (
+            "shading",
+            "shading_raw",
+            "shading_camera",
+            "shading_grey",
+            "illuminant",
+            "light_share",
+        ):
             assert (layer.data >= 0).all(), name
     share = gt.layers["light_share"].data
     lit = gt.layers["shading_grey"].data > 0
@@ -147,16 +168,19 @@ def test_d_e_identity_and_shading_sign_in_a_room_with_interreflections(make_room
 def noisy_and_converged(make_room):
     """A room at 2 batches × 8 spp, and the same room at 16× the spp as the reference."""
     scene = make_room(size=40)
-    settings = RenderSettings(16, batches=2, modes=("bands31",), max_depth=4, per_light=True,
-                              share_mode="rgb3")
+    settings = RenderSettings(
+        16, batches=2, modes=("bands31",), max_depth=4, per_light=True, share_mode="rgb3"
+    )
     noisy = render_batches(scene, settings, seed=11)
     reference = render_batches(scene, settings.with_options(spp=256, batches=4), seed=99)
     return scene, noisy, reference
 
 
 def _relative_error(estimate: np.ndarray, reference: np.ndarray, valid: np.ndarray) -> np.ndarray:
-    return (np.linalg.norm(estimate - reference, axis=-1)[valid]
-            / np.linalg.norm(reference, axis=-1)[valid])
+    return (
+        np.linalg.norm(estimate - reference, axis=-1)[valid]
+        / np.linalg.norm(reference, axis=-1)[valid]
+    )
 
 
 def test_g_the_noise_estimate_is_calibrated(noisy_and_converged):
@@ -169,8 +193,8 @@ def test_g_the_noise_estimate_is_calibrated(noisy_and_converged):
     assert valid.sum() > 500
     observed = _relative_error(gt.layers["shading"].data, ref.layers["shading"].data, valid)
     predicted = gt.layers["noise_shading_raw"].data[valid]
-    rms_pred = np.sqrt(np.mean(predicted ** 2))
-    rms_obs = np.sqrt(max(np.mean(observed ** 2) - rms_pred ** 2 / 16, 0.0))
+    rms_pred = np.sqrt(np.mean(predicted**2))
+    rms_obs = np.sqrt(max(np.mean(observed**2) - rms_pred**2 / 16, 0.0))
     assert 1 / CALIBRATION_FACTOR < rms_obs / rms_pred < CALIBRATION_FACTOR
     assert gt.noise["batches"] == 2 and gt.noise["shading_raw"]["median"] > 0
 

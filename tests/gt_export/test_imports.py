@@ -9,8 +9,19 @@ from pathlib import Path
 GT_EXPORT = Path(__file__).resolve().parents[2] / "gt_export"
 PACKAGE = "spectrinsic.gt_export"
 #: Modules that read sample folders (directly or through the loader).
-READERS = ("sample", "sample_meta", "json_fields", "integrity", "loader", "check", "gallery",
-           "shards", "manifest", "card", "diversity")
+READERS = (
+    "sample",
+    "sample_meta",
+    "json_fields",
+    "integrity",
+    "loader",
+    "check",
+    "gallery",
+    "shards",
+    "manifest",
+    "card",
+    "diversity",
+)
 
 
 def _module_name(path: Path) -> str:
@@ -43,7 +54,7 @@ def _cycle(graph: dict[str, set[str]]) -> list[str] | None:
         stack.append(node)
         for nxt in sorted(graph[node]):
             if state.get(nxt) == 1:
-                return stack[stack.index(nxt):] + [nxt]
+                return stack[stack.index(nxt) :] + [nxt]
             if nxt not in state and (found := visit(nxt)):
                 return found
         stack.pop()
@@ -63,7 +74,9 @@ def test_the_cycle_finder_finds_a_cycle():
 
 def test_gt_export_has_no_import_cycle():
     graph = _graph()
-    assert f"{PACKAGE}.layers.compose" in graph and graph[f"{PACKAGE}.card"]  # the scan sees modules
+    assert (
+        f"{PACKAGE}.layers.compose" in graph and graph[f"{PACKAGE}.card"]
+    )  # the scan sees modules
     assert _cycle(graph) is None
 
 

@@ -83,8 +83,9 @@ def test_image_equals_reflectance_times_shading_plus_residual(two_light_sample):
     gt = compute_ground_truth(scene, result, cameras=(CAMERA,))
     assert len(identities(gt)) == 2
     for ident in identities(gt):
-        image, refl, shading, res = (gt.layers[ident[k]].data
-                                     for k in ("image", "reflectance", "shading", "residual"))
+        image, refl, shading, res = (
+            gt.layers[ident[k]].data for k in ("image", "reflectance", "shading", "residual")
+        )
         assert image.dtype == refl.dtype == shading.dtype == res.dtype == np.float32
         rebuilt = refl.astype(np.float64) * shading + res
         scale = np.abs(image).max()
@@ -95,8 +96,9 @@ def test_image_equals_reflectance_times_shading_plus_residual(two_light_sample):
     ratio = gt.layers["shading_ratio"].data
     valid = np.abs(refl) > REFLECTANCE_FLOOR
     assert valid.sum() > 0.5 * valid.size
-    np.testing.assert_allclose(refl[valid].astype(np.float64) * ratio[valid], image[valid],
-                               rtol=FLOAT32_RTOL, atol=0)
+    np.testing.assert_allclose(
+        refl[valid].astype(np.float64) * ratio[valid], image[valid], rtol=FLOAT32_RTOL, atol=0
+    )
     assert (ratio[~valid] == 0).all()
 
 
@@ -203,11 +205,17 @@ def test_photometric_matrices(synth):
     from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as wl
     from spectrinsic.spectra import get_sensors, get_spectrum
 
-    chips = ["munsell:5R 4/14", "munsell:5PB 4/10", "colorchecker:dark skin", "colorchecker:foliage"]
+    chips = [
+        "munsell:5R 4/14",
+        "munsell:5PB 4/10",
+        "colorchecker:dark skin",
+        "colorchecker:foliage",
+    ]
     canonical = absolute_reflectance(chips)
     rho = np.stack([get_spectrum(c).on(wl) for c in chips])
-    under = canonical_responses(rho, get_spectrum("planck:2800K").on(wl),
-                                get_sensors("srgb").on(wl), wl)
+    under = canonical_responses(
+        rho, get_spectrum("planck:2800K").on(wl), get_sensors("srgb").on(wl), wl
+    )
     predicted = canonical @ np.asarray(m["L_CLig"]["srgb"]["light 1"]).T
     fitted, assumed = angular_error(predicted, under), angular_error(canonical, under)
     assert fitted.mean() < 2.0
@@ -248,4 +256,3 @@ def test_missing_inputs_raise_clear_errors(synth):
         compute_ground_truth(scene, no_split, cameras=())
     with pytest.raises(DatasetError, match="bands31"):
         compute_ground_truth(scene, result, cameras=(CAMERA,))
-

@@ -28,8 +28,13 @@ def test_torch_adapter_every_key_crop_transform_exposure_split(built, torch):
     arrays = {k for k, v in sample.items() if isinstance(v, np.ndarray)}
     assert arrays <= set(full) and {"ids", "sample_id", "scene"} <= set(full)
     assert full["depth"].shape == (1, 12, 16) and full["ids"]["object"].dtype == torch.int32
-    crops = torch_dataset(built, keys=("image", "depth"), crop=(5, 7), seed=1,
-                          transform=lambda item: {**item, "seen": True})
+    crops = torch_dataset(
+        built,
+        keys=("image", "depth"),
+        crop=(5, 7),
+        seed=1,
+        transform=lambda item: {**item, "seen": True},
+    )
     a, b = crops[0], crops[0]
     assert a["seen"] and a["image"].shape == (3, 5, 7) and a["depth"].shape == (1, 5, 7)
     assert torch.equal(a["image"], b["image"])  # the crop of item i is fixed by the seed
@@ -42,7 +47,9 @@ def test_torch_adapter_every_key_crop_transform_exposure_split(built, torch):
             with pytest.raises(DatasetError, match=f"split '{split}' .* is empty"):
                 torch_dataset(built, split=split)
             continue
-        assert [torch_dataset(built, split=split)[i]["sample_id"] for i in range(len(ids))] == sorted(ids)
+        assert [
+            torch_dataset(built, split=split)[i]["sample_id"] for i in range(len(ids))
+        ] == sorted(ids)
 
 
 def test_shards_feed_a_torch_dataloader(built, torch, tmp_path_factory):

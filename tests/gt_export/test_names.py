@@ -9,8 +9,13 @@ from spectrinsic.gt_export.names import camera_slug, slug
 
 @pytest.mark.parametrize(
     "text, expected",
-    [("Nikon 5100 (NPL)", "nikon-5100-npl"), ("Sigma SDMerill (NPL)", "sigma-sdmerill-npl"),
-     ("two-colour-a", "two-colour-a"), ("  A__b..c  ", "a-b-c"), ("", "")],
+    [
+        ("Nikon 5100 (NPL)", "nikon-5100-npl"),
+        ("Sigma SDMerill (NPL)", "sigma-sdmerill-npl"),
+        ("two-colour-a", "two-colour-a"),
+        ("  A__b..c  ", "a-b-c"),
+        ("", ""),
+    ],
 )
 def test_slug(text, expected):
     assert slug(text) == expected
@@ -24,5 +29,9 @@ def test_fallback_only_when_nothing_is_left():
 def test_camera_slug_of_the_sensor_set_and_of_its_layer_key_agree():
     # the ground truth names the layer file from "camera:<key>", the evaluation its scenario
     # from the layer key "<key>": the same slug, so SC4_<slug> matches camera-<slug>
-    assert camera_slug("camera:Nikon 5100 (NPL)") == camera_slug("Nikon 5100 (NPL)") == "nikon-5100-npl"
+    assert (
+        camera_slug("camera:Nikon 5100 (NPL)")
+        == camera_slug("Nikon 5100 (NPL)")
+        == "nikon-5100-npl"
+    )
     assert camera_slug("camera:") == "camera"

@@ -37,7 +37,11 @@ def test_an_output_folder_records_what_it_wrote_and_accepts_itself_again(tmp_pat
         (out / "figures").mkdir()
         (out / "figures" / "b.png").write_bytes(b"png")
         assert _marker(out)["writing"]["pid"] == os.getpid()  # says a run is writing
-    assert _marker(out) == {"spectrinsic_output": 1, "files": ["a.csv", "figures/b.png"], "writing": None}
+    assert _marker(out) == {
+        "spectrinsic_output": 1,
+        "files": ["a.csv", "figures/b.png"],
+        "writing": None,
+    }
     assert not (out / LOCK_NAME).exists()
     check_output_folder(out)  # its own folder: a second run may write again
     with output_folder(out):
@@ -82,11 +86,14 @@ def test_a_refused_run_under_the_lock_leaves_no_folder(tmp_path):
 
 def _hold_lock(folder: Path) -> subprocess.Popen:
     """A second process holding *folder*'s lock until its stdin closes."""
-    code = ("import sys; from pathlib import Path; from spectrinsic.gt_export.outfolder import folder_lock\n"
-            f"with folder_lock(Path({str(folder)!r})):\n"
-            "    print('held', flush=True); sys.stdin.read()\n")
-    proc = subprocess.Popen([sys.executable, "-P", "-c", code], stdin=subprocess.PIPE,
-                            stdout=subprocess.PIPE, text=True)
+    code = (
+        "import sys; from pathlib import Path; from spectrinsic.gt_export.outfolder import folder_lock\n"
+        f"with folder_lock(Path({str(folder)!r})):\n"
+        "    print('held', flush=True); sys.stdin.read()\n"
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-P", "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
+    )
     deadline = time.monotonic() + HOLDER_START_S
     assert proc.stdout is not None and proc.stdout.readline().strip() == "held"
     assert time.monotonic() < deadline
@@ -114,13 +121,24 @@ def test_a_second_process_is_refused_with_the_holders_pid_host_and_start(tmp_pat
 
 
 @pytest.mark.parametrize("verb", ["dataset", "export", "render", "study"])
-def test_every_writing_verb_refuses_a_held_folder_in_one_line_before_any_work(tmp_path, capsys, verb):
+def test_every_writing_verb_refuses_a_held_folder_in_one_line_before_any_work(
+    tmp_path, capsys, verb
+):
     out = tmp_path / "out"
     proc = _hold_lock(out)
     try:
         argv = {
-            "dataset": ["dataset", "--preset", "preview", "--resolution", "16x16", "--spp", "2",
-                        "--only", "obj-apple__v0__white"],
+            "dataset": [
+                "dataset",
+                "--preset",
+                "preview",
+                "--resolution",
+                "16x16",
+                "--spp",
+                "2",
+                "--only",
+                "obj-apple__v0__white",
+            ],
             "export": ["export", str(_dataset(tmp_path))],
             "render": ["render", "obj-apple", "--width", "16", "--height", "16"],
             "study": ["study", "reconstruction-error"],
@@ -131,7 +149,9 @@ def test_every_writing_verb_refuses_a_held_folder_in_one_line_before_any_work(tm
         _release(proc)
     assert rc == 2 and len(err.splitlines()) == 1, err
     assert "in use by another spectrinsic run" in err and f"pid {proc.pid}" in err
-    assert not out.exists()  # the holder removed its lock file and folder; the refused run made nothing
+    assert (
+        not out.exists()
+    )  # the holder removed its lock file and folder; the refused run made nothing
 
 
 def _dataset(tmp: Path) -> Path:

@@ -40,14 +40,26 @@ def built(tmp_path_factory, make_room):
     out = tmp_path_factory.mktemp("relight")
     scene = make_room(size=16)
     transport, result = render_transport_batches(scene, SETTINGS, seed=SEED)
-    sample = export_sample(out, scene, result, sample_id="room__v0__two", config=CONFIG,
-                           seed=SEED, denoise=True, transport=transport)
+    sample = export_sample(
+        out,
+        scene,
+        result,
+        sample_id="room__v0__two",
+        config=CONFIG,
+        seed=SEED,
+        denoise=True,
+        transport=transport,
+    )
     return out, scene, sample
 
 
 def _max_rel(a: np.ndarray, b: np.ndarray) -> float:
     scale = float(np.abs(b).max())
-    return float(np.abs(a.astype(np.float64) - b).max()) / scale if scale > 0 else float(np.abs(a).max())
+    return (
+        float(np.abs(a.astype(np.float64) - b).max()) / scale
+        if scale > 0
+        else float(np.abs(a).max())
+    )
 
 
 def _arrays(sample: dict) -> dict[str, np.ndarray]:
@@ -60,15 +72,36 @@ def _relit_and_direct(out, scene, sample, settings: RenderSettings, tag: str) ->
     relit = relight(sample, NEW_LIGHTS, out / f"relit__v0__{tag}")
     assert check_sample(relit) == []
     new_scene = relit_scene(scene, NEW_LIGHTS)
-    direct = render_batches(new_scene, settings.with_options(modes=MODES[1:], per_light=True), seed=SEED)
-    reference = export_sample(out, new_scene, direct, sample_id=f"direct__v0__{tag}", config=CONFIG,
-                              seed=SEED, denoise=True)
+    direct = render_batches(
+        new_scene, settings.with_options(modes=MODES[1:], per_light=True), seed=SEED
+    )
+    reference = export_sample(
+        out,
+        new_scene,
+        direct,
+        sample_id=f"direct__v0__{tag}",
+        config=CONFIG,
+        seed=SEED,
+        denoise=True,
+    )
     a, b = _arrays(load_sample(relit)), _arrays(load_sample(reference))
     assert set(a) == set(b)
-    assert {"image", "shading", "residual", "illuminant", "light_share", "noise_image", "image_denoised",
-            "shading_camera/Nikon 5100 (NPL)", "image_rgb6", "error_rgb3"} <= set(a)
+    assert {
+        "image",
+        "shading",
+        "residual",
+        "illuminant",
+        "light_share",
+        "noise_image",
+        "image_denoised",
+        "shading_camera/Nikon 5100 (NPL)",
+        "image_rgb6",
+        "error_rgb3",
+    } <= set(a)
     errors = {k: _max_rel(a[k], b[k]) for k in a}
-    assert max(errors.values()) <= RELIGHT_RTOL, {k: e for k, e in errors.items() if e > RELIGHT_RTOL}
+    assert max(errors.values()) <= RELIGHT_RTOL, {
+        k: e for k, e in errors.items() if e > RELIGHT_RTOL
+    }
     return a, {"relit": relit, "reference": reference}
 
 
@@ -84,7 +117,9 @@ def test_the_transport_comes_from_the_single_traversal_without_per_light_passes(
     assert "single" in transport.seconds and result.meta["integrator"] == "single"
     plain = render_batches(scene, settings, seed=SEED)
     for mode in MODES[1:]:
-        np.testing.assert_allclose(result.raw[mode], plain.raw[mode], rtol=1e-5, atol=1e-7 * plain.raw[mode].max())
+        np.testing.assert_allclose(
+            result.raw[mode], plain.raw[mode], rtol=1e-5, atol=1e-7 * plain.raw[mode].max()
+        )
     np.testing.assert_array_equal(result.images["spectral"], plain.images["spectral"])
     np.testing.assert_array_equal(result.aovs["coverage"], plain.aovs["coverage"])
 
@@ -113,14 +148,24 @@ def test_relit_sample_equals_a_direct_render_with_the_passes(tmp_path, make_room
     settings = SETTINGS.with_options(integrator="passes", spp=2)
     transport, result = render_transport_batches(scene, settings, seed=SEED)
     assert "single" not in transport.seconds and result.meta.get("integrator") != "single"
-    sample = export_sample(tmp_path, scene, result, sample_id="room__v0__passes", config=CONFIG,
-                           seed=SEED, denoise=True, transport=transport)
+    sample = export_sample(
+        tmp_path,
+        scene,
+        result,
+        sample_id="room__v0__passes",
+        config=CONFIG,
+        seed=SEED,
+        denoise=True,
+        transport=transport,
+    )
     _relit_and_direct(tmp_path, scene, sample, settings, "passes")
 
 
 def test_relighting_with_the_own_spectra_gives_the_sample_back(built):
     out, scene, sample = built
-    same = relight(sample, {i: li.spectrum for i, li in enumerate(scene.lights)}, out / "same__v0__two")
+    same = relight(
+        sample, {i: li.spectrum for i, li in enumerate(scene.lights)}, out / "same__v0__two"
+    )
     original, again = _arrays(load_sample(sample)), _arrays(load_sample(same))
     assert set(original) - set(again) == {"image_spectral"}  # not a band render: not relit
     for key, value in again.items():
@@ -133,7 +178,9 @@ def test_doubling_every_power_doubles_radiometric_layers_only(built):
     twice = relit_layers(sample, own, powers={i: 2 * li.power for i, li in enumerate(scene.lights)})
     base = relit_layers(sample, own)
     for key in ("image", "shading_raw", "image_rgb6", "image_camera/Sigma SDMerill (NPL)"):
-        np.testing.assert_allclose(twice[key], 2 * base[key], rtol=RELIGHT_RTOL, atol=1e-6 * np.abs(base[key]).max())
+        np.testing.assert_allclose(
+            twice[key], 2 * base[key], rtol=RELIGHT_RTOL, atol=1e-6 * np.abs(base[key]).max()
+        )
     for key in ("reflectance", "light_share", "error_rgb6", "noise_image"):
         np.testing.assert_allclose(twice[key], base[key], rtol=RELIGHT_RTOL, atol=1e-6)
 
@@ -154,7 +201,9 @@ def test_random_relight_is_seeded_per_item_and_epoch(built):
     pooled = RandomRelight(seed=3, pool=("cie:FL11", "planck:2500K"))
     assert set(pooled.lights(2, index=0).values()) <= {"cie:FL11", "planck:2500K"}
     item = pooled(sample, index=0)
-    assert [li["spectrum"] for li in item["meta"]["lights"]] == list(pooled.lights(2, index=0).values())
+    assert [li["spectrum"] for li in item["meta"]["lights"]] == list(
+        pooled.lights(2, index=0).values()
+    )
     assert item["image"].shape == (16, 16, 3)
 
 
@@ -164,7 +213,11 @@ def test_transport_file_is_recorded_with_its_size(built):
     record = meta["transport"]
     assert TRANSPORT_NAME in meta["files"]
     assert record["bytes"] == (sample / TRANSPORT_NAME).stat().st_size
-    assert record["lights"] == 2 and record["batches"] == 2 and record["modes"] == ["rgb3", "rgb6", "bands31"]
+    assert (
+        record["lights"] == 2
+        and record["batches"] == 2
+        and record["modes"] == ["rgb3", "rgb6", "bands31"]
+    )
 
 
 def test_relight_refuses_bad_requests_before_writing(built, tmp_path):
@@ -186,26 +239,32 @@ def test_relight_refuses_bad_requests_before_writing(built, tmp_path):
     assert not (tmp_path / "a").exists()
     empty = tmp_path / "empty"
     empty.mkdir()
-    assert check_sample(relight(sample, {0: "cie:D65"}, empty)) == []  # new or empty, as for dataset
+    assert (
+        check_sample(relight(sample, {0: "cie:D65"}, empty)) == []
+    )  # new or empty, as for dataset
 
 
 def test_a_sample_without_transport_is_refused(built, tmp_path):
     out, scene, _ = built
-    result = render_batches(scene, SETTINGS.with_options(modes=("rgb3",), per_light=True, spp=2, batches=1),
-                            seed=SEED)
+    result = render_batches(
+        scene, SETTINGS.with_options(modes=("rgb3",), per_light=True, spp=2, batches=1), seed=SEED
+    )
     plain = export_sample(out, scene, result, sample_id="plain__v0__two", config=CONFIG, seed=1)
     with pytest.raises(DatasetError, match="--store-transport"):
         relight(plain, {0: "cie:D65"}, tmp_path / "x")
 
 
-@pytest.mark.parametrize("args, expected", [
-    (["--light", "0=plank:3000K"], "did you mean 'planck'?"),
-    (["--light", "0=cie:LED-RGB9"], "did you mean 'LED-RGB1'"),
-    (["--light", "zero=cie:D65"], "expected INDEX=VALUE"),
-    (["--light", "0=cie:D65", "--light", "0=cie:A"], "given twice"),
-    (["--light", "0=cie:D65", "--power", "0=bright"], "not a number"),
-    (["--light", "0=cie:D65", "--power", "5=2"], "lights 0..1"),
-])
+@pytest.mark.parametrize(
+    "args, expected",
+    [
+        (["--light", "0=plank:3000K"], "did you mean 'planck'?"),
+        (["--light", "0=cie:LED-RGB9"], "did you mean 'LED-RGB1'"),
+        (["--light", "zero=cie:D65"], "expected INDEX=VALUE"),
+        (["--light", "0=cie:D65", "--light", "0=cie:A"], "given twice"),
+        (["--light", "0=cie:D65", "--power", "0=bright"], "not a number"),
+        (["--light", "0=cie:D65", "--power", "5=2"], "lights 0..1"),
+    ],
+)
 def test_cli_bad_input_is_one_line_with_status_2(built, tmp_path, capsys, args, expected):
     from spectrinsic.cli import main
 
@@ -241,11 +300,15 @@ def test_torch_dataset_relights_each_item_on_the_fly(built, torch, tmp_path):
 
     _, _, sample = built
     shutil.copytree(sample, tmp_path / "ds" / sample.name)
-    draw = RandomRelight(seed=2, pool=("cie:FL11", "cie:LED-RGB1", "planck:2000K", "daylight:9000K"))
+    draw = RandomRelight(
+        seed=2, pool=("cie:FL11", "cie:LED-RGB1", "planck:2000K", "daylight:9000K")
+    )
     ds = torch_dataset(tmp_path / "ds", keys=("image", "shading"), relight=draw)
     expected = relit_layers(sample, draw.lights(2, index=0))
     item = ds[0]
-    assert torch.equal(item["image"], torch.from_numpy(np.moveaxis(expected["image"], -1, 0).copy()))
+    assert torch.equal(
+        item["image"], torch.from_numpy(np.moveaxis(expected["image"], -1, 0).copy())
+    )
     assert item["shading"].shape == (3, 16, 16) and item["sample_id"] == sample.name
     ds.set_epoch(3)
     again = relit_layers(sample, draw.lights(2, index=0, epoch=3))
@@ -273,20 +336,43 @@ def test_cli_follows_the_out_rule_and_the_lock_of_every_writing_verb(built, tmp_
     dataset = tmp_path / "ds"
     dataset.mkdir()
     (dataset / "manifest.json").write_text(json.dumps({"format_version": 1, "config_hash": "h"}))
-    rc = main(["-q", "relight", str(sample), "--light", "0=cie:D65", "--out", str(dataset / "relit__v0__x")])
+    rc = main(
+        [
+            "-q",
+            "relight",
+            str(sample),
+            "--light",
+            "0=cie:D65",
+            "--out",
+            str(dataset / "relit__v0__x"),
+        ]
+    )
     err = capsys.readouterr().err.strip()
     assert rc == 2 and len(err.splitlines()) == 1 and "inside the dataset folder" in err, err
     assert sorted(p.name for p in dataset.iterdir()) == ["manifest.json"]
 
     held = tmp_path / "held"
-    code = ("import sys; from pathlib import Path; from spectrinsic.gt_export.outfolder import folder_lock\n"
-            f"with folder_lock(Path({str(held)!r})):\n"
-            "    print('held', flush=True); sys.stdin.read()\n")
-    proc = subprocess.Popen([sys.executable, "-P", "-c", code], stdin=subprocess.PIPE,
-                            stdout=subprocess.PIPE, text=True)
+    code = (
+        "import sys; from pathlib import Path; from spectrinsic.gt_export.outfolder import folder_lock\n"
+        f"with folder_lock(Path({str(held)!r})):\n"
+        "    print('held', flush=True); sys.stdin.read()\n"
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-P", "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
+    )
     try:
         assert proc.stdout is not None and proc.stdout.readline().strip() == "held"
-        rc = main(["-q", "relight", str(sample), "--light", "0=cie:D65", "--out", str(held / "relit__v0__x")])
+        rc = main(
+            [
+                "-q",
+                "relight",
+                str(sample),
+                "--light",
+                "0=cie:D65",
+                "--out",
+                str(held / "relit__v0__x"),
+            ]
+        )
         err = capsys.readouterr().err.strip()
     finally:
         assert proc.stdin is not None

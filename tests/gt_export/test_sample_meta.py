@@ -25,7 +25,9 @@ def two(tmp_path, one_light_sample, two_light_sample, config):
 
     for sid, (scene, result) in (("a-one", one_light_sample), ("b-two", two_light_sample)):
         cube = result.raw["bands31"]
-        result = dataclasses.replace(result, batch_raw=({"bands31": cube * 1.1}, {"bands31": cube * 0.9}))
+        result = dataclasses.replace(
+            result, batch_raw=({"bands31": cube * 1.1}, {"bands31": cube * 0.9})
+        )
         export_sample(tmp_path, scene, result, sample_id=sid, config=config, seed=3)
     write_manifest(tmp_path, config)
     return tmp_path
@@ -53,9 +55,18 @@ DAMAGE = [
     ("non-finite number", '"share": 1.0', '"share": NaN', "non-finite number NaN"),
     ("missing field", '"scene": "synthetic",', "", "scene: missing"),
     ("unknown field", '"size":', '"colour": 3, "size":', "colour: not a field spectrinsic writes"),
-    ("negative size", '"size": [\n    12', '"size": [\n    -12', "size[0]: expected a whole number >= 1"),
-    ("layer path outside", '"file": "image.exr"', '"file": "../../outside/secret.exr"',
-     "layers.image.file: expected a path inside the sample folder"),
+    (
+        "negative size",
+        '"size": [\n    12',
+        '"size": [\n    -12',
+        "size[0]: expected a whole number >= 1",
+    ),
+    (
+        "layer path outside",
+        '"file": "image.exr"',
+        '"file": "../../outside/secret.exr"',
+        "layers.image.file: expected a path inside the sample folder",
+    ),
 ]
 
 
@@ -63,7 +74,10 @@ DAMAGE = [
 def test_damaged_meta_json_raises_one_line_naming_file_and_field(two, old, new, field):
     path = two / "a-one" / "meta.json"
     _edit(path, old, new)
-    for read in (lambda: read_meta(two / "a-one"), lambda: load_sample(two / "a-one", verify=False)):
+    for read in (
+        lambda: read_meta(two / "a-one"),
+        lambda: load_sample(two / "a-one", verify=False),
+    ):
         with pytest.raises(SampleMetaError) as info:
             read()
         message = str(info.value)
@@ -75,7 +89,7 @@ def test_one_edited_digit_breaks_the_seal(two):
     text = path.read_text()
     start = text.index('"L_CLig"')
     digit = next(i for i in range(start, len(text)) if text[i] in "123456789")
-    path.write_text(text[:digit] + str(int(text[digit]) % 9 + 1) + text[digit + 1:])
+    path.write_text(text[:digit] + str(int(text[digit]) % 9 + 1) + text[digit + 1 :])
     with pytest.raises(SampleMetaError, match=f"{SEAL_KEY}: the content does not match its seal"):
         read_meta(two / "b-two")
     assert read_meta(two / "b-two", verify=False).sealed is False
@@ -90,8 +104,10 @@ def test_load_sample_refuses_a_file_swapped_with_another_samples(two):
     with pytest.raises(DatasetError, match=r"image\.exr: does not match its SHA-256 in meta\.json"):
         load_sample(two / "a-one")
     # trusting the files (verify=False) reads the other sample's pixels, as before
-    np.testing.assert_array_equal(load_sample(two / "a-one", layers=["image"], verify=False)["image"],
-                                  load_sample(two / "b-two", layers=["image"])["image"])
+    np.testing.assert_array_equal(
+        load_sample(two / "a-one", layers=["image"], verify=False)["image"],
+        load_sample(two / "b-two", layers=["image"])["image"],
+    )
 
 
 def test_export_and_evaluate_refuse_a_swapped_file_in_one_line(two, tmp_path_factory, capsys):
@@ -100,8 +116,18 @@ def test_export_and_evaluate_refuse_a_swapped_file_in_one_line(two, tmp_path_fac
     shutil.copyfile(two / "b-two" / "intrinsics.exr", two / "a-one" / "intrinsics.exr")
     out = tmp_path_factory.mktemp("verbs")
     pytest.importorskip("webdataset", reason="the shards extra (webdataset) is in the dev extra")
-    for argv in (["export", str(two), "--out", str(out / "shards")],
-                 ["evaluate", "--dataset", str(two), "--out", str(out / "eval"), "--methods", "image-as-reflectance"]):
+    for argv in (
+        ["export", str(two), "--out", str(out / "shards")],
+        [
+            "evaluate",
+            "--dataset",
+            str(two),
+            "--out",
+            str(out / "eval"),
+            "--methods",
+            "image-as-reflectance",
+        ],
+    ):
         rc = main(["-q", *argv])
         err = capsys.readouterr().err.strip()
         assert rc == 2, (argv, err)
@@ -117,13 +143,21 @@ def _raw_meta_reads(tree: ast.AST) -> list[int]:
         if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
             continue
         names = {n.id for n in ast.walk(node) if isinstance(n, ast.Name)}
-        texts = {n.value for n in ast.walk(node) if isinstance(n, ast.Constant) and isinstance(n.value, str)}
+        texts = {
+            n.value
+            for n in ast.walk(node)
+            if isinstance(n, ast.Constant) and isinstance(n.value, str)
+        }
         about_meta = "META_NAME" in names or any("meta.json" in t for t in texts)
         for call in ast.walk(node):
-            if (isinstance(call, ast.Call) and isinstance(call.func, ast.Attribute)
-                    and call.func.attr in ("load", "loads")
-                    and isinstance(call.func.value, ast.Name) and call.func.value.id == "json"
-                    and about_meta):
+            if (
+                isinstance(call, ast.Call)
+                and isinstance(call.func, ast.Attribute)
+                and call.func.attr in ("load", "loads")
+                and isinstance(call.func.value, ast.Name)
+                and call.func.value.id == "json"
+                and about_meta
+            ):
                 hits.append(call.lineno)
     return hits
 

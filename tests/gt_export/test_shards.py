@@ -50,7 +50,9 @@ def test_shards_follow_the_manifest_splits(built, tmp_path_factory):
     for split, ids in splits.items():
         assert index["splits"][split]["samples"] == len(ids)
         if not ids:  # fewer scenes than splits: an empty split is an error naming it
-            with pytest.raises(DatasetError, match=f"split '{split}' .* is empty: the dataset had 1 scene"):
+            with pytest.raises(
+                DatasetError, match=f"split '{split}' .* is empty: the dataset had 1 scene"
+            ):
                 shard_dataset(out, split)
             continue
         assert sorted(item["sample_id"] for item in shard_dataset(out, split)) == sorted(ids)
@@ -152,7 +154,9 @@ def test_a_shard_with_flipped_bytes_is_refused_before_any_item(built, tmp_path_f
     shard = sorted(out.glob("*.tar"))[0]
     data = bytearray(shard.read_bytes())
     middle = len(data) // 2
-    data[middle:middle + 8] = bytes(b ^ 0xFF for b in data[middle:middle + 8])
+    data[middle : middle + 8] = bytes(b ^ 0xFF for b in data[middle : middle + 8])
     shard.write_bytes(bytes(data))
-    with pytest.raises(DatasetError, match=f"{shard.name}: does not match its SHA-256 in {SHARD_INDEX}"):
+    with pytest.raises(
+        DatasetError, match=f"{shard.name}: does not match its SHA-256 in {SHARD_INDEX}"
+    ):
         shard_dataset(out)

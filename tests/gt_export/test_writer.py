@@ -25,11 +25,31 @@ FLOAT32_RTOL = 4 * float(np.finfo(np.float32).eps)
 
 def test_sample_round_trips_through_the_loader(tmp_path, two_light_sample, config):
     scene, result = two_light_sample
-    folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=5,
-                           cameras=("camera:Nikon 5100 (NPL)",), write_cube=True)
+    folder = export_sample(
+        tmp_path,
+        scene,
+        result,
+        sample_id="s",
+        config=config,
+        seed=5,
+        cameras=("camera:Nikon 5100 (NPL)",),
+        write_cube=True,
+    )
     sample = load_sample(folder)
-    for key in ("image", "reflectance", "shading", "illuminant", "mask", "depth", "normals",
-                "ids", "meta", "image_camera/Nikon 5100 (NPL)", "cube", "image_rgb3"):
+    for key in (
+        "image",
+        "reflectance",
+        "shading",
+        "illuminant",
+        "mask",
+        "depth",
+        "normals",
+        "ids",
+        "meta",
+        "image_camera/Nikon 5100 (NPL)",
+        "cube",
+        "image_rgb3",
+    ):
         assert key in sample, key
     assert sample["image"].shape == (12, 16, 3) and sample["image"].dtype == np.float32
     assert sample["mask"].dtype == bool
@@ -60,15 +80,20 @@ def test_scene_json_is_the_scene_as_plain_data(tmp_path, one_light_sample, confi
     from spectrinsic.scenes.model import scene_hash, scene_to_dict
 
     scene, result = one_light_sample
-    scene = dataclasses.replace(scene, metadata={"kind": "test", "seed": np.int64(4), "views": (1, 2)})
+    scene = dataclasses.replace(
+        scene, metadata={"kind": "test", "seed": np.int64(4), "views": (1, 2)}
+    )
     folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=5)
     data = json.loads((folder / "scene.json").read_text(encoding="utf-8"))
     assert data == scene_to_dict(scene)
     # the file reproduces scene_hash: the canonical JSON of everything but the metadata
     del data["metadata"]
     blob = json.dumps(data, sort_keys=True, separators=(",", ":")).encode()
-    assert hashlib.sha256(blob).hexdigest() == scene_hash(scene) == json.loads(
-        (folder / "meta.json").read_text(encoding="utf-8"))["scene_hash"]
+    assert (
+        hashlib.sha256(blob).hexdigest()
+        == scene_hash(scene)
+        == json.loads((folder / "meta.json").read_text(encoding="utf-8"))["scene_hash"]
+    )
 
 
 def test_is_complete_follows_the_config_hash(tmp_path, one_light_sample, config):
@@ -226,7 +251,9 @@ def test_meta_json_floats_carry_at_most_the_stated_digits(tmp_path, two_light_sa
     assert any(float(f"{x:.{META_DIGITS - 2}g}") != x for x in floats)  # not rounded coarser
 
 
-def test_previews_of_one_kind_share_an_exposure_and_state_their_encoding(tmp_path, two_light_sample, config):
+def test_previews_of_one_kind_share_an_exposure_and_state_their_encoding(
+    tmp_path, two_light_sample, config
+):
     """Every image mode uses the exposure of ``image`` (so brightness differences are real), and
     the stated scale turns a PNG pixel back into the EXR value within 8-bit precision."""
     import colour
@@ -237,8 +264,12 @@ def test_previews_of_one_kind_share_an_exposure_and_state_their_encoding(tmp_pat
     layers = json.loads((folder / "meta.json").read_text())["layers"]
     scales = {k: r["preview_encoding"]["scale"] for k, r in layers.items() if k.startswith("image")}
     assert len(scales) >= 2 and len(set(scales.values())) == 1
-    assert layers["error_rgb3"]["preview_encoding"] == {"kind": "colormap", "cmap": "magma",
-                                                        "vmin": 0.0, "vmax": 0.1}
+    assert layers["error_rgb3"]["preview_encoding"] == {
+        "kind": "colormap",
+        "cmap": "magma",
+        "vmin": 0.0,
+        "vmax": 0.1,
+    }
     png_rgb = matplotlib.image.imread(folder / layers["image_rgb3"]["preview"])[..., :3]
     linear = colour.cctf_decoding(png_rgb.astype(float), function="sRGB") / scales["image_rgb3"]
     exr = load_sample(folder)["image_rgb3"]
@@ -263,7 +294,9 @@ def test_dataset_card_shows_the_diversity_figure(built):
 
     card = (built / "DATASET.md").read_text()
     assert "diversity.png" in card and (built / "diversity.png").is_file()
-    spread = next(line for line in card.splitlines() if line.startswith("Colour spread: lights cover"))
+    spread = next(
+        line for line in card.splitlines() if line.startswith("Colour spread: lights cover")
+    )
     assert "nan" not in spread and "Duv" in spread
     samples = sample_dirs(built)
     stats = diversity_stats(samples, [read_meta(s) for s in samples])

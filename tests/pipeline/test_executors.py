@@ -93,7 +93,9 @@ def test_executor_policy_serial_local_or_dask():
     assert choose_executor(workers=4, cores=2).render_threads == 1  # never 0 threads
     assert choose_executor(workers=4, threads=5, cores=2).render_threads == 5
     dask = choose_executor(workers=4, scheduler="tcp://10.0.0.5:8786", cores=8)
-    assert isinstance(dask.executor, DaskExecutor) and dask.executor.address == "tcp://10.0.0.5:8786"
+    assert (
+        isinstance(dask.executor, DaskExecutor) and dask.executor.address == "tcp://10.0.0.5:8786"
+    )
     assert (dask.render_threads, dask.where) == (1, "Dask scheduler tcp://10.0.0.5:8786")
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 
 from spectrinsic.pipeline.presets import get_preset
-from spectrinsic.pipeline.sources import _generator_options, generator_source
+from spectrinsic.pipeline.source_plan import _generator_options, generator_source
 from spectrinsic.scenes.generators import GlossDistribution
 
 

@@ -28,7 +28,18 @@ from spectrinsic.pipeline.presets import get_preset
 IDS = ("obj-apple__v0__white", "obj-box__v0__white")
 ONLY = ",".join(IDS)
 CONFIG = get_preset("preview").with_options(width=16, height=16, spp=2)
-CLI = ["-q", "dataset", "--preset", "preview", "--resolution", "16x16", "--spp", "2", "--only", ONLY]
+CLI = [
+    "-q",
+    "dataset",
+    "--preset",
+    "preview",
+    "--resolution",
+    "16x16",
+    "--spp",
+    "2",
+    "--only",
+    ONLY,
+]
 #: How long a subprocess build may take to reach the state a test interrupts.
 WAIT_S = 180.0
 
@@ -49,7 +60,11 @@ def copy(built: Path, tmp_path: Path) -> Path:
 
 
 def _bytes(root: Path) -> dict[str, bytes]:
-    return {p.relative_to(root).as_posix(): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
+    return {
+        p.relative_to(root).as_posix(): p.read_bytes()
+        for p in sorted(root.rglob("*"))
+        if p.is_file()
+    }
 
 
 @pytest.mark.parametrize("corrupt", ["other-samples-file", "undecodable-exr", "missing-preview"])
@@ -59,7 +74,7 @@ def test_a_corrupt_sample_is_rerendered_not_resumed(copy, built, corrupt, caplog
         shutil.copyfile(copy / IDS[1] / "geometry.exr", apple / "geometry.exr")
     elif corrupt == "undecodable-exr":
         data = bytearray((apple / "image.exr").read_bytes())
-        data[len(data) // 2:] = b"\0" * (len(data) - len(data) // 2)
+        data[len(data) // 2 :] = b"\0" * (len(data) - len(data) // 2)
         (apple / "image.exr").write_bytes(bytes(data))
     else:
         next((apple / "previews").glob("*.png")).unlink()
@@ -74,7 +89,7 @@ def test_a_corrupt_sample_is_rerendered_not_resumed(copy, built, corrupt, caplog
 
 
 def test_a_bit_flipped_key_in_meta_json_is_named_then_rerendered(copy, built, capsys, caplog):
-    """"median" -> "mediaN" (one bit): check names the file and the field in one line, and a
+    """ "median" -> "mediaN" (one bit): check names the file and the field in one line, and a
     rerun re-renders the sample (it used to raise KeyError in both)."""
     meta = copy / IDS[0] / "meta.json"
     text = meta.read_text(encoding="utf-8")
@@ -87,8 +102,10 @@ def test_a_bit_flipped_key_in_meta_json_is_named_then_rerendered(copy, built, ca
     with caplog.at_level(logging.WARNING, logger="spectrinsic.pipeline.dataset"):
         report = build_dataset(copy, CONFIG, only=ONLY)
     assert [o.sample_id for o in report.built] == [IDS[0]]
-    assert any(IDS[0] in r.message and "median" in r.message and "re-rendering" in r.message
-               for r in caplog.records)
+    assert any(
+        IDS[0] in r.message and "median" in r.message and "re-rendering" in r.message
+        for r in caplog.records
+    )
     assert check_dataset(copy) == []
     assert _bytes(copy) == _bytes(built)
 
@@ -100,13 +117,19 @@ def test_an_edited_digit_of_a_fitted_matrix_is_rerendered_not_blessed(copy, buil
     text = meta.read_text(encoding="utf-8")
     start = text.index('"matrices"')
     digit = next(i for i in range(start, len(text)) if text[i] in "123456789")
-    meta.write_text(text[:digit] + str(int(text[digit]) % 9 + 1) + text[digit + 1:], encoding="utf-8")
-    assert any(p.startswith(f"{IDS[0]}: meta.json does not match its seal") for p in check_dataset(copy))
+    meta.write_text(
+        text[:digit] + str(int(text[digit]) % 9 + 1) + text[digit + 1 :], encoding="utf-8"
+    )
+    assert any(
+        p.startswith(f"{IDS[0]}: meta.json does not match its seal") for p in check_dataset(copy)
+    )
     with caplog.at_level(logging.WARNING, logger="spectrinsic.pipeline.dataset"):
         report = build_dataset(copy, CONFIG, only=ONLY)
     assert [o.sample_id for o in report.built] == [IDS[0]]
-    assert any(IDS[0] in r.message and "seal" in r.message and "re-rendering" in r.message
-               for r in caplog.records)
+    assert any(
+        IDS[0] in r.message and "seal" in r.message and "re-rendering" in r.message
+        for r in caplog.records
+    )
     assert check_dataset(copy) == []
     assert _bytes(copy) == _bytes(built)
 
@@ -136,7 +159,9 @@ def test_check_catches_a_sample_of_another_config(copy):
     meta["config_hash"] = "f" * 64
     meta_path.write_text(json.dumps(meta))
     problems = check_dataset(copy)
-    assert any(p.startswith(IDS[0]) and "built with config hash ffffffffffff" in p for p in problems)
+    assert any(
+        p.startswith(IDS[0]) and "built with config hash ffffffffffff" in p for p in problems
+    )
 
 
 def test_foreign_temporaries_in_a_dataset_are_never_removed(copy):
@@ -193,8 +218,7 @@ def _workers(pid: int) -> list[int]:
         children = Path(f"/proc/{pid}/task/{pid}/children").read_text().split()
     except OSError:
         return []
-    return [int(c) for c in children
-            if b"spawn_main" in Path(f"/proc/{c}/cmdline").read_bytes()]
+    return [int(c) for c in children if b"spawn_main" in Path(f"/proc/{c}/cmdline").read_bytes()]
 
 
 @pytest.mark.slow
@@ -207,9 +231,24 @@ def test_a_worker_killed_mid_write_leaves_a_clean_complete_set(tmp_path):
     ids = (*IDS, "obj-cup__v0__white", "obj-deer__v0__white")
     out = tmp_path / "ds"
     cli = [*CLI[:-1], ",".join(ids)]
-    proc = subprocess.Popen([sys.executable, "-P", "-m", "spectrinsic", *cli, "--workers", "2",
-                             "--threads", "1", "--out", str(out)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-P",
+            "-m",
+            "spectrinsic",
+            *cli,
+            "--workers",
+            "2",
+            "--threads",
+            "1",
+            "--out",
+            str(out),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     deadline = time.monotonic() + WAIT_S
     while not (out.is_dir() and any(p.is_dir() for p in out.glob(".spectrinsic-tmp-*"))):
         if proc.poll() is not None or time.monotonic() > deadline:

@@ -54,4 +54,6 @@ def test_this_environment_matches_the_lock(repo_root):
             installed = version(name)
         except PackageNotFoundError:
             pytest.fail(f"{name} is declared but not installed; run make setup")
-        assert installed == pins[name], f"{name} {installed} installed, constraints.txt pins {pins[name]}"
+        assert installed == pins[name], (
+            f"{name} {installed} installed, constraints.txt pins {pins[name]}"
+        )

@@ -169,8 +169,20 @@ def _cli(out: Path, *extra: str, new_session: bool = False) -> subprocess.Popen[
     """The dataset verb in a child process (one worker unless *extra* says otherwise); in a
     process group of its own with *new_session*, as a terminal runs it."""
     return subprocess.Popen(
-        [sys.executable, "-P", "-m", "spectrinsic", "-q", "dataset", "--out", str(out),
-         "--workers", "1", *CLI_TINY, *extra],
+        [
+            sys.executable,
+            "-P",
+            "-m",
+            "spectrinsic",
+            "-q",
+            "dataset",
+            "--out",
+            str(out),
+            "--workers",
+            "1",
+            *CLI_TINY,
+            *extra,
+        ],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -197,7 +209,9 @@ def test_hard_kill_mid_write_then_rerun_completes(tmp_path):
     proc = _cli(out)
 
     def writing() -> bool:
-        return out.is_dir() and any(p.name.startswith(".spectrinsic-tmp-") and p.is_dir() for p in out.iterdir())
+        return out.is_dir() and any(
+            p.name.startswith(".spectrinsic-tmp-") and p.is_dir() for p in out.iterdir()
+        )
 
     _wait_for(writing, proc, "the middle of writing a sample")
     os.kill(proc.pid, signal.SIGKILL)
@@ -227,7 +241,12 @@ def test_ctrl_c_keeps_completed_samples(tmp_path, workers):
     kept whole, the interrupted one a temporary that the re-run removes."""
     # Four samples: the other three cannot all finish in the moment the signal takes to arrive,
     # so the interrupt always lands mid-build.
-    ids = ("obj-apple__v0__white", "obj-box__v0__white", "obj-cup__v0__white", "obj-deer__v0__white")
+    ids = (
+        "obj-apple__v0__white",
+        "obj-box__v0__white",
+        "obj-cup__v0__white",
+        "obj-deer__v0__white",
+    )
     out = tmp_path / "ds"
     proc = _cli(out, "--only", ",".join(ids), "--workers", workers, new_session=True)
 

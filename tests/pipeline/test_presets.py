@@ -75,7 +75,11 @@ def test_config_hash_ignores_versions_that_do_not_change_pixels(monkeypatch):
 
     def bumped(**changes):
         def fake(dists, *, python=True):
-            return {**real(dists, python=python), **{k: v for k, v in changes.items() if k in dists}}
+            return {
+                **real(dists, python=python),
+                **{k: v for k, v in changes.items() if k in dists},
+            }
+
         return fake
 
     installed = real(("numpy", "colour-science"), python=False)
@@ -92,7 +96,10 @@ def test_config_hash_ignores_versions_that_do_not_change_pixels(monkeypatch):
 def test_hash_changes_with_output_settings_only():
     base = get_preset("preview")
     assert base.config_hash() == get_preset("preview").config_hash()
-    assert base.with_options(spp=base.render.spp + base.render.batches).config_hash() != base.config_hash()
+    assert (
+        base.with_options(spp=base.render.spp + base.render.batches).config_hash()
+        != base.config_hash()
+    )
     assert base.with_options(seed=1).config_hash() != base.config_hash()
     assert base.with_options(modes=("rgb3",)).config_hash() != base.config_hash()
 
@@ -113,7 +120,10 @@ def test_the_written_record_rebuilds_the_same_config(name):
     record = cfg.settings()
     rebuilt = DatasetConfig.from_settings(cfg.preset, **{**record, "cameras": cfg.cameras})
     assert rebuilt == cfg and rebuilt.config_hash() == cfg.config_hash()
-    assert rebuilt.render.spp == record["spp"] and rebuilt.render.batch_spp * record["batches"] == record["spp"]
+    assert (
+        rebuilt.render.spp == record["spp"]
+        and rebuilt.render.batch_spp * record["batches"] == record["spp"]
+    )
 
 
 def test_render_settings_errors_read_as_dataset_settings():

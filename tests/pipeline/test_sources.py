@@ -13,20 +13,44 @@ from spectrinsic.errors import SpectrinsicError
 from spectrinsic.gt_export import check_dataset
 from spectrinsic.pipeline.dataset import build_dataset
 from spectrinsic.pipeline.presets import DatasetConfig
-from spectrinsic.pipeline.sources import files_source, generator_source
+from spectrinsic.pipeline.source_plan import files_source, generator_source
 from spectrinsic.scenes import load_scene
 
-TINY = DatasetConfig.from_settings("tiny-test", width=8, height=8, spp=2, max_depth=3,
-                                   modes=("spectral", "rgb3"), per_light=True, seed=4)
+TINY = DatasetConfig.from_settings(
+    "tiny-test",
+    width=8,
+    height=8,
+    spp=2,
+    max_depth=3,
+    modes=("spectral", "rgb3"),
+    per_light=True,
+    seed=4,
+)
 #: Layers every sample carries at this config (a library sample's, from gt_export).
-LAYERS = {"image", "reflectance", "shading", "residual", "illuminant", "light_share", "depth",
-          "normals", "material_id", "object_id", "mask", "shading_grey", "shading_ratio"}
+LAYERS = {
+    "image",
+    "reflectance",
+    "shading",
+    "residual",
+    "illuminant",
+    "light_share",
+    "depth",
+    "normals",
+    "material_id",
+    "object_id",
+    "mask",
+    "shading_grey",
+    "shading_ratio",
+}
 MAKE_BLEND = Path(__file__).parents[1] / "scenes" / "make_blend.py"
 
 
 def _files(root: Path, sample: str) -> dict[str, str]:
-    return {p.relative_to(root).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
-            for p in sorted((root / sample).rglob("*")) if p.is_file() and p.name != "meta.json"}
+    return {
+        p.relative_to(root).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted((root / sample).rglob("*"))
+        if p.is_file() and p.name != "meta.json"
+    }
 
 
 def _layers(root: Path, sample: str) -> set[str]:
@@ -78,8 +102,10 @@ def test_same_seed_rebuild_gives_identical_samples_and_scene_files(generated, tm
 def test_splits_share_no_scene(generated):
     out, _ = generated
     manifest = json.loads((out / "manifest.json").read_text())
-    scenes = {split: {manifest["samples"][s]["scene"] for s in ids}
-              for split, ids in manifest["splits"].items()}
+    scenes = {
+        split: {manifest["samples"][s]["scene"] for s in ids}
+        for split, ids in manifest["splits"].items()
+    }
     assert sum(len(ids) for ids in manifest["splits"].values()) == manifest["n_samples"]
     assert not (scenes["train"] & scenes["val"]) and not (scenes["train"] & scenes["test"])
     assert not (scenes["val"] & scenes["test"]) and len(scenes["train"]) > len(scenes["test"])
@@ -107,7 +133,9 @@ def _build_files(tmp_path, paths, **kw):
 def test_yaml_scene_gets_every_layer(tmp_path, repo_root):
     from spectrinsic.scenes import build, save_scene
 
-    path = save_scene(build("obj-apple", seed=0, width=8, height=8), tmp_path / "mine" / "apple.yaml")
+    path = save_scene(
+        build("obj-apple", seed=0, width=8, height=8), tmp_path / "mine" / "apple.yaml"
+    )
     out, ids = _build_files(tmp_path, [path])
     assert ids == ["apple__v0__file"] and LAYERS <= _layers(out, ids[0])
 
@@ -115,9 +143,13 @@ def test_yaml_scene_gets_every_layer(tmp_path, repo_root):
 def test_obj_with_material_map_gets_every_layer(tmp_path):
     obj = tmp_path / "pyramid.obj"
     (tmp_path / "pyramid.mtl").write_text("newmtl red\nKd 1 0 0\nnewmtl base\nKd 1 1 1\n")
-    obj.write_text("mtllib pyramid.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\n"
-                   "usemtl red\nf 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\nusemtl base\nf 1 4 3\nf 1 3 2\n")
-    out, ids = _build_files(tmp_path, [obj], materials={"red": "munsell:5R 4/14", "base": "flat:0.5"})
+    obj.write_text(
+        "mtllib pyramid.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\n"
+        "usemtl red\nf 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\nusemtl base\nf 1 4 3\nf 1 3 2\n"
+    )
+    out, ids = _build_files(
+        tmp_path, [obj], materials={"red": "munsell:5R 4/14", "base": "flat:0.5"}
+    )
     meta = json.loads((out / ids[0] / "meta.json").read_text())
     assert LAYERS <= set(meta["layers"])
     assert set(meta["materials"].values()) == {"munsell:5R 4/14", "flat:0.5"}
@@ -136,8 +168,12 @@ def test_obj_material_missing_from_the_map_is_a_one_line_error(tmp_path):
 def test_blend_scene_gets_every_layer(tmp_path):
     pytest.importorskip("bpy", reason="the optional 'blender' extra (bpy) is not installed")
     blend, marker = tmp_path / "test.blend", tmp_path / "autorun.txt"
-    proc = subprocess.run([sys.executable, "-P", str(MAKE_BLEND), "--", str(blend), str(marker), "1", "0"],
-                          capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [sys.executable, "-P", str(MAKE_BLEND), "--", str(blend), str(marker), "1", "0"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert proc.returncode == 0, proc.stderr[-2000:]
     out, ids = _build_files(tmp_path, [blend], materials={"Paint": "munsell:5PB 4/10"})
     assert LAYERS <= _layers(out, ids[0]) and not marker.exists()
@@ -157,7 +193,21 @@ def test_render_ground_truth_is_the_dataset_path(tmp_path):
 
     path = save_scene(build("obj-cup", seed=0, width=8, height=8), tmp_path / "mine" / "cup.yaml")
     out = tmp_path / "gt"
-    rc = main(["-q", "render", str(path), "--ground-truth", "--out", str(out), "--width", "8",
-               "--height", "8", "--spp", "2"])
+    rc = main(
+        [
+            "-q",
+            "render",
+            str(path),
+            "--ground-truth",
+            "--out",
+            str(out),
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--spp",
+            "2",
+        ]
+    )
     assert rc == 0 and check_dataset(out) == []
     assert LAYERS <= _layers(out, "cup__v0__file")

@@ -16,9 +16,20 @@ from spectrinsic.gt_export import check_dataset
 from spectrinsic.pipeline.dataset import build_dataset
 from spectrinsic.pipeline.presets import DatasetConfig
 
-TINY = DatasetConfig.from_settings("tiny-test", width=12, height=12, spp=4, max_depth=3, batches=2,
-                                   modes=("spectral", "rgb3", "bands31"), denoise=True, seed=5,
-                                   write_cube=True, store_transport=True, relight=1)
+TINY = DatasetConfig.from_settings(
+    "tiny-test",
+    width=12,
+    height=12,
+    spp=4,
+    max_depth=3,
+    batches=2,
+    modes=("spectral", "rgb3", "bands31"),
+    denoise=True,
+    seed=5,
+    write_cube=True,
+    store_transport=True,
+    relight=1,
+)
 SAMPLE = "room-living__v0__two-colour-a"
 RELIT = SAMPLE + "-relit1"
 

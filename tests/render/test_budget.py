@@ -27,12 +27,19 @@ print(rc, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024)
 @pytest.mark.parametrize("size", [64, 192])
 def test_the_estimate_bounds_the_measured_peak(tmp_path, size):
     modes = "spectral,rgb3,rgb6"
-    done = subprocess.run([sys.executable, "-P", "-c", _RENDER, str(size), modes, str(tmp_path / "o")],
-                          capture_output=True, text=True, timeout=600, check=False)
+    done = subprocess.run(
+        [sys.executable, "-P", "-c", _RENDER, str(size), modes, str(tmp_path / "o")],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
     rc, peak = (int(x) for x in done.stdout.split()[-2:])
     assert rc == 0, done.stderr
     meta = json.loads((tmp_path / "o" / "meta.json").read_text())
     n_lights = len(meta["scene"]["lights"])
     settings = RenderSettings(2, modes=tuple(modes.split(",")))
     estimate = estimate_render_bytes(size, size, settings, n_lights=n_lights)
-    assert peak <= estimate, f"{size}x{size}: peak {peak / 2**20:.0f} MiB > estimate {estimate / 2**20:.0f} MiB"
+    assert peak <= estimate, (
+        f"{size}x{size}: peak {peak / 2**20:.0f} MiB > estimate {estimate / 2**20:.0f} MiB"
+    )

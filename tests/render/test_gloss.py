@@ -220,12 +220,33 @@ def _mirror_room(mirror: Material) -> Scene:
     floor_v = np.array([[-1.0, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]])
     wall_v = np.array([[1.0, -1, 0], [1, 1, 0], [1, 1, 1.2], [1, -1, 1.2]])
     quad = np.array([[0, 1, 2], [0, 2, 3]])
-    light = Light("area", "cie:D65", 6.0, position=(0.55, 0.0, 0.9), direction=(0.8, 0.0, -0.6),
-                  size=(0.4, 0.4), name="lamp")
-    camera = Camera(origin=(-0.9, 0.0, 1.6), target=(0.3, 0.0, 0.0), up=(0, 0, 1), fov_deg=50, width=12, height=12)
-    return Scene("mirror-room", (Mesh("floor", floor_v, quad, np.zeros(2, np.int64), 0),
-                                 Mesh("mirror", wall_v, quad, np.ones(2, np.int64), 1)),
-                 (Material("floor", "munsell:5Y 8/2"), mirror), (light,), camera)
+    light = Light(
+        "area",
+        "cie:D65",
+        6.0,
+        position=(0.55, 0.0, 0.9),
+        direction=(0.8, 0.0, -0.6),
+        size=(0.4, 0.4),
+        name="lamp",
+    )
+    camera = Camera(
+        origin=(-0.9, 0.0, 1.6),
+        target=(0.3, 0.0, 0.0),
+        up=(0, 0, 1),
+        fov_deg=50,
+        width=12,
+        height=12,
+    )
+    return Scene(
+        "mirror-room",
+        (
+            Mesh("floor", floor_v, quad, np.zeros(2, np.int64), 0),
+            Mesh("mirror", wall_v, quad, np.ones(2, np.int64), 1),
+        ),
+        (Material("floor", "munsell:5Y 8/2"), mirror),
+        (light,),
+        camera,
+    )
 
 
 def test_c_matte_floor_lit_by_a_mirror_matches_mitsubas_spectral_path_tracer():
@@ -235,14 +256,21 @@ def test_c_matte_floor_lit_by_a_mirror_matches_mitsubas_spectral_path_tracer():
     from spectrinsic.render import RenderSettings, render_scene
 
     scene = _mirror_room(Material("mirror", "flat:0", kind="conductor", metal="Ag"))
-    result = render_scene(scene, RenderSettings(512, modes=("bands31", "spectral"), max_depth=4), seed=7)
+    result = render_scene(
+        scene, RenderSettings(512, modes=("bands31", "spectral"), max_depth=4), seed=7
+    )
     floor = result.aovs["coverage"][..., 0] == 1.0  # pixels wholly on the floor
     assert floor.sum() > 50
     assert np.all(result.specular["bands31"][floor] == 0.0)  # a matte first hit: no specular part
-    ours, ref = result.images["bands31"][floor].astype(float), result.images["spectral"][floor].astype(float)
+    ours, ref = (
+        result.images["bands31"][floor].astype(float),
+        result.images["spectral"][floor].astype(float),
+    )
     stderr = np.sqrt(ours.var(axis=0, ddof=1) + ref.var(axis=0, ddof=1)) / np.sqrt(floor.sum())
     # the pixels' spread bounds the noise of the means from above (the floor is not uniform)
-    assert np.all(np.abs(ours.mean(axis=0) - ref.mean(axis=0)) <= N_SIGMA * stderr + 5e-3 * ref.mean(axis=0))
+    assert np.all(
+        np.abs(ours.mean(axis=0) - ref.mean(axis=0)) <= N_SIGMA * stderr + 5e-3 * ref.mean(axis=0)
+    )
     black = _mirror_room(Material("mirror", "flat:0"))
     without = render_scene(black, RenderSettings(64, modes=("bands31",), max_depth=4), seed=7)
     assert without.images["bands31"][floor][:, 1].mean() < 0.5 * ours[:, 1].mean()

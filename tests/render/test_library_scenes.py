@@ -19,9 +19,17 @@ SIZE, SPP = 12, 1
 
 @pytest.mark.parametrize("name", library.scene_names())
 def test_library_scene_renders_in_every_mode(name):
-    scene = library.build(name, view=library.n_views(name) - 1, condition="two-colour-b", seed=0,
-                          width=SIZE, height=SIZE)
-    result = render_scene(scene, RenderSettings(SPP, modes=mode_names(), max_depth=4, aovs=True), seed=1)
+    scene = library.build(
+        name,
+        view=library.n_views(name) - 1,
+        condition="two-colour-b",
+        seed=0,
+        width=SIZE,
+        height=SIZE,
+    )
+    result = render_scene(
+        scene, RenderSettings(SPP, modes=mode_names(), max_depth=4, aovs=True), seed=1
+    )
     assert set(result.images) == set(mode_names())
     for mode, xyz in result.images.items():
         assert xyz.shape == (SIZE, SIZE, 3), mode

@@ -28,7 +28,9 @@ def test_unknown_mode_suggests_close_names():
 
 
 def test_pass_counts():
-    assert [modes.n_passes(modes.get_mode(m)) for m in ("spectral", "rgb3", "gauss3", "rgb6", "bands31")] == [1, 1, 1, 2, 11]
+    assert [
+        modes.n_passes(modes.get_mode(m)) for m in ("spectral", "rgb3", "gauss3", "rgb6", "bands31")
+    ] == [1, 1, 1, 2, 11]
 
 
 def test_pad_to_passes_zero_pads_last_block():

@@ -44,10 +44,14 @@ FLAT_RGB6_TOL = 2e-2
 def _plane_prediction(reflectance: str, light: str, tilt_deg: float, sensors: str) -> np.ndarray:
     """Exact ``∫ ρ E S_k cosθ / π dλ`` of a Lambertian plane under a distant light."""
     rho, e = get_spectrum(reflectance).on(WL), get_spectrum(light).on(WL)
-    return responses(rho * e, get_sensors(sensors).on(WL), WL) * np.cos(np.radians(tilt_deg)) / np.pi
+    return (
+        responses(rho * e, get_sensors(sensors).on(WL), WL) * np.cos(np.radians(tilt_deg)) / np.pi
+    )
 
 
-@pytest.mark.parametrize(("reflectance", "light"), [("munsell:5R 5/12", "planck:2800K"), ("munsell:5B 5/8", "cie:D65")])
+@pytest.mark.parametrize(
+    ("reflectance", "light"), [("munsell:5R 5/12", "planck:2800K"), ("munsell:5B 5/8", "cie:D65")]
+)
 def test_plane_spectral_reference_is_analytic(make_plane, reflectance, light):
     """A diffuse plane under a directional light renders ∫ρ E S cosθ/π within noise."""
     scene = make_plane(reflectance, light, tilt_deg=30.0, size=16)
@@ -69,7 +73,9 @@ def test_plane_diagonal_renders_are_eq_5_2(make_plane):
         s = get_sensors(get_mode(mode).sensors).on(WL)
         raw = responses(rho, s, WL) / responses(np.ones(WL.size), s, WL) * responses(e, s, WL)
         raw *= np.cos(np.radians(tilt)) / np.pi
-        np.testing.assert_allclose(result.raw[mode], np.broadcast_to(raw, result.raw[mode].shape), rtol=FLOAT32_RTOL)
+        np.testing.assert_allclose(
+            result.raw[mode], np.broadcast_to(raw, result.raw[mode].shape), rtol=FLOAT32_RTOL
+        )
     # the band cube integrates to nearly the exact colour; the CMF diagonal is far off for a red
     # chip under warm light, because x̄'s blue lobe averages in the chip's low blue reflectance
     exact = _plane_prediction(reflectance, light, tilt, "cie1931")
@@ -81,15 +87,29 @@ def test_plane_diagonal_renders_are_eq_5_2(make_plane):
 @pytest.mark.slow
 def test_cube_agrees_with_spectral_reference(make_room):
     """31-band cube vs spectral reference: mean colour within 0.5 %, pixels within noise."""
-    scene = make_room(lights=(("point", "planck:3500K", 1.5), ("area", "daylight:6500K", 3.0)), size=24)
+    scene = make_room(
+        lights=(("point", "planck:3500K", 1.5), ("area", "daylight:6500K", 3.0)), size=24
+    )
     # the spectral pass costs about one RGB pass but is much noisier (wavelength sampling, heavy
     # tails): it gets 8x the samples of the 11-pass cube
-    spec = [render_scene(scene, RenderSettings(2048, modes=("spectral",), aovs=False), seed=s).images["spectral"] for s in (1, 2)]
-    cube = [render_scene(scene, RenderSettings(256, modes=("bands31",), aovs=False), seed=s).images["bands31"] for s in (1, 2)]
+    spec = [
+        render_scene(scene, RenderSettings(2048, modes=("spectral",), aovs=False), seed=s).images[
+            "spectral"
+        ]
+        for s in (1, 2)
+    ]
+    cube = [
+        render_scene(scene, RenderSettings(256, modes=("bands31",), aovs=False), seed=s).images[
+            "bands31"
+        ]
+        for s in (1, 2)
+    ]
     spec = [a.astype(np.float64) for a in spec]
     cube = [a.astype(np.float64) for a in cube]
     spec_mean, cube_mean = (spec[0] + spec[1]) / 2, (cube[0] + cube[1]) / 2
-    np.testing.assert_allclose(spec_mean.mean(axis=(0, 1)), cube_mean.mean(axis=(0, 1)), rtol=CUBE_VS_SPECTRAL_MEAN)
+    np.testing.assert_allclose(
+        spec_mean.mean(axis=(0, 1)), cube_mean.mean(axis=(0, 1)), rtol=CUBE_VS_SPECTRAL_MEAN
+    )
     # noise variance of one render from two independent seeds: var(a1 - a2) = 2 var(a)
     noise = (np.var(spec[0] - spec[1], axis=(0, 1)) + np.var(cube[0] - cube[1], axis=(0, 1))) / 2
     ratio = np.var(spec[0] - cube[0], axis=(0, 1)) / noise
@@ -113,7 +133,9 @@ def test_common_random_numbers(make_room):
 def test_interreflections_carry_energy(make_room):
     """3(d): in a closed room the full render carries more energy than direct light alone."""
     scene = make_room(size=16)
-    result = render_scene(scene, RenderSettings(16, modes=("rgb3",), direct=True, aovs=False), seed=3)
+    result = render_scene(
+        scene, RenderSettings(16, modes=("rgb3",), direct=True, aovs=False), seed=3
+    )
     full, one = result.images["rgb3"], result.direct["rgb3"]
     r = result.energy_ratio("rgb3")
     assert np.all(full >= one - 1e-6), "with shared paths a longer path depth only adds light"
@@ -124,13 +146,17 @@ def test_flat_materials_make_modes_agree(make_room):
     """3(e): all materials spectrally flat -> 3-, 6- and 31-channel renders agree."""
     flat = tuple(f"flat:{v}" for v in (0.2, 0.4, 0.6, 0.8, 0.5, 0.5))
     scene = make_room(wall_spectra=flat, cube_spectrum="flat:0.3", size=16)
-    result = render_scene(scene, RenderSettings(8, modes=("rgb3", "rgb6", "bands31"), aovs=False), seed=5)
+    result = render_scene(
+        scene, RenderSettings(8, modes=("rgb3", "rgb6", "bands31"), aovs=False), seed=5
+    )
     ref = result.images["rgb3"].astype(np.float64)
     for mode, tol in (("bands31", FLAT_BANDS_TOL), ("rgb6", FLAT_RGB6_TOL)):
         err = np.linalg.norm(result.images[mode] - ref, axis=-1) / np.linalg.norm(ref, axis=-1)
         assert float(err.max()) < tol, (mode, float(err.max()))
     # control: coloured materials break the agreement
-    coloured = render_scene(make_room(size=16), RenderSettings(8, modes=("rgb3", "bands31"), aovs=False), seed=5)
+    coloured = render_scene(
+        make_room(size=16), RenderSettings(8, modes=("rgb3", "bands31"), aovs=False), seed=5
+    )
     ref = coloured.images["bands31"].astype(np.float64)
     err = np.linalg.norm(coloured.images["rgb3"] - ref, axis=-1) / np.linalg.norm(ref, axis=-1)
     assert float(err.max()) > 10 * FLAT_BANDS_TOL
@@ -139,7 +165,9 @@ def test_flat_materials_make_modes_agree(make_room):
 def test_per_light_renders_sum_to_full_render(make_room):
     """One scene per light; their sum is the image and matches a render of all lights at once."""
     scene = make_room(size=16)
-    split = render_scene(scene, RenderSettings(128, modes=("rgb3",), per_light=True, aovs=False), seed=11)
+    split = render_scene(
+        scene, RenderSettings(128, modes=("rgb3",), per_light=True, aovs=False), seed=11
+    )
     whole = render_scene(scene, RenderSettings(128, modes=("rgb3",), aovs=False), seed=12)
     assert len(split.per_light) == 2
     total = split.per_light[0]["rgb3"].astype(np.float64) + split.per_light[1]["rgb3"]
@@ -171,5 +199,10 @@ def test_adaptive_batches_stop_at_the_target_or_the_cap(make_room):
     easy = render_batches(scene, settings.with_options(noise_target=0.99), seed=1)
     assert easy.meta["batches"] == 2
     assert easy.meta["noise_target"]["reached"] == pytest.approx(
-        image_noise([render_scene(scene, RenderSettings(2, modes=("rgb3",), aovs=False), seed=s)
-                     for s in easy.meta["batch_seeds"]]))
+        image_noise(
+            [
+                render_scene(scene, RenderSettings(2, modes=("rgb3",), aovs=False), seed=s)
+                for s in easy.meta["batch_seeds"]
+            ]
+        )
+    )

@@ -44,11 +44,14 @@ def test_single_traversal_equals_the_passes(make_room):
     """Same seed and spp: every band of every diagonal mode, full and direct-only, equals the
     ⌈K/3⌉ passes (14 of them) to float rounding; the spectral pass is untouched."""
     scene = make_room(size=24)
-    base = RenderSettings(4, modes=("spectral", *DIAGONAL), per_light=True, share_mode="rgb3", direct=True)
+    base = RenderSettings(
+        4, modes=("spectral", *DIAGONAL), per_light=True, share_mode="rgb3", direct=True
+    )
     calls: dict[str, list[int]] = {"passes": [], "single": []}
     settings = {name: base.with_options(integrator=name) for name in calls}
     results = {
-        name: render_scene(scene, settings[name], seed=5, progress=calls[name].append) for name in calls
+        name: render_scene(scene, settings[name], seed=5, progress=calls[name].append)
+        for name in calls
     }
     old, new = results["passes"], results["single"]
     for mode in DIAGONAL:
@@ -86,9 +89,16 @@ def test_per_light_split_sums_to_the_image(make_room):
     """Each light's image is its share of the one render: the shares sum to the image exactly,
     and each share is an unbiased estimate of the light alone (a separate one-light render)."""
     scene = make_room(size=16)
-    new = render_scene(scene, RenderSettings(64, modes=DIAGONAL, per_light=True, aovs=False, integrator="single"), seed=11)
-    old = render_scene(scene, RenderSettings(64, modes=("rgb3",), per_light=True, aovs=False, integrator="passes"),
-                       seed=12)
+    new = render_scene(
+        scene,
+        RenderSettings(64, modes=DIAGONAL, per_light=True, aovs=False, integrator="single"),
+        seed=11,
+    )
+    old = render_scene(
+        scene,
+        RenderSettings(64, modes=("rgb3",), per_light=True, aovs=False, integrator="passes"),
+        seed=12,
+    )
     for mode in DIAGONAL:
         total = sum(p[mode].astype(np.float64) for p in new.per_light)
         _close(total, new.images[mode])
@@ -104,22 +114,33 @@ def test_per_light_split_sums_to_the_image(make_room):
 
 def test_batches_average_the_transport(make_room):
     scene = make_room(size=8)
-    parts = [render_scene(scene, RenderSettings(2, modes=("rgb3",), aovs=False, integrator="single"), seed=s)
-             for s in (1, 2)]
+    parts = [
+        render_scene(
+            scene, RenderSettings(2, modes=("rgb3",), aovs=False, integrator="single"), seed=s
+        )
+        for s in (1, 2)
+    ]
     merged = merge_batches(parts)
-    np.testing.assert_allclose(merged.transport["rgb3"], (parts[0].transport["rgb3"].astype(np.float64)
-                                                          + parts[1].transport["rgb3"]) / 2, rtol=1e-6)
+    np.testing.assert_allclose(
+        merged.transport["rgb3"],
+        (parts[0].transport["rgb3"].astype(np.float64) + parts[1].transport["rgb3"]) / 2,
+        rtol=1e-6,
+    )
 
 
 def test_plane_under_directional_lights_is_exact(make_plane):
     """One bounce under a directional light has no noise: every band is ρ_k E_k cosθ/π."""
     tilt = 30.0
     scene = make_plane("munsell:5R 5/12", "planck:2800K", tilt_deg=tilt, size=8)
-    result = render_scene(scene, RenderSettings(4, modes=DIAGONAL, aovs=False, integrator="single"), seed=1)
+    result = render_scene(
+        scene, RenderSettings(4, modes=DIAGONAL, aovs=False, integrator="single"), seed=1
+    )
     for mode in DIAGONAL:
         v = channel_values(scene, get_sensors(get_mode(mode).sensors))
         expected = v.materials[0] * v.lights[0] * np.cos(np.radians(tilt)) / np.pi
-        np.testing.assert_allclose(result.raw[mode], np.broadcast_to(expected, result.raw[mode].shape), rtol=1e-5)
+        np.testing.assert_allclose(
+            result.raw[mode], np.broadcast_to(expected, result.raw[mode].shape), rtol=1e-5
+        )
 
 
 def _parallel_rectangle_factor(a: float, b: float, height: float) -> float:
@@ -141,11 +162,24 @@ def test_plane_under_an_area_light_is_the_view_factor():
         name="floor-under-area-light",
         meshes=(Mesh("floor", vertices, faces, np.zeros(2, np.int64), object_id=0),),
         materials=(Material("floor", "munsell:5G 6/8"),),
-        lights=(Light("area", "cie:D65", 2.0, position=(0, 0, height), direction=(0, 0, -1), size=(size, size)),),
+        lights=(
+            Light(
+                "area",
+                "cie:D65",
+                2.0,
+                position=(0, 0, height),
+                direction=(0, 0, -1),
+                size=(size, size),
+            ),
+        ),
         # a narrow view of the point under the light's centre, from beside the light
-        camera=Camera(origin=(0, -0.6, 0.25), target=(0, 0, 0), up=(0, 0, 1), fov_deg=1.0, width=8, height=8),
+        camera=Camera(
+            origin=(0, -0.6, 0.25), target=(0, 0, 0), up=(0, 0, 1), fov_deg=1.0, width=8, height=8
+        ),
     )
-    result = render_scene(scene, RenderSettings(256, modes=("bands31",), aovs=False, integrator="single"), seed=3)
+    result = render_scene(
+        scene, RenderSettings(256, modes=("bands31",), aovs=False, integrator="single"), seed=3
+    )
     v = channel_values(scene, get_sensors(get_mode("bands31").sensors))
     expected = v.materials[0] * v.lights[0] * _parallel_rectangle_factor(size, size, height)
     pixels = result.raw["bands31"].reshape(-1, 31).astype(np.float64)

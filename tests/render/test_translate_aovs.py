@@ -50,8 +50,13 @@ def _corner_normals_by_loop(v: np.ndarray, f: np.ndarray, crease_deg: float) -> 
     for i, face in enumerate(f):
         for k, vertex in enumerate(face):
             around = [j for j in range(len(f)) if vertex in f[j]]
-            total = sum((cross[j] for j in around if unit[i] @ unit[j] >= np.cos(np.radians(crease_deg))), np.zeros(3))
-            out[i, k] = total / np.linalg.norm(total) if np.linalg.norm(total) > 0 else (0.0, 0.0, 1.0)
+            total = sum(
+                (cross[j] for j in around if unit[i] @ unit[j] >= np.cos(np.radians(crease_deg))),
+                np.zeros(3),
+            )
+            out[i, k] = (
+                total / np.linalg.norm(total) if np.linalg.norm(total) > 0 else (0.0, 0.0, 1.0)
+            )
     return out
 
 
@@ -61,40 +66,61 @@ def test_corner_normals_match_a_corner_by_corner_reference():
     sphere = trimesh.creation.icosphere(subdivisions=1)
     box = trimesh.creation.box()
     v = np.concatenate([sphere.vertices, box.vertices + 3.0, [[9.0, 9.0, 9.0]]])
-    f = np.concatenate([sphere.faces, box.faces + len(sphere.vertices),
-                        [[len(v) - 1, len(v) - 1, len(v) - 1]]])  # plus a degenerate face
+    f = np.concatenate(
+        [sphere.faces, box.faces + len(sphere.vertices), [[len(v) - 1, len(v) - 1, len(v) - 1]]]
+    )  # plus a degenerate face
     for crease in (10.0, 30.0, 60.0):
-        np.testing.assert_allclose(smooth_corner_normals(v, f, crease), _corner_normals_by_loop(v, f, crease),
-                                   atol=1e-12)
+        np.testing.assert_allclose(
+            smooth_corner_normals(v, f, crease), _corner_normals_by_loop(v, f, crease), atol=1e-12
+        )
 
 
 def _marker_scene(x_offset: float) -> Scene:
     """A white floor with a small dark patch displaced along the camera's right (+x)."""
     floor_v = np.array([[-5, -5, 0], [5, -5, 0], [5, 5, 0], [-5, 5, 0]], float)
-    patch_v = np.array([[-0.3, -0.3, 0.01], [0.3, -0.3, 0.01], [0.3, 0.3, 0.01], [-0.3, 0.3, 0.01]]) + [x_offset, 0, 0]
+    patch_v = np.array(
+        [[-0.3, -0.3, 0.01], [0.3, -0.3, 0.01], [0.3, 0.3, 0.01], [-0.3, 0.3, 0.01]]
+    ) + [x_offset, 0, 0]
     faces = np.array([[0, 1, 2], [0, 2, 3]])
     return Scene(
         name="marker",
-        meshes=(Mesh("floor", floor_v, faces, np.zeros(2, np.int64), 0), Mesh("patch", patch_v, faces, np.ones(2, np.int64), 1)),
+        meshes=(
+            Mesh("floor", floor_v, faces, np.zeros(2, np.int64), 0),
+            Mesh("patch", patch_v, faces, np.ones(2, np.int64), 1),
+        ),
         materials=(Material("floor", "flat:0.8"), Material("patch", "flat:0.05")),
-        lights=(Light("area", "cie:D65", 5.0, position=(0, 0, 3), direction=(0, 0, -1), size=(1, 1)),),
-        camera=Camera(origin=(0, -4, 4), target=(0, 0, 0), up=(0, 0, 1), fov_deg=50, width=32, height=24),
+        lights=(
+            Light("area", "cie:D65", 5.0, position=(0, 0, 3), direction=(0, 0, -1), size=(1, 1)),
+        ),
+        camera=Camera(
+            origin=(0, -4, 4), target=(0, 0, 0), up=(0, 0, 1), fov_deg=50, width=32, height=24
+        ),
     )
 
 
 def test_camera_is_not_mirrored_and_area_light_points_down():
     aovs, _ = render_aovs(_marker_scene(1.2), spp=16, seed=0)
     ys, xs = np.nonzero(aovs["material_id"] == 1)
-    assert xs.size > 0 and xs.mean() > 16, "a patch at +x (camera right) must appear in the right half"
-    image = render_scene(_marker_scene(1.2), RenderSettings(16, modes=("rgb3",), aovs=False), seed=0).images["rgb3"]
+    assert xs.size > 0 and xs.mean() > 16, (
+        "a patch at +x (camera right) must appear in the right half"
+    )
+    image = render_scene(
+        _marker_scene(1.2), RenderSettings(16, modes=("rgb3",), aovs=False), seed=0
+    ).images["rgb3"]
     assert float(image[..., 1].mean()) > 0.0, "an area light facing the floor lights it"
 
 
 def test_wrong_number_of_colours_is_a_scene_error(make_plane):
     scene = make_plane("flat:0.5", "cie:D65")
     with variant_scope("scalar_rgb"), pytest.raises(SceneError, match="1 materials"):
-        scene_to_mitsuba(scene, materials=[], lights=[rgb_spectrum([1, 1, 1])], film=hdr_film(4, 4),
-                         integrator=path_integrator(2), sample_count=1)
+        scene_to_mitsuba(
+            scene,
+            materials=[],
+            lights=[rgb_spectrum([1, 1, 1])],
+            film=hdr_film(4, 4),
+            integrator=path_integrator(2),
+            sample_count=1,
+        )
 
 
 def test_plane_aovs(make_plane):
@@ -102,8 +128,12 @@ def test_plane_aovs(make_plane):
     aovs, seconds = render_aovs(scene, spp=16, seed=0)
     assert len(seconds) == 1
     np.testing.assert_allclose(aovs["coverage"][..., 0], 1.0, atol=FLOAT32_ATOL)
-    assert np.all(aovs["material_id"] == 0) and np.all(aovs["object_id"] == 0) and aovs["mask"].all()
-    np.testing.assert_allclose(aovs["normals"], np.broadcast_to([0, 0, 1], (9, 9, 3)), atol=FLOAT32_ATOL)
+    assert (
+        np.all(aovs["material_id"] == 0) and np.all(aovs["object_id"] == 0) and aovs["mask"].all()
+    )
+    np.testing.assert_allclose(
+        aovs["normals"], np.broadcast_to([0, 0, 1], (9, 9, 3)), atol=FLOAT32_ATOL
+    )
     # camera 2 above the plane looking straight down: ray distance 2 at the centre, more off-axis
     assert abs(float(aovs["depth"][4, 4]) - 2.0) < 0.01
     assert float(aovs["depth"][0, 0]) > float(aovs["depth"][4, 4])
@@ -138,15 +168,34 @@ def test_every_light_kind_of_the_scene_model_translates(make_plane):
 
     base = make_plane("flat:0.5", "cie:D65")
     for kind in LIGHT_KINDS:
-        light = make_light(kind, "cie:D65", 1.0, position=(0.0, 0.0, 1.5), direction=(0.0, 0.0, -1.0))
+        light = make_light(
+            kind, "cie:D65", 1.0, position=(0.0, 0.0, 1.5), direction=(0.0, 0.0, -1.0)
+        )
         scene = replace(base, lights=(light,))
         assert emission_key(scene, 0, spectral=True).endswith(".values")
         with variant_scope("scalar_rgb"):
-            d = scene_to_mitsuba(scene, materials=[rgb_spectrum([0.5, 0.5, 0.5])],
-                                 lights=[rgb_spectrum([1, 1, 1])], film=hdr_film(4, 4),
-                                 integrator=path_integrator(2), sample_count=1)
+            d = scene_to_mitsuba(
+                scene,
+                materials=[rgb_spectrum([0.5, 0.5, 0.5])],
+                lights=[rgb_spectrum([1, 1, 1])],
+                film=hdr_film(4, 4),
+                integrator=path_integrator(2),
+                sample_count=1,
+            )
         assert "light_0" in d
     bogus = replace(base, lights=(replace(base.lights[0], kind="laser"),))
-    with variant_scope("scalar_rgb"), pytest.raises(SceneError, match="unknown light kind 'laser'; expected one of point, spot, area, directional"):
-        scene_to_mitsuba(bogus, materials=[rgb_spectrum([0.5, 0.5, 0.5])], lights=[rgb_spectrum([1, 1, 1])],
-                         film=hdr_film(4, 4), integrator=path_integrator(2), sample_count=1)
+    with (
+        variant_scope("scalar_rgb"),
+        pytest.raises(
+            SceneError,
+            match="unknown light kind 'laser'; expected one of point, spot, area, directional",
+        ),
+    ):
+        scene_to_mitsuba(
+            bogus,
+            materials=[rgb_spectrum([0.5, 0.5, 0.5])],
+            lights=[rgb_spectrum([1, 1, 1])],
+            film=hdr_film(4, 4),
+            integrator=path_integrator(2),
+            sample_count=1,
+        )

@@ -30,7 +30,13 @@ def test_llvm_version_from_name(name, version):
 
 
 def test_find_libllvm_prefers_newest_suitable(tmp_path):
-    for name in ("libLLVM-14.so.1", "libLLVM-15.so", "libLLVM.so.19.1", "libLLVM-17.so", "libLLVM-20.a"):
+    for name in (
+        "libLLVM-14.so.1",
+        "libLLVM-15.so",
+        "libLLVM.so.19.1",
+        "libLLVM-17.so",
+        "libLLVM-20.a",
+    ):
         (tmp_path / name).write_bytes(b"")
     assert variants.find_libllvm([str(tmp_path)]).name == "libLLVM.so.19.1"
 
@@ -47,8 +53,12 @@ def test_configure_llvm_keeps_user_setting(monkeypatch):
 
 
 def test_importing_render_does_not_import_mitsuba():
-    code = "import sys, spectrinsic.render; print('mitsuba' in sys.modules or 'drjit' in sys.modules)"
-    out = subprocess.run([sys.executable, "-P", "-c", code], capture_output=True, text=True, check=True)
+    code = (
+        "import sys, spectrinsic.render; print('mitsuba' in sys.modules or 'drjit' in sys.modules)"
+    )
+    out = subprocess.run(
+        [sys.executable, "-P", "-c", code], capture_output=True, text=True, check=True
+    )
     assert out.stdout.strip() == "False"
 
 
@@ -82,7 +92,10 @@ def test_available_variants_lists_usable_variants():
     assert report["rgb"] == usable[0] and report["spectral"] == usable[1]
     assert set(usable) <= set(report["compiled"])
     if "llvm" in report["backends"]:
-        assert variants.llvm_version_from_name(report["libllvm"]) in (None, *range(variants.LLVM_MIN_VERSION, 100))
+        assert variants.llvm_version_from_name(report["libllvm"]) in (
+            None,
+            *range(variants.LLVM_MIN_VERSION, 100),
+        )
 
 
 def test_variant_scope_restores_previous_variant():
@@ -105,7 +118,9 @@ def test_scalar_variant_renders_the_same_deterministic_plane(make_plane):
     from spectrinsic.render import render_scene
 
     scene = make_plane("munsell:5R 5/12", "planck:2800K", tilt_deg=30.0, size=4)
-    scalar = render_scene(scene, RenderSettings(2, modes=("rgb3",), variant="scalar", aovs=False), seed=0)
+    scalar = render_scene(
+        scene, RenderSettings(2, modes=("rgb3",), variant="scalar", aovs=False), seed=0
+    )
     best = render_scene(scene, RenderSettings(2, modes=("rgb3",), aovs=False), seed=0)
     assert scalar.meta["variants"]["rgb3"] == "scalar_rgb"
     np.testing.assert_allclose(scalar.images["rgb3"], best.images["rgb3"], rtol=1e-5)
@@ -114,8 +129,9 @@ def test_scalar_variant_renders_the_same_deterministic_plane(make_plane):
 def _fresh(code: str, **env: str) -> list[str]:
     """stdout lines of *code* run in a new interpreter (a process whose Mitsuba is not set up)."""
     environ = {k: v for k, v in os.environ.items() if k != variants.LLVM_ENV} | env
-    out = subprocess.run([sys.executable, "-P", "-c", code], capture_output=True, text=True,
-                         check=True, env=environ)
+    out = subprocess.run(
+        [sys.executable, "-P", "-c", code], capture_output=True, text=True, check=True, env=environ
+    )
     return out.stdout.strip().splitlines()
 
 
@@ -147,7 +163,9 @@ def test_set_up_keeps_the_users_libllvm_setting():
         "variants.import_mitsuba()\n"
         "print(os.environ[variants.LLVM_ENV])\n"
     )
-    assert _fresh(code, **{variants.LLVM_ENV: "/nowhere/libLLVM-18.so"}) == ["/nowhere/libLLVM-18.so"]
+    assert _fresh(code, **{variants.LLVM_ENV: "/nowhere/libLLVM-18.so"}) == [
+        "/nowhere/libLLVM-18.so"
+    ]
 
 
 def test_variant_scope_restores_on_errors_and_documents_the_first_scope():
@@ -166,8 +184,13 @@ def test_variant_scope_restores_on_errors_and_documents_the_first_scope():
         "        print(mi.variant())\n"
         "print(mi.variant())\n"
     )
-    assert _fresh(code) == ["None", "scalar_spectral", "scalar_spectral", "scalar_rgb",
-                            "scalar_spectral"]
+    assert _fresh(code) == [
+        "None",
+        "scalar_spectral",
+        "scalar_spectral",
+        "scalar_rgb",
+        "scalar_spectral",
+    ]
 
 
 def test_batches_switch_variants_once_each(monkeypatch, make_room):

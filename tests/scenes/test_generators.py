@@ -31,7 +31,9 @@ def test_same_seed_gives_identical_scene_files(gen, tmp_path):
     assert scene_hash(a) == scene_hash(b)
     pa, pb = save_scene(a, tmp_path / "a" / "s.yaml"), save_scene(b, tmp_path / "b" / "s.yaml")
     files_a = sorted(p.relative_to(pa.parent) for p in pa.parent.rglob("*") if p.is_file())
-    assert files_a and files_a == sorted(p.relative_to(pb.parent) for p in pb.parent.rglob("*") if p.is_file())
+    assert files_a and files_a == sorted(
+        p.relative_to(pb.parent) for p in pb.parent.rglob("*") if p.is_file()
+    )
     for rel in files_a:
         assert (pa.parent / rel).read_bytes() == (pb.parent / rel).read_bytes()
 
@@ -41,7 +43,9 @@ def test_different_seeds_change_geometry_materials_lights_camera(gen):
     scenes = [_scene(gen, s) for s in range(4)]
     geometry = {tuple(len(m.faces) for m in s.meshes) for s in scenes}
     materials = {tuple(m.spectrum for m in s.materials) for s in scenes}
-    lights = {tuple((light.kind, light.spectrum, light.position) for light in s.lights) for s in scenes}
+    lights = {
+        tuple((light.kind, light.spectrum, light.position) for light in s.lights) for s in scenes
+    }
     cameras = {s.camera.origin for s in scenes}
     assert len(geometry) == len(materials) == len(lights) == len(cameras) == 4
 
@@ -89,7 +93,7 @@ def test_objects_rest_on_supports_without_overlapping(index):
         lo, hi = m.vertices.min(axis=0), m.vertices.max(axis=0)
         boxes.append((m.name, lo, hi))
     for i, (na, la, ha) in enumerate(boxes):
-        for nb, lb, hb in boxes[i + 1:]:
+        for nb, lb, hb in boxes[i + 1 :]:
             # two objects on one support must not overlap in their 3-D bounding boxes; an
             # object may stand on (or in) one piece of furniture
             overlap = np.all(la < hb) and np.all(lb < ha)
@@ -99,8 +103,12 @@ def test_objects_rest_on_supports_without_overlapping(index):
 
 
 def test_material_distribution_bounds_value_and_chroma():
-    dist = MaterialDistribution(value_range=(7.0, 9.0), chroma_range=(0.0, 2.0), pattern_probability=0.0)
-    scene = _scene("objects-on-ground", 2, options=GeneratorOptions(width=16, height=16, materials=dist))
+    dist = MaterialDistribution(
+        value_range=(7.0, 9.0), chroma_range=(0.0, 2.0), pattern_probability=0.0
+    )
+    scene = _scene(
+        "objects-on-ground", 2, options=GeneratorOptions(width=16, height=16, materials=dist)
+    )
     chips = {n: (v, c) for n, v, c in munsell_chips()}
     objects = [m for m in scene.meshes if m.name != "ground" and not m.name.startswith("lib-")]
     used = {scene.materials[k].spectrum for m in objects for k in np.unique(m.face_materials)}
@@ -110,9 +118,12 @@ def test_material_distribution_bounds_value_and_chroma():
 def test_patterns_give_several_exact_spectra_on_one_object():
     dist = MaterialDistribution(pattern_probability=1.0)
     opts = GeneratorOptions(width=16, height=16, materials=dist)
-    counts = [len(np.unique(m.face_materials)) for s in range(3)
-              for m in _scene("objects-on-ground", s, options=opts).meshes
-              if m.name != "ground" and not m.name.startswith("lib-")]
+    counts = [
+        len(np.unique(m.face_materials))
+        for s in range(3)
+        for m in _scene("objects-on-ground", s, options=opts).meshes
+        if m.name != "ground" and not m.name.startswith("lib-")
+    ]
     assert counts and max(counts) >= 2
 
 

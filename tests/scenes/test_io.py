@@ -326,7 +326,9 @@ def test_format_documentation_example_loads(tmp_path):
     example = re.search(r"```yaml\n(.*?)```", doc, re.S).group(1)
     (tmp_path / "meshes").mkdir()
     part = cup()
-    trimesh.Trimesh(part.vertices, part.faces, process=False).export(tmp_path / "meshes" / "cup.ply")
+    trimesh.Trimesh(part.vertices, part.faces, process=False).export(
+        tmp_path / "meshes" / "cup.ply"
+    )
     (tmp_path / "scene.yaml").write_text(example)
     scene = load_scene(tmp_path / "scene.yaml")
     assert [m.name for m in scene.meshes] == ["cup", "ground"]
@@ -349,8 +351,12 @@ def test_light_kind_table_is_the_one_list_of_kinds():
 
     assert typing.get_args(LightKind) == LIGHT_KINDS == tuple(LIGHT_FIELDS)
     assert set(LIGHT_PLACEMENT) == {"position", "direction", "size", "cutoff_deg"}
-    placement = {"position": (1.0, 2.0, 3.0), "direction": (0.0, 1.0, 0.0), "size": (2.0, 3.0),
-                 "cutoff_deg": 45.0}
+    placement = {
+        "position": (1.0, 2.0, 3.0),
+        "direction": (0.0, 1.0, 0.0),
+        "size": (2.0, 3.0),
+        "cutoff_deg": 45.0,
+    }
     for kind in LIGHT_KINDS:
         light = make_light(kind, "cie:D65", 1.0, **placement)
         default = Light(kind, "cie:D65", 1.0)

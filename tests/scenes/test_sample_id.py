@@ -29,8 +29,15 @@ def test_every_library_sample_round_trips():
 
 
 @pytest.mark.parametrize(
-    "bad", ["obj-vase", "obj-vase__white", "obj-vase__vx__white", "obj-vase__v0__", "__v0__white",
-            "obj-vase__v0__white__extra"]
+    "bad",
+    [
+        "obj-vase",
+        "obj-vase__white",
+        "obj-vase__vx__white",
+        "obj-vase__v0__",
+        "__v0__white",
+        "obj-vase__v0__white__extra",
+    ],
 )
 def test_parse_names_the_bad_id(bad):
     with pytest.raises(DatasetError, match=f"sample id {bad!r} is not of the form"):
@@ -41,4 +48,6 @@ def test_sample_id_is_a_frozen_record():
     sid = SampleId("obj-vase", 0, "white")
     with pytest.raises(AttributeError):
         sid.view = 1  # type: ignore[misc]
-    assert sid == SampleId("obj-vase", 0, "white") and hash(sid) == hash(SampleId("obj-vase", 0, "white"))
+    assert sid == SampleId("obj-vase", 0, "white") and hash(sid) == hash(
+        SampleId("obj-vase", 0, "white")
+    )

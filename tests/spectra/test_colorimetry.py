@@ -132,7 +132,9 @@ def test_sharpening_narrows_overlapping_sensors():
 
 
 def test_angular_error_closed_forms():
-    assert angular_error(np.array([1.0, 1, 1]), np.array([2.0, 2, 2])) == pytest.approx(0.0, abs=1e-6)
+    assert angular_error(np.array([1.0, 1, 1]), np.array([2.0, 2, 2])) == pytest.approx(
+        0.0, abs=1e-6
+    )
     assert angular_error(np.array([1.0, 0, 0]), np.array([1.0, 1, 0])) == pytest.approx(45.0)
 
 
@@ -155,8 +157,9 @@ def test_fits_and_responses_do_not_depend_on_blas_threads(tmp_path):
     )
     outputs = set()
     for env in _blas_environments():
-        run = subprocess.run([sys.executable, "-P", str(script)], capture_output=True, text=True,
-                             env=env, check=True)
+        run = subprocess.run(
+            [sys.executable, "-P", str(script)], capture_output=True, text=True, env=env, check=True
+        )
         outputs.add(run.stdout)
     assert len(outputs) == 1
 
@@ -186,7 +189,7 @@ def test_rank_deficient_fit_is_the_minimum_norm_solution_under_every_blas_kernel
 
     rng = np.random.default_rng(5)
     greys = np.linspace(0.15, 0.95, 12)[:, None]
-    a = greys * rng.random(6)        # every row a multiple of one 6-sensor response: rank 1
+    a = greys * rng.random(6)  # every row a multiple of one 6-sensor response: rank 1
     b = greys * rng.random(3)
     ref, *_ = np.linalg.lstsq(a, b, rcond=1e-8)
     np.testing.assert_allclose(fit_projection(a, b), ref.T, rtol=1e-9, atol=1e-12)
@@ -199,8 +202,12 @@ def test_rank_deficient_fit_is_the_minimum_norm_solution_under_every_blas_kernel
         "a = g * rng.random(6); b = g * rng.random(3)\n"
         "print(fit_projection(a, b).tobytes().hex())\n"
     )
-    outputs = {subprocess.run([sys.executable, "-P", str(script)], capture_output=True, text=True,
-                              env=env, check=True).stdout for env in _blas_environments()}
+    outputs = {
+        subprocess.run(
+            [sys.executable, "-P", str(script)], capture_output=True, text=True, env=env, check=True
+        ).stdout
+        for env in _blas_environments()
+    }
     assert len(outputs) == 1
 
 

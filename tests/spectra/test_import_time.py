@@ -18,8 +18,9 @@ SPECTRA = Path(__file__).resolve().parents[2] / "spectra"
 
 def _run(code: str) -> str:
     """Run *code* in a fresh interpreter (``-P``, so only the installed package is importable)."""
-    out = subprocess.run([sys.executable, "-P", "-c", code], capture_output=True, text=True,
-                         check=True)
+    out = subprocess.run(
+        [sys.executable, "-P", "-c", code], capture_output=True, text=True, check=True
+    )
     return out.stdout.strip()
 
 
@@ -54,10 +55,17 @@ def _spectra_imports(path: Path) -> set[str]:
     """The ``spectrinsic.spectra.*`` modules *path* imports, at module level or in a function."""
     names: set[str] = set()
     for node in ast.walk(ast.parse(path.read_text())):
-        if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("spectrinsic.spectra"):
+        if (
+            isinstance(node, ast.ImportFrom)
+            and node.module
+            and node.module.startswith("spectrinsic.spectra")
+        ):
             if node.module == "spectrinsic.spectra":  # from spectrinsic.spectra import io, ...
-                names.update(f"spectrinsic.spectra.{a.name}" for a in node.names
-                             if (SPECTRA / f"{a.name}.py").is_file())
+                names.update(
+                    f"spectrinsic.spectra.{a.name}"
+                    for a in node.names
+                    if (SPECTRA / f"{a.name}.py").is_file()
+                )
             else:
                 names.add(node.module)
         elif isinstance(node, ast.Import):
@@ -68,12 +76,15 @@ def _spectra_imports(path: Path) -> set[str]:
 def test_spectra_modules_import_each_other_without_cycles():
     """Lazy imports included: a cycle (colorimetry -> registry -> sensors -> colorimetry) is what
     forces imports into functions in the first place."""
-    graph = {f"spectrinsic.spectra.{p.stem}": _spectra_imports(p) for p in SPECTRA.glob("*.py")
-             if p.stem != "__init__"}
+    graph = {
+        f"spectrinsic.spectra.{p.stem}": _spectra_imports(p)
+        for p in SPECTRA.glob("*.py")
+        if p.stem != "__init__"
+    }
     done: set[str] = set()
 
     def visit(node: str, path: tuple[str, ...]) -> None:
-        assert node not in path, "import cycle: " + " -> ".join((*path[path.index(node):], node))
+        assert node not in path, "import cycle: " + " -> ".join((*path[path.index(node) :], node))
         if node in done:
             return
         for dep in graph.get(node, ()):

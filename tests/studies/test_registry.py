@@ -13,7 +13,9 @@ from spectrinsic.studies.registry import STUDIES, StudyOptions, get_study, run_s
 def test_every_study_has_the_four_steps_and_the_cli_offers_exactly_them():
     for name, study in STUDIES.items():
         assert study.name == name and study.summary
-        assert all(callable(getattr(study, step)) for step in ("settings", "run", "format", "write"))
+        assert all(
+            callable(getattr(study, step)) for step in ("settings", "run", "format", "write")
+        )
     sub = next(a for a in build_parser()._actions if a.dest == "command")
     study_parser = sub.choices["study"]
     positional = next(a for a in study_parser._actions if a.dest == "study")
@@ -27,10 +29,15 @@ def test_an_unknown_study_is_a_one_line_error_with_a_suggestion():
 
 
 def test_options_reach_each_study_settings():
-    options = StudyOptions(seed=7, include_ie=True, camera_balance="d65-white", extension=False,
-                           quality="preview")
+    options = StudyOptions(
+        seed=7, include_ie=True, camera_balance="d65-white", extension=False, quality="preview"
+    )
     photometric = get_study("photometric").settings(options)
-    assert (photometric.seed, photometric.include_ie, photometric.camera_balance) == (7, True, "d65-white")
+    assert (photometric.seed, photometric.include_ie, photometric.camera_balance) == (
+        7,
+        True,
+        "d65-white",
+    )
     rendering = get_study("rendering").settings(options)
     assert (rendering.seed, rendering.quality) == (7, "preview")
     assert get_study("reconstruction-error").settings(options) is False

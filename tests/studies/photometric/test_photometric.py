@@ -42,8 +42,11 @@ def test_srgb_ground_truth_matches_absolute_reflectance():
 def test_thesis_changes_recomputed_from_its_table():
     """Golden: thesis Table 4.4; the mean relative changes are −91.0 / +72.3 / −42.0 % (the text
     says −93 / +48 / −42; +48 % is the Planckian half alone)."""
-    table = {(c, s): dict(zip(ESTIMATE_SCENARIOS, v[4 * i: 4 * i + 4]))
-             for c, v in THESIS_TABLE_4_4.items() for i, s in enumerate(("planckian", "non-planckian"))}
+    table = {
+        (c, s): dict(zip(ESTIMATE_SCENARIOS, v[4 * i : 4 * i + 4]))
+        for c, v in THESIS_TABLE_4_4.items()
+        for i, s in enumerate(("planckian", "non-planckian"))
+    }
     ch = average_changes(table)
     assert ch["SC1_vs_SC4"] == pytest.approx(-91.0, abs=0.05)
     assert ch["SC2_vs_SC1"] == pytest.approx(72.3, abs=0.05)
@@ -59,9 +62,13 @@ def test_builtin_cameras_on_munsell_without_data_dir(monkeypatch):
     assert res.reflectance_family == "munsell"
     assert len(res.cameras) == 2
     again = run_photometric(settings)
-    assert [r.mean_angular_error_deg for r in again.rows] == [r.mean_angular_error_deg for r in res.rows]
+    assert [r.mean_angular_error_deg for r in again.rows] == [
+        r.mean_angular_error_deg for r in res.rows
+    ]
     other = run_photometric(PhotometricSettings(seed=6, n_scenes=3, reflectances_per_scene=60))
-    assert [r.mean_angular_error_deg for r in other.rows] != [r.mean_angular_error_deg for r in res.rows]
+    assert [r.mean_angular_error_deg for r in other.rows] != [
+        r.mean_angular_error_deg for r in res.rows
+    ]
 
 
 @pytest.fixture(scope="module")
@@ -116,8 +123,11 @@ SC3_TOLERANCE_POINTS = 5.0
 
 
 def _reduction(res, camera, illuminant_set="planckian"):
-    row = {r.scenario: r.mean_angular_error_deg for r in res.rows
-           if r.camera == camera and r.illuminant_set == illuminant_set}
+    row = {
+        r.scenario: r.mean_angular_error_deg
+        for r in res.rows
+        if r.camera == camera and r.illuminant_set == illuminant_set
+    }
     return (row["SC3"] - row["SC4"]) / row["SC4"] * 100.0
 
 
@@ -138,10 +148,14 @@ def test_raw_camera_curves_do_not_give_the_thesis_sc3_behaviour():
     """Without the data directory: colour-science's two cameras, Munsell chips. Raw curves make
     SC3 worse than SC4 for the Foveon camera; white-balanced curves do not."""
     cams = ("camera:Sigma SDMerill (NPL)",)
-    raw = run_photometric(PhotometricSettings(seed=0, cameras=cams, camera_balance="none",
-                                              n_scenes=3, reflectances="munsell"))
-    ee = run_photometric(PhotometricSettings(seed=0, cameras=cams, n_scenes=3,
-                                             reflectances="munsell"))
+    raw = run_photometric(
+        PhotometricSettings(
+            seed=0, cameras=cams, camera_balance="none", n_scenes=3, reflectances="munsell"
+        )
+    )
+    ee = run_photometric(
+        PhotometricSettings(seed=0, cameras=cams, n_scenes=3, reflectances="munsell")
+    )
     assert _reduction(raw, cams[0]) > 0.0
     assert _reduction(ee, cams[0]) < 0.0
     with pytest.raises(SpectrinsicError, match="camera balance"):

@@ -39,7 +39,9 @@ def test_default_settings_reproduce_thesis_table_5_2(table):
     exact_cells = 0
     for r in table.rows:
         ref = THESIS_TABLE_5_2[(r.n_sensors, r.bounces)]
-        for name, ours, theirs in zip(("mean", "sd", "max"), (r.mean_pct, r.sd_pct, r.max_pct), ref):
+        for name, ours, theirs in zip(
+            ("mean", "sd", "max"), (r.mean_pct, r.sd_pct, r.max_pct), ref
+        ):
             tol = NEAR_TOL if (r.n_sensors, r.bounces, name) in NEAR_CELLS else ROUNDING_TOL
             assert abs(ours - theirs) <= tol, (r.n_sensors, r.bounces, name, ours, theirs)
             exact_cells += abs(ours - theirs) <= ROUNDING_TOL
@@ -75,8 +77,11 @@ def test_chunked_pairs_equal_brute_force_over_ordered_pairs(include_self):
     f = reflectance_matrix("munsell", wl)[::30]
     light = get_spectrum("cie:D65").on(wl)
     curves = settings.sensors(3)
-    ours = np.sort(two_bounce_errors(f, light, curves, wl, pair_threshold=0.05,
-                                     include_self_pairs=include_self, chunk_size=7))
+    ours = np.sort(
+        two_bounce_errors(
+            f, light, curves, wl, pair_threshold=0.05, include_self_pairs=include_self, chunk_size=7
+        )
+    )
     ref = _brute_force_pairs(f, light, curves, wl, 0.05, include_self)
     assert ours.shape == ref.shape and ours.size > 0
     np.testing.assert_allclose(ours, ref, rtol=1e-9, atol=EXACT_TOL)
@@ -125,17 +130,26 @@ def test_delta_e_is_zero_for_flat_greys():
     settings = ExtensionSettings()
     wl = wavelength_grid(380, 780, 5)
     greys = np.linspace(0.15, 0.95, 12)[:, None] * np.ones(wl.size)
-    rows = delta_e_rows(greys, get_spectrum("cie:D65").on(wl), wl, illuminant_name="cie:D65",
-                        family="greys", settings=settings)
+    rows = delta_e_rows(
+        greys,
+        get_spectrum("cie:D65").on(wl),
+        wl,
+        illuminant_name="cie:D65",
+        family="greys",
+        settings=settings,
+    )
     assert {(r.method, r.bounces) for r in rows} == {
-        (m, b) for m in ("two-pass", "projection-only", "cie1931-diagonal") for b in (1, 2)}
+        (m, b) for m in ("two-pass", "projection-only", "cie1931-diagonal") for b in (1, 2)
+    }
     for r in rows:
         assert r.max_de2000 < 1e-6, r
 
 
 def test_extension_rows_agree_with_table_and_skip_sfu_without_data(monkeypatch, table):
     monkeypatch.delenv("SPECTRINSIC_DATA", raising=False)
-    ext = run_extension(ExtensionSettings(sensor_counts=(3, 6), illuminants=("cie:D65", "cie:FL11")))
+    ext = run_extension(
+        ExtensionSettings(sensor_counts=(3, 6), illuminants=("cie:D65", "cie:FL11"))
+    )
     assert any("sfu" in note for note in ext.skipped)
     ours = {(r.n_sensors, r.bounces): r for r in ext.rows if r.illuminant == "cie:D65"}
     for r in table.rows:

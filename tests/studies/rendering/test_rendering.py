@@ -12,8 +12,26 @@ from spectrinsic.studies.rendering import run_rendering_study
 
 def test_render_command_writes_named_float32_channels(tmp_path, capsys):
     out = tmp_path / "render"
-    status = main(["-q", "render", "obj-vase", "--condition", "two-colour-a", "--modes", "rgb3,bands31",
-                   "--out", str(out), "--spp", "4", "--width", "16", "--height", "12", "--direct"])
+    status = main(
+        [
+            "-q",
+            "render",
+            "obj-vase",
+            "--condition",
+            "two-colour-a",
+            "--modes",
+            "rgb3,bands31",
+            "--out",
+            str(out),
+            "--spp",
+            "4",
+            "--width",
+            "16",
+            "--height",
+            "12",
+            "--direct",
+        ]
+    )
     assert status == 0
     import OpenEXR
 
@@ -37,19 +55,43 @@ def test_render_command_writes_named_float32_channels(tmp_path, capsys):
 
 
 def test_render_command_rejects_unknown_mode(tmp_path, capsys):
-    status = main(["-q", "render", "obj-vase", "--modes", "rgb5", "--out", str(tmp_path), "--spp", "1",
-                   "--width", "8", "--height", "8"])
+    status = main(
+        [
+            "-q",
+            "render",
+            "obj-vase",
+            "--modes",
+            "rgb5",
+            "--out",
+            str(tmp_path),
+            "--spp",
+            "1",
+            "--width",
+            "8",
+            "--height",
+            "8",
+        ]
+    )
     assert status == 2
     assert "did you mean" in capsys.readouterr().err
 
 
 def test_rendering_study_writes_rows(tmp_path):
-    payload = run_rendering_study(tmp_path, quality="preview", scenes=["room-corner"], views=[0],
-                                  conditions=["two-colour-a"])
+    payload = run_rendering_study(
+        tmp_path, quality="preview", scenes=["room-corner"], views=[0], conditions=["two-colour-a"]
+    )
     data = json.loads((tmp_path / "rendering.json").read_text())
     (row,) = data["rows"]
-    for key in ("scene", "view", "condition", "err3_mean_pct", "err3_max_pct", "err6_mean_pct", "err6_max_pct",
-                "energy_ratio_r"):
+    for key in (
+        "scene",
+        "view",
+        "condition",
+        "err3_mean_pct",
+        "err3_max_pct",
+        "err6_mean_pct",
+        "err6_max_pct",
+        "energy_ratio_r",
+    ):
         assert key in row
     assert row["scene"] == "room-corner" and row["condition"] == "two-colour-a"
     # interreflections in a room: direct light is only part of the energy

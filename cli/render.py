@@ -1,0 +1,427 @@
+"""``spectrinsic render``: render one scene in several modes and write the raw passes as EXR.
+
+``SCENE`` is a library scene name (``spectrinsic.scenes.library``) or a scene file (YAML,
+``.blend`` or mesh, read as ``dataset --scenes`` reads them). For
+every mode ``DIR/<mode>.exr`` holds float32 layers ``raw`` (the K raw channels, named after the
+sensors, e.g. ``raw.B400``), ``xyz`` (CIE 1931 XYZ), and when asked ``direct`` and
+``light<i>`` (XYZ), and ``DIR/<mode>.png`` its sRGB preview; ``DIR/aovs.exr`` holds coverage, ids, depth and normals; ``DIR/meta.json``
+the render settings, variants, timings and the scene. Ground-truth layers are written by
+``spectrinsic dataset``, not here.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from tqdm import tqdm
+
+from spectrinsic.cli import dataset as cli_dataset
+from spectrinsic.errors import RenderError, SceneError
+from spectrinsic.gt_export.exr import write_exr
+from spectrinsic.gt_export.outfolder import check_output_folder, output_folder
+from spectrinsic.gt_export.png import encode_srgb8, exposure, write_png
+from spectrinsic.pipeline.presets import get_preset
+from spectrinsic.pipeline.source_plan import files_source
+from spectrinsic.render import (
+    RenderResult,
+    RenderSettings,
+    choose_variant,
+    count_passes,
+    get_mode,
+    render_scene,
+)
+from spectrinsic.render.budget import check_render_size
+from spectrinsic.render.modes import RENDER_MODES
+from spectrinsic.render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
+from spectrinsic.render.settings import DEFAULT_MODES as RENDER_DEFAULT_MODES
+from spectrinsic.scenes import library
+from spectrinsic.scenes.model import Scene, scene_to_dict
+from spectrinsic.scenes.sample_id import SampleId
+from spectrinsic.scenes.sources import FILE_SIZE, is_scene_file, load_scene_file
+from spectrinsic.spectra import get_sensors
+from spectrinsic.spectra.colorimetry import xyz_to_linear_srgb
+
+__all__ = ["register", "run", "load_scene_argument", "write_render", "requested_size"]
+
+DEFAULT_MODES = ",".join(RENDER_DEFAULT_MODES)
+
+
+def _modes_help() -> str:
+    return "; ".join(f"{m.name}: {m.description}" for m in RENDER_MODES.values())
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    # one set of documented defaults: those of the dataset's default preset
+    default = get_preset("default")
+    p = sub.add_parser(
+        "render",
+        help="render a scene in several colour modes and write raw passes as EXR",
+        description="Render SCENE (a library scene name, a YAML, .blend or mesh file) with Mitsuba 3 "
+        "in each mode and write float32 EXR files with named channels into --out "
+        "(raw passes, XYZ, AOVs; ground-truth layers come from `spectrinsic dataset`). "
+        f"Defaults are the dataset's default preset: {default.render.spp} spp, path depth "
+        f"{default.render.max_depth}, library scenes at {default.width}x{default.height}. "
+        f"Modes: {_modes_help()}.",
+    )
+    p.add_argument(
+        "scene",
+        metavar="SCENE",
+        help="library scene name (e.g. room-living) or a scene file (.yaml, .blend, .obj/.ply/.glb)",
+    )
+    p.add_argument(
+        "--condition",
+        default="white",
+        help="library scenes: illumination condition (default: white)",
+    )
+    p.add_argument(
+        "--view", type=int, default=0, help="library scenes: camera viewpoint (default: 0)"
+    )
+    p.add_argument(
+        "--modes",
+        default=DEFAULT_MODES,
+        help=f"comma-separated render modes (default: {DEFAULT_MODES})",
+    )
+    p.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder")
+    p.add_argument(
+        "--spp",
+        type=int,
+        default=None,
+        help=f"samples per pixel of every pass (default: {default.render.spp}, the default "
+        "preset's; with --ground-truth the chosen preset's)",
+    )
+    p.add_argument(
+        "--seed", type=int, default=0, help="sampler seed and library illuminant seed (default: 0)"
+    )
+    p.add_argument(
+        "--resolution",
+        default=None,
+        metavar="WxH",
+        help="image size, e.g. 256x256 (default: a scene file's own camera size; library "
+        f"scenes {default.width}x{default.height}, or the --ground-truth preset's)",
+    )
+    p.add_argument("--width", type=int, default=None, help="image width (prefer --resolution)")
+    p.add_argument("--height", type=int, default=None, help="image height (prefer --resolution)")
+    p.add_argument(
+        "--max-depth",
+        type=int,
+        default=default.render.max_depth,
+        help=f"longest path, 2 = direct light only (default: {default.render.max_depth})",
+    )
+    p.add_argument(
+        "--variant", default=None, help="Mitsuba backend or variant (default: best usable)"
+    )
+    p.add_argument("--per-light", action="store_true", help="also write one image per light")
+    p.add_argument("--direct", action="store_true", help="also write direct-light-only images")
+    p.add_argument("--no-aovs", action="store_true", help="skip coverage/id/depth/normal maps")
+    p.add_argument(
+        "--integrator",
+        choices=INTEGRATORS,
+        default=DEFAULT_INTEGRATOR,
+        help="diagonal modes from one traversal (single) or K/3 passes per mode and "
+        f"one scene per light (passes); same images (default: {DEFAULT_INTEGRATOR})",
+    )
+    p.add_argument(
+        "--ground-truth",
+        action="store_true",
+        help="write every ground-truth layer instead of raw passes: a one-sample dataset "
+        "built by the same path as `spectrinsic dataset --scenes` (uses --preset)",
+    )
+    p.add_argument(
+        "--preset",
+        default="default",
+        help="with --ground-truth: quality preset (default: default, the same spp, depth "
+        "and library size as a plain render; preview for a quick look)",
+    )
+    p.add_argument(
+        "--new-sample",
+        action="store_true",
+        help="with --ground-truth: render a scene a generated build saved as a new sample "
+        "(id from the file name, seed from --seed) instead of reproducing its own",
+    )
+    p.add_argument(
+        "--material-map",
+        metavar="FILE",
+        default=None,
+        help="material name -> spectrum map for .blend and mesh files",
+    )
+    p.add_argument(
+        "--default-spectrum",
+        metavar="NAME",
+        default=None,
+        help="reflectance of unmapped materials in .blend and mesh files",
+    )
+    p.set_defaults(func=run)
+
+
+def load_scene_argument(
+    scene: str,
+    *,
+    condition: str,
+    view: int,
+    seed: int,
+    width: int | None,
+    height: int | None,
+    materials: Mapping[str, str] | None = None,
+    default_spectrum: str | None = None,
+    data_dir: str | None = None,
+) -> Scene:
+    """The Scene named by the ``SCENE`` argument: a scene file (YAML, ``.blend`` or mesh,
+    :func:`spectrinsic.scenes.sources.load_scene_file`, the dispatch ``dataset --scenes`` uses),
+    else a library scene at the default preset's size unless *width*/*height* say otherwise."""
+    if is_scene_file(scene):
+        return load_scene_file(
+            scene,
+            width=width,
+            height=height,
+            materials=materials,
+            default_spectrum=default_spectrum,
+            data_dir=data_dir,
+        )
+    default = get_preset("default")
+    return library.build(
+        scene,
+        view=view,
+        condition=condition,
+        seed=seed,
+        width=default.width if width is None else width,
+        height=default.height if height is None else height,
+    )
+
+
+#: Largest sampler seed and samples per pixel Mitsuba takes (both are unsigned 32-bit).
+UINT32_MAX = 2**32 - 1
+
+
+def _check_size_options(args: argparse.Namespace) -> None:
+    """Every number and name the render needs, checked before anything is loaded or written."""
+    for option, value in (("--width", args.width), ("--height", args.height), ("--spp", args.spp)):
+        if value is not None and value < 1:
+            raise RenderError(f"{option} {value}; expected a positive integer")
+    if args.spp is not None and args.spp > UINT32_MAX:
+        raise RenderError(f"--spp {args.spp}; expected at most {UINT32_MAX}")
+    if not 0 <= args.seed <= UINT32_MAX:
+        raise RenderError(f"--seed {args.seed}; expected a whole number from 0 to {UINT32_MAX}")
+    if args.max_depth < 1:
+        raise RenderError(f"--max-depth {args.max_depth}; expected >= 1 (2 = direct light only)")
+    if args.variant is not None:
+        choose_variant("rgb", args.variant)  # an unknown or unusable backend, before any work
+    requested_size(args)  # a malformed --resolution, before any work
+
+
+def requested_size(args: argparse.Namespace) -> tuple[int, int] | None:
+    """``--resolution`` (or ``--width``/``--height``, a side left out taking the other's or a
+    file's default), or ``None`` when no size was asked for."""
+    if args.resolution is not None:
+        if args.width is not None or args.height is not None:
+            raise RenderError("--resolution with --width/--height; give one of them")
+        return cli_dataset.parse_resolution(args.resolution)
+    if args.width is None and args.height is None:
+        return None
+    return args.width or args.height or FILE_SIZE, args.height or args.width or FILE_SIZE
+
+
+def write_render(
+    out: Path, scene: Scene, result: RenderResult, *, data_dir: str | None = None
+) -> dict[str, Path]:
+    """Write a :class:`~spectrinsic.render.RenderResult` as EXR files, an sRGB PNG beside each
+    mode's EXR (``<mode>.png``: its XYZ as linear sRGB, times :func:`~spectrinsic.gt_export.png.
+    exposure`, sRGB-encoded to 8 bits; the scale in ``meta.json["previews"]``) and
+    ``meta.json`` into *out*."""
+    out.mkdir(parents=True, exist_ok=True)
+    paths: dict[str, Path] = {}
+    previews: dict[str, dict[str, Any]] = {}
+    for mode, raw in result.raw.items():
+        labels = get_sensors(result.meta["sensors"][mode], data_dir=data_dir).channels
+        layers = {"raw": raw, "xyz": result.images[mode]}
+        names: dict[str, tuple[str, ...]] = {"raw": tuple(labels), "xyz": ("X", "Y", "Z")}
+        if mode in result.direct:
+            layers["direct"], names["direct"] = result.direct[mode], ("X", "Y", "Z")
+        for i, light in enumerate(result.per_light):
+            layers[f"light{i}"], names[f"light{i}"] = light[mode], ("X", "Y", "Z")
+        paths[mode] = write_exr(
+            out / f"{mode}.exr",
+            layers,
+            channel_names=names,
+            attributes={"spectrinsic.mode": mode, "spectrinsic.units": result.meta["units"]},
+        )
+        rgb = xyz_to_linear_srgb(result.images[mode])
+        scale = exposure(rgb)  # the package's one exposure and sRGB encoding (gt_export.png)
+        paths[f"{mode}_png"] = write_png(out / f"{mode}.png", encode_srgb8(rgb, scale))
+        previews[mode] = {"file": f"{mode}.png", "exposure": scale}
+    if result.aovs:
+        a = result.aovs
+        paths["aovs"] = write_exr(
+            out / "aovs.exr",
+            {
+                "coverage": a["coverage"],
+                "material_id": a["material_id"],
+                "object_id": a["object_id"],
+                "depth": a["depth"],
+                "normals": a["normals"],
+                "mask": a["mask"].astype("float32"),
+            },
+            channel_names={
+                "coverage": tuple(f"m{i:02d}" for i in range(a["coverage"].shape[-1])),
+                "material_id": ("id",),
+                "object_id": ("id",),
+                "depth": ("Z",),
+                "normals": ("X", "Y", "Z"),
+                "mask": ("A",),
+            },
+        )
+    meta = {
+        **result.meta,
+        "scene": scene_to_dict(scene),
+        "files": {k: v.name for k, v in paths.items()},
+        "previews": {
+            "encoding": "sRGB (IEC 61966-2-1), 8-bit, linear sRGB x exposure, clipped",
+            **previews,
+        },
+    }
+    meta["scene"]["meshes"] = [
+        {"name": m.name, "object_id": m.object_id, "faces": len(m.faces)} for m in scene.meshes
+    ]
+    paths["meta"] = out / "meta.json"
+    paths["meta"].write_text(json.dumps(meta, indent=2, default=str) + "\n", encoding="utf-8")
+    return paths
+
+
+def _ground_truth(args: argparse.Namespace) -> int:
+    """``render --ground-truth``: a one-sample dataset (library name or scene file), built by
+    the same call as ``spectrinsic dataset`` (:func:`spectrinsic.cli.dataset.build`)."""
+    changes: dict[str, Any] = {}
+    if args.spp is not None:
+        changes["spp"] = args.spp
+    if args.direct:
+        changes["direct"] = True
+    size = requested_size(args)
+    if size is not None:
+        changes["width"], changes["height"] = size
+    only = None
+    if is_scene_file(args.scene):
+        changes["source"] = files_source(
+            [args.scene],
+            materials=cli_dataset.material_map(args.material_map),
+            default_spectrum=args.default_spectrum,
+            resolution=size,
+            new_sample=args.new_sample,
+        )
+    else:
+        only = str(SampleId(args.scene, args.view, args.condition))
+    config = get_preset(args.preset, seed=args.seed).with_options(**changes)
+    if not is_scene_file(args.scene) and not getattr(args, "quiet", False):
+        why = "--resolution" if size else f"preset {args.preset!r}"
+        print(f"spectrinsic render: {config.width}x{config.height} ({why})", file=sys.stderr)
+    cli_dataset.preflight(args.out, config, data_dir=getattr(args, "data_dir", None))
+    return cli_dataset.build(
+        args.out,
+        config,
+        only=only,
+        data_dir=getattr(args, "data_dir", None),
+        quiet=getattr(args, "quiet", False),
+    )
+
+
+def _render_settings(args: argparse.Namespace, modes: list[str]) -> RenderSettings:
+    """The render settings the options give (defaults: the default preset's spp and depth)."""
+    spp = get_preset("default").render.spp if args.spp is None else args.spp
+    return RenderSettings(
+        spp,
+        modes=tuple(modes),
+        max_depth=args.max_depth,
+        variant=args.variant,
+        per_light=args.per_light,
+        direct=args.direct,
+        aovs=not args.no_aovs,
+        integrator=args.integrator,
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    _check_size_options(args)
+    if args.ground_truth:
+        return _ground_truth(args)
+    modes = [m.strip() for m in str(args.modes).split(",") if m.strip()]
+    if not modes:
+        raise SceneError(
+            f"--modes {args.modes!r}: expected a comma-separated list such as {DEFAULT_MODES}"
+        )
+    for mode in modes:
+        get_mode(mode)
+    settings = _render_settings(args, modes)
+    check_output_folder(Path(args.out))
+    data_dir = getattr(args, "data_dir", None)
+    size = requested_size(args)
+    scene = load_scene_argument(
+        args.scene,
+        condition=args.condition,
+        view=args.view,
+        seed=args.seed,
+        width=size[0] if size else None,
+        height=size[1] if size else None,
+        materials=cli_dataset.material_map(args.material_map),
+        default_spectrum=args.default_spectrum,
+        data_dir=data_dir,
+    )
+    given = (
+        f"--resolution {args.resolution}"
+        if args.resolution
+        else " ".join(
+            f"--{k} {v}"
+            for k, v in (("width", args.width), ("height", args.height))
+            if v is not None
+        )
+    )
+    if not getattr(args, "quiet", False):
+        why = given or (
+            "the scene file's camera" if is_scene_file(args.scene) else "the default preset's"
+        )
+        print(
+            f"spectrinsic render: {scene.camera.width}x{scene.camera.height} ({why})",
+            file=sys.stderr,
+        )
+    check_render_size(
+        scene.camera.width,
+        scene.camera.height,
+        settings,
+        what=given or f"scene {args.scene!r}",
+        n_lights=len(scene.lights),
+        data_dir=data_dir,
+    )
+    total = count_passes(scene, settings, data_dir=data_dir)
+    bar = (
+        None
+        if getattr(args, "quiet", False)
+        else tqdm(total=total, desc=f"render {scene.name}", unit="pass", file=sys.stderr)
+    )
+    with output_folder(Path(args.out)):  # locked; its files recorded as spectrinsic's
+        try:
+            result = render_scene(
+                scene,
+                settings,
+                seed=args.seed,
+                progress=None if bar is None else bar.update,
+                data_dir=data_dir,
+            )
+        finally:
+            if bar is not None:
+                bar.close()
+        paths = write_render(Path(args.out), scene, result, data_dir=data_dir)
+    timings = result.meta["timings"]
+    for mode in result.images:
+        print(
+            f"{mode:<9} {timings[mode]['passes']:>3} passes {timings[mode]['seconds']:7.2f} s  -> {paths[mode]} "
+            f"(sRGB preview {paths[f'{mode}_png'].name})"
+        )
+    if "single" in timings:  # every diagonal mode (and the AOVs) from one traversal
+        print(
+            f"{'traversal':<9} {timings['single']['passes']:>3} passes {timings['single']['seconds']:7.2f} s  "
+            "(all diagonal modes and lights)"
+        )
+    print(f"wrote {paths['meta']}")
+    return 0
