@@ -12,10 +12,11 @@ from tqdm import tqdm
 
 from spectrinsic.errors import DatasetError, SceneError, SpectrinsicError
 from spectrinsic.gt_export.integrity import check_build_folder
+from spectrinsic.gt_export.manifest import SPLIT_FRACTIONS
 from spectrinsic.pipeline.dataset import SampleFailure, build_dataset
 from spectrinsic.pipeline.executors import check_scheduler, choose_executor
 from spectrinsic.pipeline.presets import PRESETS, DatasetConfig, get_preset, preset_names
-from spectrinsic.pipeline.source_plan import files_source, generator_source
+from spectrinsic.pipeline.source_plan import file_sample, files_source, generator_source
 from spectrinsic.render.budget import check_render_size
 from spectrinsic.render.settings import INTEGRATORS
 from spectrinsic.scenes.generators import GlossDistribution
@@ -23,7 +24,16 @@ from spectrinsic.scenes.sources import FileSource
 from spectrinsic.scenes.yaml_limits import load_yaml_file
 from spectrinsic.spectra import get_spectrum
 
-__all__ = ["register", "run", "config_from_args", "preflight", "build", "material_map"]
+__all__ = [
+    "register",
+    "run",
+    "config_from_args",
+    "preflight",
+    "build",
+    "material_map",
+    "source_notes",
+    "parse_resolution",
+]
 
 DEFAULT_OUT = "data/dataset"
 #: Largest root seed and samples per pixel (Mitsuba's sampler takes unsigned 32-bit values).
@@ -58,6 +68,13 @@ def register(subparsers: Any) -> None:
     _add_build_options(p)
     _add_quality_options(p)
     _add_source_options(p.add_argument_group("scene source (default: the built-in library layout)"))
+    p.add_argument(
+        "--split-fractions",
+        default=None,
+        metavar="TRAIN,VAL,TEST",
+        help="shares of the scenes in the train, val and test splits (0.8,0.1,0.1); from 3 "
+        "scenes on every split holds a scene; not hashed (a resume rewrites the manifest)",
+    )
     p.add_argument(
         "--rebuild",
         action="store_true",
@@ -201,6 +218,14 @@ def _add_source_options(src: Any) -> None:
         help="Munsell chroma range of generated materials (0,16)",
     )
     src.add_argument(
+        "--light-saturation",
+        default=None,
+        metavar="LO,HI",
+        help="keep only coloured lights whose |Duv| (Ohno 2013: CIE 1960 uv distance "
+        "from the Planckian locus) is in LO,HI; 0.02 is visibly tinted, at most "
+        "0.15 for LO (default: any, 60%% from saturated LEDs and filtered lamps)",
+    )
+    src.add_argument(
         "--sfu",
         action="store_true",
         help="also draw SFU reflectances and illuminants (needs --data-dir)",
@@ -243,6 +268,13 @@ def _add_source_options(src: Any) -> None:
         metavar="NAME",
         default=None,
         help="reflectance of unmapped materials in .blend and mesh scenes",
+    )
+    src.add_argument(
+        "--new-sample",
+        action="store_true",
+        help="render scenes a generated build saved (<dataset>/scenes/*.yaml) as new "
+        "samples (id from the file name, seed from --seed) instead of "
+        "reproducing their own sample (same id, same seed)",
     )
 
 
@@ -290,14 +322,43 @@ def _source(args: argparse.Namespace) -> str | None:
             value_range=_range("--value-range", args.value_range),
             chroma_range=_range("--chroma-range", args.chroma_range),
             gloss=gloss,
+            light_saturation=None
+            if args.light_saturation is None
+            else _range("--light-saturation", args.light_saturation),
         )
     if args.scenes:
+        size = None if args.resolution is None else parse_resolution(args.resolution)
         return files_source(
             args.scenes,
             materials=material_map(args.material_map),
             default_spectrum=args.default_spectrum,
+            resolution=size,
+            new_sample=getattr(args, "new_sample", False),
         )
     return None
+
+
+def source_notes(config: DatasetConfig) -> list[str]:
+    """What applies to each scene file of *config* (``--scenes``, ``render --ground-truth``):
+    its size (the file's camera or --resolution) and its sample (a saved one, reproduced, or a
+    new one); empty for the library and generators."""
+    spec = json.loads(config.source or "{}")
+    notes = []
+    for entry in spec.get("scenes", ()):
+        size = spec.get("resolution")
+        where = (
+            f"{size[0]}x{size[1]} (--resolution)"
+            if size
+            else "the file's camera size (--resolution to change it)"
+        )
+        sid, seed = file_sample(entry["path"], new_sample=bool(spec.get("new_sample")))
+        sample = (
+            f"reproduces its saved sample {sid} with seed {seed} (--new-sample for a new one)"
+            if seed is not None
+            else f"sample {sid}"
+        )
+        notes.append(f"{Path(entry['path']).name}: {where}; {sample}")
+    return notes
 
 
 #: Options copied into the config as they are when given (option dest -> config key).
@@ -331,11 +392,26 @@ def _overrides(args: argparse.Namespace) -> dict[str, Any]:
         if getattr(args, dest, False):
             changes[key] = value
     if args.resolution is not None:
-        changes["width"], changes["height"] = _resolution(args.resolution)
+        changes["width"], changes["height"] = parse_resolution(args.resolution)
+    if getattr(args, "split_fractions", None) is not None:
+        changes["split_fractions"] = _split_fractions(args.split_fractions)
     return changes
 
 
-def _resolution(text: str) -> tuple[int, int]:
+def _split_fractions(text: str) -> tuple[tuple[str, float], ...]:
+    """``TRAIN,VAL,TEST`` shares (each > 0, summing to 1; checked by the config)."""
+    try:
+        shares = [float(v) for v in text.split(",")]
+    except ValueError:
+        shares = []
+    if len(shares) != len(SPLIT_FRACTIONS):
+        raise DatasetError(
+            f"--split-fractions {text!r}; expected TRAIN,VAL,TEST shares, e.g. 0.8,0.1,0.1"
+        )
+    return tuple((name, v) for (name, _), v in zip(SPLIT_FRACTIONS, shares, strict=True))
+
+
+def parse_resolution(text: str) -> tuple[int, int]:
     """``WIDTHxHEIGHT`` as two positive integers."""
     w, sep, h = text.lower().partition("x")
     if not (sep and w.isdigit() and h.isdigit() and int(w) > 0 and int(h) > 0):
@@ -397,11 +473,12 @@ def _check_scene_files(config: Any, data_dir: str | None) -> None:
                 get_spectrum(name, data_dir=data_dir)
         except SpectrinsicError as exc:
             raise DatasetError(f"{option} {name!r}: {exc}") from exc
+    width, height = spec.get("resolution") or (None, None)
     for entry in spec["scenes"]:
         FileSource(
             entry["path"],
-            config.width,
-            config.height,
+            width,
+            height,
             tuple(sorted(materials.items())),
             spec.get("default_spectrum"),
         ).build(data_dir)
@@ -454,6 +531,9 @@ def build(
     shared by ``dataset`` and ``render --ground-truth``.
     """
     choice = choose_executor(workers=workers, threads=threads, scheduler=scheduler)
+    if not quiet:
+        for note in source_notes(config):
+            print(f"spectrinsic dataset: {note}", file=sys.stderr)
     executor, render_threads, where = choice.executor, choice.render_threads, choice.where
 
     bar: Any = None

@@ -14,6 +14,7 @@ from spectrinsic.decompose.evaluate import evaluate
 from spectrinsic.decompose.mit import evaluate_mit, mit_folder_objects
 from spectrinsic.decompose.predictions import Predictions
 from spectrinsic.decompose.registry import available_decomposers, get_decomposer
+from spectrinsic.decompose.targets import TARGETS
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.loader import load_sample
 from spectrinsic.gt_export.outfolder import output_folder
@@ -85,6 +86,14 @@ def register(subparsers: Any) -> None:
         metavar="GLOB",
         default=None,
         help="only samples whose id matches one of these comma-separated patterns (e.g. 'obj-*')",
+    )
+    p.add_argument(
+        "--target",
+        choices=TARGETS,
+        default="full",
+        help="image the methods decompose: the full image, or the diffuse image "
+        "(image - specular) of glossy samples (full); see "
+        "spectrinsic.decompose.targets",
     )
     p.add_argument("--seed", type=int, default=0, help="root seed of the WHDR judgements (0)")
     p.add_argument(
@@ -161,7 +170,7 @@ def run(args: argparse.Namespace) -> int:
         print(result.files[key].read_text(encoding="utf-8"))
     print(
         f"{len(result.scores)} scores for {len(folders)} samples in {args.out} "
-        f"(REPORT.md, scores.csv, tables, figures/, estimates/)"
+        f"(REPORT.md with every table and summary.png, scores.csv, figures/, estimates/)"
     )
     return 0
 
@@ -184,6 +193,7 @@ def _evaluate(args: argparse.Namespace, folders: list[Path], methods: dict[str, 
             figures=not args.no_figures,
             save_estimates=not args.no_estimates,
             progress=progress,
+            target=args.target,
         )
     finally:
         bar.close()

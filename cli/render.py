@@ -4,7 +4,7 @@
 ``.blend`` or mesh, read as ``dataset --scenes`` reads them). For
 every mode ``DIR/<mode>.exr`` holds float32 layers ``raw`` (the K raw channels, named after the
 sensors, e.g. ``raw.B400``), ``xyz`` (CIE 1931 XYZ), and when asked ``direct`` and
-``light<i>`` (XYZ); ``DIR/aovs.exr`` holds coverage, ids, depth and normals; ``DIR/meta.json``
+``light<i>`` (XYZ), and ``DIR/<mode>.png`` its sRGB preview; ``DIR/aovs.exr`` holds coverage, ids, depth and normals; ``DIR/meta.json``
 the render settings, variants, timings and the scene. Ground-truth layers are written by
 ``spectrinsic dataset``, not here.
 """
@@ -24,6 +24,7 @@ from spectrinsic.cli import dataset as cli_dataset
 from spectrinsic.errors import RenderError, SceneError
 from spectrinsic.gt_export.exr import write_exr
 from spectrinsic.gt_export.outfolder import check_output_folder, output_folder
+from spectrinsic.gt_export.png import encode_srgb8, exposure, write_png
 from spectrinsic.pipeline.presets import get_preset
 from spectrinsic.pipeline.source_plan import files_source
 from spectrinsic.render import (
@@ -43,8 +44,9 @@ from spectrinsic.scenes.model import Scene, scene_to_dict
 from spectrinsic.scenes.sample_id import SampleId
 from spectrinsic.scenes.sources import FILE_SIZE, is_scene_file, load_scene_file
 from spectrinsic.spectra import get_sensors
+from spectrinsic.spectra.colorimetry import xyz_to_linear_srgb
 
-__all__ = ["register", "run", "load_scene_argument", "write_render"]
+__all__ = ["register", "run", "load_scene_argument", "write_render", "requested_size"]
 
 DEFAULT_MODES = ",".join(RENDER_DEFAULT_MODES)
 
@@ -96,17 +98,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--seed", type=int, default=0, help="sampler seed and library illuminant seed (default: 0)"
     )
     p.add_argument(
-        "--width",
-        type=int,
+        "--resolution",
         default=None,
-        help=f"image width (default: the scene's, {default.width} for the library)",
+        metavar="WxH",
+        help="image size, e.g. 256x256 (default: a scene file's own camera size; library "
+        f"scenes {default.width}x{default.height}, or the --ground-truth preset's)",
     )
-    p.add_argument(
-        "--height",
-        type=int,
-        default=None,
-        help=f"image height (default: the scene's, {default.height} for the library)",
-    )
+    p.add_argument("--width", type=int, default=None, help="image width (prefer --resolution)")
+    p.add_argument("--height", type=int, default=None, help="image height (prefer --resolution)")
     p.add_argument(
         "--max-depth",
         type=int,
@@ -133,7 +132,16 @@ def register(sub: argparse._SubParsersAction) -> None:
         "built by the same path as `spectrinsic dataset --scenes` (uses --preset)",
     )
     p.add_argument(
-        "--preset", default="preview", help="with --ground-truth: quality preset (preview)"
+        "--preset",
+        default="default",
+        help="with --ground-truth: quality preset (default: default, the same spp, depth "
+        "and library size as a plain render; preview for a quick look)",
+    )
+    p.add_argument(
+        "--new-sample",
+        action="store_true",
+        help="with --ground-truth: render a scene a generated build saved as a new sample "
+        "(id from the file name, seed from --seed) instead of reproducing its own",
     )
     p.add_argument(
         "--material-map",
@@ -202,14 +210,31 @@ def _check_size_options(args: argparse.Namespace) -> None:
         raise RenderError(f"--max-depth {args.max_depth}; expected >= 1 (2 = direct light only)")
     if args.variant is not None:
         choose_variant("rgb", args.variant)  # an unknown or unusable backend, before any work
+    requested_size(args)  # a malformed --resolution, before any work
+
+
+def requested_size(args: argparse.Namespace) -> tuple[int, int] | None:
+    """``--resolution`` (or ``--width``/``--height``, a side left out taking the other's or a
+    file's default), or ``None`` when no size was asked for."""
+    if args.resolution is not None:
+        if args.width is not None or args.height is not None:
+            raise RenderError("--resolution with --width/--height; give one of them")
+        return cli_dataset.parse_resolution(args.resolution)
+    if args.width is None and args.height is None:
+        return None
+    return args.width or args.height or FILE_SIZE, args.height or args.width or FILE_SIZE
 
 
 def write_render(
     out: Path, scene: Scene, result: RenderResult, *, data_dir: str | None = None
 ) -> dict[str, Path]:
-    """Write a :class:`~spectrinsic.render.RenderResult` as EXR files and ``meta.json`` into *out*."""
+    """Write a :class:`~spectrinsic.render.RenderResult` as EXR files, an sRGB PNG beside each
+    mode's EXR (``<mode>.png``: its XYZ as linear sRGB, times :func:`~spectrinsic.gt_export.png.
+    exposure`, sRGB-encoded to 8 bits; the scale in ``meta.json["previews"]``) and
+    ``meta.json`` into *out*."""
     out.mkdir(parents=True, exist_ok=True)
     paths: dict[str, Path] = {}
+    previews: dict[str, dict[str, Any]] = {}
     for mode, raw in result.raw.items():
         labels = get_sensors(result.meta["sensors"][mode], data_dir=data_dir).channels
         layers = {"raw": raw, "xyz": result.images[mode]}
@@ -224,6 +249,10 @@ def write_render(
             channel_names=names,
             attributes={"spectrinsic.mode": mode, "spectrinsic.units": result.meta["units"]},
         )
+        rgb = xyz_to_linear_srgb(result.images[mode])
+        scale = exposure(rgb)  # the package's one exposure and sRGB encoding (gt_export.png)
+        paths[f"{mode}_png"] = write_png(out / f"{mode}.png", encode_srgb8(rgb, scale))
+        previews[mode] = {"file": f"{mode}.png", "exposure": scale}
     if result.aovs:
         a = result.aovs
         paths["aovs"] = write_exr(
@@ -249,6 +278,10 @@ def write_render(
         **result.meta,
         "scene": scene_to_dict(scene),
         "files": {k: v.name for k, v in paths.items()},
+        "previews": {
+            "encoding": "sRGB (IEC 61966-2-1), 8-bit, linear sRGB x exposure, clipped",
+            **previews,
+        },
     }
     meta["scene"]["meshes"] = [
         {"name": m.name, "object_id": m.object_id, "faces": len(m.faces)} for m in scene.meshes
@@ -266,18 +299,24 @@ def _ground_truth(args: argparse.Namespace) -> int:
         changes["spp"] = args.spp
     if args.direct:
         changes["direct"] = True
-    if args.width is not None or args.height is not None:
-        changes["width"], changes["height"] = args.width or FILE_SIZE, args.height or FILE_SIZE
+    size = requested_size(args)
+    if size is not None:
+        changes["width"], changes["height"] = size
     only = None
     if is_scene_file(args.scene):
         changes["source"] = files_source(
             [args.scene],
             materials=cli_dataset.material_map(args.material_map),
             default_spectrum=args.default_spectrum,
+            resolution=size,
+            new_sample=args.new_sample,
         )
     else:
         only = str(SampleId(args.scene, args.view, args.condition))
     config = get_preset(args.preset, seed=args.seed).with_options(**changes)
+    if not is_scene_file(args.scene) and not getattr(args, "quiet", False):
+        why = "--resolution" if size else f"preset {args.preset!r}"
+        print(f"spectrinsic render: {config.width}x{config.height} ({why})", file=sys.stderr)
     cli_dataset.preflight(args.out, config, data_dir=getattr(args, "data_dir", None))
     return cli_dataset.build(
         args.out,
@@ -317,20 +356,35 @@ def run(args: argparse.Namespace) -> int:
     settings = _render_settings(args, modes)
     check_output_folder(Path(args.out))
     data_dir = getattr(args, "data_dir", None)
+    size = requested_size(args)
     scene = load_scene_argument(
         args.scene,
         condition=args.condition,
         view=args.view,
         seed=args.seed,
-        width=args.width,
-        height=args.height,
+        width=size[0] if size else None,
+        height=size[1] if size else None,
         materials=cli_dataset.material_map(args.material_map),
         default_spectrum=args.default_spectrum,
         data_dir=data_dir,
     )
-    given = " ".join(
-        f"--{k} {v}" for k, v in (("width", args.width), ("height", args.height)) if v is not None
+    given = (
+        f"--resolution {args.resolution}"
+        if args.resolution
+        else " ".join(
+            f"--{k} {v}"
+            for k, v in (("width", args.width), ("height", args.height))
+            if v is not None
+        )
     )
+    if not getattr(args, "quiet", False):
+        why = given or (
+            "the scene file's camera" if is_scene_file(args.scene) else "the default preset's"
+        )
+        print(
+            f"spectrinsic render: {scene.camera.width}x{scene.camera.height} ({why})",
+            file=sys.stderr,
+        )
     check_render_size(
         scene.camera.width,
         scene.camera.height,
@@ -361,7 +415,8 @@ def run(args: argparse.Namespace) -> int:
     timings = result.meta["timings"]
     for mode in result.images:
         print(
-            f"{mode:<9} {timings[mode]['passes']:>3} passes {timings[mode]['seconds']:7.2f} s  -> {paths[mode]}"
+            f"{mode:<9} {timings[mode]['passes']:>3} passes {timings[mode]['seconds']:7.2f} s  -> {paths[mode]} "
+            f"(sRGB preview {paths[f'{mode}_png'].name})"
         )
     if "single" in timings:  # every diagonal mode (and the AOVs) from one traversal
         print(

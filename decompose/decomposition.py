@@ -31,11 +31,15 @@ class Decomposition:
         ``(H, W, 3)`` float32 linear shading-illumination, ``image / reflectance``.
     info
         Method diagnostics (label counts, timings...), JSON-serialisable.
+    specular
+        ``(H, W, 3)`` float32 linear specular estimate, for a method that predicts one (scored
+        against a glossy sample's ``specular`` layer); None otherwise.
     """
 
     reflectance: np.ndarray
     shading: np.ndarray
     info: dict[str, Any] = field(default_factory=dict)
+    specular: np.ndarray | None = None
 
 
 class Decomposer(Protocol):

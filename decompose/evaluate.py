@@ -17,7 +17,8 @@ Predictions`, a user's estimates read from files. For each sample and method:
 
 Outputs in ``out_dir`` (:func:`spectrinsic.decompose.report.write_report`): ``scores.csv``
 (sample, method, scenario, layer, metric, value), the condition tables like Tables 5.3/5.4,
-the scenario table like Table 5.1, ``REPORT.md`` (input, layers, methods and their parameters),
+the scenario table like Table 5.1, ``summary.png`` (method x condition), ``REPORT.md`` (every
+table's numbers inline, abbreviations, the summary figure, methods and their parameters),
 ``figures/<sample>.png`` and ``estimates/<method>/<scenario>/<sample>/{reflectance,shading}.exr``
 (the predictions layout, so an estimates folder can be scored again with ``--predictions``).
 """
@@ -40,7 +41,14 @@ from spectrinsic.decompose.predictions import Predictions
 from spectrinsic.decompose.registry import available_decomposers, get_decomposer
 from spectrinsic.decompose.report import write_report
 from spectrinsic.decompose.scores import CONDITION_GROUPS, INPUT_LAYERS, SCORED_LAYERS, Score
-from spectrinsic.errors import DatasetError
+from spectrinsic.decompose.targets import (
+    SPECULAR_LAYER,
+    SPECULAR_METRICS,
+    TARGETS,
+    target_image,
+    target_note,
+)
+from spectrinsic.errors import DatasetError, validate_choice
 from spectrinsic.gt_export.exr import write_exr
 from spectrinsic.gt_export.names import camera_slug
 from spectrinsic.rng import seed_from_key
@@ -150,7 +158,7 @@ def _material_ids(sample: Mapping[str, Any]) -> np.ndarray | None:
     return None if ids is None else np.asarray(ids)
 
 
-def _camera_inputs(sample: Mapping[str, Any]) -> list[tuple[str, str, np.ndarray]]:
+def _camera_inputs(sample: Mapping[str, Any], target: str) -> list[tuple[str, str, np.ndarray]]:
     """``(camera, scenario, corrected image)`` for every camera image and feasible scenario."""
     matrices = sample.get("meta", {}).get("matrices") or {}
     s_sen = matrices.get("S_Sen", {})
@@ -158,7 +166,7 @@ def _camera_inputs(sample: Mapping[str, Any]) -> list[tuple[str, str, np.ndarray
     out = []
     for key in sorted(k for k in sample if k.startswith("image_camera/")):
         camera = key.split("/", 1)[1]
-        image = input_image(sample, camera)[1]
+        image = target_image(sample, input_image(sample, camera)[1], target, camera)
         light_cam = (l_clig.get(camera) or {}).get("scene")
         light_srgb = (l_clig.get("srgb") or {}).get("scene")
         available = {
@@ -197,6 +205,8 @@ def _write_estimate(directory: Path, result: Decomposition) -> None:
     directory.mkdir(parents=True, exist_ok=True)
     write_exr(directory / "reflectance.exr", {"reflectance": result.reflectance})
     write_exr(directory / "shading.exr", {"shading": result.shading})
+    if result.specular is not None:
+        write_exr(directory / "specular.exr", {"specular": result.specular})
 
 
 def input_image(sample: Mapping[str, Any], camera: str | None = None) -> tuple[str, np.ndarray]:
@@ -225,6 +235,7 @@ def layer_metrics(layer: str, metrics: Sequence[str] | None = None) -> list[str]
         "shading_grey": _SHADING_GREY_METRICS,
         "shading": _SHADING_COLOUR_METRICS,
         "reflectance_grey": _REFLECTANCE_GREY_METRICS,
+        SPECULAR_LAYER: SPECULAR_METRICS,
     }
     if layer in defaults:
         return list(defaults[layer])
@@ -232,10 +243,15 @@ def layer_metrics(layer: str, metrics: Sequence[str] | None = None) -> list[str]
 
 
 def _estimate(
-    method: Decomposer | Predictions, sid: str, scenario: str, image: np.ndarray, mask: np.ndarray
+    method: Decomposer | Predictions,
+    sid: str,
+    scenario: str,
+    image: np.ndarray,
+    mask: np.ndarray,
+    target: str,
 ) -> Decomposition | None:
-    if isinstance(method, Predictions):
-        return method.load(sid, scenario, image, mask)
+    if isinstance(method, Predictions):  # a predicted specular is in the full image only
+        return method.load(sid, scenario, image, mask, subtract_specular=target == "full")
     return method(image, mask)
 
 
@@ -269,6 +285,8 @@ def _truth(sample: Mapping[str, Any], seed: int, n_judgements: int) -> _Truth:
         "shading_grey": _grey(colour if grey is None else grey),
         "reflectance_grey": _grey(reflectance),
     }
+    if SPECULAR_LAYER in sample:
+        layers[SPECULAR_LAYER] = np.asarray(sample[SPECULAR_LAYER], dtype=np.float64)
     return _Truth(sid, mask, layers, judgements)
 
 
@@ -290,6 +308,8 @@ def _score(
             shading_grey=_grey(result.shading),
             reflectance_grey=_grey(result.reflectance),
         )
+        if result.specular is not None and SPECULAR_LAYER in truth.layers:
+            estimates[SPECULAR_LAYER] = result.specular
     out = []
     for layer, est in estimates.items():
         which = names if layer == "reflectance" else layer_metrics(layer)
@@ -320,6 +340,7 @@ def evaluate_sample(
     cameras: bool = True,
     figure: bool = True,
     save_estimates: bool = True,
+    target: str = "full",
 ) -> list[Score]:
     """Decompose one sample with every method (or read its predictions) and score the estimates.
 
@@ -340,19 +361,23 @@ def evaluate_sample(
         Also run the photometric scenarios on the camera renderings.
     figure, save_estimates
         Draw the figure, write the estimates (of decomposers; predictions are files already).
+    target
+        ``"full"`` or ``"diffuse"``: the image decomposed (:mod:`spectrinsic.decompose.targets`).
     """
     truth = _truth(sample, seed, n_judgements)
     names = layer_metrics("reflectance", metrics)
-    inputs: list[tuple[str, str, str, np.ndarray]] = [("srgb", "", "", input_image(sample)[1])]
+    image = target_image(sample, input_image(sample)[1], target)
+    inputs: list[tuple[str, str, str, np.ndarray]] = [("srgb", "", "", image)]
     if cameras:
         inputs += [
-            (f"{sc}_{camera_slug(cam)}", cam, sc, img) for cam, sc, img in _camera_inputs(sample)
+            (f"{sc}_{camera_slug(cam)}", cam, sc, img)
+            for cam, sc, img in _camera_inputs(sample, target)
         ]
     scores: list[Score] = []
     figure_rows: list[tuple[str, Decomposition]] = []
     for method, decomposer in methods.items():
         for scenario, camera, photometric, img in inputs:
-            result = _estimate(decomposer, truth.sid, scenario, img, truth.mask)
+            result = _estimate(decomposer, truth.sid, scenario, img, truth.mask, target)
             if result is None:
                 continue
             scores += _score(truth, result, method, scenario, names, camera, photometric)
@@ -417,6 +442,7 @@ def evaluate(
     figures: bool = True,
     save_estimates: bool = True,
     progress: Callable[[str], None] | None = None,
+    target: str = "full",
 ) -> EvaluationResult:
     """Evaluate decomposers (or predictions) on *samples* and write scores, tables and figures.
 
@@ -433,7 +459,11 @@ def evaluate(
         Root seed of the WHDR judgements.
     progress
         Called with each sample id once it is done (the CLI passes a tqdm update).
+    target
+        ``"full"`` (default) or ``"diffuse"``: the image methods decompose, named in the
+        tables and ``REPORT.md`` (:mod:`spectrinsic.decompose.targets`).
     """
+    validate_choice(target, TARGETS, "evaluation target", error=DatasetError)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if methods is None:
@@ -443,7 +473,9 @@ def evaluate(
     scores: list[Score] = []
     samples_info: dict[str, tuple[str, str]] = {}
     inputs: set[str] = set()
+    glossy = False
     for sample in samples:
+        glossy = glossy or SPECULAR_LAYER in sample
         sid = _sample_id(sample)
         samples_info[sid] = (sample_kind(sample), sample_condition(sample))
         inputs.add(input_image(sample)[0])
@@ -457,10 +489,13 @@ def evaluate(
             cameras=cameras,
             figure=figures,
             save_estimates=save_estimates,
+            target=target,
         )
         if progress is not None:
             progress(sid)
     if not scores:
         raise DatasetError("no samples to evaluate")
-    files = write_report(out, scores, samples_info, methods, sorted(inputs))
+    files = write_report(
+        out, scores, samples_info, methods, sorted(inputs), note=target_note(target, glossy)
+    )
     return EvaluationResult(tuple(scores), files)

@@ -19,6 +19,11 @@ Layout of a predictions folder ``DIR`` (what ``spectrinsic evaluate --prediction
 * When only one of the two layers is given, the other is derived so that
   ``image = reflectance * shading`` per channel (thesis Eq. 3.1): ``shading = image /
   reflectance`` or ``reflectance = image / shading`` (grey shading applies to all channels).
+* Optional ``DIR/<sample_id>/specular.exr`` (or ``.png``): a predicted specular image
+  (``(H, W, 3)``, linear sRGB at the image's scale), scored against a glossy sample's
+  ``specular`` layer (:mod:`spectrinsic.decompose.targets`). On the full-image target it is
+  subtracted from the image before a missing layer is derived (``image − specular =
+  reflectance * shading``); on the diffuse target the image is diffuse already.
 * A sample without any file is an error; a camera scenario without files is not scored.
 
 If both an EXR and a PNG are present, the EXR is used. :func:`write_predictions` writes this
@@ -30,7 +35,7 @@ from __future__ import annotations
 import logging
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Literal
 
@@ -165,10 +170,18 @@ class Predictions:
         return base if scenario == "srgb" else base / scenario
 
     def load(
-        self, sample_id: str, scenario: str, image: np.ndarray, mask: np.ndarray
+        self,
+        sample_id: str,
+        scenario: str,
+        image: np.ndarray,
+        mask: np.ndarray,
+        *,
+        subtract_specular: bool = True,
     ) -> Decomposition | None:
         """The estimate of one sample and scenario, completed from *image* (module docstring).
 
+        *subtract_specular*: a predicted specular is part of *image* (the full-image target)
+        and is removed from it before a missing layer is derived.
         Returns None for a camera scenario without files; raises :class:`DatasetError` for a
         sample (``scenario="srgb"``) without any.
         """
@@ -176,6 +189,7 @@ class Predictions:
         shape = (int(image.shape[0]), int(image.shape[1]))
         refl = read_layer(folder, "reflectance", shape, encoding=self.encoding)
         shad = read_layer(folder, "shading", shape, encoding=self.encoding)
+        spec = read_layer(folder, "specular", shape, encoding=self.encoding)
         if refl is None and shad is None:
             if scenario == "srgb":
                 raise DatasetError(
@@ -185,17 +199,20 @@ class Predictions:
                 )
             logger.info("predictions %s: no files for %s / %s", self.name, sample_id, scenario)
             return None
-        img = np.clip(np.asarray(image, dtype=np.float64), 0.0, None)
+        img = np.asarray(image, dtype=np.float64)
+        img = np.clip(img - spec if spec is not None and subtract_specular else img, 0.0, None)
         if refl is None:
             assert shad is not None  # narrowed by the check above
             refl = _divide(img, shad)
-        if shad is None:
-            return finish(img, refl, mask, {"source": str(folder)})
         m = mask[:, :, None]
+        spec32 = None if spec is None else np.where(m, spec, 0.0).astype(np.float32)
+        if shad is None:
+            return replace(finish(img, refl, mask, {"source": str(folder)}), specular=spec32)
         return Decomposition(
             np.where(m, refl, 0.0).astype(np.float32),
             np.where(m, shad, 0.0).astype(np.float32),
             {"source": str(folder)},
+            spec32,
         )
 
 
@@ -269,6 +286,7 @@ def write_predictions(
     *,
     reflectance: np.ndarray | None = None,
     shading: np.ndarray | None = None,
+    specular: np.ndarray | None = None,
     fmt: Literal["exr", "png"] = "exr",
     encoding: Literal["linear", "srgb"] = "linear",
     scenario: str | None = None,
@@ -286,6 +304,9 @@ def write_predictions(
         Linear estimates at any scale: reflectance ``(H, W, 3)``, shading ``(H, W, 3)`` or
         grey ``(H, W)``; at least one. The missing one is derived by the reader from
         ``image = reflectance * shading`` (thesis Eq. 3.1).
+    specular
+        Optional linear ``(H, W, 3)`` specular estimate at the image's scale (scored against a
+        glossy sample's ``specular`` layer; module docstring).
     fmt
         ``"exr"``: float32 OpenEXR, the values as given. ``"png"``: 16-bit PNG,
         ``code = round(65535 * value / scale)`` with ``scale = max(1, layer maximum)`` and
@@ -314,9 +335,10 @@ def write_predictions(
     """
     validate_choice(fmt, PREDICTION_FORMATS, "predictions format", error=DatasetError)
     validate_choice(encoding, PNG_ENCODINGS, "PNG encoding", error=DatasetError)
-    layers = {
-        k: v for k, v in (("reflectance", reflectance), ("shading", shading)) if v is not None
-    }
+    given = (("reflectance", reflectance), ("shading", shading), ("specular", specular))
+    layers = {k: v for k, v in given if v is not None}
+    if set(layers) == {"specular"}:
+        raise DatasetError("write_predictions: give reflectance, shading or both with specular")
     if not layers:
         raise DatasetError("write_predictions: give reflectance, shading or both")
     folder = Path(root) / _plain_name(sample_id, "sample id")

@@ -17,9 +17,15 @@ from pathlib import Path
 from typing import Any
 
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export.diversity import DIVERSITY_NAME, write_diversity
+from spectrinsic.gt_export.colour_spread import shown, spread_summary
+from spectrinsic.gt_export.diversity import DIVERSITY_NAME, spread_record, write_diversity
 from spectrinsic.gt_export.integrity import guarded_write
-from spectrinsic.gt_export.manifest import noise_summary, splits_by_scene, variants_of
+from spectrinsic.gt_export.manifest import (
+    noise_summary,
+    read_manifest,
+    splits_by_scene,
+    variants_of,
+)
 from spectrinsic.gt_export.sample import CARD_NAME, META_NAME, config_hash, plain_data, sample_dirs
 from spectrinsic.gt_export.sample_meta import LayerRecord, SampleMeta, read_meta
 from spectrinsic.provenance import software_versions
@@ -43,11 +49,28 @@ def _diversity_section(root: Path, samples: Sequence[Path], metas: Sequence[Samp
     newest = max((s / META_NAME).stat().st_mtime_ns for s in samples)
     if not figure.is_file() or figure.stat().st_mtime_ns < newest:  # a resumed build: keep it
         write_diversity(root, samples, metas)
-    splits = splits_by_scene({m.sample_id: m.scene for m in metas})
-    counts = ", ".join(f"{k} {len(v)}" for k, v in splits.items())
+    manifest = read_manifest(root)  # the splits the build wrote (its --split-fractions)
+    scenes = {m.sample_id: m.scene for m in metas}
+    splits = (
+        manifest.splits if manifest is not None and manifest.splits else splits_by_scene(scenes)
+    )
+    counts = ", ".join(
+        f"{k} {len(v)} samples ({len({scenes[i] for i in v if i in scenes})} scenes)"
+        for k, v in splits.items()
+    )
+    spread = spread_summary([spread_record(m) for m in metas])
     return (
         f"\n## Splits and diversity\n\nSplits by scene (no scene in two splits; "
-        f'`manifest.json["splits"]`): {counts} samples.\n\n'
+        f'`manifest.json["splits"]`; every split holds a scene from as many scenes as '
+        f"splits on): {counts}.\n\n"
+        f"Colour spread: lights cover {shown(spread['xy_hull_area'], '.3f')} of CIE 1931 xy (hull area), "
+        f"{shown(spread['d65_distance_median'], '.3f')} median xy distance from D65, "
+        f"{shown(spread['tinted_fraction'], '.0%')} of non-D65 lights tinted (|Duv| >= 0.02, Ohno 2013), "
+        f"paired lights at least {shown(spread['pair_distance_min'], '.3f')} apart in xy; material chroma "
+        f"C*ab median {shown(spread['chroma_median'], '.1f')} (p90 {shown(spread['chroma_p90'], '.1f')}); "
+        f"{shown(spread['patterned_fraction'], '.0%')} of generated objects patterned "
+        f"({shown(spread['textured_fraction'], '.0%')} spectrally textured), "
+        f"{shown(spread['framed_fraction'], '.0%')} of views framed (>= 30 % objects).\n\n"
         f"![r, light CCT and xy, materials per image, object coverage, luminance range]"
         f"({DIVERSITY_NAME})\n"
     )

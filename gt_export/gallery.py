@@ -5,7 +5,8 @@
 * ``index.html``, ``gallery.js`` and ``gallery.css``: a page that opens from the file system (no
   server, no network) and renders only the current page of samples, with lazy thumbnails;
 * ``gallery.json``: the index (per sample its scene, generator, condition, kind, split, noise figure,
-  lights with their SPDs and chromaticities, and every layer's preview with its encoding), and
+  lights with their SPDs, chromaticities and shares, every layer's preview with its encoding,
+  ``image_denoised`` first where it exists, and the previous and next sample's ids), and
   ``gallery-index.js``, the same index assigned to ``window.SPECTRINSIC_GALLERY`` (a page opened
   from ``file://`` may not ``fetch()`` a local JSON file, but it may load a script);
 * ``contact_sheet.png`` (every sample) and ``contact_sheets/<condition>.png`` (one per condition);
@@ -45,15 +46,18 @@ __all__ = [
     "build_gallery",
     "contact_sheet",
     "gallery_index",
+    "scene_kind",
     "GALLERY_DIRS",
     "GALLERY_LAYERS",
     "INDEX_VARIABLE",
 ]
 
 #: Layer order in the per-sample switcher (others follow in name order; camera views last).
+#: ``image_denoised`` (``reflectance * shading + residual``, what a method should decompose)
+#: comes first where a sample has it, so the page opens on it rather than the noisy render.
 GALLERY_LAYERS: tuple[str, ...] = (
-    "image",
     "image_denoised",
+    "image",
     "image_rgb3",
     "image_rgb6",
     "image_spectral",
@@ -173,9 +177,11 @@ def _sample_entry(sample: Path, meta: SampleMeta, split: str | None) -> dict[str
         "condition": smeta.get("condition"),
         # generated scenes name their generator; the built-in library and user scenes do not
         "generator": smeta.get("generator") or ("library" if "library" in smeta else "own scene"),
-        "kind": smeta.get("kind"),
+        "kind": scene_kind(meta),
         "split": split,
         "noise": _noise_figure(meta),
+        "first_layer": next(iter(layers), None),
+        "light_shares": [light["share"] for light in lights],
         "size": list(meta.size),
         "reference_mode": meta.reference_mode,
         "layers": layers,
@@ -185,6 +191,27 @@ def _sample_entry(sample: Path, meta: SampleMeta, split: str | None) -> dict[str
             | {f"{sample.name}/{META_NAME}", f"{sample.name}/{SCENE_NAME}"}
         ),
     }
+
+
+#: Scene kind of a generator's scenes, for samples whose metadata does not name it.
+_GENERATOR_KINDS = {"objects-on-ground": "object", "rooms": "complex"}
+
+
+def scene_kind(meta: SampleMeta) -> str:
+    """``"object"`` or ``"complex"``: the scene's ``kind`` metadata, else its generator's, else
+    by name (library object scenes start with ``obj-``, as :func:`spectrinsic.decompose.
+    evaluate.sample_kind` reads them); never empty, so the gallery's kind filter sees every
+    sample."""
+    smeta = meta.scene_metadata
+    kind = smeta.get("kind") or _GENERATOR_KINDS.get(str(smeta.get("generator")))
+    return str(kind) if kind else ("object" if meta.scene.startswith("obj") else "complex")
+
+
+def _link_neighbours(entries: list[dict[str, Any]]) -> None:
+    """``prev``/``next``: the neighbouring sample ids in index order (``None`` at the ends)."""
+    for i, entry in enumerate(entries):
+        entry["prev"] = entries[i - 1]["id"] if i > 0 else None
+        entry["next"] = entries[i + 1]["id"] if i + 1 < len(entries) else None
 
 
 def _layer_info(metas: Sequence[SampleMeta]) -> dict[str, dict[str, Any]]:
@@ -222,6 +249,7 @@ def gallery_index(dataset_dir: str | os.PathLike[str]) -> dict[str, Any]:
     entries = [
         _sample_entry(s, m, split_of.get(s.name)) for s, m in zip(samples, metas, strict=True)
     ]
+    _link_neighbours(entries)
     cmaps = {
         enc["cmap"]
         for e in entries

@@ -120,14 +120,17 @@ EXPOSED_PREFIXES = ("image", "shading", "illuminant", "residual", "cube")
 
 def split_samples(dataset_dir: str | os.PathLike[str], split: str | None) -> list[Path]:
     """Sample folders of *split* (``"train"``, ``"val"``, ``"test"``; ``None``: all) from the
-    manifest's ``splits`` (made by scene, so no scene is in two splits)."""
+    manifest's ``splits`` (made by scene, so no scene is in two splits).
+
+    Raises
+    ------
+    DatasetError
+        An unknown split, or an empty one (naming the split and the dataset's scene count).
+    """
     folders = sample_dirs(dataset_dir)
     if split is None:
         return folders
-    splits = read_splits(dataset_dir)
-    if split not in splits:
-        raise DatasetError(f"split {split!r}; expected one of {sorted(splits)}")
-    chosen = set(splits[split])
+    chosen = set(read_splits(dataset_dir, split)[split])
     return [f for f in folders if f.name in chosen]
 
 

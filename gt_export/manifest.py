@@ -42,14 +42,20 @@ __all__ = [
     "ManifestRecord",
     "read_manifest",
     "read_splits",
-    "split_of",
+    "SplitFractions",
+    "check_split_fractions",
+    "split_counts",
     "splits_by_scene",
     "noise_summary",
     "variants_of",
 ]
 
-#: Train / val / test shares of the scenes (each scene's samples go to one split).
-SPLIT_FRACTIONS: tuple[tuple[str, float], ...] = (("train", 0.8), ("val", 0.1), ("test", 0.1))
+#: ``(split name, share of the scenes)`` pairs, in the order the splits are filled.
+SplitFractions = tuple[tuple[str, float], ...]
+
+#: Train / val / test shares of the scenes (each scene's samples go to one split); a build
+#: takes others from ``dataset --split-fractions`` (``DatasetConfig.split_fractions``).
+SPLIT_FRACTIONS: SplitFractions = (("train", 0.8), ("val", 0.1), ("test", 0.1))
 
 
 def _spectral_provenance(metas: Sequence[SampleMeta], data_dir: Any) -> dict[str, Any]:
@@ -83,8 +89,10 @@ def write_manifest(
     config: Mapping[str, Any],
     *,
     data_dir: str | os.PathLike[str] | None = None,
+    split_fractions: SplitFractions = SPLIT_FRACTIONS,
 ) -> Path:
-    """Write ``manifest.json``: settings, seed, versions, variants, provenance, SHA-256 per file.
+    """Write ``manifest.json``: settings, seed, versions, variants, provenance, splits by scene
+    (:func:`splits_by_scene` with *split_fractions*), SHA-256 per file.
 
     Every file inside every sample folder is hashed (paths relative to the dataset folder).
     Nothing time-dependent is recorded, so the same build gives the same manifest.
@@ -103,8 +111,8 @@ def write_manifest(
         "n_samples": len(samples),
         "noise": noise_summary(metas),
         "split_by": "scene",
-        "split_fractions": dict(SPLIT_FRACTIONS),
-        "splits": splits_by_scene({m.sample_id: m.scene for m in metas}),
+        "split_fractions": dict(split_fractions),
+        "splits": splits_by_scene({m.sample_id: m.scene for m in metas}, split_fractions),
         "samples": {
             s.name: {
                 "config_hash": m.config_hash,
@@ -123,14 +131,30 @@ def write_manifest(
     return path
 
 
-def read_splits(dataset_dir: str | os.PathLike[str]) -> dict[str, list[str]]:
-    """``{split: [sample ids]}`` of a built dataset's manifest."""
+def read_splits(
+    dataset_dir: str | os.PathLike[str], split: str | None = None
+) -> dict[str, list[str]]:
+    """``{split: [sample ids]}`` of a built dataset's manifest.
+
+    With *split*, that split must exist and hold a sample: an unknown name or an empty split
+    (fewer scenes than splits) is a one-line :class:`~spectrinsic.errors.DatasetError` naming
+    the split and the dataset's scene count.
+    """
     try:
         record = read_manifest(dataset_dir)
     except SampleMetaError as exc:
         raise DatasetError(f"{exc}; rebuild the dataset") from exc
     if record is None or "splits" not in record.raw:
         raise DatasetError(f"{dataset_dir}: {MANIFEST_NAME} has no splits; rebuild the dataset")
+    if split is not None and split not in record.splits:
+        raise DatasetError(f"split {split!r}; expected one of {sorted(record.splits)}")
+    if split is not None and not record.splits[split]:
+        n = record.n_scenes
+        raise DatasetError(
+            f"split {split!r} of {dataset_dir} is empty: the dataset has {n} scene(s) for "
+            f"{len(record.splits)} splits (every split gets a scene from {len(record.splits)} "
+            "scenes on; build more scenes or choose other --split-fractions)"
+        )
     return record.splits
 
 
@@ -139,29 +163,77 @@ def variants_of(metas: Sequence[SampleMeta]) -> list[str]:
     return sorted({v for m in metas for v in m.variants})
 
 
-def split_of(scene: str) -> str:
-    """The split of scene *scene*: its ``seed_from_key(0, "split:" + scene)`` as a fraction of
-    2³² against the cumulative :data:`SPLIT_FRACTIONS`. It depends on the scene name only, so a
-    scene keeps its split when the set grows and all its views and conditions share it.
+def _scene_key(scene: str) -> float:
+    """Where scene *scene* falls in [0, 1): ``seed_from_key(0, "split:" + scene) / 2³²``. It
+    depends on the name only, so the scenes' order (and mostly their splits) hold as a set grows."""
+    return seed_from_key(0, f"split:{scene}") / 2**32
 
-    >>> split_of("room-living") == split_of("room-living")
-    True
+
+def check_split_fractions(fractions: SplitFractions) -> SplitFractions:
+    """*fractions* if they are ``(name, share)`` pairs with distinct names and shares > 0 summing
+    to 1 (within 1e-6); else a one-line :class:`~spectrinsic.errors.DatasetError`.
+
+    >>> check_split_fractions((("train", 0.5), ("val", 0.5)))
+    (('train', 0.5), ('val', 0.5))
     """
-    u = seed_from_key(0, f"split:{scene}") / 2**32
-    edge = 0.0
-    for name, share in SPLIT_FRACTIONS:
-        edge += share
-        if u < edge:
-            return name
-    return SPLIT_FRACTIONS[-1][0]
+    pairs = tuple((str(name), float(share)) for name, share in fractions)
+    names = [name for name, _ in pairs]
+    shown = ", ".join(f"{n}={v:g}" for n, v in pairs)
+    if not pairs or len(set(names)) != len(names) or not all(names):
+        raise DatasetError(f"split fractions {shown or '(none)'}; expected distinct named splits")
+    if (
+        not all(np.isfinite(v) and v > 0 for _, v in pairs)
+        or abs(sum(v for _, v in pairs) - 1) > 1e-6
+    ):
+        raise DatasetError(f"split fractions {shown}; expected shares > 0 that sum to 1")
+    return pairs
 
 
-def splits_by_scene(sample_scenes: Mapping[str, str]) -> dict[str, list[str]]:
+def split_counts(n_scenes: int, fractions: SplitFractions = SPLIT_FRACTIONS) -> dict[str, int]:
+    """Scenes per split for *n_scenes* scenes: the largest-remainder rounding of
+    ``share * n_scenes``, then, when there are at least as many scenes as splits, one scene
+    moved into each empty split from the largest one, so every split exists.
+
+    >>> split_counts(11)
+    {'train': 9, 'val': 1, 'test': 1}
+    >>> split_counts(3)
+    {'train': 1, 'val': 1, 'test': 1}
+    >>> split_counts(2)
+    {'train': 2, 'val': 0, 'test': 0}
+    """
+    pairs = check_split_fractions(fractions)
+    exact = [share * n_scenes for _, share in pairs]
+    counts = [int(np.floor(x)) for x in exact]
+    by_remainder = sorted(range(len(pairs)), key=lambda i: (counts[i] - exact[i], i))
+    for i in by_remainder[: n_scenes - sum(counts)]:
+        counts[i] += 1
+    if n_scenes >= len(pairs):
+        for i in range(len(pairs)):
+            if counts[i] == 0:
+                counts[max(range(len(pairs)), key=lambda j: (counts[j], -j))] -= 1
+                counts[i] = 1
+    return {name: c for (name, _), c in zip(pairs, counts, strict=True)}
+
+
+def splits_by_scene(
+    sample_scenes: Mapping[str, str], fractions: SplitFractions = SPLIT_FRACTIONS
+) -> dict[str, list[str]]:
     """``{split: [sample ids]}`` from ``{sample id: scene name}``, made by scene (no scene in two
-    splits, so no view or condition of a scene leaks across)."""
-    out: dict[str, list[str]] = {name: [] for name, _ in SPLIT_FRACTIONS}
+    splits, so no view or condition of a scene leaks across).
+
+    The scenes, ordered by :func:`_scene_key`, fill the splits in turn with
+    :func:`split_counts` scenes each: with at least as many scenes as splits (3 for
+    train/val/test) every split holds a scene.
+    """
+    scenes = sorted(set(sample_scenes.values()), key=lambda s: (_scene_key(s), s))
+    owner: dict[str, str] = {}
+    start = 0
+    for name, count in split_counts(len(scenes), fractions).items():
+        owner.update({scene: name for scene in scenes[start : start + count]})
+        start += count
+    out: dict[str, list[str]] = {name: [] for name, _ in fractions}
     for sample, scene in sorted(sample_scenes.items()):
-        out[split_of(scene)].append(sample)
+        out[owner[scene]].append(sample)
     return out
 
 
@@ -206,6 +278,12 @@ class ManifestRecord:
     sample_hashes: Mapping[str, str | None]
     sample_files: Mapping[str, Mapping[str, str]]
     raw: Mapping[str, Any] = field(repr=False)
+
+    @property
+    def n_scenes(self) -> int:
+        """Distinct scenes of the listed samples (what the splits were made from)."""
+        listed = self.raw.get("samples", {})
+        return len({r.get("scene") for r in listed.values() if isinstance(r, dict)})
 
 
 def _manifest_samples(

@@ -156,8 +156,9 @@ def _write_index(out: Path, index: dict[str, Any]) -> None:
 def _plan(source: Path, samples_per_shard: int) -> dict[str, dict[str, list[Path]]]:
     """``{split: {shard name: sample folders}}`` in sample-id order."""
     plan: dict[str, dict[str, list[Path]]] = {}
-    for split in list(_manifest(source).get("splits") or {}) or [None]:
-        folders = split_samples(source, split)
+    splits = _manifest(source).get("splits") or {}
+    for split in list(splits) or [None]:
+        folders = split_samples(source, split) if split is None or splits[split] else []
         label = split or "all"
         plan[label] = {
             f"{label}-{i // samples_per_shard:06d}.tar": folders[i : i + samples_per_shard]
@@ -253,6 +254,9 @@ def _write_locked(
         "version": _VERSION,
         "key_separator": KEY_SEPARATOR,
         "config_hash": _manifest(source).get("config_hash"),
+        "n_scenes": len(
+            {r.get("scene") for r in (_manifest(source).get("samples") or {}).values()}
+        ),
     }
     # Before any shard: record every name this export may write, so a re-run after an
     # interruption knows them as its own (and nothing else in the folder is ever touched).
@@ -304,6 +308,11 @@ def shard_urls(out_dir: str | os.PathLike[str], split: str | None = None) -> lis
     splits = _index(out)["splits"]
     if split is not None and split not in splits:
         raise DatasetError(f"split {split!r}; the shards have {sorted(splits)}")
+    if split is not None and not splits[split]["samples"]:
+        raise DatasetError(
+            f"split {split!r} of {out} is empty: the dataset had "
+            f"{_index(out).get('n_scenes', '?')} scene(s) for {len(splits)} splits"
+        )
     chosen = [split] if split is not None else sorted(splits)
     return [str(out / name) for s in chosen for name in splits[s]["shards"]]
 
@@ -345,7 +354,7 @@ def shard_dataset(
 ) -> Iterator[dict[str, Any]]:
     """A ``webdataset.WebDataset`` over the shards of *split*, each item decoded as
     :func:`load_sample` returns it (arrays ``(H, W[, C])`` under their layer keys, ``meta``)
-    plus ``sample_id``; an empty iterator for a split with no samples.
+    plus ``sample_id``; an empty split is a :class:`~spectrinsic.errors.DatasetError` naming it.
 
     Every shard is first checked against its SHA-256 in :data:`SHARD_INDEX` (a damaged shard
     raises :class:`~spectrinsic.errors.DatasetError` before anything is yielded). It is an

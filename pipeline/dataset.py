@@ -258,7 +258,7 @@ def _task_scene(task: SampleTask) -> Any:
 
     scene = task.source.build(task.data_dir)
     if isinstance(task.source, GeneratedSource):
-        save_generated(task.out_dir, task.sample_id, scene)
+        save_generated(task.out_dir, task.sample_id, scene, task.seed)
     return scene
 
 
@@ -499,7 +499,7 @@ def finalize_dataset(
     if not sample_dirs(out):
         return {}
     cfg = config.to_dict()
-    manifest = write_manifest(out, cfg, data_dir=data_dir)
+    manifest = write_manifest(out, cfg, data_dir=data_dir, split_fractions=config.split_fractions)
     card = write_dataset_card(out, cfg)
     gallery = build_gallery(out)
     return {"manifest": str(manifest), "card": str(card), "gallery": str(gallery)}

@@ -15,6 +15,7 @@ from typing import Any
 from spectrinsic import provenance
 from spectrinsic.errors import DatasetError, RenderError, validate_choice
 from spectrinsic.gt_export import DEFAULT_CAMERAS
+from spectrinsic.gt_export.manifest import SPLIT_FRACTIONS, SplitFractions, check_split_fractions
 from spectrinsic.gt_export.sample import config_hash
 from spectrinsic.render.light_transport import diagonal_mode_names
 from spectrinsic.render.modes import RENDER_MODES
@@ -137,6 +138,11 @@ class DatasetConfig:
         Relit variants written per rendered sample (needs *store_transport*), each under light
         spectra drawn by :func:`spectrinsic.gt_export.relight_pool.draw_light_spectra`. Left
         out of the settings when 0.
+    split_fractions
+        ``(split, share)`` pairs of the scenes in the manifest's splits (default
+        :data:`~spectrinsic.gt_export.manifest.SPLIT_FRACTIONS`, 80/10/10); with at least as
+        many scenes as splits every split holds a scene. Not a setting of the samples (not
+        hashed): a resumed build with other fractions rewrites only the manifest.
     """
 
     preset: str
@@ -150,6 +156,7 @@ class DatasetConfig:
     source: str | None = None
     store_transport: bool = False
     relight: int = 0
+    split_fractions: SplitFractions = SPLIT_FRACTIONS
 
     def __post_init__(self) -> None:
         if self.cameras is not None:  # a list from JSON or the command line
@@ -164,6 +171,7 @@ class DatasetConfig:
             validate_choice(mode, RENDER_MODES, "render mode", error=DatasetError)
         if not isinstance(self.seed, int) or self.seed < 0:
             raise DatasetError(f"dataset seed {self.seed!r}; expected a non-negative integer")
+        object.__setattr__(self, "split_fractions", check_split_fractions(self.split_fractions))
         self._check_transport()
 
     def _check_transport(self) -> None:

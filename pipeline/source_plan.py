@@ -6,13 +6,17 @@ A config whose ``source`` is set plans its samples here instead of from the libr
   from V cameras; sample ids ``<scene>__v<view>__<family>``. Every generated scene is saved as
   a YAML scene file (``FORMAT.md``) in ``<out>/scenes/<sample id>.yaml``, so it can be edited
   and re-rendered with ``dataset --scenes``.
-* ``{"scenes": [{"path": ..., "sha256": ...}], "materials": {...}, "default_spectrum": ...}``:
-  one sample ``<stem>__v0__file`` per scene file; the files' SHA-256 are part of the config, so
-  editing a scene file asks for ``--rebuild``.
+* ``{"scenes": [{"path": ..., "sha256": ...}], "materials": {...}, "default_spectrum": ...,
+  "resolution": [W, H] or None, "new_sample": bool}``: one sample ``<stem>__v0__file`` per
+  scene file, at the file's own camera size unless ``resolution`` is given; the files' SHA-256
+  are part of the config, so editing a scene file asks for ``--rebuild``. A scene saved by a
+  generated build records its sample (``metadata.sample``: id and seed), and re-rendering it
+  reproduces that sample (same id, same seed) unless ``new_sample`` is set.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import re
@@ -20,7 +24,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from spectrinsic.errors import DatasetError, SceneError, validate_choice
+from spectrinsic.errors import DatasetError, SceneError, SpectrinsicError, validate_choice
 from spectrinsic.gt_export.sample import file_sha256
 from spectrinsic.pipeline.presets import DatasetConfig
 from spectrinsic.pipeline.tasks import SampleTask
@@ -32,9 +36,13 @@ from spectrinsic.scenes.generators import (
     generated_family,
     generated_scene_name,
 )
+from spectrinsic.scenes.generators.lights import check_saturation
+from spectrinsic.scenes.generators.materials import check_ranges
+from spectrinsic.scenes.model import Scene
 from spectrinsic.scenes.sample_id import SampleId
 from spectrinsic.scenes.scene_writer import save_scene
 from spectrinsic.scenes.sources import FileSource, GeneratedSource, scene_file_kind
+from spectrinsic.scenes.yaml_limits import load_yaml_file
 from spectrinsic.spectra import list_spectra
 
 __all__ = [
@@ -43,6 +51,8 @@ __all__ = [
     "files_source",
     "plan_source_samples",
     "save_generated",
+    "saved_sample",
+    "file_sample",
 ]
 
 #: Folder of a dataset holding the generated scenes' YAML files.
@@ -51,6 +61,10 @@ _SAFE = re.compile(r"[^A-Za-z0-9._-]+")
 #: Most generated scenes and cameras per scene in one dataset: planning is O(count x views)
 #: before the first render, and 10^5 scenes already take days to render on a workstation.
 MAX_COUNT = 100_000
+#: Version of what the generators draw for a seed, part of the config: a set built by an older
+#: version (other light pools, furniture, framing) asks for ``--rebuild`` instead of mixing.
+#: 2: saturated lights, ranges obeyed by every material, framed rooms (issue 22).
+GENERATOR_VERSION = 2
 MAX_VIEWS = 64
 
 
@@ -64,10 +78,24 @@ def generator_source(
     min_coverage: float = 0.15,
     sfu: bool = False,
     gloss: GlossDistribution | None = None,
+    light_saturation: Sequence[float] | None = None,
 ) -> str:
-    """The canonical ``source`` JSON of a generated set (validated); *gloss* enters it only
-    when active, so matte sets keep their source and config hash."""
+    """The canonical ``source`` JSON of a generated set (validated: an impossible range is
+    refused here, before any scene is planned); *gloss* and *light_saturation* enter it only
+    when given, so matte sets and older configs keep their source and config hash."""
     validate_choice(generator, GENERATORS, "scene generator", error=DatasetError)
+    try:
+        check_ranges(
+            (float(value_range[0]), float(value_range[1])),
+            (float(chroma_range[0]), float(chroma_range[1])),
+        )
+    except SceneError as exc:
+        raise DatasetError(f"--value-range / --chroma-range: {exc}") from None
+    try:
+        if light_saturation is not None:
+            check_saturation((float(light_saturation[0]), float(light_saturation[1])))
+    except SceneError as exc:
+        raise DatasetError(f"--light-saturation: {exc}") from None
     if not (1 <= count <= MAX_COUNT and 1 <= views <= MAX_VIEWS):
         raise DatasetError(
             f"--count {count} / --views {views}; expected whole numbers from 1 to "
@@ -81,6 +109,7 @@ def generator_source(
         "chroma_range": [float(c) for c in chroma_range],
         "min_coverage": float(min_coverage),
         "sfu": bool(sfu),
+        "generator_version": GENERATOR_VERSION,
     }
     if gloss is not None and gloss.active:
         spec["gloss"] = {
@@ -88,6 +117,8 @@ def generator_source(
             "metallic": float(gloss.metal_fraction),
             "roughness_range": [float(v) for v in gloss.roughness_range],
         }
+    if light_saturation is not None:  # absent when not given: older configs keep their hash
+        spec["light_saturation"] = [float(v) for v in light_saturation]
     return json.dumps(spec, sort_keys=True)
 
 
@@ -96,8 +127,12 @@ def files_source(
     *,
     materials: Mapping[str, str] | None = None,
     default_spectrum: str | None = None,
+    resolution: tuple[int, int] | None = None,
+    new_sample: bool = False,
 ) -> str:
-    """The canonical ``source`` JSON of a set of scene files (each must exist)."""
+    """The canonical ``source`` JSON of a set of scene files (each must exist): rendered at
+    *resolution* ``(W, H)``, else at each file's own camera size; a saved generated scene as
+    its own sample unless *new_sample*."""
     entries = []
     for p in paths:
         path = Path(p).resolve()
@@ -113,8 +148,54 @@ def files_source(
         "scenes": entries,
         "materials": dict(sorted((materials or {}).items())),
         "default_spectrum": default_spectrum,
+        "new_sample": bool(new_sample),
+        "resolution": None if resolution is None else [int(v) for v in resolution],
     }
+    ids = [str(file_sample(e["path"], new_sample=new_sample)[0]) for e in entries]
+    dupes = sorted({i for i in ids if ids.count(i) > 1})
+    if dupes:
+        raise DatasetError(
+            f"--scenes: several files are sample {dupes}; add --new-sample to "
+            "render saved scenes as new samples"
+        )
     return json.dumps(spec, sort_keys=True)
+
+
+def saved_sample(path: str | os.PathLike[str]) -> tuple[SampleId, int] | None:
+    """The sample a generated build saved this YAML scene for (``metadata.sample``: id and
+    seed), or ``None`` for any other scene file. A malformed record is a one-line error."""
+    if scene_file_kind(Path(path)) != "yaml":
+        return None
+    doc = load_yaml_file(Path(path))
+    meta = doc.get("metadata") if isinstance(doc, dict) else None
+    record = meta.get("sample") if isinstance(meta, dict) else None
+    if record is None:
+        return None
+    seed = record.get("seed") if isinstance(record, dict) else None
+    text = str(record.get("id")) if isinstance(record, dict) else ""
+    try:  # a folder name: letters, digits, '.', '_', '-' only (the file is untrusted input)
+        sid = (
+            SampleId.parse(text)
+            if _SAFE.sub("-", text) == text and not text.startswith(".")
+            else None
+        )
+    except SpectrinsicError:
+        sid = None
+    if sid is None or isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**32:
+        raise DatasetError(
+            f"{path}: metadata.sample {record!r}; expected {{id: <sample id>, "
+            "seed: <0..2^32-1>}} as a generated build saves it"
+        )
+    return sid, seed
+
+
+def file_sample(path: str | os.PathLike[str], *, new_sample: bool) -> tuple[SampleId, int | None]:
+    """A scene file's sample id and seed: the saved sample's (:func:`saved_sample`) unless
+    *new_sample*, else ``<stem>__v0__file`` with no seed (the root seed's, when planned)."""
+    saved = None if new_sample else saved_sample(path)
+    if saved is not None:
+        return saved
+    return SampleId(_SAFE.sub("-", Path(path).stem), 0, "file"), None
 
 
 def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir: str | None) -> Any:
@@ -138,6 +219,7 @@ def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir:
         )  # type: ignore[arg-type]
     except (SceneError, TypeError, ValueError) as exc:
         raise DatasetError(f"source gloss {g!r}: {exc}") from exc
+    saturation = spec.get("light_saturation")
     return GeneratorOptions(
         width=config.width,
         height=config.height,
@@ -147,6 +229,7 @@ def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir:
         sfu_reflectances=sfu_r,
         sfu_illuminants=sfu_i,
         gloss=gloss,
+        light_saturation=None if saturation is None else tuple(saturation),
     )
 
 
@@ -165,23 +248,7 @@ def plan_source_samples(
                 for v in range(options.views)
             ]
     else:
-        materials = tuple(sorted(spec.get("materials", {}).items()))
-        for entry in spec["scenes"]:
-            name = _SAFE.sub("-", Path(entry["path"]).stem)
-            rows.append(
-                (
-                    name,
-                    0,
-                    "file",
-                    FileSource(
-                        entry["path"],
-                        config.width,
-                        config.height,
-                        materials,
-                        spec.get("default_spectrum"),
-                    ),
-                )
-            )
+        return _file_tasks(spec, out, config, data_dir=data_dir, render_threads=render_threads)
     return [
         SampleTask.planned(
             SampleId(name, v, cond),
@@ -195,8 +262,36 @@ def plan_source_samples(
     ]
 
 
-def save_generated(out_dir: str | os.PathLike[str], sample_id: str, scene: Any) -> Path:
-    """Write a generated scene as ``<out>/scenes/<sample id>.yaml`` (meshes beside it)."""
+def _file_tasks(
+    spec: Mapping[str, Any],
+    out: str,
+    config: DatasetConfig,
+    *,
+    data_dir: str | None,
+    render_threads: int | None,
+) -> list[SampleTask]:
+    """One task per scene file: the file's camera size unless the spec's ``resolution``; a
+    saved generated scene keeps its sample id and seed unless ``new_sample``."""
+    materials = tuple(sorted(spec.get("materials", {}).items()))
+    width, height = spec.get("resolution") or (None, None)
+    tasks = []
+    for entry in spec["scenes"]:
+        src = FileSource(entry["path"], width, height, materials, spec.get("default_spectrum"))
+        sid, seed = file_sample(entry["path"], new_sample=bool(spec.get("new_sample")))
+        task = SampleTask.planned(
+            sid, config, out, data_dir=data_dir, render_threads=render_threads, source=src
+        )
+        tasks.append(task if seed is None else dataclasses.replace(task, seed=seed))
+    return tasks
+
+
+def save_generated(
+    out_dir: str | os.PathLike[str], sample_id: str, scene: Scene, seed: int
+) -> Path:
+    """Write a generated scene as ``<out>/scenes/<sample id>.yaml`` (meshes beside it), its
+    ``metadata.sample`` naming the sample (id and render *seed*) so re-rendering the file
+    reproduces it (:func:`saved_sample`)."""
     folder = Path(out_dir) / SCENES_FOLDER
     folder.mkdir(parents=True, exist_ok=True)
-    return save_scene(scene, folder / f"{sample_id}.yaml")
+    record = {**scene.metadata, "sample": {"id": sample_id, "seed": int(seed)}}
+    return save_scene(dataclasses.replace(scene, metadata=record), folder / f"{sample_id}.yaml")

@@ -1,5 +1,5 @@
-"""Furniture and rooms as unions of boxes: :func:`table`, :func:`shelf`, :func:`chair` and
-:func:`room`.
+"""Furniture and rooms as unions of primitives: :func:`table`, :func:`round_table`,
+:func:`shelf`, :func:`chair`, :func:`sofa`, :func:`floor_lamp` and :func:`room`.
 
 Room walls are boxes of finite thickness, so the air inside a room is *outside* every solid (a
 point's inside/outside status stays well defined for scene validation).
@@ -15,9 +15,9 @@ import numpy as np
 
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes.parts import Part, merge, moved
-from spectrinsic.scenes.primitives import box
+from spectrinsic.scenes.primitives import box, cone, cylinder
 
-__all__ = ["table", "shelf", "chair", "room"]
+__all__ = ["table", "round_table", "shelf", "shelf_boards", "chair", "sofa", "floor_lamp", "room"]
 
 
 def table(
@@ -71,6 +71,54 @@ def shelf(
     for z in np.linspace(t / 2, height - t / 2, boards + 1):
         parts.append(box((width - 2 * t, depth - t, t), spectrum, center=(cx, cy - t / 2, cz + z)))
     return merge(*parts)
+
+
+def shelf_boards(height: float, boards: int, thickness: float = 0.03) -> list[tuple[float, float]]:
+    """``(top z, free height above)`` of each board of :func:`shelf` (the top board: inf), m."""
+    zs = np.linspace(thickness / 2, height - thickness / 2, boards + 1) + thickness / 2
+    gaps = [float(b - a - thickness) for a, b in zip(zs[:-1], zs[1:], strict=True)]
+    return [(float(z), g) for z, g in zip(zs, [*gaps, np.inf], strict=True)]
+
+
+def round_table(radius: float, height: float, spectrum: str, *, top: float = 0.04) -> Part:
+    """A pedestal table standing on z = 0: a round top, a central column and a round foot."""
+    return merge(
+        cylinder(radius, top, spectrum, center=(0, 0, height - top / 2), sections=32),
+        cylinder(0.05, height - top, spectrum, center=(0, 0, (height - top) / 2), sections=16),
+        cylinder(radius * 0.55, 0.03, spectrum, center=(0, 0, 0.015), sections=24),
+    )
+
+
+def sofa(width: float, depth: float, spectrum: str, *, seat: float = 0.42) -> Part:
+    """A sofa standing on z = 0, its back on the +y side: base, seat cushions, back, arms."""
+    arm = 0.15
+    cushions = max(1, int(round((width - 2 * arm) / 0.6)))
+    cw = (width - 2 * arm) / cushions
+    parts = [
+        box((width, depth, 0.25), spectrum, center=(0, 0, 0.125)),
+        box((width, 0.2, 0.8), spectrum, center=(0, depth / 2 - 0.1, 0.4)),
+    ]
+    parts += [
+        box((arm, depth, 0.6), spectrum, center=(sx * (width - arm) / 2, 0, 0.3)) for sx in (-1, 1)
+    ]
+    parts += [
+        box(
+            (cw - 0.01, depth - 0.22, seat - 0.25),
+            spectrum,
+            center=(-width / 2 + arm + cw * (i + 0.5), -0.1, (0.25 + seat) / 2),
+        )
+        for i in range(cushions)
+    ]
+    return merge(*parts)
+
+
+def floor_lamp(height: float, spectrum: str) -> Part:
+    """A floor lamp (unlit) standing on z = 0: a round base, a pole and a conical shade."""
+    return merge(
+        cylinder(0.15, 0.03, spectrum, center=(0, 0, 0.015), sections=24),
+        cylinder(0.015, height - 0.25, spectrum, center=(0, 0, (height - 0.25) / 2), sections=8),
+        cone(0.2, 0.3, spectrum, center=(0, 0, height - 0.3), sections=24),
+    )
 
 
 def chair(

@@ -14,6 +14,7 @@ from spectrinsic.spectra.colorimetry import (
     responses,
     srgb_responses,
     white_normalised_responses,
+    xy_to_duv,
     xyz_to_linear_srgb,
     xyz_to_xy,
 )
@@ -81,6 +82,7 @@ __all__ = [
     "wavelength_grid",
     "white_normalised_responses",
     "xyz_to_linear_srgb",
+    "xy_to_duv",
     "xyz_to_xy",
 ]
 

@@ -26,6 +26,7 @@ __all__ = [
     "xyz_to_linear_srgb",
     "linear_srgb_to_xyz",
     "xyz_to_xy",
+    "xy_to_duv",
     "white_normalised_responses",
     "absolute_reflectance",
     "srgb_responses",
@@ -121,6 +122,21 @@ def xyz_to_xy(xyz: np.ndarray) -> np.ndarray:
     with np.errstate(invalid="ignore", divide="ignore"):
         xy = np.where(s > 0, xyz[..., :2] / np.where(s == 0, 1, s), 0.0)
     return xy
+
+
+def xy_to_duv(xy: np.ndarray) -> np.ndarray:
+    """Signed distance Duv of CIE 1931 chromaticities (..., 2) from the Planckian locus in the
+    CIE 1960 UCS (u, v) diagram, by Ohno (2013) (colour-science ``uv_to_CCT_Ohno2013``),
+    shape (...). Positive above the locus (greenish), negative below (pinkish/purple); lights
+    with |Duv| >= 0.02 are visibly tinted rather than whites of another temperature.
+    """
+    import colour
+
+    uv = colour.xy_to_UCS_uv(np.asarray(xy, float))
+    # beyond the method's 1000-100000 K table (very saturated lights) colour warns and measures
+    # from the table's end: still a large |Duv|, which is all a saturation test needs
+    with colour.utilities.suppress_warnings(colour_runtime_warnings=True):
+        return np.asarray(colour.temperature.uv_to_CCT_Ohno2013(uv), float)[..., 1]
 
 
 def white_normalised_responses(

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import functools
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from types import MappingProxyType
 
 import numpy as np
@@ -18,6 +18,7 @@ from spectrinsic.spectra.grid import wavelength_grid
 from spectrinsic.spectra.records import Spectrum
 
 __all__ = [
+    "mix",
     "munsell",
     "munsell_names",
     "colorchecker",
@@ -152,3 +153,34 @@ def flat(key: str) -> Spectrum:
         raise SpectrumNotFoundError(f"flat reflectance {key!r}: expected a number in [0, 1]")
     wl = wavelength_grid(360.0, 830.0, 470.0)
     return Spectrum(f"flat:{value:g}", "reflectance", wl, np.full(wl.size, value), "constant")
+
+
+def mix(key: str, resolve: Callable[[str], Spectrum]) -> Spectrum:
+    """A convex combination of reflectances, e.g. ``"0.3*munsell:5R 4/14+0.7*munsell:5B 6/8"``:
+    ``ρ(λ) = Σ w_i ρ_i(λ)`` with ``w_i >= 0`` and ``Σ w_i <= 1``, so it stays in [0, 1]
+    (spectral textures: a basis of reflectances mixed by per-texel weights). Sampled on the
+    first spectrum's wavelengths; *resolve* looks each name up in the registry.
+    """
+    terms = []
+    for term in key.split("+"):
+        weight, sep, name = term.partition("*")
+        try:
+            w = float(weight) if sep and name.strip() else -1.0
+        except ValueError:
+            w = -1.0
+        if not 0.0 <= w <= 1.0:
+            raise SpectrumNotFoundError(
+                f"mixed reflectance {key!r}: expected WEIGHT*NAME+..., e.g. "
+                "'0.3*munsell:5R 4/14+0.7*munsell:5B 6/8'"
+            )
+        terms.append((w, resolve(name.strip())))
+    if sum(w for w, _ in terms) > 1.0 + 1e-9 or any(sp.kind != "reflectance" for _, sp in terms):
+        raise SpectrumNotFoundError(
+            f"mixed reflectance {key!r}: expected reflectances with weights summing to <= 1"
+        )
+    wl = np.asarray(terms[0][1].wavelengths, float)
+    values = np.clip(sum(w * sp.on(wl) for w, sp in terms), 0.0, 1.0)  # clip: float round-off only
+    canonical = "+".join(f"{w:g}*{sp.name}" for w, sp in terms)
+    return Spectrum(
+        f"mix:{canonical}", "reflectance", wl, values, "convex combination of reflectances"
+    )

@@ -14,6 +14,9 @@ daylight      ``daylight:6500K``                    CIE D-series at any CCT
 cie           ``cie:D65``, ``cie:FL11``             colour-science ``SDS_ILLUMINANTS``
 light         ``light:Cool White FL``               colour-science ``SDS_LIGHT_SOURCES``
 sfu-illum     ``sfu-illum:mws_090``                 Barnard et al. 2002 (data directory)
+mix           ``mix:0.3*munsell:5R 4/14+0.7*...``  convex combination (spectral textures)
+led           ``led:460/20``, ``led:630/20@1+...``  narrow-band / mixed LEDs (Ohno 2005)
+filtered      ``filtered:cie:A|bandpass:520/80``    a lamp behind a generated colour filter
 ============  ====================================  ===========================================
 
 Sensor sets (:func:`get_sensors`): ``cie1931``, ``srgb``, ``gaussian:6@400-700``,
@@ -32,7 +35,7 @@ import numpy as np
 
 from spectrinsic.data_dir import resolve_data_dir
 from spectrinsic.errors import SpectrumNotFoundError, did_you_mean
-from spectrinsic.spectra import illuminants, io, reflectances, sensors
+from spectrinsic.spectra import coloured_lights, illuminants, io, reflectances, sensors
 from spectrinsic.spectra.records import SensorSet, Spectrum
 
 __all__ = [
@@ -59,6 +62,11 @@ SPECTRUM_FAMILIES: dict[str, Callable[[str, str | None], Spectrum]] = {
     "cie": lambda k, d: illuminants.cie_illuminant(k),
     "light": lambda k, d: illuminants.light_source(k),
     "sfu-illum": illuminants.sfu_illuminant,
+    "mix": lambda k, d: reflectances.mix(k, lambda name: get_spectrum(name, data_dir=d)),
+    "led": lambda k, d: coloured_lights.led(k),
+    "filtered": lambda k, d: coloured_lights.filtered(
+        k, lambda lamp: get_spectrum(lamp, data_dir=d)
+    ),
 }
 
 #: family -> example and source, the module table as data (``spectrinsic list spectra``).
@@ -72,6 +80,9 @@ SPECTRUM_FAMILY_NOTES: dict[str, str] = {
     "cie": "cie:D65, cie:FL11; colour-science SDS_ILLUMINANTS",
     "light": "light:Cool White FL; colour-science SDS_LIGHT_SOURCES",
     "sfu-illum": "sfu-illum:mws_090; Barnard et al. 2002 illuminants (data directory)",
+    "mix": "mix:0.3*munsell:5R 4/14+0.7*munsell:5B 6/8; convex combination of reflectances",
+    "led": "led:460/20 or led:630/20@1+530/30@0.6; narrow-band and mixed LEDs (Ohno 2005)",
+    "filtered": "filtered:planck:3200K|bandpass:520/80; a lamp behind a generated colour filter",
 }
 
 #: family -> loader(key, data_dir); families without a key take an empty key.
@@ -116,7 +127,9 @@ def get_spectrum(name: str, *, data_dir: DataDir = None) -> Spectrum:
         A data-directory family (``sfu``, ``sfu-illum``) without a configured directory.
     """
     family, key = _split(name, SPECTRUM_FAMILIES, "spectrum")
-    return SPECTRUM_FAMILIES[family](key, _data(data_dir) if family.startswith("sfu") else None)
+    # a filtered lamp may be an SFU illuminant, so it gets the data directory too
+    needs_data = family.startswith("sfu") or family in ("filtered", "mix")
+    return SPECTRUM_FAMILIES[family](key, _data(data_dir) if needs_data else None)
 
 
 def get_sensors(name: str, *, data_dir: DataDir = None) -> SensorSet:

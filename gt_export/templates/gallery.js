@@ -108,7 +108,7 @@
     return out;
   }
   function card(s) {
-    const thumb = s.layers.image ? s.layers.image[0] : Object.values(s.layers)[0][0];
+    const thumb = s.layers[s.first_layer] ? s.layers[s.first_layer][0] : Object.values(s.layers)[0][0];
     return el("div", { class: "card", "data-id": s.id, on: { click: () => { location.hash = "sample=" + encodeURIComponent(s.id); } } },
       el("img", { src: thumb, loading: "lazy", alt: s.id, width: "160", height: "160" }),
       el("div", { class: "id", text: s.id }),
@@ -252,8 +252,9 @@
     const s = G.samples.find((x) => x.id === id);
     if (!s) { renderOverview(); return; }
     const names = Object.keys(s.layers);
-    const view = { a: s.layers.image ? "image" : names[0], b: null, zoom: 1, split: 50 };
-    view.b = ["image_rgb3", "image_denoised", "shading_raw"].find((n) => n in s.layers && n !== view.a) || view.a;
+    // image_denoised first where it exists (the index orders it first); B: the raw render beside it
+    const view = { a: s.first_layer in s.layers ? s.first_layer : names[0], b: null, zoom: 1, split: 50 };
+    view.b = ["image", "image_rgb3", "image_denoised", "shading_raw"].find((n) => n in s.layers && n !== view.a) || view.a;
     const imgA = el("img", { class: "a", alt: "layer A" }), imgB = el("img", { class: "b", alt: "layer B" });
     const divider = el("div", { class: "divider" });
     const stack = el("div", { class: "stack" }, imgA, imgB, divider);
@@ -305,15 +306,26 @@
     stack.addEventListener("mousemove", onMove);
     const links = el("div", { class: "files" }, "files: ", ...s.files.map((f) => el("a", { href: f, text: f.split("/").pop() })));
     const lights = el("div", { class: "lights", id: "lights" }, ...s.lights.map(spdPlot), cieDiagram(s.lights));
+    const shares = s.lights.map((l) => `${l.name} ${l.share != null ? (100 * l.share).toFixed(1) + " %" : "—"}`).join(", ");
+    const step = (id, text, target) => target
+      ? el("a", { href: "#sample=" + encodeURIComponent(target), id, text, title: target })
+      : el("span", { id, class: "disabled", text });
+    const nav = el("p", { class: "nav" }, el("a", { href: "#", id: "back", text: "‹ back to the overview" }), " · ",
+      step("prev-sample", "‹ previous sample", s.prev), " · ", step("next-sample", "next sample ›", s.next));
+    // every layer of this sample at once; a click shows it as layer A above
+    const grid = el("div", { class: "layer-grid", id: "layer-grid" }, ...names.map((n) => el("figure", { "data-layer": n,
+      on: { click: () => { view.a = n; update(); window.scrollTo(0, 0); } } },
+      el("img", { src: s.layers[n][0], loading: "lazy", alt: n }), el("figcaption", { text: n }))));
     app.replaceChildren(el("div", { class: "sample", id: "sample", "data-id": s.id },
-      el("p", {}, el("a", { href: "#", id: "back", text: "‹ back to the overview" })),
+      nav,
       el("h2", { text: s.id }),
-      el("p", { class: "meta-line", text: `scene ${s.scene} · condition ${s.condition} · kind ${s.kind} · render ${s.reference_mode}`
+      el("p", { class: "meta-line", id: "sample-meta", text: `scene ${s.scene} · condition ${s.condition} · kind ${s.kind} · render ${s.reference_mode}`
+        + ` · light shares ${shares}`
         + (s.noise != null ? ` · noise (shading_raw median) ${fmt(s.noise)}` : "") + (s.split ? ` · split ${s.split}` : "") }),
       buttons,
       el("div", { class: "ab" }, "A/B: A = the selected layer (left), B =", bSelect, slider),
       el("div", { class: "viewer-row" }, viewer, el("div", { class: "side" }, readout, bars, units)),
-      el("h3", { text: "Lights" }), lights, links));
+      el("h3", { text: "Lights" }), lights, el("h3", { text: "All layers" }), grid, links));
     update();
     size();
   }

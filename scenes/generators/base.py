@@ -50,6 +50,8 @@ class GeneratorOptions:
         Fractions of glossy and metal materials and their roughness range (default: none).
     data_dir
         Spectral data directory (for ``sfu`` chromaticities).
+    light_saturation
+        ``(lo, hi)``: |Duv| range (Ohno 2013) of the coloured families' lights; None: any.
     """
 
     width: int
@@ -62,6 +64,7 @@ class GeneratorOptions:
     sfu_illuminants: tuple[str, ...] = ()
     data_dir: str | None = None
     gloss: GlossDistribution = field(default_factory=GlossDistribution)
+    light_saturation: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -78,12 +81,16 @@ class Layout:
         ``rng -> (origin, target, fov_deg)``: one camera proposal.
     info
         What the generator drew (recorded in the scene's metadata).
+    min_coverage
+        The generator's own least object coverage of a view (rooms frame furniture); the
+        camera must pass the larger of this and ``options.min_coverage``.
     """
 
     parts: tuple[tuple[str, Part], ...]
     lights: LightVolume
     propose_camera: Callable[[np.random.Generator], tuple[np.ndarray, np.ndarray, float]]
     info: dict[str, Any]
+    min_coverage: float = 0.0
 
 
 def scene_rngs(seed: int) -> dict[str, np.random.Generator]:
@@ -123,6 +130,7 @@ def assemble(
         sfu=options.sfu_illuminants,
         data_dir=options.data_dir,
         max_lights=options.max_lights,
+        saturation=options.light_saturation,
     )
     # Views 0..views-1 are drawn in order, so view k is the same in any build, and all of them
     # must pass for the layout to be used (every view of a scene shows one layout).
@@ -134,7 +142,7 @@ def assemble(
             width=options.width,
             height=options.height,
             is_object=_is_object,
-            min_coverage=options.min_coverage,
+            min_coverage=max(options.min_coverage, layout.min_coverage),
             name=f"view{k}",
         )
         if k == view:

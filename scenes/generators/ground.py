@@ -9,7 +9,7 @@ import numpy as np
 from spectrinsic.scenes.generators.base import GeneratorOptions, Layout
 from spectrinsic.scenes.generators.camera import Footprints
 from spectrinsic.scenes.generators.lights import LightVolume
-from spectrinsic.scenes.generators.materials import MaterialDistribution, draw_reflectance
+from spectrinsic.scenes.generators.materials import MaterialDistribution, draw_reflectance, within
 from spectrinsic.scenes.generators.shapes import draw_object
 from spectrinsic.scenes.parts import Part, moved
 from spectrinsic.scenes.primitives import box
@@ -17,14 +17,9 @@ from spectrinsic.scenes.primitives import box
 __all__ = ["objects_on_ground"]
 
 
-def _ground(rng: np.random.Generator) -> Part:
-    """A large thin slab whose top is z = 0, spectrally flat grey or a low-chroma chip."""
-    grey = rng.random() < 0.5
-    spectrum = (
-        f"flat:{rng.uniform(0.2, 0.8):.2f}"
-        if grey
-        else draw_reflectance(rng, MaterialDistribution((3, 8), (0, 4)))
-    )
+def _ground(rng: np.random.Generator, materials: MaterialDistribution) -> Part:
+    """A large thin slab whose top is z = 0, a low-chroma chip (within *materials*' ranges)."""
+    spectrum = draw_reflectance(rng, within(MaterialDistribution((3, 8), (0, 4)), materials))
     return box((12.0, 12.0, 0.05), spectrum, center=(0, 0, -0.025), divisions=(12, 12, 1))
 
 
@@ -86,10 +81,14 @@ def objects_on_ground(rng: np.random.Generator, options: GeneratorOptions) -> La
     )
     info = {
         "generator": "objects-on-ground",
+        "kind": "object",
         "n_objects": len(objects),
         "shapes": [n.rsplit("-", 1)[0] for n, _ in objects],
         "patterns": patterns,
     }
     return Layout(
-        parts=(*objects, ("ground", _ground(rng))), lights=volume, propose_camera=propose, info=info
+        parts=(*objects, ("ground", _ground(rng, options.materials))),
+        lights=volume,
+        propose_camera=propose,
+        info=info,
     )

@@ -3,8 +3,9 @@
 Materials are drawn from the 1269 matte Munsell chips (and the SFU reflectances when a data
 directory is configured), with a controllable distribution of Munsell value and chroma
 (:class:`MaterialDistribution`). Patterns (:data:`PATTERNS`: stripes, checkers, patches,
-printed labels, noise partitions) repaint faces by their centroids, so every region is still
-one exact spectrum (no texture filtering).
+printed labels, noise partitions, spectral textures) repaint faces by their centroids, so every
+region is still one exact spectrum (no texture filtering); a spectral texture varies smoothly
+from face to face as convex mixes of three reflectances (``mix:`` spectra).
 """
 
 from __future__ import annotations
@@ -25,6 +26,10 @@ __all__ = [
     "MaterialDistribution",
     "PATTERNS",
     "munsell_chips",
+    "check_ranges",
+    "within",
+    "obeys",
+    "repaint_outside",
     "draw_reflectance",
     "draw_palette",
     "paint",
@@ -78,14 +83,71 @@ def munsell_chips() -> tuple[tuple[str, float, float], ...]:
     return tuple(out)
 
 
+def _pool(value_range: tuple[float, float], chroma_range: tuple[float, float]) -> list[str]:
+    (v0, v1), (c0, c1) = value_range, chroma_range
+    return [n for n, v, c in munsell_chips() if v0 <= v <= v1 and c0 <= c <= c1]
+
+
+def check_ranges(value_range: tuple[float, float], chroma_range: tuple[float, float]) -> None:
+    """Refuse Munsell ranges that hold no matte chip (raises :class:`SceneError`, one line)."""
+    if not value_range[0] <= value_range[1] or not chroma_range[0] <= chroma_range[1]:
+        raise SceneError(
+            f"value range {value_range} / chroma range {chroma_range}; expected LO <= HI"
+        )
+    if not _pool(value_range, chroma_range):
+        raise SceneError(
+            f"no Munsell chip has value in {value_range[0]:g}-{value_range[1]:g} and chroma in "
+            f"{chroma_range[0]:g}-{chroma_range[1]:g}; the matte chips span value 2.5-9 and "
+            "chroma 1-14"
+        )
+
+
+def within(preferred: MaterialDistribution, user: MaterialDistribution) -> MaterialDistribution:
+    """*preferred* (a generator's own taste, e.g. light walls) narrowed to the *user*'s ranges;
+    the user's ranges alone where the two share no chip. Either way every chip drawn obeys the
+    user's ``--value-range`` / ``--chroma-range``."""
+    v = (
+        max(preferred.value_range[0], user.value_range[0]),
+        min(preferred.value_range[1], user.value_range[1]),
+    )
+    c = (
+        max(preferred.chroma_range[0], user.chroma_range[0]),
+        min(preferred.chroma_range[1], user.chroma_range[1]),
+    )
+    if v[0] <= v[1] and c[0] <= c[1] and _pool(v, c):
+        return MaterialDistribution(v, c, preferred.sfu_fraction, preferred.pattern_probability)
+    return MaterialDistribution(
+        user.value_range, user.chroma_range, preferred.sfu_fraction, preferred.pattern_probability
+    )
+
+
+def obeys(name: str, dist: MaterialDistribution) -> bool:
+    """Whether *name* is a Munsell chip inside *dist*'s value and chroma ranges."""
+    return name in _pool_set(dist.value_range, dist.chroma_range)
+
+
+@functools.lru_cache(maxsize=32)
+def _pool_set(
+    value_range: tuple[float, float], chroma_range: tuple[float, float]
+) -> frozenset[str]:
+    return frozenset(_pool(value_range, chroma_range))
+
+
+def repaint_outside(part: Part, rng: np.random.Generator, dist: MaterialDistribution) -> Part:
+    """*part* with every palette entry outside *dist* (not a chip in its ranges) replaced by a
+    chip drawn from *dist*; the regions keep their shapes (library objects keep their look
+    where the ranges allow it)."""
+    palette = tuple(n if obeys(n, dist) else draw_reflectance(rng, dist) for n in part.palette)
+    return Part(part.vertices, part.faces, part.labels, palette)
+
+
 def draw_reflectance(
     rng: np.random.Generator, dist: MaterialDistribution, sfu: Sequence[str] = ()
 ) -> str:
     """One reflectance name drawn from *dist* (Munsell, or SFU with ``dist.sfu_fraction``)."""
     if sfu and rng.random() < dist.sfu_fraction:
         return sfu[int(rng.integers(len(sfu)))]
-    (v0, v1), (c0, c1) = dist.value_range, dist.chroma_range
-    pool = [n for n, v, c in munsell_chips() if v0 <= v <= v1 and c0 <= c <= c1]
+    pool = _pool(dist.value_range, dist.chroma_range)
     if not pool:
         raise SceneError(
             f"no Munsell chip has value in {dist.value_range} and chroma in "
@@ -170,6 +232,46 @@ def _label(part: Part, rng: np.random.Generator, palette: Sequence[str]) -> Part
     )
 
 
+#: Steps of a spectral texture's mixing weights (1/8: at most 45 mixes of three reflectances).
+TEXTURE_STEPS = 8
+
+
+def _quantised(weights: np.ndarray, steps: int) -> np.ndarray:
+    """Rows of *weights* (summing to 1) as whole multiples of 1/steps still summing to 1
+    (largest remainders get the spare steps)."""
+    scaled = weights * steps
+    out = np.floor(scaled).astype(np.int64)
+    spare = steps - out.sum(axis=1)
+    order = np.argsort(-(scaled - out), axis=1)
+    for j in range(weights.shape[1]):
+        out[np.arange(len(out)), order[:, j]] += (spare > j).astype(np.int64)
+    return out
+
+
+def _texture(part: Part, rng: np.random.Generator, palette: Sequence[str]) -> Part:
+    """A spectral texture: every face (texel) is a convex mix ``mix:w1*A+w2*B+w3*C`` of up to
+    three palette reflectances, so it is a valid reflectance in [0, 1]; the weights vary
+    smoothly over the surface (softmax of random low-frequency sinusoids of the position),
+    quantised to 1/TEXTURE_STEPS. Each texel stays one exact spectrum."""
+    bases = list(dict.fromkeys(palette))[:3]
+    p = (part.centroids - part.vertices.min(axis=0)) / float(_extent(part).max())
+    fields = [
+        np.sin(2 * np.pi * p @ rng.uniform(0.3, 1.5, 3) + rng.uniform(0, 2 * np.pi)) for _ in bases
+    ]
+    raw = np.exp(2.0 * np.stack(fields, axis=1))
+    steps = _quantised(raw / raw.sum(axis=1, keepdims=True), TEXTURE_STEPS)
+    rows, index = np.unique(steps, axis=0, return_inverse=True)
+    names = []
+    for row in rows:
+        terms = [(int(k), b) for k, b in zip(row, bases, strict=True) if k > 0]
+        names.append(
+            terms[0][1]
+            if len(terms) == 1
+            else "mix:" + "+".join(f"{k / TEXTURE_STEPS:g}*{b}" for k, b in terms)
+        )
+    return _labelled(part, names, np.asarray(index).ravel())
+
+
 #: Pattern painters by name: ``(part, rng, palette) -> part``.
 PATTERNS: dict[str, Callable[[Part, np.random.Generator, Sequence[str]], Part]] = {
     "stripes": _stripes,
@@ -177,6 +279,7 @@ PATTERNS: dict[str, Callable[[Part, np.random.Generator, Sequence[str]], Part]] 
     "patches": _patches,
     "noise": _noise,
     "label": _label,
+    "texture": _texture,
 }
 
 

@@ -1,20 +1,33 @@
 """``rooms``: rooms of random size and shape, closed or open (missing walls or ceiling,
-window openings), with furniture standing on the floor and objects resting on table tops and
-the floor. Open rooms with dark walls let light escape, so the energy ratio r of direct to
+window openings), with furniture standing on the floor (tables, round tables, shelves, chairs,
+sofas, floor lamps, cabinets) and objects resting on table tops, shelf boards and the floor.
+Cameras frame a piece of furniture or an object and see at least :data:`FRAMED_COVERAGE` of
+furniture and objects. Open rooms with dark walls let light escape, so the energy ratio r of direct to
 total light spans roughly 0.3 (closed, light walls, lit indirectly) to 0.9 (open, dark walls).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
-from spectrinsic.scenes.furniture import chair, shelf, table
+from spectrinsic.scenes.furniture import (
+    chair,
+    floor_lamp,
+    round_table,
+    shelf,
+    shelf_boards,
+    sofa,
+    table,
+)
 from spectrinsic.scenes.generators.base import GeneratorOptions, Layout
 from spectrinsic.scenes.generators.camera import Footprints
 from spectrinsic.scenes.generators.lights import LightVolume
 from spectrinsic.scenes.generators.materials import (
     MaterialDistribution,
     draw_reflectance,
+    within,
 )
 from spectrinsic.scenes.generators.shapes import draw_object
 from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_KINDS
@@ -29,6 +42,8 @@ _PLACED_KINDS = tuple(k for k in LIGHT_KINDS if "position" in LIGHT_FIELDS[k])
 #: Placed kinds that can be aimed: the uplights of indirectly lit rooms.
 _AIMED_KINDS = tuple(k for k in _PLACED_KINDS if "direction" in LIGHT_FIELDS[k])
 _T = 0.1  # wall thickness, m
+#: Least fraction of a room view's rays on furniture and objects (not walls, floor, ceiling).
+FRAMED_COVERAGE = 0.3
 
 
 def _slab(lo: np.ndarray, hi: np.ndarray, spectrum: str) -> Part:
@@ -67,16 +82,17 @@ def _wall(
 
 
 def _shell(
-    rng: np.random.Generator, size: tuple[float, float, float]
+    rng: np.random.Generator, size: tuple[float, float, float], user: MaterialDistribution
 ) -> tuple[list[tuple[str, Part]], dict]:
     w, d, h = size
     # half the rooms have light, low-chroma walls (strong interreflection: low r), the others
     # any walls; with missing walls and ceilings this spreads r
     bright = rng.random() < 0.5
-    walls = (
+    walls = within(
         MaterialDistribution((7.0, 9.5), (0.0, 4.0))
         if bright
-        else MaterialDistribution((2.0, 9.0), (0.0, 10.0))
+        else MaterialDistribution((2.0, 9.0), (0.0, 10.0)),
+        user,
     )
     missing = [k for k in _WALLS if k != "back" and rng.random() < 0.3]
     ceiling = rng.random() >= 0.35
@@ -121,44 +137,68 @@ def _shell(
     }
 
 
+Support = tuple[np.ndarray, np.ndarray, float, float]  # (lo_xy, hi_xy, z, free height above)
+
+
+def _piece(
+    rng: np.random.Generator, kind: str, spectrum: str
+) -> tuple[Part, list[tuple[float, float]]]:
+    """One piece of furniture on z = 0 around the origin, and its supports ``(z, free height)``
+    as fractions of its footprint's inner rectangle (tops of tables and cabinets, shelf boards)."""
+    if kind == "table":
+        part = table(rng.uniform(0.6, 1.4), rng.uniform(0.5, 0.9), rng.uniform(0.45, 0.8), spectrum)
+        return part, [(float(part.vertices[:, 2].max()), np.inf)]
+    if kind == "round-table":
+        part = round_table(rng.uniform(0.3, 0.55), rng.uniform(0.45, 0.75), spectrum)
+        return part, [(float(part.vertices[:, 2].max()), np.inf)]
+    if kind == "shelf":
+        th, boards = rng.uniform(0.8, 1.8), int(rng.integers(2, 5))
+        part = shelf(rng.uniform(0.6, 1.2), rng.uniform(0.3, 0.45), th, spectrum, boards=boards)
+        return part, shelf_boards(th, boards)
+    if kind == "chair":
+        return chair(
+            rng.uniform(0.38, 0.5),
+            rng.uniform(0.4, 0.5),
+            spectrum,
+            facing_deg=float(rng.choice([0, 90, 180, 270])),
+        ), []
+    if kind == "sofa":
+        return sofa(rng.uniform(1.2, 2.2), rng.uniform(0.75, 0.95), spectrum), []
+    if kind == "lamp":
+        return floor_lamp(rng.uniform(1.3, 1.7), spectrum), []
+    tw, td, th = rng.uniform(0.4, 1.0), rng.uniform(0.3, 0.6), rng.uniform(0.4, 1.0)
+    return box((tw, td, th), spectrum, center=(0, 0, th / 2), divisions=(3, 3, 3)), [(th, np.inf)]
+
+
 def _furniture(
     rng: np.random.Generator,
     size: tuple[float, float, float],
     floor: Footprints,
     dist: MaterialDistribution,
-) -> tuple[list[tuple[str, Part]], list[tuple[np.ndarray, np.ndarray, float]]]:
-    """Tables, shelves, chairs and cabinets on the floor; returns them and the table tops
-    ``(lo_xy, hi_xy, z)`` objects may rest on."""
+) -> tuple[list[tuple[str, Part]], list[Support]]:
+    """Tables, shelves, chairs, sofas, lamps and cabinets on the floor; returns them and the
+    surfaces objects may rest on (table tops, cabinet tops, shelf boards)."""
     w, d, _ = size
-    parts, tops = [], []
-    kinds = ["table", "table", "shelf", "chair", "cabinet"]
-    for i in range(int(rng.integers(2, 6))):
+    parts: list[tuple[str, Part]] = []
+    tops: list[Support] = []
+    kinds = ["table", "round-table", "shelf", "shelf", "chair", "sofa", "lamp", "cabinet"]
+    for i in range(int(rng.integers(3, 7))):
         kind = kinds[int(rng.integers(len(kinds)))]
-        spectrum = draw_reflectance(rng, dist)
-        if kind == "table":
-            tw, td, th = rng.uniform(0.6, 1.4), rng.uniform(0.5, 0.9), rng.uniform(0.45, 0.8)
-            part = table(tw, td, th, spectrum)
-        elif kind == "shelf":
-            tw, td, th = rng.uniform(0.6, 1.2), rng.uniform(0.3, 0.45), rng.uniform(0.8, 1.8)
-            part = shelf(tw, td, th, spectrum, boards=int(rng.integers(2, 5)))
-        elif kind == "chair":
-            tw = rng.uniform(0.38, 0.5)
-            part = chair(
-                tw, rng.uniform(0.4, 0.5), spectrum, facing_deg=float(rng.choice([0, 90, 180, 270]))
-            )
-        else:
-            tw, td, th = rng.uniform(0.4, 1.0), rng.uniform(0.3, 0.6), rng.uniform(0.4, 1.0)
-            part = box((tw, td, th), spectrum, center=(0, 0, th / 2), divisions=(3, 3, 3))
-        half = np.ptp(part.vertices[:, :2], axis=0) / 2
+        part, levels = _piece(rng, kind, draw_reflectance(rng, dist))
+        lo, hi = part.vertices[:, :2].min(axis=0), part.vertices[:, :2].max(axis=0)
+        half = (hi - lo) / 2
+        inner_lo, inner_hi = lo + 0.04, hi - 0.04
+        if kind == "shelf":  # boards lie between the sides, in front of the back (+y)
+            inner_hi = inner_hi - np.array([0.0, 0.03])
+        if kind == "round-table":  # the square inside the round top
+            inner_lo, inner_hi = lo * 0.7, hi * 0.7
         for _ in range(30):
             c = rng.uniform(
                 [0.05 + half[0], 0.05 + half[1]], [w - 0.05 - half[0], d - 0.05 - half[1]]
             )
             if floor.try_add(c, half, gap=0.05):
                 parts.append((f"{kind}-{i}", moved(part, translate=(c[0], c[1], 0.0))))
-                if kind in ("table", "cabinet"):
-                    top = float(part.vertices[:, 2].max())
-                    tops.append((c - half + 0.04, c + half - 0.04, top))
+                tops += [(c + inner_lo, c + inner_hi, z, room) for z, room in levels]
                 break
     return parts, tops
 
@@ -167,25 +207,27 @@ def _objects(
     rng: np.random.Generator,
     size: tuple[float, float, float],
     floor: Footprints,
-    tops: list[tuple[np.ndarray, np.ndarray, float]],
+    tops: list[Support],
     options: GeneratorOptions,
 ) -> tuple[list[tuple[str, Part]], list[str]]:
-    """2-8 objects resting on table tops (preferred) or the floor, without overlaps."""
+    """3-10 objects resting on table tops and shelf boards (preferred) or the floor, without
+    overlaps and below the board above."""
     w, d, _ = size
     parts: list[tuple[str, Part]] = []
     patterns: list[str] = []
-    supports = [(lo, hi, z, Footprints([])) for lo, hi, z in tops]
-    supports.append((np.array([0.1, 0.1]), np.array([w - 0.1, d - 0.1]), 0.0, floor))
-    for i in range(int(rng.integers(2, 9))):
+    supports = [(lo, hi, z, room, Footprints([])) for lo, hi, z, room in tops]
+    supports.append((np.array([0.1, 0.1]), np.array([w - 0.1, d - 0.1]), 0.0, np.inf, floor))
+    for i in range(int(rng.integers(3, 11))):
         shape, part, pattern, half = draw_object(rng, options.materials, options.sfu_reflectances)
-        patterns += [pattern] if pattern else []
+        tall = float(np.ptp(part.vertices[:, 2]))
         for _ in range(20):
-            lo, hi, z, taken = supports[int(rng.integers(len(supports)))]
-            if np.any(hi - lo < 2 * half):
+            lo, hi, z, room, taken = supports[int(rng.integers(len(supports)))]
+            if np.any(hi - lo < 2 * half) or tall > room - 0.02:
                 continue
             c = rng.uniform(lo + half, hi - half)
             if taken.try_add(c, half):
                 parts.append((f"{shape}-{i}", moved(part, translate=(c[0], c[1], z))))
+                patterns += [pattern] if pattern else []
                 break
     return parts, patterns
 
@@ -216,6 +258,35 @@ def _light_volume(
     ), "direct"
 
 
+def _framing(
+    size: tuple[float, float, float], parts: list[Part]
+) -> Callable[[np.random.Generator], tuple[np.ndarray, np.ndarray, float]]:
+    """Camera proposals that frame one piece of furniture or object and its neighbours: the
+    camera stands 1-1.7 times the distance at which the piece fills the field of view, at eye
+    or seated height, looking at it from a random side (clipped to the room)."""
+    w, d, h = size
+    spots = [
+        (
+            (p.vertices.min(axis=0) + p.vertices.max(axis=0)) / 2,
+            max(float(np.linalg.norm(np.ptp(p.vertices, axis=0))) / 2, 0.15),
+        )
+        for p in parts
+    ]
+    spots = spots or [(np.array([w / 2, d / 2, 0.5]), 0.5)]
+
+    def propose(r: np.random.Generator) -> tuple[np.ndarray, np.ndarray, float]:
+        aim, radius = spots[int(r.integers(len(spots)))]
+        fov = float(r.uniform(45, 70))
+        distance = max(radius / np.sin(np.radians(fov) / 2) * r.uniform(1.0, 1.7), 0.6)
+        azimuth = r.uniform(0, 2 * np.pi)
+        origin = aim + distance * np.array([np.cos(azimuth), np.sin(azimuth), 0.0])
+        origin[:2] = np.clip(origin[:2], 0.25, [w - 0.25, d - 0.25])
+        origin[2] = r.uniform(0.8, min(1.8, h - 0.3))
+        return origin, aim + r.uniform(-0.1, 0.1, 3) * radius, fov
+
+    return propose
+
+
 def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
     """Lay out a generated room (see the module docstring)."""
     size = (
@@ -224,22 +295,17 @@ def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
         float(rng.uniform(2.3, 3.2)),
     )
     w, d, h = size
-    shell, openness = _shell(rng, size)
+    shell, openness = _shell(rng, size, options.materials)
     floor = Footprints([])
-    furniture, tops = _furniture(rng, size, floor, MaterialDistribution((2, 8), (0, 12)))
+    furniture, tops = _furniture(
+        rng, size, floor, within(MaterialDistribution((2, 8), (0, 12)), options.materials)
+    )
     objects, patterns = _objects(rng, size, floor, tops, options)
-    targets = [p.vertices.mean(axis=0) for _, p in objects + furniture] or [
-        np.array([w / 2, d / 2, 0.5])
-    ]
-
-    def propose(r: np.random.Generator) -> tuple[np.ndarray, np.ndarray, float]:
-        origin = r.uniform([0.25, 0.25, 0.9], [w - 0.25, d - 0.25, min(1.9, h - 0.3)])
-        target = targets[int(r.integers(len(targets)))] + r.uniform(-0.1, 0.1, 3)
-        return origin, target, float(r.uniform(50, 75))
-
+    propose = _framing(size, [p for _, p in furniture + objects])
     volume, lighting = _light_volume(rng, size, openness)
     info = {
         "generator": "rooms",
+        "kind": "complex",
         "room_size": list(size),
         **openness,
         "lighting": lighting,
@@ -249,5 +315,9 @@ def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
         "patterns": patterns,
     }
     return Layout(
-        parts=(*shell, *furniture, *objects), lights=volume, propose_camera=propose, info=info
+        parts=(*shell, *furniture, *objects),
+        lights=volume,
+        propose_camera=propose,
+        info=info,
+        min_coverage=FRAMED_COVERAGE,
     )

@@ -11,7 +11,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from spectrinsic.scenes.generators.materials import MaterialDistribution, paint
+from spectrinsic.scenes.generators.materials import MaterialDistribution, paint, repaint_outside
 from spectrinsic.scenes.objects import OBJECTS
 from spectrinsic.scenes.parts import Part, moved
 from spectrinsic.scenes.primitives import box, capsule, cone, cylinder, ellipsoid, revolve, torus
@@ -118,7 +118,8 @@ def make_shape(name: str, rng: np.random.Generator, spectrum: str) -> Part:
 def draw_object(
     rng: np.random.Generator, materials: MaterialDistribution, sfu: Sequence[str] = ()
 ) -> tuple[str, Part, str | None, np.ndarray]:
-    """A random shape, painted from *materials* (library objects keep their own paint).
+    """A random shape, painted from *materials* (library objects keep those of their own
+    colours that lie in *materials*' ranges; the others are redrawn from it).
 
     Returns
     -------
@@ -131,4 +132,6 @@ def draw_object(
     pattern = None
     if not shape.startswith("lib-"):
         part, pattern = paint(part, rng, materials, sfu)
+    else:
+        part = repaint_outside(part, rng, materials)
     return shape, part, pattern, np.ptp(part.vertices[:, :2], axis=0) / 2

@@ -748,6 +748,32 @@ CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
         "--count 100000000",
     ),
     (
+        "dataset-chroma-range-impossible",
+        lambda t: [
+            "dataset",
+            "--generator",
+            "objects-on-ground",
+            "--chroma-range",
+            "50,60",
+            "--out",
+            str(t / "new"),
+        ],
+        "chroma in 50-60",
+    ),
+    (
+        "dataset-light-saturation-impossible",
+        lambda t: [
+            "dataset",
+            "--generator",
+            "rooms",
+            "--light-saturation",
+            "0.4,0.5",
+            "--out",
+            str(t / "new"),
+        ],
+        "--light-saturation",
+    ),
+    (
         "ply-million-vertices",
         lambda t: [
             "render",

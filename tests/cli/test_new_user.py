@@ -1,5 +1,6 @@
-"""Issue 19, tried as a new user would: preview build -> check exits 0 -> load -> batches ->
-evaluate with predictions written by the helper -> the report holds the numbers."""
+"""Issue 19, tried as a new user would: preview build -> check exits 0 -> load -> batches of 8
+(a torch DataLoader where torch is installed: ``make test-torch``, which CI runs) -> evaluate
+with predictions written by the helper -> REPORT.md holds the numbers."""
 
 from __future__ import annotations
 
@@ -12,14 +13,16 @@ from spectrinsic.cli import main
 
 pytestmark = pytest.mark.slow
 
+#: Two objects under the four conditions: 8 samples, one batch of 8.
+ONLY = "obj-apple*,obj-cup*"
+#: REPORT.md prints four significant digits.
+PRINTED = 5e-4
 
-def test_preview_build_checks_loads_batches_and_scores(tmp_path, capsys):
-    from spectrinsic.decompose import write_predictions
-    from spectrinsic.gt_export import load_dataset
-    from spectrinsic.gt_export.collate import collate_arrays
-    from spectrinsic.gt_export.loader import prepare_item
 
-    data = tmp_path / "preview"
+@pytest.fixture(scope="module")
+def preview(tmp_path_factory):
+    """The README's first build, on two of its objects."""
+    data = tmp_path_factory.mktemp("new-user") / "preview"
     assert (
         main(
             [
@@ -28,7 +31,7 @@ def test_preview_build_checks_loads_batches_and_scores(tmp_path, capsys):
                 "--preset",
                 "preview",
                 "--only",
-                "obj-apple*",
+                ONLY,
                 "--out",
                 str(data),
                 "--workers",
@@ -37,13 +40,34 @@ def test_preview_build_checks_loads_batches_and_scores(tmp_path, capsys):
         )
         == 0
     )
-    capsys.readouterr()
-    assert main(["-q", "check", str(data)]) == 0  # the preview's noise is a warning, not a failure
-    assert "ok: 4 samples" in capsys.readouterr().out
+    return data
 
-    samples = list(load_dataset(data))
-    batch = collate_arrays([prepare_item(s) for s in samples])
-    assert batch["image"].shape == (4, 3, 48, 48)
+
+def _first_table(md: str) -> tuple[list[str], dict[str, list[str]]]:
+    """Header and ``{method: cells}`` of REPORT.md's first table."""
+    rows = [
+        [c.strip() for c in line.strip().strip("|").split("|")]
+        for line in md.split("\n\n| ", 1)[1].split("\n\n", 1)[0].splitlines()
+    ]
+    rows[0][0] = rows[0][0].lstrip("| ")
+    return rows[0], {r[0]: r[1:] for r in rows[2:]}
+
+
+def test_preview_build_checks_loads_batches_and_scores(preview, tmp_path, capsys):
+    from spectrinsic.decompose import write_predictions
+    from spectrinsic.gt_export import load_dataset
+    from spectrinsic.gt_export.collate import collate_arrays
+    from spectrinsic.gt_export.loader import prepare_item
+
+    capsys.readouterr()
+    assert (
+        main(["-q", "check", str(preview)]) == 0
+    )  # the preview's noise is a warning, not a failure
+    assert "ok: 8 samples" in capsys.readouterr().out
+
+    samples = list(load_dataset(preview))
+    batch = collate_arrays([prepare_item(s) for s in samples])  # what collate does without torch
+    assert batch["image"].shape == (8, 3, 48, 48)
     assert batch["light_mask"].sum(axis=1).tolist() == [len(s["meta"]["lights"]) for s in samples]
     assert max(len(s["meta"]["lights"]) for s in samples) == 2  # the two-colour conditions
 
@@ -62,7 +86,7 @@ def test_preview_build_checks_loads_batches_and_scores(tmp_path, capsys):
                 "-q",
                 "evaluate",
                 "--dataset",
-                str(data),
+                str(preview),
                 "--predictions",
                 f"truth={tmp_path / 'truth'}",
                 "--methods",
@@ -77,13 +101,50 @@ def test_preview_build_checks_loads_batches_and_scores(tmp_path, capsys):
     )
     rows = list(csv.DictReader((out / "scores.csv").open()))
     lmse = {
-        m: [
-            float(r["value"])
+        m: {
+            r["sample"]: float(r["value"])
             for r in rows
-            if r["method"] == m and r["metric"] == "lmse" and r["layer"] == "reflectance"
-        ]
+            if r["method"] == m
+            and r["metric"] == "lmse"
+            and r["layer"] == "reflectance"
+            and r["scenario"] == "srgb"
+        }
         for m in ("truth", "image-as-reflectance")
     }
-    assert len(lmse["truth"]) == 4 and max(lmse["truth"]) < 1e-6
-    assert np.mean(lmse["image-as-reflectance"]) > 100 * max(max(lmse["truth"]), 1e-9)
-    assert (out / "REPORT.md").is_file()
+    assert len(lmse["truth"]) == 8 and max(lmse["truth"].values()) < 1e-6
+    assert np.mean(list(lmse["image-as-reflectance"].values())) > 100 * max(
+        max(lmse["truth"].values()), 1e-9
+    )
+
+    md = (out / "REPORT.md").read_text(encoding="utf-8")  # the numbers, not file names
+    header, table = _first_table(md)
+    assert (
+        header[0] == "method"
+        and header[-1] == "all ↓"
+        and set(table) == {"truth", "image-as-reflectance"}
+    )
+    for method, cells in table.items():
+        for condition, cell in zip([h.removesuffix(" ↓") for h in header[1:]], cells, strict=True):
+            values = [
+                v
+                for sid, v in lmse[method].items()
+                if condition == "all" or sid.endswith(f"__{condition}")
+            ]
+            assert float(cell.strip("*")) == pytest.approx(
+                np.mean(values), rel=PRINTED, abs=1e-9
+            ), (method, condition)
+    assert all(c.startswith("**") for c in table["truth"])  # the best of every column
+    assert "![Reflectance LMSE, method x lighting condition](summary.png)" in md
+    assert (out / "summary.png").read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.torch
+def test_the_preview_build_feeds_a_dataloader_in_batches_of_8(preview, torch):
+    from spectrinsic.gt_export import torch_dataset
+    from spectrinsic.gt_export.collate import collate
+
+    loader = torch.utils.data.DataLoader(torch_dataset(preview), batch_size=8, collate_fn=collate)
+    (batch,) = list(loader)
+    assert batch["image"].shape == (8, 3, 48, 48) and batch["image"].dtype == torch.float32
+    assert batch["light_share"].shape == (8, 2, 48, 48)
+    assert sorted(batch["light_mask"].sum(dim=1).tolist()) == [1, 1, 1, 1, 2, 2, 2, 2]

@@ -352,3 +352,106 @@ def test_a_script_tag_in_a_scene_name_is_escaped_in_the_card(tmp_path, one_light
     card = write_dataset_card(tmp_path, config).read_text(encoding="utf-8")
     assert "<script>" not in card
     assert "&lt;script&gt;alert(1)&lt;/script&gt;" in card
+
+
+@pytest.fixture
+def denoised_gallery(tmp_path, one_light_sample, two_light_sample, config):
+    """Two samples exported with the OIDN-denoised shading (so with ``image_denoised``) and one
+    without, and their gallery."""
+    root = tmp_path / "dn"
+    for sid, (scene, result), denoise in (
+        ("a", two_light_sample, True),
+        ("b", one_light_sample, True),
+        ("c", one_light_sample, False),
+    ):
+        meta = {**scene.metadata, "condition": "white", "kind": "object"}
+        export_sample(
+            root,
+            dataclasses.replace(scene, metadata=meta),
+            result,
+            sample_id=sid,
+            config=config,
+            seed=1,
+            denoise=denoise,
+        )
+    return build_gallery(root)
+
+
+def test_index_opens_on_the_denoised_image_with_kind_shares_and_neighbours(denoised_gallery):
+    """Issue 19: image_denoised first where it exists, kind and light shares for every sample,
+    previous/next between samples."""
+    root = denoised_gallery.parent
+    index = json.loads((root / "gallery.json").read_text())
+    ids = [s["id"] for s in index["samples"]]
+    for i, entry in enumerate(index["samples"]):
+        meta = json.loads((root / entry["id"] / "meta.json").read_text())
+        names = list(entry["layers"])
+        first = "image_denoised" if entry["id"] != "c" else "image"
+        assert ("image_denoised" in meta["layers"]) == (entry["id"] != "c")
+        assert names[0] == entry["first_layer"] == first
+        assert entry["kind"] == "object"
+        assert entry["light_shares"] == [light["share"] for light in meta["lights"]]
+        assert sum(entry["light_shares"]) == pytest.approx(
+            1.0, abs=1e-3
+        )  # shares of the irradiance
+        assert entry["prev"] == (ids[i - 1] if i else None)
+        assert entry["next"] == (ids[i + 1] if i + 1 < len(ids) else None)
+
+
+@pytest.mark.parametrize(
+    ("metadata", "kind"),
+    [
+        ({"generator": "rooms"}, "complex"),
+        ({"generator": "objects-on-ground"}, "object"),
+        ({}, "complex"),
+    ],
+)
+def test_a_sample_without_kind_metadata_still_has_a_kind(
+    tmp_path, one_light_sample, config, metadata, kind
+):
+    scene, result = one_light_sample
+    export_sample(
+        tmp_path / "ds",
+        dataclasses.replace(scene, name="mine", metadata=metadata),
+        result,
+        sample_id="mine__v0__file",
+        config=config,
+        seed=1,
+    )
+    (entry,) = gallery_index(tmp_path / "ds")["samples"]
+    assert entry["kind"] == kind and entry["light_shares"] and None not in entry["light_shares"]
+
+
+@pytest.mark.browser
+@needs_browser
+def test_a_person_steps_between_samples_and_sees_every_layer(denoised_gallery, tmp_path):
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    gallery = denoised_gallery
+    root = gallery.parent
+    index = json.loads((root / "gallery.json").read_text())
+    first = index["samples"][0]
+    driver = _driver(tmp_path / "screenshots")
+    try:
+        wait = WebDriverWait(driver, BROWSER_WAIT_S)
+        driver.get(gallery.as_uri() + "#sample=" + first["id"])
+        wait.until(lambda d: d.find_elements("id", "sample"))
+        image = driver.find_element("css selector", "#viewer img.a")
+        assert image.get_attribute("src").endswith("previews/image_denoised.png")
+        assert "light shares" in driver.find_element("id", "sample-meta").text
+        tiles = driver.find_elements("css selector", "#layer-grid figure")
+        assert [t.get_attribute("data-layer") for t in tiles] == list(first["layers"])
+        tiles[-1].click()  # a tile shows its layer as A
+        assert image.get_attribute("src").endswith(
+            first["layers"][list(first["layers"])[-1]][0].split("/", 1)[1]
+        )
+        assert not driver.find_elements("css selector", "a#prev-sample")  # the first has none
+        driver.find_element("id", "next-sample").click()
+        wait.until(
+            lambda d: d.find_element("id", "sample").get_attribute("data-id") == first["next"]
+        )
+        driver.find_element("id", "prev-sample").click()
+        wait.until(lambda d: d.find_element("id", "sample").get_attribute("data-id") == first["id"])
+        assert _errors(driver) == []
+    finally:
+        driver.quit()

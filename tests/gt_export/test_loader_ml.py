@@ -7,7 +7,7 @@ import pytest
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.loader import EXPOSURE_PERCENTILE, prepare_item, split_samples
-from spectrinsic.gt_export.manifest import split_of, splits_by_scene
+from spectrinsic.gt_export.manifest import split_counts, splits_by_scene
 
 
 def _sample(h=6, w=8):
@@ -68,7 +68,52 @@ def test_splits_keep_every_scene_whole_and_roughly_proportional():
     assert (
         0.7 < counts["train"] < 0.9 and 0.05 < counts["val"] < 0.15 and 0.05 < counts["test"] < 0.15
     )
-    assert split_of("sc0") == owner["sc0"]
+    assert {k: len({samples[s] for s in v}) for k, v in splits.items()} == {
+        "train": 320,
+        "val": 40,
+        "test": 40,
+    }
+
+
+@pytest.mark.parametrize("n", range(3, 40))
+def test_every_split_holds_a_scene_from_three_scenes_on(n):
+    """Issue 19: 80/10/10 by hash gave val no scene for the 11-scene library set."""
+    samples = {f"sc{i}__v0__c{c}": f"sc{i}" for i in range(n) for c in range(4)}
+    splits = splits_by_scene(samples)
+    scenes = {k: {samples[s] for s in v} for k, v in splits.items()}
+    assert all(scenes.values()), scenes
+    assert sum(map(len, scenes.values())) == n and set.union(*scenes.values()) == set(
+        samples.values()
+    )
+    assert abs(len(scenes["train"]) - 0.8 * n) <= 2  # still roughly the asked shares
+
+
+def test_split_counts_follow_the_fractions_and_keep_the_scene_order():
+    assert split_counts(11) == {"train": 9, "val": 1, "test": 1}  # the library's 11 scenes
+    assert split_counts(20, (("train", 0.5), ("val", 0.25), ("test", 0.25))) == {
+        "train": 10,
+        "val": 5,
+        "test": 5,
+    }
+    assert split_counts(2) == {"train": 2, "val": 0, "test": 0}  # fewer scenes than splits
+    grown = {f"s{i}": f"s{i}" for i in range(30)}
+    small = {k: grown[k] for k in list(grown)[:20]}
+    a, b = splits_by_scene(small), splits_by_scene(grown)
+    moved = [s for s in small if s not in b[next(k for k, v in a.items() if s in v)]]
+    assert len(moved) <= 3  # ordered by a per-scene key, so a growing set mostly keeps its splits
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [
+        (("train", 0.9), ("val", 0.1), ("test", 0.0)),
+        (("train", 0.5), ("val", 0.1), ("test", 0.1)),
+        (("train", 0.5), ("train", 0.5)),
+    ],
+)
+def test_bad_split_fractions_are_one_line_errors(bad):
+    with pytest.raises(DatasetError, match="split fractions"):
+        splits_by_scene({"a": "a"}, bad)
 
 
 def test_split_selection_reads_the_manifest(tmp_path):
@@ -76,8 +121,20 @@ def test_split_selection_reads_the_manifest(tmp_path):
         (tmp_path / name).mkdir()
         (tmp_path / name / "meta.json").write_text("{}")
     (tmp_path / "manifest.json").write_text(
-        json.dumps({"splits": {"train": ["b__v0__x"], "val": [], "test": ["a__v0__x"]}})
+        json.dumps(
+            {
+                "splits": {"train": ["b__v0__x"], "val": [], "test": ["a__v0__x"]},
+                "samples": {
+                    "a__v0__x": {"scene": "a", "files": {}},
+                    "b__v0__x": {"scene": "b", "files": {}},
+                },
+            }
+        )
     )
     assert [p.name for p in split_samples(tmp_path, "train")] == ["b__v0__x"]
     with pytest.raises(DatasetError, match="expected one of"):
         split_samples(tmp_path, "training")
+    with pytest.raises(
+        DatasetError, match=r"split 'val' .* is empty: the dataset has 2 scene\(s\) for 3 splits"
+    ):
+        split_samples(tmp_path, "val")

@@ -292,13 +292,16 @@ def test_dataset_card_shows_the_diversity_figure(built):
     from spectrinsic.gt_export.sample import sample_dirs
     from spectrinsic.gt_export.sample_meta import read_meta
 
-    assert (
-        "diversity.png" in (built / "DATASET.md").read_text()
-        and (built / "diversity.png").is_file()
+    card = (built / "DATASET.md").read_text()
+    assert "diversity.png" in card and (built / "diversity.png").is_file()
+    spread = next(
+        line for line in card.splitlines() if line.startswith("Colour spread: lights cover")
     )
+    assert "nan" not in spread and "Duv" in spread
     samples = sample_dirs(built)
     stats = diversity_stats(samples, [read_meta(s) for s in samples])
     n_lights = sum(len(read_meta(s).lights) for s in samples)
     assert len(stats["luminance_decades"]) == len(samples) and len(stats["light_cct"]) == n_lights
     assert all(1000 < t < 25000 for t in stats["light_cct"])
-    assert len(diversity_figure(stats).axes) == 6
+    assert len(stats["samples"]) == len(samples) and len(stats["material_chroma"]) >= len(samples)
+    assert len(diversity_figure(stats).axes) == 8
