@@ -3,26 +3,28 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 from typing import Any
 
 from tqdm import tqdm
 
-from spectrinsic.errors import DatasetError, SceneError, SpectrinsicError
+from spectrinsic.cli.dataset_source import (
+    add_source_options,
+    check_scene_files,
+    material_map,
+    parse_resolution,
+    source_from_args,
+    source_notes,
+)
+from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.integrity import check_build_folder
 from spectrinsic.gt_export.manifest import SPLIT_FRACTIONS
 from spectrinsic.pipeline.dataset import SampleFailure, build_dataset
 from spectrinsic.pipeline.executors import check_scheduler, choose_executor
 from spectrinsic.pipeline.presets import PRESETS, DatasetConfig, get_preset, preset_names
-from spectrinsic.pipeline.source_plan import file_sample, files_source, generator_source
 from spectrinsic.render.budget import check_render_size
 from spectrinsic.render.settings import INTEGRATORS
-from spectrinsic.scenes.generators import GlossDistribution
-from spectrinsic.scenes.sources import FileSource
-from spectrinsic.scenes.yaml_limits import load_yaml_file
-from spectrinsic.spectra import get_spectrum
 
 __all__ = [
     "register",
@@ -67,7 +69,7 @@ def register(subparsers: Any) -> None:
     )
     _add_build_options(p)
     _add_quality_options(p)
-    _add_source_options(p.add_argument_group("scene source (default: the built-in library layout)"))
+    add_source_options(p.add_argument_group("scene source (default: the built-in library layout)"))
     p.add_argument(
         "--split-fractions",
         default=None,
@@ -123,6 +125,13 @@ def _add_build_options(p: Any) -> None:
 
 def _add_quality_options(p: Any) -> None:
     """Overrides of the preset's sampling, denoising and image size."""
+    _add_sampling_options(p)
+    _add_extra_layer_options(p)
+    _add_rendering_options(p)
+
+
+def _add_sampling_options(p: Any) -> None:
+    """Samples per pixel, batches and adaptive sampling."""
     p.add_argument(
         "--spp",
         type=int,
@@ -153,6 +162,11 @@ def _add_quality_options(p: Any) -> None:
         metavar="N",
         help="cap of the adaptive batches (default 4 x batches)",
     )
+
+
+def _add_extra_layer_options(p: Any) -> None:
+    """What is rendered and stored beyond the default layers: direct light, per-light
+    transport, relit variants."""
     p.add_argument(
         "--direct",
         action="store_true",
@@ -173,6 +187,10 @@ def _add_quality_options(p: Any) -> None:
         help="with --store-transport: also write N relit variants of every sample "
         "(<id>-relitK, random light spectra, seeded)",
     )
+
+
+def _add_rendering_options(p: Any) -> None:
+    """How the modes are rendered, denoised, and at what image size."""
     p.add_argument(
         "--integrator",
         choices=INTEGRATORS,
@@ -191,174 +209,6 @@ def _add_quality_options(p: Any) -> None:
         metavar="WxH",
         help="override the image size in pixels, e.g. 256x256",
     )
-
-
-def _add_source_options(src: Any) -> None:
-    """Where the scenes come from: the library (default), a generator, or scene files."""
-    src.add_argument(
-        "--generator",
-        metavar="NAME",
-        default=None,
-        help="generate scenes procedurally: objects-on-ground or rooms",
-    )
-    src.add_argument("--count", type=int, default=20, metavar="N", help="generated scenes (20)")
-    src.add_argument(
-        "--views", type=int, default=1, metavar="V", help="cameras per generated scene (1)"
-    )
-    src.add_argument(
-        "--value-range",
-        default="2,9",
-        metavar="LO,HI",
-        help="Munsell value range of generated materials (2,9)",
-    )
-    src.add_argument(
-        "--chroma-range",
-        default="0,16",
-        metavar="LO,HI",
-        help="Munsell chroma range of generated materials (0,16)",
-    )
-    src.add_argument(
-        "--light-saturation",
-        default=None,
-        metavar="LO,HI",
-        help="keep only coloured lights whose |Duv| (Ohno 2013: CIE 1960 uv distance "
-        "from the Planckian locus) is in LO,HI; 0.02 is visibly tinted, at most "
-        "0.15 for LO (default: any, 60%% from saturated LEDs and filtered lamps)",
-    )
-    src.add_argument(
-        "--sfu",
-        action="store_true",
-        help="also draw SFU reflectances and illuminants (needs --data-dir)",
-    )
-    src.add_argument(
-        "--glossy",
-        type=float,
-        default=0.0,
-        metavar="F",
-        help="fraction of generated materials made coated/glossy (plastic) (0)",
-    )
-    src.add_argument(
-        "--metallic",
-        type=float,
-        default=0.0,
-        metavar="F",
-        help="fraction of generated materials made metal (Ag, Al, Au, Cu, Cr) (0)",
-    )
-    src.add_argument(
-        "--roughness-range",
-        default="0,0.3",
-        metavar="LO,HI",
-        help="GGX roughness range of glossy and metal materials (0,0.3)",
-    )
-    src.add_argument(
-        "--scenes",
-        nargs="+",
-        metavar="PATH",
-        default=None,
-        help="render your own scene files (.yaml, .blend, .obj/.ply/.glb) with full ground truth",
-    )
-    src.add_argument(
-        "--material-map",
-        metavar="FILE",
-        default=None,
-        help="YAML/JSON mapping material name -> spectrum for .blend and mesh scenes",
-    )
-    src.add_argument(
-        "--default-spectrum",
-        metavar="NAME",
-        default=None,
-        help="reflectance of unmapped materials in .blend and mesh scenes",
-    )
-    src.add_argument(
-        "--new-sample",
-        action="store_true",
-        help="render scenes a generated build saved (<dataset>/scenes/*.yaml) as new "
-        "samples (id from the file name, seed from --seed) instead of "
-        "reproducing their own sample (same id, same seed)",
-    )
-
-
-def _range(option: str, text: str) -> tuple[float, float]:
-    try:
-        lo, hi = (float(v) for v in text.split(","))
-    except ValueError:
-        raise DatasetError(f"{option} {text!r}; expected LO,HI, e.g. 2,9") from None
-    if lo > hi:
-        raise DatasetError(f"{option} {text!r}; expected LO <= HI")
-    return lo, hi
-
-
-def material_map(path: str | None) -> dict[str, str]:
-    """The ``--material-map`` file as ``{material name: spectrum name}`` (``{}`` for none)."""
-    if path is None:
-        return {}
-
-    data = load_yaml_file(Path(path))
-    if not isinstance(data, dict) or not all(
-        isinstance(k, str) and isinstance(v, str) for k, v in data.items()
-    ):
-        raise DatasetError(
-            f"--material-map {path!r}: expected a mapping of material name -> spectrum name"
-        )
-    return data
-
-
-def _source(args: argparse.Namespace) -> str | None:
-    """The config's ``source`` for --generator / --scenes (``None``: the library)."""
-    if args.generator and args.scenes:
-        raise DatasetError("--generator and --scenes exclude each other; give one")
-    if args.generator:
-        try:
-            gloss = GlossDistribution(
-                args.glossy, args.metallic, _range("--roughness-range", args.roughness_range)
-            )
-        except SceneError as exc:
-            raise DatasetError(f"--glossy/--metallic/--roughness-range: {exc}") from None
-        return generator_source(
-            args.generator,
-            args.count,
-            views=args.views,
-            sfu=args.sfu,
-            value_range=_range("--value-range", args.value_range),
-            chroma_range=_range("--chroma-range", args.chroma_range),
-            gloss=gloss,
-            light_saturation=None
-            if args.light_saturation is None
-            else _range("--light-saturation", args.light_saturation),
-        )
-    if args.scenes:
-        size = None if args.resolution is None else parse_resolution(args.resolution)
-        return files_source(
-            args.scenes,
-            materials=material_map(args.material_map),
-            default_spectrum=args.default_spectrum,
-            resolution=size,
-            new_sample=getattr(args, "new_sample", False),
-        )
-    return None
-
-
-def source_notes(config: DatasetConfig) -> list[str]:
-    """What applies to each scene file of *config* (``--scenes``, ``render --ground-truth``):
-    its size (the file's camera or --resolution) and its sample (a saved one, reproduced, or a
-    new one); empty for the library and generators."""
-    spec = json.loads(config.source or "{}")
-    notes = []
-    for entry in spec.get("scenes", ()):
-        size = spec.get("resolution")
-        where = (
-            f"{size[0]}x{size[1]} (--resolution)"
-            if size
-            else "the file's camera size (--resolution to change it)"
-        )
-        sid, seed = file_sample(entry["path"], new_sample=bool(spec.get("new_sample")))
-        sample = (
-            f"reproduces its saved sample {sid} with seed {seed} (--new-sample for a new one)"
-            if seed is not None
-            else f"sample {sid}"
-        )
-        notes.append(f"{Path(entry['path']).name}: {where}; {sample}")
-    return notes
 
 
 #: Options copied into the config as they are when given (option dest -> config key).
@@ -382,7 +232,7 @@ def _overrides(args: argparse.Namespace) -> dict[str, Any]:
     """The config changes the options ask for (getattr: ``render --ground-truth`` builds its
     own namespace of dataset options, without some of them)."""
     changes: dict[str, Any] = {}
-    source = _source(args)
+    source = source_from_args(args)
     if source is not None:
         changes["source"] = source
     for dest, key in _VALUE_OPTIONS:
@@ -411,16 +261,6 @@ def _split_fractions(text: str) -> tuple[tuple[str, float], ...]:
     return tuple((name, v) for (name, _), v in zip(SPLIT_FRACTIONS, shares, strict=True))
 
 
-def parse_resolution(text: str) -> tuple[int, int]:
-    """``WIDTHxHEIGHT`` as two positive integers."""
-    w, sep, h = text.lower().partition("x")
-    if not (sep and w.isdigit() and h.isdigit() and int(w) > 0 and int(h) > 0):
-        raise DatasetError(
-            f"--resolution {text!r}; expected WIDTHxHEIGHT of positive integers, e.g. 256x256"
-        )
-    return int(w), int(h)
-
-
 def preflight(
     out: str | Path,
     config: DatasetConfig,
@@ -442,7 +282,7 @@ def preflight(
             f"to {UINT32_MAX} and at most {UINT32_MAX} samples per pixel"
         )
     check_build_folder(Path(out), config.config_hash(), rebuild=rebuild)
-    _check_scene_files(config, data_dir)
+    check_scene_files(config, data_dir)
     if scheduler:
         check_scheduler(scheduler)
     # two lights: the library's two-colour conditions, rendered once per light
@@ -454,34 +294,6 @@ def preflight(
         processes=workers or 1,
         n_lights=2,
     )
-
-
-def _check_scene_files(config: Any, data_dir: str | None) -> None:
-    """``--scenes``: every file reads as a valid scene with this material map and default
-    spectrum, before the folder is stamped with the config (a bad file is an input error, not
-    a failed sample)."""
-
-    spec = json.loads(config.source or "{}")
-    if "scenes" not in spec:
-        return
-    materials = spec.get("materials") or {}
-    named = [("--default-spectrum", spec.get("default_spectrum"))]
-    named += [(f"--material-map entry {k!r}", v) for k, v in sorted(materials.items())]
-    for option, name in named:
-        try:
-            if name is not None:
-                get_spectrum(name, data_dir=data_dir)
-        except SpectrinsicError as exc:
-            raise DatasetError(f"{option} {name!r}: {exc}") from exc
-    width, height = spec.get("resolution") or (None, None)
-    for entry in spec["scenes"]:
-        FileSource(
-            entry["path"],
-            width,
-            height,
-            tuple(sorted(materials.items())),
-            spec.get("default_spectrum"),
-        ).build(data_dir)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -29,6 +29,7 @@ log = logging.getLogger(__name__)
 
 
 def register(subparsers: Any) -> None:
+    """Add the ``evaluate`` subcommand to the CLI's *subparsers*."""
     p = subparsers.add_parser(
         "evaluate",
         help="score decomposers or your own predictions on a rendered dataset "
@@ -44,6 +45,14 @@ def register(subparsers: Any) -> None:
             "for the camera scenarios; see spectrinsic.decompose.predictions."
         ),
     )
+    _add_folder_options(p)
+    _add_method_options(p)
+    _add_scoring_options(p)
+    p.set_defaults(func=run)
+
+
+def _add_folder_options(p: Any) -> None:
+    """The dataset (or MIT folder) to score and the output folder."""
     p.add_argument(
         "--dataset",
         metavar="DIR",
@@ -61,6 +70,10 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--out", metavar="DIR", default=DEFAULT_OUT, help=f"output folder ({DEFAULT_OUT})"
     )
+
+
+def _add_method_options(p: Any) -> None:
+    """The decomposers to run and the prediction folders to read."""
     p.add_argument(
         "--methods",
         default=None,
@@ -81,6 +94,10 @@ def register(subparsers: Any) -> None:
         default="linear",
         help="encoding of 16-bit PNG predictions (linear)",
     )
+
+
+def _add_scoring_options(p: Any) -> None:
+    """Which samples and target are scored, and what is written besides the scores."""
     p.add_argument(
         "--samples",
         metavar="GLOB",
@@ -103,7 +120,6 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument("--no-figures", action="store_true", help="do not draw the per-sample figures")
     p.add_argument("--no-estimates", action="store_true", help="do not write the estimates")
-    p.set_defaults(func=run)
 
 
 def _methods(args: argparse.Namespace) -> dict[str, Any]:

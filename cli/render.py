@@ -12,7 +12,6 @@ the render settings, variants, timings and the scene. Ground-truth layers are wr
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from collections.abc import Mapping
 from pathlib import Path
@@ -21,11 +20,10 @@ from typing import Any
 from tqdm import tqdm
 
 from spectrinsic.cli import dataset as cli_dataset
+from spectrinsic.cli.render_files import write_render
 from spectrinsic.errors import RenderError, SceneError
-from spectrinsic.gt_export.exr import write_exr
 from spectrinsic.gt_export.outfolder import check_output_folder, output_folder
-from spectrinsic.gt_export.png import encode_srgb8, exposure, write_png
-from spectrinsic.pipeline.presets import get_preset
+from spectrinsic.pipeline.presets import DatasetConfig, get_preset
 from spectrinsic.pipeline.source_plan import files_source
 from spectrinsic.render import (
     RenderResult,
@@ -40,11 +38,9 @@ from spectrinsic.render.modes import RENDER_MODES
 from spectrinsic.render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
 from spectrinsic.render.settings import DEFAULT_MODES as RENDER_DEFAULT_MODES
 from spectrinsic.scenes import library
-from spectrinsic.scenes.model import Scene, scene_to_dict
+from spectrinsic.scenes.model import Scene
 from spectrinsic.scenes.sample_id import SampleId
 from spectrinsic.scenes.sources import FILE_SIZE, is_scene_file, load_scene_file
-from spectrinsic.spectra import get_sensors
-from spectrinsic.spectra.colorimetry import xyz_to_linear_srgb
 
 __all__ = ["register", "run", "load_scene_argument", "write_render", "requested_size"]
 
@@ -56,6 +52,7 @@ def _modes_help() -> str:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
+    """Add the ``render`` subcommand to the CLI's *subparsers*."""
     # one set of documented defaults: those of the dataset's default preset
     default = get_preset("default")
     p = sub.add_parser(
@@ -68,6 +65,18 @@ def register(sub: argparse._SubParsersAction) -> None:
         f"{default.render.max_depth}, library scenes at {default.width}x{default.height}. "
         f"Modes: {_modes_help()}.",
     )
+    _add_scene_options(p)
+    _add_output_options(p)
+    _add_sampling_options(p, default)
+    _add_size_options(p, default)
+    _add_pass_options(p, default)
+    _add_ground_truth_options(p)
+    _add_material_options(p)
+    p.set_defaults(func=run)
+
+
+def _add_scene_options(p: Any) -> None:
+    """The scene and, for library scenes, its condition and view."""
     p.add_argument(
         "scene",
         metavar="SCENE",
@@ -81,12 +90,20 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--view", type=int, default=0, help="library scenes: camera viewpoint (default: 0)"
     )
+
+
+def _add_output_options(p: Any) -> None:
+    """The render modes and the output folder."""
     p.add_argument(
         "--modes",
         default=DEFAULT_MODES,
         help=f"comma-separated render modes (default: {DEFAULT_MODES})",
     )
     p.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder")
+
+
+def _add_sampling_options(p: Any, default: DatasetConfig) -> None:
+    """Samples per pixel and seed."""
     p.add_argument(
         "--spp",
         type=int,
@@ -97,6 +114,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--seed", type=int, default=0, help="sampler seed and library illuminant seed (default: 0)"
     )
+
+
+def _add_size_options(p: Any, default: DatasetConfig) -> None:
+    """The image size."""
     p.add_argument(
         "--resolution",
         default=None,
@@ -106,6 +127,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--width", type=int, default=None, help="image width (prefer --resolution)")
     p.add_argument("--height", type=int, default=None, help="image height (prefer --resolution)")
+
+
+def _add_pass_options(p: Any, default: DatasetConfig) -> None:
+    """Path depth, backend, the extra images and the integrator."""
     p.add_argument(
         "--max-depth",
         type=int,
@@ -125,6 +150,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="diagonal modes from one traversal (single) or K/3 passes per mode and "
         f"one scene per light (passes); same images (default: {DEFAULT_INTEGRATOR})",
     )
+
+
+def _add_ground_truth_options(p: Any) -> None:
+    """``--ground-truth``: a one-sample dataset instead of raw passes."""
     p.add_argument(
         "--ground-truth",
         action="store_true",
@@ -143,6 +172,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="with --ground-truth: render a scene a generated build saved as a new sample "
         "(id from the file name, seed from --seed) instead of reproducing its own",
     )
+
+
+def _add_material_options(p: Any) -> None:
+    """Spectra of the materials of .blend and mesh files."""
     p.add_argument(
         "--material-map",
         metavar="FILE",
@@ -155,7 +188,6 @@ def register(sub: argparse._SubParsersAction) -> None:
         default=None,
         help="reflectance of unmapped materials in .blend and mesh files",
     )
-    p.set_defaults(func=run)
 
 
 def load_scene_argument(
@@ -225,72 +257,6 @@ def requested_size(args: argparse.Namespace) -> tuple[int, int] | None:
     return args.width or args.height or FILE_SIZE, args.height or args.width or FILE_SIZE
 
 
-def write_render(
-    out: Path, scene: Scene, result: RenderResult, *, data_dir: str | None = None
-) -> dict[str, Path]:
-    """Write a :class:`~spectrinsic.render.RenderResult` as EXR files, an sRGB PNG beside each
-    mode's EXR (``<mode>.png``: its XYZ as linear sRGB, times :func:`~spectrinsic.gt_export.png.
-    exposure`, sRGB-encoded to 8 bits; the scale in ``meta.json["previews"]``) and
-    ``meta.json`` into *out*."""
-    out.mkdir(parents=True, exist_ok=True)
-    paths: dict[str, Path] = {}
-    previews: dict[str, dict[str, Any]] = {}
-    for mode, raw in result.raw.items():
-        labels = get_sensors(result.meta["sensors"][mode], data_dir=data_dir).channels
-        layers = {"raw": raw, "xyz": result.images[mode]}
-        names: dict[str, tuple[str, ...]] = {"raw": tuple(labels), "xyz": ("X", "Y", "Z")}
-        if mode in result.direct:
-            layers["direct"], names["direct"] = result.direct[mode], ("X", "Y", "Z")
-        for i, light in enumerate(result.per_light):
-            layers[f"light{i}"], names[f"light{i}"] = light[mode], ("X", "Y", "Z")
-        paths[mode] = write_exr(
-            out / f"{mode}.exr",
-            layers,
-            channel_names=names,
-            attributes={"spectrinsic.mode": mode, "spectrinsic.units": result.meta["units"]},
-        )
-        rgb = xyz_to_linear_srgb(result.images[mode])
-        scale = exposure(rgb)  # the package's one exposure and sRGB encoding (gt_export.png)
-        paths[f"{mode}_png"] = write_png(out / f"{mode}.png", encode_srgb8(rgb, scale))
-        previews[mode] = {"file": f"{mode}.png", "exposure": scale}
-    if result.aovs:
-        a = result.aovs
-        paths["aovs"] = write_exr(
-            out / "aovs.exr",
-            {
-                "coverage": a["coverage"],
-                "material_id": a["material_id"],
-                "object_id": a["object_id"],
-                "depth": a["depth"],
-                "normals": a["normals"],
-                "mask": a["mask"].astype("float32"),
-            },
-            channel_names={
-                "coverage": tuple(f"m{i:02d}" for i in range(a["coverage"].shape[-1])),
-                "material_id": ("id",),
-                "object_id": ("id",),
-                "depth": ("Z",),
-                "normals": ("X", "Y", "Z"),
-                "mask": ("A",),
-            },
-        )
-    meta = {
-        **result.meta,
-        "scene": scene_to_dict(scene),
-        "files": {k: v.name for k, v in paths.items()},
-        "previews": {
-            "encoding": "sRGB (IEC 61966-2-1), 8-bit, linear sRGB x exposure, clipped",
-            **previews,
-        },
-    }
-    meta["scene"]["meshes"] = [
-        {"name": m.name, "object_id": m.object_id, "faces": len(m.faces)} for m in scene.meshes
-    ]
-    paths["meta"] = out / "meta.json"
-    paths["meta"].write_text(json.dumps(meta, indent=2, default=str) + "\n", encoding="utf-8")
-    return paths
-
-
 def _ground_truth(args: argparse.Namespace) -> int:
     """``render --ground-truth``: a one-sample dataset (library name or scene file), built by
     the same call as ``spectrinsic dataset`` (:func:`spectrinsic.cli.dataset.build`)."""
@@ -343,40 +309,15 @@ def _render_settings(args: argparse.Namespace, modes: list[str]) -> RenderSettin
 
 
 def run(args: argparse.Namespace) -> int:
+    """``spectrinsic render``: check the options, load the scene, render it, write the files."""
     _check_size_options(args)
     if args.ground_truth:
         return _ground_truth(args)
-    modes = [m.strip() for m in str(args.modes).split(",") if m.strip()]
-    if not modes:
-        raise SceneError(
-            f"--modes {args.modes!r}: expected a comma-separated list such as {DEFAULT_MODES}"
-        )
-    for mode in modes:
-        get_mode(mode)
-    settings = _render_settings(args, modes)
+    settings = _render_settings(args, _parse_modes(args))
     check_output_folder(Path(args.out))
     data_dir = getattr(args, "data_dir", None)
-    size = requested_size(args)
-    scene = load_scene_argument(
-        args.scene,
-        condition=args.condition,
-        view=args.view,
-        seed=args.seed,
-        width=size[0] if size else None,
-        height=size[1] if size else None,
-        materials=cli_dataset.material_map(args.material_map),
-        default_spectrum=args.default_spectrum,
-        data_dir=data_dir,
-    )
-    given = (
-        f"--resolution {args.resolution}"
-        if args.resolution
-        else " ".join(
-            f"--{k} {v}"
-            for k, v in (("width", args.width), ("height", args.height))
-            if v is not None
-        )
-    )
+    scene = _load_scene(args, data_dir)
+    given = _given_size(args)
     if not getattr(args, "quiet", False):
         why = given or (
             "the scene file's camera" if is_scene_file(args.scene) else "the default preset's"
@@ -393,25 +334,75 @@ def run(args: argparse.Namespace) -> int:
         n_lights=len(scene.lights),
         data_dir=data_dir,
     )
+    with output_folder(Path(args.out)):  # locked; its files recorded as spectrinsic's
+        result = _render_with_progress(args, scene, settings, data_dir)
+        paths = write_render(Path(args.out), scene, result, data_dir=data_dir)
+    _print_timings(result, paths)
+    return 0
+
+
+def _parse_modes(args: argparse.Namespace) -> list[str]:
+    """The ``--modes`` names, each checked to be a known render mode."""
+    modes = [m.strip() for m in str(args.modes).split(",") if m.strip()]
+    if not modes:
+        raise SceneError(
+            f"--modes {args.modes!r}: expected a comma-separated list such as {DEFAULT_MODES}"
+        )
+    for mode in modes:
+        get_mode(mode)
+    return modes
+
+
+def _load_scene(args: argparse.Namespace, data_dir: str | None) -> Scene:
+    """The ``SCENE`` argument as a Scene at the requested size (if any)."""
+    size = requested_size(args)
+    return load_scene_argument(
+        args.scene,
+        condition=args.condition,
+        view=args.view,
+        seed=args.seed,
+        width=size[0] if size else None,
+        height=size[1] if size else None,
+        materials=cli_dataset.material_map(args.material_map),
+        default_spectrum=args.default_spectrum,
+        data_dir=data_dir,
+    )
+
+
+def _given_size(args: argparse.Namespace) -> str:
+    """The size options as given on the command line (empty when none was)."""
+    if args.resolution:
+        return f"--resolution {args.resolution}"
+    return " ".join(
+        f"--{k} {v}" for k, v in (("width", args.width), ("height", args.height)) if v is not None
+    )
+
+
+def _render_with_progress(
+    args: argparse.Namespace, scene: Scene, settings: RenderSettings, data_dir: str | None
+) -> RenderResult:
+    """Render *scene* with a progress bar over its passes (none with --quiet)."""
     total = count_passes(scene, settings, data_dir=data_dir)
     bar = (
         None
         if getattr(args, "quiet", False)
         else tqdm(total=total, desc=f"render {scene.name}", unit="pass", file=sys.stderr)
     )
-    with output_folder(Path(args.out)):  # locked; its files recorded as spectrinsic's
-        try:
-            result = render_scene(
-                scene,
-                settings,
-                seed=args.seed,
-                progress=None if bar is None else bar.update,
-                data_dir=data_dir,
-            )
-        finally:
-            if bar is not None:
-                bar.close()
-        paths = write_render(Path(args.out), scene, result, data_dir=data_dir)
+    try:
+        return render_scene(
+            scene,
+            settings,
+            seed=args.seed,
+            progress=None if bar is None else bar.update,
+            data_dir=data_dir,
+        )
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def _print_timings(result: RenderResult, paths: dict[str, Path]) -> None:
+    """One line per mode (passes, seconds, file), the single traversal's, and meta.json."""
     timings = result.meta["timings"]
     for mode in result.images:
         print(
@@ -424,4 +415,3 @@ def run(args: argparse.Namespace) -> int:
             "(all diagonal modes and lights)"
         )
     print(f"wrote {paths['meta']}")
-    return 0

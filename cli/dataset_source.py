@@ -1,0 +1,250 @@
+"""The scene-source options of ``spectrinsic dataset`` and their parsing: library, generator
+or scene files (``--generator``, ``--scenes`` and their settings), ``--material-map``,
+``--resolution``, and the check of scene files before a build; shared with
+``render --ground-truth``."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+from spectrinsic.errors import DatasetError, SceneError, SpectrinsicError
+from spectrinsic.pipeline.presets import DatasetConfig
+from spectrinsic.pipeline.source_plan import file_sample, files_source, generator_source
+from spectrinsic.scenes.generators import GlossDistribution
+from spectrinsic.scenes.sources import FileSource
+from spectrinsic.scenes.yaml_limits import load_yaml_file
+from spectrinsic.spectra import get_spectrum
+
+__all__ = [
+    "add_source_options",
+    "check_scene_files",
+    "material_map",
+    "parse_resolution",
+    "source_from_args",
+    "source_notes",
+]
+
+
+def add_source_options(src: Any) -> None:
+    """Where the scenes come from: the library (default), a generator, or scene files."""
+    _add_generator_options(src)
+    _add_generated_draw_options(src)
+    _add_scene_file_options(src)
+
+
+def _add_generator_options(src: Any) -> None:
+    """Which generator, how many scenes and how many cameras each."""
+    src.add_argument(
+        "--generator",
+        metavar="NAME",
+        default=None,
+        help="generate scenes procedurally: objects-on-ground or rooms",
+    )
+    src.add_argument("--count", type=int, default=20, metavar="N", help="generated scenes (20)")
+    src.add_argument(
+        "--views", type=int, default=1, metavar="V", help="cameras per generated scene (1)"
+    )
+
+
+def _add_generated_draw_options(src: Any) -> None:
+    """What generated scenes draw: material ranges, light colours, SFU data, gloss."""
+    src.add_argument(
+        "--value-range",
+        default="2,9",
+        metavar="LO,HI",
+        help="Munsell value range of generated materials (2,9)",
+    )
+    src.add_argument(
+        "--chroma-range",
+        default="0,16",
+        metavar="LO,HI",
+        help="Munsell chroma range of generated materials (0,16)",
+    )
+    src.add_argument(
+        "--light-saturation",
+        default=None,
+        metavar="LO,HI",
+        help="keep only coloured lights whose |Duv| (Ohno 2013: CIE 1960 uv distance "
+        "from the Planckian locus) is in LO,HI; 0.02 is visibly tinted, at most "
+        "0.15 for LO (default: any, 60%% from saturated LEDs and filtered lamps)",
+    )
+    src.add_argument(
+        "--sfu",
+        action="store_true",
+        help="also draw SFU reflectances and illuminants (needs --data-dir)",
+    )
+    src.add_argument(
+        "--glossy",
+        type=float,
+        default=0.0,
+        metavar="F",
+        help="fraction of generated materials made coated/glossy (plastic) (0)",
+    )
+    src.add_argument(
+        "--metallic",
+        type=float,
+        default=0.0,
+        metavar="F",
+        help="fraction of generated materials made metal (Ag, Al, Au, Cu, Cr) (0)",
+    )
+    src.add_argument(
+        "--roughness-range",
+        default="0,0.3",
+        metavar="LO,HI",
+        help="GGX roughness range of glossy and metal materials (0,0.3)",
+    )
+
+
+def _add_scene_file_options(src: Any) -> None:
+    """The user's own scene files and how their materials get spectra."""
+    src.add_argument(
+        "--scenes",
+        nargs="+",
+        metavar="PATH",
+        default=None,
+        help="render your own scene files (.yaml, .blend, .obj/.ply/.glb) with full ground truth",
+    )
+    src.add_argument(
+        "--material-map",
+        metavar="FILE",
+        default=None,
+        help="YAML/JSON mapping material name -> spectrum for .blend and mesh scenes",
+    )
+    src.add_argument(
+        "--default-spectrum",
+        metavar="NAME",
+        default=None,
+        help="reflectance of unmapped materials in .blend and mesh scenes",
+    )
+    src.add_argument(
+        "--new-sample",
+        action="store_true",
+        help="render scenes a generated build saved (<dataset>/scenes/*.yaml) as new "
+        "samples (id from the file name, seed from --seed) instead of "
+        "reproducing their own sample (same id, same seed)",
+    )
+
+
+def _range(option: str, text: str) -> tuple[float, float]:
+    """An option's ``LO,HI`` text as two floats with LO <= HI."""
+    try:
+        lo, hi = (float(v) for v in text.split(","))
+    except ValueError:
+        raise DatasetError(f"{option} {text!r}; expected LO,HI, e.g. 2,9") from None
+    if lo > hi:
+        raise DatasetError(f"{option} {text!r}; expected LO <= HI")
+    return lo, hi
+
+
+def material_map(path: str | None) -> dict[str, str]:
+    """The ``--material-map`` file as ``{material name: spectrum name}`` (``{}`` for none)."""
+    if path is None:
+        return {}
+
+    data = load_yaml_file(Path(path))
+    if not isinstance(data, dict) or not all(
+        isinstance(k, str) and isinstance(v, str) for k, v in data.items()
+    ):
+        raise DatasetError(
+            f"--material-map {path!r}: expected a mapping of material name -> spectrum name"
+        )
+    return data
+
+
+def source_from_args(args: argparse.Namespace) -> str | None:
+    """The config's ``source`` for --generator / --scenes (``None``: the library)."""
+    if args.generator and args.scenes:
+        raise DatasetError("--generator and --scenes exclude each other; give one")
+    if args.generator:
+        try:
+            gloss = GlossDistribution(
+                args.glossy, args.metallic, _range("--roughness-range", args.roughness_range)
+            )
+        except SceneError as exc:
+            raise DatasetError(f"--glossy/--metallic/--roughness-range: {exc}") from None
+        return generator_source(
+            args.generator,
+            args.count,
+            views=args.views,
+            sfu=args.sfu,
+            value_range=_range("--value-range", args.value_range),
+            chroma_range=_range("--chroma-range", args.chroma_range),
+            gloss=gloss,
+            light_saturation=None
+            if args.light_saturation is None
+            else _range("--light-saturation", args.light_saturation),
+        )
+    if args.scenes:
+        size = None if args.resolution is None else parse_resolution(args.resolution)
+        return files_source(
+            args.scenes,
+            materials=material_map(args.material_map),
+            default_spectrum=args.default_spectrum,
+            resolution=size,
+            new_sample=getattr(args, "new_sample", False),
+        )
+    return None
+
+
+def source_notes(config: DatasetConfig) -> list[str]:
+    """What applies to each scene file of *config* (``--scenes``, ``render --ground-truth``):
+    its size (the file's camera or --resolution) and its sample (a saved one, reproduced, or a
+    new one); empty for the library and generators."""
+    spec = json.loads(config.source or "{}")
+    notes = []
+    for entry in spec.get("scenes", ()):
+        size = spec.get("resolution")
+        where = (
+            f"{size[0]}x{size[1]} (--resolution)"
+            if size
+            else "the file's camera size (--resolution to change it)"
+        )
+        sid, seed = file_sample(entry["path"], new_sample=bool(spec.get("new_sample")))
+        sample = (
+            f"reproduces its saved sample {sid} with seed {seed} (--new-sample for a new one)"
+            if seed is not None
+            else f"sample {sid}"
+        )
+        notes.append(f"{Path(entry['path']).name}: {where}; {sample}")
+    return notes
+
+
+def parse_resolution(text: str) -> tuple[int, int]:
+    """``WIDTHxHEIGHT`` as two positive integers."""
+    w, sep, h = text.lower().partition("x")
+    if not (sep and w.isdigit() and h.isdigit() and int(w) > 0 and int(h) > 0):
+        raise DatasetError(
+            f"--resolution {text!r}; expected WIDTHxHEIGHT of positive integers, e.g. 256x256"
+        )
+    return int(w), int(h)
+
+
+def check_scene_files(config: Any, data_dir: str | None) -> None:
+    """``--scenes``: every file reads as a valid scene with this material map and default
+    spectrum, before the folder is stamped with the config (a bad file is an input error, not
+    a failed sample)."""
+
+    spec = json.loads(config.source or "{}")
+    if "scenes" not in spec:
+        return
+    materials = spec.get("materials") or {}
+    named = [("--default-spectrum", spec.get("default_spectrum"))]
+    named += [(f"--material-map entry {k!r}", v) for k, v in sorted(materials.items())]
+    for option, name in named:
+        try:
+            if name is not None:
+                get_spectrum(name, data_dir=data_dir)
+        except SpectrinsicError as exc:
+            raise DatasetError(f"{option} {name!r}: {exc}") from exc
+    width, height = spec.get("resolution") or (None, None)
+    for entry in spec["scenes"]:
+        FileSource(
+            entry["path"],
+            width,
+            height,
+            tuple(sorted(materials.items())),
+            spec.get("default_spectrum"),
+        ).build(data_dir)
