@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from spectrinsic.decompose.evaluate import evaluate, input_image
+from spectrinsic.decompose.evaluate import evaluate
+from spectrinsic.decompose.sample_fields import input_image
 from spectrinsic.decompose.predictions import Predictions, read_layer
 from spectrinsic.decompose.registry import get_decomposer
 from spectrinsic.errors import DatasetError
