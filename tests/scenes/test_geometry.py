@@ -9,6 +9,7 @@ import pytest
 
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes.furniture import chair, room, shelf, table
+from spectrinsic.scenes.geometry import is_closed
 from spectrinsic.scenes.objects import OBJECTS
 from spectrinsic.scenes.painting import bands, patches, printed, stripes
 from spectrinsic.scenes.parts import Part, moved, to_meshes
@@ -22,7 +23,6 @@ from spectrinsic.scenes.primitives import (
     sphere,
     torus,
 )
-from spectrinsic.scenes.geometry import is_closed
 
 #: Volumes of exact polyhedra (boxes, prisms) agree to rounding only.
 EXACT = 1e-12
