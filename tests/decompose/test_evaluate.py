@@ -131,7 +131,7 @@ def test_single_objects_are_scored_on_their_own_mask_not_the_ground():
 
 def test_table_3_2_averages_grey_shading_and_grey_reflectance():
     from spectrinsic.decompose.evaluate import Score
-    from spectrinsic.decompose.report import table_3_2
+    from spectrinsic.decompose.report_tables import table_3_2
 
     samples = {
         "obj-a__v0__white": ("object", "white"),
