@@ -38,37 +38,28 @@ from spectrinsic.decompose.registry import get_decomposer
 HESSIAN = {"ridge_detector": "hessian", "creaseness": 1.0, "sigma": 1.0}
 RAD = {"ridge_detector": "rad", "creaseness": 1.5, "sigma": 2.0}
 RAD_FINE = {"ridge_detector": "rad", "creaseness": 1.0, "sigma": 1.0}
-MRF_GRID = {
-    "gamma": [0.3, 1.0, 3.0, 10.0, 30.0],
-    "gamma_over_alpha": [10.0, 100.0],
-    "ridge_detector": ["hessian", "rad"],
-    "creaseness": [1.0, 1.25, 1.5],
-    "sigma": [1.0, 1.5, 2.0, 3.0],
-}
+MRF_GRID = {"gamma": [0.3, 1.0, 3.0, 10.0, 30.0], "gamma_over_alpha": [10.0, 100.0],
+            "ridge_detector": ["hessian", "rad"], "creaseness": [1.0, 1.25, 1.5],
+            "sigma": [1.0, 1.5, 2.0, 3.0]}
 #: Round 1 (before the RAD detector): the hessian points. scripts/mit_ablation.json holds
 #: both rounds (round 1's keys, which lack the detector, are read as HESSIAN by merge()).
-HESSIAN_POINTS = [
-    {"gamma": g, "gamma_over_alpha": 100.0, **HESSIAN} for g in (1.0, 3.0, 10.0, 30.0)
-] + [{"gamma": g, "gamma_over_alpha": 10.0, **HESSIAN} for g in (1.0, 10.0)]
+HESSIAN_POINTS = [{"gamma": g, "gamma_over_alpha": 100.0, **HESSIAN} for g in (1.0, 3.0, 10.0, 30.0)
+                  ] + [{"gamma": g, "gamma_over_alpha": 10.0, **HESSIAN} for g in (1.0, 10.0)]
 #: Round 2: the RAD points.
-MRF_POINTS = [
-    {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD},
-    {"gamma": 1.0, "gamma_over_alpha": 100.0, **RAD},
-    {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD},
-    {"gamma": 10.0, "gamma_over_alpha": 100.0, **RAD},
-    {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD_FINE},
-    # round 2b (the chosen point lay on the grid's edge: gamma 1, sigma 2)
-    {"gamma": 0.3, "gamma_over_alpha": 10.0, **RAD},
-    {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "sigma": 3.0},
-    # round 2c (between the connected web of 1.0 and the chosen 1.5; sigma 1.5)
-    {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "creaseness": 1.25},
-    {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "sigma": 1.5},
-]
+MRF_POINTS = [{"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD},
+              {"gamma": 1.0, "gamma_over_alpha": 100.0, **RAD},
+              {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD},
+              {"gamma": 10.0, "gamma_over_alpha": 100.0, **RAD},
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD_FINE},
+              # round 2b (the chosen point lay on the grid's edge: gamma 1, sigma 2)
+              {"gamma": 0.3, "gamma_over_alpha": 10.0, **RAD},
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "sigma": 3.0},
+              # round 2c (between the connected web of 1.0 and the chosen 1.5; sigma 1.5)
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "creaseness": 1.25},
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "sigma": 1.5}]
 #: Parameters of steps 4-5 (run on each labelling).
-POST_GRID = {
-    "reflectance_colour": ["label-centroid", "region-mean"],
-    "split_by_ridge": [False, True],
-}
+POST_GRID = {"reflectance_colour": ["label-centroid", "region-mean"],
+             "split_by_ridge": [False, True]}
 #: Applied to each result above (with_constancy: the same as the method's own step).
 CONSTANCY = ["none", "grey-world"]
 #: The thesis' point (NamesAndShades.thesis()) with expansion to convergence, and extra rows.
@@ -80,16 +71,11 @@ REFERENCES = ("image-as-reflectance", "colour-retinex")
 #: The thesis' own per-object results on the development objects (Table 3.5 LMSE, Table 3.4
 #: Corr. and MSE; global = mean of shading and reflectance).
 THESIS_TABLES_3_4_3_5 = {
-    "apple": (0.0200, 0.7627, 0.1593),
-    "box": (0.0514, 0.6878, 0.2142),
-    "cup1": (0.0089, 0.9305, 0.0183),
-    "deer": (0.0513, 0.7792, 0.1041),
-    "frog1": (0.0627, 0.7050, 0.1916),
-    "paper1": (0.0021, 0.9395, 0.0031),
-    "pear": (0.0157, 0.4264, 0.1011),
-    "raccoon": (0.0035, 0.9687, 0.0045),
-    "sun": (0.0062, 0.9374, 0.0199),
-    "teabag1": (0.0587, 0.6610, 0.0804),
+    "apple": (0.0200, 0.7627, 0.1593), "box": (0.0514, 0.6878, 0.2142),
+    "cup1": (0.0089, 0.9305, 0.0183), "deer": (0.0513, 0.7792, 0.1041),
+    "frog1": (0.0627, 0.7050, 0.1916), "paper1": (0.0021, 0.9395, 0.0031),
+    "pear": (0.0157, 0.4264, 0.1011), "raccoon": (0.0035, 0.9687, 0.0045),
+    "sun": (0.0062, 0.9374, 0.0199), "teabag1": (0.0587, 0.6610, 0.0804),
 }
 
 
@@ -97,18 +83,16 @@ def key(point: dict) -> str:
     return json.dumps(point, sort_keys=True)
 
 
-def run(
-    mit_dir: Path, names: list[str] | None, points: list[dict], with_extra: bool = False
-) -> dict:
+def run(mit_dir: Path, names: list[str] | None, points: list[dict], with_extra: bool = False
+        ) -> dict:
     base = dataclasses.replace(NamesAndShades.thesis(), expansion_cycles=2)
     scores: dict[str, dict[str, dict]] = {}
     seconds: dict[str, float] = {}
     for path in mit_folder_objects(mit_dir, names):
         obj = load_mit_object(path)
         for name in REFERENCES:
-            scores.setdefault(name, {})[obj.name] = mit_measures(
-                obj, get_decomposer(name)(obj.image, obj.mask)
-            )
+            scores.setdefault(name, {})[obj.name] = mit_measures(obj, get_decomposer(name)(
+                obj.image, obj.mask))
         for mrf in points:
             method = dataclasses.replace(base, **mrf)
             t0 = time.perf_counter()
@@ -118,64 +102,44 @@ def run(
                 plain = dataclasses.replace(method, **dict(post)).reflectance(labelling)
                 for constancy in CONSTANCY:
                     point = {**mrf, **dict(post), "colour_constancy": constancy}
-                    result = with_constancy(plain, obj.image, obj.mask, colour_constancy=constancy)
+                    result = with_constancy(plain, obj.image, obj.mask,
+                                            colour_constancy=constancy)
                     scores.setdefault(key(point), {})[obj.name] = {
-                        **mit_measures(obj, result),
-                        "regions": plain.info["regions"],
-                    }
-        for label, change in EXTRA.items() if with_extra else ():
+                        **mit_measures(obj, result), "regions": plain.info["regions"]}
+        for label, change in (EXTRA.items() if with_extra else ()):
             method = dataclasses.replace(NamesAndShades.thesis(), **change)
             result = method(obj.image, obj.mask)
             scores.setdefault(label, {})[obj.name] = {
-                **mit_measures(obj, result),
-                "regions": result.info["regions"],
-            }
+                **mit_measures(obj, result), "regions": result.info["regions"]}
         print(obj.name, "done", flush=True)
     return {"scores": scores, "labelling_seconds": seconds}
 
 
 def choose(scores: dict) -> dict:
-    grid = {k: {o: v["lmse"] for o, v in s.items()} for k, s in scores.items() if k.startswith("{")}
+    grid = {k: {o: v["lmse"] for o, v in s.items()} for k, s in scores.items()
+            if k.startswith("{")}
     objects = sorted(next(iter(grid.values())))
     table = {tuple(sorted(json.loads(k).items())): v for k, v in grid.items()}
     result = hold_one_out(table, {o: o for o in objects})
-    return {
-        "chosen": dict(result.chosen),
-        "chosen_lmse": result.chosen_score,
-        "held_out_lmse": result.held_out_score,
-        "folds": [
-            {"held_out": f.held_out, "chosen": dict(f.chosen), "lmse": f.score}
-            for f in result.folds
-        ],
-    }
+    return {"chosen": dict(result.chosen), "chosen_lmse": result.chosen_score,
+            "held_out_lmse": result.held_out_score,
+            "folds": [{"held_out": f.held_out, "chosen": dict(f.chosen), "lmse": f.score}
+                      for f in result.folds]}
 
 
 def row(name: str, per_object: dict, baseline: dict) -> str:
     means = {m: np.nanmean([v[m] for v in per_object.values()]) for m in MEASURES}
     wins = sum(v["lmse"] < baseline[o]["lmse"] for o, v in per_object.items())
-    return (
-        f"| {name} | {means['lmse']:.4f} | {means['corr']:.4f} | {means['mse']:.4f} | "
-        f"{means['almse']:.4f} | {wins}/{len(per_object)} |"
-    )
+    return (f"| {name} | {means['lmse']:.4f} | {means['corr']:.4f} | {means['mse']:.4f} | "
+            f"{means['almse']:.4f} | {wins}/{len(per_object)} |")
 
 
 #: The thesis' settings (NamesAndShades.thesis(), 2 expansion cycles) with each detector.
-THESIS = {
-    "gamma": 1.0,
-    "gamma_over_alpha": 100.0,
-    "reflectance_colour": "label-centroid",
-    "split_by_ridge": False,
-    "colour_constancy": "none",
-}
+THESIS = {"gamma": 1.0, "gamma_over_alpha": 100.0, "reflectance_colour": "label-centroid",
+          "split_by_ridge": False, "colour_constancy": "none"}
 #: The round-1 defaults (hessian ridges), the reference for "before".
-ROUND_1 = {
-    "gamma": 1.0,
-    "gamma_over_alpha": 10.0,
-    "reflectance_colour": "region-mean",
-    "split_by_ridge": True,
-    "colour_constancy": "grey-world",
-    **HESSIAN,
-}
+ROUND_1 = {"gamma": 1.0, "gamma_over_alpha": 10.0, "reflectance_colour": "region-mean",
+           "split_by_ridge": True, "colour_constancy": "grey-world", **HESSIAN}
 
 
 def variations(label: str, centre: dict, s: dict, base: dict) -> list[str]:
@@ -190,17 +154,13 @@ def variations(label: str, centre: dict, s: dict, base: dict) -> list[str]:
 
 def markdown(report: dict) -> str:
     s, chosen = report["scores"], report["choice"]["chosen"]
-    lines = [
-        "| setting | MIT LMSE | Corr | MSE | aLMSE | beats baseline |",
-        "|---|---|---|---|---|---|",
-    ]
+    lines = ["| setting | MIT LMSE | Corr | MSE | aLMSE | beats baseline |",
+             "|---|---|---|---|---|---|"]
     base = s["image-as-reflectance"]
     for name in REFERENCES:
         lines.append(row(name, s[name], base))
-    for label, ridges in (
-        ("thesis, hessian ridges (round 1)", HESSIAN),
-        ("thesis, RAD ridges", RAD),
-    ):
+    for label, ridges in (("thesis, hessian ridges (round 1)", HESSIAN),
+                          ("thesis, RAD ridges", RAD)):
         lines.append(row(label, s[key({**THESIS, **ridges})], base))
     for label in EXTRA:
         if label in s:
@@ -210,9 +170,8 @@ def markdown(report: dict) -> str:
     lines.append(row(f"**chosen**: {chosen}", s[key(chosen)], base))
     lines += variations("chosen", chosen, s, base)
     if key({**chosen, **RAD_FINE}) in s:
-        lines.append(
-            row("chosen, RAD creaseness 1.0 and sigma 1", s[key({**chosen, **RAD_FINE})], base)
-        )
+        lines.append(row("chosen, RAD creaseness 1.0 and sigma 1", s[key({**chosen, **RAD_FINE})],
+                         base))
     return "\n".join(lines) + "\n"
 
 
@@ -232,24 +191,18 @@ def merge(parts: list[Path]) -> dict:
 def per_object(report: dict) -> str:
     """LMSE per object: the thesis' reported value beside ours (thesis settings and chosen)."""
     s, chosen = report["scores"], report["choice"]["chosen"]
-    columns = {
-        "thesis Table 3.5": None,
-        "image-as-reflectance": "image-as-reflectance",
-        "colour-retinex": "colour-retinex",
-        "ours, thesis settings, RAD": key({**THESIS, **RAD}),
-        "ours, round-1 defaults": key(ROUND_1),
-        "ours, chosen": key(chosen),
-    }
+    columns = {"thesis Table 3.5": None, "image-as-reflectance": "image-as-reflectance",
+               "colour-retinex": "colour-retinex",
+               "ours, thesis settings, RAD": key({**THESIS, **RAD}),
+               "ours, round-1 defaults": key(ROUND_1), "ours, chosen": key(chosen)}
     lines = ["| object | " + " | ".join(columns) + " |", "|---" * (len(columns) + 1) + "|"]
     objects = sorted(o for o in THESIS_TABLES_3_4_3_5 if o in s["colour-retinex"])
     for obj in objects:
         cells = [f"{THESIS_TABLES_3_4_3_5[obj][0]:.4f}"] + [
-            f"{s[k][obj]['lmse']:.4f}" for k in list(columns.values())[1:]
-        ]
+            f"{s[k][obj]['lmse']:.4f}" for k in list(columns.values())[1:]]
         lines.append(f"| {obj} | " + " | ".join(cells) + " |")
     means = [np.mean([THESIS_TABLES_3_4_3_5[o][0] for o in objects])] + [
-        np.mean([s[k][o]["lmse"] for o in objects]) for k in list(columns.values())[1:]
-    ]
+        np.mean([s[k][o]["lmse"] for o in objects]) for k in list(columns.values())[1:]]
     lines.append("| mean | " + " | ".join(f"{m:.4f}" for m in means) + " |")
     return "\n".join(lines) + "\n"
 
@@ -267,11 +220,8 @@ def main(argv: list[str]) -> int:
         return 0
     chosen = [a for a in argv if a.startswith("--points=")]  # indices into MRF_POINTS
     argv = [a for a in argv if a not in chosen]
-    points = (
-        [MRF_POINTS[int(i)] for i in chosen[0].split("=", 1)[1].split(",")]
-        if chosen
-        else MRF_POINTS
-    )
+    points = ([MRF_POINTS[int(i)] for i in chosen[0].split("=", 1)[1].split(",")] if chosen
+              else MRF_POINTS)
     mit_dir, target = Path(argv[0]), Path(argv[1])
     report = run(mit_dir, argv[2:] or None, points)
     target.write_text(json.dumps(report, indent=1, sort_keys=True) + "\n")

@@ -124,45 +124,23 @@ def stage_figures(obj, method: NamesAndShades, out: Path, tag: str) -> dict:
     scores = mit_measures(obj, result)
     m = obj.mask
     what = f"{obj.name}, {tag}"
-    panels(
-        [
-            ("input", display(obj.image, m)),
-            (
-                f"{stages.candidates.size} observed labels (Fig. 3.2b)",
-                label_image(m, stages.candidates, stages.observed),
-            ),
-        ],
-        out / f"nas-{obj.name}-{tag}-names.png",
-        f"{what}: colour names (sec. 3.2.1)",
-    )
-    ridge_figure(
-        stages, out / f"nas-{obj.name}-{tag}-ridges.png", f"{what}: colour shades (sec. 3.2.2)"
-    )
+    panels([("input", display(obj.image, m)),
+            (f"{stages.candidates.size} observed labels (Fig. 3.2b)",
+             label_image(m, stages.candidates, stages.observed))],
+           out / f"nas-{obj.name}-{tag}-names.png", f"{what}: colour names (sec. 3.2.1)")
+    ridge_figure(stages, out / f"nas-{obj.name}-{tag}-ridges.png",
+                 f"{what}: colour shades (sec. 3.2.2)")
     regions_info = result.info["regions"]
-    panels(
-        [
-            ("edge weight: A dark, B grey, C white", weight_image(method, stages)),
-            (
-                f"MRF labels: {np.unique(stages.labels).size} used",
-                label_image(m, stages.candidates, stages.labels),
-            ),
-        ],
-        out / f"nas-{obj.name}-{tag}-labels.png",
-        f"{what}: MRF (sec. 3.3, Eq. 3.4)",
-    )
-    panels(
-        [
-            ("estimated reflectance", display(result.reflectance, m)),
+    panels([("edge weight: A dark, B grey, C white", weight_image(method, stages)),
+            (f"MRF labels: {np.unique(stages.labels).size} used",
+             label_image(m, stages.candidates, stages.labels))],
+           out / f"nas-{obj.name}-{tag}-labels.png", f"{what}: MRF (sec. 3.3, Eq. 3.4)")
+    panels([("estimated reflectance", display(result.reflectance, m)),
             ("true reflectance", display(obj.reflectance, m)),
-            (
-                f"estimated shading ({regions_info} regions)",
-                display(result.shading.mean(axis=2), m),
-            ),
-            ("true shading", display(obj.shading, m)),
-        ],
-        out / f"nas-{obj.name}-{tag}-result.png",
-        f"{what}: LMSE {scores['lmse']:.4f}, Corr {scores['corr']:.3f}, MSE {scores['mse']:.4f}",
-    )
+            (f"estimated shading ({regions_info} regions)", display(result.shading.mean(axis=2), m)),
+            ("true shading", display(obj.shading, m))],
+           out / f"nas-{obj.name}-{tag}-result.png",
+           f"{what}: LMSE {scores['lmse']:.4f}, Corr {scores['corr']:.3f}, MSE {scores['mse']:.4f}")
     return scores
 
 
