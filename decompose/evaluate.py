@@ -40,6 +40,14 @@ from spectrinsic.decompose.photometric import SCENARIOS, photometric_correction
 from spectrinsic.decompose.predictions import Predictions
 from spectrinsic.decompose.registry import available_decomposers, get_decomposer
 from spectrinsic.decompose.report import write_report
+from spectrinsic.decompose.sample_fields import (
+    evaluation_mask,
+    input_image,
+    material_ids,
+    sample_condition,
+    sample_id_of,
+    sample_kind,
+)
 from spectrinsic.decompose.scores import CONDITION_GROUPS, INPUT_LAYERS, SCORED_LAYERS, Score
 from spectrinsic.decompose.targets import (
     SPECULAR_LAYER,
@@ -52,21 +60,15 @@ from spectrinsic.errors import DatasetError, validate_choice
 from spectrinsic.gt_export.exr import write_exr
 from spectrinsic.gt_export.names import camera_slug
 from spectrinsic.rng import seed_from_key
-from spectrinsic.scenes.sample_id import SampleId
 from spectrinsic.spectra.colorimetry import encode_srgb
 
 __all__ = [
     "CONDITION_GROUPS",
     "Score",
     "EvaluationResult",
-    "sample_condition",
-    "sample_kind",
     "evaluate_sample",
-    "evaluation_mask",
-    "BACKGROUND_OBJECTS",
     "INPUT_LAYERS",
     "SCORED_LAYERS",
-    "input_image",
     "layer_metrics",
     "evaluate",
 ]
@@ -74,7 +76,6 @@ __all__ = [
 logger = logging.getLogger(__name__)
 
 _GROUP_ORDER = ("WL", "1L", "2L")
-_KINDS = {"object": "single objects", "complex": "complex scenes"}
 #: Metrics of the grey shading layer (angular error needs colour).
 _SHADING_GREY_METRICS = ("si_mse", "lmse", "almse", "corr", "lcorr", "dssim")
 #: Metrics of the coloured shading layer.
@@ -92,70 +93,9 @@ class EvaluationResult:
     files: dict[str, Path] = field(default_factory=dict)
 
 
-def _sample_id(sample: Mapping[str, Any]) -> str:
-    meta = sample.get("meta", {})
-    sid = meta.get("sample_id") or sample.get("sample_id")
-    if not sid:
-        raise DatasetError("sample has no meta['sample_id']")
-    return str(sid)
-
-
-def sample_condition(sample: Mapping[str, Any]) -> str:
-    """Lighting condition: ``meta["condition"]``, else the sample id's
-    (:meth:`spectrinsic.scenes.sample_id.SampleId.parse`)."""
-    meta = sample.get("meta", {})
-    cond = meta.get("condition") or meta.get("scene_metadata", {}).get("condition")
-    if not cond:
-        cond = SampleId.parse(_sample_id(sample)).condition
-    if cond not in CONDITION_GROUPS:
-        raise DatasetError(
-            f"sample {_sample_id(sample)!r}: unknown condition {cond!r}; "
-            f"expected one of {sorted(CONDITION_GROUPS)}"
-        )
-    return str(cond)
-
-
-def sample_kind(sample: Mapping[str, Any]) -> str:
-    """``"object"`` or ``"complex"``: ``meta["scene_kind"]``, else the ``obj-`` id prefix."""
-    meta = sample.get("meta", {})
-    kind = meta.get("scene_kind") or meta.get("scene_metadata", {}).get("kind")
-    if not kind:
-        kind = "object" if _sample_id(sample).startswith("obj") else "complex"
-    if kind not in _KINDS:
-        raise DatasetError(f"sample {_sample_id(sample)!r}: unknown scene kind {kind!r}")
-    return str(kind)
-
-
 def _grey(a: np.ndarray) -> np.ndarray:
     a = np.asarray(a, dtype=np.float64)
     return a.mean(axis=2) if a.ndim == 3 else a
-
-
-#: Object names excluded from the evaluation mask of single-object scenes: like the MIT
-#: benchmark (Grosse et al. 2009), an object is scored on its own mask, not on the ground.
-BACKGROUND_OBJECTS = frozenset({"ground"})
-
-
-def evaluation_mask(sample: Mapping[str, Any]) -> np.ndarray:
-    """Pixels scored: the ``mask``, minus background objects in single-object scenes."""
-    image = np.asarray(sample["image"])
-    mask = np.asarray(sample.get("mask", np.ones(image.shape[:2], bool)), dtype=bool)
-    if sample_kind(sample) != "object":
-        return mask
-    objects = sample.get("meta", {}).get("objects") or {}
-    ids = sample.get("ids")
-    object_ids = ids.get("object") if isinstance(ids, Mapping) else None
-    background = [int(k) for k, name in objects.items() if name in BACKGROUND_OBJECTS]
-    if object_ids is None or not background:
-        return mask
-    return mask & ~np.isin(np.asarray(object_ids), background)
-
-
-def _material_ids(sample: Mapping[str, Any]) -> np.ndarray | None:
-    ids = sample.get("ids")
-    if isinstance(ids, Mapping):
-        ids = ids.get("material", ids.get("material_id"))
-    return None if ids is None else np.asarray(ids)
 
 
 def _camera_inputs(sample: Mapping[str, Any], target: str) -> list[tuple[str, str, np.ndarray]]:
@@ -177,7 +117,10 @@ def _camera_inputs(sample: Mapping[str, Any], target: str) -> list[tuple[str, st
         for scenario in _PHOTOMETRIC:
             if not available[scenario]:
                 logger.info(
-                    "sample %s, camera %s: no matrices for %s", _sample_id(sample), camera, scenario
+                    "sample %s, camera %s: no matrices for %s",
+                    sample_id_of(sample),
+                    camera,
+                    scenario,
                 )
                 continue
             light = light_cam if scenario == "SC1" else light_srgb
@@ -207,21 +150,6 @@ def _write_estimate(directory: Path, result: Decomposition) -> None:
     write_exr(directory / "shading.exr", {"shading": result.shading})
     if result.specular is not None:
         write_exr(directory / "specular.exr", {"specular": result.specular})
-
-
-def input_image(sample: Mapping[str, Any], camera: str | None = None) -> tuple[str, np.ndarray]:
-    """The image a method decomposes: the first of :data:`INPUT_LAYERS` the sample has.
-
-    For a camera, ``image_camera_denoised/<camera>`` else ``image_camera/<camera>``.
-    Returns ``(layer key, float64 array)``.
-    """
-    keys = [
-        f"{k.replace('image', 'image_camera', 1)}/{camera}" if camera else k for k in INPUT_LAYERS
-    ]
-    for key in keys:
-        if key in sample:
-            return key, np.asarray(sample[key], dtype=np.float64)
-    raise DatasetError(f"sample {_sample_id(sample)!r} has none of the layers {keys}")
 
 
 def layer_metrics(layer: str, metrics: Sequence[str] | None = None) -> list[str]:
@@ -266,7 +194,7 @@ class _Truth:
 
 
 def _truth(sample: Mapping[str, Any], seed: int, n_judgements: int) -> _Truth:
-    sid = _sample_id(sample)
+    sid = sample_id_of(sample)
     reflectance = np.asarray(sample["reflectance"], dtype=np.float64)
     colour = np.asarray(sample["shading"], dtype=np.float64)
     grey = sample.get("shading_grey")
@@ -276,7 +204,7 @@ def _truth(sample: Mapping[str, Any], seed: int, n_judgements: int) -> _Truth:
         seed=seed_from_key(seed, sid),
         n_pairs=n_judgements,
         mask=mask,
-        material_ids=_material_ids(sample),
+        material_ids=material_ids(sample),
         delta=WHDR_DELTA,
     )
     layers = {
@@ -476,7 +404,7 @@ def evaluate(
     glossy = False
     for sample in samples:
         glossy = glossy or SPECULAR_LAYER in sample
-        sid = _sample_id(sample)
+        sid = sample_id_of(sample)
         samples_info[sid] = (sample_kind(sample), sample_condition(sample))
         inputs.add(input_image(sample)[0])
         scores += evaluate_sample(

@@ -8,8 +8,7 @@ coloured irradiance shading).
 from __future__ import annotations
 
 import dataclasses
-from collections import defaultdict
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -17,132 +16,28 @@ import numpy as np
 
 from spectrinsic.decompose.metrics import METRICS
 from spectrinsic.decompose.photometric import SCENARIOS
-from spectrinsic.decompose.registry import DECOMPOSERS
 from spectrinsic.decompose.report_figure import SUMMARY_FIGURE, summary_heatmap
 from spectrinsic.decompose.report_md import Column, glossary_section, markdown_table
-from spectrinsic.decompose.scores import CONDITION_GROUPS, INPUT_LAYERS, SCORED_LAYERS, Score
+from spectrinsic.decompose.report_tables import (
+    COLOUR_COLUMNS,
+    GROUP_ORDER,
+    LMSE_COLUMNS,
+    SCENE_KINDS,
+    TABLE_3_2_COLUMNS,
+    condition_table,
+    scenario_table,
+    summary_table,
+    table_3_2,
+)
+from spectrinsic.decompose.scores import INPUT_LAYERS, SCORED_LAYERS, Score
 from spectrinsic.results import write_csv, write_json
 
 __all__ = [
-    "LMSE_COLUMNS",
-    "COLOUR_COLUMNS",
-    "TABLE_3_2_COLUMNS",
-    "condition_table",
-    "table_3_2",
-    "scenario_table",
     "method_parameters",
-    "summary_table",
     "write_report",
 ]
 
-_GROUP_ORDER = ("WL", "1L", "2L")
-_KINDS = {"object": "single objects", "complex": "complex scenes"}
 _PHOTOMETRIC = tuple(SCENARIOS)
-#: ``(column prefix, layer, metric, header)`` of the LMSE table (thesis Tables 5.3/5.4).
-LMSE_COLUMNS: tuple[tuple[str, str, str, str], ...] = (
-    ("reflectance", "reflectance", "lmse", "refl."),
-    ("shading_grey", "shading_grey", "lmse", "grey shad."),
-    ("shading", "shading", "lmse", "col. shad."),
-)
-#: The coloured-shading metrics: shading chromaticity (degrees) and the MAW-style split.
-COLOUR_COLUMNS: tuple[tuple[str, str, str, str], ...] = (
-    ("shading_chromaticity", "shading", "shading_chromaticity", "shad. chroma (°)"),
-    ("reflectance_intensity", "reflectance", "intensity_error", "refl. intensity"),
-    ("reflectance_chromaticity", "reflectance", "chromaticity_error", "refl. chroma (°)"),
-)
-
-
-def _mean(values: list[float]) -> float:
-    finite = [v for v in values if np.isfinite(v)]
-    return float(np.mean(finite)) if finite else float("nan")
-
-
-def _method_order(name: str) -> tuple[int, str]:
-    """Bundled methods in registry order, then the others (plugins, predictions) by name."""
-    order = list(DECOMPOSERS)
-    return (order.index(name) if name in order else len(order), name)
-
-
-def condition_table(
-    scores: Iterable[Score],
-    samples: Mapping[str, tuple[str, str]],
-    *,
-    columns: Sequence[tuple[str, str, str, str]] = LMSE_COLUMNS,
-) -> list[dict[str, Any]]:
-    """Rows like Tables 5.3/5.4: per scene kind and method, the mean of each column's
-    ``(layer, metric)`` over the samples of each lighting group WL/1L/2L (sRGB input).
-
-    ``samples`` maps sample ids to ``(kind, condition)``; column keys are ``<prefix>_<group>``.
-    """
-    wanted = {(layer, metric) for _, layer, metric, _ in columns}
-    groups: dict[tuple[str, str, str, str, str], list[float]] = defaultdict(list)
-    for s in scores:
-        if s.scenario == "srgb" and (s.layer, s.metric) in wanted:
-            kind, cond = samples[s.sample]
-            groups[(kind, s.method, s.layer, s.metric, CONDITION_GROUPS[cond])].append(s.value)
-    rows = []
-    for kind in _KINDS:
-        for method in sorted({k[1] for k in groups if k[0] == kind}, key=_method_order):
-            row: dict[str, Any] = {"scene_kind": kind, "method": method}
-            for prefix, layer, metric, _ in columns:
-                for g in _GROUP_ORDER:
-                    row[f"{prefix}_{g}"] = _mean(groups.get((kind, method, layer, metric, g), []))
-            rows.append(row)
-    return rows
-
-
-def scenario_table(scores: Iterable[Score], *, metric: str = "lmse") -> list[dict[str, Any]]:
-    """Rows like Table 5.1: mean reflectance *metric* per method, camera and SC1/SC3b/SC4."""
-    groups: dict[tuple[str, str, str], list[float]] = defaultdict(list)
-    for s in scores:
-        if s.camera and s.layer == "reflectance" and s.metric == metric:
-            groups[(s.camera, s.method, s.photometric)].append(s.value)
-    rows = []
-    for camera in sorted({k[0] for k in groups}):
-        for method in sorted({k[1] for k in groups if k[0] == camera}, key=_method_order):
-            row: dict[str, Any] = {"camera": camera, "method": method}
-            for sc in _PHOTOMETRIC:
-                row[sc] = _mean(groups.get((camera, method, sc), []))
-            rows.append(row)
-    return rows
-
-
-#: Thesis Table 3.2's columns: (key, metric, header); each the mean over samples of
-#: ``(shading_grey + reflectance_grey) / 2``.
-TABLE_3_2_COLUMNS: tuple[tuple[str, str, str], ...] = (
-    ("corr", "corr", "Corr."),
-    ("mse", "si_mse", "MSE"),
-    ("lmse", "lmse", "LMSE"),
-    ("almse", "almse", "aLMSE"),
-)
-
-
-def table_3_2(
-    scores: Iterable[Score], samples: Mapping[str, tuple[str, str]], *, kind: str = "object"
-) -> list[dict[str, Any]]:
-    """Rows like thesis Table 3.2 on the samples of *kind*: per method and lighting group (and
-    ``"all"``), the mean over samples of ``(shading_grey + reflectance_grey) / 2`` of each
-    metric, grey layers as the thesis (sec. 3.5)."""
-    per: dict[tuple[str, str, str], dict[str, list[float]]] = defaultdict(lambda: defaultdict(list))
-    for s in scores:
-        if s.scenario == "srgb" and s.layer in ("shading_grey", "reflectance_grey"):
-            k, cond = samples[s.sample]
-            if k == kind:
-                per[(s.method, s.metric, s.sample)][s.layer].append(s.value)
-    groups: dict[tuple[str, str, str], list[float]] = defaultdict(list)
-    for (method, metric, sid), layers in per.items():
-        if len(layers) == 2:
-            value = 0.5 * (layers["shading_grey"][0] + layers["reflectance_grey"][0])
-            for g in (CONDITION_GROUPS[samples[sid][1]], "all"):
-                groups[(method, metric, g)].append(value)
-    rows = []
-    for method in sorted({k[0] for k in groups}, key=_method_order):
-        for g in (*_GROUP_ORDER, "all"):
-            row: dict[str, Any] = {"method": method, "lighting": g}
-            for key, metric, _ in TABLE_3_2_COLUMNS:
-                row[key] = _mean(groups.get((method, metric, g), []))
-            rows.append(row)
-    return rows
 
 
 def method_parameters(methods: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
@@ -183,7 +78,7 @@ def _condition_files(
     columns: Sequence[tuple[str, str, str, str]],
     note: str = "",
 ) -> dict[str, Path]:
-    keys = [f"{prefix}_{g}" for prefix, *_ in columns for g in _GROUP_ORDER]
+    keys = [f"{prefix}_{g}" for prefix, *_ in columns for g in GROUP_ORDER]
     _write_csv(out / f"{stem}.csv", rows, ["scene_kind", "method", *keys])
     layers = sorted({layer for _, layer, _, _ in columns})
     md = [*_titled(title, note), "Mean over samples; sRGB input. Layers scored:", ""]
@@ -193,8 +88,8 @@ def _condition_files(
         for _, layer, metric, header in columns
     ]
     md.append("")
-    headers = ["method"] + [f"{h} {g}" for *_, h in columns for g in _GROUP_ORDER]
-    for kind, name in _KINDS.items():
+    headers = ["method"] + [f"{h} {g}" for *_, h in columns for g in GROUP_ORDER]
+    for kind, name in SCENE_KINDS.items():
         sel = [r for r in rows if r["scene_kind"] == kind]
         if sel:
             md += [f"## {name.capitalize()}", "", _markdown(sel, ["method", *keys], headers), ""]
@@ -202,28 +97,11 @@ def _condition_files(
     return {f"{stem}_csv": out / f"{stem}.csv", f"{stem}_md": out / f"{stem}.md"}
 
 
-def summary_table(
-    scores: Iterable[Score], samples: Mapping[str, tuple[str, str]]
-) -> list[dict[str, Any]]:
-    """Rows of the report's first table and summary figure: per method, the mean reflectance
-    LMSE (sRGB input) over the samples of each lighting condition present, and over all."""
-    per: dict[tuple[str, str], list[float]] = defaultdict(list)
-    for s in scores:
-        if s.scenario == "srgb" and s.layer == "reflectance" and s.metric == "lmse":
-            per[(s.method, samples[s.sample][1])].append(s.value)
-            per[(s.method, "all")].append(s.value)
-    conditions = [c for c in CONDITION_GROUPS if any(k[1] == c for k in per)]
-    return [
-        {"method": m, **{c: _mean(per.get((m, c), [])) for c in (*conditions, "all")}}
-        for m in sorted({k[0] for k in per}, key=_method_order)
-    ]
-
-
 def _group_columns(columns: Sequence[tuple[str, str, str, str]]) -> list[Column]:
     return [
         Column(f"{prefix}_{g}", f"{header} {g}", METRICS[metric].better)
         for prefix, _, metric, header in columns
-        for g in _GROUP_ORDER
+        for g in GROUP_ORDER
     ]
 
 
@@ -242,13 +120,13 @@ def _t32_columns(keys: Sequence[str]) -> list[Column]:
         Column(f"{key}_{g}", f"{label.get(key, header)} {g}", METRICS[metric].better)
         for key, metric, header in TABLE_3_2_COLUMNS
         if key in keys
-        for g in (*_GROUP_ORDER, "all")
+        for g in (*GROUP_ORDER, "all")
     ]
 
 
 def _kind_tables(label: str, rows: Sequence[Mapping[str, Any]], columns: list[Column]) -> list[str]:
     md = []
-    for kind, name in _KINDS.items():
+    for kind, name in SCENE_KINDS.items():
         sel = [r for r in rows if r["scene_kind"] == kind]
         if sel:
             md += [f"### {label}: {name}", "", markdown_table(sel, columns), ""]

@@ -200,7 +200,7 @@ _GENERATOR_KINDS = {"objects-on-ground": "object", "rooms": "complex"}
 def scene_kind(meta: SampleMeta) -> str:
     """``"object"`` or ``"complex"``: the scene's ``kind`` metadata, else its generator's, else
     by name (library object scenes start with ``obj-``, as :func:`spectrinsic.decompose.
-    evaluate.sample_kind` reads them); never empty, so the gallery's kind filter sees every
+    sample_fields.sample_kind` reads them); never empty, so the gallery's kind filter sees every
     sample."""
     smeta = meta.scene_metadata
     kind = smeta.get("kind") or _GENERATOR_KINDS.get(str(smeta.get("generator")))

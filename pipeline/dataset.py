@@ -14,7 +14,6 @@ order and the executor, so the same config and seed give the same pixels.
 
 from __future__ import annotations
 
-import fnmatch
 import glob
 import logging
 import os
@@ -46,11 +45,12 @@ from spectrinsic.gt_export.outfolder import folder_lock
 from spectrinsic.gt_export.relight_pool import RELIT_TAG, relit_problem, write_relit_variants
 from spectrinsic.pipeline.executors import Executor, SerialExecutor
 from spectrinsic.pipeline.presets import DatasetConfig
-from spectrinsic.pipeline.source_plan import plan_source_samples, save_generated
+from spectrinsic.pipeline.sample_plan import plan_samples
+from spectrinsic.pipeline.source_plan import save_generated
 from spectrinsic.pipeline.tasks import SampleFailure, SampleOutcome, SampleTask
 from spectrinsic.render import render_batches, set_thread_count
 from spectrinsic.render.transport import render_transport_batches
-from spectrinsic.scenes.library import build, default_samples, glossy_samples
+from spectrinsic.scenes.library import build
 from spectrinsic.scenes.sources import GeneratedSource
 
 __all__ = [
@@ -58,8 +58,6 @@ __all__ = [
     "SampleOutcome",
     "SampleFailure",
     "DatasetReport",
-    "plan_samples",
-    "select_samples",
     "build_sample",
     "build_dataset",
     "finalize_dataset",
@@ -113,75 +111,6 @@ class DatasetReport:
             "fraction_outside_mitsuba": (total - mitsuba) / total if total > 0 else 0.0,
             "peak_rss_mb": max(o.peak_rss_mb for o in self.built),
         }
-
-
-def plan_samples(
-    out_dir: str | os.PathLike[str],
-    config: DatasetConfig,
-    *,
-    only: Sequence[str] | str | None = None,
-    data_dir: str | os.PathLike[str] | None = None,
-    render_threads: int | None = None,
-) -> list[SampleTask]:
-    """The tasks of the default sample layout (68 samples), optionally filtered by *only*.
-
-    Parameters
-    ----------
-    only
-        Glob pattern(s) on the sample id (``"obj-*"``, ``"*__white"``); a string may hold
-        several separated by commas. ``None`` keeps every sample. A pattern holding
-        ``glossy`` also selects among the glossy variants (``room-living-glossy__v0__white``).
-
-    Raises
-    ------
-    DatasetError
-        If *only* matches no sample.
-    """
-    out = str(Path(out_dir))
-    if config.source is not None:
-        tasks = plan_source_samples(
-            out,
-            config,
-            render_threads=render_threads,
-            data_dir=None if data_dir is None else str(data_dir),
-        )
-        return select_samples(tasks, only)
-    tasks = [
-        SampleTask.planned(
-            sid,
-            config,
-            out,
-            render_threads=render_threads,
-            data_dir=None if data_dir is None else str(data_dir),
-        )
-        for sid in default_samples() + (glossy_samples() if _asks_glossy(only) else [])
-    ]
-    return select_samples(tasks, only)
-
-
-def _asks_glossy(only: Sequence[str] | str | None) -> bool:
-    """Whether an *only* pattern names the library's glossy variants (``*-glossy*``), which the
-    default layout leaves out."""
-    patterns = only.split(",") if isinstance(only, str) else list(only or ())
-    return any("glossy" in p for p in patterns)
-
-
-def select_samples(
-    specs: Sequence[SampleTask], only: Sequence[str] | str | None
-) -> list[SampleTask]:
-    """Keep the tasks whose ``sample_id`` matches one of the glob patterns *only*."""
-    if only is None:
-        return list(specs)
-    patterns = [p.strip() for p in only.split(",")] if isinstance(only, str) else list(only)
-    patterns = [p for p in patterns if p]
-    kept = [s for s in specs if any(fnmatch.fnmatchcase(s.sample_id, p) for p in patterns)]
-    if not kept:
-        raise DatasetError(
-            f"--only {','.join(patterns)!r} matches no sample; ids look like {specs[0].sample_id!r}"
-            if specs
-            else "no samples to select from"
-        )
-    return kept
 
 
 def build_sample(task: SampleTask) -> SampleOutcome:

@@ -125,8 +125,8 @@ class DatasetConfig:
     source
         Where the scenes come from, as canonical JSON: ``None`` for the library layout,
         ``{"generator": ..., "count": ..., ...}`` or ``{"scenes": [...], ...}`` (see
-        :func:`spectrinsic.pipeline.dataset.plan_samples`). Left out of the settings when ``None``, so
-        library configs keep their hash.
+        :func:`spectrinsic.pipeline.sample_plan.plan_samples`). Left out of the settings when
+        ``None``, so library configs keep their hash.
     store_transport
         Render the diagonal modes light by light with a flat unit spectrum and store that
         per-light transport in each sample (``transport.exr``), so the sample can be relit

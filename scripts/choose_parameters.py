@@ -18,10 +18,10 @@ from pathlib import Path
 import numpy as np
 
 from spectrinsic.decompose.constancy import with_constancy
-from spectrinsic.decompose.evaluate import evaluation_mask, input_image
 from spectrinsic.decompose.names_shades import NamesAndShades
 from spectrinsic.decompose.protocol import hold_one_out, scene_group, score_grid
 from spectrinsic.decompose.retinex import ColourRetinex
+from spectrinsic.decompose.sample_fields import evaluation_mask, input_image
 from spectrinsic.gt_export.loader import load_sample
 from spectrinsic.gt_export.sample import sample_dirs
 

@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import SceneError
+from spectrinsic.scenes.geometry import camera_rays, is_closed, winding_numbers
 from spectrinsic.scenes.model import Camera, Mesh
-from spectrinsic.scenes.validate import camera_rays, is_closed, winding_numbers
 
 __all__ = ["Footprints", "first_hits", "coverage", "is_free", "sample_camera"]
 

@@ -115,7 +115,7 @@ def test_cli_without_dataset_says_how_to_build_it(tmp_path, capsys):
 
 
 def test_single_objects_are_scored_on_their_own_mask_not_the_ground():
-    from spectrinsic.decompose.evaluate import evaluation_mask
+    from spectrinsic.decompose.sample_fields import evaluation_mask
 
     sample = _sample("obj-a__v0__white", 0, (1, 1, 1), False)
     objects = np.zeros((48, 48), np.int32)
@@ -131,7 +131,7 @@ def test_single_objects_are_scored_on_their_own_mask_not_the_ground():
 
 def test_table_3_2_averages_grey_shading_and_grey_reflectance():
     from spectrinsic.decompose.evaluate import Score
-    from spectrinsic.decompose.report import table_3_2
+    from spectrinsic.decompose.report_tables import table_3_2
 
     samples = {
         "obj-a__v0__white": ("object", "white"),

@@ -9,9 +9,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from spectrinsic.decompose.evaluate import evaluate, input_image
+from spectrinsic.decompose.evaluate import evaluate
 from spectrinsic.decompose.metrics import get_metric
 from spectrinsic.decompose.predictions import Predictions, write_predictions
+from spectrinsic.decompose.sample_fields import input_image
 from spectrinsic.decompose.targets import target_image, target_note
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import export_sample, load_sample, write_manifest

@@ -7,9 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from spectrinsic.decompose.evaluate import evaluate, input_image
+from spectrinsic.decompose.evaluate import evaluate
 from spectrinsic.decompose.predictions import Predictions, read_layer
 from spectrinsic.decompose.registry import get_decomposer
+from spectrinsic.decompose.sample_fields import input_image
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.exr import write_exr
 from spectrinsic.gt_export.png import PNG16_MAX, write_png16

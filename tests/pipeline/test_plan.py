@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from spectrinsic.errors import SpectrinsicError
-from spectrinsic.pipeline.dataset import plan_samples
 from spectrinsic.pipeline.presets import get_preset
+from spectrinsic.pipeline.sample_plan import plan_samples
 from spectrinsic.rng import seed_from_key
 
 #: 8 objects x 4 conditions + 3 complex scenes x 3 views x 4 conditions (thesis section 5.2.4).

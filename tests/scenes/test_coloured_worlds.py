@@ -145,7 +145,7 @@ def test_room_views_frame_furniture_and_objects():
     """>= 90 % of room views have >= 30 % of their rays (24 x 24, as pixels) on furniture and
     objects, measured independently of the generator's coarser check."""
     from spectrinsic.scenes.generators.camera import first_hits
-    from spectrinsic.scenes.validate import camera_rays
+    from spectrinsic.scenes.geometry import camera_rays
 
     options = GeneratorOptions(width=32, height=24)
     fractions = []

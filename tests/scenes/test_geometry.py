@@ -9,6 +9,7 @@ import pytest
 
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes.furniture import chair, room, shelf, table
+from spectrinsic.scenes.geometry import is_closed
 from spectrinsic.scenes.objects import OBJECTS
 from spectrinsic.scenes.painting import bands, patches, printed, stripes
 from spectrinsic.scenes.parts import Part, moved, to_meshes
@@ -22,7 +23,6 @@ from spectrinsic.scenes.primitives import (
     sphere,
     torus,
 )
-from spectrinsic.scenes.validate import is_closed
 
 #: Volumes of exact polyhedra (boxes, prisms) agree to rounding only.
 EXACT = 1e-12
@@ -147,7 +147,7 @@ def test_room_walls_enclose_free_air():
         (4, 3, 2.5),
         dict.fromkeys(("floor", "ceiling", "left", "right", "back", "front"), "flat:0.5"),
     )
-    from spectrinsic.scenes.validate import winding_numbers
+    from spectrinsic.scenes.geometry import winding_numbers
 
     inside_air = np.array([[2.0, 1.5, 1.2], [0.05, 0.05, 0.05]])
     for part in shell.values():
