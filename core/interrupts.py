@@ -58,10 +58,14 @@ def interrupts_reach_python() -> Iterator[None]:
 
     Call it in the main thread before any thread is started, so that all of them inherit the
     block (threads started earlier could still receive SIGINT and run a library's handler).
+
+    A process started with SIGINT ignored (``nohup``, a background job of a shell script) was
+    asked by its parent to ignore Ctrl-C: the block then changes nothing, so it stays ignored.
     """
     if (
         not hasattr(signal, "pthread_sigmask")
         or threading.current_thread() is not threading.main_thread()
+        or signal.getsignal(signal.SIGINT) is signal.SIG_IGN
     ):
         yield
         return

@@ -12,8 +12,12 @@ import textwrap
 
 import pytest
 
+#: Every check starts from Python's own Ctrl-C handler: a test process may have been started
+#: with SIGINT ignored (a background job of a script), which its children inherit and which the
+#: block then keeps (see :func:`test_an_inherited_ignored_sigint_stays_ignored`).
 PRELUDE = """
 import os, signal, time
+signal.signal(signal.SIGINT, signal.default_int_handler)
 from spectrinsic.interrupts import interrupts_reach_python, raise_if_requested, requested
 def wait_for(predicate):
     deadline = time.monotonic() + 20
@@ -112,3 +116,16 @@ def test_threads_started_inside_the_block_inherit_the_block(where):
         print(masks[0])
     """)
     assert out == ("True" if where == "inside" else "False")
+
+
+def test_an_inherited_ignored_sigint_stays_ignored():
+    """A process whose parent set SIGINT to ignored (``nohup``, ``cmd &`` in a script) keeps
+    ignoring it inside the block: no record, no interrupt, the disposition untouched."""
+    out = _run("""
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        with interrupts_reach_python():
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.3)
+            print(requested(), signal.getsignal(signal.SIGINT) is signal.SIG_IGN)
+    """)
+    assert out == "False True"

@@ -214,11 +214,21 @@ def test_when_every_sample_fails_failed_lines_and_no_manifest(tmp_path, monkeypa
 
 def _workers(pid: int) -> list[int]:
     """Pool workers (spawned children running ``spawn_main``) of process *pid*."""
-    try:
-        children = Path(f"/proc/{pid}/task/{pid}/children").read_text().split()
-    except OSError:
-        return []
-    return [int(c) for c in children if b"spawn_main" in Path(f"/proc/{c}/cmdline").read_bytes()]
+    # every thread's children: a pool may start its workers from a thread other than the main
+    children = []
+    for task in Path(f"/proc/{pid}/task").glob("*"):
+        try:
+            children += (task / "children").read_text().split()
+        except OSError:
+            continue
+    workers = []
+    for child in children:
+        try:
+            if b"spawn_main" in Path(f"/proc/{child}/cmdline").read_bytes():
+                workers.append(int(child))
+        except OSError:  # exited meanwhile
+            continue
+    return workers
 
 
 @pytest.mark.slow

@@ -187,7 +187,14 @@ def _cli(out: Path, *extra: str, new_session: bool = False) -> subprocess.Popen[
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=new_session,
+        # Ctrl-C as a terminal delivers it: the child takes SIGINT even if this test process
+        # was started with it ignored (a background job of a script), which children inherit
+        preexec_fn=_default_sigint,
     )
+
+
+def _default_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def _wait_for(predicate, proc: subprocess.Popen[str], what: str) -> None:
