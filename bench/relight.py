@@ -82,14 +82,13 @@ def _record(
 ) -> dict[str, Any]:
     """The JSON record: render seconds (plain, with transport, direct with the new spectra),
     relight seconds (images, all layers, a folder), bytes (transport, the rest) and exactness."""
-    cfg = get_preset("default")
     plain_s, transport_s, direct_s = render_s
     compose_s, layers_s, folder_s = relight_s
     transport_bytes, rest_bytes = disk
     worst = max(errors, key=errors.__getitem__)
     return {
         "scene": f"{SCENE}__v{VIEW}__{CONDITION}",
-        "size": [cfg.width, cfg.height],
+        "size": [scene.camera.width, scene.camera.height],
         "spp": settings.spp,
         "batches": settings.batches,
         "lights": len(scene.lights),

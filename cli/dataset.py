@@ -12,7 +12,6 @@ from tqdm import tqdm
 from spectrinsic.cli.dataset_source import (
     add_source_options,
     check_scene_files,
-    material_map,
     parse_resolution,
     source_from_args,
     source_notes,
@@ -32,9 +31,6 @@ __all__ = [
     "config_from_args",
     "preflight",
     "build",
-    "material_map",
-    "source_notes",
-    "parse_resolution",
 ]
 
 DEFAULT_OUT = "data/dataset"

@@ -20,6 +20,7 @@ from typing import Any
 from tqdm import tqdm
 
 from spectrinsic.cli import dataset as cli_dataset
+from spectrinsic.cli.dataset_source import material_map, parse_resolution
 from spectrinsic.cli.render_files import write_render
 from spectrinsic.errors import RenderError, SceneError
 from spectrinsic.gt_export.outfolder import check_output_folder, output_folder
@@ -42,7 +43,7 @@ from spectrinsic.scenes.model import Scene
 from spectrinsic.scenes.sample_id import SampleId
 from spectrinsic.scenes.sources import FILE_SIZE, is_scene_file, load_scene_file
 
-__all__ = ["register", "run", "load_scene_argument", "write_render", "requested_size"]
+__all__ = ["register", "run", "load_scene_argument", "requested_size"]
 
 DEFAULT_MODES = ",".join(RENDER_DEFAULT_MODES)
 
@@ -251,7 +252,7 @@ def requested_size(args: argparse.Namespace) -> tuple[int, int] | None:
     if args.resolution is not None:
         if args.width is not None or args.height is not None:
             raise RenderError("--resolution with --width/--height; give one of them")
-        return cli_dataset.parse_resolution(args.resolution)
+        return parse_resolution(args.resolution)
     if args.width is None and args.height is None:
         return None
     return args.width or args.height or FILE_SIZE, args.height or args.width or FILE_SIZE
@@ -272,7 +273,7 @@ def _ground_truth(args: argparse.Namespace) -> int:
     if is_scene_file(args.scene):
         changes["source"] = files_source(
             [args.scene],
-            materials=cli_dataset.material_map(args.material_map),
+            materials=material_map(args.material_map),
             default_spectrum=args.default_spectrum,
             resolution=size,
             new_sample=args.new_sample,
@@ -363,7 +364,7 @@ def _load_scene(args: argparse.Namespace, data_dir: str | None) -> Scene:
         seed=args.seed,
         width=size[0] if size else None,
         height=size[1] if size else None,
-        materials=cli_dataset.material_map(args.material_map),
+        materials=material_map(args.material_map),
         default_spectrum=args.default_spectrum,
         data_dir=data_dir,
     )

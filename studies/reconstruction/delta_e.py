@@ -133,9 +133,12 @@ def _fit(
 
 
 def _project(values: np.ndarray, proj: np.ndarray) -> np.ndarray:
-    """``values @ proj.T`` summed term by term in a fixed order: a BLAS product's last bits
-    depend on its kernel, threads and the operands' memory alignment, and these numbers are
-    written to files (``(N, n) x (3, n) -> (N, 3)``)."""
+    """``values @ proj.T``, ``(N, n) x (3, n) -> (N, 3)``, summed term by term in a fixed order.
+
+    These numbers are written to files. A BLAS product's last bits depend on its kernel, threads
+    and the operands' memory alignment, and so do einsum's vectorised sums here: both gave
+    0.7312853703161359 or ...136 for one ΔE2000 mean across runs of the same code.
+    """
     out = values[:, 0, None] * proj[None, :, 0]
     for k in range(1, proj.shape[1]):
         out = out + values[:, k, None] * proj[None, :, k]
