@@ -120,9 +120,17 @@ def white_radiance(
     to_xyz: np.ndarray,
     *,
     mode: str,
+    metal_white: np.ndarray | None = None,
+    metal_coverage: np.ndarray | None = None,
 ) -> WhiteRadiance:
     """``W = raw / (coverage @ band_albedos)`` per band (Eq. 1), 0 where surfaces cover less than
     :data:`COVERAGE_MIN` of the pixel.
+
+    Metals have no diffuse lobe (albedo 0); their ``W`` is the white-surface radiance the
+    renderer estimated at their hits, ``metal_white = c_metal · W_metal``
+    (:mod:`spectrinsic.render.gloss_kernel`). So a metal counts as a white surface in both the
+    numerator and the denominator: ``W = (raw + metal_white) / (coverage @ band_albedos +
+    c_metal)``, which is ``W_metal`` on a metal-only pixel and Eq. 1 where there is no metal.
 
     Parameters
     ----------
@@ -149,7 +157,12 @@ def white_radiance(
         )
     albedo = np.einsum("hwm,mk->hwk", coverage, band_albedos)
     valid = coverage.sum(axis=-1) >= COVERAGE_MIN
-    bands = np.where(valid[..., None], raw / np.maximum(albedo, ALBEDO_FLOOR), 0.0)
+    if metal_white is None or metal_coverage is None:
+        bands = np.where(valid[..., None], raw / np.maximum(albedo, ALBEDO_FLOOR), 0.0)
+    else:
+        total = raw + np.asarray(metal_white, np.float64)
+        weight = albedo + np.asarray(metal_coverage, np.float64)[..., None]
+        bands = np.where(valid[..., None], total / np.maximum(weight, ALBEDO_FLOOR), 0.0)
     return WhiteRadiance(mode, bands, albedo, valid, np.asarray(to_xyz, np.float64))
 
 

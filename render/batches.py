@@ -177,6 +177,7 @@ def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
         aovs=_merge_aovs([r.aovs for r in results]),
         transport={m: _mean([r.transport[m] for r in results]) for m in first.transport},
         specular={m: _mean([r.specular[m] for r in results]) for m in first.specular},
+        metal_white={m: _mean([r.metal_white[m] for r in results]) for m in first.metal_white},
         meta=meta,
         batch_raw=tuple(dict(r.raw) for r in results),
     )

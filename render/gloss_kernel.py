@@ -22,6 +22,15 @@ first camera-ray vertex went through the non-diffuse lobe: its band throughput s
 ``s_k (1 − a)`` at that vertex and is multiplied by (G1) afterwards. The transport ``T`` and
 the diffuse part ``T − S`` follow; emitters the camera sees directly are in neither S nor the
 diffuse part's first-hit lobe (they are the residual of the layers).
+
+A metal has no diffuse lobe, so its shading ``W = P_diff / ρ`` is 0/0. It is defined instead
+as at every other surface, the radiance a **white Lambertian** surface would reflect there,
+``W_k = E_k / π`` (the white-surface radiance, interreflections included). Scenes with metals
+get a second loop over the same camera rays (after the first, so the first loop's paths are
+unchanged): where the first hit is a metal, that vertex is a white ``diffuse`` BSDF (ρ_k = 1)
+and the path goes on through the true scene with (G1) factors; elsewhere the lane stops at
+once. Its accumulators ``M`` (:func:`metal_white_channels`) average over all of a pixel's
+samples, so ``M = c_metal · W`` with ``c_metal`` the pixel's metal coverage.
 """
 
 from __future__ import annotations
@@ -48,6 +57,7 @@ __all__ = [
     "gloss_path_class",
     "gloss_path",
     "specular_channels",
+    "metal_white_channels",
 ]
 
 #: Name the glossy integrator is registered under.
@@ -57,6 +67,11 @@ GLOSS_INTEGRATOR_NAME = "spectrinsic_bandpath_gloss"
 def specular_channels(n_lights: int, n_bands: int) -> list[str]:
     """AOV names of the specular transport channels, light-major: ``s<l>_<k>``."""
     return [f"s{j:02d}_{k:02d}" for j in range(n_lights) for k in range(n_bands)]
+
+
+def metal_white_channels(n_lights: int, n_bands: int) -> list[str]:
+    """AOV names of the white-at-metal channels (module docstring), light-major: ``m<l>_<k>``."""
+    return [f"m{j:02d}_{k:02d}" for j in range(n_lights) for k in range(n_bands)]
 
 
 class GlossKernel(_Kernel):
@@ -196,8 +211,78 @@ class GlossKernel(_Kernel):
             sacc,
         )
 
+    def white_body(
+        self,
+        sampler: Any,
+        ray: Any,
+        depth: Any,
+        beta: Any,
+        bands: list,
+        acc: list,
+        prev_si: Any,
+        prev_pdf: Any,
+        prev_delta: Any,
+        alive: Any,
+    ) -> tuple:
+        """One vertex of the white-at-metal loop: the camera ray's metal hit is a white
+        Lambertian (ρ_k = 1, ``a`` = 1), later vertices are the true scene's (G1)."""
+        mi, dr = self.mi, self.dr
+        si = self.scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=depth == 0)
+        now, valid, row = depth == 0, si.is_valid(), self.row(si)
+        swap = now & (dr.gather(mi.UInt32, self.it.metal_rows, row, valid) != 0)
+        light, weight, hit = self.emitter_hit(si, prev_si, prev_pdf, prev_delta)
+        # what the camera sees directly is not reflected by the white surface
+        acc = self.deposit(acc, light, beta * weight, bands, hit & ~now)
+        active_next = (depth + 1 < self.it.max_depth) & valid & (~now | swap)
+        bsdf = dr.select(swap, mi.BSDFPtr(self.it.white_bsdf), si.bsdf(ray))
+        light, nee, active_em, bsdf_sample, bsdf_weight, em_lobes, bs_lobes = self.vertex_gloss(
+            sampler, si, bsdf, active_next
+        )
+        rho = [dr.select(swap, 1.0, r) for r in self.albedo(si)]
+        c_em = self.factors(rho, row, em_lobes[0], em_lobes[1], valid)[0]
+        c_bs = self.factors(rho, row, bs_lobes[0], bs_lobes[1], valid)[0]
+        acc = self.deposit(
+            acc, light, beta * nee, [b * c for b, c in zip(bands, c_em, strict=True)], active_em
+        )
+        bands = [b * c for b, c in zip(bands, c_bs, strict=True)]
+        depth = dr.select(valid, depth + 1, depth)
+        beta, go_on = self.roulette(sampler, depth, beta * bsdf_weight, bands)
+        return (
+            sampler,
+            si.spawn_ray(si.to_world(bsdf_sample.wo)),
+            depth,
+            beta,
+            bands,
+            acc,
+            mi.Interaction3f(si),
+            bsdf_sample.pdf,
+            mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta),
+            active_next & go_on,
+        )
+
+    def run_white(self, sampler: Any, ray: Any, active: Any) -> list:
+        """The K·L white-at-metal accumulators ``M`` of the camera rays *ray*."""
+        mi, dr, k = self.mi, self.dr, self.it.n_bands
+        state = (
+            sampler,
+            mi.Ray3f(ray),
+            mi.UInt32(0),
+            mi.Float(1.0),
+            [mi.Float(1.0) for _ in range(k)],
+            [mi.Float(0.0) for _ in range(k * self.it.n_lights)],
+            dr.zeros(mi.Interaction3f),
+            mi.Float(1.0),
+            mi.Bool(True),
+            mi.Bool(active),
+        )
+        state = dr.while_loop(
+            state, lambda *s: s[-1], self.white_body, label="spectrinsic white at metals"
+        )
+        return list(state[5])
+
     def run(self, sampler: Any, ray: Any, active: Any) -> list:
-        """The K·L transport accumulators, the K·L specular ones, then the first-hit maps."""
+        """The K·L transport accumulators, the K·L specular ones, the K·L white-at-metal ones
+        (scenes with metals), then the first-hit maps."""
         mi, dr, k = self.mi, self.dr, self.it.n_bands
         first = (mi.UInt32(self.it.n_surfaces), mi.Float(0.0), mi.Vector3f(0.0))
         zeros = [mi.Float(0.0) for _ in range(k * self.it.n_lights)]
@@ -220,6 +305,8 @@ class GlossKernel(_Kernel):
             state, lambda *s: s[10], self.gloss_body, label="spectrinsic band path (glossy)"
         )
         out = list(state[5]) + list(state[12])
+        if self.it.metals:
+            out += self.run_white(sampler, ray, active)
         if self.it.n_surfaces:
             surface, distance, normal = state[9]
             out += [dr.select(surface == i, 1.0, 0.0) for i in range(self.it.n_surfaces)]
@@ -244,6 +331,16 @@ def gloss_path_class(variant: str) -> type:
             super().__init__(props)
             self.n_nodes = int(props.get("n_nodes", FRESNEL_NODES))
             self.specular = mi.Float(np.ones(self.n_nodes * self.n_bands, np.float32))
+            self.metals = bool(props.get("metals", False))
+            self.metal_rows = mi.UInt32(np.zeros(1, np.uint32))
+            # two-sided as every material of the scene; Mitsuba's diffuse defaults to 0.5
+            self.white_bsdf = mi.load_dict(
+                {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": 1.0}}
+            )
+
+        def set_metals(self, rows: np.ndarray) -> None:
+            """``(R,)`` bool: which albedo-table rows are metals (no diffuse lobe)."""
+            self.metal_rows = mi.UInt32(np.asarray(rows, bool).astype(np.uint32))
 
         def set_specular(self, table: np.ndarray) -> None:
             """``(R, n_nodes, K)`` band factors ``s_k(μ_j)`` per albedo-table row."""
@@ -258,6 +355,7 @@ def gloss_path_class(variant: str) -> type:
             return (
                 transport_channels(self.n_lights, self.n_bands)
                 + specular_channels(self.n_lights, self.n_bands)
+                + (metal_white_channels(self.n_lights, self.n_bands) if self.metals else [])
                 + first_hit_channels(self.n_surfaces)
             )
 
@@ -274,9 +372,18 @@ def gloss_path_class(variant: str) -> type:
     return GlossPath
 
 
-def gloss_path(mi: Any, *, max_depth: int, n_bands: int, n_lights: int, n_surfaces: int = 0) -> Any:
+def gloss_path(
+    mi: Any,
+    *,
+    max_depth: int,
+    n_bands: int,
+    n_lights: int,
+    n_surfaces: int = 0,
+    metals: bool = False,
+) -> Any:
     """A glossy band-path integrator for the active variant (rr off), as
-    :func:`~spectrinsic.render.integrator.band_path`."""
+    :func:`~spectrinsic.render.integrator.band_path`; with *metals* it also estimates the
+    white-surface radiance at metal first hits (module docstring)."""
     gloss_path_class(mi.variant())
     return mi.load_dict(
         {
@@ -286,5 +393,6 @@ def gloss_path(mi: Any, *, max_depth: int, n_bands: int, n_lights: int, n_surfac
             "n_bands": int(n_bands),
             "n_lights": int(n_lights),
             "n_surfaces": int(n_surfaces),
+            "metals": bool(metals),
         }
     )

@@ -49,7 +49,7 @@ class RenderResult:
         their spread measures the Monte Carlo noise.
     transport
         With the single-traversal integrator, mode -> ``(L, H, W, K)`` float32 per-light band
-        transport for unit emission (:class:`spectrinsic.render.single.TransportOutput`):
+        transport for unit emission (:class:`spectrinsic.render.traversal_output.TransportOutput`):
         ``raw[mode][..., k] = Σ_l E_{l,k} transport[mode][l, ..., k]``, with E the lights'
         channel values (:func:`spectrinsic.render.modes.channel_values`). Empty otherwise.
     specular
@@ -58,6 +58,11 @@ class RenderResult:
         lobes (coat reflection, metal), with everything those lobes reflect
         (:mod:`spectrinsic.render.gloss_kernel`); a part of ``raw[mode]``. Empty for matte
         scenes, where it is 0.
+    metal_white
+        Scenes with metals, single traversal: mode -> ``(H, W, K)`` float32 raw channels of the
+        radiance a white Lambertian surface would reflect at the first hits on metals, times
+        their coverage (not part of ``raw``), so the shading stays defined where the diffuse
+        albedo is 0 (:mod:`spectrinsic.render.gloss_kernel`). Empty otherwise.
     """
 
     images: dict[str, np.ndarray]
@@ -69,6 +74,7 @@ class RenderResult:
     batch_raw: tuple[dict[str, np.ndarray], ...] = ()
     transport: dict[str, np.ndarray] = field(default_factory=dict)
     specular: dict[str, np.ndarray] = field(default_factory=dict)
+    metal_white: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def shape(self) -> tuple[int, int]:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -29,6 +29,7 @@ from spectrinsic.render.result import RenderResult, render_meta
 from spectrinsic.render.settings import DEFAULT_MODES, RenderSettings
 from spectrinsic.render.single import SingleTraversal, render_jobs, resolve_integrator
 from spectrinsic.render.translate import prepare_geometry, surfaces
+from spectrinsic.render.traversal_output import TransportOutput
 from spectrinsic.render.variants import choose_variant, import_mitsuba, variant_scope
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import get_sensors
@@ -401,7 +402,7 @@ def _assemble(
     """The XYZ images of the jobs' raw outputs: totals, per-light shares and direct light."""
     main_out, share_out = outputs[: plan.n_main], outputs[plan.n_main :]
     names = [m.name for m in plan.objs]
-    matrices = plan.matrices
+    matrices, groups = plan.matrices, [job.group for job in plan.jobs[: plan.n_main]]
     raw = {
         n: np.sum([g[n].image for g in main_out], axis=0, dtype=np.float64).astype(np.float32)
         for n in names
@@ -428,18 +429,22 @@ def _assemble(
         aovs=aov_maps,
         meta=meta,
         transport={n: t.transport for n, t in single.transport.items()},
-        specular=_specular_raw(single, [job.group for job in plan.jobs[: plan.n_main]]),
+        specular=_part_raw(single, groups, TransportOutput.specular_image),
+        metal_white=_part_raw(single, groups, TransportOutput.metal_white_image),
     )
 
 
-def _specular_raw(
-    single: SingleTraversal, groups: Sequence[Sequence[int] | None]
+def _part_raw(
+    single: SingleTraversal,
+    groups: Sequence[Sequence[int] | None],
+    part: Callable[[TransportOutput, Sequence[int] | None], np.ndarray | None],
 ) -> dict[str, np.ndarray]:
-    """Mode -> raw specular channels (glossy scenes), summed over the light *groups* of the
-    main jobs exactly as ``raw`` is, so ``raw − specular`` is exactly 0 where all is specular."""
+    """Mode -> raw channels of a *part* of the traversal (specular or white-at-metal image),
+    summed over the main jobs' light *groups* as ``raw`` is (``raw − specular`` is exactly 0
+    where all is specular); modes without the part are left out."""
     out = {}
     for name, t in single.transport.items():
-        if t.specular is not None:
-            parts = [p for g in groups if (p := t.specular_image(g)) is not None]
+        parts = [p for g in groups if (p := part(t, g)) is not None]
+        if parts:
             out[name] = np.sum(parts, axis=0, dtype=np.float64).astype(np.float32)
     return out

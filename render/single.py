@@ -36,12 +36,12 @@ from spectrinsic.render.passes import (
 )
 from spectrinsic.render.plugins import hdr_film, path_integrator, rgb_spectrum
 from spectrinsic.render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
+from spectrinsic.render.traversal_output import TransportOutput
 from spectrinsic.render.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import get_sensors
 
 __all__ = [
-    "TransportOutput",
     "SingleTraversal",
     "render_traversal",
     "render_jobs",
@@ -49,57 +49,6 @@ __all__ = [
     "single_traversal_runs",
     "resolve_integrator",
 ]
-
-
-@dataclass(frozen=True, eq=False)
-class TransportOutput:
-    """Per-light band transport of one value set from one traversal.
-
-    Attributes
-    ----------
-    transport
-        ``(L, H, W, K)`` float32: light l's contribution to channel k for unit emission in
-        every band (``∫ radiance S_k`` per unit ``E_{l,k}``); the diagonal image is
-        ``Σ_l E_{l,k} · transport[l, ..., k]``.
-    direct
-        The same for direct light only (path depth 2), or ``None`` when not asked for.
-    emission
-        ``(L, K)`` float64 the lights' channel values ``E_{l,k}`` (:class:`ChannelValues`).
-    specular
-        ``(L, H, W, K)`` float32 the part of :attr:`transport` whose first camera-ray vertex
-        went through a non-diffuse lobe (:mod:`spectrinsic.render.gloss_kernel`), for scenes
-        with glossy materials; ``None`` for matte scenes (where it is 0).
-    """
-
-    transport: np.ndarray
-    direct: np.ndarray | None
-    emission: np.ndarray
-    specular: np.ndarray | None = None
-
-    def specular_image(self, lights: Sequence[int] | None = None) -> np.ndarray | None:
-        """``(H, W, K)`` float32 specular image of the *lights* (default all), summed as
-        :meth:`image` sums the transport (so both agree bit for bit where all light is
-        specular), or ``None`` for a matte scene."""
-        if self.specular is None:
-            return None
-        parts = (self.specular.astype(np.float64) * self.emission[:, None, None, :]).astype(
-            np.float32
-        )
-        chosen = range(parts.shape[0]) if lights is None else [int(j) for j in lights]
-        return np.sum(parts[list(chosen)], axis=0, dtype=np.float64).astype(np.float32)
-
-    def per_light(self, *, direct: bool = False) -> np.ndarray:
-        """``(L, H, W, K)`` float32 each light's image: ``E_{l,k} · transport``."""
-        t = self.direct if direct else self.transport
-        if t is None:
-            raise RenderError("no direct-only transport was rendered")
-        return (t.astype(np.float64) * self.emission[:, None, None, :]).astype(np.float32)
-
-    def image(self, lights: Sequence[int] | None = None, *, direct: bool = False) -> np.ndarray:
-        """``(H, W, K)`` float32 image of the *lights* (default all): the sum of their shares."""
-        parts = self.per_light(direct=direct)
-        chosen = range(parts.shape[0]) if lights is None else [int(j) for j in lights]
-        return np.sum(parts[list(chosen)], axis=0, dtype=np.float64).astype(np.float32)
 
 
 def single_traversal_runs(variant: str | None) -> bool:
@@ -184,24 +133,33 @@ def _render(
 
 @dataclass(frozen=True)
 class _Dims:
-    """Image height and width, bands K, lights L, and whether the scene has glossy materials."""
+    """Image height and width, bands K, lights L, and whether the scene has glossy materials
+    and metals."""
 
     h: int
     w: int
     n_bands: int
     n_lights: int
     glossy: bool
+    #: Per albedo-table row (materials, then the black row): whether it is a metal.
+    metal_rows: tuple[bool, ...] = ()
+
+    @property
+    def metals(self) -> bool:
+        return any(self.metal_rows)
 
 
 @dataclass(frozen=True, eq=False)
 class _Traced:
     """One traversal: transport ``(L, H, W, K)``, the first hit's non-diffuse part (glossy
-    scenes, same shape), the first-hit maps (first traversal with surfaces) and its seconds."""
+    scenes, same shape), the white-at-metal radiance (first traversal with metals, same
+    shape), the first-hit maps (first traversal with surfaces) and its seconds."""
 
     transport: np.ndarray
     specular: np.ndarray | None
     first: np.ndarray | None
     seconds: float
+    metal_white: np.ndarray | None = None
 
 
 def _trace(
@@ -216,28 +174,46 @@ def _trace(
     spp: int,
     seed: int,
 ) -> _Traced:
-    """One traversal at path *depth*; the *first* one also takes the first-hit maps."""
+    """One traversal at path *depth*; the *first* one also takes the first-hit maps and, in
+    scenes with metals, the white-at-metal radiance."""
     n_surfaces = len(tables.shape_surfaces) if first else 0
-    make = gloss_path if dims.glossy else band_path
-    integrator = make(
-        mi, max_depth=depth, n_bands=dims.n_bands, n_lights=dims.n_lights, n_surfaces=n_surfaces
-    )
+    metals = dims.metals and first
+    if dims.glossy:
+        integrator = gloss_path(
+            mi,
+            max_depth=depth,
+            n_bands=dims.n_bands,
+            n_lights=dims.n_lights,
+            n_surfaces=n_surfaces,
+            metals=metals,
+        )
+    else:
+        integrator = band_path(
+            mi, max_depth=depth, n_bands=dims.n_bands, n_lights=dims.n_lights, n_surfaces=n_surfaces
+        )
     integrator.set_tables(loaded, tables if n_surfaces else replace(tables, shape_surfaces={}))
     if spec_table is not None:
         integrator.set_specular(spec_table)
+    if metals:
+        integrator.set_metals(np.array(dims.metal_rows, bool))
     n_t = dims.n_bands * dims.n_lights
     n_spec = n_t if dims.glossy else 0
+    n_white = n_t if metals else 0
     n_first = len(first_hit_channels(n_surfaces))
-    image, dt = _render(mi, loaded, integrator, spp=spp, seed=seed, n=n_t + n_spec + n_first)
+    image, dt = _render(
+        mi, loaded, integrator, spp=spp, seed=seed, n=n_t + n_spec + n_white + n_first
+    )
 
     def per_light(channels: np.ndarray) -> np.ndarray:
         return channels.reshape(dims.h, dims.w, dims.n_lights, dims.n_bands).transpose(2, 0, 1, 3)
 
+    end = n_t + n_spec + n_white
     return _Traced(
         transport=per_light(image[..., :n_t]),
         specular=per_light(image[..., n_t : n_t + n_spec]) if dims.glossy and first else None,
-        first=image[..., n_t + n_spec :] if n_surfaces else None,
+        first=image[..., end:] if n_surfaces else None,
         seconds=dt,
+        metal_white=per_light(image[..., n_t + n_spec : end]) if metals else None,
     )
 
 
@@ -249,13 +225,14 @@ def _outputs(
 ) -> list[TransportOutput]:
     """The traversals' bands cut back into one :class:`TransportOutput` per value set."""
     edges = np.cumsum([0, *widths])
-    specular = traced[0].specular
+    specular, white = traced[0].specular, traced[0].metal_white
     return [
         TransportOutput(
             transport=np.ascontiguousarray(traced[0].transport[..., a:b]),
             direct=np.ascontiguousarray(traced[1].transport[..., a:b]) if direct else None,
             emission=np.asarray(v.lights, float),
             specular=None if specular is None else np.ascontiguousarray(specular[..., a:b]),
+            metal_white=None if white is None else np.ascontiguousarray(white[..., a:b]),
         )
         for v, a, b in zip(value_sets, edges[:-1], edges[1:], strict=True)
     ]
@@ -330,7 +307,8 @@ def render_traversal(
             )
         )
         tables = _tables(scene, value_sets, light_of_emitters(mi, loaded), aovs)
-        dims = _Dims(h, w, n_bands, n_lights, glossy)
+        metal_rows = tuple(m.kind == "conductor" for m in scene.materials) + (False,)
+        dims = _Dims(h, w, n_bands, n_lights, glossy, metal_rows)
         spec_table = _specular_table(scene, value_sets) if glossy else None
         traced: list[_Traced] = []
         for depth in [int(max_depth)] + ([DIRECT_DEPTH] if direct else []):

@@ -63,8 +63,19 @@ def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
         else to_xyz_matrix(mode, s.scene, data_dir=s.data_dir)
     )
     raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
-    # W of the first hits' diffuse lobes only: the specular part is its own layer
-    return irr.white_radiance(diffuse_raw(s, raw), coverage, albedos, to_xyz, mode=s.ref)
+    metals = np.array([m.kind == "conductor" for m in s.scene.materials], bool)
+    metal_white = (getattr(s.result, "metal_white", None) or {}).get(s.ref)
+    # W of the first hits' diffuse lobes only: the specular part is its own layer; at metals
+    # the renderer's white-surface estimate
+    return irr.white_radiance(
+        diffuse_raw(s, raw),
+        coverage,
+        albedos,
+        to_xyz,
+        mode=s.ref,
+        metal_white=metal_white,
+        metal_coverage=coverage[..., metals].sum(axis=-1) if metal_white is not None else None,
+    )
 
 
 def srgb_white(s: SampleInputs) -> np.ndarray:

@@ -1,0 +1,80 @@
+"""What one band-path traversal gives per value set: :class:`TransportOutput`.
+
+Every array is for **unit emission** in every band of every light; the images follow by
+multiplying with the lights' channel values ``E_{l,k}`` (Eq. 5.2), so each light's share is
+exact and the shares sum to the total.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from spectrinsic.errors import RenderError
+
+__all__ = ["TransportOutput"]
+
+
+@dataclass(frozen=True, eq=False)
+class TransportOutput:
+    """Per-light band transport of one value set from one traversal.
+
+    Attributes
+    ----------
+    transport
+        ``(L, H, W, K)`` float32: light l's contribution to channel k for unit emission in
+        every band (``∫ radiance S_k`` per unit ``E_{l,k}``); the diagonal image is
+        ``Σ_l E_{l,k} · transport[l, ..., k]``.
+    direct
+        The same for direct light only (path depth 2), or ``None`` when not asked for.
+    emission
+        ``(L, K)`` float64 the lights' channel values ``E_{l,k}`` (:class:`ChannelValues`).
+    specular
+        ``(L, H, W, K)`` float32 the part of :attr:`transport` whose first camera-ray vertex
+        went through a non-diffuse lobe (:mod:`spectrinsic.render.gloss_kernel`), for scenes
+        with glossy materials; ``None`` for matte scenes (where it is 0).
+    metal_white
+        ``(L, H, W, K)`` float32 for scenes with metals: the radiance a white Lambertian
+        surface would reflect at the pixel's metal first hits, times their coverage
+        (``c_metal · E_k / π``, :mod:`~spectrinsic.render.gloss_kernel`); not part of the
+        image. ``None`` without metals.
+    """
+
+    transport: np.ndarray
+    direct: np.ndarray | None
+    emission: np.ndarray
+    specular: np.ndarray | None = None
+    metal_white: np.ndarray | None = None
+
+    def _light_sum(self, parts: np.ndarray, lights: Sequence[int] | None) -> np.ndarray:
+        """``(H, W, K)`` float32 sum over the *lights* (default all) of ``E_{l,k} · parts``,
+        each share rounded to float32 first, as :meth:`image` sums them."""
+        shares = (parts.astype(np.float64) * self.emission[:, None, None, :]).astype(np.float32)
+        chosen = range(shares.shape[0]) if lights is None else [int(j) for j in lights]
+        return np.sum(shares[list(chosen)], axis=0, dtype=np.float64).astype(np.float32)
+
+    def specular_image(self, lights: Sequence[int] | None = None) -> np.ndarray | None:
+        """``(H, W, K)`` float32 specular image of the *lights* (default all), summed as
+        :meth:`image` sums the transport (so both agree bit for bit where all light is
+        specular), or ``None`` for a matte scene."""
+        return None if self.specular is None else self._light_sum(self.specular, lights)
+
+    def metal_white_image(self, lights: Sequence[int] | None = None) -> np.ndarray | None:
+        """``(H, W, K)`` float32 white-at-metal radiance of the *lights* (default all), or
+        ``None`` for a scene without metals."""
+        return None if self.metal_white is None else self._light_sum(self.metal_white, lights)
+
+    def per_light(self, *, direct: bool = False) -> np.ndarray:
+        """``(L, H, W, K)`` float32 each light's image: ``E_{l,k} · transport``."""
+        t = self.direct if direct else self.transport
+        if t is None:
+            raise RenderError("no direct-only transport was rendered")
+        return (t.astype(np.float64) * self.emission[:, None, None, :]).astype(np.float32)
+
+    def image(self, lights: Sequence[int] | None = None, *, direct: bool = False) -> np.ndarray:
+        """``(H, W, K)`` float32 image of the *lights* (default all): the sum of their shares."""
+        parts = self.per_light(direct=direct)
+        chosen = range(parts.shape[0]) if lights is None else [int(j) for j in lights]
+        return np.sum(parts[list(chosen)], axis=0, dtype=np.float64).astype(np.float32)
