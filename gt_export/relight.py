@@ -2,8 +2,8 @@
 
 Every layer of a sample is a function of its raw band channels, and those are linear in every
 light's band values (:mod:`spectrinsic.render.transport`, Eq. 1). So a sample under new light
-spectra (and powers) is its transport composed with them (:func:`~spectrinsic.render.light_transport.transport_result`,
-batch by batch, merged as a render's batches are), and every ground-truth layer is then
+spectra (and powers) is its transport composed with them (:func:`~spectrinsic.render.light_transport.relit_result`:
+the raw channels batch by batch, the images once from the batches' mean), and every ground-truth layer is then
 computed by :func:`~spectrinsic.gt_export.layers.compute_ground_truth` and written by
 :func:`~spectrinsic.gt_export.writer.export_sample`, the very functions that made the sample:
 image and the 3-/6-sensor images, reflectance, shading, residual, illuminant, light shares,
@@ -36,8 +36,7 @@ from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, file_sha256
 from spectrinsic.gt_export.sample_meta import read_meta
 from spectrinsic.gt_export.transport_file import read_transport
 from spectrinsic.gt_export.writer import export_sample
-from spectrinsic.render.batches import merge_batches
-from spectrinsic.render.light_transport import LightTransport, transport_result
+from spectrinsic.render.light_transport import LightTransport, mode_lighting, relit_result
 from spectrinsic.render.result import RenderResult
 from spectrinsic.scenes.model import GLOSS_FIELDS, Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import get_spectrum
@@ -246,11 +245,8 @@ def relit_render(
     }
     base = _render_meta(meta, transport, relit)
     dd = None if data_dir is None else str(data_dir)
-    batches = [
-        transport_result(b, scene, seed=s, spp=transport.spp, meta=base, data_dir=dd)
-        for b, s in zip(transport.batches, transport.seeds, strict=True)
-    ]
-    merged = merge_batches(batches)
+    lighting = mode_lighting(scene, transport.modes, data_dir=dd)
+    merged = relit_result(transport, scene, lighting=lighting, meta=base)
     result = dataclasses.replace(merged, aovs=_aovs(sample, meta, coverage))
     return RelitSample(scene=scene, result=result, meta=meta, transport=transport)
 
