@@ -1,19 +1,23 @@
 """The per-light transport of a sample on disk: ``transport.exr`` and its ``meta.json`` record.
 
-One float32 OpenEXR file (ZIP compressed, like every layer file) holds
+One float32 OpenEXR file (uncompressed: ZIP cannot shrink Monte Carlo noise) holds
 
 * ``L<l>_b<b>_<mode>``: the transport ``T_lk`` of light ``l`` in independent batch ``b`` for
   each relightable render mode (channels named after the mode's sensors: ``B400`` ... ``B700``
   for ``bands31``, ``X, Y, Z`` for ``rgb3``, ``G425`` ... for ``rgb6``): the raw channels
   ``∫ radiance · S_k dλ`` (render units) light ``l`` alone gives with the flat unit spectrum
   ``L(λ) = 1`` at power 1 (:mod:`spectrinsic.render.transport`, Eq. 1);
+* for scenes with glossy materials, ``S<l>_b<b>_<mode>``: the part of that transport whose
+  first camera-ray vertex went through a non-diffuse lobe (the ``specular`` layer's), and with
+  metals ``W<l>_b<b>_<mode>``: the white-surface radiance at metal first hits (the metals'
+  ``shading``), both for the same unit spectrum (:mod:`spectrinsic.render.gloss_kernel`);
 * ``coverage``: ``(H, W, M)`` fraction of each pixel's samples hitting material ``m`` (the
   reflectance and the white-surface radiance are built from it, and it cannot be recovered
   from the reflectance).
 
 ``meta.json["transport"]`` records the file, the layer pattern, modes and their sensors, the
-number of lights and batches, each batch's seed and samples per pixel, the units and the file's
-size in bytes. The batches are kept apart because the sample's noise estimate is their spread.
+number of lights and batches, each batch's seed and samples per pixel, the glossy parts held
+(``parts``), the units and the file's size in bytes. The batches are kept apart because the sample's noise estimate is their spread.
 """
 
 from __future__ import annotations
@@ -45,13 +49,26 @@ TRANSPORT_UNITS = (
 )
 
 
-def transport_layer(light: int, batch: int, mode: str) -> str:
-    """EXR layer name of light *light*'s transport in batch *batch* for *mode*.
+#: Glossy parts of the transport, and the letter their layers start with (the transport's: L).
+PARTS = {"specular": "S", "metal_white": "W"}
 
-    >>> transport_layer(1, 0, "bands31")
-    'L1_b0_bands31'
+
+def transport_layer(light: int, batch: int, mode: str, part: str = "transport") -> str:
+    """EXR layer name of light *light*'s transport (or its glossy *part*, :data:`PARTS`) in
+    batch *batch* for *mode*.
+
+    >>> transport_layer(1, 0, "bands31"), transport_layer(0, 1, "rgb3", "specular")
+    ('L1_b0_bands31', 'S0_b1_rgb3')
     """
-    return f"L{int(light)}_b{int(batch)}_{mode}"
+    letter = "L" if part == "transport" else PARTS[part]
+    return f"{letter}{int(light)}_b{int(batch)}_{mode}"
+
+
+def _parts(transport: LightTransport) -> dict[str, tuple[dict[str, np.ndarray], ...]]:
+    """The transport's batches and each glossy part it holds, by part name."""
+    held = {"transport": transport.batches}
+    held.update({p: getattr(transport, p) for p in PARTS if getattr(transport, p)})
+    return held
 
 
 def write_transport(
@@ -66,13 +83,14 @@ def write_transport(
     names: dict[str, tuple[str, ...]] = {
         COVERAGE_LAYER: tuple(f"m{m}" for m in range(np.shape(coverage)[-1]))
     }
-    for b, batch in enumerate(transport.batches):
-        for mode in transport.modes:
-            channels = get_sensors(transport.sensors[mode]).channels
-            for light in range(transport.n_lights):
-                key = transport_layer(light, b, mode)
-                layers[key] = batch[mode][light]
-                names[key] = channels
+    for part, batches in _parts(transport).items():
+        for b, batch in enumerate(batches):
+            for mode in transport.modes:
+                channels = get_sensors(transport.sensors[mode]).channels
+                for light in range(transport.n_lights):
+                    key = transport_layer(light, b, mode, part)
+                    layers[key] = batch[mode][light]
+                    names[key] = channels
     path = Path(folder) / TRANSPORT_NAME
     write_exr(
         path,
@@ -92,6 +110,7 @@ def write_transport(
         "batch_seeds": list(transport.seeds),
         "batch_spp": transport.spp,
         "max_depth": transport.max_depth,
+        "parts": [p for p in _parts(transport) if p in PARTS],
         "units": TRANSPORT_UNITS,
         "dtype": "float32",
         "bytes": path.stat().st_size,
@@ -122,12 +141,47 @@ def read_transport(
         or set(sensors) != set(modes)
     ):
         raise DatasetError(f"{where}: meta.json transport record is not spectrinsic's")
+    parts = record.get("parts", []) if isinstance(record, dict) else []
+    if not isinstance(parts, list) or any(p not in PARTS for p in parts):
+        raise DatasetError(
+            f"{where}: meta.json transport parts {parts!r}; expected some of {list(PARTS)}"
+        )
     arrays = read_exr(folder / TRANSPORT_NAME)
+    held = {
+        part: _read_part(arrays, folder, part, modes=modes, lights=lights, n_batches=len(seeds))
+        for part in ["transport", *parts]
+    }
+    if COVERAGE_LAYER not in arrays:
+        raise DatasetError(f"{folder / TRANSPORT_NAME}: lacks the {COVERAGE_LAYER!r} layer")
+    coverage = np.atleast_3d(arrays[COVERAGE_LAYER])
+    transport = LightTransport(
+        modes=tuple(modes),
+        sensors={str(k): str(v) for k, v in sensors.items()},
+        batches=held["transport"],
+        seeds=tuple(int(s) for s in seeds),
+        spp=_field(record, "batch_spp", int, where),
+        max_depth=_field(record, "max_depth", int, where),
+        specular=held.get("specular", ()),
+        metal_white=held.get("metal_white", ()),
+    )
+    return transport, coverage
+
+
+def _read_part(
+    arrays: dict[str, np.ndarray],
+    folder: Path,
+    part: str,
+    *,
+    modes: list[str],
+    lights: int,
+    n_batches: int,
+) -> tuple[dict[str, np.ndarray], ...]:
+    """One part's batches, mode -> ``(L, H, W, K)``, from the file's *arrays*."""
     batches = []
-    for b in range(len(seeds)):
+    for b in range(n_batches):
         batch = {}
         for mode in modes:
-            keys = [transport_layer(j, b, mode) for j in range(lights)]
+            keys = [transport_layer(j, b, mode, part) for j in range(lights)]
             missing = [k for k in keys if k not in arrays]
             if missing:
                 raise DatasetError(
@@ -135,15 +189,4 @@ def read_transport(
                 )
             batch[mode] = np.stack([np.atleast_3d(arrays[k]) for k in keys])
         batches.append(batch)
-    if COVERAGE_LAYER not in arrays:
-        raise DatasetError(f"{folder / TRANSPORT_NAME}: lacks the {COVERAGE_LAYER!r} layer")
-    coverage = np.atleast_3d(arrays[COVERAGE_LAYER])
-    transport = LightTransport(
-        modes=tuple(modes),
-        sensors={str(k): str(v) for k, v in sensors.items()},
-        batches=tuple(batches),
-        seeds=tuple(int(s) for s in seeds),
-        spp=_field(record, "batch_spp", int, where),
-        max_depth=_field(record, "max_depth", int, where),
-    )
-    return transport, coverage
+    return tuple(batches)

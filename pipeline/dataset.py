@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from spectrinsic.errors import DatasetError, DiskFullError
+from spectrinsic.errors import DiskFullError
 from spectrinsic.gt_export import (
     build_gallery,
     export_sample,
@@ -127,11 +127,6 @@ def build_sample(task: SampleTask) -> SampleOutcome:
     scene = _task_scene(task)
     t_render = time.perf_counter()
     transport = None
-    if cfg.store_transport and any(m.glossy for m in scene.materials):
-        raise DatasetError(
-            f"{task.sample_id}: --store-transport relights matte scenes only; this scene has "
-            "glossy materials, whose specular part the stored transport does not split"
-        )
     if cfg.store_transport:  # diagonal modes light by light, kept per light for relighting
         transport, result = render_transport_batches(
             scene, cfg.render, seed=task.seed, data_dir=task.data_dir

@@ -178,6 +178,13 @@ def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
         transport={m: _mean([r.transport[m] for r in results]) for m in first.transport},
         specular={m: _mean([r.specular[m] for r in results]) for m in first.specular},
         metal_white={m: _mean([r.metal_white[m] for r in results]) for m in first.metal_white},
+        specular_transport={
+            m: _mean([r.specular_transport[m] for r in results]) for m in first.specular_transport
+        },
+        metal_white_transport={
+            m: _mean([r.metal_white_transport[m] for r in results])
+            for m in first.metal_white_transport
+        },
         meta=meta,
         batch_raw=tuple(dict(r.raw) for r in results),
     )

@@ -24,7 +24,6 @@ __all__ = [
     "light_band_means",
     "mode_lighting",
     "relit_result",
-    "transport_result",
 ]
 
 
@@ -50,6 +49,11 @@ class LightTransport:
     seconds
         Seconds of each Mitsuba pass, per mode, and under ``"single"`` those of the traversals
         carrying every mode at once (empty when read from a file).
+    specular, metal_white
+        Scenes with glossy materials / metals, one dict per batch as :attr:`batches`: the part
+        of ``T`` whose first camera-ray vertex went through a non-diffuse lobe, and the
+        white-surface radiance at metal first hits (not part of ``T``)
+        (:mod:`~spectrinsic.render.gloss_kernel`), for the same unit spectrum; empty otherwise.
     """
 
     modes: tuple[str, ...]
@@ -59,12 +63,19 @@ class LightTransport:
     spp: int
     max_depth: int
     seconds: dict[str, tuple[float, ...]] = field(default_factory=dict, repr=False)
+    specular: tuple[dict[str, np.ndarray], ...] = field(default=(), repr=False)
+    metal_white: tuple[dict[str, np.ndarray], ...] = field(default=(), repr=False)
 
     def __post_init__(self) -> None:
         if not self.batches or len(self.batches) != len(self.seeds):
             raise RenderError(f"transport: {len(self.batches)} batches for {len(self.seeds)} seeds")
-        shapes = {a.shape[:3] for b in self.batches for a in b.values()}
-        if len(shapes) != 1 or any(set(b) != set(self.modes) for b in self.batches):
+        held = [self.batches, *(p for p in (self.specular, self.metal_white) if p)]
+        shapes = {a.shape[:3] for part in held for b in part for a in b.values()}
+        if (
+            len(shapes) != 1
+            or any(len(part) != len(self.batches) for part in held)
+            or any(set(b) != set(self.modes) for part in held for b in part)
+        ):
             raise RenderError(
                 f"transport: every batch must hold modes {list(self.modes)} with "
                 f"one (lights, height, width); got shapes {sorted(shapes)}"
@@ -128,87 +139,52 @@ def mode_lighting(
     }
 
 
-def transport_result(
-    batch: Mapping[str, np.ndarray],
-    scene: Scene,
-    *,
-    seed: int,
-    spp: int,
-    meta: Mapping[str, Any] | None = None,
-    data_dir: str | None = None,
-    lighting: Mapping[str, ModeLighting] | None = None,
-) -> RenderResult:
-    """The render of one batch under the scene's light spectra and powers, from its transport.
+@dataclass(frozen=True, eq=False)
+class _Composed:
+    """The arrays of a render composed from transport (:func:`_compose`)."""
 
-    Per mode: each light's raw channels ``T_l ∘ ē_l`` (float32, as Mitsuba returns a pass),
-    their float64 sum as ``raw`` (as :func:`~spectrinsic.render.render_scene` sums per-light
-    renders), and the XYZ of both through the mode's matrix for this scene's lights. *meta*
-    (a render's metadata) is kept, with the modes, sensors, XYZ matrices, seed and spp set.
-    *lighting* (:func:`mode_lighting` of the scene) saves computing it again per batch.
-    """
-    lighting = lighting or mode_lighting(scene, batch, data_dir=data_dir)
-    raw: dict[str, np.ndarray] = {}
-    images: dict[str, np.ndarray] = {}
-    per_light: list[dict[str, np.ndarray]] = [{} for _ in scene.lights]
-    matrices: dict[str, np.ndarray] = {}
-    for mode, t in batch.items():
-        if t.shape[0] != len(scene.lights):
-            raise RenderError(
-                f"transport of {mode!r} has {t.shape[0]} lights; the scene has {len(scene.lights)}"
-            )
-        means = lighting[mode].means
-        parts = [
-            (np.asarray(t[j], np.float64) * means[j]).astype(np.float32) for j in range(t.shape[0])
-        ]
-        raw[mode] = np.sum(parts, axis=0, dtype=np.float64).astype(np.float32)
-        matrices[mode] = lighting[mode].to_xyz
-        images[mode] = raw_to_xyz(raw[mode], matrices[mode])
-        for j, part in enumerate(parts):
-            per_light[j][mode] = raw_to_xyz(part, matrices[mode])
-    out_meta: dict[str, Any] = dict(meta or {})
-    out_meta.update(
-        seed=int(seed),
-        spp=int(spp),
-        modes=list(batch),
-        per_light=True,
-        per_light_modes=list(batch),
-        sensors={m: get_mode(m).sensors for m in batch},
-        to_xyz={m: np.asarray(v).tolist() for m, v in matrices.items()},
-    )
-    out_meta.setdefault("timings", {})
-    return RenderResult(images=images, raw=raw, per_light=tuple(per_light), meta=out_meta)
+    raw: dict[str, np.ndarray]
+    images: dict[str, np.ndarray]
+    per_light: tuple[dict[str, np.ndarray], ...]
+    batch_raw: tuple[dict[str, np.ndarray], ...]
+    specular: dict[str, np.ndarray]
+    metal_white: dict[str, np.ndarray]
 
 
 def _batch_mean(arrays: Sequence[np.ndarray]) -> np.ndarray:
     """float32 mean of the batches in float64, as :func:`~spectrinsic.render.merge_batches`."""
+    if len(arrays) == 1:
+        return arrays[0]
     return np.mean(np.stack(arrays), axis=0, dtype=np.float64).astype(np.float32)
 
 
-def relit_result(
-    transport: LightTransport,
-    scene: Scene,
-    *,
-    lighting: Mapping[str, ModeLighting],
-    meta: Mapping[str, Any] | None = None,
-) -> RenderResult:
-    """The merged render of every batch of *transport* under *scene*'s lights, with each
-    batch's raw channels: bit for bit :func:`~spectrinsic.render.merge_batches` of
-    :func:`transport_result` per batch, with every light of a batch composed and converted to
-    XYZ in one array operation and the lights' band means and XYZ matrices computed once.
-    """
+def _light_sum(parts: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each light's float32 share ``parts_l ∘ ē_l`` (as Mitsuba returns a pass) and their
+    float64 sum in float32 (as :func:`~spectrinsic.render.render_scene` sums lights)."""
+    shares = (parts.astype(np.float64) * e).astype(np.float32)
+    return shares, np.sum(shares, axis=0, dtype=np.float64).astype(np.float32)
+
+
+def _compose(
+    transport: LightTransport, scene: Scene, lighting: Mapping[str, ModeLighting]
+) -> _Composed:
+    """Eq. 1 for every batch and mode, merged over the batches as
+    :func:`~spectrinsic.render.merge_batches` merges rendered ones (bit for bit)."""
     if transport.n_lights != len(scene.lights):
         raise RenderError(
             f"transport has {transport.n_lights} lights; the scene has {len(scene.lights)}"
         )
     batch_raw: list[dict[str, np.ndarray]] = [{} for _ in transport.batches]
-    raw, images = {}, {}
+    raw: dict[str, np.ndarray] = {}
+    images: dict[str, np.ndarray] = {}
+    spec: dict[str, np.ndarray] = {}
+    white: dict[str, np.ndarray] = {}
     per_light: list[dict[str, np.ndarray]] = [{} for _ in scene.lights]
     for mode in transport.modes:
         e, to_xyz = lighting[mode].means[:, None, None, :], lighting[mode].to_xyz
         xyz, shares_xyz = [], []
         for b, batch in enumerate(transport.batches):
-            shares = (batch[mode].astype(np.float64) * e).astype(np.float32)
-            batch_raw[b][mode] = np.sum(shares, axis=0, dtype=np.float64).astype(np.float32)
+            shares, batch_raw[b][mode] = _light_sum(batch[mode], e)
             xyz.append(raw_to_xyz(batch_raw[b][mode], to_xyz))
             shares_xyz.append(raw_to_xyz(shares, to_xyz))
         raw[mode] = _batch_mean([r[mode] for r in batch_raw])
@@ -216,21 +192,19 @@ def relit_result(
         mean_shares = _batch_mean(shares_xyz)
         for j in range(len(scene.lights)):
             per_light[j][mode] = mean_shares[j]
-    return RenderResult(
-        images=images,
-        raw=raw,
-        per_light=tuple(per_light),
-        meta=_relit_meta(transport, lighting, meta),
-        batch_raw=tuple(batch_raw) if len(transport.batches) > 1 else (),
-    )
+        for part, out in ((transport.specular, spec), (transport.metal_white, white)):
+            if part:
+                out[mode] = _batch_mean([_light_sum(b[mode], e)[1] for b in part])
+    return _Composed(raw, images, tuple(per_light), tuple(batch_raw), spec, white)
 
 
-def _relit_meta(
+def _meta(
     transport: LightTransport,
     lighting: Mapping[str, ModeLighting],
     meta: Mapping[str, Any] | None,
 ) -> dict[str, Any]:
-    """*meta* with what :func:`transport_result` and a merge of the batches set."""
+    """*meta* (a render's metadata) with the modes, sensors, XYZ matrices, seed and spp set,
+    and the batches as :func:`~spectrinsic.render.merge_batches` sets them."""
     n, modes = len(transport.batches), list(transport.modes)
     out: dict[str, Any] = dict(meta or {})
     out.update(
@@ -246,3 +220,35 @@ def _relit_meta(
     if n > 1:
         out.update(batches=n, batch_spp=int(transport.spp), batch_seeds=list(transport.seeds))
     return out
+
+
+def relit_result(
+    transport: LightTransport,
+    scene: Scene,
+    *,
+    lighting: Mapping[str, ModeLighting] | None = None,
+    meta: Mapping[str, Any] | None = None,
+    data_dir: str | None = None,
+) -> RenderResult:
+    """The render of every batch of *transport* under *scene*'s light spectra and powers,
+    merged as :func:`~spectrinsic.render.merge_batches` merges rendered batches (each batch's
+    raw channels kept), from Eq. 1.
+
+    Per mode and batch: each light's raw channels ``T_l ∘ ē_l`` (float32, as Mitsuba returns a
+    pass), their float64 sum as ``raw`` (as :func:`~spectrinsic.render.render_scene` sums
+    lights), and the XYZ of both through the mode's matrix for this scene's lights; the
+    specular and white-at-metal parts likewise, where held. *meta* (a render's metadata) is
+    kept, with the modes, sensors, XYZ matrices, seeds and spp set. *lighting*
+    (:func:`mode_lighting` of the scene) saves computing it again.
+    """
+    lighting = lighting or mode_lighting(scene, transport.modes, data_dir=data_dir)
+    c = _compose(transport, scene, lighting)
+    return RenderResult(
+        images=c.images,
+        raw=c.raw,
+        per_light=c.per_light,
+        meta=_meta(transport, lighting, meta),
+        batch_raw=c.batch_raw if len(transport.batches) > 1 else (),
+        specular=c.specular,
+        metal_white=c.metal_white,
+    )

@@ -63,6 +63,9 @@ class RenderResult:
         radiance a white Lambertian surface would reflect at the first hits on metals, times
         their coverage (not part of ``raw``), so the shading stays defined where the diffuse
         albedo is 0 (:mod:`spectrinsic.render.gloss_kernel`). Empty otherwise.
+    specular_transport, metal_white_transport
+        The per-light parts behind ``specular`` and ``metal_white`` as ``transport`` is behind
+        ``raw`` (mode -> ``(L, H, W, K)`` float32 for unit emission); empty without them.
     """
 
     images: dict[str, np.ndarray]
@@ -75,6 +78,8 @@ class RenderResult:
     transport: dict[str, np.ndarray] = field(default_factory=dict)
     specular: dict[str, np.ndarray] = field(default_factory=dict)
     metal_white: dict[str, np.ndarray] = field(default_factory=dict)
+    specular_transport: dict[str, np.ndarray] = field(default_factory=dict)
+    metal_white_transport: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def shape(self) -> tuple[int, int]:

@@ -85,7 +85,6 @@ def count_passes(scene: Scene, settings: RenderSettings, *, data_dir: str | None
         )
     colour = sum(n_passes(m, data_dir=data_dir) * (2 if m.name in wanted else 1) for m in objs)
     shares = sum(n_passes(m, data_dir=data_dir) for m in share_modes)
-
     aov_passes = max(1, -(-len(surfaces(scene)) // 3)) if aovs and not single else 0
     return diagonal + groups * colour + len(scene.lights) * shares + aov_passes
 
@@ -428,7 +427,9 @@ def _assemble(
         },
         aovs=aov_maps,
         meta=meta,
-        transport={n: t.transport for n, t in single.transport.items()},
+        transport=single.per_light("transport"),
+        specular_transport=single.per_light("specular"),
+        metal_white_transport=single.per_light("metal_white"),
         specular=_part_raw(single, groups, TransportOutput.specular_image),
         metal_white=_part_raw(single, groups, TransportOutput.metal_white_image),
     )
@@ -439,9 +440,8 @@ def _part_raw(
     groups: Sequence[Sequence[int] | None],
     part: Callable[[TransportOutput, Sequence[int] | None], np.ndarray | None],
 ) -> dict[str, np.ndarray]:
-    """Mode -> raw channels of a *part* of the traversal (specular or white-at-metal image),
-    summed over the main jobs' light *groups* as ``raw`` is (``raw − specular`` is exactly 0
-    where all is specular); modes without the part are left out."""
+    """Mode -> raw channels of a traversal's *part* (specular or white-at-metal image), summed
+    over the main jobs' light *groups* as ``raw`` is; modes without the part are left out."""
     out = {}
     for name, t in single.transport.items():
         parts = [p for g in groups if (p := part(t, g)) is not None]

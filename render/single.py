@@ -348,6 +348,12 @@ class SingleTraversal:
     #: First-hit maps (:func:`~spectrinsic.render.aovs.render_aovs`'s), when asked for.
     aovs: dict[str, np.ndarray] = field(default_factory=dict)
 
+    def per_light(self, part: str) -> dict[str, np.ndarray]:
+        """Mode -> ``(L, H, W, K)`` per-light *part* (``"transport"``, ``"specular"`` or
+        ``"metal_white"``, attributes of :class:`TransportOutput`); modes without it left out."""
+        arrays = {n: getattr(t, part) for n, t in self.transport.items()}
+        return {n: a for n, a in arrays.items() if a is not None}
+
 
 def render_jobs(
     scene: Scene,

@@ -44,7 +44,7 @@ from spectrinsic.render.batches import batch_seeds, image_noise, merge_batches
 from spectrinsic.render.light_transport import (
     LightTransport,
     diagonal_mode_names,
-    transport_result,
+    relit_result,
 )
 from spectrinsic.render.modes import (
     ChannelValues,
@@ -134,6 +134,27 @@ def render_transport(
     )
 
 
+def _one_batch(
+    names: Sequence[str],
+    settings: RenderSettings,
+    seed: int,
+    t: dict[str, np.ndarray],
+    specular: dict[str, np.ndarray] | None = None,
+    metal_white: dict[str, np.ndarray] | None = None,
+) -> LightTransport:
+    """One batch's transport (and its glossy parts, where rendered) as a :class:`LightTransport`."""
+    return LightTransport(
+        modes=tuple(names),
+        sensors={m: get_mode(m).sensors for m in names},
+        batches=(t,),
+        seeds=(int(seed),),
+        spp=int(settings.batch_spp),
+        max_depth=int(settings.max_depth),
+        specular=(specular,) if specular else (),
+        metal_white=(metal_white,) if metal_white else (),
+    )
+
+
 def _join(
     diagonal: RenderResult,
     other: RenderResult | None,
@@ -163,6 +184,8 @@ def _join(
         direct=dict(other.direct),
         aovs=dict(aovs),
         meta=meta,
+        specular=dict(diagonal.specular),
+        metal_white=dict(diagonal.metal_white),
     )
 
 
@@ -173,7 +196,7 @@ def _traversal_batch(
     *,
     progress: PassProgress | None,
     data_dir: str | None,
-) -> tuple[dict[str, np.ndarray], RenderResult]:
+) -> tuple[LightTransport, RenderResult]:
     """:func:`_batch` from one single traversal (:mod:`spectrinsic.render.single`), which
     already splits every band by light: its transport ``T'_lk`` (per unit channel emission
     ``E_lk``) times the flat unit spectrum's channel values ``∫S_k dλ`` is Eq. 1's ``T_lk``,
@@ -193,19 +216,29 @@ def _traversal_batch(
         progress=progress,
         data_dir=data_dir,
     )
-    flat = {m: _unit_values(scene, get_mode(m).sensors, data_dir).lights for m in names}
-    t = {
-        m: (render.transport[m].astype(np.float64) * flat[m][:, None, None, :]).astype(np.float32)
+    flat = {
+        m: _unit_values(scene, get_mode(m).sensors, data_dir).lights[:, None, None, :]
         for m in names
     }
+
+    def unit(part: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        # per unit channel emission E_lk -> per flat unit spectrum (Eq. 1's T_lk)
+        return {m: (part[m].astype(np.float64) * flat[m]).astype(np.float32) for m in part}
+
+    batch = _one_batch(
+        names,
+        settings,
+        seed,
+        unit(render.transport),
+        unit(render.specular_transport),
+        unit(render.metal_white_transport),
+    )
     base = {
         "max_depth": int(settings.max_depth),
         "variants": {m: render.meta["variants"][m] for m in names},
         "timings": {m: render.meta["timings"][m] for m in names},
     }
-    diagonal = transport_result(
-        t, scene, seed=seed, spp=settings.batch_spp, meta=base, data_dir=data_dir
-    )
+    diagonal = relit_result(batch, scene, meta=base, data_dir=data_dir)
     others = [m for m in dict.fromkeys(settings.modes) if m not in names]
     other = (
         replace(
@@ -213,11 +246,13 @@ def _traversal_batch(
             images={m: render.images[m] for m in others},
             raw={m: render.raw[m] for m in others},
             transport={},
+            specular_transport={},
+            metal_white_transport={},
         )
         if others
         else None
     )
-    return t, _join(diagonal, other, render.aovs, list(dict.fromkeys(settings.modes)))
+    return batch, _join(diagonal, other, render.aovs, list(dict.fromkeys(settings.modes)))
 
 
 def _batch(
@@ -227,7 +262,7 @@ def _batch(
     *,
     progress: PassProgress | None,
     data_dir: str | None,
-) -> tuple[dict[str, np.ndarray], RenderResult]:
+) -> tuple[LightTransport, RenderResult]:
     """Transport of one batch and the sample's render of that batch (other modes rendered
     directly with every light on, the AOVs from the same pixel samples): from the single
     traversal where it runs (:func:`_traversal_batch`), else one set of passes per light."""
@@ -247,7 +282,8 @@ def _batch(
         "timings": timing,
         "variants": dict.fromkeys(names, rgb),
     }
-    diagonal = transport_result(t, scene, seed=seed, spp=spp, meta=base, data_dir=data_dir)
+    batch = _one_batch(names, settings, seed, t)
+    diagonal = relit_result(batch, scene, meta=base, data_dir=data_dir)
     other = None
     if others:
         direct = (
@@ -274,7 +310,7 @@ def _batch(
             "seconds": float(sum(aov_seconds)),
             "per_pass": list(aov_seconds),
         }
-    return t, _join(diagonal, other, aovs, list(dict.fromkeys(modes)))
+    return batch, _join(diagonal, other, aovs, list(dict.fromkeys(modes)))
 
 
 def render_transport_batches(
@@ -288,7 +324,7 @@ def render_transport_batches(
     """The sample's transport and its render, as :func:`~spectrinsic.render.render_batches`.
 
     The diagonal modes of every batch are composed from the transport with the scene's own
-    spectra (:func:`transport_result`), so relighting the sample with those spectra gives it
+    spectra (:func:`~spectrinsic.render.light_transport.relit_result`), so relighting the sample with those spectra gives it
     back exactly; the other modes (the spectral reference) are rendered directly with every
     light on, with a direct-only render when ``settings.direct``. Batches, seeds and adaptive
     sampling (``settings.noise_target``, ``settings.max_batches``) follow
@@ -331,11 +367,13 @@ def render_transport_batches(
     transport = LightTransport(
         modes=names,
         sensors={m: get_mode(m).sensors for m in names},
-        batches=tuple(t for t, _ in done),
+        batches=tuple(t.batches[0] for t, _ in done),
         seeds=tuple(int(s) for s in seeds[: len(done)]),
         spp=int(settings.batch_spp),
         max_depth=int(settings.max_depth),
         seconds=seconds,
+        specular=tuple(t.specular[0] for t, _ in done if t.specular),
+        metal_white=tuple(t.metal_white[0] for t, _ in done if t.metal_white),
     )
     merged.meta["transport"] = {"modes": list(names), "batches": len(done)}
     logger.debug(
