@@ -40,7 +40,9 @@ _STANDARD_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
 #: so existing datasets are rebuilt; a release that changes none keeps old datasets valid.
 #: 3: diagonal modes from one band-path traversal; per-light images are shares of the full
 #: render (render/single.py), not one render per light.
-PIXELS_VERSION = 3
+#: 4: the white-surface radiance is denoised as three broad bands (OIDN high) times per-band
+#: shares, guided by normals and a depth grey marked clean (gt_export/denoise.py).
+PIXELS_VERSION = 4
 #: What of the installed software changes pixels, hence enters the config hash, and how much
 #: of its version: the renderer exactly (its sampling changes between patch releases);
 #: colour-science's data tables (CMFs, illuminants, cameras) by minor release; numpy by major
