@@ -10,7 +10,8 @@ image and the 3-/6-sensor images, reflectance, shading, residual, illuminant, li
 camera layers, noise maps and the chapter-4 matrices, all for the new lights.
 
 * Denoising: the relit white-surface radiance is denoised by OIDN as a rendered one is
-  (same normals guide, same quality), not relit from a denoised one: a denoiser is not linear.
+  (same guides, normals and depth, same quality), not relit from a denoised one: a denoiser
+  is not linear.
 * Noise: the transport keeps the independent batches apart, so the relit sample's noise maps
   and ``meta.json["noise"]`` are measured from the spread of its own relit batches.
 * Not relit: the spectral Monte Carlo image (it samples wavelengths; no band transport

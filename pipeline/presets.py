@@ -40,7 +40,9 @@ _STANDARD_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
 #: so existing datasets are rebuilt; a release that changes none keeps old datasets valid.
 #: 3: diagonal modes from one band-path traversal; per-light images are shares of the full
 #: render (render/single.py), not one render per light.
-PIXELS_VERSION = 3
+#: 4: the white-surface radiance is denoised as three broad bands (OIDN high) times per-band
+#: shares, guided by normals and a depth grey marked clean (gt_export/denoise.py).
+PIXELS_VERSION = 4
 #: What of the installed software changes pixels, hence enters the config hash, and how much
 #: of its version: the renderer exactly (its sampling changes between patch releases);
 #: colour-science's data tables (CMFs, illuminants, cameras) by minor release; numpy by major
@@ -310,7 +312,9 @@ PRESETS: dict[str, DatasetConfig] = {
     # crop (make bench, bench_crop_reference.json) went from median 3.7 % / p95 18.5 % to
     # 2.8 % / 14.9 % (1.6 % median with the reference's own 2.3 % noise removed); a sample of
     # the costliest class takes 2.2x as long as at 16 spp, so the set's 434 s at 16 spp on an
-    # idle machine becomes about 16 minutes.
+    # idle machine becomes about 16 minutes. Against a 16384-spp reference of the crop (its own
+    # noise 1.2 % median) that render's shading is off by 2.2 % / 14.3 % with the round-3
+    # denoiser and 1.96 % / 12.0 % with the broad-band, depth-guided one (PIXELS_VERSION 4).
     "default": DatasetConfig.from_settings(
         "default",
         width=256,

@@ -9,7 +9,7 @@ import numpy as np
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import irradiance as irr
-from spectrinsic.gt_export.denoise import denoise_white_radiance
+from spectrinsic.gt_export.denoise import Denoiser, Guides, denoise_white_radiance
 from spectrinsic.gt_export.layers.cameras import camera_layers, matrices_of
 from spectrinsic.gt_export.layers.geometry import coverage_of, geometry_layers
 from spectrinsic.gt_export.layers.gloss import gloss_layers, specular_srgb
@@ -66,6 +66,7 @@ def compute_ground_truth(
     write_cube: bool = False,
     denoise: bool = False,
     denoise_quality: str = "fast",
+    denoiser: Denoiser | None = None,
     data_dir: Any = None,
     training: np.ndarray | None = None,
 ) -> GroundTruth:
@@ -91,6 +92,10 @@ def compute_ground_truth(
     denoise_quality
         OIDN quality, ``"fast"`` (the dataset's, :data:`~spectrinsic.gt_export.denoise.DENOISE_QUALITY`)
         or ``"high"``.
+    denoiser
+        With *denoise*, the function that denoises ``W`` given its guides, instead of
+        :func:`~spectrinsic.gt_export.denoise.denoise_white_radiance` (``make bench`` scores
+        alternatives with it).
     training
         ``(N, 471)`` reflectances on the 1 nm grid for the matrix fits (default: all Munsell chips).
     """
@@ -116,7 +121,12 @@ def compute_ground_truth(
     w_raw = white_radiance(s, coverage)
     w = w_raw
     if denoise:
-        w = denoise_white_radiance(w_raw, aov(result, "normals"), quality=denoise_quality)
+        guides = Guides(aov(result, "normals"), aov(result, "depth"))
+        w = (
+            denoise_white_radiance(w_raw, guides, quality=denoise_quality)
+            if denoiser is None
+            else denoiser(w_raw, guides)
+        )
     specular = specular_srgb(s, w_raw.to_xyz)
     layers += intrinsic_layers(s, w_raw, w, image, reflectance, denoised=denoise, specular=specular)
     layers += gloss_layers(s, coverage, specular)
