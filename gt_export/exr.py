@@ -95,7 +95,8 @@ def write_exr(
         Extra string header attributes (provenance).
     compressed
         ZIP compression (lossless); ``False`` for Monte Carlo noise that ZIP cannot shrink
-        (the per-light transport: 2 % smaller, 30× slower to write and 3× slower to read).
+        (the per-light transport: ZIP made it 12 % smaller, most of it on its coverage layer,
+        and 30× slower to write and 3× slower to read).
 
     Returns
     -------
