@@ -181,6 +181,11 @@ class NamesAndShades:
         RIDGE_DETECTORS`: ``"rad"``, RAD's MLSEC-ST creaseness, thinning and pruning, as the
         thesis cites; ``"hessian"``, the earlier pragmatic detector) and RAD's creaseness
         threshold.
+    max_axis_angle
+        RAD: crest bins whose local direction is further than this (degrees) from the grey
+        diagonal of the log-colour histogram are cut out, so that the ridges of two surfaces
+        joined by a crest across the diagonal come out as two (:func:`spectrinsic.decompose.
+        ridges.colour_shades`); ``None``: no cut.
     global_coherence
         Apply sec. 3.4 (off reproduces Fig. 3.7(c)).
     reflectance_colour
@@ -212,6 +217,7 @@ class NamesAndShades:
     sigma: float = 2.0
     ridge_detector: str = "rad"
     creaseness: float = 1.5
+    max_axis_angle: float | None = None
     global_coherence: bool = True
     reflectance_colour: Literal["label-centroid", "region-mean"] = "region-mean"
     split_by_ridge: bool = True
@@ -281,6 +287,7 @@ class NamesAndShades:
             sigma=self.sigma,
             detector=self.ridge_detector,
             creaseness=self.creaseness,
+            max_axis_angle=self.max_axis_angle,
         )
         t2 = time.perf_counter()
 

@@ -35,12 +35,12 @@ from spectrinsic.decompose.registry import get_decomposer
 #: thesis (only gamma/alpha = 100, gamma/beta = 2 and mu = 1/3 are); gamma/alpha = 10 was the
 #: rendered-set protocol's choice. The ridge detector (sec. 3.2.2): "hessian" (round 1) or
 #: "rad" (RAD's MLSEC-ST creaseness, thinning, pruning) at creaseness/sigma (1.0, 1) or (1.5, 2).
-HESSIAN = {"ridge_detector": "hessian", "creaseness": 1.0, "sigma": 1.0}
-RAD = {"ridge_detector": "rad", "creaseness": 1.5, "sigma": 2.0}
-RAD_FINE = {"ridge_detector": "rad", "creaseness": 1.0, "sigma": 1.0}
+HESSIAN = {"ridge_detector": "hessian", "creaseness": 1.0, "sigma": 1.0, "max_axis_angle": None}
+RAD = {"ridge_detector": "rad", "creaseness": 1.5, "sigma": 2.0, "max_axis_angle": None}
+RAD_FINE = {"ridge_detector": "rad", "creaseness": 1.0, "sigma": 1.0, "max_axis_angle": None}
 MRF_GRID = {"gamma": [0.3, 1.0, 3.0, 10.0, 30.0], "gamma_over_alpha": [10.0, 100.0],
             "ridge_detector": ["hessian", "rad"], "creaseness": [1.0, 1.25, 1.5],
-            "sigma": [1.0, 1.5, 2.0, 3.0]}
+            "sigma": [1.0, 1.5, 2.0, 3.0], "max_axis_angle": [None, 45.0, 60.0]}
 #: Round 1 (before the RAD detector): the hessian points. scripts/mit_ablation.json holds
 #: both rounds (round 1's keys, which lack the detector, are read as HESSIAN by merge()).
 HESSIAN_POINTS = [{"gamma": g, "gamma_over_alpha": 100.0, **HESSIAN} for g in (1.0, 3.0, 10.0, 30.0)
@@ -56,7 +56,14 @@ MRF_POINTS = [{"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD},
               {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "sigma": 3.0},
               # round 2c (between the connected web of 1.0 and the chosen 1.5; sigma 1.5)
               {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "creaseness": 1.25},
-              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "sigma": 1.5}]
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "sigma": 1.5},
+              # round 3 (crest bins across the grey diagonal cut: deer's paints split)
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "max_axis_angle": 60.0},
+              {"gamma": 1.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 60.0},
+              {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 60.0},
+              {"gamma": 10.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 60.0},
+              {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 45.0},
+              {"gamma": 10.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 45.0}]
 #: Parameters of steps 4-5 (run on each labelling).
 POST_GRID = {"reflectance_colour": ["label-centroid", "region-mean"],
              "split_by_ridge": [False, True]}
@@ -182,6 +189,8 @@ def merge(parts: list[Path]) -> dict:
         for k, per_object in data["scores"].items():
             if k.startswith("{") and "ridge_detector" not in k:  # round 1: the hessian detector
                 k = key({**json.loads(k), **HESSIAN})
+            elif k.startswith("{") and "max_axis_angle" not in k:  # round 2: no diagonal cut
+                k = key({"max_axis_angle": None, **json.loads(k)})
             report["scores"].setdefault(k, {}).update(per_object)
         report["labelling_seconds"].update(data["labelling_seconds"])
     report["choice"] = choose(report["scores"])
