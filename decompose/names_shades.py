@@ -235,7 +235,8 @@ class NamesAndShades:
 
         ``mu = 1/3``, ``gamma/alpha = 100``, ``gamma/beta = 2``, label-centroid colours, regions
         of equal label only, no colour constancy, alpha-expansion to convergence, RAD ridges
-        (sec. 3.2.2; its creaseness and scale, which the thesis does not give, as the defaults).
+        (sec. 3.2.2; its creaseness and scale, which the thesis does not give, as the defaults;
+        no cut of crests across the grey diagonal).
         """
         return cls(
             gamma_over_alpha=100.0,
@@ -246,6 +247,7 @@ class NamesAndShades:
             colour_constancy="none",
             expansion_cycles=-1,
             ridge_detector="rad",
+            max_axis_angle=None,
             name="names-shades-thesis",
         )
 

@@ -40,7 +40,7 @@ RAD = {"ridge_detector": "rad", "creaseness": 1.5, "sigma": 2.0, "max_axis_angle
 RAD_FINE = {"ridge_detector": "rad", "creaseness": 1.0, "sigma": 1.0, "max_axis_angle": None}
 MRF_GRID = {"gamma": [0.3, 1.0, 3.0, 10.0, 30.0], "gamma_over_alpha": [10.0, 100.0],
             "ridge_detector": ["hessian", "rad"], "creaseness": [1.0, 1.25, 1.5],
-            "sigma": [1.0, 1.5, 2.0, 3.0], "max_axis_angle": [None, 45.0, 60.0]}
+            "sigma": [1.0, 1.5, 2.0, 3.0], "max_axis_angle": [None, 30.0, 45.0, 60.0]}
 #: Round 1 (before the RAD detector): the hessian points. scripts/mit_ablation.json holds
 #: both rounds (round 1's keys, which lack the detector, are read as HESSIAN by merge()).
 HESSIAN_POINTS = [{"gamma": g, "gamma_over_alpha": 100.0, **HESSIAN} for g in (1.0, 3.0, 10.0, 30.0)
@@ -63,7 +63,10 @@ MRF_POINTS = [{"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD},
               {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 60.0},
               {"gamma": 10.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 60.0},
               {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 45.0},
-              {"gamma": 10.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 45.0}]
+              {"gamma": 10.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 45.0},
+              # round 3b (the best point, cut 45 and gamma 3, lay on the grid's edge)
+              {"gamma": 1.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 45.0},
+              {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 30.0}]
 #: Parameters of steps 4-5 (run on each labelling).
 POST_GRID = {"reflectance_colour": ["label-centroid", "region-mean"],
              "split_by_ridge": [False, True]}
