@@ -98,7 +98,7 @@ PROTOCOL = (
     "creaseness 1.5, sigma 2, gamma 1, gamma_over_alpha 10, region-mean, split by ridge, "
     "grey-world (LMSE 0.0314, held-out 0.0354; 8 of 10 folds chose it); the thesis' settings "
     "0.0721 (RAD) and 0.0716 (hessian). Round 3 adds RAD's crest cut across the grey diagonal "
-    "(max_axis_angle 60 at gamma 1, 3, 10 and 45 at gamma 1, 3, 10, 30 at gamma 3; 136 grid "
+    "(max_axis_angle 60 at gamma 1, 3, 10 and 45 at gamma 1, 3, 10, 30 at gamma 3; 184 grid "
     "points) and restricts the choice, in every fold alike, to points that lose to reflectance "
     "= image on at most 2 of the objects chosen on: chosen max_axis_angle 45, gamma 3, "
     "gamma_over_alpha 100 (the thesis' ratio), region-mean, split by ridge, grey-world (LMSE "
