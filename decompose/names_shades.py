@@ -243,12 +243,14 @@ class NamesAndShades:
     def thesis(cls) -> NamesAndShades:
         """The thesis' own settings (sec. 3.3-3.5): every documented deviation switched off.
 
-        ``mu = 1/3``, ``gamma/alpha = 100``, ``gamma/beta = 2``, label-centroid colours, regions
+        ``mu = 1/3``, ``gamma/alpha = 100``, ``gamma/beta = 2`` (``gamma = 1``: the thesis gives
+        only the ratios), label-centroid colours, regions
         of equal label only, no colour constancy, alpha-expansion to convergence, RAD ridges
         (sec. 3.2.2; its creaseness and scale, which the thesis does not give, as the defaults;
         no cut of crests across the grey diagonal).
         """
         return cls(
+            gamma=1.0,
             gamma_over_alpha=100.0,
             gamma_over_beta=2.0,
             mu=1.0 / 3.0,
