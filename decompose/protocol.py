@@ -135,12 +135,16 @@ def _group_means(scores: Mapping[str, float], groups: Mapping[str, str]) -> dict
 
 
 def hold_one_out(
-    table: Mapping[GridPoint, Mapping[str, float]], groups: Mapping[str, str]
+    table: Mapping[GridPoint, Mapping[str, float]],
+    groups: Mapping[str, str],
+    eligible: Callable[[GridPoint, Sequence[str]], bool] | None = None,
 ) -> HoldOutResult:
     """Hold-one-group-out choice of a grid point (module docstring).
 
     Each group weighs the same whatever its number of samples. Ties go to the first point in
-    *table*'s order. Non-finite scores count as infinitely bad.
+    *table*'s order. Non-finite scores count as infinitely bad, and so does a point for which
+    ``eligible(point, groups_chosen_on)`` is false (a constraint applied alike in every fold
+    and in the final choice, e.g. "loses to a baseline on at most 2 objects").
 
     Raises :class:`SpectrinsicError` with fewer than two groups.
     """
@@ -151,6 +155,8 @@ def hold_one_out(
 
     def best(keep: Sequence[str]) -> tuple[GridPoint, float]:
         def cost(p: GridPoint) -> float:
+            if eligible is not None and not eligible(p, keep):
+                return float("inf")
             v = float(np.mean([means[p][g] for g in keep]))
             return v if np.isfinite(v) else float("inf")
 

@@ -19,6 +19,15 @@ widest axis):
 2. **Ridge extraction**: bins with ``k >= creaseness`` and smoothed density at least
    ``min_density`` are thinned to one-bin-wide curves (:func:`skimage.morphology.skeletonize`),
    and curves connected in the 26-neighbourhood form one ridge.
+   With ``max_axis_angle`` set, ridge bins whose local direction (principal axis of the ridge
+   bins within ``_AXIS_RADIUS`` bins) is more than that angle from the grey diagonal are removed
+   before the curves are labelled, and pieces on one line along the diagonal (mean
+   chromaticities within ``_REJOIN_RADIUS`` bins) are joined again. On the histogram of *log* colours (as the thesis builds it)
+   a grey shading change moves every surface's colours along the diagonal ``(1, 1, 1)``, so a
+   surface's ridge runs parallel to it; a crest segment across the diagonal is a bridge
+   between the ridges of two surfaces (a saddle of the density), which the threshold-and-thin
+   step would otherwise join into one ridge (deer and paper1 of the MIT set,
+   docs/names-shades-mit.md).
 3. **Pruning**: a ridge nearest to fewer than ``min_share`` of the colours is dropped and the
    colours are assigned again (RAD keeps the ridges of the dominant colours).
 
@@ -46,6 +55,13 @@ __all__ = ["RIDGE_DETECTORS", "ColourShades", "colour_shades"]
 #: Ridge detectors of :func:`colour_shades`.
 RIDGE_DETECTORS = ("rad", "hessian")
 _DIAGONAL = np.full(3, 1.0 / np.sqrt(3.0))
+#: Radius (bins) of the neighbourhood whose principal axis is a crest bin's direction when
+#: ``max_axis_angle`` cuts the crest across the diagonal (the thinned curve's next bins).
+_AXIS_RADIUS = 2.0
+#: After the cut, pieces whose mean log chromaticity (bins projected on the plane across the
+#: diagonal) is closer than this many bins are one ridge again: the cut also breaks a
+#: surface's own ridge where it wiggles, and its pieces lie on one line along the diagonal.
+_REJOIN_RADIUS = 1.0
 
 
 @dataclass(frozen=True)
@@ -100,6 +116,7 @@ def colour_shades(
     creaseness: float = 1.0,
     min_share: float = 0.005,
     tangent_radius: float = 3.0,
+    max_axis_angle: float | None = None,
 ) -> ColourShades:
     """Find the ridges of the distribution of *colours* and describe each colour by them.
 
@@ -121,6 +138,9 @@ def colour_shades(
         ``rad``: fraction of the colours a ridge must be nearest to, else it is pruned.
     tangent_radius
         ``rad``: radius in bins of the ridge neighbourhood whose principal axis is the tangent.
+    max_axis_angle
+        ``rad``: degrees; crest bins whose local direction is further than this from the grey
+        diagonal are cut out (module docstring, step 2). ``None``: no cut.
     """
     from scipy import ndimage
 
@@ -149,6 +169,8 @@ def colour_shades(
             np.zeros(1, np.int64),
         )
     components, _ = ndimage.label(ridge_mask, structure=np.ones((3, 3, 3)))
+    if detector == "rad" and max_axis_angle is not None:
+        components = _cut_across_diagonal(components, max_axis_angle)
     if detector == "rad":
         components = _prune(components, grid.index, min_share)
         tangent_grid = _local_axes(components, tangent_radius)
@@ -195,6 +217,37 @@ def _rad_ridges(
     kappa = -sum(np.gradient(field[..., k], axis=k) for k in range(3))
     crest = support & (kappa >= creaseness)
     return np.asarray(skeletonize(crest), dtype=bool)
+
+
+def _cut_across_diagonal(components: np.ndarray, max_angle_deg: float) -> np.ndarray:
+    """Step 2's cut: ridge bins whose local axis is more than *max_angle_deg* from the grey
+    diagonal removed, the remaining curves labelled again (26-connected) and pieces of one
+    line along the diagonal joined (``_REJOIN_RADIUS``); unchanged if the cut would remove
+    every bin."""
+    from scipy import ndimage
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    axes = _local_axes(components, _AXIS_RADIUS)
+    along = np.abs(axes @ _DIAGONAL)
+    keep = (components > 0) & (along >= np.cos(np.radians(max_angle_deg)))
+    if not keep.any():
+        return components
+    pieces, n = ndimage.label(keep, structure=np.ones((3, 3, 3)))
+    points = np.argwhere(pieces > 0).astype(np.float64)
+    piece = pieces[pieces > 0]
+    across = points - np.outer(points @ _DIAGONAL, _DIAGONAL)  # chromaticity, in bins
+    count = np.bincount(piece, minlength=n + 1)[1:]
+    centre = (
+        np.stack(
+            [np.bincount(piece, weights=across[:, k], minlength=n + 1)[1:] for k in range(3)],
+            axis=1,
+        )
+        / count[:, None]
+    )
+    near = np.linalg.norm(centre[:, None, :] - centre[None, :, :], axis=2) < _REJOIN_RADIUS
+    _, group = connected_components(csr_matrix(near), directed=False)
+    return np.concatenate([[0], group + 1])[pieces]
 
 
 def _hessian_ridges(density: np.ndarray, min_density: float) -> tuple[np.ndarray, np.ndarray]:

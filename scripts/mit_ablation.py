@@ -9,8 +9,10 @@ For every object of MIT_DIR (the development half, ``$SPECTRINSIC_DATA/mit_intri
 the MRF is run once per point of MRF_POINTS (steps 1-3, :meth:`NamesAndShades.labelling`) and
 steps 4-5 once per point of POST_GRID on that labelling. Every point is scored with the thesis'
 protocol (:mod:`spectrinsic.decompose.mit`). The default is chosen by hold-one-object-out
-(:func:`spectrinsic.decompose.protocol.hold_one_out`, score = MIT LMSE) over the whole grid:
-one setting for all objects, never one per object. OUT.json keeps every score; DOC.md gets the
+(:func:`spectrinsic.decompose.protocol.hold_one_out`, score = MIT LMSE) over the whole grid,
+among the points that lose to reflectance = image on at most MAX_LOSSES of the objects they
+are chosen on (issue 23's "beats the baseline on at least 8 of the 10"): one setting for all
+objects, never one per object. OUT.json keeps every score; DOC.md gets the
 ablation table (docs/names-shades-mit.md).
 """
 
@@ -35,12 +37,12 @@ from spectrinsic.decompose.registry import get_decomposer
 #: thesis (only gamma/alpha = 100, gamma/beta = 2 and mu = 1/3 are); gamma/alpha = 10 was the
 #: rendered-set protocol's choice. The ridge detector (sec. 3.2.2): "hessian" (round 1) or
 #: "rad" (RAD's MLSEC-ST creaseness, thinning, pruning) at creaseness/sigma (1.0, 1) or (1.5, 2).
-HESSIAN = {"ridge_detector": "hessian", "creaseness": 1.0, "sigma": 1.0}
-RAD = {"ridge_detector": "rad", "creaseness": 1.5, "sigma": 2.0}
-RAD_FINE = {"ridge_detector": "rad", "creaseness": 1.0, "sigma": 1.0}
+HESSIAN = {"ridge_detector": "hessian", "creaseness": 1.0, "sigma": 1.0, "max_axis_angle": None}
+RAD = {"ridge_detector": "rad", "creaseness": 1.5, "sigma": 2.0, "max_axis_angle": None}
+RAD_FINE = {"ridge_detector": "rad", "creaseness": 1.0, "sigma": 1.0, "max_axis_angle": None}
 MRF_GRID = {"gamma": [0.3, 1.0, 3.0, 10.0, 30.0], "gamma_over_alpha": [10.0, 100.0],
             "ridge_detector": ["hessian", "rad"], "creaseness": [1.0, 1.25, 1.5],
-            "sigma": [1.0, 1.5, 2.0, 3.0]}
+            "sigma": [1.0, 1.5, 2.0, 3.0], "max_axis_angle": [None, 30.0, 45.0, 60.0]}
 #: Round 1 (before the RAD detector): the hessian points. scripts/mit_ablation.json holds
 #: both rounds (round 1's keys, which lack the detector, are read as HESSIAN by merge()).
 HESSIAN_POINTS = [{"gamma": g, "gamma_over_alpha": 100.0, **HESSIAN} for g in (1.0, 3.0, 10.0, 30.0)
@@ -56,7 +58,17 @@ MRF_POINTS = [{"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD},
               {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "sigma": 3.0},
               # round 2c (between the connected web of 1.0 and the chosen 1.5; sigma 1.5)
               {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "creaseness": 1.25},
-              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "sigma": 1.5}]
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "sigma": 1.5},
+              # round 3 (crest bins across the grey diagonal cut: deer's paints split)
+              {"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD, "max_axis_angle": 60.0},
+              {"gamma": 1.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 60.0},
+              {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 60.0},
+              {"gamma": 10.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 60.0},
+              {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 45.0},
+              {"gamma": 10.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 45.0},
+              # round 3b (the best point, cut 45 and gamma 3, lay on the grid's edge)
+              {"gamma": 1.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 45.0},
+              {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 30.0}]
 #: Parameters of steps 4-5 (run on each labelling).
 POST_GRID = {"reflectance_colour": ["label-centroid", "region-mean"],
              "split_by_ridge": [False, True]}
@@ -115,16 +127,33 @@ def run(mit_dir: Path, names: list[str] | None, points: list[dict], with_extra: 
     return {"scores": scores, "labelling_seconds": seconds}
 
 
+#: The issue's second criterion as a constraint of the choice: a point may lose to
+#: reflectance = image on at most this many of the objects it is chosen on (8 of 10 wins).
+MAX_LOSSES = 2
+
+
 def choose(scores: dict) -> dict:
+    """Hold-one-object-out (score = MIT LMSE) among the points that lose to
+    ``image-as-reflectance`` on at most MAX_LOSSES of the objects they are chosen on; the
+    unconstrained choice beside it."""
     grid = {k: {o: v["lmse"] for o, v in s.items()} for k, s in scores.items()
             if k.startswith("{")}
     objects = sorted(next(iter(grid.values())))
+    grid = {k: v for k, v in grid.items() if set(objects) <= set(v)}
+    baseline = {o: scores["image-as-reflectance"][o]["lmse"] for o in objects}
     table = {tuple(sorted(json.loads(k).items())): v for k, v in grid.items()}
-    result = hold_one_out(table, {o: o for o in objects})
+
+    def eligible(point, keep) -> bool:
+        return sum(table[point][o] >= baseline[o] for o in keep) <= MAX_LOSSES
+
+    result = hold_one_out(table, {o: o for o in objects}, eligible)
+    free = hold_one_out(table, {o: o for o in objects})
     return {"chosen": dict(result.chosen), "chosen_lmse": result.chosen_score,
-            "held_out_lmse": result.held_out_score,
+            "held_out_lmse": result.held_out_score, "max_losses": MAX_LOSSES,
             "folds": [{"held_out": f.held_out, "chosen": dict(f.chosen), "lmse": f.score}
-                      for f in result.folds]}
+                      for f in result.folds],
+            "unconstrained": {"chosen": dict(free.chosen), "chosen_lmse": free.chosen_score,
+                              "held_out_lmse": free.held_out_score}}
 
 
 def row(name: str, per_object: dict, baseline: dict) -> str:
@@ -140,6 +169,8 @@ THESIS = {"gamma": 1.0, "gamma_over_alpha": 100.0, "reflectance_colour": "label-
 #: The round-1 defaults (hessian ridges), the reference for "before".
 ROUND_1 = {"gamma": 1.0, "gamma_over_alpha": 10.0, "reflectance_colour": "region-mean",
            "split_by_ridge": True, "colour_constancy": "grey-world", **HESSIAN}
+#: The round-2 defaults (RAD ridges without the diagonal cut).
+ROUND_2 = {**ROUND_1, **RAD}
 
 
 def variations(label: str, centre: dict, s: dict, base: dict) -> list[str]:
@@ -167,6 +198,10 @@ def markdown(report: dict) -> str:
             lines.append(row(f"{label} (hessian ridges)", s[label], base))
     lines += variations("thesis, RAD ridges", {**THESIS, **RAD}, s, base)
     lines.append(row("round-1 defaults (hessian ridges)", s[key(ROUND_1)], base))
+    lines.append(row("round-2 defaults (RAD ridges, no diagonal cut)", s[key(ROUND_2)], base))
+    free = report["choice"].get("unconstrained", {}).get("chosen")
+    if free and free != chosen:
+        lines.append(row(f"unconstrained choice: {free}", s[key(free)], base))
     lines.append(row(f"**chosen**: {chosen}", s[key(chosen)], base))
     lines += variations("chosen", chosen, s, base)
     if key({**chosen, **RAD_FINE}) in s:
@@ -182,6 +217,8 @@ def merge(parts: list[Path]) -> dict:
         for k, per_object in data["scores"].items():
             if k.startswith("{") and "ridge_detector" not in k:  # round 1: the hessian detector
                 k = key({**json.loads(k), **HESSIAN})
+            elif k.startswith("{") and "max_axis_angle" not in k:  # round 2: no diagonal cut
+                k = key({"max_axis_angle": None, **json.loads(k)})
             report["scores"].setdefault(k, {}).update(per_object)
         report["labelling_seconds"].update(data["labelling_seconds"])
     report["choice"] = choose(report["scores"])
@@ -194,7 +231,8 @@ def per_object(report: dict) -> str:
     columns = {"thesis Table 3.5": None, "image-as-reflectance": "image-as-reflectance",
                "colour-retinex": "colour-retinex",
                "ours, thesis settings, RAD": key({**THESIS, **RAD}),
-               "ours, round-1 defaults": key(ROUND_1), "ours, chosen": key(chosen)}
+               "ours, round-1 defaults": key(ROUND_1), "ours, round-2 defaults": key(ROUND_2),
+               "ours, chosen": key(chosen)}
     lines = ["| object | " + " | ".join(columns) + " |", "|---" * (len(columns) + 1) + "|"]
     objects = sorted(o for o in THESIS_TABLES_3_4_3_5 if o in s["colour-retinex"])
     for obj in objects:
@@ -217,6 +255,13 @@ def main(argv: list[str]) -> int:
         doc.write_text(table)
         print(table)
         print(json.dumps(report["choice"], indent=1))
+        c, base = report["choice"], report["scores"]["image-as-reflectance"]
+        per = report["scores"][key(c["chosen"])]
+        wins = sum(v["lmse"] < base[o]["lmse"] for o, v in per.items())
+        print(f"chosen LMSE {c['chosen_lmse']:.4f}, held-out {c['held_out_lmse']:.4f}, "
+              f"beats image-as-reflectance on {wins}/{len(per)}; unconstrained "
+              f"{c['unconstrained']['chosen_lmse']:.4f} (held-out "
+              f"{c['unconstrained']['held_out_lmse']:.4f})")
         return 0
     chosen = [a for a in argv if a.startswith("--points=")]  # indices into MRF_POINTS
     argv = [a for a in argv if a not in chosen]

@@ -1,6 +1,6 @@
 """One figure per stage of names-and-shades (thesis ch. 3) on one MIT development object.
 
-Usage: python -P scripts/names_shades_stages.py MIT_DIR OBJECT OUT_DIR [PARAM=VALUE ...]
+Usage: python -P scripts/names_shades_stages.py MIT_DIR OBJECT OUT_DIR [--default-only] [PARAM=VALUE ...]
 
 Writes OUT_DIR/nas-<object>-<stage>.png for the stages of Fig. 3.4: ``names`` (observed
 Appendix A labels, each pixel painted with its label's centre of mass, as Fig. 3.2(b)),
@@ -8,7 +8,8 @@ Appendix A labels, each pixel painted with its label's centre of mass, as Fig. 3
 ridge), ``weights`` (the Case A/B/C weight of each pixel's edges, Fig. 3.6), ``labels`` (MRF
 output, as Fig. 3.7(c) before coherence), ``regions``, and ``result`` (reflectance and shading
 beside the ground truth, as Table 3.3), for the thesis' settings and, when PARAM=VALUE pairs are
-given, for those too (e.g. ``gamma=10``).
+given, for those too (e.g. ``gamma=10``); ``--default-only``: the defaults (with the pairs)
+only, without the thesis' settings.
 """
 
 from __future__ import annotations
@@ -149,11 +150,14 @@ def main(argv: list[str]) -> int:
 
     matplotlib.use("Agg")
     warnings.simplefilter("ignore")
+    default_only = "--default-only" in argv
+    argv = [a for a in argv if a != "--default-only"]
     mit_dir, name, out = Path(argv[0]), argv[1], Path(argv[2])
     out.mkdir(parents=True, exist_ok=True)
     obj = load_mit_object(mit_dir / f"{name}.npz")
-    print("thesis", stage_figures(obj, NamesAndShades.thesis(), out, "thesis"))
-    if len(argv) > 3:
+    if not default_only:
+        print("thesis", stage_figures(obj, NamesAndShades.thesis(), out, "thesis"))
+    if len(argv) > 3 or default_only:
         change = {k: ast.literal_eval(v) for k, v in (a.split("=", 1) for a in argv[3:])}
         method = dataclasses.replace(NamesAndShades(), **change)
         print("chosen", stage_figures(obj, method, out, "default"))

@@ -32,6 +32,23 @@ def test_hold_one_out_by_hand():
     assert res.held_out_score == pytest.approx((2.0 + 2.0 + 4.0) / 3.0)
 
 
+def test_hold_one_out_with_a_constraint_by_hand():
+    """The table of the test above with B ineligible wherever the groups it is chosen on
+    include z (say B loses to a baseline there): A everywhere except the fold without z."""
+    groups = {"x1": "x", "x2": "x", "y1": "y", "z1": "z"}
+    table = {
+        A: {"x1": 0.5, "x2": 1.5, "y1": 1.0, "z1": 4.0},
+        B: {"x1": 2.0, "x2": 2.0, "y1": 2.0, "z1": 1.0},
+    }
+    res = hold_one_out(table, groups, eligible=lambda p, keep: p == A or "z" not in keep)
+    assert res.chosen == A and res.chosen_score == pytest.approx(2.0)
+    folds = {f.held_out: f for f in res.folds}
+    assert folds["x"].chosen == A and folds["x"].score == 1.0
+    assert folds["y"].chosen == A and folds["y"].score == 1.0
+    assert folds["z"].chosen == A and folds["z"].score == 4.0
+    assert res.held_out_score == pytest.approx(2.0)
+
+
 def test_hold_one_out_needs_two_groups_and_treats_nan_as_worst():
     with pytest.raises(SpectrinsicError, match="at least 2 scene groups"):
         hold_one_out({A: {"a": 1.0}}, {"a": "g"})

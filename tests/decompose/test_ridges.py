@@ -86,3 +86,34 @@ def test_a_cast_shadow_is_case_c_and_a_paint_edge_case_a():
     assert np.mean(stages.weights[across_shadow] == method.gamma) > 0.9
     alpha = method.gamma / method.gamma_over_alpha
     assert np.mean(stages.weights[across_paint] == alpha) > 0.9
+
+
+def _bridged_surfaces(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Log colours of two paints (each shaded from 0.05 to 1, 3 % noise) and 10 % of pixels on
+    their shared edge: linear mixtures of the two under one shading (0.5), a crest across the
+    grey diagonal that bridges the two ridges."""
+    rng = np.random.default_rng(seed)
+    paints = np.array([[0.7, 0.35, 0.2], [0.35, 0.4, 0.5]])
+    n = 20000
+    which = rng.integers(0, 2, n)
+    mixed = rng.random(n) < 0.1
+    t = np.where(mixed, rng.random(n), which.astype(float))
+    albedo = paints[0] * (1.0 - t)[:, None] + paints[1] * t[:, None]
+    shading = np.where(mixed, 0.5, rng.uniform(0.05, 1.0, n))
+    rgb = albedo * shading[:, None] * np.exp(rng.normal(0, 0.03, (n, 3)))
+    return np.log(np.clip(rgb, 1 / 255, 1)), which, ~mixed
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_cutting_crests_across_the_diagonal_separates_bridged_surfaces(seed):
+    colours, which, pure = _bridged_surfaces(seed)
+    joined = colour_shades(colours, creaseness=1.5, sigma=2.0)
+    assert joined.n_ridges == 1  # threshold-and-thin follows the bridge
+    cut = colour_shades(colours, creaseness=1.5, sigma=2.0, max_axis_angle=60.0)
+    # no ridge holds pixels of both paints; the pieces of one paint's ridge that the cut
+    # leaves apart (where the ridge bends) are few, the largest holds most of its pixels
+    for r in range(cut.n_ridges):
+        assert np.unique(which[pure & (cut.ridge == r)]).size <= 1
+    for paint in (0, 1):
+        _, counts = np.unique(cut.ridge[pure & (which == paint)], return_counts=True)
+        assert counts.size <= 3 and counts.max() > 0.6 * counts.sum()
