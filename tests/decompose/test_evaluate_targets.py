@@ -127,7 +127,9 @@ def test_the_targets_differ_where_there_is_specular(dataset, tmp_path):
     want_f = _expected_shading_error(s, image)
     assert diffuse[key] == pytest.approx(want_d, rel=1e-6)
     assert full[key] == pytest.approx(want_f, rel=1e-6)
-    assert abs(full[key] - diffuse[key]) > 0.1 * diffuse[key]
+    # the metal's pixels weigh on both alike (their shading is defined, reflectance = 0 gives
+    # no derived shading there), so the two differ by less than the specular alone would make
+    assert abs(full[key] - diffuse[key]) > 0.05 * diffuse[key]
     assert full[("rs", "shading", "si_mse")] == pytest.approx(diffuse[key], rel=1e-6)
     assert diffuse[("r", "reflectance", "si_mse")] == full[("r", "reflectance", "si_mse")] == 0
 
