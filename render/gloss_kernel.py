@@ -199,7 +199,7 @@ class GlossKernel(_Kernel):
     def run(self, sampler: Any, ray: Any, active: Any) -> list:
         """The K·L transport accumulators, the K·L specular ones, then the first-hit maps."""
         mi, dr, k = self.mi, self.dr, self.it.n_bands
-        first = (mi.UInt32(self.it.n_surfaces), mi.Float(0.0), mi.Vector3f(0.0))
+        first = self.first_state()
         zeros = [mi.Float(0.0) for _ in range(k * self.it.n_lights)]
         state = (
             sampler,
@@ -219,12 +219,7 @@ class GlossKernel(_Kernel):
         state = dr.while_loop(
             state, lambda *s: s[10], self.gloss_body, label="spectrinsic band path (glossy)"
         )
-        out = list(state[5]) + list(state[12])
-        if self.it.n_surfaces:
-            surface, distance, normal = state[9]
-            out += [dr.select(surface == i, 1.0, 0.0) for i in range(self.it.n_surfaces)]
-            out += [distance, normal.x, normal.y, normal.z]
-        return out
+        return list(state[5]) + list(state[12]) + self.first_maps(state[9])
 
 
 @functools.cache
@@ -258,7 +253,7 @@ def gloss_path_class(variant: str) -> type:
             return (
                 transport_channels(self.n_lights, self.n_bands)
                 + specular_channels(self.n_lights, self.n_bands)
-                + first_hit_channels(self.n_surfaces)
+                + first_hit_channels(self.n_surfaces, self.n_texcols)
             )
 
         def sample(
@@ -274,7 +269,9 @@ def gloss_path_class(variant: str) -> type:
     return GlossPath
 
 
-def gloss_path(mi: Any, *, max_depth: int, n_bands: int, n_lights: int, n_surfaces: int = 0) -> Any:
+def gloss_path(
+    mi: Any, *, max_depth: int, n_bands: int, n_lights: int, n_surfaces: int = 0, n_texcols: int = 0
+) -> Any:
     """A glossy band-path integrator for the active variant (rr off), as
     :func:`~spectrinsic.render.integrator.band_path`."""
     gloss_path_class(mi.variant())
@@ -286,5 +283,6 @@ def gloss_path(mi: Any, *, max_depth: int, n_bands: int, n_lights: int, n_surfac
             "n_bands": int(n_bands),
             "n_lights": int(n_lights),
             "n_surfaces": int(n_surfaces),
+            "n_texcols": int(n_texcols),
         }
     )

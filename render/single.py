@@ -36,6 +36,7 @@ from spectrinsic.render.passes import (
 )
 from spectrinsic.render.plugins import hdr_film, path_integrator, rgb_spectrum
 from spectrinsic.render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
+from spectrinsic.render.textures import texture_tables
 from spectrinsic.render.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import get_sensors
@@ -149,12 +150,19 @@ def _tables(
     albedo = np.vstack([bands, np.zeros((1, bands.shape[1]))])  # last row: black
     surfaces = tr.surfaces(scene)
     rows = {s.key: s.material for s in surfaces if s.material >= 0}
+    textures = texture_tables(scene, albedo[:-1])
     return BandTables(
         albedo=albedo,
         shape_rows=rows,
         emitter_lights=emitters,
         n_lights=len(scene.lights),
         shape_surfaces={s.key: i for i, s in enumerate(surfaces)} if aovs else {},
+        textures=textures,
+        shape_textures={}
+        if textures is None
+        else {
+            s.key: textures.mesh_slots[s.mesh] for s in surfaces if s.mesh in textures.mesh_slots
+        },
     )
 
 
@@ -218,16 +226,22 @@ def _trace(
 ) -> _Traced:
     """One traversal at path *depth*; the *first* one also takes the first-hit maps."""
     n_surfaces = len(tables.shape_surfaces) if first else 0
+    n_texcols = 0 if tables.textures is None else len(tables.textures.columns)
     make = gloss_path if dims.glossy else band_path
     integrator = make(
-        mi, max_depth=depth, n_bands=dims.n_bands, n_lights=dims.n_lights, n_surfaces=n_surfaces
+        mi,
+        max_depth=depth,
+        n_bands=dims.n_bands,
+        n_lights=dims.n_lights,
+        n_surfaces=n_surfaces,
+        n_texcols=n_texcols,
     )
     integrator.set_tables(loaded, tables if n_surfaces else replace(tables, shape_surfaces={}))
     if spec_table is not None:
         integrator.set_specular(spec_table)
     n_t = dims.n_bands * dims.n_lights
     n_spec = n_t if dims.glossy else 0
-    n_first = len(first_hit_channels(n_surfaces))
+    n_first = len(first_hit_channels(n_surfaces, n_texcols))
     image, dt = _render(mi, loaded, integrator, spp=spp, seed=seed, n=n_t + n_spec + n_first)
 
     def per_light(channels: np.ndarray) -> np.ndarray:
@@ -352,8 +366,11 @@ def render_traversal(
                 progress(1)
     outputs = _outputs(value_sets, widths, traced, direct)
     hits = traced[0].first
+    columns = np.zeros(0, np.int64) if tables.textures is None else tables.textures.columns
     aov_maps = (
-        assemble_aovs(scene, tr.surfaces(scene), hits[..., :-4], hits[..., -4], hits[..., -3:])
+        assemble_aovs(
+            scene, tr.surfaces(scene), hits[..., :-4], hits[..., -4], hits[..., -3:], columns
+        )
         if aovs and hits is not None
         else {}
     )
