@@ -292,6 +292,7 @@ def _plain(value: Any) -> Any:
             f.name: _plain(getattr(value, f.name))
             for f in fields(value)
             if not (f.metadata.get("omit_default") and getattr(value, f.name) == f.default)
+            and not f.metadata.get("omit_when", lambda record: False)(value)
         }
     if isinstance(value, np.ndarray):
         return value.tolist()

@@ -73,7 +73,8 @@ class Texture:
 
     name: str
     basis: tuple[int, ...]
-    weights: np.ndarray
+    # a procedural texture's record (scene_to_dict, the scene hash) is its recipe alone
+    weights: np.ndarray = field(metadata={"omit_when": lambda texture: bool(texture.pattern)})
     pattern: str = field(default="", metadata={"omit_default": True})
     seed: int = field(default=0, metadata={"omit_default": True})
 
