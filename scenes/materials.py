@@ -207,7 +207,7 @@ def textured_entry(texture: Texture, spectra: list[str]) -> dict[str, Any]:
     if texture.pattern:
         return entry | {
             "pattern": texture.pattern,
-            "size": int(texture.weights.shape[0]),
+            "size": int(texture.size),
             "seed": int(texture.seed),
         }
     return entry | {"weights": np.asarray(texture.weights, np.float64).tolist()}

@@ -22,8 +22,9 @@ to steps of 1/255, mapped onto the basis by piecewise-linear interpolation along
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -36,6 +37,7 @@ __all__ = [
     "CONVEX_TOLERANCE",
     "Texture",
     "make_texture",
+    "texture_from_record",
     "pattern_weights",
     "weights_problem",
     "texture_problem",
@@ -66,9 +68,9 @@ class Texture:
         Indices into ``Scene.materials`` of the basis reflectances (diffuse materials).
     weights
         ``(h, w, B)`` float64 convex weights per texel (row 0 at v = 0).
-    pattern, seed
-        The procedural recipe the weights came from (:func:`make_texture`), or ``""`` for
-        weights given explicitly.
+    pattern, size, seed
+        The procedural recipe the weights came from (:func:`make_texture`), or ``""`` (and 0)
+        for weights given explicitly.
     """
 
     name: str
@@ -76,14 +78,15 @@ class Texture:
     # a procedural texture's record (scene_to_dict, the scene hash) is its recipe alone
     weights: np.ndarray = field(metadata={"omit_when": lambda texture: bool(texture.pattern)})
     pattern: str = field(default="", metadata={"omit_default": True})
+    size: int = field(default=0, metadata={"omit_default": True})
     seed: int = field(default=0, metadata={"omit_default": True})
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Texture):
             return NotImplemented
         return (
-            (self.name, self.basis, self.pattern, self.seed)
-            == (other.name, other.basis, other.pattern, other.seed)
+            (self.name, self.basis, self.pattern, self.size, self.seed)
+            == (other.name, other.basis, other.pattern, other.size, other.seed)
             and self.weights.shape == other.weights.shape
             and np.array_equal(self.weights, other.weights)
         )
@@ -192,7 +195,21 @@ def make_texture(name: str, basis: tuple[int, ...], pattern: str, size: int, see
     if not 1 <= size <= TEXTURE_MAX:
         raise ValueError(f"texture size {size}: expected 1..{TEXTURE_MAX} texels per side")
     weights = pattern_weights(pattern, size, len(basis), seed)
-    return Texture(name, tuple(basis), weights, pattern, int(seed))
+    return Texture(name, tuple(basis), weights, pattern, int(size), int(seed))
+
+
+def texture_from_record(record: Mapping[str, Any]) -> Texture:
+    """The :class:`Texture` of its ``scene_to_dict`` record (a recipe, or explicit weights)."""
+    basis = tuple(int(b) for b in record["basis"])
+    if record.get("pattern"):
+        return make_texture(
+            str(record["name"]),
+            basis,
+            str(record["pattern"]),
+            int(record["size"]),
+            int(record["seed"]),
+        )
+    return Texture(str(record["name"]), basis, np.asarray(record["weights"], np.float64))
 
 
 def box_uv(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:

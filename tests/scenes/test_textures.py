@@ -20,6 +20,7 @@ from spectrinsic.scenes.textures import (
     box_uv,
     pattern_weights,
     texel_index,
+    texture_from_record,
 )
 
 from .test_io import BASE, write
@@ -81,6 +82,7 @@ def test_textured_yaml_loads_validates_and_round_trips(tmp_path):
     # a procedural texture's record is its recipe, not its 16 x 16 x 3 weights
     record = scene_to_dict(scene)["meshes"][1]["texture"]
     assert "weights" not in record and record["pattern"] == "rings"
+    assert texture_from_record(record) == ground.texture  # as relight reads scene.json
     assert "texture" not in scene_to_dict(scene)["meshes"][0]
 
 
@@ -93,6 +95,8 @@ def test_explicit_weights_round_trip(tmp_path):
     scene = load_scene(write(tmp_path, _doc(wood)))
     np.testing.assert_array_equal(scene.meshes[1].texture.weights, [[[1, 0], [0.25, 0.75]]])
     assert load_scene(save_scene(scene, tmp_path / "saved.yaml")) == scene
+    record = scene_to_dict(scene)["meshes"][1]["texture"]
+    assert texture_from_record(record) == scene.meshes[1].texture
 
 
 @pytest.mark.parametrize(
