@@ -40,6 +40,7 @@ from spectrinsic.scenes.textures import (
     PATTERNS,
     TEXTURE_MAX,
     Texture,
+    basis_name,
     make_texture,
     weights_problem,
 )
@@ -50,7 +51,6 @@ __all__ = [
     "IOR_RANGE",
     "TEXTURED",
     "TexturedMaterial",
-    "basis_name",
     "material_problem",
     "parse_material",
     "material_entry",
@@ -78,11 +78,6 @@ class TexturedMaterial:
 
     materials: tuple[Material, ...]
     texture: Texture
-
-
-def basis_name(texture: str, b: int) -> str:
-    """Name of basis material *b* of textured material *texture* (``"table[0]"``)."""
-    return f"{texture}[{b}]"
 
 
 def _number(value: Any) -> bool:

@@ -19,9 +19,10 @@ import numpy as np
 import yaml
 
 from spectrinsic.errors import SceneError
-from spectrinsic.scenes.materials import basis_name, material_entry, textured_entry
+from spectrinsic.scenes.materials import material_entry, textured_entry
 from spectrinsic.scenes.model import Light, Scene, scene_to_dict
 from spectrinsic.scenes.scene_format import FORMAT_VERSION
+from spectrinsic.scenes.textures import basis_name
 
 __all__ = ["save_scene", "scene_to_yaml_dict"]
 

@@ -36,6 +36,7 @@ __all__ = [
     "BASIS_MAX",
     "CONVEX_TOLERANCE",
     "Texture",
+    "basis_name",
     "make_texture",
     "texture_from_record",
     "pattern_weights",
@@ -92,6 +93,15 @@ class Texture:
         )
 
     __hash__ = None  # type: ignore[assignment]
+
+
+def basis_name(texture: str, b: int) -> str:
+    """Name of basis material *b* of textured material *texture* in a scene (``"table[0]"``).
+
+    >>> basis_name("table", 0)
+    'table[0]'
+    """
+    return f"{texture}[{b}]"
 
 
 def weights_problem(weights: np.ndarray) -> str | None:

@@ -16,9 +16,8 @@ import pytest
 from spectrinsic.errors import RenderError
 from spectrinsic.gt_export.layers import compute_ground_truth
 from spectrinsic.render import RenderSettings, render_scene
-from spectrinsic.scenes.materials import basis_name
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
-from spectrinsic.scenes.textures import Texture, make_texture
+from spectrinsic.scenes.textures import Texture, basis_name, make_texture
 from spectrinsic.scenes.validate import validate_scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as WL
 from spectrinsic.spectra import get_spectrum

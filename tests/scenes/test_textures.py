@@ -153,3 +153,52 @@ def test_cli_rejects_a_bad_texture_before_any_work(tmp_path):
     assert run.returncode == 2 and "Traceback" not in run.stderr
     assert "size 100000" in run.stderr and len(run.stderr.strip().splitlines()) == 1
     assert not out.exists()
+
+
+@pytest.mark.parametrize("generator", ["objects-on-ground", "rooms"])
+def test_generated_objects_take_per_pixel_textures_on_request(tmp_path, generator):
+    from spectrinsic.scenes.generators import GeneratorOptions, generate
+    from spectrinsic.scenes.generators.materials import (
+        PIXEL_TEXTURE,
+        MaterialDistribution,
+        munsell_chips,
+    )
+    from spectrinsic.scenes.validate import validate_scene
+
+    def scene(fraction: float):
+        dist = MaterialDistribution(chroma_range=(2.0, 4.0), texture_fraction=fraction)
+        options = GeneratorOptions(width=16, height=16, materials=dist)
+        return generate(generator, root_seed=5, index=0, view=0, options=options)
+
+    chips = {n: (v, c) for n, v, c in munsell_chips()}
+    plain, textured = scene(0.0), scene(1.0)
+    assert all(m.texture is None for m in plain.meshes)
+    meshes = [m for m in textured.meshes if m.texture is not None]
+    assert meshes and textured.metadata["patterns"].count(PIXEL_TEXTURE) == len(meshes)
+    validate_scene(textured)
+    for mesh in meshes:
+        basis = [textured.materials[b] for b in mesh.texture.basis]
+        assert 2 <= len(basis) <= 3 and mesh.texture.weights.shape == (64, 64, len(basis))
+        assert len({m.spectrum for m in basis}) == len(basis)  # distinct chips ...
+        assert all(2.0 <= chips[m.spectrum][1] <= 4.0 for m in basis)  # ... from the range
+    assert load_scene(save_scene(textured, tmp_path / "scene.yaml")) == textured
+
+
+def test_texture_fraction_is_checked_and_textured_parts_do_not_merge():
+    from spectrinsic.errors import DatasetError
+    from spectrinsic.pipeline.source_plan import generator_source
+    from spectrinsic.scenes.generators.materials import MaterialDistribution
+    from spectrinsic.scenes.parts import merge
+    from spectrinsic.scenes.primitives import box
+
+    with pytest.raises(SceneError, match="texture_fraction=1.5"):
+        MaterialDistribution(texture_fraction=1.5)
+    with pytest.raises(DatasetError, match="--texture-fraction 1.5"):
+        generator_source("rooms", 2, texture_fraction=1.5)
+    assert "texture_fraction" not in generator_source("rooms", 2)  # older configs keep their hash
+    part = box((1, 1, 1), "flat:0.5")
+    textured = type(part)(
+        part.vertices, part.faces, part.labels, ("flat:0.2", "flat:0.8"), ("noise", 4, 0)
+    )
+    with pytest.raises(SceneError, match="textured part"):
+        merge(part, textured)
