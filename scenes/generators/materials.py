@@ -5,7 +5,9 @@ directory is configured), with a controllable distribution of Munsell value and 
 (:class:`MaterialDistribution`). Patterns (:data:`PATTERNS`: stripes, checkers, patches,
 printed labels, noise partitions, spectral textures) repaint faces by their centroids, so every
 region is still one exact spectrum (no texture filtering); a spectral texture varies smoothly
-from face to face as convex mixes of three reflectances (``mix:`` spectra).
+from face to face as convex mixes of three reflectances (``mix:`` spectra). With
+``texture_fraction`` an object instead takes a per-pixel spectral texture
+(:data:`PIXEL_TEXTURE`, :mod:`spectrinsic.scenes.textures`).
 """
 
 from __future__ import annotations
