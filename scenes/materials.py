@@ -134,7 +134,9 @@ def _parse_textured(name: str, value: dict) -> TexturedMaterial | str:
         if problem is None and w.shape[2] != len(basis):
             problem = f"weights have {w.shape[2]} per texel for {len(basis)} basis spectra"
         return problem or TexturedMaterial(mats, Texture(name, where, w))
-    pattern, size, seed = value["pattern"], value.get("size"), value.get("seed", 0)
+    pattern: Any = value["pattern"]
+    size: Any = value.get("size")
+    seed: Any = value.get("seed", 0)
     if pattern not in PATTERNS:
         return f"pattern {pattern!r}: expected one of {', '.join(PATTERNS)}" + did_you_mean(
             str(pattern), PATTERNS
