@@ -336,6 +336,24 @@ class _Kernel:
         return list(state[5]) + self.first_maps(state[9])
 
 
+def _check_fit(it: Any, tables: BandTables) -> None:
+    """Raise if *tables* do not fit integrator *it* (bands, lights, surfaces, texture columns)."""
+    shape = np.shape(tables.albedo)
+    n_texcols = 0 if tables.textures is None else len(tables.textures.columns)
+    if (
+        len(shape) != 2
+        or shape[1] != it.n_bands
+        or tables.n_lights != it.n_lights
+        or len(tables.shape_surfaces) != it.n_surfaces
+        or n_texcols != it.n_texcols
+    ):
+        raise RenderError(
+            f"band tables {shape} for {tables.n_lights} lights and {n_texcols} texture columns "
+            f"do not fit an integrator of {it.n_bands} bands, {it.n_lights} lights and "
+            f"{it.n_texcols} texture columns"
+        )
+
+
 @functools.cache
 def band_path_class(variant: str) -> type:
     """The :class:`BandPath` integrator class for the active *variant* (defined per variant,
@@ -367,30 +385,13 @@ def band_path_class(variant: str) -> type:
 
         def set_tables(self, scene: Any, tables: BandTables) -> None:
             """Point the lookups at *tables* for the loaded *scene* (no recompilation)."""
-            shape = np.shape(tables.albedo)
-            if (
-                len(shape) != 2
-                or shape[1] != self.n_bands
-                or tables.n_lights != self.n_lights
-                or len(tables.shape_surfaces) != self.n_surfaces
-                or (0 if tables.textures is None else len(tables.textures.columns))
-                != self.n_texcols
-            ):
-                raise RenderError(
-                    f"band tables {shape} for {tables.n_lights} lights do not fit an "
-                    f"integrator of {self.n_bands} bands and {self.n_lights} lights"
-                )
+            _check_fit(self, tables)
             self.albedo, self.shape_lut, self.emitter_lut, self.surface_lut = _lookups(
                 mi, dr, scene, tables
             )
-            (
-                self.slot_lut,
-                self.tex_widths,
-                self.tex_heights,
-                self.tex_offsets,
-                self.texel_albedo,
-                self.texel_weights,
-            ) = texture_lookups(mi, dr, scene, tables.textures, tables.shape_textures)
+            lookups = texture_lookups(mi, dr, scene, tables.textures, tables.shape_textures)
+            self.slot_lut, self.tex_widths, self.tex_heights, self.tex_offsets = lookups[:4]
+            self.texel_albedo, self.texel_weights = lookups[4:]
 
         def aov_names(self) -> list[str]:
             return transport_channels(self.n_lights, self.n_bands) + first_hit_channels(
