@@ -226,7 +226,10 @@ def _run_jobs(
         wanted,
         aovs,
         data_dir,
-        integrator if diagonal else "passes",
+        # a textured scene's coverage needs the traversal even without diagonal modes
+        integrator
+        if diagonal or (aovs and any(m.texture is not None for m in scene.meshes))
+        else "passes",
         dict(
             spp=spp,
             seed=seed,

@@ -27,7 +27,7 @@ from spectrinsic.render import translate as tr
 from spectrinsic.render.aovs import assemble_aovs
 from spectrinsic.render.gloss_kernel import gloss_path
 from spectrinsic.render.integrator import BandTables, band_path, first_hit_channels
-from spectrinsic.render.modes import ChannelValues, RenderMode, channel_values
+from spectrinsic.render.modes import ChannelValues, RenderMode, channel_values, get_mode
 from spectrinsic.render.passes import (
     DIRECT_DEPTH,
     PassOutput,
@@ -36,7 +36,7 @@ from spectrinsic.render.passes import (
 )
 from spectrinsic.render.plugins import hdr_film, path_integrator, rgb_spectrum
 from spectrinsic.render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
-from spectrinsic.render.textures import texture_tables
+from spectrinsic.render.textures import shape_slots, texture_tables
 from spectrinsic.render.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import get_sensors
@@ -158,11 +158,7 @@ def _tables(
         n_lights=len(scene.lights),
         shape_surfaces={s.key: i for i, s in enumerate(surfaces)} if aovs else {},
         textures=textures,
-        shape_textures={}
-        if textures is None
-        else {
-            s.key: textures.mesh_slots[s.mesh] for s in surfaces if s.mesh in textures.mesh_slots
-        },
+        shape_textures=shape_slots(textures, surfaces),
     )
 
 
@@ -409,11 +405,15 @@ def render_jobs(
     :func:`~spectrinsic.render.passes.render_diagonal`; a direct-only image is made for the
     modes in *wanted* of the jobs that ask for one. With *aovs*, the first-hit maps come from
     the same traversal (drop-in for :func:`~spectrinsic.render.aovs.render_aovs`). The jobs
-    must hold at least one diagonal mode.
+    must hold at least one diagonal mode, or none with *aovs*: one traversal then gives the
+    first-hit maps alone (a textured scene's coverage, which the coverage passes cannot give).
     """
     diagonal = list(
         {m.name: m for modes, _, _ in jobs for m in modes if m.kind == "diagonal"}.values()
     )
+    maps_only = not diagonal and aovs
+    if maps_only:  # any mode's traversal gives the first-hit maps
+        diagonal = [get_mode("rgb3")]
     want_direct = any(
         flag and m.name in wanted for modes, _, flag in jobs for m in modes if m.kind == "diagonal"
     )
@@ -433,7 +433,7 @@ def render_jobs(
         progress=progress,
         geometry=geometry,
     )
-    transport = {m.name: o for m, o in zip(diagonal, outs, strict=True)}
+    transport = {} if maps_only else {m.name: o for m, o in zip(diagonal, outs, strict=True)}
     parts = []
     for modes, group, flag in jobs:
         part = {}

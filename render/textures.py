@@ -27,7 +27,15 @@ from spectrinsic.errors import RenderError
 from spectrinsic.scenes.model import Scene
 from spectrinsic.scenes.textures import Texture
 
-__all__ = ["TextureTables", "texture_tables", "textured_bsdf", "refuse_textures", "texel_of"]
+__all__ = [
+    "TextureTables",
+    "texture_tables",
+    "shape_slots",
+    "textured_bsdf",
+    "refuse_textures",
+    "texel_of",
+    "texture_lookups",
+]
 
 
 @dataclass(frozen=True, eq=False)
@@ -84,6 +92,14 @@ def texture_tables(scene: Scene, band_albedo: np.ndarray) -> TextureTables | Non
         widths=np.array([w for _, w in sizes], np.int64),
         mesh_slots={i: s for s, (i, _) in enumerate(textured)},
     )
+
+
+def shape_slots(tables: TextureTables | None, surfaces: Sequence[Any]) -> dict[str, int]:
+    """``{shape key: texture slot}`` of the textured ones among *surfaces*
+    (:class:`~spectrinsic.render.translate.Surface` records: ``key``, ``mesh``)."""
+    if tables is None:
+        return {}
+    return {s.key: tables.mesh_slots[s.mesh] for s in surfaces if s.mesh in tables.mesh_slots}
 
 
 def _weight_bitmap(mi: Any, values: np.ndarray) -> dict[str, Any]:

@@ -144,3 +144,13 @@ def test_the_passes_integrator_refuses_textures_in_one_line():
     assert "spectral textures" in str(err.value) and "\n" not in str(err.value)
     plain = replace(scene, meshes=(replace(scene.meshes[0], texture=None),))
     render_scene(plain, RenderSettings(1, modes=("rgb3",), integrator="passes"), seed=0)
+
+
+def test_a_spectral_only_render_takes_the_textured_coverage_from_one_traversal(textured):
+    """No diagonal mode: the first-hit maps still come from a band-path traversal (the coverage
+    passes cannot split a texel), so the reflectance is the same exact one."""
+    scene, _, _, gt = textured
+    result = render_scene(scene, RenderSettings(2, max_depth=2, modes=("spectral",)), seed=3)
+    alone = compute_ground_truth(scene, result).layers["reflectance"].data
+    _, _, inside = _texel_of_pixels()
+    np.testing.assert_allclose(alone[inside], gt.layers["reflectance"].data[inside], atol=1e-6)
