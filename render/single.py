@@ -251,6 +251,14 @@ def _trace(
     )
 
 
+def _first_hit_maps(scene: Scene, tables: BandTables, hits: np.ndarray) -> dict[str, np.ndarray]:
+    """:func:`~spectrinsic.render.aovs.assemble_aovs` of the traversal's first-hit channels
+    (coverage, texture columns, ray distance, normal)."""
+    columns = None if tables.textures is None else tables.textures.columns
+    surfaces = tr.surfaces(scene)
+    return assemble_aovs(scene, surfaces, hits[..., :-4], hits[..., -4], hits[..., -3:], columns)
+
+
 def _outputs(
     value_sets: Sequence[ChannelValues],
     widths: Sequence[int],
@@ -362,14 +370,7 @@ def render_traversal(
                 progress(1)
     outputs = _outputs(value_sets, widths, traced, direct)
     hits = traced[0].first
-    columns = np.zeros(0, np.int64) if tables.textures is None else tables.textures.columns
-    aov_maps = (
-        assemble_aovs(
-            scene, tr.surfaces(scene), hits[..., :-4], hits[..., -4], hits[..., -3:], columns
-        )
-        if aovs and hits is not None
-        else {}
-    )
+    aov_maps = _first_hit_maps(scene, tables, hits) if aovs and hits is not None else {}
     seconds = [t.seconds for t in traced]
     return outputs, aov_maps, tuple(seconds), chosen
 
