@@ -285,6 +285,11 @@ class Scene:
     camera: Camera
     metadata: dict[str, Any] = field(default_factory=dict, compare=False, hash=False)
 
+    @property
+    def textured(self) -> bool:
+        """Whether a mesh carries a spectral texture."""
+        return any(m.texture is not None for m in self.meshes)
+
 
 def _plain(value: Any) -> Any:
     if is_dataclass(value) and not isinstance(value, type):
