@@ -72,6 +72,14 @@ def _add_generated_draw_options(src: Any) -> None:
         "0.15 for LO (default: any, 60%% from saturated LEDs and filtered lamps)",
     )
     src.add_argument(
+        "--texture-fraction",
+        type=float,
+        default=0.0,
+        metavar="F",
+        help="fraction of generated objects given a per-pixel spectral texture (wood rings, "
+        "weave, noise over 2-3 reflectances; exact reflectance ground truth) (0)",
+    )
+    src.add_argument(
         "--sfu",
         action="store_true",
         help="also draw SFU reflectances and illuminants (needs --data-dir)",
@@ -176,6 +184,7 @@ def source_from_args(args: argparse.Namespace) -> str | None:
             light_saturation=None
             if args.light_saturation is None
             else _range("--light-saturation", args.light_saturation),
+            texture_fraction=args.texture_fraction,
         )
     if args.scenes:
         size = None if args.resolution is None else parse_resolution(args.resolution)

@@ -23,6 +23,7 @@ from spectrinsic.gt_export.colour_spread import material_chroma, shown, spread_s
 from spectrinsic.gt_export.layers import luminance
 from spectrinsic.gt_export.loader import load_sample
 from spectrinsic.gt_export.sample_meta import SampleMeta
+from spectrinsic.scenes.generators.materials import PIXEL_TEXTURE
 
 __all__ = [
     "DIVERSITY_NAME",
@@ -35,6 +36,8 @@ __all__ = [
 DIVERSITY_NAME = "diversity.png"
 #: Luminance percentiles whose ratio is the "luminance range" (decades).
 _RANGE_PERCENTILES = (1.0, 99.0)
+#: Generator pattern names of spectral textures: face-resolution mixes and per-pixel textures.
+_TEXTURED = ("texture", PIXEL_TEXTURE)
 
 
 def _cct(xy: Sequence[float]) -> float:
@@ -61,7 +64,7 @@ def spread_record(meta: SampleMeta) -> dict[str, Any]:
         "lights": [tuple(light.xy) for light in meta.lights],
         "materials": list(meta.materials.values()),
         "patterned": len(extra.get("patterns", [])),
-        "textured": list(extra.get("patterns", [])).count("texture"),
+        "textured": sum(p in _TEXTURED for p in extra.get("patterns", [])),
         "objects": int(extra.get("n_objects", 0) or 0),
         "coverage": extra.get("object_coverage"),
     }

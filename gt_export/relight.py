@@ -40,6 +40,7 @@ from spectrinsic.gt_export.writer import export_sample
 from spectrinsic.render.light_transport import LightTransport, mode_lighting, relit_result
 from spectrinsic.render.result import RenderResult
 from spectrinsic.scenes.model import GLOSS_FIELDS, Camera, Light, Material, Mesh, Scene
+from spectrinsic.scenes.textures import texture_from_record
 from spectrinsic.spectra import get_spectrum
 
 __all__ = [
@@ -105,6 +106,7 @@ def read_sample_scene(sample_dir: str | os.PathLike[str]) -> Scene:
                 faces=np.asarray(m["faces"], np.int64).reshape(-1, 3),
                 face_materials=np.asarray(m["face_materials"], np.int64).reshape(-1),
                 object_id=int(m["object_id"]),
+                texture=texture_from_record(m["texture"]) if m.get("texture") else None,
             )
             for m in data["meshes"]
         )

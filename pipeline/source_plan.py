@@ -79,10 +79,12 @@ def generator_source(
     sfu: bool = False,
     gloss: GlossDistribution | None = None,
     light_saturation: Sequence[float] | None = None,
+    texture_fraction: float = 0.0,
 ) -> str:
     """The canonical ``source`` JSON of a generated set (validated: an impossible range is
-    refused here, before any scene is planned); *gloss* and *light_saturation* enter it only
-    when given, so matte sets and older configs keep their source and config hash."""
+    refused here, before any scene is planned); *gloss*, *light_saturation* and a
+    *texture_fraction* above 0 enter it only when given, so matte sets and older configs keep
+    their source and config hash."""
     validate_choice(generator, GENERATORS, "scene generator", error=DatasetError)
     try:
         check_ranges(
@@ -96,6 +98,8 @@ def generator_source(
             check_saturation((float(light_saturation[0]), float(light_saturation[1])))
     except SceneError as exc:
         raise DatasetError(f"--light-saturation: {exc}") from None
+    if not 0.0 <= texture_fraction <= 1.0:
+        raise DatasetError(f"--texture-fraction {texture_fraction:g}: expected a fraction in 0..1")
     if not (1 <= count <= MAX_COUNT and 1 <= views <= MAX_VIEWS):
         raise DatasetError(
             f"--count {count} / --views {views}; expected whole numbers from 1 to "
@@ -119,6 +123,8 @@ def generator_source(
         }
     if light_saturation is not None:  # absent when not given: older configs keep their hash
         spec["light_saturation"] = [float(v) for v in light_saturation]
+    if texture_fraction > 0:
+        spec["texture_fraction"] = float(texture_fraction)
     return json.dumps(spec, sort_keys=True)
 
 
@@ -207,9 +213,15 @@ def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir:
             sfu_i = tuple(list_spectra("sfu-illum", data_dir=data_dir))
         except Exception as exc:  # noqa: BLE001 - any data-directory failure reads the same
             raise DatasetError(f"--sfu needs the SFU data directory (--data-dir): {exc}") from exc
-    dist = MaterialDistribution(
-        tuple(spec["value_range"]), tuple(spec["chroma_range"]), sfu_fraction=0.5 if sfu_r else 0.0
-    )
+    try:
+        dist = MaterialDistribution(
+            tuple(spec["value_range"]),
+            tuple(spec["chroma_range"]),
+            sfu_fraction=0.5 if sfu_r else 0.0,
+            texture_fraction=float(spec.get("texture_fraction", 0.0)),
+        )
+    except (SceneError, TypeError, ValueError) as exc:
+        raise DatasetError(f"source materials: {exc}") from exc
     g = spec.get("gloss") or {}
     try:
         gloss = GlossDistribution(

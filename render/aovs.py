@@ -17,6 +17,7 @@ from spectrinsic.render.passes import (
     timed_render,
 )
 from spectrinsic.render.plugins import aov_integrator, hdr_film, rgb_spectrum
+from spectrinsic.render.textures import refuse_textures
 from spectrinsic.render.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Scene
 
@@ -54,6 +55,7 @@ def render_aovs(
     """
     if int(spp) < 1:
         raise SceneError(f"spp {spp}: expected at least 1 sample per pixel")
+    refuse_textures(scene, "the coverage passes")
     surfaces = tr.surfaces(scene)
     n_pass = max(1, -(-len(surfaces) // 3))
     chosen = choose_variant("rgb", variant)
@@ -116,10 +118,17 @@ def assemble_aovs(
     cover: np.ndarray,
     depth_sum: np.ndarray | None,
     normal_sum: np.ndarray | None,
+    texture_columns: np.ndarray | None = None,
 ) -> dict[str, np.ndarray]:
     """The maps :func:`render_aovs` returns, from the box-filtered per-surface coverage
     ``(H, W, S)``, ray distance ``(H, W)`` and shading normal ``(H, W, 3)`` of the camera rays'
-    first hits (0 where they miss)."""
+    first hits (0 where they miss).
+
+    With *texture_columns* ``(G,)`` (material indices), *cover* has ``S + G`` channels: the last
+    G hold the box-filtered texel weights of textured hits on those basis materials
+    (:mod:`~spectrinsic.render.textures`), which take the place of the textured surfaces'
+    own coverage in the material coverage."""
+    columns = np.zeros(0, np.int64) if texture_columns is None else np.asarray(texture_columns)
     h, w = cover.shape[:2]
     n_mat = len(scene.materials)
     material_cov = np.zeros((h, w, n_mat))
@@ -127,9 +136,12 @@ def assemble_aovs(
     object_cov = np.zeros((h, w, len(object_ids)))
     for i, s in enumerate(surfaces):
         if s.material >= 0:
-            material_cov[..., s.material] += cover[..., i]
+            if scene.meshes[s.mesh].texture is None:
+                material_cov[..., s.material] += cover[..., i]
             object_cov[..., object_ids.index(scene.meshes[s.mesh].object_id)] += cover[..., i]
-    hit = cover.sum(axis=-1)
+    for g, m in enumerate(columns):
+        material_cov[..., int(m)] += cover[..., len(surfaces) + g]
+    hit = cover[..., : len(surfaces)].sum(axis=-1)
     material_id = _majority(material_cov)
     winner = _majority(object_cov)
     object_id = np.where(winner >= 0, np.asarray(object_ids + [-1], np.int64)[winner], -1).astype(

@@ -284,7 +284,7 @@ class GlossKernel(_Kernel):
         """The K·L transport accumulators, the K·L specular ones, the K·L white-at-metal ones
         (scenes with metals), then the first-hit maps."""
         mi, dr, k = self.mi, self.dr, self.it.n_bands
-        first = (mi.UInt32(self.it.n_surfaces), mi.Float(0.0), mi.Vector3f(0.0))
+        first = self.first_state()
         zeros = [mi.Float(0.0) for _ in range(k * self.it.n_lights)]
         state = (
             sampler,
@@ -307,11 +307,7 @@ class GlossKernel(_Kernel):
         out = list(state[5]) + list(state[12])
         if self.it.metals:
             out += self.run_white(sampler, ray, active)
-        if self.it.n_surfaces:
-            surface, distance, normal = state[9]
-            out += [dr.select(surface == i, 1.0, 0.0) for i in range(self.it.n_surfaces)]
-            out += [distance, normal.x, normal.y, normal.z]
-        return out
+        return out + self.first_maps(state[9])
 
 
 @functools.cache
@@ -356,7 +352,7 @@ def gloss_path_class(variant: str) -> type:
                 transport_channels(self.n_lights, self.n_bands)
                 + specular_channels(self.n_lights, self.n_bands)
                 + (metal_white_channels(self.n_lights, self.n_bands) if self.metals else [])
-                + first_hit_channels(self.n_surfaces)
+                + first_hit_channels(self.n_surfaces, self.n_texcols)
             )
 
         def sample(
@@ -380,6 +376,7 @@ def gloss_path(
     n_lights: int,
     n_surfaces: int = 0,
     metals: bool = False,
+    n_texcols: int = 0,
 ) -> Any:
     """A glossy band-path integrator for the active variant (rr off), as
     :func:`~spectrinsic.render.integrator.band_path`; with *metals* it also estimates the
@@ -394,5 +391,6 @@ def gloss_path(
             "n_lights": int(n_lights),
             "n_surfaces": int(n_surfaces),
             "metals": bool(metals),
+            "n_texcols": int(n_texcols),
         }
     )

@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import RenderError
+from spectrinsic.render.textures import TextureTables, texel_of, texture_lookups
 from spectrinsic.render.variants import import_mitsuba
 
 __all__ = [
@@ -67,6 +68,10 @@ class BandTables:
     shape_surfaces
         ``{Mitsuba shape id: surface index}`` for the first-hit maps (coverage one-hot per
         surface, ray distance, shading normal), empty when not wanted.
+    textures
+        The texel tables of textured meshes (:mod:`~spectrinsic.render.textures`), or ``None``.
+    shape_textures
+        ``{Mitsuba shape id: texture slot}`` of textured shapes.
     """
 
     albedo: np.ndarray
@@ -74,6 +79,8 @@ class BandTables:
     emitter_lights: dict[int, int]
     n_lights: int
     shape_surfaces: dict[str, int] = field(default_factory=dict)
+    textures: TextureTables | None = None
+    shape_textures: dict[str, int] = field(default_factory=dict)
 
 
 def transport_channels(n_lights: int, n_bands: int) -> list[str]:
@@ -81,13 +88,15 @@ def transport_channels(n_lights: int, n_bands: int) -> list[str]:
     return [f"t{j:02d}_{k:02d}" for j in range(n_lights) for k in range(n_bands)]
 
 
-def first_hit_channels(n_surfaces: int) -> list[str]:
+def first_hit_channels(n_surfaces: int, n_texcols: int = 0) -> list[str]:
     """AOV names of the first-hit maps after the transport: the coverage of each surface, the
-    ray distance and the shading normal (as Mitsuba's ``aov`` integrator's ``depth`` and
-    ``sh_normal``); none without surfaces."""
+    texel weights of each textured coverage column (:class:`TextureTables`), the ray distance
+    and the shading normal (as Mitsuba's ``aov`` integrator's ``depth`` and ``sh_normal``);
+    none without surfaces."""
     if n_surfaces == 0:
         return []
-    return [f"cov{i:03d}" for i in range(n_surfaces)] + [
+    cover = [f"cov{i:03d}" for i in range(n_surfaces)] + [f"tex{g:03d}" for g in range(n_texcols)]
+    return cover + [
         "depth",
         "normal.x",
         "normal.y",
@@ -189,13 +198,23 @@ class _Kernel:
         return self.light_of(ds.emitter, active_em), nee, active_em, bsdf_sample, bsdf_weight[0]
 
     def albedo(self, si: Any) -> list:
-        """ρ_k of the material of the shape hit (the black row elsewhere)."""
+        """ρ_k of the material of the shape hit (the black row elsewhere), or of the nearest
+        texel on a textured shape."""
         mi, dr, k = self.mi, self.dr, self.it.n_bands
         valid = si.is_valid()
         row = dr.gather(
             mi.UInt32, self.it.shape_lut, dr.reinterpret_array(mi.UInt32, si.shape), valid
         )
-        return [dr.gather(mi.Float, self.it.albedo, row * k + b, valid) for b in range(k)]
+        rho = [dr.gather(mi.Float, self.it.albedo, row * k + b, valid) for b in range(k)]
+        if not self.it.n_texcols:
+            return rho
+        texel, textured = texel_of(mi, dr, self.it, si)
+        return [
+            dr.select(
+                textured, dr.gather(mi.Float, self.it.texel_albedo, texel * k + b, textured), r
+            )
+            for b, r in enumerate(rho)
+        ]
 
     def roulette(self, sampler: Any, depth: Any, beta: Any, bands: Sequence) -> tuple[Any, Any]:
         """Russian roulette on the largest band (``path.cpp`` uses the largest channel);
@@ -220,11 +239,36 @@ class _Kernel:
         surface = dr.select(valid, surface, self.it.n_surfaces)
         distance = dr.select(valid, si.t, 0.0)
         normal = dr.select(valid, si.sh_frame.n, mi.Vector3f(0.0))
-        return (
-            dr.select(now, surface, first[0]),
-            dr.select(now, distance, first[1]),
-            dr.select(now, normal, first[2]),
+        hit = (surface, distance, normal) + (
+            texel_of(mi, dr, self.it, si) if self.it.n_texcols else ()
         )
+        return tuple(dr.select(now, h, f) for h, f in zip(hit, first, strict=True))
+
+    def first_state(self) -> tuple:
+        """The first-hit state before any hit: no surface, no distance, no normal (no texel)."""
+        mi = self.mi
+        first = (mi.UInt32(self.it.n_surfaces), mi.Float(0.0), mi.Vector3f(0.0))
+        return first + ((mi.UInt32(0), mi.Bool(False)) if self.it.n_texcols else ())
+
+    def first_maps(self, first: tuple) -> list:
+        """The first-hit channels (:func:`first_hit_channels`) of the final first-hit state."""
+        mi, dr, n = self.mi, self.dr, self.it.n_surfaces
+        if not n:
+            return []
+        surface, distance, normal = first[:3]
+        out = [dr.select(surface == i, 1.0, 0.0) for i in range(n)]
+        if self.it.n_texcols:
+            texel, textured = first[3:]
+            g = self.it.n_texcols
+            out += [
+                dr.select(
+                    textured,
+                    dr.gather(mi.Float, self.it.texel_weights, texel * g + c, textured),
+                    0.0,
+                )
+                for c in range(g)
+            ]
+        return out + [distance, normal.x, normal.y, normal.z]
 
     def body(
         self,
@@ -274,7 +318,7 @@ class _Kernel:
         """The K·L accumulators of one wavefront of camera rays, then the first-hit maps
         (:func:`first_hit_channels`)."""
         mi, dr, k = self.mi, self.dr, self.it.n_bands
-        first = (mi.UInt32(self.it.n_surfaces), mi.Float(0.0), mi.Vector3f(0.0))
+        first = self.first_state()
         state = (
             sampler,
             mi.Ray3f(ray),
@@ -289,12 +333,25 @@ class _Kernel:
             mi.Bool(active),
         )
         state = dr.while_loop(state, lambda *s: s[-1], self.body, label="spectrinsic band path")
-        out = list(state[5])
-        if self.it.n_surfaces:
-            surface, distance, normal = state[9]
-            out += [dr.select(surface == i, 1.0, 0.0) for i in range(self.it.n_surfaces)]
-            out += [distance, normal.x, normal.y, normal.z]
-        return out
+        return list(state[5]) + self.first_maps(state[9])
+
+
+def _check_fit(it: Any, tables: BandTables) -> None:
+    """Raise if *tables* do not fit integrator *it* (bands, lights, surfaces, texture columns)."""
+    shape = np.shape(tables.albedo)
+    n_texcols = 0 if tables.textures is None else len(tables.textures.columns)
+    if (
+        len(shape) != 2
+        or shape[1] != it.n_bands
+        or tables.n_lights != it.n_lights
+        or len(tables.shape_surfaces) != it.n_surfaces
+        or n_texcols != it.n_texcols
+    ):
+        raise RenderError(
+            f"band tables {shape} for {tables.n_lights} lights and {n_texcols} texture columns "
+            f"do not fit an integrator of {it.n_bands} bands, {it.n_lights} lights and "
+            f"{it.n_texcols} texture columns"
+        )
 
 
 @functools.cache
@@ -320,6 +377,7 @@ def band_path_class(variant: str) -> type:
             self.n_bands = int(props.get("n_bands", 3))
             self.n_lights = int(props.get("n_lights", 1))
             self.n_surfaces = int(props.get("n_surfaces", 0))
+            self.n_texcols = int(props.get("n_texcols", 0))
             self.surface_lut = mi.UInt32(np.zeros(1, np.uint32))
             self.albedo = mi.Float(np.zeros(self.n_bands, np.float32))
             self.shape_lut = mi.UInt32(np.zeros(1, np.uint32))
@@ -327,24 +385,17 @@ def band_path_class(variant: str) -> type:
 
         def set_tables(self, scene: Any, tables: BandTables) -> None:
             """Point the lookups at *tables* for the loaded *scene* (no recompilation)."""
-            shape = np.shape(tables.albedo)
-            if (
-                len(shape) != 2
-                or shape[1] != self.n_bands
-                or tables.n_lights != self.n_lights
-                or len(tables.shape_surfaces) != self.n_surfaces
-            ):
-                raise RenderError(
-                    f"band tables {shape} for {tables.n_lights} lights do not fit an "
-                    f"integrator of {self.n_bands} bands and {self.n_lights} lights"
-                )
+            _check_fit(self, tables)
             self.albedo, self.shape_lut, self.emitter_lut, self.surface_lut = _lookups(
                 mi, dr, scene, tables
             )
+            lookups = texture_lookups(mi, dr, scene, tables.textures, tables.shape_textures)
+            self.slot_lut, self.tex_widths, self.tex_heights, self.tex_offsets = lookups[:4]
+            self.texel_albedo, self.texel_weights = lookups[4:]
 
         def aov_names(self) -> list[str]:
             return transport_channels(self.n_lights, self.n_bands) + first_hit_channels(
-                self.n_surfaces
+                self.n_surfaces, self.n_texcols
             )
 
         def sample(
@@ -363,9 +414,12 @@ def band_path_class(variant: str) -> type:
     return BandPath
 
 
-def band_path(mi: Any, *, max_depth: int, n_bands: int, n_lights: int, n_surfaces: int = 0) -> Any:
+def band_path(
+    mi: Any, *, max_depth: int, n_bands: int, n_lights: int, n_surfaces: int = 0, n_texcols: int = 0
+) -> Any:
     """A :class:`BandPath` instance for the active variant (rr off: ``rr_depth`` > ``max_depth``),
-    with first-hit maps of *n_surfaces* surfaces if not 0."""
+    with first-hit maps of *n_surfaces* surfaces if not 0 and textures of *n_texcols* coverage
+    columns (:class:`TextureTables`) if not 0."""
     band_path_class(mi.variant())
     return mi.load_dict(
         {
@@ -375,5 +429,6 @@ def band_path(mi: Any, *, max_depth: int, n_bands: int, n_lights: int, n_surface
             "n_bands": int(n_bands),
             "n_lights": int(n_lights),
             "n_surfaces": int(n_surfaces),
+            "n_texcols": int(n_texcols),
         }
     )

@@ -28,6 +28,7 @@ from spectrinsic.render.plugins import (
     rgb_spectrum,
     spectral_film,
 )
+from spectrinsic.render.textures import refuse_textures
 from spectrinsic.render.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, SensorSet, get_spectrum
@@ -168,6 +169,7 @@ def render_diagonal(
     One :class:`PassOutput` per value set, ``(H, W, K)`` float32 raw channels.
     """
     _check_render_args(scene, spp, max_depth)
+    refuse_textures(scene, "the diagonal passes")
     active = _active(scene, active_lights)
     flags = (
         [bool(direct)] * len(value_sets) if isinstance(direct, bool) else [bool(d) for d in direct]

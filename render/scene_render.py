@@ -216,8 +216,8 @@ def _run_jobs(
     scope and every spectral pass in another; the variant already active goes first and stays
     active afterwards (``restore=False``), so consecutive batches switch once each, not four
     times. Passes do not depend on each other's order: each sets its own values, seed and spp.
-    With ``integrator="single"`` the diagonal modes of every job come from one band-path
-    traversal (:func:`spectrinsic.render.single.render_jobs`).
+    With ``integrator="single"`` the diagonal modes of every job, and a textured scene's AOVs
+    even without them, come from one band-path traversal (:func:`.single.render_jobs`).
     """
     diagonal = any(m.kind == "diagonal" for job in jobs for m in job.modes)
     run = _Run(
@@ -226,7 +226,7 @@ def _run_jobs(
         wanted,
         aovs,
         data_dir,
-        integrator if diagonal else "passes",
+        integrator if diagonal or (aovs and scene.textured) else "passes",
         dict(
             spp=spp,
             seed=seed,

@@ -27,7 +27,7 @@ from spectrinsic.render import translate as tr
 from spectrinsic.render.aovs import assemble_aovs
 from spectrinsic.render.gloss_kernel import gloss_path
 from spectrinsic.render.integrator import BandTables, band_path, first_hit_channels
-from spectrinsic.render.modes import ChannelValues, RenderMode, channel_values
+from spectrinsic.render.modes import ChannelValues, RenderMode, channel_values, get_mode
 from spectrinsic.render.passes import (
     DIRECT_DEPTH,
     PassOutput,
@@ -36,6 +36,7 @@ from spectrinsic.render.passes import (
 )
 from spectrinsic.render.plugins import hdr_film, path_integrator, rgb_spectrum
 from spectrinsic.render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
+from spectrinsic.render.textures import shape_slots, texture_tables
 from spectrinsic.render.traversal_output import TransportOutput
 from spectrinsic.render.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Scene
@@ -98,12 +99,15 @@ def _tables(
     albedo = np.vstack([bands, np.zeros((1, bands.shape[1]))])  # last row: black
     surfaces = tr.surfaces(scene)
     rows = {s.key: s.material for s in surfaces if s.material >= 0}
+    textures = texture_tables(scene, albedo[:-1])
     return BandTables(
         albedo=albedo,
         shape_rows=rows,
         emitter_lights=emitters,
         n_lights=len(scene.lights),
         shape_surfaces={s.key: i for i, s in enumerate(surfaces)} if aovs else {},
+        textures=textures,
+        shape_textures=shape_slots(textures, surfaces),
     )
 
 
@@ -162,6 +166,31 @@ class _Traced:
     metal_white: np.ndarray | None = None
 
 
+def _integrator(
+    mi: Any, dims: _Dims, depth: int, n_surfaces: int, n_texcols: int, metals: bool
+) -> Any:
+    """The band-path integrator of one traversal: glossy (with the white-at-metal paths when
+    *metals*) or Lambertian."""
+    if dims.glossy:
+        return gloss_path(
+            mi,
+            max_depth=depth,
+            n_bands=dims.n_bands,
+            n_lights=dims.n_lights,
+            n_surfaces=n_surfaces,
+            metals=metals,
+            n_texcols=n_texcols,
+        )
+    return band_path(
+        mi,
+        max_depth=depth,
+        n_bands=dims.n_bands,
+        n_lights=dims.n_lights,
+        n_surfaces=n_surfaces,
+        n_texcols=n_texcols,
+    )
+
+
 def _trace(
     mi: Any,
     loaded: Any,
@@ -178,19 +207,8 @@ def _trace(
     scenes with metals, the white-at-metal radiance."""
     n_surfaces = len(tables.shape_surfaces) if first else 0
     metals = dims.metals and first
-    if dims.glossy:
-        integrator = gloss_path(
-            mi,
-            max_depth=depth,
-            n_bands=dims.n_bands,
-            n_lights=dims.n_lights,
-            n_surfaces=n_surfaces,
-            metals=metals,
-        )
-    else:
-        integrator = band_path(
-            mi, max_depth=depth, n_bands=dims.n_bands, n_lights=dims.n_lights, n_surfaces=n_surfaces
-        )
+    n_texcols = 0 if tables.textures is None else len(tables.textures.columns)
+    integrator = _integrator(mi, dims, depth, n_surfaces, n_texcols, metals)
     integrator.set_tables(loaded, tables if n_surfaces else replace(tables, shape_surfaces={}))
     if spec_table is not None:
         integrator.set_specular(spec_table)
@@ -199,7 +217,7 @@ def _trace(
     n_t = dims.n_bands * dims.n_lights
     n_spec = n_t if dims.glossy else 0
     n_white = n_t if metals else 0
-    n_first = len(first_hit_channels(n_surfaces))
+    n_first = len(first_hit_channels(n_surfaces, n_texcols))
     image, dt = _render(
         mi, loaded, integrator, spp=spp, seed=seed, n=n_t + n_spec + n_white + n_first
     )
@@ -215,6 +233,14 @@ def _trace(
         seconds=dt,
         metal_white=per_light(image[..., n_t + n_spec : end]) if metals else None,
     )
+
+
+def _first_hit_maps(scene: Scene, tables: BandTables, hits: np.ndarray) -> dict[str, np.ndarray]:
+    """:func:`~spectrinsic.render.aovs.assemble_aovs` of the traversal's first-hit channels
+    (coverage, texture columns, ray distance, normal)."""
+    columns = None if tables.textures is None else tables.textures.columns
+    surfaces = tr.surfaces(scene)
+    return assemble_aovs(scene, surfaces, hits[..., :-4], hits[..., -4], hits[..., -3:], columns)
 
 
 def _outputs(
@@ -330,11 +356,7 @@ def render_traversal(
                 progress(1)
     outputs = _outputs(value_sets, widths, traced, direct)
     hits = traced[0].first
-    aov_maps = (
-        assemble_aovs(scene, tr.surfaces(scene), hits[..., :-4], hits[..., -4], hits[..., -3:])
-        if aovs and hits is not None
-        else {}
-    )
+    aov_maps = _first_hit_maps(scene, tables, hits) if aovs and hits is not None else {}
     seconds = [t.seconds for t in traced]
     return outputs, aov_maps, tuple(seconds), chosen
 
@@ -376,11 +398,15 @@ def render_jobs(
     :func:`~spectrinsic.render.passes.render_diagonal`; a direct-only image is made for the
     modes in *wanted* of the jobs that ask for one. With *aovs*, the first-hit maps come from
     the same traversal (drop-in for :func:`~spectrinsic.render.aovs.render_aovs`). The jobs
-    must hold at least one diagonal mode.
+    must hold at least one diagonal mode, or none with *aovs*: one traversal then gives the
+    first-hit maps alone (a textured scene's coverage, which the coverage passes cannot give).
     """
     diagonal = list(
         {m.name: m for modes, _, _ in jobs for m in modes if m.kind == "diagonal"}.values()
     )
+    maps_only = not diagonal and aovs
+    if maps_only:  # any mode's traversal gives the first-hit maps
+        diagonal = [get_mode("rgb3")]
     want_direct = any(
         flag and m.name in wanted for modes, _, flag in jobs for m in modes if m.kind == "diagonal"
     )
@@ -400,7 +426,7 @@ def render_jobs(
         progress=progress,
         geometry=geometry,
     )
-    transport = {m.name: o for m, o in zip(diagonal, outs, strict=True)}
+    transport = {} if maps_only else {m.name: o for m, o in zip(diagonal, outs, strict=True)}
     parts = []
     for modes, group, flag in jobs:
         part = {}

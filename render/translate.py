@@ -28,8 +28,10 @@ import numpy as np
 
 from spectrinsic.errors import SceneError
 from spectrinsic.render.plugins import black_bsdf
+from spectrinsic.render.textures import textured_bsdf
 from spectrinsic.render.variants import import_mitsuba
 from spectrinsic.scenes.model import Light, Material, Scene, unknown_light_kind
+from spectrinsic.scenes.textures import box_uv
 
 __all__ = [
     "CREASE_ANGLE_DEG",
@@ -153,27 +155,29 @@ def smooth_corner_normals(
     return out.reshape(len(f), 3, 3)
 
 
-def _mitsuba_mesh(
-    mi: Any, name: str, corners: np.ndarray, normals: np.ndarray, bsdf: Mapping
-) -> Any:
-    """An ``mi.Mesh`` with unshared vertices (one per face corner) and the given normals."""
-    n_faces = corners.shape[0]
+def _mitsuba_mesh(mi: Any, part: SurfaceGeometry, bsdf: Mapping) -> Any:
+    """An ``mi.Mesh`` with unshared vertices (one per face corner), the given normals and,
+    on a textured surface, texture coordinates."""
+    corners, n_faces = part.corners, part.corners.shape[0]
     props = mi.Properties()
     props["bsdf"] = mi.load_dict(dict(bsdf))
     mesh = mi.Mesh(
-        name,
+        part.key,
         vertex_count=3 * n_faces,
         face_count=n_faces,
         has_vertex_normals=True,
-        has_vertex_texcoords=False,
+        has_vertex_texcoords=part.uv is not None,
         props=props,
     )
     params = mi.traverse(mesh)
-    for key, array in (
+    arrays = [
         ("vertex_positions", corners.reshape(-1).astype(np.float32)),
         ("faces", np.arange(3 * n_faces, dtype=np.uint32)),
-        ("vertex_normals", normals.reshape(-1).astype(np.float32)),
-    ):
+        ("vertex_normals", part.normals.reshape(-1).astype(np.float32)),
+    ]
+    if part.uv is not None:
+        arrays.append(("vertex_texcoords", part.uv.reshape(-1).astype(np.float32)))
+    for key, array in arrays:
         params[key] = type(params[key])(array)
     params.update()
     return mesh
@@ -215,6 +219,22 @@ def material_bsdf(
     if rough:
         bsdf |= {"distribution": "ggx", "alpha": float(material.roughness)}
     return {"type": "twosided", "bsdf": bsdf}
+
+
+def _surface_bsdf(
+    scene: Scene, part: SurfaceGeometry, materials: Sequence[Mapping], white_metal: bool
+) -> dict[str, Any]:
+    """The BSDF of one surface: its material's, or on a textured mesh the texel-weighted mix of
+    its basis materials (a mix of equal reflectances, such as the band path's white load, is
+    that reflectance)."""
+    texture = scene.meshes[part.mesh].texture if part.mesh >= 0 else None
+    if texture is not None:
+        basis = [materials[b] for b in texture.basis]
+        if any(dict(b) != dict(basis[0]) for b in basis[1:]):
+            return textured_bsdf(import_mitsuba(), texture, basis)
+    return material_bsdf(
+        scene.materials[part.material], materials[part.material], white_metal=white_metal
+    )
 
 
 def _look_at(mi: Any, origin: Sequence[float], direction: Sequence[float], what: str) -> Any:
@@ -295,12 +315,16 @@ def _camera(mi: Any, scene: Scene, film: Mapping, sample_count: int) -> dict[str
 
 @dataclass(frozen=True, eq=False)
 class SurfaceGeometry:
-    """Triangles of one surface, ready for Mitsuba: ``corners`` and ``normals`` ``(F, 3, 3)``."""
+    """Triangles of one surface, ready for Mitsuba: ``corners`` and ``normals`` ``(F, 3, 3)``,
+    and on a textured mesh (its ``mesh`` index) the corners' ``uv`` ``(F, 3, 2)``
+    (:func:`~spectrinsic.scenes.textures.box_uv`)."""
 
     key: str
     material: int
     corners: np.ndarray
     normals: np.ndarray
+    mesh: int = -1
+    uv: np.ndarray | None = None
 
 
 def prepare_geometry(
@@ -317,10 +341,18 @@ def prepare_geometry(
         corners = np.asarray(mesh.vertices, float)[faces]
         normals = smooth_corner_normals(mesh.vertices, faces, crease_deg)
         face_materials = np.asarray(mesh.face_materials, np.int64)
+        uv = None if mesh.texture is None else box_uv(mesh.vertices, faces)
         for m in np.unique(face_materials):
             sel = face_materials == m
             out.append(
-                SurfaceGeometry(f"surf_{index}_{int(m)}", int(m), corners[sel], normals[sel])
+                SurfaceGeometry(
+                    f"surf_{index}_{int(m)}",
+                    int(m),
+                    corners[sel],
+                    normals[sel],
+                    index,
+                    None if uv is None else uv[sel],
+                )
             )
     return tuple(out)
 
@@ -372,10 +404,7 @@ def scene_to_mitsuba(
         "sensor": _camera(mi, scene, film, sample_count),
     }
     for part in prepare_geometry(scene, crease_deg) if geometry is None else geometry:
-        bsdf = material_bsdf(
-            scene.materials[part.material], materials[part.material], white_metal=white_metal
-        )
-        out[part.key] = _mitsuba_mesh(mi, part.key, part.corners, part.normals, bsdf)
+        out[part.key] = _mitsuba_mesh(mi, part, _surface_bsdf(scene, part, materials, white_metal))
     for j, (light, emission) in enumerate(zip(scene.lights, lights, strict=True)):
         entry = _light(mi, light, emission, f"scene {scene.name!r} light {j} ({light.name})")
         if entry is not None:

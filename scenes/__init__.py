@@ -5,6 +5,8 @@
   :func:`load_scene` (:mod:`~spectrinsic.scenes.scene_reader`) and written by :func:`save_scene`
   (:mod:`~spectrinsic.scenes.scene_writer`);
 - :mod:`~spectrinsic.scenes.validate`: :func:`validate_scene` (one-line errors);
+- :mod:`~spectrinsic.scenes.textures`: :class:`Texture`, per-texel convex mixes of basis
+  reflectances on a mesh, and their generated patterns (:func:`make_texture`);
 - :mod:`~spectrinsic.scenes.parts` (painted parts, placement), :mod:`~spectrinsic.scenes.primitives`,
   :mod:`~spectrinsic.scenes.painting`, :mod:`~spectrinsic.scenes.furniture` and
   :mod:`~spectrinsic.scenes.objects`: procedural, painted geometry;
@@ -27,6 +29,7 @@ from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene, scene
 from spectrinsic.scenes.sample_id import SampleId
 from spectrinsic.scenes.scene_reader import load_scene
 from spectrinsic.scenes.scene_writer import save_scene
+from spectrinsic.scenes.textures import Texture, make_texture
 from spectrinsic.scenes.validate import validate_scene
 
 __all__ = [
@@ -37,10 +40,12 @@ __all__ = [
     "Mesh",
     "SampleId",
     "Scene",
+    "Texture",
     "build",
     "default_samples",
     "load_blend",
     "load_scene",
+    "make_texture",
     "n_views",
     "save_scene",
     "scene_hash",

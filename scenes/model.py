@@ -22,6 +22,7 @@ from typing import Any, Literal
 import numpy as np
 
 from spectrinsic.errors import did_you_mean
+from spectrinsic.scenes.textures import Texture
 
 __all__ = [
     "Material",
@@ -128,6 +129,10 @@ class Mesh:
         exact spectra (painted stripes, patches).
     object_id
         Non-negative id written to the object-id ground-truth map.
+    texture
+        A spectral :class:`~spectrinsic.scenes.textures.Texture` over every face (whose
+        ``face_materials`` are then all ``texture.basis[0]``), or ``None``: each face one exact
+        spectrum. Left out of :func:`scene_to_dict` when ``None``.
     """
 
     name: str
@@ -135,6 +140,7 @@ class Mesh:
     faces: np.ndarray
     face_materials: np.ndarray
     object_id: int
+    texture: Texture | None = field(default=None, metadata=_OPTIONAL)
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Mesh):
@@ -145,6 +151,7 @@ class Mesh:
             and np.array_equal(self.vertices, other.vertices)
             and np.array_equal(self.faces, other.faces)
             and np.array_equal(self.face_materials, other.face_materials)
+            and self.texture == other.texture
         )
 
     __hash__ = None  # type: ignore[assignment]
@@ -278,6 +285,11 @@ class Scene:
     camera: Camera
     metadata: dict[str, Any] = field(default_factory=dict, compare=False, hash=False)
 
+    @property
+    def textured(self) -> bool:
+        """Whether a mesh carries a spectral texture."""
+        return any(m.texture is not None for m in self.meshes)
+
 
 def _plain(value: Any) -> Any:
     if is_dataclass(value) and not isinstance(value, type):
@@ -285,6 +297,7 @@ def _plain(value: Any) -> Any:
             f.name: _plain(getattr(value, f.name))
             for f in fields(value)
             if not (f.metadata.get("omit_default") and getattr(value, f.name) == f.default)
+            and not f.metadata.get("omit_when", lambda record: False)(value)
         }
     if isinstance(value, np.ndarray):
         return value.tolist()

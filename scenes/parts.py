@@ -21,6 +21,7 @@ import numpy as np
 
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes.model import Material, Mesh
+from spectrinsic.scenes.textures import basis_name, make_texture
 
 __all__ = ["Part", "moved", "deformed", "merge", "to_meshes"]
 
@@ -39,12 +40,17 @@ class Part:
         ``(F,)`` int64 index of each face's spectrum in :attr:`palette`.
     palette
         Reflectance spectrum names (``"munsell:5R 4/14"``, ``"flat:0.5"``).
+    texture
+        ``(pattern, size, seed)`` of a spectral texture over the whole part whose basis is
+        :attr:`palette` (:func:`~spectrinsic.scenes.textures.make_texture`; the labels are then
+        all 0), or ``None``.
     """
 
     vertices: np.ndarray
     faces: np.ndarray
     labels: np.ndarray
     palette: tuple[str, ...]
+    texture: tuple[str, int, int] | None = None
 
     @property
     def face_spectra(self) -> np.ndarray:
@@ -94,7 +100,7 @@ def moved(
 
     matrix = rot(rz, 0, 1) @ rot(ry, 2, 0) @ rot(rx, 1, 2)
     vertices = (part.vertices * s) @ matrix.T + np.asarray(translate, dtype=np.float64)
-    return Part(vertices, part.faces, part.labels, part.palette)
+    return Part(vertices, part.faces, part.labels, part.palette, part.texture)
 
 
 def deformed(part: Part, fn: Callable[[np.ndarray], np.ndarray]) -> Part:
@@ -104,11 +110,14 @@ def deformed(part: Part, fn: Callable[[np.ndarray], np.ndarray]) -> Part:
         raise SceneError(
             f"deformation returned shape {vertices.shape}, expected {part.vertices.shape}"
         )
-    return Part(vertices, part.faces, part.labels, part.palette)
+    return Part(vertices, part.faces, part.labels, part.palette, part.texture)
 
 
 def merge(*parts: Part) -> Part:
-    """Concatenate parts into one (components stay separate closed surfaces)."""
+    """Concatenate parts into one (components stay separate closed surfaces); textured parts
+    stay meshes of their own."""
+    if any(p.texture is not None for p in parts):
+        raise SceneError("merge: a textured part is a mesh of its own; merge it untextured")
     palette = tuple(dict.fromkeys(name for p in parts for name in p.palette))
     offsets = np.cumsum([0] + [len(p.vertices) for p in parts])
     vertices = np.concatenate([p.vertices for p in parts])
@@ -127,20 +136,33 @@ def to_meshes(
 ) -> tuple[tuple[Mesh, ...], tuple[Material, ...]]:
     """Turn named parts into scene meshes (one object id each) sharing one material table.
 
-    Materials are the distinct spectra in order of first use, each named after its spectrum.
+    Materials are the distinct spectra in order of first use, each named after its spectrum; a
+    textured part's basis spectra follow as materials of their own, ``<part name>[b]``
+    (:func:`~spectrinsic.scenes.materials.basis_name`), so the scene saves as YAML.
     """
-    palette = tuple(dict.fromkeys(name for _, p in parts for name in p.palette))
+    palette = tuple(
+        dict.fromkeys(name for _, p in parts if p.texture is None for name in p.palette)
+    )
     lookup = {n: i for i, n in enumerate(palette)}
+    materials = [Material(name=n, spectrum=n) for n in palette]
     meshes = []
     for k, (name, p) in enumerate(parts):
-        remap = np.array([lookup[n] for n in p.palette], dtype=np.int64)
+        texture = None
+        if p.texture is None:
+            face_materials = np.array([lookup[n] for n in p.palette], dtype=np.int64)[p.labels]
+        else:
+            basis = tuple(range(len(materials), len(materials) + len(p.palette)))
+            materials += [Material(basis_name(name, b), s) for b, s in enumerate(p.palette)]
+            texture = make_texture(name, basis, *p.texture)
+            face_materials = np.full(len(p.faces), basis[0], dtype=np.int64)
         meshes.append(
             Mesh(
                 name=name,
                 vertices=p.vertices.copy(),
                 faces=p.faces.copy(),
-                face_materials=remap[p.labels],
+                face_materials=face_materials,
                 object_id=first_object_id + k,
+                texture=texture,
             )
         )
-    return tuple(meshes), tuple(Material(name=n, spectrum=n) for n in palette)
+    return tuple(meshes), tuple(materials)

@@ -16,14 +16,14 @@ from __future__ import annotations
 
 import os
 import re
-from dataclasses import fields
+from dataclasses import fields, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from spectrinsic.errors import SceneError, did_you_mean, with_article
-from spectrinsic.scenes.materials import parse_material
+from spectrinsic.scenes.materials import TexturedMaterial, parse_material
 from spectrinsic.scenes.model import (
     LIGHT_DEFAULTED,
     LIGHT_FIELDS,
@@ -37,6 +37,7 @@ from spectrinsic.scenes.model import (
 )
 from spectrinsic.scenes.parts import Part, moved
 from spectrinsic.scenes.scene_format import FORMAT_VERSION, MESH_SUFFIXES
+from spectrinsic.scenes.textures import Texture
 from spectrinsic.scenes.validate import Problems, validate_scene
 from spectrinsic.scenes.yaml_limits import load_yaml_file
 
@@ -322,11 +323,16 @@ def scene_from_dict(data: Any, *, base: str | os.PathLike[str], source: str = "<
             "format",
             f"unsupported format version {data['format']!r}; expected {FORMAT_VERSION}",
         )
-    materials = problems.get(_materials, doc, data.get("materials"))
+    parsed = problems.get(_materials, doc, data.get("materials"))
+    materials, textures = (None, {}) if parsed is None else parsed
     # without sound materials, every mesh would also report its material as unknown
     lookup = None if materials is None else {m.name: i for i, m in enumerate(materials)}
+    if lookup is not None:
+        lookup |= {name: t.basis[0] for name, t in textures.items()}
     meshes = [
-        problems.get(_mesh, doc, Path(base), m, i, lookup)
+        problems.get(
+            _textured, doc, problems.get(_mesh, doc, Path(base), m, i, lookup), m, textures
+        )
         for i, m in enumerate(problems.get(_entries, doc, data, "meshes") or [])
     ]
     lights = [
@@ -349,19 +355,53 @@ def scene_from_dict(data: Any, *, base: str | os.PathLike[str], source: str = "<
     )
 
 
-def _materials(doc: _Doc, mats: Any) -> tuple[Material, ...]:
+def _materials(doc: _Doc, mats: Any) -> tuple[tuple[Material, ...], dict[str, Texture]]:
+    """The materials (a textured entry's basis materials in its place) and the textures."""
     if not isinstance(mats, dict) or not mats:
         raise doc.fail(
             "materials",
             "expected a non-empty mapping of material name -> spectrum name or material",
         )
-    out = []
+    out: list[Material] = []
+    textures: dict[str, Texture] = {}
     for k, v in mats.items():
         parsed = parse_material(doc.string(k, "materials"), v)
         if isinstance(parsed, str):
             raise doc.fail(f"materials.{k}", parsed)
-        out.append(parsed)
-    return tuple(out)
+        if isinstance(parsed, TexturedMaterial):
+            tex = parsed.texture
+            textures[k] = replace(tex, basis=tuple(len(out) + b for b in tex.basis))
+            out.extend(parsed.materials)
+        else:
+            out.append(parsed)
+    names = [m.name for m in out]
+    if len(set(names)) != len(names) or set(textures) & set(names):
+        clash = next(n for n in [*names, *textures] if [*names, *textures].count(n) > 1)
+        raise doc.fail(
+            f"materials.{clash}",
+            "duplicate material name (a textured material "
+            "'x' names its basis materials 'x[0]', 'x[1]', ...)",
+        )
+    return tuple(out), textures
+
+
+def _textured(
+    doc: _Doc, mesh: Mesh | None, entry: Any, textures: dict[str, Texture]
+) -> Mesh | None:
+    """*mesh* with the texture its ``material`` names, if textured."""
+    if mesh is None or not textures or not isinstance(entry, dict):
+        return mesh
+    runs = entry.get("face_materials")
+    named = (
+        [r[0] if isinstance(r, list) and r else r for r in runs] if isinstance(runs, list) else []
+    )
+    if any(isinstance(n, str) and n in textures for n in named):
+        raise doc.fail(
+            f"mesh {mesh.name!r}.face_materials",
+            "a textured material covers a whole mesh: give it as 'material'",
+        )
+    name = entry.get("material")
+    return replace(mesh, texture=textures[name]) if name in textures else mesh
 
 
 def _entries(doc: _Doc, data: dict, key: str) -> list[Any]:

@@ -19,9 +19,10 @@ import numpy as np
 import yaml
 
 from spectrinsic.errors import SceneError
-from spectrinsic.scenes.materials import material_entry
+from spectrinsic.scenes.materials import material_entry, textured_entry
 from spectrinsic.scenes.model import Light, Scene, scene_to_dict
 from spectrinsic.scenes.scene_format import FORMAT_VERSION
+from spectrinsic.scenes.textures import basis_name
 
 __all__ = ["save_scene", "scene_to_yaml_dict"]
 
@@ -49,6 +50,29 @@ def _runs(face_materials: np.ndarray, names: list[str]) -> list[list[Any]]:
     return [[names[int(fm[s])], int(c)] for s, c in zip(starts, counts, strict=True)]
 
 
+def _materials(scene: Scene) -> dict[str, Any]:
+    """The ``materials:`` mapping: a texture's basis materials (named
+    :func:`~spectrinsic.scenes.materials.basis_name`, consecutive) as its one textured entry."""
+    textures = {m.texture.basis[0]: m.texture for m in scene.meshes if m.texture is not None}
+    covered = {b for t in textures.values() for b in t.basis}
+    out: dict[str, Any] = {}
+    for i, m in enumerate(scene.materials):
+        tex = textures.get(i)
+        if tex is not None:
+            expected = [basis_name(tex.name, b) for b in range(len(tex.basis))]
+            if list(tex.basis) != list(range(i, i + len(tex.basis))) or expected != [
+                scene.materials[b].name for b in tex.basis
+            ]:
+                raise SceneError(
+                    f"scene {scene.name!r}: texture {tex.name!r} cannot be saved: its basis "
+                    f"materials must be consecutive and named {', '.join(expected)}"
+                )
+            out[tex.name] = textured_entry(tex, [scene.materials[b].spectrum for b in tex.basis])
+        elif i not in covered:
+            out[m.name] = material_entry(m)
+    return out
+
+
 def scene_to_yaml_dict(scene: Scene, mesh_files: Mapping[str, str] | None = None) -> dict[str, Any]:
     """The YAML document of *scene*; meshes named in *mesh_files* reference that relative path
     instead of holding inline geometry."""
@@ -67,7 +91,9 @@ def scene_to_yaml_dict(scene: Scene, mesh_files: Mapping[str, str] | None = None
             entry["vertices"] = np.asarray(m.vertices, dtype=np.float64).tolist()
             entry["faces"] = np.asarray(m.faces, dtype=np.int64).tolist()
         runs = _runs(m.face_materials, names)
-        if len(runs) == 1:
+        if m.texture is not None:
+            entry["material"] = m.texture.name
+        elif len(runs) == 1:
             entry["material"] = runs[0][0]
         else:
             entry["face_materials"] = runs
@@ -85,7 +111,7 @@ def scene_to_yaml_dict(scene: Scene, mesh_files: Mapping[str, str] | None = None
     doc: dict[str, Any] = {
         "format": FORMAT_VERSION,
         "name": scene.name,
-        "materials": {m.name: material_entry(m) for m in scene.materials},
+        "materials": _materials(scene),
         "meshes": meshes,
         "lights": lights,
         "camera": cam,

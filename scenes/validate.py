@@ -29,6 +29,7 @@ from spectrinsic.errors import SceneError, SpectrinsicError, with_article
 from spectrinsic.scenes.geometry import VISIBILITY_GRID, camera_rays, is_closed, winding_numbers
 from spectrinsic.scenes.materials import material_problem
 from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_KINDS, Scene, unknown_light_kind
+from spectrinsic.scenes.textures import texture_problem
 from spectrinsic.spectra import get_spectrum
 
 __all__ = [
@@ -184,6 +185,14 @@ def _check_meshes(scene: Scene, source: str) -> None:
                 f"{where}.object_id",
                 f"expected an integer from 0 to 2**31 - 1, got {m.object_id!r}",
             )
+
+
+def _check_textures(scene: Scene, source: str) -> None:
+    kinds = [m.kind for m in scene.materials]
+    for i, m in enumerate(scene.meshes):
+        problem = None if m.texture is None else texture_problem(m.texture, m.face_materials, kinds)
+        if problem is not None:
+            raise _fail(source, f"meshes[{i}] ({m.name!r}).texture", problem)
 
 
 def _check_lights(scene: Scene, source: str) -> None:
@@ -342,7 +351,7 @@ def validate_scene(
     """
     source = source or f"scene {scene.name!r}"
     problems = Problems(source)
-    for check in (_check_meshes, _check_lights, _check_camera, _check_materials):
+    for check in (_check_meshes, _check_lights, _check_camera, _check_materials, _check_textures):
         problems.get(check, scene, source)
     if check_spectra:
         cache: dict[str, object] = {}

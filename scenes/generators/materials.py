@@ -5,7 +5,9 @@ directory is configured), with a controllable distribution of Munsell value and 
 (:class:`MaterialDistribution`). Patterns (:data:`PATTERNS`: stripes, checkers, patches,
 printed labels, noise partitions, spectral textures) repaint faces by their centroids, so every
 region is still one exact spectrum (no texture filtering); a spectral texture varies smoothly
-from face to face as convex mixes of three reflectances (``mix:`` spectra).
+from face to face as convex mixes of three reflectances (``mix:`` spectra). With
+``texture_fraction`` an object instead takes a per-pixel spectral texture
+(:data:`PIXEL_TEXTURE`, :mod:`spectrinsic.scenes.textures`).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import numpy as np
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes.painting import patches, printed, stripes
 from spectrinsic.scenes.parts import Part
+from spectrinsic.scenes.textures import PATTERNS as TEXTURE_PATTERNS
 from spectrinsic.spectra import list_spectra
 
 __all__ = [
@@ -33,6 +36,7 @@ __all__ = [
     "draw_reflectance",
     "draw_palette",
     "paint",
+    "PIXEL_TEXTURE",
 ]
 
 _NOTATION = re.compile(r"^\S+ (\d+(?:\.\d+)?)/(\d+(?:\.\d+)?)$")
@@ -53,19 +57,23 @@ class MaterialDistribution:
         caller passes SFU names).
     pattern_probability
         Probability that an object is painted with a pattern of several spectra.
+    texture_fraction
+        Probability that an object instead takes a per-pixel spectral texture
+        (:data:`PIXEL_TEXTURE`); 0 draws nothing, so scenes stay those of before.
     """
 
     value_range: tuple[float, float] = (2.0, 9.0)
     chroma_range: tuple[float, float] = (0.0, 16.0)
     sfu_fraction: float = 0.0
     pattern_probability: float = 0.5
+    texture_fraction: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("value_range", "chroma_range"):
             lo, hi = getattr(self, name)
             if not lo <= hi:
                 raise SceneError(f"material distribution {name}={(lo, hi)}; expected low <= high")
-        for name in ("sfu_fraction", "pattern_probability"):
+        for name in ("sfu_fraction", "pattern_probability", "texture_fraction"):
             if not 0.0 <= getattr(self, name) <= 1.0:
                 raise SceneError(
                     f"material distribution {name}={getattr(self, name)}; expected 0..1"
@@ -283,16 +291,41 @@ PATTERNS: dict[str, Callable[[Part, np.random.Generator, Sequence[str]], Part]] 
 }
 
 
+#: The pattern name of a per-pixel spectral texture (:mod:`spectrinsic.scenes.textures`).
+PIXEL_TEXTURE = "pixel-texture"
+#: Texels per side of a generated per-pixel texture.
+PIXEL_TEXTURE_SIZE = 64
+
+
+def _pixel_texture(
+    part: Part, rng: np.random.Generator, dist: MaterialDistribution, sfu: Sequence[str]
+) -> Part:
+    """*part* under a per-pixel texture: a generated pattern over 2-3 distinct palette spectra
+    (one flat spectrum when the distribution holds a single chip)."""
+    pattern = TEXTURE_PATTERNS[int(rng.integers(len(TEXTURE_PATTERNS)))]
+    palette = tuple(draw_palette(rng, dist, int(rng.integers(2, 4)), sfu))
+    seed = int(rng.integers(2**31))
+    labels = np.zeros(len(part.faces), np.int64)
+    if len(palette) < 2:
+        return Part(part.vertices, part.faces, labels, palette)
+    return Part(part.vertices, part.faces, labels, palette, (pattern, PIXEL_TEXTURE_SIZE, seed))
+
+
 def paint(
     part: Part, rng: np.random.Generator, dist: MaterialDistribution, sfu: Sequence[str] = ()
 ) -> tuple[Part, str]:
     """Paint *part*: one reflectance, or with ``dist.pattern_probability`` a pattern of 2-4.
+
+    With ``dist.texture_fraction`` (drawn first, only when above 0) the part instead takes a
+    per-pixel spectral texture over 2-3 reflectances (:data:`PIXEL_TEXTURE`).
 
     Returns
     -------
     tuple
         The painted part and the pattern's name (``"plain"`` for one spectrum).
     """
+    if dist.texture_fraction > 0 and rng.random() < dist.texture_fraction:
+        return _pixel_texture(part, rng, dist, sfu), PIXEL_TEXTURE
     if rng.random() >= dist.pattern_probability:
         return _labelled(
             part, [draw_reflectance(rng, dist, sfu)], np.zeros(len(part.faces))

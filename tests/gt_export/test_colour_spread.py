@@ -69,3 +69,14 @@ def test_spread_summary_of_a_two_sample_set():
     assert s["patterned_fraction"] == pytest.approx(0.25) and s["framed_fraction"] == pytest.approx(
         0.5
     )
+
+
+def test_a_sample_record_counts_face_and_per_pixel_textures_as_textured():
+    from types import SimpleNamespace
+
+    from spectrinsic.gt_export.diversity import spread_record
+
+    extra = {"patterns": ["texture", "pixel-texture", "stripes"], "n_objects": 4}
+    meta = SimpleNamespace(lights=[], materials={}, scene_metadata=extra)
+    record = spread_record(meta)  # type: ignore[arg-type]
+    assert record["textured"] == 2 and record["patterned"] == 3 and record["objects"] == 4
