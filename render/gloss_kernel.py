@@ -190,11 +190,9 @@ class GlossKernel(_Kernel):
         )
         sacc = self.deposit(sacc, light, beta * nee, s_nee, active_em)
         bands = [b * c for b, c in zip(bands, c_bs, strict=True)]
-        ray = si.spawn_ray(si.to_world(bsdf_sample.wo))
-        beta = beta * bsdf_weight
-        depth = dr.select(si.is_valid(), depth + 1, depth)
-        beta, go_on = self.roulette(sampler, depth, beta, bands)
-        delta = mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
+        ray, depth, beta, go_on, delta = self.advance(
+            sampler, si, bsdf_sample, bsdf_weight, depth, beta, bands
+        )
         return (
             sampler,
             ray,
@@ -245,37 +243,26 @@ class GlossKernel(_Kernel):
             acc, light, beta * nee, [b * c for b, c in zip(bands, c_em, strict=True)], active_em
         )
         bands = [b * c for b, c in zip(bands, c_bs, strict=True)]
-        depth = dr.select(valid, depth + 1, depth)
-        beta, go_on = self.roulette(sampler, depth, beta * bsdf_weight, bands)
+        ray, depth, beta, go_on, delta = self.advance(
+            sampler, si, bsdf_sample, bsdf_weight, depth, beta, bands
+        )
         return (
             sampler,
-            si.spawn_ray(si.to_world(bsdf_sample.wo)),
+            ray,
             depth,
             beta,
             bands,
             acc,
             mi.Interaction3f(si),
             bsdf_sample.pdf,
-            mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta),
+            delta,
             active_next & go_on,
         )
 
     def run_white(self, sampler: Any, ray: Any, active: Any) -> list:
         """The K·L white-at-metal accumulators ``M`` of the camera rays *ray*."""
-        mi, dr, k = self.mi, self.dr, self.it.n_bands
-        state = (
-            sampler,
-            mi.Ray3f(ray),
-            mi.UInt32(0),
-            mi.Float(1.0),
-            [mi.Float(1.0) for _ in range(k)],
-            [mi.Float(0.0) for _ in range(k * self.it.n_lights)],
-            dr.zeros(mi.Interaction3f),
-            mi.Float(1.0),
-            mi.Bool(True),
-            mi.Bool(active),
-        )
-        state = dr.while_loop(
+        state = (*self.path_state(sampler, ray), self.mi.Bool(active))
+        state = self.dr.while_loop(
             state, lambda *s: s[-1], self.white_body, label="spectrinsic white at metals"
         )
         return list(state[5])
@@ -283,25 +270,15 @@ class GlossKernel(_Kernel):
     def run(self, sampler: Any, ray: Any, active: Any) -> list:
         """The K·L transport accumulators, the K·L specular ones, the K·L white-at-metal ones
         (scenes with metals), then the first-hit maps."""
-        mi, dr, k = self.mi, self.dr, self.it.n_bands
-        first = self.first_state()
-        zeros = [mi.Float(0.0) for _ in range(k * self.it.n_lights)]
+        mi, k = self.mi, self.it.n_bands
         state = (
-            sampler,
-            mi.Ray3f(ray),
-            mi.UInt32(0),
-            mi.Float(1.0),
-            [mi.Float(1.0) for _ in range(k)],
-            list(zeros),
-            dr.zeros(mi.Interaction3f),
-            mi.Float(1.0),
-            mi.Bool(True),
-            first,
+            *self.path_state(sampler, ray),
+            self.first_state(),
             mi.Bool(active),
-            [mi.Float(0.0) for _ in range(k)],
-            [mi.Float(0.0) for _ in range(k * self.it.n_lights)],
+            [mi.Float(0.0) for _ in range(k)],  # specular band throughputs
+            [mi.Float(0.0) for _ in range(k * self.it.n_lights)],  # specular accumulators
         )
-        state = dr.while_loop(
+        state = self.dr.while_loop(
             state, lambda *s: s[10], self.gloss_body, label="spectrinsic band path (glossy)"
         )
         out = list(state[5]) + list(state[12])

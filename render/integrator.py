@@ -216,17 +216,6 @@ class _Kernel:
             for b, r in enumerate(rho)
         ]
 
-    def roulette(self, sampler: Any, depth: Any, beta: Any, bands: Sequence) -> tuple[Any, Any]:
-        """Russian roulette on the largest band (``path.cpp`` uses the largest channel);
-        never active when ``rr_depth`` > ``max_depth``, but its sample is drawn either way."""
-        dr = self.dr
-        throughput_max = beta * _band_max(dr, bands)
-        rr_prob = dr.minimum(throughput_max, 0.95)
-        rr_active = depth >= self.it.rr_depth
-        rr_continue = sampler.next_1d() < rr_prob
-        beta = dr.select(rr_active, beta * dr.rcp(dr.detach(rr_prob)), beta)
-        return beta, (~rr_active | rr_continue) & (throughput_max != 0.0)
-
     def first_hit(self, si: Any, depth: Any, first: tuple) -> tuple:
         """Surface index, ray distance and shading normal of the camera ray's hit."""
         mi, dr = self.mi, self.dr
@@ -270,6 +259,47 @@ class _Kernel:
             ]
         return out + [distance, normal.x, normal.y, normal.z]
 
+    def path_state(self, sampler: Any, ray: Any) -> tuple:
+        """The start of a loop's state: sampler, ray, depth 0, throughput 1 and K band
+        throughputs 1, K·L accumulators 0, and the previous vertex (none, pdf 1, delta)."""
+        mi, dr, k = self.mi, self.dr, self.it.n_bands
+        return (
+            sampler,
+            mi.Ray3f(ray),
+            mi.UInt32(0),
+            mi.Float(1.0),
+            [mi.Float(1.0) for _ in range(k)],
+            [mi.Float(0.0) for _ in range(k * self.it.n_lights)],
+            dr.zeros(mi.Interaction3f),
+            mi.Float(1.0),
+            mi.Bool(True),
+        )
+
+    def advance(
+        self,
+        sampler: Any,
+        si: Any,
+        bsdf_sample: Any,
+        bsdf_weight: Any,
+        depth: Any,
+        beta: Any,
+        bands: Sequence,
+    ) -> tuple[Any, Any, Any, Any, Any]:
+        """Step to the next vertex (bands already scaled here): ray, depth, throughput, go-on and
+        delta flags. Russian roulette on the largest band (``path.cpp``: largest channel); off
+        when ``rr_depth`` > ``max_depth``, but its sample is drawn either way."""
+        mi, dr = self.mi, self.dr
+        ray = si.spawn_ray(si.to_world(bsdf_sample.wo))
+        depth = dr.select(si.is_valid(), depth + 1, depth)
+        beta = beta * bsdf_weight
+        throughput_max = beta * _band_max(dr, bands)
+        rr_prob = dr.minimum(throughput_max, 0.95)
+        rr_active = depth >= self.it.rr_depth
+        rr_continue = sampler.next_1d() < rr_prob
+        beta = dr.select(rr_active, beta * dr.rcp(dr.detach(rr_prob)), beta)
+        go_on = (~rr_active | rr_continue) & (throughput_max != 0.0)
+        return ray, depth, beta, go_on, mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
+
     def body(
         self,
         sampler: Any,
@@ -284,7 +314,7 @@ class _Kernel:
         first: tuple,
         alive: Any,
     ) -> tuple:
-        mi, dr = self.mi, self.dr
+        mi = self.mi
         si = self.scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=depth == 0)
         first = self.first_hit(si, depth, first)
         light, weight, hit = self.emitter_hit(si, prev_si, prev_pdf, prev_delta)
@@ -295,11 +325,9 @@ class _Kernel:
         )
         bands = [b * rho for b, rho in zip(bands, self.albedo(si), strict=True)]
         acc = self.deposit(acc, light, beta * nee, bands, active_em)
-        ray = si.spawn_ray(si.to_world(bsdf_sample.wo))
-        beta = beta * bsdf_weight
-        depth = dr.select(si.is_valid(), depth + 1, depth)
-        beta, go_on = self.roulette(sampler, depth, beta, bands)
-        delta = mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
+        ray, depth, beta, go_on, delta = self.advance(
+            sampler, si, bsdf_sample, bsdf_weight, depth, beta, bands
+        )
         return (
             sampler,
             ray,
@@ -317,22 +345,10 @@ class _Kernel:
     def run(self, sampler: Any, ray: Any, active: Any) -> list:
         """The K·L accumulators of one wavefront of camera rays, then the first-hit maps
         (:func:`first_hit_channels`)."""
-        mi, dr, k = self.mi, self.dr, self.it.n_bands
-        first = self.first_state()
-        state = (
-            sampler,
-            mi.Ray3f(ray),
-            mi.UInt32(0),
-            mi.Float(1.0),
-            [mi.Float(1.0) for _ in range(k)],
-            [mi.Float(0.0) for _ in range(k * self.it.n_lights)],
-            dr.zeros(mi.Interaction3f),
-            mi.Float(1.0),
-            mi.Bool(True),
-            first,
-            mi.Bool(active),
+        state = (*self.path_state(sampler, ray), self.first_state(), self.mi.Bool(active))
+        state = self.dr.while_loop(
+            state, lambda *s: s[-1], self.body, label="spectrinsic band path"
         )
-        state = dr.while_loop(state, lambda *s: s[-1], self.body, label="spectrinsic band path")
         return list(state[5]) + self.first_maps(state[9])
 
 
