@@ -311,8 +311,8 @@ PRESETS: dict[str, DatasetConfig] = {
     # 4x the samples of the last round's 2 x 8: the denoised room shading against a converged
     # crop (make bench, bench_crop_reference.json) went from median 3.7 % / p95 18.5 % to
     # 2.8 % / 14.9 % (1.6 % median with the reference's own 2.3 % noise removed); a sample of
-    # the costliest class takes 2.2x as long as at 16 spp, so the set's 434 s at 16 spp on an
-    # idle machine becomes about 16 minutes. Against a 16384-spp reference of the crop (its own
+    # the costliest class takes 2.2x as long as at 16 spp; the whole set built in 610 s on an
+    # idle machine (make dataset, 8.8 s per sample). Against a 16384-spp reference of the crop (its own
     # noise 1.2 % median) that render's shading is off by 2.2 % / 14.3 % with the round-3
     # denoiser and 1.96 % / 12.0 % with the broad-band, depth-guided one (PIXELS_VERSION 4).
     "default": DatasetConfig.from_settings(

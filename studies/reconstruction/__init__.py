@@ -20,17 +20,14 @@ exact spectral colour (Lab relative to the D65 white).
 
 from spectrinsic.studies.reconstruction.compute import (
     THESIS_TABLE_5_2,
-    DeltaERow,
     ErrorRow,
     ExtensionResult,
-    ExtensionSettings,
-    ReconstructionSettings,
     TableResult,
-    delta_e_rows,
     reconstruction_table,
     reflectance_matrix,
     run_extension,
 )
+from spectrinsic.studies.reconstruction.delta_e import DeltaERow, delta_e_rows
 from spectrinsic.studies.reconstruction.plot import extension_figure, table_figure
 from spectrinsic.studies.reconstruction.report import (
     format_extension,
@@ -38,6 +35,7 @@ from spectrinsic.studies.reconstruction.report import (
     write_extension_outputs,
     write_table_outputs,
 )
+from spectrinsic.studies.reconstruction.settings import ExtensionSettings, ReconstructionSettings
 
 __all__ = [
     "THESIS_TABLE_5_2",

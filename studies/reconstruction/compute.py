@@ -46,14 +46,10 @@ from spectrinsic.studies.reconstruction.settings import ExtensionSettings, Recon
 
 __all__ = [
     "THESIS_TABLE_5_2",
-    "ReconstructionSettings",
-    "ExtensionSettings",
     "ErrorRow",
-    "DeltaERow",
     "TableResult",
     "ExtensionResult",
     "reflectance_matrix",
-    "delta_e_rows",
     "reconstruction_table",
     "run_extension",
 ]

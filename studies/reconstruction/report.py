@@ -18,10 +18,10 @@ from spectrinsic.studies.reconstruction.compute import (
     THESIS_TABLE_5_2,
     ErrorRow,
     ExtensionResult,
-    ReconstructionSettings,
     TableResult,
 )
 from spectrinsic.studies.reconstruction.plot import extension_figure, table_figure
+from spectrinsic.studies.reconstruction.settings import ReconstructionSettings
 
 __all__ = ["format_table", "format_extension", "write_table_outputs", "write_extension_outputs"]
 
