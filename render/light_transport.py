@@ -14,6 +14,7 @@ import numpy as np
 from spectrinsic.errors import RenderError
 from spectrinsic.render.modes import get_mode, light_spectra, raw_to_xyz, to_xyz_matrix
 from spectrinsic.render.result import RenderResult
+from spectrinsic.render.traversal_output import light_shares, sum_lights
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, diagonal_values, get_sensors
 
@@ -158,13 +159,6 @@ def _batch_mean(arrays: Sequence[np.ndarray]) -> np.ndarray:
     return np.mean(np.stack(arrays), axis=0, dtype=np.float64).astype(np.float32)
 
 
-def _light_sum(parts: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Each light's float32 share ``parts_l ∘ ē_l`` (as Mitsuba returns a pass) and their
-    float64 sum in float32 (as :func:`~spectrinsic.render.render_scene` sums lights)."""
-    shares = (parts.astype(np.float64) * e).astype(np.float32)
-    return shares, np.sum(shares, axis=0, dtype=np.float64).astype(np.float32)
-
-
 def _compose(
     transport: LightTransport, scene: Scene, lighting: Mapping[str, ModeLighting]
 ) -> _Composed:
@@ -181,10 +175,11 @@ def _compose(
     white: dict[str, np.ndarray] = {}
     per_light: list[dict[str, np.ndarray]] = [{} for _ in scene.lights]
     for mode in transport.modes:
-        e, to_xyz = lighting[mode].means[:, None, None, :], lighting[mode].to_xyz
+        e, to_xyz = lighting[mode].means, lighting[mode].to_xyz
         xyz, shares_xyz = [], []
         for b, batch in enumerate(transport.batches):
-            shares, batch_raw[b][mode] = _light_sum(batch[mode], e)
+            shares = light_shares(batch[mode], e)
+            batch_raw[b][mode] = sum_lights(shares)
             xyz.append(raw_to_xyz(batch_raw[b][mode], to_xyz))
             shares_xyz.append(raw_to_xyz(shares, to_xyz))
         raw[mode] = _batch_mean([r[mode] for r in batch_raw])
@@ -194,7 +189,7 @@ def _compose(
             per_light[j][mode] = mean_shares[j]
         for part, out in ((transport.specular, spec), (transport.metal_white, white)):
             if part:
-                out[mode] = _batch_mean([_light_sum(b[mode], e)[1] for b in part])
+                out[mode] = _batch_mean([sum_lights(light_shares(b[mode], e)) for b in part])
     return _Composed(raw, images, tuple(per_light), tuple(batch_raw), spec, white)
 
 

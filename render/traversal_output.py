@@ -14,7 +14,21 @@ import numpy as np
 
 from spectrinsic.errors import RenderError
 
-__all__ = ["TransportOutput"]
+__all__ = ["TransportOutput", "light_shares", "sum_lights"]
+
+
+def light_shares(parts: np.ndarray, emission: np.ndarray) -> np.ndarray:
+    """``(L, H, W, K)`` float32 each light's share ``parts_l ∘ E_l`` of *parts* ``(L, H, W, K)``
+    under channel values *emission* ``(L, K)``, rounded to float32 as Mitsuba returns a pass."""
+    e = np.asarray(emission, np.float64)[:, None, None, :]
+    return (np.asarray(parts).astype(np.float64) * e).astype(np.float32)
+
+
+def sum_lights(shares: np.ndarray, lights: Sequence[int] | None = None) -> np.ndarray:
+    """``(H, W, K)`` float32 sum of the *lights*' (default all) float32 *shares* in float64,
+    as :func:`~spectrinsic.render.render_scene` sums per-light renders."""
+    chosen = range(shares.shape[0]) if lights is None else [int(j) for j in lights]
+    return np.sum(shares[list(chosen)], axis=0, dtype=np.float64).astype(np.float32)
 
 
 @dataclass(frozen=True, eq=False)
@@ -49,11 +63,8 @@ class TransportOutput:
     metal_white: np.ndarray | None = None
 
     def _light_sum(self, parts: np.ndarray, lights: Sequence[int] | None) -> np.ndarray:
-        """``(H, W, K)`` float32 sum over the *lights* (default all) of ``E_{l,k} · parts``,
-        each share rounded to float32 first, as :meth:`image` sums them."""
-        shares = (parts.astype(np.float64) * self.emission[:, None, None, :]).astype(np.float32)
-        chosen = range(shares.shape[0]) if lights is None else [int(j) for j in lights]
-        return np.sum(shares[list(chosen)], axis=0, dtype=np.float64).astype(np.float32)
+        """``(H, W, K)`` float32 sum over the *lights* (default all) of ``E_{l,k} · parts``."""
+        return sum_lights(light_shares(parts, self.emission), lights)
 
     def specular_image(self, lights: Sequence[int] | None = None) -> np.ndarray | None:
         """``(H, W, K)`` float32 specular image of the *lights* (default all), summed as
@@ -71,10 +82,8 @@ class TransportOutput:
         t = self.direct if direct else self.transport
         if t is None:
             raise RenderError("no direct-only transport was rendered")
-        return (t.astype(np.float64) * self.emission[:, None, None, :]).astype(np.float32)
+        return light_shares(t, self.emission)
 
     def image(self, lights: Sequence[int] | None = None, *, direct: bool = False) -> np.ndarray:
         """``(H, W, K)`` float32 image of the *lights* (default all): the sum of their shares."""
-        parts = self.per_light(direct=direct)
-        chosen = range(parts.shape[0]) if lights is None else [int(j) for j in lights]
-        return np.sum(parts[list(chosen)], axis=0, dtype=np.float64).astype(np.float32)
+        return sum_lights(self.per_light(direct=direct), lights)
