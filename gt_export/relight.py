@@ -37,7 +37,7 @@ from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, file_sha256
 from spectrinsic.gt_export.sample_meta import read_meta
 from spectrinsic.gt_export.transport_file import read_transport
 from spectrinsic.gt_export.writer import export_sample
-from spectrinsic.render.light_transport import LightTransport, mode_lighting, relit_result
+from spectrinsic.render.light_transport import LightTransport, relit_result
 from spectrinsic.render.result import RenderResult
 from spectrinsic.scenes.model import GLOSS_FIELDS, Camera, Light, Material, Mesh, Scene
 from spectrinsic.scenes.textures import texture_from_record
@@ -248,8 +248,7 @@ def relit_render(
     }
     base = _render_meta(meta, transport, relit)
     dd = None if data_dir is None else str(data_dir)
-    lighting = mode_lighting(scene, transport.modes, data_dir=dd)
-    merged = relit_result(transport, scene, lighting=lighting, meta=base)
+    merged = relit_result(transport, scene, meta=base, data_dir=dd)
     result = dataclasses.replace(merged, aovs=_aovs(sample, meta, coverage))
     return RelitSample(scene=scene, result=result, meta=meta, transport=transport)
 

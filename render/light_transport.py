@@ -221,7 +221,6 @@ def relit_result(
     transport: LightTransport,
     scene: Scene,
     *,
-    lighting: Mapping[str, ModeLighting] | None = None,
     meta: Mapping[str, Any] | None = None,
     data_dir: str | None = None,
 ) -> RenderResult:
@@ -233,10 +232,10 @@ def relit_result(
     pass), their float64 sum as ``raw`` (as :func:`~spectrinsic.render.render_scene` sums
     lights), and the XYZ of both through the mode's matrix for this scene's lights; the
     specular and white-at-metal parts likewise, where held. *meta* (a render's metadata) is
-    kept, with the modes, sensors, XYZ matrices, seeds and spp set. *lighting*
-    (:func:`mode_lighting` of the scene) saves computing it again.
+    kept, with the modes, sensors, XYZ matrices, seeds and spp set. The lights' band means
+    and XYZ matrices are computed once for all batches (:func:`mode_lighting`).
     """
-    lighting = lighting or mode_lighting(scene, transport.modes, data_dir=data_dir)
+    lighting = mode_lighting(scene, transport.modes, data_dir=data_dir)
     c = _compose(transport, scene, lighting)
     return RenderResult(
         images=c.images,
