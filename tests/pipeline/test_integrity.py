@@ -212,20 +212,29 @@ def test_when_every_sample_fails_failed_lines_and_no_manifest(tmp_path, monkeypa
     assert not (out / "manifest.json").exists() and not (out / "DATASET.md").exists()
 
 
+def _parent_pid(pid: str) -> int | None:
+    """The parent of process *pid* from ``/proc/<pid>/stat`` (``None`` if it exited)."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    # "pid (comm) state ppid ...": comm may hold spaces and parentheses, so split after the last ")"
+    return int(stat[stat.rindex(")") + 2 :].split()[1])
+
+
 def _workers(pid: int) -> list[int]:
-    """Pool workers (spawned children running ``spawn_main``) of process *pid*."""
-    # every thread's children: a pool may start its workers from a thread other than the main
-    children = []
-    for task in Path(f"/proc/{pid}/task").glob("*"):
-        try:
-            children += (task / "children").read_text().split()
-        except OSError:
-            continue
+    """Pool workers (spawned children running ``spawn_main``) of process *pid*.
+
+    Found by each process's parent in ``/proc/<pid>/stat``, which every Linux kernel has
+    (``/proc/<pid>/task/<tid>/children`` needs ``CONFIG_PROC_CHILDREN``, which some lack).
+    """
     workers = []
-    for child in children:
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit() or _parent_pid(entry.name) != pid:
+            continue
         try:
-            if b"spawn_main" in Path(f"/proc/{child}/cmdline").read_bytes():
-                workers.append(int(child))
+            if b"spawn_main" in (entry / "cmdline").read_bytes():
+                workers.append(int(entry.name))
         except OSError:  # exited meanwhile
             continue
     return workers
