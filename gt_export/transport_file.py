@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export.exr import read_exr, write_exr
+from spectrinsic.gt_export.exr import read_exr_stacks, write_exr
 from spectrinsic.gt_export.sample import TRANSPORT_NAME
 from spectrinsic.render.light_transport import LightTransport
 from spectrinsic.spectra import get_sensors
@@ -146,14 +146,21 @@ def read_transport(
         raise DatasetError(
             f"{where}: meta.json transport parts {parts!r}; expected some of {list(PARTS)}"
         )
-    arrays = read_exr(folder / TRANSPORT_NAME)
+    path = folder / TRANSPORT_NAME
+    layers = {
+        (part, b, mode): [transport_layer(j, b, mode, part) for j in range(lights)]
+        for part in ["transport", *parts]
+        for b in range(len(seeds))
+        for mode in modes
+    }
+    stacks = read_exr_stacks(path, {_key(k): v for k, v in layers.items()} | {"": [COVERAGE_LAYER]})
     held = {
-        part: _read_part(arrays, folder, part, modes=modes, lights=lights, n_batches=len(seeds))
+        part: tuple(
+            {mode: stacks[_key((part, b, mode))] for mode in modes} for b in range(len(seeds))
+        )
         for part in ["transport", *parts]
     }
-    if COVERAGE_LAYER not in arrays:
-        raise DatasetError(f"{folder / TRANSPORT_NAME}: lacks the {COVERAGE_LAYER!r} layer")
-    coverage = np.atleast_3d(arrays[COVERAGE_LAYER])
+    coverage = stacks[""][0]
     transport = LightTransport(
         modes=tuple(modes),
         sensors={str(k): str(v) for k, v in sensors.items()},
@@ -167,26 +174,6 @@ def read_transport(
     return transport, coverage
 
 
-def _read_part(
-    arrays: dict[str, np.ndarray],
-    folder: Path,
-    part: str,
-    *,
-    modes: list[str],
-    lights: int,
-    n_batches: int,
-) -> tuple[dict[str, np.ndarray], ...]:
-    """One part's batches, mode -> ``(L, H, W, K)``, from the file's *arrays*."""
-    batches = []
-    for b in range(n_batches):
-        batch = {}
-        for mode in modes:
-            keys = [transport_layer(j, b, mode, part) for j in range(lights)]
-            missing = [k for k in keys if k not in arrays]
-            if missing:
-                raise DatasetError(
-                    f"{folder / TRANSPORT_NAME}: lacks the transport layers {missing[:3]}"
-                )
-            batch[mode] = np.stack([np.atleast_3d(arrays[k]) for k in keys])
-        batches.append(batch)
-    return tuple(batches)
+def _key(layer: tuple[str, int, str]) -> str:
+    part, batch, mode = layer
+    return f"{part}/{batch}/{mode}"

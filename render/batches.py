@@ -21,6 +21,7 @@ from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.model import Scene
 
 __all__ = [
+    "batch_mean",
     "batch_seeds",
     "render_batches",
     "relative_standard_error",
@@ -121,8 +122,17 @@ def image_noise(results: Sequence[RenderResult]) -> float | None:
     return float(np.median(rel[rel > 0])) if (rel > 0).any() else 0.0
 
 
-def _mean(arrays: Sequence[np.ndarray]) -> np.ndarray:
-    return np.mean(np.stack(arrays), axis=0, dtype=np.float64).astype(np.float32)
+def batch_mean(arrays: Sequence[np.ndarray]) -> np.ndarray:
+    """float32 mean of independent batch estimates, summed in order in float64 and divided by
+    their number (the bits of ``np.mean(np.stack(arrays), axis=0, dtype=np.float64)``, without
+    the stacked copy); one array is returned as it is."""
+    if len(arrays) == 1:
+        return np.asarray(arrays[0])
+    total = np.asarray(arrays[0], np.float64).copy()
+    for array in arrays[1:]:
+        total += array
+    total /= len(arrays)
+    return total.astype(np.float32)
 
 
 def _merge_aovs(parts: Sequence[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
@@ -133,7 +143,7 @@ def _merge_aovs(parts: Sequence[dict[str, np.ndarray]]) -> dict[str, np.ndarray]
     merged = dict(parts[0])
     for key in ("coverage", "depth", "normals"):
         if key in merged:
-            merged[key] = _mean([p[key] for p in parts])
+            merged[key] = batch_mean([p[key] for p in parts])
     if "normals" in merged:
         n = merged["normals"].astype(np.float64)
         length = np.linalg.norm(n, axis=-1, keepdims=True)
@@ -167,22 +177,23 @@ def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
         },
     )
     return RenderResult(
-        images={m: _mean([r.images[m] for r in results]) for m in modes},
-        raw={m: _mean([r.raw[m] for r in results]) for m in first.raw},
+        images={m: batch_mean([r.images[m] for r in results]) for m in modes},
+        raw={m: batch_mean([r.raw[m] for r in results]) for m in first.raw},
         per_light=tuple(
-            {m: _mean([r.per_light[i][m] for r in results]) for m in pl}
+            {m: batch_mean([r.per_light[i][m] for r in results]) for m in pl}
             for i, pl in enumerate(first.per_light)
         ),
-        direct={m: _mean([r.direct[m] for r in results]) for m in first.direct},
+        direct={m: batch_mean([r.direct[m] for r in results]) for m in first.direct},
         aovs=_merge_aovs([r.aovs for r in results]),
-        transport={m: _mean([r.transport[m] for r in results]) for m in first.transport},
-        specular={m: _mean([r.specular[m] for r in results]) for m in first.specular},
-        metal_white={m: _mean([r.metal_white[m] for r in results]) for m in first.metal_white},
+        transport={m: batch_mean([r.transport[m] for r in results]) for m in first.transport},
+        specular={m: batch_mean([r.specular[m] for r in results]) for m in first.specular},
+        metal_white={m: batch_mean([r.metal_white[m] for r in results]) for m in first.metal_white},
         specular_transport={
-            m: _mean([r.specular_transport[m] for r in results]) for m in first.specular_transport
+            m: batch_mean([r.specular_transport[m] for r in results])
+            for m in first.specular_transport
         },
         metal_white_transport={
-            m: _mean([r.metal_white_transport[m] for r in results])
+            m: batch_mean([r.metal_white_transport[m] for r in results])
             for m in first.metal_white_transport
         },
         meta=meta,

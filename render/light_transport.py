@@ -5,18 +5,20 @@ under any other light spectra and powers composed from it (Eq. 1 of :mod:`.trans
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from spectrinsic.errors import RenderError
+from spectrinsic.render.batches import batch_mean
 from spectrinsic.render.modes import get_mode, light_spectra, raw_to_xyz, to_xyz_matrix
 from spectrinsic.render.result import RenderResult
 from spectrinsic.render.traversal_output import light_shares, sum_lights
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, diagonal_values, get_sensors
+from spectrinsic.threads import thread_map
 
 __all__ = [
     "LightTransport",
@@ -152,45 +154,56 @@ class _Composed:
     metal_white: dict[str, np.ndarray]
 
 
-def _batch_mean(arrays: Sequence[np.ndarray]) -> np.ndarray:
-    """float32 mean of the batches in float64, as :func:`~spectrinsic.render.merge_batches`."""
-    if len(arrays) == 1:
-        return arrays[0]
-    return np.mean(np.stack(arrays), axis=0, dtype=np.float64).astype(np.float32)
+@dataclass(frozen=True, eq=False)
+class _BatchImages:
+    """One batch of one mode under the new lights: raw channels, their XYZ, each light's XYZ."""
+
+    raw: np.ndarray
+    xyz: np.ndarray
+    shares_xyz: np.ndarray
+
+
+def _batch_images(transport: np.ndarray, lighting: ModeLighting) -> _BatchImages:
+    """Eq. 1 for one batch of one mode: ``(L, H, W, K)`` *transport* under *lighting*."""
+    shares = light_shares(transport, lighting.means)
+    raw = sum_lights(shares)
+    return _BatchImages(raw, raw_to_xyz(raw, lighting.to_xyz), raw_to_xyz(shares, lighting.to_xyz))
 
 
 def _compose(
     transport: LightTransport, scene: Scene, lighting: Mapping[str, ModeLighting]
 ) -> _Composed:
     """Eq. 1 for every batch and mode, merged over the batches as
-    :func:`~spectrinsic.render.merge_batches` merges rendered ones (bit for bit)."""
+    :func:`~spectrinsic.render.merge_batches` merges rendered ones (bit for bit); the batches
+    and modes are independent, so they run side by side (:func:`~spectrinsic.threads.thread_map`)."""
     if transport.n_lights != len(scene.lights):
         raise RenderError(
             f"transport has {transport.n_lights} lights; the scene has {len(scene.lights)}"
         )
-    batch_raw: list[dict[str, np.ndarray]] = [{} for _ in transport.batches]
+    n = len(transport.batches)
+    tasks = [(m, b) for m in transport.modes for b in range(n)]
+    composed = thread_map(
+        lambda t: _batch_images(transport.batches[t[1]][t[0]], lighting[t[0]]), tasks
+    )
+    done = dict(zip(tasks, composed))
+    batch_raw = tuple({m: done[m, b].raw for m in transport.modes} for b in range(n))
     raw: dict[str, np.ndarray] = {}
     images: dict[str, np.ndarray] = {}
     spec: dict[str, np.ndarray] = {}
     white: dict[str, np.ndarray] = {}
     per_light: list[dict[str, np.ndarray]] = [{} for _ in scene.lights]
     for mode in transport.modes:
-        e, to_xyz = lighting[mode].means, lighting[mode].to_xyz
-        xyz, shares_xyz = [], []
-        for b, batch in enumerate(transport.batches):
-            shares = light_shares(batch[mode], e)
-            batch_raw[b][mode] = sum_lights(shares)
-            xyz.append(raw_to_xyz(batch_raw[b][mode], to_xyz))
-            shares_xyz.append(raw_to_xyz(shares, to_xyz))
-        raw[mode] = _batch_mean([r[mode] for r in batch_raw])
-        images[mode] = _batch_mean(xyz)
-        mean_shares = _batch_mean(shares_xyz)
+        mine = [done[mode, b] for b in range(n)]
+        raw[mode] = batch_mean([c.raw for c in mine])
+        images[mode] = batch_mean([c.xyz for c in mine])
+        mean_shares = batch_mean([c.shares_xyz for c in mine])
         for j in range(len(scene.lights)):
             per_light[j][mode] = mean_shares[j]
+        e = lighting[mode].means
         for part, out in ((transport.specular, spec), (transport.metal_white, white)):
             if part:
-                out[mode] = _batch_mean([sum_lights(light_shares(b[mode], e)) for b in part])
-    return _Composed(raw, images, tuple(per_light), tuple(batch_raw), spec, white)
+                out[mode] = batch_mean([sum_lights(light_shares(b[mode], e)) for b in part])
+    return _Composed(raw, images, tuple(per_light), batch_raw, spec, white)
 
 
 def _meta(

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export.exr import read_exr, read_exr_attributes, write_exr
+from spectrinsic.gt_export.exr import read_exr, read_exr_attributes, read_exr_stacks, write_exr
 
 
 def _random_layers(rng: np.random.Generator) -> dict[str, np.ndarray]:
@@ -98,3 +100,26 @@ def test_ids_outside_int32_are_refused_not_wrapped(tmp_path):
     with pytest.raises(DatasetError, match="beyond the 32-bit range"):
         write_exr(tmp_path / "ids.exr", {"object_id": np.array([[3_000_000_000]], dtype=np.int64)})
     assert not (tmp_path / "ids.exr").exists()
+
+
+def test_stacked_read_equals_the_layers_stacked_and_refuses_what_does_not_stack(tmp_path):
+    """read_exr_stacks fills (N, H, W, C) straight from the decoded channels: bit for bit the
+    layers read_exr returns, stacked; absent, integer and unequal layers are one-line errors."""
+    rng = np.random.default_rng(3)
+    layers = _random_layers(rng)
+    layers["cube2"] = rng.standard_normal((9, 7, 31)).astype(np.float32) * 1e-30
+    path = write_exr(tmp_path / "s.exr", layers)
+    plain = read_exr(path)
+    got = read_exr_stacks(path, {"cubes": ["cube2", "cube"], "one": ["depth"]})
+    assert got["cubes"].dtype == np.float32 and got["cubes"].shape == (2, 9, 7, 31)
+    assert np.array_equal(got["cubes"], np.stack([plain["cube2"], plain["cube"]]))
+    assert got["one"].shape == (1, 9, 7, 1)
+    assert np.array_equal(got["one"][0, ..., 0], plain["depth"])
+    for bad, words in (
+        (["cube", "nope"], "lacks the layers ['nope']"),
+        (["cube", "shading"], "one channel count"),
+        (["material_id"], "not float layers"),
+    ):
+        with pytest.raises(DatasetError, match=re.escape(words)) as info:
+            read_exr_stacks(path, {"x": bad})
+        assert "\n" not in str(info.value)

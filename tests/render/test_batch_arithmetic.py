@@ -1,0 +1,97 @@
+"""The float arithmetic that merges batches and lights, and composes a relighting, against
+the float64 definitions it replaces (bit for bit) and independent of the number of threads."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import spectrinsic.threads as threads
+from spectrinsic.render.batches import batch_mean
+from spectrinsic.render.light_transport import LightTransport, relit_result
+from spectrinsic.render.traversal_output import light_shares, sum_lights
+from spectrinsic.scenes.model import Camera, Light, Scene
+
+
+def _wide(rng: np.random.Generator, shape: tuple[int, ...]) -> np.ndarray:
+    """float32 values over 60 decades, both signs, with subnormals."""
+    exponent = rng.uniform(-44, 15, shape)
+    return (rng.choice([-1.0, 1.0], shape) * 10.0**exponent).astype(np.float32)
+
+
+@pytest.mark.parametrize("n", [2, 3, 5])
+def test_batch_mean_is_the_float64_mean_bit_for_bit(n):
+    rng = np.random.default_rng(n)
+    arrays = [_wide(rng, (64, 64, 7)) for _ in range(n)]
+    expected = np.mean(np.stack(arrays), axis=0, dtype=np.float64).astype(np.float32)
+    got = batch_mean(arrays)
+    assert got.dtype == np.float32
+    assert np.array_equal(got, expected, equal_nan=False)
+
+
+def test_two_lights_sum_in_float32_equals_the_float64_sum_rounded():
+    shares = _wide(np.random.default_rng(1), (4, 128, 128, 3))
+    for chosen in ([0, 1], [3, 1], None):
+        picked = shares[:2] if chosen is None else shares[chosen]
+        expected = np.sum(picked, axis=0, dtype=np.float64).astype(np.float32)
+        got = sum_lights(shares[:2] if chosen is None else shares, chosen)
+        assert got.dtype == np.float32 and np.array_equal(got, expected)
+    three = sum_lights(shares, [0, 1, 2])
+    assert np.array_equal(three, np.sum(shares[:3], axis=0, dtype=np.float64).astype(np.float32))
+
+
+def test_light_shares_are_within_one_float32_rounding_of_the_exact_product():
+    rng = np.random.default_rng(2)
+    parts = rng.random((2, 32, 32, 31), dtype=np.float32)
+    emission = rng.uniform(1e-3, 1e3, (2, 31))
+    got = light_shares(parts, emission)
+    exact = parts.astype(np.float64) * emission[:, None, None, :]
+    assert got.dtype == np.float32
+    # two roundings (the value, the product) of 2**-24 each
+    assert np.max(np.abs(got - exact) / exact) <= 2.0**-23
+
+
+def test_thread_map_keeps_order_and_raises_the_tasks_error(monkeypatch):
+    monkeypatch.setattr(threads, "array_threads", lambda: 3)
+    assert threads.thread_map(lambda x: x * x, range(20)) == [x * x for x in range(20)]
+
+    def fail(x: int) -> int:
+        if x == 7:
+            raise ValueError("task 7")
+        return x
+
+    with pytest.raises(ValueError, match="task 7"):
+        threads.thread_map(fail, range(10))
+
+
+def test_a_relighting_is_the_same_on_one_thread_and_on_several(monkeypatch):
+    """The batches and modes compose side by side: the bits must not depend on it."""
+    rng = np.random.default_rng(4)
+    batches = tuple(
+        {
+            "rgb3": rng.random((2, 16, 16, 3), dtype=np.float32),
+            "bands31": rng.random((2, 16, 16, 31), dtype=np.float32),
+        }
+        for _ in range(3)
+    )
+    transport = LightTransport(
+        modes=("rgb3", "bands31"),
+        sensors={"rgb3": "rgb3", "bands31": "bands:31@400-700"},
+        batches=batches,
+        seeds=(1, 2, 3),
+        spp=4,
+        max_depth=3,
+    )
+    lights = (Light("point", "planck:3000K", 2.0), Light("point", "cie:D65", 0.5))
+    scene = Scene("s", (), (), lights, Camera((0, 0, 1), (0, 0, 0)))
+    results = []
+    for n in (1, 4):
+        monkeypatch.setattr(threads, "array_threads", lambda n=n: n)
+        results.append(relit_result(transport, scene))
+    one, many = results
+    for mode in transport.modes:
+        assert np.array_equal(one.images[mode], many.images[mode])
+        assert np.array_equal(one.raw[mode], many.raw[mode])
+        for a, b in zip(one.per_light, many.per_light):
+            assert np.array_equal(a[mode], b[mode])
+    assert not np.array_equal(one.raw["bands31"], batches[0]["bands31"].sum(axis=0))
