@@ -1,10 +1,10 @@
 """spectrinsic: spectral rendering of synthetic intrinsic-image datasets.
 
 Layers, each importing only those before it: the base modules (:mod:`spectrinsic.errors`,
-``typing``, ``config``, ``rng``, ``provenance``, ``results``); the data-flow packages
-:mod:`spectrinsic.spectra` (measured spectra and colour maths), :mod:`spectrinsic.scenes`
-(scenes as plain data), :mod:`spectrinsic.render` (Mitsuba 3 backends),
-:mod:`spectrinsic.gt_export` (ground-truth layers, writers, loader) and
+``arrays``, ``data_dir``, ``rng``, ``provenance``, ``results``, ``interrupts``, ``threads``); the
+data-flow packages :mod:`spectrinsic.spectra` (measured spectra and colour maths),
+:mod:`spectrinsic.scenes` (scenes as plain data), :mod:`spectrinsic.render` (Mitsuba 3
+backends), :mod:`spectrinsic.gt_export` (ground-truth layers, writers, loader) and
 :mod:`spectrinsic.decompose` (decomposers, metrics, evaluation); then the top:
 :mod:`spectrinsic.pipeline` (the dataset build), :mod:`spectrinsic.studies`,
 :mod:`spectrinsic.bench` and :mod:`spectrinsic.cli`.

@@ -23,7 +23,16 @@ FOLDERS = {
 #: Data flows one way. The root package's base modules come first; then the data-flow packages;
 #: then the top layer (the dataset pipeline, the studies, the benchmarks and the CLI). A module
 #: may import its own layer and the layers to its left, never one to its right.
-CORE_BASE = {"errors", "arrays", "data_dir", "rng", "provenance", "results", "interrupts"}
+CORE_BASE = {
+    "errors",
+    "arrays",
+    "data_dir",
+    "rng",
+    "provenance",
+    "results",
+    "interrupts",
+    "threads",
+}
 ORDER = ["spectra", "scenes", "render", "gt_export", "decompose"]
 #: The top layer, left to right: a study may run the pipeline, a benchmark a study, the CLI all.
 TOP = ["pipeline", "studies", "bench", "cli"]
