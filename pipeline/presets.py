@@ -42,7 +42,9 @@ _STANDARD_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
 #: render (render/single.py), not one render per light.
 #: 4: the white-surface radiance is denoised as three broad bands (OIDN high) times per-band
 #: shares, guided by normals and a depth grey marked clean (gt_export/denoise.py).
-PIXELS_VERSION = 4
+#: 5: each light's share is one float32 product (render/traversal_output.py): images and
+#: layers move by at most one float32 rounding.
+PIXELS_VERSION = 5
 #: What of the installed software changes pixels, hence enters the config hash, and how much
 #: of its version: the renderer exactly (its sampling changes between patch releases);
 #: colour-science's data tables (CMFs, illuminants, cameras) by minor release; numpy by major
