@@ -153,14 +153,16 @@ def read_transport(
         for b in range(len(seeds))
         for mode in modes
     }
-    stacks = read_exr_stacks(path, {_key(k): v for k, v in layers.items()} | {"": [COVERAGE_LAYER]})
+    # the stacks' names: "<part>/<batch>/<mode>" and the coverage layer's (which has no "/")
+    named = {_key(k): v for k, v in layers.items()} | {COVERAGE_LAYER: [COVERAGE_LAYER]}
+    stacks = read_exr_stacks(path, named)
     held = {
         part: tuple(
             {mode: stacks[_key((part, b, mode))] for mode in modes} for b in range(len(seeds))
         )
         for part in ["transport", *parts]
     }
-    coverage = stacks[""][0]
+    coverage = stacks[COVERAGE_LAYER][0]
     transport = LightTransport(
         modes=tuple(modes),
         sensors={str(k): str(v) for k, v in sensors.items()},
@@ -175,5 +177,6 @@ def read_transport(
 
 
 def _key(layer: tuple[str, int, str]) -> str:
+    """The name of one (part, batch, mode) stack of :func:`read_transport`."""
     part, batch, mode = layer
     return f"{part}/{batch}/{mode}"

@@ -125,9 +125,9 @@ def image_noise(results: Sequence[RenderResult]) -> float | None:
 def batch_mean(arrays: Sequence[np.ndarray]) -> np.ndarray:
     """float32 mean of independent batch estimates, summed in order in float64 and divided by
     their number (the bits of ``np.mean(np.stack(arrays), axis=0, dtype=np.float64)``, without
-    the stacked copy); one array is returned as it is."""
+    the stacked copy); one float32 array is returned as it is."""
     if len(arrays) == 1:
-        return np.asarray(arrays[0])
+        return np.asarray(arrays[0], np.float32)
     total = np.asarray(arrays[0], np.float64).copy()
     for array in arrays[1:]:
         total += array
