@@ -87,6 +87,32 @@ def plane_scene(
     )
 
 
+def corner_scene(first: Material, wall: str = "munsell:5R 5/12", *, size: int = 16) -> Scene:
+    """A wall of material *first* (plane x = 0, facing +x) beside a coloured *wall* (plane
+    y = 1, facing -y). A distant D65 light along +y lights the coloured wall head-on and
+    grazes the first one (cos θ = 0), which so receives only light bounced off the coloured
+    wall. The camera sees the first wall alone."""
+    first_v, first_f = quad((0, -3, -3), (0, 0, 6), (0, 4, 0))  # seen from its back: two-sided
+    wall_v, wall_f = quad((0, 1, -3), (6, 0, 0), (0, 0, 6))
+    return Scene(
+        name="corner",
+        meshes=(
+            Mesh(first.name, first_v, first_f, np.zeros(2, np.int64), object_id=0),
+            Mesh("wall", wall_v, wall_f, np.ones(2, np.int64), object_id=1),
+        ),
+        materials=(first, Material("wall", wall)),
+        lights=(Light("directional", "cie:D65", 5.0, direction=(0.0, 1.0, 0.0)),),
+        camera=Camera(
+            origin=(1.0, -0.5, 0.0),
+            target=(0.0, 0.2, 0.0),
+            up=(0, 0, 1),
+            fov_deg=20,
+            width=size,
+            height=size,
+        ),
+    )
+
+
 def _box(lo: Sequence[float], hi: Sequence[float]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Axis-aligned box: vertices, faces and a face -> side index (0..5: -x,+x,-y,+y,-z,+z)."""
     (x0, y0, z0), (x1, y1, z1) = lo, hi
@@ -181,3 +207,8 @@ def make_plane() -> Callable[..., Scene]:
 @pytest.fixture(scope="session")
 def make_room() -> Callable[..., Scene]:
     return box_room
+
+
+@pytest.fixture(scope="session")
+def make_corner() -> Callable[..., Scene]:
+    return corner_scene

@@ -12,7 +12,7 @@ import pytest
 
 from spectrinsic.gt_export.layers import compute_ground_truth, identities
 from spectrinsic.render import RenderSettings, render_batches, render_scene
-from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
+from spectrinsic.scenes.model import Material, Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as WL
 from spectrinsic.spectra import get_sensors, get_spectrum, responses, xyz_to_linear_srgb
 
@@ -26,45 +26,15 @@ BOUNCE_MAX_DEG = 1.0
 SWAP_MAX = 0.01
 #: Issue 8 (g): predicted and observed standard errors agree within this factor.
 CALIBRATION_FACTOR = 1.5
+#: The first wall of the corner scene (tests/conftest.corner_scene): a flat grey, a saturated chip.
+GREY = Material("grey", "flat:0.8")
+GREEN = Material("grey", "munsell:5G 6/8")
 
 
 def _angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     a, b = np.asarray(a, float), np.asarray(b, float)
     cos = (a * b).sum(-1) / (np.linalg.norm(a, axis=-1) * np.linalg.norm(b, axis=-1))
     return np.degrees(np.arccos(np.clip(cos, -1, 1)))
-
-
-def _quad(corner, u, v):
-    c, a, b = (np.asarray(x, float) for x in (corner, u, v))
-    return np.stack([c, c + a, c + a + b, c + b]), np.array([[0, 1, 2], [0, 2, 3]])
-
-
-def _corner_scene(grey: str = "flat:0.8", wall: str = "munsell:5R 5/12", size: int = 16) -> Scene:
-    """A grey wall (plane x = 0, facing +x) beside a coloured wall (plane y = 1, facing -y).
-
-    A distant D65 light travels along +y: it lights the coloured wall head-on and grazes the
-    grey wall (cos θ = 0), so the grey wall receives only light bounced off the coloured one.
-    The camera sees the grey wall alone.
-    """
-    grey_v, grey_f = _quad((0, -3, -3), (0, 0, 6), (0, 4, 0))
-    wall_v, wall_f = _quad((0, 1, -3), (6, 0, 0), (0, 0, 6))
-    return Scene(
-        name="corner",
-        meshes=(
-            Mesh("grey", grey_v, grey_f, np.zeros(2, np.int64), object_id=0),
-            Mesh("wall", wall_v, wall_f, np.ones(2, np.int64), object_id=1),
-        ),
-        materials=(Material("grey", grey), Material("wall", wall)),
-        lights=(Light("directional", "cie:D65", 5.0, direction=(0.0, 1.0, 0.0)),),
-        camera=Camera(
-            origin=(1.0, -0.5, 0.0),
-            target=(0.0, 0.2, 0.0),
-            up=(0, 0, 1),
-            fov_deg=20,
-            width=size,
-            height=size,
-        ),
-    )
 
 
 def _gt(scene: Scene, **render: object):
@@ -95,9 +65,9 @@ def test_a_plane_under_d65_has_the_analytic_shading_and_no_residual(make_plane):
     np.testing.assert_allclose(gt.layers["illuminant"].data.reshape(-1, 3), 1.0, atol=BAND_RTOL)
 
 
-def test_b_f_a_grey_wall_lit_by_a_bounce_carries_the_bounce_colour():
+def test_b_f_a_grey_wall_lit_by_a_bounce_carries_the_bounce_colour(make_corner):
     """(f) illuminant = colour of ρ_wall · D65 within 1°; (b) shading is that colour, not white."""
-    gt, _ = _gt(_corner_scene())
+    gt, _ = _gt(make_corner(GREY))
     inside = _interior(gt)
     assert inside.sum() > 100
     rho = get_spectrum("munsell:5R 5/12").on(WL)
@@ -109,16 +79,16 @@ def test_b_f_a_grey_wall_lit_by_a_bounce_carries_the_bounce_colour():
     assert _angle(shading, bounce).max() < BOUNCE_MAX_DEG
     assert _angle(shading, np.ones(3)).min() > 10.0  # a D65-white shading would be (1, 1, 1)
     # with every bounce (depth 6) the light stays the wall's colour, only brighter
-    deep, _ = _gt(_corner_scene(), max_depth=6)
+    deep, _ = _gt(make_corner(GREY), max_depth=6)
     assert _angle(deep.layers["shading"].data[inside], bounce).max() < 3 * BOUNCE_MAX_DEG
     grey_y = deep.layers["shading_grey"].data[inside]
     assert (grey_y >= gt.layers["shading_grey"].data[inside]).all()
 
 
-def test_c_swapping_a_material_leaves_its_shading_and_changes_its_image():
+def test_c_swapping_a_material_leaves_its_shading_and_changes_its_image(make_corner):
     """(c) same paths (same seed), other material: shading moves < 1 %, the image a lot."""
-    grey, _ = _gt(_corner_scene(grey="flat:0.8"))
-    green, _ = _gt(_corner_scene(grey="munsell:5G 6/8"))
+    grey, _ = _gt(make_corner(GREY))
+    green, _ = _gt(make_corner(GREEN))
     inside = _interior(grey)
     s0, s1 = grey.layers["shading"].data[inside], green.layers["shading"].data[inside]
     change = np.linalg.norm(s1 - s0, axis=-1) / np.linalg.norm(s0, axis=-1)
@@ -211,11 +181,11 @@ def test_h_denoised_shading_is_closer_to_the_converged_render(noisy_and_converge
     assert "shading" in gt.denoised and "shading_raw" not in gt.denoised
 
 
-def test_residual_vanishes_on_a_flat_grey_and_not_on_a_saturated_chip():
+def test_residual_vanishes_on_a_flat_grey_and_not_on_a_saturated_chip(make_corner):
     """A flat reflectance commutes with any light, here the red bounce: the residual of the grey
     wall is float32 round-off; the green chip in the same light does not commute."""
-    grey, _ = _gt(_corner_scene(grey="flat:0.8"))
-    green, _ = _gt(_corner_scene(grey="munsell:5G 6/8"))
+    grey, _ = _gt(make_corner(GREY))
+    green, _ = _gt(make_corner(GREEN))
     inside = _interior(grey)
     image, residual = grey.layers["image"].data[inside], grey.layers["residual"].data[inside]
     assert np.abs(residual).max() < 1e-5 * np.abs(image).max()

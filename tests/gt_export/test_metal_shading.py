@@ -13,7 +13,7 @@ import numpy as np
 
 from spectrinsic.gt_export.layers import compute_ground_truth
 from spectrinsic.render import RenderSettings, render_scene
-from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
+from spectrinsic.scenes.model import Material
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as WL
 from spectrinsic.spectra import get_sensors, get_spectrum, responses, xyz_to_linear_srgb
 
@@ -41,44 +41,14 @@ def test_a_metal_plane_has_the_analytic_white_surface_shading(make_plane):
     np.testing.assert_allclose(shading, expected, rtol=BAND_RTOL)
 
 
-def _quad(corner, u, v):
-    c, a, b = (np.asarray(x, float) for x in (corner, u, v))
-    return np.stack([c, c + a, c + a + b, c + b]), np.array([[0, 1, 2], [0, 2, 3]])
-
-
-def _corner(material: Material) -> Scene:
-    """A wall of *material* (plane x = 0, facing +x) beside a red wall (plane y = 1, facing -y);
-    a distant D65 light along +y lights the red wall head-on and grazes the first wall, which
-    so receives only light bounced off the red one. The camera sees the first wall alone."""
-    wall_v, wall_f = _quad((0, -3, -3), (0, 0, 6), (0, 4, 0))  # seen from its back: two-sided
-    red_v, red_f = _quad((0, 1, -3), (6, 0, 0), (0, 0, 6))
-    return Scene(
-        name="corner",
-        meshes=(
-            Mesh("wall", wall_v, wall_f, np.zeros(2, np.int64), object_id=0),
-            Mesh("red", red_v, red_f, np.ones(2, np.int64), object_id=1),
-        ),
-        materials=(material, Material("red", "munsell:5R 5/12")),
-        lights=(Light("directional", "cie:D65", 5.0, direction=(0.0, 1.0, 0.0)),),
-        camera=Camera(
-            origin=(1.0, -0.5, 0.0),
-            target=(0.0, 0.2, 0.0),
-            up=(0, 0, 1),
-            fov_deg=20,
-            width=16,
-            height=16,
-        ),
-    )
-
-
-def test_a_metal_lit_by_a_bounce_has_the_shading_a_matte_wall_has_there():
+def test_a_metal_lit_by_a_bounce_has_the_shading_a_matte_wall_has_there(make_corner):
     """A mirror-like gold wall lit only by light bounced off a red wall: its shading carries
     the bounce's light and equals, within Monte Carlo error, the shading of a grey Lambertian
     wall in its place (paths of depth ≤ 3: the first wall's own reflection never comes back)."""
     settings = RenderSettings(64, modes=("bands31",), max_depth=3)
     shading = {}
     for name, material in (("gold", GOLD), ("grey", Material("grey", "flat:0.8"))):
-        scene = _corner(material)
+        scene = make_corner(material)
         gt = compute_ground_truth(scene, render_scene(scene, settings, seed=7))
         inside = gt.layers["mask"].data > 0
         inside[[0, -1], :] = inside[:, [0, -1]] = False
