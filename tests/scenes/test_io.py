@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import copy
 import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -50,6 +52,21 @@ def write(folder: Path, doc: dict, name: str = "scene.yaml") -> Path:
     path = folder / name
     path.write_text(yaml.safe_dump(doc, sort_keys=False))
     return path
+
+
+def render_refusal(path: Path, out: Path) -> str:
+    """The one-line stderr of ``spectrinsic render PATH --out OUT`` refusing the scene before
+    any work: rc 2, no traceback, nothing written."""
+    run = subprocess.run(
+        [sys.executable, "-P", "-m", "spectrinsic", "render", str(path), "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert run.returncode == 2 and "Traceback" not in run.stderr
+    assert len(run.stderr.strip().splitlines()) == 1
+    assert not out.exists()
+    return run.stderr
 
 
 def load_error(folder: Path, doc: dict) -> str:
