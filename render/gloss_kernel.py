@@ -190,24 +190,10 @@ class GlossKernel(_Kernel):
         )
         sacc = self.deposit(sacc, light, beta * nee, s_nee, active_em)
         bands = [b * c for b, c in zip(bands, c_bs, strict=True)]
-        ray, depth, beta, go_on, delta = self.advance(
-            sampler, si, bsdf_sample, bsdf_weight, depth, beta, bands
+        state, go_on = self.next_state(
+            sampler, si, bsdf_sample, bsdf_weight, depth, beta, bands, acc
         )
-        return (
-            sampler,
-            ray,
-            depth,
-            beta,
-            bands,
-            acc,
-            mi.Interaction3f(si),
-            bsdf_sample.pdf,
-            delta,
-            first,
-            active_next & go_on,
-            sbands,
-            sacc,
-        )
+        return (*state, first, active_next & go_on, sbands, sacc)
 
     def white_body(
         self,
@@ -243,21 +229,10 @@ class GlossKernel(_Kernel):
             acc, light, beta * nee, [b * c for b, c in zip(bands, c_em, strict=True)], active_em
         )
         bands = [b * c for b, c in zip(bands, c_bs, strict=True)]
-        ray, depth, beta, go_on, delta = self.advance(
-            sampler, si, bsdf_sample, bsdf_weight, depth, beta, bands
+        state, go_on = self.next_state(
+            sampler, si, bsdf_sample, bsdf_weight, depth, beta, bands, acc
         )
-        return (
-            sampler,
-            ray,
-            depth,
-            beta,
-            bands,
-            acc,
-            mi.Interaction3f(si),
-            bsdf_sample.pdf,
-            delta,
-            active_next & go_on,
-        )
+        return (*state, active_next & go_on)
 
     def run_white(self, sampler: Any, ray: Any, active: Any) -> list:
         """The K·L white-at-metal accumulators ``M`` of the camera rays *ray*."""

@@ -34,7 +34,12 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import RenderError
-from spectrinsic.render.textures import TextureTables, texel_of, texture_lookups
+from spectrinsic.render.textures import (
+    TextureTables,
+    shape_id_table,
+    texel_of,
+    texture_lookups,
+)
 from spectrinsic.render.variants import import_mitsuba
 
 __all__ = [
@@ -96,12 +101,7 @@ def first_hit_channels(n_surfaces: int, n_texcols: int = 0) -> list[str]:
     if n_surfaces == 0:
         return []
     cover = [f"cov{i:03d}" for i in range(n_surfaces)] + [f"tex{g:03d}" for g in range(n_texcols)]
-    return cover + [
-        "depth",
-        "normal.x",
-        "normal.y",
-        "normal.z",
-    ]
+    return [*cover, "depth", "normal.x", "normal.y", "normal.z"]
 
 
 def _mis_weight(dr: Any, mi: Any, pdf_a: Any, pdf_b: Any) -> Any:
@@ -127,17 +127,8 @@ def _lookups(mi: Any, dr: Any, scene: Any, tables: BandTables) -> tuple[Any, Any
     id -> surface (``len(shape_surfaces)`` where none)."""
     albedo = np.asarray(tables.albedo, np.float32)
     black, none = albedo.shape[0] - 1, len(tables.shape_surfaces)
-    shapes = list(scene.shapes())
-    ids = (
-        np.array(dr.reinterpret_array(mi.UInt32, mi.ShapePtr(shapes)), np.int64)
-        if shapes
-        else np.zeros(0, np.int64)
-    )
-    rows = np.full(int(ids.max(initial=0)) + 1, black, np.uint32)
-    surfaces = np.full(rows.size, none, np.uint32)
-    for sid, shape in zip(ids, shapes, strict=True):
-        rows[sid] = tables.shape_rows.get(shape.id(), black)
-        surfaces[sid] = tables.shape_surfaces.get(shape.id(), none)
+    rows = shape_id_table(mi, dr, scene, tables.shape_rows, black)
+    surfaces = shape_id_table(mi, dr, scene, tables.shape_surfaces, none)
     lights = np.zeros(max(tables.emitter_lights, default=0) + 1, np.uint32)
     for eid, light in tables.emitter_lights.items():
         lights[eid] = light
@@ -300,6 +291,25 @@ class _Kernel:
         go_on = (~rr_active | rr_continue) & (throughput_max != 0.0)
         return ray, depth, beta, go_on, mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
 
+    def next_state(
+        self,
+        sampler: Any,
+        si: Any,
+        bsdf_sample: Any,
+        bsdf_weight: Any,
+        depth: Any,
+        beta: Any,
+        bands: list,
+        acc: list,
+    ) -> tuple[tuple, Any]:
+        """The state every loop carries to its next vertex (:meth:`path_state`'s fields, after
+        :meth:`advance`), and the go-on flag of Russian roulette."""
+        ray, depth, beta, go_on, delta = self.advance(
+            sampler, si, bsdf_sample, bsdf_weight, depth, beta, bands
+        )
+        state = (sampler, ray, depth, beta, bands, acc, self.mi.Interaction3f(si))
+        return (*state, bsdf_sample.pdf, delta), go_on
+
     def body(
         self,
         sampler: Any,
@@ -325,22 +335,10 @@ class _Kernel:
         )
         bands = [b * rho for b, rho in zip(bands, self.albedo(si), strict=True)]
         acc = self.deposit(acc, light, beta * nee, bands, active_em)
-        ray, depth, beta, go_on, delta = self.advance(
-            sampler, si, bsdf_sample, bsdf_weight, depth, beta, bands
+        state, go_on = self.next_state(
+            sampler, si, bsdf_sample, bsdf_weight, depth, beta, bands, acc
         )
-        return (
-            sampler,
-            ray,
-            depth,
-            beta,
-            bands,
-            acc,
-            mi.Interaction3f(si),
-            bsdf_sample.pdf,
-            delta,
-            first,
-            active_next & go_on,
-        )
+        return (*state, first, active_next & go_on)
 
     def run(self, sampler: Any, ray: Any, active: Any) -> list:
         """The K·L accumulators of one wavefront of camera rays, then the first-hit maps

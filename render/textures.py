@@ -34,6 +34,7 @@ __all__ = [
     "textured_bsdf",
     "refuse_textures",
     "texel_of",
+    "shape_id_table",
     "texture_lookups",
 ]
 
@@ -156,6 +157,23 @@ def texel_of(mi: Any, dr: Any, it: Any, si: Any) -> tuple[Any, Any]:
     return mi.UInt32(dr.select(textured, offset + row * width + col, 0)), textured
 
 
+def shape_id_table(
+    mi: Any, dr: Any, scene: Any, values: Mapping[str, int], default: int
+) -> np.ndarray:
+    """``uint32`` table indexed by the Mitsuba registry id of each shape of the loaded *scene*
+    (``dr.reinterpret_array`` of ``si.shape``): ``values[shape.id()]``, *default* elsewhere."""
+    shapes = list(scene.shapes())
+    ids = (
+        np.array(dr.reinterpret_array(mi.UInt32, mi.ShapePtr(shapes)), np.int64)
+        if shapes
+        else np.zeros(0, np.int64)
+    )
+    table = np.full(int(ids.max(initial=0)) + 1, default, np.uint32)
+    for sid, shape in zip(ids, shapes, strict=True):
+        table[sid] = values.get(shape.id(), default)
+    return table
+
+
 def texture_lookups(
     mi: Any, dr: Any, scene: Any, tables: TextureTables | None, shape_slots: Mapping[str, int]
 ) -> tuple[Any, ...]:
@@ -163,15 +181,7 @@ def texture_lookups(
     slot's width, height and first row (a last slot of width 0 for untextured shapes), the
     ``(N·K)`` texel albedos and ``(N·G)`` coverage weights."""
     n_slots = 0 if tables is None else len(tables.widths)
-    shapes = list(scene.shapes())
-    ids = (
-        np.array(dr.reinterpret_array(mi.UInt32, mi.ShapePtr(shapes)), np.int64)
-        if shapes
-        else np.zeros(0, np.int64)
-    )
-    slots = np.full(int(ids.max(initial=0)) + 1, n_slots, np.uint32)
-    for sid, shape in zip(ids, shapes, strict=True):
-        slots[sid] = shape_slots.get(shape.id(), n_slots)
+    slots = shape_id_table(mi, dr, scene, shape_slots, n_slots)
     if tables is None:
         zero = np.zeros(1, np.int32)
         return (
