@@ -266,31 +266,6 @@ class _Kernel:
             mi.Bool(True),
         )
 
-    def advance(
-        self,
-        sampler: Any,
-        si: Any,
-        bsdf_sample: Any,
-        bsdf_weight: Any,
-        depth: Any,
-        beta: Any,
-        bands: Sequence,
-    ) -> tuple[Any, Any, Any, Any, Any]:
-        """Step to the next vertex (bands already scaled here): ray, depth, throughput, go-on and
-        delta flags. Russian roulette on the largest band (``path.cpp``: largest channel); off
-        when ``rr_depth`` > ``max_depth``, but its sample is drawn either way."""
-        mi, dr = self.mi, self.dr
-        ray = si.spawn_ray(si.to_world(bsdf_sample.wo))
-        depth = dr.select(si.is_valid(), depth + 1, depth)
-        beta = beta * bsdf_weight
-        throughput_max = beta * _band_max(dr, bands)
-        rr_prob = dr.minimum(throughput_max, 0.95)
-        rr_active = depth >= self.it.rr_depth
-        rr_continue = sampler.next_1d() < rr_prob
-        beta = dr.select(rr_active, beta * dr.rcp(dr.detach(rr_prob)), beta)
-        go_on = (~rr_active | rr_continue) & (throughput_max != 0.0)
-        return ray, depth, beta, go_on, mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
-
     def next_state(
         self,
         sampler: Any,
@@ -302,13 +277,23 @@ class _Kernel:
         bands: list,
         acc: list,
     ) -> tuple[tuple, Any]:
-        """The state every loop carries to its next vertex (:meth:`path_state`'s fields, after
-        :meth:`advance`), and the go-on flag of Russian roulette."""
-        ray, depth, beta, go_on, delta = self.advance(
-            sampler, si, bsdf_sample, bsdf_weight, depth, beta, bands
-        )
-        state = (sampler, ray, depth, beta, bands, acc, self.mi.Interaction3f(si))
-        return (*state, bsdf_sample.pdf, delta), go_on
+        """Step to the next vertex (bands already scaled here): the state every loop carries
+        (:meth:`path_state`'s fields: ray, depth, throughput, previous vertex, its pdf and delta
+        flag) and the go-on flag. Russian roulette on the largest band (``path.cpp``: largest
+        channel); off when ``rr_depth`` > ``max_depth``, but its sample is drawn either way."""
+        mi, dr = self.mi, self.dr
+        ray = si.spawn_ray(si.to_world(bsdf_sample.wo))
+        depth = dr.select(si.is_valid(), depth + 1, depth)
+        beta = beta * bsdf_weight
+        throughput_max = beta * _band_max(dr, bands)
+        rr_prob = dr.minimum(throughput_max, 0.95)
+        rr_active = depth >= self.it.rr_depth
+        rr_continue = sampler.next_1d() < rr_prob
+        beta = dr.select(rr_active, beta * dr.rcp(dr.detach(rr_prob)), beta)
+        go_on = (~rr_active | rr_continue) & (throughput_max != 0.0)
+        delta = mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
+        state = (sampler, ray, depth, beta, bands, acc, mi.Interaction3f(si), bsdf_sample.pdf)
+        return (*state, delta), go_on
 
     def body(
         self,
