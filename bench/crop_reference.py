@@ -227,6 +227,7 @@ def run(out_dir: Path) -> dict[str, Any]:
         "crop": list(CROP),
         "estimate": {
             "spp": cfg.render.spp,
+            "spectral_spp": cfg.render.spectral_spp,
             "batches": cfg.render.batches,
             "render_seconds": t_render,
         },

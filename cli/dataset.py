@@ -41,7 +41,8 @@ UINT32_MAX = 2**32 - 1
 def _presets_help() -> str:
     """The presets with their numbers, for ``--help``."""
     parts = [
-        f"{name}: {c.width}x{c.height}, {c.render.batches} batch(es) x {c.render.batch_spp} spp, "
+        f"{name}: {c.width}x{c.height}, {c.render.batches} batch(es) x {c.render.batch_spp} spp"
+        f" (spectral {c.render.spectral_batch_spp}), "
         f"depth {c.render.max_depth}, modes {'+'.join(c.render.modes)}"
         f"{', denoised' if c.denoise else ''}"
         for name, c in PRESETS.items()
@@ -136,6 +137,14 @@ def _add_sampling_options(p: Any) -> None:
         help="override samples per pixel (the total over all batches)",
     )
     p.add_argument(
+        "--spectral-spp",
+        type=int,
+        default=None,
+        metavar="N",
+        help="override samples per pixel of the spectral Monte Carlo pass (total over all "
+        "batches; the reference image and ground truth come from the diagonal modes' --spp)",
+    )
+    p.add_argument(
         "--batches",
         type=int,
         default=None,
@@ -210,6 +219,7 @@ def _add_rendering_options(p: Any) -> None:
 #: Options copied into the config as they are when given (option dest -> config key).
 _VALUE_OPTIONS: tuple[tuple[str, str], ...] = (
     ("spp", "spp"),
+    ("spectral_spp", "spectral_spp"),
     ("batches", "batches"),
     ("relight", "relight"),
     ("noise_target", "noise_target"),
@@ -272,9 +282,10 @@ def preflight(
         raise DatasetError(f"--workers {workers}; expected a positive integer")
     if threads is not None and threads < 1:
         raise DatasetError(f"--threads {threads}; expected a positive integer")
-    if not 0 <= config.seed <= UINT32_MAX or config.render.spp > UINT32_MAX:
+    spp = max(config.render.spp, config.render.spectral_spp or 0)
+    if not 0 <= config.seed <= UINT32_MAX or spp > UINT32_MAX:
         raise DatasetError(
-            f"--seed {config.seed} / --spp {config.render.spp}; expected a seed from 0 "
+            f"--seed {config.seed} / --spp {spp}; expected a seed from 0 "
             f"to {UINT32_MAX} and at most {UINT32_MAX} samples per pixel"
         )
     check_build_folder(Path(out), config.config_hash(), rebuild=rebuild)

@@ -109,8 +109,9 @@ def _add_sampling_options(p: Any, default: DatasetConfig) -> None:
         "--spp",
         type=int,
         default=None,
-        help=f"samples per pixel of every pass (default: {default.render.spp}, the default "
-        "preset's; with --ground-truth the chosen preset's)",
+        help=f"samples per pixel of every pass (default: the default preset's "
+        f"{default.render.spp}, and {default.render.spectral_spp or default.render.spp} for a "
+        "spectral pass; with --ground-truth the chosen preset's)",
     )
     p.add_argument(
         "--seed", type=int, default=0, help="sampler seed and library illuminant seed (default: 0)"
@@ -295,10 +296,13 @@ def _ground_truth(args: argparse.Namespace) -> int:
 
 
 def _render_settings(args: argparse.Namespace, modes: list[str]) -> RenderSettings:
-    """The render settings the options give (defaults: the default preset's spp and depth)."""
-    spp = get_preset("default").render.spp if args.spp is None else args.spp
+    """The render settings the options give (defaults: the default preset's spp, spectral
+    spp and depth; ``--spp`` sets every pass)."""
+    default = get_preset("default").render
+    spp, spectral = (default.spp, default.spectral_spp) if args.spp is None else (args.spp, None)
     return RenderSettings(
         spp,
+        spectral_spp=spectral,
         modes=tuple(modes),
         max_depth=args.max_depth,
         variant=args.variant,

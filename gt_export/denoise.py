@@ -26,8 +26,8 @@ The K bands are denoised in two steps (a luminance/chroma split):
 Every band shares its light paths with the others (common random numbers), so the blocks see
 the same noise pattern and a share is much less noisy than its band.
 
-Against a 16384-spp crop of a room at the ``default`` preset (``make bench``,
-``bench_crop_reference.json``) the 95th percentile of the shading error went from 14.3 %
+Against a 16384-spp crop of a room at 2 × 32 spp (``make bench``,
+``bench_crop_reference.json`` at that preset) the 95th percentile of the shading error went from 14.3 %
 (every band through ``fast``, normals only, not marked clean) to 12.0 %, the median from
 2.2 % to 2.0 %, for one more OIDN call per image; on an analytic outline (a lit card above a
 floor, tests/gt_export/test_denoise_edges.py) the 95th percentile beside the outline went

@@ -44,7 +44,10 @@ _STANDARD_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
 #: shares, guided by normals and a depth grey marked clean (gt_export/denoise.py).
 #: 5: each light's share is one float32 product (render/traversal_output.py): images and
 #: layers move by at most one float32 rounding.
-PIXELS_VERSION = 5
+#: 6: raw channels go to XYZ by einsum in chunks rather than BLAS (render/modes.py), and an
+#: image's XYZ is the float64 sum of its lights' XYZ (render/light_transport.py): XYZ images
+#: move by at most one float32 rounding, and no longer depend on the BLAS kernel.
+PIXELS_VERSION = 6
 #: What of the installed software changes pixels, hence enters the config hash, and how much
 #: of its version: the renderer exactly (its sampling changes between patch releases);
 #: colour-science's data tables (CMFs, illuminants, cameras) by minor release; numpy by major
@@ -84,6 +87,7 @@ DATASET_RENDER: dict[str, Any] = {
 #: ``integrator`` are recorded and hashed (:meth:`DatasetConfig.settings`).
 RENDER_KEYS: tuple[str, ...] = (
     "spp",
+    "spectral_spp",
     "max_depth",
     "modes",
     "per_light",
@@ -245,6 +249,7 @@ class DatasetConfig:
             "width": self.width,
             "height": self.height,
             "spp": r.spp,
+            "spectral_spp": r.spectral_spp,
             "max_depth": r.max_depth,
             "modes": list(r.modes),
             "per_light": r.per_light,
@@ -309,19 +314,20 @@ PRESETS: dict[str, DatasetConfig] = {
     ),
     # The thesis layout (68 samples) at 256² in <= 20 minutes on 2 cores: every render mode,
     # so the reference image is the 31-band cube and the 3-/6-sensor approximations carry error
-    # maps; two batches of 32 spp measure the noise. The single traversal's saved time buys
-    # 4x the samples of the last round's 2 x 8: the denoised room shading against a converged
-    # crop (make bench, bench_crop_reference.json) went from median 3.7 % / p95 18.5 % to
-    # 2.8 % / 14.9 % (1.6 % median with the reference's own 2.3 % noise removed); a sample of
-    # the costliest class takes 2.2x as long as at 16 spp; the whole set built in 610 s on an
-    # idle machine (make dataset, 8.8 s per sample). Against a 16384-spp reference of the crop (its own
-    # noise 1.2 % median) that render's shading is off by 2.2 % / 14.3 % with the round-3
-    # denoiser and 1.96 % / 12.0 % with the broad-band, depth-guided one (PIXELS_VERSION 4).
+    # maps; two batches measure the noise. The reference image, the ground truth and the
+    # transport come from the traversal, 2 x 160 spp; the spectral image, which only measures
+    # the diagonal modes' spectral error, keeps 2 x 32 (per sample it costs as much as the
+    # traversal of all 40 bands). Against a 16384-spp reference of a room crop (its own noise
+    # 1.2 % median; make bench, bench_crop_reference.json) the denoised shading is off by
+    # median / p95 1.96 % / 12.0 % at 2 x 32 spp, 1.76 % / 8.7 % at 2 x 96 and 1.62 % / 7.8 %
+    # at 2 x 160: samples buy the tail slowly. The whole set built and checked in 610 s,
+    # 777 s and 1119 s on an idle machine (make dataset); 2 x 192 was on course for 22 min.
     "default": DatasetConfig.from_settings(
         "default",
         width=256,
         height=256,
-        spp=64,
+        spp=320,
+        spectral_spp=64,
         max_depth=6,
         per_light=True,
         batches=2,

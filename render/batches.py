@@ -122,12 +122,30 @@ def image_noise(results: Sequence[RenderResult]) -> float | None:
     return float(np.median(rel[rel > 0])) if (rel > 0).any() else 0.0
 
 
+def _half_sum(a: np.ndarray, b: np.ndarray) -> np.ndarray | None:
+    """``(a + b) / 2`` of two float32 arrays in float32, the bits of the float64 mean: the
+    float32 sum is the float64 sum rounded once more, which is innocuous for one addition
+    (53 >= 2 * 24 + 2); halving is exact, and where the half is subnormal the sum was exact
+    (every float32 is a multiple of 2^-149, and one below 2^-125 has at most 24 bits).
+    ``None`` where that does not hold: not both float32, or a sum beyond float32's range."""
+    if not (a.dtype == b.dtype == np.float32):
+        return None
+    with np.errstate(over="ignore"):  # an overflow is detected below and left to float64
+        half = np.add(a, b)
+    half *= np.float32(0.5)
+    return half if np.isfinite(half).all() else None
+
+
 def batch_mean(arrays: Sequence[np.ndarray]) -> np.ndarray:
     """float32 mean of independent batch estimates, summed in order in float64 and divided by
     their number (the bits of ``np.mean(np.stack(arrays), axis=0, dtype=np.float64)``, without
     the stacked copy); one float32 array is returned as it is."""
     if len(arrays) == 1:
         return np.asarray(arrays[0], np.float32)
+    if len(arrays) == 2:
+        half = _half_sum(arrays[0], arrays[1])
+        if half is not None:
+            return half
     total = np.asarray(arrays[0], np.float64).copy()
     for array in arrays[1:]:
         total += array

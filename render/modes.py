@@ -63,6 +63,7 @@ __all__ = [
     "regression_matrix",
     "munsell_reflectances",
     "to_xyz_matrix",
+    "lights_to_xyz_matrix",
     "raw_to_xyz",
     "pad_to_passes",
 ]
@@ -327,6 +328,24 @@ def to_xyz_matrix(
     wavelengths: Wavelengths = COLORIMETRIC_WAVELENGTHS,
 ) -> np.ndarray:
     """``(3, K)`` matrix taking *mode*'s raw channels to CIE 1931 XYZ: ``xyz = raw @ T.T``."""
+    emitted = (
+        light_spectra(scene, wavelengths, data_dir=data_dir)
+        if mode.to_xyz == "regression"
+        else np.zeros((0, np.size(wavelengths)))
+    )
+    return lights_to_xyz_matrix(mode, emitted, data_dir=data_dir, wavelengths=wavelengths)
+
+
+def lights_to_xyz_matrix(
+    mode: RenderMode,
+    emitted: np.ndarray,
+    *,
+    data_dir: str | None = None,
+    wavelengths: Wavelengths = COLORIMETRIC_WAVELENGTHS,
+) -> np.ndarray:
+    """:func:`to_xyz_matrix` for lights whose ``(L, W)`` spectra on *wavelengths* are already
+    known (:func:`light_spectra`; only a regression mode uses them), so a caller that needs
+    them anyway computes them once."""
     sensors = get_sensors(mode.sensors, data_dir=data_dir)
     xyz = get_sensors(XYZ_SENSORS)
     if mode.to_xyz == "identity":
@@ -337,14 +356,28 @@ def to_xyz_matrix(
         return np.eye(3)
     if mode.to_xyz == "integration":
         return integration_matrix(sensors, xyz, wavelengths)
-    return regression_matrix(
-        sensors, xyz, light_spectra(scene, wavelengths, data_dir=data_dir), wavelengths
-    )
+    return regression_matrix(sensors, xyz, emitted, wavelengths)
 
 
-def raw_to_xyz(raw: np.ndarray, matrix: np.ndarray) -> np.ndarray:
-    """``(..., 3)`` float32 XYZ from ``(..., K)`` raw channels with a ``(3, K)`` matrix."""
-    return (np.asarray(raw, np.float64) @ np.asarray(matrix, float).T).astype(np.float32)
+#: Pixels converted at a time by :func:`raw_to_xyz`: one chunk's float64 copy stays in cache.
+_XYZ_CHUNK = 8192
+
+
+def raw_to_xyz(
+    raw: np.ndarray, matrix: np.ndarray, dtype: type[np.floating] = np.float32
+) -> np.ndarray:
+    """``(..., 3)`` XYZ from ``(..., K)`` raw channels with a ``(3, K)`` matrix, summed in
+    float64 by einsum's own loop rather than BLAS, so the bits written do not depend on the
+    BLAS kernel or its threads (and many threads may convert at once without contention);
+    returned as *dtype* (float32 as stored, float64 to add several before rounding)."""
+    values = np.asarray(raw)
+    m = np.asarray(matrix, np.float64)
+    flat = values.reshape(-1, values.shape[-1])
+    out = np.empty((flat.shape[0], m.shape[0]), dtype)
+    for start in range(0, flat.shape[0], _XYZ_CHUNK):
+        part = slice(start, start + _XYZ_CHUNK)
+        out[part] = np.einsum("nk,ck->nc", flat[part].astype(np.float64), m)
+    return out.reshape(*values.shape[:-1], m.shape[0])
 
 
 def pad_to_passes(values: np.ndarray) -> Sequence[np.ndarray]:

@@ -120,6 +120,8 @@ class _Run:
     common: dict[str, Any]
     #: One dict mode -> pass output per job, filled by the parts.
     outputs: list[dict[str, PassOutput]]
+    #: Samples per pixel of the spectral passes (``common["spp"]`` is the diagonal modes').
+    spectral_spp: int
 
 
 def _rgb_part(
@@ -190,7 +192,7 @@ def _spectral_part(run: _Run, spectral_variant: str) -> None:
                 active_lights=job.group,
                 variant=spectral_variant,
                 data_dir=run.data_dir,
-                **run.common,
+                **{**run.common, "spp": run.spectral_spp},
             )
 
 
@@ -207,6 +209,7 @@ def _run_jobs(
     progress: PassProgress | None,
     data_dir: str | None,
     integrator: str = "passes",
+    spectral_spp: int | None = None,
 ) -> tuple[list[dict[str, PassOutput]], dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
     """Every pass of *jobs*, grouped by Mitsuba variant, plus the AOVs.
 
@@ -218,6 +221,7 @@ def _run_jobs(
     times. Passes do not depend on each other's order: each sets its own values, seed and spp.
     With ``integrator="single"`` the diagonal modes of every job, and a textured scene's AOVs
     even without them, come from one band-path traversal (:func:`.single.render_jobs`).
+    The spectral passes render *spectral_spp* samples (default *spp*).
     """
     diagonal = any(m.kind == "diagonal" for job in jobs for m in job.modes)
     run = _Run(
@@ -235,12 +239,10 @@ def _run_jobs(
             geometry=prepare_geometry(scene),
         ),
         [{} for _ in jobs],
+        spp if spectral_spp is None else spectral_spp,
     )
-    found: tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal] = (
-        {},
-        (),
-        SingleTraversal({}, ()),
-    )
+    found: tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]
+    found = ({}, (), SingleTraversal({}, ()))
     parts = []
     if aovs or diagonal:
         parts.append(("rgb", choose_variant("rgb", variant)))
@@ -265,8 +267,9 @@ def render_scene(
 ) -> RenderResult:
     """Render *scene* in each of ``settings.modes`` and convert every mode to CIE 1931 XYZ.
 
-    One batch: every pass renders ``settings.batch_spp`` samples with sampler seed *seed*.
-    All diagonal modes share one loaded scene and the same paths (same seed and sample count,
+    One batch: every pass renders ``settings.batch_spp`` samples with sampler seed *seed*
+    (a spectral pass ``settings.spectral_batch_spp``, in ``meta["spectral_spp"]``). All
+    diagonal modes share one loaded scene and the same paths (same seed and sample count,
     Russian roulette off): ``rgb3``, ``rgb6`` and ``bands31`` differ only by spectral error.
     With ``settings.per_light`` and no ``share_mode`` every mode is rendered light by light and
     ``images`` is exactly the sum of the per-light images (and ``direct`` of per-light direct
@@ -285,10 +288,6 @@ def render_scene(
         Sampler seed, shared by every pass.
     progress
         Called with 1 after each Mitsuba pass; :func:`count_passes` gives the total.
-
-    Returns
-    -------
-    RenderResult
     """
     plan = _plan(scene, settings, data_dir)
     outputs, aov_maps, aov_seconds, single = _run_jobs(
@@ -303,6 +302,7 @@ def render_scene(
         progress=progress,
         data_dir=data_dir,
         integrator=plan.integrator,
+        spectral_spp=settings.spectral_batch_spp,
     )
     timings: dict[str, list[float]] = {m.name: [] for m in plan.objs + plan.share}
     variants: dict[str, str] = {}
@@ -332,9 +332,9 @@ def render_scene(
         [m.name for m in plan.share] if plan.split else (names if settings.per_light else [])
     )
     meta["integrator"] = plan.integrator
-    logger.debug(
-        "rendered %s: %s", scene.name, {k: v["seconds"] for k, v in meta["timings"].items()}
-    )
+    if any(m.kind == "spectral" for m in plan.objs):
+        meta["spectral_spp"] = settings.spectral_batch_spp
+    logger.debug("rendered %s: %s", scene.name, {k: sum(v) for k, v in timings.items()})
     return _assemble(scene, plan, outputs, aov_maps, single, meta, data_dir=data_dir)
 
 

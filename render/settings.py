@@ -74,10 +74,15 @@ class RenderSettings:
         back to ``"passes"`` on a scalar variant
         (:func:`spectrinsic.render.single.resolve_integrator`). Not hashed by a dataset
         config: both give the same pixels to float rounding.
+    spectral_spp
+        Samples per pixel of the spectral Monte Carlo pass over all batches (``None``: *spp*).
+        The reference image, the ground truth and the per-light transport come from the
+        diagonal modes; the spectral image only measures their spectral error, so a preset
+        may spend fewer samples on it than on the traversal.
 
     >>> s = RenderSettings(8, modes=("rgb3",), batches=2)
-    >>> s.batch_spp, s.with_options(spp=16).batch_spp
-    (4, 8)
+    >>> s.batch_spp, s.with_options(spp=16).batch_spp, s.with_options(spectral_spp=2).spectral_batch_spp
+    (4, 8, 1)
     >>> RenderSettings(spp=3, batches=2)
     Traceback (most recent call last):
     ...
@@ -96,6 +101,7 @@ class RenderSettings:
     noise_target: float | None = None
     max_batches: int | None = None
     integrator: str = DEFAULT_INTEGRATOR
+    spectral_spp: int | None = None
 
     def __post_init__(self) -> None:
         # lists from JSON or the command line become tuples, so settings stay hashable records
@@ -104,11 +110,15 @@ class RenderSettings:
             object.__setattr__(self, "direct", tuple(self.direct))
         for name in ("spp", "max_depth", "batches"):
             _positive(name, getattr(self, name))
-        if self.spp % self.batches:
-            raise RenderError(
-                f"render setting spp={self.spp} with batches={self.batches}; expected "
-                "spp divisible by batches (each batch renders spp / batches samples)"
-            )
+        if self.spectral_spp is not None:
+            _positive("spectral_spp", self.spectral_spp)
+        for name in ("spp", "spectral_spp"):
+            if (getattr(self, name) or 0) % self.batches:
+                raise RenderError(
+                    f"render setting {name}={getattr(self, name)} with batches={self.batches}; "
+                    f"expected {name} divisible by batches (each batch renders {name} / "
+                    "batches samples)"
+                )
         if self.noise_target is not None and not (
             isinstance(self.noise_target, int | float) and 0 < self.noise_target < 1
         ):
@@ -133,6 +143,11 @@ class RenderSettings:
     def batch_spp(self) -> int:
         """Samples per pixel of every pass of one batch, ``spp / batches``."""
         return self.spp // self.batches
+
+    @property
+    def spectral_batch_spp(self) -> int:
+        """Samples per pixel of the spectral pass of one batch."""
+        return (self.spp if self.spectral_spp is None else self.spectral_spp) // self.batches
 
     @property
     def per_light_modes(self) -> tuple[str, ...] | None:

@@ -18,12 +18,14 @@ __all__ = ["TransportOutput", "light_shares", "sum_lights"]
 
 
 def light_shares(parts: np.ndarray, emission: np.ndarray) -> np.ndarray:
-    """``(L, H, W, K)`` float32 each light's share ``parts_l ∘ E_l`` of *parts* ``(L, H, W, K)``
-    under channel values *emission* ``(L, K)``, multiplied in float32 (the values rounded to
-    float32 first, as a float32 render would use them): one product per value, the same in
-    every kernel, and no float64 copy of the transport (the relighting's main cost)."""
-    e = np.asarray(emission, np.float64).astype(np.float32)[:, None, None, :]
-    return np.multiply(np.asarray(parts, np.float32), e)
+    """``(L, ..., K)`` float32 each light's share ``parts_l ∘ E_l`` of *parts* ``(L, ..., K)``
+    (``(L, H, W, K)`` images, or ``(L, N, K)`` pixels) under channel values *emission*
+    ``(L, K)``, multiplied in float32 (the values rounded to float32 first, as a float32 render
+    would use them): one product per value, the same in every kernel, and no float64 copy of
+    the transport (the relighting's main cost)."""
+    values = np.asarray(parts, np.float32)
+    e = np.asarray(emission, np.float64).astype(np.float32)
+    return np.multiply(values, e.reshape(e.shape[0], *([1] * (values.ndim - 2)), e.shape[1]))
 
 
 def sum_lights(shares: np.ndarray, lights: Sequence[int] | None = None) -> np.ndarray:

@@ -84,7 +84,9 @@ def responses(spectra: SpectralValues, curves: SensorCurves, wavelengths: Wavele
     _check(x, s, wl)
     # einsum's own loop rather than BLAS: its summation order does not depend on the thread
     # count or the CPU kernel, so fitted matrices and written files are reproducible anywhere.
-    return np.einsum("...w,kw->...k", x * integration_weights(wl), s)
+    # The weights go on the K curves, not on the many spectra (the same bits on the 1 nm grid,
+    # whose weights are 1).
+    return np.einsum("...w,kw->...k", x, s * integration_weights(wl))
 
 
 def diagonal_values(

@@ -101,6 +101,7 @@ def test_hash_changes_with_output_settings_only():
         != base.config_hash()
     )
     assert base.with_options(seed=1).config_hash() != base.config_hash()
+    assert base.with_options(spectral_spp=base.render.batches).config_hash() != base.config_hash()
     assert base.with_options(modes=("rgb3",)).config_hash() != base.config_hash()
 
 
@@ -129,5 +130,7 @@ def test_the_written_record_rebuilds_the_same_config(name):
 def test_render_settings_errors_read_as_dataset_settings():
     with pytest.raises(DatasetError, match="dataset setting spp=3 with batches=2"):
         get_preset("preview").with_options(spp=3)
+    with pytest.raises(DatasetError, match="dataset setting spectral_spp=3 with batches=2"):
+        get_preset("preview").with_options(spectral_spp=3)
     with pytest.raises(DatasetError, match="unknown dataset setting.*'aovs'"):
         get_preset("preview").with_options(aovs=False)

@@ -95,3 +95,42 @@ def test_a_relighting_is_the_same_on_one_thread_and_on_several(monkeypatch):
         for a, b in zip(one.per_light, many.per_light):
             assert np.array_equal(a[mode], b[mode])
     assert not np.array_equal(one.raw["bands31"], batches[0]["bands31"].sum(axis=0))
+
+
+def test_two_batches_whose_float32_sum_overflows_keep_the_float64_mean():
+    big = np.full((4, 4), 3.0e38, np.float32)
+    got = batch_mean([big, big])
+    assert np.isfinite(got).all() and np.array_equal(got, big)
+
+
+def test_light_shares_of_pixel_rows_equal_those_of_the_images():
+    rng = np.random.default_rng(6)
+    parts = rng.random((3, 8, 9, 6), dtype=np.float32)
+    emission = rng.uniform(0.1, 10.0, (3, 6))
+    rows = light_shares(parts.reshape(3, 72, 6), emission)
+    assert np.array_equal(rows.reshape(parts.shape), light_shares(parts, emission))
+
+
+def test_a_relit_image_is_the_sum_of_its_lights_and_the_xyz_of_its_raw_channels():
+    """The image's XYZ is composed as the float64 sum of the lights' XYZ: it must equal the
+    per-light images summed and the mode's matrix applied to the relit raw channels."""
+    rng = np.random.default_rng(7)
+    batches = tuple({"rgb6": rng.random((2, 24, 24, 6), dtype=np.float32)} for _ in range(2))
+    transport = LightTransport(
+        modes=("rgb6",),
+        sensors={"rgb6": "gaussian:6@400-700"},
+        batches=batches,
+        seeds=(1, 2),
+        spp=4,
+        max_depth=3,
+    )
+    lights = (Light("point", "planck:2700K", 2.0), Light("point", "cie:LED-RGB1", 0.7))
+    scene = Scene("s", (), (), lights, Camera((0, 0, 1), (0, 0, 0)))
+    result = relit_result(transport, scene)
+    image = result.images["rgb6"].astype(np.float64)
+    summed = sum(p["rgb6"].astype(np.float64) for p in result.per_light)
+    matrix = np.asarray(result.meta["to_xyz"]["rgb6"])
+    from_raw = result.raw["rgb6"].astype(np.float64) @ matrix.T
+    scale = np.abs(image).max()
+    assert np.abs(image - summed).max() <= 4e-7 * scale
+    assert np.abs(image - from_raw).max() <= 4e-7 * scale

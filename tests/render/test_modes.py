@@ -81,3 +81,24 @@ def test_channel_values_follow_eq_5_2(make_plane):
 def test_identity_modes_need_three_sensors(make_plane):
     scene = make_plane("flat:0.4", "cie:D65")
     np.testing.assert_array_equal(modes.to_xyz_matrix(modes.get_mode("rgb3"), scene), np.eye(3))
+
+
+def test_raw_to_xyz_is_the_float64_product_over_chunk_boundaries():
+    """Chunked einsum (no BLAS) against exact sums: float64 output within a few ulps of
+    ``math.fsum`` of the products, float32 output that value rounded once."""
+    import math
+
+    rng = np.random.default_rng(5)
+    raw = rng.uniform(-1.0, 4.0, (3, 101, 97, 31)).astype(np.float32)  # 29391 pixels: 4 chunks
+    matrix = rng.standard_normal((3, 31))
+    wide = modes.raw_to_xyz(raw, matrix, np.float64)
+    narrow = modes.raw_to_xyz(raw, matrix)
+    assert wide.shape == narrow.shape == (3, 101, 97, 3)
+    assert wide.dtype == np.float64 and narrow.dtype == np.float32
+    assert np.array_equal(narrow, wide.astype(np.float32))
+    flat_raw, flat_wide = raw.reshape(-1, 31).astype(np.float64), wide.reshape(-1, 3)
+    for i in rng.choice(flat_raw.shape[0], 200, replace=False):
+        for c in range(3):
+            exact = math.fsum(flat_raw[i] * matrix[c])
+            scale = math.fsum(np.abs(flat_raw[i] * matrix[c]))
+            assert abs(flat_wide[i, c] - exact) <= 64 * np.finfo(float).eps * scale

@@ -200,3 +200,21 @@ def test_integrator_is_a_render_setting_not_hashed():
     passes = config.with_options(integrator="passes")
     assert (config.render.integrator, passes.render.integrator) == ("single", "passes")
     assert passes.config_hash() == config.config_hash()
+
+
+def test_the_spectral_pass_renders_its_own_sample_count(make_room):
+    """``spectral_spp`` sets the spectral pass alone: its image is that of a spectral-only render
+    at that count (same seed, bit for bit), the diagonal modes those of a render at ``spp``."""
+    scene = make_room(size=16)
+    both = RenderSettings(8, modes=("spectral", "rgb3"), batches=2, spectral_spp=2)
+    got = render_scene(scene, both.with_options(spp=4, batches=1, spectral_spp=1), seed=3)
+    spectral = render_scene(scene, RenderSettings(1, modes=("spectral",)), seed=3)
+    diagonal = render_scene(scene, RenderSettings(4, modes=("rgb3",)), seed=3)
+    assert both.batch_spp == 4 and both.spectral_batch_spp == 1
+    np.testing.assert_array_equal(got.raw["spectral"], spectral.raw["spectral"])
+    np.testing.assert_array_equal(got.raw["rgb3"], diagonal.raw["rgb3"])
+    assert not np.array_equal(
+        got.raw["spectral"],
+        render_scene(scene, RenderSettings(4, modes=("spectral",)), seed=3).raw["spectral"],
+    )
+    assert got.meta["spectral_spp"] == 1 and got.meta["spp"] == 4
