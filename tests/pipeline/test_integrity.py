@@ -22,6 +22,7 @@ import pytest
 
 from spectrinsic.cli import main
 from spectrinsic.gt_export import check_dataset, is_complete
+from spectrinsic.gt_export.sample import TMP_PREFIX
 from spectrinsic.pipeline.dataset import build_dataset
 from spectrinsic.pipeline.presets import get_preset
 
@@ -269,7 +270,11 @@ def test_a_worker_killed_mid_write_leaves_a_clean_complete_set(tmp_path):
         text=True,
     )
     deadline = time.monotonic() + WAIT_S
-    while not (out.is_dir() and any(p.is_dir() for p in out.glob(".spectrinsic-tmp-*"))):
+    # a sample's own temporary (``<prefix><id>-*``, made by the worker writing it): the main
+    # process briefly makes a write probe with the same prefix, before any worker exists
+    while not (
+        out.is_dir() and any(p.is_dir() for i in ids for p in out.glob(f"{TMP_PREFIX}{i}-*"))
+    ):
         if proc.poll() is not None or time.monotonic() > deadline:
             proc.kill()
             pytest.fail(f"the build never started writing: {proc.communicate()[1][-2000:]}")
