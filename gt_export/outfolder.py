@@ -114,7 +114,19 @@ def _require_writable(root: Path, option: str) -> None:
 
 
 def _entries(root: Path) -> list[Path]:
-    return sorted(p for p in root.iterdir() if p.name != LOCK_NAME)
+    """What *root* holds for the "new or empty" rule: not the lock, nor a write probe that a
+    run killed between making and removing it left behind (:func:`_stale_probe`)."""
+    return sorted(p for p in root.iterdir() if p.name != LOCK_NAME and not _stale_probe(p))
+
+
+def _stale_probe(path: Path) -> bool:
+    """An empty folder named as :func:`_require_writable`'s probe (``<prefix>probe-<pid>``)."""
+    return (
+        path.name.startswith(f"{_TMP_PREFIX}probe-")
+        and path.is_dir()
+        and not path.is_symlink()
+        and not any(path.iterdir())
+    )
 
 
 def check_out_folder(

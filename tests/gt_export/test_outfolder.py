@@ -14,6 +14,8 @@ import pytest
 
 from spectrinsic.cli import main
 from spectrinsic.errors import DatasetError, FolderLockedError
+from spectrinsic.gt_export import remove_stale_temporaries
+from spectrinsic.gt_export.integrity import check_build_folder, write_marker
 from spectrinsic.gt_export.outfolder import (
     LOCK_NAME,
     OUTPUT_MARKER,
@@ -160,3 +162,23 @@ def _dataset(tmp: Path) -> Path:
     root.mkdir()
     (root / "manifest.json").write_text(json.dumps({"format_version": 1, "config_hash": "h"}))
     return root
+
+
+def test_a_write_probe_left_by_a_killed_run_does_not_block_the_next(tmp_path):
+    """A run killed (kill -9) between making and removing its write probe leaves an empty
+    ``.spectrinsic-tmp-probe-<pid>`` folder in ``--out``: the folder still counts as new for
+    every verb and for a build (seen in the hard-kill test, whose re-run was refused). A
+    probe-named folder holding anything is not spectrinsic's probe and keeps the folder foreign."""
+    out = tmp_path / "ds"
+    probe = out / ".spectrinsic-tmp-probe-4242"
+    probe.mkdir(parents=True)
+    check_output_folder(out)
+    assert check_build_folder(out, "h" * 64, rebuild=False) is None
+    write_marker(out, "h" * 64)  # what a build does first; its clean-up then takes the probe
+    assert probe in remove_stale_temporaries(out) and not probe.exists()
+    other = tmp_path / "other"
+    (other / ".spectrinsic-tmp-probe-4242").mkdir(parents=True)
+    (other / ".spectrinsic-tmp-probe-4242" / "mine.txt").write_text("mine")
+    with pytest.raises(DatasetError, match="not empty"):
+        check_build_folder(other, "h" * 64, rebuild=False)
+    assert (other / ".spectrinsic-tmp-probe-4242" / "mine.txt").read_text() == "mine"

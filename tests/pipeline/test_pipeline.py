@@ -216,8 +216,9 @@ def test_hard_kill_mid_write_then_rerun_completes(tmp_path):
     proc = _cli(out)
 
     def writing() -> bool:
+        # a sample's own temporary: the main process's brief write probe has the same prefix
         return out.is_dir() and any(
-            p.name.startswith(".spectrinsic-tmp-") and p.is_dir() for p in out.iterdir()
+            p.is_dir() for i in IDS for p in out.glob(f".spectrinsic-tmp-{i}-*")
         )
 
     _wait_for(writing, proc, "the middle of writing a sample")
