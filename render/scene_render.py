@@ -209,7 +209,7 @@ def _run_jobs(
     progress: PassProgress | None,
     data_dir: str | None,
     integrator: str = "passes",
-    spectral_spp: int | None = None,
+    spectral_spp: int,
 ) -> tuple[list[dict[str, PassOutput]], dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
     """Every pass of *jobs*, grouped by Mitsuba variant, plus the AOVs.
 
@@ -221,7 +221,7 @@ def _run_jobs(
     times. Passes do not depend on each other's order: each sets its own values, seed and spp.
     With ``integrator="single"`` the diagonal modes of every job, and a textured scene's AOVs
     even without them, come from one band-path traversal (:func:`.single.render_jobs`).
-    The spectral passes render *spectral_spp* samples (default *spp*).
+    The spectral passes render *spectral_spp* samples.
     """
     diagonal = any(m.kind == "diagonal" for job in jobs for m in job.modes)
     run = _Run(
@@ -239,7 +239,7 @@ def _run_jobs(
             geometry=prepare_geometry(scene),
         ),
         [{} for _ in jobs],
-        spp if spectral_spp is None else spectral_spp,
+        spectral_spp,
     )
     found: tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]
     found = ({}, (), SingleTraversal({}, ()))
