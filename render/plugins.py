@@ -13,7 +13,14 @@ import numpy as np
 
 from spectrinsic.errors import SceneError
 
+#: A spectrum whose largest value is below this (per nm) is written as Mitsuba's ``uniform``
+#: spectrum of value 0: ``regular``/``irregular`` build a sampling distribution from their
+#: values, which fails with no probability mass for an all-zero (or float32-underflowing)
+#: spectrum such as a black material (``flat:0``, soot, velvet).
+BLACK_SPECTRUM = 1e-30
+
 __all__ = [
+    "BLACK_SPECTRUM",
     "rgb_spectrum",
     "regular_spectrum",
     "black_bsdf",
@@ -35,10 +42,14 @@ def rgb_spectrum(values: Sequence[float]) -> dict[str, Any]:
 def regular_spectrum(values: np.ndarray, wavelengths: np.ndarray) -> dict[str, Any]:
     """A spectrum for the spectral variant: *values* on *wavelengths* (nm), linearly interpolated.
 
-    Uses Mitsuba's ``regular`` plugin on an evenly spaced grid, ``irregular`` otherwise.
+    Uses Mitsuba's ``regular`` plugin on an evenly spaced grid, ``irregular`` otherwise, and
+    a ``uniform`` 0 (which needs no sampling distribution) for a black spectrum, whose values
+    are all below :data:`BLACK_SPECTRUM`.
     """
     wl = np.asarray(wavelengths, float)
     v = np.asarray(values, float)
+    if np.all(np.abs(v) < BLACK_SPECTRUM):
+        return {"type": "uniform", "value": 0.0}
     text = ", ".join(f"{x:.9g}" for x in v)
     if np.allclose(np.diff(wl), wl[1] - wl[0]):
         return {

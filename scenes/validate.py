@@ -35,6 +35,8 @@ from spectrinsic.spectra import get_spectrum
 __all__ = [
     "validate_scene",
     "Problems",
+    "POWER_RANGE",
+    "MAX_COORDINATE",
 ]
 
 log = logging.getLogger(__name__)
@@ -43,6 +45,15 @@ log = logging.getLogger(__name__)
 #: 0 outside for a closed outward-oriented surface; overlapping parts add up).
 _INSIDE_WINDING = 0.5
 _RAY_BATCHES = 16
+#: A light's power, in the scene's relative units, must lie in this closed range: the renderer
+#: carries power × spectrum (unit luminance-weighted mean) × geometry in float32 (largest
+#: 3.4e38, smallest normal 1.2e-38), so 1e±20 leaves 18 orders of magnitude for the spectrum's
+#: peak, the distance falloff and the sampling weights; a light below it is negligible (it
+#: would underflow to black, and alone gives Mitsuba an emitter with no probability mass).
+POWER_RANGE = (1e-20, 1e20)
+#: Largest absolute coordinate (vertices, light positions and directions, camera) in scene
+#: units: vertices are cast to float32 (largest 3.4e38) and squared distances must stay finite.
+MAX_COORDINATE = 1e18
 
 
 T = TypeVar("T")
@@ -91,11 +102,14 @@ def _check_materials(scene: Scene, source: str) -> None:
 
 
 def _vec(value: object, n: int = 3) -> np.ndarray | None:
+    """*value* as ``n`` finite numbers of magnitude <= :data:`MAX_COORDINATE`, else ``None``."""
     try:
         arr = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         return None
-    return arr if arr.shape == (n,) and np.all(np.isfinite(arr)) else None
+    if arr.shape != (n,) or not np.all(np.abs(arr) <= MAX_COORDINATE):
+        return None
+    return arr
 
 
 def _check_spectrum(
@@ -159,6 +173,14 @@ def _check_meshes(scene: Scene, source: str) -> None:
                 f"{where}.vertices",
                 f"{int(bad.sum())} vertices are NaN or infinite (first: vertex {int(np.argmax(bad))})",
             )
+        far = ~(np.abs(v.astype(np.float64)) <= MAX_COORDINATE).all(axis=1)
+        if far.any():
+            raise _fail(
+                source,
+                f"{where}.vertices",
+                f"{int(far.sum())} vertices have a coordinate beyond ±{MAX_COORDINATE:g} "
+                f"(first: vertex {int(np.argmax(far))}); float32 rendering needs smaller ones",
+            )
         if f.ndim != 2 or f.shape[1] != 3 or len(f) == 0 or not np.issubdtype(f.dtype, np.integer):
             raise _fail(
                 source,
@@ -207,9 +229,19 @@ def _check_lights(scene: Scene, source: str) -> None:
             raise _fail(source, f"{where}.power", f"expected a number, got {power!r}")
         if not math.isfinite(power) or power <= 0:
             raise _fail(source, f"{where}.power", f"must be a finite number > 0, got {power!r}")
+        lo, hi = POWER_RANGE
+        if not lo <= power <= hi:
+            raise _fail(
+                source,
+                f"{where}.power",
+                f"{power!r} is outside [{lo:g}, {hi:g}] (a negligible or overflowing light "
+                "in float32 rendering)",
+            )
         if _vec(light.position) is None:
             raise _fail(
-                source, f"{where}.position", f"expected 3 finite numbers, got {light.position!r}"
+                source,
+                f"{where}.position",
+                f"expected 3 finite numbers within ±{MAX_COORDINATE:g}, got {light.position!r}",
             )
         uses = LIGHT_FIELDS[light.kind]
         if "direction" in uses:
@@ -239,7 +271,9 @@ def _check_camera(scene: Scene, source: str) -> None:
     for attr in ("origin", "target", "up"):
         if _vec(getattr(cam, attr)) is None:
             raise _fail(
-                source, f"camera.{attr}", f"expected 3 finite numbers, got {getattr(cam, attr)!r}"
+                source,
+                f"camera.{attr}",
+                f"expected 3 finite numbers within ±{MAX_COORDINATE:g}, got {getattr(cam, attr)!r}",
             )
     forward = np.asarray(cam.target, float) - np.asarray(cam.origin, float)
     if np.linalg.norm(forward) == 0:
