@@ -147,6 +147,25 @@ def _check_area(v: np.ndarray, f: np.ndarray, source: str, where: str) -> None:
         )
 
 
+def _check_coordinates(v: np.ndarray, source: str, where: str) -> None:
+    """Vertices finite and within ±:data:`MAX_COORDINATE` (finite once cast to float32)."""
+    bad = ~np.isfinite(v).all(axis=1)
+    if bad.any():
+        raise _fail(
+            source,
+            f"{where}.vertices",
+            f"{int(bad.sum())} vertices are NaN or infinite (first: vertex {int(np.argmax(bad))})",
+        )
+    far = ~(np.abs(v.astype(np.float64)) <= MAX_COORDINATE).all(axis=1)
+    if far.any():
+        raise _fail(
+            source,
+            f"{where}.vertices",
+            f"{int(far.sum())} vertices have a coordinate beyond ±{MAX_COORDINATE:g} "
+            f"(first: vertex {int(np.argmax(far))}); float32 rendering needs smaller ones",
+        )
+
+
 def _check_meshes(scene: Scene, source: str) -> None:
     if not scene.meshes:
         raise _fail(source, "meshes", "a scene needs at least one mesh")
@@ -166,21 +185,7 @@ def _check_meshes(scene: Scene, source: str) -> None:
                 f"{where}.vertices",
                 f"expected a (V>=3, 3) float array, got shape {v.shape}",
             )
-        bad = ~np.isfinite(v).all(axis=1)
-        if bad.any():
-            raise _fail(
-                source,
-                f"{where}.vertices",
-                f"{int(bad.sum())} vertices are NaN or infinite (first: vertex {int(np.argmax(bad))})",
-            )
-        far = ~(np.abs(v.astype(np.float64)) <= MAX_COORDINATE).all(axis=1)
-        if far.any():
-            raise _fail(
-                source,
-                f"{where}.vertices",
-                f"{int(far.sum())} vertices have a coordinate beyond ±{MAX_COORDINATE:g} "
-                f"(first: vertex {int(np.argmax(far))}); float32 rendering needs smaller ones",
-            )
+        _check_coordinates(v, source, where)
         if f.ndim != 2 or f.shape[1] != 3 or len(f) == 0 or not np.issubdtype(f.dtype, np.integer):
             raise _fail(
                 source,
@@ -217,6 +222,22 @@ def _check_textures(scene: Scene, source: str) -> None:
             raise _fail(source, f"meshes[{i}] ({m.name!r}).texture", problem)
 
 
+def _check_power(power: object, source: str, field: str) -> None:
+    """A light's power: a finite number in :data:`POWER_RANGE`."""
+    if isinstance(power, bool) or not isinstance(power, (int, float, np.floating, np.integer)):
+        raise _fail(source, field, f"expected a number, got {power!r}")
+    if not math.isfinite(power) or power <= 0:
+        raise _fail(source, field, f"must be a finite number > 0, got {power!r}")
+    lo, hi = POWER_RANGE
+    if not lo <= power <= hi:
+        raise _fail(
+            source,
+            field,
+            f"{power!r} is outside [{lo:g}, {hi:g}] (a negligible or overflowing light "
+            "in float32 rendering)",
+        )
+
+
 def _check_lights(scene: Scene, source: str) -> None:
     if not scene.lights:
         raise _fail(source, "lights", "a scene needs at least one light")
@@ -224,19 +245,7 @@ def _check_lights(scene: Scene, source: str) -> None:
         where = f"lights[{i}]"
         if light.kind not in LIGHT_KINDS:
             raise _fail(source, f"{where}.kind", unknown_light_kind(light.kind))
-        power = light.power
-        if isinstance(power, bool) or not isinstance(power, (int, float, np.floating, np.integer)):
-            raise _fail(source, f"{where}.power", f"expected a number, got {power!r}")
-        if not math.isfinite(power) or power <= 0:
-            raise _fail(source, f"{where}.power", f"must be a finite number > 0, got {power!r}")
-        lo, hi = POWER_RANGE
-        if not lo <= power <= hi:
-            raise _fail(
-                source,
-                f"{where}.power",
-                f"{power!r} is outside [{lo:g}, {hi:g}] (a negligible or overflowing light "
-                "in float32 rendering)",
-            )
+        _check_power(light.power, source, f"{where}.power")
         if _vec(light.position) is None:
             raise _fail(
                 source,
