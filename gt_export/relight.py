@@ -33,6 +33,7 @@ import numpy as np
 from spectrinsic.errors import DatasetError, SpectrinsicError
 from spectrinsic.gt_export.exr import read_exr
 from spectrinsic.gt_export.integrity import replaceable_sample
+from spectrinsic.gt_export.relight_checks import check_relight_inputs
 from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, file_sha256
 from spectrinsic.gt_export.sample_meta import read_meta
 from spectrinsic.gt_export.transport_file import read_transport
@@ -238,6 +239,7 @@ def relit_render(
     stray = [i for i in (powers or {}) if not (isinstance(i, int) and 0 <= i < n_lights)]
     if stray:
         raise DatasetError(f"--power {stray[0]!r}: the sample has lights 0..{n_lights - 1}")
+    check_relight_inputs(sample, meta)  # every file read matches meta.json; the EXR's header
     transport, coverage = read_transport(sample, meta["transport"])
     scene = relit_scene(read_sample_scene(sample), lights, powers, source=str(meta["sample_id"]))
     relit = {

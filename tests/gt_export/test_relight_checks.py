@@ -1,0 +1,96 @@
+"""Issue 36, cause 3: ``relight`` verifies what it reads before using it.
+
+A source sample whose ``transport.exr`` has 200 flipped bytes, or whose ``scene.json`` has one
+light's power edited (still valid JSON), was relit with rc 0 and written with fresh SHA-256s,
+so ``check`` could no longer find the damage. Now each is refused in one line naming the file,
+before anything is written; and the transport's header (declared size and channels) is checked
+against the sample's ``meta.json`` record before any pixel is decoded.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from spectrinsic.cli import main
+from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export import export_sample
+from spectrinsic.gt_export.sample_meta import read_meta
+from spectrinsic.gt_export.transport_file import TRANSPORT_NAME
+from spectrinsic.render import RenderSettings
+from spectrinsic.render.transport import render_transport_batches
+
+SETTINGS = RenderSettings(spp=2, modes=("rgb3",), batches=2, max_depth=3)
+
+
+@pytest.fixture(scope="module")
+def source(tmp_path_factory, make_room) -> Path:
+    """A two-light room sample (8x8) stored with its transport."""
+    out = tmp_path_factory.mktemp("relight-checks")
+    scene = make_room(size=8)
+    transport, result = render_transport_batches(scene, SETTINGS, seed=3)
+    return export_sample(
+        out, scene, result, sample_id="room__v0__two", config={"t": 36}, seed=3,
+        transport=transport,
+    )  # fmt: skip
+
+
+@pytest.fixture
+def sample(source, tmp_path) -> Path:
+    """A private copy of the source sample, free to damage."""
+    return Path(shutil.copytree(source, tmp_path / source.name))
+
+
+def _relight(sample: Path, out: Path, capsys) -> tuple[int, str]:
+    rc = main(["relight", str(sample), "--light", "0=planck:3000K", "--out", str(out)])
+    return rc, capsys.readouterr().err.strip()
+
+
+def test_a_sound_sample_still_relights(sample, tmp_path, capsys):
+    rc, _ = _relight(sample, tmp_path / "relit", capsys)
+    assert rc == 0 and (tmp_path / "relit" / "meta.json").is_file()
+
+
+def test_flipped_bytes_in_the_transport_are_refused_naming_the_file(sample, tmp_path, capsys):
+    path = sample / TRANSPORT_NAME
+    data = bytearray(path.read_bytes())
+    start = len(data) // 2  # inside the pixel data, past the header
+    data[start : start + 200] = bytes(b ^ 0xFF for b in data[start : start + 200])
+    path.write_bytes(bytes(data))
+    rc, err = _relight(sample, tmp_path / "relit", capsys)
+    assert rc == 2 and "\n" not in err
+    assert str(path) in err and "SHA-256" in err
+    assert not (tmp_path / "relit").exists()
+
+
+def test_an_edited_light_power_in_scene_json_is_refused(sample, tmp_path, capsys):
+    path = sample / "scene.json"
+    scene = json.loads(path.read_text())
+    scene["lights"][0]["power"] = scene["lights"][0]["power"] * 10  # still valid JSON
+    path.write_text(json.dumps(scene))
+    rc, err = _relight(sample, tmp_path / "relit", capsys)
+    assert rc == 2 and "\n" not in err
+    assert str(path) in err and "SHA-256" in err
+    assert not (tmp_path / "relit").exists()
+
+
+def test_the_transport_header_must_declare_the_samples_size_and_channels(sample):
+    from spectrinsic.gt_export.relight_checks import check_transport_header, transport_channels
+
+    meta = read_meta(sample).raw
+    record, (h, w) = meta["transport"], meta["size"]
+    path = sample / TRANSPORT_NAME
+    check_transport_header(path, record, (h, w))  # the file as written: accepted
+    # 2 lights x 2 batches x rgb3's X, Y, Z
+    assert transport_channels(record) == {
+        f"L{j}_b{b}_rgb3.{c}" for j in (0, 1) for b in (0, 1) for c in "XYZ"
+    }
+    with pytest.raises(DatasetError, match=rf"{TRANSPORT_NAME}: declares {w}x{h} pixels"):
+        check_transport_header(path, record, (h + 1, w))
+    with pytest.raises(DatasetError, match="missing \\['L2_b0_rgb3.X'"):
+        check_transport_header(path, {**record, "lights": 3}, (h, w))
+    with pytest.raises(DatasetError, match="unexpected \\['L1_b0_rgb3.X'"):
+        check_transport_header(path, {**record, "lights": 1}, (h, w))
