@@ -33,7 +33,7 @@ import numpy as np
 from spectrinsic.errors import DatasetError, SpectrinsicError
 from spectrinsic.gt_export.exr import read_exr
 from spectrinsic.gt_export.integrity import replaceable_sample
-from spectrinsic.gt_export.relight_checks import check_relight_inputs
+from spectrinsic.gt_export.relight_checks import check_finite_result, check_relight_inputs
 from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, file_sha256
 from spectrinsic.gt_export.sample_meta import read_meta
 from spectrinsic.gt_export.transport_file import read_transport
@@ -42,6 +42,7 @@ from spectrinsic.render.light_transport import LightTransport, relit_result
 from spectrinsic.render.result import RenderResult
 from spectrinsic.scenes.model import GLOSS_FIELDS, Camera, Light, Material, Mesh, Scene
 from spectrinsic.scenes.textures import texture_from_record
+from spectrinsic.scenes.validate import POWER_RANGE
 from spectrinsic.spectra import get_spectrum
 
 __all__ = [
@@ -156,10 +157,12 @@ def relit_scene(
     """*scene* with light i's spectrum ``lights[i]`` (and power ``powers[i]``); others kept.
     Its metadata names the source sample and drops the energy ratio r (not relit)."""
     powers = dict(powers or {})
-    bad = [i for i, p in powers.items() if not (isinstance(p, int | float) and p > 0)]
+    lo, hi = POWER_RANGE  # the bounds of a scene file's powers: finite in float32 rendering
+    bad = [i for i, p in powers.items() if not (isinstance(p, int | float) and lo <= p <= hi)]
     if bad:
         raise DatasetError(
-            f"light power {powers[bad[0]]!r} for light {bad[0]}: expected a positive number"
+            f"light power {powers[bad[0]]!r} for light {bad[0]}: expected a number in "
+            f"[{lo:g}, {hi:g}]"
         )
     new = tuple(
         dataclasses.replace(
@@ -297,6 +300,7 @@ def relight(
     sample, out = Path(sample_dir), Path(out_dir)
     _check_out(sample, out)
     relit = relit_render(sample, lights, powers=powers, data_dir=data_dir)
+    check_finite_result(relit.result, sample)  # before anything is written
     meta = relit.meta
     if _empty_folder(out):
         out.rmdir()  # an empty --out is allowed, as for `dataset`; rmdir removes nothing else

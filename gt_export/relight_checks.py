@@ -12,6 +12,9 @@ be laundered: ``check`` could no longer find the damage. Before anything is deco
   with its sensors' channels, and the coverage's ``m0`` ... ``m<M-1>``), so a file that would
   decode to something else is refused from its header alone.
 
+After composing, :func:`check_finite_result` refuses a relit render holding a NaN or an
+infinity (powers that overflow float32) before anything is written.
+
 Each refusal is one line naming the file.
 """
 
@@ -22,13 +25,22 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.exr import read_exr_attributes
 from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, file_sha256
 from spectrinsic.gt_export.transport_file import COVERAGE_LAYER, TRANSPORT_NAME, transport_layer
+from spectrinsic.render.result import RenderResult
 from spectrinsic.spectra import get_sensors
 
-__all__ = ["verified_file", "transport_channels", "check_transport_header", "check_relight_inputs"]
+__all__ = [
+    "verified_file",
+    "transport_channels",
+    "check_transport_header",
+    "check_relight_inputs",
+    "check_finite_result",
+]
 
 #: AOV layers relighting reads back from the sample (their files come from ``meta.json``).
 AOV_LAYERS = ("depth", "normals", "material_id", "object_id", "mask")
@@ -122,3 +134,14 @@ def check_relight_inputs(sample: Path, meta: Mapping[str, Any]) -> None:
     if not (isinstance(size, list) and len(size) == 2):
         raise DatasetError(f"{sample / META_NAME}: size {size!r}; expected [height, width]")
     check_transport_header(sample / TRANSPORT_NAME, record, (int(size[0]), int(size[1])))
+
+
+def check_finite_result(result: RenderResult, sample: Path) -> None:
+    """Refuse a relit render whose images or raw channels hold a NaN or an infinity."""
+    for what, arrays in (("image", result.images), ("raw channels", result.raw)):
+        for mode, array in arrays.items():
+            if not np.isfinite(array).all():
+                raise DatasetError(
+                    f"{sample}: relit {what} of mode {mode!r} is not finite (the new lights "
+                    "overflow float32); nothing written"
+                )

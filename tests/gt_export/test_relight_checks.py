@@ -94,3 +94,31 @@ def test_the_transport_header_must_declare_the_samples_size_and_channels(sample)
         check_transport_header(path, {**record, "lights": 3}, (h, w))
     with pytest.raises(DatasetError, match="unexpected \\['L1_b0_rgb3.X'"):
         check_transport_header(path, {**record, "lights": 1}, (h, w))
+
+
+@pytest.mark.parametrize("power", ["inf", "1e308", "1e400", "nan", "1e-300"])
+def test_a_power_that_overflows_or_vanishes_is_refused_in_one_line(source, tmp_path, capsys, power):
+    """Cause 5: these gave all-NaN images with rc 0 and ``"power": "inf"`` in meta.json."""
+    out = tmp_path / "relit"
+    args = ["relight", str(source), "--light", "0=planck:3000K", "--power", f"0={power}"]
+    assert main([*args, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "light power" in err and "[1e-20, 1e+20]" in err
+    assert not out.exists()
+
+
+def test_a_relit_render_that_is_not_finite_is_refused_before_writing(source):
+    import dataclasses
+
+    import numpy as np
+
+    from spectrinsic.gt_export.relight import relit_render
+    from spectrinsic.gt_export.relight_checks import check_finite_result
+
+    relit = relit_render(source, {0: "planck:3000K"})
+    check_finite_result(relit.result, source)  # a sound relighting passes
+    image = relit.result.images["rgb3"].copy()
+    image[0, 0, 1] = np.inf
+    broken = dataclasses.replace(relit.result, images={**relit.result.images, "rgb3": image})
+    with pytest.raises(DatasetError, match="relit image of mode 'rgb3' is not finite"):
+        check_finite_result(broken, source)
