@@ -131,7 +131,7 @@ class CameraModel:
     colour_matrix: bool = True
     tone_curve: str = "srgb"
     output_bits: int = 8
-    sources: tuple[tuple[str, str], ...] = field(default=(), compare=True)
+    sources: tuple[tuple[str, str], ...] = field(default=(), compare=False)
 
     def __post_init__(self) -> None:
         positive = {
