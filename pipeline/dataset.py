@@ -52,6 +52,7 @@ from spectrinsic.render import render_batches, set_thread_count
 from spectrinsic.render.transport import render_transport_batches
 from spectrinsic.scenes.library import build
 from spectrinsic.scenes.sources import GeneratedSource
+from spectrinsic.spectra.camera_model import camera_model
 
 __all__ = [
     "SampleTask",
@@ -151,6 +152,7 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         denoise=cfg.denoise,
         data_dir=task.data_dir,
         transport=transport,
+        camera=camera_model(cfg.camera) if cfg.camera else None,
     )
     if cfg.relight:
         write_relit_variants(path, cfg.relight, seed=task.seed, data_dir=task.data_dir)
