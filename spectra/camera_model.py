@@ -238,7 +238,9 @@ CAMERA_PRESETS: dict[str, CameraModel] = {
         name="nikon-d5100-npl",
         sensitivities="camera:Nikon 5100 (NPL)",
         adc_bits=14,
-        **GENERIC_FIGURES,
+        gain_e_per_dn=GENERIC_FIGURES["gain_e_per_dn"],
+        full_well_e=GENERIC_FIGURES["full_well_e"],
+        read_noise_e=GENERIC_FIGURES["read_noise_e"],
         sources=(
             ("sensitivities", _NPL),
             ("gain_e_per_dn", "1/0.2287 = 3.46 e-/DN, borrowed from the D800E: " + _BJANES),
@@ -280,7 +282,9 @@ def camera_model(name: str) -> CameraModel:
         return CameraModel(
             name=name,
             sensitivities=name,
-            **GENERIC_FIGURES,
+            gain_e_per_dn=GENERIC_FIGURES["gain_e_per_dn"],
+            full_well_e=GENERIC_FIGURES["full_well_e"],
+            read_noise_e=GENERIC_FIGURES["read_noise_e"],
             sources=(
                 ("sensitivities", name),
                 ("gain_e_per_dn, full_well_e, read_noise_e", "generic: " + _BJANES),

@@ -97,11 +97,12 @@ def capture(
     if q.ndim != 2:
         raise ValueError(f"electrons: expected an (H, W) array, got shape {q.shape}")
     rng = np.random.default_rng(seed)
-    gain_map, offset = fixed_pattern(model, q.shape)
+    shape = (q.shape[0], q.shape[1])
+    gain_map, offset = fixed_pattern(model, shape)
     dark = model.dark_current_e_per_s * model.exposure_time_s
     mean = np.maximum(q * gain_map + dark + offset, 0.0)
     signal = np.minimum(rng.poisson(mean).astype(np.float64), model.full_well_e)
-    signal += _read_noise(model, q.shape, rng)
+    signal += _read_noise(model, shape, rng)
     dn = np.rint(signal / model.gain + model.black_level_dn)
     raw = np.clip(dn, 0, 2**model.adc_bits - 1).astype(np.uint16)
     return RawCapture(raw, noise_variance_dn(model, mean), mean)

@@ -9,8 +9,9 @@ import sys
 
 import numpy as np
 import pytest
+from PIL import Image
 
-from spectrinsic.gt_export import export_sample
+from spectrinsic.gt_export import export_sample, load_sample
 from spectrinsic.gt_export.check import check_sample
 from spectrinsic.gt_export.exr import read_exr
 from spectrinsic.gt_export.sensor import model_from_meta
@@ -56,6 +57,11 @@ def test_sensor_sample_is_complete_and_its_identity_holds(tmp_path, two_light_sa
     assert stages["tone_curve"]["applied_to_ground_truth"] is False
     assert model_from_meta(meta) == camera_model("nikon-d5100-npl").with_options(black_level_dn=600)
     assert (folder / f"sensor-{SLUG}.png").is_file()
+    loaded = load_sample(folder)  # the loader returns the raw and processed images too
+    assert loaded[f"raw_sensor/{KEY}"].shape == loaded["image"].shape[:2]
+    assert loaded[f"processed_sensor/{KEY}"].max() <= 255
+    png = np.asarray(Image.open(folder / f"sensor-{SLUG}.png"))
+    np.testing.assert_array_equal(png, loaded[f"processed_sensor/{KEY}"])
 
 
 def test_dng_read_back_by_rawpy_equals_the_raw_mosaic(tmp_path, big_sample, config):
