@@ -109,3 +109,25 @@ def test_raw_scatters_around_the_exposed_camera_image_with_the_stored_variance(
     # sqrt(2/n)
     assert abs(z.mean()) < 4 / np.sqrt(n)
     assert z.var() == pytest.approx(1.0, abs=4 * np.sqrt(2 / n))
+
+
+def test_evaluate_scores_the_processed_image_against_the_carried_ground_truth(
+    tmp_path, one_light_sample, config
+):
+    """An oracle returning the carried ground truth scores zero on the processed image's
+    scenario; the same estimates scored against the sRGB truth do not."""
+    from spectrinsic.decompose.decomposition import Decomposition
+    from spectrinsic.decompose.evaluate import evaluate_sample
+
+    sample = load_sample(_export(tmp_path, one_light_sample, config))
+    refl, shading = sample[f"reflectance_sensor/{KEY}"], sample[f"shading_sensor/{KEY}"]
+
+    def oracle(image, mask):
+        return Decomposition(refl * mask[..., None], shading)
+
+    scores = evaluate_sample(sample, {"oracle": oracle}, seed=0, n_judgements=50, figure=False)
+    by = {(s.scenario, s.layer, s.metric): s.value for s in scores}
+    scenario = f"sensor_{SLUG}"
+    assert by[(scenario, "reflectance", "si_mse")] == pytest.approx(0.0, abs=1e-10)
+    assert by[(scenario, "shading", "si_mse")] == pytest.approx(0.0, abs=1e-10)
+    assert by[("srgb", "reflectance", "si_mse")] > 1e-6
