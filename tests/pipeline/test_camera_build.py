@@ -80,3 +80,13 @@ def test_a_rendered_sample_and_its_relit_variant_go_through_the_camera(tmp_path)
     rebuilt = source["reflectance_sensor"].astype(np.float64) * source["shading_sensor"]
     rebuilt += source["residual_sensor"]
     np.testing.assert_allclose(rebuilt, source["image_sensor"], rtol=1e-6, atol=1e-7)
+
+
+def test_a_camera_whose_curves_are_missing_is_refused_before_any_work(tmp_path, monkeypatch):
+    from spectrinsic.errors import SpectrumNotFoundError
+
+    monkeypatch.delenv("SPECTRINSIC_DATA", raising=False)  # the Jiang curves need a data dir
+    cfg = DatasetConfig.from_settings("t", **SETTINGS, camera="nikon-d3")
+    with pytest.raises(SpectrumNotFoundError, match="unknown camera 'Nikon D3'"):
+        build_dataset(tmp_path / "out", cfg, only=SAMPLE)
+    assert not (tmp_path / "out").exists()
