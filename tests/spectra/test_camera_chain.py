@@ -255,3 +255,22 @@ def test_presets_and_bad_models():
         _model(gain_e_per_dn=0.0)
     with pytest.raises(CameraModelError, match="cfa"):
         _model(cfa="RGBW")
+
+
+def test_dark_current_and_iso():
+    dark = _flat(_model(dark_current_e_per_s=400.0, exposure_time_s=5.0), 0.0)
+    assert dark.mean() == pytest.approx(2000.0 / GAIN, rel=0.01)  # 2000 e- of dark signal
+    assert dark.var() == pytest.approx(2000.0 / GAIN**2 + READ**2 / GAIN**2 + 1 / 12, rel=STAT_TOL)
+    fast = _model(iso=400.0)  # analogue gain x4: a quarter of the electrons per DN
+    assert fast.gain == pytest.approx(GAIN / 4)
+    assert _flat(fast, 1000.0).mean() == pytest.approx(1000.0 / (GAIN / 4), rel=0.01)
+
+
+def test_sixteen_bit_output_and_fixed_exposure():
+    curves = _camera()
+    image = np.full((16, 16, 3), 2.0)
+    model = _model(output_bits=16, electrons_per_unit=1000.0, white_balance="none")
+    out = run_chain(model, image, curves=curves, wavelengths=WL, seed=0)
+    assert out.processed.dtype == np.uint16 and out.electrons_per_unit == 1000.0
+    raw_mean = out.raw.astype(float).mean() - BLACK
+    assert raw_mean == pytest.approx(2000.0 / GAIN, rel=0.01)
