@@ -135,6 +135,9 @@ def test_eld_tail_and_row_noise():
     centred = heavy - heavy.mean()
     kurtosis = np.mean(centred**4) / np.mean(centred**2) ** 2
     assert kurtosis > 4.0  # a Gaussian has 3
+    tail_model = _model(read_noise_e=0.0, tail_lambda=-0.2, tail_scale_e=3.0)
+    predicted = float(noise_variance_dn(tail_model, np.zeros((1, 1)))[0, 0])
+    assert heavy.var() == pytest.approx(predicted, rel=0.1)  # a heavy tail: a looser estimate
     rows = _flat(_model(read_noise_e=0.5, row_noise_e=4.0), 0.0)
     assert rows.mean(axis=1).var() == pytest.approx(4.0**2 / GAIN**2, rel=0.3)  # 256 rows
 
