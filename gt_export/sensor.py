@@ -139,7 +139,9 @@ def _layers(
 def sensor_output(
     gt: GroundTruth, model: CameraModel, *, seed: int, sample_id: str, data_dir: Any = None
 ) -> SensorOutput:
-    """Run the camera chain of *model* on *gt*'s camera image and carry its ground truth."""
+    """Run the camera chain of *model* on *gt*'s camera image and carry its ground truth (the
+    known-light balance falls back to grey world for a sample without lights: the recorded
+    stages say which ran)."""
     key = camera_key(model.sensitivities)
     needed = f"image_camera/{key}"
     if needed not in gt.layers:
@@ -150,13 +152,17 @@ def sensor_output(
     clean = gt.layers[denoised if denoised in gt.layers else needed].data
     wl = grid()
     curves = camera_curves(model.sensitivities, wl, data_dir=data_dir)
+    light = _illuminant_rgb(gt, key)
+    used = model
+    if light is None and model.white_balance == "illuminant":  # no light to balance for
+        used = model.with_options(white_balance="grey-world")
     chain = run_chain(
-        model,
+        used,
         gt.layers[needed].data,
         curves=curves,
         wavelengths=wl,
         seed=noise_seed(seed, sample_id),
-        illuminant_rgb=_illuminant_rgb(gt, key),
+        illuminant_rgb=light,
     )
     spec = gt.layers.get(f"specular_camera/{key}")
     space = carry(
@@ -177,7 +183,7 @@ def sensor_output(
     meta = {
         "camera": model.name,
         "model": model.settings(),
-        "stages": chain.stages(model),
+        "stages": chain.stages(used),
         "files": {"dng": f"sensor-{slug}.dng", "png": f"sensor-{slug}.png"},
         "noise_seed": {"seed": int(seed), "sample_id": sample_id},
         "carried": "white balance and colour matrix (linear) applied to the ground truth; tone curve and quantisation not",
