@@ -192,6 +192,14 @@ def _add_extra_layer_options(p: Any) -> None:
         help="with --store-transport: also write N relit variants of every sample "
         "(<id>-relitK, random light spectra, seeded)",
     )
+    p.add_argument(
+        "--camera",
+        default=None,
+        metavar="NAME",
+        help="run every sample through a camera (raw mosaic + DNG, noise, demosaic, white "
+        "balance, colour matrix, tone curve; ground truth in the processed linear space): a "
+        "preset (nikon-d5100-npl, nikon-d3) or 'camera:NAME'/'csv:PATH'; needs bands31",
+    )
 
 
 def _add_rendering_options(p: Any) -> None:
@@ -225,6 +233,7 @@ _VALUE_OPTIONS: tuple[tuple[str, str], ...] = (
     ("noise_target", "noise_target"),
     ("max_batches", "max_batches"),
     ("integrator", "integrator"),
+    ("camera", "camera"),
 )
 #: Switches and the config value each sets when given (option dest -> (config key, value)).
 _SWITCHES: tuple[tuple[str, str, bool], ...] = (

@@ -13,7 +13,9 @@ Predictions`, a user's estimates read from files. For each sample and method:
   coloured ``shading`` (LMSE and the shading chromaticity error);
 * scenarios ``SC1``, ``SC3b``, ``SC4`` per camera (sec. 5.1.3): the camera rendering, corrected
   by :func:`spectrinsic.decompose.photometric.photometric_correction`, is decomposed and its
-  reflectance scored against the absolute reflectance.
+  reflectance scored against the absolute reflectance;
+* scenario ``sensor_<camera>`` (``dataset --camera``; :mod:`~spectrinsic.decompose.processed`):
+  the camera chain's processed image, scored against the ground truth carried through it.
 
 Outputs in ``out_dir`` (:func:`spectrinsic.decompose.report.write_report`): ``scores.csv``
 (sample, method, scenario, layer, metric, value), the condition tables like Tables 5.3/5.4,
@@ -27,7 +29,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -38,6 +40,7 @@ from spectrinsic.decompose.judgements import Judgements, sample_judgements
 from spectrinsic.decompose.metrics import METRICS, WHDR_DELTA, get_metric, whdr
 from spectrinsic.decompose.photometric import SCENARIOS, photometric_correction
 from spectrinsic.decompose.predictions import Predictions
+from spectrinsic.decompose.processed import processed_inputs
 from spectrinsic.decompose.registry import available_decomposers, get_decomposer
 from spectrinsic.decompose.report import write_report
 from spectrinsic.decompose.sample_fields import (
@@ -227,10 +230,11 @@ def _score(
     camera: str = "",
     photometric: str = "",
 ) -> list[Score]:
-    """Scores of one estimate: reflectance always, shading (grey and colour) for sRGB input."""
+    """Scores of one estimate: reflectance always, shading (grey and colour) for sRGB input and
+    a camera's processed image (:mod:`~spectrinsic.decompose.processed`)."""
     extra = {"camera": camera, "photometric": photometric}
     estimates = {"reflectance": result.reflectance}
-    if scenario == "srgb":
+    if scenario == "srgb" or scenario.startswith("sensor_"):
         estimates.update(
             shading=result.shading,
             shading_grey=_grey(result.shading),
@@ -301,6 +305,8 @@ def evaluate_sample(
             (f"{sc}_{camera_slug(cam)}", cam, sc, img)
             for cam, sc, img in _camera_inputs(sample, target)
         ]
+    truths = {s: replace(truth, layers=gt) for s, _, gt in processed_inputs(sample, target)}
+    inputs += [(s, "", "", img) for s, img, _ in processed_inputs(sample, target) if cameras]
     scores: list[Score] = []
     figure_rows: list[tuple[str, Decomposition]] = []
     for method, decomposer in methods.items():
@@ -308,7 +314,8 @@ def evaluate_sample(
             result = _estimate(decomposer, truth.sid, scenario, img, truth.mask, target)
             if result is None:
                 continue
-            scores += _score(truth, result, method, scenario, names, camera, photometric)
+            scored = truths.get(scenario, truth)  # a processed image: its carried ground truth
+            scores += _score(scored, result, method, scenario, names, camera, photometric)
             if scenario == "srgb":
                 figure_rows.append((method, result))
             if save_estimates and out_dir is not None and not isinstance(decomposer, Predictions):

@@ -120,6 +120,19 @@ def _mask_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
     return _categorical(np.repeat((layer.data > 0.5).astype(np.uint8)[..., None] * 255, 3, axis=-1))
 
 
+def _processed_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
+    """A camera chain's processed codes, as they are (16-bit codes to their top 8 bits)."""
+    top = 255.0 if layer.data.max() <= 255 else 65535.0
+    return _categorical(np.rint(layer.data / top * 255).astype(np.uint8))
+
+
+def _raw_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
+    """A raw Bayer mosaic in grey, its 99th percentile white."""
+    return _colormap(
+        layer.data, float(layer.data.min()), float(np.percentile(layer.data, 99)), cmap="gray"
+    )
+
+
 #: (layer-name prefix, preview maker); the first matching prefix wins; no match, no preview.
 _PREVIEWS: tuple[tuple[str, Callable[[Layer, Mapping[str, Layer]], Preview]], ...] = (
     ("image", _colour_preview),
@@ -139,6 +152,8 @@ _PREVIEWS: tuple[tuple[str, Callable[[Layer, Mapping[str, Layer]], Preview]], ..
     ("material_id", _ids_preview),
     ("object_id", _ids_preview),
     ("mask", _mask_preview),
+    ("processed_sensor", _processed_preview),
+    ("raw_sensor", _raw_preview),
 )
 
 

@@ -36,6 +36,7 @@ from spectrinsic.gt_export.integrity import replaceable_sample
 from spectrinsic.gt_export.relight_checks import check_finite_result, check_relight_inputs
 from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, file_sha256
 from spectrinsic.gt_export.sample_meta import read_meta
+from spectrinsic.gt_export.sensor import model_from_meta
 from spectrinsic.gt_export.transport_file import read_transport
 from spectrinsic.gt_export.writer import export_sample
 from spectrinsic.render.light_transport import LightTransport, relit_result
@@ -317,4 +318,5 @@ def relight(
         denoise=bool(meta.get("denoised_layers")),
         data_dir=data_dir,
         transport=relit.transport if keep_transport else None,
+        camera=model_from_meta(meta),  # the camera chain, if any, re-runs on the relit image
     )

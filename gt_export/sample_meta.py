@@ -83,7 +83,7 @@ META_FIELDS = frozenset(
 )
 #: Fields written only by some builds: ``transport`` (``dataset --store-transport``, the record
 #: of :func:`~spectrinsic.gt_export.transport_file.write_transport`).
-OPTIONAL_META_FIELDS = frozenset({"transport"})
+OPTIONAL_META_FIELDS = frozenset({"transport", "sensor"})  # sensor: dataset --camera
 _LAYER_FIELDS = frozenset(
     {
         "file",

@@ -55,6 +55,7 @@ from spectrinsic.gt_export.sample import (
     meta_seal,
     plain_data,
 )
+from spectrinsic.gt_export.sensor import SensorOutput, sensor_output, write_sensor_files
 from spectrinsic.gt_export.transport_file import TRANSPORT_NAME, write_transport
 from spectrinsic.provenance import software_versions
 from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash
@@ -62,6 +63,7 @@ from spectrinsic.spectra import DEFAULT_WAVELENGTHS, get_spectrum
 
 if TYPE_CHECKING:
     from spectrinsic.render.light_transport import LightTransport
+    from spectrinsic.spectra.camera_model import CameraModel
 
 __all__ = [
     "DEFAULT_CAMERAS",
@@ -196,9 +198,12 @@ def _fill_folder(
     gt: GroundTruth,
     *,
     transport: LightTransport | None = None,
+    sensor: SensorOutput | None = None,
     **meta_kw: Any,
 ) -> None:
     files = _write_layers(folder, gt, meta_kw["sample_id"])
+    if sensor is not None:  # the camera chain's raw DNG and processed PNG (gt_export.sensor)
+        files += write_sensor_files(folder, sensor)
     previews = _write_previews(folder, gt)
     files += [rel for rel, _ in previews.values()]
     # the Scene itself, not scene_to_dict(scene): plain_data makes the same plain data of it,
@@ -218,6 +223,9 @@ def _fill_folder(
     meta = _meta(scene, result, gt, previews=previews, files=files, **meta_kw)
     if record is not None:  # before the hashes and the seal, which cover it
         meta["transport"] = record
+    if sensor is not None:
+        meta["sensor"] = sensor.meta
+        meta["identities"].append(sensor.identity)
     meta[HASHES_KEY] = {rel: file_sha256(folder / rel) for rel in sorted(files)}
     meta = plain_data(meta, META_DIGITS)
     meta[SEAL_KEY] = meta_seal(meta)
@@ -237,6 +245,7 @@ def export_sample(
     denoise: bool = False,
     data_dir: str | os.PathLike[str] | None = None,
     transport: LightTransport | None = None,
+    camera: CameraModel | None = None,
 ) -> Path:
     """Compute every ground-truth layer of a rendered sample and write it atomically.
 
@@ -269,6 +278,10 @@ def export_sample(
         A :class:`~spectrinsic.render.light_transport.LightTransport` of this render to store as
         ``transport.exr`` (:mod:`~spectrinsic.gt_export.transport_file`), for exact
         relighting (:func:`spectrinsic.gt_export.relight.relight`).
+    camera
+        A :class:`~spectrinsic.spectra.camera_model.CameraModel` to run the sample through
+        (:mod:`~spectrinsic.gt_export.sensor`): raw mosaic, DNG, processed image and the ground
+        truth in the processed linear space; its sensitivities must be among *cameras*.
 
     Returns
     -------
@@ -281,9 +294,15 @@ def export_sample(
         raise DatasetError(f"sample id {sample_id!r}: expected a plain folder name")
     if cameras is None:
         cameras = DEFAULT_CAMERAS if "bands31" in (getattr(result, "raw", None) or {}) else ()
+    if camera is not None and camera.sensitivities not in cameras:
+        cameras = (*cameras, camera.sensitivities)  # the chain runs on that camera's image
     gt = compute_ground_truth(
         scene, result, cameras=cameras, write_cube=write_cube, denoise=denoise, data_dir=data_dir
     )
+    sensor = None
+    if camera is not None:
+        sensor = sensor_output(gt, camera, seed=seed, sample_id=sample_id, data_dir=data_dir)
+        gt = sensor.ground_truth
     final = out_dir / sample_id
     tmp = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{sample_id}-", dir=out_dir))
     try:
@@ -297,6 +316,7 @@ def export_sample(
             config=config,
             seed=seed,
             transport=transport,
+            sensor=sensor,
         )
         _move_into_place(tmp, final, config_hash(config))
     except BaseException:

@@ -52,6 +52,8 @@ from spectrinsic.render import render_batches, set_thread_count
 from spectrinsic.render.transport import render_transport_batches
 from spectrinsic.scenes.library import build
 from spectrinsic.scenes.sources import GeneratedSource
+from spectrinsic.spectra import get_sensors
+from spectrinsic.spectra.camera_model import camera_model
 
 __all__ = [
     "SampleTask",
@@ -151,6 +153,7 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         denoise=cfg.denoise,
         data_dir=task.data_dir,
         transport=transport,
+        camera=camera_model(cfg.camera) if cfg.camera else None,
     )
     if cfg.relight:
         write_relit_variants(path, cfg.relight, seed=task.seed, data_dir=task.data_dir)
@@ -260,6 +263,8 @@ def build_dataset(
     """
 
     out = Path(out_dir)
+    if config.camera:  # its curves exist (a data-directory camera needs --data-dir): one line
+        get_sensors(camera_model(config.camera).sensitivities, data_dir=data_dir)
     check_build_folder(out, config.config_hash(), rebuild=rebuild)  # before the folder is made
     with folder_lock(out):  # one build per folder: a second one is refused, naming this one
         return _build_locked(

@@ -20,6 +20,7 @@ from spectrinsic.gt_export.sample import config_hash
 from spectrinsic.render.light_transport import diagonal_mode_names
 from spectrinsic.render.modes import RENDER_MODES
 from spectrinsic.render.settings import RenderSettings
+from spectrinsic.spectra.camera_model import camera_model
 
 __all__ = [
     "DatasetConfig",
@@ -151,6 +152,12 @@ class DatasetConfig:
         :data:`~spectrinsic.gt_export.manifest.SPLIT_FRACTIONS`, 80/10/10); with at least as
         many scenes as splits every split holds a scene. Not a setting of the samples (not
         hashed): a resumed build with other fractions rewrites only the manifest.
+    camera
+        A camera model to run every sample through (``--camera``, a name of
+        :func:`spectrinsic.spectra.camera_model.camera_model`): raw mosaic, DNG, processed image
+        and the ground truth in the processed linear space (:mod:`spectrinsic.gt_export.sensor`).
+        Needs ``bands31``; its sensitivities join *cameras*. Its whole model is hashed; left
+        out of the settings when ``None``.
     """
 
     preset: str
@@ -165,6 +172,7 @@ class DatasetConfig:
     store_transport: bool = False
     relight: int = 0
     split_fractions: SplitFractions = SPLIT_FRACTIONS
+    camera: str | None = None
 
     def __post_init__(self) -> None:
         if self.cameras is not None:  # a list from JSON or the command line
@@ -181,6 +189,13 @@ class DatasetConfig:
             raise DatasetError(f"dataset seed {self.seed!r}; expected a non-negative integer")
         object.__setattr__(self, "split_fractions", check_split_fractions(self.split_fractions))
         self._check_transport()
+        if self.camera is not None:
+            camera_model(self.camera)  # a one-line CameraModelError for an unknown name
+            if "bands31" not in self.render.modes:
+                raise DatasetError(
+                    f"--camera {self.camera} with modes {list(self.render.modes)}: the camera "
+                    "chain needs the 'bands31' mode (use a preset that renders it, e.g. default)"
+                )
 
     def _check_transport(self) -> None:
         modes, direct = self.render.modes, self.render.direct
@@ -270,16 +285,20 @@ class DatasetConfig:
             d["store_transport"] = True
         if self.relight:
             d["relight"] = self.relight
+        if self.camera is not None:  # off: out of the hash
+            d["camera"] = camera_model(self.camera).settings()
         return d
 
     def resolved_cameras(self) -> tuple[str, ...]:
         """The camera sensor sets exported, with ``cameras=None`` resolved."""
         if self.cameras is not None:
-            return tuple(self.cameras)
-        if "bands31" not in self.render.modes:
-            return ()
-
-        return tuple(DEFAULT_CAMERAS)
+            cams = tuple(self.cameras)
+        else:
+            cams = tuple(DEFAULT_CAMERAS) if "bands31" in self.render.modes else ()
+        if self.camera is not None:  # the camera chain runs on its own camera's image
+            sensor = camera_model(self.camera).sensitivities
+            cams += () if sensor in cams else (sensor,)
+        return cams
 
     def to_dict(self) -> dict[str, Any]:
         """The record written with the dataset (``export_sample``, manifest): preset name,

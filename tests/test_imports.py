@@ -46,6 +46,8 @@ HEAVY = frozenset(
         "webdataset",
         "gco",
         "colour",
+        "colour_demosaicing",
+        "pidng",
         "matplotlib",
         "scipy",
         "skimage",
