@@ -5,13 +5,13 @@ environment whose code is checked (its ``spectrinsic`` command beside it). Needs
 (``SPECTRINSIC_DATA``, default ``/work/shared/data``).
 
 It builds, in a temporary folder: a matte library sample (single traversal), the same sample
-with ``--integrator passes``, a glossy and a textured generated sample, a gold-room scene file
+with ``--integrator passes``, a glossy (plastics and metals) and a textured generated room, a gold-room scene file
 (metals, plastic, a textured material), a sample with ``--store-transport`` plus a sample
 relit from it by ``spectrinsic relight``, an ``evaluate`` run on the matte dataset, and the two
 spectral studies. It writes ``{relative path: sha256}`` of every output file to OUT.json:
 ``scene.json`` is left out (its texel weights follow the scene hash since issue 35), and
-``meta.json`` / ``manifest.json`` are hashed as canonical JSON without version strings and
-``config_hash``, and without the hashes of ``scene.json`` and ``meta.json`` they list (so a
+JSON files (``meta.json``, ``manifest.json``, the studies') are hashed as canonical JSON without
+version strings, the git commit and ``config_hash``, and without the hashes of ``scene.json`` and ``meta.json`` they list (so a
 version bump alone does not count as a change). Compare two runs with
 ``python scripts/byte_identity.py --compare A.json B.json``; re-hash a folder kept with
 ``--keep DIR`` by ``--hash DIR OUT.json``.
@@ -75,7 +75,15 @@ camera:
 """
 
 #: Keys removed before hashing meta.json / manifest.json.
-_DROPPED = {"config_hash", "version", "versions", "spectrinsic_version", "git_commit", "created"}
+_DROPPED = {
+    "config_hash",
+    "version",
+    "versions",
+    "spectrinsic_version",
+    "git_commit",
+    "git_sha",
+    "created",
+}
 _FAST = ["--preset", "preview", "--resolution", "24x24", "--spp", "4", "--spectral-spp", "2"]
 
 
@@ -93,7 +101,7 @@ def _strip(value: object) -> object:
 
 
 def _digest(path: Path) -> str:
-    if path.name in ("meta.json", "manifest.json"):
+    if path.suffix == ".json":
         data = _strip(json.loads(path.read_text()))
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()
     return hashlib.sha256(path.read_bytes()).hexdigest()
@@ -113,8 +121,9 @@ def build(root: Path) -> None:
     only = ["--only", "obj-apple__v0__two-colour-a"]
     _run(exe, "dataset", "--out", str(root / "matte"), *_FAST, *only)
     _run(exe, "dataset", "--out", str(root / "passes"), *_FAST, *only, "--integrator", "passes")
-    gen = ["--generator", "objects-on-ground", "--count", "1", "--views", "1"]
-    _run(exe, "dataset", "--out", str(root / "glossy"), *_FAST, *gen, "--glossy", "1")
+    gen = ["--generator", "rooms", "--count", "1", "--views", "1"]
+    gloss = ["--glossy", "0.5", "--metallic", "0.3"]
+    _run(exe, "dataset", "--out", str(root / "glossy"), *_FAST, *gen, *gloss)
     _run(exe, "dataset", "--out", str(root / "textured"), *_FAST, *gen, "--texture-fraction", "1")
     # a fixed path: the scene file's path is part of the dataset config (and its hash)
     scene_file = Path(tempfile.gettempdir()) / "spectrinsic-byte-identity" / "gold-room.yaml"
