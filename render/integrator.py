@@ -8,7 +8,9 @@ value E_k; neither changes the path. So one traversal can carry all K bands at o
 (``src/integrators/path.cpp``: emitter hits and next-event estimation with the same power-
 heuristic MIS, the same sampler calls in the same order) written in Python on Dr.Jit, whose
 throughput is a list of K band products gathered from a per-material table, and whose
-contributions go to one accumulator per (light, band).
+contributions go to one accumulator per (light, band). Its loop is the one body of
+:class:`~spectrinsic.render.band_kernel.BandKernel`; ``gloss`` and ``metals`` switch on its
+glossy (G1) factors with the specular part and the white-at-metal loop when it is traced.
 
 The scene is loaded with white Lambertian surfaces (area-light shapes black) and unit white
 emitters, so Mitsuba's own BSDF and emitter sampling give the band-independent factors
