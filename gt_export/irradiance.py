@@ -128,7 +128,7 @@ def white_radiance(
 
     Metals have no diffuse lobe (albedo 0); their ``W`` is the white-surface radiance the
     renderer estimated at their hits, ``metal_white = c_metal · W_metal``
-    (:mod:`spectrinsic.render.gloss_kernel`). So a metal counts as a white surface in both the
+    (:mod:`spectrinsic.render.band_kernel`). So a metal counts as a white surface in both the
     numerator and the denominator: ``W = (raw + metal_white) / (coverage @ band_albedos +
     c_metal)``, which is ``W_metal`` on a metal-only pixel and Eq. 1 where there is no metal.
 

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from spectrinsic.errors import DatasetError, SpectrinsicError
+from spectrinsic.errors import DatasetError, SceneError, SpectrinsicError
 from spectrinsic.gt_export.exr import read_exr
 from spectrinsic.gt_export.integrity import replaceable_sample
 from spectrinsic.gt_export.relight_checks import check_finite_result, check_relight_inputs
@@ -41,8 +41,7 @@ from spectrinsic.gt_export.transport_file import read_transport
 from spectrinsic.gt_export.writer import export_sample
 from spectrinsic.render.light_transport import LightTransport, relit_result
 from spectrinsic.render.result import RenderResult
-from spectrinsic.scenes.model import GLOSS_FIELDS, Camera, Light, Material, Mesh, Scene
-from spectrinsic.scenes.textures import texture_from_record
+from spectrinsic.scenes.model import Scene, scene_from_dict
 from spectrinsic.scenes.validate import POWER_RANGE
 from spectrinsic.spectra import get_spectrum
 
@@ -87,13 +86,10 @@ def _fail(sample: Path, what: str) -> DatasetError:
     return DatasetError(f"{sample / SCENE_NAME}: {what}; not a scene spectrinsic wrote")
 
 
-def _fields(entry: Any) -> dict[str, Any]:
-    """A record's fields from JSON: lists back to the tuples the frozen records hold."""
-    return {str(k): tuple(v) if isinstance(v, list) else v for k, v in entry.items()}
-
-
 def read_sample_scene(sample_dir: str | os.PathLike[str]) -> Scene:
-    """The :class:`Scene` a sample was rendered from, read from its ``scene.json``."""
+    """The :class:`Scene` a sample was rendered from, read from its ``scene.json``
+    (:func:`~spectrinsic.scenes.model.scene_from_dict`, the inverse of the writer's
+    :func:`~spectrinsic.scenes.model.scene_to_dict`)."""
     sample = Path(sample_dir)
     try:
         data = json.loads((sample / SCENE_NAME).read_text(encoding="utf-8"))
@@ -102,29 +98,9 @@ def read_sample_scene(sample_dir: str | os.PathLike[str]) -> Scene:
     except ValueError as exc:
         raise _fail(sample, f"not valid JSON ({exc})") from exc
     try:
-        meshes = tuple(
-            Mesh(
-                name=str(m["name"]),
-                vertices=np.asarray(m["vertices"], np.float64).reshape(-1, 3),
-                faces=np.asarray(m["faces"], np.int64).reshape(-1, 3),
-                face_materials=np.asarray(m["face_materials"], np.int64).reshape(-1),
-                object_id=int(m["object_id"]),
-                texture=texture_from_record(m["texture"]) if m.get("texture") else None,
-            )
-            for m in data["meshes"]
-        )
-        materials = tuple(
-            Material(
-                str(m["name"]), str(m["spectrum"]), **{k: m[k] for k in GLOSS_FIELDS if k in m}
-            )
-            for m in data["materials"]
-        )
-        lights = tuple(Light(**_fields(x)) for x in data["lights"])
-        camera = Camera(**_fields(data["camera"]))
-        metadata = data.get("metadata") or {}
-        return Scene(str(data["name"]), meshes, materials, lights, camera, dict(metadata))
-    except (KeyError, TypeError, ValueError, AttributeError) as exc:
-        raise _fail(sample, f"unexpected structure ({type(exc).__name__}: {exc})") from exc
+        return scene_from_dict(data)
+    except SceneError as exc:
+        raise _fail(sample, str(exc).removeprefix("scene record: ")) from exc
 
 
 def check_light_spectra(

@@ -21,13 +21,14 @@ import hashlib
 import json
 import os
 from collections.abc import Mapping
-from dataclasses import fields, is_dataclass
+from dataclasses import is_dataclass
 from pathlib import Path, PurePosixPath
 from typing import Any
 
 import numpy as np
 
 from spectrinsic.errors import DatasetError
+from spectrinsic.scenes.model import record_fields
 
 __all__ = [
     "FORMAT_VERSION",
@@ -88,13 +89,9 @@ def plain_data(value: Any, digits: int | None = None) -> Any:
     {'a': 0.5, 'b': [1, 2], 'c': 0.333}
     """
     if is_dataclass(value) and not isinstance(value, type):
-        # fields marked omit_default (a material's gloss) are left out at their defaults, as
-        # scene_to_dict does, so matte scenes are written as before they existed
-        return {
-            f.name: plain_data(getattr(value, f.name), digits)
-            for f in fields(value)
-            if not (f.metadata.get("omit_default") and getattr(value, f.name) == f.default)
-        }
+        # the fields scene_to_dict keeps (a material's gloss left out at its defaults, so matte
+        # scenes are written as before it existed; a procedural texture's weights left out)
+        return {k: plain_data(v, digits) for k, v in record_fields(value).items()}
     if isinstance(value, Mapping):
         return {str(k): plain_data(v, digits) for k, v in value.items()}
     if isinstance(value, np.ndarray):

@@ -10,7 +10,7 @@ One float32 OpenEXR file (uncompressed: ZIP cannot shrink Monte Carlo noise) hol
 * for scenes with glossy materials, ``S<l>_b<b>_<mode>``: the part of that transport whose
   first camera-ray vertex went through a non-diffuse lobe (the ``specular`` layer's), and with
   metals ``W<l>_b<b>_<mode>``: the white-surface radiance at metal first hits (the metals'
-  ``shading``), both for the same unit spectrum (:mod:`spectrinsic.render.gloss_kernel`);
+  ``shading``), both for the same unit spectrum (:mod:`spectrinsic.render.band_kernel`);
 * ``coverage``: ``(H, W, M)`` fraction of each pixel's samples hitting material ``m`` (the
   reflectance and the white-surface radiance are built from it, and it cannot be recovered
   from the reflectance).

@@ -58,7 +58,7 @@ from spectrinsic.gt_export.sample import (
 from spectrinsic.gt_export.sensor import SensorOutput, sensor_output, write_sensor_files
 from spectrinsic.gt_export.transport_file import TRANSPORT_NAME, write_transport
 from spectrinsic.provenance import software_versions
-from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash
+from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash, scene_to_dict
 from spectrinsic.spectra import DEFAULT_WAVELENGTHS, get_spectrum
 
 if TYPE_CHECKING:
@@ -206,9 +206,9 @@ def _fill_folder(
         files += write_sensor_files(folder, sensor)
     previews = _write_previews(folder, gt)
     files += [rel for rel, _ in previews.values()]
-    # the Scene itself, not scene_to_dict(scene): plain_data makes the same plain data of it,
-    # but converts its vertex and face arrays whole rather than element by element
-    _dump_json(folder / SCENE_NAME, plain_data(scene), compact=True)
+    # scene_to_dict, the record the scene hash is taken of (a procedural texture's recipe, not
+    # its texel weights); scene_from_dict reads it back
+    _dump_json(folder / SCENE_NAME, plain_data(scene_to_dict(scene)), compact=True)
     files.append(SCENE_NAME)
     # meta.json last: its presence (with the right config hash) marks the folder complete; it
     # records the SHA-256 of every other file, so a resumed build can tell an intact sample,

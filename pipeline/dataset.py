@@ -129,7 +129,7 @@ def build_sample(task: SampleTask) -> SampleOutcome:
     scene = _task_scene(task)
     t_render = time.perf_counter()
     transport = None
-    if cfg.store_transport:  # diagonal modes light by light, kept per light for relighting
+    if cfg.store_transport:  # the per-light transport kept (split by light) for relighting
         transport, result = render_transport_batches(
             scene, cfg.render, seed=task.seed, data_dir=task.data_dir
         )

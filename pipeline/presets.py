@@ -137,7 +137,8 @@ class DatasetConfig:
         :func:`spectrinsic.pipeline.sample_plan.plan_samples`). Left out of the settings when
         ``None``, so library configs keep their hash.
     store_transport
-        Render the diagonal modes light by light with a flat unit spectrum and store that
+        Keep each light's band transport for a flat unit spectrum (the single traversal's
+        split by light; light by light only with ``integrator="passes"``) and store that
         per-light transport in each sample (``transport.exr``), so the sample can be relit
         exactly (:mod:`spectrinsic.gt_export.relight`). Left out of the settings when off, so
         other configs keep their hash. A dataset setting rather than a render one: it picks

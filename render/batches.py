@@ -8,7 +8,8 @@ sampling of ``RenderSettings.noise_target``).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import TypeVar
 
 import numpy as np
 
@@ -20,9 +21,13 @@ from spectrinsic.render.settings import RenderSettings
 from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.model import Scene
 
+#: What one batch gives: a :class:`RenderResult`, or a pair holding one (the transport's).
+Batch = TypeVar("Batch")
+
 __all__ = [
     "batch_mean",
     "batch_seeds",
+    "run_batches",
     "render_batches",
     "relative_standard_error",
     "image_noise",
@@ -58,31 +63,48 @@ def render_batches(
     ``settings.max_batches`` (default ``4 * batches``). ``meta["noise_target"]`` records the
     target and the median reached.
     """
-    batches, noise_target = settings.batches, settings.noise_target
-    cap = max(batches, settings.max_batches if settings.max_batches is not None else 4 * batches)
-    seeds = batch_seeds(seed, cap if noise_target is not None else batches)
 
     def one(s: int) -> RenderResult:
         return render_scene(scene, settings, seed=s, progress=progress, data_dir=data_dir)
 
-    results = [one(s) for s in seeds[:batches]]
-    reached = image_noise(results) if noise_target is not None else None
+    return run_batches(settings, seed, one, lambda result: result)[1]
+
+
+def run_batches(
+    settings: RenderSettings,
+    seed: int,
+    one: Callable[[int], Batch],
+    result_of: Callable[[Batch], RenderResult],
+) -> tuple[list[Batch], RenderResult, list[int]]:
+    """The one batch loop: ``one(seed)`` for the ``settings.batches`` seeds of
+    :func:`batch_seeds`, then, with ``settings.noise_target``, one batch at a time while the
+    median relative standard error of the images (:func:`image_noise` of ``result_of`` each
+    batch) is above the target, up to ``settings.max_batches`` (default ``4 * batches``).
+
+    Returns the batches, their :func:`merge_batches` (``meta["noise_target"]``: the target,
+    the median reached and the cap) and the seeds used.
+    """
+    batches, noise_target = settings.batches, settings.noise_target
+    cap = max(batches, settings.max_batches if settings.max_batches is not None else 4 * batches)
+    seeds = batch_seeds(seed, cap if noise_target is not None else batches)
+    done = [one(s) for s in seeds[:batches]]
+    reached = image_noise([result_of(d) for d in done]) if noise_target is not None else None
     while (
         reached is not None
         and noise_target is not None
         and reached > noise_target
-        and len(results) < cap
+        and len(done) < cap
     ):
-        results.append(one(seeds[len(results)]))
-        reached = image_noise(results)
-    merged = merge_batches(results)
+        done.append(one(seeds[len(done)]))
+        reached = image_noise([result_of(d) for d in done])
+    merged = merge_batches([result_of(d) for d in done])
     if noise_target is not None:
         merged.meta["noise_target"] = {
             "target": float(noise_target),
             "reached": reached,
             "max_batches": cap,
         }
-    return merged
+    return done, merged, seeds[: len(done)]
 
 
 def relative_standard_error(batches: Sequence[np.ndarray], valid: np.ndarray) -> np.ndarray:

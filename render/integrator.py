@@ -8,7 +8,9 @@ value E_k; neither changes the path. So one traversal can carry all K bands at o
 (``src/integrators/path.cpp``: emitter hits and next-event estimation with the same power-
 heuristic MIS, the same sampler calls in the same order) written in Python on Dr.Jit, whose
 throughput is a list of K band products gathered from a per-material table, and whose
-contributions go to one accumulator per (light, band).
+contributions go to one accumulator per (light, band). Its loop is the one body of
+:class:`~spectrinsic.render.band_kernel.BandKernel`; ``gloss`` and ``metals`` switch on its
+glossy (G1) factors with the specular part and the white-at-metal loop when it is traced.
 
 The scene is loaded with white Lambertian surfaces (area-light shapes black) and unit white
 emitters, so Mitsuba's own BSDF and emitter sampling give the band-independent factors
@@ -27,27 +29,26 @@ the same number of bands and lights.
 from __future__ import annotations
 
 import functools
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from spectrinsic.errors import RenderError
-from spectrinsic.render.textures import (
-    TextureTables,
-    shape_id_table,
-    texel_of,
-    texture_lookups,
-)
+from spectrinsic.render.band_kernel import BandKernel
+from spectrinsic.render.textures import TextureTables, shape_id_table, texture_lookups
 from spectrinsic.render.variants import import_mitsuba
+from spectrinsic.spectra.conductors import FRESNEL_NODES
 
 __all__ = [
     "INTEGRATOR_NAME",
     "BandTables",
     "band_path_class",
     "band_path",
+    "aov_channels",
     "transport_channels",
+    "specular_channels",
+    "metal_white_channels",
     "first_hit_channels",
 ]
 
@@ -93,6 +94,36 @@ def transport_channels(n_lights: int, n_bands: int) -> list[str]:
     return [f"t{j:02d}_{k:02d}" for j in range(n_lights) for k in range(n_bands)]
 
 
+def specular_channels(n_lights: int, n_bands: int) -> list[str]:
+    """AOV names of the specular transport channels, light-major: ``s<l>_<k>``."""
+    return [f"s{j:02d}_{k:02d}" for j in range(n_lights) for k in range(n_bands)]
+
+
+def metal_white_channels(n_lights: int, n_bands: int) -> list[str]:
+    """AOV names of the white-at-metal channels, light-major: ``m<l>_<k>``."""
+    return [f"m{j:02d}_{k:02d}" for j in range(n_lights) for k in range(n_bands)]
+
+
+def aov_channels(
+    n_lights: int,
+    n_bands: int,
+    n_surfaces: int = 0,
+    n_texcols: int = 0,
+    *,
+    gloss: bool = False,
+    metals: bool = False,
+) -> list[str]:
+    """Every AOV of a :class:`BandPath`, in order: the L·K transports, with *gloss* (or
+    *metals*) the L·K specular ones, with *metals* the L·K white-at-metal ones, then the
+    first-hit maps."""
+    return (
+        transport_channels(n_lights, n_bands)
+        + (specular_channels(n_lights, n_bands) if gloss or metals else [])
+        + (metal_white_channels(n_lights, n_bands) if metals else [])
+        + first_hit_channels(n_surfaces, n_texcols)
+    )
+
+
 def first_hit_channels(n_surfaces: int, n_texcols: int = 0) -> list[str]:
     """AOV names of the first-hit maps after the transport: the coverage of each surface, the
     texel weights of each textured coverage column (:class:`TextureTables`), the ray distance
@@ -102,24 +133,6 @@ def first_hit_channels(n_surfaces: int, n_texcols: int = 0) -> list[str]:
         return []
     cover = [f"cov{i:03d}" for i in range(n_surfaces)] + [f"tex{g:03d}" for g in range(n_texcols)]
     return [*cover, "depth", "normal.x", "normal.y", "normal.z"]
-
-
-def _mis_weight(dr: Any, mi: Any, pdf_a: Any, pdf_b: Any) -> Any:
-    """Power heuristic exactly as ``path.cpp``'s ``mis_weight``."""
-    a, b = pdf_a * pdf_a, pdf_b * pdf_b
-    w = a / (a + b)
-    return dr.detach(dr.select(dr.isfinite(w), w, mi.Float(0.0)))
-
-
-def _band_max(dr: Any, bands: Sequence) -> Any:
-    """Largest band value per lane (a balanced tree of ``dr.maximum``)."""
-    values = list(bands)
-    while len(values) > 1:
-        values = [
-            dr.maximum(values[i], values[i + 1]) if i + 1 < len(values) else values[i]
-            for i in range(0, len(values), 2)
-        ]
-    return values[0]
 
 
 def _lookups(mi: Any, dr: Any, scene: Any, tables: BandTables) -> tuple[Any, Any, Any, Any]:
@@ -133,206 +146,6 @@ def _lookups(mi: Any, dr: Any, scene: Any, tables: BandTables) -> tuple[Any, Any
     for eid, light in tables.emitter_lights.items():
         lights[eid] = light
     return mi.Float(albedo.ravel()), mi.UInt32(rows), mi.UInt32(lights), mi.UInt32(surfaces)
-
-
-class _Kernel:
-    """The loop of ``path.cpp`` on band throughputs; *it* is the integrator (depths, sizes,
-    lookups). Each method is one step of the loop body, in ``path.cpp``'s order, so the
-    sampler is called exactly as there and the paths are the same."""
-
-    def __init__(self, mi: Any, dr: Any, it: Any, scene: Any) -> None:
-        self.mi, self.dr, self.it, self.scene = mi, dr, it, scene
-
-    def light_of(self, emitter: Any, mask: Any) -> Any:
-        return self.dr.gather(
-            self.mi.UInt32,
-            self.it.emitter_lut,
-            self.dr.reinterpret_array(self.mi.UInt32, emitter),
-            mask,
-        )
-
-    def deposit(self, acc: list, light: Any, weight: Any, bands: Sequence, mask: Any) -> list:
-        """``acc[l·K + k] += bands[k]·weight`` on the lanes whose light is l."""
-        k, out = self.it.n_bands, list(acc)
-        for j in range(self.it.n_lights):
-            w = self.dr.select(mask & (light == j), weight, 0.0)
-            for b in range(k):
-                out[j * k + b] = self.dr.fma(bands[b], w, out[j * k + b])
-        return out
-
-    def emitter_hit(
-        self, si: Any, prev_si: Any, prev_pdf: Any, prev_delta: Any
-    ) -> tuple[Any, Any, Any]:
-        """Light, weight (radiance x BSDF-sampling MIS weight) and mask of an emitter hit."""
-        mi, dr = self.mi, self.dr
-        emitter = si.emitter(self.scene)
-        hit = emitter != None  # noqa: E711 (a Dr.Jit pointer array, compared lane by lane)
-        ds = mi.DirectionSample3f(self.scene, si=si, ref=prev_si)
-        em_pdf = dr.select(
-            prev_delta, 0.0, self.scene.pdf_emitter_direction(prev_si, ds, ~prev_delta)
-        )
-        radiance = emitter.eval(si, (prev_pdf > 0.0) & hit)[0]
-        return self.light_of(emitter, hit), radiance * _mis_weight(dr, mi, prev_pdf, em_pdf), hit
-
-    def vertex(self, sampler: Any, si: Any, bsdf: Any, active_next: Any) -> tuple:
-        """Emitter sample, then BSDF evaluation and sample (``eval_pdf_sample``)."""
-        mi, dr = self.mi, self.dr
-        active_em = active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth)
-        ds, em_weight = self.scene.sample_emitter_direction(si, sampler.next_2d(), True, active_em)
-        active_em &= ds.pdf != 0.0
-        sample_1, sample_2 = sampler.next_1d(), sampler.next_2d()
-        bsdf_val, bsdf_pdf, bsdf_sample, bsdf_weight = bsdf.eval_pdf_sample(
-            mi.BSDFContext(), si, si.to_local(ds.d), sample_1, sample_2
-        )
-        mis_em = dr.select(ds.delta, 1.0, _mis_weight(dr, mi, ds.pdf, bsdf_pdf))
-        nee = bsdf_val[0] * em_weight[0] * mis_em
-        return self.light_of(ds.emitter, active_em), nee, active_em, bsdf_sample, bsdf_weight[0]
-
-    def albedo(self, si: Any) -> list:
-        """ρ_k of the material of the shape hit (the black row elsewhere), or of the nearest
-        texel on a textured shape."""
-        mi, dr, k = self.mi, self.dr, self.it.n_bands
-        valid = si.is_valid()
-        row = dr.gather(
-            mi.UInt32, self.it.shape_lut, dr.reinterpret_array(mi.UInt32, si.shape), valid
-        )
-        rho = [dr.gather(mi.Float, self.it.albedo, row * k + b, valid) for b in range(k)]
-        if not self.it.n_texcols:
-            return rho
-        texel, textured = texel_of(mi, dr, self.it, si)
-        return [
-            dr.select(
-                textured, dr.gather(mi.Float, self.it.texel_albedo, texel * k + b, textured), r
-            )
-            for b, r in enumerate(rho)
-        ]
-
-    def first_hit(self, si: Any, depth: Any, first: tuple) -> tuple:
-        """Surface index, ray distance and shading normal of the camera ray's hit."""
-        mi, dr = self.mi, self.dr
-        if not self.it.n_surfaces:
-            return first
-        now, valid = depth == 0, si.is_valid()
-        surface = dr.gather(
-            mi.UInt32, self.it.surface_lut, dr.reinterpret_array(mi.UInt32, si.shape), valid
-        )
-        surface = dr.select(valid, surface, self.it.n_surfaces)
-        distance = dr.select(valid, si.t, 0.0)
-        normal = dr.select(valid, si.sh_frame.n, mi.Vector3f(0.0))
-        hit = (surface, distance, normal) + (
-            texel_of(mi, dr, self.it, si) if self.it.n_texcols else ()
-        )
-        return tuple(dr.select(now, h, f) for h, f in zip(hit, first, strict=True))
-
-    def first_state(self) -> tuple:
-        """The first-hit state before any hit: no surface, no distance, no normal (no texel)."""
-        mi = self.mi
-        first = (mi.UInt32(self.it.n_surfaces), mi.Float(0.0), mi.Vector3f(0.0))
-        return first + ((mi.UInt32(0), mi.Bool(False)) if self.it.n_texcols else ())
-
-    def first_maps(self, first: tuple) -> list:
-        """The first-hit channels (:func:`first_hit_channels`) of the final first-hit state."""
-        mi, dr, n = self.mi, self.dr, self.it.n_surfaces
-        if not n:
-            return []
-        surface, distance, normal = first[:3]
-        out = [dr.select(surface == i, 1.0, 0.0) for i in range(n)]
-        if self.it.n_texcols:
-            texel, textured = first[3:]
-            g = self.it.n_texcols
-            out += [
-                dr.select(
-                    textured,
-                    dr.gather(mi.Float, self.it.texel_weights, texel * g + c, textured),
-                    0.0,
-                )
-                for c in range(g)
-            ]
-        return out + [distance, normal.x, normal.y, normal.z]
-
-    def path_state(self, sampler: Any, ray: Any) -> tuple:
-        """The start of a loop's state: sampler, ray, depth 0, throughput 1 and K band
-        throughputs 1, K·L accumulators 0, and the previous vertex (none, pdf 1, delta)."""
-        mi, dr, k = self.mi, self.dr, self.it.n_bands
-        return (
-            sampler,
-            mi.Ray3f(ray),
-            mi.UInt32(0),
-            mi.Float(1.0),
-            [mi.Float(1.0) for _ in range(k)],
-            [mi.Float(0.0) for _ in range(k * self.it.n_lights)],
-            dr.zeros(mi.Interaction3f),
-            mi.Float(1.0),
-            mi.Bool(True),
-        )
-
-    def next_state(
-        self,
-        sampler: Any,
-        si: Any,
-        bsdf_sample: Any,
-        bsdf_weight: Any,
-        depth: Any,
-        beta: Any,
-        bands: list,
-        acc: list,
-    ) -> tuple[tuple, Any]:
-        """Step to the next vertex (bands already scaled here): the state every loop carries
-        (:meth:`path_state`'s fields: ray, depth, throughput, previous vertex, its pdf and delta
-        flag) and the go-on flag. Russian roulette on the largest band (``path.cpp``: largest
-        channel); off when ``rr_depth`` > ``max_depth``, but its sample is drawn either way."""
-        mi, dr = self.mi, self.dr
-        ray = si.spawn_ray(si.to_world(bsdf_sample.wo))
-        depth = dr.select(si.is_valid(), depth + 1, depth)
-        beta = beta * bsdf_weight
-        throughput_max = beta * _band_max(dr, bands)
-        rr_prob = dr.minimum(throughput_max, 0.95)
-        rr_active = depth >= self.it.rr_depth
-        rr_continue = sampler.next_1d() < rr_prob
-        beta = dr.select(rr_active, beta * dr.rcp(dr.detach(rr_prob)), beta)
-        go_on = (~rr_active | rr_continue) & (throughput_max != 0.0)
-        delta = mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
-        state = (sampler, ray, depth, beta, bands, acc, mi.Interaction3f(si), bsdf_sample.pdf)
-        return (*state, delta), go_on
-
-    def body(
-        self,
-        sampler: Any,
-        ray: Any,
-        depth: Any,
-        beta: Any,
-        bands: list,
-        acc: list,
-        prev_si: Any,
-        prev_pdf: Any,
-        prev_delta: Any,
-        first: tuple,
-        alive: Any,
-    ) -> tuple:
-        mi = self.mi
-        si = self.scene.ray_intersect(ray, ray_flags=mi.RayFlags.All, coherent=depth == 0)
-        first = self.first_hit(si, depth, first)
-        light, weight, hit = self.emitter_hit(si, prev_si, prev_pdf, prev_delta)
-        acc = self.deposit(acc, light, beta * weight, bands, hit)
-        active_next = (depth + 1 < self.it.max_depth) & si.is_valid()
-        light, nee, active_em, bsdf_sample, bsdf_weight = self.vertex(
-            sampler, si, si.bsdf(ray), active_next
-        )
-        bands = [b * rho for b, rho in zip(bands, self.albedo(si), strict=True)]
-        acc = self.deposit(acc, light, beta * nee, bands, active_em)
-        state, go_on = self.next_state(
-            sampler, si, bsdf_sample, bsdf_weight, depth, beta, bands, acc
-        )
-        return (*state, first, active_next & go_on)
-
-    def run(self, sampler: Any, ray: Any, active: Any) -> list:
-        """The K·L accumulators of one wavefront of camera rays, then the first-hit maps
-        (:func:`first_hit_channels`)."""
-        state = (*self.path_state(sampler, ray), self.first_state(), self.mi.Bool(active))
-        state = self.dr.while_loop(
-            state, lambda *s: s[-1], self.body, label="spectrinsic band path"
-        )
-        return list(state[5]) + self.first_maps(state[9])
 
 
 def _check_fit(it: Any, tables: BandTables) -> None:
@@ -353,21 +166,36 @@ def _check_fit(it: Any, tables: BandTables) -> None:
         )
 
 
-@functools.cache
-def band_path_class(variant: str) -> type:
-    """The :class:`BandPath` integrator class for the active *variant* (defined per variant,
-    since ``mi.SamplingIntegrator`` is the variant's), registered as :data:`INTEGRATOR_NAME`.
+def _init_gloss(mi: Any, it: Any, props: Any) -> None:
+    """The glossy properties of integrator *it*: flags, μ nodes, a specular table of ones, no
+    metal rows, and the white BSDF the white-at-metal loop swaps in."""
+    it.metals = bool(props.get("metals", False))
+    it.gloss = bool(props.get("gloss", False)) or it.metals
+    it.n_nodes = int(props.get("n_nodes", FRESNEL_NODES))
+    if it.gloss:
+        it.specular = mi.Float(np.ones(it.n_nodes * it.n_bands, np.float32))
+        it.metal_rows = mi.UInt32(np.zeros(1, np.uint32))
+        # two-sided as every material of the scene; Mitsuba's diffuse defaults to 0.5
+        it.white_bsdf = mi.load_dict(
+            {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": 1.0}}
+        )
 
-    Properties: ``max_depth``, ``rr_depth`` (as ``path``), ``n_bands`` (K), ``n_lights`` (L).
-    Its AOVs are the L·K transports (:func:`transport_channels`); its RGB output is zero.
-    """
-    mi = import_mitsuba()
-    if mi.variant() != variant:
-        raise RenderError(f"band_path_class({variant!r}) called while {mi.variant()!r} is active")
-    import drjit as dr
+
+def _check_specular(it: Any, table: np.ndarray) -> None:
+    """Raise unless *table* is ``(R, n_nodes, K)`` for integrator *it*."""
+    shape = np.shape(table)
+    if len(shape) != 3 or shape[1:] != (it.n_nodes, it.n_bands):
+        raise RenderError(
+            f"specular table {shape} does not fit {it.n_nodes} nodes x {it.n_bands} bands"
+        )
+
+
+def _make_class(mi: Any, dr: Any) -> type:
+    """The :class:`BandPath` class of the active variant (module docstring)."""
 
     class BandPath(mi.SamplingIntegrator):  # type: ignore[misc, name-defined]
-        """``path`` with K band throughputs and L·K per-light accumulators (module docstring)."""
+        """``path`` with K band throughputs and L·K per-light accumulators; with ``gloss`` the
+        (G1) factors and the specular accumulators, with ``metals`` the white-at-metal loop."""
 
         def __init__(self, props: Any) -> None:
             super().__init__(props)
@@ -381,6 +209,7 @@ def band_path_class(variant: str) -> type:
             self.albedo = mi.Float(np.zeros(self.n_bands, np.float32))
             self.shape_lut = mi.UInt32(np.zeros(1, np.uint32))
             self.emitter_lut = mi.UInt32(np.zeros(1, np.uint32))
+            _init_gloss(mi, self, props)
 
         def set_tables(self, scene: Any, tables: BandTables) -> None:
             """Point the lookups at *tables* for the loaded *scene* (no recompilation)."""
@@ -392,33 +221,74 @@ def band_path_class(variant: str) -> type:
             self.slot_lut, self.tex_widths, self.tex_heights, self.tex_offsets = lookups[:4]
             self.texel_albedo, self.texel_weights = lookups[4:]
 
+        def set_metals(self, rows: np.ndarray) -> None:
+            """``(R,)`` bool: which albedo-table rows are metals (no diffuse lobe)."""
+            self.metal_rows = mi.UInt32(np.asarray(rows, bool).astype(np.uint32))
+
+        def set_specular(self, table: np.ndarray) -> None:
+            """``(R, n_nodes, K)`` band factors ``s_k(μ_j)`` per albedo-table row."""
+            _check_specular(self, table)
+            self.specular = mi.Float(np.asarray(table, np.float32).ravel())
+
         def aov_names(self) -> list[str]:
-            return transport_channels(self.n_lights, self.n_bands) + first_hit_channels(
-                self.n_surfaces, self.n_texcols
-            )
+            return aov_channels(
+                self.n_lights, self.n_bands, self.n_surfaces, self.n_texcols,
+                gloss=self.gloss, metals=self.metals,
+            )  # fmt: skip
 
         def sample(
             self, scene: Any, sampler: Any, ray: Any, medium: Any = None, active: Any = True
         ) -> tuple:
-            return (
-                mi.Spectrum(0.0),
-                mi.Bool(True),
-                _Kernel(mi, dr, self, scene).run(sampler, ray, active),
-            )
+            kernel = BandKernel(mi, dr, self, scene, gloss=self.gloss)
+            state, out = kernel.run(sampler, ray, active)
+            if self.metals:  # after the first loop, so its paths are unchanged
+                out += BandKernel(mi, dr, self, scene, white=True).run(sampler, ray, active)[1]
+            return mi.Spectrum(0.0), mi.Bool(True), out + kernel.first_maps(state.first)
 
         def to_string(self) -> str:
-            return f"BandPath[max_depth={self.max_depth}, n_bands={self.n_bands}, n_lights={self.n_lights}]"
+            return (
+                f"BandPath[max_depth={self.max_depth}, n_bands={self.n_bands}, "
+                f"n_lights={self.n_lights}, gloss={self.gloss}, metals={self.metals}]"
+            )
 
-    mi.register_integrator(INTEGRATOR_NAME, lambda props: BandPath(props))
     return BandPath
 
 
+@functools.cache
+def band_path_class(variant: str) -> type:
+    """The :class:`BandPath` integrator class for the active *variant* (defined per variant,
+    since ``mi.SamplingIntegrator`` is the variant's), registered as :data:`INTEGRATOR_NAME`.
+
+    Properties: ``max_depth``, ``rr_depth`` (as ``path``), ``n_bands`` (K), ``n_lights`` (L),
+    ``n_surfaces``, ``n_texcols``, ``gloss``, ``metals``, ``n_nodes`` (μ nodes of the band
+    Fresnel tables). Its AOVs are :func:`aov_channels`; its RGB output is zero.
+    """
+    mi = import_mitsuba()
+    if mi.variant() != variant:
+        raise RenderError(f"band_path_class({variant!r}) called while {mi.variant()!r} is active")
+    import drjit as dr
+
+    cls = _make_class(mi, dr)
+    mi.register_integrator(INTEGRATOR_NAME, lambda props: cls(props))
+    return cls
+
+
 def band_path(
-    mi: Any, *, max_depth: int, n_bands: int, n_lights: int, n_surfaces: int = 0, n_texcols: int = 0
+    mi: Any,
+    *,
+    max_depth: int,
+    n_bands: int,
+    n_lights: int,
+    n_surfaces: int = 0,
+    n_texcols: int = 0,
+    gloss: bool = False,
+    metals: bool = False,
 ) -> Any:
     """A :class:`BandPath` instance for the active variant (rr off: ``rr_depth`` > ``max_depth``),
-    with first-hit maps of *n_surfaces* surfaces if not 0 and textures of *n_texcols* coverage
-    columns (:class:`TextureTables`) if not 0."""
+    with first-hit maps of *n_surfaces* surfaces if not 0, textures of *n_texcols* coverage
+    columns (:class:`TextureTables`) if not 0, the glossy (G1) factors and specular part with
+    *gloss*, and the white-surface radiance at metal first hits with *metals* (implies *gloss*;
+    :mod:`~spectrinsic.render.band_kernel`)."""
     band_path_class(mi.variant())
     return mi.load_dict(
         {
@@ -429,5 +299,7 @@ def band_path(
             "n_lights": int(n_lights),
             "n_surfaces": int(n_surfaces),
             "n_texcols": int(n_texcols),
+            "gloss": bool(gloss),
+            "metals": bool(metals),
         }
     )

@@ -56,7 +56,7 @@ class LightTransport:
         Scenes with glossy materials / metals, one dict per batch as :attr:`batches`: the part
         of ``T`` whose first camera-ray vertex went through a non-diffuse lobe, and the
         white-surface radiance at metal first hits (not part of ``T``)
-        (:mod:`~spectrinsic.render.gloss_kernel`), for the same unit spectrum; empty otherwise.
+        (:mod:`~spectrinsic.render.band_kernel`), for the same unit spectrum; empty otherwise.
     """
 
     modes: tuple[str, ...]

@@ -56,13 +56,13 @@ class RenderResult:
         Scenes with glossy materials, single traversal: mode -> ``(H, W, K)`` float32 raw
         channels of the light the camera rays' first hits return through their non-diffuse
         lobes (coat reflection, metal), with everything those lobes reflect
-        (:mod:`spectrinsic.render.gloss_kernel`); a part of ``raw[mode]``. Empty for matte
+        (:mod:`spectrinsic.render.band_kernel`); a part of ``raw[mode]``. Empty for matte
         scenes, where it is 0.
     metal_white
         Scenes with metals, single traversal: mode -> ``(H, W, K)`` float32 raw channels of the
         radiance a white Lambertian surface would reflect at the first hits on metals, times
         their coverage (not part of ``raw``), so the shading stays defined where the diffuse
-        albedo is 0 (:mod:`spectrinsic.render.gloss_kernel`). Empty otherwise.
+        albedo is 0 (:mod:`spectrinsic.render.band_kernel`). Empty otherwise.
     specular_transport, metal_white_transport
         The per-light parts behind ``specular`` and ``metal_white`` as ``transport`` is behind
         ``raw`` (mode -> ``(L, H, W, K)`` float32 for unit emission); empty without them.

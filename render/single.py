@@ -25,7 +25,6 @@ import numpy as np
 from spectrinsic.errors import RenderError, SceneError, validate_choice
 from spectrinsic.render import translate as tr
 from spectrinsic.render.aovs import assemble_aovs
-from spectrinsic.render.gloss_kernel import gloss_path
 from spectrinsic.render.integrator import BandTables, band_path, first_hit_channels
 from spectrinsic.render.modes import ChannelValues, RenderMode, channel_values, get_mode
 from spectrinsic.render.passes import (
@@ -166,31 +165,6 @@ class _Traced:
     metal_white: np.ndarray | None = None
 
 
-def _integrator(
-    mi: Any, dims: _Dims, depth: int, n_surfaces: int, n_texcols: int, metals: bool
-) -> Any:
-    """The band-path integrator of one traversal: glossy (with the white-at-metal paths when
-    *metals*) or Lambertian."""
-    if dims.glossy:
-        return gloss_path(
-            mi,
-            max_depth=depth,
-            n_bands=dims.n_bands,
-            n_lights=dims.n_lights,
-            n_surfaces=n_surfaces,
-            metals=metals,
-            n_texcols=n_texcols,
-        )
-    return band_path(
-        mi,
-        max_depth=depth,
-        n_bands=dims.n_bands,
-        n_lights=dims.n_lights,
-        n_surfaces=n_surfaces,
-        n_texcols=n_texcols,
-    )
-
-
 def _trace(
     mi: Any,
     loaded: Any,
@@ -208,7 +182,16 @@ def _trace(
     n_surfaces = len(tables.shape_surfaces) if first else 0
     metals = dims.metals and first
     n_texcols = 0 if tables.textures is None else len(tables.textures.columns)
-    integrator = _integrator(mi, dims, depth, n_surfaces, n_texcols, metals)
+    integrator = band_path(
+        mi,
+        max_depth=depth,
+        n_bands=dims.n_bands,
+        n_lights=dims.n_lights,
+        n_surfaces=n_surfaces,
+        n_texcols=n_texcols,
+        gloss=dims.glossy,
+        metals=metals,
+    )
     integrator.set_tables(loaded, tables if n_surfaces else replace(tables, shape_surfaces={}))
     if spec_table is not None:
         integrator.set_specular(spec_table)

@@ -40,7 +40,7 @@ import numpy as np
 
 from spectrinsic.errors import SceneError
 from spectrinsic.render.aovs import render_aovs
-from spectrinsic.render.batches import batch_seeds, image_noise, merge_batches
+from spectrinsic.render.batches import run_batches
 from spectrinsic.render.light_transport import (
     LightTransport,
     diagonal_mode_names,
@@ -331,33 +331,17 @@ def render_transport_batches(
     :func:`~spectrinsic.render.render_batches`; ``per_light`` and ``share_mode`` do not apply
     (the transport is per light already).
     """
-    modes, batches, noise_target = settings.modes, settings.batches, settings.noise_target
+    modes = settings.modes
     if settings.direct and not [m for m in modes if m not in diagonal_mode_names(modes)]:
         raise SceneError(
             "direct-only renders with the transport need the 'spectral' mode "
             "(the diagonal modes are composed, not rendered with every light)"
         )
-    cap = max(batches, settings.max_batches if settings.max_batches is not None else 4 * batches)
-    seeds = batch_seeds(seed, cap if noise_target is not None else batches)
-    done = [
-        _batch(scene, settings, s, progress=progress, data_dir=data_dir) for s in seeds[:batches]
-    ]
-    reached = image_noise([r for _, r in done]) if noise_target is not None else None
-    while (
-        reached is not None
-        and noise_target is not None
-        and reached > noise_target
-        and len(done) < cap
-    ):
-        done.append(_batch(scene, settings, seeds[len(done)], progress=progress, data_dir=data_dir))
-        reached = image_noise([r for _, r in done])
-    merged = merge_batches([r for _, r in done])
-    if noise_target is not None:
-        merged.meta["noise_target"] = {
-            "target": float(noise_target),
-            "reached": reached,
-            "max_batches": cap,
-        }
+
+    def one(s: int) -> tuple[LightTransport, RenderResult]:
+        return _batch(scene, settings, s, progress=progress, data_dir=data_dir)
+
+    done, merged, seeds = run_batches(settings, seed, one, lambda d: d[1])
     names = diagonal_mode_names(modes)
     seconds = {
         m: tuple(x for r in done for x in r[1].meta["timings"][m]["per_pass"])

@@ -55,12 +55,12 @@ class TransportOutput:
         ``(L, K)`` float64 the lights' channel values ``E_{l,k}`` (:class:`ChannelValues`).
     specular
         ``(L, H, W, K)`` float32 the part of :attr:`transport` whose first camera-ray vertex
-        went through a non-diffuse lobe (:mod:`spectrinsic.render.gloss_kernel`), for scenes
+        went through a non-diffuse lobe (:mod:`spectrinsic.render.band_kernel`), for scenes
         with glossy materials; ``None`` for matte scenes (where it is 0).
     metal_white
         ``(L, H, W, K)`` float32 for scenes with metals: the radiance a white Lambertian
         surface would reflect at the pixel's metal first hits, times their coverage
-        (``c_metal · E_k / π``, :mod:`~spectrinsic.render.gloss_kernel`); not part of the
+        (``c_metal · E_k / π``, :mod:`~spectrinsic.render.band_kernel`); not part of the
         image. ``None`` without metals.
     """
 

@@ -16,13 +16,14 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, is_dataclass
 from typing import Any, Literal
 
 import numpy as np
 
-from spectrinsic.errors import did_you_mean
-from spectrinsic.scenes.textures import Texture
+from spectrinsic.errors import SceneError, did_you_mean
+from spectrinsic.scenes.textures import Texture, texture_from_record
 
 __all__ = [
     "Material",
@@ -41,7 +42,9 @@ __all__ = [
     "make_light",
     "unknown_light_kind",
     "light_power",
+    "record_fields",
     "scene_to_dict",
+    "scene_from_dict",
     "scene_hash",
 ]
 
@@ -291,14 +294,22 @@ class Scene:
         return any(m.texture is not None for m in self.meshes)
 
 
+def record_fields(record: Any) -> dict[str, Any]:
+    """The fields of dataclass *record* that its plain record keeps: all but those marked
+    ``omit_default`` at their default and those whose ``omit_when(record)`` holds (a procedural
+    texture's weights). The one rule of :func:`scene_to_dict` and of the sample files' JSON
+    (:func:`spectrinsic.gt_export.sample.plain_data`)."""
+    return {
+        f.name: getattr(record, f.name)
+        for f in fields(record)
+        if not (f.metadata.get("omit_default") and getattr(record, f.name) == f.default)
+        and not f.metadata.get("omit_when", lambda record: False)(record)
+    }
+
+
 def _plain(value: Any) -> Any:
     if is_dataclass(value) and not isinstance(value, type):
-        return {
-            f.name: _plain(getattr(value, f.name))
-            for f in fields(value)
-            if not (f.metadata.get("omit_default") and getattr(value, f.name) == f.default)
-            and not f.metadata.get("omit_when", lambda record: False)(value)
-        }
+        return {k: _plain(v) for k, v in record_fields(value).items()}
     if isinstance(value, np.ndarray):
         return value.tolist()
     if isinstance(value, (tuple, list)):
@@ -313,6 +324,49 @@ def _plain(value: Any) -> Any:
 def scene_to_dict(scene: Scene) -> dict[str, Any]:
     """Return *scene* as JSON-serialisable plain data (arrays become nested lists)."""
     return _plain(scene)
+
+
+def _record(entry: Mapping[str, Any]) -> dict[str, Any]:
+    """A record's fields from plain data: lists back to the tuples the frozen records hold."""
+    return {str(k): tuple(v) if isinstance(v, list) else v for k, v in entry.items()}
+
+
+def _mesh_from_dict(m: Mapping[str, Any]) -> Mesh:
+    return Mesh(
+        name=str(m["name"]),
+        vertices=np.asarray(m["vertices"], np.float64).reshape(-1, 3),
+        faces=np.asarray(m["faces"], np.int64).reshape(-1, 3),
+        face_materials=np.asarray(m["face_materials"], np.int64).reshape(-1),
+        object_id=int(m["object_id"]),
+        texture=texture_from_record(m["texture"]) if m.get("texture") else None,
+    )
+
+
+def scene_from_dict(data: Mapping[str, Any]) -> Scene:
+    """The :class:`Scene` of its :func:`scene_to_dict` record, the inverse:
+    ``scene_from_dict(scene_to_dict(s)) == s`` (fields left out at their defaults come back as
+    those defaults; a procedural texture's weights from its recipe). Raises
+    :class:`~spectrinsic.errors.SceneError` (one line) on any other structure.
+
+    >>> s = scene_from_dict({"name": "s", "meshes": [], "materials": [{"name": "m",
+    ...     "spectrum": "flat:0.5"}], "lights": [], "camera": {"origin": [0, 0, 1],
+    ...     "target": [0, 0, 0]}})
+    >>> s.materials[0].kind, s.camera.width
+    ('diffuse', 128)
+    """
+    try:
+        return Scene(
+            str(data["name"]),
+            tuple(_mesh_from_dict(m) for m in data["meshes"]),
+            tuple(Material(**_record(m)) for m in data["materials"]),
+            tuple(Light(**_record(x)) for x in data["lights"]),
+            Camera(**_record(data["camera"])),
+            dict(data.get("metadata") or {}),
+        )
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise SceneError(
+            f"scene record: unexpected structure ({type(exc).__name__}: {exc})"
+        ) from exc
 
 
 def scene_hash(scene: Scene) -> str:

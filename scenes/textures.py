@@ -216,8 +216,8 @@ def texture_from_record(record: Mapping[str, Any]) -> Texture:
             str(record["name"]),
             basis,
             str(record["pattern"]),
-            int(record["size"]),
-            int(record["seed"]),
+            int(record.get("size", 0)),
+            int(record.get("seed", 0)),  # left out of the record at its default, 0
         )
     return Texture(str(record["name"]), basis, np.asarray(record["weights"], np.float64))
 

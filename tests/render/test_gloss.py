@@ -1,4 +1,4 @@
-"""Glossy materials in the single traversal (render/gloss_kernel.py) against closed forms
+"""Glossy materials in the single traversal (render/band_kernel.py) against closed forms
 computed here, and against Mitsuba's own spectral path tracer.
 
 The expected values are independent of the code under test: the dielectric Fresnel reflectance
@@ -13,7 +13,6 @@ import pytest
 
 from spectrinsic.render import channel_values
 from spectrinsic.render import translate as tr
-from spectrinsic.render.gloss_kernel import gloss_path
 from spectrinsic.render.integrator import band_path
 from spectrinsic.render.plugins import hdr_film, path_integrator, rgb_spectrum
 from spectrinsic.render.single import _tables, light_of_emitters, render_traversal
@@ -186,10 +185,12 @@ def test_e_gloss_kernel_on_a_matte_scene_is_the_band_path(make_room):
             )
         )
         tables = _tables(scene, [values], light_of_emitters(mi, loaded), aovs=False)
-        for make in (band_path, gloss_path):
-            integrator = make(mi, max_depth=4, n_bands=6, n_lights=len(scene.lights))
+        for gloss in (False, True):
+            integrator = band_path(
+                mi, max_depth=4, n_bands=6, n_lights=len(scene.lights), gloss=gloss
+            )
             integrator.set_tables(loaded, tables)
-            if make is gloss_path:
+            if gloss:
                 n = integrator.n_nodes
                 integrator.set_specular(np.ones((len(scene.materials) + 1, n, 6)))
             images.append(np.asarray(mi.render(loaded, integrator=integrator, seed=2, spp=4)))

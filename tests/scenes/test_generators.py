@@ -145,6 +145,7 @@ def test_rooms_with_a_ceiling_get_no_directional_light():
     assert roofed and all(light.kind != "directional" for s in roofed for light in s.lights)
 
 
+@pytest.mark.slow
 def test_rooms_are_lit_directly_and_indirectly():
     """Low energy ratios r need rooms lit after a bounce: their lights sit below a ceiling and
     aim up at it, in closed-ceiling rooms with light walls (measured r 0.30-0.36 at the preview

@@ -188,7 +188,9 @@ def test_light_inside_geometry(tmp_path, kind):
 
 
 def test_light_just_outside_geometry_is_fine(tmp_path):
-    load_scene(write(tmp_path, edited(lights__0__position=[0.0, 0.0, 1.01])))
+    """1 cm above the cube's top face (z = 1) loads, and the light is where the file put it."""
+    scene = load_scene(write(tmp_path, edited(lights__0__position=[0.0, 0.0, 1.01])))
+    assert scene.lights[0].position == (0.0, 0.0, 1.01)
 
 
 def test_directional_light_has_no_position_to_check(tmp_path):

@@ -138,6 +138,7 @@ def test_angular_error_closed_forms():
     assert angular_error(np.array([1.0, 0, 0]), np.array([1.0, 1, 0])) == pytest.approx(45.0)
 
 
+@pytest.mark.slow
 def test_fits_and_responses_do_not_depend_on_blas_threads(tmp_path):
     """The fitted matrices written to meta.json come out bit-identical with 1 and 2 BLAS threads
     (issue 9, point 10): responses and least squares avoid threaded BLAS reductions."""
