@@ -198,3 +198,17 @@ def test_unsupported_xml_is_refused_in_one_line(cornell, capsys, old, new, expec
     assert main(["render", str(bad), "--out", str(cornell / "o")]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and expected in err
+
+
+def test_built_in_shapes_are_closed_outward_and_of_the_right_size():
+    import trimesh
+
+    from spectrinsic.scenes import mitsuba_parts as parts
+
+    cube = trimesh.Trimesh(*parts.cube(), process=False)
+    ball = trimesh.Trimesh(*parts.sphere(np.array([1.0, 2.0, 3.0]), 0.5), process=False)
+    assert cube.is_watertight and cube.volume == pytest.approx(8.0)
+    assert ball.is_watertight and ball.volume == pytest.approx(4 / 3 * np.pi * 0.125, rel=0.03)
+    np.testing.assert_allclose(ball.vertices.mean(0), [1, 2, 3], atol=1e-9)
+    disk = trimesh.Trimesh(*parts.disk(), process=False)
+    assert disk.area == pytest.approx(np.pi, rel=0.01) and (disk.face_normals[:, 2] > 0).all()
