@@ -232,7 +232,7 @@ def _scene(root: ET.Element, base: Path, name: str) -> Scene:
     lights: list[Light] = []
     camera = None
     for i, el in enumerate(root):
-        where = f"{_label(el)} #{i}"
+        where = f"element {i}" + (f" (id {el.get('id')!r})" if el.get("id") else "")
         if el.tag in _IGNORED or el.tag == "default":
             continue
         if el.tag == "bsdf" and el.get("id"):

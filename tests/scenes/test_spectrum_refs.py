@@ -106,3 +106,19 @@ def test_a_scene_with_csv_spectra_renders_their_exact_reflectance(folder):
     digest = hashlib.sha256((root / "spectra" / "measured.csv").read_bytes()).hexdigest()
     assert {r["column"] for r in meta["spectrum_files"]} == {"paint", "lamp"}
     assert {r["sha256"] for r in meta["spectrum_files"]} == {digest}
+
+
+def test_a_material_map_takes_csv_paths_from_its_folder_and_inline_spectra(folder):
+    from spectrinsic.cli.dataset_source import material_map
+    from spectrinsic.errors import DatasetError
+
+    root, _ = folder
+    path = root / "map.yaml"
+    inline = {"wavelengths": [400, 700], "values": [0.2, 0.3]}
+    path.write_text(yaml.safe_dump({"paint": "csv:spectra/measured.csv#paint", "clay": inline}))
+    mapping = material_map(str(path))
+    assert mapping["paint"] == f"csv:{(root / 'spectra' / 'measured.csv').resolve()}#paint"
+    assert mapping["clay"] == "inline:reflectance:400.0=0.2,700.0=0.3"
+    path.write_text(yaml.safe_dump({"paint": "csv:../x.csv#paint"}))
+    with pytest.raises(DatasetError, match="paint: path '../x.csv' leads outside"):
+        material_map(str(path))
