@@ -10,10 +10,14 @@ their ``<default>`` values. Translated:
   (``center``, ``radius``), each with a ``to_world`` transform; built-in shapes become triangles
   (:mod:`~spectrinsic.scenes.mitsuba_parts`);
 - BSDFs ``diffuse`` (``reflectance`` as ``rgb``: linear sRGB through Mallett & Yuksel 2019;
-  ``spectrum``: ``"WL:V, ..."`` or one number; ``float``) and ``twosided`` around one, at the top
-  level with an ``id`` (``<ref id=.../>``) or inside a shape;
+  ``spectrum``: ``"WL:V, ..."`` or one number; ``float``), ``plastic`` and ``roughplastic``
+  (``diffuse_reflectance`` likewise, ``int_ior``/``ext_ior`` as numbers, ``alpha``: taken as the
+  GGX α whatever the ``distribution``), ``conductor`` and ``roughconductor`` (``material`` one
+  of Mitsuba's measured metals), bare or in a ``twosided``, at the top level with an ``id``
+  (``<ref id=.../>``) or inside a shape;
 - emitters ``area`` on a ``rectangle`` (an area light of the rectangle's centre, normal and
-  size), ``point``, ``directional`` and ``constant`` (a ``sky`` light), with ``rgb`` (grey: D65)
+  size), ``point``, ``spot`` (``cutoff_angle``; Mitsuba's default ``beam_width``), ``directional``
+  and ``constant`` (a ``sky`` light), with ``rgb`` (grey: D65)
   or ``spectrum`` emission (:func:`~spectrinsic.scenes.mitsuba_parts.emission`);
 - the ``perspective`` sensor (``fov``, ``fov_axis`` x or y, ``to_world``) and its film's
   ``width`` and ``height``.
@@ -35,6 +39,7 @@ import numpy as np
 
 from spectrinsic.errors import SceneError, SpectrinsicError
 from spectrinsic.scenes import mitsuba_parts as parts
+from spectrinsic.scenes.materials import METAL_SPECTRUM
 from spectrinsic.scenes.meshes import check_mesh_size
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.scenes.validate import validate_scene
@@ -84,19 +89,51 @@ def _parse(path: Path) -> ET.Element:
     return root
 
 
-def _bsdf(el: ET.Element, where: str) -> str:
-    """The reflectance spectrum name of a ``diffuse`` (or ``twosided`` diffuse) BSDF."""
+_BSDF_PARAMS = {
+    "diffuse": ("reflectance",),
+    "plastic": ("diffuse_reflectance", "int_ior", "ext_ior"),
+    "roughplastic": ("diffuse_reflectance", "int_ior", "ext_ior", "alpha", "distribution"),
+    "conductor": ("material",),
+    "roughconductor": ("material", "alpha", "distribution"),
+}
+
+
+def _bsdf(el: ET.Element, where: str) -> Material:
+    """The material of a ``diffuse``, ``(rough)plastic`` or ``(rough)conductor`` BSDF, bare or
+    inside a ``twosided``; named after its spectrum (diffuse) or its ``id``."""
+    name = el.get("id", "")
     if el.get("type") == "twosided":
         inner = [c for c in el if c.tag == "bsdf"]
         if len(inner) != 1:
             raise SceneError(f"{where}: {_label(el)} needs exactly one inner <bsdf>")
         el = inner[0]
-    if el.get("type") != "diffuse":
-        raise SceneError(f"{where}: unsupported element {_label(el)}; expected a diffuse bsdf")
+    kind = el.get("type", "")
+    if kind not in _BSDF_PARAMS:
+        raise SceneError(
+            f"{where}: unsupported element {_label(el)}; expected a bsdf of type "
+            + ", ".join(_BSDF_PARAMS)
+        )
     for child in el:
-        if child.get("name") != "reflectance":
+        if child.get("name") not in _BSDF_PARAMS[kind]:
             raise SceneError(f"{where}: unsupported element {_label(child)} in {_label(el)}")
-    return parts.reflectance_name(_named(el, "reflectance"), f"{where} reflectance")
+    alpha = _float(el, "alpha", 0.1, f"{where} alpha") if kind.startswith("rough") else 0.0
+    if kind == "diffuse":
+        spectrum = parts.reflectance_name(_named(el, "reflectance"), f"{where} reflectance")
+        return Material(spectrum, spectrum)
+    if kind.endswith("conductor"):
+        metal = _named(el, "material")
+        if metal is None:
+            raise SceneError(f"{where}: {_label(el)} needs a 'material' (Au, Cu, Al, ...)")
+        return Material(
+            name or f"{kind} {metal.get('value')}",
+            METAL_SPECTRUM,
+            kind="conductor",
+            roughness=alpha,
+            metal=metal.get("value", ""),
+        )
+    base = parts.reflectance_name(_named(el, "diffuse_reflectance"), f"{where} reflectance")
+    ior = _float(el, "int_ior", 1.49, f"{where} int_ior") / _float(el, "ext_ior", 1.0, where)
+    return Material(name or f"{kind} {base}", base, kind="plastic", roughness=alpha, ior=ior)
 
 
 def _mesh_file(el: ET.Element, base: Path, where: str) -> tuple[np.ndarray, np.ndarray]:
@@ -169,6 +206,17 @@ def _emitter(el: ET.Element, where: str) -> Light:
         d = _named(el, "direction")
         direction = parts.numbers(None if d is None else d.get("value"), 3, f"{where} direction")
         return Light("directional", spectrum, power, direction=tuple(float(x) for x in direction))  # type: ignore[arg-type]
+    if kind == "spot":
+        spectrum, power = parts.emission(_named(el, "intensity"), f"{where} intensity")
+        m = parts.transform(_named(el, "to_world"), where)
+        return Light(
+            "spot",
+            spectrum,
+            power,
+            position=tuple(float(x) for x in m[:3, 3]),  # type: ignore[arg-type]
+            direction=tuple(float(x) for x in m[:3, 2] / np.linalg.norm(m[:3, 2])),  # type: ignore[arg-type]
+            cutoff_deg=_float(el, "cutoff_angle", 20.0, f"{where} cutoff_angle"),
+        )
     if kind == "constant":
         spectrum, power = parts.emission(_named(el, "radiance"), f"{where} radiance")
         return Light("sky", spectrum, power)
@@ -202,9 +250,9 @@ def _camera(el: ET.Element, where: str) -> Camera:
 
 
 def _shape(
-    el: ET.Element, base: Path, bsdfs: dict[str, str], where: str
-) -> tuple[str | None, tuple[np.ndarray, np.ndarray] | None, Light | None]:
-    """``(spectrum, geometry, None)`` of a surface or ``(None, None, light)`` of an area light."""
+    el: ET.Element, base: Path, bsdfs: dict[str, Material], where: str
+) -> tuple[Material | None, tuple[np.ndarray, np.ndarray] | None, Light | None]:
+    """``(material, geometry, None)`` of a surface or ``(None, None, light)`` of an area light."""
     if el.get("type") not in _SHAPES:
         raise SceneError(f"{where}: unsupported element {_label(el)}")
     emitters = [c for c in el if c.tag == "emitter"]
@@ -212,22 +260,22 @@ def _shape(
         if emitters[0].get("type") != "area":
             raise SceneError(f"{where}: unsupported element {_label(emitters[0])} in a shape")
         return None, None, _area_light(el, emitters[0], where)
-    spectrum = "flat:0.5"
+    material = Material("flat:0.5", "flat:0.5")  # Mitsuba's default BSDF
     for child in el:
         if child.tag == "ref":
             if child.get("id") not in bsdfs:
                 raise SceneError(f"{where}: <ref id={child.get('id')!r}> names no bsdf")
-            spectrum = bsdfs[child.get("id", "")]
+            material = bsdfs[child.get("id", "")]
         elif child.tag == "bsdf":
-            spectrum = _bsdf(child, where)
+            material = _bsdf(child, where)
         elif child.tag not in ("string", "float", "point", "transform", "boolean"):
             raise SceneError(f"{where}: unsupported element {_label(child)}")
-    return spectrum, _geometry(el, base, where), None
+    return material, _geometry(el, base, where), None
 
 
 def _scene(root: ET.Element, base: Path, name: str) -> Scene:
-    bsdfs: dict[str, str] = {}
-    materials: dict[str, int] = {}
+    bsdfs: dict[str, Material] = {}
+    materials: dict[Material, int] = {}
     meshes: list[Mesh] = []
     lights: list[Light] = []
     camera = None
@@ -242,11 +290,11 @@ def _scene(root: ET.Element, base: Path, name: str) -> Scene:
         elif el.tag == "emitter":
             lights.append(_emitter(el, where))
         elif el.tag == "shape":
-            spectrum, geometry, light = _shape(el, base, bsdfs, where)
+            material, geometry, light = _shape(el, base, bsdfs, where)
             if light is not None:
                 lights.append(light)
-            elif spectrum is not None and geometry is not None:
-                index = materials.setdefault(spectrum, len(materials))
+            elif material is not None and geometry is not None:
+                index = materials.setdefault(material, len(materials))
                 v, f = geometry
                 meshes.append(
                     Mesh(
@@ -264,7 +312,7 @@ def _scene(root: ET.Element, base: Path, name: str) -> Scene:
     return Scene(
         name=name,
         meshes=tuple(meshes),
-        materials=tuple(Material(s, s) for s in materials),
+        materials=tuple(materials),
         lights=tuple(lights),
         camera=camera,
         metadata={"source": f"{name}.xml (Mitsuba 3 XML)"},

@@ -119,7 +119,7 @@ def is_scene_file(argument: str | Path) -> bool:
     (True, True, False)
     """
     p = Path(argument)
-    return p.suffix.lower() in (".yaml", ".yml", ".blend", *MESH_SUFFIXES) or p.exists()
+    return p.suffix.lower() in (".yaml", ".yml", ".xml", ".blend", *MESH_SUFFIXES) or p.exists()
 
 
 def load_scene_file(

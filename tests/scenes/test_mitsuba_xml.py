@@ -164,8 +164,8 @@ def test_the_xml_box_renders_with_full_ground_truth(cornell):
     [
         (
             '<bsdf type="diffuse" id="red">',
-            '<bsdf type="roughconductor" id="red">',
-            "unsupported element <bsdf type='roughconductor' id='red'>",
+            '<bsdf type="dielectric" id="red">',
+            "unsupported element <bsdf type='dielectric' id='red'>",
         ),
         (
             '<scene version="3.0.0">',
@@ -212,3 +212,43 @@ def test_built_in_shapes_are_closed_outward_and_of_the_right_size():
     np.testing.assert_allclose(ball.vertices.mean(0), [1, 2, 3], atol=1e-9)
     disk = trimesh.Trimesh(*parts.disk(), process=False)
     assert disk.area == pytest.approx(np.pi, rel=0.01) and (disk.face_normals[:, 2] > 0).all()
+
+
+def test_glossy_bsdfs_and_a_spot_become_glossy_materials_and_a_spot_light(cornell):
+    glossy = (
+        XML.replace(
+            '<bsdf type="diffuse" id="red"><rgb name="reflectance" value="0.6, 0.05, 0.05"/></bsdf>',
+            '<bsdf type="roughplastic" id="red"><rgb name="diffuse_reflectance" value="0.6, 0.05, 0.05"/>'
+            '<float name="alpha" value="0.2"/><float name="int_ior" value="1.6"/></bsdf>',
+        )
+        .replace(
+            '<bsdf type="diffuse" id="white"><rgb name="reflectance" value="0.7, 0.7, 0.7"/></bsdf>',
+            '<bsdf type="conductor" id="white"><string name="material" value="Au"/></bsdf>',
+        )
+        .replace(
+            "</scene>",
+            '<emitter type="spot"><rgb name="intensity" value="3, 3, 3"/>'
+            '<float name="cutoff_angle" value="25"/><transform name="to_world">'
+            '<lookat origin="0, 0, 1.9" target="0, 0, 0" up="0, 1, 0"/></transform></emitter></scene>',
+        )
+    )
+    (cornell / "glossy.xml").write_text(glossy)
+    scene = load_mitsuba_xml(cornell / "glossy.xml")
+    by_name = {m.name: m for m in scene.materials}
+    red, gold = by_name["red"], by_name["white"]
+    assert (red.kind, red.spectrum, red.roughness, red.ior) == (
+        "plastic",
+        "rgb:0.6,0.05,0.05",
+        0.2,
+        1.6,
+    )
+    assert (gold.kind, gold.metal, gold.roughness, gold.spectrum) == (
+        "conductor",
+        "Au",
+        0.0,
+        "flat:0",
+    )
+    spot = scene.lights[-1]
+    assert (spot.kind, spot.spectrum, spot.power, spot.cutoff_deg) == ("spot", "cie:D65", 3.0, 25.0)
+    np.testing.assert_allclose(spot.position, [0, 0, 1.9])
+    np.testing.assert_allclose(spot.direction, [0, 0, -1], atol=1e-12)
