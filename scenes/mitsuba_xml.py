@@ -167,6 +167,9 @@ def _geometry(el: ET.Element, base: Path, where: str) -> tuple[np.ndarray, np.nd
         v, f = parts.sphere(centre, _float(el, "radius", 1.0, f"{where} radius"))
     else:
         v, f = getattr(parts, kind)()
+    flip = _named(el, "flip_normals")
+    if flip is not None and flip.get("value", "false").lower() == "true":
+        f = f[:, ::-1]
     return parts.apply(parts.transform(_named(el, "to_world"), where), v), f
 
 
@@ -176,6 +179,9 @@ def _area_light(el: ET.Element, emitter: ET.Element, where: str) -> Light:
     m = parts.transform(_named(el, "to_world"), where)
     u, v = m[:3, 0], m[:3, 1]
     normal = np.cross(u, v)
+    flip = _named(el, "flip_normals")
+    if flip is not None and flip.get("value", "false").lower() == "true":
+        normal = -normal
     spectrum, power = parts.emission(_named(emitter, "radiance"), f"{where} radiance")
     return Light(
         "area",

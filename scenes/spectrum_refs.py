@@ -32,7 +32,7 @@ _INLINE_KEYS = {"wavelengths", "values"}
 def confined_csv(name: str, base: Path) -> str:
     """``csv:PATH#COLUMN`` with PATH resolved inside folder *base*; a one-phrase
     :class:`SceneError` otherwise (absolute, escaping, missing or too large)."""
-    path, column = split_csv_key(name.removeprefix("csv:"))
+    path, column = split_csv_key(name.strip()[4:])  # after "csv:", in any case
     if Path(path).is_absolute() or re.match(r"^[A-Za-z]:[\\/]", path):
         raise SceneError(
             f"absolute path {path!r} not allowed; give a path relative to the scene's folder"

@@ -252,3 +252,20 @@ def test_glossy_bsdfs_and_a_spot_become_glossy_materials_and_a_spot_light(cornel
     assert (spot.kind, spot.spectrum, spot.power, spot.cutoff_deg) == ("spot", "cie:D65", 3.0, 25.0)
     np.testing.assert_allclose(spot.position, [0, 0, 1.9])
     np.testing.assert_allclose(spot.direction, [0, 0, -1], atol=1e-12)
+
+
+def test_flip_normals_turns_a_rectangle_and_an_area_light_round(cornell):
+    flipped = XML.replace(
+        '<shape type="rectangle" id="floor"><ref id="white"/>',
+        '<shape type="rectangle" id="floor"><ref id="white"/><boolean name="flip_normals" value="true"/>',
+    ).replace(
+        '<emitter type="area">',
+        '<boolean name="flip_normals" value="true"/><emitter type="area">',
+    )
+    (cornell / "flipped.xml").write_text(flipped)
+    plain, turned = (load_mitsuba_xml(cornell / n) for n in ("cornell.xml", "flipped.xml"))
+    floor = {s.name: s for s in turned.meshes}["floor"]
+    np.testing.assert_array_equal(
+        floor.faces, {s.name: s for s in plain.meshes}["floor"].faces[:, ::-1]
+    )
+    np.testing.assert_allclose(turned.lights[0].direction, [0, 0, 1], atol=1e-12)
