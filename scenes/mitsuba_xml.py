@@ -10,7 +10,8 @@ their ``<default>`` values. Translated:
   (``center``, ``radius``), each with a ``to_world`` transform; built-in shapes become triangles
   (:mod:`~spectrinsic.scenes.mitsuba_parts`);
 - BSDFs ``diffuse`` (``reflectance`` as ``rgb``: linear sRGB through Mallett & Yuksel 2019;
-  ``spectrum``: ``"WL:V, ..."`` or one number; ``float``), ``plastic`` and ``roughplastic``
+  ``spectrum``: ``"WL:V, ..."``, one number or a ``filename`` of a ``.spd`` file in the
+  scene's folder; ``float``), ``plastic`` and ``roughplastic``
   (``diffuse_reflectance`` likewise, ``int_ior``/``ext_ior`` as numbers, ``alpha``: taken as the
   GGX α whatever the ``distribution``), ``conductor`` and ``roughconductor`` (``material`` one
   of Mitsuba's measured metals), bare or in a ``twosided``, at the top level with an ``id``
@@ -43,6 +44,7 @@ from spectrinsic.scenes.materials import METAL_SPECTRUM
 from spectrinsic.scenes.meshes import check_mesh_size
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.scenes.validate import validate_scene
+from spectrinsic.spectra.io import read_spd
 
 __all__ = ["MAX_XML_BYTES", "load_mitsuba_xml"]
 
@@ -86,6 +88,7 @@ def _parse(path: Path) -> ET.Element:
                 el.set(
                     key, re.sub(r"\$(\w+)", lambda m: defaults.get(m.group(1), m.group(0)), value)
                 )
+    _read_spectrum_files(root, path.parent)
     return root
 
 
@@ -96,6 +99,22 @@ _BSDF_PARAMS = {
     "conductor": ("material",),
     "roughconductor": ("material", "alpha", "distribution"),
 }
+
+
+def _read_spectrum_files(root: ET.Element, base: Path) -> None:
+    """Every ``<spectrum filename=...>`` (a Mitsuba ``.spd`` inside the scene's folder) made a
+    ``value`` of its samples, so the rest of the reader sees written-out spectra."""
+    for el in root.iter("spectrum"):
+        if "filename" not in el.attrib:
+            continue
+        rel = el.attrib.pop("filename")
+        path = (base.resolve() / rel).resolve()
+        if Path(rel).is_absolute() or not path.is_relative_to(base.resolve()):
+            raise SceneError(
+                f"spectrum filename {rel!r}; expected a path inside the scene's folder"
+            )
+        wl, values = read_spd(path)
+        el.set("value", ", ".join(f"{w!r}:{v!r}" for w, v in zip(wl.tolist(), values.tolist())))
 
 
 def _bsdf(el: ET.Element, where: str) -> Material:

@@ -39,6 +39,7 @@ __all__ = [
     "read_camera_table",
     "read_user_csv",
     "read_csv_column",
+    "read_spd",
     "Column",
     "CSV_MAX_BYTES",
 ]
@@ -334,6 +335,23 @@ def read_csv_column(path: str | os.PathLike[str], column: str) -> Column:
                 f"follows {wl[i - 1]:g} nm; expected strictly increasing wavelengths"
             )
     return Column(np.array(wl), np.array(values), header[col], tuple(n for n, _ in body))
+
+
+def read_spd(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Wavelengths (nm) and values of a Mitsuba ``.spd`` file (``WL VALUE`` per line, ``#``
+    comments), at most :data:`CSV_MAX_BYTES`; one-line :class:`SpectralDataError` otherwise."""
+    path = Path(path)
+    if not path.is_file() or path.stat().st_size > CSV_MAX_BYTES:
+        raise SpectralDataError(
+            f"spectrum file {str(path)!r}: expected a file of at most {CSV_MAX_BYTES} bytes"
+        )
+    try:
+        data = np.loadtxt(path, comments="#", dtype=float, ndmin=2)
+    except ValueError as exc:
+        raise SpectralDataError(f"{path}: expected 'WAVELENGTH VALUE' lines ({exc})") from None
+    if data.shape[1] != 2 or len(data) < 2 or not np.isfinite(data).all():
+        raise SpectralDataError(f"{path}: expected >= 2 lines of two finite numbers")
+    return data[:, 0].copy(), data[:, 1].copy()
 
 
 def mitsuba_ior_dir() -> Path:

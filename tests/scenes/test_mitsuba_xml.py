@@ -269,3 +269,17 @@ def test_flip_normals_turns_a_rectangle_and_an_area_light_round(cornell):
         floor.faces, {s.name: s for s in plain.meshes}["floor"].faces[:, ::-1]
     )
     np.testing.assert_allclose(turned.lights[0].direction, [0, 0, 1], atol=1e-12)
+
+
+def test_a_spectrum_from_an_spd_file_equals_the_written_out_one(cornell):
+    lines = "".join(f"{w} {v}\n" for w, v in zip(GREEN["wavelengths"], GREEN["values"]))
+    (cornell / "green.spd").write_text("# measured green\n" + lines)
+    spd = XML.replace(f'value="{_spectrum(GREEN)}"', 'filename="green.spd"')
+    (cornell / "spd.xml").write_text(spd)
+    plain, from_file = (load_mitsuba_xml(cornell / n) for n in ("cornell.xml", "spd.xml"))
+    assert [m.spectrum for m in plain.materials] == [m.spectrum for m in from_file.materials]
+    (cornell / "out.xml").write_text(spd.replace('"green.spd"', '"../green.spd"'))
+    with pytest.raises(
+        SceneError, match="spectrum filename '../green.spd'; expected a path inside"
+    ):
+        load_mitsuba_xml(cornell / "out.xml")
