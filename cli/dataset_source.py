@@ -15,6 +15,7 @@ from spectrinsic.pipeline.presets import DatasetConfig
 from spectrinsic.pipeline.source_plan import file_sample, files_source, generator_source
 from spectrinsic.scenes.generators import GlossDistribution
 from spectrinsic.scenes.sources import FileSource
+from spectrinsic.scenes.spectrum_refs import resolve_spectrum
 from spectrinsic.scenes.yaml_limits import load_yaml_file
 from spectrinsic.spectra import get_spectrum
 
@@ -148,18 +149,30 @@ def _range(option: str, text: str) -> tuple[float, float]:
 
 
 def material_map(path: str | None) -> dict[str, str]:
-    """The ``--material-map`` file as ``{material name: spectrum name}`` (``{}`` for none)."""
+    """The ``--material-map`` file as ``{material name: spectrum name}`` (``{}`` for none).
+
+    A value may also be ``csv:PATH#COLUMN`` (PATH relative to the map's folder) or an inline
+    ``{wavelengths: [...], values: [...]}`` (:mod:`spectrinsic.scenes.spectrum_refs`).
+    """
     if path is None:
         return {}
 
     data = load_yaml_file(Path(path))
     if not isinstance(data, dict) or not all(
-        isinstance(k, str) and isinstance(v, str) for k, v in data.items()
+        isinstance(k, str) and isinstance(v, (str, dict)) for k, v in data.items()
     ):
         raise DatasetError(
             f"--material-map {path!r}: expected a mapping of material name -> spectrum name"
         )
-    return data
+    out = {}
+    for k, v in data.items():
+        try:
+            out[k] = resolve_spectrum(v, "reflectance", Path(path).parent)
+        except SpectrinsicError as exc:
+            raise DatasetError(f"--material-map {path!r}: {k}: {exc}") from None
+        if not isinstance(out[k], str):
+            raise DatasetError(f"--material-map {path!r}: {k}: expected a spectrum name")
+    return out
 
 
 def source_from_args(args: argparse.Namespace) -> str | None:

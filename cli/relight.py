@@ -11,10 +11,11 @@ import sys
 import time
 from pathlib import Path
 
-from spectrinsic.errors import DatasetError
+from spectrinsic.errors import DatasetError, SpectrinsicError
 from spectrinsic.gt_export.outfolder import check_out_folder, check_unlocked, folder_lock
 from spectrinsic.gt_export.relight import relight
 from spectrinsic.gt_export.sample_meta import owned_files
+from spectrinsic.spectra.user_spectra import absolute_csv
 
 __all__ = ["register", "run", "parse_assignments"]
 
@@ -83,7 +84,10 @@ def parse_assignments(
             except ValueError:
                 raise DatasetError(f"{option} {text!r}: {value!r} is not a number") from None
         else:
-            out[key] = value.strip()
+            try:
+                out[key] = absolute_csv(value.strip())
+            except SpectrinsicError as exc:
+                raise DatasetError(f"{option} {text!r}: {exc}") from None
     return out
 
 

@@ -59,7 +59,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "render",
         help="render a scene in several colour modes and write raw passes as EXR",
-        description="Render SCENE (a library scene name, a YAML, .blend or mesh file) with Mitsuba 3 "
+        description="Render SCENE (a library scene name, a YAML, Mitsuba 3 XML, .blend or mesh file) with Mitsuba 3 "
         "in each mode and write float32 EXR files with named channels into --out "
         "(raw passes, XYZ, AOVs; ground-truth layers come from `spectrinsic dataset`). "
         f"Defaults are the dataset's default preset: {default.render.spp} spp, path depth "
@@ -81,7 +81,7 @@ def _add_scene_options(p: Any) -> None:
     p.add_argument(
         "scene",
         metavar="SCENE",
-        help="library scene name (e.g. room-living) or a scene file (.yaml, .blend, .obj/.ply/.glb)",
+        help="library scene name (e.g. room-living) or a scene file (.yaml, .xml, .blend, .obj/.ply/.glb)",
     )
     p.add_argument(
         "--condition",

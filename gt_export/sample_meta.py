@@ -82,8 +82,10 @@ META_FIELDS = frozenset(
     }
 )
 #: Fields written only by some builds: ``transport`` (``dataset --store-transport``, the record
-#: of :func:`~spectrinsic.gt_export.transport_file.write_transport`).
-OPTIONAL_META_FIELDS = frozenset({"transport", "sensor"})  # sensor: dataset --camera
+#: of :func:`~spectrinsic.gt_export.transport_file.write_transport`); ``sensor``
+#: (``dataset --camera``); ``spectrum_files`` (a scene with ``csv:`` spectra: name, file,
+#: column and SHA-256 of each, :func:`~spectrinsic.spectra.user_spectra.spectrum_files`).
+OPTIONAL_META_FIELDS = frozenset({"transport", "sensor", "spectrum_files"})
 _LAYER_FIELDS = frozenset(
     {
         "file",

@@ -60,6 +60,7 @@ from spectrinsic.gt_export.transport_file import TRANSPORT_NAME, write_transport
 from spectrinsic.provenance import software_versions
 from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash, scene_to_dict
 from spectrinsic.spectra import DEFAULT_WAVELENGTHS, get_spectrum
+from spectrinsic.spectra.user_spectra import spectrum_files
 
 if TYPE_CHECKING:
     from spectrinsic.render.light_transport import LightTransport
@@ -125,6 +126,9 @@ def _meta(
         entry["spd"] = get_spectrum(record.spectrum).on(DEFAULT_WAVELENGTHS)
         lights.append(entry)
     height, width = gt.layers["image"].data.shape[:2]
+    files_used = spectrum_files(
+        [m.spectrum for m in scene.materials] + [li.spectrum for li in scene.lights]
+    )
     return {
         "format_version": FORMAT_VERSION,
         "sample_id": sample_id,
@@ -155,7 +159,7 @@ def _meta(
         "shading_clipping": gt.clipping,
         "files": sorted(files),
         "versions": software_versions(),
-    }
+    } | ({"spectrum_files": files_used} if files_used else {})
 
 
 def _write_layers(folder: Path, gt: GroundTruth, sample_id: str) -> list[str]:

@@ -56,6 +56,7 @@ _EMISSION_PARAM = {
     "spot": "intensity",
     "directional": "irradiance",
     "area": "radiance",
+    "sky": "radiance",
 }
 
 
@@ -281,6 +282,8 @@ def _light(mi: Any, light: Light, emission: Mapping | None, what: str) -> dict[s
                 "irradiance": dict(emission),
             }
         )
+    if light.kind == "sky":
+        return None if emission is None else {"type": "constant", "radiance": dict(emission)}
     if light.kind == "area":
         w, h = (float(s) for s in light.size)
         shape: dict[str, Any] = {

@@ -9,8 +9,9 @@ the named file is read (no textures, no referenced files outside its folder are 
 A glTF material's ``pbrMetallicRoughness`` factors set the gloss as for ``.blend`` files: metallic
 ≥ 0.5 makes a metal (``conductor``, Al: the factors name no metal; no spectrum needed), else
 roughness < 0.5 a coated diffuse (``plastic``, η = 1.5); GGX α = roughness². Absent factors
-count as matte (not glTF's default of 1), so files without them import as before; base colour,
-textures and every other material field are ignored.
+count as matte (not glTF's default of 1), so files without them import as before. A material
+not in the map takes its ``baseColorFactor`` as an ``rgb:`` reflectance if the file states one
+(:mod:`spectrinsic.scenes.gltf_colours`); textures and every other field are ignored.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.errors import SceneError
+from spectrinsic.scenes.gltf_colours import gltf_base_colours
 from spectrinsic.scenes.materials import METAL_SPECTRUM
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.scenes.validate import validate_scene
@@ -225,13 +227,14 @@ def load_mesh_scene(
     """
     path = Path(path)
     geoms = _geometries(path)
+    colours = gltf_base_colours(path)
     table: dict[str, Material] = {}  # matte materials keep their spectrum's name
     meshes = []
     for i, (node, material, verts, faces, gloss) in enumerate(geoms):
         spectrum = (
             METAL_SPECTRUM
             if gloss.get("kind") == "conductor"
-            else materials.get(material, default_spectrum)
+            else materials.get(material, colours.get(material, default_spectrum))
         )
         if spectrum is None:
             known = sorted({g[1] for g in geoms})

@@ -37,6 +37,7 @@ __all__ = [
     "LightKind",
     "LIGHT_FIELDS",
     "LIGHT_KINDS",
+    "DRAWN_LIGHT_KINDS",
     "LIGHT_PLACEMENT",
     "LIGHT_DEFAULTED",
     "make_light",
@@ -48,7 +49,7 @@ __all__ = [
     "scene_hash",
 ]
 
-LightKind = Literal["point", "spot", "area", "directional"]
+LightKind = Literal["point", "spot", "area", "directional", "sky"]
 #: The one table of light kinds: the placement fields each kind uses (the others are ignored,
 #: and records such as meta.json leave them out).
 LIGHT_FIELDS: dict[str, tuple[str, ...]] = {
@@ -56,9 +57,12 @@ LIGHT_FIELDS: dict[str, tuple[str, ...]] = {
     "spot": ("position", "direction", "cutoff_deg"),
     "area": ("position", "direction", "size"),
     "directional": ("direction",),
+    "sky": (),
 }
 #: The light kinds, in the table's order (``typing.get_args(LightKind)`` is the same).
 LIGHT_KINDS: tuple[LightKind, ...] = tuple(LIGHT_FIELDS)  # type: ignore[arg-type]
+#: The kinds the scene generators draw (a sky comes from scene files only).
+DRAWN_LIGHT_KINDS: tuple[LightKind, ...] = tuple(k for k in LIGHT_KINDS if k != "sky")
 #: Every placement field some kind uses (the union of :data:`LIGHT_FIELDS`).
 LIGHT_PLACEMENT: tuple[str, ...] = tuple(
     dict.fromkeys(f for fs in LIGHT_FIELDS.values() for f in fs)
@@ -167,14 +171,16 @@ class Light:
     Attributes
     ----------
     kind
-        One of :data:`LIGHT_KINDS`: ``"point"``, ``"spot"``, ``"area"`` (a rectangle) or
-        ``"directional"``; :data:`LIGHT_FIELDS` lists the placement fields each uses.
+        One of :data:`LIGHT_KINDS`: ``"point"``, ``"spot"``, ``"area"`` (a rectangle),
+        ``"directional"`` or ``"sky"`` (a uniform sky dome at infinity, Mitsuba ``constant``);
+        :data:`LIGHT_FIELDS` lists the placement fields each uses.
     spectrum
         Registry name of an illuminant, e.g. ``"planck:2800K"``. The registry normalises every
         illuminant to unit luminance-weighted mean, so *power* alone sets brightness.
     power
         Scale on the normalised SPD: radiant intensity for point and spot lights, radiance for
-        area lights, irradiance for directional lights (relative units). Must be > 0.
+        area lights and the sky (an unoccluded surface then receives irradiance π × power),
+        irradiance for directional lights (relative units). Must be > 0.
     position
         World position (point, spot, area centre); unused for directional lights.
     direction
@@ -199,7 +205,7 @@ def unknown_light_kind(kind: object) -> str:
     """The message for a light kind not in :data:`LIGHT_KINDS`, with a did-you-mean.
 
     >>> unknown_light_kind("spto")
-    "unknown light kind 'spto'; expected one of point, spot, area, directional (did you mean 'spot'?)"
+    "unknown light kind 'spto'; expected one of point, spot, area, directional, sky (did you mean 'spot'?)"
     """
     return f"unknown light kind {kind!r}; expected one of {', '.join(LIGHT_KINDS)}" + did_you_mean(
         str(kind), LIGHT_KINDS
@@ -238,12 +244,14 @@ def light_power(
 
     Inverse square law for point and spot lights (power ``E d²``, a radiant intensity); an
     area light of radiance L and area A gives about ``L A cos θ / d²`` (cos θ of its normal
-    *direction* towards *focus*, at least 0.2); a directional light's power is the irradiance.
+    *direction* towards *focus*, at least 0.2); a directional light's power is the irradiance, a sky's the irradiance over π.
     Positions in scene units, *direction* a unit vector; relative radiometric units.
 
     >>> light_power("point", np.zeros(3), np.array([0, 0, 1.0]), np.array([0, 0, 2.0]), (1, 1), 1.0)
     4.0
     """
+    if kind == "sky":
+        return irradiance / math.pi  # a uniform sky of radiance L gives E = π L
     if "position" not in LIGHT_FIELDS[kind]:
         return irradiance
     offset = focus - np.asarray(position, float)

@@ -37,6 +37,7 @@ from spectrinsic.scenes.model import (
 )
 from spectrinsic.scenes.parts import Part, moved
 from spectrinsic.scenes.scene_format import FORMAT_VERSION, MESH_SUFFIXES
+from spectrinsic.scenes.spectrum_refs import resolve_spectrum_refs
 from spectrinsic.scenes.textures import Texture
 from spectrinsic.scenes.validate import Problems, validate_scene
 from spectrinsic.scenes.yaml_limits import load_yaml_file
@@ -434,7 +435,7 @@ def load_scene(
     """
     path = Path(path)
     source = str(path)
-    data = load_yaml_file(path)
+    data = resolve_spectrum_refs(load_yaml_file(path), path.parent, source)
     scene = scene_from_dict(data, base=path.parent, source=source)
     if validate:
         validate_scene(scene, source=source, data_dir=data_dir)

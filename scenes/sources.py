@@ -18,6 +18,7 @@ from spectrinsic.errors import SceneError
 from spectrinsic.scenes.blender import load_blend
 from spectrinsic.scenes.generators import GeneratorOptions, generate
 from spectrinsic.scenes.meshes import MESH_SUFFIXES, load_mesh_scene
+from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml
 from spectrinsic.scenes.model import Scene
 from spectrinsic.scenes.scene_reader import load_scene
 
@@ -84,7 +85,7 @@ def _compressed_blend(head: bytes, path: Path) -> bool:
 
 
 def scene_file_kind(path: str | Path) -> str:
-    """``"yaml"``, ``"blend"`` or ``"mesh"`` for a scene file, by suffix; a ``.blend`` also by
+    """``"yaml"``, ``"mitsuba"`` (``.xml``), ``"blend"`` or ``"mesh"`` for a scene file, by suffix; a ``.blend`` also by
     its magic bytes, plain or compressed (gzip, zstd), under any name. One-line error for
     anything else. The one dispatcher of scene files (``render``, ``dataset --scenes``)."""
     p = Path(path)
@@ -95,6 +96,8 @@ def scene_file_kind(path: str | Path) -> str:
         return "mesh"
     if suffix == ".blend":
         return "blend"
+    if suffix == ".xml":
+        return "mitsuba"
     try:
         with p.open("rb") as fh:
             head = fh.read(len(BLEND_MAGIC))
@@ -103,7 +106,7 @@ def scene_file_kind(path: str | Path) -> str:
     except OSError:
         pass
     raise SceneError(
-        f"scene file {str(p)!r}: expected .yaml/.yml, .blend (plain, gzip or zstd) "
+        f"scene file {str(p)!r}: expected .yaml/.yml, .xml (Mitsuba 3), .blend (plain, gzip or zstd) "
         f"or a mesh ({', '.join(MESH_SUFFIXES)})"
     )
 
@@ -116,7 +119,7 @@ def is_scene_file(argument: str | Path) -> bool:
     (True, True, False)
     """
     p = Path(argument)
-    return p.suffix.lower() in (".yaml", ".yml", ".blend", *MESH_SUFFIXES) or p.exists()
+    return p.suffix.lower() in (".yaml", ".yml", ".xml", ".blend", *MESH_SUFFIXES) or p.exists()
 
 
 def load_scene_file(
@@ -161,7 +164,10 @@ def load_scene_file(
             default_spectrum=default_spectrum,
             data_dir=data_dir,
         )
-    scene = load_scene(path, data_dir=data_dir)
+    if kind == "mitsuba":
+        scene = load_mitsuba_xml(path, data_dir=data_dir)
+    else:
+        scene = load_scene(path, data_dir=data_dir)
     camera = dataclasses.replace(
         scene.camera,
         width=scene.camera.width if width is None else width,

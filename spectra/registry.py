@@ -17,6 +17,9 @@ sfu-illum     ``sfu-illum:mws_090``                 Barnard et al. 2002 (data di
 mix           ``mix:0.3*munsell:5R 4/14+0.7*...``  convex combination (spectral textures)
 led           ``led:460/20``, ``led:630/20@1+...``  narrow-band / mixed LEDs (Ohno 2005)
 filtered      ``filtered:cie:A|bandpass:520/80``    a lamp behind a generated colour filter
+csv           ``csv:paints.csv#red``                a user's CSV column, unit in its header
+inline        ``inline:reflectance:400=0.1,...``    written-out samples
+rgb, srgb     ``rgb:0.8,0.2,0.1``, ``srgb:#cc3311``  Mallett & Yuksel 2019 uplift of a colour
 ============  ====================================  ===========================================
 
 Sensor sets (:func:`get_sensors`): ``cie1931``, ``srgb``, ``gaussian:6@400-700``,
@@ -35,7 +38,14 @@ import numpy as np
 
 from spectrinsic.data_dir import resolve_data_dir
 from spectrinsic.errors import SpectrumNotFoundError, did_you_mean
-from spectrinsic.spectra import coloured_lights, illuminants, io, reflectances, sensors
+from spectrinsic.spectra import (
+    coloured_lights,
+    illuminants,
+    io,
+    reflectances,
+    sensors,
+    user_spectra,
+)
 from spectrinsic.spectra.records import SensorSet, Spectrum
 
 __all__ = [
@@ -67,6 +77,10 @@ SPECTRUM_FAMILIES: dict[str, Callable[[str, str | None], Spectrum]] = {
     "filtered": lambda k, d: coloured_lights.filtered(
         k, lambda lamp: get_spectrum(lamp, data_dir=d)
     ),
+    "csv": lambda k, d: user_spectra.csv_spectrum(k),
+    "inline": lambda k, d: user_spectra.inline_spectrum(k),
+    "rgb": lambda k, d: user_spectra.rgb_spectrum(k),
+    "srgb": lambda k, d: user_spectra.srgb_spectrum(k),
 }
 
 #: family -> example and source, the module table as data (``spectrinsic list spectra``).
@@ -83,6 +97,10 @@ SPECTRUM_FAMILY_NOTES: dict[str, str] = {
     "mix": "mix:0.3*munsell:5R 4/14+0.7*munsell:5B 6/8; convex combination of reflectances",
     "led": "led:460/20 or led:630/20@1+530/30@0.6; narrow-band and mixed LEDs (Ohno 2005)",
     "filtered": "filtered:planck:3200K|bandpass:520/80; a lamp behind a generated colour filter",
+    "csv": "csv:paints.csv#red; a column of your CSV, unit in its header ([%], [1], [W/m2/nm])",
+    "inline": "inline:reflectance:400=0.1,700=0.5; samples written out (YAML: wavelengths/values)",
+    "rgb": "rgb:0.8,0.2,0.1; linear sRGB as a reflectance (Mallett & Yuksel 2019)",
+    "srgb": "srgb:#cc3311 or srgb:0.8,0.2,0.1; sRGB-encoded colour as a reflectance",
 }
 
 #: family -> loader(key, data_dir); families without a key take an empty key.

@@ -29,8 +29,8 @@ import numpy as np
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes.library import MIN_XY_DISTANCE, TARGET_IRRADIANCE, WHITE
 from spectrinsic.scenes.model import (
+    DRAWN_LIGHT_KINDS,
     LIGHT_FIELDS,
-    LIGHT_KINDS,
     Light,
     LightKind,
     light_power,
@@ -85,7 +85,7 @@ class LightVolume:
     lo: tuple[float, float, float]
     hi: tuple[float, float, float]
     focus: tuple[float, float, float]
-    kinds: tuple[LightKind, ...] = LIGHT_KINDS
+    kinds: tuple[LightKind, ...] = DRAWN_LIGHT_KINDS
 
 
 def _spd_draws(sfu: Sequence[str]) -> dict[str, Callable[[np.random.Generator], str]]:

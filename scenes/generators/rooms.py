@@ -30,7 +30,7 @@ from spectrinsic.scenes.generators.materials import (
     within,
 )
 from spectrinsic.scenes.generators.shapes import draw_object
-from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_KINDS
+from spectrinsic.scenes.model import DRAWN_LIGHT_KINDS, LIGHT_FIELDS, LIGHT_KINDS
 from spectrinsic.scenes.parts import Part, merge, moved
 from spectrinsic.scenes.primitives import box
 
@@ -254,7 +254,7 @@ def _light_volume(
         lo=(0.3, 0.3, 0.6 * h),
         hi=(w - 0.3, d - 0.3, h - 0.15),
         focus=(w / 2, d / 2, 0.6),
-        kinds=_PLACED_KINDS if openness["ceiling"] else LIGHT_KINDS,
+        kinds=_PLACED_KINDS if openness["ceiling"] else DRAWN_LIGHT_KINDS,
     ), "direct"
 
 

@@ -381,3 +381,30 @@ def test_cli_follows_the_out_rule_and_the_lock_of_every_writing_verb(built, tmp_
     assert rc == 2 and len(err.splitlines()) == 1, err
     assert "in use by another spectrinsic run" in err and f"pid {proc.pid}" in err
     assert not held.exists()  # the holder removed its folder; the refused run wrote nothing
+
+
+def test_cli_relights_with_a_light_from_a_csv_file(built, tmp_path, monkeypatch):
+    """Issue 32: ``--light 0=csv:PATH#COLUMN`` (PATH from the working folder) relights, the
+    sample names the file by its absolute path and records its SHA-256."""
+    import hashlib
+
+    from spectrinsic.cli import main
+
+    _, _, sample = built
+    wl = np.arange(380, 781, 5)
+    rows = "\n".join(f"{w},{1 + 0.002 * (w - 380):.4f}" for w in wl)
+    (tmp_path / "lamp.csv").write_text("wavelength [nm],lamp [W/m2/nm]\n" + rows + "\n")
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "csv__v0__two"
+    assert (
+        main(["-q", "relight", str(sample), "--light", "0=csv:lamp.csv#lamp", "--out", str(out)])
+        == 0
+    )
+    assert check_sample(out) == []
+    meta = json.loads((out / "meta.json").read_text())
+    name = f"csv:{(tmp_path / 'lamp.csv').resolve()}#lamp"
+    assert meta["lights"][0]["spectrum"] == name
+    digest = hashlib.sha256((tmp_path / "lamp.csv").read_bytes()).hexdigest()
+    assert meta["spectrum_files"] == [
+        {"spectrum": name, "file": name[4:-5], "column": "lamp", "sha256": digest}
+    ]

@@ -1,0 +1,39 @@
+"""glTF base colours become rgb: reflectances (issue 32)."""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+from trimesh.visual.material import PBRMaterial
+
+from spectrinsic.scenes.meshes import load_mesh_scene
+from spectrinsic.spectra import get_spectrum
+
+
+def test_base_colour_factors_become_rgb_spectra_unless_mapped(tmp_path):
+    import colour
+
+    scene = trimesh.Scene()
+    for name, offset, rgba in (
+        ("brick", -1.0, [200, 60, 40, 255]),
+        ("sky", 1.0, [40, 90, 220, 255]),
+    ):
+        box = trimesh.creation.box((1.0, 1.0, 1.0))
+        box.apply_translation((offset, 0.0, 0.5))
+        box.visual = trimesh.visual.TextureVisuals(
+            material=PBRMaterial(name=name, baseColorFactor=rgba)
+        )
+        scene.add_geometry(box, name)
+    path = tmp_path / "two.glb"
+    scene.export(path)
+    loaded = load_mesh_scene(path, materials={"sky": "flat:0.5"}, width=8, height=8)
+    spectra = {m.spectrum for m in loaded.materials}
+    assert "flat:0.5" in spectra  # the map wins over the file's colour
+    (brick,) = spectra - {"flat:0.5"}
+    assert brick.startswith("rgb:")
+    s = get_spectrum(brick)
+    sd = colour.SpectralDistribution(dict(zip(s.wavelengths, s.values)))
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(sd.shape)
+    d65 = colour.SDS_ILLUMINANTS["D65"].copy().align(sd.shape)
+    rgb = colour.XYZ_to_RGB(colour.sd_to_XYZ(sd, cmfs, d65) / 100, "sRGB")
+    np.testing.assert_allclose(rgb, np.array([200, 60, 40]) / 255, atol=1e-3)
