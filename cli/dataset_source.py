@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -138,11 +139,14 @@ def _add_scene_file_options(src: Any) -> None:
 
 
 def _range(option: str, text: str) -> tuple[float, float]:
-    """An option's ``LO,HI`` text as two floats with LO <= HI."""
+    """An option's ``LO,HI`` text as two finite floats with LO <= HI (the configuration
+    records them as JSON, which has no infinity)."""
     try:
         lo, hi = (float(v) for v in text.split(","))
     except ValueError:
         raise DatasetError(f"{option} {text!r}; expected LO,HI, e.g. 2,9") from None
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        raise DatasetError(f"{option} {text!r}; expected two finite numbers LO,HI, e.g. 2,9")
     if lo > hi:
         raise DatasetError(f"{option} {text!r}; expected LO <= HI")
     return lo, hi

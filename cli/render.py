@@ -36,6 +36,7 @@ from spectrinsic.render import (
 )
 from spectrinsic.render.budget import check_render_size
 from spectrinsic.render.modes import RENDER_MODES
+from spectrinsic.render.plugins import MAX_PATH_DEPTH
 from spectrinsic.render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
 from spectrinsic.render.settings import DEFAULT_MODES as RENDER_DEFAULT_MODES
 from spectrinsic.scenes import library
@@ -240,8 +241,10 @@ def _check_size_options(args: argparse.Namespace) -> None:
         raise RenderError(f"--spp {args.spp}; expected at most {UINT32_MAX}")
     if not 0 <= args.seed <= UINT32_MAX:
         raise RenderError(f"--seed {args.seed}; expected a whole number from 0 to {UINT32_MAX}")
-    if args.max_depth < 1:
-        raise RenderError(f"--max-depth {args.max_depth}; expected >= 1 (2 = direct light only)")
+    if not 1 <= args.max_depth <= MAX_PATH_DEPTH:
+        raise RenderError(
+            f"--max-depth {args.max_depth}; expected 1 to {MAX_PATH_DEPTH} (2 = direct light only)"
+        )
     if args.variant is not None:
         choose_variant("rgb", args.variant)  # an unknown or unusable backend, before any work
     requested_size(args)  # a malformed --resolution, before any work

@@ -79,5 +79,7 @@ def write_render(
         {"name": m.name, "object_id": m.object_id, "faces": len(m.faces)} for m in scene.meshes
     ]
     paths["meta"] = out / "meta.json"
-    paths["meta"].write_text(json.dumps(meta, indent=2, default=str) + "\n", encoding="utf-8")
+    paths["meta"].write_text(
+        json.dumps(meta, indent=2, default=str, allow_nan=False) + "\n", encoding="utf-8"
+    )
     return paths

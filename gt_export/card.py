@@ -128,8 +128,10 @@ def write_dataset_card(
         scenes=", ".join(_text(s) for s in scenes),
         layer_table=_layer_table(metas),
         config_hash=config_hash(config) if config is not None else metas[0].config_hash,
-        config=json.dumps(plain_data(config or {}), indent=2, sort_keys=True),  # a code block
-        versions=json.dumps(software_versions(), indent=2, sort_keys=True),
+        config=json.dumps(
+            plain_data(config or {}), indent=2, sort_keys=True, allow_nan=False
+        ),  # a code block
+        versions=json.dumps(software_versions(), indent=2, sort_keys=True, allow_nan=False),
         variants=", ".join(_text(v) for v in variants_of(metas)),
     ) + _diversity_section(root, samples, metas)
     path = root / CARD_NAME

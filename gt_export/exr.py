@@ -149,11 +149,11 @@ def write_exr(
     header = {
         "compression": OpenEXR.ZIP_COMPRESSION if compressed else OpenEXR.NO_COMPRESSION,
         "type": OpenEXR.scanlineimage,
-        CHANNELS_ATTRIBUTE: json.dumps(order, separators=(",", ":")),
+        CHANNELS_ATTRIBUTE: json.dumps(order, separators=(",", ":"), allow_nan=False),
     }
     int32 = [name for name, array in layers.items() if np.asarray(array).dtype.kind in "iu"]
     if int32:  # only then: a file without ids keeps its header (and its bytes) as before
-        header[INT32_ATTRIBUTE] = json.dumps(int32, separators=(",", ":"))
+        header[INT32_ATTRIBUTE] = json.dumps(int32, separators=(",", ":"), allow_nan=False)
     for key, value in (attributes or {}).items():
         header[str(key)] = str(value)
     path = Path(path)
@@ -177,7 +177,7 @@ def _channel_order(path: Path, text: object) -> dict[str, list[str]]:
     """The :data:`CHANNELS_ATTRIBUTE` of *path*'s header: ``{layer: [channel, ...]}``."""
     try:
         order = json.loads(str(text))
-    except ValueError:
+    except (ValueError, RecursionError):
         order = None
     if not (
         isinstance(order, dict)

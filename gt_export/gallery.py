@@ -392,7 +392,10 @@ def _write_pixel_scripts(root: Path, index: Mapping[str, Any]) -> None:
                 f"{target}: not a gallery file spectrinsic wrote; move it away to "
                 "rebuild the gallery"
             )
-        _write_text(target, f"{_PIXELS_HEAD}{json.dumps(entry['id'])}] = {json.dumps(urls)};\n")
+        _write_text(
+            target,
+            f"{_PIXELS_HEAD}{json.dumps(entry['id'], allow_nan=False)}] = {json.dumps(urls, allow_nan=False)};\n",
+        )
         entry["pixels"] = rel
 
 
@@ -413,7 +416,7 @@ def build_gallery(
         _write_pixel_scripts(root, index)
     contact_sheet(root)
     index["contact_sheets"] = {"all": "contact_sheet.png", **_condition_sheets(root, index)}
-    data = json.dumps(plain_data(index), ensure_ascii=False, separators=(",", ":"))
+    data = json.dumps(plain_data(index), ensure_ascii=False, separators=(",", ":"), allow_nan=False)
     _write_text(root / "gallery.json", data + "\n")
     _write_text(root / "gallery-index.js", f"window.{INDEX_VARIABLE} = {data};\n")
     for name in _STATIC:

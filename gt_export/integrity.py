@@ -141,7 +141,7 @@ def dataset_config_hash(root: Path) -> str | None:
     for name, key in ((MARKER_NAME, "spectrinsic_dataset"), (MANIFEST_NAME, "format_version")):
         try:
             record = json.loads((root / name).read_text(encoding="utf-8"))
-        except (OSError, ValueError):
+        except (OSError, ValueError, RecursionError):
             continue
         if (
             isinstance(record, dict)
@@ -188,7 +188,8 @@ def write_marker(root: Path, config_hash: str) -> None:
     tmp = root / f"{TMP_PREFIX}{MARKER_NAME.lstrip('.')}"
     with guarded_write(root / MARKER_NAME):
         tmp.write_text(
-            json.dumps({"spectrinsic_dataset": 1, "config_hash": config_hash}) + "\n",
+            json.dumps({"spectrinsic_dataset": 1, "config_hash": config_hash}, allow_nan=False)
+            + "\n",
             encoding="utf-8",
         )
         tmp.replace(root / MARKER_NAME)

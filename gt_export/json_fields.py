@@ -128,5 +128,5 @@ def load_json(path: Path) -> Any:
         raise SampleMetaError(f"{path}: not UTF-8 text ({exc})") from exc
     try:
         return json.loads(text, parse_constant=reject_constant)
-    except ValueError as exc:
+    except (ValueError, RecursionError) as exc:  # RecursionError: nesting too deep
         raise SampleMetaError(f"{path}: not valid JSON ({exc})") from exc

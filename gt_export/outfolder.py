@@ -72,7 +72,7 @@ def _json_record(path: Path, key: str) -> dict[str, object] | None:
     """The JSON object in *path* if it has *key*, else ``None`` (absent, unreadable, other)."""
     try:
         record = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
         return None
     return record if isinstance(record, dict) and key in record else None
 
@@ -174,7 +174,7 @@ def _locked_message(root: Path, fd: int, option: str) -> str:
     try:
         holder = json.loads(os.pread(fd, 4096, 0).decode("utf-8"))
         who = f"pid {holder['pid']} on {holder['host']}, started {holder['started']}"
-    except (OSError, ValueError, KeyError, TypeError):
+    except (OSError, ValueError, KeyError, TypeError, RecursionError):
         who = "its details are not written yet"
     return (
         f"{option} {str(root)!r} is in use by another spectrinsic run ({who}); wait for it "
@@ -240,7 +240,7 @@ def folder_lock(root: Path, option: str = "--out") -> Iterator[None]:
     held = root.resolve()
     try:
         os.ftruncate(fd, 0)
-        os.pwrite(fd, (json.dumps(_holder()) + "\n").encode("utf-8"), 0)
+        os.pwrite(fd, (json.dumps(_holder(), allow_nan=False) + "\n").encode("utf-8"), 0)
         _HELD_HERE.add(held)
         yield
     finally:
@@ -327,7 +327,7 @@ def _write_marker(root: Path, files: set[str], writing: dict[str, object] | None
     tmp = root / f"{_TMP_PREFIX}{OUTPUT_MARKER.lstrip('.')}"
     record = {"spectrinsic_output": 1, "files": sorted(files), "writing": writing}
     try:
-        tmp.write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
+        tmp.write_text(json.dumps(record, indent=1, allow_nan=False) + "\n", encoding="utf-8")
         tmp.replace(root / OUTPUT_MARKER)
     except OSError as exc:
         raise WriteError(

@@ -95,7 +95,7 @@ def read_sample_scene(sample_dir: str | os.PathLike[str]) -> Scene:
         data = json.loads((sample / SCENE_NAME).read_text(encoding="utf-8"))
     except OSError as exc:
         raise DatasetError(f"sample {str(sample)!r} has no readable {SCENE_NAME}") from exc
-    except ValueError as exc:
+    except (ValueError, RecursionError) as exc:
         raise _fail(sample, f"not valid JSON ({exc})") from exc
     try:
         return scene_from_dict(data)

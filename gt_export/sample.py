@@ -121,7 +121,7 @@ def canonical_json(data: Any, *, compact: bool = False) -> str:
     '{"a":[1,2],"b":1}\\n'
     """
     layout: dict[str, Any] = {"separators": (",", ":")} if compact else {"indent": 2}
-    return json.dumps(data, sort_keys=True, ensure_ascii=False, **layout) + "\n"
+    return json.dumps(data, sort_keys=True, ensure_ascii=False, **layout, allow_nan=False) + "\n"
 
 
 def config_hash(config: Mapping[str, Any]) -> str:
@@ -138,7 +138,13 @@ def config_hash(config: Mapping[str, Any]) -> str:
     own = config.get("config_hash")
     if isinstance(own, str) and own:
         return own
-    blob = json.dumps(plain_data(config), sort_keys=True, separators=(",", ":"), ensure_ascii=False)
+    blob = json.dumps(
+        plain_data(config),
+        sort_keys=True,
+        separators=(",", ":"),
+        ensure_ascii=False,
+        allow_nan=False,
+    )
     return hashlib.sha256(blob.encode("utf-8")).hexdigest()
 
 

@@ -404,7 +404,7 @@ def meta_from_bytes(data: bytes, path: Path, *, verify: bool = True) -> SampleMe
     *path* is where it came from, ``<somewhere>/<sample_id>/meta.json``."""
     try:
         parsed = json.loads(data.decode("utf-8"), parse_constant=reject_constant)
-    except ValueError as exc:
+    except (ValueError, RecursionError) as exc:  # RecursionError: nesting too deep
         raise SampleMetaError(f"{path}: not valid JSON ({exc})") from exc
     return parse_meta(parsed, path, verify=verify)
 
@@ -439,7 +439,7 @@ def owned_files(folder: Path) -> frozenset[str] | None:
     """
     try:
         meta = json.loads((folder / META_NAME).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
         return None
     if not isinstance(meta, dict) or meta.get("sample_id") != folder.name:
         return None

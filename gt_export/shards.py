@@ -110,7 +110,9 @@ def _encode(sample: dict[str, Any]) -> dict[str, Any]:
     for key, value in sample.items():
         if isinstance(value, np.ndarray):
             record[_member_name(key)] = _npy(value)
-    record["meta.json"] = json.dumps(sample["meta"], sort_keys=True).encode("utf-8")
+    record["meta.json"] = json.dumps(sample["meta"], sort_keys=True, allow_nan=False).encode(
+        "utf-8"
+    )
     return record
 
 
@@ -128,7 +130,7 @@ def check_shard_folder(out: Path, option: str = "--out") -> set[str]:
     index_path = out / SHARD_INDEX
     try:
         previous = json.loads(index_path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, RecursionError) as exc:
         raise DatasetError(f"{index_path}: not a spectrinsic shard index ({exc})") from exc
     if not isinstance(previous, dict) or previous.get("format") != _FORMAT:
         raise DatasetError(f"{index_path}: not a spectrinsic shard index")
@@ -149,7 +151,7 @@ def check_shard_folder(out: Path, option: str = "--out") -> set[str]:
 
 def _write_index(out: Path, index: dict[str, Any]) -> None:
     tmp = out / f"{TMP_PREFIX}{SHARD_INDEX}"
-    tmp.write_text(json.dumps(index, indent=2, sort_keys=True), encoding="utf-8")
+    tmp.write_text(json.dumps(index, indent=2, sort_keys=True, allow_nan=False), encoding="utf-8")
     os.replace(tmp, out / SHARD_INDEX)
 
 
@@ -295,7 +297,7 @@ def _write_locked(
 def _index(out: Path) -> dict[str, Any]:
     try:
         index = json.loads((out / SHARD_INDEX).read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, RecursionError) as exc:
         raise DatasetError(f"{out}: no shard export ({SHARD_INDEX} missing or unreadable)") from exc
     if not isinstance(index, dict) or not index.get("complete"):
         raise DatasetError(f"{out}: the shard export was interrupted; run it again to finish")

@@ -125,7 +125,7 @@ def generator_source(
         spec["light_saturation"] = [float(v) for v in light_saturation]
     if texture_fraction > 0:
         spec["texture_fraction"] = float(texture_fraction)
-    return json.dumps(spec, sort_keys=True)
+    return json.dumps(spec, sort_keys=True, allow_nan=False)
 
 
 def files_source(
@@ -164,7 +164,7 @@ def files_source(
             f"--scenes: several files are sample {dupes}; add --new-sample to "
             "render saved scenes as new samples"
         )
-    return json.dumps(spec, sort_keys=True)
+    return json.dumps(spec, sort_keys=True, allow_nan=False)
 
 
 def saved_sample(path: str | os.PathLike[str]) -> tuple[SampleId, int] | None:

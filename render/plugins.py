@@ -18,9 +18,14 @@ from spectrinsic.errors import SceneError
 #: values, which fails with no probability mass for an all-zero (or float32-underflowing)
 #: spectrum such as a black material (``flat:0``, soot, velvet).
 BLACK_SPECTRUM = 1e-30
+#: Longest path (``max_depth``) spectrinsic asks of Mitsuba: far beyond what converges (each
+#: bounce multiplies by a reflectance <= 1), and with ``rr_depth`` = depth + 1 inside the
+#: 32-bit integer Mitsuba's ``path`` plugin takes.
+MAX_PATH_DEPTH = 1024
 
 __all__ = [
     "BLACK_SPECTRUM",
+    "MAX_PATH_DEPTH",
     "rgb_spectrum",
     "regular_spectrum",
     "black_bsdf",
@@ -117,8 +122,10 @@ def spectral_film(
 def path_integrator(max_depth: int) -> dict[str, Any]:
     """Path tracer with Russian roulette off (``rr_depth`` > ``max_depth``): passes that share a
     seed and sample count then trace identical paths (common random numbers)."""
-    if max_depth < 1:
-        raise SceneError(f"max_depth {max_depth}: expected >= 1 (2 = direct light only)")
+    if not 1 <= max_depth <= MAX_PATH_DEPTH:
+        raise SceneError(
+            f"max_depth {max_depth}: expected 1 to {MAX_PATH_DEPTH} (2 = direct light only)"
+        )
     return {"type": "path", "max_depth": int(max_depth), "rr_depth": int(max_depth) + 1}
 
 

@@ -127,7 +127,12 @@ class _Doc:
                 if isinstance(x, bool) or not ok:
                     kind = "an integer" if dtype is np.int64 else "a number"
                     raise self.fail(f"{field}[{i}][{j}]", f"expected {kind}, got {x!r}")
-        return np.asarray(value, dtype=dtype)
+                if dtype is np.int64 and not -(2**31) <= x < 2**31:  # int32 in the renderer
+                    raise self.fail(f"{field}[{i}][{j}]", f"index {x} is beyond 32-bit integers")
+        try:
+            return np.asarray(value, dtype=dtype)
+        except OverflowError:  # an integer too large for a float64
+            raise self.fail(field, "holds a number too large for a 64-bit float") from None
 
 
 def _resolve(doc: _Doc, base: Path, value: Any, field: str) -> Path:

@@ -107,6 +107,27 @@ def _expanded_size(node: yaml.Node, memo: dict[int, int], loader: _LimitedLoader
     return size
 
 
+def _invalid(exc: yaml.YAMLError, source: str) -> SceneError:
+    """One line for a YAML error: the line (or the character position) and the problem."""
+    mark = getattr(exc, "problem_mark", None)
+    position = getattr(exc, "position", None)  # a ReaderError: a character not allowed
+    if mark is not None:
+        where = f"line {mark.line + 1}"
+    elif isinstance(position, int):
+        where = f"character {position}"
+    else:
+        where = "YAML"
+    problem = " ".join(
+        str(getattr(exc, "problem", None) or getattr(exc, "reason", None) or exc).split()
+    )
+    character = getattr(exc, "character", None)  # a ReaderError's code point (or character)
+    if isinstance(character, str) and len(character) == 1:
+        character = ord(character)
+    if isinstance(character, int):
+        problem = f"character #x{character:04x}: {problem}"
+    return SceneError(f"{source}: {where}: invalid YAML ({problem})")
+
+
 def load_yaml_text(text: str, source: str) -> Any:
     """Parse *text* with the limits above; *source* names it in errors."""
     if len(text) > MAX_YAML_BYTES:
@@ -120,14 +141,14 @@ def load_yaml_text(text: str, source: str) -> Any:
             f"{source}: about {rough:,} YAML values (counted from commas, list items "
             f"and keys), more than {MAX_NODES:,}; put large meshes in PLY files (FORMAT.md)"
         )
-    loader = _LimitedLoader(text, source)
+    try:
+        loader = _LimitedLoader(text, source)  # the reader refuses control characters here
+    except yaml.YAMLError as exc:
+        raise _invalid(exc, source) from exc
     try:
         return loader.get_single_data()
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f"line {mark.line + 1}" if mark is not None else "YAML"
-        problem = " ".join(str(getattr(exc, "problem", None) or exc).split())
-        raise SceneError(f"{source}: {where}: invalid YAML ({problem})") from exc
+        raise _invalid(exc, source) from exc
     except RecursionError as exc:  # a construct deeper than the checks foresaw
         raise SceneError(f"{source}: nesting too deep to read") from exc
     finally:

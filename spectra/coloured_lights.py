@@ -13,7 +13,10 @@ Names (registry families ``led`` and ``filtered``):
   ``longpass:E/W`` and ``shortpass:E/W`` (logistic edge at E nm, 10-90 % rise over W nm), each
   leaking :data:`FILTER_FLOOR` outside its pass band like real gels.
 
-All are illuminants, normalised like every other (unit luminance-weighted mean).
+All are illuminants, normalised like every other (unit luminance-weighted mean). An LED peaks
+inside :data:`LED_PEAKS`; a filtered lamp is an illuminant whose pass band transmits at least
+:data:`~spectrinsic.spectra.illuminants.VISIBLE_SHARE` of its luminance; each light's visible
+share is checked as for every illuminant.
 """
 
 from __future__ import annotations
@@ -24,15 +27,17 @@ from collections.abc import Callable
 
 import numpy as np
 
-from spectrinsic.errors import SpectrumNotFoundError
+from spectrinsic.errors import SpectralDataError, SpectrumNotFoundError
 from spectrinsic.spectra.grid import wavelength_grid
-from spectrinsic.spectra.illuminants import normalise_illuminant
+from spectrinsic.spectra.illuminants import VISIBLE_SHARE, normalise_illuminant, ybar_at
 from spectrinsic.spectra.records import Spectrum
 
-__all__ = ["FILTER_FLOOR", "FILTERS", "filter_transmission", "led", "filtered"]
+__all__ = ["FILTER_FLOOR", "FILTERS", "LED_PEAKS", "filter_transmission", "led", "filtered"]
 
 #: Transmission of a filter far outside its pass band (theatre gels leak about 1 %).
 FILTER_FLOOR = 0.01
+#: Peak wavelengths (nm) an LED may have: the range illuminants are sampled on.
+LED_PEAKS = (360.0, 830.0)
 _NUM = r"(\d+(?:\.\d+)?)"
 _LED_TERM = re.compile(rf"^{_NUM}/{_NUM}(?:@{_NUM})?$")
 _FILTER = re.compile(rf"^(bandpass|longpass|shortpass):{_NUM}/{_NUM}$")
@@ -61,18 +66,20 @@ FILTERS: dict[str, Callable[[np.ndarray, float, float], np.ndarray]] = {
 }
 
 
-def filter_transmission(spec: str, wavelengths: np.ndarray) -> np.ndarray:
-    """Transmission in [FILTER_FLOOR, 1] of filter *spec* (``"bandpass:520/80"``) at *wavelengths* nm."""
+def _pass_band(spec: str, wavelengths: np.ndarray) -> np.ndarray:
+    """The pass band in [0, 1] of filter *spec* at *wavelengths* nm, without the leak."""
     m = _FILTER.match(spec.strip())
     if not m or not float(m.group(3)) > 0:
         raise SpectrumNotFoundError(
             f"filter {spec!r}: expected bandpass:CENTRE/FWHM, longpass:EDGE/RISE or "
             "shortpass:EDGE/RISE in nm, e.g. 'bandpass:520/80'"
         )
-    shape = FILTERS[m.group(1)](
-        np.asarray(wavelengths, float), float(m.group(2)), float(m.group(3))
-    )
-    return FILTER_FLOOR + (1.0 - FILTER_FLOOR) * shape
+    return FILTERS[m.group(1)](np.asarray(wavelengths, float), float(m.group(2)), float(m.group(3)))
+
+
+def filter_transmission(spec: str, wavelengths: np.ndarray) -> np.ndarray:
+    """Transmission in [FILTER_FLOOR, 1] of filter *spec* (``"bandpass:520/80"``) at *wavelengths* nm."""
+    return FILTER_FLOOR + (1.0 - FILTER_FLOOR) * _pass_band(spec, wavelengths)
 
 
 def led(key: str) -> Spectrum:
@@ -88,6 +95,12 @@ def led(key: str) -> Spectrum:
     peaks, fwhm, ratio = (
         np.array([float(m.group(i) or 1.0) for m in terms if m]) for i in (1, 2, 3)
     )
+    lo, hi = LED_PEAKS
+    if not np.all((peaks >= lo) & (peaks <= hi)):
+        raise SpectralDataError(
+            f"LED {key!r}: peak {peaks[(peaks < lo) | (peaks > hi)][0]:g} nm is outside "
+            f"{lo:g}-{hi:g} nm, the visible range spectra are sampled on (a UV or IR LED)"
+        )
     shape = colour.SpectralShape(360, 830, 1)
     # the sum of single LEDs, as sd_multi_leds_Ohno2005 defines it (colour 0.4.6's own returns
     # NaN where an LED's tail underflows)
@@ -103,6 +116,19 @@ def led(key: str) -> Spectrum:
     )
 
 
+def _check_passes_visible(key: str, wl: np.ndarray, lamp: np.ndarray, band: np.ndarray) -> None:
+    """Refuse a filter whose pass band transmits less than :data:`VISIBLE_SHARE` of the lamp's
+    luminance (its leak alone would give back the lamp's own shape)."""
+    ybar = ybar_at(wl)
+    lum = float(np.sum(lamp * ybar))
+    passed = float(np.sum(lamp * band * ybar)) / lum if lum > 0 else 0.0
+    if not passed >= VISIBLE_SHARE:
+        raise SpectralDataError(
+            f"filtered light {key!r}: the filter's pass band transmits {passed:.2g} of the "
+            f"lamp's luminance (below {VISIBLE_SHARE:g}); it blocks all the visible light"
+        )
+
+
 def filtered(key: str, lamp: Callable[[str], Spectrum]) -> Spectrum:
     """Lamp times filter: *key* is ``"<lamp name>|<filter>"``; *lamp* resolves the lamp's name."""
     name, sep, spec = key.rpartition("|")
@@ -111,8 +137,15 @@ def filtered(key: str, lamp: Callable[[str], Spectrum]) -> Spectrum:
             f"filtered light {key!r}: expected LAMP|FILTER, e.g. 'filtered:planck:3200K|bandpass:520/80'"
         )
     base = lamp(name.strip())
+    if base.kind != "illuminant":
+        raise SpectralDataError(
+            f"filtered light {key!r}: lamp {name.strip()!r} is a {base.kind} spectrum; "
+            "expected an illuminant (planck:3200K, cie:A, ...)"
+        )
     wl = np.asarray(base.wavelengths, float)
-    values = base.values * filter_transmission(spec, wl)
+    band = _pass_band(spec, wl)
+    _check_passes_visible(key, wl, base.values, band)
+    values = base.values * (FILTER_FLOOR + (1.0 - FILTER_FLOOR) * band)
     source = f"{base.source}; generated filter {spec.strip()}"
     return Spectrum(
         f"filtered:{name.strip()}|{spec.strip()}",

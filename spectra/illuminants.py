@@ -3,6 +3,11 @@
 Every illuminant is normalised to unit luminance-weighted mean, ``Σ L(λ) ȳ(λ) = Σ ȳ(λ)`` on
 its own grid, so that a perfect white under any light has luminance Y = 1 and a light's
 brightness is set only by its ``power``.
+
+A light that is not one the eye can see is refused rather than scaled up through its tails:
+its *visible share* ``∫ L ȳ dλ / (max ȳ · ∫ L dλ)`` (1 for a monochromatic 555 nm light, about
+0.4 for daylight) must be at least :data:`VISIBLE_SHARE` (UV or IR LEDs, a black body of a few
+hundred kelvin).
 """
 
 from __future__ import annotations
@@ -31,7 +36,14 @@ __all__ = [
     "normalise_illuminant",
     "illuminant_set",
     "ILLUMINANT_SETS",
+    "VISIBLE_SHARE",
+    "visible_share",
+    "ybar_at",
 ]
+
+#: Smallest visible share (module notes) of an illuminant: below it almost all its power is
+#: where the eye is insensitive, and unit-luminance scaling would blow its invisible part up.
+VISIBLE_SHARE = 1e-4
 
 #: Named sets of 5 like thesis Appendix B, drawn from what the dependencies ship. Planckian:
 #: a wide range of common colour temperatures. Non-Planckian: fluorescent (broadband, narrow
@@ -62,13 +74,40 @@ def _ybar() -> tuple[np.ndarray, np.ndarray]:
     return wavelengths, ybar
 
 
-def normalise_illuminant(wavelengths: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """Scale *values* so that ``Σ L ȳ = Σ ȳ`` over *wavelengths* (ȳ: CIE 1931 2°)."""
+def ybar_at(wavelengths: np.ndarray) -> np.ndarray:
+    """CIE 1931 ȳ (peak 1 at 555 nm) at *wavelengths* nm, 0 outside 360-830 nm."""
     wl_y, y = _ybar()
-    ybar = np.interp(wavelengths, wl_y, y, left=0.0, right=0.0)
+    return np.interp(np.asarray(wavelengths, float), wl_y, y, left=0.0, right=0.0)
+
+
+def visible_share(wavelengths: np.ndarray, values: np.ndarray) -> float:
+    """``∫ L ȳ dλ / (max ȳ · ∫ L dλ)`` of a spectrum *values* on *wavelengths* (nm), in [0, 1]
+    for non-negative values: the luminance-weighted share of its power (0 without any).
+
+    >>> round(visible_share(np.array([554.0, 555.0, 556.0]), np.array([0.0, 1.0, 0.0])), 6)
+    1.0
+    """
+    wl = np.asarray(wavelengths, float)
+    v = np.asarray(values, float)
+    ybar = ybar_at(wl)
+    dl = np.gradient(wl) if len(wl) > 1 else np.ones_like(wl)
+    total = float(np.sum(np.abs(v) * dl)) * float(_ybar()[1].max())
+    return float(np.sum(v * ybar * dl)) / total if total > 0 else 0.0
+
+
+def normalise_illuminant(wavelengths: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Scale *values* so that ``Σ L ȳ = Σ ȳ`` over *wavelengths* (ȳ: CIE 1931 2°); refuse a light
+    with no power where the eye is sensitive, or a visible share below :data:`VISIBLE_SHARE`."""
+    ybar = ybar_at(wavelengths)
     lum = float(np.sum(values * ybar))
     if not lum > 0:
         raise SpectralDataError("illuminant has no power where the eye is sensitive (380-780 nm)")
+    share = visible_share(wavelengths, values)
+    if not share >= VISIBLE_SHARE:
+        raise SpectralDataError(
+            f"illuminant has a visible share of {share:.2g} (luminance-weighted), below "
+            f"{VISIBLE_SHARE:g}: almost all its power is where the eye is insensitive"
+        )
     return values * (float(np.sum(ybar)) / lum)
 
 
@@ -91,7 +130,8 @@ def planck_law(wavelengths_nm: np.ndarray, temperature: float) -> np.ndarray:
     if not temperature > 0:
         raise SpectralDataError(f"Planckian temperature {temperature!r} K: expected T > 0")
     wl = np.asarray(wavelengths_nm, float)
-    values = colour.colorimetry.planck_law(wl.ravel() * 1e-9, float(temperature))
+    with np.errstate(over="ignore", under="ignore"):  # exp overflow: 0 radiance, said after
+        values = colour.colorimetry.planck_law(wl.ravel() * 1e-9, float(temperature))
     return np.asarray(values, float).reshape(wl.shape)
 
 
@@ -103,8 +143,8 @@ def _kelvin(key: str, what: str) -> float:
         raise SpectrumNotFoundError(
             f"{what} {key!r}: expected a temperature like '2800K'"
         ) from None
-    if not t > 0:
-        raise SpectralDataError(f"{what} {key!r}: temperature must be > 0 K")
+    if not 0 < t < float("inf"):
+        raise SpectralDataError(f"{what} {key!r}: temperature must be a finite number > 0 K")
     return t
 
 

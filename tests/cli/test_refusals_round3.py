@@ -1,0 +1,120 @@
+"""Issue 36, causes 7-10 and 14: inputs refused in one line (rc 2, no traceback) before any work.
+
+Each case runs the command line in-process and checks the exit status, that stderr is one line
+naming the input, and that ``--out`` was not created. None of them renders.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from spectrinsic.cli import main
+from spectrinsic.gt_export.integrity import write_marker
+from spectrinsic.pipeline.presets import get_preset
+
+SCENE = """\
+name: quad
+materials: {grey: "flat:0.5"}
+meshes:
+  - name: ground
+    vertices: [[-2, -2, 0], [2, -2, 0], [2, 2, 0], [-2, 2, 0]]
+    faces: [[0, 1, 2], [0, 2, 3]]
+    material: grey
+lights:
+  - {kind: point, spectrum: "cie:D65", power: 4, position: [0, 0, 2]}
+camera: {origin: [0, -3, 2], target: [0, 0, 0], width: 16, height: 16}
+"""
+TINY = ["--preset", "preview", "--resolution", "16x16", "--spp", "2"]
+APPLE = "obj-apple__v0__white"
+GENERATED = ["--generator", "objects-on-ground", "--count", "1", *TINY]
+
+
+def _one_line(capsys, *needles: str) -> str:
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "Traceback" not in err, err
+    for needle in needles:
+        assert needle in err, err
+    return err
+
+
+def _scene(tmp_path: Path, text: str = SCENE) -> str:
+    path = tmp_path / "scene.yaml"
+    path.write_text(text)
+    return str(path)
+
+
+# -- cause 10: non-finite numbers in the records -------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("option", "value"), [("--light-saturation", "0,inf"), ("--chroma-range", "1,1e400")]
+)
+def test_a_range_with_an_infinite_end_is_refused(tmp_path, capsys, option, value):
+    out = tmp_path / "ds"
+    assert main(["dataset", *GENERATED, option, value, "--out", str(out)]) == 2
+    _one_line(capsys, option, "finite")
+    assert not out.exists()
+
+
+def test_the_json_spectrinsic_writes_is_strict():
+    """A NaN or an infinity is not JSON (a browser's JSON.parse rejects ``Infinity``)."""
+    from spectrinsic.gt_export.sample import canonical_json
+
+    assert canonical_json({"a": 1.5}) == '{\n  "a": 1.5\n}\n'
+    for bad in (math.nan, math.inf):
+        with pytest.raises(ValueError, match="not JSON compliant"):
+            canonical_json({"a": bad})
+
+
+# -- cause 8: tracebacks instead of one line --------------------------------------------------
+
+
+def test_a_yaml_file_with_a_control_character_is_one_line(tmp_path, capsys):
+    scene = _scene(tmp_path, SCENE.replace("name: quad", "name: qu\x01ad"))
+    assert main(["render", scene, "--out", str(tmp_path / "o")]) == 2
+    _one_line(capsys, "scene.yaml", "invalid YAML", "#x0001")
+
+
+def test_a_face_index_beyond_32_bits_is_one_line(tmp_path, capsys):
+    scene = _scene(tmp_path, SCENE.replace("[0, 2, 3]", f"[0, 2, {2**70}]"))
+    assert main(["render", scene, "--out", str(tmp_path / "o")]) == 2
+    _one_line(capsys, "meshes[0].faces[1][2]", "32-bit")
+
+
+def test_a_vertex_too_large_for_a_float_is_one_line(tmp_path, capsys):
+    scene = _scene(tmp_path, SCENE.replace("[-2, -2, 0]", f"[-2, -2, {10**400}]", 1))
+    assert main(["render", scene, "--out", str(tmp_path / "o")]) == 2
+    _one_line(capsys, "meshes[0].vertices", "too large")
+
+
+def test_a_path_depth_beyond_mitsubas_integers_is_one_line(tmp_path, capsys):
+    out = tmp_path / "o"
+    assert main(["render", _scene(tmp_path), "--out", str(out), "--max-depth", "2147483648"]) == 2
+    _one_line(capsys, "--max-depth 2147483648", "expected 1 to")
+    assert not out.exists()
+
+
+def _nested_meta(root: Path) -> Path:
+    sample = root / APPLE
+    sample.mkdir(parents=True)
+    (sample / "meta.json").write_text("[" * 100_000 + "]" * 100_000)
+    return sample
+
+
+def test_check_of_a_deeply_nested_meta_json_is_one_line_per_problem(tmp_path, capsys):
+    _nested_meta(tmp_path / "ds")
+    assert main(["check", str(tmp_path / "ds")]) != 0
+    out = capsys.readouterr()
+    assert "Traceback" not in out.err + out.out and "RecursionError" not in out.err
+    assert "not valid JSON" in out.err + out.out
+
+
+def test_a_dataset_rerun_over_a_deeply_nested_meta_json_is_one_line(tmp_path, capsys):
+    root = tmp_path / "ds"
+    write_marker(root, get_preset("preview").with_options(width=16, height=16, spp=2).config_hash())
+    _nested_meta(root)
+    assert main(["dataset", "--out", str(root), *TINY, "--only", APPLE]) == 2
+    _one_line(capsys, APPLE)
