@@ -151,6 +151,7 @@ def _meta(
         "denoised_layers": list(gt.denoised),
         "noise": gt.noise,
         "shading_clipping": gt.clipping,
+        "residual_share": gt.residual_share,
         "files": sorted(files),
         "versions": software_versions(),
     }
@@ -237,6 +238,7 @@ def export_sample(
     denoise: bool = False,
     data_dir: str | os.PathLike[str] | None = None,
     transport: LightTransport | None = None,
+    spectral_layers: bool = False,
 ) -> Path:
     """Compute every ground-truth layer of a rendered sample and write it atomically.
 
@@ -269,6 +271,9 @@ def export_sample(
         A :class:`~spectrinsic.render.light_transport.LightTransport` of this render to store as
         ``transport.exr`` (:mod:`~spectrinsic.gt_export.transport_file`), for exact
         relighting (:func:`spectrinsic.gt_export.relight.relight`).
+    spectral_layers
+        Also write the per-band intrinsic layers (``spectral.exr``,
+        :mod:`~spectrinsic.gt_export.layers.spectral_intrinsics`); needs the 31-band cube.
 
     Returns
     -------
@@ -282,7 +287,13 @@ def export_sample(
     if cameras is None:
         cameras = DEFAULT_CAMERAS if "bands31" in (getattr(result, "raw", None) or {}) else ()
     gt = compute_ground_truth(
-        scene, result, cameras=cameras, write_cube=write_cube, denoise=denoise, data_dir=data_dir
+        scene,
+        result,
+        cameras=cameras,
+        write_cube=write_cube,
+        denoise=denoise,
+        data_dir=data_dir,
+        spectral=spectral_layers,
     )
     final = out_dir / sample_id
     tmp = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{sample_id}-", dir=out_dir))
