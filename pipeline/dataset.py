@@ -151,6 +151,7 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         denoise=cfg.denoise,
         data_dir=task.data_dir,
         transport=transport,
+        spectral_layers=cfg.spectral_layers,
     )
     if cfg.relight:
         write_relit_variants(path, cfg.relight, seed=task.seed, data_dir=task.data_dir)

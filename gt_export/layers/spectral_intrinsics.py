@@ -52,6 +52,9 @@ __all__ = [
     "residual_share",
     "residual_shares",
     "rgb_residual_share",
+    "LIGHT_FAMILIES",
+    "light_family",
+    "residual_summary",
 ]
 
 #: The render mode whose raw cube the spectral layers come from.
@@ -202,3 +205,87 @@ def rgb_residual_share(meta: Any) -> float | None:
         return None
     value = shares.get("image_denoised", shares.get("image"))
     return float(value) if isinstance(value, (int, float)) else None
+
+
+#: Light families from the most to the least saturated; a sample's family is the first that
+#: one of its lights belongs to (:func:`light_family`).
+LIGHT_FAMILIES: tuple[str, ...] = (
+    "narrow-led",
+    "rgb-led",
+    "filtered",
+    "fluorescent",
+    "white-led",
+    "daylight",
+    "planckian",
+    "d65",
+    "other",
+)
+
+
+def _family_of(spectrum: str) -> str:
+    kind, _, key = spectrum.partition(":")
+    if kind == "led":
+        return "rgb-led" if "+" in key else "narrow-led"
+    if kind == "filtered":
+        return "filtered"
+    if kind == "cie" and key.startswith("FL") or kind == "sfu":
+        return "fluorescent"
+    if kind == "cie" and key.startswith("LED"):
+        return "white-led"
+    if kind == "cie" and key == "D65":
+        return "d65"
+    if kind == "daylight" or (kind == "cie" and key.startswith("D")):
+        return "daylight"
+    return "planckian" if kind in ("planck", "blackbody") or key == "A" else "other"
+
+
+def light_family(spectra: Any) -> str:
+    """The family of a set of light spectrum names: that of its most saturated light
+    (:data:`LIGHT_FAMILIES` order).
+
+    >>> light_family(["cie:D65", "led:540/31"]), light_family(["planck:2800K"])
+    ('narrow-led', 'planckian')
+    """
+    found = {_family_of(str(s)) for s in spectra}
+    return next((f for f in LIGHT_FAMILIES if f in found), "other")
+
+
+def _figures(values: list[float]) -> dict[str, float]:
+    v = np.asarray(values, np.float64)
+    return {
+        "median": float(np.median(v)),
+        "p95": float(np.percentile(v, 95)),
+        "max": float(v.max()),
+    }
+
+
+def residual_summary(metas: Any) -> dict[str, Any]:
+    """Per light family (:func:`light_family` of each sample's lights) and ``"all"``: the
+    samples' RGB residual share, per-band residual share (where written) and the share of lit
+    pixels whose sRGB shading was clipped, each as median / p95 / max over samples (fractions).
+    *metas* are parsed ``meta.json`` objects; samples without a residual share are skipped.
+
+    >>> m = {"lights": [{"spectrum": "cie:D65"}], "residual_share": {"image": 0.01},
+    ...      "shading_clipping": {"pixels": 0.0}}
+    >>> residual_summary([m])["d65"]["rgb"]["median"]
+    0.01
+    """
+    rows: dict[str, dict[str, list[float]]] = {}
+    for meta in metas:
+        rgb = rgb_residual_share(meta)
+        if rgb is None:
+            continue
+        family = light_family(li.get("spectrum", "") for li in meta.get("lights", []))
+        spectral = (meta.get("residual_share") or {}).get("image_spectral")
+        clipped = (meta.get("shading_clipping") or {}).get("pixels")
+        for key in (family, "all"):
+            row = rows.setdefault(key, {"rgb": [], "spectral": [], "clipped_pixels": []})
+            row["rgb"].append(rgb)
+            if isinstance(spectral, (int, float)):
+                row["spectral"].append(float(spectral))
+            if isinstance(clipped, (int, float)):
+                row["clipped_pixels"].append(float(clipped))
+    return {
+        family: {"samples": len(row["rgb"])} | {k: _figures(v) for k, v in row.items() if v}
+        for family, row in sorted(rows.items())
+    }

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export import export_sample, load_sample
+from spectrinsic.gt_export import check_sample, export_sample, load_sample
 from spectrinsic.gt_export.layers import compute_ground_truth, identities
 from spectrinsic.gt_export.loader import filter_residual_share
 from spectrinsic.gt_export.relight import relight, relit_scene
@@ -145,6 +145,7 @@ def room_sample(tmp_path_factory, make_room):
 
 def test_c_residual_share_in_meta_equals_a_recomputation_from_the_stored_layers(room_sample):
     _, _, sample, _ = room_sample
+    assert check_sample(sample) == []  # every identity, the per-band one included, holds
     loaded = load_sample(sample)
     meta = json.loads((sample / "meta.json").read_text())
     assert "spectral.exr" in meta["files"]
