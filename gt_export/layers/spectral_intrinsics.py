@@ -33,6 +33,7 @@ identity, above the 1e-5 the layers promise).
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -200,8 +201,8 @@ def rgb_residual_share(meta: Any) -> float | None:
     >>> rgb_residual_share({"residual_share": {"image": 0.1, "image_spectral": 0.001}})
     0.1
     """
-    shares = meta.get("residual_share") if hasattr(meta, "get") else None
-    if not hasattr(shares, "get"):
+    shares = meta.get("residual_share") if isinstance(meta, Mapping) else None
+    if not isinstance(shares, Mapping):
         return None
     value = shares.get("image_denoised", shares.get("image"))
     return float(value) if isinstance(value, (int, float)) else None
