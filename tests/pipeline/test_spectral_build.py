@@ -57,6 +57,8 @@ def test_a_build_with_spectral_layers_is_sound_and_reports_its_residual(tmp_path
     assert manifest["samples"][SAMPLE]["residual_share"] == shares
     assert manifest["residual_share"]["all"]["samples"] == 1
     assert manifest["residual_share"]["all"]["rgb"]["median"] == pytest.approx(shares["image"])
+    card = (out / "DATASET.md").read_text()
+    assert "## Residual by light family" in card and "| all | 1 |" in card
     rgb = shares["image"]
     assert main(["check", str(out), "--max-residual-share", f"{rgb * 1.01}"]) == 0
     capsys.readouterr()
