@@ -341,7 +341,7 @@ def residual_share_problems(dataset_dir: str | os.PathLike[str], limit: float) -
     for sample in sample_dirs(Path(dataset_dir)):
         meta = read_meta(sample, verify=False).raw
         share = rgb_residual_share(meta)
-        spectral = (meta.get("residual_share") or {}).get("image_spectral")
+        spectral = (meta.get("residual_share") or {}).get("image_bands")
         per_band = "" if spectral is None else f"; per band {100 * spectral:.3g} %"
         if share is None:
             out.append(f"{sample.name}: records no residual share (built before it existed)")

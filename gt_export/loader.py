@@ -233,7 +233,7 @@ def torch_dataset(
     need *seed*: item *i* is cropped with
     ``default_rng([seed, i])``, the same on every worker and epoch. *max_residual_share* keeps
     only the samples whose RGB residual share is at most that fraction
-    (:func:`filter_residual_share`). The spectral layers (``*_spectral``, ``(31, H, W)``) come
+    (:func:`filter_residual_share`). The spectral layers (``*_bands``, ``(31, H, W)``) come
     with the rest when the set was built with ``--spectral-layers``. torch is imported only here.
 
     Raises

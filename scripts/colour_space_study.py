@@ -131,7 +131,7 @@ def space_figures(gt: object, to_xyz: np.ndarray, m: np.ndarray) -> dict[str, fl
     layers = gt.layers  # type: ignore[attr-defined]
     cube, refl, w = (
         layers[k].data.astype(np.float64)
-        for k in ("image_spectral", "reflectance_spectral", "shading_spectral")
+        for k in ("image_bands", "reflectance_bands", "shading_bands")
     )
     mask = layers["mask"].data > 0
     d65 = responses(get_spectrum("cie:D65").on(WL), get_sensors("bands:31@400-700").on(WL), WL)
@@ -142,7 +142,7 @@ def space_figures(gt: object, to_xyz: np.ndarray, m: np.ndarray) -> dict[str, fl
     reflectance = (refl * d65) @ x.T / y_d
     shading = (w @ x.T) / white
     lit = mask & (np.abs(w).sum(-1) > 0)
-    spec = layers.get("specular_spectral")
+    spec = layers.get("specular_bands")
     diffuse = image if spec is None else image - spec.data.astype(np.float64) @ x.T
     return {
         "share_unclipped": _share(image, diffuse - reflectance * shading, mask),
@@ -174,7 +174,7 @@ def room_rows(args: argparse.Namespace, matrices: dict[str, np.ndarray]) -> list
             "glossy": any(m.kind != "diffuse" for m in scene.materials),
             "layers_rgb_share": gt.residual_share["image"],
             "layers_clipped_pixels": gt.clipping.get("pixels", 0.0),
-            "bands31_share": gt.residual_share["image_spectral"],
+            "bands31_share": gt.residual_share["image_bands"],
             "spaces": {k: space_figures(gt, to_xyz, m) for k, m in matrices.items()},
         }
         rows.append(row)

@@ -157,7 +157,7 @@ class GroundTruth:
     #: relative to the shading's norm over those pixels.
     clipping: dict[str, float] = field(default_factory=dict)
     #: ``Σ|residual| / Σ|image|`` over the mask, per identity, keyed by its image layer
-    #: (``image``/``image_denoised``: RGB; ``image_spectral``: per band).
+    #: (``image``/``image_denoised``: RGB; ``image_bands``: per band).
     residual_share: dict[str, float] = field(default_factory=dict)
 
 

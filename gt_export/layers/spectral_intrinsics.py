@@ -6,18 +6,18 @@ surface ``cube_k = ρ_k · W_k`` holds per band (Eq. 1 of :mod:`spectrinsic.gt_e
 with ``ρ_k = ∫ρ B_k dλ / ∫B_k dλ`` the material's spectrum integrated over band k and ``W_k``
 the white-surface radiance (``E_k / π``). The layers are
 
-* ``reflectance_spectral``: ``ρ_k`` coverage-weighted over the pixel, the values the renderer
+* ``reflectance_bands``: ``ρ_k`` coverage-weighted over the pixel, the values the renderer
   gave each material (dimensionless; metals 0, as in ``reflectance``);
-* ``shading_spectral``: ``W_k``, the band radiance a perfect white surface would reflect
+* ``shading_bands``: ``W_k``, the band radiance a perfect white surface would reflect
   (render units; OIDN-denoised when the sample is, by the band-share scheme of
   :mod:`spectrinsic.gt_export.denoise`);
-* ``specular_spectral`` (glossy scenes): the raw band channels of the first hits'
+* ``specular_bands`` (glossy scenes): the raw band channels of the first hits'
   non-diffuse lobes;
-* ``image_spectral``: the image of the identity, the raw cube, or (denoised samples) the cube
+* ``image_bands``: the image of the identity, the raw cube, or (denoised samples) the cube
   rebuilt from the denoised ``W`` plus the raw specular, with the raw cube kept as
-  ``image_spectral_raw``;
-* ``residual_spectral = image_spectral − reflectance_spectral ∘ shading_spectral −
-  specular_spectral``.
+  ``image_bands_raw``;
+* ``residual_bands = image_bands − reflectance_bands ∘ shading_bands −
+  specular_bands``.
 
 Per band the product is exact up to float32 rounding where surfaces cover at least
 :data:`~spectrinsic.gt_export.irradiance.COVERAGE_MIN` of a pixel and the band albedo is above
@@ -93,7 +93,7 @@ def spectral_layers(
     *,
     denoised: bool,
 ) -> list[Layer]:
-    """The ``*_spectral`` layers of one sample (module notes); :class:`DatasetError` without
+    """The ``*_bands`` layers of one sample (module notes); :class:`DatasetError` without
     the 31-band cube."""
     if SPECTRAL_MODE not in s.result.raw:
         raise DatasetError(
@@ -115,25 +115,25 @@ def spectral_layers(
     refl = raw_w.albedo
     out = [
         layer(
-            "image_spectral",
+            "image_bands",
             image,
             units
             + (
-                "; rebuilt as band reflectance × denoised shading_spectral (+ specular) where "
+                "; rebuilt as band reflectance × denoised shading_bands (+ specular) where "
                 "surfaces cover the pixel, the raw cube elsewhere"
                 if rebuilt
                 else "; the rendered cube"
             ),
         ),
         layer(
-            "reflectance_spectral",
+            "reflectance_bands",
             refl,
             "dimensionless band reflectance ∫ρ B_k dλ / ∫B_k dλ, box-filtered by pixel "
             "coverage (0 for background and metals)",
             nonnegative=True,
         ),
         layer(
-            "shading_spectral",
+            "shading_bands",
             used_w.bands,
             "white-surface band radiance W_k = E_k/π (render units), the band light a perfect "
             "white would reflect"
@@ -142,14 +142,14 @@ def spectral_layers(
         ),
     ]
     if rebuilt:
-        out.append(layer("image_spectral_raw", cube, units + "; the rendered cube", True))
+        out.append(layer("image_bands_raw", cube, units + "; the rendered cube", True))
     if specular is not None:
-        out.append(layer("specular_spectral", specular, units + "; non-diffuse lobes"))
+        out.append(layer("specular_bands", specular, units + "; non-diffuse lobes"))
     out.append(
         layer(
-            "residual_spectral",
+            "residual_bands",
             irr.residual(image, refl, used_w.bands, specular),
-            "image_spectral − reflectance_spectral ∘ shading_spectral [− specular_spectral] "
+            "image_bands − reflectance_bands ∘ shading_bands [− specular_bands] "
             "(render units): the background, silhouette fringes, metals and bands a surface "
             "does not reflect",
         )
@@ -159,15 +159,15 @@ def spectral_layers(
 
 def spectral_identity(layers: Any) -> dict[str, str] | None:
     """The per-band identity's layer names, or ``None`` without spectral layers."""
-    if "shading_spectral" not in layers:
+    if "shading_bands" not in layers:
         return None
     out = {
-        "image": "image_spectral",
-        "reflectance": "reflectance_spectral",
-        "shading": "shading_spectral",
-        "residual": "residual_spectral",
+        "image": "image_bands",
+        "reflectance": "reflectance_bands",
+        "shading": "shading_bands",
+        "residual": "residual_bands",
     }
-    return out | ({"specular": "specular_spectral"} if "specular_spectral" in layers else {})
+    return out | ({"specular": "specular_bands"} if "specular_bands" in layers else {})
 
 
 def residual_share(image: np.ndarray, residual: np.ndarray, mask: np.ndarray) -> float:
@@ -184,7 +184,7 @@ def residual_share(image: np.ndarray, residual: np.ndarray, mask: np.ndarray) ->
 
 def residual_shares(identities: list[dict[str, str]], layers: Any, mask: np.ndarray) -> dict:
     """``{identity image layer: residual share}`` of every identity (``meta.json``'s
-    ``residual_share``): ``image``/``image_denoised`` is the RGB share, ``image_spectral`` the
+    ``residual_share``): ``image``/``image_denoised`` is the RGB share, ``image_bands`` the
     per-band one."""
     return {
         ident["image"]: residual_share(
@@ -198,7 +198,7 @@ def rgb_residual_share(meta: Any) -> float | None:
     """The RGB residual share a ``meta.json`` records (of ``image_denoised`` when denoised,
     else of ``image``), or ``None`` if it records none.
 
-    >>> rgb_residual_share({"residual_share": {"image": 0.1, "image_spectral": 0.001}})
+    >>> rgb_residual_share({"residual_share": {"image": 0.1, "image_bands": 0.001}})
     0.1
     """
     shares = meta.get("residual_share") if isinstance(meta, Mapping) else None
@@ -277,7 +277,7 @@ def residual_summary(metas: Any) -> dict[str, Any]:
         if rgb is None:
             continue
         family = light_family(li.get("spectrum", "") for li in meta.get("lights", []))
-        spectral = (meta.get("residual_share") or {}).get("image_spectral")
+        spectral = (meta.get("residual_share") or {}).get("image_bands")
         clipped = (meta.get("shading_clipping") or {}).get("pixels")
         for key in (family, "all"):
             row = rows.setdefault(key, {"rgb": [], "spectral": [], "clipped_pixels": []})

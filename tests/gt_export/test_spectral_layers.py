@@ -31,7 +31,7 @@ TOL = 1e-5
 #: Band centres of ``bands:31@400-700``.
 CENTRES = np.arange(400.0, 701.0, 10.0)
 CHIP = "munsell:5G 6/8"
-SPECTRAL = ("image_spectral", "reflectance_spectral", "shading_spectral", "residual_spectral")
+SPECTRAL = ("image_bands", "reflectance_bands", "shading_bands", "residual_bands")
 
 
 def _band_means_by_colour(name: str) -> np.ndarray:
@@ -49,10 +49,15 @@ def _band_means_by_colour(name: str) -> np.ndarray:
 
 def test_a_plane_under_a_narrow_led_has_the_exact_band_identity_and_reflectance(make_plane):
     scene = make_plane(CHIP, "led:540/31", size=8)
-    result = render_scene(scene, RenderSettings(spp=4, max_depth=2, modes=("bands31",)), seed=1)
-    gt = compute_ground_truth(scene, result, spectral=True)
+    settings = RenderSettings(spp=4, max_depth=2, modes=("spectral", "bands31"))
+    gt = compute_ground_truth(scene, render_scene(scene, settings, seed=1), spectral=True)
+    # Mitsuba's spectral image keeps its own name beside the band layers
+    assert (
+        gt.layers["image_spectral"].group == "image"
+        and gt.layers["image_bands"].group == "spectral"
+    )
     image, refl, shading, res = (gt.layers[k].data.astype(np.float64) for k in SPECTRAL)
-    assert image.shape == (8, 8, 31) and gt.layers["image_spectral"].data.dtype == np.float32
+    assert image.shape == (8, 8, 31) and gt.layers["image_bands"].data.dtype == np.float32
     scale = np.abs(image).max()
     # the identity holds per band, with a residual of float32 rounding: the product explains it
     assert np.abs(refl * shading + res - image).max() <= TOL * scale
@@ -60,8 +65,8 @@ def test_a_plane_under_a_narrow_led_has_the_exact_band_identity_and_reflectance(
     expected = _band_means_by_colour(CHIP)
     np.testing.assert_allclose(refl.reshape(-1, 31), np.broadcast_to(expected, (64, 31)), atol=TOL)
     # the RGB layers of the same pixels do not multiply out under this light
-    assert gt.residual_share["image"] > 0.05 > 1e-4 > gt.residual_share["image_spectral"]
-    spectral = [i for i in identities(gt) if i["image"] == "image_spectral"]
+    assert gt.residual_share["image"] > 0.05 > 1e-4 > gt.residual_share["image_bands"]
+    spectral = [i for i in identities(gt) if i["image"] == "image_bands"]
     assert spectral == [dict(zip(("image", "reflectance", "shading", "residual"), SPECTRAL))]
 
 
@@ -106,7 +111,7 @@ def test_b_band_shading_of_one_bounce_between_coloured_planes_is_the_closed_form
     e_light = responses(power * get_spectrum(light).on(WL), bands, WL)
     rho = _band_means_by_colour("munsell:5R 5/12")
     expected = rho * e_light * 0.5 / np.pi
-    shading = gt.layers["shading_spectral"].data[inside].astype(np.float64)
+    shading = gt.layers["shading_bands"].data[inside].astype(np.float64)
     ratio = shading / expected
     # every band traces the same paths: per pixel, one geometric factor for all 31 bands
     spread = np.abs(ratio / ratio.mean(axis=-1, keepdims=True) - 1).max()
@@ -116,7 +121,7 @@ def test_b_band_shading_of_one_bounce_between_coloured_planes_is_the_closed_form
     assert ratio.mean() == pytest.approx(1.0, abs=0.04)
     # the plane's own colour does not enter its shading; its image is ρ_first,k · W_k
     np.testing.assert_allclose(
-        gt.layers["reflectance_spectral"].data[inside],
+        gt.layers["reflectance_bands"].data[inside],
         np.broadcast_to(_band_means_by_colour("munsell:5PB 4/10"), shading.shape),
         atol=TOL,
     )
@@ -150,14 +155,14 @@ def test_c_residual_share_in_meta_equals_a_recomputation_from_the_stored_layers(
     meta = json.loads((sample / "meta.json").read_text())
     assert "spectral.exr" in meta["files"]
     shares = meta["residual_share"]
-    assert set(shares) >= {"image_denoised", "image", "image_spectral"}
+    assert set(shares) >= {"image_denoised", "image", "image_bands"}
     mask = loaded["mask"]
     for ident in meta["identities"]:
         image = loaded[ident["image"]][mask].astype(np.float64)
         residual = loaded[ident["residual"]][mask].astype(np.float64)
         recomputed = np.abs(residual).sum() / np.abs(image).sum()
         assert shares[ident["image"]] == pytest.approx(recomputed, rel=1e-9)
-    assert shares["image_spectral"] < 1e-3 < shares["image_denoised"]
+    assert shares["image_bands"] < 1e-3 < shares["image_denoised"]
     # the loader's filter reads the same figure
     rgb = shares["image_denoised"]
     assert filter_residual_share([sample], rgb) == [sample]
@@ -184,14 +189,14 @@ def test_d_relit_spectral_layers_equal_a_direct_render(room_sample):
             spectral_layers=True,
         )
     )
-    before = load_sample(sample, layers=["image_spectral"])["image_spectral"]
-    for name in [*SPECTRAL, "image_spectral_raw"]:
+    before = load_sample(sample, layers=["image_bands"])["image_bands"]
+    for name in [*SPECTRAL, "image_bands_raw"]:
         a, b = relit[name].astype(np.float64), reference[name].astype(np.float64)
         assert a.shape == b.shape == before.shape
         # the residual is float32 rounding of the image here: measured on the image's scale
-        scale = reference["image_spectral" if name == "residual_spectral" else name]
+        scale = reference["image_bands" if name == "residual_bands" else name]
         assert np.abs(a - b).max() <= TOL * np.abs(scale).max(), name
-    assert np.abs(relit["image_spectral"] - before).max() > 0.05 * np.abs(before).max()
+    assert np.abs(relit["image_bands"] - before).max() > 0.05 * np.abs(before).max()
 
 
 def test_spectral_layers_without_the_cube_are_refused(make_plane):

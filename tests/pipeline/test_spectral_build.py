@@ -51,7 +51,7 @@ def test_a_build_with_spectral_layers_is_sound_and_reports_its_residual(tmp_path
     assert report.ok, report.failed
     assert check_dataset(out) == []
     sample = load_sample(out / SAMPLE)
-    assert sample["shading_spectral"].shape == (12, 12, 31)
+    assert sample["shading_bands"].shape == (12, 12, 31)
     shares = sample["meta"]["residual_share"]
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest["samples"][SAMPLE]["residual_share"] == shares
