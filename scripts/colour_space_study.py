@@ -1,7 +1,7 @@
 """Which working colour space makes the RGB intrinsic identity hold best (issue 30).
 
 Usage: python -P scripts/colour_space_study.py OUT.json [--rooms N] [--size S] [--spp P]
-       [--seed K] [--gloss F]
+       [--seed K] [--gloss F] [--library]
 
 Renders N generated rooms (``rooms`` generator, matte unless ``--gloss``) as 31-band cubes,
 computes their spectral layers (:mod:`spectrinsic.gt_export.layers.spectral_intrinsics`, raw,
@@ -151,19 +151,41 @@ def space_figures(gt: object, to_xyz: np.ndarray, m: np.ndarray) -> dict[str, fl
     }
 
 
-def room_rows(args: argparse.Namespace, matrices: dict[str, np.ndarray]) -> list[dict]:
+def _scenes(args: argparse.Namespace) -> list[object]:
+    """The benchmark's scenes: the library's default samples, or N generated rooms."""
+    if args.library:
+        from spectrinsic.scenes import library  # noqa: PLC0415
+
+        return [
+            library.build(
+                s.scene,
+                view=s.view,
+                condition=s.condition,
+                seed=args.seed,
+                width=args.size,
+                height=args.size,
+            )
+            for s in library.default_samples()
+        ]
     options = GeneratorOptions(
         width=args.size,
         height=args.size,
         gloss=GlossDistribution(glossy_fraction=args.gloss) if args.gloss else GlossDistribution(),
     )
+    return [
+        generate("rooms", root_seed=args.seed, index=i, view=0, options=options)
+        for i in range(args.rooms)
+    ]
+
+
+def room_rows(args: argparse.Namespace, matrices: dict[str, np.ndarray]) -> list[dict]:
     settings = RenderSettings(
         spp=args.spp, max_depth=args.depth, modes=("rgb3", "bands31"), per_light=True
     )
+    scenes = _scenes(args)
     rows = []
-    for index in range(args.rooms):
+    for index, scene in enumerate(scenes):
         t0 = time.perf_counter()
-        scene = generate("rooms", root_seed=args.seed, index=index, view=0, options=options)
         result = render_scene(scene, settings, seed=args.seed + index)
         gt = compute_ground_truth(scene, result, spectral=True)
         to_xyz = np.asarray(result.meta["to_xyz"]["bands31"], np.float64)
@@ -179,7 +201,7 @@ def room_rows(args: argparse.Namespace, matrices: dict[str, np.ndarray]) -> list
         }
         rows.append(row)
         print(
-            f"{index + 1}/{args.rooms} {scene.name} {row['family']}: sRGB "
+            f"{index + 1}/{len(scenes)} {scene.name} {row['family']}: sRGB "
             f"{100 * row['spaces']['srgb']['share_clipped']:.2f} %, bands "
             f"{100 * row['bands31_share']:.4f} % ({time.perf_counter() - t0:.1f} s)",
             flush=True,
@@ -246,6 +268,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--depth", type=int, default=5)
     p.add_argument("--seed", type=int, default=30)
     p.add_argument("--gloss", type=float, default=0.0, help="fraction of glossy materials")
+    p.add_argument("--library", action="store_true", help="the library's 68 samples instead")
     args = p.parse_args(argv)
     sharpened = fit_sharpened()
     rows = room_rows(args, spaces(sharpened))
