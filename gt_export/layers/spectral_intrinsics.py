@@ -225,8 +225,8 @@ LIGHT_FAMILIES: tuple[str, ...] = (
 
 def _family_of(spectrum: str) -> str:
     kind, _, key = spectrum.partition(":")
-    if kind == "led":
-        return "rgb-led" if "+" in key else "narrow-led"
+    if kind == "led" or (kind == "cie" and key.startswith("LED-RGB")):
+        return "rgb-led" if "+" in key or kind == "cie" else "narrow-led"
     if kind == "filtered":
         return "filtered"
     if kind == "cie" and key.startswith("FL") or kind == "sfu":
