@@ -26,8 +26,9 @@ background and silhouette fringes, metals, black bands). The RGB identity is not
 this sense: a 3-channel product cannot represent a spectral one, so its residual holds the
 spectral non-commutativity (:func:`residual_share` measures both).
 
-Storage: float32 (half floats measured 5.9e-4 relative error on the spectral residual's
-identity, above the 1e-5 the layers promise).
+Storage: float32. Stored as half floats, the per-band identity of a denoised room (24², two
+lights) was off by 7.0e-4 of the image's largest value (2.6e-4 per value at the median),
+against 2e-15 in float32: far above the 1e-5 the layers promise.
 """
 
 from __future__ import annotations
