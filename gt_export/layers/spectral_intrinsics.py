@@ -22,7 +22,8 @@ the white-surface radiance (``E_k / π``). The layers are
 Per band the product is exact up to float32 rounding where surfaces cover at least
 :data:`~spectrinsic.gt_export.irradiance.COVERAGE_MIN` of a pixel and the band albedo is above
 :data:`~spectrinsic.gt_export.irradiance.ALBEDO_FLOOR`; the residual holds the rest (the
-background and silhouette fringes, metals, black bands). The RGB identity is not exact in
+background and silhouette fringes, pixels a metal shares with a diffuse surface, black
+bands). The RGB identity is not exact in
 this sense: a 3-channel product cannot represent a spectral one, so its residual holds the
 spectral non-commutativity (:func:`residual_share` measures both).
 
@@ -151,8 +152,8 @@ def spectral_layers(
             "residual_bands",
             irr.residual(image, refl, used_w.bands, specular),
             "image_bands − reflectance_bands ∘ shading_bands [− specular_bands] "
-            "(render units): the background, silhouette fringes, metals and bands a surface "
-            "does not reflect",
+            "(render units): the background, silhouette fringes, pixels a metal shares with "
+            "a diffuse surface, and bands a surface does not reflect",
         )
     )
     return out
