@@ -116,7 +116,7 @@ def test_b_band_shading_of_one_bounce_between_coloured_planes_is_the_closed_form
     ratio = shading / expected
     # every band traces the same paths: per pixel, one geometric factor for all 31 bands
     spread = np.abs(ratio / ratio.mean(axis=-1, keepdims=True) - 1).max()
-    assert spread < 1e-4, spread
+    assert spread < TOL, spread
     # and that factor is the closed form's, within the Monte Carlo error of the mean
     # (Bernoulli p = 1/2 per cosine-weighted sample: ~1 % at 64 spp over 200 pixels)
     assert ratio.mean() == pytest.approx(1.0, abs=0.04)
