@@ -23,6 +23,7 @@ BENCHMARKS = (
     "ground_truth",
     "crop_reference",
     "relight",
+    "residual",
 )
 
 

@@ -12,7 +12,12 @@ from tqdm import tqdm
 from spectrinsic.cli.problems import problem_lines
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import check_dataset, sample_dirs
-from spectrinsic.gt_export.check import NOISE_THRESHOLD, TARGET_MISSED, noise_report
+from spectrinsic.gt_export.check import (
+    NOISE_THRESHOLD,
+    TARGET_MISSED,
+    noise_report,
+    residual_share_problems,
+)
 
 __all__ = ["register", "run"]
 
@@ -47,6 +52,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         "(default: warn above 0.25, fail only on a missed noise_target)",
     )
     p.add_argument("--noise", action="store_true", help="print every sample's noise figures")
+    p.add_argument(
+        "--max-residual-share",
+        type=float,
+        default=None,
+        metavar="F",
+        help="fail on samples whose RGB residual holds more than the fraction F of the image "
+        "(sum |residual| / sum |image| over the mask, meta.json residual_share), e.g. 0.05",
+    )
     p.set_defaults(func=run)
 
 
@@ -58,6 +71,11 @@ def run(args: argparse.Namespace) -> int:
         raise DatasetError(
             f"--noise-threshold {args.noise_threshold}; expected a positive finite "
             "relative error, e.g. 0.25"
+        )
+    share = getattr(args, "max_residual_share", None)
+    if share is not None and not (math.isfinite(share) and share >= 0):
+        raise DatasetError(
+            f"--max-residual-share {share}; expected a fraction >= 0 of the image, e.g. 0.05"
         )
     if args.max_per_sample < 0:
         raise DatasetError(f"--max-per-sample {args.max_per_sample}; expected a whole number >= 0")
@@ -71,6 +89,8 @@ def run(args: argparse.Namespace) -> int:
         problems = check_dataset(root, progress=lambda _sample: bar.update(1))
     if n_samples:
         problems += _noise_problems(root, args.noise_threshold, n_samples, verbose=args.noise)
+    if n_samples and share is not None:
+        problems += residual_share_problems(root, share)
     if not problems:
         print(f"ok: {n_samples} samples in {root} passed every check")
         return 0

@@ -20,6 +20,7 @@ from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.colour_spread import shown, spread_summary
 from spectrinsic.gt_export.diversity import DIVERSITY_NAME, spread_record, write_diversity
 from spectrinsic.gt_export.integrity import guarded_write
+from spectrinsic.gt_export.layers.spectral_intrinsics import residual_summary
 from spectrinsic.gt_export.manifest import (
     noise_summary,
     read_manifest,
@@ -100,6 +101,37 @@ def _noise_table(summary: Mapping[str, Any]) -> str:
     return "\n".join(lines)
 
 
+def _residual_table(summary: Mapping[str, Any]) -> str:
+    if not summary:
+        return "The samples record no residual share (built before it was measured)."
+    lines = [
+        "Share of the image the intrinsic product does not explain, Σ|residual| / Σ|image| over "
+        "the mask, per sample; median / 95th percentile / max over the samples of each light "
+        "family (a sample's family is its most saturated light's). The RGB layers' residual "
+        "holds the spectral non-commutativity a 3-channel product cannot represent, and the "
+        "out-of-gamut light clipped from the sRGB shading (clipped pixels: the share of lit "
+        "pixels with a clipped channel). The per-band layers (`--spectral-layers`) multiply "
+        "out band by band. `spectrinsic check --max-residual-share F` and the loaders' "
+        "`max_residual_share` select samples by the RGB figure.",
+        "",
+        "| light family | samples | RGB residual | per-band residual | sRGB shading clipped pixels |",
+        "|---|---|---|---|---|",
+    ]
+
+    def cell(row: Mapping[str, Any], key: str) -> str:
+        fig = row.get(key)
+        if not fig:
+            return "–"
+        return " / ".join(f"{100 * fig[k]:.2g} %" for k in ("median", "p95", "max"))
+
+    for family, row in summary.items():
+        lines.append(
+            f"| {_text(family)} | {row['samples']} | {cell(row, 'rgb')} | "
+            f"{cell(row, 'spectral')} | {cell(row, 'clipped_pixels')} |"
+        )
+    return "\n".join(lines)
+
+
 def _layer_table(metas: Sequence[SampleMeta]) -> str:
     rows: dict[str, LayerRecord] = {}
     for meta in metas:
@@ -123,6 +155,7 @@ def write_dataset_card(
     scenes = sorted({m.scene for m in metas})
     text = string.Template(read_template("DATASET.md")).substitute(
         noise_table=_noise_table(noise_summary(metas)),
+        residual_table=_residual_table(residual_summary([m.raw for m in metas])),
         n_samples=len(samples),
         n_scenes=len(scenes),
         scenes=", ".join(_text(s) for s in scenes),

@@ -28,6 +28,7 @@ import numpy as np
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.exr import read_exr
 from spectrinsic.gt_export.layers import REFLECTANCE_FLOOR
+from spectrinsic.gt_export.layers.spectral_intrinsics import rgb_residual_share
 from spectrinsic.gt_export.manifest import ManifestRecord, read_manifest
 from spectrinsic.gt_export.sample import (
     MANIFEST_NAME,
@@ -40,6 +41,7 @@ from spectrinsic.gt_export.sample import (
 from spectrinsic.gt_export.sample_meta import Identity, LayerRecord, SampleMeta, read_meta
 
 __all__ = [
+    "residual_share_problems",
     "check_dataset",
     "check_sample",
     "noise_report",
@@ -330,3 +332,22 @@ def _missed_target(render: object) -> str:
         f"; {TARGET_MISSED} (image median {100 * reached:.1f} % above the config's "
         f"noise_target {100 * target:.1f} % after {record.get('max_batches')} batches)"
     )
+
+
+def residual_share_problems(dataset_dir: str | os.PathLike[str], limit: float) -> list[str]:
+    """``"<sample>: ..."`` for each sample whose RGB residual share (``Σ|residual| / Σ|image|``
+    over the mask, ``meta.json["residual_share"]``) is above *limit* or not recorded."""
+    out = []
+    for sample in sample_dirs(Path(dataset_dir)):
+        meta = read_meta(sample, verify=False).raw
+        share = rgb_residual_share(meta)
+        spectral = (meta.get("residual_share") or {}).get("image_bands")
+        per_band = "" if spectral is None else f"; per band {100 * spectral:.3g} %"
+        if share is None:
+            out.append(f"{sample.name}: records no residual share (built before it existed)")
+        elif share > limit:
+            out.append(
+                f"{sample.name}: residual share {100 * share:.3g} % of the image above "
+                f"--max-residual-share {limit:g}{per_band}"
+            )
+    return out

@@ -35,6 +35,7 @@ import numpy as np
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.card import read_template
 from spectrinsic.gt_export.integrity import guarded_write
+from spectrinsic.gt_export.layers.spectral_intrinsics import rgb_residual_share
 from spectrinsic.gt_export.manifest import read_manifest
 from spectrinsic.gt_export.names import slug
 from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, plain_data, sample_dirs
@@ -180,6 +181,8 @@ def _sample_entry(sample: Path, meta: SampleMeta, split: str | None) -> dict[str
         "kind": scene_kind(meta),
         "split": split,
         "noise": _noise_figure(meta),
+        # Σ|residual| / Σ|image| of the RGB layers (None for samples written before it)
+        "residual_share": rgb_residual_share(meta.raw),
         "first_layer": next(iter(layers), None),
         "light_shares": [light["share"] for light in lights],
         "size": list(meta.size),

@@ -11,6 +11,7 @@ import numpy as np
 
 from spectrinsic.errors import DatasetError, MissingDependencyError
 from spectrinsic.gt_export.exr import read_exr
+from spectrinsic.gt_export.layers.spectral_intrinsics import rgb_residual_share
 from spectrinsic.gt_export.manifest import read_splits
 from spectrinsic.gt_export.png import EXPOSURE_PERCENTILE, exposure
 from spectrinsic.gt_export.sample import META_NAME, file_sha256, sample_dirs
@@ -22,6 +23,7 @@ __all__ = [
     "split_samples",
     "prepare_item",
     "torch_dataset",
+    "filter_residual_share",
     "EXPOSURE_PERCENTILE",
 ]
 
@@ -108,14 +110,35 @@ def load_dataset(
     *,
     layers: Sequence[str] | None = None,
     verify: bool = True,
+    max_residual_share: float | None = None,
 ) -> Iterator[dict[str, Any]]:
-    """Iterate :func:`load_sample` over the complete samples of *dataset_dir*, sorted by id."""
-    for sample in sample_dirs(dataset_dir):
+    """Iterate :func:`load_sample` over the complete samples of *dataset_dir*, sorted by id;
+    with *max_residual_share*, only those whose RGB residual share is at most that
+    (:func:`filter_residual_share`)."""
+    for sample in filter_residual_share(sample_dirs(dataset_dir), max_residual_share):
         yield load_sample(sample, layers=layers, verify=verify)
 
 
+def filter_residual_share(folders: Sequence[Path], limit: float | None) -> list[Path]:
+    """The sample *folders* whose RGB residual share (``meta.json["residual_share"]``,
+    ``Σ|residual| / Σ|image|`` over the mask, a fraction) is at most *limit*; all for ``None``.
+    Samples that record no share (written before it existed) are left out."""
+    if limit is None:
+        return list(folders)
+    if not (isinstance(limit, (int, float)) and 0 <= limit):
+        raise DatasetError(
+            f"max_residual_share={limit!r}; expected a fraction >= 0 (e.g. 0.05 for 5 %)"
+        )
+    out = []
+    for folder in folders:
+        share = rgb_residual_share(read_meta(folder, verify=False).raw)
+        if share is not None and share <= limit:
+            out.append(folder)
+    return out
+
+
 #: Layers in radiometric units that exposure normalisation scales (reflectance is unitless).
-EXPOSED_PREFIXES = ("image", "shading", "illuminant", "residual", "cube")
+EXPOSED_PREFIXES = ("image", "shading", "illuminant", "residual", "specular", "cube")
 
 
 def split_samples(dataset_dir: str | os.PathLike[str], split: str | None) -> list[Path]:
@@ -197,6 +220,7 @@ def torch_dataset(
     normalize_exposure: bool = False,
     transform: Any = None,
     relight: Callable[[Path, int, int], dict[str, Any]] | None = None,
+    max_residual_share: float | None = None,
 ) -> Any:
     """A map-style ``torch.utils.data.Dataset`` over a dataset folder.
 
@@ -207,7 +231,10 @@ def torch_dataset(
     :class:`~spectrinsic.gt_export.relight_pool.RandomRelight`) replaces each sample by itself
     relit under random light spectra (samples built with ``--store-transport``). Random crops
     need *seed*: item *i* is cropped with
-    ``default_rng([seed, i])``, the same on every worker and epoch. torch is imported only here.
+    ``default_rng([seed, i])``, the same on every worker and epoch. *max_residual_share* keeps
+    only the samples whose RGB residual share is at most that fraction
+    (:func:`filter_residual_share`). The spectral layers (``*_bands``, ``(31, H, W)``) come
+    with the rest when the set was built with ``--spectral-layers``. torch is imported only here.
 
     Raises
     ------
@@ -223,7 +250,7 @@ def torch_dataset(
         ) from exc
     if crop is not None and seed is None:
         raise DatasetError("torch_dataset: a random crop needs an explicit seed")
-    folders = split_samples(dataset_dir, split)
+    folders = filter_residual_share(split_samples(dataset_dir, split), max_residual_share)
     wanted = None if keys is None else [k for k in keys if k != "ids"]
 
     def tensors(value: Any) -> Any:

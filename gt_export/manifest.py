@@ -21,6 +21,7 @@ from spectrinsic.data_dir import resolve_data_dir
 from spectrinsic.errors import DatasetError, SampleMetaError
 from spectrinsic.gt_export.integrity import guarded_write
 from spectrinsic.gt_export.json_fields import JsonFields, load_json
+from spectrinsic.gt_export.layers.spectral_intrinsics import residual_summary
 from spectrinsic.gt_export.sample import (
     FORMAT_VERSION,
     MANIFEST_NAME,
@@ -110,6 +111,7 @@ def write_manifest(
         "spectral_data": _spectral_provenance(metas, data_dir),
         "n_samples": len(samples),
         "noise": noise_summary(metas),
+        "residual_share": residual_summary([m.raw for m in metas]),
         "split_by": "scene",
         "split_fractions": dict(split_fractions),
         "splits": splits_by_scene({m.sample_id: m.scene for m in metas}, split_fractions),
@@ -118,6 +120,9 @@ def write_manifest(
                 "config_hash": m.config_hash,
                 "scene": m.scene,
                 "seed": m.seed,
+                **(
+                    {"residual_share": m.raw["residual_share"]} if "residual_share" in m.raw else {}
+                ),
                 "files": {p.relative_to(root).as_posix(): file_sha256(p) for p in _sample_files(s)},
             }
             for s, m in zip(samples, metas, strict=True)

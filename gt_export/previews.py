@@ -158,7 +158,10 @@ _PREVIEWS: tuple[tuple[str, Callable[[Layer, Mapping[str, Layer]], Preview]], ..
 
 
 def preview_maker(layer: Layer) -> Callable[[Layer, Mapping[str, Layer]], Preview] | None:
-    """The maker of *layer*'s preview (first matching prefix of :data:`_PREVIEWS`), or ``None``."""
+    """The maker of *layer*'s preview (first matching prefix of :data:`_PREVIEWS`), or ``None``
+    (also for band layers, ``*_bands``: their sRGB views are the RGB layers' previews)."""
+    if layer.data.ndim == 3 and layer.data.shape[-1] not in (1, 3):
+        return None
     return next((f for prefix, f in _PREVIEWS if layer.name.startswith(prefix)), None)
 
 

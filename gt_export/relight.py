@@ -291,6 +291,7 @@ def relight(
         seed=int(meta["seed"]),
         cameras=cameras,
         write_cube="cube" in meta.get("layers", {}),
+        spectral_layers="shading_bands" in meta.get("layers", {}),
         denoise=bool(meta.get("denoised_layers")),
         data_dir=data_dir,
         transport=relit.transport if keep_transport else None,

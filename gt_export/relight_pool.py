@@ -128,6 +128,7 @@ def relit_layers(
         write_cube="cube" in meta.get("layers", {}),
         denoise=bool(meta.get("denoised_layers")) if denoise is None else denoise,
         data_dir=data_dir,
+        spectral="shading_bands" in meta.get("layers", {}),
     )
     out: dict[str, Any] = {name: layer.data for name, layer in gt.layers.items()}
     if "mask" in out:

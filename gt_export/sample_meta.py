@@ -81,11 +81,10 @@ META_FIELDS = frozenset(
         HASHES_KEY,
     }
 )
-#: Fields written only by some builds: ``transport`` (``dataset --store-transport``, the record
-#: of :func:`~spectrinsic.gt_export.transport_file.write_transport`); ``sensor``
-#: (``dataset --camera``); ``spectrum_files`` (a scene with ``csv:`` spectra: name, file,
-#: column and SHA-256 of each, :func:`~spectrinsic.spectra.user_spectra.spectrum_files`).
-OPTIONAL_META_FIELDS = frozenset({"transport", "sensor", "spectrum_files"})
+#: Fields written only by some builds: ``transport`` (``--store-transport``, see
+#: :func:`~spectrinsic.gt_export.transport_file.write_transport`), ``sensor`` (``--camera``),
+#: ``spectrum_files`` (``csv:`` spectra, :func:`~spectrinsic.spectra.user_spectra.spectrum_files`).
+OPTIONAL_META_FIELDS = frozenset({"transport", "sensor", "spectrum_files", "residual_share"})
 _LAYER_FIELDS = frozenset(
     {
         "file",
@@ -324,6 +323,8 @@ def _check_records(f: JsonFields, meta: Mapping[str, object]) -> None:
     """The fields kept as plain JSON in :class:`SampleMeta` (``raw``): checked for type only."""
     for name in ("matrices", "spectral_grid", "shading_clipping", "render"):
         f.numeric_tree(f.mapping(meta[name], name), name)
+    if "residual_share" in meta:  # Σ|residual| / Σ|image| per identity (samples since issue 30)
+        f.numeric_tree(f.mapping(meta["residual_share"], "residual_share"), "residual_share")
     for name in ("objects", "versions"):
         for key, value in f.mapping(meta[name], name).items():
             f.text(value, f"{name}.{key}")

@@ -157,6 +157,7 @@ def _meta(
         "denoised_layers": list(gt.denoised),
         "noise": gt.noise,
         "shading_clipping": gt.clipping,
+        "residual_share": gt.residual_share,
         "files": sorted(files),
         "versions": software_versions(),
     } | ({"spectrum_files": files_used} if files_used else {})
@@ -250,6 +251,7 @@ def export_sample(
     data_dir: str | os.PathLike[str] | None = None,
     transport: LightTransport | None = None,
     camera: CameraModel | None = None,
+    spectral_layers: bool = False,
 ) -> Path:
     """Compute every ground-truth layer of a rendered sample and write it atomically.
 
@@ -286,6 +288,9 @@ def export_sample(
         A :class:`~spectrinsic.spectra.camera_model.CameraModel` to run the sample through
         (:mod:`~spectrinsic.gt_export.sensor`): raw mosaic, DNG, processed image and the ground
         truth in the processed linear space; its sensitivities must be among *cameras*.
+    spectral_layers
+        Also write the per-band intrinsic layers (``spectral.exr``,
+        :mod:`~spectrinsic.gt_export.layers.spectral_intrinsics`); needs the 31-band cube.
 
     Returns
     -------
@@ -301,7 +306,13 @@ def export_sample(
     if camera is not None and camera.sensitivities not in cameras:
         cameras = (*cameras, camera.sensitivities)  # the chain runs on that camera's image
     gt = compute_ground_truth(
-        scene, result, cameras=cameras, write_cube=write_cube, denoise=denoise, data_dir=data_dir
+        scene,
+        result,
+        cameras=cameras,
+        write_cube=write_cube,
+        denoise=denoise,
+        data_dir=data_dir,
+        spectral=spectral_layers,
     )
     sensor = None
     if camera is not None:

@@ -154,6 +154,7 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         data_dir=task.data_dir,
         transport=transport,
         camera=camera_model(cfg.camera) if cfg.camera else None,
+        spectral_layers=cfg.spectral_layers,
     )
     if cfg.relight:
         write_relit_variants(path, cfg.relight, seed=task.seed, data_dir=task.data_dir)

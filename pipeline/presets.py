@@ -148,6 +148,10 @@ class DatasetConfig:
         Relit variants written per rendered sample (needs *store_transport*), each under light
         spectra drawn by :func:`spectrinsic.gt_export.relight_pool.draw_light_spectra`. Left
         out of the settings when 0.
+    spectral_layers
+        Write the per-band intrinsic layers of the 31-band cube in each sample
+        (``spectral.exr``, :mod:`spectrinsic.gt_export.layers.spectral_intrinsics`); needs the
+        ``bands31`` mode. Left out of the settings when off.
     split_fractions
         ``(split, share)`` pairs of the scenes in the manifest's splits (default
         :data:`~spectrinsic.gt_export.manifest.SPLIT_FRACTIONS`, 80/10/10); with at least as
@@ -172,6 +176,7 @@ class DatasetConfig:
     source: str | None = None
     store_transport: bool = False
     relight: int = 0
+    spectral_layers: bool = False
     split_fractions: SplitFractions = SPLIT_FRACTIONS
     camera: str | None = None
 
@@ -213,6 +218,11 @@ class DatasetConfig:
         if isinstance(self.relight, bool) or not isinstance(self.relight, int) or self.relight < 0:
             raise DatasetError(
                 f"dataset setting relight={self.relight!r}; expected a non-negative integer"
+            )
+        if self.spectral_layers and "bands31" not in self.render.modes:
+            raise DatasetError(
+                f"--spectral-layers with modes {list(self.render.modes)}: the spectral layers "
+                "need the 31-band cube (mode bands31, as in the default preset)"
             )
         if self.relight and not self.store_transport:
             raise DatasetError(
@@ -288,6 +298,8 @@ class DatasetConfig:
             d["relight"] = self.relight
         if self.camera is not None:  # off: out of the hash
             d["camera"] = camera_model(self.camera).settings()
+        if self.spectral_layers:  # off: out of the hash, as before it existed
+            d["spectral_layers"] = True
         return d
 
     def resolved_cameras(self) -> tuple[str, ...]:

@@ -28,6 +28,7 @@ from spectrinsic.gt_export.layers.lights import light_records, share_layers
 from spectrinsic.gt_export.layers.records import (
     RGB,
     GroundTruth,
+    Layer,
     RenderRecord,
     SampleInputs,
     aov,
@@ -38,6 +39,11 @@ from spectrinsic.gt_export.layers.records import (
     reference_mode,
 )
 from spectrinsic.gt_export.layers.spectral import camera_curves
+from spectrinsic.gt_export.layers.spectral_intrinsics import (
+    residual_shares,
+    spectral_identity,
+    spectral_layers,
+)
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import absolute_reflectance, get_sensors, get_spectrum
 
@@ -58,6 +64,22 @@ def _sample(scene: Scene, result: Any, data_dir: Any) -> SampleInputs:
     )
 
 
+def _reflectance(coverage: np.ndarray, names: list[str], data_dir: Any) -> tuple[Layer, Any]:
+    """``reflectance`` (linear sRGB under D65 of each material, coverage-weighted) as a layer
+    and in float64."""
+    values = coverage_weighted(
+        coverage, absolute_reflectance(names, data_dir=data_dir) if names else np.zeros((0, 3))
+    )
+    return make_layer(
+        "reflectance",
+        values,
+        RGB,
+        "dimensionless absolute reflectance, linear sRGB under D65 (perfect white = 1); "
+        "box-filtered by pixel coverage, 0 for background",
+        "intrinsics",
+    ), values
+
+
 def compute_ground_truth(
     scene: Scene,
     result: RenderRecord,
@@ -69,6 +91,7 @@ def compute_ground_truth(
     denoiser: Denoiser | None = None,
     data_dir: Any = None,
     training: np.ndarray | None = None,
+    spectral: bool = False,
 ) -> GroundTruth:
     """Compute every ground-truth layer of one rendered sample.
 
@@ -98,6 +121,9 @@ def compute_ground_truth(
         alternatives with it).
     training
         ``(N, 471)`` reflectances on the 1 nm grid for the matrix fits (default: all Munsell chips).
+    spectral
+        Add the per-band intrinsic layers of the 31-band cube (``spectral.exr``,
+        :mod:`~spectrinsic.gt_export.layers.spectral_intrinsics`).
     """
     s = _sample(scene, result, data_dir)
     layers = image_layers(s)
@@ -105,19 +131,8 @@ def compute_ground_truth(
     coverage, mask = coverage_of(s, (image.shape[0], image.shape[1]))
     layers += geometry_layers(s, mask)
     names = [m.spectrum for m in scene.materials]
-    reflectance = coverage_weighted(
-        coverage, absolute_reflectance(names, data_dir=data_dir) if names else np.zeros((0, 3))
-    )
-    layers.append(
-        make_layer(
-            "reflectance",
-            reflectance,
-            RGB,
-            "dimensionless absolute reflectance, linear sRGB under D65 (perfect white = 1); "
-            "box-filtered by pixel coverage, 0 for background",
-            "intrinsics",
-        )
-    )
+    reflectance_layer, reflectance = _reflectance(coverage, names, data_dir)
+    layers.append(reflectance_layer)
     w_raw = white_radiance(s, coverage)
     w = w_raw
     if denoise:
@@ -144,8 +159,11 @@ def compute_ground_truth(
     cube_name = cube_sensor_name(result) if "bands31" in result.raw else None
     if write_cube:
         layers.append(cube_layer(s, cube_name))
+    if spectral:
+        layers += spectral_layers(s, coverage, w_raw, w, denoised=denoise)
+    by_name = {layer.name: layer for layer in layers}
     return GroundTruth(
-        layers={layer.name: layer for layer in layers},
+        layers=by_name,
         lights=light_records(s, shares, spaces, cameras),
         materials={str(i): n for i, n in enumerate(names)},
         matrices=matrices_of(s, shares, spaces, training),
@@ -157,16 +175,21 @@ def compute_ground_truth(
         ),
         noise=noise,
         clipping=clipping_of(srgb_of(w) / srgb_white(s), w.valid & (irr.luminance_of(w) > 0)),
+        residual_share=residual_shares(_identities(by_name, cameras), by_name, mask),
     )
 
 
 def identities(gt: GroundTruth) -> list[dict[str, str]]:
     """The exact identities the layers satisfy: ``image = reflectance ∘ shading [+ specular] +
     residual`` per sensor space (and on the raw layers when denoised), the specular term only in
-    glossy scenes; recorded in ``meta.json``."""
+    glossy scenes, and per band with the spectral layers; recorded in ``meta.json``."""
+    return _identities(gt.layers, gt.cameras)
+
+
+def _identities(layers: dict[str, Any], cameras: Sequence[str]) -> list[dict[str, str]]:
     out = []
-    denoised = "image_denoised" in gt.layers
-    glossy = "specular" in gt.layers
+    denoised = "image_denoised" in layers
+    glossy = "specular" in layers
     spec = {"specular": "specular"} if glossy else {}
     out.append(
         {
@@ -187,7 +210,7 @@ def identities(gt: GroundTruth) -> list[dict[str, str]]:
             }
             | spec
         )
-    for cam in gt.cameras:
+    for cam in cameras:
         key = camera_key(cam)
         image = f"image_camera_denoised/{key}" if denoised else f"image_camera/{key}"
         out.append(
@@ -199,4 +222,5 @@ def identities(gt: GroundTruth) -> list[dict[str, str]]:
             }
             | ({"specular": f"specular_camera/{key}"} if glossy else {})
         )
-    return out
+    spectral = spectral_identity(layers)
+    return out if spectral is None else [*out, spectral]

@@ -291,4 +291,7 @@ def from_denoised(name: str) -> bool:
         "shading_camera",
         "residual_camera",
         "illuminant_camera",
+        "image_bands",
+        "shading_bands",
+        "residual_bands",
     )

@@ -156,6 +156,9 @@ class GroundTruth:
     #: fraction of lit pixels with a clipped channel; ``mean``/``max``, the clipped part's norm
     #: relative to the shading's norm over those pixels.
     clipping: dict[str, float] = field(default_factory=dict)
+    #: ``Σ|residual| / Σ|image|`` over the mask, per identity, keyed by its image layer
+    #: (``image``/``image_denoised``: RGB; ``image_bands``: per band).
+    residual_share: dict[str, float] = field(default_factory=dict)
 
 
 def grid() -> np.ndarray:

@@ -7,7 +7,7 @@
   const G = window.SPECTRINSIC_GALLERY;
   const PAGE_SIZE = 60;
   const SVG = "http://www.w3.org/2000/svg";
-  const state = { scene: "", generator: "", condition: "", kind: "", split: "", noiseMax: "", page: 0 };
+  const state = { scene: "", generator: "", condition: "", kind: "", split: "", noiseMax: "", residualMax: "", page: 0 };
   const app = document.getElementById("app");
 
   function el(tag, attrs, ...children) {
@@ -73,12 +73,14 @@
   // ------------------------------------------------------------------ overview
   function filtered() {
     const max = state.noiseMax === "" ? Infinity : parseFloat(state.noiseMax);
+    const rmax = state.residualMax === "" ? Infinity : parseFloat(state.residualMax);
     return G.samples.filter((s) => (!state.scene || s.scene === state.scene)
       && (!state.generator || s.generator === state.generator)
       && (!state.condition || s.condition === state.condition)
       && (!state.kind || s.kind === state.kind)
       && (!state.split || s.split === state.split)
-      && (max === Infinity || (s.noise != null && s.noise <= max)));
+      && (max === Infinity || (s.noise != null && s.noise <= max))
+      && (rmax === Infinity || (s.residual_share != null && s.residual_share <= rmax)));
   }
   function select(key, label, values) {
     const s = el("select", { id: `filter-${key}`, on: { change: (e) => { state[key] = e.target.value; state.page = 0; renderList(); } } },
@@ -94,6 +96,10 @@
       on: { change: (e) => { state.noiseMax = e.target.value; state.page = 0; renderList(); } } });
     noise.value = state.noiseMax;
     bar.append(el("label", { title: "median relative standard error of shading_raw" }, "noise ≤", noise));
+    const residual = el("input", { id: "filter-residual", type: "number", step: "0.01", min: "0", placeholder: "any",
+      on: { change: (e) => { state.residualMax = e.target.value; state.page = 0; renderList(); } } });
+    residual.value = state.residualMax;
+    bar.append(el("label", { title: "share of the image in the RGB residual, sum |residual| / sum |image| over the mask" }, "residual ≤", residual));
     return bar;
   }
   function overviewPanels() {
@@ -112,7 +118,7 @@
     return el("div", { class: "card", "data-id": s.id, on: { click: () => { location.hash = "sample=" + encodeURIComponent(s.id); } } },
       el("img", { src: thumb, loading: "lazy", alt: s.id, width: "160", height: "160" }),
       el("div", { class: "id", text: s.id }),
-      el("div", { class: "sub", text: `${s.condition ?? ""} · ${s.kind ?? ""}${s.noise != null ? " · noise " + fmt(s.noise) : ""}${s.split ? " · " + s.split : ""}` }));
+      el("div", { class: "sub", text: `${s.condition ?? ""} · ${s.kind ?? ""}${s.noise != null ? " · noise " + fmt(s.noise) : ""}${s.residual_share != null ? " · residual " + fmt(s.residual_share) : ""}${s.split ? " · " + s.split : ""}` }));
   }
   function renderList() {
     const list = filtered();

@@ -42,3 +42,16 @@ def test_render_and_decompose_benchmarks_write_their_results(tiny, tmp_path, cap
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert set(summary) == {"bench_render", "bench_decompose"}
     assert "bench_render:" in capsys.readouterr().out
+
+
+def test_residual_benchmark_reports_rgb_and_band_shares(monkeypatch, tmp_path):
+    from spectrinsic.bench import residual as bench_residual
+
+    monkeypatch.setattr(bench_residual, "ROOMS", 1)
+    monkeypatch.setattr(bench_residual, "SIZE", 12)
+    monkeypatch.setattr(bench_residual, "SPP", 2)
+    assert bench.main(["--out", str(tmp_path), "--only", "residual"]) == 0
+    result = json.loads((tmp_path / "bench_residual.json").read_text())
+    assert result["band_residual_share"]["max"] < 1e-4 < result["rgb_residual_share"]["max"]
+    cost = result["spectral_exr_cost"]
+    assert cost["folder_bytes_with_bands"] > cost["folder_bytes_without_bands"]
