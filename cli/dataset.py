@@ -9,6 +9,7 @@ from typing import Any
 
 from tqdm import tqdm
 
+from spectrinsic.cli.dataset_layers import add_extra_layer_options
 from spectrinsic.cli.dataset_source import (
     add_source_options,
     check_scene_files,
@@ -123,7 +124,7 @@ def _add_build_options(p: Any) -> None:
 def _add_quality_options(p: Any) -> None:
     """Overrides of the preset's sampling, denoising and image size."""
     _add_sampling_options(p)
-    _add_extra_layer_options(p)
+    add_extra_layer_options(p)
     _add_rendering_options(p)
 
 
@@ -166,47 +167,6 @@ def _add_sampling_options(p: Any) -> None:
         default=None,
         metavar="N",
         help="cap of the adaptive batches (default 4 x batches)",
-    )
-
-
-def _add_extra_layer_options(p: Any) -> None:
-    """What is rendered and stored beyond the default layers: direct light, per-light
-    transport, relit variants."""
-    p.add_argument(
-        "--direct",
-        action="store_true",
-        help="also render direct light only, to record the energy ratio r per sample",
-    )
-    p.add_argument(
-        "--store-transport",
-        action="store_true",
-        help="store each light's 31-band transport in every sample (transport.exr), so "
-        "`spectrinsic relight` can relight it exactly; renders the diagonal modes "
-        "light by light",
-    )
-    p.add_argument(
-        "--spectral-layers",
-        action="store_true",
-        help="also write per-band intrinsic layers of the 31-band cube (spectral.exr: "
-        "image, reflectance, shading, specular, residual per 10 nm band, float32), where "
-        "image = reflectance * shading + specular + residual holds band by band; needs the "
-        "bands31 mode (default preset); about +24 MB and +2.3 s per 256x256 sample",
-    )
-    p.add_argument(
-        "--relight",
-        type=int,
-        default=None,
-        metavar="N",
-        help="with --store-transport: also write N relit variants of every sample "
-        "(<id>-relitK, random light spectra, seeded)",
-    )
-    p.add_argument(
-        "--camera",
-        default=None,
-        metavar="NAME",
-        help="run every sample through a camera (raw mosaic + DNG, noise, demosaic, white "
-        "balance, colour matrix, tone curve; ground truth in the processed linear space): a "
-        "preset (nikon-d5100-npl, nikon-d3) or 'camera:NAME'/'csv:PATH'; needs bands31",
     )
 
 
