@@ -50,16 +50,16 @@ def sample_lighting(sample: Mapping[str, Any]) -> LightingCondition:
 
 
 def sample_condition(sample: Mapping[str, Any]) -> str:
-    """Lighting condition: the library's (``meta["condition"]`` or the sample id's, when it is
-    one of :data:`CONDITION_GROUPS` and the scene is not generated), else the group measured from the sample's lights
-    (``WL``, ``1L``, ``2L``: :func:`sample_lighting`), so generated sets, scene files and
-    relit samples are grouped by what they hold."""
+    """Lighting condition: the library's (``meta["condition"]``, else the sample id's, when it
+    is one of :data:`CONDITION_GROUPS` and the scene was not generated), else the group
+    measured from the sample's lights (``WL``, ``1L``, ``2L``: :func:`sample_lighting`), so
+    generated sets, scene files and relit samples are grouped by what they hold."""
     meta = sample.get("meta", {})
-    cond = meta.get("condition") or meta.get("scene_metadata", {}).get("condition")
+    cond = meta.get("condition")
     if not cond:
         try:
             cond = SampleId.parse(sample_id_of(sample)).condition
-        except DatasetError:  # a relit sample's or a user's own id
+        except DatasetError:  # a user's own id
             cond = None
     if cond in CONDITION_GROUPS and "generator" not in meta.get("scene_metadata", {}):
         return str(cond)
