@@ -18,8 +18,8 @@ from spectrinsic.decompose.scored import add_scored_section, describe_scored
 from spectrinsic.decompose.targets import TARGETS
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.loader import load_sample
-from spectrinsic.gt_export.staged_output import staged_output
 from spectrinsic.gt_export.sample import sample_dirs
+from spectrinsic.gt_export.staged_output import staged_output
 
 __all__ = ["register", "run", "DEFAULT_DATASET", "DEFAULT_OUT"]
 
