@@ -70,8 +70,10 @@ def describe_scored(dataset: Path, folders: Sequence[Path]) -> ScoredSet:
     groups: Counter[str] = Counter()
     lights: Counter[str] = Counter()
     noise = []
+    hashes = set()
     for folder in folders:
         meta = _json(folder / "meta.json")
+        hashes.add(meta.get("config_hash") if isinstance(meta.get("config_hash"), str) else "")
         try:
             lighting = describe_lighting(meta.get("lights") or [])
         except ValueError as exc:
@@ -85,7 +87,10 @@ def describe_scored(dataset: Path, folders: Sequence[Path]) -> ScoredSet:
     return ScoredSet(
         dataset=str(dataset.resolve()),
         preset=config.get("preset") if isinstance(config, dict) else None,
-        config_hash=manifest.get("config_hash"),
+        # without a manifest (a sample folder), the samples' own hash when they share one
+        config_hash=manifest.get("config_hash")
+        or (hashes.pop() if len(hashes) == 1 else None)
+        or None,
         n_listed=n_listed if isinstance(n_listed, int) else None,
         n_scored=len(folders),
         groups={g: groups[g] for g in GROUPS if groups[g]},
@@ -102,7 +107,7 @@ def scored_section(s: ScoredSet) -> list[str]:
         "",
         f"* dataset: `{s.dataset}`",
         f"* preset: `{s.preset or 'not recorded (no manifest.json)'}`; config hash: "
-        f"`{s.config_hash or 'not recorded (no manifest.json)'}`",
+        f"`{s.config_hash or 'not recorded'}`",
         f"* samples scored: {s.n_scored}{listed}",
         "* lighting, measured from each sample's lights (WL: white light, 1L: one coloured "
         "light colour, 2L: two or more light colours): "

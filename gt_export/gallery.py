@@ -39,6 +39,7 @@ from spectrinsic.gt_export.manifest import read_manifest
 from spectrinsic.gt_export.names import slug
 from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, plain_data, sample_dirs
 from spectrinsic.gt_export.sample_meta import SampleMeta, read_meta
+from spectrinsic.scenes.lighting import describe_lighting
 from spectrinsic.scenes.sample_id import SEPARATOR
 from spectrinsic.spectra import get_sensors, xyz_to_xy
 
@@ -174,7 +175,8 @@ def _sample_entry(sample: Path, meta: SampleMeta, split: str | None) -> dict[str
     return {
         "id": sample.name,
         "scene": meta.scene,
-        "condition": smeta.get("condition"),
+        # a scene file's lights say what its condition is (white, one-colour, two-colour)
+        "condition": smeta.get("condition") or describe_lighting(lights).family,
         # generated scenes name their generator; the built-in library and user scenes do not
         "generator": smeta.get("generator") or ("library" if "library" in smeta else "own scene"),
         "kind": scene_kind(meta),

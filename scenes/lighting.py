@@ -16,8 +16,8 @@ lights); the library's conditions fall in them as the thesis groups them
 (``white`` -> WL, ``one-colour`` -> 1L, ``two-colour-a/b`` -> 2L).
 
 >>> d = describe_lighting([{"spectrum": "cie:D65", "xy": [0.3127, 0.3290], "share": 1.0}])
->>> d.group, d.n_lights, d.n_colours
-('WL', 1, 1)
+>>> d.group, d.family, d.n_lights, d.n_colours
+('WL', 'white', 1, 1)
 >>> two = [{"spectrum": "cie:A", "xy": [0.4476, 0.4074], "share": 0.6},
 ...        {"spectrum": "cie:F2", "xy": [0.3721, 0.3751], "share": 0.4}]
 >>> d = describe_lighting(two)
@@ -75,6 +75,11 @@ class LightingCondition:
     n_colours: int
     xy_spread: float
     white: bool
+
+    @property
+    def family(self) -> str:
+        """The generators' name of the group: ``white``, ``one-colour`` or ``two-colour``."""
+        return {"WL": "white", "1L": "one-colour", "2L": "two-colour"}[self.group]
 
     @property
     def group(self) -> str:

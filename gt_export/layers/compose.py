@@ -38,6 +38,7 @@ from spectrinsic.gt_export.layers.records import (
     reference_mode,
 )
 from spectrinsic.gt_export.layers.spectral import camera_curves
+from spectrinsic.scenes.material_labels import material_label
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import absolute_reflectance, get_sensors, get_spectrum
 
@@ -147,7 +148,7 @@ def compute_ground_truth(
     return GroundTruth(
         layers={layer.name: layer for layer in layers},
         lights=light_records(s, shares, spaces, cameras),
-        materials={str(i): n for i, n in enumerate(names)},
+        materials={str(i): material_label(m) for i, m in enumerate(scene.materials)},
         matrices=matrices_of(s, shares, spaces, training),
         reference_mode=s.ref,
         cameras=tuple(cameras),
