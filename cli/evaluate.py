@@ -18,6 +18,7 @@ from spectrinsic.decompose.scored import add_scored_section, describe_scored
 from spectrinsic.decompose.targets import TARGETS
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.loader import load_sample
+from spectrinsic.gt_export.outfolder import check_output_folder
 from spectrinsic.gt_export.sample import sample_dirs
 from spectrinsic.gt_export.staged_output import staged_output
 
@@ -182,6 +183,7 @@ def run(args: argparse.Namespace) -> int:
         return _run_mit(args)
     folders = _folders(Path(args.dataset), args.samples)
     methods = _methods(args)
+    check_output_folder(Path(args.out))  # the folder first, as every verb does
     scored = describe_scored(Path(args.dataset), folders)  # refuses a bad sample before work
     with staged_output(Path(args.out)) as stage:  # a failed run leaves --out as it was
         result = _evaluate(args, folders, methods, stage)

@@ -4,7 +4,8 @@ lighting, and a warning when the renderings are preview-grade noisy.
 ``spectrinsic evaluate`` adds :func:`scored_section` to ``REPORT.md`` (under its first
 paragraph, :func:`add_scored_section`) and writes the same record as ``scored.json``, so a
 report says which data its numbers come from. The lighting groups are measured from each
-sample's lights (:func:`spectrinsic.scenes.lighting.describe_lighting`).
+sample's lights where the sample is not one of the library's conditions
+(:func:`spectrinsic.decompose.sample_fields.sample_condition`).
 """
 
 from __future__ import annotations
@@ -18,10 +19,12 @@ from typing import Any
 
 import numpy as np
 
+from spectrinsic.decompose.sample_fields import sample_condition
+from spectrinsic.decompose.scores import condition_group
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.check import NOISE_THRESHOLD
 from spectrinsic.gt_export.sample import MANIFEST_NAME
-from spectrinsic.scenes.lighting import GROUPS, describe_lighting
+from spectrinsic.scenes.lighting import GROUPS
 
 __all__ = ["ScoredSet", "add_scored_section", "describe_scored", "scored_section"]
 
@@ -74,12 +77,10 @@ def describe_scored(dataset: Path, folders: Sequence[Path]) -> ScoredSet:
     for folder in folders:
         meta = _json(folder / "meta.json")
         hashes.add(meta.get("config_hash") if isinstance(meta.get("config_hash"), str) else "")
-        try:
-            lighting = describe_lighting(meta.get("lights") or [])
-        except ValueError as exc:
-            raise DatasetError(f"sample {folder.name!r}: {exc}") from None
-        groups[lighting.group] += 1
-        lights[str(lighting.n_lights)] += 1
+        # the evaluation's own grouping; refuses a sample it could not group, before any work
+        sample = {"meta": {"sample_id": folder.name, **meta}}
+        groups[condition_group(sample_condition(sample))] += 1
+        lights[str(len(meta.get("lights") or []))] += 1
         median = (meta.get("noise") or {}).get("image", {}).get("median")
         if isinstance(median, int | float):
             noise.append(float(median))
