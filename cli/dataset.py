@@ -54,7 +54,8 @@ def register(subparsers: Any) -> None:
     """Add the ``dataset`` subcommand to the CLI's *subparsers*."""
     p = subparsers.add_parser(
         "dataset",
-        help="render the dataset (68 samples) with ground truth; resumable",
+        help="render a dataset with ground truth: the thesis' 68 library samples, generated "
+        "scenes (--generator) or your own scene files (--scenes); resumable",
         description=(
             "Render the dataset layout of the thesis (8 objects x 4 conditions + 3 complex "
             "scenes x 3 views x 4 conditions) with ground-truth layers, then write "
@@ -181,8 +182,9 @@ def _add_extra_layer_options(p: Any) -> None:
         "--store-transport",
         action="store_true",
         help="store each light's 31-band transport in every sample (transport.exr), so "
-        "`spectrinsic relight` can relight it exactly; renders the diagonal modes "
-        "light by light",
+        "`spectrinsic relight` can relight it exactly; no extra render with the default "
+        "single integrator (it splits every band by light), the lights one at a time "
+        "with --integrator passes",
     )
     p.add_argument(
         "--relight",

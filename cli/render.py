@@ -61,10 +61,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="render a scene in several colour modes and write raw passes as EXR",
         description="Render SCENE (a library scene name, a YAML, .blend or mesh file) with Mitsuba 3 "
         "in each mode and write float32 EXR files with named channels into --out "
-        "(raw passes, XYZ, AOVs; ground-truth layers come from `spectrinsic dataset`). "
+        "(raw passes, XYZ, AOVs; with --ground-truth every ground-truth layer, by the "
+        "path of `spectrinsic dataset`). "
         f"Defaults are the dataset's default preset: {default.render.spp} spp, path depth "
         f"{default.render.max_depth}, library scenes at {default.width}x{default.height}. "
-        f"Modes: {_modes_help()}.",
+        f"Modes: {_modes_help()}. The pass counts are those of --integrator passes; the "
+        "default single integrator renders every diagonal mode in one path traversal.",
     )
     _add_scene_options(p)
     _add_output_options(p)

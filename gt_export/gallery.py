@@ -287,7 +287,8 @@ def contact_sheet(
     out: str | os.PathLike[str] | None = None,
     samples: Sequence[Path] | None = None,
 ) -> Path:
-    """Tile the ``image`` preview of every sample (or of *samples*) with its id into one PNG.
+    """Tile the ``image_denoised`` preview (``image`` where there is none) of every sample (or
+    of *samples*) with its id into one PNG, each scaled to fill a :data:`TILE`-pixel tile.
 
     Ids longer than a tile are written on two lines, never truncated.
     """
@@ -306,12 +307,8 @@ def contact_sheet(
     sheet = Image.new("RGB", (cols * TILE, rows * cell), (255, 255, 255))
     draw = ImageDraw.Draw(sheet)
     for i, sample in enumerate(samples):
-        preview = read_meta(sample).layers["image"].preview
-        if preview is None:
-            raise DatasetError(f"{sample / META_NAME}: layers.image.preview: expected a preview")
-        with Image.open(sample / preview) as img:
-            tile = img.convert("RGB")
-            tile.thumbnail((TILE, TILE), Image.Resampling.LANCZOS)
+        with Image.open(sample / _sheet_preview(sample)) as img:
+            tile = _fit(img.convert("RGB"), Image.Resampling)
         x0, y0 = (i % cols) * TILE, (i // cols) * cell
         sheet.paste(tile, (x0 + (TILE - tile.width) // 2, y0 + (TILE - tile.height) // 2))
         for line_no, line in enumerate(_wrap(sample.name, draw, font)):
@@ -323,6 +320,23 @@ def contact_sheet(
         path.parent.mkdir(parents=True, exist_ok=True)
         sheet.save(path, format="PNG")
     return path
+
+
+def _sheet_preview(sample: Path) -> str:
+    """The preview a contact sheet shows: the denoised image's, else the raw image's."""
+    layers = read_meta(sample).layers
+    for name in ("image_denoised", "image"):
+        if name in layers and layers[name].preview is not None:
+            return str(layers[name].preview)
+    raise DatasetError(f"{sample / META_NAME}: layers.image.preview: expected a preview")
+
+
+def _fit(tile: Any, resampling: Any) -> Any:
+    """*tile* scaled to fit :data:`TILE` (enlarged too: pixels stay square blocks)."""
+    scale = TILE / max(tile.width, tile.height)
+    size = (max(1, round(tile.width * scale)), max(1, round(tile.height * scale)))
+    method = resampling.NEAREST if scale > 1 else resampling.LANCZOS
+    return tile.resize(size, method)
 
 
 def _wrap(text: str, draw: Any, font: Any) -> list[str]:

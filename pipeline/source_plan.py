@@ -64,7 +64,8 @@ MAX_COUNT = 100_000
 #: Version of what the generators draw for a seed, part of the config: a set built by an older
 #: version (other light pools, furniture, framing) asks for ``--rebuild`` instead of mixing.
 #: 2: saturated lights, ranges obeyed by every material, framed rooms (issue 22).
-GENERATOR_VERSION = 2
+#: 3: cameras pass the view rule (``scenes.generators.view_rule``, issue 31).
+GENERATOR_VERSION = 3
 MAX_VIEWS = 64
 
 

@@ -29,6 +29,7 @@ import numpy as np
 
 from spectrinsic.scenes.generators.camera import ray_triangle_hits
 from spectrinsic.scenes.geometry import camera_rays
+from spectrinsic.scenes.library import TARGET_IRRADIANCE
 from spectrinsic.scenes.model import Camera, Light, Mesh
 
 __all__ = [
@@ -56,6 +57,9 @@ MIN_MATERIAL_SHARE = 0.02
 MIN_LIT_SHARE = 0.5
 MAX_CONTRAST = 25.0
 BRIGHT_PERCENTILE = 95.0
+#: Least median irradiance over the frame, as a fraction of the target irradiance the
+#: generators give the lights' focus (a view looking into the dark fails).
+MIN_MEDIAN_LIGHT = 0.05
 #: Bounce rays per visible surface point, and the albedo the bounce is weighted with.
 BOUNCE_RAYS = 8
 BOUNCE_ALBEDO = 0.5
@@ -71,6 +75,9 @@ class ViewJudgement:
     max_material_share: float
     n_materials: int
     lit_share: float
+    #: Median over the frame of the estimated irradiance, relative to the generators' target
+    #: irradiance at the lights' focus (``TARGET_IRRADIANCE``).
+    median_light: float = 1.0
 
     @property
     def reasons(self) -> tuple[str, ...]:
@@ -84,6 +91,8 @@ class ViewJudgement:
             out.append(f"one material fills {self.max_material_share:.0%} of the frame")
         if self.lit_share < MIN_LIT_SHARE:
             out.append(f"only {self.lit_share:.0%} of the frame is lit")
+        if self.median_light < MIN_MEDIAN_LIGHT:
+            out.append(f"the frame's median irradiance is {self.median_light:.2g} of the target")
         return tuple(out)
 
     @property
@@ -212,7 +221,12 @@ def judge_view(meshes: Sequence[Mesh], lights: Sequence[Light], camera: Camera) 
     """The view rule's measurements of *camera* in a scene of *meshes* and *lights*."""
     g = _geometry(meshes)
     o, d = camera_rays(
-        camera.origin, camera.target, camera.up, camera.fov_deg, camera.width, camera.height,
+        camera.origin,
+        camera.target,
+        camera.up,
+        camera.fov_deg,
+        camera.width,
+        camera.height,
         n=VIEW_GRID,
     )
     hit, t = g.hits(o, d)
@@ -232,4 +246,5 @@ def judge_view(meshes: Sequence[Mesh], lights: Sequence[Light], camera: Camera) 
         max_material_share=float(materials_seen.max()) / total,
         n_materials=int((materials_seen >= MIN_MATERIAL_SHARE * total).sum()),
         lit_share=float(lit.mean()),
+        median_light=float(np.median(light)) / TARGET_IRRADIANCE,
     )

@@ -138,3 +138,25 @@ def test_a_refused_evaluation_leaves_no_output(generated, tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and victim.parent.name in err
     assert not out.exists()
+
+
+def test_the_contact_sheet_shows_the_denoised_image_at_tile_size(generated):
+    from PIL import Image
+
+    from spectrinsic.gt_export.gallery import TILE, _fit
+    from spectrinsic.gt_export.sample import sample_dirs
+
+    first = sample_dirs(generated)[0]
+    layers = _meta(first)["layers"]
+    with Image.open(generated / "contact_sheet.png") as sheet:
+        shown = sheet.convert("RGB").crop((0, 0, TILE, TILE))
+
+    def tile(layer):
+        with Image.open(first / layers[layer]["preview"]) as img:
+            fitted = _fit(img.convert("RGB"), Image.Resampling)
+        canvas = Image.new("RGB", (TILE, TILE), (255, 255, 255))
+        canvas.paste(fitted, ((TILE - fitted.width) // 2, (TILE - fitted.height) // 2))
+        return canvas
+
+    assert shown.tobytes() == tile("image_denoised").tobytes()  # 16 px enlarged to the tile
+    assert shown.tobytes() != tile("image").tobytes()  # not the raw, noisy image
