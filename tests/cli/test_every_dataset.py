@@ -98,6 +98,8 @@ def test_a_generated_set_with_two_light_samples_checks_and_evaluates(generated, 
     manifest = json.loads((generated / "manifest.json").read_text())
     assert scored["config_hash"] == manifest["config_hash"] and scored["n_scored"] == 4
     assert scored["groups"].get("2L", 0) >= 1 and "| 2L" in report
+    card = (generated / "DATASET.md").read_text()
+    assert "## Intended use" in card and "## Licence" in card and "## Citation" in card
 
 
 def test_own_scene_is_labelled_from_the_scene_and_evaluates(own_scene, tmp_path, capsys):
