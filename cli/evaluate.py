@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import csv
 import fnmatch
 import logging
 from pathlib import Path
@@ -12,6 +13,7 @@ from tqdm import tqdm
 
 from spectrinsic.decompose.evaluate import evaluate
 from spectrinsic.decompose.mit import evaluate_mit, mit_folder_objects
+from spectrinsic.decompose.mit_report import MIT_FIGURE, write_mit_report
 from spectrinsic.decompose.predictions import Predictions
 from spectrinsic.decompose.registry import available_decomposers, get_decomposer
 from spectrinsic.decompose.scored import add_scored_section, describe_scored
@@ -171,10 +173,24 @@ def _run_mit(args: argparse.Namespace) -> int:
     patterns = [g.strip() for g in args.samples.split(",") if g.strip()] if args.samples else None
     files = mit_folder_objects(Path(args.mit), patterns)
     methods = _methods(args)
+    bar = tqdm(total=len(files), desc="evaluate --mit", unit="object", disable=args.quiet)
+
+    def progress(name: str) -> None:
+        bar.set_postfix_str(name)
+        bar.update(1)
+
     with staged_output(Path(args.out)) as stage:  # a failed run leaves --out as it was
-        written = evaluate_mit(files, methods, stage)
+        try:
+            written = evaluate_mit(files, methods, stage, progress=progress)
+        finally:
+            bar.close()
+        rows = list(csv.DictReader(written["table_csv"].open(encoding="utf-8")))
+        write_mit_report(stage, Path(args.mit), len(files), rows)
         print(written["table_md"].read_text(encoding="utf-8"))
-    print(f"MIT protocol on {len(files)} objects in {args.out} (mit_scores.csv, mit_table_3_2.*)")
+    print(
+        f"MIT protocol on {len(files)} objects in {args.out} "
+        f"(REPORT.md, {MIT_FIGURE}, mit_scores.csv, mit_table_3_2.*)"
+    )
     return 0
 
 
