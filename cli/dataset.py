@@ -16,6 +16,7 @@ from spectrinsic.cli.dataset_source import (
     source_from_args,
     source_notes,
 )
+from spectrinsic.cli.dataset_variant import add_variant_option, check_variant
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.integrity import check_build_folder
 from spectrinsic.gt_export.manifest import SPLIT_FRACTIONS
@@ -205,6 +206,7 @@ def _add_rendering_options(p: Any) -> None:
         help="diagonal modes from one traversal (single, the default) or the passes; "
         "same pixels to float rounding, so not part of the config hash",
     )
+    add_variant_option(p)
     p.add_argument(
         "--no-denoise",
         action="store_true",
@@ -227,6 +229,7 @@ _VALUE_OPTIONS: tuple[tuple[str, str], ...] = (
     ("noise_target", "noise_target"),
     ("max_batches", "max_batches"),
     ("integrator", "integrator"),
+    ("variant", "variant"),
 )
 #: Switches and the config value each sets when given (option dest -> (config key, value)).
 _SWITCHES: tuple[tuple[str, str, bool], ...] = (
@@ -306,6 +309,7 @@ def preflight(
 
 
 def run(args: argparse.Namespace) -> int:
+    check_variant(args)
     config = config_from_args(args)
     preflight(
         args.out,

@@ -269,6 +269,8 @@ def _ground_truth(args: argparse.Namespace) -> int:
         changes["spp"] = args.spp
     if args.direct:
         changes["direct"] = True
+    if args.variant is not None:  # the backend of the one-sample dataset too
+        changes["variant"] = args.variant
     size = requested_size(args)
     if size is not None:
         changes["width"], changes["height"] = size
