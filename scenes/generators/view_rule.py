@@ -11,8 +11,13 @@ Judged when the camera is drawn, before any render, from a low-resolution ray ca
   at least 1/:data:`MAX_CONTRAST` of the irradiance of the frame's bright end, counting the
   lights' direct irradiance (a shadow ray per light, spot cones and one-sided area lights
   respected, the model's radiometry) and one bounce (:data:`BOUNCE_RAYS` cosine-distributed
-  rays per point). Rays that leave the scene (a missing wall, a window) are dark. A view lit
-  on a small patch only (black once exposed for the patch) fails.
+  rays per point), and the frame's median irradiance is at least :data:`MIN_MEDIAN_LIGHT` of
+  the target irradiance the generators give the lights' focus. Rays that leave the scene (a
+  missing wall, a window) are dark. A view lit on a small patch only (black once exposed for
+  the patch) fails, and so does one looking into the dark.
+
+Measured on 50 rooms (root seed 11): 50 of 92 judged cameras pass (acceptance 54 %), about
+0.4 s per judged camera on one core (``tests/scenes/test_view_rule.py``).
 
 A camera that fails is re-drawn from the scene's seeded camera generator
 (:func:`spectrinsic.scenes.generators.camera.sample_camera`), so a build stays reproducible.
