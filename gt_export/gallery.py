@@ -175,8 +175,9 @@ def _sample_entry(sample: Path, meta: SampleMeta, split: str | None) -> dict[str
     return {
         "id": sample.name,
         "scene": meta.scene,
-        # a scene file's lights say what its condition is (white, one-colour, two-colour)
-        "condition": smeta.get("condition") or describe_lighting(lights).family,
+        # a scene file's or a relit sample's lights say what its condition is
+        "condition": ("relit_from" not in smeta and smeta.get("condition"))
+        or describe_lighting(lights).family,
         # generated scenes name their generator; the built-in library and user scenes do not
         "generator": smeta.get("generator") or ("library" if "library" in smeta else "own scene"),
         "kind": scene_kind(meta),

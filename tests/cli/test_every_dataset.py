@@ -125,6 +125,14 @@ def test_a_relit_sample_checks_and_evaluates(tmp_path, capsys):
     assert main(["-q", "relight", str(data / only), *leds, "--out", str(relit)]) == 0
     _, scored = _checks_and_evaluates(relit, tmp_path / "ev", capsys, preview=False)
     assert scored["config_hash"] == _meta(relit)["config_hash"] and scored["n_scored"] == 1
+    # its condition is its new lights', not the two-colour-a its scene metadata still names
+    from spectrinsic.gt_export.gallery import _sample_entry
+    from spectrinsic.gt_export.sample_meta import read_meta
+    from spectrinsic.scenes.lighting import describe_lighting
+
+    entry = _sample_entry(relit, read_meta(relit), None)
+    assert entry["condition"] == describe_lighting(_meta(relit)["lights"]).family
+    assert entry["condition"] != "two-colour-a"
 
 
 def test_a_refused_evaluation_leaves_no_output(generated, tmp_path, capsys):
