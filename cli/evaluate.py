@@ -184,7 +184,8 @@ def _run_mit(args: argparse.Namespace) -> int:
             written = evaluate_mit(files, methods, stage, progress=progress)
         finally:
             bar.close()
-        rows = list(csv.DictReader(written["table_csv"].open(encoding="utf-8")))
+        with written["table_csv"].open(encoding="utf-8") as table:
+            rows = list(csv.DictReader(table))
         write_mit_report(stage, Path(args.mit), len(files), rows)
         print(written["table_md"].read_text(encoding="utf-8"))
     print(
