@@ -12,7 +12,7 @@ import logging
 import sys
 import traceback
 from collections.abc import Sequence
-from typing import NoReturn
+from typing import Any, NoReturn
 
 from spectrinsic.data_dir import resolve_data_dir
 from spectrinsic.errors import SpectrinsicError
@@ -54,22 +54,44 @@ def build_parser() -> argparse.ArgumentParser:
         prog="spectrinsic",
         description="Spectral rendering of synthetic intrinsic-image datasets.",
     )
-    parser.add_argument(
-        "--data-dir",
-        metavar="DIR",
-        default=None,
-        help="spectral data directory (SFU set, extra cameras); default: $SPECTRINSIC_DATA",
-    )
+    _add_global_options(parser)
     parser.add_argument("--version", action="version", version=f"spectrinsic {_version()}")
-    parser.add_argument("-v", "--verbose", action="count", default=0, help="more logging")
-    parser.add_argument("-q", "--quiet", action="store_true", help="no progress bars or plan lines")
-    parser.add_argument(
-        "--debug", action="store_true", help="print the traceback behind an error message"
-    )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in _COMMANDS:
         importlib.import_module(name).register(sub)
+    for command in sub.choices.values():  # the global options work after the verb too
+        _add_global_options(command.add_argument_group("global options"), after_verb=True)
     return parser
+
+
+def _add_global_options(p: Any, *, after_verb: bool = False) -> None:
+    """--data-dir, -v, -q, --debug: before the verb with their defaults; after it (on every
+    sub-command) without defaults (``SUPPRESS``), so a flag given there is set and one not
+    given keeps what the top-level parser set."""
+
+    def default(value: Any) -> Any:
+        return argparse.SUPPRESS if after_verb else value
+
+    p.add_argument(
+        "--data-dir",
+        metavar="DIR",
+        default=default(None),
+        help="spectral data directory (SFU set, extra cameras); default: $SPECTRINSIC_DATA",
+    )
+    p.add_argument("-v", "--verbose", action="count", default=default(0), help="more logging")
+    p.add_argument(
+        "-q",
+        "--quiet",
+        action="store_true",
+        default=default(False),
+        help="no progress bars or plan lines",
+    )
+    p.add_argument(
+        "--debug",
+        action="store_true",
+        default=default(False),
+        help="print the traceback behind an error message",
+    )
 
 
 def _version() -> str:

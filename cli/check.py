@@ -15,9 +15,12 @@ from spectrinsic.gt_export import check_dataset, sample_dirs
 from spectrinsic.gt_export.check import (
     NOISE_THRESHOLD,
     TARGET_MISSED,
+    check_sample,
     noise_report,
     residual_share_problems,
+    sample_share_problem,
 )
+from spectrinsic.gt_export.sample import META_NAME
 
 __all__ = ["register", "run"]
 
@@ -25,7 +28,7 @@ __all__ = ["register", "run"]
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "check",
-        help="verify a built dataset: files and layers present, no NaN/Inf or forbidden "
+        help="verify a built dataset or a sample folder: files and layers present, no NaN/Inf or forbidden "
         "negatives, image = reflectance * shading + residual, manifest hashes; report noise",
         description="Verify a built dataset and report each sample's measured Monte Carlo noise "
         "(relative standard error from independent batches). Exit status 1 when a check fails, "
@@ -35,7 +38,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         "promises a look at the layout, not training data. A problem shared by several samples "
         "is printed once with their count.",
     )
-    p.add_argument("dir", metavar="DIR", help="dataset folder (with manifest.json)")
+    p.add_argument(
+        "dir",
+        metavar="DIR",
+        help="dataset folder (with manifest.json), or one sample folder (with meta.json, "
+        "e.g. what `relight --out` writes: its files, layers, values, identities and hashes)",
+    )
     p.add_argument(
         "--max-per-sample",
         type=int,
@@ -81,7 +89,14 @@ def run(args: argparse.Namespace) -> int:
         raise DatasetError(f"--max-per-sample {args.max_per_sample}; expected a whole number >= 0")
     root = Path(args.dir)
     if not root.is_dir():
-        raise DatasetError(f"check {str(root)!r}: no such folder; expected a dataset folder")
+        raise DatasetError(
+            f"check {str(root)!r}: no such folder; expected a dataset folder or a sample folder"
+        )
+    if (root / META_NAME).is_file():  # one sample folder, e.g. what `relight --out` writes
+        problems = [f"{root.name}: {p}" for p in check_sample(root)]
+        if share is not None and (problem := sample_share_problem(root, share)) is not None:
+            problems.append(problem)
+        return _report(problems, root, 1, args)
     n_samples = len(sample_dirs(root))
     with tqdm(
         total=n_samples, desc="checking", unit="sample", disable=args.quiet or None, leave=False
@@ -91,8 +106,14 @@ def run(args: argparse.Namespace) -> int:
         problems += _noise_problems(root, args.noise_threshold, n_samples, verbose=args.noise)
     if n_samples and share is not None:
         problems += residual_share_problems(root, share)
+    return _report(problems, root, n_samples, args)
+
+
+def _report(problems: list[str], root: Path, n_samples: int, args: argparse.Namespace) -> int:
+    """Print *problems* grouped per sample, or the ok line; the exit status."""
     if not problems:
-        print(f"ok: {n_samples} samples in {root} passed every check")
+        what = "1 sample" if n_samples == 1 else f"{n_samples} samples"
+        print(f"ok: {what} in {root} passed every check")
         return 0
     for line in problem_lines(problems, max_per_sample=args.max_per_sample):
         print(line)

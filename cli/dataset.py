@@ -17,6 +17,7 @@ from spectrinsic.cli.dataset_source import (
     source_from_args,
     source_notes,
 )
+from spectrinsic.cli.dataset_variant import add_variant_option, check_variant
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.integrity import check_build_folder
 from spectrinsic.gt_export.manifest import SPLIT_FRACTIONS
@@ -55,7 +56,8 @@ def register(subparsers: Any) -> None:
     """Add the ``dataset`` subcommand to the CLI's *subparsers*."""
     p = subparsers.add_parser(
         "dataset",
-        help="render the dataset (68 samples) with ground truth; resumable",
+        help="render a dataset with ground truth: the thesis' 68 library samples, generated "
+        "scenes (--generator) or your own scene files (--scenes); resumable",
         description=(
             "Render the dataset layout of the thesis (8 objects x 4 conditions + 3 complex "
             "scenes x 3 views x 4 conditions) with ground-truth layers, then write "
@@ -179,6 +181,7 @@ def _add_rendering_options(p: Any) -> None:
         help="diagonal modes from one traversal (single, the default) or the passes; "
         "same pixels to float rounding, so not part of the config hash",
     )
+    add_variant_option(p)
     p.add_argument(
         "--no-denoise",
         action="store_true",
@@ -202,6 +205,7 @@ _VALUE_OPTIONS: tuple[tuple[str, str], ...] = (
     ("max_batches", "max_batches"),
     ("integrator", "integrator"),
     ("camera", "camera"),
+    ("variant", "variant"),
 )
 #: Switches and the config value each sets when given (option dest -> (config key, value)).
 _SWITCHES: tuple[tuple[str, str, bool], ...] = (
@@ -282,6 +286,7 @@ def preflight(
 
 
 def run(args: argparse.Namespace) -> int:
+    check_variant(args)
     config = config_from_args(args)
     preflight(
         args.out,

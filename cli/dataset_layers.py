@@ -20,8 +20,9 @@ def add_extra_layer_options(p: Any) -> None:
         "--store-transport",
         action="store_true",
         help="store each light's 31-band transport in every sample (transport.exr), so "
-        "`spectrinsic relight` can relight it exactly; renders the diagonal modes "
-        "light by light",
+        "`spectrinsic relight` can relight it exactly; no extra render with the default "
+        "single integrator (it splits every band by light), the lights one at a time "
+        "with --integrator passes",
     )
     p.add_argument(
         "--spectral-layers",

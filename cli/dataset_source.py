@@ -15,6 +15,11 @@ from spectrinsic.errors import DatasetError, SceneError, SpectrinsicError
 from spectrinsic.pipeline.presets import DatasetConfig
 from spectrinsic.pipeline.source_plan import file_sample, files_source, generator_source
 from spectrinsic.scenes.generators import GlossDistribution
+from spectrinsic.scenes.generators.world_defaults import (
+    GLOSSY_FRACTION,
+    METALLIC_FRACTION,
+    TEXTURE_FRACTION,
+)
 from spectrinsic.scenes.sources import FileSource
 from spectrinsic.scenes.spectrum_refs import resolve_spectrum
 from spectrinsic.scenes.yaml_limits import load_yaml_file
@@ -76,10 +81,11 @@ def _add_generated_draw_options(src: Any) -> None:
     src.add_argument(
         "--texture-fraction",
         type=float,
-        default=0.0,
+        default=TEXTURE_FRACTION,
         metavar="F",
         help="fraction of generated objects given a per-pixel spectral texture (wood rings, "
-        "weave, noise over 2-3 reflectances; exact reflectance ground truth) (0)",
+        "weave, noise over 2-3 reflectances; exact reflectance ground truth) "
+        f"({TEXTURE_FRACTION:g}; 0 for none)",
     )
     src.add_argument(
         "--sfu",
@@ -89,16 +95,17 @@ def _add_generated_draw_options(src: Any) -> None:
     src.add_argument(
         "--glossy",
         type=float,
-        default=0.0,
+        default=GLOSSY_FRACTION,
         metavar="F",
-        help="fraction of generated materials made coated/glossy (plastic) (0)",
+        help=f"fraction of generated materials made coated/glossy (plastic) ({GLOSSY_FRACTION:g}; "
+        "--glossy 0 --metallic 0 --texture-fraction 0: the matte world)",
     )
     src.add_argument(
         "--metallic",
         type=float,
-        default=0.0,
+        default=METALLIC_FRACTION,
         metavar="F",
-        help="fraction of generated materials made metal (Ag, Al, Au, Cu, Cr) (0)",
+        help=f"fraction of generated materials made metal (Ag, Al, Au, Cu, Cr) ({METALLIC_FRACTION:g})",
     )
     src.add_argument(
         "--roughness-range",

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import csv
 import fnmatch
 import logging
 from pathlib import Path
@@ -12,13 +13,16 @@ from tqdm import tqdm
 
 from spectrinsic.decompose.evaluate import evaluate
 from spectrinsic.decompose.mit import evaluate_mit, mit_folder_objects
+from spectrinsic.decompose.mit_report import MIT_FIGURE, write_mit_report
 from spectrinsic.decompose.predictions import Predictions
 from spectrinsic.decompose.registry import available_decomposers, get_decomposer
+from spectrinsic.decompose.scored import add_scored_section, describe_scored
 from spectrinsic.decompose.targets import TARGETS
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.loader import load_sample
-from spectrinsic.gt_export.outfolder import output_folder
+from spectrinsic.gt_export.outfolder import check_output_folder
 from spectrinsic.gt_export.sample import sample_dirs
+from spectrinsic.gt_export.staged_output import staged_output
 
 __all__ = ["register", "run", "DEFAULT_DATASET", "DEFAULT_OUT"]
 
@@ -153,7 +157,8 @@ def _folders(dataset: Path, patterns: str | None) -> list[Path]:
             f"`spectrinsic dataset --out {dataset}` (or `make dataset`; "
             f"`--preset preview` builds a small set in about 2 minutes)"
         )
-    folders = sample_dirs(dataset)
+    # a sample folder (what `relight --out` writes) is scored on its own
+    folders = [dataset] if (dataset / "meta.json").is_file() else sample_dirs(dataset)
     if patterns:
         globs = [g.strip() for g in patterns.split(",") if g.strip()]
         folders = [f for f in folders if any(fnmatch.fnmatchcase(f.name, g) for g in globs)]
@@ -168,10 +173,25 @@ def _run_mit(args: argparse.Namespace) -> int:
     patterns = [g.strip() for g in args.samples.split(",") if g.strip()] if args.samples else None
     files = mit_folder_objects(Path(args.mit), patterns)
     methods = _methods(args)
-    with output_folder(Path(args.out)):  # locked; its files recorded as spectrinsic's
-        written = evaluate_mit(files, methods, Path(args.out))
-    print(written["table_md"].read_text(encoding="utf-8"))
-    print(f"MIT protocol on {len(files)} objects in {args.out} (mit_scores.csv, mit_table_3_2.*)")
+    bar = tqdm(total=len(files), desc="evaluate --mit", unit="object", disable=args.quiet)
+
+    def progress(name: str) -> None:
+        bar.set_postfix_str(name)
+        bar.update(1)
+
+    with staged_output(Path(args.out)) as stage:  # a failed run leaves --out as it was
+        try:
+            written = evaluate_mit(files, methods, stage, progress=progress)
+        finally:
+            bar.close()
+        with written["table_csv"].open(encoding="utf-8") as table:
+            rows = list(csv.DictReader(table))
+        write_mit_report(stage, Path(args.mit), len(files), rows)
+        print(written["table_md"].read_text(encoding="utf-8"))
+    print(
+        f"MIT protocol on {len(files)} objects in {args.out} "
+        f"(REPORT.md, {MIT_FIGURE}, mit_scores.csv, mit_table_3_2.*)"
+    )
     return 0
 
 
@@ -180,18 +200,27 @@ def run(args: argparse.Namespace) -> int:
         return _run_mit(args)
     folders = _folders(Path(args.dataset), args.samples)
     methods = _methods(args)
-    with output_folder(Path(args.out)):  # locked; its files recorded as spectrinsic's
-        result = _evaluate(args, folders, methods)
-    for key in ("lmse_by_condition_md", "colour_by_condition_md", "scenario_md"):
-        print(result.files[key].read_text(encoding="utf-8"))
+    check_output_folder(Path(args.out))  # the folder first, as every verb does
+    scored = describe_scored(Path(args.dataset), folders)  # refuses a bad sample before work
+    with staged_output(Path(args.out)) as stage:  # a failed run leaves --out as it was
+        result = _evaluate(args, folders, methods, stage)
+        add_scored_section(result.files["report"], scored)
+        for key in ("lmse_by_condition_md", "colour_by_condition_md", "scenario_md"):
+            print(result.files[key].read_text(encoding="utf-8"))
+    written = ["REPORT.md with every table and summary.png", "scored.json", "scores.csv"]
+    written += [] if args.no_figures else ["figures/"]
+    written += [] if args.no_estimates else ["estimates/"]
     print(
-        f"{len(result.scores)} scores for {len(folders)} samples in {args.out} "
-        f"(REPORT.md with every table and summary.png, scores.csv, figures/, estimates/)"
+        f"{len(result.scores)} scores for {len(folders)} samples in {args.out} ({', '.join(written)})"
     )
+    if scored.preview_grade:
+        log.warning("%s: preview-grade renderings; REPORT.md says so", args.dataset)
     return 0
 
 
-def _evaluate(args: argparse.Namespace, folders: list[Path], methods: dict[str, Any]) -> Any:
+def _evaluate(
+    args: argparse.Namespace, folders: list[Path], methods: dict[str, Any], out: Path
+) -> Any:
     """Score every sample with a progress bar; return the evaluation result."""
     bar = tqdm(total=len(folders), desc="evaluate", unit="sample", disable=args.quiet)
 
@@ -202,7 +231,7 @@ def _evaluate(args: argparse.Namespace, folders: list[Path], methods: dict[str, 
     try:
         result = evaluate(
             (load_sample(f) for f in folders),
-            args.out,
+            out,
             methods=methods,
             seed=args.seed,
             cameras=not args.no_cameras,

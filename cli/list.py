@@ -20,6 +20,7 @@ from spectrinsic.errors import SpectrinsicError, validate_choice
 from spectrinsic.pipeline.presets import PRESETS
 from spectrinsic.scenes.generators import GENERATORS
 from spectrinsic.scenes.library import CONDITION_DESCRIPTIONS, CONDITIONS, n_views, scene_names
+from spectrinsic.scenes.library_gloss import GLOSSY_SUFFIX
 from spectrinsic.spectra import get_sensors, list_spectra
 from spectrinsic.spectra.registry import SPECTRUM_FAMILIES, SPECTRUM_FAMILY_NOTES
 
@@ -40,14 +41,17 @@ def _first_sentence(text: str | None) -> str:
 
 
 def _scenes(_data_dir: str | None) -> list[Row]:
+    """Every library scene: the thesis' 11 and their 11 ``*-glossy`` variants."""
     objects = set(scene_names("object"))
+    glossy = scene_names("glossy")
     return [
         (
             name,
-            f"{'single object' if name in objects else 'room'}, "
-            f"{n_views(name)} view{'s' if n_views(name) > 1 else ''}",
+            f"{'single object' if name.removesuffix(GLOSSY_SUFFIX) in objects else 'room'}, "
+            f"{n_views(name)} view{'s' if n_views(name) > 1 else ''}"
+            + (", glossy variant (not in the default layout)" if name in glossy else ""),
         )
-        for name in scene_names()
+        for name in scene_names() + glossy
     ]
 
 

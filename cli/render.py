@@ -62,10 +62,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="render a scene in several colour modes and write raw passes as EXR",
         description="Render SCENE (a library scene name, a YAML, Mitsuba 3 XML, .blend or mesh file) with Mitsuba 3 "
         "in each mode and write float32 EXR files with named channels into --out "
-        "(raw passes, XYZ, AOVs; ground-truth layers come from `spectrinsic dataset`). "
+        "(raw passes, XYZ, AOVs; with --ground-truth every ground-truth layer, by the "
+        "path of `spectrinsic dataset`). "
         f"Defaults are the dataset's default preset: {default.render.spp} spp, path depth "
         f"{default.render.max_depth}, library scenes at {default.width}x{default.height}. "
-        f"Modes: {_modes_help()}.",
+        f"Modes: {_modes_help()}. The pass counts are those of --integrator passes; the "
+        "default single integrator renders every diagonal mode in one path traversal.",
     )
     _add_scene_options(p)
     _add_output_options(p)
@@ -270,6 +272,8 @@ def _ground_truth(args: argparse.Namespace) -> int:
         changes["spp"] = args.spp
     if args.direct:
         changes["direct"] = True
+    if args.variant is not None:  # the backend of the one-sample dataset too
+        changes["variant"] = args.variant
     size = requested_size(args)
     if size is not None:
         changes["width"], changes["height"] = size

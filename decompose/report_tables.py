@@ -15,7 +15,7 @@ import numpy as np
 
 from spectrinsic.decompose.photometric import SCENARIOS
 from spectrinsic.decompose.registry import DECOMPOSERS
-from spectrinsic.decompose.scores import CONDITION_GROUPS, Score
+from spectrinsic.decompose.scores import CONDITION_GROUPS, Score, condition_group
 
 __all__ = [
     "GROUP_ORDER",
@@ -75,7 +75,7 @@ def condition_table(
     for s in scores:
         if s.scenario == "srgb" and (s.layer, s.metric) in wanted:
             kind, cond = samples[s.sample]
-            groups[(kind, s.method, s.layer, s.metric, CONDITION_GROUPS[cond])].append(s.value)
+            groups[(kind, s.method, s.layer, s.metric, condition_group(cond))].append(s.value)
     rows = []
     for kind in SCENE_KINDS:
         for method in sorted({k[1] for k in groups if k[0] == kind}, key=_method_order):
@@ -129,7 +129,7 @@ def table_3_2(
     for (method, metric, sid), layers in per.items():
         if len(layers) == 2:
             value = 0.5 * (layers["shading_grey"][0] + layers["reflectance_grey"][0])
-            for g in (CONDITION_GROUPS[samples[sid][1]], "all"):
+            for g in (condition_group(samples[sid][1]), "all"):
                 groups[(method, metric, g)].append(value)
     rows = []
     for method in sorted({k[0] for k in groups}, key=_method_order):
@@ -151,7 +151,7 @@ def summary_table(
         if s.scenario == "srgb" and s.layer == "reflectance" and s.metric == "lmse":
             per[(s.method, samples[s.sample][1])].append(s.value)
             per[(s.method, "all")].append(s.value)
-    conditions = [c for c in CONDITION_GROUPS if any(k[1] == c for k in per)]
+    conditions = [c for c in (*CONDITION_GROUPS, *GROUP_ORDER) if any(k[1] == c for k in per)]
     return [
         {"method": m, **{c: _mean(per.get((m, c), [])) for c in (*conditions, "all")}}
         for m in sorted({k[0] for k in per}, key=_method_order)

@@ -14,6 +14,7 @@ import numpy as np
 
 from spectrinsic.decompose.scores import CONDITION_GROUPS, INPUT_LAYERS
 from spectrinsic.errors import DatasetError
+from spectrinsic.scenes.lighting import LightingCondition, describe_lighting
 from spectrinsic.scenes.sample_id import SampleId
 
 __all__ = [
@@ -24,6 +25,7 @@ __all__ = [
     "sample_condition",
     "sample_id_of",
     "sample_kind",
+    "sample_lighting",
 ]
 
 _KINDS = {"object": "single objects", "complex": "complex scenes"}
@@ -38,19 +40,30 @@ def sample_id_of(sample: Mapping[str, Any]) -> str:
     return str(sid)
 
 
+def sample_lighting(sample: Mapping[str, Any]) -> LightingCondition:
+    """The sample's lighting measured from ``meta["lights"]``
+    (:func:`spectrinsic.scenes.lighting.describe_lighting`)."""
+    try:
+        return describe_lighting(sample.get("meta", {}).get("lights") or [])
+    except ValueError as exc:
+        raise DatasetError(f"sample {sample_id_of(sample)!r}: {exc}") from None
+
+
 def sample_condition(sample: Mapping[str, Any]) -> str:
-    """Lighting condition: ``meta["condition"]``, else the sample id's
-    (:meth:`spectrinsic.scenes.sample_id.SampleId.parse`)."""
+    """Lighting condition: the library's (``meta["condition"]``, else the sample id's, when it
+    is one of :data:`CONDITION_GROUPS` and the scene was not generated), else the group
+    measured from the sample's lights (``WL``, ``1L``, ``2L``: :func:`sample_lighting`), so
+    generated sets, scene files and relit samples are grouped by what they hold."""
     meta = sample.get("meta", {})
-    cond = meta.get("condition") or meta.get("scene_metadata", {}).get("condition")
+    cond = meta.get("condition")
     if not cond:
-        cond = SampleId.parse(sample_id_of(sample)).condition
-    if cond not in CONDITION_GROUPS:
-        raise DatasetError(
-            f"sample {sample_id_of(sample)!r}: unknown condition {cond!r}; "
-            f"expected one of {sorted(CONDITION_GROUPS)}"
-        )
-    return str(cond)
+        try:
+            cond = SampleId.parse(sample_id_of(sample)).condition
+        except DatasetError:  # a user's own id
+            cond = None
+    if cond in CONDITION_GROUPS and "generator" not in meta.get("scene_metadata", {}):
+        return str(cond)
+    return sample_lighting(sample).group
 
 
 def sample_kind(sample: Mapping[str, Any]) -> str:

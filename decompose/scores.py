@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["CONDITION_GROUPS", "INPUT_LAYERS", "SCORED_LAYERS", "Score"]
+__all__ = ["CONDITION_GROUPS", "condition_group", "INPUT_LAYERS", "SCORED_LAYERS", "Score"]
 
 #: Lighting conditions of the dataset and the column of Tables 5.3/5.4 each belongs to.
 CONDITION_GROUPS: dict[str, str] = {
@@ -20,6 +20,15 @@ CONDITION_GROUPS: dict[str, str] = {
     "two-colour-a": "2L",
     "two-colour-b": "2L",
 }
+
+
+def condition_group(condition: str) -> str:
+    """The lighting group (WL/1L/2L) of *condition*: a library condition's
+    (:data:`CONDITION_GROUPS`), else *condition* itself, a group measured from a sample's
+    lights (:func:`spectrinsic.decompose.sample_fields.sample_condition`)."""
+    return CONDITION_GROUPS.get(condition, condition)
+
+
 #: The image a method decomposes: the first of these layers a sample has. ``image_denoised``
 #: (``reflectance * shading + residual`` exactly, from the denoised irradiance) is the input
 #: consistent with the ground truth; ``image`` is the raw Monte Carlo rendering.

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from spectrinsic.scenes.material_labels import label_spectrum
 from spectrinsic.spectra import get_sensors, get_spectrum, responses, xy_to_duv, xyz_to_xy
 
 __all__ = [
@@ -123,7 +124,9 @@ def spread_summary(samples: Sequence[Mapping[str, Any]]) -> dict[str, float]:
         for s in samples
         if len(pts := {tuple(p) for p in s["lights"]}) >= 2
     ]
-    chroma = np.array([material_chroma(n) for s in samples for n in s["materials"]], float)
+    chroma = np.array(
+        [material_chroma(label_spectrum(n)) for s in samples for n in s["materials"]], float
+    )
     objects = sum(int(s.get("objects", 0)) for s in samples)
     covs = [float(s["coverage"]) for s in samples if s.get("coverage") is not None]
 

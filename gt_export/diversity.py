@@ -24,6 +24,7 @@ from spectrinsic.gt_export.layers import luminance
 from spectrinsic.gt_export.loader import load_sample
 from spectrinsic.gt_export.sample_meta import SampleMeta
 from spectrinsic.scenes.generators.materials import PIXEL_TEXTURE
+from spectrinsic.scenes.material_labels import label_spectrum
 
 __all__ = [
     "DIVERSITY_NAME",
@@ -104,7 +105,9 @@ def diversity_stats(
             out["light_xy"].append(light.xy)
             out["light_cct"].append(_cct(light.xy))
         out["n_materials"].append(len(meta.materials))
-        out["material_chroma"] += [material_chroma(n) for n in meta.materials.values()]
+        out["material_chroma"] += [
+            material_chroma(label_spectrum(n)) for n in meta.materials.values()
+        ]
         out["samples"].append(spread_record(meta))
         if isinstance(extra.get("object_coverage"), float):
             out["coverage"].append(extra["object_coverage"])

@@ -34,13 +34,14 @@ import numpy as np
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.card import read_template
+from spectrinsic.gt_export.contact_sheet import contact_sheet
 from spectrinsic.gt_export.integrity import guarded_write
 from spectrinsic.gt_export.layers.spectral_intrinsics import rgb_residual_share
 from spectrinsic.gt_export.manifest import read_manifest
 from spectrinsic.gt_export.names import slug
 from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, plain_data, sample_dirs
 from spectrinsic.gt_export.sample_meta import SampleMeta, read_meta
-from spectrinsic.scenes.sample_id import SEPARATOR
+from spectrinsic.scenes.lighting import describe_lighting
 from spectrinsic.spectra import get_sensors, xyz_to_xy
 
 __all__ = [
@@ -92,10 +93,6 @@ _STATIC = ("gallery.js", "gallery.css")
 #: Significant digits of the lights' SPDs in the index (for plotting; every other number is
 #: copied from ``meta.json`` unrounded, so preview encodings decode exactly).
 _SPD_DIGITS = 5
-#: Contact-sheet tile width in pixels and number of columns.
-TILE = 160
-COLUMNS = 8
-_CAPTION_HEIGHT = 14
 #: Folder of the per-condition contact sheets and file-name pattern of summary plots.
 _SHEETS_DIR = "contact_sheets"
 _PIXELS_DIR = "gallery-pixels"
@@ -175,7 +172,9 @@ def _sample_entry(sample: Path, meta: SampleMeta, split: str | None) -> dict[str
     return {
         "id": sample.name,
         "scene": meta.scene,
-        "condition": smeta.get("condition"),
+        # a scene file's or a relit sample's lights say what its condition is
+        "condition": ("relit_from" not in smeta and smeta.get("condition"))
+        or describe_lighting(lights).family,
         # generated scenes name their generator; the built-in library and user scenes do not
         "generator": smeta.get("generator") or ("library" if "library" in smeta else "own scene"),
         "kind": scene_kind(meta),
@@ -280,60 +279,6 @@ def _summary_plots(root: Path) -> list[str]:
         p.relative_to(root).as_posix() for pattern in _SUMMARY_GLOBS for p in root.glob(pattern)
     }
     return sorted(f for f in found if not f.startswith("contact_sheet"))
-
-
-def contact_sheet(
-    dataset_dir: str | os.PathLike[str],
-    *,
-    out: str | os.PathLike[str] | None = None,
-    samples: Sequence[Path] | None = None,
-) -> Path:
-    """Tile the ``image`` preview of every sample (or of *samples*) with its id into one PNG.
-
-    Ids longer than a tile are written on two lines, never truncated.
-    """
-    from PIL import Image, ImageDraw, ImageFont
-
-    root = Path(dataset_dir)
-    samples = sample_dirs(root) if samples is None else list(samples)
-    if not samples:
-        raise DatasetError(
-            f"dataset folder {str(root)!r} has no complete samples for a contact sheet"
-        )
-    font = ImageFont.load_default()
-    cols = min(COLUMNS, len(samples))
-    rows = -(-len(samples) // cols)
-    cell = TILE + 2 * _CAPTION_HEIGHT
-    sheet = Image.new("RGB", (cols * TILE, rows * cell), (255, 255, 255))
-    draw = ImageDraw.Draw(sheet)
-    for i, sample in enumerate(samples):
-        preview = read_meta(sample).layers["image"].preview
-        if preview is None:
-            raise DatasetError(f"{sample / META_NAME}: layers.image.preview: expected a preview")
-        with Image.open(sample / preview) as img:
-            tile = img.convert("RGB")
-            tile.thumbnail((TILE, TILE), Image.Resampling.LANCZOS)
-        x0, y0 = (i % cols) * TILE, (i // cols) * cell
-        sheet.paste(tile, (x0 + (TILE - tile.width) // 2, y0 + (TILE - tile.height) // 2))
-        for line_no, line in enumerate(_wrap(sample.name, draw, font)):
-            draw.text(
-                (x0 + 2, y0 + TILE + 1 + line_no * _CAPTION_HEIGHT), line, fill=(0, 0, 0), font=font
-            )
-    path = Path(out) if out is not None else root / "contact_sheet.png"
-    with guarded_write(path):
-        path.parent.mkdir(parents=True, exist_ok=True)
-        sheet.save(path, format="PNG")
-    return path
-
-
-def _wrap(text: str, draw: Any, font: Any) -> list[str]:
-    """*text* in at most two lines that fit a tile, split after a sample id's ``__`` where
-    possible (:data:`spectrinsic.scenes.sample_id.SEPARATOR`)."""
-    if draw.textlength(text, font=font) <= TILE - 4:
-        return [text]
-    cut = text.rfind(SEPARATOR, 0, len(text) // 2 + 8)
-    cut = cut + len(SEPARATOR) if cut > 0 else len(text) // 2
-    return [text[:cut], text[cut:]]
 
 
 def _condition_sheets(root: Path, index: Mapping[str, Any]) -> dict[str, str]:

@@ -36,6 +36,7 @@ from spectrinsic.gt_export.sample import (
 from spectrinsic.gt_export.sample_meta import SampleMeta, read_meta
 from spectrinsic.provenance import software_versions
 from spectrinsic.rng import seed_from_key
+from spectrinsic.scenes.material_labels import label_spectrum
 
 __all__ = [
     "SPLIT_FRACTIONS",
@@ -62,7 +63,7 @@ SPLIT_FRACTIONS: SplitFractions = (("train", 0.8), ("val", 0.1), ("test", 0.1))
 def _spectral_provenance(metas: Sequence[SampleMeta], data_dir: Any) -> dict[str, Any]:
     used: set[str] = set()
     for meta in metas:
-        used.update(meta.materials.values())
+        used.update(label_spectrum(n) for n in meta.materials.values())
         used.update(light.spectrum for light in meta.lights)
         used.update(f"camera:{c}" for c in meta.cameras)
         if meta.cube_sensors:

@@ -64,7 +64,8 @@ MAX_COUNT = 100_000
 #: Version of what the generators draw for a seed, part of the config: a set built by an older
 #: version (other light pools, furniture, framing) asks for ``--rebuild`` instead of mixing.
 #: 2: saturated lights, ranges obeyed by every material, framed rooms (issue 22).
-GENERATOR_VERSION = 2
+#: 3: cameras pass the view rule (``scenes.generators.view_rule``, issue 31).
+GENERATOR_VERSION = 3
 MAX_VIEWS = 64
 
 
@@ -146,10 +147,10 @@ def files_source(
             raise DatasetError(f"--scenes {str(p)!r}: no such file")
         scene_file_kind(path)
         entries.append({"path": str(path), "sha256": file_sha256(path)})
-    stems = [_SAFE.sub("-", Path(e["path"]).stem) for e in entries]
+    stems = [_SAFE.sub("-", scene_file_name(Path(e["path"]))) for e in entries]
     dupes = sorted({s for s in stems if stems.count(s) > 1})
     if dupes:
-        raise DatasetError(f"--scenes: several files named {dupes}; scene names must be unique")
+        raise DatasetError(f"--scenes: several scenes named {dupes}; scene names must be unique")
     spec = {
         "scenes": entries,
         "materials": dict(sorted((materials or {}).items())),
@@ -197,11 +198,21 @@ def saved_sample(path: str | os.PathLike[str]) -> tuple[SampleId, int] | None:
 
 def file_sample(path: str | os.PathLike[str], *, new_sample: bool) -> tuple[SampleId, int | None]:
     """A scene file's sample id and seed: the saved sample's (:func:`saved_sample`) unless
-    *new_sample*, else ``<stem>__v0__file`` with no seed (the root seed's, when planned)."""
+    *new_sample*, else ``<name>__v0__file`` (:func:`scene_file_name`) with no seed (the root seed's, when planned)."""
     saved = None if new_sample else saved_sample(path)
     if saved is not None:
         return saved
-    return SampleId(_SAFE.sub("-", Path(path).stem), 0, "file"), None
+    return SampleId(_SAFE.sub("-", scene_file_name(Path(path))), 0, "file"), None
+
+
+def scene_file_name(path: Path) -> str:
+    """The scene's own ``name`` for a YAML scene file that has one, else the file's stem."""
+    if scene_file_kind(path) == "yaml":
+        doc = load_yaml_file(path)
+        name = doc.get("name") if isinstance(doc, dict) else None
+        if isinstance(name, str) and name.strip() and not name.startswith("."):
+            return name.strip()
+    return path.stem
 
 
 def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir: str | None) -> Any:

@@ -44,6 +44,7 @@ from spectrinsic.gt_export.layers.spectral_intrinsics import (
     spectral_identity,
     spectral_layers,
 )
+from spectrinsic.scenes.material_labels import material_label
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import absolute_reflectance, get_sensors, get_spectrum
 
@@ -165,7 +166,7 @@ def compute_ground_truth(
     return GroundTruth(
         layers=by_name,
         lights=light_records(s, shares, spaces, cameras),
-        materials={str(i): n for i, n in enumerate(names)},
+        materials={str(i): material_label(m) for i, m in enumerate(scene.materials)},
         matrices=matrices_of(s, shares, spaces, training),
         reference_mode=s.ref,
         cameras=tuple(cameras),

@@ -19,7 +19,8 @@ from spectrinsic.scenes.generators.camera import is_free, sample_camera
 from spectrinsic.scenes.generators.gloss import GlossDistribution
 from spectrinsic.scenes.generators.lights import FAMILIES, LightVolume, draw_lights
 from spectrinsic.scenes.generators.materials import MaterialDistribution
-from spectrinsic.scenes.model import Mesh, Scene
+from spectrinsic.scenes.generators.view_rule import judge_view
+from spectrinsic.scenes.model import Camera, Mesh, Scene
 from spectrinsic.scenes.parts import Part, to_meshes
 
 __all__ = ["GeneratorOptions", "Layout", "assemble", "family_of", "scene_rngs"]
@@ -84,6 +85,10 @@ class Layout:
     min_coverage
         The generator's own least object coverage of a view (rooms frame furniture); the
         camera must pass the larger of this and ``options.min_coverage``.
+    view_rule
+        Cameras must also pass :func:`~spectrinsic.scenes.generators.view_rule.judge_view`
+        (rooms: several materials, no surface filling the frame, enough light). Objects on a
+        ground are MIT-like: the ground fills most of the frame by design.
     """
 
     parts: tuple[tuple[str, Part], ...]
@@ -91,6 +96,7 @@ class Layout:
     propose_camera: Callable[[np.random.Generator], tuple[np.ndarray, np.ndarray, float]]
     info: dict[str, Any]
     min_coverage: float = 0.0
+    view_rule: bool = False
 
 
 def scene_rngs(seed: int) -> dict[str, np.random.Generator]:
@@ -132,6 +138,13 @@ def assemble(
         max_lights=options.max_lights,
         saturation=options.light_saturation,
     )
+    draws = [0, 0]  # cameras judged by the view rule, and passed
+
+    def judged(cam: Camera) -> bool:
+        ok = judge_view(meshes, lights, cam).ok  # a view worth learning from
+        draws[0], draws[1] = draws[0] + 1, draws[1] + ok
+        return ok
+
     # Views 0..views-1 are drawn in order, so view k is the same in any build, and all of them
     # must pass for the layout to be used (every view of a scene shows one layout).
     for k in range(max(view + 1, options.views)):
@@ -144,6 +157,7 @@ def assemble(
             is_object=_is_object,
             min_coverage=max(options.min_coverage, layout.min_coverage),
             name=f"view{k}",
+            accept=judged if layout.view_rule else None,
         )
         if k == view:
             camera, cov = drawn
@@ -156,6 +170,8 @@ def assemble(
         "illuminants": [light.spectrum for light in lights],
         "light_kinds": [light.kind for light in lights],
     }
+    if layout.view_rule:  # how many cameras the rule judged for this scene's views
+        meta["view_rule"] = {"judged": draws[0], "passed": draws[1]}
     return Scene(
         name=name, meshes=meshes, materials=materials, lights=lights, camera=camera, metadata=meta
     )

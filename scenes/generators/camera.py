@@ -19,7 +19,7 @@ from spectrinsic.errors import SceneError
 from spectrinsic.scenes.geometry import camera_rays, is_closed, winding_numbers
 from spectrinsic.scenes.model import Camera, Mesh
 
-__all__ = ["Footprints", "first_hits", "coverage", "is_free", "sample_camera"]
+__all__ = ["Footprints", "first_hits", "ray_triangle_hits", "coverage", "is_free", "sample_camera"]
 
 #: Rays per side of the coverage grid.
 COVERAGE_GRID = 12
@@ -41,13 +41,11 @@ class Footprints:
         return True
 
 
-def first_hits(meshes: Sequence[Mesh], origins: np.ndarray, dirs: np.ndarray) -> np.ndarray:
-    """Index into *meshes* of the first surface each ray hits (-1: none), by Möller-Trumbore.
-
-    *origins*, *dirs*: ``(R, 3)``; cost ``O(R x F)`` in chunks of triangles.
-    """
-    tri = np.concatenate([m.vertices[m.faces] for m in meshes])
-    owner = np.concatenate([np.full(len(m.faces), i) for i, m in enumerate(meshes)])
+def ray_triangle_hits(
+    tri: np.ndarray, origins: np.ndarray, dirs: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Index into *tri* ``(F, 3, 3)`` of the first triangle each ray hits (-1: none) and its
+    distance along the ray (inf: none), by Möller-Trumbore; cost ``O(R x F)`` in chunks."""
     best = np.full(len(origins), np.inf)
     hit = np.full(len(origins), -1)
     for s in range(0, len(tri), 4096):
@@ -70,8 +68,19 @@ def first_hits(meshes: Sequence[Mesh], origins: np.ndarray, dirs: np.ndarray) ->
         k = t.argmin(axis=1)
         tk = t[np.arange(len(t)), k]
         closer = tk < best
-        best[closer], hit[closer] = tk[closer], owner[s + k[closer]]
-    return hit
+        best[closer], hit[closer] = tk[closer], s + k[closer]
+    return hit, best
+
+
+def first_hits(meshes: Sequence[Mesh], origins: np.ndarray, dirs: np.ndarray) -> np.ndarray:
+    """Index into *meshes* of the first surface each ray hits (-1: none), by Möller-Trumbore.
+
+    *origins*, *dirs*: ``(R, 3)``; cost ``O(R x F)`` in chunks of triangles.
+    """
+    tri = np.concatenate([m.vertices[m.faces] for m in meshes])
+    owner = np.concatenate([np.full(len(m.faces), i) for i, m in enumerate(meshes)])
+    hit, _ = ray_triangle_hits(tri, origins, dirs)
+    return np.where(hit >= 0, owner[np.maximum(hit, 0)], -1)
 
 
 def coverage(meshes: Sequence[Mesh], camera: Camera, is_object: Callable[[Mesh], bool]) -> float:
@@ -112,9 +121,11 @@ def sample_camera(
     min_coverage: float,
     name: str = "view0",
     tries: int = 40,
+    accept: Callable[[Camera], bool] | None = None,
 ) -> tuple[Camera, float]:
     """Draw cameras from ``propose(rng) -> (origin, target, fov_deg)`` until one is in free
-    space and sees at least *min_coverage* of objects; return it and its coverage.
+    space, sees at least *min_coverage* of objects and passes *accept* (e.g. the view rule,
+    :mod:`spectrinsic.scenes.generators.view_rule`); return it and its coverage.
 
     Raises
     ------
@@ -140,8 +151,9 @@ def sample_camera(
         )
         cov = coverage(meshes, cam, is_object)
         best = max(best, cov)
-        if cov >= min_coverage:
+        if cov >= min_coverage and (accept is None or accept(cam)):
             return cam, cov
     raise SceneError(
         f"no camera of {tries} draws saw >= {min_coverage:.1%} objects (best {best:.1%})"
+        + ("" if accept is None else " and passed the view rule")
     )

@@ -320,4 +320,5 @@ def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
         propose_camera=propose,
         info=info,
         min_coverage=FRAMED_COVERAGE,
+        view_rule=True,
     )

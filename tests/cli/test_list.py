@@ -34,7 +34,7 @@ def test_each_listing_is_its_registry(capsys):
     from spectrinsic.scenes.generators import GENERATORS
     from spectrinsic.spectra.registry import SPECTRUM_FAMILIES
 
-    assert _listed(capsys, "scenes") == scene_names()
+    assert _listed(capsys, "scenes") == scene_names() + scene_names("glossy")
     assert _listed(capsys, "conditions") == list(CONDITIONS)
     assert _listed(capsys, "presets") == list(PRESETS)
     assert _listed(capsys, "methods") == list(available_decomposers())

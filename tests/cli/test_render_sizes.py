@@ -15,6 +15,7 @@ from spectrinsic.gt_export import load_sample
 from spectrinsic.gt_export.exr import read_exr
 from spectrinsic.pipeline.presets import get_preset
 from spectrinsic.scenes import build, save_scene
+from spectrinsic.scenes.sample_id import SampleId
 
 TINY = ["--spp", "2", "--max-depth", "3"]
 
@@ -83,7 +84,7 @@ def test_ground_truth_keeps_the_files_camera_size_and_says_so(wide_cup, tmp_path
         == 0
     )
     assert "cup.yaml: the file's camera size" in capsys.readouterr().err
-    assert load_sample(out / "cup__v0__file")["image"].shape == (8, 12, 3)
+    assert load_sample(out / "obj-cup__v0__file")["image"].shape == (8, 12, 3)
 
 
 def test_render_and_ground_truth_share_their_defaults():
@@ -141,7 +142,7 @@ def test_a_saved_generated_scene_reproduces_its_sample(tmp_path, capsys):
     )
     (folder,) = [p for p in new.iterdir() if p.is_dir() and "__v0__file" in p.name]
     assert (
-        folder.name == f"{sid}__v0__file"
+        folder.name == f"{SampleId.parse(sid).scene}__v0__file"  # the scene's own name
         and json.loads((folder / "meta.json").read_text())["seed"] != seed
     )
 

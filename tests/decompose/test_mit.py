@@ -163,6 +163,11 @@ def test_cli_scores_methods_and_predictions_on_an_mit_folder(mit_folder, tmp_pat
             _reference_score(obj, method(obj.image, obj.mask)), abs=1e-6
         )
     assert "MIT protocol on 2 objects" in capsys.readouterr().out
+    # issue 31: a REPORT.md saying what was scored and explaining every column, and a figure
+    report = (out / "REPORT.md").read_text()
+    assert str(mit_folder.resolve()) in report and "objects: 2" in report
+    assert "**beats baseline**" in report and "`image-as-reflectance`" in report
+    assert "| colour-retinex | 2 |" in report and (out / "mit_lmse.png").stat().st_size > 0
 
 
 @pytest.mark.parametrize(

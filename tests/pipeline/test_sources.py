@@ -137,7 +137,8 @@ def test_yaml_scene_gets_every_layer(tmp_path, repo_root):
         build("obj-apple", seed=0, width=8, height=8), tmp_path / "mine" / "apple.yaml"
     )
     out, ids = _build_files(tmp_path, [path])
-    assert ids == ["apple__v0__file"] and LAYERS <= _layers(out, ids[0])
+    # the id is the scene's own name (obj-apple), not the file's (apple.yaml)
+    assert ids == ["obj-apple__v0__file"] and LAYERS <= _layers(out, ids[0])
 
 
 def test_obj_with_material_map_gets_every_layer(tmp_path):
@@ -210,4 +211,4 @@ def test_render_ground_truth_is_the_dataset_path(tmp_path):
         ]
     )
     assert rc == 0 and check_dataset(out) == []
-    assert LAYERS <= _layers(out, "cup__v0__file")
+    assert LAYERS <= _layers(out, "obj-cup__v0__file")

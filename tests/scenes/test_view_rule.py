@@ -1,0 +1,71 @@
+"""The view rule of generated scenes (issue 31): close-ups of one surface, views dominated by
+one material and dark views fail; the generators' views all pass it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from spectrinsic.scenes.generators import GeneratorOptions, generate
+from spectrinsic.scenes.generators.view_rule import MAX_SHARE, judge_view
+from spectrinsic.scenes.model import Camera, Mesh, make_light
+
+
+def _quad(name, z, half, material, object_id):
+    """A horizontal square at height *z*, facing up."""
+    v = np.array([[-half, -half, z], [half, -half, z], [half, half, z], [-half, half, z]], float)
+    return Mesh(name, v, np.array([[0, 1, 2], [0, 2, 3]]), np.full(2, material), object_id)
+
+
+def _floor_with_tiles():
+    """A grey floor with three coloured tiles on it (4 materials), seen from above."""
+    meshes = [_quad("floor", 0.0, 2.0, 0, 0)]
+    for i, x in enumerate((-0.65, 0.0, 0.65)):
+        m = _quad(f"tile{i}", 0.01, 0.3, i + 1, i + 1)
+        meshes.append(Mesh(m.name, m.vertices + [x, 0, 0], m.faces, m.face_materials, i + 1))
+    return meshes
+
+
+def _camera(origin, target=(0, 0, 0), fov=50.0):
+    return Camera(origin=origin, target=target, up=(0, 1, 0), fov_deg=fov, width=64, height=48)
+
+
+LAMP = make_light("point", "cie:D65", 4 * np.pi, position=(0.0, 0.0, 2.0))
+
+
+def test_a_view_of_several_lit_materials_passes():
+    j = judge_view(_floor_with_tiles(), [LAMP], _camera((0, 0, 1.5), fov=60))
+    assert j.ok, j.reasons
+    assert j.n_materials == 4 and j.lit_share > 0.9
+
+
+def test_a_close_up_of_one_surface_fails():
+    j = judge_view(_floor_with_tiles(), [LAMP], _camera((0.6, 0, 0.2), target=(0.6, 0, 0)))
+    assert not j.ok and j.max_material_share > MAX_SHARE
+    assert any("fills" in r for r in j.reasons)
+
+
+def test_a_view_without_light_fails():
+    below = make_light("point", "cie:D65", 4 * np.pi, position=(0.0, 0.0, -1.0))  # under the floor
+    j = judge_view(_floor_with_tiles(), [below], _camera((0, 0, 2.5)))
+    assert not j.ok and j.lit_share == 0.0
+    assert any("lit" in r for r in j.reasons)
+
+
+def test_an_occluded_light_does_not_count():
+    roof = _quad("roof", 1.5, 3.0, 5, 9)  # between the lamp and the floor
+    j = judge_view([*_floor_with_tiles(), roof], [LAMP], _camera((0, 0, 1.2), fov=60))
+    assert j.median_light < 0.05
+
+
+@pytest.mark.slow
+def test_fifty_generated_rooms_all_pass_the_view_rule(capsys):
+    options = GeneratorOptions(width=64, height=48)
+    scenes = [generate("rooms", root_seed=11, index=i, view=0, options=options) for i in range(50)]
+    verdicts = [judge_view(s.meshes, s.lights, s.camera) for s in scenes]
+    assert all(v.ok for v in verdicts), [v.reasons for v in verdicts if not v.ok]
+    judged = sum(s.metadata["view_rule"]["judged"] for s in scenes)
+    passed = sum(s.metadata["view_rule"]["passed"] for s in scenes)
+    assert passed == 50 and judged >= passed
+    with capsys.disabled():
+        print(f"\nview rule: acceptance {passed / judged:.0%} ({passed} of {judged} cameras)")
