@@ -36,7 +36,11 @@ import numpy as np
 from scipy.optimize import minimize
 
 from spectrinsic.gt_export.layers import compute_ground_truth
-from spectrinsic.gt_export.layers.spectral_intrinsics import LIGHT_FAMILIES, light_family
+from spectrinsic.gt_export.layers.spectral_intrinsics import (
+    LIGHT_FAMILIES,
+    bands_to_rgb,
+    light_family,
+)
 from spectrinsic.render import RenderSettings, render_scene
 from spectrinsic.scenes.generators import generate
 from spectrinsic.scenes.generators.base import GeneratorOptions
@@ -127,26 +131,17 @@ def _share(image: np.ndarray, residual: np.ndarray, mask: np.ndarray) -> float:
 
 
 def space_figures(gt: object, to_xyz: np.ndarray, m: np.ndarray) -> dict[str, float]:
-    """Residual share (clipped and unclipped shading) and clipped-pixel share in one space."""
-    layers = gt.layers  # type: ignore[attr-defined]
-    cube, refl, w = (
-        layers[k].data.astype(np.float64)
-        for k in ("image_bands", "reflectance_bands", "shading_bands")
-    )
-    mask = layers["mask"].data > 0
-    d65 = responses(get_spectrum("cie:D65").on(WL), get_sensors("bands:31@400-700").on(WL), WL)
-    x = m @ to_xyz
-    y_d = float((to_xyz @ d65)[1])
-    white = x @ d65 / y_d
-    image = cube @ x.T
-    reflectance = (refl * d65) @ x.T / y_d
-    shading = (w @ x.T) / white
-    lit = mask & (np.abs(w).sum(-1) > 0)
-    spec = layers.get("specular_bands")
-    diffuse = image if spec is None else image - spec.data.astype(np.float64) @ x.T
+    """Residual share (clipped and unclipped shading) and clipped-pixel share in one space,
+    from the band layers (:func:`~spectrinsic.gt_export.layers.spectral_intrinsics.bands_to_rgb`)."""
+    layers = {k: v.data for k, v in gt.layers.items()}  # type: ignore[attr-defined]
+    rgb = bands_to_rgb(layers, to_xyz, m)
+    mask = layers["mask"] > 0
+    image, shading = rgb["image"], rgb["shading"]
+    clipped = rgb["residual"] + rgb["reflectance"] * (shading - np.clip(shading, 0, None))
+    lit = mask & (np.abs(layers["shading_bands"]).sum(-1) > 0)
     return {
-        "share_unclipped": _share(image, diffuse - reflectance * shading, mask),
-        "share_clipped": _share(image, diffuse - reflectance * np.clip(shading, 0, None), mask),
+        "share_unclipped": _share(image, rgb["residual"], mask),
+        "share_clipped": _share(image, clipped, mask),
         "clipped_pixels": float((shading[lit] < 0).any(-1).mean()) if lit.any() else 0.0,
     }
 

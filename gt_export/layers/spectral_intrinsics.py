@@ -45,7 +45,8 @@ from spectrinsic.gt_export import irradiance as irr
 from spectrinsic.gt_export.layers.gloss import diffuse_raw, specular_raw
 from spectrinsic.gt_export.layers.intrinsics import white_radiance
 from spectrinsic.gt_export.layers.records import Layer, SampleInputs, cube_sensor_name, make_layer
-from spectrinsic.spectra import get_sensors
+from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, get_sensors, get_spectrum, responses
+from spectrinsic.spectra.colourspace import srgb_matrices
 
 __all__ = [
     "SPECTRAL_MODE",
@@ -58,6 +59,9 @@ __all__ = [
     "LIGHT_FAMILIES",
     "light_family",
     "residual_summary",
+    "WORKING_SPACES",
+    "working_space_matrix",
+    "bands_to_rgb",
 ]
 
 #: The render mode whose raw cube the spectral layers come from.
@@ -292,3 +296,64 @@ def residual_summary(metas: Any) -> dict[str, Any]:
         family: {"samples": len(row["rgb"])} | {k: _figures(v) for k, v in row.items() if v}
         for family, row in sorted(rows.items())
     }
+
+
+#: RGB working spaces :func:`bands_to_rgb` knows (name -> colour-science colourspace, or ours).
+WORKING_SPACES: dict[str, str] = {
+    "srgb": "sRGB",
+    "rec2020": "ITU-R BT.2020",
+    "acescg": "ACEScg",
+}
+
+
+def working_space_matrix(space: str) -> np.ndarray:
+    """``(3, 3)`` CIE XYZ -> linear RGB of a :data:`WORKING_SPACES` space (colour-science)."""
+    if space not in WORKING_SPACES:
+        raise DatasetError(f"working space {space!r}; expected one of {sorted(WORKING_SPACES)}")
+    if space == "srgb":
+        return np.asarray(srgb_matrices()[0], np.float64)
+    import colour  # noqa: PLC0415 - heavy; only here
+
+    return np.asarray(colour.RGB_COLOURSPACES[WORKING_SPACES[space]].matrix_XYZ_to_RGB)
+
+
+def bands_to_rgb(
+    layers: Mapping[str, np.ndarray],
+    to_xyz: np.ndarray,
+    matrix: np.ndarray,
+    *,
+    bands: str = "bands:31@400-700",
+    clip: bool = False,
+) -> dict[str, np.ndarray]:
+    """RGB intrinsic layers in the space of *matrix* (XYZ -> RGB) from a sample's band layers:
+    ``image = M X cube``, ``reflectance = M X (ρ ∘ D) / Y_D`` (under D65, D its band values),
+    ``shading = M X W / white`` with ``white = M X D / Y_D`` (clipped at 0 if *clip*),
+    ``specular``, and ``residual = image − reflectance ∘ shading − specular``; X = *to_xyz*,
+    the cube's raw -> XYZ matrix (``meta.json["render"]["to_xyz"]["bands31"]``). The
+    reflectance is integrated from the bands (within 0.5 % of the 1 nm one). Render units.
+    """
+    wl = COLORIMETRIC_WAVELENGTHS
+    d65 = responses(get_spectrum("cie:D65").on(wl), get_sensors(bands).on(wl), wl)
+    x = np.asarray(matrix, np.float64) @ np.asarray(to_xyz, np.float64)
+    y_d = float((np.asarray(to_xyz, np.float64) @ d65)[1])
+    white = x @ d65 / y_d
+
+    def rgb(name: str) -> np.ndarray:
+        return np.einsum("hwk,ck->hwc", np.asarray(layers[name], np.float64), x)
+
+    out = {
+        "image": rgb("image_bands"),
+        "reflectance": np.einsum(
+            "hwk,ck->hwc", np.asarray(layers["reflectance_bands"], np.float64) * d65, x
+        )
+        / y_d,
+        "shading": rgb("shading_bands") / white,
+    }
+    if clip:
+        out["shading"] = np.clip(out["shading"], 0.0, None)
+    rest = out["image"] - out["reflectance"] * out["shading"]
+    if "specular_bands" in layers:
+        out["specular"] = rgb("specular_bands")
+        rest = rest - out["specular"]
+    out["residual"] = rest
+    return out

@@ -18,7 +18,7 @@ import pytest
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import check_sample, export_sample, load_sample
 from spectrinsic.gt_export.layers import compute_ground_truth, identities
-from spectrinsic.gt_export.loader import filter_residual_share
+from spectrinsic.gt_export.loader import filter_residual_share, working_space_view
 from spectrinsic.gt_export.relight import relight, relit_scene
 from spectrinsic.render import RenderSettings, render_batches, render_scene
 from spectrinsic.render.transport import render_transport_batches
@@ -164,6 +164,15 @@ def test_c_residual_share_in_meta_equals_a_recomputation_from_the_stored_layers(
         recomputed = np.abs(residual).sum() / np.abs(image).sum()
         assert shares[ident["image"]] == pytest.approx(recomputed, rel=1e-9)
     assert shares["image_bands"] < 1e-3 < shares["image_denoised"]
+    # the RGB view from the band layers reproduces the stored sRGB layers' residual share (the
+    # reflectance integrated from the bands rather than at 1 nm), and holds in other spaces
+    srgb = working_space_view(loaded, "srgb", clip=True)
+    np.testing.assert_allclose(srgb["image"], loaded["image_denoised"], rtol=1e-4, atol=1e-6)
+    view_share = np.abs(srgb["residual"][mask]).sum() / np.abs(srgb["image"][mask]).sum()
+    assert view_share == pytest.approx(shares["image_denoised"], rel=0.1)
+    aces = working_space_view(loaded, "acescg")
+    rebuilt = aces["reflectance"] * aces["shading"] + aces["residual"]
+    np.testing.assert_allclose(rebuilt, aces["image"], atol=1e-9 * np.abs(aces["image"]).max())
     # the loader's filter reads the same figure
     rgb = shares["image_denoised"]
     assert filter_residual_share([sample], rgb) == [sample]
