@@ -59,13 +59,16 @@ def test_an_occluded_light_does_not_count():
 
 
 @pytest.mark.slow
-def test_fifty_generated_rooms_all_pass_the_view_rule(capsys):
+def test_generated_rooms_all_pass_the_view_rule(capsys):
+    # 12 rooms keep make test within budget (about 3 s a room here); scripts/view_rule_figure.py
+    # measures the acceptance on 50 and more
     options = GeneratorOptions(width=64, height=48)
-    scenes = [generate("rooms", root_seed=11, index=i, view=0, options=options) for i in range(50)]
+    n = 12
+    scenes = [generate("rooms", root_seed=11, index=i, view=0, options=options) for i in range(n)]
     verdicts = [judge_view(s.meshes, s.lights, s.camera) for s in scenes]
     assert all(v.ok for v in verdicts), [v.reasons for v in verdicts if not v.ok]
     judged = sum(s.metadata["view_rule"]["judged"] for s in scenes)
     passed = sum(s.metadata["view_rule"]["passed"] for s in scenes)
-    assert passed == 50 and judged >= passed
+    assert passed == n and judged >= passed
     with capsys.disabled():
         print(f"\nview rule: acceptance {passed / judged:.0%} ({passed} of {judged} cameras)")
