@@ -3,7 +3,9 @@
 A glTF material's ``pbrMetallicRoughness.baseColorFactor`` is a linear-sRGB colour (glTF 2.0
 spec, section 3.9.2); :func:`gltf_base_colours` turns each one the file states into the
 registry name ``rgb:R,G,B`` (:mod:`spectrinsic.spectra.user_spectra`: Mallett & Yuksel 2019),
-so a coloured asset renders in its colours without a material map. Alpha is ignored (surfaces
+so a coloured asset renders in its colours without a material map when asked for
+(``colours_from_asset=True``, ``--colours-from-asset``; without it an unmapped material is an
+error, :mod:`spectrinsic.scenes.meshes`). Alpha is ignored (surfaces
 are opaque). A factor outside [0, 1] is refused when the scene is validated, not clipped.
 Materials without an explicit factor get none (glTF's default white is not assumed), and
 ``baseColorTexture`` images are not read: such materials still need the map or a default.

@@ -19,7 +19,7 @@ from spectrinsic.scenes.generators.camera import is_free, sample_camera
 from spectrinsic.scenes.generators.gloss import GlossDistribution
 from spectrinsic.scenes.generators.lights import FAMILIES, LightVolume, draw_lights
 from spectrinsic.scenes.generators.materials import MaterialDistribution
-from spectrinsic.scenes.model import Mesh, Scene
+from spectrinsic.scenes.model import Light, Mesh, Scene
 from spectrinsic.scenes.parts import Part, to_meshes
 
 __all__ = ["GeneratorOptions", "Layout", "assemble", "family_of", "scene_rngs"]
@@ -52,6 +52,9 @@ class GeneratorOptions:
         Spectral data directory (for ``sfu`` chromaticities).
     light_saturation
         ``(lo, hi)``: |Duv| range (Ohno 2013) of the coloured families' lights; None: any.
+    daylight_share
+        Fraction of ``rooms`` lit also by sun and sky through a window, 0..1
+        (:mod:`~spectrinsic.scenes.generators.daylight`); 0 leaves every room as before.
     """
 
     width: int
@@ -65,6 +68,7 @@ class GeneratorOptions:
     data_dir: str | None = None
     gloss: GlossDistribution = field(default_factory=GlossDistribution)
     light_saturation: tuple[float, float] | None = None
+    daylight_share: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -84,6 +88,9 @@ class Layout:
     min_coverage
         The generator's own least object coverage of a view (rooms frame furniture); the
         camera must pass the larger of this and ``options.min_coverage``.
+    extra_lights
+        Lights of the layout itself, added to the condition's drawn lights (a daylight
+        room's sun and sky).
     """
 
     parts: tuple[tuple[str, Part], ...]
@@ -91,6 +98,7 @@ class Layout:
     propose_camera: Callable[[np.random.Generator], tuple[np.ndarray, np.ndarray, float]]
     info: dict[str, Any]
     min_coverage: float = 0.0
+    extra_lights: tuple[Light, ...] = ()
 
 
 def scene_rngs(seed: int) -> dict[str, np.random.Generator]:
@@ -131,7 +139,7 @@ def assemble(
         data_dir=options.data_dir,
         max_lights=options.max_lights,
         saturation=options.light_saturation,
-    )
+    ) + tuple(layout.extra_lights)
     # Views 0..views-1 are drawn in order, so view k is the same in any build, and all of them
     # must pass for the layout to be used (every view of a scene shows one layout).
     for k in range(max(view + 1, options.views)):
