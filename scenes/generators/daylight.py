@@ -96,8 +96,9 @@ def draw_daylight(
     axis = 1 if wall in ("left", "right") else 0
     length, depth = (d, w) if axis == 1 else (w, d)
     a = float(rng.uniform(0.2, 0.45))
-    hole = (a, a + float(rng.uniform(0.25, 0.4)), float(rng.uniform(0.5, 0.9)))
-    hole += (float(rng.uniform(1.7, min(2.2, h - 0.15))),)
+    b = a + float(rng.uniform(0.25, 0.4))
+    sill = float(rng.uniform(0.5, 0.9))
+    hole = (a, b, sill, float(rng.uniform(1.7, min(2.2, h - 0.15))))
     lo, hi = np.zeros(3), np.zeros(3)
     lo[axis], hi[axis] = hole[0] * length, hole[1] * length
     lo[1 - axis] = {"left": -thickness, "right": w, "back": d, "front": -thickness}[wall]
