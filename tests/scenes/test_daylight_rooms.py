@@ -2,6 +2,7 @@
 the floor is checked against the window box and the sun direction in closed form, by casting
 rays (trimesh) through the room's walls, floor and ceiling."""
 
+import dataclasses
 import json
 
 import numpy as np
@@ -92,3 +93,45 @@ def test_bad_daylight_share_is_refused_in_one_line(tmp_path, capsys, generator, 
     assert main(args) == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "--daylight-share" in err and not out.exists()
+
+
+def test_rendered_sun_patch_has_the_closed_form_radiance():
+    """Direct light only, walls, floor and ceiling only, the sun alone: a floor spot 0.3 m
+    inside the patch the window box predicts shows radiance ρ E cos θ / π (E the sun's
+    irradiance, θ its zenith angle; CIE 1931 responses), a spot 0.3 m outside it shows none."""
+    from spectrinsic.render import RenderSettings, render_scene
+    from spectrinsic.scenes.model import Camera
+    from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as WL
+    from spectrinsic.spectra import get_sensors, get_spectrum, responses
+
+    scene = generate("rooms", root_seed=11, index=0, view=0, options=DAY)
+    day, (w, d, h) = scene.metadata["daylight"], scene.metadata["room_size"]
+    sun = next(light for light in scene.lights if light.name == "sun")
+    lo, hi = np.asarray(day["opening"][0]), np.asarray(day["opening"][1])
+    xs, ys = np.meshgrid(np.linspace(0.4, w - 0.4, 60), np.linspace(0.4, d - 0.4, 60))
+    floor = np.column_stack([xs.ravel(), ys.ravel(), np.zeros(xs.size)])
+    to_sun = -np.asarray(sun.direction)
+    margin = np.where(hi - lo < 0.2, 0.0, 0.3)  # not across the wall's thickness
+    inside = floor[_through(floor, to_sun, lo + margin, hi - margin)][0]
+    outside = floor[~_through(floor, to_sun, lo - margin, hi + margin)][0]
+    shell = tuple(m for m in scene.meshes if m.name.startswith(SHELL))
+    floor_mesh = next(m for m in shell if m.name == "floor")
+    rho = get_spectrum(scene.materials[int(floor_mesh.face_materials[0])].spectrum).on(WL)
+    cie = get_sensors("cie1931").on(WL)
+    expected = responses(rho * get_spectrum(sun.spectrum).on(WL), cie, WL)
+    expected *= sun.power * to_sun[2] / np.pi
+    settings = RenderSettings(16, modes=("spectral",), max_depth=2, aovs=False)
+    for spot, want in ((inside, expected), (outside, 0.0 * expected)):
+        camera = Camera(
+            origin=(spot[0], spot[1], h - 0.05),
+            target=(spot[0], spot[1], 0.0),
+            up=(0.0, 1.0, 0.0),
+            fov_deg=8.0,
+            width=8,
+            height=8,
+        )
+        probe = dataclasses.replace(scene, meshes=shell, lights=(sun,), camera=camera)
+        pixels = render_scene(probe, settings, seed=1).images["spectral"].reshape(-1, 3)
+        # spectral Monte Carlo noise (4 sigma) and the 1 nm sum against Mitsuba's integral
+        stderr = pixels.std(axis=0, ddof=1) / np.sqrt(len(pixels))
+        assert np.all(np.abs(pixels.mean(0) - want) <= 4 * stderr + 5e-4 * expected)
