@@ -56,8 +56,21 @@ def _add_generator_options(src: Any) -> None:
     )
 
 
+def _add_daylight_option(src: Any) -> None:
+    """``--daylight-share``: rooms lit also by sun and sky through a window."""
+    src.add_argument(
+        "--daylight-share",
+        type=float,
+        default=0.0,
+        metavar="F",
+        help="fraction of generated rooms closed, with a window, and lit also by a sun and a "
+        "sky of CIE daylight spectra shining through it (0)",
+    )
+
+
 def _add_generated_draw_options(src: Any) -> None:
     """What generated scenes draw: material ranges, light colours, SFU data, gloss."""
+    _add_daylight_option(src)
     src.add_argument(
         "--value-range",
         default="2,9",
@@ -137,6 +150,12 @@ def _add_scene_file_options(src: Any) -> None:
         help="reflectance of unmapped materials in .blend and mesh scenes",
     )
     src.add_argument(
+        "--colours-from-asset",
+        action="store_true",
+        help="give unmapped glTF and .blend materials their base colour (glTF "
+        "baseColorFactor, Principled Base Color) as an rgb: reflectance (default: an error)",
+    )
+    src.add_argument(
         "--new-sample",
         action="store_true",
         help="render scenes a generated build saved (<dataset>/scenes/*.yaml) as new "
@@ -209,6 +228,7 @@ def source_from_args(args: argparse.Namespace) -> str | None:
             if args.light_saturation is None
             else _range("--light-saturation", args.light_saturation),
             texture_fraction=args.texture_fraction,
+            daylight_share=args.daylight_share,
         )
     if args.scenes:
         size = None if args.resolution is None else parse_resolution(args.resolution)
@@ -218,6 +238,7 @@ def source_from_args(args: argparse.Namespace) -> str | None:
             default_spectrum=args.default_spectrum,
             resolution=size,
             new_sample=getattr(args, "new_sample", False),
+            colours_from_asset=args.colours_from_asset,
         )
     return None
 
@@ -280,4 +301,5 @@ def check_scene_files(config: Any, data_dir: str | None) -> None:
             height,
             tuple(sorted(materials.items())),
             spec.get("default_spectrum"),
+            colours_from_asset=bool(spec.get("colours_from_asset")),
         ).build(data_dir)

@@ -193,6 +193,12 @@ def _add_material_options(p: Any) -> None:
         default=None,
         help="reflectance of unmapped materials in .blend and mesh files",
     )
+    p.add_argument(
+        "--colours-from-asset",
+        action="store_true",
+        help="give unmapped glTF and .blend materials their base colour (glTF "
+        "baseColorFactor, Principled Base Color) as an rgb: reflectance (default: an error)",
+    )
 
 
 def load_scene_argument(
@@ -206,6 +212,7 @@ def load_scene_argument(
     materials: Mapping[str, str] | None = None,
     default_spectrum: str | None = None,
     data_dir: str | None = None,
+    colours_from_asset: bool = False,
 ) -> Scene:
     """The Scene named by the ``SCENE`` argument: a scene file (YAML, ``.blend`` or mesh,
     :func:`spectrinsic.scenes.sources.load_scene_file`, the dispatch ``dataset --scenes`` uses),
@@ -218,6 +225,7 @@ def load_scene_argument(
             materials=materials,
             default_spectrum=default_spectrum,
             data_dir=data_dir,
+            colours_from_asset=colours_from_asset,
         )
     default = get_preset("default")
     return library.build(
@@ -285,6 +293,7 @@ def _ground_truth(args: argparse.Namespace) -> int:
             default_spectrum=args.default_spectrum,
             resolution=size,
             new_sample=args.new_sample,
+            colours_from_asset=args.colours_from_asset,
         )
     else:
         only = str(SampleId(args.scene, args.view, args.condition))
@@ -378,6 +387,7 @@ def _load_scene(args: argparse.Namespace, data_dir: str | None) -> Scene:
         materials=material_map(args.material_map),
         default_spectrum=args.default_spectrum,
         data_dir=data_dir,
+        colours_from_asset=args.colours_from_asset,
     )
 
 

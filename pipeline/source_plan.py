@@ -81,11 +81,12 @@ def generator_source(
     gloss: GlossDistribution | None = None,
     light_saturation: Sequence[float] | None = None,
     texture_fraction: float = 0.0,
+    daylight_share: float = 0.0,
 ) -> str:
     """The canonical ``source`` JSON of a generated set (validated: an impossible range is
     refused here, before any scene is planned); *gloss*, *light_saturation* and a
     *texture_fraction* above 0 enter it only when given, so matte sets and older configs keep
-    their source and config hash."""
+    their source and config hash; so does a *daylight_share* (``rooms`` only) above 0."""
     validate_choice(generator, GENERATORS, "scene generator", error=DatasetError)
     try:
         check_ranges(
@@ -101,6 +102,11 @@ def generator_source(
         raise DatasetError(f"--light-saturation: {exc}") from None
     if not 0.0 <= texture_fraction <= 1.0:
         raise DatasetError(f"--texture-fraction {texture_fraction:g}: expected a fraction in 0..1")
+    if not 0.0 <= daylight_share <= 1.0 or (daylight_share > 0 and generator != "rooms"):
+        raise DatasetError(
+            f"--daylight-share {daylight_share:g}: expected a fraction in 0..1 of the rooms "
+            f"generator's scenes (generator {generator!r})"
+        )
     if not (1 <= count <= MAX_COUNT and 1 <= views <= MAX_VIEWS):
         raise DatasetError(
             f"--count {count} / --views {views}; expected whole numbers from 1 to "
@@ -126,6 +132,8 @@ def generator_source(
         spec["light_saturation"] = [float(v) for v in light_saturation]
     if texture_fraction > 0:
         spec["texture_fraction"] = float(texture_fraction)
+    if daylight_share > 0:
+        spec["daylight_share"] = float(daylight_share)
     return json.dumps(spec, sort_keys=True, allow_nan=False)
 
 
@@ -136,10 +144,12 @@ def files_source(
     default_spectrum: str | None = None,
     resolution: tuple[int, int] | None = None,
     new_sample: bool = False,
+    colours_from_asset: bool = False,
 ) -> str:
     """The canonical ``source`` JSON of a set of scene files (each must exist): rendered at
     *resolution* ``(W, H)``, else at each file's own camera size; a saved generated scene as
-    its own sample unless *new_sample*."""
+    its own sample unless *new_sample*; *colours_from_asset* (in the JSON only when set, so
+    older configs keep their hash): base colours of glTF and ``.blend`` materials as spectra."""
     entries = []
     for p in paths:
         path = Path(p).resolve()
@@ -158,6 +168,8 @@ def files_source(
         "new_sample": bool(new_sample),
         "resolution": None if resolution is None else [int(v) for v in resolution],
     }
+    if colours_from_asset:
+        spec["colours_from_asset"] = True
     ids = [str(file_sample(e["path"], new_sample=new_sample)[0]) for e in entries]
     dupes = sorted({i for i in ids if ids.count(i) > 1})
     if dupes:
@@ -253,6 +265,7 @@ def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir:
         sfu_illuminants=sfu_i,
         gloss=gloss,
         light_saturation=None if saturation is None else tuple(saturation),
+        daylight_share=float(spec.get("daylight_share", 0.0)),
     )
 
 
@@ -299,7 +312,14 @@ def _file_tasks(
     width, height = spec.get("resolution") or (None, None)
     tasks = []
     for entry in spec["scenes"]:
-        src = FileSource(entry["path"], width, height, materials, spec.get("default_spectrum"))
+        src = FileSource(
+            entry["path"],
+            width,
+            height,
+            materials,
+            spec.get("default_spectrum"),
+            colours_from_asset=bool(spec.get("colours_from_asset")),
+        )
         sid, seed = file_sample(entry["path"], new_sample=bool(spec.get("new_sample")))
         task = SampleTask.planned(
             sid, config, out, data_dir=data_dir, render_threads=render_threads, source=src

@@ -19,8 +19,16 @@ spectrum chosen by, in order: the *materials* mapping passed in, the material's 
 else is needed). A Principled BSDF node sets the gloss (:func:`principled_gloss`): Metallic
 ≥ 0.5 makes a metal (``conductor``, η/k of the custom property ``"metal"``, default ``Al``; no
 spectrum needed), else Roughness < 0.5 a coated diffuse (``plastic``, the node's IOR); GGX α is
-Roughness² (Blender's convention). Everything else of the node (base colour, coat, sheen,
-subsurface, transmission, emission, textures) is ignored; other materials are Lambertian.
+Roughness² (Blender's convention). Everything else of the node (coat, sheen, subsurface,
+transmission, emission, textures) is ignored; other materials are Lambertian.
+
+With ``colours_from_asset=True`` (``--colours-from-asset``), a material that the mapping, its
+custom property and its name leave without a spectrum takes the Principled node's Base Color
+(scene-linear Rec. 709, as Blender stores it; alpha ignored) as the reflectance ``rgb:R,G,B``
+(:mod:`spectrinsic.spectra.user_spectra`, Mallett & Yuksel 2019); a colour outside [0, 1] is
+refused when validated, not clipped, and a Base Color fed by a node (an image texture) is not
+read, so that material still needs a spectrum. Without the option such a material is an error,
+so no colour is taken from a file unless asked for.
 
 Opening a file replaces the data of the running ``bpy`` session (Blender has one global state).
 """
@@ -42,7 +50,7 @@ from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.scenes.validate import validate_scene
 from spectrinsic.spectra import get_spectrum
 
-__all__ = ["load_blend", "SPECTRUM_PROPERTY", "METAL_PROPERTY", "principled_gloss"]
+__all__ = ["load_blend", "SPECTRUM_PROPERTY", "METAL_PROPERTY", "base_colour", "principled_gloss"]
 
 log = logging.getLogger(__name__)
 
@@ -69,15 +77,28 @@ def _matrix(obj: Any) -> np.ndarray:
     return np.array([list(row) for row in obj.matrix_world], dtype=np.float64)
 
 
+def _principled(mat: Any) -> Any:
+    """*mat*'s first Principled BSDF node, or None."""
+    tree = getattr(mat, "node_tree", None)
+    if tree is None:
+        return None
+    return next((n for n in tree.nodes if n.type == "BSDF_PRINCIPLED"), None)
+
+
+def base_colour(mat: Any) -> str | None:
+    """``"rgb:R,G,B"`` of *mat*'s Principled Base Color (module docstring); None without the
+    node or when a texture (any link) feeds the colour."""
+    node = _principled(mat)
+    if node is None or node.inputs["Base Color"].is_linked:
+        return None
+    rgba = node.inputs["Base Color"].default_value
+    return "rgb:" + ",".join(f"{float(c):.9g}" for c in list(rgba)[:3])
+
+
 def principled_gloss(mat: Any) -> dict[str, Any]:
     """Gloss fields of :class:`Material` from *mat*'s first Principled BSDF node (module
     docstring); ``{}`` (Lambertian) without one or when it is matte."""
-    tree = getattr(mat, "node_tree", None)
-    node = (
-        next((n for n in tree.nodes if n.type == "BSDF_PRINCIPLED"), None)
-        if tree is not None
-        else None
-    )
+    node = _principled(mat)
     if node is None:
         return {}
     rough = float(node.inputs["Roughness"].default_value)
@@ -233,8 +254,10 @@ class _MaterialTable:
         mapping: Mapping[str, str],
         default_spectrum: str | None,
         data_dir: str | None,
+        colours_from_asset: bool = False,
     ) -> None:
         self.source = source
+        self.colours_from_asset = colours_from_asset
         self.mapping = dict(mapping)
         self.default_spectrum = default_spectrum
         self.data_dir = data_dir
@@ -250,7 +273,7 @@ class _MaterialTable:
             name, spectrum = "default", self.default_spectrum
         else:
             name = mat.name
-            spectrum = self.mapping.get(name) or _prop(mat) or name
+            spectrum = self.mapping.get(name) or _prop(mat) or self._colour(mat) or name
         gloss = principled_gloss(mat) if mat is not None else {}
         if name not in self.table and gloss.get("kind") == "conductor":
             material = Material(name=name, spectrum=METAL_SPECTRUM, **gloss)
@@ -270,6 +293,16 @@ class _MaterialTable:
             )
             self.table[name] = Material(name=name, spectrum=spectrum, **gloss)
         return list(self.table).index(name)
+
+    def _colour(self, mat: Any) -> str | None:
+        """The base colour when asked for and the name is no spectrum (module docstring)."""
+        if not self.colours_from_asset:
+            return None
+        try:
+            get_spectrum(mat.name, data_dir=self.data_dir)
+        except SpectrinsicError:
+            return base_colour(mat)
+        return None
 
 
 def _triangles(obj: Any, depsgraph: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
@@ -326,6 +359,7 @@ def load_blend(
     resolution: tuple[int, int] | None = None,
     data_dir: str | None = None,
     validate: bool = True,
+    colours_from_asset: bool = False,
 ) -> Scene:
     """Read a ``.blend`` file into a :class:`~spectrinsic.scenes.model.Scene`.
 
@@ -346,6 +380,9 @@ def load_blend(
         Spectral data directory for spectra that need one.
     validate
         Run :func:`~spectrinsic.scenes.validate.validate_scene` on the result.
+    colours_from_asset
+        Give materials without a spectrum their Principled Base Color as an ``rgb:``
+        reflectance (module docstring); False: they are an error.
 
     Raises
     ------
@@ -362,7 +399,7 @@ def load_blend(
     bpy_scene = bpy.context.scene
     camera = _camera(source, bpy_scene, resolution)
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    table = _MaterialTable(source, materials or {}, default_spectrum, data_dir)
+    table = _MaterialTable(source, materials or {}, default_spectrum, data_dir, colours_from_asset)
     meshes: list[Mesh] = []
     lights: list[Light] = []
     for obj in sorted(bpy_scene.objects, key=lambda o: o.name):

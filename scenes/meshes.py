@@ -9,9 +9,11 @@ the named file is read (no textures, no referenced files outside its folder are 
 A glTF material's ``pbrMetallicRoughness`` factors set the gloss as for ``.blend`` files: metallic
 ≥ 0.5 makes a metal (``conductor``, Al: the factors name no metal; no spectrum needed), else
 roughness < 0.5 a coated diffuse (``plastic``, η = 1.5); GGX α = roughness². Absent factors
-count as matte (not glTF's default of 1), so files without them import as before. A material
-not in the map takes its ``baseColorFactor`` as an ``rgb:`` reflectance if the file states one
-(:mod:`spectrinsic.scenes.gltf_colours`); textures and every other field are ignored.
+count as matte (not glTF's default of 1), so files without them import as before. With
+``colours_from_asset=True`` (``--colours-from-asset``), a material not in the map takes its
+``baseColorFactor`` as an ``rgb:`` reflectance if the file states one
+(:mod:`spectrinsic.scenes.gltf_colours`); without it an unmapped material is an error, as for
+``.blend`` files. Textures and every other field are ignored.
 """
 
 from __future__ import annotations
@@ -205,6 +207,7 @@ def load_mesh_scene(
     height: int,
     default_spectrum: str | None = None,
     data_dir: str | None = None,
+    colours_from_asset: bool = False,
 ) -> Scene:
     """Read a mesh file into a validated :class:`~spectrinsic.scenes.model.Scene`.
 
@@ -219,6 +222,9 @@ def load_mesh_scene(
         Image size in pixels of the framing camera.
     default_spectrum
         Reflectance of materials not in *materials*; ``None``: such a material is an error.
+    colours_from_asset
+        Give glTF materials not in *materials* their ``baseColorFactor`` as an ``rgb:``
+        reflectance before *default_spectrum* (module docstring).
 
     Raises
     ------
@@ -227,7 +233,7 @@ def load_mesh_scene(
     """
     path = Path(path)
     geoms = _geometries(path)
-    colours = gltf_base_colours(path)
+    colours = gltf_base_colours(path) if colours_from_asset else {}
     table: dict[str, Material] = {}  # matte materials keep their spectrum's name
     meshes = []
     for i, (node, material, verts, faces, gloss) in enumerate(geoms):

@@ -61,7 +61,7 @@ LIGHT_FIELDS: dict[str, tuple[str, ...]] = {
 }
 #: The light kinds, in the table's order (``typing.get_args(LightKind)`` is the same).
 LIGHT_KINDS: tuple[LightKind, ...] = tuple(LIGHT_FIELDS)  # type: ignore[arg-type]
-#: The kinds the scene generators draw (a sky comes from scene files only).
+#: The kinds the scene generators draw (a sky comes from scene files and daylight rooms).
 DRAWN_LIGHT_KINDS: tuple[LightKind, ...] = tuple(k for k in LIGHT_KINDS if k != "sky")
 #: Every placement field some kind uses (the union of :data:`LIGHT_FIELDS`).
 LIGHT_PLACEMENT: tuple[str, ...] = tuple(

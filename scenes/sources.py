@@ -130,6 +130,7 @@ def load_scene_file(
     materials: Mapping[str, str] | None = None,
     default_spectrum: str | None = None,
     data_dir: str | None = None,
+    colours_from_asset: bool = False,
 ) -> Scene:
     """Read any scene file (:func:`scene_file_kind`) into a validated scene: the one dispatch
     over YAML, ``.blend`` and mesh files, for ``dataset --scenes`` and ``render``.
@@ -143,6 +144,9 @@ def load_scene_file(
         Material name -> spectrum, for meshes and ``.blend`` files.
     default_spectrum
         Reflectance of mesh or ``.blend`` materials not in *materials*.
+    colours_from_asset
+        Give glTF and ``.blend`` materials without a spectrum the file's base colour as an
+        ``rgb:`` reflectance (``--colours-from-asset``); False: they are an error.
     """
     kind = scene_file_kind(path)
     mapping = dict(materials or {})
@@ -155,6 +159,7 @@ def load_scene_file(
             height=height or FILE_SIZE,
             default_spectrum=default_spectrum,
             data_dir=data_dir,
+            colours_from_asset=colours_from_asset,
         )
     if kind == "blend":
         return load_blend(
@@ -163,6 +168,7 @@ def load_scene_file(
             resolution=(width or FILE_SIZE, height or FILE_SIZE) if given else None,
             default_spectrum=default_spectrum,
             data_dir=data_dir,
+            colours_from_asset=colours_from_asset,
         )
     if kind == "mitsuba":
         scene = load_mitsuba_xml(path, data_dir=data_dir)
@@ -187,6 +193,8 @@ class FileSource:
         Material name -> spectrum pairs, for meshes and ``.blend`` files.
     default_spectrum
         Reflectance of mesh or ``.blend`` materials not in *materials*.
+    colours_from_asset
+        Base colours of glTF and ``.blend`` materials without a spectrum as ``rgb:`` spectra.
     """
 
     path: str
@@ -194,6 +202,7 @@ class FileSource:
     height: int | None
     materials: tuple[tuple[str, str], ...] = ()
     default_spectrum: str | None = None
+    colours_from_asset: bool = False
 
     def build(self, data_dir: str | None = None) -> Scene:
         """Read and validate the file; one-line :class:`SceneError` naming it on bad input."""
@@ -204,4 +213,5 @@ class FileSource:
             materials=dict(self.materials),
             default_spectrum=self.default_spectrum,
             data_dir=data_dir,
+            colours_from_asset=self.colours_from_asset,
         )

@@ -20,7 +20,7 @@ from spectrinsic.scenes.generators.gloss import GlossDistribution
 from spectrinsic.scenes.generators.lights import FAMILIES, LightVolume, draw_lights
 from spectrinsic.scenes.generators.materials import MaterialDistribution
 from spectrinsic.scenes.generators.view_rule import judge_view
-from spectrinsic.scenes.model import Camera, Mesh, Scene
+from spectrinsic.scenes.model import Camera, Light, Mesh, Scene
 from spectrinsic.scenes.parts import Part, to_meshes
 
 __all__ = ["GeneratorOptions", "Layout", "assemble", "family_of", "scene_rngs"]
@@ -53,6 +53,9 @@ class GeneratorOptions:
         Spectral data directory (for ``sfu`` chromaticities).
     light_saturation
         ``(lo, hi)``: |Duv| range (Ohno 2013) of the coloured families' lights; None: any.
+    daylight_share
+        Fraction of ``rooms`` lit also by sun and sky through a window, 0..1
+        (:mod:`~spectrinsic.scenes.generators.daylight`); 0 leaves every room as before.
     """
 
     width: int
@@ -66,6 +69,7 @@ class GeneratorOptions:
     data_dir: str | None = None
     gloss: GlossDistribution = field(default_factory=GlossDistribution)
     light_saturation: tuple[float, float] | None = None
+    daylight_share: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -89,6 +93,9 @@ class Layout:
         Cameras must also pass :func:`~spectrinsic.scenes.generators.view_rule.judge_view`
         (rooms: several materials, no surface filling the frame, enough light). Objects on a
         ground are MIT-like: the ground fills most of the frame by design.
+    extra_lights
+        Lights of the layout itself, added to the condition's drawn lights (a daylight
+        room's sun and sky).
     """
 
     parts: tuple[tuple[str, Part], ...]
@@ -97,6 +104,7 @@ class Layout:
     info: dict[str, Any]
     min_coverage: float = 0.0
     view_rule: bool = False
+    extra_lights: tuple[Light, ...] = ()
 
 
 def scene_rngs(seed: int) -> dict[str, np.random.Generator]:
@@ -137,7 +145,7 @@ def assemble(
         data_dir=options.data_dir,
         max_lights=options.max_lights,
         saturation=options.light_saturation,
-    )
+    ) + tuple(layout.extra_lights)
     draws = [0, 0]  # cameras judged by the view rule, and passed
 
     def judged(cam: Camera) -> bool:

@@ -23,6 +23,7 @@ from spectrinsic.scenes.furniture import (
 )
 from spectrinsic.scenes.generators.base import GeneratorOptions, Layout
 from spectrinsic.scenes.generators.camera import Footprints
+from spectrinsic.scenes.generators.daylight import Daylight, draw_daylight
 from spectrinsic.scenes.generators.lights import LightVolume
 from spectrinsic.scenes.generators.materials import (
     MaterialDistribution,
@@ -82,8 +83,12 @@ def _wall(
 
 
 def _shell(
-    rng: np.random.Generator, size: tuple[float, float, float], user: MaterialDistribution
+    rng: np.random.Generator,
+    size: tuple[float, float, float],
+    user: MaterialDistribution,
+    day: Daylight | None = None,
 ) -> tuple[list[tuple[str, Part]], dict]:
+    """Floor, walls and ceiling; a daylight room (*day*) is closed, with its one window."""
     w, d, h = size
     # half the rooms have light, low-chroma walls (strong interreflection: low r), the others
     # any walls; with missing walls and ceilings this spreads r
@@ -96,6 +101,8 @@ def _shell(
     )
     missing = [k for k in _WALLS if k != "back" and rng.random() < 0.3]
     ceiling = rng.random() >= 0.35
+    if day is not None:
+        missing, ceiling = [], True
     parts = [
         (
             "floor",
@@ -128,6 +135,8 @@ def _shell(
                 (a, a + rng.uniform(0.2, 0.4), rng.uniform(0.6, 1.0), rng.uniform(1.6, h - 0.2)),
                 windows + 1,
             )
+        if day is not None:
+            hole, windows = (day.hole if key == day.wall else None), 1
         parts.append((f"wall-{key}", _wall(key, size, draw_reflectance(rng, walls), hole)))
     return parts, {
         "missing_walls": missing,
@@ -295,7 +304,13 @@ def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
         float(rng.uniform(2.3, 3.2)),
     )
     w, d, h = size
-    shell, openness = _shell(rng, size, options.materials)
+    # a child generator leaves the layout's draws as they were: rooms not drawn for daylight
+    # (all of them with --daylight-share 0, the default) are unchanged
+    day_rng = rng.spawn(1)[0] if options.daylight_share > 0 else None
+    day = None
+    if day_rng is not None and day_rng.random() < options.daylight_share:
+        day = draw_daylight(day_rng, size, _T)
+    shell, openness = _shell(rng, size, options.materials, day)
     floor = Footprints([])
     furniture, tops = _furniture(
         rng, size, floor, within(MaterialDistribution((2, 8), (0, 12)), options.materials)
@@ -314,6 +329,8 @@ def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
         "shapes": [n.rsplit("-", 1)[0] for n, _ in objects],
         "patterns": patterns,
     }
+    if day is not None:
+        info["daylight"] = day.info()
     return Layout(
         parts=(*shell, *furniture, *objects),
         lights=volume,
@@ -321,4 +338,5 @@ def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
         info=info,
         min_coverage=FRAMED_COVERAGE,
         view_rule=True,
+        extra_lights=() if day is None else day.lights,
     )

@@ -166,7 +166,10 @@ def _irradiance_by(g: _Geometry, light: Light, p: np.ndarray, n: np.ndarray) -> 
     """Irradiance *light* gives each point *p* (normal *n*), 0 where occluded: the model's
     radiometry (:func:`spectrinsic.scenes.model.light_power`: ``P / d²`` for point and spot
     lights, ``P A cos θ_light / d²`` for area lights, ``P`` for directional ones) times the cosine
-    at the receiver; relative units."""
+    at the receiver; relative units. A sky counts 0: through a window it lights only what
+    the window shows, which this cheap test does not trace (the rule stays conservative)."""
+    if light.kind == "sky":
+        return np.zeros(len(p))
     if light.kind == "directional":
         to = np.broadcast_to(-np.asarray(light.direction, float), p.shape).copy()
         to /= np.linalg.norm(to, axis=1, keepdims=True)

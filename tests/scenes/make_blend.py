@@ -4,7 +4,7 @@ Usage: python make_blend.py -- OUT.blend MARKER_PATH WITH_CAMERA(0|1) UNKNOWN_MA
 
 The scene: a unit cube placed by T(1, 2, 0.5) Rz(90 deg) S(2, 1, 1) whose first 4 quads use
 material "munsell:5R 4/14" (named after its spectrum) and last 2 use "Paint" (mapped by the
-caller); a ground quad with material "Floor" (custom property spectrum = "flat:0.5"); point,
+caller, Principled Base Color (0.2, 0.3, 0.6)); a ground quad with material "Floor" (custom property spectrum = "flat:0.5"); point,
 spot, area and sun lights; a 35 mm lens on a 36 mm sensor, 64 x 48 px; and a registered text
 block that writes MARKER_PATH if Blender ever runs the file's Python.
 """
@@ -35,7 +35,12 @@ me.from_pydata(verts, [], quads)
 me.update()
 cube = bpy.data.objects.new("Cube", me)
 cube.data.materials.append(material("munsell:5R 4/14"))
-cube.data.materials.append(material("Paint"))
+paint = material("Paint")
+# a Principled Base Color, read only with colours_from_asset=True (the node exists by default)
+next(n for n in paint.node_tree.nodes if n.type == "BSDF_PRINCIPLED").inputs[
+    "Base Color"
+].default_value = (0.2, 0.3, 0.6, 1.0)
+cube.data.materials.append(paint)
 for i, poly in enumerate(me.polygons):
     poly.material_index = 0 if i < 4 else 1
 cube.location = (1.0, 2.0, 0.5)

@@ -142,6 +142,25 @@ def test_blend_with_unknown_spectrum(tmp_path):
         load_blend(path, materials={"Floor": "flat:0.5"})
 
 
+@pytest.mark.blender
+def test_base_colour_only_when_asked_for(blend_file):
+    """An unmapped material is an error by default; with colours_from_asset its Principled Base
+    Color becomes an rgb: reflectance, while a name or property that is a spectrum still wins."""
+    from spectrinsic.scenes.blender import load_blend
+
+    path, _ = blend_file
+    with pytest.raises(SceneError, match="material 'Paint'.*materials="):
+        load_blend(path)
+    scene = load_blend(path, colours_from_asset=True)
+    spectra = {m.name: m.spectrum for m in scene.materials}
+    assert spectra.pop("munsell:5R 4/14") == "munsell:5R 4/14"
+    assert spectra.pop("Floor") == "flat:0.5"
+    paint = spectra.pop("Paint")
+    assert paint.startswith("rgb:") and not spectra
+    rgb = [float(c) for c in paint.removeprefix("rgb:").split(",")]
+    np.testing.assert_allclose(rgb, [0.2, 0.3, 0.6], atol=FLOAT32)
+
+
 def test_missing_bpy_gives_a_helpful_error(monkeypatch, tmp_path):
     from spectrinsic.scenes.blender import load_blend
 

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import trimesh
 from trimesh.visual.material import PBRMaterial
 
+from spectrinsic.errors import SceneError
 from spectrinsic.scenes.meshes import load_mesh_scene
 from spectrinsic.spectra import get_spectrum
 
@@ -26,7 +28,12 @@ def test_base_colour_factors_become_rgb_spectra_unless_mapped(tmp_path):
         scene.add_geometry(box, name)
     path = tmp_path / "two.glb"
     scene.export(path)
-    loaded = load_mesh_scene(path, materials={"sky": "flat:0.5"}, width=8, height=8)
+    # the file's colours are used only when asked for: by default an unmapped material is refused
+    with pytest.raises(SceneError, match="material 'brick' is not in the material map"):
+        load_mesh_scene(path, materials={"sky": "flat:0.5"}, width=8, height=8)
+    loaded = load_mesh_scene(
+        path, materials={"sky": "flat:0.5"}, width=8, height=8, colours_from_asset=True
+    )
     spectra = {m.spectrum for m in loaded.materials}
     assert "flat:0.5" in spectra  # the map wins over the file's colour
     (brick,) = spectra - {"flat:0.5"}
@@ -37,3 +44,21 @@ def test_base_colour_factors_become_rgb_spectra_unless_mapped(tmp_path):
     d65 = colour.SDS_ILLUMINANTS["D65"].copy().align(sd.shape)
     rgb = colour.XYZ_to_RGB(colour.sd_to_XYZ(sd, cmfs, d65) / 100, "sRGB")
     np.testing.assert_allclose(rgb, np.array([200, 60, 40]) / 255, atol=1e-3)
+
+
+def test_render_takes_gltf_colours_only_with_the_option(tmp_path, capsys):
+    """``render x.glb`` refuses an unmapped material in one line; ``--colours-from-asset``
+    renders it in its base colour."""
+    from spectrinsic.cli import main
+
+    box = trimesh.creation.box((1.0, 1.0, 1.0))
+    box.visual = trimesh.visual.TextureVisuals(
+        material=PBRMaterial(name="brick", baseColorFactor=[200, 60, 40, 255])
+    )
+    path = tmp_path / "one.glb"
+    trimesh.Scene({"brick": box}).export(path)
+    args = ["-q", "render", str(path), "--modes", "rgb3", "--spp", "2", "--resolution", "8x8"]
+    assert main([*args, "--out", str(tmp_path / "a")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "'brick'" in err and not (tmp_path / "a").exists()
+    assert main([*args, "--out", str(tmp_path / "b"), "--colours-from-asset"]) == 0

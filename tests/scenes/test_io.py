@@ -187,6 +187,38 @@ def test_light_inside_geometry(tmp_path, kind):
     assert f"lights[0].position ({kind} light)" in msg and "inside the closed mesh 'cube'" in msg
 
 
+@pytest.mark.parametrize(
+    "light",
+    [
+        {"kind": "directional", "spectrum": "cie:D65", "power": 3.0, "direction": [0, 0, -1]},
+        {
+            "kind": "area",
+            "spectrum": "cie:D65",
+            "power": 3.0,
+            "position": [0, 0, 3],
+            "direction": [0, 0, -1],
+            "size": [1, 1],
+        },
+        {
+            "kind": "spot",
+            "spectrum": "cie:D65",
+            "power": 3.0,
+            "position": [0, 0, 3],
+            "direction": [0, 0, -1],
+        },
+    ],
+    ids=lambda light: light["kind"],
+)
+def test_lights_at_default_placement_round_trip(tmp_path, light):
+    """A light whose required fields equal the record's defaults (a sun straight down) is saved
+    with those fields, so the saved file loads again (it was refused: ``direction`` missing)."""
+    scene = load_scene(write(tmp_path, edited(lights__0=light)))
+    assert scene.lights[0].direction == (0.0, 0.0, -1.0)
+    path = save_scene(scene, tmp_path / "saved.yaml")
+    assert yaml.safe_load(path.read_text())["lights"][0]["direction"] == [0.0, 0.0, -1.0]
+    assert load_scene(path) == scene
+
+
 def test_light_just_outside_geometry_is_fine(tmp_path):
     """1 cm above the cube's top face (z = 1) loads, and the light is where the file put it."""
     scene = load_scene(write(tmp_path, edited(lights__0__position=[0.0, 0.0, 1.01])))
