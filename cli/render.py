@@ -86,11 +86,11 @@ def _add_scene_options(p: Any) -> None:
     )
     p.add_argument(
         "--condition",
-        default="white",
+        default=None,
         help="library scenes: illumination condition (default: white)",
     )
     p.add_argument(
-        "--view", type=int, default=0, help="library scenes: camera viewpoint (default: 0)"
+        "--view", type=int, default=None, help="library scenes: camera viewpoint (default: 0)"
     )
 
 
@@ -250,6 +250,26 @@ def _check_size_options(args: argparse.Namespace) -> None:
     requested_size(args)  # a malformed --resolution, before any work
 
 
+def _check_source_options(args: argparse.Namespace) -> None:
+    """Refuse options that do not apply to SCENE (a library name or a scene file), then give
+    the library options their defaults (condition white, view 0)."""
+    file = is_scene_file(args.scene)
+    given = {
+        "--condition": args.condition is not None,
+        "--view": args.view is not None,
+        "--material-map": args.material_map is not None,
+        "--default-spectrum": args.default_spectrum is not None,
+    }
+    library_only, file_only = ("--condition", "--view"), ("--material-map", "--default-spectrum")
+    for option in library_only if file else file_only:
+        if given[option]:
+            kind = "a scene file" if file else "a library scene"
+            applies = "library scenes" if file else ".blend and mesh files"
+            raise RenderError(f"{option} applies to {applies}; {args.scene!r} is {kind}")
+    args.condition = "white" if args.condition is None else args.condition
+    args.view = 0 if args.view is None else args.view
+
+
 def requested_size(args: argparse.Namespace) -> tuple[int, int] | None:
     """``--resolution`` (or ``--width``/``--height``, a side left out taking the other's or a
     file's default), or ``None`` when no size was asked for."""
@@ -319,6 +339,7 @@ def _render_settings(args: argparse.Namespace, modes: list[str]) -> RenderSettin
 def run(args: argparse.Namespace) -> int:
     """``spectrinsic render``: check the options, load the scene, render it, write the files."""
     _check_size_options(args)
+    _check_source_options(args)
     if args.ground_truth:
         return _ground_truth(args)
     settings = _render_settings(args, _parse_modes(args))

@@ -28,6 +28,7 @@ from spectrinsic.scenes.model import (
     LIGHT_DEFAULTED,
     LIGHT_FIELDS,
     LIGHT_KINDS,
+    LIGHT_PLACEMENT,
     Camera,
     Light,
     Material,
@@ -276,6 +277,9 @@ def _light(doc: _Doc, entry: Any, i: int) -> Light:
     if kind not in LIGHT_KINDS:
         raise doc.fail(f"{field}.kind", unknown_light_kind(kind))
     needs = [f for f in LIGHT_FIELDS[kind] if f not in LIGHT_DEFAULTED]
+    for key in (k for k in LIGHT_PLACEMENT if k in entry and k not in LIGHT_FIELDS[kind]):
+        uses = ", ".join(LIGHT_FIELDS[kind])
+        raise doc.fail(f"{field}.{key}", f"{with_article(kind)} light has no {key} (uses {uses})")
     for key in needs:
         if key not in entry:
             raise doc.fail(
