@@ -15,7 +15,7 @@ export PYTHONSAFEPATH := 1
 export SPECTRINSIC_DATA ?= $(DATA_DIR)
 
 .DEFAULT_GOAL := help
-.PHONY: help setup test test-torch test-fast study study-spectral dataset evaluate bench lint info clean
+.PHONY: help setup test test-torch test-properties test-fast study study-spectral dataset evaluate bench lint info clean
 
 help: ## list the targets
 	@awk 'BEGIN {FS = ":.*## "} /^[a-zA-Z_-]+:.*## / {printf "  make %-15s %s\n", $$1, $$2}' $(MAKEFILE_LIST)
@@ -40,6 +40,9 @@ test: $(PKG) ## run the test suite (tiny renders; < 15 min on 2 cores)
 test-torch: $(PKG) ## install the CPU build of PyTorch, then run the torch adapter tests (CI runs it)
 	$(BIN)/pip install -q -c constraints.txt torch
 	SPECTRINSIC_REQUIRE_TORCH=1 $(PY) -m pytest -q -p no:xdist -m torch
+
+test-properties: $(PKG) ## the property-based input tests with 2000 examples each (minutes)
+	SPECTRINSIC_PROPERTY_EXAMPLES=2000 $(PY) -m pytest -p no:xdist -q tests/test_properties.py
 
 test-fast: $(PKG) ## the tests not marked slow (no dataset builds or converged renders)
 	$(PY) -m pytest -n 2 -q --durations=10 -m "not slow"

@@ -24,6 +24,7 @@ from spectrinsic.gt_export.manifest import SPLIT_FRACTIONS
 from spectrinsic.pipeline.dataset import SampleFailure, build_dataset
 from spectrinsic.pipeline.executors import check_scheduler, choose_executor
 from spectrinsic.pipeline.presets import PRESETS, DatasetConfig, get_preset, preset_names
+from spectrinsic.pipeline.source_plan import check_integrator_plan
 from spectrinsic.render.budget import check_render_size
 from spectrinsic.render.settings import INTEGRATORS
 
@@ -272,6 +273,7 @@ def preflight(
         )
     check_build_folder(Path(out), config.config_hash(), rebuild=rebuild)
     check_scene_files(config, data_dir)
+    check_integrator_plan(config)  # integrator x materials: every sample would fail
     if scheduler:
         check_scheduler(scheduler)
     # two lights: the library's two-colour conditions, rendered once per light

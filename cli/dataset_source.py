@@ -50,9 +50,9 @@ def _add_generator_options(src: Any) -> None:
         default=None,
         help="generate scenes procedurally: objects-on-ground or rooms",
     )
-    src.add_argument("--count", type=int, default=20, metavar="N", help="generated scenes (20)")
+    src.add_argument("--count", type=int, default=None, metavar="N", help="generated scenes (20)")
     src.add_argument(
-        "--views", type=int, default=1, metavar="V", help="cameras per generated scene (1)"
+        "--views", type=int, default=None, metavar="V", help="cameras per generated scene (1)"
     )
 
 
@@ -73,13 +73,13 @@ def _add_generated_draw_options(src: Any) -> None:
     _add_daylight_option(src)
     src.add_argument(
         "--value-range",
-        default="2,9",
+        default=None,
         metavar="LO,HI",
         help="Munsell value range of generated materials (2,9)",
     )
     src.add_argument(
         "--chroma-range",
-        default="0,16",
+        default=None,
         metavar="LO,HI",
         help="Munsell chroma range of generated materials (0,16)",
     )
@@ -94,7 +94,7 @@ def _add_generated_draw_options(src: Any) -> None:
     src.add_argument(
         "--texture-fraction",
         type=float,
-        default=TEXTURE_FRACTION,
+        default=None,
         metavar="F",
         help="fraction of generated objects given a per-pixel spectral texture (wood rings, "
         "weave, noise over 2-3 reflectances; exact reflectance ground truth) "
@@ -108,7 +108,7 @@ def _add_generated_draw_options(src: Any) -> None:
     src.add_argument(
         "--glossy",
         type=float,
-        default=GLOSSY_FRACTION,
+        default=None,
         metavar="F",
         help=f"fraction of generated materials made coated/glossy (plastic) ({GLOSSY_FRACTION:g}; "
         "--glossy 0 --metallic 0 --texture-fraction 0: the matte world)",
@@ -116,13 +116,13 @@ def _add_generated_draw_options(src: Any) -> None:
     src.add_argument(
         "--metallic",
         type=float,
-        default=METALLIC_FRACTION,
+        default=None,
         metavar="F",
         help=f"fraction of generated materials made metal (Ag, Al, Au, Cu, Cr) ({METALLIC_FRACTION:g})",
     )
     src.add_argument(
         "--roughness-range",
-        default="0,0.3",
+        default=None,
         metavar="LO,HI",
         help="GGX roughness range of glossy and metal materials (0,0.3)",
     )
@@ -205,10 +205,56 @@ def material_map(path: str | None) -> dict[str, str]:
     return out
 
 
+#: The options of generated sets and their defaults (``None`` on the parser, so that one
+#: given to another source is refused rather than ignored).
+GENERATOR_DEFAULTS: dict[str, Any] = {
+    "count": 20,
+    "views": 1,
+    "value_range": "2,9",
+    "chroma_range": "0,16",
+    "light_saturation": None,
+    "texture_fraction": TEXTURE_FRACTION,
+    "sfu": False,
+    "glossy": GLOSSY_FRACTION,
+    "metallic": METALLIC_FRACTION,
+    "roughness_range": "0,0.3",
+}
+#: The options of scene files (``--scenes``).
+FILE_OPTIONS = ("material_map", "default_spectrum", "new_sample")
+
+
+def _given(value: object) -> bool:
+    """An option given on the command line (its parser default is ``None``, or ``False`` for a
+    flag)."""
+    return value is not None and value is not False
+
+
+def _option(name: str) -> str:
+    return "--" + name.replace("_", "-")
+
+
+def _check_options_apply(args: argparse.Namespace) -> None:
+    """Refuse a generator option without --generator and a scene-file option without --scenes
+    (in one line naming it), then fill in the generator options' defaults."""
+    source = "generated scenes" if args.generator else "scene files" if args.scenes else None
+    what = source or "the library's scenes"
+    given = [n for n in (*GENERATOR_DEFAULTS, *FILE_OPTIONS) if _given(getattr(args, n, None))]
+    unused = [n for n in given if n in GENERATOR_DEFAULTS] if not args.generator else []
+    if not args.scenes:
+        unused += [n for n in given if n in FILE_OPTIONS]
+    if unused:
+        applies = "--scenes" if unused[0] in FILE_OPTIONS else "--generator"
+        raise DatasetError(f"{_option(unused[0])} applies to {applies}; this build renders {what}")
+    for name, value in GENERATOR_DEFAULTS.items():
+        if getattr(args, name, None) is None:
+            setattr(args, name, value)
+
+
 def source_from_args(args: argparse.Namespace) -> str | None:
     """The config's ``source`` for --generator / --scenes (``None``: the library)."""
     if args.generator and args.scenes:
         raise DatasetError("--generator and --scenes exclude each other; give one")
+    _check_options_apply(args)
     if args.generator:
         try:
             gloss = GlossDistribution(

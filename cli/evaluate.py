@@ -139,6 +139,10 @@ def _methods(args: argparse.Namespace) -> dict[str, Any]:
         name, sep, folder = spec.partition("=")
         if not sep:
             name, folder = Path(spec).name or "predictions", spec
+        elif not name.strip() or not folder.strip():
+            raise DatasetError(
+                f"--predictions {spec!r}: expected NAME=DIR with a name and a folder"
+            )
         if name in methods:
             raise DatasetError(
                 f"--predictions {spec!r}: the name {name!r} is already used; "

@@ -53,7 +53,11 @@ def run(args: argparse.Namespace) -> int:
             f"export {str(root)!r}: no {MANIFEST_NAME}; expected a built dataset folder"
         )
     check_shard_folder(Path(args.out))  # before the progress bar: new, empty or an earlier export
-    layers = [k.strip() for k in args.layers.split(",") if k.strip()] if args.layers else None
+    layers = None if args.layers is None else [k.strip() for k in args.layers.split(",")]
+    if layers is not None and not all(layers):
+        raise DatasetError(
+            f"--layers {args.layers!r}: expected comma-separated layer keys, e.g. image,shading"
+        )
     with tqdm(
         total=len(sample_dirs(root)),
         desc="exporting",

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +21,7 @@ from tqdm import tqdm
 from spectrinsic.cli import dataset as cli_dataset
 from spectrinsic.cli.dataset_source import material_map, parse_resolution
 from spectrinsic.cli.render_files import write_render
+from spectrinsic.cli.render_scene import load_scene_argument
 from spectrinsic.errors import RenderError, SceneError
 from spectrinsic.gt_export.outfolder import check_output_folder, output_folder
 from spectrinsic.pipeline.presets import DatasetConfig, get_preset
@@ -39,12 +39,11 @@ from spectrinsic.render.modes import RENDER_MODES
 from spectrinsic.render.plugins import MAX_PATH_DEPTH
 from spectrinsic.render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
 from spectrinsic.render.settings import DEFAULT_MODES as RENDER_DEFAULT_MODES
-from spectrinsic.scenes import library
 from spectrinsic.scenes.model import Scene
 from spectrinsic.scenes.sample_id import SampleId
-from spectrinsic.scenes.sources import FILE_SIZE, is_scene_file, load_scene_file
+from spectrinsic.scenes.sources import FILE_SIZE, is_scene_file
 
-__all__ = ["register", "run", "load_scene_argument", "requested_size"]
+__all__ = ["register", "run", "requested_size"]
 
 DEFAULT_MODES = ",".join(RENDER_DEFAULT_MODES)
 
@@ -88,11 +87,11 @@ def _add_scene_options(p: Any) -> None:
     )
     p.add_argument(
         "--condition",
-        default="white",
+        default=None,
         help="library scenes: illumination condition (default: white)",
     )
     p.add_argument(
-        "--view", type=int, default=0, help="library scenes: camera viewpoint (default: 0)"
+        "--view", type=int, default=None, help="library scenes: camera viewpoint (default: 0)"
     )
 
 
@@ -201,43 +200,6 @@ def _add_material_options(p: Any) -> None:
     )
 
 
-def load_scene_argument(
-    scene: str,
-    *,
-    condition: str,
-    view: int,
-    seed: int,
-    width: int | None,
-    height: int | None,
-    materials: Mapping[str, str] | None = None,
-    default_spectrum: str | None = None,
-    data_dir: str | None = None,
-    colours_from_asset: bool = False,
-) -> Scene:
-    """The Scene named by the ``SCENE`` argument: a scene file (YAML, ``.blend`` or mesh,
-    :func:`spectrinsic.scenes.sources.load_scene_file`, the dispatch ``dataset --scenes`` uses),
-    else a library scene at the default preset's size unless *width*/*height* say otherwise."""
-    if is_scene_file(scene):
-        return load_scene_file(
-            scene,
-            width=width,
-            height=height,
-            materials=materials,
-            default_spectrum=default_spectrum,
-            data_dir=data_dir,
-            colours_from_asset=colours_from_asset,
-        )
-    default = get_preset("default")
-    return library.build(
-        scene,
-        view=view,
-        condition=condition,
-        seed=seed,
-        width=default.width if width is None else width,
-        height=default.height if height is None else height,
-    )
-
-
 #: Largest sampler seed and samples per pixel Mitsuba takes (both are unsigned 32-bit).
 UINT32_MAX = 2**32 - 1
 
@@ -258,6 +220,26 @@ def _check_size_options(args: argparse.Namespace) -> None:
     if args.variant is not None:
         choose_variant("rgb", args.variant)  # an unknown or unusable backend, before any work
     requested_size(args)  # a malformed --resolution, before any work
+
+
+def _check_source_options(args: argparse.Namespace) -> None:
+    """Refuse options that do not apply to SCENE (a library name or a scene file), then give
+    the library options their defaults (condition white, view 0)."""
+    file = is_scene_file(args.scene)
+    given = {
+        "--condition": args.condition is not None,
+        "--view": args.view is not None,
+        "--material-map": args.material_map is not None,
+        "--default-spectrum": args.default_spectrum is not None,
+    }
+    library_only, file_only = ("--condition", "--view"), ("--material-map", "--default-spectrum")
+    for option in library_only if file else file_only:
+        if given[option]:
+            kind = "a scene file" if file else "a library scene"
+            applies = "library scenes" if file else ".blend and mesh files"
+            raise RenderError(f"{option} applies to {applies}; {args.scene!r} is {kind}")
+    args.condition = "white" if args.condition is None else args.condition
+    args.view = 0 if args.view is None else args.view
 
 
 def requested_size(args: argparse.Namespace) -> tuple[int, int] | None:
@@ -332,6 +314,7 @@ def _render_settings(args: argparse.Namespace, modes: list[str]) -> RenderSettin
 def run(args: argparse.Namespace) -> int:
     """``spectrinsic render``: check the options, load the scene, render it, write the files."""
     _check_size_options(args)
+    _check_source_options(args)
     if args.ground_truth:
         return _ground_truth(args)
     settings = _render_settings(args, _parse_modes(args))

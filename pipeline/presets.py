@@ -24,6 +24,7 @@ from spectrinsic.spectra.camera_model import camera_model
 
 __all__ = [
     "DatasetConfig",
+    "MAX_RELIGHT",
     "PRESETS",
     "HASHED_PACKAGES",
     "PIXELS_VERSION",
@@ -100,6 +101,11 @@ RENDER_KEYS: tuple[str, ...] = (
     "variant",
     "integrator",
 )
+
+
+#: Most relit variants per sample (``--relight N``): each is a whole sample folder written
+#: from the transport, so the bound keeps a build's size within reach of its plan.
+MAX_RELIGHT = 1000
 
 
 @dataclass(frozen=True)
@@ -215,7 +221,8 @@ class DatasetConfig:
                 "--store-transport with --direct needs the 'spectral' mode (the "
                 "diagonal modes are composed from the transport, not rendered directly)"
             )
-        if isinstance(self.relight, bool) or not isinstance(self.relight, int) or self.relight < 0:
+        relight = self.relight
+        if isinstance(relight, bool) or not isinstance(relight, int) or relight < 0:
             raise DatasetError(
                 f"dataset setting relight={self.relight!r}; expected a non-negative integer"
             )
@@ -223,6 +230,11 @@ class DatasetConfig:
             raise DatasetError(
                 f"--spectral-layers with modes {list(self.render.modes)}: the spectral layers "
                 "need the 31-band cube (mode bands31, as in the default preset)"
+            )
+        if relight > MAX_RELIGHT:
+            raise DatasetError(
+                f"--relight {relight}: at most {MAX_RELIGHT} relit variants per sample (each "
+                "is a full sample folder)"
             )
         if self.relight and not self.store_transport:
             raise DatasetError(

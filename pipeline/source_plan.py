@@ -28,6 +28,8 @@ from spectrinsic.errors import DatasetError, SceneError, SpectrinsicError, valid
 from spectrinsic.gt_export.sample import file_sha256
 from spectrinsic.pipeline.presets import DatasetConfig
 from spectrinsic.pipeline.tasks import SampleTask
+from spectrinsic.render.light_transport import diagonal_mode_names
+from spectrinsic.render.single import resolve_integrator
 from spectrinsic.scenes.generators import (
     GENERATORS,
     GeneratorOptions,
@@ -46,6 +48,7 @@ from spectrinsic.scenes.yaml_limits import load_yaml_file
 from spectrinsic.spectra import list_spectra
 
 __all__ = [
+    "check_integrator_plan",
     "SCENES_FOLDER",
     "generator_source",
     "files_source",
@@ -338,3 +341,19 @@ def save_generated(
     folder.mkdir(parents=True, exist_ok=True)
     record = {**scene.metadata, "sample": {"id": sample_id, "seed": int(seed)}}
     return save_scene(dataclasses.replace(scene, metadata=record), folder / f"{sample_id}.yaml")
+
+
+def check_integrator_plan(config: DatasetConfig) -> None:
+    """Refuse, before the first sample, a generated set with glossy or metal materials
+    (``--glossy``/``--metallic``) whose diagonal modes would render with the passes integrator
+    (``--integrator passes``, or ``single`` on a scalar variant): every sample would fail."""
+    spec = json.loads(config.source or "{}")
+    if "generator" not in spec or "gloss" not in spec:
+        return
+    if not diagonal_mode_names(config.render.modes):
+        return
+    if resolve_integrator(config.render.integrator, config.render.variant) == "passes":
+        raise DatasetError(
+            "--glossy/--metallic with the passes integrator: the diagonal modes render glossy "
+            "and metal materials only with --integrator single on a JIT (LLVM/CUDA) variant"
+        )

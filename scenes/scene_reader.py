@@ -28,6 +28,7 @@ from spectrinsic.scenes.model import (
     LIGHT_DEFAULTED,
     LIGHT_FIELDS,
     LIGHT_KINDS,
+    LIGHT_PLACEMENT,
     Camera,
     Light,
     Material,
@@ -45,16 +46,7 @@ from spectrinsic.scenes.yaml_limits import load_yaml_file
 __all__ = ["load_scene", "scene_from_dict"]
 
 _TOP = ("format", "name", "materials", "meshes", "lights", "camera", "metadata")
-_MESH = (
-    "name",
-    "object_id",
-    "file",
-    "transform",
-    "vertices",
-    "faces",
-    "material",
-    "face_materials",
-)
+_MESH = tuple("name object_id file transform vertices faces material face_materials".split())
 _TRANSFORM = ("scale", "rotate_deg", "translate")
 _LIGHT = tuple(f.name for f in fields(Light))
 _CAMERA = tuple(f.name for f in fields(Camera))
@@ -277,6 +269,9 @@ def _light(doc: _Doc, entry: Any, i: int) -> Light:
     if kind not in LIGHT_KINDS:
         raise doc.fail(f"{field}.kind", unknown_light_kind(kind))
     needs = [f for f in LIGHT_FIELDS[kind] if f not in LIGHT_DEFAULTED]
+    for key in (k for k in LIGHT_PLACEMENT if k in entry and k not in LIGHT_FIELDS[kind]):
+        uses = ", ".join(LIGHT_FIELDS[kind])
+        raise doc.fail(f"{field}.{key}", f"{with_article(kind)} light has no {key} (uses {uses})")
     for key in needs:
         if key not in entry:
             raise doc.fail(

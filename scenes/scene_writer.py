@@ -20,7 +20,14 @@ import yaml
 
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes.materials import material_entry, textured_entry
-from spectrinsic.scenes.model import LIGHT_DEFAULTED, LIGHT_FIELDS, Light, Scene, scene_to_dict
+from spectrinsic.scenes.model import (
+    LIGHT_DEFAULTED,
+    LIGHT_FIELDS,
+    LIGHT_PLACEMENT,
+    Light,
+    Scene,
+    scene_to_dict,
+)
 from spectrinsic.scenes.scene_format import FORMAT_VERSION
 from spectrinsic.scenes.textures import basis_name
 
@@ -102,14 +109,13 @@ def scene_to_yaml_dict(scene: Scene, mesh_files: Mapping[str, str] | None = None
     lights = []
     for light in scene.lights:
         entry = {"kind": light.kind, "spectrum": light.spectrum, "power": float(light.power)}
-        # a kind's required placement fields are written even at their defaults (the reader
-        # asks for them); the other fields only when they differ from the defaults
-        required = {f for f in LIGHT_FIELDS[light.kind] if f not in LIGHT_DEFAULTED}
         for f in fields(Light):
             value = getattr(light, f.name)
-            if f.name in entry:
-                continue
-            if f.name in required or value != getattr(defaults, f.name):
+            # the placement keys its kind uses: always (the reader needs them), others never
+            used = f.name in LIGHT_FIELDS[light.kind] and f.name not in LIGHT_DEFAULTED
+            unused = f.name in LIGHT_PLACEMENT and f.name not in LIGHT_FIELDS[light.kind]
+            changed = value != getattr(defaults, f.name)
+            if f.name not in entry and (used or changed) and not unused:
                 entry[f.name] = list(map(float, value)) if isinstance(value, tuple) else value
         lights.append(entry)
     cam = scene_to_dict(scene)["camera"]

@@ -118,3 +118,114 @@ def test_a_dataset_rerun_over_a_deeply_nested_meta_json_is_one_line(tmp_path, ca
     _nested_meta(root)
     assert main(["dataset", "--out", str(root), *TINY, "--only", APPLE]) == 2
     _one_line(capsys, APPLE)
+
+
+# -- cause 7: options and keys that do not apply ------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("light", "key"),
+    [
+        ('{kind: point, spectrum: "cie:D65", power: 4, position: [0, 0, 2], direction: [0, 0, -1]}', "direction"),
+        ('{kind: directional, spectrum: "cie:D65", power: 4, direction: [0, 0, -1], position: [0, 0, 2]}', "position"),
+        ('{kind: point, spectrum: "cie:D65", power: 4, position: [0, 0, 2], size: [1, 1]}', "size"),
+    ],
+)  # fmt: skip
+def test_a_light_key_of_another_kind_is_refused(tmp_path, capsys, light, key):
+    text = SCENE.replace('{kind: point, spectrum: "cie:D65", power: 4, position: [0, 0, 2]}', light)
+    assert main(["render", _scene(tmp_path, text), "--out", str(tmp_path / "o")]) == 2
+    _one_line(capsys, f"lights[0].{key}", "light has no")
+
+
+def test_save_scene_writes_only_the_keys_a_light_kind_uses(tmp_path):
+    """A directional light carrying an (unused) position round-trips through a scene file."""
+    import dataclasses
+
+    from spectrinsic.scenes import load_scene, save_scene
+
+    scene = load_scene(_scene(tmp_path))
+    sun = dataclasses.replace(
+        scene.lights[0], kind="directional", direction=(0.0, 0.0, -1.0), position=(5.0, 5.0, 5.0)
+    )
+    saved = save_scene(dataclasses.replace(scene, lights=(sun,)), tmp_path / "saved.yaml")
+    assert "position" not in saved.read_text().split("lights:")[1].split("camera:")[0]
+    assert load_scene(saved).lights[0].direction == (0.0, 0.0, -1.0)
+
+
+@pytest.mark.parametrize(
+    ("extra", "option"),
+    [(["--condition", "white"], "--condition"), (["--view", "0"], "--view")],
+)
+def test_library_options_on_a_scene_file_are_refused(tmp_path, capsys, extra, option):
+    out = tmp_path / "o"
+    assert main(["render", _scene(tmp_path), "--out", str(out), *extra]) == 2
+    _one_line(capsys, option, "library scenes", "scene.yaml")
+    assert not out.exists()
+
+
+def test_file_options_on_a_library_scene_are_refused(tmp_path, capsys):
+    out = tmp_path / "o"
+    assert main(["render", "obj-apple", "--out", str(out), "--default-spectrum", "flat:0.5"]) == 2
+    _one_line(capsys, "--default-spectrum", "obj-apple")
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "extra",
+    [["--glossy", "0.5"], ["--count", "3"], ["--texture-fraction", "0"], ["--sfu"]],
+    ids=lambda e: e[0],
+)
+def test_generator_options_on_a_library_dataset_are_refused(tmp_path, capsys, extra):
+    out = tmp_path / "ds"
+    assert main(["dataset", *TINY, "--only", APPLE, *extra, "--out", str(out)]) == 2
+    _one_line(capsys, extra[0], "applies to --generator")
+    assert not out.exists()
+
+
+def test_a_scene_file_option_on_a_generated_dataset_is_refused(tmp_path, capsys):
+    out = tmp_path / "ds"
+    args = ["dataset", *GENERATED, "--default-spectrum", "flat:0.5", "--out", str(out)]
+    assert main(args) == 2
+    _one_line(capsys, "--default-spectrum", "applies to --scenes")
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("spec", ["=DIR", "name="])
+def test_predictions_without_a_name_or_folder_are_refused(spec):
+    import argparse
+
+    from spectrinsic.cli.evaluate import _methods
+    from spectrinsic.errors import DatasetError
+
+    args = argparse.Namespace(methods=None, predictions=[spec], png_encoding="linear")
+    with pytest.raises(DatasetError, match="expected NAME=DIR"):
+        _methods(args)
+
+
+def test_an_empty_layer_list_is_refused(tmp_path, capsys):
+    root = tmp_path / "ds"
+    root.mkdir()
+    (root / "manifest.json").write_text("{}")
+    out = tmp_path / "shards"
+    assert main(["export", str(root), "--out", str(out), "--layers", ""]) == 2
+    _one_line(capsys, "--layers ''")
+    assert not out.exists()
+
+
+# -- cause 9: bounds from the plan; cause 14: integrator x materials ------------------------
+
+
+def test_a_billion_relit_variants_are_refused_before_work(tmp_path, capsys):
+    out = tmp_path / "ds"
+    args = ["dataset", "--scenes", _scene(tmp_path), *TINY, "--store-transport"]
+    assert main([*args, "--relight", "1000000000", "--out", str(out)]) == 2
+    _one_line(capsys, "--relight 1000000000", "at most 1000")
+    assert not out.exists()
+
+
+def test_gloss_with_the_passes_integrator_is_refused_before_the_first_sample(tmp_path, capsys):
+    out = tmp_path / "ds"
+    args = ["dataset", "--generator", "rooms", "--glossy", "0.5", "--integrator", "passes"]
+    assert main([*args, "--count", "1", *TINY, "--out", str(out)]) == 2
+    _one_line(capsys, "--glossy/--metallic", "passes")
+    assert not out.exists()
