@@ -80,6 +80,18 @@ def ybar_at(wavelengths: np.ndarray) -> np.ndarray:
     return np.interp(np.asarray(wavelengths, float), wl_y, y, left=0.0, right=0.0)
 
 
+def _dense(wavelengths: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The spectrum on its own samples and every whole nanometre between them, linearly
+    interpolated (what a spectrum given by a few samples means: two samples at 380 and 780 nm
+    have power where the eye is sensitive, though ȳ is 0 at both)."""
+    wl = np.asarray(wavelengths, float)
+    v = np.asarray(values, float)
+    if len(wl) < 2:
+        return wl, v
+    grid = np.union1d(wl, np.arange(np.ceil(wl[0]), np.floor(wl[-1]) + 1.0))
+    return grid, np.interp(grid, wl, v)
+
+
 def visible_share(wavelengths: np.ndarray, values: np.ndarray) -> float:
     """``∫ L ȳ dλ / (max ȳ · ∫ L dλ)`` of a spectrum *values* on *wavelengths* (nm), in [0, 1]
     for non-negative values: the luminance-weighted share of its power (0 without any).
@@ -87,8 +99,7 @@ def visible_share(wavelengths: np.ndarray, values: np.ndarray) -> float:
     >>> round(visible_share(np.array([554.0, 555.0, 556.0]), np.array([0.0, 1.0, 0.0])), 6)
     1.0
     """
-    wl = np.asarray(wavelengths, float)
-    v = np.asarray(values, float)
+    wl, v = _dense(wavelengths, values)
     ybar = ybar_at(wl)
     dl = np.gradient(wl) if len(wl) > 1 else np.ones_like(wl)
     total = float(np.sum(np.abs(v) * dl)) * float(_ybar()[1].max())

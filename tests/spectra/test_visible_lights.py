@@ -14,6 +14,7 @@ import pytest
 from spectrinsic.cli import main
 from spectrinsic.errors import SpectrinsicError
 from spectrinsic.spectra import get_spectrum
+from spectrinsic.spectra.illuminants import VISIBLE_SHARE, visible_share
 
 REFUSED = {
     "led:200/20": "peak 200 nm is outside 360-830 nm",
@@ -83,3 +84,12 @@ def test_a_scene_with_an_infrared_led_is_refused_in_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "lights[0].spectrum" in err and "1000 nm" in err
     assert not out.exists()
+
+
+def test_a_spectrum_given_by_few_samples_is_judged_between_them():
+    # two samples at 380 and 780 nm, where ȳ is almost 0, describe a flat light: its visible
+    # share is that of the same light sampled every nanometre (a CSV or inline spectrum)
+    wl = np.arange(380.0, 781.0)
+    flat = visible_share(wl, np.ones_like(wl))
+    assert visible_share(np.array([380.0, 780.0]), np.array([1.0, 1.0])) == pytest.approx(flat)
+    assert flat > 100 * VISIBLE_SHARE
