@@ -15,7 +15,7 @@ from spectrinsic.errors import RenderError
 from spectrinsic.render.batches import batch_mean
 from spectrinsic.render.modes import get_mode, light_spectra, lights_to_xyz_matrix, raw_to_xyz
 from spectrinsic.render.result import RenderResult
-from spectrinsic.render.traversal_output import light_shares, sum_lights
+from spectrinsic.render.traversal_output import compose, light_shares, sum_lights
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, diagonal_values, get_sensors
 from spectrinsic.threads import thread_map
@@ -208,7 +208,7 @@ def _compose(
         e = lighting[mode].means
         for part, out in ((transport.specular, spec), (transport.metal_white, white)):
             if part:
-                out[mode] = batch_mean([sum_lights(light_shares(b[mode], e)) for b in part])
+                out[mode] = batch_mean([compose(b[mode], e) for b in part])
     return _Composed(raw, images, tuple(per_light), batch_raw, spec, white)
 
 

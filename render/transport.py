@@ -265,8 +265,9 @@ def _batch(
 ) -> tuple[LightTransport, RenderResult]:
     """Transport of one batch and the sample's render of that batch (other modes rendered
     directly with every light on, the AOVs from the same pixel samples): from the single
-    traversal where it runs (:func:`_traversal_batch`), else one set of passes per light."""
-    if resolve_integrator(settings.integrator, settings.variant) == "single":
+    traversal where it runs (*settings*' integrator, resolved by
+    :func:`render_transport_batches`), else one set of passes per light."""
+    if settings.integrator == "single":
         return _traversal_batch(scene, settings, seed, progress=progress, data_dir=data_dir)
     modes, spp, variant = settings.modes, settings.batch_spp, settings.variant
     names = diagonal_mode_names(modes)
@@ -338,8 +339,13 @@ def render_transport_batches(
             "(the diagonal modes are composed, not rendered with every light)"
         )
 
+    # the integrator resolved once for every batch ("passes" where the traversal cannot run)
+    resolved = settings.with_options(
+        integrator=resolve_integrator(settings.integrator, settings.variant)
+    )
+
     def one(s: int) -> tuple[LightTransport, RenderResult]:
-        return _batch(scene, settings, s, progress=progress, data_dir=data_dir)
+        return _batch(scene, resolved, s, progress=progress, data_dir=data_dir)
 
     done, merged, seeds = run_batches(settings, seed, one, lambda d: d[1])
     names = diagonal_mode_names(modes)
