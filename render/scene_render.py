@@ -27,7 +27,7 @@ from spectrinsic.render.passes import (
 )
 from spectrinsic.render.result import RenderResult, render_meta
 from spectrinsic.render.settings import DEFAULT_MODES, RenderSettings
-from spectrinsic.render.single import SingleTraversal, render_jobs, resolve_integrator
+from spectrinsic.render.single import PARTS, SingleTraversal, render_jobs, resolve_integrator
 from spectrinsic.render.translate import SurfaceGeometry, prepare_geometry, surfaces
 from spectrinsic.render.variants import choose_variant, import_mitsuba, variant_scope
 from spectrinsic.scenes.model import Scene
@@ -408,10 +408,8 @@ def _assemble(
         aovs=aov_maps,
         meta=meta,
         transport=single.per_light("transport"),
-        specular_transport=single.per_light("specular"),
-        metal_white_transport=single.per_light("metal_white"),
-        specular=_part_raw(single, groups, "specular"),
-        metal_white=_part_raw(single, groups, "metal_white"),
+        parts={p: raw_part for p in PARTS if (raw_part := _part_raw(single, groups, p))},
+        part_transport={p: per_light for p in PARTS if (per_light := single.per_light(p))},
     )
 
 
@@ -420,7 +418,7 @@ def _part_raw(
     groups: Sequence[Sequence[int] | None],
     part: str,
 ) -> dict[str, np.ndarray]:
-    """Mode -> raw channels of a traversal's *part* (one of :data:`.traversal_output.PARTS`), summed
+    """Mode -> raw channels of a traversal's *part* (one of :data:`.single.PARTS`), summed
     over the main jobs' light *groups* as ``raw`` is; modes without the part are left out."""
     out = {}
     for name, t in single.transport.items():

@@ -42,6 +42,7 @@ from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import get_sensors
 
 __all__ = [
+    "PARTS",
     "SingleTraversal",
     "render_traversal",
     "render_jobs",
@@ -49,6 +50,17 @@ __all__ = [
     "single_traversal_runs",
     "resolve_integrator",
 ]
+
+
+#: The parts a traversal splits off beside its transport, in the order of its AOV channels
+#: (:func:`.integrator.aov_channels`), and the letter of their layers in ``transport.exr``
+#: (:mod:`spectrinsic.gt_export.transport_file`; the transport's is L): glossy scenes'
+#: ``"specular"`` part of the transport (the light whose first camera-ray vertex went through
+#: a non-diffuse lobe) and metals' ``"metal_white"`` radiance (not part of the transport). Each
+#: is ``(L, H, W, K)`` per unit emission, composed as the transport is; every record below the
+#: traversal (:class:`TransportOutput`, ``RenderResult.parts``, ``LightTransport.parts``, the
+#: batches, the file) holds the parts by these names.
+PARTS: dict[str, str] = {"specular": "S", "metal_white": "W"}
 
 
 def single_traversal_runs(variant: str | None) -> bool:
@@ -154,7 +166,7 @@ class _Dims:
 
 @dataclass(frozen=True, eq=False)
 class _Traced:
-    """One traversal: transport ``(L, H, W, K)``, the parts of :data:`.traversal_output.PARTS`
+    """One traversal: transport ``(L, H, W, K)``, the parts of :data:`PARTS`
     it rendered (same shape; the first traversal only), the first-hit maps (first traversal
     with surfaces) and its seconds."""
 
@@ -356,7 +368,7 @@ class SingleTraversal:
 
     def per_light(self, part: str) -> dict[str, np.ndarray]:
         """Mode -> ``(L, H, W, K)`` per-light *part* (``"transport"`` or one of
-        :data:`.traversal_output.PARTS`); modes without it left out."""
+        :data:`PARTS`); modes without it left out."""
         arrays = {
             n: t.transport if part == "transport" else t.parts.get(part)
             for n, t in self.transport.items()

@@ -14,13 +14,7 @@ import numpy as np
 
 from spectrinsic.errors import RenderError
 
-__all__ = ["PARTS", "TransportOutput", "compose", "light_shares", "sum_lights"]
-
-#: The parts a traversal splits off beside its transport, by name, in the order of its AOV
-#: channels (:mod:`~spectrinsic.render.band_kernel`): glossy scenes' ``"specular"`` part of the
-#: transport, and metals' ``"metal_white"`` radiance (not part of the transport). Each is an
-#: ``(L, H, W, K)`` array for unit emission, composed as the transport is (:func:`compose`).
-PARTS: tuple[str, ...] = ("specular", "metal_white")
+__all__ = ["TransportOutput", "compose", "light_shares", "sum_lights"]
 
 
 def light_shares(parts: np.ndarray, emission: np.ndarray) -> np.ndarray:
@@ -70,7 +64,7 @@ class TransportOutput:
     emission
         ``(L, K)`` float64 the lights' channel values ``E_{l,k}`` (:class:`ChannelValues`).
     parts
-        Part name (:data:`PARTS`) -> ``(L, H, W, K)`` float32, the parts the traversal rendered:
+        Part name (:data:`~spectrinsic.render.single.PARTS`) -> ``(L, H, W, K)`` float32, the parts the traversal rendered:
         ``"specular"``, the part of :attr:`transport` whose first camera-ray vertex went through
         a non-diffuse lobe (glossy scenes; 0 in matte ones); ``"metal_white"``, the radiance a
         white Lambertian surface would reflect at the pixel's metal first hits, times their
@@ -94,7 +88,7 @@ class TransportOutput:
         return sum_lights(self.per_light(direct=direct), lights)
 
     def part_image(self, part: str, lights: Sequence[int] | None = None) -> np.ndarray | None:
-        """``(H, W, K)`` float32 image of *part* (:data:`PARTS`) for the *lights* (default all),
+        """``(H, W, K)`` float32 image of *part* (:data:`~spectrinsic.render.single.PARTS`) for the *lights* (default all),
         composed as :meth:`image` composes the transport (so both agree bit for bit where all
         light is specular), or ``None`` where the traversal did not render it."""
         held = self.parts.get(part)
