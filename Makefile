@@ -15,7 +15,7 @@ export PYTHONSAFEPATH := 1
 export SPECTRINSIC_DATA ?= $(DATA_DIR)
 
 .DEFAULT_GOAL := help
-.PHONY: help setup test test-torch test-properties test-fast study study-spectral dataset evaluate bench lint info clean
+.PHONY: help setup test test-torch test-properties test-fast test-unit study study-spectral dataset evaluate bench lint info clean
 
 help: ## list the targets
 	@awk 'BEGIN {FS = ":.*## "} /^[a-zA-Z_-]+:.*## / {printf "  make %-15s %s\n", $$1, $$2}' $(MAKEFILE_LIST)
@@ -46,6 +46,9 @@ test-properties: $(PKG) ## the property-based input tests with 2000 examples eac
 
 test-fast: $(PKG) ## the tests not marked slow (no dataset builds or converged renders)
 	$(PY) -m pytest -n 2 -q --durations=10 -m "not slow"
+
+test-unit: $(PKG) ## the tests that render nothing (no Mitsuba: spectra, scenes, layers, records, CLI checks); under a minute
+	SPECTRINSIC_UNIT_TESTS=1 $(PY) -m pytest -n 2 -q --durations=5 -m "not render and not slow"
 
 study: study-spectral ## all studies: Table 5.2, Table 4.4 and the rendered study (a few minutes)
 	$(BIN)/spectrinsic study rendering

@@ -32,6 +32,7 @@ from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.exr import read_exr_stacks, write_exr
 from spectrinsic.gt_export.sample import TRANSPORT_NAME
 from spectrinsic.render.light_transport import LightTransport
+from spectrinsic.render.single import PARTS as TRAVERSAL_PARTS
 from spectrinsic.spectra import get_sensors
 
 __all__ = [
@@ -49,8 +50,9 @@ TRANSPORT_UNITS = (
 )
 
 
-#: Glossy parts of the transport, and the letter their layers start with (the transport's: L).
-PARTS = {"specular": "S", "metal_white": "W"}
+#: Glossy parts of the transport, and the letter their layers start with (the transport's: L);
+#: their one home is the traversal's (:data:`spectrinsic.render.single.PARTS`).
+PARTS = TRAVERSAL_PARTS
 
 
 def transport_layer(light: int, batch: int, mode: str, part: str = "transport") -> str:
@@ -67,7 +69,7 @@ def transport_layer(light: int, batch: int, mode: str, part: str = "transport") 
 def _parts(transport: LightTransport) -> dict[str, tuple[dict[str, np.ndarray], ...]]:
     """The transport's batches and each glossy part it holds, by part name."""
     held = {"transport": transport.batches}
-    held.update({p: getattr(transport, p) for p in PARTS if getattr(transport, p)})
+    held.update({p: transport.parts[p] for p in PARTS if transport.parts.get(p)})
     return held
 
 
@@ -170,8 +172,7 @@ def read_transport(
         seeds=tuple(int(s) for s in seeds),
         spp=_field(record, "batch_spp", int, where),
         max_depth=_field(record, "max_depth", int, where),
-        specular=held.get("specular", ()),
-        metal_white=held.get("metal_white", ()),
+        parts={p: held[p] for p in PARTS if p in held},
     )
     return transport, coverage
 

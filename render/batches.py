@@ -193,6 +193,12 @@ def _merge_aovs(parts: Sequence[dict[str, np.ndarray]]) -> dict[str, np.ndarray]
     return merged
 
 
+def _mean_part(results: Sequence[RenderResult], field: str, part: str) -> dict[str, np.ndarray]:
+    """Mode -> :func:`batch_mean` of one *part* of the results' ``parts`` or ``part_transport``."""
+    held = [getattr(r, field)[part] for r in results]
+    return {m: batch_mean([h[m] for h in held]) for m in held[0]}
+
+
 def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
     """The mean of independent batch renders of one scene, keeping each batch's raw channels."""
     if not results:
@@ -226,16 +232,8 @@ def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
         direct={m: batch_mean([r.direct[m] for r in results]) for m in first.direct},
         aovs=_merge_aovs([r.aovs for r in results]),
         transport={m: batch_mean([r.transport[m] for r in results]) for m in first.transport},
-        specular={m: batch_mean([r.specular[m] for r in results]) for m in first.specular},
-        metal_white={m: batch_mean([r.metal_white[m] for r in results]) for m in first.metal_white},
-        specular_transport={
-            m: batch_mean([r.specular_transport[m] for r in results])
-            for m in first.specular_transport
-        },
-        metal_white_transport={
-            m: batch_mean([r.metal_white_transport[m] for r in results])
-            for m in first.metal_white_transport
-        },
+        parts={p: _mean_part(results, "parts", p) for p in first.parts},
+        part_transport={p: _mean_part(results, "part_transport", p) for p in first.part_transport},
         meta=meta,
         batch_raw=tuple(dict(r.raw) for r in results),
     )

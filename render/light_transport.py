@@ -15,7 +15,7 @@ from spectrinsic.errors import RenderError
 from spectrinsic.render.batches import batch_mean
 from spectrinsic.render.modes import get_mode, light_spectra, lights_to_xyz_matrix, raw_to_xyz
 from spectrinsic.render.result import RenderResult
-from spectrinsic.render.traversal_output import light_shares, sum_lights
+from spectrinsic.render.traversal_output import compose, light_shares, sum_lights
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, diagonal_values, get_sensors
 from spectrinsic.threads import thread_map
@@ -52,11 +52,12 @@ class LightTransport:
     seconds
         Seconds of each Mitsuba pass, per mode, and under ``"single"`` those of the traversals
         carrying every mode at once (empty when read from a file).
-    specular, metal_white
-        Scenes with glossy materials / metals, one dict per batch as :attr:`batches`: the part
-        of ``T`` whose first camera-ray vertex went through a non-diffuse lobe, and the
+    parts
+        Part name (:data:`spectrinsic.render.single.PARTS`) -> one dict per batch as
+        :attr:`batches`, for the same unit spectrum: glossy scenes' ``"specular"`` part of ``T``
+        (first camera-ray vertex through a non-diffuse lobe) and metals' ``"metal_white"``
         white-surface radiance at metal first hits (not part of ``T``)
-        (:mod:`~spectrinsic.render.band_kernel`), for the same unit spectrum; empty otherwise.
+        (:mod:`~spectrinsic.render.band_kernel`); only the parts held.
     """
 
     modes: tuple[str, ...]
@@ -66,13 +67,12 @@ class LightTransport:
     spp: int
     max_depth: int
     seconds: dict[str, tuple[float, ...]] = field(default_factory=dict, repr=False)
-    specular: tuple[dict[str, np.ndarray], ...] = field(default=(), repr=False)
-    metal_white: tuple[dict[str, np.ndarray], ...] = field(default=(), repr=False)
+    parts: dict[str, tuple[dict[str, np.ndarray], ...]] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
         if not self.batches or len(self.batches) != len(self.seeds):
             raise RenderError(f"transport: {len(self.batches)} batches for {len(self.seeds)} seeds")
-        held = [self.batches, *(p for p in (self.specular, self.metal_white) if p)]
+        held = [self.batches, *(p for p in self.parts.values() if p)]
         shapes = {a.shape[:3] for part in held for b in part for a in b.values()}
         if (
             len(shapes) != 1
@@ -83,6 +83,16 @@ class LightTransport:
                 f"transport: every batch must hold modes {list(self.modes)} with "
                 f"one (lights, height, width); got shapes {sorted(shapes)}"
             )
+
+    @property
+    def specular(self) -> tuple[dict[str, np.ndarray], ...]:
+        """``parts["specular"]`` (empty for a matte scene)."""
+        return self.parts.get("specular", ())
+
+    @property
+    def metal_white(self) -> tuple[dict[str, np.ndarray], ...]:
+        """``parts["metal_white"]`` (empty without metals)."""
+        return self.parts.get("metal_white", ())
 
     @property
     def n_lights(self) -> int:
@@ -152,8 +162,7 @@ class _Composed:
     images: dict[str, np.ndarray]
     per_light: tuple[dict[str, np.ndarray], ...]
     batch_raw: tuple[dict[str, np.ndarray], ...]
-    specular: dict[str, np.ndarray]
-    metal_white: dict[str, np.ndarray]
+    parts: dict[str, dict[str, np.ndarray]]
 
 
 @dataclass(frozen=True, eq=False)
@@ -195,8 +204,7 @@ def _compose(
     batch_raw = tuple({m: done[m, b].raw for m in transport.modes} for b in range(n))
     raw: dict[str, np.ndarray] = {}
     images: dict[str, np.ndarray] = {}
-    spec: dict[str, np.ndarray] = {}
-    white: dict[str, np.ndarray] = {}
+    parts: dict[str, dict[str, np.ndarray]] = {p: {} for p, held in transport.parts.items() if held}
     per_light: list[dict[str, np.ndarray]] = [{} for _ in scene.lights]
     for mode in transport.modes:
         mine = [done[mode, b] for b in range(n)]
@@ -206,10 +214,9 @@ def _compose(
         for j in range(len(scene.lights)):
             per_light[j][mode] = mean_shares[j]
         e = lighting[mode].means
-        for part, out in ((transport.specular, spec), (transport.metal_white, white)):
-            if part:
-                out[mode] = batch_mean([sum_lights(light_shares(b[mode], e)) for b in part])
-    return _Composed(raw, images, tuple(per_light), batch_raw, spec, white)
+        for p, out in parts.items():
+            out[mode] = batch_mean([compose(b[mode], e) for b in transport.parts[p]])
+    return _Composed(raw, images, tuple(per_light), batch_raw, parts)
 
 
 def _meta(
@@ -262,6 +269,5 @@ def relit_result(
         per_light=c.per_light,
         meta=_meta(transport, lighting, meta),
         batch_raw=c.batch_raw if len(transport.batches) > 1 else (),
-        specular=c.specular,
-        metal_white=c.metal_white,
+        parts=c.parts,
     )

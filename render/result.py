@@ -52,20 +52,18 @@ class RenderResult:
         transport for unit emission (:class:`spectrinsic.render.traversal_output.TransportOutput`):
         ``raw[mode][..., k] = Σ_l E_{l,k} transport[mode][l, ..., k]``, with E the lights'
         channel values (:func:`spectrinsic.render.modes.channel_values`). Empty otherwise.
-    specular
-        Scenes with glossy materials, single traversal: mode -> ``(H, W, K)`` float32 raw
-        channels of the light the camera rays' first hits return through their non-diffuse
-        lobes (coat reflection, metal), with everything those lobes reflect
-        (:mod:`spectrinsic.render.band_kernel`); a part of ``raw[mode]``. Empty for matte
-        scenes, where it is 0.
-    metal_white
-        Scenes with metals, single traversal: mode -> ``(H, W, K)`` float32 raw channels of the
-        radiance a white Lambertian surface would reflect at the first hits on metals, times
-        their coverage (not part of ``raw``), so the shading stays defined where the diffuse
-        albedo is 0 (:mod:`spectrinsic.render.band_kernel`). Empty otherwise.
-    specular_transport, metal_white_transport
-        The per-light parts behind ``specular`` and ``metal_white`` as ``transport`` is behind
-        ``raw`` (mode -> ``(L, H, W, K)`` float32 for unit emission); empty without them.
+    parts
+        Single traversal: part name (:data:`spectrinsic.render.single.PARTS`) -> mode ->
+        ``(H, W, K)`` float32 raw channels of that part, summed over the lights as ``raw`` is;
+        only the parts the scene has. ``"specular"`` (glossy materials): the light the camera
+        rays' first hits return through their non-diffuse lobes (coat reflection, metal), with
+        everything those lobes reflect (:mod:`spectrinsic.render.band_kernel`), a part of
+        ``raw[mode]``. ``"metal_white"`` (metals): the radiance a white Lambertian surface would
+        reflect at the first hits on metals, times their coverage (not part of ``raw``), so the
+        shading stays defined where the diffuse albedo is 0.
+    part_transport
+        The per-light parts behind ``parts`` as ``transport`` is behind ``raw`` (part name ->
+        mode -> ``(L, H, W, K)`` float32 for unit emission); empty without them.
     """
 
     images: dict[str, np.ndarray]
@@ -76,10 +74,18 @@ class RenderResult:
     meta: dict[str, Any] = field(default_factory=dict)
     batch_raw: tuple[dict[str, np.ndarray], ...] = ()
     transport: dict[str, np.ndarray] = field(default_factory=dict)
-    specular: dict[str, np.ndarray] = field(default_factory=dict)
-    metal_white: dict[str, np.ndarray] = field(default_factory=dict)
-    specular_transport: dict[str, np.ndarray] = field(default_factory=dict)
-    metal_white_transport: dict[str, np.ndarray] = field(default_factory=dict)
+    parts: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+    part_transport: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+
+    @property
+    def specular(self) -> dict[str, np.ndarray]:
+        """``parts["specular"]``: mode -> ``(H, W, K)`` raw specular part (empty: matte scene)."""
+        return self.parts.get("specular", {})
+
+    @property
+    def metal_white(self) -> dict[str, np.ndarray]:
+        """``parts["metal_white"]``: mode -> ``(H, W, K)`` raw white-at-metal radiance."""
+        return self.parts.get("metal_white", {})
 
     @property
     def shape(self) -> tuple[int, int]:

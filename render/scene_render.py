@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -27,9 +27,8 @@ from spectrinsic.render.passes import (
 )
 from spectrinsic.render.result import RenderResult, render_meta
 from spectrinsic.render.settings import DEFAULT_MODES, RenderSettings
-from spectrinsic.render.single import SingleTraversal, render_jobs, resolve_integrator
-from spectrinsic.render.translate import prepare_geometry, surfaces
-from spectrinsic.render.traversal_output import TransportOutput
+from spectrinsic.render.single import PARTS, SingleTraversal, render_jobs, resolve_integrator
+from spectrinsic.render.translate import SurfaceGeometry, prepare_geometry, surfaces
 from spectrinsic.render.variants import choose_variant, import_mitsuba, variant_scope
 from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import get_sensors
@@ -65,28 +64,20 @@ def _direct_modes(direct: bool | Iterable[str], modes: Sequence[RenderMode]) -> 
 
 
 def count_passes(scene: Scene, settings: RenderSettings, *, data_dir: str | None = None) -> int:
-    """Number of Mitsuba passes :func:`render_scene` runs (the total of its progress calls)."""
-    modes, per_light, per_light_modes = settings.modes, settings.per_light, settings.per_light_modes
-    direct, aovs = settings.direct, settings.aovs
-    objs = _modes(modes)
-    wanted = _direct_modes(direct, objs)
-    split = per_light and per_light_modes is not None
-    groups = len(scene.lights) if per_light and not split else 1
-    share_modes = _modes(per_light_modes) if per_light and per_light_modes is not None else []
-    single = resolve_integrator(settings.integrator, settings.variant) == "single" and any(
-        m.kind == "diagonal" for m in objs + share_modes
-    )
+    """Number of Mitsuba passes :func:`render_scene` runs (the total of its progress calls),
+    from the same plan (and so the same integrator) as the render."""
+    plan = _plan(scene, settings, data_dir)
+    objs, share = plan.objs, plan.share
     diagonal = 0
-    if single:  # every diagonal mode and the AOVs: one traversal (+1 direct-only)
-        diagonal = 1 + any(m.kind == "diagonal" and m.name in wanted for m in objs)
-        objs, share_modes = (
-            [m for m in objs if m.kind != "diagonal"],
-            [m for m in share_modes if m.kind != "diagonal"],
-        )
-    colour = sum(n_passes(m, data_dir=data_dir) * (2 if m.name in wanted else 1) for m in objs)
-    shares = sum(n_passes(m, data_dir=data_dir) for m in share_modes)
-    aov_passes = max(1, -(-len(surfaces(scene)) // 3)) if aovs and not single else 0
-    return diagonal + groups * colour + len(scene.lights) * shares + aov_passes
+    if plan.traversal:  # every diagonal mode and the AOVs: one traversal (+1 direct-only)
+        diagonal = 1 + any(m.kind == "diagonal" and m.name in plan.wanted for m in objs)
+        objs = [m for m in objs if m.kind != "diagonal"]
+        share = [m for m in share if m.kind != "diagonal"]
+    colour = sum(n_passes(m, data_dir=data_dir) * (2 if m.name in plan.wanted else 1) for m in objs)
+    shares = sum(n_passes(m, data_dir=data_dir) for m in share)
+    aovs = settings.aovs and not plan.traversal
+    aov_passes = max(1, -(-len(surfaces(scene)) // 3)) if aovs else 0
+    return diagonal + plan.n_main * colour + len(scene.lights) * shares + aov_passes
 
 
 def _sum_direct(parts: Sequence[np.ndarray | None]) -> np.ndarray:
@@ -109,42 +100,48 @@ class _Job:
 
 @dataclass(frozen=True)
 class _Run:
-    """What every pass of one :func:`_run_jobs` call shares."""
+    """What every pass of one :func:`_run_jobs` call shares: the plan (with its settings), the
+    batch's seed, the progress callback, the data directory and the prepared geometry."""
 
     scene: Scene
-    jobs: Sequence[_Job]
-    wanted: set[str]
-    aovs: bool
+    plan: _Plan
+    seed: int
+    progress: PassProgress | None
     data_dir: str | None
-    integrator: str
-    common: dict[str, Any]
+    geometry: Sequence[SurfaceGeometry]
     #: One dict mode -> pass output per job, filled by the parts.
     outputs: list[dict[str, PassOutput]]
-    #: Samples per pixel of the spectral passes (``common["spp"]`` is the diagonal modes').
-    spectral_spp: int
+
+    @property
+    def settings(self) -> RenderSettings:
+        return self.plan.settings
 
 
 def _rgb_part(
     run: _Run, rgb_variant: str
 ) -> tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
     """The diagonal modes of every job (one traversal, or the passes) and the AOVs."""
-    scene, common, single = run.scene, run.common, SingleTraversal({}, ())
+    scene, plan, settings, single = run.scene, run.plan, run.settings, SingleTraversal({}, ())
     aov_maps: dict[str, np.ndarray] = {}
-    if run.integrator == "single":
+    if plan.traversal:
         parts, single = render_jobs(
             scene,
-            [(j.modes, j.group, j.with_direct) for j in run.jobs],
-            wanted=run.wanted,
+            [(j.modes, j.group, j.with_direct) for j in plan.jobs],
+            wanted=plan.wanted,
+            spp=settings.batch_spp,
+            seed=run.seed,
+            max_depth=settings.max_depth,
             variant=rgb_variant,
+            progress=run.progress,
+            geometry=run.geometry,
             data_dir=run.data_dir,
-            aovs=run.aovs,
-            **common,
+            aovs=settings.aovs,
         )
         aov_maps = single.aovs
         for out, part in zip(run.outputs, parts, strict=True):
             out.update(part)
         return aov_maps, (), single
-    for out, job in zip(run.outputs, run.jobs, strict=True):
+    for out, job in zip(run.outputs, plan.jobs, strict=True):
         diagonal = [m for m in job.modes if m.kind == "diagonal"]
         values = [
             channel_values(
@@ -158,60 +155,61 @@ def _rgb_part(
                 render_diagonal(
                     scene,
                     values,
-                    direct=[job.with_direct and m.name in run.wanted for m in diagonal],
+                    spp=settings.batch_spp,
+                    seed=run.seed,
+                    max_depth=settings.max_depth,
+                    direct=[job.with_direct and m.name in plan.wanted for m in diagonal],
                     active_lights=job.group,
                     variant=rgb_variant,
-                    **common,
+                    progress=run.progress,
+                    geometry=run.geometry,
                 ),
                 strict=True,
             )
             if diagonal
             else ()
         )
-    if not run.aovs:
+    if not settings.aovs:
         return aov_maps, (), single
     aov_maps, aov_seconds = render_aovs(
         scene,
-        spp=common["spp"],
-        seed=common["seed"],
+        spp=settings.batch_spp,
+        seed=run.seed,
         variant=rgb_variant,
-        progress=common["progress"],
-        geometry=common["geometry"],
+        progress=run.progress,
+        geometry=run.geometry,
     )
     return aov_maps, aov_seconds, single
 
 
 def _spectral_part(run: _Run, spectral_variant: str) -> None:
-    """The spectral passes of every job."""
-    for out, job in zip(run.outputs, run.jobs, strict=True):
+    """The spectral passes of every job (``settings.spectral_batch_spp`` samples each)."""
+    for out, job in zip(run.outputs, run.plan.jobs, strict=True):
         for m in (m for m in job.modes if m.kind == "spectral"):
             out[m.name] = render_spectral(
                 run.scene,
                 get_sensors(m.sensors, data_dir=run.data_dir),
-                direct=job.with_direct and m.name in run.wanted,
+                spp=run.settings.spectral_batch_spp,
+                seed=run.seed,
+                max_depth=run.settings.max_depth,
+                direct=job.with_direct and m.name in run.plan.wanted,
                 active_lights=job.group,
                 variant=spectral_variant,
+                progress=run.progress,
+                geometry=run.geometry,
                 data_dir=run.data_dir,
-                **{**run.common, "spp": run.spectral_spp},
             )
 
 
 def _run_jobs(
     scene: Scene,
-    jobs: Sequence[_Job],
+    plan: _Plan,
     *,
-    wanted: set[str],
-    spp: int,
     seed: int,
-    max_depth: int,
-    variant: str | None,
-    aovs: bool,
     progress: PassProgress | None,
     data_dir: str | None,
-    integrator: str = "passes",
-    spectral_spp: int,
 ) -> tuple[list[dict[str, PassOutput]], dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
-    """Every pass of *jobs*, grouped by Mitsuba variant, plus the AOVs.
+    """Every pass of *plan*'s jobs, grouped by Mitsuba variant, plus the AOVs.
 
     Each switch between the RGB and the spectral variant reloads Mitsuba's Python modules
     (0.25 s on the 2-core machine, measured: 8 switches were 2.0 s of a 14.5 s default sample),
@@ -219,34 +217,18 @@ def _run_jobs(
     scope and every spectral pass in another; the variant already active goes first and stays
     active afterwards (``restore=False``), so consecutive batches switch once each, not four
     times. Passes do not depend on each other's order: each sets its own values, seed and spp.
-    With ``integrator="single"`` the diagonal modes of every job, and a textured scene's AOVs
-    even without them, come from one band-path traversal (:func:`.single.render_jobs`).
-    The spectral passes render *spectral_spp* samples.
+    With ``plan.traversal`` the diagonal modes of every job, and a textured scene's AOVs even
+    without them, come from one band-path traversal (:func:`.single.render_jobs`).
     """
-    diagonal = any(m.kind == "diagonal" for job in jobs for m in job.modes)
     run = _Run(
-        scene,
-        jobs,
-        wanted,
-        aovs,
-        data_dir,
-        integrator if diagonal or (aovs and scene.textured) else "passes",
-        dict(
-            spp=spp,
-            seed=seed,
-            max_depth=max_depth,
-            progress=progress,
-            geometry=prepare_geometry(scene),
-        ),
-        [{} for _ in jobs],
-        spectral_spp,
+        scene, plan, seed, progress, data_dir, prepare_geometry(scene), [{} for _ in plan.jobs]
     )
     found: tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]
     found = ({}, (), SingleTraversal({}, ()))
-    parts = []
-    if aovs or diagonal:
+    variant, parts = plan.settings.variant, []
+    if plan.settings.aovs or plan.diagonal:
         parts.append(("rgb", choose_variant("rgb", variant)))
-    if any(m.kind == "spectral" for job in jobs for m in job.modes):
+    if any(m.kind == "spectral" for job in plan.jobs for m in job.modes):
         parts.append(("spectral", choose_variant("spectral", variant)))
     for kind, chosen in sorted(parts, key=lambda p: p[1] != import_mitsuba().variant()):
         with variant_scope(chosen, restore=False):
@@ -291,18 +273,7 @@ def render_scene(
     """
     plan = _plan(scene, settings, data_dir)
     outputs, aov_maps, aov_seconds, single = _run_jobs(
-        scene,
-        plan.jobs,
-        wanted=plan.wanted,
-        spp=settings.batch_spp,
-        seed=seed,
-        max_depth=settings.max_depth,
-        variant=settings.variant,
-        aovs=settings.aovs,
-        progress=progress,
-        data_dir=data_dir,
-        integrator=plan.integrator,
-        spectral_spp=settings.spectral_batch_spp,
+        scene, plan, seed=seed, progress=progress, data_dir=data_dir
     )
     timings: dict[str, list[float]] = {m.name: [] for m in plan.objs + plan.share}
     variants: dict[str, str] = {}
@@ -340,21 +311,32 @@ def render_scene(
 
 @dataclass(frozen=True)
 class _Plan:
-    """What :func:`render_scene` renders: the modes, their XYZ matrices and the jobs.
+    """What :func:`render_scene` renders: the settings, the modes, their XYZ matrices, the
+    jobs, and the integrator, resolved once (:func:`~.single.resolve_integrator`).
 
     ``jobs[:n_main]`` render every mode (all lights, or one light each with ``per_light`` and
     no separate share modes); the rest render the share modes light by light (``split``).
     """
 
+    settings: RenderSettings
     objs: list[RenderMode]
     share: list[RenderMode]
     wanted: set[str]
+    #: ``"single"`` or ``"passes"``, as recorded in ``meta["integrator"]``.
     integrator: str
     matrices: dict[str, np.ndarray]
     split: bool
-    per_light: bool
     jobs: list[_Job]
     n_main: int
+    #: Whether the RGB part is one band-path traversal (:func:`.single.render_jobs`): the
+    #: integrator is ``"single"`` and there are diagonal modes, or a textured scene's AOVs
+    #: (which the coverage passes cannot give) without them.
+    traversal: bool
+
+    @property
+    def diagonal(self) -> bool:
+        """Whether any job renders a diagonal mode."""
+        return any(m.kind == "diagonal" for job in self.jobs for m in job.modes)
 
 
 def _plan(scene: Scene, settings: RenderSettings, data_dir: str | None) -> _Plan:
@@ -366,25 +348,23 @@ def _plan(scene: Scene, settings: RenderSettings, data_dir: str | None) -> _Plan
     main = [_Job(tuple(objs), g) for g in (lights if per_light and not split else [None])]
     jobs = main + [_Job(tuple(share), g, with_direct=False) for g in lights] if split else main
     integrator = resolve_integrator(settings.integrator, settings.variant)
-    if (
-        integrator == "passes"
-        and any(m.glossy for m in scene.materials)
-        and any(m.kind == "diagonal" for m in objs)
-    ):
+    diagonal = any(m.kind == "diagonal" for m in objs + share)
+    if integrator == "passes" and any(m.glossy for m in scene.materials) and diagonal:
         raise RenderError(
             f"scene {scene.name!r} has glossy materials: diagonal modes render them only with "
             "integrator 'single' on a JIT (LLVM/CUDA) variant; spectral modes render them either way"
         )
     return _Plan(
+        settings=settings,
         objs=objs,
         share=share,
         wanted=_direct_modes(settings.direct, objs),
         integrator=integrator,
         matrices={m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in objs},
         split=split,
-        per_light=per_light,
         jobs=jobs,
         n_main=len(main),
+        traversal=integrator == "single" and (diagonal or (settings.aovs and scene.textured)),
     )
 
 
@@ -412,7 +392,7 @@ def _assemble(
         per_light_images = tuple(
             {n: raw_to_xyz(g[n].image, share_xyz[n]) for n in share_xyz} for g in share_out
         )
-    elif plan.per_light:
+    elif plan.settings.per_light:
         per_light_images = tuple(
             {n: raw_to_xyz(g[n].image, matrices[n]) for n in names} for g in main_out
         )
@@ -428,23 +408,21 @@ def _assemble(
         aovs=aov_maps,
         meta=meta,
         transport=single.per_light("transport"),
-        specular_transport=single.per_light("specular"),
-        metal_white_transport=single.per_light("metal_white"),
-        specular=_part_raw(single, groups, TransportOutput.specular_image),
-        metal_white=_part_raw(single, groups, TransportOutput.metal_white_image),
+        parts={p: raw_part for p in PARTS if (raw_part := _part_raw(single, groups, p))},
+        part_transport={p: per_light for p in PARTS if (per_light := single.per_light(p))},
     )
 
 
 def _part_raw(
     single: SingleTraversal,
     groups: Sequence[Sequence[int] | None],
-    part: Callable[[TransportOutput, Sequence[int] | None], np.ndarray | None],
+    part: str,
 ) -> dict[str, np.ndarray]:
-    """Mode -> raw channels of a traversal's *part* (specular or white-at-metal image), summed
+    """Mode -> raw channels of a traversal's *part* (one of :data:`.single.PARTS`), summed
     over the main jobs' light *groups* as ``raw`` is; modes without the part are left out."""
     out = {}
     for name, t in single.transport.items():
-        parts = [p for g in groups if (p := part(t, g)) is not None]
+        parts = [p for g in groups if (p := t.part_image(part, g)) is not None]
         if parts:
             out[name] = np.sum(parts, axis=0, dtype=np.float64).astype(np.float32)
     return out

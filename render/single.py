@@ -42,6 +42,7 @@ from spectrinsic.scenes.model import Scene
 from spectrinsic.spectra import get_sensors
 
 __all__ = [
+    "PARTS",
     "SingleTraversal",
     "render_traversal",
     "render_jobs",
@@ -49,6 +50,17 @@ __all__ = [
     "single_traversal_runs",
     "resolve_integrator",
 ]
+
+
+#: The parts a traversal splits off beside its transport, in the order of its AOV channels
+#: (:func:`.integrator.aov_channels`), and the letter of their layers in ``transport.exr``
+#: (:mod:`spectrinsic.gt_export.transport_file`; the transport's is L): glossy scenes'
+#: ``"specular"`` part of the transport (the light whose first camera-ray vertex went through
+#: a non-diffuse lobe) and metals' ``"metal_white"`` radiance (not part of the transport). Each
+#: is ``(L, H, W, K)`` per unit emission, composed as the transport is; every record below the
+#: traversal (:class:`TransportOutput`, ``RenderResult.parts``, ``LightTransport.parts``, the
+#: batches, the file) holds the parts by these names.
+PARTS: dict[str, str] = {"specular": "S", "metal_white": "W"}
 
 
 def single_traversal_runs(variant: str | None) -> bool:
@@ -154,15 +166,14 @@ class _Dims:
 
 @dataclass(frozen=True, eq=False)
 class _Traced:
-    """One traversal: transport ``(L, H, W, K)``, the first hit's non-diffuse part (glossy
-    scenes, same shape), the white-at-metal radiance (first traversal with metals, same
-    shape), the first-hit maps (first traversal with surfaces) and its seconds."""
+    """One traversal: transport ``(L, H, W, K)``, the parts of :data:`PARTS`
+    it rendered (same shape; the first traversal only), the first-hit maps (first traversal
+    with surfaces) and its seconds."""
 
     transport: np.ndarray
-    specular: np.ndarray | None
+    parts: dict[str, np.ndarray]
     first: np.ndarray | None
     seconds: float
-    metal_white: np.ndarray | None = None
 
 
 def _trace(
@@ -209,12 +220,16 @@ def _trace(
         return channels.reshape(dims.h, dims.w, dims.n_lights, dims.n_bands).transpose(2, 0, 1, 3)
 
     end = n_t + n_spec + n_white
+    parts = {}
+    if dims.glossy and first:
+        parts["specular"] = per_light(image[..., n_t : n_t + n_spec])
+    if metals:
+        parts["metal_white"] = per_light(image[..., n_t + n_spec : end])
     return _Traced(
         transport=per_light(image[..., :n_t]),
-        specular=per_light(image[..., n_t : n_t + n_spec]) if dims.glossy and first else None,
+        parts=parts,
         first=image[..., end:] if n_surfaces else None,
         seconds=dt,
-        metal_white=per_light(image[..., n_t + n_spec : end]) if metals else None,
     )
 
 
@@ -234,14 +249,12 @@ def _outputs(
 ) -> list[TransportOutput]:
     """The traversals' bands cut back into one :class:`TransportOutput` per value set."""
     edges = np.cumsum([0, *widths])
-    specular, white = traced[0].specular, traced[0].metal_white
     return [
         TransportOutput(
             transport=np.ascontiguousarray(traced[0].transport[..., a:b]),
             direct=np.ascontiguousarray(traced[1].transport[..., a:b]) if direct else None,
             emission=np.asarray(v.lights, float),
-            specular=None if specular is None else np.ascontiguousarray(specular[..., a:b]),
-            metal_white=None if white is None else np.ascontiguousarray(white[..., a:b]),
+            parts={n: np.ascontiguousarray(p[..., a:b]) for n, p in traced[0].parts.items()},
         )
         for v, a, b in zip(value_sets, edges[:-1], edges[1:], strict=True)
     ]
@@ -354,9 +367,12 @@ class SingleTraversal:
     aovs: dict[str, np.ndarray] = field(default_factory=dict)
 
     def per_light(self, part: str) -> dict[str, np.ndarray]:
-        """Mode -> ``(L, H, W, K)`` per-light *part* (``"transport"``, ``"specular"`` or
-        ``"metal_white"``, attributes of :class:`TransportOutput`); modes without it left out."""
-        arrays = {n: getattr(t, part) for n, t in self.transport.items()}
+        """Mode -> ``(L, H, W, K)`` per-light *part* (``"transport"`` or one of
+        :data:`PARTS`); modes without it left out."""
+        arrays = {
+            n: t.transport if part == "transport" else t.parts.get(part)
+            for n, t in self.transport.items()
+        }
         return {n: a for n, a in arrays.items() if a is not None}
 
 

@@ -139,8 +139,7 @@ def _one_batch(
     settings: RenderSettings,
     seed: int,
     t: dict[str, np.ndarray],
-    specular: dict[str, np.ndarray] | None = None,
-    metal_white: dict[str, np.ndarray] | None = None,
+    parts: Mapping[str, dict[str, np.ndarray]] | None = None,
 ) -> LightTransport:
     """One batch's transport (and its glossy parts, where rendered) as a :class:`LightTransport`."""
     return LightTransport(
@@ -150,8 +149,7 @@ def _one_batch(
         seeds=(int(seed),),
         spp=int(settings.batch_spp),
         max_depth=int(settings.max_depth),
-        specular=(specular,) if specular else (),
-        metal_white=(metal_white,) if metal_white else (),
+        parts={p: (held,) for p, held in (parts or {}).items() if held},
     )
 
 
@@ -184,8 +182,7 @@ def _join(
         direct=dict(other.direct),
         aovs=dict(aovs),
         meta=meta,
-        specular=dict(diagonal.specular),
-        metal_white=dict(diagonal.metal_white),
+        parts=dict(diagonal.parts),
     )
 
 
@@ -225,14 +222,8 @@ def _traversal_batch(
         # per unit channel emission E_lk -> per flat unit spectrum (Eq. 1's T_lk)
         return {m: (part[m].astype(np.float64) * flat[m]).astype(np.float32) for m in part}
 
-    batch = _one_batch(
-        names,
-        settings,
-        seed,
-        unit(render.transport),
-        unit(render.specular_transport),
-        unit(render.metal_white_transport),
-    )
+    parts = {p: unit(held) for p, held in render.part_transport.items()}
+    batch = _one_batch(names, settings, seed, unit(render.transport), parts)
     base = {
         "max_depth": int(settings.max_depth),
         "variants": {m: render.meta["variants"][m] for m in names},
@@ -246,8 +237,7 @@ def _traversal_batch(
             images={m: render.images[m] for m in others},
             raw={m: render.raw[m] for m in others},
             transport={},
-            specular_transport={},
-            metal_white_transport={},
+            part_transport={},
         )
         if others
         else None
@@ -265,8 +255,9 @@ def _batch(
 ) -> tuple[LightTransport, RenderResult]:
     """Transport of one batch and the sample's render of that batch (other modes rendered
     directly with every light on, the AOVs from the same pixel samples): from the single
-    traversal where it runs (:func:`_traversal_batch`), else one set of passes per light."""
-    if resolve_integrator(settings.integrator, settings.variant) == "single":
+    traversal where it runs (*settings*' integrator, resolved by
+    :func:`render_transport_batches`), else one set of passes per light."""
+    if settings.integrator == "single":
         return _traversal_batch(scene, settings, seed, progress=progress, data_dir=data_dir)
     modes, spp, variant = settings.modes, settings.batch_spp, settings.variant
     names = diagonal_mode_names(modes)
@@ -338,8 +329,13 @@ def render_transport_batches(
             "(the diagonal modes are composed, not rendered with every light)"
         )
 
+    # the integrator resolved once for every batch ("passes" where the traversal cannot run)
+    resolved = settings.with_options(
+        integrator=resolve_integrator(settings.integrator, settings.variant)
+    )
+
     def one(s: int) -> tuple[LightTransport, RenderResult]:
-        return _batch(scene, settings, s, progress=progress, data_dir=data_dir)
+        return _batch(scene, resolved, s, progress=progress, data_dir=data_dir)
 
     done, merged, seeds = run_batches(settings, seed, one, lambda d: d[1])
     names = diagonal_mode_names(modes)
@@ -356,8 +352,7 @@ def render_transport_batches(
         spp=int(settings.batch_spp),
         max_depth=int(settings.max_depth),
         seconds=seconds,
-        specular=tuple(t.specular[0] for t, _ in done if t.specular),
-        metal_white=tuple(t.metal_white[0] for t, _ in done if t.metal_white),
+        parts={p: tuple(t.parts[p][0] for t, _ in done) for p in done[0][0].parts},
     )
     merged.meta["transport"] = {"modes": list(names), "batches": len(done)}
     logger.debug(

@@ -8,13 +8,13 @@ exact and the shares sum to the total.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from spectrinsic.errors import RenderError
 
-__all__ = ["TransportOutput", "light_shares", "sum_lights"]
+__all__ = ["TransportOutput", "compose", "light_shares", "sum_lights"]
 
 
 def light_shares(parts: np.ndarray, emission: np.ndarray) -> np.ndarray:
@@ -39,6 +39,16 @@ def sum_lights(shares: np.ndarray, lights: Sequence[int] | None = None) -> np.nd
     return np.sum(shares[chosen], axis=0, dtype=np.float64).astype(np.float32)
 
 
+def compose(
+    parts: np.ndarray, emission: np.ndarray, lights: Sequence[int] | None = None
+) -> np.ndarray:
+    """``(H, W, K)`` float32 image of the *lights* (default all) from per-light *parts*
+    ``(L, H, W, K)`` for unit emission under channel values *emission* ``(L, K)``: the sum of
+    their shares (:func:`light_shares`, :func:`sum_lights`), the one composition of the transport
+    and of every part (Eq. 5.2 per channel)."""
+    return sum_lights(light_shares(parts, emission), lights)
+
+
 @dataclass(frozen=True, eq=False)
 class TransportOutput:
     """Per-light band transport of one value set from one traversal.
@@ -53,37 +63,18 @@ class TransportOutput:
         The same for direct light only (path depth 2), or ``None`` when not asked for.
     emission
         ``(L, K)`` float64 the lights' channel values ``E_{l,k}`` (:class:`ChannelValues`).
-    specular
-        ``(L, H, W, K)`` float32 the part of :attr:`transport` whose first camera-ray vertex
-        went through a non-diffuse lobe (:mod:`spectrinsic.render.band_kernel`), for scenes
-        with glossy materials; ``None`` for matte scenes (where it is 0).
-    metal_white
-        ``(L, H, W, K)`` float32 for scenes with metals: the radiance a white Lambertian
-        surface would reflect at the pixel's metal first hits, times their coverage
-        (``c_metal · E_k / π``, :mod:`~spectrinsic.render.band_kernel`); not part of the
-        image. ``None`` without metals.
+    parts
+        Part name (:data:`~spectrinsic.render.single.PARTS`) -> ``(L, H, W, K)`` float32, the parts the traversal rendered:
+        ``"specular"``, the part of :attr:`transport` whose first camera-ray vertex went through
+        a non-diffuse lobe (glossy scenes; 0 in matte ones); ``"metal_white"``, the radiance a
+        white Lambertian surface would reflect at the pixel's metal first hits, times their
+        coverage (``c_metal · E_k / π``; scenes with metals; not part of the image).
     """
 
     transport: np.ndarray
     direct: np.ndarray | None
     emission: np.ndarray
-    specular: np.ndarray | None = None
-    metal_white: np.ndarray | None = None
-
-    def _light_sum(self, parts: np.ndarray, lights: Sequence[int] | None) -> np.ndarray:
-        """``(H, W, K)`` float32 sum over the *lights* (default all) of ``E_{l,k} · parts``."""
-        return sum_lights(light_shares(parts, self.emission), lights)
-
-    def specular_image(self, lights: Sequence[int] | None = None) -> np.ndarray | None:
-        """``(H, W, K)`` float32 specular image of the *lights* (default all), summed as
-        :meth:`image` sums the transport (so both agree bit for bit where all light is
-        specular), or ``None`` for a matte scene."""
-        return None if self.specular is None else self._light_sum(self.specular, lights)
-
-    def metal_white_image(self, lights: Sequence[int] | None = None) -> np.ndarray | None:
-        """``(H, W, K)`` float32 white-at-metal radiance of the *lights* (default all), or
-        ``None`` for a scene without metals."""
-        return None if self.metal_white is None else self._light_sum(self.metal_white, lights)
+    parts: dict[str, np.ndarray] = field(default_factory=dict)
 
     def per_light(self, *, direct: bool = False) -> np.ndarray:
         """``(L, H, W, K)`` float32 each light's image: ``E_{l,k} · transport``."""
@@ -95,3 +86,10 @@ class TransportOutput:
     def image(self, lights: Sequence[int] | None = None, *, direct: bool = False) -> np.ndarray:
         """``(H, W, K)`` float32 image of the *lights* (default all): the sum of their shares."""
         return sum_lights(self.per_light(direct=direct), lights)
+
+    def part_image(self, part: str, lights: Sequence[int] | None = None) -> np.ndarray | None:
+        """``(H, W, K)`` float32 image of *part* (:data:`~spectrinsic.render.single.PARTS`) for the *lights* (default all),
+        composed as :meth:`image` composes the transport (so both agree bit for bit where all
+        light is specular), or ``None`` where the traversal did not render it."""
+        held = self.parts.get(part)
+        return None if held is None else compose(held, self.emission, lights)

@@ -3,7 +3,10 @@ directly from scene-model records for the render and ground-truth tests."""
 
 from __future__ import annotations
 
+import importlib.abc
 import os
+import re
+import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -13,6 +16,48 @@ import pytest
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
+
+#: What marks a test module's tests ``render`` (they run Mitsuba): naming Mitsuba, Dr.Jit or a
+#: function that renders, or a command that renders; ``make test-unit`` runs the others.
+_RENDERS = re.compile(
+    r"\b(?:mitsuba|drjit|render_\w+|count_passes|run_batches|build_dataset|run_study|"
+    r"relight_sample|bench_\w+)\b|\"(?:dataset|render|relight|study|bench)\""
+)
+#: The scene fixtures of the render tests: a test taking one is marked ``render`` too.
+_RENDER_FIXTURES = frozenset({"make_plane", "make_room", "make_corner"})
+#: ``make test-unit`` sets it: Dr.Jit (which every Mitsuba render needs) cannot be imported in
+#: this process then, so a test that renders but was not marked fails loudly instead of slowing
+#: the tier down (finding Mitsuba's shipped data files, without importing it, stays allowed).
+UNIT_ENV = "SPECTRINSIC_UNIT_TESTS"
+
+
+class _NoMitsuba(importlib.abc.MetaPathFinder):
+    """Refuses to import Dr.Jit, and so to render (the unit tier renders nothing)."""
+
+    def find_spec(self, name, path=None, target=None):  # noqa: ANN001, ANN201
+        if name.split(".")[0] == "drjit":
+            raise ImportError(
+                f"{name} imported in the unit tier ({UNIT_ENV}=1): the test renders, so mark it "
+                "'render' (tests/conftest.py _RENDERS) or run it with make test"
+            )
+        return None
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    if os.environ.get(UNIT_ENV) == "1":
+        sys.meta_path.insert(0, _NoMitsuba())
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Mark ``render`` every test of a module that renders (:data:`_RENDERS`) and every test
+    taking a render scene fixture; ``-m "not render"`` (``make test-unit``) leaves them out."""
+    renders: dict[Path, bool] = {}
+    for item in items:
+        path = Path(item.path)
+        if path not in renders:
+            renders[path] = bool(_RENDERS.search(path.read_text(encoding="utf-8")))
+        if renders[path] or _RENDER_FIXTURES & set(getattr(item, "fixturenames", ())):
+            item.add_marker(pytest.mark.render)
 
 
 def _data_dir() -> Path | None:

@@ -107,8 +107,10 @@ def test_a_coated_plane_diffuse_part_and_fresnel_highlight():
         * t_o[..., None]
         / (IOR**2 * (1.0 - internal_diffuse_reflectance(IOR)))
     )
-    diffuse = out.transport[0] - out.specular[0]
-    assert np.all(out.specular[0] == 0.0)  # a delta light is never seen through a delta coat
+    diffuse = out.transport[0] - out.parts["specular"][0]
+    assert np.all(
+        out.parts["specular"][0] == 0.0
+    )  # a delta light is never seen through a delta coat
     np.testing.assert_allclose(diffuse, expected, rtol=DIFFUSE_RTOL)
     # the sky seen in the coat: unit radiance times the coat's Fresnel reflectance, every band
     # alike; Mitsuba picks the coat lobe with a probability, so this part is a Monte Carlo mean
@@ -123,7 +125,7 @@ def test_a_coated_plane_diffuse_part_and_fresnel_highlight():
             seed=5,
             max_depth=2,
         )
-        highlight = o.specular[0]
+        highlight = o.parts["specular"][0]
         assert np.all(highlight == highlight[..., :1])  # band-independent: the ior is scalar
         ratio = highlight[..., 0] / fresnel_dielectric(cos_o, ior)
         stderr = ratio.std(ddof=1) / np.sqrt(ratio.size)
@@ -155,13 +157,17 @@ def test_b_metal_band_fresnel_is_the_normal_incidence_reflectance(metal):
     sensors = get_sensors("bands:31@400-700")
     values = channel_values(scene, sensors)
     (out,), _, _, _ = render_traversal(scene, [values], spp=2, seed=1, max_depth=3)
-    assert np.array_equal(out.transport, out.specular)  # all of it through the metal's lobe
+    assert np.array_equal(
+        out.transport, out.parts["specular"]
+    )  # all of it through the metal's lobe
     wl = np.arange(360.0, 831.0)
     curves = sensors.on(wl)
     f0 = (curves @ _normal_incidence_reflectance(metal, wl)) / curves.sum(axis=1)
     # 2° off the normal at most: F changes by < 1e-4 there
     np.testing.assert_allclose(
-        out.specular[0], np.broadcast_to(f0, out.specular[0].shape), rtol=DELTA_RTOL
+        out.parts["specular"][0],
+        np.broadcast_to(f0, out.parts["specular"][0].shape),
+        rtol=DELTA_RTOL,
     )
 
 
