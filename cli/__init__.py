@@ -14,7 +14,7 @@ import traceback
 from collections.abc import Sequence
 from typing import Any, NoReturn
 
-from spectrinsic.data_dir import resolve_data_dir
+from spectrinsic.data_dir import one_data_dir
 from spectrinsic.errors import SpectrinsicError
 from spectrinsic.interrupts import interrupts_reach_python
 from spectrinsic.provenance import software_versions
@@ -117,9 +117,11 @@ def _main(argv: Sequence[str] | None) -> int:
         format="%(levelname)s %(name)s: %(message)s",
     )
     try:
-        if args.data_dir is not None:  # a wrong --data-dir is an input error, before any work
-            resolve_data_dir(args.data_dir)
-        return int(args.func(args) or 0)
+        # one data directory for the whole run (--data-dir, else $SPECTRINSIC_DATA), resolved
+        # once, before any work (a wrong one is an input error), and seen by every worker
+        with one_data_dir(args.data_dir) as data_dir:
+            args.data_dir = data_dir
+            return int(args.func(args) or 0)
     except SpectrinsicError as exc:
         return _error(args, str(exc))
     except OSError as exc:  # a file the command could not read or write, named by the OS

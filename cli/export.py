@@ -10,7 +10,7 @@ from tqdm import tqdm
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import sample_dirs
 from spectrinsic.gt_export.sample import MANIFEST_NAME
-from spectrinsic.gt_export.shards import check_shard_folder, write_shards
+from spectrinsic.gt_export.shards import check_export_source, check_shard_folder, write_shards
 
 __all__ = ["register", "run"]
 
@@ -52,6 +52,7 @@ def run(args: argparse.Namespace) -> int:
         raise DatasetError(
             f"export {str(root)!r}: no {MANIFEST_NAME}; expected a built dataset folder"
         )
+    check_export_source(root)  # whole and held by no build: never a partial export
     check_shard_folder(Path(args.out))  # before the progress bar: new, empty or an earlier export
     layers = None if args.layers is None else [k.strip() for k in args.layers.split(",")]
     if layers is not None and not all(layers):

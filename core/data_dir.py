@@ -9,11 +9,13 @@ directory*: the ``--data-dir`` option, else the ``SPECTRINSIC_DATA`` environment
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from spectrinsic.errors import DataDirectoryError
 
-__all__ = ["DATA_ENV", "DATA_SUBDIRS", "resolve_data_dir", "require_data_file"]
+__all__ = ["DATA_ENV", "DATA_SUBDIRS", "resolve_data_dir", "require_data_file", "one_data_dir"]
 
 DATA_ENV = "SPECTRINSIC_DATA"
 
@@ -66,3 +68,34 @@ def require_data_file(relative: str, data_dir: str | os.PathLike[str] | None = N
             f"data directory {str(root)!r} lacks the expected file {relative!r}"
         )
     return path
+
+
+@contextmanager
+def one_data_dir(data_dir: str | os.PathLike[str] | None = None) -> Iterator[str | None]:
+    """One data directory for a whole run: *data_dir* (``--data-dir``), else
+    ``SPECTRINSIC_DATA``, resolved once and yielded as an absolute path (``None`` when none is
+    configured).
+
+    While the run lasts ``SPECTRINSIC_DATA`` holds that same path, so every reader that is not
+    handed the directory explicitly, and every worker the run starts (processes inherit the
+    environment, local Dask workers too), sees the directory the run resolved, never another
+    one. The previous value is restored afterwards. A *data_dir* that does not exist is
+    refused here; a wrong ``SPECTRINSIC_DATA`` only where something is read from it.
+    """
+    try:
+        root = resolve_data_dir(data_dir)
+    except DataDirectoryError:
+        if data_dir is not None:
+            raise
+        root = None  # a wrong $SPECTRINSIC_DATA is refused where it is read, naming it
+    previous = os.environ.get(DATA_ENV)
+    if root is not None:
+        os.environ[DATA_ENV] = str(root)
+    try:
+        yield None if root is None else str(root)
+    finally:
+        if root is not None:
+            if previous is None:
+                os.environ.pop(DATA_ENV, None)
+            else:
+                os.environ[DATA_ENV] = previous

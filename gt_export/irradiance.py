@@ -54,6 +54,7 @@ __all__ = [
     "unit_luminance",
     "residual",
     "recompose",
+    "unlit_masked",
     "share_maps",
     "relative_standard_error",
     "noise_figures",
@@ -207,6 +208,19 @@ def residual(
         np.float64
     ) * np.asarray(shading, f32).astype(np.float64)
     return out if specular is None else out - np.asarray(specular, f32).astype(np.float64)
+
+
+def unlit_masked(
+    estimate: WhiteRadiance, raw: WhiteRadiance, batches: tuple[np.ndarray, ...] = ()
+) -> WhiteRadiance:
+    """*estimate* (a denoised ``W``) set to exactly 0 at the pixels where no light arrives: the
+    raw ``W`` and the raw channels of every independent batch are 0 in every band there. A
+    denoiser spreads light from lit neighbours into such pixels, and ``illuminant`` divides by
+    the tiny luminance it leaves (saturated colours); the layers are documented as 0 there."""
+    lit = np.any(raw.bands != 0, axis=-1)
+    for batch in batches:
+        lit |= np.any(np.asarray(batch) != 0, axis=-1)
+    return estimate.with_bands(np.where(lit[..., None], estimate.bands, 0.0))
 
 
 def recompose(radiance: WhiteRadiance, raw: np.ndarray) -> np.ndarray:

@@ -4,6 +4,8 @@ Every verb that writes (``dataset``, ``export``, ``render``, ``evaluate``, ``stu
 one rule for its ``--out`` (:func:`check_out_folder`): a new folder, an empty one, or one of
 spectrinsic's own of the same kind; never a file, never a folder inside a dataset, and never
 one another spectrinsic run holds. Nothing the program did not write is replaced.
+A folder holding a symbolic link (to a file or a folder, at any depth) is refused: nothing is
+ever written through a link, so nothing lands outside ``--out``.
 
 * A dataset knows itself by its marker (:mod:`spectrinsic.gt_export.integrity`), a shard
   export by its index (:mod:`spectrinsic.gt_export.shards`).
@@ -154,8 +156,25 @@ def check_out_folder(
             f"{option} {str(root)!r} is not empty and is not {what}, so it "
             "holds files spectrinsic did not write; choose a new or empty folder"
         )
+    _refuse_links(root, option)
     _require_writable(root, option)
     return False
+
+
+def _refuse_links(root: Path, option: str) -> None:
+    """A folder a run writes into holds no symbolic link, to a file or a folder, at any depth:
+    spectrinsic never writes through one (a rerun would otherwise write a ``meta.json``, a
+    ``REPORT.md`` or a whole ``gallery-pixels/`` into wherever the link points, outside
+    *root*). spectrinsic writes no links itself, so one is the user's: refused in one line."""
+    for dirpath, dirnames, filenames in os.walk(root):  # links are listed, never followed
+        here = Path(dirpath)
+        for name in sorted(dirnames + filenames):
+            if (here / name).is_symlink():
+                rel = (here / name).relative_to(root).as_posix()
+                raise DatasetError(
+                    f"{option} {str(root)!r} holds {rel!r}, a symbolic link; spectrinsic never "
+                    "writes through a link in its output folder: remove it or choose another folder"
+                )
 
 
 # ----------------------------------------------------------------------------------------------

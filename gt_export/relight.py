@@ -33,6 +33,7 @@ import numpy as np
 from spectrinsic.errors import DatasetError, SceneError, SpectrinsicError
 from spectrinsic.gt_export.exr import read_exr
 from spectrinsic.gt_export.integrity import replaceable_sample
+from spectrinsic.gt_export.layers.records import reference_mode
 from spectrinsic.gt_export.relight_checks import check_finite_result, check_relight_inputs
 from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, file_sha256
 from spectrinsic.gt_export.sample_meta import read_meta
@@ -231,8 +232,22 @@ def relit_render(
     base = _render_meta(meta, transport, relit)
     dd = None if data_dir is None else str(data_dir)
     merged = relit_result(transport, scene, meta=base, data_dir=dd)
+    _same_reference(sample, meta, merged)
     result = dataclasses.replace(merged, aovs=_aovs(sample, meta, coverage))
     return RelitSample(scene=scene, result=result, meta=meta, transport=transport)
+
+
+def _same_reference(sample: Path, meta: Mapping[str, Any], relit: Any) -> None:
+    """A relit sample keeps its base sample's reference mode, or relighting is refused: the
+    preview preset's reference image is the ``spectral`` render, which the stored (diagonal)
+    transport cannot give again, and a variant from another mode would not be comparable."""
+    base, ref = meta.get("reference_mode"), reference_mode(relit)
+    if base is not None and base != ref:
+        raise DatasetError(
+            f"SAMPLE {str(sample)!r}: its reference image is the {base!r} render, which the "
+            f"stored transport cannot relight (it holds {', '.join(sorted(relit.images))}); "
+            "relight samples of a preset whose reference mode is stored (the default preset)"
+        )
 
 
 def _empty_folder(path: Path) -> bool:

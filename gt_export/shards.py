@@ -33,8 +33,14 @@ import numpy as np
 from spectrinsic.errors import DatasetError, MissingDependencyError
 from spectrinsic.gt_export.loader import load_sample, split_samples
 from spectrinsic.gt_export.manifest import read_manifest
-from spectrinsic.gt_export.outfolder import LOCK_NAME, check_out_folder, folder_lock
-from spectrinsic.gt_export.sample import MANIFEST_NAME, META_NAME, TMP_PREFIX, file_sha256
+from spectrinsic.gt_export.outfolder import LOCK_NAME, check_out_folder, check_unlocked, folder_lock
+from spectrinsic.gt_export.sample import (
+    MANIFEST_NAME,
+    META_NAME,
+    TMP_PREFIX,
+    file_sha256,
+    sample_dirs,
+)
 from spectrinsic.gt_export.sample_meta import meta_from_bytes
 
 __all__ = [
@@ -233,10 +239,34 @@ def write_shards(
     if samples_per_shard < 1:
         raise DatasetError(f"samples per shard {samples_per_shard}; expected a whole number >= 1")
     source, out = Path(dataset_dir), Path(out_dir)
+    check_export_source(source)
     check_shard_folder(out)
     with folder_lock(out):  # one export per folder; a second is refused, naming this one
         return _write_locked(
             source, out, check_shard_folder(out), samples_per_shard, layers, progress
+        )
+
+
+def check_export_source(source: Path, option: str = "DIR") -> None:
+    """The dataset an export reads must be whole and at rest (writes nothing).
+
+    Raises
+    ------
+    FolderLockedError
+        A build holds the dataset's lock (a ``--rebuild`` running now would mix config hashes).
+    DatasetError
+        Samples the manifest lists are missing (an export would be partial): one line naming
+        the first and how many.
+    """
+    check_unlocked(source, option)
+    listed = sorted(_manifest(source).get("samples") or {})
+    present = {p.name for p in sample_dirs(source)}
+    missing = [name for name in listed if name not in present]
+    if missing:
+        more = f", and {len(missing) - 1} more" if len(missing) > 1 else ""
+        raise DatasetError(
+            f"{option} {str(source)!r}: {len(missing)} sample(s) listed in {MANIFEST_NAME} are "
+            f"missing ({missing[0]!r}{more}); an export would be partial: run the build again"
         )
 
 
@@ -271,6 +301,9 @@ def _write_locked(
         for name, folders in shards.items():
             seen |= _write_shard(out, name, folders, layers, progress)
             files[name] = file_sha256(out / name)
+    check_export_source(source)  # a build that started meanwhile: the export stays incomplete
+    if _manifest(source).get("config_hash") != base["config_hash"]:
+        raise DatasetError(f"DIR {str(source)!r} was rebuilt during the export; export again")
     _write_index(
         out,
         {

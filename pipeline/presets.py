@@ -15,6 +15,7 @@ from typing import Any
 from spectrinsic import provenance
 from spectrinsic.errors import DatasetError, RenderError, validate_choice
 from spectrinsic.gt_export import DEFAULT_CAMERAS
+from spectrinsic.gt_export.layers.records import REFERENCE_MODES
 from spectrinsic.gt_export.manifest import SPLIT_FRACTIONS, SplitFractions, check_split_fractions
 from spectrinsic.gt_export.sample import config_hash
 from spectrinsic.render.light_transport import diagonal_mode_names
@@ -106,6 +107,19 @@ RENDER_KEYS: tuple[str, ...] = (
 #: Most relit variants per sample (``--relight N``): each is a whole sample folder written
 #: from the transport, so the bound keeps a build's size within reach of its plan.
 MAX_RELIGHT = 1000
+
+
+def _check_relit_reference(relight: int, modes: tuple[str, ...]) -> None:
+    """Relit variants keep their base sample's reference mode: with ``--relight``, the
+    reference mode (the first of the render's modes in ``REFERENCE_MODES``) must be one the
+    stored transport relights (a diagonal mode); the preview preset's ``spectral`` is not."""
+    reference = next((m for m in REFERENCE_MODES if m in modes), None)
+    if relight and reference is not None and reference not in diagonal_mode_names(modes):
+        raise DatasetError(
+            f"--relight {relight} with modes {list(modes)}: the reference image is the "
+            f"{reference!r} render, which the stored transport cannot relight (variants would "
+            "come from another mode than their base samples); use the default preset"
+        )
 
 
 @dataclass(frozen=True)
@@ -241,6 +255,7 @@ class DatasetConfig:
                 f"--relight {self.relight} needs --store-transport (relit variants are "
                 "composed from the stored transport)"
             )
+        _check_relit_reference(self.relight, tuple(self.render.modes))
 
     @classmethod
     def from_settings(cls, preset: str, **settings: Any) -> DatasetConfig:

@@ -143,6 +143,8 @@ def compute_ground_truth(
             if denoiser is None
             else denoiser(w_raw, guides)
         )
+        batches = tuple(b[s.ref] for b in getattr(result, "batch_raw", ()) or () if s.ref in b)
+        w = irr.unlit_masked(w, w_raw, batches)
     specular = specular_srgb(s, w_raw.to_xyz)
     layers += intrinsic_layers(s, w_raw, w, image, reflectance, denoised=denoise, specular=specular)
     layers += gloss_layers(s, coverage, specular)

@@ -1,0 +1,69 @@
+"""Issue 36, cause 4 (first half): a relit sample keeps its base sample's reference mode.
+
+In the preview preset the reference ``image`` is the ``spectral`` render, but the stored
+transport is diagonal (``rgb3``): relighting gave a variant whose reference mode had switched
+to ``rgb3`` (11 layers changed relighting with the sample's own spectra, shading by up to 67.5
+of 208.6). Now ``relight`` refuses such a sample in one line, and ``dataset --relight N`` with
+such modes is refused before the first sample.
+"""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from spectrinsic.cli import main
+from spectrinsic.errors import DatasetError
+from spectrinsic.pipeline.presets import DatasetConfig
+
+SCENE = """\
+name: quad
+materials: {grey: "flat:0.5"}
+meshes:
+  - name: ground
+    vertices: [[-2, -2, 0], [2, -2, 0], [2, 2, 0], [-2, 2, 0]]
+    faces: [[0, 1, 2], [0, 2, 3]]
+    material: grey
+lights:
+  - {kind: point, spectrum: "cie:D65", power: 4, position: [0, 0, 2]}
+camera: {origin: [0, -3, 2], target: [0, 0, 0], width: 16, height: 16}
+"""
+TINY = {"width": 8, "height": 8, "spp": 2, "max_depth": 3}
+PREVIEW = ["--preset", "preview", "--resolution", "16x16", "--spp", "2"]
+
+
+def _one_line(capsys, *needles: str) -> None:
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "Traceback" not in err, err
+    for needle in needles:
+        assert needle in err, err
+
+
+def test_relighting_a_preview_sample_is_refused_not_switched_to_rgb3(tmp_path, capsys):
+    (tmp_path / "s.yaml").write_text(SCENE)
+    ds = tmp_path / "ds"
+    argv = ["-q", "dataset", *PREVIEW, "--scenes", str(tmp_path / "s.yaml"), "--store-transport"]
+    assert main([*argv, "--out", str(ds)]) == 0, capsys.readouterr().err
+    (sample,) = [p.parent for p in ds.glob("*/meta.json")]
+    assert json.loads((sample / "meta.json").read_text())["reference_mode"] == "spectral"
+    out = tmp_path / "relit"
+    rc = main(["-q", "relight", str(sample), "--light", "0=cie:D65", "--out", str(out)])
+    assert rc == 2
+    _one_line(capsys, "'spectral'", "cannot relight")
+    assert not out.exists()
+    # and a build that would make such variants is refused before its first sample
+    rc = main([*argv, "--relight", "1", "--out", str(tmp_path / "ds2")])
+    assert rc == 2
+    _one_line(capsys, "--relight 1", "'spectral'")
+    assert not (tmp_path / "ds2").exists()
+
+
+def test_the_plan_allows_relighting_where_the_reference_is_stored():
+    DatasetConfig.from_settings(
+        "tiny", **TINY, modes=("bands31", "rgb3"), store_transport=True, relight=2
+    )
+    with pytest.raises(DatasetError, match="'spectral'"):
+        DatasetConfig.from_settings(
+            "tiny", **TINY, modes=("spectral", "rgb3"), store_transport=True, relight=2
+        )
