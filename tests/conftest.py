@@ -97,6 +97,22 @@ def torch():
     )
 
 
+#: A small valid scene file (FORMAT.md's example reduced to a grey quad, one point light, a
+#: 16x16 camera), as YAML text: the input of the CLI's refusal and output-folder tests.
+QUAD_YAML = """\
+name: quad
+materials: {grey: "flat:0.5"}
+meshes:
+  - name: ground
+    vertices: [[-2, -2, 0], [2, -2, 0], [2, 2, 0], [-2, 2, 0]]
+    faces: [[0, 1, 2], [0, 2, 3]]
+    material: grey
+lights:
+  - {kind: point, spectrum: "cie:D65", power: 4, position: [0, 0, 2]}
+camera: {origin: [0, -3, 2], target: [0, 0, 0], width: 16, height: 16}
+"""
+
+
 def quad(
     corner: Sequence[float], u: Sequence[float], v: Sequence[float]
 ) -> tuple[np.ndarray, np.ndarray]:

@@ -20,6 +20,7 @@ from spectrinsic.cli import main
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.integrity import MARKER_NAME, write_marker
 from spectrinsic.pipeline.presets import get_preset
+from tests.conftest import QUAD_YAML
 
 #: The dataset options of the tiny builds (as in tests/pipeline/test_pipeline.py).
 TINY = [
@@ -35,23 +36,9 @@ TINY = [
 TINY_HASH = get_preset("preview").with_options(width=16, height=16, spp=2).config_hash()
 APPLE = "obj-apple__v0__white"
 
-#: A small valid scene (as in tests/scenes/test_io.py), as YAML text.
-SCENE = """\
-name: quad
-materials: {grey: "flat:0.5"}
-meshes:
-  - name: ground
-    vertices: [[-2, -2, 0], [2, -2, 0], [2, 2, 0], [-2, 2, 0]]
-    faces: [[0, 1, 2], [0, 2, 3]]
-    material: grey
-lights:
-  - {kind: point, spectrum: "cie:D65", power: 4, position: [0, 0, 2]}
-camera: {origin: [0, -3, 2], target: [0, 0, 0], width: 16, height: 16}
-"""
-
 
 #: A scene whose second mesh has only a zero-area face (three collinear vertices).
-SLIVER = SCENE.replace(
+SLIVER = QUAD_YAML.replace(
     "lights:",
     """  - name: sliver
     vertices: [[0, 0, 0.5], [1, 0, 0.5], [2, 0, 0.5]]
@@ -127,11 +114,11 @@ def _sfu_render(tmp: Path, value: str | None, encoding: str = "utf-8") -> list[s
     """``render`` of a scene using an SFU reflectance from a data directory holding *value*
     (``None``: a data directory that does not exist)."""
     data = _sfu_data_dir(tmp, value, encoding) if value is not None else tmp / "nope"
-    scene = _scene(tmp, SCENE.replace("flat:0.5", "sfu:mine/1"))
+    scene = _scene(tmp, QUAD_YAML.replace("flat:0.5", "sfu:mine/1"))
     return ["--data-dir", str(data), "render", scene, "--out", str(tmp / "o")]
 
 
-def _scene(tmp: Path, text: str = SCENE, name: str = "scene.yaml") -> str:
+def _scene(tmp: Path, text: str = QUAD_YAML, name: str = "scene.yaml") -> str:
     path = tmp / name
     path.write_text(text) if isinstance(text, str) else path.write_bytes(text)
     return str(path)
@@ -393,7 +380,7 @@ CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
     ),
     (
         "yaml-duplicate-key",
-        lambda t: ["render", _scene(t, SCENE + "name: again\n"), "--out", str(t / "o")],
+        lambda t: ["render", _scene(t, QUAD_YAML + "name: again\n"), "--out", str(t / "o")],
         "duplicate key 'name'",
     ),
     (
@@ -407,7 +394,7 @@ CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
             "render",
             _scene(
                 t,
-                SCENE.replace("point,", "pointy,")
+                QUAD_YAML.replace("point,", "pointy,")
                 .replace("width: 16", "width: -3")
                 .replace("material: grey", "material: blue")
                 + "colour: 3\n",
@@ -622,7 +609,7 @@ CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
             "--preset",
             "preview",
             "--scenes",
-            _scene(t, SCENE.replace("flat:0.5", "flat:7")),
+            _scene(t, QUAD_YAML.replace("flat:0.5", "flat:7")),
             "--out",
             str(t / "new"),
         ],
@@ -675,7 +662,7 @@ CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
         "render-ground-truth-bad-file",
         lambda t: [
             "render",
-            _scene(t, SCENE.replace("flat:0.5", "flat:7")),
+            _scene(t, QUAD_YAML.replace("flat:0.5", "flat:7")),
             "--ground-truth",
             "--out",
             str(t / "new"),
@@ -697,7 +684,7 @@ CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
         "render-variant-bogus",
         lambda t: [
             "render",
-            _scene(t, SCENE.replace("flat:0.5", "flat:7")),
+            _scene(t, QUAD_YAML.replace("flat:0.5", "flat:7")),
             "--variant",
             "bogus",
             "--out",

@@ -17,19 +17,8 @@ import pytest
 
 from spectrinsic.cli import main
 from spectrinsic.gt_export.outfolder import output_folder
+from tests.conftest import QUAD_YAML
 
-SCENE = """\
-name: quad
-materials: {grey: "flat:0.5"}
-meshes:
-  - name: ground
-    vertices: [[-2, -2, 0], [2, -2, 0], [2, 2, 0], [-2, 2, 0]]
-    faces: [[0, 1, 2], [0, 2, 3]]
-    material: grey
-lights:
-  - {kind: point, spectrum: "cie:D65", power: 4, position: [0, 0, 2]}
-camera: {origin: [0, -3, 2], target: [0, 0, 0], width: 16, height: 16}
-"""
 TINY = ["--preset", "preview", "--resolution", "16x16", "--spp", "2"]
 MINE = "the user's own words\n"
 
@@ -59,7 +48,7 @@ def _refused(rc: int, capsys, name: str) -> None:
 
 def test_render_rerun_over_a_linked_meta_json_is_refused(tmp_path, capsys):
     scene = tmp_path / "s.yaml"
-    scene.write_text(SCENE)
+    scene.write_text(QUAD_YAML)
     out = tmp_path / "r"
     argv = ["-q", "render", str(scene), "--spp", "2", "--out", str(out)]
     assert main(argv) == 0, capsys.readouterr().err
@@ -72,7 +61,7 @@ def test_render_rerun_over_a_linked_meta_json_is_refused(tmp_path, capsys):
 @pytest.fixture(scope="module")
 def dataset(tmp_path_factory) -> Path:
     root = tmp_path_factory.mktemp("links")
-    (root / "s.yaml").write_text(SCENE)
+    (root / "s.yaml").write_text(QUAD_YAML)
     assert main(_dataset_argv(root / "ds")) == 0
     return root / "ds"
 
@@ -84,7 +73,7 @@ def _dataset_argv(out: Path) -> list[str]:
 @pytest.mark.parametrize("name", ["DATASET.md", "index.html", "gallery.js", "gallery-pixels"])
 def test_dataset_rerun_over_a_linked_file_or_folder_is_refused(dataset, name, tmp_path, capsys):
     root = Path(shutil.copytree(dataset, tmp_path / "ds"))
-    (tmp_path / "s.yaml").write_text(SCENE)
+    (tmp_path / "s.yaml").write_text(QUAD_YAML)
     assert (root / name).exists(), f"the dataset build no longer writes {name}"
     target = _outside(tmp_path)
     if (root / name).is_dir():

@@ -14,19 +14,8 @@ import pytest
 from spectrinsic.cli import main
 from spectrinsic.gt_export.integrity import write_marker
 from spectrinsic.pipeline.presets import get_preset
+from tests.conftest import QUAD_YAML
 
-SCENE = """\
-name: quad
-materials: {grey: "flat:0.5"}
-meshes:
-  - name: ground
-    vertices: [[-2, -2, 0], [2, -2, 0], [2, 2, 0], [-2, 2, 0]]
-    faces: [[0, 1, 2], [0, 2, 3]]
-    material: grey
-lights:
-  - {kind: point, spectrum: "cie:D65", power: 4, position: [0, 0, 2]}
-camera: {origin: [0, -3, 2], target: [0, 0, 0], width: 16, height: 16}
-"""
 TINY = ["--preset", "preview", "--resolution", "16x16", "--spp", "2"]
 APPLE = "obj-apple__v0__white"
 GENERATED = ["--generator", "objects-on-ground", "--count", "1", *TINY]
@@ -40,7 +29,7 @@ def _one_line(capsys, *needles: str) -> str:
     return err
 
 
-def _scene(tmp_path: Path, text: str = SCENE) -> str:
+def _scene(tmp_path: Path, text: str = QUAD_YAML) -> str:
     path = tmp_path / "scene.yaml"
     path.write_text(text)
     return str(path)
@@ -73,19 +62,19 @@ def test_the_json_spectrinsic_writes_is_strict():
 
 
 def test_a_yaml_file_with_a_control_character_is_one_line(tmp_path, capsys):
-    scene = _scene(tmp_path, SCENE.replace("name: quad", "name: qu\x01ad"))
+    scene = _scene(tmp_path, QUAD_YAML.replace("name: quad", "name: qu\x01ad"))
     assert main(["render", scene, "--out", str(tmp_path / "o")]) == 2
     _one_line(capsys, "scene.yaml", "invalid YAML", "#x0001")
 
 
 def test_a_face_index_beyond_32_bits_is_one_line(tmp_path, capsys):
-    scene = _scene(tmp_path, SCENE.replace("[0, 2, 3]", f"[0, 2, {2**70}]"))
+    scene = _scene(tmp_path, QUAD_YAML.replace("[0, 2, 3]", f"[0, 2, {2**70}]"))
     assert main(["render", scene, "--out", str(tmp_path / "o")]) == 2
     _one_line(capsys, "meshes[0].faces[1][2]", "32-bit")
 
 
 def test_a_vertex_too_large_for_a_float_is_one_line(tmp_path, capsys):
-    scene = _scene(tmp_path, SCENE.replace("[-2, -2, 0]", f"[-2, -2, {10**400}]", 1))
+    scene = _scene(tmp_path, QUAD_YAML.replace("[-2, -2, 0]", f"[-2, -2, {10**400}]", 1))
     assert main(["render", scene, "--out", str(tmp_path / "o")]) == 2
     _one_line(capsys, "meshes[0].vertices", "too large")
 
@@ -132,7 +121,9 @@ def test_a_dataset_rerun_over_a_deeply_nested_meta_json_is_one_line(tmp_path, ca
     ],
 )  # fmt: skip
 def test_a_light_key_of_another_kind_is_refused(tmp_path, capsys, light, key):
-    text = SCENE.replace('{kind: point, spectrum: "cie:D65", power: 4, position: [0, 0, 2]}', light)
+    text = QUAD_YAML.replace(
+        '{kind: point, spectrum: "cie:D65", power: 4, position: [0, 0, 2]}', light
+    )
     assert main(["render", _scene(tmp_path, text), "--out", str(tmp_path / "o")]) == 2
     _one_line(capsys, f"lights[0].{key}", "light has no")
 

@@ -16,19 +16,8 @@ import pytest
 from spectrinsic.cli import main
 from spectrinsic.errors import DatasetError
 from spectrinsic.pipeline.presets import DatasetConfig
+from tests.conftest import QUAD_YAML
 
-SCENE = """\
-name: quad
-materials: {grey: "flat:0.5"}
-meshes:
-  - name: ground
-    vertices: [[-2, -2, 0], [2, -2, 0], [2, 2, 0], [-2, 2, 0]]
-    faces: [[0, 1, 2], [0, 2, 3]]
-    material: grey
-lights:
-  - {kind: point, spectrum: "cie:D65", power: 4, position: [0, 0, 2]}
-camera: {origin: [0, -3, 2], target: [0, 0, 0], width: 16, height: 16}
-"""
 TINY = {"width": 8, "height": 8, "spp": 2, "max_depth": 3}
 PREVIEW = ["--preset", "preview", "--resolution", "16x16", "--spp", "2"]
 
@@ -41,7 +30,7 @@ def _one_line(capsys, *needles: str) -> None:
 
 
 def test_relighting_a_preview_sample_is_refused_not_switched_to_rgb3(tmp_path, capsys):
-    (tmp_path / "s.yaml").write_text(SCENE)
+    (tmp_path / "s.yaml").write_text(QUAD_YAML)
     ds = tmp_path / "ds"
     argv = ["-q", "dataset", *PREVIEW, "--scenes", str(tmp_path / "s.yaml"), "--store-transport"]
     assert main([*argv, "--out", str(ds)]) == 0, capsys.readouterr().err
