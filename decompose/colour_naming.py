@@ -35,6 +35,7 @@ __all__ = [
     "appendix_a_labels",
     "discretise_memberships",
     "label_centroids",
+    "observed_labels",
 ]
 
 #: The 11 basic colour terms, in the order of the thesis' set N (section 3.2.1).
@@ -280,3 +281,20 @@ def label_centroids(grid: int = 33) -> npt.NDArray[np.float64]:
         out = sums / counts[:, None]
     out.flags.writeable = False
     return out
+
+
+def observed_labels(encoded: np.ndarray, name_bits: int = 8) -> np.ndarray:
+    """``(N,)`` Appendix A label of each sRGB-encoded ``(N, 3)`` colour in [0, 1], named once
+    per distinct quantised colour.
+
+    With ``name_bits = b`` the encoded values are rounded to ``2**b`` levels first (the
+    thesis' images are 8-bit, ``b = 8``); ``0`` names every colour as it is.
+    """
+    if name_bits <= 0:
+        return discretise_memberships(colour_name_memberships(encoded))
+    levels = (1 << name_bits) - 1
+    codes = np.rint(np.clip(encoded, 0.0, 1.0) * levels).astype(np.int64)
+    packed = (codes[:, 0] * (levels + 1) + codes[:, 1]) * (levels + 1) + codes[:, 2]
+    unique, inverse = np.unique(packed, return_inverse=True)
+    rgb = np.stack(np.unravel_index(unique, (levels + 1,) * 3), axis=1) / levels
+    return discretise_memberships(colour_name_memberships(rgb))[inverse.ravel()]

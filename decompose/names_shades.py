@@ -45,6 +45,10 @@ all of them off):
 * ``max_axis_angle=45``: RAD's crest bins more than 45 degrees from the grey diagonal of the
   log-colour histogram are cut before the ridges are labelled (a surface's ridge runs along
   the diagonal; a crest across it bridges two surfaces, which would otherwise share a ridge);
+* ``flooding``: each colour takes the ridge of RAD's flooding step (histogram bins given to the
+  ridges by descending density, :mod:`spectrinsic.decompose.ridges`), not Eq. 3.3's nearest;
+* ``merge_shading``: touching regions whose shared boundary is mostly Case C (one ridge, step
+  along it: shading) are one region (:mod:`spectrinsic.decompose.shade_cases`);
 * ``colour_constancy``, ``gamma=3`` (the thesis gives only ratios; ``gamma_over_alpha=100``
   and ``gamma_over_beta=2`` are the thesis' own), the cut's angle and the RAD parameters the
   thesis does not state (``creaseness=1.5``, ``sigma=2`` bins) chosen by :data:`PROTOCOL`
@@ -66,13 +70,13 @@ import numpy.typing as npt
 from spectrinsic.decompose.coherence import global_coherence, grid_edges
 from spectrinsic.decompose.colour_naming import (
     appendix_a_labels,
-    colour_name_memberships,
-    discretise_memberships,
     label_centroids,
+    observed_labels,
 )
 from spectrinsic.decompose.constancy import discount_illuminant
 from spectrinsic.decompose.decomposition import Decomposition, finish, prepare_input
 from spectrinsic.decompose.ridges import RIDGE_DETECTORS, ColourShades, colour_shades
+from spectrinsic.decompose.shade_cases import CASE_C, edge_cases, merge_shading_boundaries
 from spectrinsic.errors import DecomposeError, MissingDependencyError, validate_choice
 from spectrinsic.spectra.colorimetry import decode_srgb as _srgb_decode
 from spectrinsic.spectra.colorimetry import encode_srgb as _srgb_encode
@@ -146,8 +150,11 @@ class Labelling:
         ``(N,)`` observation ``y_i`` of each pixel, an index into ``candidates`` (sec. 3.2.1).
     shades
         Colour-shade descriptor of the log colours (sec. 3.2.2).
+    cases
+        ``(E,)`` Case A/B/C of the 4-neighbour edges (:func:`grid_edges` order; sec. 3.3.2,
+        :func:`spectrinsic.decompose.shade_cases.edge_cases`).
     weights
-        ``(E,)`` ``w_ij`` of the 4-neighbour edges (:func:`grid_edges` order; sec. 3.3.2).
+        ``(E,)`` ``w_ij`` of the same edges (alpha, beta or gamma by case).
     labels
         ``(N,)`` MRF output, an index into ``candidates`` (sec. 3.3).
     timings
@@ -161,6 +168,7 @@ class Labelling:
     candidates: np.ndarray
     observed: np.ndarray
     shades: ColourShades
+    cases: np.ndarray
     weights: np.ndarray
     labels: np.ndarray
     timings: dict[str, float]
@@ -196,6 +204,12 @@ class NamesAndShades:
         diagonal of the log-colour histogram are cut out, so that the ridges of two surfaces
         joined by a crest across the diagonal come out as two (:func:`spectrinsic.decompose.
         ridges.colour_shades`); ``None``: no cut.
+    flooding
+        RAD's flooding: each colour takes the ridge whose histogram domain (bins flooded from
+        the ridges by descending density) holds it, instead of the nearest ridge (Eq. 3.3).
+    merge_shading
+        Touching regions whose shared boundary is mostly Case C are one region of uniform
+        reflectance (:mod:`spectrinsic.decompose.shade_cases`).
     global_coherence
         Apply sec. 3.4 (off reproduces Fig. 3.7(c)).
     reflectance_colour
@@ -228,6 +242,8 @@ class NamesAndShades:
     ridge_detector: str = "rad"
     creaseness: float = 1.5
     max_axis_angle: float | None = 45.0
+    flooding: bool = True
+    merge_shading: bool = True
     global_coherence: bool = True
     reflectance_colour: Literal["label-centroid", "region-mean"] = "region-mean"
     split_by_ridge: bool = True
@@ -260,6 +276,8 @@ class NamesAndShades:
             expansion_cycles=-1,
             ridge_detector="rad",
             max_axis_angle=None,
+            flooding=False,
+            merge_shading=False,
             name="names-shades-thesis",
         )
 
@@ -302,15 +320,21 @@ class NamesAndShades:
             detector=self.ridge_detector,
             creaseness=self.creaseness,
             max_axis_angle=self.max_axis_angle,
+            flooding=self.flooding,
         )
         t2 = time.perf_counter()
 
         # 3. MRF (Eq. 3.4) by alpha-expansion
         edges, _ = grid_edges(m)
-        weights = self._edge_weights(edges, log_colours, shades)
-        labels = self._mrf(gco, edges, weights, y, distance)
+        cases = edge_cases(
+            edges, log_colours, shades.ridge, shades.tangent, self.parallel_threshold_deg
+        )
+        w = self.gamma / np.array([self.gamma_over_alpha, self.gamma_over_beta, 1.0])
+        labels = self._mrf(gco, edges, w[cases], y, distance)
         timings = {"names_s": t1 - t0, "shades_s": t2 - t1, "mrf_s": time.perf_counter() - t2}
-        return Labelling(img, m, linear, pixels, candidates, y, shades, weights, labels, timings)
+        return Labelling(
+            img, m, linear, pixels, candidates, y, shades, cases, w[cases], labels, timings
+        )
 
     def reflectance(self, stages: Labelling) -> Decomposition:
         """Steps 4-5 (regions, their colour, global coherence) on a :meth:`labelling`.
@@ -321,9 +345,7 @@ class NamesAndShades:
         """
         t3 = time.perf_counter()
         m, linear = stages.mask, stages.linear
-        regions, colours = self._regions(
-            m, stages.labels, stages.candidates, stages.shades, stages.pixels
-        )
+        regions, colours = self._regions(stages)
         n_regions = int(regions.max())
         if self.global_coherence:
             lam = global_coherence(regions, colours.mean(axis=1), linear.mean(axis=2))
@@ -348,7 +370,7 @@ class NamesAndShades:
         """Step 1: the candidate labels ``(K,)`` (Appendix A indices observed in the image), each
         pixel's observation ``y`` ``(N,)`` as an index into them, and the label-to-label L1
         distance ``(K, K)`` of their membership vectors."""
-        observed = self._observed_labels(_srgb_encode(pixels))
+        observed = observed_labels(_srgb_encode(pixels), self.name_bits)
         candidates, y = np.unique(observed, return_inverse=True)
         vectors = appendix_a_labels()[candidates]
         distance = np.abs(vectors[:, None, :] - vectors[None, :, :]).sum(axis=2)
@@ -379,23 +401,19 @@ class NamesAndShades:
             )
         return np.asarray(y)
 
-    def _regions(
-        self,
-        m: np.ndarray,
-        labels: np.ndarray,
-        candidates: np.ndarray,
-        shades: Any,
-        pixels: np.ndarray,
-    ) -> tuple[np.ndarray, np.ndarray]:
+    def _regions(self, stages: Labelling) -> tuple[np.ndarray, np.ndarray]:
         """Step 4: the region image ``(H, W)`` (0 off the mask, regions 1..R) and each region's
         linear RGB colour ``(R + 1, 3)``, at least 1e-6 (row 0 is unused)."""
         from skimage.measure import label as connected_regions
 
+        m, labels, candidates, pixels = stages.mask, stages.labels, stages.candidates, stages.pixels
         label_image = np.zeros(m.shape, dtype=np.int64)
         label_image[m] = labels + 1
         if self.split_by_ridge:
-            label_image[m] += (candidates.size + 1) * shades.ridge
+            label_image[m] += (candidates.size + 1) * stages.shades.ridge
         regions = connected_regions(label_image, background=0, connectivity=1)
+        if self.merge_shading:
+            regions = merge_shading_boundaries(regions, grid_edges(m)[1], stages.cases == CASE_C)
         n_regions = int(regions.max())
         region_of_pixel = regions[m]
         counts = np.bincount(region_of_pixel, minlength=n_regions + 1).astype(np.float64)
@@ -418,32 +436,3 @@ class NamesAndShades:
         else:
             colours = mean_colour
         return regions, np.maximum(colours, 1e-6)
-
-    def _observed_labels(self, encoded: np.ndarray) -> np.ndarray:
-        """Appendix A label of each sRGB-encoded colour, named once per distinct quantised colour.
-
-        With ``name_bits = b`` the encoded values are rounded to ``2**b`` levels first (the
-        thesis' images are 8-bit, ``b = 8``); ``0`` names every pixel as it is.
-        """
-        if self.name_bits <= 0:
-            return discretise_memberships(colour_name_memberships(encoded))
-        levels = (1 << self.name_bits) - 1
-        codes = np.rint(np.clip(encoded, 0.0, 1.0) * levels).astype(np.int64)
-        packed = (codes[:, 0] * (levels + 1) + codes[:, 1]) * (levels + 1) + codes[:, 2]
-        unique, inverse = np.unique(packed, return_inverse=True)
-        rgb = np.stack(np.unravel_index(unique, (levels + 1,) * 3), axis=1) / levels
-        return discretise_memberships(colour_name_memberships(rgb))[inverse.ravel()]
-
-    def _edge_weights(self, edges: np.ndarray, colours: np.ndarray, shades) -> np.ndarray:
-        """``w_ij`` of sec. 3.3.2: alpha (different ridges), beta (same, not parallel), gamma."""
-        i, j = edges[:, 0], edges[:, 1]
-        same = shades.ridge[i] == shades.ridge[j]
-        step = colours[j] - colours[i]
-        length = np.linalg.norm(step, axis=1)
-        along = np.abs((step * shades.tangent[i]).sum(axis=1))
-        with np.errstate(invalid="ignore", divide="ignore"):
-            cos_theta = np.where(length > 0.0, along / np.where(length > 0.0, length, 1.0), 1.0)
-        parallel = cos_theta >= np.cos(np.radians(self.parallel_threshold_deg))
-        alpha = self.gamma / self.gamma_over_alpha
-        beta = self.gamma / self.gamma_over_beta
-        return np.where(same, np.where(parallel, self.gamma, beta), alpha).astype(np.float64)

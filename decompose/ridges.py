@@ -36,7 +36,12 @@ negative Hessian eigenvalues of the smoothed histogram are negative and it is a 
 both transverse eigenvectors); kept for the ablation (docs/names-shades-mit.md).
 
 Each colour is assigned the ridge of the nearest ridge bin (Euclidean distance transform of the
-grid, Eq. 3.3). Its projection ``pi(p)`` is the foot of the perpendicular on the ridge's local
+grid, Eq. 3.3), or, with ``flooding``, the ridge of RAD's flooding step: the histogram's bins,
+taken by descending smoothed density, join the ridge of the denser neighbour they are reached
+from (a watershed of ``-density`` seeded by the ridges), so each ridge owns the "dominant
+structure" around it and a colour takes the ridge whose density it lies under, not the one
+nearest in Euclidean distance (two surfaces' ridges converge at the dark end of the log
+histogram, where a shadowed colour can be nearer another surface's ridge than its own). Its projection ``pi(p)`` is the foot of the perpendicular on the ridge's local
 tangent line through that bin (``rad``: principal axis of the ridge's bins within
 ``tangent_radius`` bins; ``hessian``: the Hessian eigenvector of the largest eigenvalue).
 """
@@ -117,6 +122,7 @@ def colour_shades(
     min_share: float = 0.005,
     tangent_radius: float = 3.0,
     max_axis_angle: float | None = None,
+    flooding: bool = False,
 ) -> ColourShades:
     """Find the ridges of the distribution of *colours* and describe each colour by them.
 
@@ -141,6 +147,9 @@ def colour_shades(
     max_axis_angle
         ``rad``: degrees; crest bins whose local direction is further than this from the grey
         diagonal are cut out (module docstring, step 2). ``None``: no cut.
+    flooding
+        Each colour takes the ridge whose flooded domain holds its bin (module docstring)
+        instead of the nearest ridge; its projection is on that ridge's nearest bin.
     """
     from scipy import ndimage
 
@@ -174,7 +183,8 @@ def colour_shades(
     if detector == "rad":
         components = _prune(components, grid.index, min_share)
         tangent_grid = _local_axes(components, tangent_radius)
-    return _describe(x, grid, components, tangent_grid)
+    domains = _flood(components, density) if flooding else None
+    return _describe(x, grid, components, tangent_grid, domains)
 
 
 def _histogram(x: np.ndarray, bins: int, sigma: float) -> _Grid:
@@ -326,15 +336,42 @@ def _local_axes(components: np.ndarray, radius: float) -> np.ndarray:
     return tangent_grid
 
 
+def _flood(components: np.ndarray, density: np.ndarray) -> np.ndarray:
+    """RAD's flooding: every bin of the smoothed histogram's support joins a ridge, the bins
+    taken by descending density and each given the ridge of the denser neighbour it is
+    reached from (a watershed of ``-density`` seeded by the ridges)."""
+    from skimage.segmentation import watershed
+
+    return np.asarray(watershed(-density, markers=components, mask=density > 0.0), np.int64)
+
+
+def _nearest_on(components: np.ndarray, domains: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """``(N, 3)`` for each colour's bin, the nearest bin of the ridge whose domain holds it."""
+    near = np.zeros((index.shape[0], 3), np.int64)
+    owner = domains[index[:, 0], index[:, 1], index[:, 2]]
+    for k in np.unique(owner):
+        sel = owner == k
+        mask = components == k if k > 0 else components > 0
+        near[sel] = _nearest(mask, index[sel])
+    return near
+
+
 def _describe(
-    x: np.ndarray, grid: _Grid, components: np.ndarray, tangent_grid: np.ndarray
+    x: np.ndarray,
+    grid: _Grid,
+    components: np.ndarray,
+    tangent_grid: np.ndarray,
+    domains: np.ndarray | None = None,
 ) -> ColourShades:
     """Eq. 3.3 on labelled ridge bins: each colour's ridge, projection and tangent."""
     ridge_mask = components > 0
     ids = np.unique(components[ridge_mask])
     renumber = np.zeros(int(components.max()) + 1, np.int64)
     renumber[ids] = np.arange(ids.size)
-    near = _nearest(ridge_mask, grid.index)
+    if domains is None:
+        near = _nearest(ridge_mask, grid.index)
+    else:
+        near = _nearest_on(components, domains, grid.index)
     ridge = renumber[components[near[:, 0], near[:, 1], near[:, 2]]]
     centre = grid.lo + (near - grid.pad) * grid.width
     tangent = tangent_grid[near[:, 0], near[:, 1], near[:, 2]]
