@@ -42,7 +42,8 @@ RAD = {"ridge_detector": "rad", "creaseness": 1.5, "sigma": 2.0, "max_axis_angle
 RAD_FINE = {"ridge_detector": "rad", "creaseness": 1.0, "sigma": 1.0, "max_axis_angle": None}
 MRF_GRID = {"gamma": [0.3, 1.0, 3.0, 10.0, 30.0], "gamma_over_alpha": [10.0, 100.0],
             "ridge_detector": ["hessian", "rad"], "creaseness": [1.0, 1.25, 1.5],
-            "sigma": [1.0, 1.5, 2.0, 3.0], "max_axis_angle": [None, 30.0, 45.0, 60.0]}
+            "sigma": [1.0, 1.5, 2.0, 3.0], "max_axis_angle": [None, 30.0, 45.0, 60.0],
+            "flooding": [False, True]}
 #: Round 1 (before the RAD detector): the hessian points. scripts/mit_ablation.json holds
 #: both rounds (round 1's keys, which lack the detector, are read as HESSIAN by merge()).
 HESSIAN_POINTS = [{"gamma": g, "gamma_over_alpha": 100.0, **HESSIAN} for g in (1.0, 3.0, 10.0, 30.0)
@@ -68,10 +69,17 @@ MRF_POINTS = [{"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD},
               {"gamma": 10.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 45.0},
               # round 3b (the best point, cut 45 and gamma 3, lay on the grid's edge)
               {"gamma": 1.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 45.0},
-              {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 30.0}]
+              {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 30.0},
+              # round 4 (issue 33, structure only, round 3's parameters): RAD's flooding step
+              {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 45.0,
+               "flooding": True}]
+#: Round 4 runs only these points (--round4): round 3's defaults without and with flooding.
+ROUND_4_POINTS = [13, 17]
 #: Parameters of steps 4-5 (run on each labelling).
 POST_GRID = {"reflectance_colour": ["label-centroid", "region-mean"],
-             "split_by_ridge": [False, True]}
+             "split_by_ridge": [False, True], "merge_shading": [False, True]}
+#: Structural switches of round 4, absent from older keys (read as off by merge()).
+STRUCTURE = {"flooding": False, "merge_shading": False}
 #: Applied to each result above (with_constancy: the same as the method's own step).
 CONSTANCY = ["none", "grey-world"]
 #: The thesis' point (NamesAndShades.thesis()) with expansion to convergence, and extra rows.
@@ -106,6 +114,7 @@ def run(mit_dir: Path, names: list[str] | None, points: list[dict], with_extra: 
             scores.setdefault(name, {})[obj.name] = mit_measures(obj, get_decomposer(name)(
                 obj.image, obj.mask))
         for mrf in points:
+            mrf = {"flooding": False, **mrf}
             method = dataclasses.replace(base, **mrf)
             t0 = time.perf_counter()
             labelling = method.labelling(obj.image, obj.mask)
@@ -165,12 +174,14 @@ def row(name: str, per_object: dict, baseline: dict) -> str:
 
 #: The thesis' settings (NamesAndShades.thesis(), 2 expansion cycles) with each detector.
 THESIS = {"gamma": 1.0, "gamma_over_alpha": 100.0, "reflectance_colour": "label-centroid",
-          "split_by_ridge": False, "colour_constancy": "none"}
+          "split_by_ridge": False, "colour_constancy": "none", **STRUCTURE}
 #: The round-1 defaults (hessian ridges), the reference for "before".
 ROUND_1 = {"gamma": 1.0, "gamma_over_alpha": 10.0, "reflectance_colour": "region-mean",
-           "split_by_ridge": True, "colour_constancy": "grey-world", **HESSIAN}
+           "split_by_ridge": True, "colour_constancy": "grey-world", **HESSIAN, **STRUCTURE}
 #: The round-2 defaults (RAD ridges without the diagonal cut).
 ROUND_2 = {**ROUND_1, **RAD}
+#: The round-3 defaults (the diagonal cut at 45 degrees, gamma 3 at the thesis' ratios).
+ROUND_3 = {**ROUND_2, "gamma": 3.0, "gamma_over_alpha": 100.0, "max_axis_angle": 45.0}
 
 
 def variations(label: str, centre: dict, s: dict, base: dict) -> list[str]:
@@ -199,6 +210,11 @@ def markdown(report: dict) -> str:
     lines += variations("thesis, RAD ridges", {**THESIS, **RAD}, s, base)
     lines.append(row("round-1 defaults (hessian ridges)", s[key(ROUND_1)], base))
     lines.append(row("round-2 defaults (RAD ridges, no diagonal cut)", s[key(ROUND_2)], base))
+    lines.append(row("round-3 defaults (diagonal cut 45, gamma 3)", s[key(ROUND_3)], base))
+    for label, change in (("flooding", {"flooding": True}),
+                          ("shading boundaries merged", {"merge_shading": True})):
+        if key({**ROUND_3, **change}) in s:
+            lines.append(row(f"round-3 defaults + {label}", s[key({**ROUND_3, **change})], base))
     free = report["choice"].get("unconstrained", {}).get("chosen")
     if free and free != chosen:
         lines.append(row(f"unconstrained choice: {free}", s[key(free)], base))
@@ -219,6 +235,8 @@ def merge(parts: list[Path]) -> dict:
                 k = key({**json.loads(k), **HESSIAN})
             elif k.startswith("{") and "max_axis_angle" not in k:  # round 2: no diagonal cut
                 k = key({"max_axis_angle": None, **json.loads(k)})
+            if k.startswith("{") and "flooding" not in k:  # rounds 1-3: no round-4 structure
+                k = key({**STRUCTURE, **json.loads(k)})
             report["scores"].setdefault(k, {}).update(per_object)
         report["labelling_seconds"].update(data["labelling_seconds"])
     report["choice"] = choose(report["scores"])
@@ -232,6 +250,9 @@ def per_object(report: dict) -> str:
                "colour-retinex": "colour-retinex",
                "ours, thesis settings, RAD": key({**THESIS, **RAD}),
                "ours, round-1 defaults": key(ROUND_1), "ours, round-2 defaults": key(ROUND_2),
+               "ours, round-3 defaults": key(ROUND_3),
+               "round 3 + flooding": key({**ROUND_3, "flooding": True}),
+               "round 3 + shading merge": key({**ROUND_3, "merge_shading": True}),
                "ours, chosen": key(chosen)}
     lines = ["| object | " + " | ".join(columns) + " |", "|---" * (len(columns) + 1) + "|"]
     objects = sorted(o for o in THESIS_TABLES_3_4_3_5 if o in s["colour-retinex"])
@@ -263,6 +284,9 @@ def main(argv: list[str]) -> int:
               f"{c['unconstrained']['chosen_lmse']:.4f} (held-out "
               f"{c['unconstrained']['held_out_lmse']:.4f})")
         return 0
+    if "--round4" in argv:
+        argv = [a for a in argv if a != "--round4"] + [
+            "--points=" + ",".join(str(i) for i in ROUND_4_POINTS)]
     chosen = [a for a in argv if a.startswith("--points=")]  # indices into MRF_POINTS
     argv = [a for a in argv if a not in chosen]
     points = ([MRF_POINTS[int(i)] for i in chosen[0].split("=", 1)[1].split(",")] if chosen
