@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from spectrinsic.errors import RenderError, SpectrinsicError, SpectrinsicWarning
-from spectrinsic.render import RenderSettings, variants
+from spectrinsic.render import RenderSettings
+from spectrinsic.render.base import variants
 
 
 @pytest.mark.parametrize(
