@@ -38,9 +38,9 @@ from ..gt_export.layers.denoise import Guides, denoise_blocks, denoise_rgb
 from ..gt_export.layers.irradiance import WhiteRadiance
 from ..pipeline.presets import get_preset
 from ..render import render_batches
+from ..render.algebra.batch_means import batch_seeds, merge_batches
 from ..render.algebra.modes import channel_values, get_mode, raw_to_xyz, to_xyz_matrix
 from ..render.band_path.traversal import render_traversal
-from ..render.batches import batch_seeds, merge_batches
 from ..render.result import RenderResult
 from ..scenes.library import build
 from ..scenes.model import Scene

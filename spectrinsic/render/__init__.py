@@ -17,6 +17,7 @@ Nothing is imported from Mitsuba when this package is imported; variants are cho
 - :func:`scene_to_mitsuba`: the one translation of a scene into a Mitsuba dict.
 """
 
+from .algebra.batch_means import batch_seeds, image_noise, merge_batches, relative_standard_error
 from .algebra.light_transport import LightTransport
 from .algebra.modes import (
     RENDER_MODES,
@@ -35,18 +36,13 @@ from .base.variants import (
     variant_report,
     variant_scope,
 )
-from .batches import (
-    batch_seeds,
-    image_noise,
-    merge_batches,
-    relative_standard_error,
-    render_batches,
-)
-from .passes import render_diagonal, render_spectral
+from .batches import render_batches
+from .passes import render_diagonal
 from .passes.aovs import render_aovs
 from .result import RenderResult
 from .scene_render import count_passes, render_scene
 from .settings import DEFAULT_MODES, RenderSettings
+from .spectral import render_spectral
 from .transport_render import render_transport, render_transport_batches
 
 __all__ = [

@@ -14,12 +14,14 @@ from ..scenes.model import Scene
 from ..spectra import get_sensors
 from .algebra.modes import RenderMode, channel_values, get_mode, n_passes, raw_to_xyz, to_xyz_matrix
 from .band_path.traversal import PARTS, SingleTraversal, render_jobs, resolve_integrator
+from .base.one_pass import PassOutput, PassProgress
 from .base.translate import SurfaceGeometry, prepare_geometry, surfaces
 from .base.variants import choose_variant, import_mitsuba, variant_scope
-from .passes import PassOutput, PassProgress, render_diagonal, render_spectral
+from .passes import render_diagonal
 from .passes.aovs import render_aovs
 from .result import RenderResult, render_meta
 from .settings import DEFAULT_MODES, RenderSettings
+from .spectral import render_spectral
 
 __all__ = [
     "DEFAULT_MODES",

@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import DatasetError
-from ...render.batches import relative_standard_error
+from ...render.algebra.batch_means import relative_standard_error
 
 __all__ = [
     "COVERAGE_MIN",

@@ -15,8 +15,8 @@ from ...errors import RenderError
 from ...scenes.model import Scene
 from ...spectra import COLORIMETRIC_WAVELENGTHS, diagonal_values, get_sensors
 from ...threads import thread_map
-from ..batches import batch_mean
 from ..result import RenderResult
+from .batch_means import batch_mean
 from .modes import get_mode, light_spectra, lights_to_xyz_matrix, raw_to_xyz
 from .shares import compose, light_shares, sum_lights
 

@@ -28,10 +28,10 @@ from ...spectra import get_sensors
 from ..algebra.modes import ChannelValues, RenderMode, channel_values, get_mode
 from ..algebra.shares import TransportOutput
 from ..base import translate as tr
+from ..base.one_pass import DIRECT_DEPTH, PassOutput, PassProgress, timed_render
 from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
 from ..base.textures import shape_slots, texture_tables
 from ..base.variants import choose_variant, variant_scope
-from ..passes import DIRECT_DEPTH, PassOutput, PassProgress, timed_render
 from ..passes.aovs import assemble_aovs
 from ..settings import DEFAULT_INTEGRATOR, INTEGRATORS
 from .integrator import BandTables, band_path, first_hit_channels

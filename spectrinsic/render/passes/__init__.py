@@ -1,4 +1,5 @@
-"""Mitsuba passes: K-channel diagonal renders, the spectral reference, and AOVs.
+"""Mitsuba passes: K-channel diagonal renders as ⌈K/3⌉ RGB passes (the first-hit maps are in
+:mod:`.aovs`, the spectral reference in :mod:`spectrinsic.render.spectral`).
 
 Every pass of one image uses the same sampler seed, sample count and path depth with Russian
 roulette off, so passes trace identical paths (common random numbers): the differences between
@@ -10,120 +11,34 @@ per variant and light subset; between passes only BSDF and emitter values change
 from __future__ import annotations
 
 import logging
-import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ...errors import RenderError, SceneError
-from ...interrupts import raise_if_requested
+from ...errors import SceneError
 from ...scenes.model import Scene
-from ...spectra import COLORIMETRIC_WAVELENGTHS, SensorSet, get_spectrum
-from ..algebra.modes import ChannelValues, light_spectra, pad_to_passes
+from ..algebra.modes import ChannelValues, pad_to_passes
 from ..base import translate as tr
-from ..base.plugins import hdr_film, path_integrator, regular_spectrum, rgb_spectrum, spectral_film
+from ..base.one_pass import (
+    DIRECT_DEPTH,
+    PassOutput,
+    PassProgress,
+    active_light_set,
+    check_render_args,
+    placeholder_light,
+    scene_parameters,
+    set_rgb,
+    timed_render,
+)
+from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
 from ..base.textures import refuse_textures
 from ..base.variants import choose_variant, variant_scope
 
-__all__ = [
-    "DIRECT_DEPTH",
-    "PassProgress",
-    "PassOutput",
-    "render_diagonal",
-    "render_spectral",
-    "AOV_NAMES",
-]
+__all__ = ["render_diagonal"]
 
 logger = logging.getLogger(__name__)
-
-#: Path depth of a direct-light-only render (camera -> surface -> light).
-DIRECT_DEPTH = 2
-#: Called with 1 after each Mitsuba pass (e.g. ``tqdm.update``).
-PassProgress = Callable[[int], Any]
-#: Keys of the dict :func:`~spectrinsic.render.passes.aovs.render_aovs` returns.
-AOV_NAMES = ("coverage", "material_id", "object_id", "depth", "normals", "mask")
-
-
-@dataclass(frozen=True, eq=False)
-class PassOutput:
-    """Raw images of one set of channel values.
-
-    Attributes
-    ----------
-    image
-        ``(H, W, K)`` float32 full render (all bounces up to ``max_depth``).
-    direct
-        ``(H, W, K)`` float32 direct-light-only render, or ``None`` when not asked for.
-    seconds
-        Wall-clock seconds of each Mitsuba pass, in order (full passes, then direct ones).
-    variant
-        The Mitsuba variant used.
-    """
-
-    image: np.ndarray
-    direct: np.ndarray | None
-    seconds: tuple[float, ...]
-    variant: str
-
-
-def _check_render_args(scene: Scene, spp: int, max_depth: int) -> None:
-    if int(spp) < 1:
-        raise SceneError(f"spp {spp}: expected at least 1 sample per pixel")
-    if int(max_depth) < 1:
-        raise SceneError(f"max_depth {max_depth}: expected >= 1")
-    if not scene.lights:
-        raise SceneError(f"scene {scene.name!r} has no lights: nothing to render")
-
-
-def _active(scene: Scene, active_lights: Sequence[int] | None) -> set[int]:
-    active = (
-        set(range(len(scene.lights))) if active_lights is None else {int(i) for i in active_lights}
-    )
-    bad = sorted(i for i in active if not 0 <= i < len(scene.lights))
-    if bad or not active:
-        raise SceneError(
-            f"scene {scene.name!r}: active lights {sorted(active)} must be a non-empty subset of "
-            f"0..{len(scene.lights) - 1}"
-        )
-    return active
-
-
-def timed_render(
-    mi: Any, loaded: Any, *, spp: int, seed: int, integrator: Any = None
-) -> tuple[np.ndarray, float]:
-    """One ``mi.render`` as float32 and its seconds; a Ctrl-C stops the build within it."""
-    raise_if_requested()
-    start = time.perf_counter()
-    try:
-        image = np.array(
-            mi.render(loaded, spp=int(spp), seed=int(seed), integrator=integrator), dtype=np.float32
-        )
-    except RuntimeError as exc:
-        raise_if_requested()  # Dr.Jit re-raises a Ctrl-C inside the render as RuntimeError
-        raise RenderError(f"Mitsuba render failed: {exc}") from exc
-    raise_if_requested()  # Mitsuba's own SIGINT handler may have cut the pass short
-    return image, time.perf_counter() - start
-
-
-def placeholder_light(index: int) -> dict[str, Any]:
-    """Distinct emission per light at load time (identical dicts could be merged into one
-    shared object); every pass sets the real values before rendering."""
-    return rgb_spectrum([1.0 + index, 1.0, 1.0])
-
-
-def scene_parameters(mi: Any, loaded: Any, keys: Sequence[str]) -> Any:
-    """``mi.traverse`` of a loaded scene, checked to expose every parameter a pass updates."""
-    params = mi.traverse(loaded)
-    missing = [k for k in keys if k not in params]
-    if missing:
-        raise RenderError(f"Mitsuba scene lacks the parameters {missing[:3]} the passes update")
-    return params
-
-
-def set_rgb(mi: Any, params: Any, key: str, values: np.ndarray) -> None:
-    params[key] = mi.Color3f(*(float(v) for v in values))
 
 
 def render_diagonal(
@@ -162,9 +77,9 @@ def render_diagonal(
     -------
     One :class:`PassOutput` per value set, ``(H, W, K)`` float32 raw channels.
     """
-    _check_render_args(scene, spp, max_depth)
+    check_render_args(scene, spp, max_depth)
     refuse_textures(scene, "the diagonal passes")
-    active = _active(scene, active_lights)
+    active = active_light_set(scene, active_lights)
     flags = (
         [bool(direct)] * len(value_sets) if isinstance(direct, bool) else [bool(d) for d in direct]
     )
@@ -259,72 +174,3 @@ class _DiagonalPasses:
             seconds=tuple(seconds),
             variant=variant,
         )
-
-
-def render_spectral(
-    scene: Scene,
-    sensors: SensorSet,
-    *,
-    spp: int,
-    seed: int,
-    max_depth: int = 8,
-    direct: bool = False,
-    active_lights: Sequence[int] | None = None,
-    variant: str | None = None,
-    data_dir: str | None = None,
-    progress: PassProgress | None = None,
-    geometry: Sequence[tr.SurfaceGeometry] | None = None,
-) -> PassOutput:
-    """Spectral reference: Mitsuba's spectral variant with a ``specfilm`` of *sensors*' curves.
-
-    Materials and lights are their registry spectra on the 1 nm CIE grid (360–830 nm), lights
-    scaled by their power; channel k is ``∫ L(λ) S_k(λ) dλ`` (nm), the exact counterpart of a
-    diagonal render's channel k. Works with any sensor set (CIE 1931, a camera's curves);
-    negative lobes (``"srgb"``) are not supported by ``specfilm`` and are clipped.
-    """
-    _check_render_args(scene, spp, max_depth)
-    active = _active(scene, active_lights)
-    wl = COLORIMETRIC_WAVELENGTHS
-    if np.any(sensors.curves < 0):
-        raise SceneError(
-            f"sensor set {sensors.name!r} has negative lobes; render 'cie1931' and convert instead"
-        )
-    chosen = choose_variant("spectral", variant)
-    emission = light_spectra(scene, wl, data_dir=data_dir)
-    with variant_scope(chosen) as mi:
-        mitsuba_dict = tr.scene_to_mitsuba(
-            scene,
-            materials=[
-                regular_spectrum(get_spectrum(m.spectrum, data_dir=data_dir).on(wl), wl)
-                for m in scene.materials
-            ],
-            lights=[
-                regular_spectrum(emission[j], wl) if j in active else None
-                for j in range(len(scene.lights))
-            ],
-            film=spectral_film(scene.camera.width, scene.camera.height, sensors.on(wl), wl),
-            integrator=path_integrator(max_depth),
-            sample_count=spp,
-            geometry=geometry,
-        )
-        loaded = mi.load_dict(mitsuba_dict)
-        image, dt = timed_render(mi, loaded, spp=spp, seed=seed)
-        seconds = [dt]
-        if progress is not None:
-            progress(1)
-        direct_image = None
-        if direct:
-            integrator = mi.load_dict(path_integrator(DIRECT_DEPTH))
-            direct_image, dt = timed_render(mi, loaded, spp=spp, seed=seed, integrator=integrator)
-            seconds.append(dt)
-            if progress is not None:
-                progress(1)
-    k = sensors.n
-    if image.shape[-1] < k:
-        raise RenderError(f"specfilm returned {image.shape[-1]} channels for {k} sensors")
-    return PassOutput(
-        image=image[..., :k],
-        direct=None if direct_image is None else direct_image[..., :k],
-        seconds=tuple(seconds),
-        variant=chosen,
-    )

@@ -10,10 +10,16 @@ import numpy as np
 from ...errors import RenderError, SceneError
 from ...scenes.model import Scene
 from ..base import translate as tr
+from ..base.one_pass import (
+    PassProgress,
+    placeholder_light,
+    scene_parameters,
+    set_rgb,
+    timed_render,
+)
 from ..base.plugins import aov_integrator, hdr_film, rgb_spectrum
 from ..base.textures import refuse_textures
 from ..base.variants import choose_variant, variant_scope
-from . import PassProgress, placeholder_light, scene_parameters, set_rgb, timed_render
 
 __all__ = ["render_aovs", "assemble_aovs"]
 
