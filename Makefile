@@ -5,7 +5,7 @@ BIN      := $(VENV)/bin
 PY       := $(BIN)/python -P
 DEPS     := $(VENV)/.deps-installed
 PKG      := $(VENV)/.pkg-installed
-PACKAGES := core spectra scenes render gt_export decompose pipeline studies bench cli
+PACKAGES := spectrinsic
 # Adding or removing a module changes its folder's mtime: strict editable installs only link
 # the files present at install time, so the package is relinked then.
 PKG_DIRS := $(shell find $(addprefix $(CURDIR)/,$(PACKAGES)) -type d -not -name __pycache__ 2>/dev/null)

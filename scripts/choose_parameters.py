@@ -4,7 +4,7 @@ Usage: python -P scripts/choose_parameters.py DATASET OUT.json [retinex|names-sh
        python -P scripts/choose_parameters.py --mit scripts/mit_ablation.json
        (names-shades' choice on the MIT development half, from the ablation's run of record)
 
-The protocol is :mod:`spectrinsic.decompose.protocol`; the grids are below. The chosen values
+The protocol is :mod:`spectrinsic.decompose.methods.protocol`; the grids are below. The chosen values
 are copied by hand into the decomposers' defaults (PROTOCOL in retinex.py and names_shades.py);
 the run of record, per grid point and sample, is scripts/choose_parameters.json.
 
@@ -28,13 +28,13 @@ from pathlib import Path
 
 import numpy as np
 
-from spectrinsic.decompose.constancy import with_constancy
-from spectrinsic.decompose.names_shades import NamesAndShades
-from spectrinsic.decompose.protocol import hold_one_out, scene_group, score_grid
-from spectrinsic.decompose.retinex import ColourRetinex
-from spectrinsic.decompose.sample_fields import evaluation_mask, input_image
-from spectrinsic.gt_export.loader import load_sample
+from spectrinsic.decompose.evaluation.sample_fields import evaluation_mask, input_image
+from spectrinsic.decompose.methods.constancy import with_constancy
+from spectrinsic.decompose.methods.names_shades import NamesAndShades
+from spectrinsic.decompose.methods.protocol import hold_one_out, scene_group, score_grid
+from spectrinsic.decompose.methods.retinex import ColourRetinex
 from spectrinsic.gt_export.sample import sample_dirs
+from spectrinsic.gt_export.sample.loader import load_sample
 
 LAYERS = ["image", "image_denoised", "reflectance", "shading", "shading_grey", "mask",
           "object_id", "material_id"]

@@ -8,8 +8,8 @@ Usage: python -P scripts/mit_ablation.py MIT_DIR OUT.json [--points=I,J] [OBJECT
 For every object of MIT_DIR (the development half, ``$SPECTRINSIC_DATA/mit_intrinsic_dev``)
 the MRF is run once per point of MRF_POINTS (steps 1-3, :meth:`NamesAndShades.labelling`) and
 steps 4-5 once per point of POST_GRID on that labelling. Every point is scored with the thesis'
-protocol (:mod:`spectrinsic.decompose.mit`). The default is chosen by hold-one-object-out
-(:func:`spectrinsic.decompose.protocol.hold_one_out`, score = MIT LMSE) over the whole grid,
+protocol (:mod:`spectrinsic.decompose.evaluation.mit`). The default is chosen by hold-one-object-out
+(:func:`spectrinsic.decompose.methods.protocol.hold_one_out`, score = MIT LMSE) over the whole grid,
 among the points that lose to reflectance = image on at most MAX_LOSSES of the objects they
 are chosen on (issue 23's "beats the baseline on at least 8 of the 10"): one setting for all
 objects, never one per object. OUT.json keeps every score; DOC.md gets the
@@ -27,11 +27,16 @@ from pathlib import Path
 
 import numpy as np
 
-from spectrinsic.decompose.constancy import with_constancy
-from spectrinsic.decompose.mit import MEASURES, load_mit_object, mit_folder_objects, mit_measures
-from spectrinsic.decompose.names_shades import NamesAndShades
-from spectrinsic.decompose.protocol import grid_points, hold_one_out
-from spectrinsic.decompose.registry import get_decomposer
+from spectrinsic.decompose.evaluation.mit import (
+    MEASURES,
+    load_mit_object,
+    mit_folder_objects,
+    mit_measures,
+)
+from spectrinsic.decompose.methods.constancy import with_constancy
+from spectrinsic.decompose.methods.names_shades import NamesAndShades
+from spectrinsic.decompose.methods.protocol import grid_points, hold_one_out
+from spectrinsic.decompose.methods.registry import get_decomposer
 
 #: Parameters of steps 1-3 (each point runs the MRF). gamma's absolute scale is not in the
 #: thesis (only gamma/alpha = 100, gamma/beta = 2 and mu = 1/3 are); gamma/alpha = 10 was the

@@ -22,9 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
-from spectrinsic.decompose.colour_naming import label_centroids
-from spectrinsic.decompose.mit import load_mit_object, mit_measures
-from spectrinsic.decompose.names_shades import NamesAndShades, grid_edges
+from spectrinsic.decompose.evaluation.mit import load_mit_object, mit_measures
+from spectrinsic.decompose.methods.colour_naming import label_centroids
+from spectrinsic.decompose.methods.names_shades import NamesAndShades, grid_edges
 from spectrinsic.spectra.colorimetry import encode_srgb
 
 DPI = 80

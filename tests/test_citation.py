@@ -7,7 +7,7 @@ from pathlib import Path
 
 import yaml
 
-from spectrinsic.gt_export.card import read_template
+from spectrinsic.gt_export.dataset.card import read_template
 
 ROOT = Path(__file__).resolve().parents[1]
 

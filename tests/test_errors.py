@@ -28,12 +28,12 @@ def _calls():
     """(id, call, error): an unknown name given to each package's validated choices."""
     import numpy as np
 
-    from spectrinsic.decompose.constancy import illuminant_colour
+    from spectrinsic.decompose.methods.constancy import illuminant_colour
     from spectrinsic.decompose.metrics import get_metric
     from spectrinsic.pipeline.executors import make_executor
     from spectrinsic.pipeline.presets import get_preset
-    from spectrinsic.render.modes import get_mode
-    from spectrinsic.render.variants import choose_variant
+    from spectrinsic.render.algebra.modes import get_mode
+    from spectrinsic.render.base.variants import choose_variant
     from spectrinsic.scenes.generators import generated_scene_name
     from spectrinsic.spectra import illuminant_set
 

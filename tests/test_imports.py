@@ -9,29 +9,24 @@ SciPy-backed parts, trimesh). Never to break an import cycle: a cycle is fixed b
 shared vocabulary down into a module both sides import. ``if TYPE_CHECKING:`` blocks are not
 executed and do not count.
 
-The graph has one node per module (the folder -> package map of ``pyproject.toml``) and one
-edge per import statement, *function-level imports included*: a cycle hidden inside a function
+The graph has one node per module of ``spectrinsic/`` and one edge per import statement, *function-level imports included*: a cycle hidden inside a function
 is still a cycle (it only moves the failure from import time to the first call).
 """
 
 from __future__ import annotations
 
 import ast
-import tomllib
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-#: Folder -> package, as packaged: ``pyproject.toml``'s ``package-dir`` is the one list
-#: (tests/test_packaging.py guards it against the folders on disk).
-FOLDERS = {
-    folder: package
-    for package, folder in tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"][
-        "setuptools"
-    ]["package-dir"].items()
-}
+PACKAGE_DIR = ROOT / "spectrinsic"
+#: The package's parts: its subpackages, and ``core`` for the modules at its root.
+FOLDERS = sorted(
+    {p.name for p in PACKAGE_DIR.iterdir() if (p / "__init__.py").is_file()} | {"core"}
+)
 #: Top-level names that may be imported inside a function (see the module docstring).
 HEAVY = frozenset(
     {
@@ -61,12 +56,11 @@ HEAVY = frozenset(
 
 def module_files() -> Iterator[tuple[str, Path]]:
     """``(module name, path)`` of every module of the package."""
-    for folder, package in FOLDERS.items():
-        for path in sorted((ROOT / folder).rglob("*.py")):
-            parts = list(path.relative_to(ROOT / folder).with_suffix("").parts)
-            if parts[-1] == "__init__":
-                parts = parts[:-1]
-            yield ".".join([package, *parts]), path
+    for path in sorted(PACKAGE_DIR.rglob("*.py")):
+        parts = list(path.relative_to(ROOT).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        yield ".".join(parts), path
 
 
 def _type_checking_nodes(tree: ast.AST) -> set[int]:

@@ -3,26 +3,21 @@
 from __future__ import annotations
 
 import ast
+import warnings
 from pathlib import Path
 
 #: The longest function body allowed, in source lines, not counting its docstring.
 MAX_BODY_LINES = 60
-#: The most lines a module of the package may hold (STYLE.md: no god modules); a module that
-#: grows past it is split into modules named for what they hold.
+#: Past this many lines a module of the package draws a warning, not a failure (issue 35: the
+#: rule measures concepts, not lines): it is split by concept when it holds more than one, or it
+#: says in a ``# long module: <reason>`` line why it is one concept; that line silences the warning.
 MAX_MODULE_LINES = 450
-#: The folders that make up the installed package (see pyproject's ``package-dir``).
-PACKAGE_FOLDERS = (
-    "core",
-    "spectra",
-    "scenes",
-    "render",
-    "gt_export",
-    "decompose",
-    "pipeline",
-    "studies",
-    "bench",
-    "cli",
-)
+#: Past this a module fails whatever its reason (STYLE.md: no god modules).
+HARD_MODULE_LINES = 900
+#: The comment that states why a module past :data:`MAX_MODULE_LINES` is one concept.
+LONG_MODULE_REASON = "# long module:"
+#: The folder that is the installed package.
+PACKAGE_FOLDERS = ("spectrinsic",)
 
 
 def _body_lines(node: ast.FunctionDef | ast.AsyncFunctionDef) -> int:
@@ -92,30 +87,60 @@ def test_no_function_body_is_over_sixty_lines(repo_root: Path):
 
 def long_modules(root: Path, limit: int = MAX_MODULE_LINES) -> list[str]:
     """``"<path> (<n> lines)"`` for every module under the package folders of *root* that holds
-    more than *limit* lines."""
+    more than *limit* lines and does not say why (a ``# long module: <reason>`` line) when
+    *limit* is :data:`MAX_MODULE_LINES`."""
     found = []
     for folder in PACKAGE_FOLDERS:
         for path in sorted((root / folder).rglob("*.py")):
-            n = len(path.read_text(encoding="utf-8").splitlines())
-            if n > limit:
+            text = path.read_text(encoding="utf-8")
+            n = len(text.splitlines())
+            reason = limit == MAX_MODULE_LINES and any(
+                line.strip().startswith(LONG_MODULE_REASON) and line.split(":", 1)[1].strip()
+                for line in text.splitlines()
+            )
+            if n > limit and not reason:
                 found.append(f"{path.relative_to(root)} ({n} lines)")
     return found
 
 
 def test_the_module_checker_counts_lines_in_every_package_folder(tmp_path: Path):
-    for folder in PACKAGE_FOLDERS:
-        (tmp_path / folder / "sub").mkdir(parents=True)
-        (tmp_path / folder / "ok.py").write_text("x = 1\n" * MAX_MODULE_LINES)
-    (tmp_path / "scenes" / "sub" / "big.py").write_text("x = 1\n" * (MAX_MODULE_LINES + 1))
+    (tmp_path / "spectrinsic" / "scenes" / "sub").mkdir(parents=True)
+    (tmp_path / "spectrinsic" / "ok.py").write_text("x = 1\n" * MAX_MODULE_LINES)
+    big = tmp_path / "spectrinsic" / "scenes" / "sub" / "big.py"
+    big.write_text("x = 1\n" * (MAX_MODULE_LINES + 1))
+    said = tmp_path / "spectrinsic" / "said.py"
+    said.write_text("# long module: one table\n" + "x = 1\n" * MAX_MODULE_LINES)
+    empty = tmp_path / "spectrinsic" / "empty_reason.py"
+    empty.write_text("# long module:\n" + "x = 1\n" * MAX_MODULE_LINES)
     (tmp_path / "tests").mkdir()
-    (tmp_path / "tests" / "big_test.py").write_text("x = 1\n" * 1000)  # not a package folder
-    assert long_modules(tmp_path) == [f"scenes/sub/big.py ({MAX_MODULE_LINES + 1} lines)"]
+    (tmp_path / "tests" / "big_test.py").write_text("x = 1\n" * 1000)  # not the package
+    assert long_modules(tmp_path) == [
+        f"spectrinsic/empty_reason.py ({MAX_MODULE_LINES + 1} lines)",
+        f"spectrinsic/scenes/sub/big.py ({MAX_MODULE_LINES + 1} lines)",
+    ]
+    assert long_modules(tmp_path, HARD_MODULE_LINES) == []
+    said.write_text("# long module: one table\n" + "x = 1\n" * HARD_MODULE_LINES)
+    assert long_modules(tmp_path, HARD_MODULE_LINES) == [
+        f"spectrinsic/said.py ({HARD_MODULE_LINES + 1} lines)"
+    ]
 
 
-def test_no_module_is_over_450_lines(repo_root: Path):
+def test_long_modules_say_why_or_draw_a_warning(repo_root: Path):
+    """Past 450 lines: a warning (shown in pytest's summary), not a failure."""
     offenders = long_modules(repo_root)
+    if offenders:
+        warnings.warn(
+            f"modules past {MAX_MODULE_LINES} lines that do not say why: split each by concept "
+            f"if it holds more than one, else add a '{LONG_MODULE_REASON} <reason>' line:\n"
+            + "\n".join(offenders),
+            stacklevel=1,
+        )
+
+
+def test_no_module_is_over_900_lines(repo_root: Path):
+    offenders = long_modules(repo_root, HARD_MODULE_LINES)
     assert not offenders, (
-        f"modules with more than {MAX_MODULE_LINES} lines; split them into modules named for "
+        f"modules with more than {HARD_MODULE_LINES} lines; split them into modules named for "
         "what they hold:\n" + "\n".join(offenders)
     )
 

@@ -8,9 +8,9 @@ import pytest
 
 from spectrinsic.bench import crop_reference as cr
 from spectrinsic.errors import SceneError
-from spectrinsic.render.modes import channel_values, get_mode
-from spectrinsic.render.plugins import hdr_film
-from spectrinsic.render.single import render_traversal
+from spectrinsic.render.algebra.modes import channel_values, get_mode
+from spectrinsic.render.band_path.traversal import render_traversal
+from spectrinsic.render.base.plugins import hdr_film
 from spectrinsic.spectra import get_sensors
 
 CROP = (5, 3, 7, 6)  # x, y, width, height: not square, not centred, odd sizes

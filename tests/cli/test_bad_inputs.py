@@ -18,7 +18,7 @@ import pytest
 
 from spectrinsic.cli import main
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export.integrity import MARKER_NAME, write_marker
+from spectrinsic.gt_export.sample.integrity import MARKER_NAME, write_marker
 from spectrinsic.pipeline.presets import get_preset
 from tests.conftest import QUAD_YAML
 
@@ -61,7 +61,7 @@ TRIANGLE_OBJ = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
 def _own_output(tmp: Path, extra: str, killed: bool = False) -> str:
     """An output folder spectrinsic wrote (its marker lists ``a.json``) holding *extra* too;
     *killed*: the marker says a run was writing when it died."""
-    from spectrinsic.gt_export.outfolder import OUTPUT_MARKER
+    from spectrinsic.gt_export.folders.outfolder import OUTPUT_MARKER
 
     out = tmp / "results"
     out.mkdir()
@@ -903,7 +903,7 @@ def test_an_exr_whose_channels_attribute_is_not_json_is_one_line(tmp_path, capsy
     import numpy as np
     import OpenEXR
 
-    from spectrinsic.gt_export.exr import CHANNELS_ATTRIBUTE, read_exr
+    from spectrinsic.gt_export.formats.exr import CHANNELS_ATTRIBUTE, read_exr
 
     path = tmp_path / "reflectance.exr"
     header = {

@@ -129,8 +129,8 @@ def test_a_relit_sample_checks_and_evaluates(tmp_path, capsys):
     _, scored = _checks_and_evaluates(relit, tmp_path / "ev", capsys, preview=False)
     assert scored["config_hash"] == _meta(relit)["config_hash"] and scored["n_scored"] == 1
     # its condition is its new lights', not the two-colour-a its scene metadata still names
-    from spectrinsic.gt_export.gallery import _sample_entry
-    from spectrinsic.gt_export.sample_meta import read_meta
+    from spectrinsic.gt_export.dataset.gallery import _sample_entry
+    from spectrinsic.gt_export.sample.meta import read_meta
     from spectrinsic.scenes.lighting import describe_lighting
 
     entry = _sample_entry(relit, read_meta(relit), None)
@@ -156,7 +156,7 @@ def test_a_refused_evaluation_leaves_no_output(generated, tmp_path, capsys):
 def test_the_contact_sheet_shows_the_denoised_image_at_tile_size(generated):
     from PIL import Image
 
-    from spectrinsic.gt_export.contact_sheet import TILE, _fit
+    from spectrinsic.gt_export.dataset.contact_sheet import TILE, _fit
     from spectrinsic.gt_export.sample import sample_dirs
 
     first = sample_dirs(generated)[0]

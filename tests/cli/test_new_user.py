@@ -56,8 +56,8 @@ def _first_table(md: str) -> tuple[list[str], dict[str, list[str]]]:
 def test_preview_build_checks_loads_batches_and_scores(preview, tmp_path, capsys):
     from spectrinsic.decompose import write_predictions
     from spectrinsic.gt_export import load_dataset
-    from spectrinsic.gt_export.collate import collate_arrays
-    from spectrinsic.gt_export.loader import prepare_item
+    from spectrinsic.gt_export.dataset.collate import collate_arrays
+    from spectrinsic.gt_export.sample.loader import prepare_item
 
     capsys.readouterr()
     assert (
@@ -141,7 +141,7 @@ def test_preview_build_checks_loads_batches_and_scores(preview, tmp_path, capsys
 @pytest.mark.torch
 def test_the_preview_build_feeds_a_dataloader_in_batches_of_8(preview, torch):
     from spectrinsic.gt_export import torch_dataset
-    from spectrinsic.gt_export.collate import collate
+    from spectrinsic.gt_export.dataset.collate import collate
 
     loader = torch.utils.data.DataLoader(torch_dataset(preview), batch_size=8, collate_fn=collate)
     (batch,) = list(loader)

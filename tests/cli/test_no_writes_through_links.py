@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 from spectrinsic.cli import main
-from spectrinsic.gt_export.outfolder import output_folder
+from spectrinsic.gt_export.folders.outfolder import output_folder
 from tests.conftest import QUAD_YAML
 
 TINY = ["--preset", "preview", "--resolution", "16x16", "--spp", "2"]

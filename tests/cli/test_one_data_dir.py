@@ -17,7 +17,7 @@ import pytest
 from spectrinsic.cli import main
 from spectrinsic.gt_export import export_sample
 from spectrinsic.render import RenderSettings
-from spectrinsic.render.transport import render_transport_batches
+from spectrinsic.render.transport_render import render_transport_batches
 
 TINY = ["--preset", "preview", "--resolution", "16x16", "--spp", "2"]
 SCENE = """\

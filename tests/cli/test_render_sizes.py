@@ -12,7 +12,7 @@ import pytest
 
 from spectrinsic.cli import build_parser, main
 from spectrinsic.gt_export import load_sample
-from spectrinsic.gt_export.exr import read_exr
+from spectrinsic.gt_export.formats.exr import read_exr
 from spectrinsic.pipeline.presets import get_preset
 from spectrinsic.scenes import build, save_scene
 from spectrinsic.scenes.sample_id import SampleId

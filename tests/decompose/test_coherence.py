@@ -7,8 +7,8 @@ import pytest
 import scipy.sparse as sp
 from scipy.optimize import lsq_linear
 
-import spectrinsic.decompose.coherence as coherence
-from spectrinsic.decompose.coherence import bounded_minimum, global_coherence
+import spectrinsic.decompose.methods.coherence as coherence
+from spectrinsic.decompose.methods.coherence import bounded_minimum, global_coherence
 
 
 @pytest.fixture(autouse=True)

@@ -8,7 +8,7 @@ from importlib import resources
 import numpy as np
 import pytest
 
-from spectrinsic.decompose import colour_naming as cn
+from spectrinsic.decompose.methods import colour_naming as cn
 
 #: Focal examples of the 11 basic terms, as sRGB (8-bit) values of W3C CSS Color Module Level 4
 #: named colours (https://www.w3.org/TR/css-color-4/#named-colors), one per term: the keyword

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from spectrinsic.decompose import DECOMPOSERS, decompose, get_decomposer
-from spectrinsic.decompose.metrics_scale import lmse
-from spectrinsic.decompose.names_shades import NamesAndShades, global_coherence
-from spectrinsic.decompose.retinex import log_gradients, poisson_solve
+from spectrinsic.decompose.methods.names_shades import NamesAndShades, global_coherence
+from spectrinsic.decompose.methods.retinex import log_gradients, poisson_solve
+from spectrinsic.decompose.metrics.scale import lmse
 from spectrinsic.decompose.synthetic import mondrian
 from spectrinsic.errors import DecomposeError, SpectrinsicError
 
@@ -117,7 +117,7 @@ def test_registry_rejects_unknown_parameters_with_the_accepted_ones():
     with pytest.raises(DecomposeError, match=r"no parameter 'mu_'.*'mu'"):
         decompose(np.ones((4, 4, 3)), method="names-shades", mu_=0.5)
     # a factory taking **kwargs is not second-guessed
-    from spectrinsic.decompose.registry import _check_parameters
+    from spectrinsic.decompose.methods.registry import _check_parameters
 
     _check_parameters("any", lambda **kw: kw, {"whatever": 1})
 

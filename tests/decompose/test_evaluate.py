@@ -7,7 +7,7 @@ import csv
 import numpy as np
 import pytest
 
-from spectrinsic.decompose.evaluate import evaluate
+from spectrinsic.decompose.evaluation.evaluate import evaluate
 from spectrinsic.decompose.synthetic import mondrian
 
 METHODS = ["colour-retinex", "image-as-reflectance"]
@@ -95,7 +95,7 @@ def test_tables(result):
 
 
 def test_estimates_and_figures_written(result):
-    from spectrinsic.gt_export.exr import read_exr
+    from spectrinsic.gt_export.formats.exr import read_exr
 
     _, out, _ = result
     folder = out / "estimates" / "colour-retinex" / "srgb" / "obj-a__v0__white"
@@ -115,7 +115,7 @@ def test_cli_without_dataset_says_how_to_build_it(tmp_path, capsys):
 
 
 def test_single_objects_are_scored_on_their_own_mask_not_the_ground():
-    from spectrinsic.decompose.sample_fields import evaluation_mask
+    from spectrinsic.decompose.evaluation.sample_fields import evaluation_mask
 
     sample = _sample("obj-a__v0__white", 0, (1, 1, 1), False)
     objects = np.zeros((48, 48), np.int32)
@@ -130,8 +130,8 @@ def test_single_objects_are_scored_on_their_own_mask_not_the_ground():
 
 
 def test_table_3_2_averages_grey_shading_and_grey_reflectance():
-    from spectrinsic.decompose.evaluate import Score
-    from spectrinsic.decompose.report_tables import table_3_2
+    from spectrinsic.decompose.evaluation.evaluate import Score
+    from spectrinsic.decompose.report.tables import table_3_2
 
     samples = {
         "obj-a__v0__white": ("object", "white"),

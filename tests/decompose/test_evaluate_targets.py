@@ -9,11 +9,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from spectrinsic.decompose.evaluate import evaluate
+from spectrinsic.decompose.evaluation.evaluate import evaluate
+from spectrinsic.decompose.evaluation.predictions import Predictions, write_predictions
+from spectrinsic.decompose.evaluation.sample_fields import input_image
+from spectrinsic.decompose.evaluation.targets import target_image, target_note
 from spectrinsic.decompose.metrics import get_metric
-from spectrinsic.decompose.predictions import Predictions, write_predictions
-from spectrinsic.decompose.sample_fields import input_image
-from spectrinsic.decompose.targets import target_image, target_note
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import export_sample, load_sample, write_manifest
 from spectrinsic.render import RenderSettings, render_batches

@@ -9,10 +9,10 @@ import pytest
 from skimage.metrics import structural_similarity
 
 from spectrinsic.decompose import metrics as M
-from spectrinsic.decompose import metrics_colour as MC
-from spectrinsic.decompose import metrics_scale as MS
 from spectrinsic.decompose._validation import ImageShapeError
-from spectrinsic.decompose.judgements import (
+from spectrinsic.decompose.metrics import colour as MC
+from spectrinsic.decompose.metrics import scale as MS
+from spectrinsic.decompose.metrics.judgements import (
     DARKER_1,
     DARKER_2,
     EQUAL,

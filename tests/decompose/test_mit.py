@@ -14,17 +14,17 @@ import numpy as np
 import pytest
 
 from spectrinsic.cli import main
-from spectrinsic.decompose.baselines import ImageAsReflectance
 from spectrinsic.decompose.decomposition import Decomposition
-from spectrinsic.decompose.mit import (
+from spectrinsic.decompose.evaluation.mit import (
     load_mit_object,
     mit_folder_objects,
     mit_measures,
     score_mit,
 )
-from spectrinsic.decompose.retinex import ColourRetinex
+from spectrinsic.decompose.methods.baselines import ImageAsReflectance
+from spectrinsic.decompose.methods.retinex import ColourRetinex
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export.png import write_png16
+from spectrinsic.gt_export.formats.png import write_png16
 
 
 def _ssq_error(correct, estimate, mask):
@@ -220,7 +220,7 @@ def test_names_shades_beats_the_baseline_on_cup1_and_pear(data_dir):
     beat reflectance = image (cup1 0.0208 against 0.0198); with RAD ridges both are clearly
     below it (docs/names-shades-mit.md: cup1 0.0131, pear 0.0121 in round 2; 0.0145 and 0.0119
     at round 3's defaults)."""
-    from spectrinsic.decompose.names_shades import NamesAndShades
+    from spectrinsic.decompose.methods.names_shades import NamesAndShades
 
     folder = _mit_dev(data_dir)
     for name in ("cup1", "pear"):
@@ -235,7 +235,7 @@ def test_the_diagonal_cut_splits_the_deer_s_paints_into_ridges(data_dir):
     across the grey diagonal joins them); with crest bins across the diagonal cut, the ridges
     each hold colours of a narrower range of true reflectance chromaticity (docs/names-shades-
     mit.md: 1 ridge before, 8 after)."""
-    from spectrinsic.decompose.ridges import colour_shades
+    from spectrinsic.decompose.methods.ridges import colour_shades
 
     obj = load_mit_object(_mit_dev(data_dir) / "deer.npz")
     m = obj.mask

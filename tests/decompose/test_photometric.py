@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from spectrinsic.decompose._validation import ImageShapeError
-from spectrinsic.decompose.photometric import correction_matrix, photometric_correction
+from spectrinsic.decompose.evaluation.photometric import correction_matrix, photometric_correction
 from spectrinsic.errors import SpectrinsicError
 
 EXACT = 1e-10

@@ -7,8 +7,8 @@ import csv
 import numpy as np
 import pytest
 
-from spectrinsic.decompose.evaluate import evaluate
-from spectrinsic.decompose.registry import (
+from spectrinsic.decompose.evaluation.evaluate import evaluate
+from spectrinsic.decompose.methods.registry import (
     DECOMPOSERS,
     ENTRY_POINT_GROUP,
     PluginError,

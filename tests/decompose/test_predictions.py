@@ -7,13 +7,13 @@ import math
 import numpy as np
 import pytest
 
-from spectrinsic.decompose.evaluate import evaluate
-from spectrinsic.decompose.predictions import Predictions, read_layer
-from spectrinsic.decompose.registry import get_decomposer
-from spectrinsic.decompose.sample_fields import input_image
+from spectrinsic.decompose.evaluation.evaluate import evaluate
+from spectrinsic.decompose.evaluation.predictions import Predictions, read_layer
+from spectrinsic.decompose.evaluation.sample_fields import input_image
+from spectrinsic.decompose.methods.registry import get_decomposer
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export.exr import write_exr
-from spectrinsic.gt_export.png import PNG16_MAX, write_png16
+from spectrinsic.gt_export.formats.exr import write_exr
+from spectrinsic.gt_export.formats.png import PNG16_MAX, write_png16
 from tests.decompose.test_evaluate import _sample
 
 BASELINE = "image-as-reflectance"
@@ -172,7 +172,7 @@ def _exr_declaring(path, width: int, height: int) -> None:
     """A 4 x 4 EXR whose header's dataWindow is patched to declare *width* x *height*."""
     import struct
 
-    from spectrinsic.gt_export.exr import write_exr
+    from spectrinsic.gt_export.formats.exr import write_exr
 
     write_exr(path, {"reflectance": np.zeros((4, 4, 3), np.float32)})
     data = bytearray(path.read_bytes())
@@ -185,7 +185,7 @@ def _exr_declaring(path, width: int, height: int) -> None:
 def test_a_prediction_declaring_a_huge_image_is_refused_from_its_header(tmp_path, fmt):
     """Issue 17 item 7: a 0.8 MB PNG declaring 20000^2 took 4.8 GB before its shape was refused.
     The header is read first; the refusal names the declared and the expected size."""
-    from spectrinsic.decompose.predictions import read_layer
+    from spectrinsic.decompose.evaluation.predictions import read_layer
 
     path = tmp_path / f"reflectance.{fmt}"
     (_png_declaring if fmt == "png" else _exr_declaring)(path, 20000, 20000)

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from spectrinsic.decompose.constancy import discount_illuminant, illuminant_colour
-from spectrinsic.decompose.protocol import grid_points, hold_one_out, scene_group
+from spectrinsic.decompose.methods.constancy import discount_illuminant, illuminant_colour
+from spectrinsic.decompose.methods.protocol import grid_points, hold_one_out, scene_group
 from spectrinsic.errors import SpectrinsicError
 
 A, B = (("t", 1),), (("t", 2),)
@@ -85,8 +85,8 @@ def test_colour_constancy_estimates_by_hand():
 def test_post_hoc_constancy_equals_the_decomposer_option(method):
     """score_grid applies colour constancy after the decomposition; it must be what the
     decomposer's own option gives (up to float32 storage)."""
-    from spectrinsic.decompose.constancy import with_constancy
-    from spectrinsic.decompose.registry import get_decomposer
+    from spectrinsic.decompose.methods.constancy import with_constancy
+    from spectrinsic.decompose.methods.registry import get_decomposer
     from spectrinsic.decompose.synthetic import mondrian
 
     scene = mondrian(40, 40, seed=4, light=(1.0, 0.8, 0.5))

@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from spectrinsic.decompose.evaluation.scores import Score
 from spectrinsic.decompose.report import write_report
-from spectrinsic.decompose.report_md import GLOSSARY
-from spectrinsic.decompose.scores import Score
+from spectrinsic.decompose.report.markdown import GLOSSARY
 
 CONDITIONS = ("white", "one-colour", "two-colour-a", "two-colour-b")
 SAMPLES = {f"obj-a__v0__{c}": ("object", c) for c in CONDITIONS} | {

@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from spectrinsic.decompose.names_shades import NamesAndShades, grid_edges
-from spectrinsic.decompose.ridges import colour_shades
+from spectrinsic.decompose.methods.names_shades import NamesAndShades, grid_edges
+from spectrinsic.decompose.methods.ridges import colour_shades
 from spectrinsic.errors import SpectrinsicError
 
 pytestmark = pytest.mark.filterwarnings("ignore::FutureWarning")  # gco's numpy aliases

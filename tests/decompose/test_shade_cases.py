@@ -16,9 +16,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from spectrinsic.decompose.names_shades import NamesAndShades
-from spectrinsic.decompose.ridges import colour_shades
-from spectrinsic.decompose.shade_cases import CASE_A, CASE_C, merge_shading_boundaries
+from spectrinsic.decompose.methods.names_shades import NamesAndShades
+from spectrinsic.decompose.methods.ridges import colour_shades
+from spectrinsic.decompose.methods.shade_cases import CASE_A, CASE_C, merge_shading_boundaries
 
 pytestmark = pytest.mark.filterwarnings("ignore::FutureWarning")  # gco's numpy aliases
 

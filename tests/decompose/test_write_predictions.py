@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from spectrinsic.decompose import Predictions, evaluate, write_predictions
-from spectrinsic.decompose.predictions import read_layer
-from spectrinsic.decompose.sample_fields import input_image
+from spectrinsic.decompose.evaluation.predictions import read_layer
+from spectrinsic.decompose.evaluation.sample_fields import input_image
 from spectrinsic.errors import DatasetError
 from tests.decompose.test_evaluate import _sample
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from spectrinsic.gt_export import check_dataset, export_sample, write_manifest
-from spectrinsic.gt_export.exr import read_exr, read_exr_attributes, write_exr
+from spectrinsic.gt_export.formats.exr import read_exr, read_exr_attributes, write_exr
 
 
 @pytest.fixture
@@ -98,9 +98,9 @@ def test_noise_from_two_batches_is_reported_and_flagged(tmp_path, synth, config)
     (sqrt(Σ(±0.1x)² / (2·1)) / x), for image and shading alike."""
     import dataclasses
 
-    from spectrinsic.gt_export.check import noise_report
-    from spectrinsic.gt_export.manifest import noise_summary
-    from spectrinsic.gt_export.sample_meta import read_meta
+    from spectrinsic.gt_export.dataset.check import noise_report
+    from spectrinsic.gt_export.dataset.manifest import noise_summary
+    from spectrinsic.gt_export.sample.meta import read_meta
 
     scene = synth.make_scene(("planck:2800K",))
     result = synth.make_result(scene)

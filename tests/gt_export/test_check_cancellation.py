@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from spectrinsic.gt_export.check import IDENTITY_RTOL, _identity_problem
-from spectrinsic.gt_export.irradiance import residual
+from spectrinsic.gt_export.dataset.check import IDENTITY_RTOL, _identity_problem
+from spectrinsic.gt_export.layers.irradiance import residual
 
 F32 = np.float32
 

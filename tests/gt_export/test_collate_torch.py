@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from spectrinsic.gt_export import load_sample, torch_dataset
-from spectrinsic.gt_export.collate import collate
+from spectrinsic.gt_export.dataset.collate import collate
 
 pytestmark = pytest.mark.torch
 
@@ -37,7 +37,7 @@ def test_torch_dataset_batches_of_8_with_a_light_mask(built, torch):
 
 def test_shard_dataset_batches_of_8(built, torch, tmp_path_factory):
     pytest.importorskip("webdataset", reason="the shards extra is not installed")
-    from spectrinsic.gt_export.shards import shard_dataset, write_shards
+    from spectrinsic.gt_export.dataset.shards import shard_dataset, write_shards
 
     out = tmp_path_factory.mktemp("shards")
     write_shards(built, out)

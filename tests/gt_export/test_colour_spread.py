@@ -6,7 +6,12 @@ import colour
 import numpy as np
 import pytest
 
-from spectrinsic.gt_export.colour_spread import hull_area, light_xy, material_chroma, spread_summary
+from spectrinsic.gt_export.dataset.colour_spread import (
+    hull_area,
+    light_xy,
+    material_chroma,
+    spread_summary,
+)
 
 
 def test_hull_area_of_known_polygons():
@@ -74,7 +79,7 @@ def test_spread_summary_of_a_two_sample_set():
 def test_a_sample_record_counts_face_and_per_pixel_textures_as_textured():
     from types import SimpleNamespace
 
-    from spectrinsic.gt_export.diversity import spread_record
+    from spectrinsic.gt_export.dataset.diversity import spread_record
 
     extra = {"patterns": ["texture", "pixel-texture", "stripes"], "n_objects": 4}
     meta = SimpleNamespace(lights=[], materials={}, scene_metadata=extra)

@@ -23,9 +23,9 @@ from collections.abc import Sequence
 import numpy as np
 import pytest
 
-from spectrinsic.gt_export.denoise import Guides, denoise_blocks
-from spectrinsic.gt_export.irradiance import WhiteRadiance
 from spectrinsic.gt_export.layers import compute_ground_truth
+from spectrinsic.gt_export.layers.denoise import Guides, denoise_blocks
+from spectrinsic.gt_export.layers.irradiance import WhiteRadiance
 from spectrinsic.render import RenderSettings, render_batches
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as WL
@@ -62,7 +62,7 @@ def _scene() -> Scene:
 
 def _light_corners(light: np.ndarray = LIGHT, target: Sequence[float] = (0, 0, 0)) -> list:
     """Corners of the 1 × 1 light at *light* facing *target*, placed as the renderer places it
-    (look-at frame with world z as up; render/translate.py)."""
+    (look-at frame with world z as up; spectrinsic/render/base/translate.py)."""
     aim = np.asarray(target, float) - light
     aim /= np.linalg.norm(aim)
     left = np.cross([0.0, 0.0, 1.0], aim)
@@ -188,7 +188,7 @@ def test_the_previous_denoiser_blurred_the_outline(card):
 def test_denoised_bands_of_a_third_sum_to_its_denoised_broad_band(card):
     """W = share · broad: the shares of a third sum to 1, so the stored bands of a third sum to
     the broad band OIDN denoised; W ≥ 0 everywhere."""
-    from spectrinsic.gt_export import denoise as dn
+    from spectrinsic.gt_export.layers import denoise as dn
 
     scene, result, *_ = card
     seen = {}

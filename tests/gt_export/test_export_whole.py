@@ -15,11 +15,11 @@ import pytest
 
 from spectrinsic.cli import main
 from spectrinsic.errors import DatasetError, FolderLockedError
-from spectrinsic.gt_export.outfolder import LOCK_NAME
+from spectrinsic.gt_export.folders.outfolder import LOCK_NAME
 
 pytest.importorskip("webdataset", reason="the shards extra (webdataset) is in the dev extra")
 
-from spectrinsic.gt_export.shards import write_shards  # noqa: E402
+from spectrinsic.gt_export.dataset.shards import write_shards  # noqa: E402
 
 HOLD = """
 import fcntl, os, sys, time

@@ -8,7 +8,12 @@ import numpy as np
 import pytest
 
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export.exr import read_exr, read_exr_attributes, read_exr_stacks, write_exr
+from spectrinsic.gt_export.formats.exr import (
+    read_exr,
+    read_exr_attributes,
+    read_exr_stacks,
+    write_exr,
+)
 
 
 def _random_layers(rng: np.random.Generator) -> dict[str, np.ndarray]:

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from spectrinsic.gt_export import build_gallery, export_sample, read_exr
-from spectrinsic.gt_export.contact_sheet import COLUMNS, TILE
-from spectrinsic.gt_export.gallery import INDEX_VARIABLE, gallery_index
+from spectrinsic.gt_export.dataset.contact_sheet import COLUMNS, TILE
+from spectrinsic.gt_export.dataset.gallery import INDEX_VARIABLE, gallery_index
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 CHROMEDRIVER = shutil.which("chromedriver")

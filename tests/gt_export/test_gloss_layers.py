@@ -1,4 +1,4 @@
-"""Ground truth of glossy scenes (gt_export/layers/gloss.py): the identity with the specular term,
+"""Ground truth of glossy scenes (spectrinsic/gt_export/layers/gloss.py): the identity with the specular term,
 raw and denoised, in every sensor space; the material maps; the sample's check reads it back."""
 
 from __future__ import annotations
@@ -91,7 +91,7 @@ def test_material_maps_and_metal_pixels(glossy_room):
 
 
 def test_a_glossy_sample_passes_the_check_and_a_broken_specular_does_not(glossy_room, tmp_path):
-    from spectrinsic.gt_export.exr import read_exr, read_exr_attributes, write_exr
+    from spectrinsic.gt_export.formats.exr import read_exr, read_exr_attributes, write_exr
 
     scene, result = glossy_room
     config = {"preset": "test", "width": 16, "height": 16, "spp": 16, "seed": 5}

@@ -54,7 +54,7 @@ def test_torch_adapter_every_key_crop_transform_exposure_split(built, torch):
 
 def test_shards_feed_a_torch_dataloader(built, torch, tmp_path_factory):
     pytest.importorskip("webdataset", reason="the shards extra is not installed")
-    from spectrinsic.gt_export.shards import shard_dataset, write_shards
+    from spectrinsic.gt_export.dataset.shards import shard_dataset, write_shards
 
     out = tmp_path_factory.mktemp("shards")
     write_shards(built, out)

@@ -1,5 +1,5 @@
 """The shading of metals (issue 21): where the diffuse albedo is 0, ``shading`` is the radiance a
-white Lambertian surface would reflect there (render/band_kernel.py's second loop), so the layer
+white Lambertian surface would reflect there (spectrinsic/render/band_path/kernel.py's second loop), so the layer
 stays continuous and finite across a metal.
 
 Independent values: the analytic irradiance of a plane under a distant light, and the same

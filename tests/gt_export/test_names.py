@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from spectrinsic.gt_export.names import camera_slug, slug
+from spectrinsic.gt_export.formats.names import camera_slug, slug
 
 
 @pytest.mark.parametrize(

@@ -15,14 +15,14 @@ import pytest
 from spectrinsic.cli import main
 from spectrinsic.errors import DatasetError, FolderLockedError
 from spectrinsic.gt_export import remove_stale_temporaries
-from spectrinsic.gt_export.integrity import check_build_folder, write_marker
-from spectrinsic.gt_export.outfolder import (
+from spectrinsic.gt_export.folders.outfolder import (
     LOCK_NAME,
     OUTPUT_MARKER,
     check_output_folder,
     folder_lock,
     output_folder,
 )
+from spectrinsic.gt_export.sample.integrity import check_build_folder, write_marker
 
 #: Longest wait for the helper process to take the lock, seconds.
 HOLDER_START_S = 60.0
@@ -89,7 +89,7 @@ def test_a_refused_run_under_the_lock_leaves_no_folder(tmp_path):
 def _hold_lock(folder: Path) -> subprocess.Popen:
     """A second process holding *folder*'s lock until its stdin closes."""
     code = (
-        "import sys; from pathlib import Path; from spectrinsic.gt_export.outfolder import folder_lock\n"
+        "import sys; from pathlib import Path; from spectrinsic.gt_export.folders.outfolder import folder_lock\n"
         f"with folder_lock(Path({str(folder)!r})):\n"
         "    print('held', flush=True); sys.stdin.read()\n"
     )

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from spectrinsic.gt_export import png
+from spectrinsic.gt_export.formats import png
 
 
 def test_encoding_matches_the_srgb_cctf():

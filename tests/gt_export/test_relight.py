@@ -16,10 +16,10 @@ import pytest
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import check_sample, export_sample, load_sample
 from spectrinsic.gt_export.relight import relight, relit_scene
-from spectrinsic.gt_export.relight_pool import RandomRelight, relit_layers
-from spectrinsic.gt_export.transport_file import TRANSPORT_NAME
+from spectrinsic.gt_export.relight.augment import RandomRelight, relit_layers
+from spectrinsic.gt_export.sample.transport_exr import TRANSPORT_NAME
 from spectrinsic.render import RenderSettings, count_passes, render_batches
-from spectrinsic.render.transport import render_transport_batches
+from spectrinsic.render.transport_render import render_transport_batches
 
 #: Issue 20: a relit layer and the direct render's agree to float rounding, 1e-5 of the
 #: layer's largest magnitude (float32 storage, and ē multiplied after the path sum, not inside).
@@ -353,7 +353,7 @@ def test_cli_follows_the_out_rule_and_the_lock_of_every_writing_verb(built, tmp_
 
     held = tmp_path / "held"
     code = (
-        "import sys; from pathlib import Path; from spectrinsic.gt_export.outfolder import folder_lock\n"
+        "import sys; from pathlib import Path; from spectrinsic.gt_export.folders.outfolder import folder_lock\n"
         f"with folder_lock(Path({str(held)!r})):\n"
         "    print('held', flush=True); sys.stdin.read()\n"
     )

@@ -18,10 +18,10 @@ import pytest
 from spectrinsic.cli import main
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import export_sample
-from spectrinsic.gt_export.sample_meta import read_meta
-from spectrinsic.gt_export.transport_file import TRANSPORT_NAME
+from spectrinsic.gt_export.sample.meta import read_meta
+from spectrinsic.gt_export.sample.transport_exr import TRANSPORT_NAME
 from spectrinsic.render import RenderSettings
-from spectrinsic.render.transport import render_transport_batches
+from spectrinsic.render.transport_render import render_transport_batches
 
 SETTINGS = RenderSettings(spp=2, modes=("rgb3",), batches=2, max_depth=3)
 
@@ -78,7 +78,7 @@ def test_an_edited_light_power_in_scene_json_is_refused(sample, tmp_path, capsys
 
 
 def test_the_transport_header_must_declare_the_samples_size_and_channels(sample):
-    from spectrinsic.gt_export.relight_checks import check_transport_header, transport_channels
+    from spectrinsic.gt_export.relight.checks import check_transport_header, transport_channels
 
     meta = read_meta(sample).raw
     record, (h, w) = meta["transport"], meta["size"]
@@ -113,7 +113,7 @@ def test_a_relit_render_that_is_not_finite_is_refused_before_writing(source):
     import numpy as np
 
     from spectrinsic.gt_export.relight import relit_render
-    from spectrinsic.gt_export.relight_checks import check_finite_result
+    from spectrinsic.gt_export.relight.checks import check_finite_result
 
     relit = relit_render(source, {0: "planck:3000K"})
     check_finite_result(relit.result, source)  # a sound relighting passes

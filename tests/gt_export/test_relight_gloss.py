@@ -16,7 +16,7 @@ import pytest
 from spectrinsic.gt_export import check_sample, export_sample, load_sample
 from spectrinsic.gt_export.relight import relight, relit_scene
 from spectrinsic.render import RenderSettings, render_batches
-from spectrinsic.render.transport import render_transport_batches
+from spectrinsic.render.transport_render import render_transport_batches
 from spectrinsic.scenes.model import Material
 
 #: A relit layer and the direct render's agree to float rounding (as tests/gt_export/test_relight.py).

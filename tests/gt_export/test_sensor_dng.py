@@ -12,9 +12,9 @@ import pytest
 from PIL import Image
 
 from spectrinsic.gt_export import export_sample, load_sample
-from spectrinsic.gt_export.check import check_sample
-from spectrinsic.gt_export.exr import read_exr
-from spectrinsic.gt_export.sensor import model_from_meta
+from spectrinsic.gt_export.dataset.check import check_sample
+from spectrinsic.gt_export.formats.exr import read_exr
+from spectrinsic.gt_export.sample.sensor import model_from_meta
 from spectrinsic.spectra.camera_model import camera_model
 
 KEY = "Nikon 5100 (NPL)"
@@ -117,7 +117,7 @@ def test_evaluate_scores_the_processed_image_against_the_carried_ground_truth(
     """An oracle returning the carried ground truth scores zero on the processed image's
     scenario; the same estimates scored against the sRGB truth do not."""
     from spectrinsic.decompose.decomposition import Decomposition
-    from spectrinsic.decompose.evaluate import evaluate_sample
+    from spectrinsic.decompose.evaluation.evaluate import evaluate_sample
 
     sample = load_sample(_export(tmp_path, one_light_sample, config))
     refl, shading = sample[f"reflectance_sensor/{KEY}"], sample[f"shading_sensor/{KEY}"]

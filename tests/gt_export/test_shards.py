@@ -16,7 +16,12 @@ from spectrinsic.gt_export import load_sample
 
 wds = pytest.importorskip("webdataset", reason="the shards extra (webdataset) is in the dev extra")
 
-from spectrinsic.gt_export.shards import SHARD_INDEX, shard_dataset, shard_urls, write_shards  # noqa: E402
+from spectrinsic.gt_export.dataset.shards import (  # noqa: E402
+    SHARD_INDEX,
+    shard_dataset,
+    shard_urls,
+    write_shards,
+)
 
 
 def _sha(path) -> str:
@@ -82,7 +87,7 @@ def test_refuses_a_folder_with_foreign_files_and_keeps_them(built, tmp_path_fact
 
 
 def test_interrupted_export_is_not_complete_and_resumes(built, tmp_path_factory, monkeypatch):
-    import spectrinsic.gt_export.shards as shards
+    import spectrinsic.gt_export.dataset.shards as shards
 
     out = tmp_path_factory.mktemp("shards")
     real = shards._encode

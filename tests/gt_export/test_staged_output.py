@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from spectrinsic.gt_export.outfolder import OUTPUT_MARKER
-from spectrinsic.gt_export.staged_output import staged_output
+from spectrinsic.gt_export.folders.outfolder import OUTPUT_MARKER
+from spectrinsic.gt_export.folders.staged_output import staged_output
 
 
 def _tree(root):

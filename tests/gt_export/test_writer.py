@@ -109,7 +109,7 @@ def test_is_complete_follows_the_config_hash(tmp_path, one_light_sample, config)
 def test_a_write_failing_midway_leaves_nothing_complete_looking(
     tmp_path, one_light_sample, config, monkeypatch
 ):
-    from spectrinsic.gt_export import png
+    from spectrinsic.gt_export.formats import png
 
     scene, result = one_light_sample
     calls = {"n": 0}
@@ -288,9 +288,9 @@ def test_light_records_carry_only_the_fields_of_their_kind(tmp_path, two_light_s
 
 
 def test_dataset_card_shows_the_diversity_figure(built):
-    from spectrinsic.gt_export.diversity import diversity_figure, diversity_stats
+    from spectrinsic.gt_export.dataset.diversity import diversity_figure, diversity_stats
     from spectrinsic.gt_export.sample import sample_dirs
-    from spectrinsic.gt_export.sample_meta import read_meta
+    from spectrinsic.gt_export.sample.meta import read_meta
 
     card = (built / "DATASET.md").read_text()
     assert "diversity.png" in card and (built / "diversity.png").is_file()

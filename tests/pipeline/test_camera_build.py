@@ -15,7 +15,7 @@ import pytest
 
 from spectrinsic.errors import DatasetError, SpectrinsicError
 from spectrinsic.gt_export import check_dataset
-from spectrinsic.gt_export.exr import read_exr
+from spectrinsic.gt_export.formats.exr import read_exr
 from spectrinsic.pipeline.dataset import build_dataset
 from spectrinsic.pipeline.presets import DatasetConfig, get_preset
 

@@ -22,7 +22,7 @@ import pytest
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import check_dataset, is_complete
-from spectrinsic.gt_export.gallery import GALLERY_DIRS
+from spectrinsic.gt_export.dataset.gallery import GALLERY_DIRS
 from spectrinsic.pipeline.dataset import build_dataset
 from spectrinsic.pipeline.executors import ProcessExecutor
 from spectrinsic.pipeline.presets import DatasetConfig, get_preset
@@ -138,7 +138,7 @@ def test_config_change_rerenders(built, tmp_path):
 def test_crash_while_writing_leaves_no_complete_looking_folder(tmp_path, monkeypatch):
     """A sample whose export dies half-way is reported failed and leaves no folder under its
     name; the other sample still builds; a re-run completes the set."""
-    import spectrinsic.gt_export.writer as writer
+    import spectrinsic.gt_export.sample.writer as writer
 
     real_write_exr = writer.write_exr
     calls = []

@@ -40,7 +40,7 @@ def test_invalid_settings_raise(bad):
 def test_every_registered_render_mode_validates():
     """The config accepts exactly the render package's registry (gauss3 included), no list of
     its own."""
-    from spectrinsic.render.modes import RENDER_MODES
+    from spectrinsic.render.algebra.modes import RENDER_MODES
 
     assert "gauss3" in RENDER_MODES
     cfg = get_preset("preview").with_options(modes=tuple(RENDER_MODES), share_mode="gauss3")

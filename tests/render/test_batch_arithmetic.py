@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import spectrinsic.threads as threads
-from spectrinsic.render.batches import batch_mean
-from spectrinsic.render.light_transport import LightTransport, relit_result
-from spectrinsic.render.traversal_output import light_shares, sum_lights
+from spectrinsic.render.algebra.batch_means import batch_mean
+from spectrinsic.render.algebra.light_transport import LightTransport, relit_result
+from spectrinsic.render.algebra.shares import light_shares, sum_lights
 from spectrinsic.scenes.model import Camera, Light, Scene
 
 

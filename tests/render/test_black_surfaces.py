@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 from spectrinsic.cli import main
-from spectrinsic.gt_export.exr import read_exr
-from spectrinsic.render import plugins
-from spectrinsic.render.variants import choose_variant, variant_scope
+from spectrinsic.gt_export.formats.exr import read_exr
+from spectrinsic.render.base import plugins
+from spectrinsic.render.base.variants import choose_variant, variant_scope
 
 #: A box (object 0) on a ground plane (object 1) lit by one point light: FORMAT.md's example
 #: reduced as in the issue; ``MATERIAL`` is replaced by the box's material.

@@ -1,4 +1,4 @@
-"""Glossy materials in the single traversal (render/band_kernel.py) against closed forms
+"""Glossy materials in the single traversal (spectrinsic/render/band_path/kernel.py) against closed forms
 computed here, and against Mitsuba's own spectral path tracer.
 
 The expected values are independent of the code under test: the dielectric Fresnel reflectance
@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 
 from spectrinsic.render import channel_values
-from spectrinsic.render import translate as tr
-from spectrinsic.render.integrator import band_path
-from spectrinsic.render.plugins import hdr_film, path_integrator, rgb_spectrum
-from spectrinsic.render.single import _tables, light_of_emitters, render_traversal
-from spectrinsic.render.variants import choose_variant, variant_scope
+from spectrinsic.render.band_path.integrator import band_path
+from spectrinsic.render.band_path.traversal import _tables, light_of_emitters, render_traversal
+from spectrinsic.render.base import translate as tr
+from spectrinsic.render.base.plugins import hdr_film, path_integrator, rgb_spectrum
+from spectrinsic.render.base.variants import choose_variant, variant_scope
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import get_sensors
 

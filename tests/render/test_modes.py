@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from spectrinsic.errors import SpectrinsicError
-from spectrinsic.render import modes
+from spectrinsic.render.algebra import modes
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as WL
 from spectrinsic.spectra import get_sensors, get_spectrum, responses
 

@@ -1,4 +1,4 @@
-"""The single band-path traversal (render/integrator.py, render/single.py) against the passes
+"""The single band-path traversal (spectrinsic/render/band_path/integrator.py, spectrinsic/render/band_path/traversal.py) against the passes
 it replaces, identities of its per-light split, and closed forms.
 
 Tolerances: the traversal multiplies the same float32 factors as Mitsuba's ``path`` in another
@@ -21,8 +21,8 @@ from spectrinsic.render import (
     render_diagonal,
     render_scene,
 )
+from spectrinsic.render.band_path.traversal import render_traversal
 from spectrinsic.render.settings import RenderSettings
-from spectrinsic.render.single import render_traversal
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import get_sensors
 

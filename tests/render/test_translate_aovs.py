@@ -13,8 +13,8 @@ from spectrinsic.render import (
     scene_to_mitsuba,
     variant_scope,
 )
-from spectrinsic.render.plugins import hdr_film, path_integrator, rgb_spectrum
-from spectrinsic.render.translate import smooth_corner_normals
+from spectrinsic.render.base.plugins import hdr_film, path_integrator, rgb_spectrum
+from spectrinsic.render.base.translate import smooth_corner_normals
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 
 #: float32 round-off.
@@ -159,7 +159,7 @@ def test_every_light_kind_of_the_scene_model_translates(make_plane):
     """The translator covers exactly the scene model's table of light kinds."""
     from dataclasses import replace
 
-    from spectrinsic.render.translate import emission_key
+    from spectrinsic.render.base.translate import emission_key
     from spectrinsic.scenes.model import LIGHT_KINDS, make_light
 
     base = make_plane("flat:0.5", "cie:D65")

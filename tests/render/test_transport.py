@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 
 from spectrinsic.render import RenderSettings
-from spectrinsic.render.transport import render_transport, render_transport_batches
+from spectrinsic.render.transport_render import render_transport, render_transport_batches
 
 SEED = 4
 #: Two samples per pixel per batch.

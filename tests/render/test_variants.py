@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from spectrinsic.errors import RenderError, SpectrinsicError, SpectrinsicWarning
-from spectrinsic.render import RenderSettings, variants
+from spectrinsic.render import RenderSettings
+from spectrinsic.render.base import variants
 
 
 @pytest.mark.parametrize(
@@ -140,7 +141,7 @@ def test_set_up_leaves_the_environment_as_it_was():
     """Dr.Jit gets the chosen libLLVM while it is imported; the environment is not changed."""
     code = (
         "import os, sys\n"
-        "from spectrinsic.render import variants\n"
+        "from spectrinsic.render.base import variants\n"
         "variants.import_mitsuba()\n"
         "print(repr(os.environ.get(variants.LLVM_ENV)))\n"
         "print(repr(variants.llvm_library()))\n"
@@ -159,7 +160,7 @@ def test_set_up_leaves_the_environment_as_it_was():
 def test_set_up_keeps_the_users_libllvm_setting():
     code = (
         "import os\n"
-        "from spectrinsic.render import variants\n"
+        "from spectrinsic.render.base import variants\n"
         "variants.import_mitsuba()\n"
         "print(os.environ[variants.LLVM_ENV])\n"
     )
@@ -170,7 +171,7 @@ def test_set_up_keeps_the_users_libllvm_setting():
 
 def test_variant_scope_restores_on_errors_and_documents_the_first_scope():
     code = (
-        "from spectrinsic.render import variants\n"
+        "from spectrinsic.render.base import variants\n"
         "mi = variants.import_mitsuba()\n"
         "print(mi.variant())\n"
         "with variants.variant_scope('scalar_spectral'):\n"

@@ -1,4 +1,4 @@
-"""Glossy and metal surfaces in generated scenes (scenes/generators/gloss.py)."""
+"""Glossy and metal surfaces in generated scenes (spectrinsic/scenes/generators/gloss.py)."""
 
 from __future__ import annotations
 

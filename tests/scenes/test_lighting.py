@@ -1,4 +1,4 @@
-"""A sample's lighting measured from its light records (scenes/lighting.py)."""
+"""A sample's lighting measured from its light records (spectrinsic/scenes/lighting.py)."""
 
 from __future__ import annotations
 

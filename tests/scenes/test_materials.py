@@ -1,4 +1,4 @@
-"""Glossy materials in scene files (scenes/materials.py): parsing, round trips, one-line errors,
+"""Glossy materials in scene files (spectrinsic/scenes/materials.py): parsing, round trips, one-line errors,
 and the records of matte scenes left as they were."""
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ import pytest
 from spectrinsic.spectra import colorimetry, illuminants, io, reflectances, registry, sensors
 from spectrinsic.spectra.colourspace import srgb_matrices
 
-SPECTRA = Path(__file__).resolve().parents[2] / "spectra"
+SPECTRA = Path(__file__).resolve().parents[2] / "spectrinsic" / "spectra"
 
 
 def _run(code: str) -> str:
@@ -55,19 +55,19 @@ def _spectra_imports(path: Path) -> set[str]:
     """The ``spectrinsic.spectra.*`` modules *path* imports, at module level or in a function."""
     names: set[str] = set()
     for node in ast.walk(ast.parse(path.read_text())):
-        if (
-            isinstance(node, ast.ImportFrom)
-            and node.module
-            and node.module.startswith("spectrinsic.spectra")
-        ):
-            if node.module == "spectrinsic.spectra":  # from spectrinsic.spectra import io, ...
+        module = node.module if isinstance(node, ast.ImportFrom) else None
+        if isinstance(node, ast.ImportFrom) and node.level:  # from .io import / from . import io
+            anchor = ["spectrinsic", "spectra"][: 3 - node.level]
+            module = ".".join([*anchor, node.module] if node.module else anchor)
+        if isinstance(node, ast.ImportFrom) and module and module.startswith("spectrinsic.spectra"):
+            if module == "spectrinsic.spectra":  # from . import io, ...
                 names.update(
                     f"spectrinsic.spectra.{a.name}"
                     for a in node.names
                     if (SPECTRA / f"{a.name}.py").is_file()
                 )
             else:
-                names.add(node.module)
+                names.add(module)
         elif isinstance(node, ast.Import):
             names.update(a.name for a in node.names if a.name.startswith("spectrinsic.spectra."))
     return names

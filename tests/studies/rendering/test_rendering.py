@@ -35,7 +35,7 @@ def test_render_command_writes_named_float32_channels(tmp_path, capsys):
     assert status == 0
     import OpenEXR
 
-    from spectrinsic.gt_export.exr import read_exr
+    from spectrinsic.gt_export.formats.exr import read_exr
 
     with OpenEXR.File(str(out / "bands31.exr"), separate_channels=True) as f:
         channels = f.channels()

@@ -1,5 +1,0 @@
-import sys
-
-from spectrinsic.cli import main
-
-sys.exit(main())

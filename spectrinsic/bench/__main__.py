@@ -1,0 +1,7 @@
+"""``python -m spectrinsic.bench``: see :func:`spectrinsic.bench.main`."""
+
+import sys
+
+from . import main
+
+sys.exit(main())

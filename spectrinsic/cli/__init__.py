@@ -1,0 +1,148 @@
+"""The ``spectrinsic`` command line. The only place that configures logging and progress bars.
+
+Each sub-command lives in its own ``spectrinsic.cli.<name>`` module exposing
+``register(subparsers)``; the module's ``run(args)`` is called with the parsed namespace.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import logging
+import sys
+import traceback
+from collections.abc import Sequence
+from typing import Any, NoReturn
+
+from ..data_dir import one_data_dir
+from ..errors import SpectrinsicError
+from ..interrupts import interrupts_reach_python
+from ..provenance import software_versions
+
+__all__ = ["main", "build_parser"]
+
+#: Sub-command modules, in the order ``--help`` lists them.
+_COMMANDS: tuple[str, ...] = (
+    "spectrinsic.cli.info",
+    "spectrinsic.cli.render",
+    "spectrinsic.cli.dataset",
+    "spectrinsic.cli.check",
+    "spectrinsic.cli.relight",
+    "spectrinsic.cli.export",
+    "spectrinsic.cli.study",
+    "spectrinsic.cli.evaluate",
+    "spectrinsic.cli.list",
+)
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (``spectrinsic: error: ...``, status 2),
+    like every other bad input; ``--help`` still prints the usage. Sub-command parsers are of
+    this class too (``add_subparsers`` makes them with the parent's class)."""
+
+    def error(self, message: str) -> NoReturn:
+        where = self.prog.removeprefix("spectrinsic").strip()
+        text = " ".join(message.split())
+        self.exit(
+            2,
+            f"spectrinsic: error: {where + ': ' if where else ''}{text} (see {self.prog} --help)\n",
+        )
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="spectrinsic",
+        description="Spectral rendering of synthetic intrinsic-image datasets.",
+    )
+    _add_global_options(parser)
+    parser.add_argument("--version", action="version", version=f"spectrinsic {_version()}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for name in _COMMANDS:
+        importlib.import_module(name).register(sub)
+    for command in sub.choices.values():  # the global options work after the verb too
+        _add_global_options(command.add_argument_group("global options"), after_verb=True)
+    return parser
+
+
+def _add_global_options(p: Any, *, after_verb: bool = False) -> None:
+    """--data-dir, -v, -q, --debug: before the verb with their defaults; after it (on every
+    sub-command) without defaults (``SUPPRESS``), so a flag given there is set and one not
+    given keeps what the top-level parser set."""
+
+    def default(value: Any) -> Any:
+        return argparse.SUPPRESS if after_verb else value
+
+    p.add_argument(
+        "--data-dir",
+        metavar="DIR",
+        default=default(None),
+        help="spectral data directory (SFU set, extra cameras); default: $SPECTRINSIC_DATA",
+    )
+    p.add_argument("-v", "--verbose", action="count", default=default(0), help="more logging")
+    p.add_argument(
+        "-q",
+        "--quiet",
+        action="store_true",
+        default=default(False),
+        help="no progress bars or plan lines",
+    )
+    p.add_argument(
+        "--debug",
+        action="store_true",
+        default=default(False),
+        help="print the traceback behind an error message",
+    )
+
+
+def _version() -> str:
+    """spectrinsic's installed version, from package metadata (nothing heavy imported)."""
+
+    return software_versions(("spectrinsic",), python=False)["spectrinsic"]
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point. Returns the process exit status (0 ok, 1 problems found or samples failed,
+    2 bad input or a resource that failed: one line on stderr, the traceback only with
+    ``--debug``; 130 interrupted)."""
+    # Before anything starts a thread: Ctrl-C must reach Python even mid-render.
+    with interrupts_reach_python():
+        return _main(argv)
+
+
+def _main(argv: Sequence[str] | None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(
+        level=logging.WARNING - 10 * min(args.verbose, 2),
+        format="%(levelname)s %(name)s: %(message)s",
+    )
+    try:
+        # one data directory for the whole run (--data-dir, else $SPECTRINSIC_DATA), resolved
+        # once, before any work (a wrong one is an input error), and seen by every worker
+        with one_data_dir(args.data_dir) as data_dir:
+            args.data_dir = data_dir
+            return int(args.func(args) or 0)
+    except SpectrinsicError as exc:
+        return _error(args, str(exc))
+    except OSError as exc:  # a file the command could not read or write, named by the OS
+        where = f"{exc.filename}: " if exc.filename else ""
+        return _error(args, f"{where}{exc.strerror or exc}")
+    except MemoryError:
+        return _error(
+            args, "out of memory; try a smaller --resolution/--width/--height or fewer --workers"
+        )
+    except KeyboardInterrupt:
+        print("spectrinsic: interrupted; completed work is kept, re-run to resume", file=sys.stderr)
+        return 130
+
+
+def _error(args: argparse.Namespace, message: str) -> int:
+    """Print the one-line error (after the traceback with ``--debug``); return status 2."""
+    if getattr(args, "debug", False):
+        traceback.print_exc()
+    print(f"spectrinsic: error: {' '.join(message.split())}", file=sys.stderr)
+    return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

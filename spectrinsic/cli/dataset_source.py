@@ -1,0 +1,347 @@
+"""The scene-source options of ``spectrinsic dataset`` and their parsing: library, generator
+or scene files (``--generator``, ``--scenes`` and their settings), ``--material-map``,
+``--resolution``, and the check of scene files before a build; shared with
+``render --ground-truth``."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+from ..errors import DatasetError, SceneError, SpectrinsicError
+from ..pipeline.presets import DatasetConfig
+from ..pipeline.source_plan import file_sample, files_source, generator_source
+from ..scenes.generators import GlossDistribution
+from ..scenes.generators.world_defaults import GLOSSY_FRACTION, METALLIC_FRACTION, TEXTURE_FRACTION
+from ..scenes.sources import FileSource
+from ..scenes.spectrum_refs import resolve_spectrum
+from ..scenes.yaml_limits import load_yaml_file
+from ..spectra import get_spectrum
+
+__all__ = [
+    "add_source_options",
+    "check_scene_files",
+    "material_map",
+    "parse_resolution",
+    "source_from_args",
+    "source_notes",
+]
+
+
+def add_source_options(src: Any) -> None:
+    """Where the scenes come from: the library (default), a generator, or scene files."""
+    _add_generator_options(src)
+    _add_generated_draw_options(src)
+    _add_scene_file_options(src)
+
+
+def _add_generator_options(src: Any) -> None:
+    """Which generator, how many scenes and how many cameras each."""
+    src.add_argument(
+        "--generator",
+        metavar="NAME",
+        default=None,
+        help="generate scenes procedurally: objects-on-ground or rooms",
+    )
+    src.add_argument("--count", type=int, default=None, metavar="N", help="generated scenes (20)")
+    src.add_argument(
+        "--views", type=int, default=None, metavar="V", help="cameras per generated scene (1)"
+    )
+
+
+def _add_daylight_option(src: Any) -> None:
+    """``--daylight-share``: rooms lit also by sun and sky through a window."""
+    src.add_argument(
+        "--daylight-share",
+        type=float,
+        default=0.0,
+        metavar="F",
+        help="fraction of generated rooms closed, with a window, and lit also by a sun and a "
+        "sky of CIE daylight spectra shining through it (0)",
+    )
+
+
+def _add_generated_draw_options(src: Any) -> None:
+    """What generated scenes draw: material ranges, light colours, SFU data, gloss."""
+    _add_daylight_option(src)
+    src.add_argument(
+        "--value-range",
+        default=None,
+        metavar="LO,HI",
+        help="Munsell value range of generated materials (2,9)",
+    )
+    src.add_argument(
+        "--chroma-range",
+        default=None,
+        metavar="LO,HI",
+        help="Munsell chroma range of generated materials (0,16)",
+    )
+    src.add_argument(
+        "--light-saturation",
+        default=None,
+        metavar="LO,HI",
+        help="keep only coloured lights whose |Duv| (Ohno 2013: CIE 1960 uv distance "
+        "from the Planckian locus) is in LO,HI; 0.02 is visibly tinted, at most "
+        "0.15 for LO (default: any, 60%% from saturated LEDs and filtered lamps)",
+    )
+    src.add_argument(
+        "--texture-fraction",
+        type=float,
+        default=None,
+        metavar="F",
+        help="fraction of generated objects given a per-pixel spectral texture (wood rings, "
+        "weave, noise over 2-3 reflectances; exact reflectance ground truth) "
+        f"({TEXTURE_FRACTION:g}; 0 for none)",
+    )
+    src.add_argument(
+        "--sfu",
+        action="store_true",
+        help="also draw SFU reflectances and illuminants (needs --data-dir)",
+    )
+    src.add_argument(
+        "--glossy",
+        type=float,
+        default=None,
+        metavar="F",
+        help=f"fraction of generated materials made coated/glossy (plastic) ({GLOSSY_FRACTION:g}; "
+        "--glossy 0 --metallic 0 --texture-fraction 0: the matte world)",
+    )
+    src.add_argument(
+        "--metallic",
+        type=float,
+        default=None,
+        metavar="F",
+        help=f"fraction of generated materials made metal (Ag, Al, Au, Cu, Cr) ({METALLIC_FRACTION:g})",
+    )
+    src.add_argument(
+        "--roughness-range",
+        default=None,
+        metavar="LO,HI",
+        help="GGX roughness range of glossy and metal materials (0,0.3)",
+    )
+
+
+def _add_scene_file_options(src: Any) -> None:
+    """The user's own scene files and how their materials get spectra."""
+    src.add_argument(
+        "--scenes",
+        nargs="+",
+        metavar="PATH",
+        default=None,
+        help="render your own scene files (.yaml, .blend, .obj/.ply/.glb) with full ground truth",
+    )
+    src.add_argument(
+        "--material-map",
+        metavar="FILE",
+        default=None,
+        help="YAML/JSON mapping material name -> spectrum for .blend and mesh scenes",
+    )
+    src.add_argument(
+        "--default-spectrum",
+        metavar="NAME",
+        default=None,
+        help="reflectance of unmapped materials in .blend and mesh scenes",
+    )
+    src.add_argument(
+        "--colours-from-asset",
+        action="store_true",
+        help="give unmapped glTF and .blend materials their base colour (glTF "
+        "baseColorFactor, Principled Base Color) as an rgb: reflectance (default: an error)",
+    )
+    src.add_argument(
+        "--new-sample",
+        action="store_true",
+        help="render scenes a generated build saved (<dataset>/scenes/*.yaml) as new "
+        "samples (id from the file name, seed from --seed) instead of "
+        "reproducing their own sample (same id, same seed)",
+    )
+
+
+def _range(option: str, text: str) -> tuple[float, float]:
+    """An option's ``LO,HI`` text as two finite floats with LO <= HI (the configuration
+    records them as JSON, which has no infinity)."""
+    try:
+        lo, hi = (float(v) for v in text.split(","))
+    except ValueError:
+        raise DatasetError(f"{option} {text!r}; expected LO,HI, e.g. 2,9") from None
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        raise DatasetError(f"{option} {text!r}; expected two finite numbers LO,HI, e.g. 2,9")
+    if lo > hi:
+        raise DatasetError(f"{option} {text!r}; expected LO <= HI")
+    return lo, hi
+
+
+def material_map(path: str | None) -> dict[str, str]:
+    """The ``--material-map`` file as ``{material name: spectrum name}`` (``{}`` for none).
+
+    A value may also be ``csv:PATH#COLUMN`` (PATH relative to the map's folder) or an inline
+    ``{wavelengths: [...], values: [...]}`` (:mod:`spectrinsic.scenes.spectrum_refs`).
+    """
+    if path is None:
+        return {}
+
+    data = load_yaml_file(Path(path))
+    if not isinstance(data, dict) or not all(
+        isinstance(k, str) and isinstance(v, (str, dict)) for k, v in data.items()
+    ):
+        raise DatasetError(
+            f"--material-map {path!r}: expected a mapping of material name -> spectrum name"
+        )
+    out = {}
+    for k, v in data.items():
+        try:
+            out[k] = resolve_spectrum(v, "reflectance", Path(path).parent)
+        except SpectrinsicError as exc:
+            raise DatasetError(f"--material-map {path!r}: {k}: {exc}") from None
+        if not isinstance(out[k], str):
+            raise DatasetError(f"--material-map {path!r}: {k}: expected a spectrum name")
+    return out
+
+
+#: The options of generated sets and their defaults (``None`` on the parser, so that one
+#: given to another source is refused rather than ignored).
+GENERATOR_DEFAULTS: dict[str, Any] = {
+    "count": 20,
+    "views": 1,
+    "value_range": "2,9",
+    "chroma_range": "0,16",
+    "light_saturation": None,
+    "texture_fraction": TEXTURE_FRACTION,
+    "sfu": False,
+    "glossy": GLOSSY_FRACTION,
+    "metallic": METALLIC_FRACTION,
+    "roughness_range": "0,0.3",
+}
+#: The options of scene files (``--scenes``).
+FILE_OPTIONS = ("material_map", "default_spectrum", "new_sample")
+
+
+def _given(value: object) -> bool:
+    """An option given on the command line (its parser default is ``None``, or ``False`` for a
+    flag)."""
+    return value is not None and value is not False
+
+
+def _option(name: str) -> str:
+    return "--" + name.replace("_", "-")
+
+
+def _check_options_apply(args: argparse.Namespace) -> None:
+    """Refuse a generator option without --generator and a scene-file option without --scenes
+    (in one line naming it), then fill in the generator options' defaults."""
+    source = "generated scenes" if args.generator else "scene files" if args.scenes else None
+    what = source or "the library's scenes"
+    given = [n for n in (*GENERATOR_DEFAULTS, *FILE_OPTIONS) if _given(getattr(args, n, None))]
+    unused = [n for n in given if n in GENERATOR_DEFAULTS] if not args.generator else []
+    if not args.scenes:
+        unused += [n for n in given if n in FILE_OPTIONS]
+    if unused:
+        applies = "--scenes" if unused[0] in FILE_OPTIONS else "--generator"
+        raise DatasetError(f"{_option(unused[0])} applies to {applies}; this build renders {what}")
+    for name, value in GENERATOR_DEFAULTS.items():
+        if getattr(args, name, None) is None:
+            setattr(args, name, value)
+
+
+def source_from_args(args: argparse.Namespace) -> str | None:
+    """The config's ``source`` for --generator / --scenes (``None``: the library)."""
+    if args.generator and args.scenes:
+        raise DatasetError("--generator and --scenes exclude each other; give one")
+    _check_options_apply(args)
+    if args.generator:
+        try:
+            gloss = GlossDistribution(
+                args.glossy, args.metallic, _range("--roughness-range", args.roughness_range)
+            )
+        except SceneError as exc:
+            raise DatasetError(f"--glossy/--metallic/--roughness-range: {exc}") from None
+        return generator_source(
+            args.generator,
+            args.count,
+            views=args.views,
+            sfu=args.sfu,
+            value_range=_range("--value-range", args.value_range),
+            chroma_range=_range("--chroma-range", args.chroma_range),
+            gloss=gloss,
+            light_saturation=None
+            if args.light_saturation is None
+            else _range("--light-saturation", args.light_saturation),
+            texture_fraction=args.texture_fraction,
+            daylight_share=args.daylight_share,
+        )
+    if args.scenes:
+        size = None if args.resolution is None else parse_resolution(args.resolution)
+        return files_source(
+            args.scenes,
+            materials=material_map(args.material_map),
+            default_spectrum=args.default_spectrum,
+            resolution=size,
+            new_sample=getattr(args, "new_sample", False),
+            colours_from_asset=args.colours_from_asset,
+        )
+    return None
+
+
+def source_notes(config: DatasetConfig) -> list[str]:
+    """What applies to each scene file of *config* (``--scenes``, ``render --ground-truth``):
+    its size (the file's camera or --resolution) and its sample (a saved one, reproduced, or a
+    new one); empty for the library and generators."""
+    spec = json.loads(config.source or "{}")
+    notes = []
+    for entry in spec.get("scenes", ()):
+        size = spec.get("resolution")
+        where = (
+            f"{size[0]}x{size[1]} (--resolution)"
+            if size
+            else "the file's camera size (--resolution to change it)"
+        )
+        sid, seed = file_sample(entry["path"], new_sample=bool(spec.get("new_sample")))
+        sample = (
+            f"reproduces its saved sample {sid} with seed {seed} (--new-sample for a new one)"
+            if seed is not None
+            else f"sample {sid}"
+        )
+        notes.append(f"{Path(entry['path']).name}: {where}; {sample}")
+    return notes
+
+
+def parse_resolution(text: str) -> tuple[int, int]:
+    """``WIDTHxHEIGHT`` as two positive integers."""
+    w, sep, h = text.lower().partition("x")
+    if not (sep and w.isdigit() and h.isdigit() and int(w) > 0 and int(h) > 0):
+        raise DatasetError(
+            f"--resolution {text!r}; expected WIDTHxHEIGHT of positive integers, e.g. 256x256"
+        )
+    return int(w), int(h)
+
+
+def check_scene_files(config: Any, data_dir: str | None) -> None:
+    """``--scenes``: every file reads as a valid scene with this material map and default
+    spectrum, before the folder is stamped with the config (a bad file is an input error, not
+    a failed sample)."""
+
+    spec = json.loads(config.source or "{}")
+    if "scenes" not in spec:
+        return
+    materials = spec.get("materials") or {}
+    named = [("--default-spectrum", spec.get("default_spectrum"))]
+    named += [(f"--material-map entry {k!r}", v) for k, v in sorted(materials.items())]
+    for option, name in named:
+        try:
+            if name is not None:
+                get_spectrum(name, data_dir=data_dir)
+        except SpectrinsicError as exc:
+            raise DatasetError(f"{option} {name!r}: {exc}") from exc
+    width, height = spec.get("resolution") or (None, None)
+    for entry in spec["scenes"]:
+        FileSource(
+            entry["path"],
+            width,
+            height,
+            tuple(sorted(materials.items())),
+            spec.get("default_spectrum"),
+            colours_from_asset=bool(spec.get("colours_from_asset")),
+        ).build(data_dir)

@@ -1,0 +1,1 @@
+"""Evaluation of decomposers on rendered samples, MIT objects and predictions folders."""

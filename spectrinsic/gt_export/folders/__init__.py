@@ -1,0 +1,1 @@
+"""Output folders a verb writes into: the folder rule, the lock and staged output."""

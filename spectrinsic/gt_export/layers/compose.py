@@ -1,0 +1,225 @@
+"""Every family together: :func:`compute_ground_truth` and the identities the layers satisfy."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ...errors import DatasetError
+from ...scenes.material_labels import material_label
+from ...scenes.model import Scene
+from ...spectra import absolute_reflectance, get_sensors, get_spectrum
+from . import irradiance as irr
+from .cameras import camera_layers, matrices_of
+from .denoise import Denoiser, Guides, denoise_white_radiance
+from .geometry import coverage_of, geometry_layers
+from .gloss import gloss_layers, specular_srgb
+from .images import cube_layer, image_layers
+from .imaging import coverage_weighted
+from .intrinsics import (
+    clipping_of,
+    from_denoised,
+    intrinsic_layers,
+    noise_of,
+    srgb_of,
+    srgb_white,
+    white_radiance,
+)
+from .lights import light_records, share_layers
+from .records import (
+    RGB,
+    GroundTruth,
+    Layer,
+    RenderRecord,
+    SampleInputs,
+    aov,
+    camera_key,
+    cube_sensor_name,
+    grid,
+    make_layer,
+    reference_mode,
+)
+from .spectral import camera_curves
+from .spectral_intrinsics import residual_shares, spectral_identity, spectral_layers
+
+# Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
+
+__all__ = ["compute_ground_truth", "identities"]
+
+
+def _sample(scene: Scene, result: Any, data_dir: Any) -> SampleInputs:
+    wl = grid()
+    rho = (
+        np.stack([get_spectrum(m.spectrum, data_dir=data_dir).on(wl) for m in scene.materials])
+        if scene.materials
+        else np.zeros((0, wl.size))
+    )
+    return SampleInputs(
+        scene, result, reference_mode(result), wl, rho, get_spectrum("cie:D65").on(wl), data_dir
+    )
+
+
+def _reflectance(coverage: np.ndarray, names: list[str], data_dir: Any) -> tuple[Layer, Any]:
+    """``reflectance`` (linear sRGB under D65 of each material, coverage-weighted) as a layer
+    and in float64."""
+    values = coverage_weighted(
+        coverage, absolute_reflectance(names, data_dir=data_dir) if names else np.zeros((0, 3))
+    )
+    return make_layer(
+        "reflectance",
+        values,
+        RGB,
+        "dimensionless absolute reflectance, linear sRGB under D65 (perfect white = 1); "
+        "box-filtered by pixel coverage, 0 for background",
+        "intrinsics",
+    ), values
+
+
+def compute_ground_truth(
+    scene: Scene,
+    result: RenderRecord,
+    *,
+    cameras: Sequence[str] = (),
+    write_cube: bool = False,
+    denoise: bool = False,
+    denoise_quality: str = "fast",
+    denoiser: Denoiser | None = None,
+    data_dir: Any = None,
+    training: np.ndarray | None = None,
+    spectral: bool = False,
+) -> GroundTruth:
+    """Compute every ground-truth layer of one rendered sample.
+
+    Parameters
+    ----------
+    scene
+        The scene that was rendered (names every material and light spectrum).
+    result
+        The render (:class:`RenderRecord`).
+    cameras
+        Sensor-set names (``"camera:Nikon 5100 (NPL)"``); each adds an image integrated from
+        the 31-band cube, a relative reflectance, shading, residual and illuminant in that
+        camera's RGB.
+    write_cube
+        Add the raw multispectral cube as layer ``cube``.
+    denoise
+        Denoise the white-surface radiance with OIDN (:mod:`~spectrinsic.gt_export.layers.denoise`):
+        ``shading``, ``residual``, ``illuminant``, ``shading_grey`` and the camera shading
+        come from it, ``image_denoised = reflectance ∘ shading + residual`` is rebuilt from it,
+        and the raw ``shading_raw``/``residual_raw`` are kept beside ``image``.
+    denoise_quality
+        OIDN quality, ``"fast"`` (the dataset's, :data:`~spectrinsic.gt_export.layers.denoise.DENOISE_QUALITY`)
+        or ``"high"``.
+    denoiser
+        With *denoise*, the function that denoises ``W`` given its guides, instead of
+        :func:`~spectrinsic.gt_export.layers.denoise.denoise_white_radiance` (``make bench`` scores
+        alternatives with it).
+    training
+        ``(N, 471)`` reflectances on the 1 nm grid for the matrix fits (default: all Munsell chips).
+    spectral
+        Add the per-band intrinsic layers of the 31-band cube (``spectral.exr``,
+        :mod:`~spectrinsic.gt_export.layers.spectral_intrinsics`).
+    """
+    s = _sample(scene, result, data_dir)
+    layers = image_layers(s)
+    image = layers[0].data.astype(np.float64)
+    coverage, mask = coverage_of(s, (image.shape[0], image.shape[1]))
+    layers += geometry_layers(s, mask)
+    names = [m.spectrum for m in scene.materials]
+    reflectance_layer, reflectance = _reflectance(coverage, names, data_dir)
+    layers.append(reflectance_layer)
+    w_raw = white_radiance(s, coverage)
+    w = w_raw
+    if denoise:
+        guides = Guides(aov(result, "normals"), aov(result, "depth"))
+        w = (
+            denoise_white_radiance(w_raw, guides, quality=denoise_quality)
+            if denoiser is None
+            else denoiser(w_raw, guides)
+        )
+        batches = tuple(b[s.ref] for b in getattr(result, "batch_raw", ()) or () if s.ref in b)
+        w = irr.unlit_masked(w, w_raw, batches)
+    specular = specular_srgb(s, w_raw.to_xyz)
+    layers += intrinsic_layers(s, w_raw, w, image, reflectance, denoised=denoise, specular=specular)
+    layers += gloss_layers(s, coverage, specular)
+    noise_maps, noise = noise_of(s, w_raw)
+    light_maps, shares = share_layers(s, w, mask)
+    layers += noise_maps + light_maps
+    spaces: dict[str, np.ndarray] = {"srgb": get_sensors("srgb").on(s.wl)}
+    spaces.update({cam: camera_curves(cam, s.wl, data_dir=data_dir) for cam in cameras})
+    if cameras and "bands31" not in result.raw:
+        raise DatasetError(
+            "camera images need the 31-band cube (render mode 'bands31'); render it or pass cameras=()"
+        )
+    for cam in cameras:
+        layers += camera_layers(s, cam, spaces[cam], coverage, w, denoised=denoise)
+    cube_name = cube_sensor_name(result) if "bands31" in result.raw else None
+    if write_cube:
+        layers.append(cube_layer(s, cube_name))
+    if spectral:
+        layers += spectral_layers(s, coverage, w_raw, w, denoised=denoise)
+    by_name = {layer.name: layer for layer in layers}
+    return GroundTruth(
+        layers=by_name,
+        lights=light_records(s, shares, spaces, cameras),
+        materials={str(i): material_label(m) for i, m in enumerate(scene.materials)},
+        matrices=matrices_of(s, shares, spaces, training),
+        reference_mode=s.ref,
+        cameras=tuple(cameras),
+        cube_sensors=cube_name,
+        denoised=tuple(
+            sorted(layer.name for layer in layers if denoise and from_denoised(layer.name))
+        ),
+        noise=noise,
+        clipping=clipping_of(srgb_of(w) / srgb_white(s), w.valid & (irr.luminance_of(w) > 0)),
+        residual_share=residual_shares(_identities(by_name, cameras), by_name, mask),
+    )
+
+
+def identities(gt: GroundTruth) -> list[dict[str, str]]:
+    """The exact identities the layers satisfy: ``image = reflectance ∘ shading [+ specular] +
+    residual`` per sensor space (and on the raw layers when denoised), the specular term only in
+    glossy scenes, and per band with the spectral layers; recorded in ``meta.json``."""
+    return _identities(gt.layers, gt.cameras)
+
+
+def _identities(layers: dict[str, Any], cameras: Sequence[str]) -> list[dict[str, str]]:
+    out = []
+    denoised = "image_denoised" in layers
+    glossy = "specular" in layers
+    spec = {"specular": "specular"} if glossy else {}
+    out.append(
+        {
+            "image": "image_denoised" if denoised else "image",
+            "reflectance": "reflectance",
+            "shading": "shading",
+            "residual": "residual",
+        }
+        | spec
+    )
+    if denoised:
+        out.append(
+            {
+                "image": "image",
+                "reflectance": "reflectance",
+                "shading": "shading_raw",
+                "residual": "residual_raw",
+            }
+            | spec
+        )
+    for cam in cameras:
+        key = camera_key(cam)
+        image = f"image_camera_denoised/{key}" if denoised else f"image_camera/{key}"
+        out.append(
+            {
+                "image": image,
+                "reflectance": f"reflectance_camera/{key}",
+                "shading": f"shading_camera/{key}",
+                "residual": f"residual_camera/{key}",
+            }
+            | ({"specular": f"specular_camera/{key}"} if glossy else {})
+        )
+    spectral = spectral_identity(layers)
+    return out if spectral is None else [*out, spectral]

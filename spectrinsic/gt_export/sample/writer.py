@@ -1,0 +1,369 @@
+"""Writing one sample folder: EXR data, PNG previews, ``scene.json`` and a sealed ``meta.json``.
+
+A sample folder ``<out_dir>/<sample_id>/`` holds
+
+* ``image.exr``, ``intrinsics.exr``, ``geometry.exr``, ``camera-<slug>.exr`` (and ``cube.exr``
+  on request): float32 layers with named channels, integer ids as UINT channels (see
+  ``meta.json["layers"]``);
+* ``previews/<layer>.png``: 8-bit sRGB previews for looking only
+  (:mod:`~spectrinsic.gt_export.sample.previews`);
+* ``scene.json``: the scene as plain data (compact JSON); ``meta.json``: provenance, materials,
+  lights, matrices, the units of every layer, the SHA-256 of every other file and its own seal
+  (:func:`~spectrinsic.gt_export.sample.meta_seal`). ``meta.json`` is written last.
+
+Everything is written into a hidden temporary folder next to the target and renamed into
+place, so a folder named ``<sample_id>`` is always whole: partial output never looks complete.
+The file names and the JSON layout come from :mod:`~spectrinsic.gt_export.sample`; readers
+take them from there too, never from this module.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import shutil
+import tempfile
+import uuid
+from collections.abc import Mapping, Sequence
+from dataclasses import asdict
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from ...errors import DatasetError
+from ...provenance import software_versions
+from ...scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash, scene_to_dict
+from ...spectra import DEFAULT_WAVELENGTHS, get_spectrum
+from ...spectra.user_spectra import spectrum_files
+from ..formats import png
+from ..formats.exr import write_exr
+from ..layers import GroundTruth, Layer, compute_ground_truth, identities
+from . import (
+    FORMAT_VERSION,
+    HASHES_KEY,
+    META_DIGITS,
+    META_NAME,
+    PREVIEW_DIR,
+    SCENE_NAME,
+    SEAL_KEY,
+    TMP_PREFIX,
+    canonical_json,
+    config_hash,
+    file_sha256,
+    meta_seal,
+    plain_data,
+)
+from .integrity import guarded_write, remove_owned_temporaries, replaceable_sample, sample_problem
+from .previews import preview_maker, preview_path
+from .sensor import SensorOutput, sensor_output, write_sensor_files
+from .transport_exr import TRANSPORT_NAME, write_transport
+
+if TYPE_CHECKING:
+    from ...render.algebra.light_transport import LightTransport
+    from ...spectra.camera_model import CameraModel
+
+__all__ = [
+    "DEFAULT_CAMERAS",
+    "export_sample",
+    "is_complete",
+    "remove_stale_temporaries",
+]
+
+log = logging.getLogger(__name__)
+
+#: Cameras exported by default when the 31-band cube is available (shipped by colour-science).
+DEFAULT_CAMERAS: tuple[str, ...] = ("camera:Nikon 5100 (NPL)", "camera:Sigma SDMerill (NPL)")
+#: Render metadata that varies from run to run and so is not written (files stay reproducible).
+_VOLATILE_META = ("timings",)
+
+
+def _dump_json(path: Path, data: Any, *, compact: bool = False) -> None:
+    with guarded_write(path):
+        path.write_text(canonical_json(data, compact=compact), encoding="utf-8")
+
+
+def _layer_records(
+    gt: GroundTruth, previews: Mapping[str, tuple[str, dict[str, Any]]]
+) -> dict[str, Any]:
+    return {
+        layer.name: {
+            "file": f"{layer.group}.exr",
+            "exr_layer": layer.name.split("/", 1)[0],
+            "channels": list(layer.channels),
+            "shape": list(layer.data.shape),
+            "dtype": str(layer.data.dtype),
+            "units": layer.units,
+            "nonnegative": layer.nonnegative,
+            "preview": previews[layer.name][0] if layer.name in previews else None,
+            "preview_encoding": previews[layer.name][1] if layer.name in previews else None,
+        }
+        for layer in gt.layers.values()
+    }
+
+
+def _meta(
+    scene: Scene,
+    result: Any,
+    gt: GroundTruth,
+    *,
+    sample_id: str,
+    config: Mapping[str, Any],
+    seed: int,
+    previews: Mapping[str, tuple[str, dict[str, Any]]],
+    files: Sequence[str],
+) -> dict[str, Any]:
+    render_meta = {
+        k: v for k, v in (getattr(result, "meta", None) or {}).items() if k not in _VOLATILE_META
+    }
+    lights = []
+    for record in gt.lights:
+        unused = set(LIGHT_PLACEMENT) - set(LIGHT_FIELDS[record.kind])
+        entry = {k: v for k, v in asdict(record).items() if k not in unused}
+        entry["spd"] = get_spectrum(record.spectrum).on(DEFAULT_WAVELENGTHS)
+        lights.append(entry)
+    height, width = gt.layers["image"].data.shape[:2]
+    files_used = spectrum_files(
+        [m.spectrum for m in scene.materials] + [li.spectrum for li in scene.lights]
+    )
+    return {
+        "format_version": FORMAT_VERSION,
+        "sample_id": sample_id,
+        "scene": scene.name,
+        "scene_hash": scene_hash(scene),
+        "scene_metadata": scene.metadata,
+        "config_hash": config_hash(config),
+        "seed": int(seed),
+        "variants": sorted(set((render_meta.get("variants") or {}).values())),
+        "render": render_meta,
+        "reference_mode": gt.reference_mode,
+        "size": [height, width],
+        "spectral_grid": {
+            "ground_truth": "360-830 nm at 1 nm (CIE 1931 grid); colours integrated by the rectangle rule",
+            "render": render_meta.get("wavelengths"),
+            "lights_spd": {"start_nm": 380.0, "end_nm": 780.0, "step_nm": 5.0},
+        },
+        "materials": gt.materials,
+        "objects": {str(m.object_id): m.name for m in scene.meshes},
+        "lights": lights,
+        "cameras": [c.split(":", 1)[-1] for c in gt.cameras],
+        "cube_sensors": gt.cube_sensors,
+        "matrices": gt.matrices,
+        "layers": _layer_records(gt, previews),
+        "identities": identities(gt),
+        "denoised_layers": list(gt.denoised),
+        "noise": gt.noise,
+        "shading_clipping": gt.clipping,
+        "residual_share": gt.residual_share,
+        "files": sorted(files),
+        "versions": software_versions(),
+    } | ({"spectrum_files": files_used} if files_used else {})
+
+
+def _write_layers(folder: Path, gt: GroundTruth, sample_id: str) -> list[str]:
+    """One EXR file per layer group; return the file names."""
+    groups: dict[str, list[Layer]] = {}
+    for layer in gt.layers.values():
+        groups.setdefault(layer.group, []).append(layer)
+    files = []
+    for group, members in groups.items():
+        name = f"{group}.exr"
+        write_exr(
+            folder / name,
+            {layer.name.split("/", 1)[0]: layer.data for layer in members},
+            channel_names={layer.name.split("/", 1)[0]: layer.channels for layer in members},
+            attributes={"spectrinsic.sample": sample_id},
+        )
+        files.append(name)
+    return files
+
+
+def _write_previews(folder: Path, gt: GroundTruth) -> dict[str, tuple[str, dict[str, Any]]]:
+    """One PNG per layer that has a preview maker; return ``{layer: (path, encoding)}``."""
+    (folder / PREVIEW_DIR).mkdir()
+    previews: dict[str, tuple[str, dict[str, Any]]] = {}
+    for layer in gt.layers.values():
+        maker = preview_maker(layer)
+        if maker is None:
+            continue
+        rel = preview_path(layer)
+        rgb8, encoding = maker(layer, gt.layers)
+        png.write_png(folder / rel, rgb8)
+        previews[layer.name] = (rel, encoding)
+    return previews
+
+
+def _fill_folder(
+    folder: Path,
+    scene: Scene,
+    result: Any,
+    gt: GroundTruth,
+    *,
+    transport: LightTransport | None = None,
+    sensor: SensorOutput | None = None,
+    **meta_kw: Any,
+) -> None:
+    files = _write_layers(folder, gt, meta_kw["sample_id"])
+    if sensor is not None:  # the camera chain's raw DNG and processed PNG (gt_export.sensor)
+        files += write_sensor_files(folder, sensor)
+    previews = _write_previews(folder, gt)
+    files += [rel for rel, _ in previews.values()]
+    # scene_to_dict, the record the scene hash is taken of (a procedural texture's recipe, not
+    # its texel weights); scene_from_dict reads it back
+    _dump_json(folder / SCENE_NAME, plain_data(scene_to_dict(scene)), compact=True)
+    files.append(SCENE_NAME)
+    # meta.json last: its presence (with the right config hash) marks the folder complete; it
+    # records the SHA-256 of every other file, so a resumed build can tell an intact sample,
+    # and its own seal, so it can tell an intact meta.json
+    record = None
+    if transport is not None:  # the per-light transport, for exact relighting
+        record = write_transport(
+            folder, transport, result.aovs["coverage"], sample_id=meta_kw["sample_id"]
+        )
+        record["cameras"] = list(gt.cameras)  # full sensor-set names, to relight the camera layers
+        files.append(TRANSPORT_NAME)
+    meta = _meta(scene, result, gt, previews=previews, files=files, **meta_kw)
+    if record is not None:  # before the hashes and the seal, which cover it
+        meta["transport"] = record
+    if sensor is not None:
+        meta["sensor"] = sensor.meta
+        meta["identities"].append(sensor.identity)
+    meta[HASHES_KEY] = {rel: file_sha256(folder / rel) for rel in sorted(files)}
+    meta = plain_data(meta, META_DIGITS)
+    meta[SEAL_KEY] = meta_seal(meta)
+    _dump_json(folder / META_NAME, meta)
+
+
+def export_sample(
+    out_dir: str | os.PathLike[str],
+    scene: Scene,
+    result: Any,
+    *,
+    sample_id: str,
+    config: Mapping[str, Any],
+    seed: int,
+    cameras: Sequence[str] | None = None,
+    write_cube: bool = False,
+    denoise: bool = False,
+    data_dir: str | os.PathLike[str] | None = None,
+    transport: LightTransport | None = None,
+    camera: CameraModel | None = None,
+    spectral_layers: bool = False,
+) -> Path:
+    """Compute every ground-truth layer of a rendered sample and write it atomically.
+
+    Parameters
+    ----------
+    out_dir
+        Dataset folder; the sample goes to ``out_dir/sample_id``.
+    scene
+        The rendered scene.
+    result
+        A :class:`~spectrinsic.render.result.RenderResult`, or any record with its fields
+        (``images``, ``raw``, ``per_light``, ``direct``, ``aovs``, ``meta``, ``batch_raw``);
+        never a live renderer.
+    sample_id
+        Folder name, e.g. ``"obj-vase__v0__two-colour-a"``.
+    config
+        The settings the sample was built with; ``meta.json`` records :func:`config_hash` of it.
+    seed
+        The sample's render seed.
+    cameras
+        Camera sensor sets for per-camera layers; default :data:`DEFAULT_CAMERAS` when the
+        render has the 31-band cube, none otherwise.
+    write_cube
+        Also write the multispectral cube (``cube.exr``).
+    denoise
+        Compute shading, residual and illuminant from the OIDN-denoised irradiance.
+    data_dir
+        Spectral data directory (for ``sfu:``/data-directory cameras).
+    transport
+        A :class:`~spectrinsic.render.algebra.light_transport.LightTransport` of this render to store as
+        ``transport.exr`` (:mod:`~spectrinsic.gt_export.sample.transport_exr`), for exact
+        relighting (:func:`spectrinsic.gt_export.relight.relight`).
+    camera
+        A :class:`~spectrinsic.spectra.camera_model.CameraModel` to run the sample through
+        (:mod:`~spectrinsic.gt_export.sample.sensor`): raw mosaic, DNG, processed image and the ground
+        truth in the processed linear space; its sensitivities must be among *cameras*.
+    spectral_layers
+        Also write the per-band intrinsic layers (``spectral.exr``,
+        :mod:`~spectrinsic.gt_export.layers.spectral_intrinsics`); needs the 31-band cube.
+
+    Returns
+    -------
+    Path
+        The complete sample folder.
+    """
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    if not sample_id or "/" in sample_id or sample_id.startswith("."):
+        raise DatasetError(f"sample id {sample_id!r}: expected a plain folder name")
+    if cameras is None:
+        cameras = DEFAULT_CAMERAS if "bands31" in (getattr(result, "raw", None) or {}) else ()
+    if camera is not None and camera.sensitivities not in cameras:
+        cameras = (*cameras, camera.sensitivities)  # the chain runs on that camera's image
+    gt = compute_ground_truth(
+        scene,
+        result,
+        cameras=cameras,
+        write_cube=write_cube,
+        denoise=denoise,
+        data_dir=data_dir,
+        spectral=spectral_layers,
+    )
+    sensor = None
+    if camera is not None:
+        sensor = sensor_output(gt, camera, seed=seed, sample_id=sample_id, data_dir=data_dir)
+        gt = sensor.ground_truth
+    final = out_dir / sample_id
+    tmp = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{sample_id}-", dir=out_dir))
+    try:
+        tmp.chmod(0o755)
+        _fill_folder(
+            tmp,
+            scene,
+            result,
+            gt,
+            sample_id=sample_id,
+            config=config,
+            seed=seed,
+            transport=transport,
+            sensor=sensor,
+        )
+        _move_into_place(tmp, final, config_hash(config))
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    log.debug("wrote sample %s", final)
+    return final
+
+
+def _move_into_place(tmp: Path, final: Path, chash: str) -> None:
+    if final.exists() or final.is_symlink():
+        # an older version: move it aside first, so no moment shows a mixed folder; a folder
+        # spectrinsic did not write (or one holding a user's file) is never replaced
+        replaceable_sample(final)
+        aside = final.with_name(f"{TMP_PREFIX}old-{final.name}-{uuid.uuid4().hex[:8]}")
+        final.rename(aside)
+        shutil.rmtree(aside, ignore_errors=True)
+    try:
+        tmp.rename(final)
+    except OSError:
+        # another worker finished the same sample meanwhile (e.g. a retried distributed task)
+        if is_complete(final, chash):
+            shutil.rmtree(tmp, ignore_errors=True)
+        else:
+            raise
+
+
+def is_complete(sample_dir: str | os.PathLike[str], config_hash: str) -> bool:
+    """True iff *sample_dir* holds a ``meta.json`` with this *config_hash* and all its files,
+    each matching its recorded SHA-256 (see :func:`~spectrinsic.gt_export.sample.integrity.sample_problem`)."""
+    return sample_problem(sample_dir, config_hash) is None
+
+
+def remove_stale_temporaries(dataset_dir: str | os.PathLike[str]) -> list[Path]:
+    """Delete spectrinsic's temporaries left by interrupted writes; return what was removed.
+
+    Only names starting with :data:`TMP_PREFIX`, and only in a recognised dataset folder. Call
+    it only when no other writer works on *dataset_dir*.
+    """
+    return remove_owned_temporaries(Path(dataset_dir))

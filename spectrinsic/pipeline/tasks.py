@@ -1,0 +1,116 @@
+"""The records of one sample's work: the task a worker gets, and what it gives back.
+
+Plain picklable records (no live objects), below both the planner of the library layout
+(:mod:`spectrinsic.pipeline.dataset`) and that of generated scenes and scene files
+(:mod:`spectrinsic.pipeline.source_plan`), which both make :class:`SampleTask` lists.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Literal
+
+from ..rng import seed_from_key
+from ..scenes.sample_id import SampleId
+from .presets import DatasetConfig
+
+__all__ = ["SampleTask", "SampleOutcome", "SampleFailure"]
+
+
+@dataclass(frozen=True)
+class SampleTask:
+    """Everything a worker needs to build one sample (picklable; no live objects).
+
+    Attributes
+    ----------
+    id
+        Which scene, camera view and lighting condition; ``str(id)`` is the sample's folder
+        name (:attr:`sample_id`).
+    seed
+        The sample's render seed, ``seed_from_key(config.seed, sample_id)``. The scene library
+        draws the lights from the root seed ``config.seed`` instead, so every view of a scene
+        under one condition shares its lights.
+    out_dir
+        Dataset folder; the sample is written to ``out_dir/sample_id``.
+    config
+        The build settings.
+    data_dir
+        Spectral data directory, or ``None`` for ``$SPECTRINSIC_DATA``.
+    render_threads
+        Dr.Jit worker threads per process, or ``None`` to leave Dr.Jit's default (all cores).
+    source
+        A :mod:`spectrinsic.scenes.sources` record (generated scene or scene file) the worker
+        builds the scene from; ``None`` for a library scene.
+    """
+
+    id: SampleId
+    seed: int
+    out_dir: str
+    config: DatasetConfig
+    data_dir: str | None = None
+    render_threads: int | None = None
+    source: Any = None
+
+    @property
+    def sample_id(self) -> str:
+        """Folder name of the sample, ``str(self.id)``, e.g. ``"obj-vase__v0__two-colour-a"``."""
+        return str(self.id)
+
+    @property
+    def scene(self) -> str:
+        """The scene's name, ``self.id.scene``."""
+        return self.id.scene
+
+    @classmethod
+    def planned(
+        cls, sid: SampleId, config: DatasetConfig, out_dir: str, **options: Any
+    ) -> SampleTask:
+        """The task of sample *sid*, seeded ``seed_from_key(config.seed, str(sid))``; *options*
+        are the remaining fields (``data_dir``, ``render_threads``, ``source``)."""
+        return cls(
+            id=sid,
+            seed=seed_from_key(config.seed, str(sid)),
+            out_dir=out_dir,
+            config=config,
+            **options,
+        )
+
+
+@dataclass(frozen=True)
+class SampleOutcome:
+    """The result of one sample.
+
+    Attributes
+    ----------
+    sample_id
+        Which sample.
+    status
+        ``"built"`` or ``"skipped"`` (already complete with the same config hash).
+    path
+        The sample folder.
+    seconds
+        Wall time of the whole task in s (scene, render, export).
+    render_seconds
+        Wall time spent inside ``render_scene`` in s (Mitsuba plus its array conversions).
+    mitsuba_seconds
+        Time inside Mitsuba's ``render`` calls in s, as reported by the renderer's
+        ``meta["timings"]``; equal to *render_seconds* when the renderer reports none.
+    peak_rss_mb
+        Peak resident memory of the worker process so far, MiB (``ru_maxrss``).
+    """
+
+    sample_id: str
+    status: Literal["built", "skipped"]
+    path: str
+    seconds: float = 0.0
+    render_seconds: float = 0.0
+    mitsuba_seconds: float = 0.0
+    peak_rss_mb: float = 0.0
+
+
+@dataclass(frozen=True)
+class SampleFailure:
+    """A sample whose task raised; *error* is ``"ExceptionType: message"``."""
+
+    sample_id: str
+    error: str

@@ -1,0 +1,166 @@
+"""Independent batches of one scene's render: their seeds, their mean and their spread, as
+arithmetic on the batches' arrays (no render here: :mod:`~spectrinsic.render.batches` runs them).
+
+The batches differ only in their seed (:func:`batch_seeds`), so the spread between them is a
+direct estimate of the Monte Carlo error of their mean (:func:`relative_standard_error`,
+:func:`image_noise`); :func:`batch_mean` and :func:`merge_batches` give the mean in float32,
+summed in float64 in batch order.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ...errors import RenderError, SceneError
+from ...rng import seed_from_key
+from ..result import RenderResult
+
+__all__ = [
+    "batch_mean",
+    "batch_seeds",
+    "relative_standard_error",
+    "image_noise",
+    "merge_batches",
+]
+
+
+def batch_seeds(seed: int, batches: int) -> list[int]:
+    """Sampler seeds of *batches* independent batches: the sample's own seed first (so one
+    batch is exactly :func:`render_scene`), then seeds derived from it by key."""
+    if isinstance(batches, bool) or not isinstance(batches, int) or batches < 1:
+        raise SceneError(f"batches {batches!r}: expected a positive integer")
+    return [int(seed)] + [seed_from_key(int(seed), f"batch-{b}") for b in range(1, batches)]
+
+
+def relative_standard_error(batches: Sequence[np.ndarray], valid: np.ndarray) -> np.ndarray:
+    """Per-pixel relative standard error of the mean of independent batch estimates.
+
+    ``se = sqrt(Σ_b ‖x_b − x̄‖² / (B (B − 1)))`` over channels, divided by ``‖x̄‖``; 0 where
+    not *valid* or where ``‖x̄‖`` is below 1e-3 of its 99th percentile (unlit).
+
+    Parameters
+    ----------
+    batches
+        ``B >= 2`` arrays ``(H, W, C)``, one estimate per independent batch.
+    """
+    stack = np.stack([np.asarray(b, np.float64) for b in batches])
+    if stack.shape[0] < 2:
+        raise RenderError("a noise estimate needs at least two independent batches")
+    mean = stack.mean(axis=0)
+    b = stack.shape[0]
+    se = np.sqrt(((stack - mean) ** 2).sum(axis=(0, -1)) / (b * (b - 1)))
+    norm = np.linalg.norm(mean, axis=-1)
+    positive = norm[valid & (norm > 0)]
+    floor = 1e-3 * np.percentile(positive, 99) if positive.size else np.inf
+    ok = valid & (norm > floor)
+    return np.where(ok, se / np.where(ok, norm, 1.0), 0.0)
+
+
+def image_noise(results: Sequence[RenderResult]) -> float | None:
+    """Median over lit pixels of the relative standard error of the mean image (XYZ of the
+    31-band cube, else of the first mode), from independent batch renders; ``None`` for fewer
+    than two."""
+    if len(results) < 2:
+        return None
+    images = results[0].images
+    mode = "bands31" if "bands31" in images else next(iter(images))
+    stack = [np.asarray(r.images[mode], np.float64) for r in results]
+    rel = relative_standard_error(stack, np.ones(stack[0].shape[:2], bool))
+    return float(np.median(rel[rel > 0])) if (rel > 0).any() else 0.0
+
+
+def _half_sum(a: np.ndarray, b: np.ndarray) -> np.ndarray | None:
+    """``(a + b) / 2`` of two float32 arrays in float32, the bits of the float64 mean: the
+    float32 sum is the float64 sum rounded once more, which is innocuous for one addition
+    (53 >= 2 * 24 + 2); halving is exact, and where the half is subnormal the sum was exact
+    (every float32 is a multiple of 2^-149, and one below 2^-125 has at most 24 bits).
+    ``None`` where that does not hold: not both float32, or a sum beyond float32's range."""
+    if not (a.dtype == b.dtype == np.float32):
+        return None
+    with np.errstate(over="ignore"):  # an overflow is detected below and left to float64
+        half = np.add(a, b)
+    half *= np.float32(0.5)
+    return half if np.isfinite(half).all() else None
+
+
+def batch_mean(arrays: Sequence[np.ndarray]) -> np.ndarray:
+    """float32 mean of independent batch estimates, summed in order in float64 and divided by
+    their number (the bits of ``np.mean(np.stack(arrays), axis=0, dtype=np.float64)``, without
+    the stacked copy); one float32 array is returned as it is."""
+    if len(arrays) == 1:
+        return np.asarray(arrays[0], np.float32)
+    if len(arrays) == 2:
+        half = _half_sum(arrays[0], arrays[1])
+        if half is not None:
+            return half
+    total = np.asarray(arrays[0], np.float64).copy()
+    for array in arrays[1:]:
+        total += array
+    total /= len(arrays)
+    return total.astype(np.float32)
+
+
+def _merge_aovs(parts: Sequence[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
+    """Coverage, depth and normals averaged over the batches (each batch's AOVs saw that
+    batch's own pixel samples); the integer maps and the mask are those of the first batch."""
+    if not parts or not parts[0]:
+        return {}
+    merged = dict(parts[0])
+    for key in ("coverage", "depth", "normals"):
+        if key in merged:
+            merged[key] = batch_mean([p[key] for p in parts])
+    if "normals" in merged:
+        n = merged["normals"].astype(np.float64)
+        length = np.linalg.norm(n, axis=-1, keepdims=True)
+        merged["normals"] = np.divide(n, length, out=np.zeros_like(n), where=length > 1e-6).astype(
+            np.float32
+        )
+    return merged
+
+
+def _mean_part(results: Sequence[RenderResult], field: str, part: str) -> dict[str, np.ndarray]:
+    """Mode -> :func:`batch_mean` of one *part* of the results' ``parts`` or ``part_transport``."""
+    held = [getattr(r, field)[part] for r in results]
+    return {m: batch_mean([h[m] for h in held]) for m in held[0]}
+
+
+def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
+    """The mean of independent batch renders of one scene, keeping each batch's raw channels."""
+    if not results:
+        raise RenderError("no batches to merge")
+    if len(results) == 1:
+        return results[0]
+    first = results[0]
+    modes = list(first.images)
+    meta = dict(first.meta)
+    meta.update(
+        spp=int(first.meta["spp"]) * len(results),
+        batches=len(results),
+        batch_spp=int(first.meta["spp"]),
+        batch_seeds=[int(r.meta["seed"]) for r in results],
+        timings={
+            k: {
+                "passes": sum(r.meta["timings"][k]["passes"] for r in results),
+                "seconds": sum(r.meta["timings"][k]["seconds"] for r in results),
+                "per_pass": [x for r in results for x in r.meta["timings"][k]["per_pass"]],
+            }
+            for k in first.meta["timings"]
+        },
+    )
+    return RenderResult(
+        images={m: batch_mean([r.images[m] for r in results]) for m in modes},
+        raw={m: batch_mean([r.raw[m] for r in results]) for m in first.raw},
+        per_light=tuple(
+            {m: batch_mean([r.per_light[i][m] for r in results]) for m in pl}
+            for i, pl in enumerate(first.per_light)
+        ),
+        direct={m: batch_mean([r.direct[m] for r in results]) for m in first.direct},
+        aovs=_merge_aovs([r.aovs for r in results]),
+        transport={m: batch_mean([r.transport[m] for r in results]) for m in first.transport},
+        parts={p: _mean_part(results, "parts", p) for p in first.parts},
+        part_transport={p: _mean_part(results, "part_transport", p) for p in first.part_transport},
+        meta=meta,
+        batch_raw=tuple(dict(r.raw) for r in results),
+    )

@@ -1,0 +1,380 @@
+"""The one band-path loop: Mitsuba's ``path`` on K band throughputs, its features chosen when traced.
+
+:class:`BandKernel` is the loop of Mitsuba's ``path`` integrator (``src/integrators/path.cpp``:
+emitter hits and next-event estimation with the power-heuristic :func:`mis_weight`, the same
+sampler calls in the same order) whose throughput is a list of K band products and whose
+contributions go to one accumulator per (light, band). The scene is loaded white, so Mitsuba's
+own BSDF and emitter sampling give the band-independent factors; the kernel multiplies each by a
+band factor ``c_k`` of the vertex (:mod:`spectrinsic.render.band_path.integrator` builds the integrator).
+One body, three loops, told apart by Python flags read while Dr.Jit traces the kernel (as
+Mitsuba's ``prb.py`` switches its features), so each traced kernel holds only its own steps:
+
+* **matte** (no flag): ``c_k = ρ_k``, the band albedo of the material hit (or of the nearest
+  texel of a textured shape).
+* **gloss**: a glossy material is loaded as Mitsuba's ``plastic`` / ``roughplastic`` with a white
+  base, or as a perfect-mirror ``conductor`` / ``roughconductor``. Its white BSDF is
+  ``f = f_d + f_s`` (diffuse and non-diffuse lobes, told apart by evaluating with a
+  ``BSDFContext`` whose ``type_mask`` is ``BSDFFlags.Diffuse``), and its band BSDF is
+  ``ρ_k f_d + s_k f_s``: the plastic's diffuse lobe is linear in the base reflectance and its coat
+  band-independent (``s_k = 1``); a metal has ``f_d = 0`` and ``s_k = F_k(μ)``, the band Fresnel
+  of its η/k at ``μ = |wi · h|``, read from a per-row table
+  (:func:`spectrinsic.spectra.conductors.fresnel_table`). With ``a = f_d / f`` at the direction
+  used (0 for a delta-sampled lobe) the band factor is exactly::
+
+      c_k = ρ_k a + s_k (1 − a)                                                    (G1)
+
+  in both the emitter and the BSDF sample (``a = 1`` at a Lambertian vertex). The loop also
+  carries the **specular transport** ``S``: the part whose first camera-ray vertex went through
+  the non-diffuse lobe; its band throughput starts as ``s_k (1 − a)`` there and is multiplied by
+  (G1) afterwards. Emitters the camera sees directly are in neither S nor the diffuse part.
+* **white at metals** (with gloss): a metal has no diffuse lobe, so its shading ``W = P_diff / ρ``
+  is 0/0; it is defined as the radiance a white Lambertian surface would reflect there,
+  ``W_k = E_k / π``. A second loop over the same camera rays (after the first, whose paths are so
+  unchanged) makes a metal first hit a white ``diffuse`` vertex (ρ_k = 1) and goes on through the
+  true scene with (G1); elsewhere the lane stops at once. Its accumulators ``M`` average over all
+  of a pixel's samples, so ``M = c_metal · W`` with ``c_metal`` the pixel's metal coverage.
+* **first-hit maps** (``n_surfaces`` > 0, not in the white loop): the camera ray's surface, ray
+  distance, shading normal (and texel) are kept in the loop state.
+
+Where to add a glossy part (a new per-light accumulator): a flag and its step here, its
+channel names and AOV order in :mod:`~spectrinsic.render.band_path.integrator`, and its cut into the
+per-light record in :mod:`~spectrinsic.render.band_path.traversal`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..base.textures import texel_of
+
+__all__ = ["PathState", "BandKernel", "mis_weight", "band_max"]
+
+
+def mis_weight(dr: Any, mi: Any, pdf_a: Any, pdf_b: Any) -> Any:
+    """Power heuristic exactly as ``path.cpp``'s ``mis_weight`` (pdfs in the same measure)."""
+    a, b = pdf_a * pdf_a, pdf_b * pdf_b
+    w = a / (a + b)
+    return dr.detach(dr.select(dr.isfinite(w), w, mi.Float(0.0)))
+
+
+def band_max(dr: Any, bands: Sequence) -> Any:
+    """Largest band value per lane (a balanced tree of ``dr.maximum``)."""
+    values = list(bands)
+    while len(values) > 1:
+        values = [
+            dr.maximum(values[i], values[i + 1]) if i + 1 < len(values) else values[i]
+            for i in range(0, len(values), 2)
+        ]
+    return values[0]
+
+
+@dataclass
+class PathState:
+    """The loop state Dr.Jit carries (a dataclass: ``dr.while_loop`` traverses its fields in
+    this order). Band lists hold K entries, accumulators K·L (light-major)."""
+
+    sampler: Any
+    ray: Any
+    depth: Any
+    #: Band-independent throughput (Mitsuba's BSDF weights and the roulette's scale).
+    beta: Any
+    bands: list
+    acc: list
+    prev_si: Any
+    prev_pdf: Any
+    prev_delta: Any
+    #: First-hit state (surface, distance, normal[, texel, textured]); empty without maps.
+    first: tuple
+    alive: Any
+    #: Specular band throughputs and accumulators (gloss loop only).
+    sbands: list = field(default_factory=list)
+    sacc: list = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class _Vertex:
+    """What a vertex's sampling gives: the light and weight of the emitter sample, its mask,
+    Mitsuba's BSDF sample and weight, and (gloss) ``(a, μ)`` of both directions."""
+
+    light: Any
+    nee: Any
+    active_em: Any
+    bsdf_sample: Any
+    bsdf_weight: Any
+    em_lobes: tuple = ()
+    bs_lobes: tuple = ()
+
+
+class BandKernel:
+    """The loop of ``path.cpp`` on band throughputs (module docstring); *it* is the integrator
+    (depths, sizes, lookups). *gloss* switches on the (G1) factors and, outside the white loop,
+    the specular accumulators; *white* is the white-at-metal loop."""
+
+    def __init__(
+        self, mi: Any, dr: Any, it: Any, scene: Any, *, gloss: bool = False, white: bool = False
+    ) -> None:
+        self.mi, self.dr, self.it, self.scene = mi, dr, it, scene
+        self.gloss, self.white = gloss or white, white
+        self.spec = gloss and not white
+
+    # -- lookups ---------------------------------------------------------------------------
+
+    def light_of(self, emitter: Any, mask: Any) -> Any:
+        ids = self.dr.reinterpret_array(self.mi.UInt32, emitter)
+        return self.dr.gather(self.mi.UInt32, self.it.emitter_lut, ids, mask)
+
+    def row(self, si: Any) -> Any:
+        """Albedo-table row of the shape hit."""
+        mi, dr = self.mi, self.dr
+        ids = dr.reinterpret_array(mi.UInt32, si.shape)
+        return dr.gather(mi.UInt32, self.it.shape_lut, ids, si.is_valid())
+
+    def albedo(self, si: Any) -> list:
+        """ρ_k of the material of the shape hit (the black row elsewhere), or of the nearest
+        texel on a textured shape."""
+        mi, dr, k = self.mi, self.dr, self.it.n_bands
+        valid = si.is_valid()
+        row = dr.gather(
+            mi.UInt32, self.it.shape_lut, dr.reinterpret_array(mi.UInt32, si.shape), valid
+        )
+        rho = [dr.gather(mi.Float, self.it.albedo, row * k + b, valid) for b in range(k)]
+        if not self.it.n_texcols:
+            return rho
+        texel, textured = texel_of(mi, dr, self.it, si)
+        return [
+            dr.select(
+                textured, dr.gather(mi.Float, self.it.texel_albedo, texel * k + b, textured), r
+            )
+            for b, r in enumerate(rho)
+        ]
+
+    def deposit(self, acc: list, light: Any, weight: Any, bands: Sequence, mask: Any) -> list:
+        """``acc[l·K + k] += bands[k]·weight`` on the lanes whose light is l."""
+        k, out = self.it.n_bands, list(acc)
+        for j in range(self.it.n_lights):
+            w = self.dr.select(mask & (light == j), weight, 0.0)
+            for b in range(k):
+                out[j * k + b] = self.dr.fma(bands[b], w, out[j * k + b])
+        return out
+
+    # -- the steps of a vertex -------------------------------------------------------------
+
+    def emitter_hit(self, si: Any, s: PathState) -> tuple[Any, Any, Any]:
+        """Light, weight (radiance x BSDF-sampling MIS weight) and mask of an emitter hit."""
+        mi, dr = self.mi, self.dr
+        emitter = si.emitter(self.scene)
+        hit = emitter != None  # noqa: E711 (a Dr.Jit pointer array, compared lane by lane)
+        ds = mi.DirectionSample3f(self.scene, si=si, ref=s.prev_si)
+        em_pdf = dr.select(
+            s.prev_delta, 0.0, self.scene.pdf_emitter_direction(s.prev_si, ds, ~s.prev_delta)
+        )
+        radiance = emitter.eval(si, (s.prev_pdf > 0.0) & hit)[0]
+        return self.light_of(emitter, hit), radiance * mis_weight(dr, mi, s.prev_pdf, em_pdf), hit
+
+    def lobes(self, si: Any, bsdf: Any, wo: Any, delta: Any, active: Any) -> tuple[Any, Any]:
+        """``a = f_d / f`` at local direction *wo* (0 where *delta*; exactly 1 for a BSDF
+        without non-diffuse lobes) and ``μ = |wi · h|``."""
+        mi, dr = self.mi, self.dr
+        diffuse = bsdf.eval(
+            mi.BSDFContext(mi.TransportMode.Radiance, mi.BSDFFlags.Diffuse), si, wo, active
+        )[0]
+        full = bsdf.eval(mi.BSDFContext(), si, wo, active)[0]
+        a = dr.clip(dr.select(full > 0.0, diffuse / full, 1.0), 0.0, 1.0)
+        flags = bsdf.flags()
+        matte = ~(mi.has_flag(flags, mi.BSDFFlags.Glossy) | mi.has_flag(flags, mi.BSDFFlags.Delta))
+        a = dr.select(matte, 1.0, dr.select(delta, 0.0, a))
+        h = si.wi + wo
+        norm = dr.norm(h)
+        mu = dr.select(norm > 0.0, dr.abs(dr.dot(si.wi, h)) / norm, 1.0)
+        return a, dr.clip(mu, 0.0, 1.0)
+
+    def vertex(self, sampler: Any, si: Any, bsdf: Any, active_next: Any) -> _Vertex:
+        """Emitter sample, then BSDF evaluation and sample (``eval_pdf_sample``); with gloss
+        also ``a`` and ``μ`` of both directions."""
+        mi, dr = self.mi, self.dr
+        active_em = active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth)
+        ds, em_weight = self.scene.sample_emitter_direction(si, sampler.next_2d(), True, active_em)
+        active_em &= ds.pdf != 0.0
+        sample_1, sample_2 = sampler.next_1d(), sampler.next_2d()
+        wo_em = si.to_local(ds.d)
+        bsdf_val, bsdf_pdf, bsdf_sample, bsdf_weight = bsdf.eval_pdf_sample(
+            mi.BSDFContext(), si, wo_em, sample_1, sample_2
+        )
+        mis_em = dr.select(ds.delta, 1.0, mis_weight(dr, mi, ds.pdf, bsdf_pdf))
+        nee = bsdf_val[0] * em_weight[0] * mis_em
+        if not self.gloss:
+            light = self.light_of(ds.emitter, active_em)
+            return _Vertex(light, nee, active_em, bsdf_sample, bsdf_weight[0])
+        em_lobes = self.lobes(si, bsdf, wo_em, mi.Bool(False), active_em)
+        delta = mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
+        bs_lobes = self.lobes(si, bsdf, bsdf_sample.wo, delta, active_next)
+        light = self.light_of(ds.emitter, active_em)
+        return _Vertex(light, nee, active_em, bsdf_sample, bsdf_weight[0], em_lobes, bs_lobes)
+
+    def specular_bands(self, row: Any, mu: Any, valid: Any) -> list:
+        """``s_k(μ)`` of table row *row*: linear interpolation over the μ nodes."""
+        mi, dr, k, n = self.mi, self.dr, self.it.n_bands, self.it.n_nodes
+        x = mu * (n - 1)
+        j = dr.minimum(mi.UInt32(dr.floor(x)), n - 2)
+        t = x - mi.Float(j)
+        base = (row * n + j) * k
+        out = []
+        for b in range(k):
+            lo = dr.gather(mi.Float, self.it.specular, base + b, valid)
+            hi = dr.gather(mi.Float, self.it.specular, base + k + b, valid)
+            out.append(dr.fma(t, hi - lo, lo))
+        return out
+
+    def factors(self, rho: list, row: Any, lobes: tuple, valid: Any) -> tuple[list, list]:
+        """(G1) ``c_k`` and its non-diffuse part ``s_k (1 − a)`` for ``lobes = (a, μ)``."""
+        a, mu = lobes
+        spec = [s * (1.0 - a) for s in self.specular_bands(row, mu, valid)]
+        return [self.dr.fma(r, a, s) for r, s in zip(rho, spec, strict=True)], spec
+
+    # -- first-hit maps --------------------------------------------------------------------
+
+    def first_hit(self, si: Any, depth: Any, first: tuple) -> tuple:
+        """Surface index, ray distance and shading normal of the camera ray's hit."""
+        mi, dr = self.mi, self.dr
+        if not self.it.n_surfaces:
+            return first
+        now, valid = depth == 0, si.is_valid()
+        surface = dr.gather(
+            mi.UInt32, self.it.surface_lut, dr.reinterpret_array(mi.UInt32, si.shape), valid
+        )
+        surface = dr.select(valid, surface, self.it.n_surfaces)
+        distance = dr.select(valid, si.t, 0.0)
+        normal = dr.select(valid, si.sh_frame.n, mi.Vector3f(0.0))
+        hit = (surface, distance, normal) + (
+            texel_of(mi, dr, self.it, si) if self.it.n_texcols else ()
+        )
+        return tuple(dr.select(now, h, f) for h, f in zip(hit, first, strict=True))
+
+    def first_state(self) -> tuple:
+        """The first-hit state before any hit: no surface, no distance, no normal (no texel)."""
+        mi = self.mi
+        if self.white:
+            return ()
+        first = (mi.UInt32(self.it.n_surfaces), mi.Float(0.0), mi.Vector3f(0.0))
+        return first + ((mi.UInt32(0), mi.Bool(False)) if self.it.n_texcols else ())
+
+    def first_maps(self, first: tuple) -> list:
+        """The first-hit channels (``first_hit_channels``) of the final first-hit state."""
+        mi, dr, n = self.mi, self.dr, self.it.n_surfaces
+        if not n:
+            return []
+        surface, distance, normal = first[:3]
+        out = [dr.select(surface == i, 1.0, 0.0) for i in range(n)]
+        if self.it.n_texcols:
+            texel, textured = first[3:]
+            g = self.it.n_texcols
+            out += [
+                dr.select(
+                    textured,
+                    dr.gather(mi.Float, self.it.texel_weights, texel * g + c, textured),
+                    0.0,
+                )
+                for c in range(g)
+            ]
+        return out + [distance, normal.x, normal.y, normal.z]
+
+    # -- the loop --------------------------------------------------------------------------
+
+    def start(self, sampler: Any, ray: Any, active: Any) -> PathState:
+        """Depth 0, throughput 1, K band throughputs 1, K·L accumulators 0, no previous vertex
+        (pdf 1, delta); the specular ones 0 with gloss."""
+        mi, dr, k, n = self.mi, self.dr, self.it.n_bands, self.it.n_bands * self.it.n_lights
+        return PathState(
+            sampler,
+            mi.Ray3f(ray),
+            mi.UInt32(0),
+            mi.Float(1.0),
+            [mi.Float(1.0) for _ in range(k)],
+            [mi.Float(0.0) for _ in range(n)],
+            dr.zeros(mi.Interaction3f),
+            mi.Float(1.0),
+            mi.Bool(True),
+            self.first_state(),
+            mi.Bool(active),
+            [mi.Float(0.0) for _ in range(k)] if self.spec else [],
+            [mi.Float(0.0) for _ in range(n)] if self.spec else [],
+        )
+
+    def step(self, s: PathState, si: Any, v: _Vertex, bands: list) -> tuple[PathState, Any]:
+        """Go on to the next vertex with the new band throughputs *bands*: ray, depth, previous
+        vertex and the go-on flag. Russian roulette on the largest band (``path.cpp``: largest
+        channel); off when ``rr_depth`` > ``max_depth``, but its sample is drawn either way."""
+        mi, dr = self.mi, self.dr
+        ray = si.spawn_ray(si.to_world(v.bsdf_sample.wo))
+        depth = dr.select(si.is_valid(), s.depth + 1, s.depth)
+        beta = s.beta * v.bsdf_weight
+        throughput_max = beta * band_max(dr, bands)
+        rr_prob = dr.minimum(throughput_max, 0.95)
+        rr_active = depth >= self.it.rr_depth
+        rr_continue = s.sampler.next_1d() < rr_prob
+        beta = dr.select(rr_active, beta * dr.rcp(dr.detach(rr_prob)), beta)
+        go_on = (~rr_active | rr_continue) & (throughput_max != 0.0)
+        delta = mi.has_flag(v.bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
+        state = PathState(
+            s.sampler, ray, depth, beta, bands, s.acc, mi.Interaction3f(si),
+            v.bsdf_sample.pdf, delta, s.first, s.alive, s.sbands, s.sacc,
+        )  # fmt: skip
+        return state, go_on
+
+    def body(self, s: PathState) -> PathState:
+        """One vertex: emitter hit, emitter sample, BSDF sample, in ``path.cpp``'s order."""
+        mi, dr = self.mi, self.dr
+        si = self.scene.ray_intersect(s.ray, ray_flags=mi.RayFlags.All, coherent=s.depth == 0)
+        now, valid, swap = s.depth == 0, si.is_valid(), None
+        if self.white:  # the camera ray's metal hit becomes a white Lambertian vertex
+            row = self.row(si)
+            swap = now & (dr.gather(mi.UInt32, self.it.metal_rows, row, valid) != 0)
+        else:
+            s.first = self.first_hit(si, s.depth, s.first)
+        light, weight, hit = self.emitter_hit(si, s)
+        # the white loop: what the camera sees directly is not reflected by the white surface
+        s.acc = self.deposit(
+            s.acc, light, s.beta * weight, s.bands, hit if swap is None else hit & ~now
+        )
+        if self.spec:
+            s.sacc = self.deposit(s.sacc, light, s.beta * weight, s.sbands, hit)
+        active_next = (s.depth + 1 < self.it.max_depth) & valid
+        bsdf = si.bsdf(s.ray)
+        if swap is not None:
+            active_next &= ~now | swap
+            bsdf = dr.select(swap, mi.BSDFPtr(self.it.white_bsdf), bsdf)
+        v = self.vertex(s.sampler, si, bsdf, active_next)
+        c_em = c_bs = rho = self.albedo(si)
+        if swap is not None:
+            rho = [dr.select(swap, 1.0, r) for r in rho]
+        if self.gloss:
+            row = row if self.white else self.row(si)
+            c_em, s_em = self.factors(rho, row, v.em_lobes, valid)
+            c_bs, s_bs = self.factors(rho, row, v.bs_lobes, valid)
+        if self.spec:  # the first vertex starts the specular throughput; later ones scale it
+            pairs = zip(s.bands, s_em, s.sbands, c_em, strict=True)
+            s_nee = [dr.select(now, b * x, sb * c) for b, x, sb, c in pairs]
+            pairs = zip(s.bands, s_bs, s.sbands, c_bs, strict=True)
+            s.sbands = [dr.select(now, b * x, sb * c) for b, x, sb, c in pairs]
+        nee_bands = [b * c for b, c in zip(s.bands, c_em, strict=True)]
+        s.acc = self.deposit(s.acc, v.light, s.beta * v.nee, nee_bands, v.active_em)
+        if self.spec:
+            s.sacc = self.deposit(s.sacc, v.light, s.beta * v.nee, s_nee, v.active_em)
+        bands = nee_bands if c_bs is c_em else [b * c for b, c in zip(s.bands, c_bs, strict=True)]
+        s, go_on = self.step(s, si, v, bands)
+        s.alive = active_next & go_on
+        return s
+
+    def run(self, sampler: Any, ray: Any, active: Any) -> tuple[PathState, list]:
+        """The final state of one wavefront of camera rays, and its accumulators then (gloss)
+        the specular ones."""
+        label = "spectrinsic " + ("white at metals" if self.white else "band path")
+        (s,) = self.dr.while_loop(
+            (self.start(sampler, ray, active),),
+            lambda s: s.alive,
+            lambda s: (self.body(s),),
+            label=label + (" (glossy)" if self.spec else ""),
+        )
+        return s, list(s.acc) + list(s.sacc)

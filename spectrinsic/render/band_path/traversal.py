@@ -1,0 +1,436 @@
+"""Every diagonal mode of one scene in a single path traversal, split by light.
+
+The counterpart of :func:`spectrinsic.render.passes.render_diagonal` (⌈K/3⌉ RGB passes per
+mode, one scene per light subset) built on the band-path integrator of
+:mod:`spectrinsic.render.band_path.integrator`: the bands of every value set are stacked into one table
+(K = 3 + 6 + 31 = 40 for the default modes) and traced once, with every light on. Because the
+passes trace identical paths (same seed and spp, Russian roulette off), the images are those of
+the passes to float rounding; each light's image is its exact share of that render (the
+per-light images sum to the total), not a separate render with the other lights removed.
+The coverage, ids, depth and normals of :func:`~spectrinsic.render.passes.aovs.render_aovs` come
+from the same traversal's camera rays (their first hits), so no coverage passes are needed.
+
+Cost, measured on ``room-living__v1__two-colour-a`` at the default preset (256², 2 batches of
+8 spp, 2 lights, 25 surfaces): see ``make bench`` (``bench_traversal.json``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from ...errors import RenderError, SceneError, validate_choice
+from ...scenes.model import Scene
+from ...spectra import get_sensors
+from ..algebra.modes import ChannelValues, RenderMode, channel_values, get_mode
+from ..algebra.shares import TransportOutput
+from ..base import translate as tr
+from ..base.one_pass import DIRECT_DEPTH, PassOutput, PassProgress, timed_render
+from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
+from ..base.textures import shape_slots, texture_tables
+from ..base.variants import choose_variant, variant_scope
+from ..passes.aovs import assemble_aovs
+from ..settings import DEFAULT_INTEGRATOR, INTEGRATORS
+from .integrator import BandTables, band_path, first_hit_channels
+
+__all__ = [
+    "PARTS",
+    "SingleTraversal",
+    "render_traversal",
+    "render_jobs",
+    "light_of_emitters",
+    "single_traversal_runs",
+    "resolve_integrator",
+]
+
+
+#: The parts a traversal splits off beside its transport, in the order of its AOV channels
+#: (:func:`~spectrinsic.render.band_path.integrator.aov_channels`), and the letter of their layers in ``transport.exr``
+#: (:mod:`spectrinsic.gt_export.sample.transport_exr`; the transport's is L): glossy scenes'
+#: ``"specular"`` part of the transport (the light whose first camera-ray vertex went through
+#: a non-diffuse lobe) and metals' ``"metal_white"`` radiance (not part of the transport). Each
+#: is ``(L, H, W, K)`` per unit emission, composed as the transport is; every record below the
+#: traversal (:class:`TransportOutput`, ``RenderResult.parts``, ``LightTransport.parts``, the
+#: batches, the file) holds the parts by these names.
+PARTS: dict[str, str] = {"specular": "S", "metal_white": "W"}
+
+
+def single_traversal_runs(variant: str | None) -> bool:
+    """Whether the band-path traversal runs with *variant*'s RGB variant: a JIT one (LLVM or
+    CUDA), where Dr.Jit traces it into one kernel. On a scalar variant a Python integrator
+    would run once per sample, so :func:`spectrinsic.render.render_scene` uses the passes."""
+    return not choose_variant("rgb", variant).startswith("scalar")
+
+
+def resolve_integrator(name: str | None, variant: str | None = None) -> str:
+    """*name* checked against :data:`~spectrinsic.render.settings.INTEGRATORS` (``None``:
+    :data:`~spectrinsic.render.settings.DEFAULT_INTEGRATOR`);
+    ``"passes"`` where the traversal does not run (:func:`single_traversal_runs`)."""
+    chosen = (
+        DEFAULT_INTEGRATOR
+        if name is None
+        else validate_choice(name, INTEGRATORS, "integrator", error=RenderError)
+    )
+    return chosen if chosen == "passes" or single_traversal_runs(variant) else "passes"
+
+
+def light_of_emitters(mi: Any, loaded: Any) -> dict[int, int]:
+    """``{emitter registry id: scene light index}`` of a scene translated by
+    :func:`~spectrinsic.render.base.translate.scene_to_mitsuba` (ids ``light_<i>``; an area
+    emitter is named by its rectangle)."""
+    import drjit as dr
+
+    emitters = list(loaded.emitters())
+    if not emitters:
+        return {}
+    ids = np.array(dr.reinterpret_array(mi.UInt32, mi.EmitterPtr(emitters)), np.int64)
+    out = {}
+    for eid, emitter in zip(ids, emitters, strict=True):
+        shape = emitter.get_shape()
+        key = shape.id() if shape is not None else emitter.id()
+        prefix = tr.light_key(0)[:-1]
+        if not key.startswith(prefix) or not key[len(prefix) :].isdigit():
+            raise RenderError(f"emitter {key!r} is not one of the scene's lights ({prefix}<i>)")
+        out[int(eid)] = int(key[len(prefix) :])
+    return out
+
+
+def _tables(
+    scene: Scene, value_sets: Sequence[ChannelValues], emitters: dict[int, int], aovs: bool
+) -> BandTables:
+    bands = np.concatenate([np.asarray(v.materials, float) for v in value_sets], axis=1)
+    albedo = np.vstack([bands, np.zeros((1, bands.shape[1]))])  # last row: black
+    surfaces = tr.surfaces(scene)
+    rows = {s.key: s.material for s in surfaces if s.material >= 0}
+    textures = texture_tables(scene, albedo[:-1])
+    return BandTables(
+        albedo=albedo,
+        shape_rows=rows,
+        emitter_lights=emitters,
+        n_lights=len(scene.lights),
+        shape_surfaces={s.key: i for i, s in enumerate(surfaces)} if aovs else {},
+        textures=textures,
+        shape_textures=shape_slots(textures, surfaces),
+    )
+
+
+def _specular_table(scene: Scene, value_sets: Sequence[ChannelValues]) -> np.ndarray:
+    """``(M + 1, N, K)`` band factors of the non-diffuse lobes of every material (the value
+    sets' tables side by side over bands; the last row, black, all ones)."""
+    tables = [np.asarray(v.specular, float) for v in value_sets if v.specular is not None]
+    if len(tables) != len(value_sets):
+        raise RenderError(
+            f"scene {scene.name!r} has glossy materials but its channel values carry no specular tables"
+        )
+    table = np.concatenate(tables, axis=2)
+    return np.concatenate([table, np.ones((1, *table.shape[1:]))], axis=0)
+
+
+def _render(
+    mi: Any, loaded: Any, integrator: Any, *, spp: int, seed: int, n: int
+) -> tuple[np.ndarray, float]:
+    """The traversal's last *n* AOV channels (the band transport) and the render's seconds."""
+    image, seconds = timed_render(mi, loaded, spp=spp, seed=seed, integrator=integrator)
+    if image.shape[-1] < n:
+        raise RenderError(
+            f"band-path render returned {image.shape[-1]} channels; expected at least {n}"
+        )
+    return image[..., image.shape[-1] - n :], seconds
+
+
+@dataclass(frozen=True)
+class _Dims:
+    """Image height and width, bands K, lights L, and whether the scene has glossy materials
+    and metals."""
+
+    h: int
+    w: int
+    n_bands: int
+    n_lights: int
+    glossy: bool
+    #: Per albedo-table row (materials, then the black row): whether it is a metal.
+    metal_rows: tuple[bool, ...] = ()
+
+    @property
+    def metals(self) -> bool:
+        return any(self.metal_rows)
+
+
+@dataclass(frozen=True, eq=False)
+class _Traced:
+    """One traversal: transport ``(L, H, W, K)``, the parts of :data:`PARTS`
+    it rendered (same shape; the first traversal only), the first-hit maps (first traversal
+    with surfaces) and its seconds."""
+
+    transport: np.ndarray
+    parts: dict[str, np.ndarray]
+    first: np.ndarray | None
+    seconds: float
+
+
+def _trace(
+    mi: Any,
+    loaded: Any,
+    tables: BandTables,
+    dims: _Dims,
+    spec_table: np.ndarray | None,
+    *,
+    depth: int,
+    first: bool,
+    spp: int,
+    seed: int,
+) -> _Traced:
+    """One traversal at path *depth*; the *first* one also takes the first-hit maps and, in
+    scenes with metals, the white-at-metal radiance."""
+    n_surfaces = len(tables.shape_surfaces) if first else 0
+    metals = dims.metals and first
+    n_texcols = 0 if tables.textures is None else len(tables.textures.columns)
+    integrator = band_path(
+        mi,
+        max_depth=depth,
+        n_bands=dims.n_bands,
+        n_lights=dims.n_lights,
+        n_surfaces=n_surfaces,
+        n_texcols=n_texcols,
+        gloss=dims.glossy,
+        metals=metals,
+    )
+    integrator.set_tables(loaded, tables if n_surfaces else replace(tables, shape_surfaces={}))
+    if spec_table is not None:
+        integrator.set_specular(spec_table)
+    if metals:
+        integrator.set_metals(np.array(dims.metal_rows, bool))
+    n_t = dims.n_bands * dims.n_lights
+    n_spec = n_t if dims.glossy else 0
+    n_white = n_t if metals else 0
+    n_first = len(first_hit_channels(n_surfaces, n_texcols))
+    image, dt = _render(
+        mi, loaded, integrator, spp=spp, seed=seed, n=n_t + n_spec + n_white + n_first
+    )
+
+    def per_light(channels: np.ndarray) -> np.ndarray:
+        return channels.reshape(dims.h, dims.w, dims.n_lights, dims.n_bands).transpose(2, 0, 1, 3)
+
+    end = n_t + n_spec + n_white
+    parts = {}
+    if dims.glossy and first:
+        parts["specular"] = per_light(image[..., n_t : n_t + n_spec])
+    if metals:
+        parts["metal_white"] = per_light(image[..., n_t + n_spec : end])
+    return _Traced(
+        transport=per_light(image[..., :n_t]),
+        parts=parts,
+        first=image[..., end:] if n_surfaces else None,
+        seconds=dt,
+    )
+
+
+def _first_hit_maps(scene: Scene, tables: BandTables, hits: np.ndarray) -> dict[str, np.ndarray]:
+    """:func:`~spectrinsic.render.passes.aovs.assemble_aovs` of the traversal's first-hit channels
+    (coverage, texture columns, ray distance, normal)."""
+    columns = None if tables.textures is None else tables.textures.columns
+    surfaces = tr.surfaces(scene)
+    return assemble_aovs(scene, surfaces, hits[..., :-4], hits[..., -4], hits[..., -3:], columns)
+
+
+def _outputs(
+    value_sets: Sequence[ChannelValues],
+    widths: Sequence[int],
+    traced: Sequence[_Traced],
+    direct: bool,
+) -> list[TransportOutput]:
+    """The traversals' bands cut back into one :class:`TransportOutput` per value set."""
+    edges = np.cumsum([0, *widths])
+    return [
+        TransportOutput(
+            transport=np.ascontiguousarray(traced[0].transport[..., a:b]),
+            direct=np.ascontiguousarray(traced[1].transport[..., a:b]) if direct else None,
+            emission=np.asarray(v.lights, float),
+            parts={n: np.ascontiguousarray(p[..., a:b]) for n, p in traced[0].parts.items()},
+        )
+        for v, a, b in zip(value_sets, edges[:-1], edges[1:], strict=True)
+    ]
+
+
+def render_traversal(
+    scene: Scene,
+    value_sets: Sequence[ChannelValues],
+    *,
+    spp: int,
+    seed: int,
+    max_depth: int = 8,
+    direct: bool = False,
+    aovs: bool = False,
+    variant: str | None = None,
+    progress: PassProgress | None = None,
+    geometry: Sequence[tr.SurfaceGeometry] | None = None,
+    crop: tuple[int, int, int, int] | None = None,
+) -> tuple[list[TransportOutput], dict[str, np.ndarray], tuple[float, ...], str]:
+    """Per-light band transport of every value set, in one traversal (two with *direct*).
+
+    Parameters
+    ----------
+    value_sets
+        Channel values (:func:`spectrinsic.render.algebra.modes.channel_values`) of each diagonal mode;
+        their bands are traced together.
+    direct
+        Also trace direct light only (path depth 2), for the energy ratio r of Eq. 5.8.
+    aovs
+        Also take coverage, ids, depth and normals from the camera rays' first hits, as
+        :func:`~spectrinsic.render.passes.aovs.render_aovs` computes them from the same samples.
+    crop
+        ``(x, y, width, height)``: render only that window of the image
+        (:func:`~spectrinsic.render.base.plugins.hdr_film`); every map is the window's.
+
+    Returns
+    -------
+    outputs
+        One :class:`TransportOutput` per value set.
+    aov_maps
+        The maps of :func:`~spectrinsic.render.passes.aovs.render_aovs` (empty without *aovs*).
+    seconds
+        Wall-clock seconds of each traversal.
+    variant
+        The Mitsuba variant used.
+    """
+    if int(spp) < 1 or int(max_depth) < 1:
+        raise SceneError(f"spp {spp}, max_depth {max_depth}: expected at least 1 each")
+    if not scene.lights:
+        raise SceneError(f"scene {scene.name!r} has no lights: nothing to render")
+    if not value_sets:
+        raise SceneError("render_traversal: expected at least one set of channel values")
+    widths = [np.asarray(v.materials).shape[1] for v in value_sets]
+    n_bands, n_lights = sum(widths), len(scene.lights)
+    chosen = choose_variant("rgb", variant)
+    h, w = (
+        (scene.camera.height, scene.camera.width) if crop is None else (int(crop[3]), int(crop[2]))
+    )
+    white = rgb_spectrum([1.0, 1.0, 1.0])
+    glossy = any(m.glossy for m in scene.materials)
+    with variant_scope(chosen) as mi:
+        loaded = mi.load_dict(
+            tr.scene_to_mitsuba(
+                scene,
+                materials=[white] * len(scene.materials),
+                lights=[white] * n_lights,
+                film=hdr_film(scene.camera.width, scene.camera.height, crop),
+                integrator=path_integrator(max_depth),
+                sample_count=spp,
+                geometry=geometry,
+                white_metal=True,
+            )
+        )
+        tables = _tables(scene, value_sets, light_of_emitters(mi, loaded), aovs)
+        metal_rows = tuple(m.kind == "conductor" for m in scene.materials) + (False,)
+        dims = _Dims(h, w, n_bands, n_lights, glossy, metal_rows)
+        spec_table = _specular_table(scene, value_sets) if glossy else None
+        traced: list[_Traced] = []
+        for depth in [int(max_depth)] + ([DIRECT_DEPTH] if direct else []):
+            first = not traced
+            traced.append(
+                _trace(
+                    mi,
+                    loaded,
+                    tables,
+                    dims,
+                    spec_table,
+                    depth=depth,
+                    first=first,
+                    spp=spp,
+                    seed=seed,
+                )
+            )
+            if progress is not None:
+                progress(1)
+    outputs = _outputs(value_sets, widths, traced, direct)
+    hits = traced[0].first
+    aov_maps = _first_hit_maps(scene, tables, hits) if aovs and hits is not None else {}
+    seconds = [t.seconds for t in traced]
+    return outputs, aov_maps, tuple(seconds), chosen
+
+
+@dataclass(frozen=True, eq=False)
+class SingleTraversal:
+    """The transport of every diagonal mode from :func:`render_jobs`, and its seconds."""
+
+    transport: dict[str, TransportOutput]
+    seconds: tuple[float, ...]
+    #: First-hit maps (:func:`~spectrinsic.render.passes.aovs.render_aovs`'s), when asked for.
+    aovs: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def per_light(self, part: str) -> dict[str, np.ndarray]:
+        """Mode -> ``(L, H, W, K)`` per-light *part* (``"transport"`` or one of
+        :data:`PARTS`); modes without it left out."""
+        arrays = {
+            n: t.transport if part == "transport" else t.parts.get(part)
+            for n, t in self.transport.items()
+        }
+        return {n: a for n, a in arrays.items() if a is not None}
+
+
+def render_jobs(
+    scene: Scene,
+    jobs: Sequence[tuple[Sequence[RenderMode], Sequence[int] | None, bool]],
+    *,
+    wanted: set[str],
+    spp: int,
+    seed: int,
+    max_depth: int,
+    variant: str | None,
+    progress: PassProgress | None,
+    geometry: Sequence[tr.SurfaceGeometry] | None,
+    data_dir: str | None,
+    aovs: bool = False,
+) -> tuple[list[dict[str, PassOutput]], SingleTraversal]:
+    """The diagonal images of every job ``(modes, lights or None for all, with_direct)`` from
+    one traversal: each job's image of a mode is the sum of its lights' shares.
+
+    Drop-in for rendering each job's diagonal modes with
+    :func:`~spectrinsic.render.passes.render_diagonal`; a direct-only image is made for the
+    modes in *wanted* of the jobs that ask for one. With *aovs*, the first-hit maps come from
+    the same traversal (drop-in for :func:`~spectrinsic.render.passes.aovs.render_aovs`). The jobs
+    must hold at least one diagonal mode, or none with *aovs*: one traversal then gives the
+    first-hit maps alone (a textured scene's coverage, which the coverage passes cannot give).
+    """
+    diagonal = list(
+        {m.name: m for modes, _, _ in jobs for m in modes if m.kind == "diagonal"}.values()
+    )
+    maps_only = not diagonal and aovs
+    if maps_only:  # any mode's traversal gives the first-hit maps
+        diagonal = [get_mode("rgb3")]
+    want_direct = any(
+        flag and m.name in wanted for modes, _, flag in jobs for m in modes if m.kind == "diagonal"
+    )
+    values = [
+        channel_values(scene, get_sensors(m.sensors, data_dir=data_dir), data_dir=data_dir)
+        for m in diagonal
+    ]
+    outs, aov_maps, seconds, chosen = render_traversal(
+        scene,
+        values,
+        spp=spp,
+        seed=seed,
+        max_depth=max_depth,
+        direct=want_direct,
+        aovs=aovs,
+        variant=variant,
+        progress=progress,
+        geometry=geometry,
+    )
+    transport = {} if maps_only else {m.name: o for m, o in zip(diagonal, outs, strict=True)}
+    parts = []
+    for modes, group, flag in jobs:
+        part = {}
+        for m in (m for m in modes if m.kind == "diagonal"):
+            t = transport[m.name]
+            part[m.name] = PassOutput(
+                image=t.image(group),
+                direct=t.image(group, direct=True) if flag and m.name in wanted else None,
+                seconds=(),
+                variant=chosen,
+            )
+        parts.append(part)
+    return parts, SingleTraversal(transport, seconds, aov_maps)

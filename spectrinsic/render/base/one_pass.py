@@ -1,0 +1,120 @@
+"""One Mitsuba pass, shared by every pass and the band-path traversal: its record
+(:class:`PassOutput`), its timed render call, and the checks every pass makes first.
+
+Every pass of one image uses the same sampler seed, sample count and path depth with Russian
+roulette off, so passes trace identical paths (common random numbers).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ...errors import RenderError, SceneError
+from ...interrupts import raise_if_requested
+from ...scenes.model import Scene
+from .plugins import rgb_spectrum
+
+__all__ = [
+    "DIRECT_DEPTH",
+    "PassProgress",
+    "PassOutput",
+    "AOV_NAMES",
+    "check_render_args",
+    "active_light_set",
+    "timed_render",
+    "placeholder_light",
+    "scene_parameters",
+    "set_rgb",
+]
+
+#: Path depth of a direct-light-only render (camera -> surface -> light).
+DIRECT_DEPTH = 2
+#: Called with 1 after each Mitsuba pass (e.g. ``tqdm.update``).
+PassProgress = Callable[[int], Any]
+#: Keys of the dict :func:`~spectrinsic.render.passes.aovs.render_aovs` returns.
+AOV_NAMES = ("coverage", "material_id", "object_id", "depth", "normals", "mask")
+
+
+@dataclass(frozen=True, eq=False)
+class PassOutput:
+    """Raw images of one set of channel values.
+
+    Attributes
+    ----------
+    image
+        ``(H, W, K)`` float32 full render (all bounces up to ``max_depth``).
+    direct
+        ``(H, W, K)`` float32 direct-light-only render, or ``None`` when not asked for.
+    seconds
+        Wall-clock seconds of each Mitsuba pass, in order (full passes, then direct ones).
+    variant
+        The Mitsuba variant used.
+    """
+
+    image: np.ndarray
+    direct: np.ndarray | None
+    seconds: tuple[float, ...]
+    variant: str
+
+
+def check_render_args(scene: Scene, spp: int, max_depth: int) -> None:
+    if int(spp) < 1:
+        raise SceneError(f"spp {spp}: expected at least 1 sample per pixel")
+    if int(max_depth) < 1:
+        raise SceneError(f"max_depth {max_depth}: expected >= 1")
+    if not scene.lights:
+        raise SceneError(f"scene {scene.name!r} has no lights: nothing to render")
+
+
+def active_light_set(scene: Scene, active_lights: Sequence[int] | None) -> set[int]:
+    active = (
+        set(range(len(scene.lights))) if active_lights is None else {int(i) for i in active_lights}
+    )
+    bad = sorted(i for i in active if not 0 <= i < len(scene.lights))
+    if bad or not active:
+        raise SceneError(
+            f"scene {scene.name!r}: active lights {sorted(active)} must be a non-empty subset of "
+            f"0..{len(scene.lights) - 1}"
+        )
+    return active
+
+
+def timed_render(
+    mi: Any, loaded: Any, *, spp: int, seed: int, integrator: Any = None
+) -> tuple[np.ndarray, float]:
+    """One ``mi.render`` as float32 and its seconds; a Ctrl-C stops the build within it."""
+    raise_if_requested()
+    start = time.perf_counter()
+    try:
+        image = np.array(
+            mi.render(loaded, spp=int(spp), seed=int(seed), integrator=integrator), dtype=np.float32
+        )
+    except RuntimeError as exc:
+        raise_if_requested()  # Dr.Jit re-raises a Ctrl-C inside the render as RuntimeError
+        raise RenderError(f"Mitsuba render failed: {exc}") from exc
+    raise_if_requested()  # Mitsuba's own SIGINT handler may have cut the pass short
+    return image, time.perf_counter() - start
+
+
+def placeholder_light(index: int) -> dict[str, Any]:
+    """Distinct emission per light at load time (identical dicts could be merged into one
+    shared object); every pass sets the real values before rendering."""
+    return rgb_spectrum([1.0 + index, 1.0, 1.0])
+
+
+def scene_parameters(mi: Any, loaded: Any, keys: Sequence[str]) -> Any:
+    """``mi.traverse`` of a loaded scene, checked to expose every parameter a pass updates."""
+    params = mi.traverse(loaded)
+    missing = [k for k in keys if k not in params]
+    if missing:
+        raise RenderError(f"Mitsuba scene lacks the parameters {missing[:3]} the passes update")
+    return params
+
+
+def set_rgb(mi: Any, params: Any, key: str, values: np.ndarray) -> None:
+    params[key] = mi.Color3f(*(float(v) for v in values))

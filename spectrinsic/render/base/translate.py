@@ -1,0 +1,415 @@
+"""The one translation of a :class:`~spectrinsic.scenes.model.Scene` into a Mitsuba scene dict.
+
+Geometry, lights and camera come from the scene; colours come from the caller as Mitsuba
+spectrum dicts (:func:`rgb_spectrum` for the channel values of a diagonal pass,
+:func:`regular_spectrum` for the spectral variant), so the same translation serves every pass.
+
+Naming, which :mod:`spectrinsic.render.passes` relies on to update parameters between passes:
+
+* each mesh is split by material into shapes ``surf_<mesh>_<material>``, each with its own
+  two-sided BSDF: Lambertian (``<id>.bsdf.brdf_0.reflectance``), or for a glossy material
+  (:func:`material_bsdf`) Mitsuba's ``plastic``/``roughplastic`` (the reflectance is the
+  ``diffuse_reflectance`` under the coat) or ``conductor``/``roughconductor``;
+* light ``i`` is ``light_<i>``; an area light is a rectangle shape with an ``area`` emitter and a
+  black two-sided BSDF, so it occludes and reflects nothing.
+
+Two-sided BSDFs make face winding irrelevant (a room's walls render from inside whichever way
+they were wound). Vertex normals are smoothed across edges whose faces meet at less than
+:data:`CREASE_ANGLE_DEG`, and kept sharp elsewhere (box corners stay crisp, spheres look round).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ...errors import SceneError
+from ...scenes.model import Light, Material, Scene, unknown_light_kind
+from ...scenes.textures import box_uv
+from .plugins import black_bsdf
+from .textures import textured_bsdf
+from .variants import import_mitsuba
+
+__all__ = [
+    "CREASE_ANGLE_DEG",
+    "Surface",
+    "surfaces",
+    "light_key",
+    "reflectance_key",
+    "material_bsdf",
+    "emission_key",
+    "smooth_corner_normals",
+    "SurfaceGeometry",
+    "prepare_geometry",
+    "scene_to_mitsuba",
+]
+
+#: Faces meeting at a smaller angle than this share smoothed vertex normals (degrees).
+CREASE_ANGLE_DEG = 30.0
+#: Emitter parameter holding the spectrum of each kind of
+#: :data:`spectrinsic.scenes.model.LIGHT_KINDS` in Mitsuba (the meaning of ``Light.power``).
+_EMISSION_PARAM = {
+    "point": "intensity",
+    "spot": "intensity",
+    "directional": "irradiance",
+    "area": "radiance",
+    "sky": "radiance",
+}
+
+
+@dataclass(frozen=True)
+class Surface:
+    """A Mitsuba shape carrying one BSDF: a mesh's faces of one material, or an area light.
+
+    Attributes
+    ----------
+    key
+        Shape id in the Mitsuba dict.
+    mesh
+        Index into ``scene.meshes``, or -1 for an area light.
+    material
+        Index into ``scene.materials``, or -1 for an area light.
+    light
+        Index into ``scene.lights`` for an area light, else -1.
+    """
+
+    key: str
+    mesh: int
+    material: int
+    light: int = -1
+
+
+def light_key(index: int) -> str:
+    """Id of light *index* in the Mitsuba dict."""
+    return f"light_{index}"
+
+
+def surfaces(scene: Scene) -> list[Surface]:
+    """Every BSDF-carrying shape of *scene*'s Mitsuba dict, in a stable order."""
+    out = []
+    for i, mesh in enumerate(scene.meshes):
+        for m in np.unique(np.asarray(mesh.face_materials)):
+            out.append(Surface(f"surf_{i}_{int(m)}", i, int(m)))
+    for j, light in enumerate(scene.lights):
+        if light.kind == "area":
+            out.append(Surface(light_key(j), -1, -1, j))
+    return out
+
+
+def reflectance_key(surface: Surface, *, spectral: bool) -> str:
+    """``mi.traverse`` key of a surface's reflectance values."""
+    return f"{surface.key}.bsdf.brdf_0.reflectance." + ("values" if spectral else "value")
+
+
+def emission_key(scene: Scene, index: int, *, spectral: bool) -> str:
+    """``mi.traverse`` key of light *index*'s emitted spectrum."""
+    light = scene.lights[index]
+    prefix = f"{light_key(index)}.emitter." if light.kind == "area" else f"{light_key(index)}."
+    return prefix + _EMISSION_PARAM[light.kind] + (".values" if spectral else ".value")
+
+
+def smooth_corner_normals(
+    vertices: np.ndarray, faces: np.ndarray, crease_deg: float = CREASE_ANGLE_DEG
+) -> np.ndarray:
+    """``(F, 3, 3)`` unit normals at each face corner, smoothed below a crease angle.
+
+    A corner's normal is the area-weighted mean of the normals of the faces around its vertex
+    that meet the corner's face at less than *crease_deg* degrees; degenerate faces fall back
+    to ``+z``.
+    """
+    v = np.asarray(vertices, float)
+    f = np.asarray(faces, np.int64)
+    tri = v[f]
+    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])  # length = 2 × area
+    length = np.linalg.norm(cross, axis=1)
+    unit = np.divide(cross, length[:, None], out=np.zeros_like(cross), where=length[:, None] > 0)
+    corner_vertex = f.ravel()  # corner i is corner i % 3 of face i // 3
+    order = np.argsort(corner_vertex, kind="stable")
+    sorted_v = corner_vertex[order]
+    sorted_face = order // 3
+    starts = np.flatnonzero(np.r_[True, sorted_v[1:] != sorted_v[:-1]])
+    counts = np.diff(np.r_[starts, sorted_v.size])
+    # every ordered pair (a, b) of sorted corners at one vertex: a runs over the sorted corners,
+    # each repeated once per corner of its vertex, and b over that vertex's corners. Built with
+    # np.repeat rather than fancy indexing, which is the costly part on large meshes.
+    per = np.repeat(counts, counts)  # pairs each sorted corner takes part in
+    b = np.repeat(starts, counts * counts) + (
+        np.arange(per.sum()) - np.repeat(np.cumsum(per) - per, per)
+    )
+    fb = sorted_face[b]
+    unit_a = np.repeat(unit[sorted_face], per, axis=0)
+    keep = np.einsum("ij,ij->i", unit_a, unit[fb]) >= np.cos(np.radians(crease_deg))
+    target, weights = np.repeat(order, per)[keep], cross[fb[keep]]
+    acc = np.stack(
+        [
+            np.bincount(target, weights=weights[:, c], minlength=corner_vertex.size)
+            for c in range(3)
+        ],
+        axis=1,
+    ).astype(np.float64)  # no pairs: bincount gives int
+    norm = np.linalg.norm(acc, axis=1)
+    out = np.divide(acc, norm[:, None], out=np.zeros_like(acc), where=norm[:, None] > 0)
+    out[norm == 0] = (0.0, 0.0, 1.0)
+    return out.reshape(len(f), 3, 3)
+
+
+def _mitsuba_mesh(mi: Any, part: SurfaceGeometry, bsdf: Mapping) -> Any:
+    """An ``mi.Mesh`` with unshared vertices (one per face corner), the given normals and,
+    on a textured surface, texture coordinates."""
+    corners, n_faces = part.corners, part.corners.shape[0]
+    props = mi.Properties()
+    props["bsdf"] = mi.load_dict(dict(bsdf))
+    mesh = mi.Mesh(
+        part.key,
+        vertex_count=3 * n_faces,
+        face_count=n_faces,
+        has_vertex_normals=True,
+        has_vertex_texcoords=part.uv is not None,
+        props=props,
+    )
+    params = mi.traverse(mesh)
+    arrays = [
+        ("vertex_positions", corners.reshape(-1).astype(np.float32)),
+        ("faces", np.arange(3 * n_faces, dtype=np.uint32)),
+        ("vertex_normals", part.normals.reshape(-1).astype(np.float32)),
+    ]
+    if part.uv is not None:
+        arrays.append(("vertex_texcoords", part.uv.reshape(-1).astype(np.float32)))
+    for key, array in arrays:
+        params[key] = type(params[key])(array)
+    params.update()
+    return mesh
+
+
+def _lambertian(reflectance: Mapping) -> dict[str, Any]:
+    return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": dict(reflectance)}}
+
+
+def material_bsdf(
+    material: Material, reflectance: Mapping, *, white_metal: bool = False
+) -> dict[str, Any]:
+    """The two-sided Mitsuba BSDF of *material* with diffuse *reflectance*.
+
+    ``plastic``: Mitsuba's ``plastic`` (smooth) or ``roughplastic`` (GGX, α = roughness) with
+    the linear diffuse term (``nonlinear: false``, so the diffuse lobe is proportional to the
+    base reflectance) and ``int_ior`` = the coat's index over air. ``conductor``: Mitsuba's
+    ``conductor``/``roughconductor`` with its measured η/k of ``material.metal``, or with
+    *white_metal* a perfect mirror (``material: none``, F = 1) whose Fresnel factor the band
+    integrator applies per band. Lambertian otherwise.
+    """
+    if material.kind == "diffuse":
+        return _lambertian(reflectance)
+    rough = material.roughness > 0.0
+    bsdf: dict[str, Any]
+    if material.kind == "plastic":
+        bsdf = {
+            "type": "roughplastic" if rough else "plastic",
+            "diffuse_reflectance": dict(reflectance),
+            "int_ior": float(material.ior),
+            "ext_ior": 1.0,
+            "nonlinear": False,
+        }
+    else:
+        bsdf = {
+            "type": "roughconductor" if rough else "conductor",
+            "material": "none" if white_metal else material.metal,
+        }
+    if rough:
+        bsdf |= {"distribution": "ggx", "alpha": float(material.roughness)}
+    return {"type": "twosided", "bsdf": bsdf}
+
+
+def _surface_bsdf(
+    scene: Scene, part: SurfaceGeometry, materials: Sequence[Mapping], white_metal: bool
+) -> dict[str, Any]:
+    """The BSDF of one surface: its material's, or on a textured mesh the texel-weighted mix of
+    its basis materials (a mix of equal reflectances, such as the band path's white load, is
+    that reflectance)."""
+    texture = scene.meshes[part.mesh].texture if part.mesh >= 0 else None
+    if texture is not None:
+        basis = [materials[b] for b in texture.basis]
+        if any(dict(b) != dict(basis[0]) for b in basis[1:]):
+            return textured_bsdf(import_mitsuba(), texture, basis)
+    return material_bsdf(
+        scene.materials[part.material], materials[part.material], white_metal=white_metal
+    )
+
+
+def _look_at(mi: Any, origin: Sequence[float], direction: Sequence[float], what: str) -> Any:
+    d = np.asarray(direction, float)
+    if not np.linalg.norm(d) > 0:
+        raise SceneError(f"{what}: direction {tuple(direction)} has zero length")
+    d = d / np.linalg.norm(d)
+    up = np.array([0.0, 0.0, 1.0]) if abs(d[2]) < 0.99 else np.array([0.0, 1.0, 0.0])
+    o = np.asarray(origin, float)
+    return mi.ScalarTransform4f().look_at(
+        origin=o.tolist(), target=(o + d).tolist(), up=up.tolist()
+    )
+
+
+def _light(mi: Any, light: Light, emission: Mapping | None, what: str) -> dict[str, Any] | None:
+    if light.kind == "point":
+        return (
+            None
+            if emission is None
+            else {
+                "type": "point",
+                "position": list(map(float, light.position)),
+                "intensity": dict(emission),
+            }
+        )
+    if light.kind == "spot":
+        return (
+            None
+            if emission is None
+            else {
+                "type": "spot",
+                "to_world": _look_at(mi, light.position, light.direction, what),
+                "cutoff_angle": float(light.cutoff_deg),
+                "intensity": dict(emission),
+            }
+        )
+    if light.kind == "directional":
+        return (
+            None
+            if emission is None
+            else {
+                "type": "directional",
+                "direction": list(map(float, light.direction)),
+                "irradiance": dict(emission),
+            }
+        )
+    if light.kind == "sky":
+        return None if emission is None else {"type": "constant", "radiance": dict(emission)}
+    if light.kind == "area":
+        w, h = (float(s) for s in light.size)
+        shape: dict[str, Any] = {
+            "type": "rectangle",
+            "to_world": _look_at(mi, light.position, light.direction, what)
+            @ mi.ScalarTransform4f().scale([w / 2, h / 2, 1.0]),
+            # an instance, not a dict: load_dict merges identical dicts into one shared BSDF,
+            # and every surface needs its own for the per-surface coverage passes
+            "bsdf": mi.load_dict(black_bsdf()),
+        }
+        if emission is not None:
+            shape["emitter"] = {"type": "area", "radiance": dict(emission)}
+        return shape
+    raise SceneError(f"{what}: {unknown_light_kind(light.kind)}")
+
+
+def _camera(mi: Any, scene: Scene, film: Mapping, sample_count: int) -> dict[str, Any]:
+    cam = scene.camera
+    return {
+        "type": "perspective",
+        "fov": float(cam.fov_deg),
+        "fov_axis": "x",
+        "to_world": mi.ScalarTransform4f().look_at(
+            origin=list(map(float, cam.origin)),
+            target=list(map(float, cam.target)),
+            up=list(map(float, cam.up)),
+        ),
+        "film": dict(film),
+        "sampler": {"type": "independent", "sample_count": int(sample_count)},
+    }
+
+
+@dataclass(frozen=True, eq=False)
+class SurfaceGeometry:
+    """Triangles of one surface, ready for Mitsuba: ``corners`` and ``normals`` ``(F, 3, 3)``,
+    and on a textured mesh (its ``mesh`` index) the corners' ``uv`` ``(F, 3, 2)``
+    (:func:`~spectrinsic.scenes.textures.box_uv`)."""
+
+    key: str
+    material: int
+    corners: np.ndarray
+    normals: np.ndarray
+    mesh: int = -1
+    uv: np.ndarray | None = None
+
+
+def prepare_geometry(
+    scene: Scene, crease_deg: float = CREASE_ANGLE_DEG
+) -> tuple[SurfaceGeometry, ...]:
+    """Split every mesh by material and compute its smoothed corner normals (pure numpy).
+
+    :func:`scene_to_mitsuba` does this itself when not given the result; callers translating
+    one scene several times (several variants, light subsets) compute it once.
+    """
+    out = []
+    for index, mesh in enumerate(scene.meshes):
+        faces = np.asarray(mesh.faces, np.int64)
+        corners = np.asarray(mesh.vertices, float)[faces]
+        normals = smooth_corner_normals(mesh.vertices, faces, crease_deg)
+        face_materials = np.asarray(mesh.face_materials, np.int64)
+        uv = None if mesh.texture is None else box_uv(mesh.vertices, faces)
+        for m in np.unique(face_materials):
+            sel = face_materials == m
+            out.append(
+                SurfaceGeometry(
+                    f"surf_{index}_{int(m)}",
+                    int(m),
+                    corners[sel],
+                    normals[sel],
+                    index,
+                    None if uv is None else uv[sel],
+                )
+            )
+    return tuple(out)
+
+
+def scene_to_mitsuba(
+    scene: Scene,
+    *,
+    materials: Sequence[Mapping],
+    lights: Sequence[Mapping | None],
+    film: Mapping,
+    integrator: Mapping,
+    sample_count: int,
+    crease_deg: float = CREASE_ANGLE_DEG,
+    geometry: Sequence[SurfaceGeometry] | None = None,
+    white_metal: bool = False,
+) -> dict[str, Any]:
+    """Translate *scene* into a dict for ``mitsuba.load_dict``.
+
+    Call inside :func:`spectrinsic.render.base.variants.variant_scope`: meshes become ``mi.Mesh``
+    objects of the active variant.
+
+    Parameters
+    ----------
+    materials
+        One Mitsuba spectrum dict per ``scene.materials`` entry: its reflectance.
+    lights
+        One Mitsuba spectrum dict per ``scene.lights`` entry: its emission (already scaled by
+        the light's power), or ``None`` to leave that light out (an area light's rectangle then
+        stays, black, so per-light renders sum to the full render).
+    film, integrator
+        Mitsuba dicts (:func:`hdr_film`, :func:`spectral_film`, :func:`path_integrator`,
+        :func:`aov_integrator`).
+    sample_count
+        Samples per pixel of the sensor's sampler.
+    geometry
+        :func:`prepare_geometry` of *scene*, if already computed.
+    white_metal
+        Metals as perfect mirrors (:func:`material_bsdf`), for the band integrator.
+    """
+    mi = import_mitsuba()
+    if len(materials) != len(scene.materials) or len(lights) != len(scene.lights):
+        raise SceneError(
+            f"scene {scene.name!r}: got {len(materials)} material and {len(lights)} light colours for "
+            f"{len(scene.materials)} materials and {len(scene.lights)} lights"
+        )
+    out: dict[str, Any] = {
+        "type": "scene",
+        "integrator": dict(integrator),
+        "sensor": _camera(mi, scene, film, sample_count),
+    }
+    for part in prepare_geometry(scene, crease_deg) if geometry is None else geometry:
+        out[part.key] = _mitsuba_mesh(mi, part, _surface_bsdf(scene, part, materials, white_metal))
+    for j, (light, emission) in enumerate(zip(scene.lights, lights, strict=True)):
+        entry = _light(mi, light, emission, f"scene {scene.name!r} light {j} ({light.name})")
+        if entry is not None:
+            out[light_key(j)] = entry
+    return out

@@ -1,0 +1,345 @@
+"""Choosing a Mitsuba variant, and importing Mitsuba safely.
+
+Dr.Jit's LLVM backend JIT-compiles through a system ``libLLVM``. The LLVM 14 and 15 libraries
+that Debian ships crash it (``Cannot select: fminimum``); LLVM 16 or newer works. Dr.Jit loads
+the library named by the environment variable ``DRJIT_LIBLLVM_PATH`` when ``drjit`` is first
+imported, and has no other way to be told.
+
+The set-up step is :func:`import_mitsuba`, the one place that imports Mitsuba (and so Dr.Jit).
+On its first call it picks the library (:func:`configure_llvm`: the user's
+``DRJIT_LIBLLVM_PATH`` if set, else the newest ``libLLVM`` >= 16 found), sets the variable for
+the duration of ``import drjit`` only, and restores the environment as it was. So the process
+environment is never changed for good, and child processes (which call :func:`import_mitsuba`
+themselves) inherit the user's. When no suitable library exists the LLVM variants are not used:
+renders fall back to the (about twice slower) scalar variants with one
+:class:`~spectrinsic.errors.SpectrinsicWarning`.
+
+Variants are chosen per pass (cuda > llvm > scalar; ``*_spectral`` for the spectral reference,
+``*_rgb`` for diagonal passes and AOVs) and activated only inside :func:`variant_scope`; nothing
+here runs at import time.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import glob
+import importlib
+import logging
+import os
+import re
+import sys
+import warnings
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from types import ModuleType
+from typing import Any, Literal
+
+from ...errors import MissingDependencyError, RenderError, SpectrinsicWarning, validate_choice
+
+__all__ = [
+    "LLVM_ENV",
+    "LLVM_MIN_VERSION",
+    "BACKENDS",
+    "VariantKind",
+    "llvm_version_from_name",
+    "find_libllvm",
+    "configure_llvm",
+    "import_mitsuba",
+    "set_thread_count",
+    "usable_backends",
+    "choose_variant",
+    "available_variants",
+    "llvm_library",
+    "variant_report",
+    "variant_scope",
+]
+
+logger = logging.getLogger(__name__)
+
+#: Environment variable Dr.Jit reads for the path of ``libLLVM``.
+LLVM_ENV = "DRJIT_LIBLLVM_PATH"
+#: Oldest LLVM major version whose instruction selection handles Dr.Jit's ``fminimum``.
+LLVM_MIN_VERSION = 16
+#: Dr.Jit backends in order of preference, with the prefix of their Mitsuba variants.
+BACKENDS: dict[str, str] = {"cuda": "cuda_ad", "llvm": "llvm_ad", "scalar": "scalar"}
+
+VariantKind = Literal["rgb", "spectral"]
+
+#: Where distributions put ``libLLVM`` (globs allowed); searched in this order.
+_LIB_DIRS: tuple[str, ...] = (
+    "/usr/lib/x86_64-linux-gnu",
+    "/usr/lib/aarch64-linux-gnu",
+    "/usr/lib64",
+    "/usr/lib",
+    "/usr/local/lib",
+    "/usr/lib/llvm-*/lib",
+    "/usr/lib64/llvm*/lib",
+    "/opt/homebrew/opt/llvm/lib",
+    "/usr/local/opt/llvm/lib",
+)
+_NAME_DASH = re.compile(r"^libLLVM-(\d+)")  # libLLVM-19.so, libLLVM-14.0.6.so.1
+_NAME_SOVERSION = re.compile(r"^libLLVM\.(?:so|dylib)\.(\d+)")  # libLLVM.so.19.1
+_DIR_VERSION = re.compile(r"llvm-?(\d+)")  # /usr/lib/llvm-19/lib/libLLVM.so
+
+
+def llvm_version_from_name(path: str | os.PathLike[str]) -> int | None:
+    """Major LLVM version encoded in a ``libLLVM`` file name (or its folder), else ``None``.
+
+    >>> llvm_version_from_name("/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1")
+    19
+    >>> llvm_version_from_name("libLLVM-14.0.6.so.1")
+    14
+    >>> llvm_version_from_name("/usr/lib/llvm-17/lib/libLLVM.so") is None
+    False
+    """
+    p = Path(path)
+    for pattern in (_NAME_DASH, _NAME_SOVERSION):
+        m = pattern.match(p.name)
+        if m:
+            return int(m.group(1))
+    m = _DIR_VERSION.search(str(p.parent))
+    return int(m.group(1)) if m and p.name.startswith("libLLVM") else None
+
+
+def find_libllvm(
+    dirs: Sequence[str] | None = None, *, min_version: int = LLVM_MIN_VERSION
+) -> Path | None:
+    """The newest ``libLLVM`` shared library of version >= *min_version* in *dirs*, or ``None``.
+
+    Parameters
+    ----------
+    dirs
+        Folders (glob patterns allowed) to search; default: the usual system library folders.
+    """
+    best: tuple[int, Path] | None = None
+    for pattern in dirs if dirs is not None else _LIB_DIRS:
+        for folder in sorted(glob.glob(pattern)):
+            for lib in sorted(Path(folder).glob("libLLVM*")):
+                if not (lib.suffix in (".so", ".dylib") or ".so." in lib.name) or not lib.exists():
+                    continue
+                version = llvm_version_from_name(lib)
+                if (
+                    version is not None
+                    and version >= min_version
+                    and (best is None or version > best[0])
+                ):
+                    best = (version, lib)
+    return None if best is None else best[1]
+
+
+def configure_llvm() -> str | None:
+    """The ``libLLVM`` Dr.Jit should load: ``DRJIT_LIBLLVM_PATH`` if the user set it, else the
+    newest ``libLLVM`` >= :data:`LLVM_MIN_VERSION` found (``None`` if neither).
+
+    Changes nothing: :func:`import_mitsuba` hands the path to Dr.Jit.
+    """
+    current = os.environ.get(LLVM_ENV, "").strip()
+    if current:
+        return current
+    found = find_libllvm()
+    return None if found is None else str(found)
+
+
+#: The ``libLLVM`` Dr.Jit was pointed at when :func:`import_mitsuba` first imported it (None: no
+#: suitable one, or Dr.Jit imported before without ``DRJIT_LIBLLVM_PATH``). Set once, by the
+#: set-up step; a record of what this process loaded, not a setting.
+_loaded_libllvm: str | None = None
+_set_up = False
+
+
+@contextlib.contextmanager
+def _environment_variable(name: str, value: str | None) -> Iterator[None]:
+    """Set *name* to *value* (unless None or already set) inside the block, then restore it."""
+    if value is None or name in os.environ:
+        yield
+        return
+    os.environ[name] = value
+    try:
+        yield
+    finally:
+        del os.environ[name]
+
+
+def import_mitsuba() -> ModuleType:
+    """Return the ``mitsuba`` module; the first call is spectrinsic's Mitsuba set-up step.
+
+    That call imports Dr.Jit with ``DRJIT_LIBLLVM_PATH`` pointing at :func:`configure_llvm`'s
+    library, for the duration of the import only (Dr.Jit loads ``libLLVM`` then), and records
+    the library used. If ``drjit`` was imported before, by someone else, its library is the one
+    ``DRJIT_LIBLLVM_PATH`` names now, if any.
+
+    Raises
+    ------
+    MissingDependencyError
+        If Mitsuba 3 is not installed.
+    """
+    global _loaded_libllvm, _set_up
+    try:
+        if not _set_up:
+            if "drjit" in sys.modules:
+                _loaded_libllvm = os.environ.get(LLVM_ENV, "").strip() or None
+            else:
+                _loaded_libllvm = configure_llvm()
+                with _environment_variable(LLVM_ENV, _loaded_libllvm):
+                    importlib.import_module("drjit")
+                logger.debug("Dr.Jit's LLVM backend uses %s", _loaded_libllvm)
+            _set_up = True
+        return importlib.import_module("mitsuba")
+    except ImportError as exc:  # pragma: no cover - mitsuba is a declared dependency
+        raise MissingDependencyError(
+            f"rendering needs Mitsuba 3 ('pip install mitsuba'): {exc}"
+        ) from exc
+
+
+def set_thread_count(n: int | None) -> None:
+    """Limit Dr.Jit's thread pool in this process to *n* threads (``None``: leave it).
+
+    With several worker processes on one machine, one pool per process sized to its share of
+    the cores avoids oversubscription.
+    """
+    if n is None:
+        return
+    import_mitsuba()  # points Dr.Jit at a suitable libLLVM before drjit is first imported
+    import drjit
+
+    if drjit.thread_count() != n:
+        drjit.set_thread_count(n)
+
+
+def _llvm_suitable() -> bool:
+    """Whether Dr.Jit loaded a ``libLLVM`` that can run spectrinsic's kernels."""
+    import_mitsuba()
+    path = _loaded_libllvm
+    if not path:
+        return False  # Dr.Jit would pick whatever libLLVM it finds: possibly 14/15, which crash
+    version = llvm_version_from_name(path)
+    return (
+        version is None or version >= LLVM_MIN_VERSION
+    )  # an unversioned path set by the user is trusted
+
+
+def usable_backends() -> tuple[str, ...]:
+    """Dr.Jit backends that can render here, best first (always ends with ``"scalar"``)."""
+    import_mitsuba()
+    import drjit as dr
+
+    found = []
+    if dr.has_backend(dr.JitBackend.CUDA):
+        found.append("cuda")
+    if _llvm_suitable() and dr.has_backend(dr.JitBackend.LLVM):
+        found.append("llvm")
+    found.append("scalar")
+    return tuple(found)
+
+
+def _backend_of(requested: str) -> str:
+    """``"llvm"`` for ``"llvm"``, ``"llvm_ad_rgb"`` or ``"llvm_ad_spectral"``; likewise cuda/scalar."""
+    head = requested.split("_", 1)[0]
+    return validate_choice(head, BACKENDS, "Mitsuba backend", error=RenderError)
+
+
+def choose_variant(kind: VariantKind, requested: str | None = None) -> str:
+    """The Mitsuba variant for a pass of *kind* (``"rgb"`` or ``"spectral"``).
+
+    Parameters
+    ----------
+    kind
+        ``"spectral"`` for the spectral reference, ``"rgb"`` for diagonal passes and AOVs.
+    requested
+        A backend (``"cuda"``, ``"llvm"``, ``"scalar"``) or any variant name, whose backend is
+        used (``"llvm_ad_rgb"`` also selects ``llvm_ad_spectral`` for spectral passes).
+        ``None``: the best usable backend, cuda > llvm > scalar.
+
+    Raises
+    ------
+    RenderError
+        If the requested backend cannot run here or Mitsuba lacks the variant.
+    """
+    validate_choice(kind, ("rgb", "spectral"), "variant kind", error=RenderError)
+    mi = import_mitsuba()
+    usable = usable_backends()
+    if requested is not None:
+        backend = _backend_of(requested)
+        if backend not in usable:
+            raise RenderError(
+                f"Mitsuba backend {backend!r} (from {requested!r}) is not usable here; usable: "
+                f"{', '.join(usable)}"
+            )
+    else:
+        backend = usable[0]
+        if backend == "scalar":
+            warnings.warn(
+                f"no libLLVM >= {LLVM_MIN_VERSION} found (set {LLVM_ENV}); rendering with Mitsuba's "
+                "scalar variants, about twice slower",
+                SpectrinsicWarning,
+                stacklevel=2,
+            )
+    variant = f"{BACKENDS[backend]}_{kind}"
+    if variant not in mi.variants():
+        raise RenderError(
+            f"this Mitsuba build lacks variant {variant!r}; it has {', '.join(mi.variants())}"
+        )
+    return variant
+
+
+def llvm_library() -> str | None:
+    """Path of the ``libLLVM`` Dr.Jit's LLVM backend uses, or ``None`` if none is suitable."""
+    return _loaded_libllvm if _llvm_suitable() else None
+
+
+def available_variants() -> list[str]:
+    """Mitsuba variants usable here for spectrinsic's passes, best backend first
+    (e.g. ``["llvm_ad_rgb", "llvm_ad_spectral", "scalar_rgb", "scalar_spectral"]``)."""
+    mi = import_mitsuba()
+    compiled = set(mi.variants())
+    return [
+        f"{BACKENDS[b]}_{kind}"
+        for b in usable_backends()
+        for kind in ("rgb", "spectral")
+        if f"{BACKENDS[b]}_{kind}" in compiled
+    ]
+
+
+def variant_report() -> dict[str, Any]:
+    """Versions, compiled and usable variants, the LLVM library and the variants chosen by default."""
+    mi = import_mitsuba()
+    import drjit as dr
+
+    usable = usable_backends()
+    prefix = BACKENDS[usable[0]]
+    return {
+        "mitsuba": mi.__version__,
+        "drjit": getattr(dr, "__version__", "unknown"),
+        "compiled": list(mi.variants()),
+        "usable": available_variants(),
+        "libllvm": llvm_library(),
+        "backends": list(usable),
+        "rgb": f"{prefix}_rgb",
+        "spectral": f"{prefix}_spectral",
+    }
+
+
+@contextlib.contextmanager
+def variant_scope(variant: str, *, restore: bool = True) -> Iterator[ModuleType]:
+    """Make *variant* Mitsuba's active variant inside a ``with`` block; yields ``mitsuba``.
+
+    On leaving the block, normally or by an exception, the variant that was active before it
+    is active again (nested scopes unwind in order). With ``restore=False`` *variant* stays
+    active: every switch reloads Mitsuba's Python modules (0.25 s on 2 cores), and a caller
+    that sets the variant it needs at each of its scopes (the render pipeline) need not pay
+    for switching back.
+
+    One case cannot be undone: Mitsuba 3.9 keeps its current variant in C++ state that only
+    ``set_variant(name)`` replaces (``set_variant(None)`` raises ``TypeError``), so there is no
+    way back to "no variant". When no variant was active before the block, *variant* stays
+    active after it: ``mi.variant()`` returns it until another variant is set. This happens
+    at most once per process, at the first scope; spectrinsic sets variants nowhere else.
+    """
+    mi = import_mitsuba()
+    previous = mi.variant()
+    mi.set_variant(variant)
+    try:
+        yield mi
+    finally:
+        if restore and previous is not None:
+            mi.set_variant(previous)

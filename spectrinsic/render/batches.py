@@ -1,0 +1,88 @@
+"""Independent batches of one scene's render, run: the one batch loop (:func:`run_batches`).
+
+Inside a batch every mode shares seed and paths (:func:`~spectrinsic.render.scene_render.render_scene`);
+the batches differ only in their seed, so the spread between them is a direct estimate of the
+Monte Carlo error of their mean (the noise budget of the ground truth, and the adaptive
+sampling of ``RenderSettings.noise_target``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import TypeVar
+
+from ..scenes.model import Scene
+from .algebra.batch_means import batch_seeds, image_noise, merge_batches
+from .base.one_pass import PassProgress
+from .result import RenderResult
+from .scene_render import render_scene
+from .settings import RenderSettings
+
+#: What one batch gives: a :class:`RenderResult`, or a pair holding one (the transport's).
+Batch = TypeVar("Batch")
+
+__all__ = ["run_batches", "render_batches"]
+
+
+def render_batches(
+    scene: Scene,
+    settings: RenderSettings,
+    *,
+    seed: int,
+    progress: PassProgress | None = None,
+    data_dir: str | None = None,
+) -> RenderResult:
+    """:func:`render_scene` as ``settings.batches`` independent batches, merged.
+
+    Inside a batch every mode and the AOVs share seed and paths (common random numbers); the
+    batches differ only in their seed (:func:`batch_seeds`), so the spread between them is a
+    direct estimate of the Monte Carlo error of their mean (the noise budget of the ground
+    truth).
+
+    Adaptive sampling: with ``settings.noise_target``, batches are added one at a time while
+    the median relative standard error of the image (:func:`image_noise`) is above it, up to
+    ``settings.max_batches`` (default ``4 * batches``). ``meta["noise_target"]`` records the
+    target and the median reached.
+    """
+
+    def one(s: int) -> RenderResult:
+        return render_scene(scene, settings, seed=s, progress=progress, data_dir=data_dir)
+
+    return run_batches(settings, seed, one, lambda result: result)[1]
+
+
+def run_batches(
+    settings: RenderSettings,
+    seed: int,
+    one: Callable[[int], Batch],
+    result_of: Callable[[Batch], RenderResult],
+) -> tuple[list[Batch], RenderResult, list[int]]:
+    """The one batch loop: ``one(seed)`` for the ``settings.batches`` seeds of
+    :func:`batch_seeds`, then, with ``settings.noise_target``, one batch at a time while the
+    median relative standard error of the images (:func:`image_noise` of ``result_of`` each
+    batch) is above the target, up to ``settings.max_batches`` (default ``4 * batches``).
+
+    Returns the batches, their :func:`merge_batches` (``meta["noise_target"]``: the target,
+    the median reached and the cap) and the seeds used.
+    """
+    batches, noise_target = settings.batches, settings.noise_target
+    cap = max(batches, settings.max_batches if settings.max_batches is not None else 4 * batches)
+    seeds = batch_seeds(seed, cap if noise_target is not None else batches)
+    done = [one(s) for s in seeds[:batches]]
+    reached = image_noise([result_of(d) for d in done]) if noise_target is not None else None
+    while (
+        reached is not None
+        and noise_target is not None
+        and reached > noise_target
+        and len(done) < cap
+    ):
+        done.append(one(seeds[len(done)]))
+        reached = image_noise([result_of(d) for d in done])
+    merged = merge_batches([result_of(d) for d in done])
+    if noise_target is not None:
+        merged.meta["noise_target"] = {
+            "target": float(noise_target),
+            "reached": reached,
+            "max_batches": cap,
+        }
+    return done, merged, seeds[: len(done)]

@@ -1,0 +1,165 @@
+"""The first-hit maps of a scene with the passes integrator: coverage per surface, ids, depth
+and normals, from Mitsuba's ``aov`` integrator (the single traversal makes them itself)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ...errors import RenderError, SceneError
+from ...scenes.model import Scene
+from ..base import translate as tr
+from ..base.one_pass import (
+    PassProgress,
+    placeholder_light,
+    scene_parameters,
+    set_rgb,
+    timed_render,
+)
+from ..base.plugins import aov_integrator, hdr_film, rgb_spectrum
+from ..base.textures import refuse_textures
+from ..base.variants import choose_variant, variant_scope
+
+__all__ = ["render_aovs", "assemble_aovs"]
+
+
+def render_aovs(
+    scene: Scene,
+    *,
+    spp: int,
+    seed: int,
+    variant: str | None = None,
+    progress: PassProgress | None = None,
+    geometry: Sequence[tr.SurfaceGeometry] | None = None,
+) -> tuple[dict[str, np.ndarray], tuple[float, ...]]:
+    """Coverage, id, depth and normal maps, box-filtered over the same pixel samples as a render.
+
+    Each BSDF-carrying surface gets a one-hot diffuse reflectance in turn (three per pass) and
+    the ``albedo`` AOV, averaged by a box filter, is the fraction of the pixel's samples hitting
+    it; with the seed and sample count of the colour passes these are the very samples those
+    passes averaged, so ``Σ_m coverage_m ρ_m`` is the ground-truth reflectance of each pixel.
+    Mitsuba's own albedo of the real materials is not used (it assumes RGB wavelengths).
+
+    Returns
+    -------
+    aovs
+        ``coverage`` ``(H, W, M)`` float32 per material; ``material_id`` and ``object_id``
+        ``(H, W)`` int32, the material (object) covering most of the pixel, -1 where background
+        or light geometry covers most; ``depth`` ``(H, W)`` float32 mean ray distance from the
+        camera centre over the pixel's hits (scene units, 0 where nothing is hit);
+        ``normals`` ``(H, W, 3)`` float32 unit mean shading normal in world space as wound by
+        the mesh (zero where nothing is hit); ``mask`` ``(H, W)`` bool, ``material_id >= 0``.
+    seconds
+        Seconds per pass.
+    """
+    if int(spp) < 1:
+        raise SceneError(f"spp {spp}: expected at least 1 sample per pixel")
+    refuse_textures(scene, "the coverage passes")
+    surfaces = tr.surfaces(scene)
+    n_pass = max(1, -(-len(surfaces) // 3))
+    chosen = choose_variant("rgb", variant)
+    h, w = scene.camera.height, scene.camera.width
+    cover = np.zeros((h, w, len(surfaces)), np.float64)
+    seconds = []
+    with variant_scope(chosen) as mi:
+        zero = rgb_spectrum([0.0, 0.0, 0.0])
+        mitsuba_dict = tr.scene_to_mitsuba(
+            scene,
+            materials=[zero] * len(scene.materials),
+            lights=[placeholder_light(j) for j in range(len(scene.lights))],
+            film=hdr_film(w, h),
+            integrator=aov_integrator(),
+            sample_count=spp,
+            geometry=geometry,
+        )
+        loaded = mi.load_dict(mitsuba_dict)
+        params = scene_parameters(
+            mi, loaded, [tr.reflectance_key(s, spectral=False) for s in surfaces]
+        )
+        depth_sum = normal_sum = None
+        for p in range(n_pass):
+            for i, s in enumerate(surfaces):
+                onehot = np.zeros(3)
+                if i // 3 == p:
+                    onehot[i % 3] = 1.0
+                set_rgb(mi, params, tr.reflectance_key(s, spectral=False), onehot)
+            params.update()
+            image, dt = timed_render(mi, loaded, spp=spp, seed=seed)
+            seconds.append(dt)
+            if progress is not None:
+                progress(1)
+            if image.shape[-1] != 7:
+                raise RenderError(
+                    f"AOV pass returned {image.shape[-1]} channels; expected 7 (depth, normal, albedo)"
+                )
+            if p == 0:
+                depth_sum, normal_sum = (
+                    image[..., 0].astype(np.float64),
+                    image[..., 1:4].astype(np.float64),
+                )
+            block = surfaces[3 * p : 3 * p + 3]
+            cover[..., 3 * p : 3 * p + len(block)] = image[..., 4 : 4 + len(block)]
+    return assemble_aovs(scene, surfaces, cover, depth_sum, normal_sum), tuple(seconds)
+
+
+def _majority(coverage: np.ndarray) -> np.ndarray:
+    """Index of the largest coverage per pixel, -1 where the uncovered rest is larger."""
+    if coverage.shape[-1] == 0:
+        return np.full(coverage.shape[:2], -1, np.int32)
+    rest = 1.0 - coverage.sum(axis=-1, keepdims=True)
+    winner = np.argmax(np.concatenate([coverage, rest], axis=-1), axis=-1)
+    return np.where(winner == coverage.shape[-1], -1, winner).astype(np.int32)
+
+
+def assemble_aovs(
+    scene: Scene,
+    surfaces: Sequence[tr.Surface],
+    cover: np.ndarray,
+    depth_sum: np.ndarray | None,
+    normal_sum: np.ndarray | None,
+    texture_columns: np.ndarray | None = None,
+) -> dict[str, np.ndarray]:
+    """The maps :func:`render_aovs` returns, from the box-filtered per-surface coverage
+    ``(H, W, S)``, ray distance ``(H, W)`` and shading normal ``(H, W, 3)`` of the camera rays'
+    first hits (0 where they miss).
+
+    With *texture_columns* ``(G,)`` (material indices), *cover* has ``S + G`` channels: the last
+    G hold the box-filtered texel weights of textured hits on those basis materials
+    (:mod:`~spectrinsic.render.base.textures`), which take the place of the textured surfaces'
+    own coverage in the material coverage."""
+    columns = np.zeros(0, np.int64) if texture_columns is None else np.asarray(texture_columns)
+    h, w = cover.shape[:2]
+    n_mat = len(scene.materials)
+    material_cov = np.zeros((h, w, n_mat))
+    object_ids = sorted({m.object_id for m in scene.meshes})
+    object_cov = np.zeros((h, w, len(object_ids)))
+    for i, s in enumerate(surfaces):
+        if s.material >= 0:
+            if scene.meshes[s.mesh].texture is None:
+                material_cov[..., s.material] += cover[..., i]
+            object_cov[..., object_ids.index(scene.meshes[s.mesh].object_id)] += cover[..., i]
+    for g, m in enumerate(columns):
+        material_cov[..., int(m)] += cover[..., len(surfaces) + g]
+    hit = cover[..., : len(surfaces)].sum(axis=-1)
+    material_id = _majority(material_cov)
+    winner = _majority(object_cov)
+    object_id = np.where(winner >= 0, np.asarray(object_ids + [-1], np.int64)[winner], -1).astype(
+        np.int32
+    )
+    depth = (
+        np.zeros((h, w))
+        if depth_sum is None
+        else np.divide(depth_sum, hit, out=np.zeros((h, w)), where=hit > 1e-6)
+    )
+    normals = np.zeros((h, w, 3)) if normal_sum is None else normal_sum
+    length = np.linalg.norm(normals, axis=-1, keepdims=True)
+    normals = np.divide(normals, length, out=np.zeros_like(normals), where=length > 1e-6)
+    return {
+        "coverage": np.clip(material_cov, 0.0, 1.0).astype(np.float32),
+        "material_id": material_id,
+        "object_id": object_id,
+        "depth": depth.astype(np.float32),
+        "normals": normals.astype(np.float32),
+        "mask": material_id >= 0,
+    }

@@ -1,0 +1,144 @@
+"""The record a render returns: arrays and metadata, no live renderer."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import RenderError
+from ..scenes.model import Scene
+from ..spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
+from .algebra.modes import RenderMode
+from .base.variants import import_mitsuba
+
+__all__ = ["RenderResult", "render_meta"]
+
+
+@dataclass(frozen=True, eq=False)
+class RenderResult:
+    """Images of one scene in several render modes, with ground-truth helper maps.
+
+    Attributes
+    ----------
+    images
+        mode -> ``(H, W, 3)`` float32 linear CIE 1931 XYZ (``∫ L x̄ dλ`` etc., λ in nm).
+    raw
+        mode -> ``(H, W, K)`` float32 raw channels (the ``(H, W, 31)`` band cube, the 6 Gaussian
+        sensors, ...), ``∫ L S_k dλ`` under each mode's diagonal approximation.
+    per_light
+        One dict mode -> ``(H, W, 3)`` XYZ per scene light (empty unless asked for);
+        ``images[mode]`` is exactly their sum.
+    direct
+        mode -> ``(H, W, 3)`` XYZ of direct light only (path depth 2), for the energy ratio r of
+        Eq. 5.8 (empty unless asked for).
+    aovs
+        ``coverage`` ``(H, W, M)`` float32, ``material_id`` / ``object_id`` ``(H, W)`` int32 (-1
+        background), ``depth`` ``(H, W)`` float32, ``normals`` ``(H, W, 3)`` float32, ``mask``
+        ``(H, W)`` bool; see :func:`spectrinsic.render.passes.aovs.render_aovs` (empty unless asked).
+    meta
+        Variants, spp, seed, max_depth, sensors and XYZ matrices per mode, wavelength grid,
+        timings (seconds per pass), Mitsuba version; with batches also ``batches``,
+        ``batch_spp`` and ``batch_seeds``.
+    batch_raw
+        Per independent batch (:func:`spectrinsic.render.render_batches`), mode -> ``(H, W, K)``
+        float32 raw channels of that batch alone; ``raw`` is their mean. Empty for a single
+        batch. Inside a batch every mode shares its paths; batches have independent seeds, so
+        their spread measures the Monte Carlo noise.
+    transport
+        With the single-traversal integrator, mode -> ``(L, H, W, K)`` float32 per-light band
+        transport for unit emission (:class:`spectrinsic.render.algebra.shares.TransportOutput`):
+        ``raw[mode][..., k] = Σ_l E_{l,k} transport[mode][l, ..., k]``, with E the lights'
+        channel values (:func:`spectrinsic.render.algebra.modes.channel_values`). Empty otherwise.
+    parts
+        Single traversal: part name (:data:`spectrinsic.render.band_path.traversal.PARTS`) -> mode ->
+        ``(H, W, K)`` float32 raw channels of that part, summed over the lights as ``raw`` is;
+        only the parts the scene has. ``"specular"`` (glossy materials): the light the camera
+        rays' first hits return through their non-diffuse lobes (coat reflection, metal), with
+        everything those lobes reflect (:mod:`spectrinsic.render.band_path.kernel`), a part of
+        ``raw[mode]``. ``"metal_white"`` (metals): the radiance a white Lambertian surface would
+        reflect at the first hits on metals, times their coverage (not part of ``raw``), so the
+        shading stays defined where the diffuse albedo is 0.
+    part_transport
+        The per-light parts behind ``parts`` as ``transport`` is behind ``raw`` (part name ->
+        mode -> ``(L, H, W, K)`` float32 for unit emission); empty without them.
+    """
+
+    images: dict[str, np.ndarray]
+    raw: dict[str, np.ndarray]
+    per_light: tuple[dict[str, np.ndarray], ...] = ()
+    direct: dict[str, np.ndarray] = field(default_factory=dict)
+    aovs: dict[str, np.ndarray] = field(default_factory=dict)
+    meta: dict[str, Any] = field(default_factory=dict)
+    batch_raw: tuple[dict[str, np.ndarray], ...] = ()
+    transport: dict[str, np.ndarray] = field(default_factory=dict)
+    parts: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+    part_transport: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+
+    @property
+    def specular(self) -> dict[str, np.ndarray]:
+        """``parts["specular"]``: mode -> ``(H, W, K)`` raw specular part (empty: matte scene)."""
+        return self.parts.get("specular", {})
+
+    @property
+    def metal_white(self) -> dict[str, np.ndarray]:
+        """``parts["metal_white"]``: mode -> ``(H, W, K)`` raw white-at-metal radiance."""
+        return self.parts.get("metal_white", {})
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """``(H, W)`` of the images."""
+        first = next(iter(self.images.values()))
+        return int(first.shape[0]), int(first.shape[1])
+
+    def energy_ratio(self, mode: str) -> float:
+        """r = Σ_x ‖p¹(x)‖ / Σ_x ‖p^∞(x)‖ (Eq. 5.8) on *mode*'s XYZ, from the direct-only render."""
+        if mode not in self.direct:
+            raise RenderError(f"no direct-only render of mode {mode!r}; render with direct=True")
+        full = float(np.linalg.norm(self.images[mode].astype(np.float64), axis=-1).sum())
+        one = float(np.linalg.norm(self.direct[mode].astype(np.float64), axis=-1).sum())
+        return one / full if full > 0 else float("nan")
+
+
+def render_meta(
+    scene: Scene,
+    objs: Sequence[RenderMode],
+    matrices: dict[str, np.ndarray],
+    variants: dict[str, str],
+    timings: dict[str, list[float]],
+    *,
+    spp: int,
+    seed: int,
+    max_depth: int,
+    per_light: bool,
+    wanted: set[str],
+    data_dir: str | None,
+) -> dict[str, Any]:
+    """The ``meta`` record of one batch's render: versions, variants, samples, modes, their
+    sensors and XYZ matrices, the spectral grid, which modes have direct light, and timings (s)."""
+    names = [m.name for m in objs]
+    return {
+        "mitsuba": import_mitsuba().__version__,
+        "variants": variants,
+        "spp": int(spp),
+        "seed": int(seed),
+        "max_depth": int(max_depth),
+        "modes": names,
+        "sensors": {m.name: get_sensors(m.sensors, data_dir=data_dir).name for m in objs},
+        "to_xyz": {n: np.asarray(matrices[n]).tolist() for n in names},
+        "wavelengths": {
+            "start": float(COLORIMETRIC_WAVELENGTHS[0]),
+            "end": float(COLORIMETRIC_WAVELENGTHS[-1]),
+            "step": float(COLORIMETRIC_WAVELENGTHS[1] - COLORIMETRIC_WAVELENGTHS[0]),
+            "unit": "nm",
+        },
+        "per_light": bool(per_light),
+        "direct_modes": sorted(wanted),
+        "timings": {
+            k: {"passes": len(v), "seconds": float(sum(v)), "per_pass": [float(x) for x in v]}
+            for k, v in timings.items()
+        },
+        "units": "XYZ = integral of radiance times CIE 1931 CMF over nm; raw = integral of radiance times S_k",
+    }

@@ -1,0 +1,418 @@
+"""``render_scene``: every requested mode of one scene, converted to XYZ, with AOVs."""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import RenderError, SceneError
+from ..scenes.model import Scene
+from ..spectra import get_sensors
+from .algebra.modes import RenderMode, channel_values, get_mode, n_passes, raw_to_xyz, to_xyz_matrix
+from .band_path.traversal import PARTS, SingleTraversal, render_jobs, resolve_integrator
+from .base.one_pass import PassOutput, PassProgress
+from .base.translate import SurfaceGeometry, prepare_geometry, surfaces
+from .base.variants import choose_variant, import_mitsuba, variant_scope
+from .passes import render_diagonal
+from .passes.aovs import render_aovs
+from .result import RenderResult, render_meta
+from .settings import DEFAULT_MODES, RenderSettings
+from .spectral import render_spectral
+
+__all__ = [
+    "DEFAULT_MODES",
+    "render_scene",
+    "count_passes",
+]
+
+logger = logging.getLogger(__name__)
+
+
+def _modes(modes: Iterable[str]) -> list[RenderMode]:
+    names = list(dict.fromkeys(modes))
+    if not names:
+        raise SceneError("modes: expected at least one render mode, e.g. 'rgb3'")
+    return [get_mode(m) for m in names]
+
+
+def _direct_modes(direct: bool | Iterable[str], modes: Sequence[RenderMode]) -> set[str]:
+    if direct is True:
+        return {m.name for m in modes}
+    if direct is False or direct is None:
+        return set()
+    wanted = {get_mode(m).name for m in direct}  # type: ignore[union-attr]
+    missing = wanted - {m.name for m in modes}
+    if missing:
+        raise SceneError(
+            f"direct modes {sorted(missing)} are not among the rendered modes {[m.name for m in modes]}"
+        )
+    return wanted
+
+
+def count_passes(scene: Scene, settings: RenderSettings, *, data_dir: str | None = None) -> int:
+    """Number of Mitsuba passes :func:`render_scene` runs (the total of its progress calls),
+    from the same plan (and so the same integrator) as the render."""
+    plan = _plan(scene, settings, data_dir)
+    objs, share = plan.objs, plan.share
+    diagonal = 0
+    if plan.traversal:  # every diagonal mode and the AOVs: one traversal (+1 direct-only)
+        diagonal = 1 + any(m.kind == "diagonal" and m.name in plan.wanted for m in objs)
+        objs = [m for m in objs if m.kind != "diagonal"]
+        share = [m for m in share if m.kind != "diagonal"]
+    colour = sum(n_passes(m, data_dir=data_dir) * (2 if m.name in plan.wanted else 1) for m in objs)
+    shares = sum(n_passes(m, data_dir=data_dir) for m in share)
+    aovs = settings.aovs and not plan.traversal
+    aov_passes = max(1, -(-len(surfaces(scene)) // 3)) if aovs else 0
+    return diagonal + plan.n_main * colour + len(scene.lights) * shares + aov_passes
+
+
+def _sum_direct(parts: Sequence[np.ndarray | None]) -> np.ndarray:
+    """Sum of the direct-only renders of every light group (each was asked for)."""
+    present = [p for p in parts if p is not None]
+    if len(present) != len(parts):
+        raise RenderError("a direct-only render is missing for a light group")
+    return np.sum(present, axis=0, dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class _Job:
+    """One set of passes: some modes with some lights on (``None``: all)."""
+
+    modes: tuple[RenderMode, ...]
+    group: Sequence[int] | None
+    #: Whether the modes asked for a direct-only render get one in this job.
+    with_direct: bool = True
+
+
+@dataclass(frozen=True)
+class _Run:
+    """What every pass of one :func:`_run_jobs` call shares: the plan (with its settings), the
+    batch's seed, the progress callback, the data directory and the prepared geometry."""
+
+    scene: Scene
+    plan: _Plan
+    seed: int
+    progress: PassProgress | None
+    data_dir: str | None
+    geometry: Sequence[SurfaceGeometry]
+    #: One dict mode -> pass output per job, filled by the parts.
+    outputs: list[dict[str, PassOutput]]
+
+    @property
+    def settings(self) -> RenderSettings:
+        return self.plan.settings
+
+
+def _rgb_part(
+    run: _Run, rgb_variant: str
+) -> tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
+    """The diagonal modes of every job (one traversal, or the passes) and the AOVs."""
+    scene, plan, settings, single = run.scene, run.plan, run.settings, SingleTraversal({}, ())
+    aov_maps: dict[str, np.ndarray] = {}
+    if plan.traversal:
+        parts, single = render_jobs(
+            scene,
+            [(j.modes, j.group, j.with_direct) for j in plan.jobs],
+            wanted=plan.wanted,
+            spp=settings.batch_spp,
+            seed=run.seed,
+            max_depth=settings.max_depth,
+            variant=rgb_variant,
+            progress=run.progress,
+            geometry=run.geometry,
+            data_dir=run.data_dir,
+            aovs=settings.aovs,
+        )
+        aov_maps = single.aovs
+        for out, part in zip(run.outputs, parts, strict=True):
+            out.update(part)
+        return aov_maps, (), single
+    for out, job in zip(run.outputs, plan.jobs, strict=True):
+        diagonal = [m for m in job.modes if m.kind == "diagonal"]
+        values = [
+            channel_values(
+                scene, get_sensors(m.sensors, data_dir=run.data_dir), data_dir=run.data_dir
+            )
+            for m in diagonal
+        ]
+        out.update(
+            zip(
+                (m.name for m in diagonal),
+                render_diagonal(
+                    scene,
+                    values,
+                    spp=settings.batch_spp,
+                    seed=run.seed,
+                    max_depth=settings.max_depth,
+                    direct=[job.with_direct and m.name in plan.wanted for m in diagonal],
+                    active_lights=job.group,
+                    variant=rgb_variant,
+                    progress=run.progress,
+                    geometry=run.geometry,
+                ),
+                strict=True,
+            )
+            if diagonal
+            else ()
+        )
+    if not settings.aovs:
+        return aov_maps, (), single
+    aov_maps, aov_seconds = render_aovs(
+        scene,
+        spp=settings.batch_spp,
+        seed=run.seed,
+        variant=rgb_variant,
+        progress=run.progress,
+        geometry=run.geometry,
+    )
+    return aov_maps, aov_seconds, single
+
+
+def _spectral_part(run: _Run, spectral_variant: str) -> None:
+    """The spectral passes of every job (``settings.spectral_batch_spp`` samples each)."""
+    for out, job in zip(run.outputs, run.plan.jobs, strict=True):
+        for m in (m for m in job.modes if m.kind == "spectral"):
+            out[m.name] = render_spectral(
+                run.scene,
+                get_sensors(m.sensors, data_dir=run.data_dir),
+                spp=run.settings.spectral_batch_spp,
+                seed=run.seed,
+                max_depth=run.settings.max_depth,
+                direct=job.with_direct and m.name in run.plan.wanted,
+                active_lights=job.group,
+                variant=spectral_variant,
+                progress=run.progress,
+                geometry=run.geometry,
+                data_dir=run.data_dir,
+            )
+
+
+def _run_jobs(
+    scene: Scene,
+    plan: _Plan,
+    *,
+    seed: int,
+    progress: PassProgress | None,
+    data_dir: str | None,
+) -> tuple[list[dict[str, PassOutput]], dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
+    """Every pass of *plan*'s jobs, grouped by Mitsuba variant, plus the AOVs.
+
+    Each switch between the RGB and the spectral variant reloads Mitsuba's Python modules
+    (0.25 s on the 2-core machine, measured: 8 switches were 2.0 s of a 14.5 s default sample),
+    so every RGB-variant pass (all diagonal modes of every job, then the AOVs) runs in one
+    scope and every spectral pass in another; the variant already active goes first and stays
+    active afterwards (``restore=False``), so consecutive batches switch once each, not four
+    times. Passes do not depend on each other's order: each sets its own values, seed and spp.
+    With ``plan.traversal`` the diagonal modes of every job, and a textured scene's AOVs even
+    without them, come from one band-path traversal (:func:`~spectrinsic.render.band_path.traversal.render_jobs`).
+    """
+    run = _Run(
+        scene, plan, seed, progress, data_dir, prepare_geometry(scene), [{} for _ in plan.jobs]
+    )
+    found: tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]
+    found = ({}, (), SingleTraversal({}, ()))
+    variant, parts = plan.settings.variant, []
+    if plan.settings.aovs or plan.diagonal:
+        parts.append(("rgb", choose_variant("rgb", variant)))
+    if any(m.kind == "spectral" for job in plan.jobs for m in job.modes):
+        parts.append(("spectral", choose_variant("spectral", variant)))
+    for kind, chosen in sorted(parts, key=lambda p: p[1] != import_mitsuba().variant()):
+        with variant_scope(chosen, restore=False):
+            if kind == "rgb":
+                found = _rgb_part(run, chosen)
+            else:
+                _spectral_part(run, chosen)
+    return run.outputs, *found
+
+
+def render_scene(
+    scene: Scene,
+    settings: RenderSettings,
+    *,
+    seed: int,
+    progress: PassProgress | None = None,
+    data_dir: str | None = None,
+) -> RenderResult:
+    """Render *scene* in each of ``settings.modes`` and convert every mode to CIE 1931 XYZ.
+
+    One batch: every pass renders ``settings.batch_spp`` samples with sampler seed *seed*
+    (a spectral pass ``settings.spectral_batch_spp``, in ``meta["spectral_spp"]``). All
+    diagonal modes share one loaded scene and the same paths (same seed and sample count,
+    Russian roulette off): ``rgb3``, ``rgb6`` and ``bands31`` differ only by spectral error.
+    With ``settings.per_light`` and no ``share_mode`` every mode is rendered light by light and
+    ``images`` is exactly the sum of the per-light images (and ``direct`` of per-light direct
+    images), costing no extra.
+
+    Parameters
+    ----------
+    settings
+        Modes, samples, path depth, variant, per-light, direct and AOV choices
+        (:class:`~spectrinsic.render.settings.RenderSettings`), and the integrator of the
+        diagonal modes: ``"passes"``, ⌈K/3⌉ RGB passes per mode and one scene per light;
+        ``"single"`` (default), one traversal for every diagonal mode, band and light
+        (:mod:`spectrinsic.render.band_path.traversal`): the same images to float rounding, per-light
+        images that are exact shares of the full render, and ``RenderResult.transport``.
+    seed
+        Sampler seed, shared by every pass.
+    progress
+        Called with 1 after each Mitsuba pass; :func:`count_passes` gives the total.
+    """
+    plan = _plan(scene, settings, data_dir)
+    outputs, aov_maps, aov_seconds, single = _run_jobs(
+        scene, plan, seed=seed, progress=progress, data_dir=data_dir
+    )
+    timings: dict[str, list[float]] = {m.name: [] for m in plan.objs + plan.share}
+    variants: dict[str, str] = {}
+    for out in outputs:
+        for name, o in out.items():
+            timings[name].extend(o.seconds)
+            variants[name] = o.variant
+    if settings.aovs:
+        timings["aovs"] = list(aov_seconds)
+    if single.seconds:
+        timings["single"] = list(single.seconds)
+    meta = render_meta(
+        scene,
+        plan.objs,
+        plan.matrices,
+        variants,
+        timings,
+        spp=settings.batch_spp,
+        seed=seed,
+        max_depth=settings.max_depth,
+        per_light=settings.per_light,
+        wanted=plan.wanted,
+        data_dir=data_dir,
+    )
+    names = [m.name for m in plan.objs]
+    meta["per_light_modes"] = (
+        [m.name for m in plan.share] if plan.split else (names if settings.per_light else [])
+    )
+    meta["integrator"] = plan.integrator
+    if any(m.kind == "spectral" for m in plan.objs):
+        meta["spectral_spp"] = settings.spectral_batch_spp
+    logger.debug("rendered %s: %s", scene.name, {k: sum(v) for k, v in timings.items()})
+    return _assemble(scene, plan, outputs, aov_maps, single, meta, data_dir=data_dir)
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """What :func:`render_scene` renders: the settings, the modes, their XYZ matrices, the
+    jobs, and the integrator, resolved once (:func:`~spectrinsic.render.band_path.traversal.resolve_integrator`).
+
+    ``jobs[:n_main]`` render every mode (all lights, or one light each with ``per_light`` and
+    no separate share modes); the rest render the share modes light by light (``split``).
+    """
+
+    settings: RenderSettings
+    objs: list[RenderMode]
+    share: list[RenderMode]
+    wanted: set[str]
+    #: ``"single"`` or ``"passes"``, as recorded in ``meta["integrator"]``.
+    integrator: str
+    matrices: dict[str, np.ndarray]
+    split: bool
+    jobs: list[_Job]
+    n_main: int
+    #: Whether the RGB part is one band-path traversal (:func:`~spectrinsic.render.band_path.traversal.render_jobs`): the
+    #: integrator is ``"single"`` and there are diagonal modes, or a textured scene's AOVs
+    #: (which the coverage passes cannot give) without them.
+    traversal: bool
+
+    @property
+    def diagonal(self) -> bool:
+        """Whether any job renders a diagonal mode."""
+        return any(m.kind == "diagonal" for job in self.jobs for m in job.modes)
+
+
+def _plan(scene: Scene, settings: RenderSettings, data_dir: str | None) -> _Plan:
+    objs = _modes(settings.modes)
+    per_light, per_light_modes = settings.per_light, settings.per_light_modes
+    lights = [[j] for j in range(len(scene.lights))]
+    split = per_light and per_light_modes is not None
+    share = _modes(per_light_modes) if split and per_light_modes is not None else []
+    main = [_Job(tuple(objs), g) for g in (lights if per_light and not split else [None])]
+    jobs = main + [_Job(tuple(share), g, with_direct=False) for g in lights] if split else main
+    integrator = resolve_integrator(settings.integrator, settings.variant)
+    diagonal = any(m.kind == "diagonal" for m in objs + share)
+    if integrator == "passes" and any(m.glossy for m in scene.materials) and diagonal:
+        raise RenderError(
+            f"scene {scene.name!r} has glossy materials: diagonal modes render them only with "
+            "integrator 'single' on a JIT (LLVM/CUDA) variant; spectral modes render them either way"
+        )
+    return _Plan(
+        settings=settings,
+        objs=objs,
+        share=share,
+        wanted=_direct_modes(settings.direct, objs),
+        integrator=integrator,
+        matrices={m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in objs},
+        split=split,
+        jobs=jobs,
+        n_main=len(main),
+        traversal=integrator == "single" and (diagonal or (settings.aovs and scene.textured)),
+    )
+
+
+def _assemble(
+    scene: Scene,
+    plan: _Plan,
+    outputs: Sequence[dict[str, PassOutput]],
+    aov_maps: dict[str, np.ndarray],
+    single: SingleTraversal,
+    meta: dict[str, Any],
+    *,
+    data_dir: str | None,
+) -> RenderResult:
+    """The XYZ images of the jobs' raw outputs: totals, per-light shares and direct light."""
+    main_out, share_out = outputs[: plan.n_main], outputs[plan.n_main :]
+    names = [m.name for m in plan.objs]
+    matrices, groups = plan.matrices, [job.group for job in plan.jobs[: plan.n_main]]
+    raw = {
+        n: np.sum([g[n].image for g in main_out], axis=0, dtype=np.float64).astype(np.float32)
+        for n in names
+    }
+    per_light_images: tuple[dict[str, np.ndarray], ...] = ()
+    if plan.split:
+        share_xyz = {m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in plan.share}
+        per_light_images = tuple(
+            {n: raw_to_xyz(g[n].image, share_xyz[n]) for n in share_xyz} for g in share_out
+        )
+    elif plan.settings.per_light:
+        per_light_images = tuple(
+            {n: raw_to_xyz(g[n].image, matrices[n]) for n in names} for g in main_out
+        )
+    return RenderResult(
+        images={n: raw_to_xyz(raw[n], matrices[n]) for n in names},
+        raw=raw,
+        per_light=per_light_images,
+        direct={
+            n: raw_to_xyz(_sum_direct([g[n].direct for g in main_out]), matrices[n])
+            for n in names
+            if n in plan.wanted
+        },
+        aovs=aov_maps,
+        meta=meta,
+        transport=single.per_light("transport"),
+        parts={p: raw_part for p in PARTS if (raw_part := _part_raw(single, groups, p))},
+        part_transport={p: per_light for p in PARTS if (per_light := single.per_light(p))},
+    )
+
+
+def _part_raw(
+    single: SingleTraversal,
+    groups: Sequence[Sequence[int] | None],
+    part: str,
+) -> dict[str, np.ndarray]:
+    """Mode -> raw channels of a traversal's *part* (one of :data:`~spectrinsic.render.band_path.traversal.PARTS`), summed
+    over the main jobs' light *groups* as ``raw`` is; modes without the part are left out."""
+    out = {}
+    for name, t in single.transport.items():
+        parts = [p for g in groups if (p := t.part_image(part, g)) is not None]
+        if parts:
+            out[name] = np.sum(parts, axis=0, dtype=np.float64).astype(np.float32)
+    return out

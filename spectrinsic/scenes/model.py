@@ -1,0 +1,385 @@
+"""The scene model: a scene is plain data.
+
+Geometry is arrays; materials, lights and the camera are frozen records that *name* spectra
+(``"munsell:5R 4/14"``, ``"planck:2800K"``) from :mod:`spectrinsic.spectra` rather than hold
+colours, so any layer of ground truth can be recomputed from the spectra. A scene can be
+compared, hashed (:func:`scene_hash`) and written as JSON (:func:`scene_to_dict`) next to every
+rendered sample. Only :mod:`spectrinsic.render` translates a scene into a Mitsuba dict.
+
+Units: lengths in scene units (metres by convention), angles in degrees, wavelengths in nm.
+Materials are Lambertian by default (as in the thesis dataset); a material may instead be a
+coated diffuse (``plastic``) or a metal (``conductor``), smooth or rough (:class:`Material`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields, is_dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+from ..errors import SceneError, did_you_mean
+from .textures import Texture, texture_from_record
+
+__all__ = [
+    "Material",
+    "MaterialKind",
+    "MATERIAL_KINDS",
+    "GLOSS_FIELDS",
+    "Mesh",
+    "Light",
+    "Camera",
+    "Scene",
+    "LightKind",
+    "LIGHT_FIELDS",
+    "LIGHT_KINDS",
+    "DRAWN_LIGHT_KINDS",
+    "LIGHT_PLACEMENT",
+    "LIGHT_DEFAULTED",
+    "make_light",
+    "unknown_light_kind",
+    "light_power",
+    "record_fields",
+    "scene_to_dict",
+    "scene_from_dict",
+    "scene_hash",
+]
+
+LightKind = Literal["point", "spot", "area", "directional", "sky"]
+#: The one table of light kinds: the placement fields each kind uses (the others are ignored,
+#: and records such as meta.json leave them out).
+LIGHT_FIELDS: dict[str, tuple[str, ...]] = {
+    "point": ("position",),
+    "spot": ("position", "direction", "cutoff_deg"),
+    "area": ("position", "direction", "size"),
+    "directional": ("direction",),
+    "sky": (),
+}
+#: The light kinds, in the table's order (``typing.get_args(LightKind)`` is the same).
+LIGHT_KINDS: tuple[LightKind, ...] = tuple(LIGHT_FIELDS)  # type: ignore[arg-type]
+#: The kinds the scene generators draw (a sky comes from scene files and daylight rooms).
+DRAWN_LIGHT_KINDS: tuple[LightKind, ...] = tuple(k for k in LIGHT_KINDS if k != "sky")
+#: Every placement field some kind uses (the union of :data:`LIGHT_FIELDS`).
+LIGHT_PLACEMENT: tuple[str, ...] = tuple(
+    dict.fromkeys(f for fs in LIGHT_FIELDS.values() for f in fs)
+)
+#: Placement fields with a default that a scene file may leave out (a spot's cone half-angle,
+#: :attr:`Light.cutoff_deg`).
+LIGHT_DEFAULTED: tuple[str, ...] = ("cutoff_deg",)
+
+
+MaterialKind = Literal["diffuse", "plastic", "conductor"]
+#: Material kinds: Lambertian; a diffuse base under a dielectric coat (Mitsuba ``plastic`` /
+#: ``roughplastic``); a metal (``conductor`` / ``roughconductor``).
+MATERIAL_KINDS: tuple[MaterialKind, ...] = ("diffuse", "plastic", "conductor")
+#: The optional fields of :class:`Material`; at their defaults they are left out of
+#: :func:`scene_to_dict`, so a matte scene's record and hash are those of before they existed.
+GLOSS_FIELDS = ("kind", "roughness", "ior", "metal")
+_OPTIONAL = {"omit_default": True}
+
+
+@dataclass(frozen=True)
+class Material:
+    """A material: Lambertian (default), coated diffuse or metal.
+
+    Attributes
+    ----------
+    name
+        Human-readable name (``"wall"``, ``"stripe 2"``).
+    spectrum
+        Registry name of the diffuse reflectance spectrum, e.g. ``"munsell:5R 4/14"`` (the base
+        under the coat of a ``plastic``; ``"flat:0"`` for a ``conductor``, which has no diffuse
+        lobe).
+    kind
+        One of :data:`MATERIAL_KINDS`.
+    roughness
+        GGX α of the coat or metal surface (dimensionless, 0 = smooth, i.e. a delta lobe);
+        ignored for ``diffuse``.
+    ior
+        Index of refraction of a ``plastic``'s coat (the base medium has index 1).
+    metal
+        Name of a conductor whose measured η/k Mitsuba ships (``Au``, ``Cu``, ``Al``, ``Ag``...),
+        for ``conductor``.
+    """
+
+    name: str
+    spectrum: str
+    kind: MaterialKind = field(default="diffuse", metadata=_OPTIONAL)
+    roughness: float = field(default=0.0, metadata=_OPTIONAL)
+    ior: float = field(default=1.5, metadata=_OPTIONAL)
+    metal: str = field(default="", metadata=_OPTIONAL)
+
+    @property
+    def glossy(self) -> bool:
+        """Whether the material has a non-diffuse lobe."""
+        return self.kind != "diffuse"
+
+
+@dataclass(frozen=True, eq=False)
+class Mesh:
+    """A triangle mesh in world space with one material index per face.
+
+    Attributes
+    ----------
+    name
+        Object name, unique in its scene.
+    vertices
+        ``(V, 3)`` float64 world-space positions.
+    faces
+        ``(F, 3)`` int64 vertex indices, counter-clockwise seen from outside.
+    face_materials
+        ``(F,)`` int64 indices into :attr:`Scene.materials`; lets one object carry several
+        exact spectra (painted stripes, patches).
+    object_id
+        Non-negative id written to the object-id ground-truth map.
+    texture
+        A spectral :class:`~spectrinsic.scenes.textures.Texture` over every face (whose
+        ``face_materials`` are then all ``texture.basis[0]``), or ``None``: each face one exact
+        spectrum. Left out of :func:`scene_to_dict` when ``None``.
+    """
+
+    name: str
+    vertices: np.ndarray
+    faces: np.ndarray
+    face_materials: np.ndarray
+    object_id: int
+    texture: Texture | None = field(default=None, metadata=_OPTIONAL)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Mesh):
+            return NotImplemented
+        return (
+            self.name == other.name
+            and self.object_id == other.object_id
+            and np.array_equal(self.vertices, other.vertices)
+            and np.array_equal(self.faces, other.faces)
+            and np.array_equal(self.face_materials, other.face_materials)
+            and self.texture == other.texture
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+@dataclass(frozen=True)
+class Light:
+    """A light source with the relative spectral power distribution called *spectrum*.
+
+    Attributes
+    ----------
+    kind
+        One of :data:`LIGHT_KINDS`: ``"point"``, ``"spot"``, ``"area"`` (a rectangle),
+        ``"directional"`` or ``"sky"`` (a uniform sky dome at infinity, Mitsuba ``constant``);
+        :data:`LIGHT_FIELDS` lists the placement fields each uses.
+    spectrum
+        Registry name of an illuminant, e.g. ``"planck:2800K"``. The registry normalises every
+        illuminant to unit luminance-weighted mean, so *power* alone sets brightness.
+    power
+        Scale on the normalised SPD: radiant intensity for point and spot lights, radiance for
+        area lights and the sky (an unoccluded surface then receives irradiance π × power),
+        irradiance for directional lights (relative units). Must be > 0.
+    position
+        World position (point, spot, area centre); unused for directional lights.
+    direction
+        Direction the light travels (spot, area normal, directional); unused for point lights.
+    size
+        ``(width, height)`` of an area light in scene units.
+    cutoff_deg
+        Spot cone half-angle in degrees.
+    """
+
+    kind: LightKind
+    spectrum: str
+    power: float
+    position: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    direction: tuple[float, float, float] = (0.0, 0.0, -1.0)
+    size: tuple[float, float] = (1.0, 1.0)
+    cutoff_deg: float = 30.0
+    name: str = "light"
+
+
+def unknown_light_kind(kind: object) -> str:
+    """The message for a light kind not in :data:`LIGHT_KINDS`, with a did-you-mean.
+
+    >>> unknown_light_kind("spto")
+    "unknown light kind 'spto'; expected one of point, spot, area, directional, sky (did you mean 'spot'?)"
+    """
+    return f"unknown light kind {kind!r}; expected one of {', '.join(LIGHT_KINDS)}" + did_you_mean(
+        str(kind), LIGHT_KINDS
+    )
+
+
+def make_light(
+    kind: LightKind, spectrum: str, power: float, *, name: str = "light", **placement: Any
+) -> Light:
+    """A :class:`Light` of *kind* with only the placement fields its kind uses
+    (:data:`LIGHT_FIELDS`) taken from *placement*; the others keep their defaults, so saved
+    scenes and records stay tidy.
+
+    >>> make_light("point", "cie:D65", 1.0, position=(0, 0, 2), direction=(1, 0, 0)).direction
+    (0.0, 0.0, -1.0)
+    """
+    unknown = set(placement) - set(LIGHT_PLACEMENT)
+    if unknown:
+        raise TypeError(
+            f"make_light: unknown placement field(s) {sorted(unknown)}; "
+            f"expected some of {list(LIGHT_PLACEMENT)}"
+        )
+    used = {k: v for k, v in placement.items() if k in LIGHT_FIELDS[kind]}
+    return Light(kind=kind, spectrum=spectrum, power=power, name=name, **used)
+
+
+def light_power(
+    kind: str,
+    position: np.ndarray,
+    direction: np.ndarray,
+    focus: np.ndarray,
+    size: tuple[float, float],
+    irradiance: float,
+) -> float:
+    """:attr:`Light.power` delivering *irradiance* at *focus* on a surface facing the light.
+
+    Inverse square law for point and spot lights (power ``E d²``, a radiant intensity); an
+    area light of radiance L and area A gives about ``L A cos θ / d²`` (cos θ of its normal
+    *direction* towards *focus*, at least 0.2); a directional light's power is the irradiance, a sky's the irradiance over π.
+    Positions in scene units, *direction* a unit vector; relative radiometric units.
+
+    >>> light_power("point", np.zeros(3), np.array([0, 0, 1.0]), np.array([0, 0, 2.0]), (1, 1), 1.0)
+    4.0
+    """
+    if kind == "sky":
+        return irradiance / math.pi  # a uniform sky of radiance L gives E = π L
+    if "position" not in LIGHT_FIELDS[kind]:
+        return irradiance
+    offset = focus - np.asarray(position, float)
+    d2 = float(offset @ offset)
+    if "size" in LIGHT_FIELDS[kind]:
+        cos_light = float(direction @ offset) / math.sqrt(d2)
+        return irradiance * d2 / (size[0] * size[1] * max(cos_light, 0.2))
+    return irradiance * d2
+
+
+@dataclass(frozen=True)
+class Camera:
+    """A pinhole camera.
+
+    Attributes
+    ----------
+    origin, target, up
+        World-space eye position, look-at point and up vector.
+    fov_deg
+        Horizontal field of view in degrees.
+    width, height
+        Image size in pixels.
+    """
+
+    origin: tuple[float, float, float]
+    target: tuple[float, float, float]
+    up: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    fov_deg: float = 40.0
+    width: int = 128
+    height: int = 128
+    name: str = "view0"
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A complete renderable scene: geometry, materials, lights and one camera."""
+
+    name: str
+    meshes: tuple[Mesh, ...]
+    materials: tuple[Material, ...]
+    lights: tuple[Light, ...]
+    camera: Camera
+    metadata: dict[str, Any] = field(default_factory=dict, compare=False, hash=False)
+
+    @property
+    def textured(self) -> bool:
+        """Whether a mesh carries a spectral texture."""
+        return any(m.texture is not None for m in self.meshes)
+
+
+def record_fields(record: Any) -> dict[str, Any]:
+    """The fields of dataclass *record* that its plain record keeps: all but those marked
+    ``omit_default`` at their default and those whose ``omit_when(record)`` holds (a procedural
+    texture's weights). The one rule of :func:`scene_to_dict` and of the sample files' JSON
+    (:func:`spectrinsic.gt_export.sample.plain_data`)."""
+    return {
+        f.name: getattr(record, f.name)
+        for f in fields(record)
+        if not (f.metadata.get("omit_default") and getattr(record, f.name) == f.default)
+        and not f.metadata.get("omit_when", lambda record: False)(record)
+    }
+
+
+def _plain(value: Any) -> Any:
+    if is_dataclass(value) and not isinstance(value, type):
+        return {k: _plain(v) for k, v in record_fields(value).items()}
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, (tuple, list)):
+        return [_plain(v) for v in value]
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def scene_to_dict(scene: Scene) -> dict[str, Any]:
+    """Return *scene* as JSON-serialisable plain data (arrays become nested lists)."""
+    return _plain(scene)
+
+
+def _record(entry: Mapping[str, Any]) -> dict[str, Any]:
+    """A record's fields from plain data: lists back to the tuples the frozen records hold."""
+    return {str(k): tuple(v) if isinstance(v, list) else v for k, v in entry.items()}
+
+
+def _mesh_from_dict(m: Mapping[str, Any]) -> Mesh:
+    return Mesh(
+        name=str(m["name"]),
+        vertices=np.asarray(m["vertices"], np.float64).reshape(-1, 3),
+        faces=np.asarray(m["faces"], np.int64).reshape(-1, 3),
+        face_materials=np.asarray(m["face_materials"], np.int64).reshape(-1),
+        object_id=int(m["object_id"]),
+        texture=texture_from_record(m["texture"]) if m.get("texture") else None,
+    )
+
+
+def scene_from_dict(data: Mapping[str, Any]) -> Scene:
+    """The :class:`Scene` of its :func:`scene_to_dict` record, the inverse:
+    ``scene_from_dict(scene_to_dict(s)) == s`` (fields left out at their defaults come back as
+    those defaults; a procedural texture's weights from its recipe). Raises
+    :class:`~spectrinsic.errors.SceneError` (one line) on any other structure.
+
+    >>> s = scene_from_dict({"name": "s", "meshes": [], "materials": [{"name": "m",
+    ...     "spectrum": "flat:0.5"}], "lights": [], "camera": {"origin": [0, 0, 1],
+    ...     "target": [0, 0, 0]}})
+    >>> s.materials[0].kind, s.camera.width
+    ('diffuse', 128)
+    """
+    try:
+        return Scene(
+            str(data["name"]),
+            tuple(_mesh_from_dict(m) for m in data["meshes"]),
+            tuple(Material(**_record(m)) for m in data["materials"]),
+            tuple(Light(**_record(x)) for x in data["lights"]),
+            Camera(**_record(data["camera"])),
+            dict(data.get("metadata") or {}),
+        )
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise SceneError(
+            f"scene record: unexpected structure ({type(exc).__name__}: {exc})"
+        ) from exc
+
+
+def scene_hash(scene: Scene) -> str:
+    """SHA-256 of the scene's canonical JSON (metadata excluded): equal scenes, equal hashes."""
+    data = scene_to_dict(scene)
+    data.pop("metadata", None)
+    blob = json.dumps(data, sort_keys=True, separators=(",", ":")).encode()
+    return hashlib.sha256(blob).hexdigest()
