@@ -7,6 +7,7 @@ turn a pixel back into the value it stands for.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -15,8 +16,10 @@ import numpy as np
 from spectrinsic.gt_export import png
 from spectrinsic.gt_export.layers import Layer
 from spectrinsic.gt_export.sample import PREVIEW_DIR
+from spectrinsic.gt_export.working_view import srgb_layer, view_kind
+from spectrinsic.spectra.working_space import WorkingSpace
 
-__all__ = ["Preview", "preview_maker", "preview_path"]
+__all__ = ["Preview", "preview_maker", "preview_path", "shown_layers"]
 
 
 #: A preview and how its pixels encode the layer: ``{"kind": "srgb", "scale": k}`` (PNG =
@@ -171,3 +174,21 @@ def preview_path(layer: Layer) -> str:
     base, _, camera = layer.name.partition("/")
     name = f"{base}--{layer.group.removeprefix('camera-')}.png" if camera else f"{base}.png"
     return f"{PREVIEW_DIR}/{name}"
+
+
+def shown_layers(layers: Mapping[str, Layer], space: WorkingSpace) -> dict[str, Layer]:
+    """*layers* with the working-space RGB ones in linear sRGB, as previews show them
+    (:mod:`~spectrinsic.gt_export.working_view`; residuals by the matrix alone, enough for
+    their magnitude maps); the same layers for an sRGB sample."""
+    if space.name == "srgb":
+        return dict(layers)
+    out = dict(layers)
+    for name, layer in layers.items():
+        if layer.data.ndim != 3 or layer.data.shape[-1] != 3:
+            continue
+        data = srgb_layer(name, layer.data, space)
+        if data is None and view_kind(name) == "recomputed":
+            data = space.srgb(layer.data)
+        if data is not None:
+            out[name] = dataclasses.replace(layer, data=data.astype(np.float32))
+    return out

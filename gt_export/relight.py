@@ -39,6 +39,7 @@ from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, file_sha256
 from spectrinsic.gt_export.sample_meta import read_meta
 from spectrinsic.gt_export.sensor import model_from_meta
 from spectrinsic.gt_export.transport_file import read_transport
+from spectrinsic.gt_export.working_view import space_of
 from spectrinsic.gt_export.writer import export_sample
 from spectrinsic.render.light_transport import LightTransport, relit_result
 from spectrinsic.render.result import RenderResult
@@ -307,6 +308,7 @@ def relight(
         cameras=cameras,
         write_cube="cube" in meta.get("layers", {}),
         spectral_layers="shading_bands" in meta.get("layers", {}),
+        working_space=space_of(meta).name,  # the source's (srgb for samples before issue 30)
         denoise=bool(meta.get("denoised_layers")),
         data_dir=data_dir,
         transport=relit.transport if keep_transport else None,

@@ -30,6 +30,7 @@ from spectrinsic.gt_export.integrity import sample_problem
 from spectrinsic.gt_export.layers import compute_ground_truth
 from spectrinsic.gt_export.relight import relight, relit_render
 from spectrinsic.gt_export.sample_meta import read_meta
+from spectrinsic.gt_export.working_view import space_of
 from spectrinsic.rng import seed_from_key
 from spectrinsic.scenes.generators.lights import draw_illuminant
 
@@ -129,6 +130,7 @@ def relit_layers(
         denoise=bool(meta.get("denoised_layers")) if denoise is None else denoise,
         data_dir=data_dir,
         spectral="shading_bands" in meta.get("layers", {}),
+        working_space=space_of(meta).name,
     )
     out: dict[str, Any] = {name: layer.data for name, layer in gt.layers.items()}
     if "mask" in out:

@@ -39,7 +39,7 @@ from spectrinsic.gt_export.integrity import (
     sample_problem,
 )
 from spectrinsic.gt_export.layers import GroundTruth, Layer, compute_ground_truth, identities
-from spectrinsic.gt_export.previews import preview_maker, preview_path
+from spectrinsic.gt_export.previews import preview_maker, preview_path, shown_layers
 from spectrinsic.gt_export.sample import (
     FORMAT_VERSION,
     HASHES_KEY,
@@ -61,6 +61,7 @@ from spectrinsic.provenance import software_versions
 from spectrinsic.scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash, scene_to_dict
 from spectrinsic.spectra import DEFAULT_WAVELENGTHS, get_spectrum
 from spectrinsic.spectra.user_spectra import spectrum_files
+from spectrinsic.spectra.working_space import DEFAULT_WORKING_SPACE
 
 if TYPE_CHECKING:
     from spectrinsic.render.light_transport import LightTransport
@@ -157,6 +158,7 @@ def _meta(
         "denoised_layers": list(gt.denoised),
         "noise": gt.noise,
         "shading_clipping": gt.clipping,
+        "working_space": gt.working_space.record(),
         "residual_share": gt.residual_share,
         "files": sorted(files),
         "versions": software_versions(),
@@ -185,12 +187,13 @@ def _write_previews(folder: Path, gt: GroundTruth) -> dict[str, tuple[str, dict[
     """One PNG per layer that has a preview maker; return ``{layer: (path, encoding)}``."""
     (folder / PREVIEW_DIR).mkdir()
     previews: dict[str, tuple[str, dict[str, Any]]] = {}
-    for layer in gt.layers.values():
+    shown = shown_layers(gt.layers, gt.working_space)  # previews are sRGB
+    for layer in shown.values():
         maker = preview_maker(layer)
         if maker is None:
             continue
         rel = preview_path(layer)
-        rgb8, encoding = maker(layer, gt.layers)
+        rgb8, encoding = maker(layer, shown)
         png.write_png(folder / rel, rgb8)
         previews[layer.name] = (rel, encoding)
     return previews
@@ -252,6 +255,7 @@ def export_sample(
     transport: LightTransport | None = None,
     camera: CameraModel | None = None,
     spectral_layers: bool = False,
+    working_space: str = DEFAULT_WORKING_SPACE,
 ) -> Path:
     """Compute every ground-truth layer of a rendered sample and write it atomically.
 
@@ -291,6 +295,9 @@ def export_sample(
     spectral_layers
         Also write the per-band intrinsic layers (``spectral.exr``,
         :mod:`~spectrinsic.gt_export.layers.spectral_intrinsics`); needs the 31-band cube.
+    working_space
+        The RGB working space of the RGB layers (``"acescg"``, default, or ``"srgb"``,
+        :mod:`spectrinsic.spectra.working_space`); recorded in ``meta.json["working_space"]``.
 
     Returns
     -------
@@ -313,6 +320,7 @@ def export_sample(
         denoise=denoise,
         data_dir=data_dir,
         spectral=spectral_layers,
+        working_space=working_space,
     )
     sensor = None
     if camera is not None:

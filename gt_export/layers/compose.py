@@ -12,7 +12,7 @@ from spectrinsic.gt_export import irradiance as irr
 from spectrinsic.gt_export.denoise import Denoiser, Guides, denoise_white_radiance
 from spectrinsic.gt_export.layers.cameras import camera_layers, matrices_of
 from spectrinsic.gt_export.layers.geometry import coverage_of, geometry_layers
-from spectrinsic.gt_export.layers.gloss import gloss_layers, specular_srgb
+from spectrinsic.gt_export.layers.gloss import gloss_layers, specular_rgb
 from spectrinsic.gt_export.layers.images import cube_layer, image_layers
 from spectrinsic.gt_export.layers.imaging import coverage_weighted
 from spectrinsic.gt_export.layers.intrinsics import (
@@ -20,8 +20,8 @@ from spectrinsic.gt_export.layers.intrinsics import (
     from_denoised,
     intrinsic_layers,
     noise_of,
-    srgb_of,
-    srgb_white,
+    rgb_of,
+    rgb_white,
     white_radiance,
 )
 from spectrinsic.gt_export.layers.lights import light_records, share_layers
@@ -46,14 +46,16 @@ from spectrinsic.gt_export.layers.spectral_intrinsics import (
 )
 from spectrinsic.scenes.material_labels import material_label
 from spectrinsic.scenes.model import Scene
-from spectrinsic.spectra import absolute_reflectance, get_sensors, get_spectrum
+from spectrinsic.spectra import get_sensors, get_spectrum, white_normalised_responses
+from spectrinsic.spectra.working_space import DEFAULT_WORKING_SPACE, WorkingSpace
+from spectrinsic.spectra.working_space import working_space as working_space_of
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 
 __all__ = ["compute_ground_truth", "identities"]
 
 
-def _sample(scene: Scene, result: Any, data_dir: Any) -> SampleInputs:
+def _sample(scene: Scene, result: Any, data_dir: Any, space: WorkingSpace) -> SampleInputs:
     wl = grid()
     rho = (
         np.stack([get_spectrum(m.spectrum, data_dir=data_dir).on(wl) for m in scene.materials])
@@ -61,22 +63,31 @@ def _sample(scene: Scene, result: Any, data_dir: Any) -> SampleInputs:
         else np.zeros((0, wl.size))
     )
     return SampleInputs(
-        scene, result, reference_mode(result), wl, rho, get_spectrum("cie:D65").on(wl), data_dir
+        scene,
+        result,
+        reference_mode(result),
+        wl,
+        rho,
+        get_spectrum("cie:D65").on(wl),
+        data_dir,
+        space,
     )
 
 
-def _reflectance(coverage: np.ndarray, names: list[str], data_dir: Any) -> tuple[Layer, Any]:
-    """``reflectance`` (linear sRGB under D65 of each material, coverage-weighted) as a layer
-    and in float64."""
-    values = coverage_weighted(
-        coverage, absolute_reflectance(names, data_dir=data_dir) if names else np.zeros((0, 3))
-    )
+def _reflectance(s: SampleInputs, coverage: np.ndarray) -> tuple[Layer, Any]:
+    """``reflectance`` (working-space RGB under D65 of each material, the perfect white at
+    Y = 1, coverage-weighted; in sRGB :func:`~spectrinsic.spectra.absolute_reflectance`) as a
+    layer and in float64."""
+    xyz = white_normalised_responses(s.material_rho, s.d65, get_sensors("cie1931").on(s.wl), s.wl)
+    values = coverage_weighted(coverage, s.space.rgb(xyz))
+    white = ", ".join(f"{v:.3f}" for v in s.space.white)
     return make_layer(
         "reflectance",
         values,
         RGB,
-        "dimensionless absolute reflectance, linear sRGB under D65 (perfect white = 1); "
-        "box-filtered by pixel coverage, 0 for background",
+        f"dimensionless absolute reflectance, linear {s.space.colourspace} under D65 (perfect "
+        f"white = ({white}), the space's D65 white); box-filtered by pixel coverage, 0 for "
+        "background",
         "intrinsics",
     ), values
 
@@ -93,6 +104,7 @@ def compute_ground_truth(
     data_dir: Any = None,
     training: np.ndarray | None = None,
     spectral: bool = False,
+    working_space: str = DEFAULT_WORKING_SPACE,
 ) -> GroundTruth:
     """Compute every ground-truth layer of one rendered sample.
 
@@ -125,14 +137,17 @@ def compute_ground_truth(
     spectral
         Add the per-band intrinsic layers of the 31-band cube (``spectral.exr``,
         :mod:`~spectrinsic.gt_export.layers.spectral_intrinsics`).
+    working_space
+        The RGB working space of the RGB layers (:mod:`spectrinsic.spectra.working_space`):
+        ``"acescg"`` (default; shading negatives kept) or ``"srgb"`` (the layers of before,
+        shading clipped at 0).
     """
-    s = _sample(scene, result, data_dir)
+    s = _sample(scene, result, data_dir, working_space_of(working_space))
     layers = image_layers(s)
     image = layers[0].data.astype(np.float64)
     coverage, mask = coverage_of(s, (image.shape[0], image.shape[1]))
     layers += geometry_layers(s, mask)
-    names = [m.spectrum for m in scene.materials]
-    reflectance_layer, reflectance = _reflectance(coverage, names, data_dir)
+    reflectance_layer, reflectance = _reflectance(s, coverage)
     layers.append(reflectance_layer)
     w_raw = white_radiance(s, coverage)
     w = w_raw
@@ -145,7 +160,7 @@ def compute_ground_truth(
         )
         batches = tuple(b[s.ref] for b in getattr(result, "batch_raw", ()) or () if s.ref in b)
         w = irr.unlit_masked(w, w_raw, batches)
-    specular = specular_srgb(s, w_raw.to_xyz)
+    specular = specular_rgb(s, w_raw.to_xyz)
     layers += intrinsic_layers(s, w_raw, w, image, reflectance, denoised=denoise, specular=specular)
     layers += gloss_layers(s, coverage, specular)
     noise_maps, noise = noise_of(s, w_raw)
@@ -177,7 +192,8 @@ def compute_ground_truth(
             sorted(layer.name for layer in layers if denoise and from_denoised(layer.name))
         ),
         noise=noise,
-        clipping=clipping_of(srgb_of(w) / srgb_white(s), w.valid & (irr.luminance_of(w) > 0)),
+        clipping=clipping_of(rgb_of(s, w) / rgb_white(s), w.valid & (irr.luminance_of(w) > 0)),
+        working_space=s.space,
         residual_share=residual_shares(_identities(by_name, cameras), by_name, mask),
     )
 

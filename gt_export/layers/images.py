@@ -10,7 +10,7 @@ from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.layers.imaging import relative_error_map
 from spectrinsic.gt_export.layers.records import RGB, UNITS_IMAGE, Layer, SampleInputs, make_layer
 from spectrinsic.render.modes import RENDER_MODES
-from spectrinsic.spectra import get_sensors, xyz_to_linear_srgb
+from spectrinsic.spectra import get_sensors
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 
@@ -30,7 +30,7 @@ def image_layers(s: SampleInputs) -> list[Layer]:
     out = [
         make_layer(
             "image",
-            xyz_to_linear_srgb(ref_xyz),
+            s.space.rgb(ref_xyz),
             RGB,
             UNITS_IMAGE + f"; render mode {s.ref!r}",
             "image",
@@ -41,7 +41,7 @@ def image_layers(s: SampleInputs) -> list[Layer]:
         out.append(
             make_layer(
                 f"image_{mode}",
-                xyz_to_linear_srgb(xyz),
+                s.space.rgb(xyz),
                 RGB,
                 UNITS_IMAGE + f"; render mode {mode!r}",
                 "image",
