@@ -264,6 +264,7 @@ def torch_dataset(
     transform: Any = None,
     relight: Callable[[Path, int, int], dict[str, Any]] | None = None,
     max_residual_share: float | None = None,
+    space: str | None = None,
 ) -> Any:
     """A map-style ``torch.utils.data.Dataset`` over a dataset folder.
 
@@ -277,7 +278,8 @@ def torch_dataset(
     ``default_rng([seed, i])``, the same on every worker and epoch. *max_residual_share* keeps
     only the samples whose RGB residual share is at most that fraction
     (:func:`filter_residual_share`). The spectral layers (``*_bands``, ``(31, H, W)``) come
-    with the rest when the set was built with ``--spectral-layers``. torch is imported only here.
+    with the rest when the set was built with ``--spectral-layers``. *space* ``"srgb"``: the
+    RGB layers' linear sRGB view (:func:`load_sample`). torch is imported only here.
 
     Raises
     ------
@@ -293,6 +295,7 @@ def torch_dataset(
         ) from exc
     if crop is not None and seed is None:
         raise DatasetError("torch_dataset: a random crop needs an explicit seed")
+    _check_space(space)
     folders = filter_residual_share(split_samples(dataset_dir, split), max_residual_share)
     wanted = None if keys is None else [k for k in keys if k != "ids"]
 
@@ -313,9 +316,10 @@ def torch_dataset(
 
         def __getitem__(self, index: int) -> dict[str, Any]:
             if relight is None:
-                sample = load_sample(folders[index], layers=wanted, verify=verify)
+                sample = load_sample(folders[index], layers=wanted, verify=verify, space=space)
             else:
                 relit = relight(folders[index], index, self.epoch)
+                relit = srgb_view(relit, relit["meta"]) if space == "srgb" else relit
                 sample = {
                     k: v for k, v in relit.items() if wanted is None or k in wanted or k == "meta"
                 }

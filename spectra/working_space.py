@@ -58,10 +58,12 @@ class WorkingSpace:
     colourspace
         colour-science's name of the space (``"ACEScg"``).
     from_xyz, to_xyz
-        ``(3, 3)`` float64 matrices CIE 1931 XYZ -> linear RGB and back (no chromatic
-        adaptation: the RGB values are the space's own).
+        ``(3, 3)`` float64 matrices CIE 1931 XYZ -> linear RGB (colour-science's) and back
+        (its exact inverse; sRGB: IEC 61966-2-1's pair). No chromatic adaptation: the RGB
+        values are the space's own.
     to_srgb
-        ``(3, 3)`` linear RGB of this space -> linear sRGB (``M_sRGB · to_xyz``).
+        ``(3, 3)`` linear RGB of this space -> linear sRGB (``M_sRGB · to_xyz``; the
+        identity for sRGB).
     white
         ``(3,)`` the space's colour of the perfect white under D65 at unit luminance Y = 1:
         the shading's white normalisation.
@@ -128,10 +130,11 @@ def working_space(name: str) -> WorkingSpace:
     else:
         import colour  # noqa: PLC0415 - heavy; only here
 
-        cs = colour.RGB_COLOURSPACES[WORKING_SPACES[name]]
-        from_xyz = np.array(cs.matrix_XYZ_to_RGB, np.float64)
-        to_xyz = np.array(cs.matrix_RGB_to_XYZ, np.float64)
-    to_srgb = np.asarray(srgb_matrices()[0], np.float64) @ to_xyz
+        # the exact inverse, not colour-science's published RGB -> XYZ (rounded: their
+        # product is the identity to 4e-5 only), so the sRGB view is exact
+        from_xyz = np.array(colour.RGB_COLOURSPACES[WORKING_SPACES[name]].matrix_XYZ_to_RGB)
+        to_xyz = np.linalg.inv(from_xyz)
+    to_srgb = np.eye(3) if name == "srgb" else np.asarray(srgb_matrices()[0]) @ to_xyz
     white = np.asarray(_d65_white(from_xyz), np.float64)
     for matrix in (from_xyz, to_xyz, to_srgb, white):
         matrix.flags.writeable = False
