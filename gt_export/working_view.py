@@ -93,11 +93,16 @@ def _recompute(out: dict[str, Any], identities: Any) -> None:
 
 def srgb_view(sample: Mapping[str, Any], meta: Any) -> dict[str, Any]:
     """A copy of a loaded sample dict with its working-space RGB layers in linear sRGB
-    (module notes; float32 like the stored layers); the sample itself if it is sRGB."""
+    (module notes; float32 like the stored layers) and its ``meta["working_space"]`` the
+    sRGB record (with ``"view_of"``: the stored space), so a second call changes nothing; a
+    copy of the sample itself if it is sRGB."""
     space = space_of(meta)
     if space.name == "srgb":
         return dict(sample)
     out = dict(sample)
+    if isinstance(sample.get("meta"), Mapping):
+        record = working_space("srgb").record() | {"view_of": space.name}
+        out["meta"] = {**sample["meta"], "working_space": record}
     for name, value in sample.items():
         if isinstance(value, np.ndarray) and value.ndim == 3 and value.shape[-1] == 3:
             viewed = srgb_layer(name, value, space)

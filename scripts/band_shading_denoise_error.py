@@ -97,6 +97,8 @@ def main(argv: list[str] | None = None) -> int:
         "denoised_max": float(np.max(den)),
         "raw_median": float(np.median(raw)),
         "raw_max": float(np.max(raw)),
+        # the reference's own noise, from the raw error scaled by sqrt(spp / ref_spp)
+        "reference_noise_estimate": float(np.median(raw) * np.sqrt(args.spp / args.ref_spp)),
         "seconds": time.perf_counter() - start,
     }
     args.out.write_text(json.dumps({"summary": summary, "rooms": rows}, indent=1))
