@@ -133,3 +133,21 @@ def test_working_space_is_a_hashed_dataset_setting():
     assert base.config_hash() != srgb.config_hash()
     with pytest.raises(DatasetError, match="--working-space 'xyz'; expected one of"):
         base.with_options(working_space="xyz")
+
+
+def test_dataset_card_shows_the_residual_figure_by_light_family(built):
+    """DATASET.md links residual.png, a real PNG written beside it, and names the space; the
+    figure's data are the samples' recorded shares by family."""
+    from spectrinsic.gt_export.card_residual import residual_by_family
+    from spectrinsic.gt_export.sample import sample_dirs
+
+    card = (built / "DATASET.md").read_text()
+    assert "![Residual share by light family](residual.png)" in card
+    assert "working space: ACEScg" in card
+    png = (built / "residual.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 2000
+    metas = [json.loads((d / "meta.json").read_text()) for d in sample_dirs(built)]
+    by_family = residual_by_family(metas)
+    assert sum(len(v["rgb"]) for v in by_family.values()) == len(metas) == 2
+    shares = sorted(m["residual_share"]["image"] for m in metas)
+    assert sorted(x for v in by_family.values() for x in v["rgb"]) == shares
