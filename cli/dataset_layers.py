@@ -38,7 +38,8 @@ def add_extra_layer_options(p: Any) -> None:
         metavar="SPACE",
         help="RGB working space of the RGB layers: acescg (default; shading keeps its "
         "negative components: half linear sRGB's residual share, no clipping) or srgb "
-        "(linear sRGB with the shading clipped at 0, the layers of before); previews stay "
+        "(linear sRGB with the shading clipped at 0, the layers of before) or rec2020 "
+        "(linear Rec.2020, shading unclipped); previews stay "
         "sRGB, load_sample(..., space='srgb') gives the sRGB view",
     )
     p.add_argument(
