@@ -232,7 +232,8 @@ def prepare_item(
     arrays = {k: v for k, v in sample.items() if isinstance(v, np.ndarray)}
     scale = 1.0
     if normalize_exposure and "image" in arrays:
-        scale = exposure(arrays["image"])  # the previews' exposure: one definition
+        # the previews' exposure, one definition: of the sRGB view's luminance
+        scale = exposure(space_of(sample.get("meta")).srgb(arrays["image"]))
     if crop is not None:
         if rng is None:
             raise DatasetError("a random crop needs an explicit numpy Generator (rng=...)")
