@@ -207,6 +207,7 @@ _VALUE_OPTIONS: tuple[tuple[str, str], ...] = (
     ("integrator", "integrator"),
     ("camera", "camera"),
     ("variant", "variant"),
+    ("working_space", "working_space"),
 )
 #: Switches and the config value each sets when given (option dest -> (config key, value)).
 _SWITCHES: tuple[tuple[str, str, bool], ...] = (

@@ -33,6 +33,16 @@ def add_extra_layer_options(p: Any) -> None:
         "bands31 mode (default preset); about +24 MB and +2.3 s per 256x256 sample",
     )
     p.add_argument(
+        "--working-space",
+        default=None,
+        metavar="SPACE",
+        help="RGB working space of the RGB layers: acescg (default; shading keeps its "
+        "negative components: half linear sRGB's residual share, no clipping) or srgb "
+        "(linear sRGB with the shading clipped at 0, the layers of before) or rec2020 "
+        "(linear Rec.2020, shading unclipped); previews stay "
+        "sRGB, load_sample(..., space='srgb') gives the sRGB view",
+    )
+    p.add_argument(
         "--relight",
         type=int,
         default=None,

@@ -234,7 +234,7 @@ def _evaluate(
 
     try:
         result = evaluate(
-            (load_sample(f) for f in folders),
+            (load_sample(f, space="srgb") for f in folders),  # scored in linear sRGB
             out,
             methods=methods,
             seed=args.seed,

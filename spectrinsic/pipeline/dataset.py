@@ -155,6 +155,7 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         transport=transport,
         camera=camera_model(cfg.camera) if cfg.camera else None,
         spectral_layers=cfg.spectral_layers,
+        working_space=cfg.working_space,
     )
     if cfg.relight:
         write_relit_variants(path, cfg.relight, seed=task.seed, data_dir=task.data_dir)

@@ -22,6 +22,7 @@ from ..render.algebra.light_transport import diagonal_mode_names
 from ..render.algebra.modes import RENDER_MODES
 from ..render.settings import RenderSettings
 from ..spectra.camera_model import camera_model
+from ..spectra.working_space import DEFAULT_WORKING_SPACE, WORKING_SPACES, working_space_names
 
 __all__ = [
     "DatasetConfig",
@@ -172,6 +173,11 @@ class DatasetConfig:
         Write the per-band intrinsic layers of the 31-band cube in each sample
         (``spectral.exr``, :mod:`spectrinsic.gt_export.layers.spectral_intrinsics`); needs the
         ``bands31`` mode. Left out of the settings when off.
+    working_space
+        The RGB working space of the RGB layers (``--working-space``,
+        :mod:`spectrinsic.spectra.working_space`): ``"acescg"`` (default; shading negatives
+        kept) or ``"srgb"`` (linear sRGB, shading clipped: the layers of before). Hashed
+        unless ``"srgb"``, so sRGB configs keep their hash.
     split_fractions
         ``(split, share)`` pairs of the scenes in the manifest's splits (default
         :data:`~spectrinsic.gt_export.dataset.manifest.SPLIT_FRACTIONS`, 80/10/10); with at least as
@@ -197,6 +203,7 @@ class DatasetConfig:
     store_transport: bool = False
     relight: int = 0
     spectral_layers: bool = False
+    working_space: str = DEFAULT_WORKING_SPACE
     split_fractions: SplitFractions = SPLIT_FRACTIONS
     camera: str | None = None
 
@@ -214,6 +221,10 @@ class DatasetConfig:
         if not isinstance(self.seed, int) or self.seed < 0:
             raise DatasetError(f"dataset seed {self.seed!r}; expected a non-negative integer")
         object.__setattr__(self, "split_fractions", check_split_fractions(self.split_fractions))
+        if self.working_space not in WORKING_SPACES:
+            raise DatasetError(
+                f"--working-space {self.working_space!r}; expected one of {working_space_names()}"
+            )
         self._check_transport()
         if self.camera is not None:
             camera_model(self.camera)  # a one-line CameraModelError for an unknown name
@@ -327,6 +338,8 @@ class DatasetConfig:
             d["camera"] = camera_model(self.camera).settings()
         if self.spectral_layers:  # off: out of the hash, as before it existed
             d["spectral_layers"] = True
+        if self.working_space != "srgb":  # srgb: the layers of before, their hash
+            d["working_space"] = self.working_space
         return d
 
     def resolved_cameras(self) -> tuple[str, ...]:

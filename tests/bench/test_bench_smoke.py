@@ -53,5 +53,9 @@ def test_residual_benchmark_reports_rgb_and_band_shares(monkeypatch, tmp_path):
     assert bench.main(["--out", str(tmp_path), "--only", "residual"]) == 0
     result = json.loads((tmp_path / "bench_residual.json").read_text())
     assert result["band_residual_share"]["max"] < 1e-4 < result["rgb_residual_share"]["max"]
+    # the default working space beside linear sRGB, on the same render, as ratios
+    assert result["working_space"] == "acescg"
+    ratio = result["rgb_residual_share"]["median"] / result["srgb_residual_share"]["median"]
+    assert result["default_over_srgb"]["median"] == pytest.approx(ratio)
     cost = result["spectral_exr_cost"]
     assert cost["folder_bytes_with_bands"] > cost["folder_bytes_without_bands"]

@@ -65,7 +65,8 @@ def test_preview_build_checks_loads_batches_and_scores(preview, tmp_path, capsys
     )  # the preview's noise is a warning, not a failure
     assert "ok: 8 samples" in capsys.readouterr().out
 
-    samples = list(load_dataset(preview))
+    # the sRGB view: what evaluate scores against (README, "Decompose each sample's ...")
+    samples = list(load_dataset(preview, space="srgb"))
     batch = collate_arrays([prepare_item(s) for s in samples])  # what collate does without torch
     assert batch["image"].shape == (8, 3, 48, 48)
     assert batch["light_mask"].sum(axis=1).tolist() == [len(s["meta"]["lights"]) for s in samples]

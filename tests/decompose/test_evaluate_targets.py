@@ -40,7 +40,7 @@ def dataset(make_room, tmp_path_factory):
     config = {"preset": "test", "width": 24, "height": 24, "spp": 8, "seed": 5}
     export_sample(root, scene, result, sample_id=SID, config=config, seed=5)
     write_manifest(root, config)
-    return root, load_sample(root / SID)
+    return root, load_sample(root / SID, space="srgb")  # evaluate scores the sRGB view
 
 
 def _scores(out) -> dict[tuple[str, str, str], float]:

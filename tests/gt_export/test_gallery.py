@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from spectrinsic.gt_export import build_gallery, export_sample, read_exr
+from spectrinsic.gt_export import build_gallery, export_sample, load_sample
 from spectrinsic.gt_export.dataset.contact_sheet import COLUMNS, TILE
 from spectrinsic.gt_export.dataset.gallery import INDEX_VARIABLE, gallery_index
 
@@ -171,9 +171,10 @@ def _pixel_report(driver, element, dx: int, dy: int, layers: tuple[str, ...]) ->
 def _check_readout_against_exr(
     report: dict, root: Path, sample: str, layer: str, info: dict
 ) -> int:
-    """Assert the readout of *layer* matches the EXR pixel within its stated precision; return
-    how many channels were inside the encoded range (and so compared to a value)."""
-    exr = read_exr(root / sample / info["file"], layers=[info["exr_layer"]])[info["exr_layer"]]
+    """Assert the readout of *layer* matches the EXR pixel (of the sRGB view the previews
+    show: the sample's working space is ACEScg) within its stated precision; return how many
+    channels were inside the encoded range (and so compared to a value)."""
+    exr = load_sample(root / sample, layers=[layer], space="srgb")[layer]
     truth = np.atleast_1d(exr[report["y"], report["x"]])
     shown = report["layers"][layer]
     compared = 0

@@ -127,7 +127,7 @@ def test_b_metal_sample_reflectance_is_zero_and_specular_has_the_hue_of_f0(metal
 
     from spectrinsic.render import render_scene
     from spectrinsic.scenes.model import Camera, Light, Mesh, Scene
-    from spectrinsic.spectra import get_sensors, get_spectrum, linear_srgb_to_xyz
+    from spectrinsic.spectra import get_sensors, get_spectrum
     from spectrinsic.spectra.io import mitsuba_ior_dir
 
     v = np.array([[-50.0, -50, 0], [50, -50, 0], [50, 50, 0], [-50, 50, 0]])
@@ -157,7 +157,9 @@ def test_b_metal_sample_reflectance_is_zero_and_specular_has_the_hue_of_f0(metal
     n, kk = np.interp(wl, eta[:, 0], eta[:, 1]), np.interp(wl, k[:, 0], k[:, 1])
     f0 = ((n - 1) ** 2 + kk**2) / ((n + 1) ** 2 + kk**2)
     expected = get_sensors("cie1931").on(wl) @ (f0 * get_spectrum("cie:D65").on(wl))
-    got = linear_srgb_to_xyz(gt.layers["specular"].data.reshape(-1, 3).mean(axis=0))
+    # the layer is RGB of the sample's working space: back to XYZ by its recorded matrix
+    to_xyz = np.asarray(gt.working_space.record()["rgb_to_xyz"])
+    got = to_xyz @ gt.layers["specular"].data.reshape(-1, 3).mean(axis=0)
     white = colour.CCS_ILLUMINANTS["CIE 1931 2 Degree Standard Observer"]["D65"]
     hue = [
         float(colour.Lab_to_LCHab(colour.XYZ_to_Lab(x / x[1] * 0.5, white))[2])

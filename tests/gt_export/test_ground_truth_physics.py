@@ -15,6 +15,7 @@ from spectrinsic.render import RenderSettings, render_batches, render_scene
 from spectrinsic.scenes.model import Material, Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as WL
 from spectrinsic.spectra import get_sensors, get_spectrum, responses, xyz_to_linear_srgb
+from spectrinsic.spectra.working_space import DEFAULT_WORKING_SPACE, working_space
 
 #: Band integration (31 box bands of 10 nm) against 1 nm integration of smooth spectra.
 BAND_RTOL = 5e-3
@@ -71,9 +72,11 @@ def test_b_f_a_grey_wall_lit_by_a_bounce_carries_the_bounce_colour(make_corner):
     inside = _interior(gt)
     assert inside.sum() > 100
     rho = get_spectrum("munsell:5R 5/12").on(WL)
-    bounce = xyz_to_linear_srgb(
+    # the layers' working space (ACEScg by default), relative to its D65 white as the shading
+    space = working_space(DEFAULT_WORKING_SPACE)
+    bounce = space.rgb(
         responses(rho * get_spectrum("cie:D65").on(WL), get_sensors("cie1931").on(WL), WL)
-    )
+    ) / np.asarray(space.white)
     assert _angle(gt.layers["illuminant"].data[inside], bounce).max() < BOUNCE_MAX_DEG
     shading = gt.layers["shading"].data[inside]
     assert _angle(shading, bounce).max() < BOUNCE_MAX_DEG

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from spectrinsic.gt_export.layers import REFLECTANCE_FLOOR, compute_ground_truth
+from spectrinsic.spectra.working_space import DEFAULT_WORKING_SPACE, WORKING_SPACES
 
 #: The issue's bound for reflectance against colour-science.
 REFLECTANCE_TOL = 1e-4
@@ -19,8 +20,13 @@ CUBE_BAND_RTOL = 0.02
 CAMERA = "camera:Nikon 5100 (NPL)"
 
 
+#: colour-science's name of the layers' default working space (ACEScg).
+CS_SPACE = WORKING_SPACES[DEFAULT_WORKING_SPACE]
+
+
 def _cs_absolute_reflectance(spectrum: np.ndarray) -> np.ndarray:
-    """Linear sRGB of a reflectance under D65, by colour-science alone (white Y = 1).
+    """Working-space RGB (ACEScg, no chromatic adaptation) of a reflectance under D65, by
+    colour-science alone (white Y = 1).
 
     *spectrum* is given on the 1 nm CIE grid 360-830 nm, so colour-science interpolates
     nothing: resampling of coarser data (linear in spectrinsic, Sprague in colour-science,
@@ -32,20 +38,26 @@ def _cs_absolute_reflectance(spectrum: np.ndarray) -> np.ndarray:
     cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
     d65 = colour.SDS_ILLUMINANTS["D65"].copy().align(cmfs.shape)  # Sprague, edge held
     xyz = colour.sd_to_XYZ(sd, cmfs, d65, method="Integration") / 100
-    return colour.XYZ_to_RGB(xyz, "sRGB", apply_cctf_encoding=False)
+    return colour.XYZ_to_RGB(xyz, CS_SPACE, apply_cctf_encoding=False)
 
 
-def _cs_light_srgb(name: str) -> np.ndarray:
-    """Linear sRGB of a light's SPD at unit luminance, by colour-science."""
+def _cs_unit_rgb(spd: np.ndarray) -> np.ndarray:
+    """Working-space RGB of an SPD on the 1 nm grid at unit luminance, by colour-science."""
     import colour
 
+    sd = colour.SpectralDistribution(dict(zip(np.arange(360.0, 831.0), spd)))
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+    xyz = colour.sd_to_XYZ(sd, cmfs, method="Integration")
+    return colour.XYZ_to_RGB(xyz / xyz[1], CS_SPACE, apply_cctf_encoding=False)
+
+
+def _cs_light_rgb(name: str) -> np.ndarray:
+    """A light's colour at unit luminance in the working space relative to the space's D65
+    white (the ``illuminant`` layer's units, D65 = (1, 1, 1)), by colour-science."""
     from spectrinsic.spectra import get_spectrum
 
     wl = np.arange(360.0, 831.0)
-    sd = colour.SpectralDistribution(dict(zip(wl, get_spectrum(name).on(wl))))
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
-    xyz = colour.sd_to_XYZ(sd, cmfs, method="Integration")
-    return colour.XYZ_to_RGB(xyz / xyz[1], "sRGB", apply_cctf_encoding=False)
+    return _cs_unit_rgb(get_spectrum(name).on(wl)) / _cs_unit_rgb(get_spectrum("cie:D65").on(wl))
 
 
 def _angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -107,7 +119,7 @@ def test_shading_of_a_flat_grey_is_geometry_times_light_colour(one_light_sample)
     gt = compute_ground_truth(scene, result, cameras=())
     block = (slice(6, 11), slice(8, 15))  # material 3 = flat:0.8
     shading = gt.layers["shading"].data[block]
-    light = _cs_light_srgb(scene.lights[0].spectrum)
+    light = _cs_light_rgb(scene.lights[0].spectrum)
     assert _angle(shading, light).max() < 0.05
     # grey shading is proportional to the geometric factor there (the ramp of the fixture)
     yy, xx = np.mgrid[0:12, 0:16] / 16
@@ -126,7 +138,7 @@ def test_one_light_illuminant_map_has_the_light_chromaticity(synth):
     gt = compute_ground_truth(scene, result, cameras=())
     illum = gt.layers["illuminant"].data
     lit = result.aovs["mask"] & (geometry[0] > 0)
-    expected = _cs_light_srgb("planck:2800K")
+    expected = _cs_light_rgb("planck:2800K")
     assert _angle(illum[lit], expected).max() < ILLUMINANT_MAX_DEG
     assert (illum[:, :5] == 0).all()
     # and the chromaticity recorded for the light agrees with colour-science's xy
@@ -149,7 +161,7 @@ def test_two_lights_mix_by_their_share_of_the_light(synth):
     gt = compute_ground_truth(scene, result, cameras=())
     illum = gt.layers["illuminant"].data
     mask = result.aovs["mask"]
-    c0, c1 = _cs_light_srgb("planck:2800K"), _cs_light_srgb("cie:FL11")
+    c0, c1 = _cs_light_rgb("planck:2800K"), _cs_light_rgb("cie:FL11")
     left, right = mask.copy(), mask.copy()
     left[:, 6:] = right[:, :10] = False
     assert _angle(illum[left], c0).max() < ILLUMINANT_MAX_DEG
@@ -158,7 +170,14 @@ def test_two_lights_mix_by_their_share_of_the_light(synth):
     # the same luminance of each unit-luminance light, so the light there is their mean colour
     middle_grey = illum[6:11, 8:10].reshape(-1, 3)
     assert _angle(middle_grey, 0.5 * (c0 + c1)).max() < ILLUMINANT_MAX_DEG
-    y = illum[mask] @ np.array([0.2126, 0.7152, 0.0722])
+    import colour
+
+    from spectrinsic.spectra import get_spectrum
+
+    # unit luminance: Y of the light (the illuminant times the space's D65 white) is 1
+    white = _cs_unit_rgb(get_spectrum("cie:D65").on(np.arange(360.0, 831.0)))
+    to_y = np.asarray(colour.RGB_COLOURSPACES[CS_SPACE].matrix_RGB_to_XYZ)[1]
+    y = (illum[mask] * white) @ to_y
     np.testing.assert_allclose(y, 1.0, atol=1e-3)
     assert gt.lights[0].share + gt.lights[1].share == pytest.approx(1.0)
 

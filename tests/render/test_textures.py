@@ -21,6 +21,7 @@ from spectrinsic.scenes.textures import Texture, basis_name, make_texture
 from spectrinsic.scenes.validate import validate_scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as WL
 from spectrinsic.spectra import get_spectrum
+from spectrinsic.spectra.working_space import DEFAULT_WORKING_SPACE, WORKING_SPACES
 
 #: Done-when of issue 22: textured reflectance equals the texel spectra integrated independently.
 EXACT = 1e-4
@@ -63,8 +64,9 @@ def _texel_of_pixels() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return rows.astype(int), cols.astype(int), inside
 
 
-def _srgb_colour_science(spectrum: np.ndarray) -> np.ndarray:
-    """Linear sRGB of a reflectance under D65, white Y = 1, integrated by colour-science."""
+def _rgb_colour_science(spectrum: np.ndarray) -> np.ndarray:
+    """Linear RGB of the layers' default working space (ACEScg, no chromatic adaptation) of a
+    reflectance under D65, white Y = 1, integrated by colour-science."""
     import colour
 
     shape = colour.SpectralShape(float(WL[0]), float(WL[-1]), 1.0)
@@ -72,7 +74,8 @@ def _srgb_colour_science(spectrum: np.ndarray) -> np.ndarray:
     d65 = colour.SDS_ILLUMINANTS["D65"].copy().align(shape)
     sd = colour.SpectralDistribution(dict(zip(WL.tolist(), spectrum.tolist(), strict=True)))
     xyz = colour.sd_to_XYZ(sd, cmfs, d65, method="Integration") / 100.0
-    return np.asarray(colour.XYZ_to_RGB(xyz, "sRGB", apply_cctf_encoding=False))
+    space = WORKING_SPACES[DEFAULT_WORKING_SPACE]
+    return np.asarray(colour.XYZ_to_RGB(xyz, space, apply_cctf_encoding=False))
 
 
 @pytest.fixture(scope="module")
@@ -93,7 +96,7 @@ def test_textured_reflectance_equals_the_texel_spectra_integrated_by_colour_scie
     rho = np.stack([get_spectrum(s).on(WL) for s in BASIS])
     expected = np.array(
         [
-            _srgb_colour_science(texture.weights[r, c] @ rho)
+            _rgb_colour_science(texture.weights[r, c] @ rho)
             for r, c in zip(rows[inside], cols[inside])
         ]
     )

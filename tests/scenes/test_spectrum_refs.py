@@ -83,7 +83,8 @@ def test_a_bad_csv_in_a_scene_stops_render_with_rc_2_before_any_work(folder, cap
 
 def test_a_scene_with_csv_spectra_renders_their_exact_reflectance(folder):
     """The reflectance layer equals the CSV's spectrum integrated by colour-science (D65,
-    CIE 1931 2°, linear sRGB) within 1e-5, and meta.json records the file's SHA-256."""
+    CIE 1931 2°, linear RGB of the working space meta.json records: ACEScg by default) within
+    1e-5, and meta.json records the file's SHA-256."""
     import colour
 
     from spectrinsic.gt_export import load_sample
@@ -99,7 +100,8 @@ def test_a_scene_with_csv_spectra_renders_their_exact_reflectance(folder):
     cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
     d65 = colour.SDS_ILLUMINANTS["D65"].copy().align(cmfs.shape)
     xyz = colour.sd_to_XYZ(sd, cmfs, d65, method="Integration") / 100
-    expected = colour.XYZ_to_RGB(xyz, "sRGB", apply_cctf_encoding=False)
+    space = loaded["meta"]["working_space"]["colourspace"]
+    expected = colour.XYZ_to_RGB(xyz, space, apply_cctf_encoding=False)
     refl = loaded["reflectance"].reshape(-1, 3)
     assert np.abs(refl - expected).max() < 1e-5
     meta = json.loads((sample / "meta.json").read_text())

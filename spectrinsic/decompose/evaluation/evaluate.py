@@ -1,7 +1,9 @@
 """Evaluation of decomposers on rendered samples (thesis Tables 5.1, 5.3, 5.4).
 
-Input: any iterable of sample dicts as :func:`spectrinsic.gt_export.load_sample` returns them
-(``image`` / ``image_denoised``, ``reflectance``, ``shading``, ``shading_grey``, ``mask``,
+Input: any iterable of sample dicts as :func:`spectrinsic.gt_export.load_sample` returns them,
+scored in their linear sRGB view whatever the set's working space
+(:func:`spectrinsic.gt_export.sample.working_view.srgb_view`; ACEScg samples are converted, so
+decomposers see sRGB images and metrics compare in sRGB) (``image`` / ``image_denoised``, ``reflectance``, ``shading``, ``shading_grey``, ``mask``,
 ``ids``, ``meta``, optional ``image_camera/<name>`` and ``meta["matrices"]``). Methods are
 registered decomposers (plugins included) or :class:`~spectrinsic.decompose.evaluation.predictions.
 Predictions`, a user's estimates read from files. For each sample and method:
@@ -38,6 +40,7 @@ import numpy as np
 from ...errors import DatasetError, validate_choice
 from ...gt_export.formats.exr import write_exr
 from ...gt_export.formats.names import camera_slug
+from ...gt_export.sample.working_view import srgb_view
 from ...rng import seed_from_key
 from ...spectra.colorimetry import encode_srgb
 from ..decomposition import Decomposer, Decomposition
@@ -403,7 +406,8 @@ def evaluate(
     samples_info: dict[str, tuple[str, str]] = {}
     inputs: set[str] = set()
     glossy = False
-    for sample in samples:
+    for stored in samples:
+        sample = srgb_view(stored, stored.get("meta"))  # scored in linear sRGB, any working space
         glossy = glossy or SPECULAR_LAYER in sample
         sid = sample_id_of(sample)
         samples_info[sid] = (sample_kind(sample), sample_condition(sample))

@@ -22,6 +22,8 @@ from ..layers.spectral_intrinsics import residual_summary
 from ..sample import CARD_NAME, META_NAME, config_hash, plain_data, sample_dirs
 from ..sample.integrity import guarded_write
 from ..sample.meta import LayerRecord, SampleMeta, read_meta
+from ..sample.working_view import space_of
+from .card_residual import write_residual_figure
 from .colour_spread import shown, spread_summary
 from .diversity import DIVERSITY_NAME, spread_record, write_diversity
 from .manifest import noise_summary, read_manifest, splits_by_scene, variants_of
@@ -96,20 +98,27 @@ def _noise_table(summary: Mapping[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def _residual_table(summary: Mapping[str, Any]) -> str:
+def _residual_table(summary: Mapping[str, Any], root: Path, metas: Sequence[SampleMeta]) -> str:
     if not summary:
         return "The samples record no residual share (built before it was measured)."
+    spaces = sorted({space_of(m.raw).colourspace for m in metas})
+    space = spaces[0] if len(spaces) == 1 else "working space"
+    figure = write_residual_figure(root, [m.raw for m in metas], space)
     lines = [
         "Share of the image the intrinsic product does not explain, Σ|residual| / Σ|image| over "
         "the mask, per sample; median / 95th percentile / max over the samples of each light "
         "family (a sample's family is its most saturated light's). The RGB layers' residual "
-        "holds the spectral non-commutativity a 3-channel product cannot represent, and the "
-        "out-of-gamut light clipped from the sRGB shading (clipped pixels: the share of lit "
-        "pixels with a clipped channel). The per-band layers (`--spectral-layers`) multiply "
-        "out band by band. `spectrinsic check --max-residual-share F` and the loaders' "
-        "`max_residual_share` select samples by the RGB figure.",
+        f"(working space: {_text(', '.join(spaces))}) holds the spectral non-commutativity a "
+        "3-channel product cannot represent; out-of-gamut pixels are the share of lit pixels "
+        "whose shading has a negative channel in the working space (linear sRGB clips it into "
+        "the residual; ACEScg keeps it in the shading). The per-band layers "
+        "(`--spectral-layers`) multiply out band by band. `spectrinsic check "
+        "--max-residual-share F` and the loaders' `max_residual_share` select samples by the "
+        "RGB figure.",
         "",
-        "| light family | samples | RGB residual | per-band residual | sRGB shading clipped pixels |",
+        f"![Residual share by light family]({figure.name})" if figure is not None else "",
+        "",
+        "| light family | samples | RGB residual | per-band residual | shading out-of-gamut pixels |",
         "|---|---|---|---|---|",
     ]
 
@@ -150,7 +159,7 @@ def write_dataset_card(
     scenes = sorted({m.scene for m in metas})
     text = string.Template(read_template("DATASET.md")).substitute(
         noise_table=_noise_table(noise_summary(metas)),
-        residual_table=_residual_table(residual_summary([m.raw for m in metas])),
+        residual_table=_residual_table(residual_summary([m.raw for m in metas]), root, metas),
         n_samples=len(samples),
         n_scenes=len(scenes),
         scenes=", ".join(_text(s) for s in scenes),

@@ -111,7 +111,9 @@ def diversity_stats(
         out["samples"].append(spread_record(meta))
         if isinstance(extra.get("object_coverage"), float):
             out["coverage"].append(extra["object_coverage"])
-        sample = load_sample(folder, layers=[k for k in ("image", "mask") if k in meta.layers])
+        sample = load_sample(
+            folder, layers=[k for k in ("image", "mask") if k in meta.layers], space="srgb"
+        )
         out["luminance_decades"].append(_luminance_decades(sample["image"], sample.get("mask")))
     return out
 

@@ -18,7 +18,10 @@ so the perfect white has luminance 1 under any light, and under D65 with sRGB se
 factor so that the mean channel of the perfect white under D65 is 1 (white balance is left to
 the camera, as the thesis' relative reflectance ``S_Sen · I^a`` keeps it). Every integral uses
 the 1 nm CIE grid (360–830 nm). Shading, residual and illuminant come from the spectral
-irradiance (:mod:`spectrinsic.gt_export.layers.irradiance`).
+irradiance (:mod:`spectrinsic.gt_export.layers.irradiance`). The RGB layers (``image*``,
+``reflectance``, ``shading*``, ``illuminant``, ``specular``, ``residual*``) are in the working
+space (:mod:`spectrinsic.spectra.working_space`: ACEScg by default, its matrix applied to the
+same XYZ; linear sRGB with ``working_space="srgb"``); the chapter-4 matrices stay sRGB.
 """
 
 from .compose import compute_ground_truth, identities

@@ -10,12 +10,14 @@ import numpy as np
 from ...errors import DatasetError
 from ...scenes.material_labels import material_label
 from ...scenes.model import Scene
-from ...spectra import absolute_reflectance, get_sensors, get_spectrum
+from ...spectra import get_sensors, get_spectrum, white_normalised_responses
+from ...spectra.working_space import DEFAULT_WORKING_SPACE, WorkingSpace
+from ...spectra.working_space import working_space as working_space_of
 from . import irradiance as irr
 from .cameras import camera_layers, matrices_of
 from .denoise import Denoiser, Guides, denoise_white_radiance
 from .geometry import coverage_of, geometry_layers
-from .gloss import gloss_layers, specular_srgb
+from .gloss import gloss_layers, specular_rgb
 from .images import cube_layer, image_layers
 from .imaging import coverage_weighted
 from .intrinsics import (
@@ -23,8 +25,8 @@ from .intrinsics import (
     from_denoised,
     intrinsic_layers,
     noise_of,
-    srgb_of,
-    srgb_white,
+    rgb_of,
+    rgb_white,
     white_radiance,
 )
 from .lights import light_records, share_layers
@@ -49,7 +51,7 @@ from .spectral_intrinsics import residual_shares, spectral_identity, spectral_la
 __all__ = ["compute_ground_truth", "identities"]
 
 
-def _sample(scene: Scene, result: Any, data_dir: Any) -> SampleInputs:
+def _sample(scene: Scene, result: Any, data_dir: Any, space: WorkingSpace) -> SampleInputs:
     wl = grid()
     rho = (
         np.stack([get_spectrum(m.spectrum, data_dir=data_dir).on(wl) for m in scene.materials])
@@ -57,22 +59,31 @@ def _sample(scene: Scene, result: Any, data_dir: Any) -> SampleInputs:
         else np.zeros((0, wl.size))
     )
     return SampleInputs(
-        scene, result, reference_mode(result), wl, rho, get_spectrum("cie:D65").on(wl), data_dir
+        scene,
+        result,
+        reference_mode(result),
+        wl,
+        rho,
+        get_spectrum("cie:D65").on(wl),
+        data_dir,
+        space,
     )
 
 
-def _reflectance(coverage: np.ndarray, names: list[str], data_dir: Any) -> tuple[Layer, Any]:
-    """``reflectance`` (linear sRGB under D65 of each material, coverage-weighted) as a layer
-    and in float64."""
-    values = coverage_weighted(
-        coverage, absolute_reflectance(names, data_dir=data_dir) if names else np.zeros((0, 3))
-    )
+def _reflectance(s: SampleInputs, coverage: np.ndarray) -> tuple[Layer, Any]:
+    """``reflectance`` (working-space RGB under D65 of each material, the perfect white at
+    Y = 1, coverage-weighted; in sRGB :func:`~spectrinsic.spectra.absolute_reflectance`) as a
+    layer and in float64."""
+    xyz = white_normalised_responses(s.material_rho, s.d65, get_sensors("cie1931").on(s.wl), s.wl)
+    values = coverage_weighted(coverage, s.space.rgb(xyz))
+    white = ", ".join(f"{v:.3f}" for v in s.space.white)
     return make_layer(
         "reflectance",
         values,
         RGB,
-        "dimensionless absolute reflectance, linear sRGB under D65 (perfect white = 1); "
-        "box-filtered by pixel coverage, 0 for background",
+        f"dimensionless absolute reflectance, linear {s.space.colourspace} under D65 (perfect "
+        f"white = ({white}), the space's D65 white); box-filtered by pixel coverage, 0 for "
+        "background",
         "intrinsics",
     ), values
 
@@ -89,6 +100,7 @@ def compute_ground_truth(
     data_dir: Any = None,
     training: np.ndarray | None = None,
     spectral: bool = False,
+    working_space: str = DEFAULT_WORKING_SPACE,
 ) -> GroundTruth:
     """Compute every ground-truth layer of one rendered sample.
 
@@ -121,14 +133,17 @@ def compute_ground_truth(
     spectral
         Add the per-band intrinsic layers of the 31-band cube (``spectral.exr``,
         :mod:`~spectrinsic.gt_export.layers.spectral_intrinsics`).
+    working_space
+        The RGB working space of the RGB layers (:mod:`spectrinsic.spectra.working_space`):
+        ``"acescg"`` (default; shading negatives kept) or ``"srgb"`` (the layers of before,
+        shading clipped at 0).
     """
-    s = _sample(scene, result, data_dir)
+    s = _sample(scene, result, data_dir, working_space_of(working_space))
     layers = image_layers(s)
     image = layers[0].data.astype(np.float64)
     coverage, mask = coverage_of(s, (image.shape[0], image.shape[1]))
     layers += geometry_layers(s, mask)
-    names = [m.spectrum for m in scene.materials]
-    reflectance_layer, reflectance = _reflectance(coverage, names, data_dir)
+    reflectance_layer, reflectance = _reflectance(s, coverage)
     layers.append(reflectance_layer)
     w_raw = white_radiance(s, coverage)
     w = w_raw
@@ -141,7 +156,7 @@ def compute_ground_truth(
         )
         batches = tuple(b[s.ref] for b in getattr(result, "batch_raw", ()) or () if s.ref in b)
         w = irr.unlit_masked(w, w_raw, batches)
-    specular = specular_srgb(s, w_raw.to_xyz)
+    specular = specular_rgb(s, w_raw.to_xyz)
     layers += intrinsic_layers(s, w_raw, w, image, reflectance, denoised=denoise, specular=specular)
     layers += gloss_layers(s, coverage, specular)
     noise_maps, noise = noise_of(s, w_raw)
@@ -173,7 +188,8 @@ def compute_ground_truth(
             sorted(layer.name for layer in layers if denoise and from_denoised(layer.name))
         ),
         noise=noise,
-        clipping=clipping_of(srgb_of(w) / srgb_white(s), w.valid & (irr.luminance_of(w) > 0)),
+        clipping=clipping_of(rgb_of(s, w) / rgb_white(s), w.valid & (irr.luminance_of(w) > 0)),
+        working_space=s.space,
         residual_share=residual_shares(_identities(by_name, cameras), by_name, mask),
     )
 

@@ -8,7 +8,7 @@ With ``P`` the raw image, ρ the pixel's band albedo and X the mode's raw → XY
 
     P_diff   = P − P_spec                 the first hits' diffuse lobes (and the light seen directly)
     W        = P_diff / ρ                 white-surface radiance (Eq. 1 of irradiance), per band
-    specular = sRGB(X · P_spec)           linear sRGB, render units (< 0 only out of gamut)
+    specular = RGB(X · P_spec)            working-space RGB, render units (< 0 only out of gamut)
     image    = reflectance ∘ shading + specular + residual
 
 Scenes without glossy materials get none of these layers (their specular part is 0, every
@@ -19,11 +19,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...spectra import xyz_to_linear_srgb
 from .imaging import coverage_weighted
 from .records import RGB, UNITS_IMAGE, Layer, SampleInputs, make_layer
 
-__all__ = ["specular_raw", "diffuse_raw", "specular_srgb", "gloss_layers"]
+__all__ = ["specular_raw", "diffuse_raw", "specular_rgb", "gloss_layers"]
 
 
 def specular_raw(s: SampleInputs) -> np.ndarray | None:
@@ -38,14 +37,14 @@ def diffuse_raw(s: SampleInputs, raw: np.ndarray) -> np.ndarray:
     return raw if spec is None else np.asarray(raw, np.float64) - spec
 
 
-def specular_srgb(s: SampleInputs, to_xyz: np.ndarray) -> np.ndarray | None:
-    """``(H, W, 3)`` linear sRGB of the specular channels, or ``None`` (matte)."""
+def specular_rgb(s: SampleInputs, to_xyz: np.ndarray) -> np.ndarray | None:
+    """``(H, W, 3)`` working-space RGB of the specular channels, or ``None`` (matte)."""
     spec = specular_raw(s)
-    return None if spec is None else xyz_to_linear_srgb(np.einsum("hwk,ck->hwc", spec, to_xyz))
+    return None if spec is None else s.space.rgb(np.einsum("hwk,ck->hwc", spec, to_xyz))
 
 
 def gloss_layers(s: SampleInputs, coverage: np.ndarray, specular: np.ndarray | None) -> list[Layer]:
-    """``specular`` (given, sRGB) and the coverage-weighted material maps; none if matte."""
+    """``specular`` (given, working-space RGB) and the coverage-weighted material maps; none if matte."""
     if specular is None:
         return []
     mats = s.scene.materials

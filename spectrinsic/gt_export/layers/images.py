@@ -8,7 +8,7 @@ import numpy as np
 
 from ...errors import DatasetError
 from ...render.algebra.modes import RENDER_MODES
-from ...spectra import get_sensors, xyz_to_linear_srgb
+from ...spectra import get_sensors
 from .imaging import relative_error_map
 from .records import RGB, UNITS_IMAGE, Layer, SampleInputs, make_layer
 
@@ -30,7 +30,7 @@ def image_layers(s: SampleInputs) -> list[Layer]:
     out = [
         make_layer(
             "image",
-            xyz_to_linear_srgb(ref_xyz),
+            s.space.rgb(ref_xyz),
             RGB,
             UNITS_IMAGE + f"; render mode {s.ref!r}",
             "image",
@@ -41,7 +41,7 @@ def image_layers(s: SampleInputs) -> list[Layer]:
         out.append(
             make_layer(
                 f"image_{mode}",
-                xyz_to_linear_srgb(xyz),
+                s.space.rgb(xyz),
                 RGB,
                 UNITS_IMAGE + f"; render mode {mode!r}",
                 "image",

@@ -10,10 +10,7 @@ from typing import Any
 import numpy as np
 
 from ...render.algebra.modes import channel_values, get_mode, to_xyz_matrix
-from ...spectra import get_sensors, xyz_to_linear_srgb
-
-# Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
-from ...spectra import white_normalised_responses as canonical_responses
+from ...spectra import get_sensors
 from . import irradiance as irr
 from .gloss import diffuse_raw
 from .imaging import shading_ratio
@@ -21,8 +18,8 @@ from .records import REFLECTANCE_FLOOR, RGB, UNITS_IMAGE, Layer, SampleInputs, m
 
 __all__ = [
     "white_radiance",
-    "srgb_white",
-    "srgb_of",
+    "rgb_white",
+    "rgb_of",
     "shading_set",
     "intrinsic_layers",
     "noise_of",
@@ -71,12 +68,14 @@ def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
     )
 
 
-def srgb_white(s: SampleInputs) -> np.ndarray:
-    return canonical_responses(np.ones(s.wl.size), s.d65, get_sensors("srgb").on(s.wl), s.wl)
+def rgb_white(s: SampleInputs) -> np.ndarray:
+    """The working space's colour of the perfect white under D65 at Y = 1 (``(3,)``)."""
+    return np.asarray(s.space.white, np.float64)
 
 
-def srgb_of(w: irr.WhiteRadiance) -> np.ndarray:
-    return xyz_to_linear_srgb(w.xyz())
+def rgb_of(s: SampleInputs, w: irr.WhiteRadiance) -> np.ndarray:
+    """``(H, W, 3)`` working-space RGB of ``W`` (render units)."""
+    return s.space.rgb(w.xyz())
 
 
 def shading_set(
@@ -90,20 +89,24 @@ def shading_set(
     group: str,
     space: str,
     specular: np.ndarray | None = None,
+    clip: bool = True,
 ) -> list[Layer]:
     """``shading``, ``residual`` and, if a third name is given, ``illuminant`` of one sensor
-    space from ``W``'s colour (the residual less *specular*, if given)."""
-    shading = irr.relative_shading(colour, white, w.valid)
+    space from ``W``'s colour (the residual less *specular*, if given); the shading clipped at
+    0 if *clip*, else its negative (out-of-gamut) components kept."""
+    shading = irr.relative_shading(colour, white, w.valid, clip=clip)
     grey = irr.luminance_of(w)
+    sign = "≥ 0" if clip else "negative components kept"
     layers = [
         make_layer(
             names[0],
             shading,
             RGB,
             f"shading-illumination: {space} of the light a perfect white would reflect here "
-            "(render units, relative to that space's white under D65; ≥ 0, 0 where no surface)",
+            f"(render units, relative to that space's white under D65; {sign}, 0 where no "
+            "surface)",
             group,
-            nonnegative=True,
+            nonnegative=clip,
         ),
         make_layer(
             names[1],
@@ -122,7 +125,7 @@ def shading_set(
                 f"{space} colour of the light arriving at unit luminance "
                 "(D65 = (1, 1, 1)); 0 where none arrives",
                 group,
-                nonnegative=True,
+                nonnegative=clip,
             )
         )
     return layers
@@ -138,12 +141,10 @@ def _denoised_image(
 ) -> tuple[np.ndarray, list[Layer]]:
     """``image_denoised`` (the reflectance-weighted denoised ``W`` plus the raw *specular*) and
     the raw shading and residual it replaces, ``shading_raw``/``residual_raw``."""
-    white = srgb_white(s)
+    white = rgb_white(s)
     out: list[Layer] = []
     raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
-    used = xyz_to_linear_srgb(
-        np.einsum("hwk,ck->hwc", irr.recompose(w, diffuse_raw(s, raw)), w.to_xyz)
-    )
+    used = s.space.rgb(np.einsum("hwk,ck->hwc", irr.recompose(w, diffuse_raw(s, raw)), w.to_xyz))
     used = used if specular is None else used + specular
     out.append(
         make_layer(
@@ -158,14 +159,15 @@ def _denoised_image(
     )
     out += shading_set(
         w_raw,
-        srgb_of(w_raw),
+        rgb_of(s, w_raw),
         white,
         image,
         reflectance,
-        space="linear sRGB",
+        space=_space_words(s),
         names=("shading_raw", "residual_raw"),
         group="intrinsics",
         specular=specular,
+        clip=s.space.clip_shading,
     )
     return used, out
 
@@ -180,10 +182,10 @@ def intrinsic_layers(
     denoised: bool,
     specular: np.ndarray | None = None,
 ) -> list[Layer]:
-    """sRGB shading, residual and illuminant (from the denoised ``W`` if asked, with
+    """Working-space shading, residual and illuminant (from the denoised ``W`` if asked, with
     ``image_denoised`` rebuilt from it plus the raw *specular*, and the raw ``shading_raw``/
     ``residual_raw``), grey shading and ratio shading."""
-    white = srgb_white(s)
+    white = rgb_white(s)
     used = image
     out: list[Layer] = []
     if denoised:
@@ -191,14 +193,15 @@ def intrinsic_layers(
         out += denoised_layers
     out += shading_set(
         w,
-        srgb_of(w),
+        rgb_of(s, w),
         white,
         used,
         reflectance,
-        space="linear sRGB",
+        space=_space_words(s),
         names=("shading", "residual", "illuminant"),
         group="intrinsics",
         specular=specular,
+        clip=s.space.clip_shading,
     )
     out.append(
         make_layer(
@@ -228,12 +231,14 @@ def noise_of(s: SampleInputs, w: irr.WhiteRadiance) -> tuple[list[Layer], dict[s
     batches = [b[s.ref] for b in getattr(s.result, "batch_raw", ()) or () if s.ref in b]
     if len(batches) < 2:
         return [], {}
-    white = srgb_white(s)
+    white = rgb_white(s)
+    clip = s.space.clip_shading
     images = [
-        xyz_to_linear_srgb(np.einsum("hwk,ck->hwc", np.asarray(b, float), w.to_xyz))
-        for b in batches
+        s.space.rgb(np.einsum("hwk,ck->hwc", np.asarray(b, float), w.to_xyz)) for b in batches
     ]
-    shadings = [irr.relative_shading(srgb_of(w.from_raw(b)), white, w.valid) for b in batches]
+    shadings = [
+        irr.relative_shading(rgb_of(s, w.from_raw(b)), white, w.valid, clip=clip) for b in batches
+    ]
     lit = w.valid
     maps = {
         "image": irr.relative_standard_error(images, lit),
@@ -256,8 +261,14 @@ def noise_of(s: SampleInputs, w: irr.WhiteRadiance) -> tuple[list[Layer], dict[s
     return layers, figures
 
 
+def _space_words(s: SampleInputs) -> str:
+    return f"linear {s.space.colourspace}"
+
+
 def clipping_of(colour: np.ndarray, lit: np.ndarray) -> dict[str, float]:
-    """How much out-of-gamut light the clip of the sRGB shading moved into the residual."""
+    """How much of the working-space shading is out of gamut (a negative component): the
+    share of lit pixels, and the negative part's norm relative to the shading's. The ``srgb``
+    space clips it into the residual; the others keep it in the shading."""
     values = colour[lit]
     if not values.size:
         return {"pixels": 0.0, "mean": 0.0, "max": 0.0}

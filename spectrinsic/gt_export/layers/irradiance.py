@@ -167,17 +167,20 @@ def white_radiance(
     return WhiteRadiance(mode, bands, albedo, valid, np.asarray(to_xyz, np.float64))
 
 
-def relative_shading(colour: np.ndarray, white: np.ndarray, valid: np.ndarray) -> np.ndarray:
-    """Shading in a sensor space: ``max(colour / white, 0)``, 0 where not *valid*.
+def relative_shading(
+    colour: np.ndarray, white: np.ndarray, valid: np.ndarray, *, clip: bool = True
+) -> np.ndarray:
+    """Shading in a sensor space: ``max(colour / white, 0)`` (``colour / white`` without
+    *clip*), 0 where not *valid*.
 
     *colour* ``(H, W, 3)`` is ``W`` seen by the space's sensors; *white* ``(3,)`` is the space's
     response to the perfect white under D65 at unit luminance (its reflectance of white), so
     ``reflectance ∘ shading`` reproduces a white or grey surface exactly. Negative values
-    (light out of the space's gamut after bounces off saturated surfaces) are clipped; the
-    residual keeps them.
+    (light out of the space's gamut after bounces off saturated surfaces) are clipped if
+    *clip*; the residual keeps them.
     """
     shading = np.asarray(colour, np.float64) / np.asarray(white, np.float64)
-    return np.where(valid[..., None], np.clip(shading, 0.0, None), 0.0)
+    return np.where(valid[..., None], np.clip(shading, 0.0, None) if clip else shading, 0.0)
 
 
 def luminance_of(radiance: WhiteRadiance) -> np.ndarray:

@@ -14,6 +14,7 @@ import numpy as np
 from ...errors import DatasetError
 from ...scenes.model import Scene
 from ...spectra import COLORIMETRIC_WAVELENGTHS
+from ...spectra.working_space import DEFAULT_WORKING_SPACE, WorkingSpace, working_space
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 
@@ -152,13 +153,17 @@ class GroundTruth:
     #: Relative standard error per layer (``{"image": {"median", "p95", "pixels"}, ...}``),
     #: from the spread of independent batches; empty for a single batch.
     noise: dict[str, dict[str, float | int]] = field(default_factory=dict)
-    #: Out-of-gamut light clipped from the sRGB shading into the residual: ``pixels``, the
-    #: fraction of lit pixels with a clipped channel; ``mean``/``max``, the clipped part's norm
-    #: relative to the shading's norm over those pixels.
+    #: Out-of-gamut shading in the working space (clipped into the residual in ``srgb``,
+    #: kept in the others): ``pixels``, the fraction of lit pixels with a negative channel;
+    #: ``mean``/``max``, the negative part's norm relative to the shading's norm there.
     clipping: dict[str, float] = field(default_factory=dict)
     #: ``Σ|residual| / Σ|image|`` over the mask, per identity, keyed by its image layer
     #: (``image``/``image_denoised``: RGB; ``image_bands``: per band).
     residual_share: dict[str, float] = field(default_factory=dict)
+    #: The RGB working space of the RGB layers (``meta.json["working_space"]``).
+    working_space: WorkingSpace = field(
+        default_factory=lambda: working_space(DEFAULT_WORKING_SPACE)
+    )
 
 
 def grid() -> np.ndarray:
@@ -197,7 +202,8 @@ def camera_key(name: str) -> str:
 
 
 UNITS_IMAGE = (
-    "relative radiance (render units), linear sRGB (IEC 61966-2-1, D65 white), from CIE XYZ"
+    "relative radiance (render units), linear RGB of the working space "
+    "(meta.json working_space), from CIE XYZ"
 )
 
 
@@ -234,3 +240,5 @@ class SampleInputs:
     material_rho: np.ndarray
     d65: np.ndarray
     data_dir: Any
+    #: The RGB working space of the layers (:mod:`spectrinsic.spectra.working_space`).
+    space: WorkingSpace = field(default_factory=lambda: working_space(DEFAULT_WORKING_SPACE))

@@ -42,7 +42,7 @@ import numpy as np
 
 from ...errors import DatasetError
 from ...spectra import COLORIMETRIC_WAVELENGTHS, get_sensors, get_spectrum, responses
-from ...spectra.colourspace import srgb_matrices
+from ...spectra.working_space import WORKING_SPACES, working_space
 from . import irradiance as irr
 from .gloss import diffuse_raw, specular_raw
 from .intrinsics import white_radiance
@@ -298,23 +298,12 @@ def residual_summary(metas: Any) -> dict[str, Any]:
     }
 
 
-#: RGB working spaces :func:`bands_to_rgb` knows (name -> colour-science colourspace, or ours).
-WORKING_SPACES: dict[str, str] = {
-    "srgb": "sRGB",
-    "rec2020": "ITU-R BT.2020",
-    "acescg": "ACEScg",
-}
-
-
 def working_space_matrix(space: str) -> np.ndarray:
-    """``(3, 3)`` CIE XYZ -> linear RGB of a :data:`WORKING_SPACES` space (colour-science)."""
+    """``(3, 3)`` CIE XYZ -> linear RGB of a :data:`WORKING_SPACES` space
+    (:func:`spectrinsic.spectra.working_space.working_space`)."""
     if space not in WORKING_SPACES:
         raise DatasetError(f"working space {space!r}; expected one of {sorted(WORKING_SPACES)}")
-    if space == "srgb":
-        return np.asarray(srgb_matrices()[0], np.float64)
-    import colour  # noqa: PLC0415 - heavy; only here
-
-    return np.asarray(colour.RGB_COLOURSPACES[WORKING_SPACES[space]].matrix_XYZ_to_RGB)
+    return np.asarray(working_space(space).from_xyz, np.float64)
 
 
 def bands_to_rgb(

@@ -43,6 +43,7 @@ from ..sample.integrity import replaceable_sample
 from ..sample.meta import read_meta
 from ..sample.sensor import model_from_meta
 from ..sample.transport_exr import read_transport
+from ..sample.working_view import space_of
 from ..sample.writer import export_sample
 from .checks import check_finite_result, check_relight_inputs
 
@@ -307,6 +308,7 @@ def relight(
         cameras=cameras,
         write_cube="cube" in meta.get("layers", {}),
         spectral_layers="shading_bands" in meta.get("layers", {}),
+        working_space=space_of(meta).name,  # the source's (srgb for samples before issue 30)
         denoise=bool(meta.get("denoised_layers")),
         data_dir=data_dir,
         transport=relit.transport if keep_transport else None,

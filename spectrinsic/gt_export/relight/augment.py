@@ -31,6 +31,7 @@ from ...scenes.generators.lights import draw_illuminant
 from ..layers import compute_ground_truth
 from ..sample.integrity import sample_problem
 from ..sample.meta import read_meta
+from ..sample.working_view import space_of
 from . import relight, relit_render
 
 __all__ = [
@@ -129,6 +130,7 @@ def relit_layers(
         denoise=bool(meta.get("denoised_layers")) if denoise is None else denoise,
         data_dir=data_dir,
         spectral="shading_bands" in meta.get("layers", {}),
+        working_space=space_of(meta).name,
     )
     out: dict[str, Any] = {name: layer.data for name, layer in gt.layers.items()}
     if "mask" in out:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +16,7 @@ from ..formats.png import EXPOSURE_PERCENTILE, exposure
 from ..layers.spectral_intrinsics import bands_to_rgb, rgb_residual_share, working_space_matrix
 from . import META_NAME, file_sha256, sample_dirs
 from .meta import SampleMeta, read_meta
+from .working_view import space_of, srgb_view, view_kind
 
 __all__ = [
     "load_sample",
@@ -45,7 +46,11 @@ def _verified(meta: SampleMeta, file: str) -> Path:
 
 
 def load_sample(
-    path: str | os.PathLike[str], *, layers: Sequence[str] | None = None, verify: bool = True
+    path: str | os.PathLike[str],
+    *,
+    layers: Sequence[str] | None = None,
+    verify: bool = True,
+    space: str | None = None,
 ) -> dict[str, Any]:
     """Load one sample folder written by :func:`spectrinsic.gt_export.export_sample`.
 
@@ -58,12 +63,18 @@ def load_sample(
     verify
         Check ``meta.json`` against its seal and every file read against its SHA-256 before
         decoding it (about as long again as reading; ``False`` trusts the files).
+    space
+        ``None`` (default): the RGB layers as stored, in the sample's working space
+        (``meta["working_space"]``: ACEScg by default, linear sRGB for ``--working-space
+        srgb`` and samples from before the working space was recorded); ``"srgb"``: their
+        linear sRGB view (:mod:`~spectrinsic.gt_export.sample.working_view`; the residuals
+        recomputed so the identities hold; shading not clipped).
 
     Returns
     -------
     dict
         ``image``, ``reflectance``, ``shading``, ``illuminant`` (``(H, W, 3)`` float32 linear
-        sRGB), ``shading_grey``, ``depth`` (``(H, W)`` float32), ``normals`` (``(H, W, 3)``),
+        RGB of the working space, or sRGB with ``space="srgb"``), ``shading_grey``, ``depth`` (``(H, W)`` float32), ``normals`` (``(H, W, 3)``),
         ``mask`` (``(H, W)`` bool), ``ids`` (``{"material": (H, W) int32, "object": ...}``, -1
         background), per-camera keys ``image_camera/<name>`` etc., ``cube`` when written, and
         ``meta`` (the parsed ``meta.json``). Units are in ``meta["layers"][key]["units"]``.
@@ -75,6 +86,7 @@ def load_sample(
         the field; layer files outside the sample folder are refused there), an unknown layer,
         or (with *verify*) a file that does not match its SHA-256.
     """
+    _check_space(space)
     meta = read_meta(path, verify=verify)
     records = meta.layers
     wanted = list(records) if layers is None else list(layers)
@@ -83,6 +95,8 @@ def load_sample(
         raise DatasetError(
             f"sample {meta.sample_id!r} has no layers {unknown}; it has {sorted(records)}"
         )
+    asked = wanted
+    wanted = _with_identity_members(wanted, meta.raw, records) if space == "srgb" else wanted
     by_file: dict[str, list[str]] = {}
     for key in wanted:
         by_file.setdefault(records[key].file, []).append(key)
@@ -103,6 +117,29 @@ def load_sample(
     if ids:
         out["ids"] = ids
     out["meta"] = dict(meta.raw)
+    if space == "srgb":
+        out = srgb_view(out, out["meta"])
+        out = {k: v for k, v in out.items() if k in asked or k in ("ids", "meta")}
+    return out
+
+
+def _check_space(space: str | None) -> None:
+    if space not in (None, "srgb"):
+        raise DatasetError(f"load_sample space={space!r}; expected None (as stored) or 'srgb'")
+
+
+def _with_identity_members(wanted: list[str], meta: Any, records: Any) -> list[str]:
+    """*wanted* plus what the sRGB view needs to recompute a wanted residual or ratio."""
+    out = list(wanted)
+    if space_of(meta).name == "srgb":
+        return out
+    identities = meta.get("identities")
+    needs = [k for k in wanted if view_kind(k) == "recomputed"]
+    for ident in identities if needs and isinstance(identities, list) else []:
+        if isinstance(ident, Mapping) and (
+            ident.get("residual") in needs or "shading_ratio" in needs
+        ):
+            out += [v for v in ident.values() if v in records and v not in out]
     return out
 
 
@@ -112,12 +149,13 @@ def load_dataset(
     layers: Sequence[str] | None = None,
     verify: bool = True,
     max_residual_share: float | None = None,
+    space: str | None = None,
 ) -> Iterator[dict[str, Any]]:
     """Iterate :func:`load_sample` over the complete samples of *dataset_dir*, sorted by id;
     with *max_residual_share*, only those whose RGB residual share is at most that
-    (:func:`filter_residual_share`)."""
+    (:func:`filter_residual_share`); *space* as :func:`load_sample`'s."""
     for sample in filter_residual_share(sample_dirs(dataset_dir), max_residual_share):
-        yield load_sample(sample, layers=layers, verify=verify)
+        yield load_sample(sample, layers=layers, verify=verify, space=space)
 
 
 def filter_residual_share(folders: Sequence[Path], limit: float | None) -> list[Path]:
@@ -190,7 +228,8 @@ def prepare_item(
     arrays = {k: v for k, v in sample.items() if isinstance(v, np.ndarray)}
     scale = 1.0
     if normalize_exposure and "image" in arrays:
-        scale = exposure(arrays["image"])  # the previews' exposure: one definition
+        # the previews' exposure, one definition: of the sRGB view's luminance
+        scale = exposure(space_of(sample.get("meta")).srgb(arrays["image"]))
     if crop is not None:
         if rng is None:
             raise DatasetError("a random crop needs an explicit numpy Generator (rng=...)")
@@ -222,6 +261,7 @@ def torch_dataset(
     transform: Any = None,
     relight: Callable[[Path, int, int], dict[str, Any]] | None = None,
     max_residual_share: float | None = None,
+    space: str | None = None,
 ) -> Any:
     """A map-style ``torch.utils.data.Dataset`` over a dataset folder.
 
@@ -235,7 +275,8 @@ def torch_dataset(
     ``default_rng([seed, i])``, the same on every worker and epoch. *max_residual_share* keeps
     only the samples whose RGB residual share is at most that fraction
     (:func:`filter_residual_share`). The spectral layers (``*_bands``, ``(31, H, W)``) come
-    with the rest when the set was built with ``--spectral-layers``. torch is imported only here.
+    with the rest when the set was built with ``--spectral-layers``. *space* ``"srgb"``: the
+    RGB layers' linear sRGB view (:func:`load_sample`). torch is imported only here.
 
     Raises
     ------
@@ -251,6 +292,7 @@ def torch_dataset(
         ) from exc
     if crop is not None and seed is None:
         raise DatasetError("torch_dataset: a random crop needs an explicit seed")
+    _check_space(space)
     folders = filter_residual_share(split_samples(dataset_dir, split), max_residual_share)
     wanted = None if keys is None else [k for k in keys if k != "ids"]
 
@@ -271,9 +313,10 @@ def torch_dataset(
 
         def __getitem__(self, index: int) -> dict[str, Any]:
             if relight is None:
-                sample = load_sample(folders[index], layers=wanted, verify=verify)
+                sample = load_sample(folders[index], layers=wanted, verify=verify, space=space)
             else:
                 relit = relight(folders[index], index, self.epoch)
+                relit = srgb_view(relit, relit["meta"]) if space == "srgb" else relit
                 sample = {
                     k: v for k, v in relit.items() if wanted is None or k in wanted or k == "meta"
                 }
@@ -294,7 +337,9 @@ def working_space_view(
     ``"rec2020"``, ``"acescg"``), from its band layers
     (:func:`~spectrinsic.gt_export.layers.spectral_intrinsics.bands_to_rgb`). Measured on 200
     generated rooms, ACEScg with unclipped shading halves linear sRGB's residual share (median
-    and p95; docs/spectral-layers.md). ``(H, W, 3)`` float64, render units."""
+    and p95; docs/spectral-layers.md), hence the default working space of the stored RGB
+    layers; for their sRGB view use ``load_sample(..., space="srgb")``. ``(H, W, 3)``
+    float64, render units."""
     if "shading_bands" not in sample:
         raise DatasetError(
             "working_space_view needs the band layers: build the set with --spectral-layers"

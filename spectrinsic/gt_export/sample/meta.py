@@ -6,8 +6,7 @@ manifest and card, the gallery, the shards, and through the loader the evaluatio
 file and the field (:class:`~spectrinsic.errors.SampleMetaError`), instead of as a ``KeyError``
 deep inside whichever reader indexed it first:
 
-* not JSON, or a JSON ``NaN``/``Infinity`` (the writer never writes them);
-* a field missing, a field spectrinsic does not write (a bit flip in a key does both), or a
+* not JSON, or a JSON ``NaN``/``Infinity`` (the writer never writes them); a field missing, a field spectrinsic does not write (a bit flip in a key does both), or a
   field of the wrong type (``"seed": "7"``, a negative size, a layer file outside the folder);
 * content that no longer matches its seal (:func:`~spectrinsic.gt_export.sample.meta_seal`),
   e.g. one digit of a fitted matrix edited by hand.
@@ -83,8 +82,11 @@ META_FIELDS = frozenset(
 )
 #: Fields written only by some builds: ``transport`` (``--store-transport``, see
 #: :func:`~spectrinsic.gt_export.sample.transport_exr.write_transport`), ``sensor`` (``--camera``),
-#: ``spectrum_files`` (``csv:`` spectra, :func:`~spectrinsic.spectra.user_spectra.spectrum_files`).
-OPTIONAL_META_FIELDS = frozenset({"transport", "sensor", "spectrum_files", "residual_share"})
+#: ``spectrum_files`` (``csv:`` spectra, :func:`~spectrinsic.spectra.user_spectra.spectrum_files`),
+#: ``residual_share``, ``working_space`` (since issue 30; no working space: linear sRGB).
+OPTIONAL_META_FIELDS = frozenset(
+    {"transport", "sensor", "spectrum_files", "residual_share", "working_space"}
+)
 _LAYER_FIELDS = frozenset(
     {
         "file",
@@ -116,8 +118,7 @@ class LayerRecord:
     #: ``(H, W)`` or ``(H, W, C)``.
     shape: tuple[int, ...]
     dtype: str
-    #: Units and encoding, in words.
-    units: str
+    units: str  #: units and encoding, in words
     nonnegative: bool
     #: Preview PNG inside the sample folder, or ``None``.
     preview: str | None
@@ -142,10 +143,8 @@ class LightEntry:
     name: str
     kind: str
     spectrum: str
-    #: CIE 1931 xy chromaticity.
-    xy: tuple[float, float]
-    #: Linear sRGB colour at unit luminance.
-    srgb: tuple[float, ...]
+    xy: tuple[float, float]  #: CIE 1931 xy chromaticity
+    srgb: tuple[float, ...]  #: linear sRGB colour at unit luminance
     #: Fraction of the image's luminance due to this light.
     share: float
     #: SPD on ``spectral_grid.lights_spd`` (unit luminance).
@@ -323,8 +322,8 @@ def _check_records(f: JsonFields, meta: Mapping[str, object]) -> None:
     """The fields kept as plain JSON in :class:`SampleMeta` (``raw``): checked for type only."""
     for name in ("matrices", "spectral_grid", "shading_clipping", "render"):
         f.numeric_tree(f.mapping(meta[name], name), name)
-    if "residual_share" in meta:  # Σ|residual| / Σ|image| per identity (samples since issue 30)
-        f.numeric_tree(f.mapping(meta["residual_share"], "residual_share"), "residual_share")
+    for name in ("residual_share", "working_space"):  # samples since issue 30
+        f.numeric_tree(f.mapping(meta.get(name, {}), name), name)
     for name in ("objects", "versions"):
         for key, value in f.mapping(meta[name], name).items():
             f.text(value, f"{name}.{key}")

@@ -7,16 +7,19 @@ turn a pixel back into the value it stands for.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
 
+from ...spectra.working_space import WorkingSpace
 from ..formats import png
 from ..layers import Layer
 from . import PREVIEW_DIR
+from .working_view import srgb_layer, view_kind
 
-__all__ = ["Preview", "preview_maker", "preview_path"]
+__all__ = ["Preview", "preview_maker", "preview_path", "shown_layers"]
 
 
 #: A preview and how its pixels encode the layer: ``{"kind": "srgb", "scale": k}`` (PNG =
@@ -171,3 +174,21 @@ def preview_path(layer: Layer) -> str:
     base, _, camera = layer.name.partition("/")
     name = f"{base}--{layer.group.removeprefix('camera-')}.png" if camera else f"{base}.png"
     return f"{PREVIEW_DIR}/{name}"
+
+
+def shown_layers(layers: Mapping[str, Layer], space: WorkingSpace) -> dict[str, Layer]:
+    """*layers* with the working-space RGB ones in linear sRGB, as previews show them
+    (:mod:`~spectrinsic.gt_export.sample.working_view`; residuals by the matrix alone, enough for
+    their magnitude maps); the same layers for an sRGB sample."""
+    if space.name == "srgb":
+        return dict(layers)
+    out = dict(layers)
+    for name, layer in layers.items():
+        if layer.data.ndim != 3 or layer.data.shape[-1] != 3:
+            continue
+        data = srgb_layer(name, layer.data, space)
+        if data is None and view_kind(name) == "recomputed":
+            data = space.srgb(layer.data)
+        if data is not None:
+            out[name] = dataclasses.replace(layer, data=data.astype(np.float32))
+    return out

@@ -34,6 +34,7 @@ from ...provenance import software_versions
 from ...scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash, scene_to_dict
 from ...spectra import DEFAULT_WAVELENGTHS, get_spectrum
 from ...spectra.user_spectra import spectrum_files
+from ...spectra.working_space import DEFAULT_WORKING_SPACE
 from ..formats import png
 from ..formats.exr import write_exr
 from ..layers import GroundTruth, Layer, compute_ground_truth, identities
@@ -53,7 +54,7 @@ from . import (
     plain_data,
 )
 from .integrity import guarded_write, remove_owned_temporaries, replaceable_sample, sample_problem
-from .previews import preview_maker, preview_path
+from .previews import preview_maker, preview_path, shown_layers
 from .sensor import SensorOutput, sensor_output, write_sensor_files
 from .transport_exr import TRANSPORT_NAME, write_transport
 
@@ -152,6 +153,7 @@ def _meta(
         "denoised_layers": list(gt.denoised),
         "noise": gt.noise,
         "shading_clipping": gt.clipping,
+        "working_space": gt.working_space.record(),
         "residual_share": gt.residual_share,
         "files": sorted(files),
         "versions": software_versions(),
@@ -180,12 +182,13 @@ def _write_previews(folder: Path, gt: GroundTruth) -> dict[str, tuple[str, dict[
     """One PNG per layer that has a preview maker; return ``{layer: (path, encoding)}``."""
     (folder / PREVIEW_DIR).mkdir()
     previews: dict[str, tuple[str, dict[str, Any]]] = {}
-    for layer in gt.layers.values():
+    shown = shown_layers(gt.layers, gt.working_space)  # previews are sRGB
+    for layer in shown.values():
         maker = preview_maker(layer)
         if maker is None:
             continue
         rel = preview_path(layer)
-        rgb8, encoding = maker(layer, gt.layers)
+        rgb8, encoding = maker(layer, shown)
         png.write_png(folder / rel, rgb8)
         previews[layer.name] = (rel, encoding)
     return previews
@@ -247,6 +250,7 @@ def export_sample(
     transport: LightTransport | None = None,
     camera: CameraModel | None = None,
     spectral_layers: bool = False,
+    working_space: str = DEFAULT_WORKING_SPACE,
 ) -> Path:
     """Compute every ground-truth layer of a rendered sample and write it atomically.
 
@@ -286,6 +290,9 @@ def export_sample(
     spectral_layers
         Also write the per-band intrinsic layers (``spectral.exr``,
         :mod:`~spectrinsic.gt_export.layers.spectral_intrinsics`); needs the 31-band cube.
+    working_space
+        The RGB working space of the RGB layers (``"acescg"``, default, or ``"srgb"``,
+        :mod:`spectrinsic.spectra.working_space`); recorded in ``meta.json["working_space"]``.
 
     Returns
     -------
@@ -308,6 +315,7 @@ def export_sample(
         denoise=denoise,
         data_dir=data_dir,
         spectral=spectral_layers,
+        working_space=working_space,
     )
     sensor = None
     if camera is not None:
