@@ -23,7 +23,8 @@ from spectrinsic.cli.dataset_source import material_map, parse_resolution
 from spectrinsic.cli.render_files import write_render
 from spectrinsic.cli.render_scene import load_scene_argument
 from spectrinsic.errors import RenderError, SceneError
-from spectrinsic.gt_export.outfolder import check_output_folder, output_folder
+from spectrinsic.gt_export.outfolder import check_output_folder
+from spectrinsic.gt_export.staged_output import staged_output
 from spectrinsic.pipeline.presets import DatasetConfig, get_preset
 from spectrinsic.pipeline.source_plan import files_source
 from spectrinsic.render import (
@@ -338,10 +339,10 @@ def run(args: argparse.Namespace) -> int:
         n_lights=len(scene.lights),
         data_dir=data_dir,
     )
-    with output_folder(Path(args.out)):  # locked; its files recorded as spectrinsic's
+    with staged_output(Path(args.out)) as stage:  # a failed run leaves --out as it was
         result = _render_with_progress(args, scene, settings, data_dir)
-        paths = write_render(Path(args.out), scene, result, data_dir=data_dir)
-    _print_timings(result, paths)
+        paths = write_render(stage, scene, result, data_dir=data_dir)
+    _print_timings(result, {k: Path(args.out) / v.relative_to(stage) for k, v in paths.items()})
     return 0
 
 

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from spectrinsic.gt_export.colour_spread import material_chroma, shown, spread_summary
+from spectrinsic.gt_export.integrity import guarded_write
 from spectrinsic.gt_export.layers import luminance
 from spectrinsic.gt_export.loader import load_sample
 from spectrinsic.gt_export.sample_meta import SampleMeta
@@ -185,5 +186,7 @@ def write_diversity(
 ) -> Path:
     """Compute the statistics and save the figure as ``<dataset>/diversity.png``."""
     path = Path(dataset_dir) / DIVERSITY_NAME
-    diversity_figure(diversity_stats(sample_dirs, metas)).savefig(path, dpi=90)
+    figure = diversity_figure(diversity_stats(sample_dirs, metas))
+    with guarded_write(path):  # a full disk names the file and leaves no part of it
+        figure.savefig(path, dpi=90)
     return path

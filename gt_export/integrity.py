@@ -25,7 +25,13 @@ import shutil
 from collections.abc import Iterator
 from pathlib import Path, PurePosixPath
 
-from spectrinsic.errors import DatasetError, DiskFullError, SampleMetaError, WriteError
+from spectrinsic.errors import (
+    DatasetError,
+    DiskFullError,
+    SampleMetaError,
+    SpectrinsicError,
+    WriteError,
+)
 from spectrinsic.gt_export.outfolder import check_out_folder, require_folder_path
 from spectrinsic.gt_export.sample import (
     FORMAT_VERSION,
@@ -38,6 +44,8 @@ from spectrinsic.gt_export.sample_meta import owned_files, read_meta
 
 __all__ = [
     "MARKER_NAME",
+    "NO_SPACE",
+    "disk_full",
     "guarded_write",
     "sample_problem",
     "replaceable_sample",
@@ -52,22 +60,40 @@ __all__ = [
 #: Written first into every dataset folder: ``{"spectrinsic_dataset": 1, "config_hash": ...}``.
 MARKER_NAME = ".spectrinsic-dataset"
 #: errno values that mean "no space": retrying another sample cannot help.
-_NO_SPACE = frozenset({errno.ENOSPC, errno.EDQUOT})
+NO_SPACE = frozenset({errno.ENOSPC, errno.EDQUOT})
+#: How C libraries (OpenEXR) word a full disk in the ``RuntimeError`` they raise.
+_NO_SPACE_TEXT = tuple(os.strerror(code) for code in sorted(NO_SPACE))
+
+
+def disk_full(exc: BaseException) -> bool:
+    """Whether *exc* says the disk (or the user's quota) is full: an ``OSError`` with
+    ``ENOSPC``/``EDQUOT``, or a C library's ``RuntimeError`` quoting that error's text."""
+    if isinstance(exc, OSError):
+        return exc.errno in NO_SPACE
+    return isinstance(exc, RuntimeError) and any(t in str(exc) for t in _NO_SPACE_TEXT)
 
 
 @contextlib.contextmanager
 def guarded_write(path: str | os.PathLike[str]) -> Iterator[None]:
-    """Turn an ``OSError`` while writing *path* into a one-line error naming *path*.
+    """Turn a failure while writing *path* into a one-line error naming *path*, and remove
+    what was written of it (a full disk leaves no partial or zero-byte file behind).
 
     ``write()`` failures (a full disk) carry no file name of their own, so without this the
-    message would not say which file could not be written.
+    message would not say which file could not be written. An ``OSError`` becomes a
+    :class:`~spectrinsic.errors.WriteError`, a full disk (also as a C library's
+    ``RuntimeError``, :func:`disk_full`) a :class:`~spectrinsic.errors.DiskFullError`.
     """
     try:
         yield
-    except OSError as exc:
-        reason = exc.strerror or str(exc)
-        cls = DiskFullError if exc.errno in _NO_SPACE else WriteError
-        raise cls(f"cannot write {str(path)!r}: {reason}") from exc
+    except (OSError, RuntimeError) as exc:
+        if isinstance(exc, SpectrinsicError) or not (isinstance(exc, OSError) or disk_full(exc)):
+            raise  # already one line (a nested guard), or not a write failure
+        target = Path(path)
+        if disk_full(exc) and target.is_file() and not target.is_symlink():
+            target.unlink(missing_ok=True)  # the file this block was writing: partial at best
+        reason = os.strerror(errno.ENOSPC) if not isinstance(exc, OSError) else exc.strerror
+        cls = DiskFullError if disk_full(exc) else WriteError
+        raise cls(f"cannot write {str(path)!r}: {reason or exc}") from exc
 
 
 def sample_problem(folder: str | os.PathLike[str], config_hash: str) -> str | None:

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import logging
 import os
 from collections.abc import Mapping
 from pathlib import Path
@@ -39,7 +40,7 @@ from spectrinsic.gt_export.sample import META_NAME, SCENE_NAME, file_sha256
 from spectrinsic.gt_export.sample_meta import read_meta
 from spectrinsic.gt_export.sensor import model_from_meta
 from spectrinsic.gt_export.transport_file import read_transport
-from spectrinsic.gt_export.writer import export_sample
+from spectrinsic.gt_export.writer import export_sample, remove_sample_temporaries
 from spectrinsic.render.light_transport import LightTransport, relit_result
 from spectrinsic.render.result import RenderResult
 from spectrinsic.scenes.model import Scene, scene_from_dict
@@ -54,6 +55,8 @@ __all__ = [
     "relight",
     "check_light_spectra",
 ]
+
+log = logging.getLogger(__name__)
 
 #: AOV layers read back from ``geometry.exr`` (coverage comes from ``transport.exr``).
 _AOV_LAYERS = ("depth", "normals", "material_id", "object_id", "mask")
@@ -291,6 +294,8 @@ def relight(
     """
     sample, out = Path(sample_dir), Path(out_dir)
     _check_out(sample, out)
+    for path in remove_sample_temporaries(out.parent, out.name):
+        log.info("removed %s, left by a relight that was killed", path.name)
     relit = relit_render(sample, lights, powers=powers, data_dir=data_dir)
     check_finite_result(relit.result, sample)  # before anything is written
     meta = relit.meta

@@ -14,12 +14,13 @@ order and the executor, so the same config and seed give the same pixels.
 
 from __future__ import annotations
 
+import contextlib
 import glob
 import logging
 import os
 import resource
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -34,6 +35,7 @@ from spectrinsic.gt_export import (
     write_manifest,
 )
 from spectrinsic.gt_export.integrity import (
+    MARKER_NAME,
     check_build_folder,
     remove_owned_temporaries,
     remove_sample,
@@ -41,7 +43,7 @@ from spectrinsic.gt_export.integrity import (
     sample_problem,
     write_marker,
 )
-from spectrinsic.gt_export.outfolder import folder_lock
+from spectrinsic.gt_export.outfolder import LOCK_NAME, folder_lock
 from spectrinsic.gt_export.relight_pool import RELIT_TAG, relit_problem, write_relit_variants
 from spectrinsic.pipeline.executors import Executor, SerialExecutor
 from spectrinsic.pipeline.presets import DatasetConfig
@@ -266,8 +268,8 @@ def build_dataset(
     out = Path(out_dir)
     if config.camera:  # its curves exist (a data-directory camera needs --data-dir): one line
         get_sensors(camera_model(config.camera).sensitivities, data_dir=data_dir)
-    check_build_folder(out, config.config_hash(), rebuild=rebuild)  # before the folder is made
-    with folder_lock(out):  # one build per folder: a second one is refused, naming this one
+    new = check_build_folder(out, config.config_hash(), rebuild=rebuild) is None  # before mkdir
+    with folder_lock(out), _unmarked_on_error(out, new):  # one build per folder, held
         return _build_locked(
             out,
             config,
@@ -281,6 +283,19 @@ def build_dataset(
             finalize=finalize,
             rebuild=rebuild,
         )
+
+
+@contextlib.contextmanager
+def _unmarked_on_error(out: Path, new: bool) -> Iterator[None]:
+    """A build into a new (or empty) folder that stops with an error (a full disk, a refusal)
+    before any sample is in place leaves no dataset marker, so the folder is left as it was
+    (:func:`~spectrinsic.gt_export.outfolder.folder_lock` then removes a folder it made)."""
+    try:
+        yield
+    except Exception:
+        if new and {p.name for p in out.iterdir()} <= {MARKER_NAME, LOCK_NAME}:
+            (out / MARKER_NAME).unlink(missing_ok=True)
+        raise
 
 
 def _build_locked(
