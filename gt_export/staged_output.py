@@ -84,7 +84,7 @@ def staged_output(root: Path, option: str = "--out") -> Iterator[Path]:
 
     The staged files land in *root* only when the block ends normally (module docstring).
     """
-    existed = root.exists()
+    made = [p for p in (root, *root.parents) if not p.exists()]  # deepest first
     try:
         with output_folder(root, option):
             _sweep_stages(root)  # killed runs' (the lock is ours: nobody else's is in use)
@@ -102,6 +102,9 @@ def staged_output(root: Path, option: str = "--out") -> Iterator[Path]:
             finally:
                 shutil.rmtree(stage, ignore_errors=True)
     except BaseException:
-        if not existed:
+        if made:
             _remove_created(root)
+            for folder in made[1:]:  # the parents made for it, if nothing else is in them
+                with contextlib.suppress(OSError):
+                    folder.rmdir()
         raise

@@ -1,0 +1,170 @@
+"""Issue 36, cause 11: a refusal, a full disk or a kill leaves no trace.
+
+* A full disk is a real one: each command runs with ``--out`` on a small ``tmpfs`` mounted in
+  a private mount namespace (``unshare --user --map-root-user --mount``, no root needed where
+  user namespaces are allowed), so every writer fails with the kernel's ``ENOSPC``, C
+  libraries (OpenEXR) included. Each run must end with rc 2 and one line naming a file under
+  ``--out``, leave nothing in a folder it created (no zero-byte temporary, no partial file),
+  and, once the disk has room again (the ``tmpfs`` is remounted larger), the same command must
+  finish (rc 0) with nothing of spectrinsic's temporaries left.
+* A kill is a real one: the command runs in a child process that gets SIGTERM or SIGKILL while
+  its temporaries are on disk; SIGTERM stops it like Ctrl-C (rc 143, its folder as before) and
+  after SIGKILL the same command resumes into its folder and sweeps what the killed run left.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from spectrinsic.cli import main
+from tests.conftest import QUAD_YAML
+
+#: The tmpfs sizes tried per command, as fractions of what its whole output takes: the first
+#: file fails, or one of the last (a dataset's own files after its samples, meta.json).
+FRACTIONS = (0.0, 0.85)
+#: What a run whose disk filled must leave in a folder it created: nothing.
+_TMP = ".spectrinsic-tmp-"
+
+
+def _unshare_works() -> bool:
+    if shutil.which("unshare") is None or shutil.which("mount") is None:
+        return False
+    probe = subprocess.run(
+        ["unshare", "-rm", "sh", "-c", "mount -t tmpfs -o size=8k tmpfs /mnt || exit 1"],
+        capture_output=True,
+        check=False,
+    )
+    return probe.returncode == 0
+
+
+def _cases(inputs: dict[str, str]) -> dict[str, list[str]]:
+    """Each writing verb's command line, writing into ``out`` (relative to the small disk)."""
+    scene, ds, sample = inputs["scene"], inputs["dataset"], inputs["sample"]
+    return {
+        "render": ["render", scene, "--out", "out", "-q"],
+        "render --ground-truth": ["render", scene, "--ground-truth", "--out", "out", "-q"],
+        "dataset": ["dataset", "--scenes", scene, "--out", "out", "-q"],
+        "relight": ["relight", sample, "--light", "0=planck:3000K", "--out", "out", "-q"],
+        "export": ["export", ds, "--out", "out", "-q"],
+        "evaluate": ["evaluate", "--dataset", ds, "--methods", "image-as-shading"]
+        + ["--no-figures", "--out", "out", "-q"],
+        "study": ["study", "photometric", "--out", "out", "-q"],
+    }
+
+
+def _listing(root: Path) -> dict[str, int]:
+    return {
+        p.relative_to(root).as_posix(): p.stat().st_size
+        for p in sorted(root.rglob("*"))
+        if p.is_file()
+    }
+
+
+def _run_captured(argv: list[str], err_file: Path) -> tuple[int, str]:
+    """``main(argv)`` with file descriptor 2 (C libraries' stderr too) sent to *err_file*."""
+    saved = os.dup(2)
+    with err_file.open("w") as fh:
+        os.dup2(fh.fileno(), 2)
+        try:
+            rc = main(argv)
+        finally:
+            sys.stderr.flush()
+            os.dup2(saved, 2)
+            os.close(saved)
+    return rc, err_file.read_text()
+
+
+def _driver(work: Path) -> None:
+    """Inside the private mount namespace: every case on a small tmpfs, then with room."""
+    scene = work / "scene.yaml"
+    scene.write_text(QUAD_YAML)
+    ds = work / "ds"
+    assert (
+        main(["dataset", "--scenes", str(scene), "--out", str(ds), "--store-transport", "-q"]) == 0
+    )
+    sample = next(p for p in ds.iterdir() if (p / "meta.json").is_file())
+    inputs = {"scene": str(scene), "dataset": str(ds), "sample": str(sample)}
+    results = []
+    for name, argv in _cases(inputs).items():
+        needed = _mounted(work / f"room-{name}", "16m", argv, work)["used"]
+        for fraction in FRACTIONS:
+            size = f"{max(8, int(needed * fraction) // 4096 * 4)}k"
+            results.append(
+                {"case": name, "size": size}
+                | _mounted(work / f"disk-{len(results)}", size, argv, work)
+            )
+    print(json.dumps(results))
+
+
+def _mounted(disk: Path, size: str, argv: list[str], work: Path) -> dict:
+    """Run *argv* in *disk*, a tmpfs of *size*; then with room again (the same command)."""
+    disk.mkdir()
+    subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(disk)], check=True)
+    os.chdir(disk)
+    try:
+        rc, err = _run_captured(argv, work / "err.txt")
+        left, used = _listing(disk), shutil.disk_usage(disk).used
+        subprocess.run(["mount", "-o", "remount,size=16m", str(disk)], check=True)
+        again, _ = _run_captured(argv, work / "err.txt")
+        return {"rc": rc, "err": err, "left": left, "used": used} | {
+            "again": again,
+            "after": _listing(disk),
+        }
+    finally:
+        os.chdir(work)
+
+
+@pytest.fixture(scope="module")
+def full_disk_runs(tmp_path_factory) -> list[dict]:
+    if not _unshare_works():
+        pytest.skip("needs user and mount namespaces (unshare -rm) to mount a small tmpfs")
+    work = tmp_path_factory.mktemp("full-disk")
+    proc = subprocess.run(
+        ["unshare", "-rm", sys.executable, __file__, str(work)],
+        capture_output=True,
+        text=True,
+        check=False,
+        cwd=Path(__file__).parents[2],
+        env={**os.environ, "PYTHONPATH": str(Path(__file__).parents[2])},
+    )
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", list(_cases({"scene": "", "dataset": "", "sample": ""})))
+def test_a_full_disk_is_one_line_naming_the_file_and_leaves_no_trace(full_disk_runs, case):
+    runs = [r for r in full_disk_runs if r["case"] == case]
+    assert len(runs) == len(FRACTIONS)
+    assert any(r["rc"] != 0 for r in runs), f"{case}: no size filled the disk"
+    for r in runs:
+        lines = [line for line in r["err"].splitlines() if not line.startswith("WARNING ")]
+        if r["rc"] == 0:  # the command fitted: nothing to check but its success
+            continue
+        assert r["rc"] == 2, r
+        assert len(lines) == 1, r["err"]
+        assert lines[0].startswith("spectrinsic: error: cannot write 'out/"), lines[0]
+        assert "No space left on device" in lines[0], lines[0]
+        assert "Traceback" not in r["err"] and "Exception ignored" not in r["err"], r["err"]
+        if any(k.endswith("/meta.json") for k in r["left"]):  # a dataset (render --ground-truth)
+            # samples were complete when the dataset's own files filled the disk: kept, whole
+            assert not any(_TMP in k for k in r["left"]), r["left"]
+            assert all(size > 0 for size in r["left"].values()), r["left"]
+        else:  # a folder the run created is removed again: nothing at all is left
+            assert r["left"] == {}, r["left"]
+        # with room again, the same command finishes and leaves no temporary behind
+        assert r["again"] == 0, r
+        assert r["after"] and not any(_TMP in k for k in r["after"]), r["after"]
+
+
+if __name__ == "__main__":
+    _driver(Path(sys.argv[1]))
