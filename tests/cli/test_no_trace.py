@@ -21,6 +21,8 @@ import signal
 import subprocess
 import sys
 import time
+import traceback
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -76,6 +78,9 @@ def _run_captured(argv: list[str], err_file: Path) -> tuple[int, str]:
         os.dup2(fh.fileno(), 2)
         try:
             rc = main(argv)
+        except Exception:  # what would reach the user as a traceback: recorded as one
+            traceback.print_exc()
+            rc = 1
         finally:
             sys.stderr.flush()
             os.dup2(saved, 2)
@@ -164,6 +169,82 @@ def test_a_full_disk_is_one_line_naming_the_file_and_leaves_no_trace(full_disk_r
         # with room again, the same command finishes and leaves no temporary behind
         assert r["again"] == 0, r
         assert r["after"] and not any(_TMP in k for k in r["after"]), r["after"]
+
+
+# -- kills: SIGTERM is Ctrl-C; after SIGKILL the same command resumes and sweeps -------------
+
+
+@pytest.fixture(scope="module")
+def transport_dataset(tmp_path_factory) -> Path:
+    work = tmp_path_factory.mktemp("kills")
+    scene = work / "scene.yaml"
+    scene.write_text(QUAD_YAML)
+    ds = work / "ds"
+    assert (
+        main(["dataset", "--scenes", str(scene), "--out", str(ds), "--store-transport", "-q"]) == 0
+    )
+    return ds
+
+
+def _signal_when(argv: list[str], there: Callable[[], bool], sig: int) -> tuple[int, str]:
+    """Run ``spectrinsic *argv*`` in a child; send *sig* as soon as *there()*; (rc, stderr)."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "spectrinsic", *argv],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        deadline = time.monotonic() + 300
+        while not there():
+            assert proc.poll() is None, "the command ended before it could be stopped"
+            assert time.monotonic() < deadline
+            time.sleep(0.002)
+        proc.send_signal(sig)
+        _, err = proc.communicate(timeout=300)
+    finally:
+        proc.kill()
+    return proc.returncode, err
+
+
+def _evaluate(ds: Path, out: Path) -> list[str]:
+    return ["evaluate", "--dataset", str(ds), "--methods", "image-as-shading", "--out", str(out)]
+
+
+def _stage(out: Path) -> Callable[[], bool]:
+    return lambda: any(out.glob(".spectrinsic-tmp-stage-*/*"))
+
+
+def _ours(folder: Path) -> list[str]:
+    return sorted(p.name for p in folder.rglob(f"{_TMP}*"))
+
+
+def test_sigterm_stops_evaluate_like_ctrl_c(transport_dataset, tmp_path):
+    out = tmp_path / "ev"
+    rc, err = _signal_when(_evaluate(transport_dataset, out), _stage(out), signal.SIGTERM)
+    assert rc == 128 + signal.SIGTERM, err
+    assert "interrupted" in err and "Traceback" not in err, err
+    assert not out.exists()  # the folder it made, with its staged files, is gone
+
+
+def test_evaluate_killed_resumes_into_its_folder_and_sweeps_the_killed_runs_files(
+    transport_dataset, tmp_path
+):
+    out = tmp_path / "ev"
+    rc, _ = _signal_when(_evaluate(transport_dataset, out), _stage(out), signal.SIGKILL)
+    assert rc == -signal.SIGKILL and _ours(out)  # the killed run's staging folder is there
+    assert main([*_evaluate(transport_dataset, out), "-q"]) == 0
+    assert _ours(out) == [] and (out / "REPORT.md").is_file()
+
+
+def test_relight_killed_leaves_a_temporary_the_next_run_sweeps(transport_dataset, tmp_path):
+    sample = next(p for p in transport_dataset.iterdir() if (p / "meta.json").is_file())
+    argv = ["relight", str(sample), "--light", "0=planck:3000K", "--out", str(tmp_path / "rl")]
+    writing = lambda: any(tmp_path.glob(".spectrinsic-tmp-rl-*/*"))  # noqa: E731
+    rc, _ = _signal_when(argv, writing, signal.SIGKILL)
+    assert rc == -signal.SIGKILL and _ours(tmp_path)
+    assert main([*argv, "-q"]) == 0
+    assert _ours(tmp_path) == [] and (tmp_path / "rl" / "meta.json").is_file()
 
 
 if __name__ == "__main__":
