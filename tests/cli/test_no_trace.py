@@ -247,5 +247,37 @@ def test_relight_killed_leaves_a_temporary_the_next_run_sweeps(transport_dataset
     assert _ours(tmp_path) == [] and (tmp_path / "rl" / "meta.json").is_file()
 
 
+# -- refusals: what a refused run created is removed ------------------------------------------
+
+
+def test_a_refused_evaluate_leaves_no_folder_not_even_the_parents_it_made(
+    transport_dataset, tmp_path, capsys
+):
+    sample = next(p for p in transport_dataset.iterdir() if (p / "meta.json").is_file())
+    bad = tmp_path / "pred" / sample.name
+    bad.mkdir(parents=True)
+    (bad / "reflectance.png").write_text("not a PNG")  # refused while scoring, inside --out
+    out = tmp_path / "new" / "deeper" / "ev"
+    argv = ["evaluate", "--dataset", str(transport_dataset), "--predictions", str(bad.parent)]
+    assert main([*argv, "--out", str(out), "-q"]) == 2
+    assert "reflectance.png" in capsys.readouterr().err
+    assert not (tmp_path / "new").exists()
+
+
+def test_a_refused_export_leaves_no_index_naming_missing_shards(
+    transport_dataset, tmp_path, capsys
+):
+    ds = tmp_path / "ds"
+    shutil.copytree(transport_dataset, ds)
+    image = next(ds.glob("*/image.exr"))
+    data = bytearray(image.read_bytes())
+    data[-200:-100] = bytes(100)  # damaged: refused by its SHA-256 while the shard is written
+    image.write_bytes(bytes(data))
+    out = tmp_path / "shards"
+    assert main(["export", str(ds), "--out", str(out), "-q"]) == 2
+    assert "image.exr" in capsys.readouterr().err
+    assert not out.exists()
+
+
 if __name__ == "__main__":
     _driver(Path(sys.argv[1]))
