@@ -177,6 +177,12 @@ def _add_ground_truth_options(p: Any) -> None:
         help="with --ground-truth: render a scene a generated build saved as a new sample "
         "(id from the file name, seed from --seed) instead of reproducing its own",
     )
+    p.add_argument(
+        "--ignore-disk-space",
+        action="store_true",
+        help="with --ground-truth: write the sample even if its estimated size is more than "
+        "the free space where --out lies",
+    )
 
 
 def _add_material_options(p: Any) -> None:
@@ -291,6 +297,7 @@ def _ground_truth(args: argparse.Namespace) -> int:
         only=only,
         data_dir=getattr(args, "data_dir", None),
         quiet=getattr(args, "quiet", False),
+        disk_check=not args.ignore_disk_space,
     )
 
 
@@ -318,6 +325,8 @@ def run(args: argparse.Namespace) -> int:
     _check_source_options(args)
     if args.ground_truth:
         return _ground_truth(args)
+    if args.ignore_disk_space:  # a plain render's files are small: never estimated
+        raise RenderError("--ignore-disk-space applies only with --ground-truth")
     settings = _render_settings(args, _parse_modes(args))
     check_output_folder(Path(args.out))
     data_dir = getattr(args, "data_dir", None)

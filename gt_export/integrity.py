@@ -32,7 +32,7 @@ from spectrinsic.errors import (
     SpectrinsicError,
     WriteError,
 )
-from spectrinsic.gt_export.outfolder import check_out_folder, require_folder_path
+from spectrinsic.gt_export.outfolder import LOCK_NAME, check_out_folder, require_folder_path
 from spectrinsic.gt_export.sample import (
     FORMAT_VERSION,
     MANIFEST_NAME,
@@ -55,6 +55,7 @@ __all__ = [
     "check_build_folder",
     "write_marker",
     "remove_owned_temporaries",
+    "unmarked_on_error",
 ]
 
 #: Written first into every dataset folder: ``{"spectrinsic_dataset": 1, "config_hash": ...}``.
@@ -236,3 +237,16 @@ def remove_owned_temporaries(root: Path) -> list[Path]:
         else:
             path.unlink(missing_ok=True)
     return stale
+
+
+@contextlib.contextmanager
+def unmarked_on_error(out: Path, new: bool) -> Iterator[None]:
+    """A build into a new (or empty) folder that stops with an error (a full disk, a refusal)
+    before any sample is in place leaves no dataset marker, so the folder is left as it was
+    (:func:`~spectrinsic.gt_export.outfolder.folder_lock` then removes a folder it made)."""
+    try:
+        yield
+    except Exception:
+        if new and {p.name for p in out.iterdir()} <= {MARKER_NAME, LOCK_NAME}:
+            (out / MARKER_NAME).unlink(missing_ok=True)
+        raise

@@ -14,13 +14,12 @@ order and the executor, so the same config and seed give the same pixels.
 
 from __future__ import annotations
 
-import contextlib
 import glob
 import logging
 import os
 import resource
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -35,16 +34,17 @@ from spectrinsic.gt_export import (
     write_manifest,
 )
 from spectrinsic.gt_export.integrity import (
-    MARKER_NAME,
     check_build_folder,
     remove_owned_temporaries,
     remove_sample,
     replaceable_sample,
     sample_problem,
+    unmarked_on_error,
     write_marker,
 )
-from spectrinsic.gt_export.outfolder import LOCK_NAME, folder_lock
+from spectrinsic.gt_export.outfolder import folder_lock
 from spectrinsic.gt_export.relight_pool import RELIT_TAG, relit_problem, write_relit_variants
+from spectrinsic.pipeline.disk_space import check_disk_space
 from spectrinsic.pipeline.executors import Executor, SerialExecutor
 from spectrinsic.pipeline.presets import DatasetConfig
 from spectrinsic.pipeline.sample_plan import plan_samples
@@ -219,6 +219,7 @@ def build_dataset(
     progress: Callable[[SampleOutcome | SampleFailure], None] | None = None,
     finalize: bool = True,
     rebuild: bool = False,
+    disk_check: bool = True,
 ) -> DatasetReport:
     """Build (or resume) the dataset in *out_dir*.
 
@@ -245,6 +246,9 @@ def build_dataset(
     rebuild
         Allow a folder built with another config: its samples are removed and rebuilt with
         *config* (together with those *only* selects), so the folder holds one config.
+    disk_check
+        Refuse a build whose samples to build cannot fit in the free space of *out_dir*
+        (:func:`spectrinsic.pipeline.disk_space.check_disk_space`); False goes ahead anyway.
 
     Returns
     -------
@@ -262,14 +266,15 @@ def build_dataset(
         Another build holds *out_dir* (its advisory lock); the message names its pid, host and
         start time.
     DiskFullError
-        When the disk is full: the build stops at the first sample that hits it.
+        When the disk is full: the build stops at the first sample that hits it; with
+        *disk_check*, before the first sample if the estimate does not fit.
     """
 
     out = Path(out_dir)
     if config.camera:  # its curves exist (a data-directory camera needs --data-dir): one line
         get_sensors(camera_model(config.camera).sensitivities, data_dir=data_dir)
     new = check_build_folder(out, config.config_hash(), rebuild=rebuild) is None  # before mkdir
-    with folder_lock(out), _unmarked_on_error(out, new):  # one build per folder, held
+    with folder_lock(out), unmarked_on_error(out, new):  # one build per folder, held
         return _build_locked(
             out,
             config,
@@ -282,20 +287,8 @@ def build_dataset(
             progress=progress,
             finalize=finalize,
             rebuild=rebuild,
+            disk_check=disk_check,
         )
-
-
-@contextlib.contextmanager
-def _unmarked_on_error(out: Path, new: bool) -> Iterator[None]:
-    """A build into a new (or empty) folder that stops with an error (a full disk, a refusal)
-    before any sample is in place leaves no dataset marker, so the folder is left as it was
-    (:func:`~spectrinsic.gt_export.outfolder.folder_lock` then removes a folder it made)."""
-    try:
-        yield
-    except Exception:
-        if new and {p.name for p in out.iterdir()} <= {MARKER_NAME, LOCK_NAME}:
-            (out / MARKER_NAME).unlink(missing_ok=True)
-        raise
 
 
 def _build_locked(
@@ -311,13 +304,13 @@ def _build_locked(
     progress: Callable[[SampleOutcome | SampleFailure], None] | None,
     finalize: bool,
     rebuild: bool,
+    disk_check: bool,
 ) -> DatasetReport:
     """:func:`build_dataset` once the folder's lock is held."""
     start = time.perf_counter()
     executor = executor if executor is not None else SerialExecutor()
-    todo, skipped = _prepare(
-        out, config, only=only, data_dir=data_dir, render_threads=render_threads, rebuild=rebuild
-    )
+    kw: dict[str, Any] = {"data_dir": data_dir, "render_threads": render_threads}
+    todo, skipped = _prepare(out, config, only=only, rebuild=rebuild, disk_check=disk_check, **kw)
     # Rooms cost ~5x objects and the layout lists all objects first; a fixed pseudo-random
     # order (by sample seed) mixes them, so the progress bar's ETA holds from the start.
     todo.sort(key=lambda t: (t.seed, t.sample_id))
@@ -348,6 +341,7 @@ def _prepare(
     data_dir: str | os.PathLike[str] | None,
     render_threads: int | None,
     rebuild: bool,
+    disk_check: bool,
 ) -> tuple[list[SampleTask], list[SampleOutcome]]:
     """Check *out*, split the planned samples into to-build and intact, then mark the folder.
 
@@ -380,6 +374,8 @@ def _prepare(
             stale.append(folder)
             stale += _relit_variants(folder)  # made from the old render: go with it
         todo.append(t)
+    if disk_check:  # the last refusal: nothing is written before it
+        check_disk_space(out, config, len(todo))
     write_marker(out, config_hash)
     for path in remove_owned_temporaries(out):
         log.info("removed %s, left by an interrupted build", path.name)
