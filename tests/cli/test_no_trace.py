@@ -280,5 +280,31 @@ def test_a_refused_export_leaves_no_index_naming_missing_shards(
     assert not out.exists()
 
 
+# -- cause 8: a damaged EXR is one line, whatever OpenEXR's C library prints -----------------
+
+
+def test_a_truncated_exr_is_one_line_on_stderr_and_nothing_on_stdout(transport_dataset, tmp_path):
+    import numpy as np
+
+    from spectrinsic.gt_export.exr import write_exr
+
+    sample = next(p for p in transport_dataset.iterdir() if (p / "meta.json").is_file())
+    pred = tmp_path / "pred" / sample.name
+    pred.mkdir(parents=True)
+    whole = write_exr(tmp_path / "whole.exr", {"": np.full((16, 16, 3), 0.5, np.float32)})
+    for name in ("reflectance.exr", "shading.exr"):  # pixel data cut off halfway
+        (pred / name).write_bytes(whole.read_bytes()[: whole.stat().st_size // 2])
+    argv = ["evaluate", "--dataset", str(transport_dataset), "--predictions", str(pred.parent)]
+    proc = subprocess.run(
+        [sys.executable, "-m", "spectrinsic", *argv, "--out", str(tmp_path / "ev"), "-q"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    err = [line for line in proc.stderr.splitlines() if not line.startswith("WARNING ")]
+    assert proc.returncode == 2 and proc.stdout == "", (proc.stdout, proc.stderr)
+    assert len(err) == 1 and "reflectance.exr" in err[0] and "cannot be" in err[0], err
+
+
 if __name__ == "__main__":
     _driver(Path(sys.argv[1]))
