@@ -291,7 +291,8 @@ def test_a_truncated_exr_is_one_line_on_stderr_and_nothing_on_stdout(transport_d
     sample = next(p for p in transport_dataset.iterdir() if (p / "meta.json").is_file())
     pred = tmp_path / "pred" / sample.name
     pred.mkdir(parents=True)
-    whole = write_exr(tmp_path / "whole.exr", {"": np.full((16, 16, 3), 0.5, np.float32)})
+    noise = np.random.default_rng(0).random((16, 16, 3), np.float32)  # incompressible pixels
+    whole = write_exr(tmp_path / "whole.exr", {"": noise})
     for name in ("reflectance.exr", "shading.exr"):  # pixel data cut off halfway
         (pred / name).write_bytes(whole.read_bytes()[: whole.stat().st_size // 2])
     argv = ["evaluate", "--dataset", str(transport_dataset), "--predictions", str(pred.parent)]
