@@ -247,6 +247,6 @@ def unmarked_on_error(out: Path, new: bool) -> Iterator[None]:
     try:
         yield
     except Exception:
-        if new and {p.name for p in out.iterdir()} <= {MARKER_NAME, LOCK_NAME}:
+        if new and out.is_dir() and {p.name for p in out.iterdir()} <= {MARKER_NAME, LOCK_NAME}:
             (out / MARKER_NAME).unlink(missing_ok=True)
         raise
