@@ -19,6 +19,12 @@ and a task runner that survives failed items would then go on. Long loops call
 :func:`raise_if_requested` between their steps (passes, samples), so a build stops within one
 render pass of the Ctrl-C (a pass of a default sample takes well under a second).
 
+SIGTERM (what ``timeout``, ``kill`` and batch schedulers send) is handled like Ctrl-C within
+the block: a Python handler records it and raises ``KeyboardInterrupt``, so a run stopped that
+way cleans up as after Ctrl-C (temporaries removed, completed work kept) and exits with status
+143 (:func:`exit_status`). It is not blocked, so pool workers (started with ``spawn``, which
+resets handlers) still die of it at once.
+
 Child processes inherit the blocked mask (they are stopped by their parent, see
 :mod:`spectrinsic.pipeline.executors`). Only POSIX systems have per-thread signal masks;
 elsewhere the context manager does nothing.
@@ -32,12 +38,28 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-__all__ = ["interrupts_reach_python", "requested", "raise_if_requested"]
+__all__ = ["interrupts_reach_python", "requested", "raise_if_requested", "exit_status"]
 
 _SIGINT = {signal.SIGINT}
 _watcher_lock = threading.Lock()
 _watcher: threading.Thread | None = None
 _requested = threading.Event()
+#: The signal that stopped the run (SIGINT unless a SIGTERM came first).
+_by: list[int] = [signal.SIGINT]
+
+
+def exit_status() -> int:
+    """The shell's exit status for a run stopped by the recorded signal: 130 (Ctrl-C), 143
+    (SIGTERM)."""
+    return 128 + int(_by[0])
+
+
+def _on_sigterm(signum: int, _frame: object) -> None:
+    """SIGTERM as Ctrl-C: recorded, then ``KeyboardInterrupt`` in the main thread."""
+    if not _requested.is_set():
+        _by[0] = signum
+    _requested.set()
+    raise KeyboardInterrupt
 
 
 def requested() -> bool:
@@ -61,21 +83,30 @@ def interrupts_reach_python() -> Iterator[None]:
 
     A process started with SIGINT ignored (``nohup``, a background job of a shell script) was
     asked by its parent to ignore Ctrl-C: the block then changes nothing, so it stays ignored.
+    SIGTERM raises ``KeyboardInterrupt`` too (module notes), unless it was ignored at the start.
     """
-    if (
-        not hasattr(signal, "pthread_sigmask")
-        or threading.current_thread() is not threading.main_thread()
-        or signal.getsignal(signal.SIGINT) is signal.SIG_IGN
-    ):
+    if threading.current_thread() is not threading.main_thread():
         yield
         return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGINT)
+    term = signal.getsignal(signal.SIGTERM)
+    if term is not signal.SIG_IGN:  # asked to ignore it (``nohup``): it stays ignored
+        signal.signal(signal.SIGTERM, _on_sigterm)
     _requested.clear()
+    _by[0] = signal.SIGINT
     try:
-        _start_watcher()
-        yield
+        if hasattr(signal, "pthread_sigmask") and signal.getsignal(signal.SIGINT) is not (
+            signal.SIG_IGN
+        ):
+            previous = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGINT)
+            try:
+                _start_watcher()
+                yield
+            finally:
+                signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        else:
+            yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL if term is None else term)
         _requested.clear()
 
 

@@ -16,7 +16,7 @@ from typing import Any, NoReturn
 
 from ..data_dir import one_data_dir
 from ..errors import SpectrinsicError
-from ..interrupts import interrupts_reach_python
+from ..interrupts import exit_status, interrupts_reach_python
 from ..provenance import software_versions
 
 __all__ = ["main", "build_parser"]
@@ -103,10 +103,17 @@ def _version() -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point. Returns the process exit status (0 ok, 1 problems found or samples failed,
     2 bad input or a resource that failed: one line on stderr, the traceback only with
-    ``--debug``; 130 interrupted)."""
+    ``--debug``; 130 interrupted, 143 stopped by SIGTERM)."""
     # Before anything starts a thread: Ctrl-C must reach Python even mid-render.
     with interrupts_reach_python():
-        return _main(argv)
+        try:
+            return _main(argv)
+        except KeyboardInterrupt:  # Ctrl-C, or SIGTERM (spectrinsic.interrupts), even at start
+            print(
+                "spectrinsic: interrupted; completed work is kept, re-run to resume",
+                file=sys.stderr,
+            )
+            return exit_status()
 
 
 def _main(argv: Sequence[str] | None) -> int:
@@ -131,9 +138,6 @@ def _main(argv: Sequence[str] | None) -> int:
         return _error(
             args, "out of memory; try a smaller --resolution/--width/--height or fewer --workers"
         )
-    except KeyboardInterrupt:
-        print("spectrinsic: interrupted; completed work is kept, re-run to resume", file=sys.stderr)
-        return 130
 
 
 def _error(args: argparse.Namespace, message: str) -> int:

@@ -117,6 +117,12 @@ def _add_build_options(p: Any) -> None:
         help="run on a Dask distributed cluster (tcp://host:8786) instead of local workers",
     )
     p.add_argument(
+        "--ignore-disk-space",
+        action="store_true",
+        help="build even if the disk space the plan needs (estimated from the preset, "
+        "resolution, layers and sample count) is more than is free where --out lies",
+    )
+    p.add_argument(
         "--only",
         metavar="PATTERN",
         default=None,
@@ -310,6 +316,7 @@ def run(args: argparse.Namespace) -> int:
         rebuild=args.rebuild,
         data_dir=args.data_dir,
         quiet=args.quiet,
+        disk_check=not args.ignore_disk_space,
     )
 
 
@@ -329,6 +336,7 @@ def build(
     rebuild: bool = False,
     data_dir: str | None = None,
     quiet: bool = False,
+    disk_check: bool = True,
 ) -> int:
     """Build *config* into *out* with a progress bar and print the summary; the exit status.
 
@@ -374,6 +382,7 @@ def build(
             rebuild=rebuild,
             on_plan=on_plan,
             progress=progress,
+            disk_check=disk_check,
         )
     except KeyboardInterrupt:
         done = bar.n if bar is not None else 0

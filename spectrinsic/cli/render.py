@@ -19,7 +19,8 @@ from typing import Any
 from tqdm import tqdm
 
 from ..errors import RenderError, SceneError
-from ..gt_export.folders.outfolder import check_output_folder, output_folder
+from ..gt_export.folders.outfolder import check_output_folder
+from ..gt_export.folders.staged_output import staged_output
 from ..pipeline.presets import DatasetConfig, get_preset
 from ..pipeline.source_plan import files_source
 from ..render import (
@@ -176,6 +177,12 @@ def _add_ground_truth_options(p: Any) -> None:
         help="with --ground-truth: render a scene a generated build saved as a new sample "
         "(id from the file name, seed from --seed) instead of reproducing its own",
     )
+    p.add_argument(
+        "--ignore-disk-space",
+        action="store_true",
+        help="with --ground-truth: write the sample even if its estimated size is more than "
+        "the free space where --out lies",
+    )
 
 
 def _add_material_options(p: Any) -> None:
@@ -290,6 +297,7 @@ def _ground_truth(args: argparse.Namespace) -> int:
         only=only,
         data_dir=getattr(args, "data_dir", None),
         quiet=getattr(args, "quiet", False),
+        disk_check=not args.ignore_disk_space,
     )
 
 
@@ -317,6 +325,8 @@ def run(args: argparse.Namespace) -> int:
     _check_source_options(args)
     if args.ground_truth:
         return _ground_truth(args)
+    if args.ignore_disk_space:  # a plain render's files are small: never estimated
+        raise RenderError("--ignore-disk-space applies only with --ground-truth")
     settings = _render_settings(args, _parse_modes(args))
     check_output_folder(Path(args.out))
     data_dir = getattr(args, "data_dir", None)
@@ -338,10 +348,10 @@ def run(args: argparse.Namespace) -> int:
         n_lights=len(scene.lights),
         data_dir=data_dir,
     )
-    with output_folder(Path(args.out)):  # locked; its files recorded as spectrinsic's
+    with staged_output(Path(args.out)) as stage:  # a failed run leaves --out as it was
         result = _render_with_progress(args, scene, settings, data_dir)
-        paths = write_render(Path(args.out), scene, result, data_dir=data_dir)
-    _print_timings(result, paths)
+        paths = write_render(stage, scene, result, data_dir=data_dir)
+    _print_timings(result, {k: Path(args.out) / v.relative_to(stage) for k, v in paths.items()})
     return 0
 
 

@@ -17,7 +17,7 @@ from typing import Any
 from tqdm import tqdm
 
 from ..errors import StudyError
-from ..gt_export.folders.outfolder import output_folder
+from ..gt_export.folders.staged_output import staged_output
 from ..studies.photometric import CAMERA_BALANCES
 from ..studies.photometric.compute import default_cameras
 from ..studies.registry import STUDIES, StudyOptions, run_study
@@ -99,7 +99,7 @@ def _print_paths(paths: dict[str, Path]) -> None:
 
 def run(args: argparse.Namespace) -> int:
     _check_options(args)
-    with output_folder(Path(args.out)):  # checked and locked; its files recorded as spectrinsic's
+    with staged_output(Path(args.out)) as stage:  # a failed run leaves --out as it was
         options = StudyOptions(
             seed=args.seed,
             include_ie=args.include_ie,
@@ -110,13 +110,13 @@ def run(args: argparse.Namespace) -> int:
         with _progress(bool(getattr(args, "quiet", False)), args.study) as progress:
             done = run_study(
                 args.study,
-                Path(args.out),
+                stage,
                 options,
                 data_dir=getattr(args, "data_dir", None),
                 progress=progress,
             )
     print(done.text)
-    _print_paths(done.paths)
+    _print_paths({k: Path(args.out) / v.relative_to(stage) for k, v in done.paths.items()})
     return 0
 
 

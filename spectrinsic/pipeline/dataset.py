@@ -41,6 +41,7 @@ from ..gt_export.sample.integrity import (
     remove_sample,
     replaceable_sample,
     sample_problem,
+    unmarked_on_error,
     write_marker,
 )
 from ..render import render_batches, set_thread_count
@@ -49,6 +50,7 @@ from ..scenes.library import build
 from ..scenes.sources import GeneratedSource
 from ..spectra import get_sensors
 from ..spectra.camera_model import camera_model
+from .disk_space import check_disk_space
 from .executors import Executor, SerialExecutor
 from .presets import DatasetConfig
 from .sample_plan import plan_samples
@@ -218,6 +220,7 @@ def build_dataset(
     progress: Callable[[SampleOutcome | SampleFailure], None] | None = None,
     finalize: bool = True,
     rebuild: bool = False,
+    disk_check: bool = True,
 ) -> DatasetReport:
     """Build (or resume) the dataset in *out_dir*.
 
@@ -244,6 +247,9 @@ def build_dataset(
     rebuild
         Allow a folder built with another config: its samples are removed and rebuilt with
         *config* (together with those *only* selects), so the folder holds one config.
+    disk_check
+        Refuse a build whose samples to build cannot fit in the free space of *out_dir*
+        (:func:`spectrinsic.pipeline.disk_space.check_disk_space`); False goes ahead anyway.
 
     Returns
     -------
@@ -261,14 +267,15 @@ def build_dataset(
         Another build holds *out_dir* (its advisory lock); the message names its pid, host and
         start time.
     DiskFullError
-        When the disk is full: the build stops at the first sample that hits it.
+        When the disk is full: the build stops at the first sample that hits it; with
+        *disk_check*, before the first sample if the estimate does not fit.
     """
 
     out = Path(out_dir)
     if config.camera:  # its curves exist (a data-directory camera needs --data-dir): one line
         get_sensors(camera_model(config.camera).sensitivities, data_dir=data_dir)
-    check_build_folder(out, config.config_hash(), rebuild=rebuild)  # before the folder is made
-    with folder_lock(out):  # one build per folder: a second one is refused, naming this one
+    new = check_build_folder(out, config.config_hash(), rebuild=rebuild) is None  # before mkdir
+    with folder_lock(out), unmarked_on_error(out, new):  # one build per folder, held
         return _build_locked(
             out,
             config,
@@ -281,6 +288,7 @@ def build_dataset(
             progress=progress,
             finalize=finalize,
             rebuild=rebuild,
+            disk_check=disk_check,
         )
 
 
@@ -297,13 +305,13 @@ def _build_locked(
     progress: Callable[[SampleOutcome | SampleFailure], None] | None,
     finalize: bool,
     rebuild: bool,
+    disk_check: bool,
 ) -> DatasetReport:
     """:func:`build_dataset` once the folder's lock is held."""
     start = time.perf_counter()
     executor = executor if executor is not None else SerialExecutor()
-    todo, skipped = _prepare(
-        out, config, only=only, data_dir=data_dir, render_threads=render_threads, rebuild=rebuild
-    )
+    kw: dict[str, Any] = {"data_dir": data_dir, "render_threads": render_threads}
+    todo, skipped = _prepare(out, config, only=only, rebuild=rebuild, disk_check=disk_check, **kw)
     # Rooms cost ~5x objects and the layout lists all objects first; a fixed pseudo-random
     # order (by sample seed) mixes them, so the progress bar's ETA holds from the start.
     todo.sort(key=lambda t: (t.seed, t.sample_id))
@@ -334,6 +342,7 @@ def _prepare(
     data_dir: str | os.PathLike[str] | None,
     render_threads: int | None,
     rebuild: bool,
+    disk_check: bool,
 ) -> tuple[list[SampleTask], list[SampleOutcome]]:
     """Check *out*, split the planned samples into to-build and intact, then mark the folder.
 
@@ -366,6 +375,8 @@ def _prepare(
             stale.append(folder)
             stale += _relit_variants(folder)  # made from the old render: go with it
         todo.append(t)
+    if disk_check:  # the last refusal: nothing is written before it
+        check_disk_space(out, config, len(todo))
     write_marker(out, config_hash)
     for path in remove_owned_temporaries(out):
         log.info("removed %s, left by an interrupted build", path.name)

@@ -44,10 +44,13 @@ __all__ = [
 ]
 
 MESH_SUFFIXES = (".obj", ".ply", ".glb", ".gltf", ".stl", ".off")
-#: Largest mesh read, checked from the file's header before loading: loading takes about
-#: 2.5 KiB per vertex (a 10^6-vertex PLY took 2.5 GB), so these bound it near 1.3 GB.
-MAX_VERTICES = 500_000
-MAX_FACES = 1_000_000
+#: Largest mesh read, checked from the file's header before loading (and the most faces of
+#: a whole scene file, checked once its meshes are read, before validation). Reading takes
+#: about 2.5 KiB per vertex (a 10^6-vertex PLY took 2.5 GB) and validating the camera's view
+#: (trimesh's ray index) about 5.3 KiB per face (200k faces: 1.2 GB peak, 12 s; 10^6 faces:
+#: 7 GB, 41 s), so these bound a scene near 1.5 GB.
+MAX_VERTICES = 250_000
+MAX_FACES = 250_000
 #: Irradiance (relative units) at the model's centre from the default light.
 _IRRADIANCE = math.pi
 

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import SceneError, did_you_mean, with_article
 from .materials import TexturedMaterial, parse_material
+from .meshes import MAX_FACES, check_mesh_size
 from .model import (
     LIGHT_DEFAULTED,
     LIGHT_FIELDS,
@@ -151,6 +152,7 @@ def _resolve(doc: _Doc, base: Path, value: Any, field: str) -> Path:
 def _read_mesh_file(doc: _Doc, path: Path, field: str) -> tuple[np.ndarray, np.ndarray]:
     import trimesh
 
+    check_mesh_size(path)  # from its header, before trimesh builds it
     try:
         # process=False keeps vertex and face order, so face_materials runs stay valid
         mesh = trimesh.load(str(path), force="mesh", process=False)
@@ -336,6 +338,11 @@ def scene_from_dict(data: Any, *, base: str | os.PathLike[str], source: str = "<
         )
         for i, m in enumerate(problems.get(_entries, doc, data, "meshes") or [])
     ]
+    faces = sum(len(m.faces) for m in meshes if m is not None)
+    if faces > MAX_FACES:  # several files, each within the limit: the scene is not
+        problems.get(
+            doc._raise, "meshes", f"{faces:,} faces in all; a scene holds at most {MAX_FACES:,}"
+        )
     lights = [
         problems.get(_light, doc, x, i)
         for i, x in enumerate(problems.get(_entries, doc, data, "lights") or [])

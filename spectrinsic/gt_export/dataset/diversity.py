@@ -22,6 +22,7 @@ import numpy as np
 from ...scenes.generators.materials import PIXEL_TEXTURE
 from ...scenes.material_labels import label_spectrum
 from ..layers import luminance
+from ..sample.integrity import guarded_write
 from ..sample.loader import load_sample
 from ..sample.meta import SampleMeta
 from .colour_spread import material_chroma, shown, spread_summary
@@ -187,5 +188,7 @@ def write_diversity(
 ) -> Path:
     """Compute the statistics and save the figure as ``<dataset>/diversity.png``."""
     path = Path(dataset_dir) / DIVERSITY_NAME
-    diversity_figure(diversity_stats(sample_dirs, metas)).savefig(path, dpi=90)
+    figure = diversity_figure(diversity_stats(sample_dirs, metas))
+    with guarded_write(path):  # a full disk names the file and leaves no part of it
+        figure.savefig(path, dpi=90)
     return path

@@ -20,6 +20,7 @@ is what marks an export complete.
 
 from __future__ import annotations
 
+import contextlib
 import io
 import json
 import os
@@ -33,6 +34,7 @@ import numpy as np
 from ...errors import DatasetError, MissingDependencyError
 from ..folders.outfolder import LOCK_NAME, check_out_folder, check_unlocked, folder_lock
 from ..sample import MANIFEST_NAME, META_NAME, TMP_PREFIX, file_sha256, sample_dirs
+from ..sample.integrity import guarded_write
 from ..sample.loader import load_sample, split_samples
 from ..sample.meta import meta_from_bytes
 from .manifest import read_manifest
@@ -151,8 +153,13 @@ def check_shard_folder(out: Path, option: str = "--out") -> set[str]:
 
 def _write_index(out: Path, index: dict[str, Any]) -> None:
     tmp = out / f"{TMP_PREFIX}{SHARD_INDEX}"
-    tmp.write_text(json.dumps(index, indent=2, sort_keys=True, allow_nan=False), encoding="utf-8")
-    os.replace(tmp, out / SHARD_INDEX)
+    with guarded_write(out / SHARD_INDEX):
+        try:
+            text = json.dumps(index, indent=2, sort_keys=True, allow_nan=False)
+            tmp.write_text(text, encoding="utf-8")
+            os.replace(tmp, out / SHARD_INDEX)
+        finally:
+            tmp.unlink(missing_ok=True)
 
 
 def _plan(source: Path, samples_per_shard: int) -> dict[str, dict[str, list[Path]]]:
@@ -181,14 +188,19 @@ def _write_shard(
     tmp = out / f"{TMP_PREFIX}{name}"
     seen: set[str] = set()
     try:
-        with open(tmp, "wb") as stream:
+        with guarded_write(out / name), open(tmp, "wb") as stream:
             writer = wds.TarWriter(stream, mtime=0, user="spectrinsic", group="spectrinsic")
-            for folder in folders:
-                sample = load_sample(folder, layers=layers)
-                seen.update(k for k, v in sample.items() if isinstance(v, np.ndarray))
-                writer.write(_encode(sample))
-                if progress is not None:
-                    progress(folder.name)
+            try:
+                for folder in folders:
+                    sample = load_sample(folder, layers=layers)
+                    seen.update(k for k, v in sample.items() if isinstance(v, np.ndarray))
+                    writer.write(_encode(sample))
+                    if progress is not None:
+                        progress(folder.name)
+            except BaseException:
+                with contextlib.suppress(Exception):  # else tarfile flushes its buffer at
+                    writer.close()  # exit, into the closed file ("Exception ignored ...")
+                raise
             writer.close()
         os.replace(tmp, out / name)
     finally:
@@ -291,13 +303,17 @@ def _write_locked(
     )
     files: dict[str, str] = {}
     seen: set[str] = set()
-    for shards in plan.values():
-        for name, folders in shards.items():
-            seen |= _write_shard(out, name, folders, layers, progress)
-            files[name] = file_sha256(out / name)
-    check_export_source(source)  # a build that started meanwhile: the export stays incomplete
-    if _manifest(source).get("config_hash") != base["config_hash"]:
-        raise DatasetError(f"DIR {str(source)!r} was rebuilt during the export; export again")
+    try:
+        for shards in plan.values():
+            for name, folders in shards.items():
+                seen |= _write_shard(out, name, folders, layers, progress)
+                files[name] = file_sha256(out / name)
+        check_export_source(source)  # a build that started meanwhile: the export stays incomplete
+        if _manifest(source).get("config_hash") != base["config_hash"]:
+            raise DatasetError(f"DIR {str(source)!r} was rebuilt during the export; export again")
+    except Exception:  # refused or a full disk (Ctrl-C keeps the index: a re-run finishes it)
+        _roll_back(out, base, ours, set(files))
+        raise
     _write_index(
         out,
         {
@@ -319,6 +335,20 @@ def _write_locked(
         {k: sum(map(len, v.values())) for k, v in plan.items()},
         tuple(sorted(seen)),
     )
+
+
+def _roll_back(out: Path, base: dict[str, Any], ours: set[str], written: set[str]) -> None:
+    """After a failed export, the index names no file that is not there: a first export's
+    shards and index are removed (the folder is as before); an earlier export's index is
+    rewritten (still incomplete) to list only the shards on disk."""
+    if not ours:
+        for name in written:
+            (out / name).unlink(missing_ok=True)
+        (out / SHARD_INDEX).unlink(missing_ok=True)
+        return
+    present = sorted(name for name in ours | written if (out / name).is_file())
+    with contextlib.suppress(DatasetError):  # a full disk: the earlier index stays
+        _write_index(out, {**base, "complete": False, "files": dict.fromkeys(present, "")})
 
 
 def _index(out: Path) -> dict[str, Any]:

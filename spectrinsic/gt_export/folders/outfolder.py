@@ -259,7 +259,8 @@ def folder_lock(root: Path, option: str = "--out") -> Iterator[None]:
     held = root.resolve()
     try:
         os.ftruncate(fd, 0)
-        os.pwrite(fd, (json.dumps(_holder(), allow_nan=False) + "\n").encode("utf-8"), 0)
+        with contextlib.suppress(OSError):  # a full disk: the lock holds, without its details
+            os.pwrite(fd, (json.dumps(_holder(), allow_nan=False) + "\n").encode("utf-8"), 0)
         _HELD_HERE.add(held)
         yield
     finally:
@@ -349,6 +350,7 @@ def _write_marker(root: Path, files: set[str], writing: dict[str, object] | None
         tmp.write_text(json.dumps(record, indent=1, allow_nan=False) + "\n", encoding="utf-8")
         tmp.replace(root / OUTPUT_MARKER)
     except OSError as exc:
+        tmp.unlink(missing_ok=True)  # no zero-byte temporary left by a full disk
         raise WriteError(
             f"cannot write {str(root / OUTPUT_MARKER)!r}: {exc.strerror or exc}"
         ) from exc
@@ -369,5 +371,10 @@ def output_folder(root: Path, option: str = "--out") -> Iterator[Path]:
         _write_marker(root, listed, _holder())
         try:
             yield root
-        finally:
-            _write_marker(root, listed | _files_below(root), None)
+        except BaseException:
+            # the block's own error is the one to report (a full disk names its file there):
+            # a marker that cannot be written now keeps "writing", as after a kill
+            with contextlib.suppress(WriteError):
+                _write_marker(root, listed | _files_below(root), None)
+            raise
+        _write_marker(root, listed | _files_below(root), None)

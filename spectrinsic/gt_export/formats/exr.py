@@ -12,9 +12,14 @@ This is the only module of spectrinsic that imports ``OpenEXR``.
 
 from __future__ import annotations
 
+import contextlib
 import json
+import logging
 import os
-from collections.abc import Mapping, Sequence
+import sys
+import tempfile
+import threading
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -33,6 +38,10 @@ __all__ = [
     "exr_size",
     "default_channel_names",
 ]
+
+log = logging.getLogger(__name__)
+#: Serialises :func:`_c_output_held` (file descriptors are shared by all threads).
+_HOLD = threading.RLock()
 
 #: Header attribute holding ``{layer: [channel, ...]}`` as JSON.
 CHANNELS_ATTRIBUTE = "spectrinsic.channels"
@@ -162,13 +171,45 @@ def write_exr(
     return path
 
 
+@contextlib.contextmanager
+def _c_output_held() -> Iterator[None]:
+    """Hold what is written to file descriptors 1 and 2 during the block: OpenEXR prints its
+    own lines about a damaged file there (its C core to stderr, the bindings' "Warning: ..." to
+    stdout) before it fails. Given back after a block that ends normally; dropped (logged at
+    debug level) after one that raises, whose error is then the one line the user sees."""
+    for stream in (sys.stdout, sys.stderr):
+        stream.flush()
+    with _HOLD, tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
+        saved = {fd: os.dup(fd) for fd in (1, 2)}  # one thread at a time: they are the process's
+        held = {1: out, 2: err}
+        for fd, file in held.items():
+            os.dup2(file.fileno(), fd)
+        failed = True
+        try:
+            yield
+            failed = False
+        finally:
+            for stream in (sys.stdout, sys.stderr):
+                stream.flush()
+            for fd, file in held.items():
+                os.dup2(saved[fd], fd)
+                os.close(saved[fd])
+                file.seek(0)
+                text = file.read()
+                if text and not failed:
+                    os.write(fd, text)
+                elif text:
+                    log.debug("OpenEXR: %s", text.decode("utf-8", "replace").strip())
+
+
 def _open(path: Path, *, header_only: bool):  # noqa: ANN202 - OpenEXR.File
     import OpenEXR
 
     if not path.is_file():
         raise DatasetError(f"EXR file {str(path)!r} does not exist")
     try:
-        return OpenEXR.File(str(path), separate_channels=True, header_only=header_only)
+        with _c_output_held():
+            return OpenEXR.File(str(path), separate_channels=True, header_only=header_only)
     except Exception as exc:  # the bindings raise bare RuntimeError/Exception on corrupt files
         raise DatasetError(f"EXR file {str(path)!r} cannot be read: {exc}") from exc
 
@@ -256,15 +297,17 @@ def _decode(path: Path, threads: int = 0) -> _Decoded:
     before = OpenEXR.global_thread_count()
     OpenEXR.set_global_thread_count(threads)
     try:
-        exr = _open(path, header_only=False)
+        # a corrupt chunk makes the bindings warn (held: dropped if decoding then fails) and
+        # return a file with no parts, not raise
+        with _c_output_held():
+            exr = _open(path, header_only=False)
+            try:
+                header = exr.header()
+                pixels = {name: ch.pixels for name, ch in exr.channels().items()}
+            except Exception as exc:
+                raise DatasetError(f"EXR file {str(path)!r} cannot be decoded: {exc}") from exc
     finally:
         OpenEXR.set_global_thread_count(before)
-    try:
-        # a corrupt chunk makes the bindings warn and return a file with no parts, not raise
-        header = exr.header()
-        pixels = {name: ch.pixels for name, ch in exr.channels().items()}
-    except Exception as exc:
-        raise DatasetError(f"EXR file {str(path)!r} cannot be decoded: {exc}") from exc
     order: dict[str, list[str]]
     if CHANNELS_ATTRIBUTE in header:
         order = _channel_order(path, header[CHANNELS_ATTRIBUTE])

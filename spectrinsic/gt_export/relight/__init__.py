@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import logging
 import os
 from collections.abc import Mapping
 from pathlib import Path
@@ -44,7 +45,7 @@ from ..sample.meta import read_meta
 from ..sample.sensor import model_from_meta
 from ..sample.transport_exr import read_transport
 from ..sample.working_view import space_of
-from ..sample.writer import export_sample
+from ..sample.writer import export_sample, remove_sample_temporaries
 from .checks import check_finite_result, check_relight_inputs
 
 __all__ = [
@@ -55,6 +56,8 @@ __all__ = [
     "relight",
     "check_light_spectra",
 ]
+
+log = logging.getLogger(__name__)
 
 #: AOV layers read back from ``geometry.exr`` (coverage comes from ``transport.exr``).
 _AOV_LAYERS = ("depth", "normals", "material_id", "object_id", "mask")
@@ -292,6 +295,8 @@ def relight(
     """
     sample, out = Path(sample_dir), Path(out_dir)
     _check_out(sample, out)
+    for path in remove_sample_temporaries(out.parent, out.name):
+        log.info("removed %s, left by a relight that was killed", path.name)
     relit = relit_render(sample, lights, powers=powers, data_dir=data_dir)
     check_finite_result(relit.result, sample)  # before anything is written
     meta = relit.meta

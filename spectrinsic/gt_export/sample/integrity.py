@@ -25,13 +25,15 @@ import shutil
 from collections.abc import Iterator
 from pathlib import Path, PurePosixPath
 
-from ...errors import DatasetError, DiskFullError, SampleMetaError, WriteError
-from ..folders.outfolder import check_out_folder, require_folder_path
+from ...errors import DatasetError, DiskFullError, SampleMetaError, SpectrinsicError, WriteError
+from ..folders.outfolder import LOCK_NAME, check_out_folder, require_folder_path
 from . import FORMAT_VERSION, MANIFEST_NAME, META_NAME, TMP_PREFIX, file_sha256
 from .meta import owned_files, read_meta
 
 __all__ = [
     "MARKER_NAME",
+    "NO_SPACE",
+    "disk_full",
     "guarded_write",
     "sample_problem",
     "replaceable_sample",
@@ -41,27 +43,46 @@ __all__ = [
     "check_build_folder",
     "write_marker",
     "remove_owned_temporaries",
+    "unmarked_on_error",
 ]
 
 #: Written first into every dataset folder: ``{"spectrinsic_dataset": 1, "config_hash": ...}``.
 MARKER_NAME = ".spectrinsic-dataset"
 #: errno values that mean "no space": retrying another sample cannot help.
-_NO_SPACE = frozenset({errno.ENOSPC, errno.EDQUOT})
+NO_SPACE = frozenset({errno.ENOSPC, errno.EDQUOT})
+#: How C libraries (OpenEXR) word a full disk in the ``RuntimeError`` they raise.
+_NO_SPACE_TEXT = tuple(os.strerror(code) for code in sorted(NO_SPACE))
+
+
+def disk_full(exc: BaseException) -> bool:
+    """Whether *exc* says the disk (or the user's quota) is full: an ``OSError`` with
+    ``ENOSPC``/``EDQUOT``, or a C library's ``RuntimeError`` quoting that error's text."""
+    if isinstance(exc, OSError):
+        return exc.errno in NO_SPACE
+    return isinstance(exc, RuntimeError) and any(t in str(exc) for t in _NO_SPACE_TEXT)
 
 
 @contextlib.contextmanager
 def guarded_write(path: str | os.PathLike[str]) -> Iterator[None]:
-    """Turn an ``OSError`` while writing *path* into a one-line error naming *path*.
+    """Turn a failure while writing *path* into a one-line error naming *path*, and remove
+    what was written of it (a full disk leaves no partial or zero-byte file behind).
 
     ``write()`` failures (a full disk) carry no file name of their own, so without this the
-    message would not say which file could not be written.
+    message would not say which file could not be written. An ``OSError`` becomes a
+    :class:`~spectrinsic.errors.WriteError`, a full disk (also as a C library's
+    ``RuntimeError``, :func:`disk_full`) a :class:`~spectrinsic.errors.DiskFullError`.
     """
     try:
         yield
-    except OSError as exc:
-        reason = exc.strerror or str(exc)
-        cls = DiskFullError if exc.errno in _NO_SPACE else WriteError
-        raise cls(f"cannot write {str(path)!r}: {reason}") from exc
+    except (OSError, RuntimeError) as exc:
+        if isinstance(exc, SpectrinsicError) or not (isinstance(exc, OSError) or disk_full(exc)):
+            raise  # already one line (a nested guard), or not a write failure
+        target = Path(path)
+        if disk_full(exc) and target.is_file() and not target.is_symlink():
+            target.unlink(missing_ok=True)  # the file this block was writing: partial at best
+        reason = os.strerror(errno.ENOSPC) if not isinstance(exc, OSError) else exc.strerror
+        cls = DiskFullError if disk_full(exc) else WriteError
+        raise cls(f"cannot write {str(path)!r}: {reason or exc}") from exc
 
 
 def sample_problem(folder: str | os.PathLike[str], config_hash: str) -> str | None:
@@ -204,3 +225,16 @@ def remove_owned_temporaries(root: Path) -> list[Path]:
         else:
             path.unlink(missing_ok=True)
     return stale
+
+
+@contextlib.contextmanager
+def unmarked_on_error(out: Path, new: bool) -> Iterator[None]:
+    """A build into a new (or empty) folder that stops with an error (a full disk, a refusal)
+    before any sample is in place leaves no dataset marker, so the folder is left as it was
+    (:func:`~spectrinsic.gt_export.folders.outfolder.folder_lock` then removes a folder it made)."""
+    try:
+        yield
+    except Exception:
+        if new and out.is_dir() and {p.name for p in out.iterdir()} <= {MARKER_NAME, LOCK_NAME}:
+            (out / MARKER_NAME).unlink(missing_ok=True)
+        raise

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import logging
 import os
+import re
 import shutil
 import tempfile
 import uuid
@@ -29,7 +30,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ...errors import DatasetError
+from ...errors import DatasetError, WriteError
 from ...provenance import software_versions
 from ...scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash, scene_to_dict
 from ...spectra import DEFAULT_WAVELENGTHS, get_spectrum
@@ -66,6 +67,7 @@ __all__ = [
     "DEFAULT_CAMERAS",
     "export_sample",
     "is_complete",
+    "remove_sample_temporaries",
     "remove_stale_temporaries",
 ]
 
@@ -337,6 +339,9 @@ def export_sample(
             sensor=sensor,
         )
         _move_into_place(tmp, final, config_hash(config))
+    except WriteError as exc:  # named as the file will be (a full disk): not the temporary
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise type(exc)(str(exc).replace(str(tmp), str(final))) from exc
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
@@ -366,6 +371,27 @@ def is_complete(sample_dir: str | os.PathLike[str], config_hash: str) -> bool:
     """True iff *sample_dir* holds a ``meta.json`` with this *config_hash* and all its files,
     each matching its recorded SHA-256 (see :func:`~spectrinsic.gt_export.sample.integrity.sample_problem`)."""
     return sample_problem(sample_dir, config_hash) is None
+
+
+def remove_sample_temporaries(out_dir: Path, sample_id: str) -> list[Path]:
+    """Delete the temporaries :func:`export_sample` makes for *sample_id* in *out_dir* (its
+    ``mkdtemp`` folder, an older version moved aside) that a killed run left; return them.
+
+    Only folders named exactly as this module names them are touched; call it only while
+    holding *out_dir*'s lock (no other writer can be using them then).
+    """
+    ours = re.compile(
+        rf"{re.escape(TMP_PREFIX)}(?:{re.escape(sample_id)}-[a-z0-9_]{{8}}"
+        rf"|old-{re.escape(sample_id)}-[0-9a-f]{{8}})"
+    )
+    stale = sorted(
+        p
+        for p in (out_dir.iterdir() if out_dir.is_dir() else ())
+        if ours.fullmatch(p.name) and p.is_dir() and not p.is_symlink()
+    )
+    for path in stale:
+        shutil.rmtree(path, ignore_errors=True)
+    return stale
 
 
 def remove_stale_temporaries(dataset_dir: str | os.PathLike[str]) -> list[Path]:
