@@ -109,10 +109,10 @@ PROTOCOL = (
     "= image on at most 2 of the objects chosen on: chosen max_axis_angle 45, gamma 3, "
     "gamma_over_alpha 100 (the thesis' ratio), region-mean, split by ridge, grey-world (LMSE "
     "0.0296, held-out 0.0448, 8 of 10 objects below the baseline; unconstrained choice gamma 10, "
-    "0.0295, 7 of 10). Round 4 (issue 33) chooses no parameter: RAD's flooding step and regions "
-    "joined across mostly-Case-C boundaries (structure, on by default, off in thesis()) at round "
-    "3's values give LMSE 0.0277, hold-one-out 0.0277 over the grid with both switches (0.0289 "
-    "counting every structural variant tried), 8 of 10 objects below the baseline"
+    "0.0295, 7 of 10). Round 4 (issue 33) chooses no parameter: structure only, on by default, "
+    "off in thesis(), at round 3's values: RAD's flooding and regions joined across mostly-Case-C "
+    "boundaries (LMSE 0.0277, hold-one-out 0.0277), then white/grey-to-chromatic name edges as "
+    "Case A (round 4b: LMSE 0.0257, hold-one-out 0.0276 over 240 points), 8 of 10 below baseline"
 )
 #: Linear values are normalised so that this percentile of the brightest channel maps to 1
 #: before sRGB encoding for the naming model (which expects display values).

@@ -21,7 +21,7 @@ ridge (Case B) or between ridges (Case A) stays a reflectance edge. The rule has
 of its own ("mostly" is a majority of the boundary's edges).
 
 **A pale achromatic name beside a chromatic one** (:func:`split_pale_from_chromatic`). The
-thesis assumes a white light (secs. 2.3, 3.6): shading "affects the intensity of the
+thesis assumes a white light (secs. 2.1, 3.6): shading "affects the intensity of the
 reflectances in the scene but not their chromaticity", and the naming model follows it on an
 achromatic surface, whose ridge "spans colors from the lightest white to the darker gray
 present in the shadowed part" (sec. 3.2.2, Fig. 3.3). A step between a pixel named only white
