@@ -4,6 +4,8 @@ Usage: python -P scripts/mit_ablation.py MIT_DIR OUT.json [--points=I,J] [OBJECT
        (score the MRF_POINTS given by index, all by default; all objects by default, several
        runs on disjoint objects can share the 2 cores)
        python -P scripts/mit_ablation.py --merge OUT.json DOC.md PART.json ...
+       --round4 scores round 3's defaults without and with flooding, --round4b the same two
+       with pale_vs_chromatic (a white/grey name beside a chromatic one is Case A)
 
 For every object of MIT_DIR (the development half, ``$SPECTRINSIC_DATA/mit_intrinsic_dev``)
 the MRF is run once per point of MRF_POINTS (steps 1-3, :meth:`NamesAndShades.labelling`) and
@@ -48,7 +50,7 @@ RAD_FINE = {"ridge_detector": "rad", "creaseness": 1.0, "sigma": 1.0, "max_axis_
 MRF_GRID = {"gamma": [0.3, 1.0, 3.0, 10.0, 30.0], "gamma_over_alpha": [10.0, 100.0],
             "ridge_detector": ["hessian", "rad"], "creaseness": [1.0, 1.25, 1.5],
             "sigma": [1.0, 1.5, 2.0, 3.0], "max_axis_angle": [None, 30.0, 45.0, 60.0],
-            "flooding": [False, True]}
+            "flooding": [False, True], "pale_vs_chromatic": [False, True]}
 #: Round 1 (before the RAD detector): the hessian points. scripts/mit_ablation.json holds
 #: both rounds (round 1's keys, which lack the detector, are read as HESSIAN by merge()).
 HESSIAN_POINTS = [{"gamma": g, "gamma_over_alpha": 100.0, **HESSIAN} for g in (1.0, 3.0, 10.0, 30.0)
@@ -77,14 +79,21 @@ MRF_POINTS = [{"gamma": 1.0, "gamma_over_alpha": 10.0, **RAD},
               {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 30.0},
               # round 4 (issue 33, structure only, round 3's parameters): RAD's flooding step
               {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 45.0,
-               "flooding": True}]
+               "flooding": True},
+              # round 4b (issue 33): a white/grey name beside a chromatic one is Case A
+              {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 45.0,
+               "pale_vs_chromatic": True},
+              {"gamma": 3.0, "gamma_over_alpha": 100.0, **RAD, "max_axis_angle": 45.0,
+               "flooding": True, "pale_vs_chromatic": True}]
 #: Round 4 runs only these points (--round4): round 3's defaults without and with flooding.
 ROUND_4_POINTS = [13, 17]
+#: Round 4b (--round4b): the same two with pale_vs_chromatic.
+ROUND_4B_POINTS = [18, 19]
 #: Parameters of steps 4-5 (run on each labelling).
 POST_GRID = {"reflectance_colour": ["label-centroid", "region-mean"],
              "split_by_ridge": [False, True], "merge_shading": [False, True]}
 #: Structural switches of round 4, absent from older keys (read as off by merge()).
-STRUCTURE = {"flooding": False, "merge_shading": False}
+STRUCTURE = {"flooding": False, "merge_shading": False, "pale_vs_chromatic": False}
 #: Applied to each result above (with_constancy: the same as the method's own step).
 CONSTANCY = ["none", "grey-world"]
 #: The thesis' point (NamesAndShades.thesis()) with expansion to convergence, and extra rows.
@@ -119,7 +128,7 @@ def run(mit_dir: Path, names: list[str] | None, points: list[dict], with_extra: 
             scores.setdefault(name, {})[obj.name] = mit_measures(obj, get_decomposer(name)(
                 obj.image, obj.mask))
         for mrf in points:
-            mrf = {"flooding": False, **mrf}
+            mrf = {"flooding": False, "pale_vs_chromatic": False, **mrf}
             method = dataclasses.replace(base, **mrf)
             t0 = time.perf_counter()
             labelling = method.labelling(obj.image, obj.mask)
@@ -217,7 +226,8 @@ def markdown(report: dict) -> str:
     lines.append(row("round-2 defaults (RAD ridges, no diagonal cut)", s[key(ROUND_2)], base))
     lines.append(row("round-3 defaults (diagonal cut 45, gamma 3)", s[key(ROUND_3)], base))
     for label, change in (("flooding", {"flooding": True}),
-                          ("shading boundaries merged", {"merge_shading": True})):
+                          ("shading boundaries merged", {"merge_shading": True}),
+                          ("pale/chromatic edges Case A", {"pale_vs_chromatic": True})):
         if key({**ROUND_3, **change}) in s:
             lines.append(row(f"round-3 defaults + {label}", s[key({**ROUND_3, **change})], base))
     free = report["choice"].get("unconstrained", {}).get("chosen")
@@ -242,6 +252,8 @@ def merge(parts: list[Path]) -> dict:
                 k = key({"max_axis_angle": None, **json.loads(k)})
             if k.startswith("{") and "flooding" not in k:  # rounds 1-3: no round-4 structure
                 k = key({**STRUCTURE, **json.loads(k)})
+            if k.startswith("{") and "pale_vs_chromatic" not in k:  # round 4: not round 4b's
+                k = key({"pale_vs_chromatic": False, **json.loads(k)})
             report["scores"].setdefault(k, {}).update(per_object)
         report["labelling_seconds"].update(data["labelling_seconds"])
     report["choice"] = choose(report["scores"])
@@ -258,6 +270,9 @@ def per_object(report: dict) -> str:
                "ours, round-3 defaults": key(ROUND_3),
                "round 3 + flooding": key({**ROUND_3, "flooding": True}),
                "round 3 + shading merge": key({**ROUND_3, "merge_shading": True}),
+               "round 4": key({**ROUND_3, "flooding": True, "merge_shading": True}),
+               "round 4 + pale/chromatic": key({**ROUND_3, "flooding": True, "merge_shading": True,
+                                                "pale_vs_chromatic": True}),
                "ours, chosen": key(chosen)}
     lines = ["| object | " + " | ".join(columns) + " |", "|---" * (len(columns) + 1) + "|"]
     objects = sorted(o for o in THESIS_TABLES_3_4_3_5 if o in s["colour-retinex"])
@@ -289,9 +304,10 @@ def main(argv: list[str]) -> int:
               f"{c['unconstrained']['chosen_lmse']:.4f} (held-out "
               f"{c['unconstrained']['held_out_lmse']:.4f})")
         return 0
-    if "--round4" in argv:
-        argv = [a for a in argv if a != "--round4"] + [
-            "--points=" + ",".join(str(i) for i in ROUND_4_POINTS)]
+    for flag, round_points in (("--round4", ROUND_4_POINTS), ("--round4b", ROUND_4B_POINTS)):
+        if flag in argv:
+            argv = [a for a in argv if a != flag] + [
+                "--points=" + ",".join(str(i) for i in round_points)]
     chosen = [a for a in argv if a.startswith("--points=")]  # indices into MRF_POINTS
     argv = [a for a in argv if a not in chosen]
     points = ([MRF_POINTS[int(i)] for i in chosen[0].split("=", 1)[1].split(",")] if chosen

@@ -49,6 +49,7 @@ all of them off):
   ridges by descending density, :mod:`spectrinsic.decompose.methods.ridges`), not Eq. 3.3's nearest;
 * ``merge_shading``: touching regions whose shared boundary is mostly Case C (one ridge, step
   along it: shading) are one region (:mod:`spectrinsic.decompose.methods.shade_cases`);
+* ``pale_vs_chromatic``: white/grey-to-chromatic name edges are Case A (a white light's shading);
 * ``colour_constancy``, ``gamma=3`` (the thesis gives only ratios; ``gamma_over_alpha=100``
   and ``gamma_over_beta=2`` are the thesis' own), the cut's angle and the RAD parameters the
   thesis does not state (``creaseness=1.5``, ``sigma=2`` bins) chosen by :data:`PROTOCOL`
@@ -80,6 +81,7 @@ from .colour_naming import (
 from .constancy import discount_illuminant
 from .ridges import RIDGE_DETECTORS, ColourShades, colour_shades
 from .shade_cases import CASE_C, edge_cases, merge_shading_boundaries
+from .shade_cases import split_pale_from_chromatic as _split_pale
 
 __all__ = ["Labelling", "NamesAndShades", "global_coherence", "grid_edges"]
 
@@ -107,10 +109,10 @@ PROTOCOL = (
     "= image on at most 2 of the objects chosen on: chosen max_axis_angle 45, gamma 3, "
     "gamma_over_alpha 100 (the thesis' ratio), region-mean, split by ridge, grey-world (LMSE "
     "0.0296, held-out 0.0448, 8 of 10 objects below the baseline; unconstrained choice gamma 10, "
-    "0.0295, 7 of 10). Round 4 (issue 33) chooses no parameter: RAD's flooding step and regions "
-    "joined across mostly-Case-C boundaries (structure, on by default, off in thesis()) at round "
-    "3's values give LMSE 0.0277, hold-one-out 0.0277 over the grid with both switches (0.0289 "
-    "counting every structural variant tried), 8 of 10 objects below the baseline"
+    "0.0295, 7 of 10). Round 4 (issue 33) chooses no parameter: structure only, on by default, "
+    "off in thesis(), at round 3's values: RAD's flooding and regions joined across mostly-Case-C "
+    "boundaries (LMSE 0.0277, hold-one-out 0.0277), then white/grey-to-chromatic name edges as "
+    "Case A (round 4b: LMSE 0.0257, hold-one-out 0.0276 over 240 points), 8 of 10 below baseline"
 )
 #: Linear values are normalised so that this percentile of the brightest channel maps to 1
 #: before sRGB encoding for the naming model (which expects display values).
@@ -213,6 +215,9 @@ class NamesAndShades:
     merge_shading
         Touching regions whose shared boundary is mostly Case C are one region of uniform
         reflectance (:mod:`spectrinsic.decompose.methods.shade_cases`).
+    pale_vs_chromatic
+        Edges between a white/grey name and a chromatic one are Case A whatever the ridges say
+        (:func:`spectrinsic.decompose.methods.shade_cases.split_pale_from_chromatic`).
     global_coherence
         Apply sec. 3.4 (off reproduces Fig. 3.7(c)).
     reflectance_colour
@@ -247,6 +252,7 @@ class NamesAndShades:
     max_axis_angle: float | None = 45.0
     flooding: bool = True
     merge_shading: bool = True
+    pale_vs_chromatic: bool = True
     global_coherence: bool = True
     reflectance_colour: Literal["label-centroid", "region-mean"] = "region-mean"
     split_by_ridge: bool = True
@@ -278,10 +284,10 @@ class NamesAndShades:
             split_by_ridge=False,
             colour_constancy="none",
             expansion_cycles=-1,
-            ridge_detector="rad",
             max_axis_angle=None,
             flooding=False,
             merge_shading=False,
+            pale_vs_chromatic=False,
             name="names-shades-thesis",
         )
 
@@ -333,6 +339,8 @@ class NamesAndShades:
         cases = edge_cases(
             edges, log_colours, shades.ridge, shades.tangent, self.parallel_threshold_deg
         )
+        if self.pale_vs_chromatic:  # a white light keeps a white or grey surface achromatic
+            cases = _split_pale(cases, edges, appendix_a_labels()[candidates[y]])
         w = self.gamma / np.array([self.gamma_over_alpha, self.gamma_over_beta, 1.0])
         labels = self._mrf(gco, edges, w[cases], y, distance)
         timings = {"names_s": t1 - t0, "shades_s": t2 - t1, "mrf_s": time.perf_counter() - t2}

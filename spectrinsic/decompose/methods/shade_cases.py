@@ -19,16 +19,38 @@ one ridge), then any two touching areas whose shared boundary is *mostly* Case C
 half of its 4-neighbour edges) are one area. A boundary where the colour changes across the
 ridge (Case B) or between ridges (Case A) stays a reflectance edge. The rule has no parameter
 of its own ("mostly" is a majority of the boundary's edges).
+
+**A pale achromatic name beside a chromatic one** (:func:`split_pale_from_chromatic`). The
+thesis assumes a white light (secs. 2.1, 3.6): shading "affects the intensity of the
+reflectances in the scene but not their chromaticity", and the naming model follows it on an
+achromatic surface, whose ridge "spans colors from the lightest white to the darker gray
+present in the shadowed part" (sec. 3.2.2, Fig. 3.3). A step between a pixel named only white
+or grey and a neighbour whose name has a chromatic term is therefore not a shading step of one
+surface, even where the two colours lie on one ridge along its direction (a faint, darker print
+on white paper: in the log histogram it is a step along the paper's ridge, Case C, and the MRF
+erases its 1-2 pixel lines). Such an edge is Case A, the case of Fig. 3.6(b), "no continuity is
+expected between these two pixels in the reflectance image". Black is left out: a coloured
+paint shaded towards black is named black, which the white light does allow. No parameter.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["CASE_A", "CASE_B", "CASE_C", "edge_cases", "merge_shading_boundaries"]
+__all__ = [
+    "CASE_A",
+    "CASE_B",
+    "CASE_C",
+    "edge_cases",
+    "merge_shading_boundaries",
+    "split_pale_from_chromatic",
+]
 
 #: Edge classes of sec. 3.3.2, the values of :func:`edge_cases`.
 CASE_A, CASE_B, CASE_C = 0, 1, 2
+#: Coordinates of the pale achromatic terms (white, grey) and of black in a colour-name
+#: vector (thesis set N, :data:`spectrinsic.decompose.methods.colour_naming.COLOUR_NAMES`).
+_WHITE, _GREY, _BLACK = 1, 10, 0
 
 
 def edge_cases(
@@ -109,3 +131,30 @@ def merge_shading_boundaries(
     renumber = np.zeros(int(group.max()) + 1, np.int64)
     renumber[used] = np.arange(1, used.size + 1)
     return np.where(regions > 0, renumber[group][regions], 0)
+
+
+def split_pale_from_chromatic(
+    cases: np.ndarray, edges: np.ndarray, names: np.ndarray
+) -> np.ndarray:
+    """*cases* with every edge between a pale achromatic name and a chromatic one set to
+    :data:`CASE_A` (module docstring).
+
+    Parameters
+    ----------
+    cases
+        ``(E,)`` cases of the edges (:func:`edge_cases`).
+    edges
+        ``(E, 2)`` indices into *names* of neighbouring pixels.
+    names
+        ``(N, 11)`` colour-name vector of each pixel (memberships, thesis set N order).
+
+    >>> white, grey_blue = np.eye(11)[1], 0.5 * (np.eye(11)[10] + np.eye(11)[5])
+    >>> names = np.stack([white, grey_blue, np.eye(11)[0]])
+    >>> split_pale_from_chromatic(np.array([2, 2]), np.array([[0, 1], [1, 2]]), names).tolist()
+    [0, 2]
+    """
+    pale = names[:, _WHITE] + names[:, _GREY] > 1.0 - 1e-9
+    chromatic = names.sum(axis=1) - names[:, [_WHITE, _GREY, _BLACK]].sum(axis=1) > 1e-9
+    i, j = edges[:, 0], edges[:, 1]
+    across = (pale[i] & chromatic[j]) | (pale[j] & chromatic[i])
+    return np.where(across, CASE_A, cases).astype(np.int8)
