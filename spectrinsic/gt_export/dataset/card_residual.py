@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from ..layers.spectral_intrinsics import LIGHT_FAMILIES, light_family, rgb_residual_share
+from ..layers.spectral_intrinsics import LIGHT_FAMILIES, residual_rows
 
 __all__ = ["RESIDUAL_FIGURE_NAME", "residual_by_family", "residual_figure", "write_residual_figure"]
 
@@ -35,18 +35,12 @@ def residual_by_family(metas: Sequence[Any]) -> dict[str, dict[str, list[float]]
     >>> residual_by_family([m])
     {'narrow-led': {'rgb': [0.2], 'bands': []}}
     """
-    rows: dict[str, dict[str, list[float]]] = {}
-    for meta in metas:
-        rgb = rgb_residual_share(meta)
-        if rgb is None:
-            continue
-        family = light_family(li.get("spectrum", "") for li in meta.get("lights", []))
-        row = rows.setdefault(family, {"rgb": [], "bands": []})
-        row["rgb"].append(rgb)
-        bands = (meta.get("residual_share") or {}).get("image_bands")
-        if isinstance(bands, (int, float)):
-            row["bands"].append(float(bands))
-    return {f: rows[f] for f in LIGHT_FAMILIES if f in rows}
+    rows = residual_rows(metas)
+    return {
+        f: {"rgb": rows[f]["rgb"], "bands": rows[f]["spectral"]}
+        for f in LIGHT_FAMILIES
+        if f in rows
+    }
 
 
 def residual_figure(by_family: Mapping[str, Mapping[str, list[float]]], space: str) -> Any:

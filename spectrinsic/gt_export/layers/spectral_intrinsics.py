@@ -58,6 +58,7 @@ __all__ = [
     "rgb_residual_share",
     "LIGHT_FAMILIES",
     "light_family",
+    "residual_rows",
     "residual_summary",
     "WORKING_SPACES",
     "working_space_matrix",
@@ -266,6 +267,31 @@ def _figures(values: list[float]) -> dict[str, float]:
     }
 
 
+_ROW_KEYS = ("rgb", "spectral", "clipped_pixels")
+
+
+def residual_rows(metas: Any) -> dict[str, dict[str, list[float]]]:
+    """Per light family (:func:`light_family` of each sample's lights): the samples' RGB
+    residual shares (``"rgb"``), per-band residual shares where written (``"spectral"``) and
+    shares of lit pixels with clipped sRGB shading (``"clipped_pixels"``), fractions in sample
+    order. *metas* are parsed ``meta.json`` objects; samples without a residual share are skipped.
+    """
+    rows: dict[str, dict[str, list[float]]] = {}
+    for meta in metas:
+        rgb = rgb_residual_share(meta)
+        if rgb is None:
+            continue
+        family = light_family(li.get("spectrum", "") for li in meta.get("lights", []))
+        row = rows.setdefault(family, {k: [] for k in _ROW_KEYS})
+        row["rgb"].append(rgb)
+        spectral = (meta.get("residual_share") or {}).get("image_bands")
+        clipped = (meta.get("shading_clipping") or {}).get("pixels")
+        for key, value in (("spectral", spectral), ("clipped_pixels", clipped)):
+            if isinstance(value, (int, float)):
+                row[key].append(float(value))
+    return rows
+
+
 def residual_summary(metas: Any) -> dict[str, Any]:
     """Per light family (:func:`light_family` of each sample's lights) and ``"all"``: the
     samples' RGB residual share, per-band residual share (where written) and the share of lit
@@ -277,21 +303,9 @@ def residual_summary(metas: Any) -> dict[str, Any]:
     >>> residual_summary([m])["d65"]["rgb"]["median"]
     0.01
     """
-    rows: dict[str, dict[str, list[float]]] = {}
-    for meta in metas:
-        rgb = rgb_residual_share(meta)
-        if rgb is None:
-            continue
-        family = light_family(li.get("spectrum", "") for li in meta.get("lights", []))
-        spectral = (meta.get("residual_share") or {}).get("image_bands")
-        clipped = (meta.get("shading_clipping") or {}).get("pixels")
-        for key in (family, "all"):
-            row = rows.setdefault(key, {"rgb": [], "spectral": [], "clipped_pixels": []})
-            row["rgb"].append(rgb)
-            if isinstance(spectral, (int, float)):
-                row["spectral"].append(float(spectral))
-            if isinstance(clipped, (int, float)):
-                row["clipped_pixels"].append(float(clipped))
+    rows = residual_rows(metas)
+    if rows:
+        rows["all"] = {k: [v for row in rows.values() for v in row[k]] for k in _ROW_KEYS}
     return {
         family: {"samples": len(row["rgb"])} | {k: _figures(v) for k, v in row.items() if v}
         for family, row in sorted(rows.items())
