@@ -24,7 +24,7 @@ def load_scene_argument(
     materials: Mapping[str, str] | None = None,
     default_spectrum: str | None = None,
     data_dir: str | None = None,
-    colours_from_asset: bool = False,
+    colours_from_asset: bool = True,
 ) -> Scene:
     """The Scene named by the ``SCENE`` argument: a scene file (YAML, ``.blend`` or mesh,
     :func:`spectrinsic.scenes.sources.load_scene_file`, the dispatch ``dataset --scenes`` uses),

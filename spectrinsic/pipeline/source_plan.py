@@ -147,12 +147,13 @@ def files_source(
     default_spectrum: str | None = None,
     resolution: tuple[int, int] | None = None,
     new_sample: bool = False,
-    colours_from_asset: bool = False,
+    colours_from_asset: bool = True,
 ) -> str:
     """The canonical ``source`` JSON of a set of scene files (each must exist): rendered at
     *resolution* ``(W, H)``, else at each file's own camera size; a saved generated scene as
-    its own sample unless *new_sample*; *colours_from_asset* (in the JSON only when set, so
-    older configs keep their hash): base colours of glTF and ``.blend`` materials as spectra."""
+    its own sample unless *new_sample*; *colours_from_asset* (always in the JSON since issue 41,
+    when it became the default; a config without it was written before and means False, so
+    older datasets rebuild as they were): the colours and textures the files state."""
     entries = []
     for p in paths:
         path = Path(p).resolve()
@@ -171,8 +172,7 @@ def files_source(
         "new_sample": bool(new_sample),
         "resolution": None if resolution is None else [int(v) for v in resolution],
     }
-    if colours_from_asset:
-        spec["colours_from_asset"] = True
+    spec["colours_from_asset"] = bool(colours_from_asset)
     ids = [str(file_sample(e["path"], new_sample=new_sample)[0]) for e in entries]
     dupes = sorted({i for i in ids if ids.count(i) > 1})
     if dupes:
@@ -321,7 +321,7 @@ def _file_tasks(
             height,
             materials,
             spec.get("default_spectrum"),
-            colours_from_asset=bool(spec.get("colours_from_asset")),
+            colours_from_asset=bool(spec.get("colours_from_asset", False)),
         )
         sid, seed = file_sample(entry["path"], new_sample=bool(spec.get("new_sample")))
         task = SampleTask.planned(

@@ -22,13 +22,14 @@ spectrum needed), else Roughness < 0.5 a coated diffuse (``plastic``, the node's
 Roughness² (Blender's convention). Everything else of the node (coat, sheen, subsurface,
 transmission, emission, textures) is ignored; other materials are Lambertian.
 
-With ``colours_from_asset=True`` (``--colours-from-asset``), a material that the mapping, its
+With ``colours_from_asset=True`` (the default; ``--no-colours-from-asset`` turns it off), a
+material that the mapping, its
 custom property and its name leave without a spectrum takes the Principled node's Base Color
 (scene-linear Rec. 709, as Blender stores it; alpha ignored) as the reflectance ``rgb:R,G,B``
 (:mod:`spectrinsic.spectra.user_spectra`, Mallett & Yuksel 2019); a colour outside [0, 1] is
 refused when validated, not clipped, and a Base Color fed by a node (an image texture) is not
-read, so that material still needs a spectrum. Without the option such a material is an error,
-so no colour is taken from a file unless asked for.
+read (image-texture nodes are not read yet), so that material still needs a spectrum. Without
+the option such a material is an error.
 
 Opening a file replaces the data of the running ``bpy`` session (Blender has one global state).
 """
@@ -254,7 +255,7 @@ class _MaterialTable:
         mapping: Mapping[str, str],
         default_spectrum: str | None,
         data_dir: str | None,
-        colours_from_asset: bool = False,
+        colours_from_asset: bool = True,
     ) -> None:
         self.source = source
         self.colours_from_asset = colours_from_asset
@@ -359,7 +360,7 @@ def load_blend(
     resolution: tuple[int, int] | None = None,
     data_dir: str | None = None,
     validate: bool = True,
-    colours_from_asset: bool = False,
+    colours_from_asset: bool = True,
 ) -> Scene:
     """Read a ``.blend`` file into a :class:`~spectrinsic.scenes.model.Scene`.
 
@@ -382,7 +383,7 @@ def load_blend(
         Run :func:`~spectrinsic.scenes.validate.validate_scene` on the result.
     colours_from_asset
         Give materials without a spectrum their Principled Base Color as an ``rgb:``
-        reflectance (module docstring); False: they are an error.
+        reflectance (module docstring, the default); False: they are an error.
 
     Raises
     ------

@@ -130,7 +130,7 @@ def load_scene_file(
     materials: Mapping[str, str] | None = None,
     default_spectrum: str | None = None,
     data_dir: str | None = None,
-    colours_from_asset: bool = False,
+    colours_from_asset: bool = True,
 ) -> Scene:
     """Read any scene file (:func:`scene_file_kind`) into a validated scene: the one dispatch
     over YAML, ``.blend`` and mesh files, for ``dataset --scenes`` and ``render``.
@@ -145,8 +145,9 @@ def load_scene_file(
     default_spectrum
         Reflectance of mesh or ``.blend`` materials not in *materials*.
     colours_from_asset
-        Give glTF and ``.blend`` materials without a spectrum the file's base colour as an
-        ``rgb:`` reflectance (``--colours-from-asset``); False: they are an error.
+        Give mesh and ``.blend`` materials without a spectrum the colour or texture the file
+        states (glTF base colour and texture, MTL ``Kd``/``map_Kd``, Principled Base Color;
+        the default); False (``--no-colours-from-asset``): they are an error.
     """
     kind = scene_file_kind(path)
     mapping = dict(materials or {})
@@ -194,7 +195,7 @@ class FileSource:
     default_spectrum
         Reflectance of mesh or ``.blend`` materials not in *materials*.
     colours_from_asset
-        Base colours of glTF and ``.blend`` materials without a spectrum as ``rgb:`` spectra.
+        The colours and textures the file states, for materials without a spectrum.
     """
 
     path: str
@@ -202,7 +203,7 @@ class FileSource:
     height: int | None
     materials: tuple[tuple[str, str], ...] = ()
     default_spectrum: str | None = None
-    colours_from_asset: bool = False
+    colours_from_asset: bool = True
 
     def build(self, data_dir: str | None = None) -> Scene:
         """Read and validate the file; one-line :class:`SceneError` naming it on bad input."""
