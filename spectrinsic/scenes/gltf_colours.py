@@ -121,7 +121,7 @@ def gltf_colours(path: str | Path) -> dict[str, AssetColour]:
                 path, doc, binary, pbr["baseColorTexture"], factor if stated else [1, 1, 1]
             )
             out[material["name"]] = AssetColour(image=image)
-        elif stated:
+        elif isinstance(factor, list) and len(factor) == 4:
             rgb = "rgb:" + ",".join(f"{float(c):.9g}" for c in factor[:3])
             out[material["name"]] = AssetColour(spectrum=rgb)
     return out

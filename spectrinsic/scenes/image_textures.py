@@ -182,7 +182,7 @@ def _read_pixels(data: bytes, what: str) -> np.ndarray:
                 raise SceneError(
                     f"{what}: image mode {img.mode!r}; expected 8-bit {', '.join(_MODES)}"
                 )
-            alpha = img.mode in ("LA", "RGBA") and img.getextrema()[-1][0] < 255
+            alpha = img.mode in ("LA", "RGBA") and np.asarray(img.getchannel("A")).min() < 255
             pixels = np.asarray(img.convert("RGB"), np.float64) / 255.0
     except (OSError, UnidentifiedImageError) as exc:
         raise SceneError(f"{what}: cannot read it as an image ({exc})") from None

@@ -118,12 +118,15 @@ class Texture:
             == (other.name, other.basis, other.pattern, other.size, other.seed)
             and self.weights.shape == other.weights.shape
             and np.array_equal(self.weights, other.weights)
-            and (self.uv is None) == (other.uv is None)
-            and (self.uv is None or np.array_equal(self.uv, other.uv))
+            and _same_uv(self.uv, other.uv)
             and self.image == other.image
         )
 
     __hash__ = None  # type: ignore[assignment]
+
+
+def _same_uv(a: np.ndarray | None, b: np.ndarray | None) -> bool:
+    return a is None and b is None or (a is not None and b is not None and np.array_equal(a, b))
 
 
 def basis_name(texture: str, b: int) -> str:
