@@ -1,0 +1,138 @@
+"""Image textures as exact spectral textures (issue 41, item 2): the corner weights, decoding,
+wrapping and the refusals, without rendering."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from spectrinsic.errors import SceneError, SpectrinsicWarning
+from spectrinsic.scenes.image_textures import (
+    CORNERS,
+    IMAGE_TEXELS_MAX,
+    ImageTexture,
+    corner_spectra,
+    corner_weights,
+    image_texture_from_file,
+)
+from spectrinsic.scenes.model import Camera, Material, Mesh, Scene, scene_from_dict, scene_to_dict
+from spectrinsic.scenes.textures import make_image_texture, texel_index
+from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as WL
+from spectrinsic.spectra import get_spectrum
+
+#: float64 round-off of a product of three numbers in [0, 1].
+EXACT = 1e-12
+
+
+def test_corner_weights_are_convex_and_reproduce_the_colour():
+    rgb = np.random.default_rng(3).random((50, 3))
+    w = corner_weights(rgb)
+    assert w.shape == (50, 8) and np.all(w >= 0)
+    np.testing.assert_allclose(w.sum(axis=1), 1.0, atol=EXACT)
+    np.testing.assert_allclose(w @ np.array(CORNERS), rgb, atol=EXACT)
+
+
+def test_a_texel_spectrum_is_the_basis_matrix_times_its_rgb():
+    """Σ_c w_c ρ_c (the corners' registry spectra) equals R b_R + G b_G + B b_B, the spectrum
+    the registry gives ``rgb:R,G,B`` (Mallett & Yuksel 2019)."""
+    rho = np.stack([get_spectrum(name).on(WL) for name in corner_spectra()])
+    basis = rho[[1, 2, 4]]  # rgb:1,0,0, rgb:0,1,0, rgb:0,0,1
+    assert np.all(rho >= 0) and np.all(rho <= 1)
+    # flat on 400-700 nm: b_R + b_G + b_B = 1 (3.3e-8 measured; 1e-5 below 400 nm)
+    visible = (WL >= 400) & (WL <= 700)
+    np.testing.assert_allclose(basis.sum(axis=0)[visible], 1.0, atol=1e-7)
+    for rgb in ([0.2, 0.7, 0.4], [1.0, 0.0, 0.5], [0.03, 0.03, 0.9]):
+        mixed = corner_weights(np.array(rgb)) @ rho
+        np.testing.assert_allclose(mixed, np.array(rgb) @ basis, atol=1e-9)
+        reference = get_spectrum("rgb:" + ",".join(map(str, rgb))).on(WL)
+        np.testing.assert_allclose(mixed, reference, atol=1e-9)
+
+
+def _png(folder, pixels, name="t.png"):
+    Image.fromarray(np.asarray(pixels, np.uint8)).save(folder / name)
+    return folder / name
+
+
+def test_srgb_images_are_decoded_times_the_factor_bottom_row_first(tmp_path):
+    import colour
+
+    pixels = np.array([[[255, 0, 0], [128, 128, 128]], [[0, 64, 255], [10, 20, 30]]])
+    path = _png(tmp_path, pixels)
+    image = image_texture_from_file(path, root=tmp_path, srgb=True, factor=(1.0, 0.5, 0.25))
+    expected = colour.cctf_decoding(pixels / 255.0, function="sRGB") * [1.0, 0.5, 0.25]
+    np.testing.assert_allclose(image.texels, expected[::-1], atol=EXACT)
+    assert image.source == "t.png" and len(image.sha256) == 64
+    linear = image_texture_from_file(path, root=tmp_path, srgb=False)
+    np.testing.assert_allclose(linear.texels, pixels[::-1] / 255.0, atol=EXACT)
+
+
+def test_texels_above_one_are_clipped_and_said(tmp_path):
+    path = _png(tmp_path, np.full((2, 2, 3), 200))
+    with pytest.warns(SpectrinsicWarning, match="4 texels outside"):
+        image = image_texture_from_file(path, root=tmp_path, srgb=False, factor=(2.0, 1, 1))
+    assert image.texels[..., 0].max() == 1.0
+
+
+def test_bad_images_are_refused_in_one_line(tmp_path):
+    inside = tmp_path / "scene"
+    inside.mkdir()
+    outside = _png(tmp_path, np.zeros((2, 2, 3)))
+    cases = [
+        (outside, "outside the scene's folder"),
+        (inside / "missing.png", "no such file"),
+    ]
+    (inside / "junk.png").write_bytes(b"not an image")
+    cases.append((inside / "junk.png", "cannot read it as an image"))
+    big = Image.new("L", (IMAGE_TEXELS_MAX + 1, 1))
+    big.save(inside / "big.png")
+    cases.append((inside / "big.png", "expected at most"))
+    for path, message in cases:
+        with pytest.raises(SceneError, match=message) as info:
+            image_texture_from_file(path, root=inside, srgb=True)
+        assert "\n" not in str(info.value)
+
+
+def _image(h=2, w=3) -> ImageTexture:
+    texels = np.random.default_rng(1).random((h, w, 3))
+    return ImageTexture("t.png", "0" * 64, texels, wrap="repeat", filter="nearest")
+
+
+def test_repeat_wrapping_is_exact_under_the_clamped_nearest_lookup():
+    """Coordinates spanning [-1, 2] × [0, 2]: the texture is repeated 3 × 2 times and the
+    coordinates rescaled; every point then finds the texel that repeat wrapping gives."""
+    image = _image()
+    uv = np.array([[[-1.0, 0.0], [2.0, 0.0], [2.0, 2.0]], [[-1.0, 0.0], [2.0, 2.0], [-1.0, 2.0]]])
+    texture = make_image_texture("t", tuple(range(8)), image, uv)
+    assert texture.image.tiles == (2, 3) and texture.weights.shape == (4, 9, 8)
+    points = np.random.default_rng(2).uniform((-1, 0), (2, 2), (200, 2))
+    scaled = (points - (-1.0, 0.0)) / (3.0, 2.0)  # the same affine map as the face corners
+    np.testing.assert_allclose(texture.uv[0, 1], (1.0, 0.0))
+    row, col = texel_index(scaled, texture.weights.shape[:2])
+    wrapped_row, wrapped_col = texel_index(points % 1.0, image.texels.shape[:2])
+    np.testing.assert_array_equal(
+        texture.weights[row, col], corner_weights(image.texels[wrapped_row, wrapped_col])
+    )
+
+
+def test_mirror_wrapping_outside_the_unit_square_is_refused():
+    image = ImageTexture("t.png", "", _image().texels, wrap="mirror", filter="nearest")
+    uv = np.array([[[0.0, 0.0], [1.5, 0.0], [1.5, 1.0]]])
+    with pytest.raises(SceneError, match="mirror wrapping"):
+        make_image_texture("t", tuple(range(8)), image, uv)
+
+
+def test_an_image_texture_survives_its_scene_record():
+    texture = make_image_texture(
+        "t", tuple(range(8)), _image(), np.array([[[0, 0], [1, 0], [1, 1.0]]])
+    )
+    scene = Scene(
+        "s",
+        (Mesh("m", np.eye(3), np.array([[0, 1, 2]]), np.zeros(1, np.int64), 0, texture),),
+        tuple(Material(name, name) for name in corner_spectra()),
+        (),
+        Camera((0, 0, 3), (0, 0, 0), (0, 1, 0), 30.0, 8, 8),
+    )
+    record = scene_to_dict(scene)
+    assert "weights" not in record["meshes"][0]["texture"]  # derived from the texels
+    assert scene_from_dict(record) == scene
