@@ -89,8 +89,12 @@ class ImageTexture:
         The filter the asset asks for (:data:`FILTERS`); the band path reads the nearest texel,
         so ``bilinear`` is rendered nearest (said once when the scene is read).
     tiles
-        ``(rows, columns)`` repetitions of the image the renderer's texture holds, so that the
-        asset's coordinates outside [0, 1] under ``repeat`` wrap exactly (1, 1 otherwise).
+        ``(rows, columns)`` copies of the image the renderer's texture holds, so that the
+        asset's coordinates outside [0, 1] wrap exactly under ``repeat`` and ``mirror``
+        (1, 1 otherwise); :func:`~spectrinsic.scenes.textures.image_weights`.
+    first_tile
+        ``(v, u)`` integer index of the first copy (copies with an odd index are flipped under
+        ``mirror``).
     """
 
     source: str
@@ -99,17 +103,21 @@ class ImageTexture:
     wrap: Wrap = "repeat"
     filter: Filter = "bilinear"
     tiles: tuple[int, int] = field(default=(1, 1))
+    first_tile: tuple[int, int] = field(default=(0, 0))
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, ImageTexture):
             return NotImplemented
-        return (self.source, self.sha256, self.wrap, self.filter, tuple(self.tiles)) == (
+        mine = (self.source, self.sha256, self.wrap, self.filter, *self.tiles, *self.first_tile)
+        theirs = (
             other.source,
             other.sha256,
             other.wrap,
             other.filter,
-            tuple(other.tiles),
-        ) and np.array_equal(self.texels, other.texels)
+            *other.tiles,
+            *other.first_tile,
+        )
+        return mine == theirs and np.array_equal(self.texels, other.texels)
 
     __hash__ = None  # type: ignore[assignment]
 

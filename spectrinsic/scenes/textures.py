@@ -17,8 +17,8 @@ covers ``u ∈ [j/w, (j+1)/w)``, ``v ∈ [i/h, (i+1)/h)`` (row 0 at v = 0), clam
 Image textures (:mod:`spectrinsic.scenes.image_textures`, issue 41) are the same record with
 the 8 RGB-cube corner spectra as basis, the image's trilinear corner weights as ``weights``
 (:func:`make_image_texture`) and the asset's own coordinates in ``uv`` instead of the box
-projection; ``repeat`` wrapping outside [0, 1] is made exact by repeating the image in the texel
-table and rescaling ``uv`` into [0, 1].
+projection; ``repeat`` and ``mirror`` wrapping outside [0, 1] are made exact by copying the
+image (flipped for ``mirror``) in the texel table and rescaling ``uv`` into [0, 1].
 
 Patterns (:data:`PATTERNS`) are generated here (licence: spectrinsic's own): ``rings`` (wood
 grain: rings around a centre, perturbed by value noise), ``weave`` (fabric: two crossing sets of
@@ -260,30 +260,37 @@ def make_texture(name: str, basis: tuple[int, ...], pattern: str, size: int, see
 
 
 def image_weights(image: ImageTexture) -> np.ndarray:
-    """``(h·rows, w·columns, 8)`` corner weights of *image*'s texels, repeated ``image.tiles``
-    times (:func:`~spectrinsic.scenes.image_textures.corner_weights`)."""
-    rows, cols = image.tiles
-    return np.tile(corner_weights(image.texels), (int(rows), int(cols), 1))
+    """``(h·rows, w·columns, 8)`` corner weights of *image*'s texels
+    (:func:`~spectrinsic.scenes.image_textures.corner_weights`) in ``image.tiles`` copies,
+    from copy ``image.first_tile`` on; under ``mirror`` a copy with an odd index is flipped."""
+    weights = corner_weights(image.texels)
+    rows, cols = (int(t) for t in image.tiles)
+    row0, col0 = (int(t) for t in image.first_tile)
+    mirror = image.wrap == "mirror"
+    line = [weights[:, ::-1] if mirror and (col0 + c) % 2 else weights for c in range(cols)]
+    strip = np.concatenate(line, axis=1)
+    return np.concatenate(
+        [strip[::-1] if mirror and (row0 + r) % 2 else strip for r in range(rows)], axis=0
+    )
 
 
-def _wrapped(uv: np.ndarray, image: ImageTexture, what: str) -> tuple[np.ndarray, tuple[int, int]]:
-    """*uv* rescaled into [0, 1] and the ``(rows, columns)`` repetitions that make *image*'s
-    wrap mode exact under the renderer's clamped nearest lookup."""
-    lo, hi = np.floor(uv.min(axis=(0, 1))), np.ceil(uv.max(axis=(0, 1)))
+def _wrapped(uv: np.ndarray, image: ImageTexture, what: str) -> tuple[np.ndarray, ImageTexture]:
+    """*uv* rescaled into [0, 1] and *image* with the copies that make its wrap mode exact
+    under the renderer's clamped nearest lookup (:attr:`ImageTexture.tiles`)."""
     inside = bool(np.all(uv >= 0.0) and np.all(uv <= 1.0))
     if inside or image.wrap == "clamp":
-        return uv, (1, 1)
-    if image.wrap == "mirror":
-        raise SceneError(f"{what}: mirror wrapping of coordinates outside [0, 1] is not supported")
+        return uv, replace(image, tiles=(1, 1), first_tile=(0, 0))
+    lo, hi = np.floor(uv.min(axis=(0, 1))), np.ceil(uv.max(axis=(0, 1)))
     span = np.maximum(hi - lo, 1.0)
     cols, rows = int(span[0]), int(span[1])
     h, w = image.texels.shape[:2]
     if h * w * rows * cols > IMAGE_TEXELS_MAX:
         raise SceneError(
-            f"{what}: coordinates span {cols}x{rows} repetitions of a {w}x{h} image, more than "
+            f"{what}: coordinates span {cols}x{rows} copies of a {w}x{h} image, more than "
             f"{IMAGE_TEXELS_MAX:,} texels"
         )
-    return (uv - lo) / span, (rows, cols)
+    tiled = replace(image, tiles=(rows, cols), first_tile=(int(lo[1]), int(lo[0])))
+    return (uv - lo) / span, tiled
 
 
 def make_image_texture(
@@ -298,7 +305,7 @@ def make_image_texture(
     if uv.ndim != 3 or uv.shape[1:] != (3, 2) or not np.all(np.isfinite(uv)):
         raise SceneError(f"texture {image.source or name}: expected finite (F, 3, 2) uv")
     what = f"texture {image.source or name}"
-    scaled, tiles = _wrapped(uv, image, what)
+    scaled, tiled = _wrapped(uv, image, what)
     if image.filter != "nearest":
         warnings.warn(
             f"{what}: {image.filter} filtering approximated by the nearest texel "
@@ -306,7 +313,6 @@ def make_image_texture(
             SpectrinsicWarning,
             stacklevel=2,
         )
-    tiled = replace(image, tiles=tiles)
     return Texture(name, tuple(basis), image_weights(tiled), uv=scaled, image=tiled)
 
 
@@ -318,6 +324,7 @@ def _image_from_record(record: Mapping[str, Any]) -> ImageTexture:
         wrap=record.get("wrap", "repeat"),
         filter=record.get("filter", "bilinear"),
         tiles=tuple(int(t) for t in record.get("tiles", (1, 1))),  # type: ignore[arg-type]
+        first_tile=tuple(int(t) for t in record.get("first_tile", (0, 0))),  # type: ignore[arg-type]
     )
 
 

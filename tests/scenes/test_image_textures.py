@@ -93,39 +93,55 @@ def test_bad_images_are_refused_in_one_line(tmp_path):
         assert "\n" not in str(info.value)
 
 
-def _image(h=2, w=3) -> ImageTexture:
+def _image(wrap="repeat", h=2, w=3) -> ImageTexture:
     texels = np.random.default_rng(1).random((h, w, 3))
-    return ImageTexture("t.png", "0" * 64, texels, wrap="repeat", filter="nearest")
+    return ImageTexture("t.png", "0" * 64, texels, wrap=wrap, filter="nearest")
 
 
-def test_repeat_wrapping_is_exact_under_the_clamped_nearest_lookup():
-    """Coordinates spanning [-1, 2] × [0, 2]: the texture is repeated 3 × 2 times and the
-    coordinates rescaled; every point then finds the texel that repeat wrapping gives."""
-    image = _image()
+def _wrap(x: np.ndarray, wrap: str) -> np.ndarray:
+    """Coordinates *x* wrapped into [0, 1) as the glTF sampler / Mitsuba define the mode."""
+    if wrap == "repeat":
+        return x % 1.0
+    tile, frac = np.divmod(x, 1.0)
+    return np.where(tile % 2 == 0, frac, 1.0 - frac)  # mirror: odd copies run backwards
+
+
+@pytest.mark.parametrize("wrap", ["repeat", "mirror"])
+def test_wrapping_is_exact_under_the_clamped_nearest_lookup(wrap):
+    """Coordinates spanning [-1, 2] × [0, 2]: the image is copied 3 × 2 times and the
+    coordinates rescaled; every point then finds the texel its wrap mode gives."""
+    image = _image(wrap)
     uv = np.array([[[-1.0, 0.0], [2.0, 0.0], [2.0, 2.0]], [[-1.0, 0.0], [2.0, 2.0], [-1.0, 2.0]]])
     texture = make_image_texture("t", tuple(range(8)), image, uv)
-    assert texture.image.tiles == (2, 3) and texture.weights.shape == (4, 9, 8)
-    points = np.random.default_rng(2).uniform((-1, 0), (2, 2), (200, 2))
-    scaled = (points - (-1.0, 0.0)) / (3.0, 2.0)  # the same affine map as the face corners
+    assert texture.image.tiles == (2, 3) and texture.image.first_tile == (0, -1)
+    assert texture.weights.shape == (4, 9, 8)
     np.testing.assert_allclose(texture.uv[0, 1], (1.0, 0.0))
+    points = np.random.default_rng(2).uniform((-1, 0), (2, 2), (400, 2))
+    scaled = (points - (-1.0, 0.0)) / (3.0, 2.0)  # the same affine map as the face corners
     row, col = texel_index(scaled, texture.weights.shape[:2])
-    wrapped_row, wrapped_col = texel_index(points % 1.0, image.texels.shape[:2])
+    wrapped_row, wrapped_col = texel_index(_wrap(points, wrap), image.texels.shape[:2])
     np.testing.assert_array_equal(
         texture.weights[row, col], corner_weights(image.texels[wrapped_row, wrapped_col])
     )
 
 
-def test_mirror_wrapping_outside_the_unit_square_is_refused():
-    image = ImageTexture("t.png", "", _image().texels, wrap="mirror", filter="nearest")
-    uv = np.array([[[0.0, 0.0], [1.5, 0.0], [1.5, 1.0]]])
-    with pytest.raises(SceneError, match="mirror wrapping"):
-        make_image_texture("t", tuple(range(8)), image, uv)
+def test_clamped_coordinates_keep_the_image_once():
+    uv = np.array([[[-0.5, 0.0], [1.5, 0.0], [1.5, 1.0]]])
+    texture = make_image_texture("t", tuple(range(8)), _image("clamp"), uv)
+    assert texture.image.tiles == (1, 1) and np.array_equal(texture.uv, uv)
+
+
+def test_too_many_copies_are_refused():
+    uv = np.array([[[0.0, 0.0], [600.0, 0.0], [600.0, 600.0]]])
+    with pytest.raises(SceneError, match="copies of a 3x2 image"):
+        make_image_texture("t", tuple(range(8)), _image(), uv)
 
 
 def test_an_image_texture_survives_its_scene_record():
     texture = make_image_texture(
-        "t", tuple(range(8)), _image(), np.array([[[0, 0], [1, 0], [1, 1.0]]])
+        "t", tuple(range(8)), _image("mirror"), np.array([[[-1, 0], [1, 0], [1, 1.0]]])
     )
+    assert texture.image.tiles == (1, 2)
     scene = Scene(
         "s",
         (Mesh("m", np.eye(3), np.array([[0, 1, 2]]), np.zeros(1, np.int64), 0, texture),),
