@@ -95,7 +95,7 @@ def _expected() -> tuple[np.ndarray, np.ndarray]:
 
     linear = colour.cctf_decoding(COLOURS / 255.0, function="sRGB") * np.array(FACTOR)
     basis = colour.recovery.MSDS_BASIS_FUNCTIONS_sRGB_MALLETT2019
-    shape = colour.SpectralShape(400, 700, 1)
+    shape = colour.SpectralShape(360, 830, 1)  # the CMFs' range, as the layers integrate
     cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape)
     d65 = colour.SDS_ILLUMINANTS["D65"].copy().align(shape)
     srgb, bands = [], []
