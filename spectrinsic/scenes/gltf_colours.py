@@ -82,6 +82,10 @@ def _texture(path: Path, doc: dict[str, Any], binary: bytes, ref: Any, factor: A
         raise SceneError(
             f"{path}: baseColorTexture {ref!r} names nothing readable ({exc!r})"
         ) from None
+    if ref.get("extensions"):  # KHR_texture_transform and the like would move the texels
+        raise SceneError(
+            f"{path}: baseColorTexture extensions {sorted(ref['extensions'])} are not supported"
+        )
     if int(ref.get("texCoord", 0)) != 0:
         raise SceneError(f"{path}: baseColorTexture uses TEXCOORD_{ref['texCoord']}; expected 0")
     wraps = {_WRAP.get(int(sampler.get(k, 10497)), "repeat") for k in ("wrapS", "wrapT")}

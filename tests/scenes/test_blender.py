@@ -173,11 +173,13 @@ def test_missing_bpy_gives_a_helpful_error(monkeypatch, tmp_path):
 @pytest.mark.blender
 def test_render_routes_a_blend_file_to_the_importer(blend_file, tmp_path, capsys):
     """``spectrinsic render x.blend`` reads it with the importer (not as YAML): here the
-    importer's own one-line error for the material named after no spectrum."""
+    importer's own one-line error for the material named after no spectrum (its base colour
+    not read: ``--no-colours-from-asset``)."""
     from spectrinsic.cli import main
 
     path, _ = blend_file
-    rc = main(["-q", "render", str(path), "--modes", "rgb3", "--out", str(tmp_path / "o")])
+    args = ["-q", "render", str(path), "--modes", "rgb3", "--no-colours-from-asset"]
+    rc = main([*args, "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err.strip()
     assert rc == 2 and len(err.splitlines()) == 1
     assert str(path) in err and "'Paint'" in err and "UnicodeDecodeError" not in err
