@@ -63,11 +63,11 @@ IMAGE_TEXELS_MAX = 1 << 20
 #: Wrap modes of texture coordinates outside [0, 1] (glTF sampler / Mitsuba ``wrap_mode``).
 WRAP_MODES = ("repeat", "clamp", "mirror")
 #: Texture filters an asset may ask for; the renderer looks up the nearest texel.
-FILTERS = ("nearest", "bilinear")
+FILTERS = ("nearest", "bilinear", "cubic")
 _MODES = ("1", "L", "LA", "P", "RGB", "RGBA")
 
 Wrap = Literal["repeat", "clamp", "mirror"]
-Filter = Literal["nearest", "bilinear"]
+Filter = Literal["nearest", "bilinear", "cubic"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -87,7 +87,7 @@ class ImageTexture:
         How coordinates outside [0, 1] are mapped (:data:`WRAP_MODES`).
     filter
         The filter the asset asks for (:data:`FILTERS`); the band path reads the nearest texel,
-        so ``bilinear`` is rendered nearest (said once when the scene is read).
+        so ``bilinear`` and ``cubic`` are rendered nearest (said once when the scene is read).
     tiles
         ``(rows, columns)`` copies of the image the renderer's texture holds, so that the
         asset's coordinates outside [0, 1] wrap exactly under ``repeat`` and ``mirror``
