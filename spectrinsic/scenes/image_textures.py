@@ -28,12 +28,14 @@ Untrusted input: an image of more than :data:`IMAGE_TEXELS_MAX` texels (after re
 
 from __future__ import annotations
 
+import base64
 import hashlib
 import io
 import warnings
-from dataclasses import dataclass, field
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 
@@ -51,6 +53,7 @@ __all__ = [
     "decode_texels",
     "image_texture_from_file",
     "image_texture_from_bytes",
+    "image_from_record",
 ]
 
 #: The RGB cube's corners, in the order of the corner weights (R varies fastest).
@@ -95,29 +98,46 @@ class ImageTexture:
     first_tile
         ``(v, u)`` integer index of the first copy (copies with an odd index are flipped under
         ``mirror``).
+    data, srgb, factor
+        The image file's bytes (base64), its encoding and the factor the texels were decoded
+        with (:func:`image_texture_from_bytes`), or ``""`` for texels given in memory. The
+        scene record (``scene.json``) keeps these instead of the texels, which
+        :func:`texture_from_record <spectrinsic.scenes.textures.texture_from_record>` decodes
+        again: a 1024² image is its file's size there, not 67 MB of numbers.
     """
 
     source: str
     sha256: str
-    texels: np.ndarray
+    # an image read from a file is recorded by its bytes (data), the texels derived from them
+    texels: np.ndarray = field(metadata={"omit_when": lambda image: bool(image.data)})
     wrap: Wrap = "repeat"
     filter: Filter = "bilinear"
     tiles: tuple[int, int] = field(default=(1, 1))
     first_tile: tuple[int, int] = field(default=(0, 0))
+    data: str = field(default="", metadata={"omit_default": True})
+    srgb: bool = field(default=False, metadata={"omit_default": True})
+    factor: tuple[float, float, float] = field(
+        default=(1.0, 1.0, 1.0), metadata={"omit_default": True}
+    )
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, ImageTexture):
             return NotImplemented
-        mine = (self.source, self.sha256, self.wrap, self.filter, *self.tiles, *self.first_tile)
-        theirs = (
-            other.source,
-            other.sha256,
-            other.wrap,
-            other.filter,
-            *other.tiles,
-            *other.first_tile,
-        )
-        return mine == theirs and np.array_equal(self.texels, other.texels)
+
+        def key(image: ImageTexture) -> tuple:
+            return (
+                image.source,
+                image.sha256,
+                image.wrap,
+                image.filter,
+                *image.tiles,
+                *image.first_tile,
+                image.data,
+                image.srgb,
+                *image.factor,
+            )
+
+        return key(self) == key(other) and np.array_equal(self.texels, other.texels)
 
     __hash__ = None  # type: ignore[assignment]
 
@@ -275,4 +295,37 @@ def image_texture_from_bytes(
         texels=np.ascontiguousarray(texels[::-1]),  # row 0 at v = 0: the bottom row
         wrap=wrap,
         filter=filter,
+        data=base64.b64encode(data).decode("ascii"),
+        srgb=bool(srgb),
+        factor=(float(factor[0]), float(factor[1]), float(factor[2])),
     )
+
+
+def _pair(values: Any) -> tuple[int, int]:
+    return int(values[0]), int(values[1])
+
+
+def image_from_record(record: Mapping[str, Any]) -> ImageTexture:
+    """The :class:`ImageTexture` of its ``scene_to_dict`` record: decoded again from its file's
+    bytes (checked against its SHA-256), or its texels as written."""
+    source, sha = str(record["source"]), str(record["sha256"])
+    wrap, filt = record.get("wrap", "repeat"), record.get("filter", "bilinear")
+    tiles, first = _pair(record.get("tiles", (1, 1))), _pair(record.get("first_tile", (0, 0)))
+    if not record.get("data"):
+        texels = np.asarray(record["texels"], np.float64)
+        return ImageTexture(source, sha, texels, wrap, filt, tiles, first)
+    data = base64.b64decode(str(record["data"]))
+    if hashlib.sha256(data).hexdigest() != sha:
+        raise SceneError(f"texture {source}: its bytes do not match its SHA-256")
+    r, g, b = (float(c) for c in record.get("factor", (1.0, 1.0, 1.0)))
+    with warnings.catch_warnings():  # said when the asset was read
+        warnings.simplefilter("ignore", SpectrinsicWarning)
+        image = image_texture_from_bytes(
+            data,
+            source=source,
+            srgb=bool(record.get("srgb", False)),
+            wrap=wrap,
+            filter=filt,
+            factor=(r, g, b),
+        )
+    return replace(image, tiles=tiles, first_tile=first)

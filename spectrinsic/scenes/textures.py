@@ -41,6 +41,7 @@ from .image_textures import (
     IMAGE_TEXELS_MAX,
     ImageTexture,
     corner_weights,
+    image_from_record,
 )
 
 __all__ = [
@@ -316,25 +317,13 @@ def make_image_texture(
     return Texture(name, tuple(basis), image_weights(tiled), uv=scaled, image=tiled)
 
 
-def _image_from_record(record: Mapping[str, Any]) -> ImageTexture:
-    return ImageTexture(
-        source=str(record["source"]),
-        sha256=str(record["sha256"]),
-        texels=np.asarray(record["texels"], np.float64),
-        wrap=record.get("wrap", "repeat"),
-        filter=record.get("filter", "bilinear"),
-        tiles=tuple(int(t) for t in record.get("tiles", (1, 1))),  # type: ignore[arg-type]
-        first_tile=tuple(int(t) for t in record.get("first_tile", (0, 0))),  # type: ignore[arg-type]
-    )
-
-
 def texture_from_record(record: Mapping[str, Any]) -> Texture:
     """The :class:`Texture` of its ``scene_to_dict`` record (a recipe, an image, or explicit
     weights)."""
     basis = tuple(int(b) for b in record["basis"])
     uv = None if record.get("uv") is None else np.asarray(record["uv"], np.float64)
     if record.get("image"):
-        image = _image_from_record(record["image"])
+        image = image_from_record(record["image"])
         return Texture(str(record["name"]), basis, image_weights(image), uv=uv, image=image)
     if record.get("pattern"):
         return make_texture(

@@ -137,18 +137,42 @@ def test_too_many_copies_are_refused():
         make_image_texture("t", tuple(range(8)), _image(), uv)
 
 
-def test_an_image_texture_survives_its_scene_record():
-    texture = make_image_texture(
-        "t", tuple(range(8)), _image("mirror"), np.array([[[-1, 0], [1, 0], [1, 1.0]]])
-    )
-    assert texture.image.tiles == (1, 2)
-    scene = Scene(
+def _scene_of(texture) -> Scene:
+    return Scene(
         "s",
         (Mesh("m", np.eye(3), np.array([[0, 1, 2]]), np.zeros(1, np.int64), 0, texture),),
         tuple(Material(name, name) for name in corner_spectra()),
         (),
         Camera((0, 0, 3), (0, 0, 0), (0, 1, 0), 30.0, 8, 8),
     )
-    record = scene_to_dict(scene)
+
+
+def test_an_image_texture_in_memory_survives_its_scene_record():
+    texture = make_image_texture(
+        "t", tuple(range(8)), _image("mirror"), np.array([[[-1, 0], [1, 0], [1, 1.0]]])
+    )
+    assert texture.image.tiles == (1, 2)
+    record = scene_to_dict(_scene_of(texture))
     assert "weights" not in record["meshes"][0]["texture"]  # derived from the texels
-    assert scene_from_dict(record) == scene
+    assert scene_from_dict(record) == _scene_of(texture)
+
+
+def test_a_file_read_image_is_recorded_by_its_bytes_and_checked(tmp_path):
+    """The scene record keeps the image file's bytes (not its texels) and decodes them again;
+    bytes that do not match the recorded SHA-256 are refused."""
+    import base64
+
+    path = _png(tmp_path, np.random.default_rng(4).integers(0, 256, (16, 16, 3)))
+    image = image_texture_from_file(path, root=tmp_path, srgb=True, factor=(0.5, 1.0, 1.0))
+    uv = np.array([[[0, 0], [2, 0], [2, 1.0]]])  # two copies across u
+    with pytest.warns(SpectrinsicWarning, match="bilinear filtering approximated"):
+        texture = make_image_texture("t", tuple(range(8)), image, uv)
+    record = scene_to_dict(_scene_of(texture))
+    kept = record["meshes"][0]["texture"]["image"]
+    assert "texels" not in kept and base64.b64decode(kept["data"]) == path.read_bytes()
+    back = scene_from_dict(record)
+    assert back == _scene_of(texture)
+    np.testing.assert_array_equal(back.meshes[0].texture.weights, texture.weights)
+    kept["data"] = base64.b64encode(b"\x89PNG tampered").decode()
+    with pytest.raises(SceneError, match="do not match its SHA-256"):
+        scene_from_dict(record)
