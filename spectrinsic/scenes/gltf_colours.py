@@ -78,6 +78,8 @@ def _texture(path: Path, doc: dict[str, Any], binary: bytes, ref: Any, factor: A
         sampler = (
             (doc.get("samplers") or [{}])[int(texture["sampler"])] if "sampler" in texture else {}
         )
+    except SceneError:
+        raise
     except (KeyError, IndexError, TypeError, ValueError) as exc:
         raise SceneError(
             f"{path}: baseColorTexture {ref!r} names nothing readable ({exc!r})"

@@ -176,3 +176,24 @@ def test_a_file_read_image_is_recorded_by_its_bytes_and_checked(tmp_path):
     kept["data"] = base64.b64encode(b"\x89PNG tampered").decode()
     with pytest.raises(SceneError, match="do not match its SHA-256"):
         scene_from_dict(record)
+
+
+def test_a_gltf_image_outside_its_folder_is_refused_in_one_line(tmp_path):
+    """A ``.gltf`` whose image URI leads out of its folder: refused before any pixel is read."""
+    import json
+
+    from spectrinsic.scenes.gltf_colours import gltf_colours
+
+    document = {
+        "asset": {"version": "2.0"},
+        "images": [{"uri": "../outside.png"}],
+        "textures": [{"source": 0}],
+        "materials": [{"name": "m", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+    }
+    inside = tmp_path / "asset"
+    inside.mkdir()
+    _png(tmp_path, np.zeros((2, 2, 3)), "outside.png")
+    (inside / "a.gltf").write_text(json.dumps(document))
+    with pytest.raises(SceneError, match="'../outside.png' is not a file inside") as info:
+        gltf_colours(inside / "a.gltf")
+    assert "\n" not in str(info.value) and "SceneError(" not in str(info.value)
