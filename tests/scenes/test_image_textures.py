@@ -197,3 +197,23 @@ def test_a_gltf_image_outside_its_folder_is_refused_in_one_line(tmp_path):
     with pytest.raises(SceneError, match="'../outside.png' is not a file inside") as info:
         gltf_colours(inside / "a.gltf")
     assert "\n" not in str(info.value) and "SceneError(" not in str(info.value)
+
+
+def test_mtl_colours_kd_alone_and_refusals(tmp_path):
+    from spectrinsic.scenes.mtl_colours import mtl_colours
+
+    obj = tmp_path / "a.obj"
+    obj.write_text("mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    mtl = tmp_path / "a.mtl"
+    mtl.write_text("newmtl paint\nKd 0.25 0.5 0.75\nnewmtl bare\n")
+    colours = mtl_colours(obj)
+    assert colours["paint"].spectrum == "rgb:0.25,0.5,0.75" and "bare" not in colours
+    for body, message in (
+        ("newmtl t\nmap_Kd -s 2 2 1 t.png\n", "map_Kd option '-s' is not supported"),
+        ("newmtl t\nmap_Kd ../t.png\n", "'../t.png' is not a file inside"),
+        ("newmtl t\nKd 1 x 1\n", "expected three numbers"),
+    ):
+        mtl.write_text(body)
+        with pytest.raises(SceneError, match=message) as info:
+            mtl_colours(obj)
+        assert "\n" not in str(info.value)
