@@ -275,7 +275,8 @@ class _MaterialTable:
                 spectrum,
                 "reflectance",
                 f"name the material after a spectrum, set its custom property {SPECTRUM_PROPERTY!r}, "
-                f"or pass materials={{{name!r}: ...}}",
+                f"or pass materials={{{name!r}: ...}} (--material-map, --default-spectrum; "
+                "--colours-from-asset reads a Base Color or image texture)",
                 self.data_dir,
             )
             self.table[name] = Material(name=name, spectrum=spectrum, **gloss)
