@@ -9,7 +9,7 @@ from spectrinsic.cli import build_parser, main
 from spectrinsic.cli.dataset_layers import LAYER_OPTIONS
 from spectrinsic.scenes import build, save_scene
 
-LAYERS = ["--camera", "nikon-d5100-npl", "--spectral-layers", "--working-space", "rec2020"]
+LAYERS = ["--camera", "nikon-5100-npl", "--spectral-layers", "--working-space", "rec2020"]
 
 
 def _options(verb: str) -> set[str]:

@@ -23,7 +23,7 @@ SLUG = "nikon-5100-npl"
 
 def _export(tmp_path, sample, config, *, sample_id="s", seed=1, **changes):
     scene, result = sample
-    model = camera_model("nikon-d5100-npl").with_options(black_level_dn=600, **changes)
+    model = camera_model("nikon-5100-npl").with_options(black_level_dn=600, **changes)
     return export_sample(
         tmp_path, scene, result, sample_id=sample_id, config=config, seed=seed, camera=model
     )
@@ -55,7 +55,7 @@ def test_sensor_sample_is_complete_and_its_identity_holds(tmp_path, two_light_sa
     } in meta["identities"]
     stages = meta["sensor"]["stages"]
     assert stages["tone_curve"]["applied_to_ground_truth"] is False
-    assert model_from_meta(meta) == camera_model("nikon-d5100-npl").with_options(black_level_dn=600)
+    assert model_from_meta(meta) == camera_model("nikon-5100-npl").with_options(black_level_dn=600)
     assert (folder / f"sensor-{SLUG}.png").is_file()
     loaded = load_sample(folder)  # the loader returns the raw and processed images too
     assert loaded[f"raw_sensor/{KEY}"].shape == loaded["image"].shape[:2]

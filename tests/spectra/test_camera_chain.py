@@ -246,7 +246,7 @@ def test_tone_curve_is_the_srgb_encoding():
 
 
 def test_presets_and_bad_models():
-    assert camera_model("nikon-d5100-npl") is CAMERA_PRESETS["nikon-d5100-npl"]
+    assert camera_model("nikon-5100-npl") is CAMERA_PRESETS["nikon-5100-npl"]
     for preset in CAMERA_PRESETS.values():
         fields = " ".join(k for k, _ in preset.sources)
         assert "sensitivities" in fields and "read_noise_e" in fields and "full_well_e" in fields
