@@ -78,8 +78,9 @@ class CameraModel:
         The ISO used and the sensor's base ISO: the gain in e⁻/DN is
         ``gain_e_per_dn · iso_base / iso`` (analogue gain; read noise in electrons kept).
     exposure_target
-        Fraction of the full well the 99th percentile of the clean camera image reaches (an
-        auto exposure); used when ``electrons_per_unit`` is ``None``.
+        Fraction of the full well the metered luminance reaches (an auto exposure, as a camera
+        meters: :func:`spectrinsic.spectra.camera_chain.exposure_scale`); 0.18, middle grey, by
+        default. Used when ``electrons_per_unit`` is ``None``.
     electrons_per_unit
         A fixed exposure instead: electrons per unit of the camera image (render units), i.e.
         the product of shutter time, aperture area and quantum efficiency for this render.
@@ -117,7 +118,7 @@ class CameraModel:
     cfa: str = "RGGB"
     iso: float = 100.0
     iso_base: float = 100.0
-    exposure_target: float = 0.5
+    exposure_target: float = 0.18
     electrons_per_unit: float | None = None
     exposure_time_s: float = 0.01
     dark_current_e_per_s: float = 0.0
