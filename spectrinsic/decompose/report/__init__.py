@@ -20,6 +20,7 @@ from ..evaluation.scores import INPUT_LAYERS, SCORED_LAYERS, Score, condition_gr
 from ..metrics import METRICS
 from .figure import SUMMARY_FIGURE, summary_heatmap
 from .markdown import Column, glossary_section, markdown_table
+from .sensor import sensor_md, sensor_table
 from .tables import (
     COLOUR_COLUMNS,
     GROUP_ORDER,
@@ -210,6 +211,7 @@ def _report_md(
             "",
         ]
     md += _scenario_md(tables["scenario"])
+    md += sensor_md(tables["sensor"])
     md += _methods_md(methods)
     md += ["## Files", ""] + [f"* `{p.name}`" for p in files.values()]
     md += [f"* `{SUMMARY_FIGURE}`"] if summary else []
@@ -332,6 +334,7 @@ def write_report(
         "lmse": condition_table(scores, samples, columns=LMSE_COLUMNS),
         "colour": condition_table(scores, samples, columns=COLOUR_COLUMNS),
         "scenario": scenario_table(scores),
+        "sensor": sensor_table(scores),
         "t32": table_3_2(scores, samples),
     }
     files.update(_summary_files(out, tables["summary"]))
