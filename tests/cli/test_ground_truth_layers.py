@@ -3,6 +3,8 @@ shared option group, and builds the same files as ``dataset --scenes`` of the sa
 
 from __future__ import annotations
 
+import json
+
 import pytest
 
 from spectrinsic.cli import build_parser, main
@@ -37,6 +39,13 @@ def test_render_ground_truth_equals_dataset_scenes_byte_for_byte(tmp_path):
     assert {"spectral.exr", "sensor-nikon-5100-npl.exr"} <= names  # the layers were asked for
     different = [p for p in files_a if (a / p).read_bytes() != (b / p).read_bytes()]
     assert different == []
+    # the gallery's camera-chain panel: the sensor layers in the order light goes through them
+    (entry,) = json.loads((a / "gallery.json").read_text())["samples"]
+    panel = [name.split("/")[0] for name, _ in entry["sensor"]["layers"]]
+    assert panel[:3] == ["raw_sensor", "image_sensor_noisy", "processed_sensor"]
+    assert (
+        entry["sensor"]["camera"] == "nikon-5100-npl" and entry["sensor"]["electrons_per_unit"] > 0
+    )
 
 
 @pytest.mark.parametrize("option", [["--camera", "nikon-d3"], ["--spectral-layers"]])
