@@ -107,3 +107,14 @@ def test_percentages_are_written_for_people():
         "0.0123 %",
         "0 %",
     ]
+
+
+def test_load_dataset_takes_a_split_like_torch_dataset(acescg_set):
+    from spectrinsic.errors import DatasetError
+    from spectrinsic.gt_export import load_dataset
+
+    data, _ = acescg_set
+    loaded = [s["meta"]["sample_id"] for s in load_dataset(data, split="train", verify=False)]
+    assert loaded == ["obj-cup__v0__file"]
+    with pytest.raises(DatasetError, match="val"):  # a 1-scene set has no val scene
+        list(load_dataset(data, split="val"))
