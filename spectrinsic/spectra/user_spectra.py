@@ -19,10 +19,12 @@ Registry families (:func:`spectrinsic.spectra.get_spectrum`):
   spectral primary decomposition, ``ρ(λ) = R b_R(λ) + G b_G(λ) + B b_B(λ)`` with colour-science's
   ``MSDS_BASIS_FUNCTIONS_sRGB_MALLETT2019``: a non-negative mix of three fixed spectra summing
   to about one, so it stays in [0, 1]. Colours outside the sRGB gamut (a channel outside
-  [0, 1]) are refused, not clipped. Round trip: the spectrum's linear sRGB under D65
-  (colour-science, CIE 1931 2°, on the basis' 5 nm grid) differs from the input by at most
-  2.4e-4 on an 11³ grid of the sRGB cube (measured; ``tests/spectra/test_user_spectra.py``
-  checks 1e-3 on a 5³ grid).
+  [0, 1]) are refused, not clipped. Round trip: the spectrum's linear sRGB under D65 differs
+  from the input by at most 1.2e-3 over an 11³ grid of the sRGB cube (which holds the
+  primaries), worst at the blue primary ``rgb:0,0,1``, on spectrinsic's own 1 nm colorimetry
+  (the ``reflectance`` layer's: the basis interpolated to 1 nm); colour-science's integration
+  on the basis' 5 nm grid gives 2.4e-4 there (measured; ``tests/spectra/test_user_spectra.py``
+  checks both, the first on the primaries).
 
 Every file spectrum is checked before any work: finite numbers, strictly increasing
 wavelengths covering :data:`REQUIRED_RANGE`, reflectances in [0, 1]; errors name the file, the
