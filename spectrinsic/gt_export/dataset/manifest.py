@@ -22,6 +22,7 @@ from ...errors import DatasetError, SampleMetaError
 from ...provenance import software_versions
 from ...rng import seed_from_key
 from ...scenes.material_labels import label_spectrum
+from ..formats.exr import DEFAULT_COMPRESSION
 from ..layers.spectral_intrinsics import residual_summary
 from ..sample import (
     FORMAT_VERSION,
@@ -37,6 +38,7 @@ from ..sample import (
 from ..sample.integrity import guarded_write
 from ..sample.json_fields import JsonFields, load_json
 from ..sample.meta import SampleMeta, read_meta
+from ..sample.transport_exr import COMPACT_LAYOUT, TRANSPORT_COMPRESSION, TRANSPORT_NAME
 from ..sample.working_view import space_of
 
 __all__ = [
@@ -138,6 +140,13 @@ def write_manifest(
         "noise": noise_summary(metas),
         "residual_share": residual_summary([m.raw for m in metas]),
         "working_space": working_spaces(metas),
+        "storage": {
+            "exr_compression": {
+                "*.exr": DEFAULT_COMPRESSION,
+                TRANSPORT_NAME: TRANSPORT_COMPRESSION,
+            },
+            "transport_layout": COMPACT_LAYOUT,
+        },
         "split_by": "scene",
         "split_fractions": dict(split_fractions),
         "splits": splits_by_scene({m.sample_id: m.scene for m in metas}, split_fractions),
