@@ -106,10 +106,38 @@ def table(rows: list[dict[str, object]]) -> str:
     return "\n".join(lines)
 
 
+def summary(rows: list[dict[str, object]]) -> str:
+    """Markdown: objects x variants, each cell "after (after / IaR)"; means before and after."""
+    lmse = {(r["variant"], r["object"], r["method"]): float(r["lmse"]) for r in rows}  # type: ignore[arg-type]
+    variants = [v for v in VARIANTS if any(r["variant"] == v for r in rows)]
+    objects = sorted({str(r["object"]) for r in rows})
+    lines = [
+        "| object | " + " | ".join(variants) + " |",
+        "|---|" + "---|" * len(variants),
+    ]
+    for name in objects:
+        cells = []
+        for v in variants:
+            if (v, name, "after") not in lmse:
+                cells.append("")
+                continue
+            ratio = lmse[(v, name, "after")] / lmse[(v, name, "image-as-reflectance")]
+            mark = "**" if ratio > BOUND else ""
+            cells.append(f"{mark}{lmse[(v, name, 'after')]:.4f} ({ratio:.2f}){mark}")
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    for method in ("after", "before", "image-as-reflectance"):
+        means = []
+        for v in variants:
+            vals = [lmse[(v, o, method)] for o in objects if (v, o, method) in lmse]
+            means.append(f"{sum(vals) / len(vals):.4f}" if vals else "")
+        lines.append(f"| mean {method} | " + " | ".join(means) + " |")
+    return "\n".join(lines)
+
+
 def main(argv: list[str]) -> int:
     if len(argv) >= 2 and argv[0] == "--table":
         rows = [r for p in argv[2:] for r in json.loads(Path(p).read_text(encoding="utf-8"))]
-        Path(argv[1]).write_text(table(rows) + "\n", encoding="utf-8")
+        Path(argv[1]).write_text(summary(rows) + "\n\n" + table(rows) + "\n", encoding="utf-8")
         return 0
     if len(argv) < 2:
         print(
