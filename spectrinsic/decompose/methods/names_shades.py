@@ -50,6 +50,10 @@ all of them off):
 * ``merge_shading``: touching regions whose shared boundary is mostly Case C (one ridge, step
   along it: shading) are one region (:mod:`spectrinsic.decompose.methods.shade_cases`);
 * ``pale_vs_chromatic``: white/grey-to-chromatic name edges are Case A (a white light's shading);
+* ``sharp_edges="achromatic"``: sharp, high-contrast edges between achromatic names are Case A
+  (the Retinex cue where the colour cues are silent; :mod:`spectrinsic.decompose.methods.
+  sharp_edges`), and ``collapse_guard``: a collapsed result is re-solved or replaced
+  (:mod:`spectrinsic.decompose.methods.collapse`; docs/names-shades-mit.md, round 5);
 * ``colour_constancy``, ``gamma=3`` (the thesis gives only ratios; ``gamma_over_alpha=100``
   and ``gamma_over_beta=2`` are the thesis' own), the cut's angle and the RAD parameters the
   thesis does not state (``creaseness=1.5``, ``sigma=2`` bins) chosen by :data:`PROTOCOL`
@@ -224,11 +228,12 @@ class NamesAndShades:
         Edges between a white/grey name and a chromatic one are Case A whatever the ridges say
         (:func:`spectrinsic.decompose.methods.shade_cases.split_pale_from_chromatic`).
     sharp_edges
-        Sharp, high-contrast edges (1-2 px, half an achromatic name in one pixel) are Case A:
+        Sharp, high-contrast edges (1-2 px, one achromatic name step in one pixel) are Case A:
         ``"achromatic"`` those between two achromatic names (default), ``"all"`` every one,
         ``"none"`` none (:mod:`spectrinsic.decompose.methods.sharp_edges`).
     collapse_guard
-        A result whose reflectance lost most of the image's sharp contrast is re-solved with
+        A result whose reflectance lost almost all (more than 90 %) of the image's sharp,
+        high-contrast steps is re-solved with
         ``sharp_edges="all"``, else replaced by colour Retinex; ``info["collapse"]`` says which
         (:mod:`spectrinsic.decompose.methods.collapse`).
     global_coherence
