@@ -136,7 +136,19 @@ def summary(rows: list[dict[str, object]]) -> str:
 
 def main(argv: list[str]) -> int:
     if len(argv) >= 2 and argv[0] == "--table":
-        rows = [r for p in argv[2:] for r in json.loads(Path(p).read_text(encoding="utf-8"))]
+        if Path(argv[1]).exists():
+            print(f"mit_stress.py: {argv[1]} exists; expected a new file", file=sys.stderr)
+            return 2
+        rows = []
+        for part in argv[2:]:
+            try:
+                rows += json.loads(Path(part).read_text(encoding="utf-8"))
+            except (OSError, ValueError) as exc:
+                print(
+                    f"mit_stress.py: {part}: {exc} (expected a JSON file this script wrote)",
+                    file=sys.stderr,
+                )
+                return 2
         Path(argv[1]).write_text(summary(rows) + "\n\n" + table(rows) + "\n", encoding="utf-8")
         return 0
     if len(argv) < 2:
