@@ -25,6 +25,7 @@ def load_scene_argument(
     default_spectrum: str | None = None,
     data_dir: str | None = None,
     colours_from_asset: bool = False,
+    approximate: bool = False,
 ) -> Scene:
     """The Scene named by the ``SCENE`` argument: a scene file (YAML, ``.blend`` or mesh,
     :func:`spectrinsic.scenes.sources.load_scene_file`, the dispatch ``dataset --scenes`` uses),
@@ -38,6 +39,7 @@ def load_scene_argument(
             default_spectrum=default_spectrum,
             data_dir=data_dir,
             colours_from_asset=colours_from_asset,
+            approximate=approximate,
         )
     default = get_preset("default")
     return library.build(

@@ -267,6 +267,8 @@ def _check_lights(scene: Scene, source: str) -> None:
                 raise _fail(
                     source, f"{where}.size", f"expected (width, height) > 0, got {light.size!r}"
                 )
+        if "radius" in uses and not (math.isfinite(light.radius) and light.radius > 0):
+            raise _fail(source, f"{where}.radius", f"expected a radius > 0, got {light.radius!r}")
         if "cutoff_deg" in uses and not 0 < light.cutoff_deg <= 90:
             raise _fail(
                 source,
