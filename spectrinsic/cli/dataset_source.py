@@ -359,6 +359,7 @@ def check_scene_files(config: Any, data_dir: str | None, *, quiet: bool = False)
         if not quiet:
             for note in xml_notes(scene):
                 print(f"spectrinsic dataset: {note}", file=sys.stderr)
-            line = render_hints_line(scene, config.render.spp, config.render.max_depth)
+            given = f"the dataset's settings (preset {config.preset!r} and options)"
+            line = render_hints_line(scene, config.render.spp, config.render.max_depth, given)
             if line is not None:
-                print(f"spectrinsic dataset: {line} (preset {config.preset!r})", file=sys.stderr)
+                print(f"spectrinsic dataset: {line}", file=sys.stderr)

@@ -62,13 +62,13 @@ def _unsupported(node: XmlNode, what: str, say: Say, instead: str) -> None:
             f"{what}: {node.label()} has no exact ground truth yet; refused "
             f"(--approximate: {instead})"
         )
-    say(f"{what}: {node.label()} approximated: {instead}")
+    say(f"{what}: {node.label()} {instead}")
 
 
 def _colour(node: XmlNode, key: str, what: str, base: Path, say: Say) -> str:
     value: Value | None = node.props.get(key)
     if isinstance(value, XmlNode) and value.plugin == "bitmap":
-        _unsupported(value, f"{what} {key}", say, "a uniform 0.5 reflectance")
+        _unsupported(value, f"{what} {key}", say, "replaced by a uniform 0.5 reflectance")
         return "flat:0.5"
     return reflectance_name(value, f"{what} {key}", base)
 
@@ -84,7 +84,7 @@ def _unit_specular(node: XmlNode, what: str, say: Say) -> None:
                 f"{what}: specular_reflectance {shown!r} in {node.label()}; only 1 has exact "
                 "ground truth (--approximate would use 1)"
             )
-        say(f"{what}: {node.label()} specular_reflectance {shown!r} approximated by 1")
+        say(f"{what}: {node.label()} specular_reflectance {shown!r} taken as 1")
 
 
 def _inner(node: XmlNode, what: str) -> XmlNode:
@@ -106,12 +106,12 @@ def material_of(node: XmlNode, what: str, base: Path, say: Say) -> Material | No
     name = node.id if node.id and not node.id.startswith("_unnamed") else ""
     while node.plugin == "twosided" or node.plugin in WRAPPERS:
         if node.plugin in WRAPPERS:
-            _unsupported(node, what, say, "the BSDF it wraps")
+            _unsupported(node, what, say, "replaced by the BSDF it wraps")
         node = _inner(node, what)
         name = name or (node.id if not node.id.startswith("_unnamed") else "")
     kind = node.plugin
     if kind in GLASS:
-        _unsupported(node, what, say, "the shape left out")
+        _unsupported(node, what, say, "left out with its shape")
         return None
     if kind not in _PARAMS:
         raise SceneError(
@@ -134,7 +134,7 @@ def material_of(node: XmlNode, what: str, base: Path, say: Say) -> Material | No
                 f"{what}: distribution {shown} in {node.label()}; only ggx has exact ground "
                 "truth (--approximate would use ggx of the same alpha)"
             )
-        say(f"{what}: {node.label()} distribution {shown} approximated by ggx of the same alpha")
+        say(f"{what}: {node.label()} distribution {shown} taken as ggx of the same alpha")
     if kind == "diffuse":
         spectrum = _colour(node, "reflectance", what, base, say)
         return Material(name or spectrum, spectrum)

@@ -72,7 +72,7 @@ class _Reading:
                 f"{where}: {node.label()} has no exact ground truth yet; refused "
                 f"(--approximate: {what} left out)"
             )
-        self.approximated.append(f"{where}: {node.label()} left out")
+        self.approximated.append(f"{where}: {node.label()} left out")  # the refusal says what
 
 
 def _vec(value: Any) -> tuple[float, float, float]:
@@ -336,25 +336,27 @@ def xml_notes(scene: Scene) -> list[str]:
     ``scene.metadata``; empty for other scenes), for stderr."""
     meta = scene.metadata
     return [
-        f"{meta.get('source', scene.name)}: {what} {phrase}"
+        f"{meta.get('source', scene.name)}: {what}: {phrase}"
         for what in ("fixed", "approximated", "ignored")
         for phrase in meta.get(what, ())
     ]
 
 
-def render_hints_line(scene: Scene, spp: int | None, max_depth: int | None) -> str | None:
+def render_hints_line(
+    scene: Scene, spp: int | None, max_depth: int | None, given: str = "the command line"
+) -> str | None:
     """The line saying which spp and path depth apply to a Mitsuba XML scene: the file's
-    (``sample_count``, ``max_depth``) unless the command line gave *spp* / *max_depth*;
-    ``None`` when the file gives neither."""
+    (``sample_count``, ``max_depth``) unless *given* (the command line, a dataset's settings)
+    sets *spp* / *max_depth*; ``None`` when the file gives neither."""
     hints = scene.metadata.get("render_hints") or {}
     if not hints:
         return None
     parts = []
-    for key, label, given in (("spp", "spp", spp), ("max_depth", "max depth", max_depth)):
+    for key, label, value in (("spp", "spp", spp), ("max_depth", "max depth", max_depth)):
         if key in hints:
             parts.append(
                 f"{label} {hints[key]} from the file"
-                if given is None
-                else f"{label} {given} from the command line (the file says {hints[key]})"
+                if value is None
+                else f"{label} {value} from {given} (the file says {hints[key]})"
             )
     return f"{scene.name}: " + ", ".join(parts)
