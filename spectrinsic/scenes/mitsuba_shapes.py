@@ -1,7 +1,7 @@
 """Mitsuba XML shapes as triangles, counted before any is built.
 
-Every shape Mitsuba loads: ``obj`` and ``ply`` (read by trimesh), ``serialized`` (Mitsuba's
-own reader on that one built-in shape, ``shape_index`` kept), ``rectangle``, ``cube``,
+Every shape Mitsuba loads: ``obj``, ``ply`` and ``serialized`` (``shape_index``) read by
+Mitsuba's own loader of that one built-in shape (the triangles Mitsuba renders; fast C++), ``rectangle``, ``cube``,
 ``disk``, ``sphere`` (``center``, ``radius``) and ``cylinder`` (``p0``, ``p1``, ``radius``;
 tessellated, :mod:`~spectrinsic.scenes.mitsuba_parts`), each with its ``to_world`` and
 ``flip_normals``; ``shapegroup`` and ``instance`` (each instance is a copy of its group's
@@ -21,7 +21,6 @@ import struct
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -29,7 +28,7 @@ from ..errors import SceneError
 from . import mitsuba_parts as parts
 from .meshes import MAX_FACES, MAX_VERTICES, check_mesh_size, mesh_counts
 from .mitsuba_files import confined_file
-from .mitsuba_tree import XmlNode, serialized_mesh
+from .mitsuba_tree import XmlNode, mesh_file
 
 __all__ = ["BUILT_IN", "FILE_SHAPES", "Placed", "occurrences", "check_budget", "triangles"]
 
@@ -162,17 +161,13 @@ def check_budget(placed: list[Placed], base: Path) -> None:
 
 
 def _mesh_file(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray]:
-    import trimesh
-
     path = _file(p, base)
-    if p.node.plugin == "serialized":
-        return serialized_mesh(str(path), p.node.integer("shape_index", 0))
-    check_mesh_size(path)
+    if p.node.plugin != "serialized":
+        check_mesh_size(path)
     try:
-        mesh: Any = trimesh.load(str(path), force="mesh", process=False)
-    except Exception as exc:  # noqa: BLE001 - trimesh raises many types for corrupt files
-        raise SceneError(f"{p.where}: cannot read {path.name!r} ({type(exc).__name__})") from None
-    return np.asarray(mesh.vertices, float), np.asarray(mesh.faces, np.int64)
+        return mesh_file(p.node.plugin, str(path), p.node.integer("shape_index", 0))
+    except SceneError as exc:
+        raise SceneError(f"{p.where}: {exc}") from None
 
 
 def _local(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray]:

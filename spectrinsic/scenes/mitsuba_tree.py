@@ -16,13 +16,14 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import Any, Union
 
 import numpy as np
 
 from ..errors import SceneError
 
-__all__ = ["Spectrum", "Value", "XmlNode", "ParsedXml", "parse_xml", "serialized_mesh"]
+__all__ = ["Spectrum", "Value", "XmlNode", "ParsedXml", "parse_xml", "mesh_file"]
 
 
 @dataclass(frozen=True)
@@ -225,14 +226,24 @@ def _order(mi: Any, state: Any) -> list[int]:
     return out
 
 
-def serialized_mesh(path: str, index: int) -> tuple[np.ndarray, np.ndarray]:
-    """Vertices ``(V, 3)`` and faces ``(F, 3)`` of mesh *index* of a Mitsuba ``.serialized``
-    file, read by Mitsuba's own plugin (one built-in shape; the caller checked the file)."""
+def mesh_file(plugin: str, path: str, index: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices ``(V, 3)`` and faces ``(F, 3)`` of an ``obj``, ``ply`` or ``serialized``
+    (mesh *index*) file, read by Mitsuba's own loader of that one built-in shape (the caller
+    checked the file and its declared size): the triangles Mitsuba would render."""
     import mitsuba as mi
 
     if mi.variant() is None:
         mi.set_variant("scalar_rgb")
-    shape: Any = mi.load_dict({"type": "serialized", "filename": path, "shape_index": index})
+    spec: dict[str, Any] = {"type": plugin, "filename": path}
+    if plugin == "serialized":
+        spec["shape_index"] = index
+    try:
+        shape: Any = mi.load_dict(spec)
+    except RuntimeError as exc:
+        message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise SceneError(
+            f"cannot read {Path(path).name!r} ({message.split('] ', 1)[-1]})"
+        ) from None
     params = mi.traverse(shape)
     v = np.array(params["vertex_positions"], dtype=np.float64).reshape(-1, 3)
     return v, np.array(params["faces"], dtype=np.int64).reshape(-1, 3)
