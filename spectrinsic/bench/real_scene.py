@@ -40,7 +40,8 @@ MEMORY_GOAL_BYTES = 2 * 1024**3
 
 def _box_obj(grid: int) -> str:
     """An OBJ box [-1, 1]³ with each face split into *grid* × *grid* quads (two triangles each)."""
-    lines, faces = [], []
+    lines: list[str] = []
+    faces: list[str] = []
     t = np.linspace(-1.0, 1.0, grid + 1)
     for axis in range(3):
         for sign in (-1.0, 1.0):
