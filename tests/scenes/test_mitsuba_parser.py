@@ -324,3 +324,34 @@ def test_approximate_is_said_and_recorded_in_the_samples_meta(tmp_path, capsys):
     (meta_path,) = out.glob("**/meta.json")
     record = json.loads(meta_path.read_text())["scene_metadata"]
     assert record["approximate"] is True and "bumpmap" in record["approximated"][0]
+
+
+def _serialized(meshes) -> bytes:
+    """A Mitsuba ``.serialized`` file (format 4, single precision) holding *meshes*, written
+    by hand from the format's description: per mesh a header and a zlib stream (flags, name,
+    counts, positions, indices), then the table of mesh offsets and their count."""
+    import struct
+    import zlib
+
+    out, offsets = b"", []
+    for v, f in meshes:
+        offsets.append(len(out))
+        body = struct.pack("<I", 0x1000) + b"part\0" + struct.pack("<QQ", len(v), len(f))
+        body += np.asarray(v, "<f4").tobytes() + np.asarray(f, "<u4").tobytes()
+        out += struct.pack("<HH", 0x041C, 4) + zlib.compress(body)
+    return out + b"".join(struct.pack("<Q", o) for o in offsets) + struct.pack("<I", len(meshes))
+
+
+def test_a_serialized_mesh_is_read_by_index_and_counted_from_its_header(tmp_path):
+    tri = ([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
+    quad = ([[0, 0, 0.5], [0.4, 0, 0.5], [0.4, 0.4, 0.5], [0, 0.4, 0.5]], [[0, 1, 2], [0, 2, 3]])
+    (tmp_path / "parts.serialized").write_bytes(_serialized([tri, quad]))
+    shape = '<shape type="serialized" id="lid"><string name="filename" value="parts.serialized"/>'
+    shape += '<integer name="shape_index" value="1"/></shape>'
+    scene = load_mitsuba_xml(_write(tmp_path, _scene(LAMP + shape)))
+    lid = {m.name: m for m in scene.meshes}["lid"]
+    np.testing.assert_allclose(
+        lid.vertices[lid.faces].reshape(-1, 3), np.asarray(quad[0])[[0, 1, 2, 0, 2, 3]]
+    )
+    with pytest.raises(SceneError, match="shape_index 2; the file holds 2 meshes"):
+        load_mitsuba_xml(_write(tmp_path, _scene(LAMP + shape.replace('value="1"', 'value="2"'))))
