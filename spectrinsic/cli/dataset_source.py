@@ -15,6 +15,7 @@ from typing import Any
 from ..errors import DatasetError, SceneError, SpectrinsicError
 from ..pipeline.presets import DatasetConfig
 from ..pipeline.source_plan import file_sample, files_source, generator_source
+from ..render.base.variants import import_mitsuba
 from ..scenes.generators import GlossDistribution
 from ..scenes.generators.world_defaults import GLOSSY_FRACTION, METALLIC_FRACTION, TEXTURE_FRACTION
 from ..scenes.mitsuba_xml import render_hints_line, xml_notes
@@ -346,6 +347,7 @@ def check_scene_files(config: Any, data_dir: str | None, *, quiet: bool = False)
         except SpectrinsicError as exc:
             raise DatasetError(f"{option} {name!r}: {exc}") from exc
     width, height = spec.get("resolution") or (None, None)
+    import_mitsuba()  # set up before a Mitsuba XML read imports it (the libLLVM Dr.Jit loads)
     for entry in spec["scenes"]:
         scene = FileSource(
             entry["path"],

@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from ..pipeline.presets import get_preset
+from ..render.base.variants import import_mitsuba
 from ..scenes import library
 from ..scenes.model import Scene
 from ..scenes.sources import is_scene_file, load_scene_file
@@ -31,6 +32,7 @@ def load_scene_argument(
     :func:`spectrinsic.scenes.sources.load_scene_file`, the dispatch ``dataset --scenes`` uses),
     else a library scene at the default preset's size unless *width*/*height* say otherwise."""
     if is_scene_file(scene):
+        import_mitsuba()  # set up before a Mitsuba XML read imports it (the libLLVM Dr.Jit loads)
         return load_scene_file(
             scene,
             width=width,

@@ -83,10 +83,9 @@ def cylinder(p0: np.ndarray, p1: np.ndarray, radius: float) -> tuple[np.ndarray,
     return verts, faces
 
 
-#: Faces each built-in shape has (the scene budget counts them before building any).
 def faces_of(plugin: str) -> int:
     """Triangles :func:`rectangle`, :func:`cube`, :func:`disk`, :func:`sphere` or
-    :func:`cylinder` makes."""
+    :func:`cylinder` makes (the scene budget counts them before building any)."""
     rings = SEGMENTS // 2
     return {
         "rectangle": 2,

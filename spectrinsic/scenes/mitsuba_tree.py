@@ -10,6 +10,10 @@ nodes into :class:`XmlNode` records and makes the usual fixes Mitsuba's upgrade 
 
 The XML text comes from :func:`~spectrinsic.scenes.mitsuba_files.prepare_xml` (includes
 inlined, files checked), so the parser reads no file.
+
+Mitsuba is imported as found: a caller that renders in the same process sets it up first with
+:func:`spectrinsic.render.base.variants.import_mitsuba` (the command line and the dataset
+workers do), so that Dr.Jit loads the ``libLLVM`` spectrinsic chose.
 """
 
 from __future__ import annotations
