@@ -231,9 +231,9 @@ def _order(mi: Any, state: Any) -> list[int]:
 
 
 def mesh_file(plugin: str, path: str, index: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """Vertices ``(V, 3)`` and faces ``(F, 3)`` of an ``obj``, ``ply`` or ``serialized``
-    (mesh *index*) file, read by Mitsuba's own loader of that one built-in shape (the caller
-    checked the file and its declared size): the triangles Mitsuba would render."""
+    """Vertices ``(V, 3)`` and faces ``(F, 3)`` of a mesh file (a ``serialized`` file's mesh
+    *index*), read by Mitsuba's own loader of that one built-in shape (the caller checked the
+    file and its declared size). Positions come back as Mitsuba stores them, float32."""
     import mitsuba as mi
 
     if mi.variant() is None:

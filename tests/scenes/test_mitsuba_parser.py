@@ -355,3 +355,17 @@ def test_a_serialized_mesh_is_read_by_index_and_counted_from_its_header(tmp_path
     )
     with pytest.raises(SceneError, match="shape_index 2; the file holds 2 meshes"):
         load_mitsuba_xml(_write(tmp_path, _scene(LAMP + shape.replace('value="1"', 'value="2"'))))
+
+
+def test_approximate_needs_an_xml_scene_among_the_dataset_files(tmp_path):
+    import json
+
+    from spectrinsic.errors import DatasetError
+    from spectrinsic.pipeline.source_plan import files_source
+
+    yaml_scene = _write(tmp_path, "name: x\n", "x.yaml")
+    with pytest.raises(DatasetError, match="--approximate applies to Mitsuba XML scenes"):
+        files_source([yaml_scene], approximate=True)
+    spec = json.loads(files_source([_write(tmp_path, _scene(LAMP))], approximate=True))
+    assert spec["approximate"] is True
+    assert "approximate" not in json.loads(files_source([_write(tmp_path, _scene(LAMP))]))
