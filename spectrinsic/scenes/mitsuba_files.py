@@ -6,7 +6,8 @@ A scene file is untrusted. Before Mitsuba's parser sees it (:mod:`~spectrinsic.s
 - refuses a scene file that is not a regular file (a FIFO would hang the read), one over
   :data:`MAX_XML_BYTES`, and DOCTYPE or ENTITY declarations (entity bombs);
 - inlines every ``<include filename=...>`` itself (at most :data:`MAX_INCLUDES` files, nested at
-  most :data:`MAX_INCLUDE_DEPTH` deep), so the parser reads no file;
+  most :data:`MAX_INCLUDE_DEPTH` deep, :data:`MAX_TOTAL_XML_BYTES` in all), so the parser
+  reads no file;
 - reads every ``<spectrum filename=...>`` (a Mitsuba ``.spd`` file) into written-out samples;
 - checks every other file the scene names (``<string name="filename">``: meshes, bitmaps,
   ``csv:`` spectra) without reading it.
@@ -32,6 +33,7 @@ from ..spectra.user_spectra import split_csv_key
 
 __all__ = [
     "MAX_XML_BYTES",
+    "MAX_TOTAL_XML_BYTES",
     "MAX_INCLUDES",
     "MAX_INCLUDE_DEPTH",
     "SceneFile",
@@ -43,6 +45,8 @@ __all__ = [
 
 #: Largest scene (or included) XML file read, in bytes.
 MAX_XML_BYTES = 4 * 1024 * 1024
+#: Most bytes of XML in one scene, its includes counted.
+MAX_TOTAL_XML_BYTES = 4 * MAX_XML_BYTES
 #: Most ``<include>`` files in one scene, and their deepest nesting.
 MAX_INCLUDES = 256
 MAX_INCLUDE_DEPTH = 8
@@ -122,6 +126,7 @@ class _Reader:
         self.defaults = defaults
         self.files: dict[str, SceneFile] = {}
         self.includes = 0
+        self.xml_bytes = 0
 
     def substitute(self, value: str, what: str) -> str:
         out = re.sub(r"\$(\w+)", lambda m: self.defaults.get(m.group(1), m.group(0)), value)
@@ -154,6 +159,12 @@ class _Reader:
                 f"than {MAX_INCLUDE_DEPTH}"
             )
         path = self.record(rel, "include", "<include>")
+        self.xml_bytes += path.stat().st_size
+        if self.xml_bytes > MAX_TOTAL_XML_BYTES:
+            raise SceneError(
+                f"<include filename={rel!r}>: the scene's XML passes {MAX_TOTAL_XML_BYTES} bytes "
+                "with its includes"
+            )
         inner = _read_root(path, rel)
         if inner.get("version", version) != version:
             raise SceneError(
@@ -196,6 +207,7 @@ def prepare_xml(path: Path) -> PreparedXml:
         raise SceneError("<scene> has no version attribute; expected e.g. version='3.0.0'")
     defaults = {d.get("name", ""): d.get("value", "") for d in root.iter("default")}
     reader = _Reader(path.parent, defaults)
+    reader.xml_bytes = path.stat().st_size
     reader.expand(root, version, 0)
     text = ET.tostring(root, encoding="unicode")
     return PreparedXml(text, version, tuple(reader.files.values()))

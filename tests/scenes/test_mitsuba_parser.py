@@ -369,3 +369,17 @@ def test_approximate_needs_an_xml_scene_among_the_dataset_files(tmp_path):
     spec = json.loads(files_source([_write(tmp_path, _scene(LAMP))], approximate=True))
     assert spec["approximate"] is True
     assert "approximate" not in json.loads(files_source([_write(tmp_path, _scene(LAMP))]))
+
+
+def test_includes_are_inlined_with_bounds_and_stay_in_the_folder(tmp_path):
+    (tmp_path / "loop.xml").write_text(
+        '<scene version="3.0.0"><include filename="loop.xml"/></scene>'
+    )
+    with pytest.raises(SceneError, match="more than 256 includes or nested deeper than 8"):
+        load_mitsuba_xml(_write(tmp_path, _scene(LAMP + '<include filename="loop.xml"/>')))
+    (tmp_path / "old.xml").write_text('<scene version="0.5.0"/>')
+    with pytest.raises(SceneError, match="version '0.5.0' differs from the scene's '3.0.0'"):
+        load_mitsuba_xml(_write(tmp_path, _scene(LAMP + '<include filename="old.xml"/>')))
+    os.mkfifo(tmp_path / "pipe_inc.xml")
+    with pytest.raises(SceneError, match="pipe_inc.xml' is not a regular file"):
+        load_mitsuba_xml(_write(tmp_path, _scene(LAMP + '<include filename="pipe_inc.xml"/>')))
