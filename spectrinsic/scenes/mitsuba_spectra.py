@@ -7,7 +7,7 @@ Values come from :mod:`~spectrinsic.scenes.mitsuba_tree` (Mitsuba's parser):
 - a colour (``<rgb value="0.6, 0.1, 0.1"/>``, ``<rgb value="5"/>``): ``rgb:R,G,B``, linear
   sRGB upsampled by Mallett & Yuksel 2019 (:mod:`~spectrinsic.spectra.user_spectra`), as a
   reflectance; a grey emission is D65 of power V (as Mitsuba's spectral variants emit it), a
-  coloured one is refused;
+  coloured one that colour's reflectance times D65, written out (its linear sRGB is the rgb);
 - written-out samples (``<spectrum value="400:0.1, ..."/>``, a ``.spd`` file, ``irregular``,
   ``regular``): ``inline:KIND:...`` names; an emission keeps its absolute scale in the power
   (the registry normalises illuminants to unit luminance-weighted mean);
@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SceneError
+from ..spectra import get_spectrum
 from ..spectra.illuminants import normalise_illuminant
 from ..spectra.user_spectra import inline_name
 from .mitsuba_tree import Spectrum, Value, XmlNode
@@ -93,6 +94,20 @@ def _absolute(wl: np.ndarray, values: np.ndarray, what: str) -> tuple[str, float
     return inline_name(wl, values, "illuminant", where=what), power
 
 
+def _rgb_emission(rgb: np.ndarray, what: str) -> tuple[str, float]:
+    """A grey ``rgb`` emission as D65 of that power; a coloured one as the reflectance of its
+    colour (over its largest channel) times D65 (unit luminance) times that channel, written
+    out every 5 nm: under D65 the basis keeps linear sRGB, so the light's colour is *rgb*."""
+    if not (np.isfinite(rgb).all() and (rgb >= 0).all() and rgb.max() > 0):
+        raise SceneError(f"{what}: rgb emission {rgb.tolist()}; expected channels >= 0, not all 0")
+    if np.ptp(rgb) == 0:
+        return "cie:D65", float(rgb[0])
+    scale = float(rgb.max())
+    wl = np.arange(360.0, 831.0, 5.0)
+    colour = get_spectrum("rgb:" + ",".join(f"{c / scale:.9g}" for c in rgb)).on(wl)
+    return _absolute(wl, colour * get_spectrum("cie:D65").on(wl) * scale, what)
+
+
 def emission(value: Value | None, what: str, base: Path) -> tuple[str, float]:
     """``(illuminant name, power)`` of an emitter's radiance, intensity or irradiance."""
     if value is None:
@@ -100,9 +115,7 @@ def emission(value: Value | None, what: str, base: Path) -> tuple[str, float]:
     if isinstance(value, (int, float)) and not isinstance(value, bool):
         return "cie:E", float(value)
     if isinstance(value, np.ndarray) and value.size == 3:
-        if not (np.ptp(value) == 0 and value[0] > 0):
-            raise SceneError(f"{what}: coloured rgb emission {value.tolist()}; give a spectrum")
-        return "cie:D65", float(value[0])
+        return _rgb_emission(value, what)
     if isinstance(value, XmlNode) and value.plugin == "blackbody":
         extra = set(value.props) - {"temperature"}
         if extra:

@@ -383,3 +383,23 @@ def test_includes_are_inlined_with_bounds_and_stay_in_the_folder(tmp_path):
     os.mkfifo(tmp_path / "pipe_inc.xml")
     with pytest.raises(SceneError, match="pipe_inc.xml' is not a regular file"):
         load_mitsuba_xml(_write(tmp_path, _scene(LAMP + '<include filename="pipe_inc.xml"/>')))
+
+
+def test_a_coloured_rgb_emission_is_a_light_of_that_linear_srgb_colour(tmp_path):
+    import colour
+
+    from spectrinsic.spectra import get_spectrum
+
+    lamp = LAMP.replace(
+        '<rgb name="intensity" value="5"/>', '<rgb name="intensity" value="10, 8, 6"/>'
+    )
+    (light,) = load_mitsuba_xml(_write(tmp_path, _scene(lamp))).lights
+    wl = np.arange(360.0, 831.0)
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy()
+    cmf = cmfs.align(colour.SpectralShape(360, 830, 1)).values
+    xyz = (get_spectrum(light.spectrum).on(wl)[:, None] * light.power * cmf).sum(0) / cmf[
+        :, 1
+    ].sum()
+    rgb = colour.XYZ_to_RGB(xyz, colour.RGB_COLOURSPACES["sRGB"], apply_cctf_encoding=False)
+    np.testing.assert_allclose(rgb, [10, 8, 6], rtol=1e-3)  # the basis's round trip under D65
+    assert light.power == pytest.approx(xyz[1], rel=1e-4)  # power: the luminance (5 nm samples)
