@@ -54,7 +54,8 @@ MAX_INCLUDE_DEPTH = 8
 
 @dataclass(frozen=True)
 class SceneFile:
-    """A file a scene reads: *path* relative to the scene's folder, its role and SHA-256."""
+    """A file a scene reads: *path* relative to the scene's folder, its role (``include``,
+    ``spd``, ``csv`` or ``file``: a mesh or bitmap) and SHA-256."""
 
     path: str
     role: str
@@ -180,7 +181,7 @@ class _Reader:
     def check(self, el: ET.Element) -> None:
         if el.tag == "spectrum" and "filename" in el.attrib:
             rel = self.substitute(el.attrib.pop("filename"), "<spectrum filename>")
-            path = self.record(rel, "spectrum", "<spectrum>")
+            path = self.record(rel, "spd", "<spectrum>")
             wl, values = read_spd(path)
             samples = zip(wl.tolist(), values.tolist())
             el.set("value", ", ".join(f"{w!r}:{v!r}" for w, v in samples))
@@ -190,7 +191,7 @@ class _Reader:
             self.record(rel, "file", "<string name='filename'>")
         elif el.tag == "string" and value.strip().lower().startswith("csv:"):
             rel, _ = split_csv_key(value.strip()[4:])
-            self.record(rel, "spectrum", f"<string value={value!r}>")
+            self.record(rel, "csv", f"<string value={value!r}>")
 
 
 def prepare_xml(path: Path) -> PreparedXml:

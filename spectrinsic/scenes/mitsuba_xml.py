@@ -36,7 +36,7 @@ import numpy as np
 from ..errors import SceneError, SpectrinsicError
 from . import mitsuba_shapes as shapes
 from .mitsuba_bsdfs import DEFAULT_MATERIAL, material_of
-from .mitsuba_files import MAX_XML_BYTES, prepare_xml
+from .mitsuba_files import MAX_XML_BYTES, SceneFile, prepare_xml
 from .mitsuba_spectra import emission
 from .mitsuba_tree import XmlNode, parse_xml
 from .model import Camera, Light, Material, Mesh, Scene
@@ -318,7 +318,7 @@ def load_mitsuba_xml(
         raise SceneError(f"{path}: {exc}") from None
     except (ValueError, OSError) as exc:
         raise SceneError(f"{path}: {exc}") from None
-    metadata = {
+    metadata: dict[str, Any] = {
         "source": f"{path.name} (Mitsuba XML {prepared.version})",
         "approximate": approximate,
         "files": [{"path": f.path, "role": f.role, "sha256": f.sha256} for f in prepared.files],
@@ -327,8 +327,21 @@ def load_mitsuba_xml(
         "approximated": reading.approximated,
         "ignored": reading.ignored,
     }
+    spd = [f for f in prepared.files if f.role == "spd"]
+    if spd:  # recorded beside the csv: files in each sample's meta.json (issue 47)
+        metadata["spectrum_files"] = _spd_records(path.parent, spd)
     scene = Scene(scene.name, scene.meshes, scene.materials, scene.lights, scene.camera, metadata)
     return validate_scene(scene, source=str(path), data_dir=data_dir)
+
+
+def _spd_records(base: Path, files: list[SceneFile]) -> list[dict[str, str]]:
+    """``meta.json["spectrum_files"]`` records of the ``.spd`` files read (their values are
+    written out in the scene's spectrum names), by path."""
+    out = []
+    for f in sorted(files, key=lambda f: f.path):
+        file = str((base / f.path).resolve())
+        out.append({"spectrum": f"spd:{file}", "file": file, "sha256": f.sha256})
+    return out
 
 
 def xml_notes(scene: Scene) -> list[str]:

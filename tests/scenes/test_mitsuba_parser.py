@@ -105,7 +105,7 @@ def test_irregular_csv_and_spd_spectra_and_their_files_are_recorded(tmp_path):
     assert by_name["irr"] == inline_name([400, 550, 700], [0.2, 0.5, 0.3], "reflectance")
     assert by_name["paint"].startswith("csv:") and by_name["paint"].endswith("paints.csv#red")
     files = {f["path"]: f["role"] for f in scene.metadata["files"]}
-    assert files == {"sub/inc.xml": "include", "paints.csv": "spectrum"}
+    assert files == {"sub/inc.xml": "include", "paints.csv": "csv"}
     assert all(len(f["sha256"]) == 64 for f in scene.metadata["files"])
 
 

@@ -126,7 +126,7 @@ def _meta(
     height, width = gt.layers["image"].data.shape[:2]
     files_used = spectrum_files(
         [m.spectrum for m in scene.materials] + [li.spectrum for li in scene.lights]
-    )
+    ) + list(scene.metadata.get("spectrum_files", []))  # the .spd files a Mitsuba XML read
     return {
         "format_version": FORMAT_VERSION,
         "sample_id": sample_id,
