@@ -28,6 +28,9 @@ from typing import Any
 
 import numpy as np
 
+from ..render.base.variants import import_mitsuba
+from ..scenes.mitsuba_xml import load_mitsuba_xml
+
 MESHES = 300
 #: Triangles of each mesh: a box whose faces are split into a 6 x 6 grid of quads (432).
 GRID = 6
@@ -119,13 +122,11 @@ def _rss_bytes() -> int:
 def _measure(reader: str, path: str) -> dict[str, Any]:
     """Load *path* with *reader* in this (fresh) process: median seconds and peak memory."""
     if reader == "spectrinsic":
-        from ..scenes.mitsuba_xml import load_mitsuba_xml
 
         def load() -> Any:
             return load_mitsuba_xml(path)
     else:
-        import mitsuba as mi
-
+        mi = import_mitsuba()
         mi.set_variant("scalar_rgb")
 
         def load() -> Any:

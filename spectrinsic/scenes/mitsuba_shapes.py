@@ -173,18 +173,17 @@ def _mesh_file(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray]:
     # no check_mesh_size: check_budget counted this file's header, within the same limits
     try:
         if p.node.plugin == "obj":
-            return _obj(path)
+            return _obj(path, trimesh.exchange.obj.load_obj)
         mesh: Any = trimesh.load(str(path), force="mesh", process=False)
     except Exception as exc:  # noqa: BLE001 - trimesh raises many types for corrupt files
         raise SceneError(f"{p.where}: cannot read {path.name!r} ({type(exc).__name__})") from None
     return np.asarray(mesh.vertices, float), np.asarray(mesh.faces, np.int64)
 
 
-def _obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """An OBJ file's triangles by trimesh's OBJ parser alone (materials skipped: the scene's
-    BSDF applies), its objects concatenated; twice as fast as ``trimesh.load``'s scene path."""
-    from trimesh.exchange.obj import load_obj
-
+def _obj(path: Path, load_obj: Any) -> tuple[np.ndarray, np.ndarray]:
+    """An OBJ file's triangles by trimesh's OBJ parser *load_obj* alone (materials skipped: the
+    scene's BSDF applies), its objects concatenated; twice as fast as ``trimesh.load``'s scene
+    path."""
     with path.open("rb") as fh:
         loaded = load_obj(fh, skip_materials=True, maintain_order=True, group_material=False)
     vertices, faces, offset = [], [], 0
