@@ -263,8 +263,10 @@ def preflight(
     scheduler: str | None = None,
     rebuild: bool = False,
     data_dir: str | None = None,
+    quiet: bool = False,
 ) -> None:
-    """Every refusal that needs no rendering, before anything is written or started."""
+    """Every refusal that needs no rendering, before anything is written or started (what a
+    scene file's read fixed or approximated said on stderr unless *quiet*)."""
     if workers is not None and workers < 1:
         raise DatasetError(f"--workers {workers}; expected a positive integer")
     if threads is not None and threads < 1:
@@ -276,7 +278,7 @@ def preflight(
             f"to {UINT32_MAX} and at most {UINT32_MAX} samples per pixel"
         )
     check_build_folder(Path(out), config.config_hash(), rebuild=rebuild)
-    check_scene_files(config, data_dir)
+    check_scene_files(config, data_dir, quiet=quiet)
     check_integrator_plan(config)  # integrator x materials: every sample would fail
     if scheduler:
         check_scheduler(scheduler)
@@ -302,6 +304,7 @@ def run(args: argparse.Namespace) -> int:
         scheduler=args.scheduler,
         rebuild=args.rebuild,
         data_dir=args.data_dir,
+        quiet=getattr(args, "quiet", False),
     )
     return build(
         args.out,

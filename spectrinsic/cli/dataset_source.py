@@ -8,14 +8,17 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from pathlib import Path
 from typing import Any
 
 from ..errors import DatasetError, SceneError, SpectrinsicError
 from ..pipeline.presets import DatasetConfig
 from ..pipeline.source_plan import file_sample, files_source, generator_source
+from ..render.base.variants import import_mitsuba
 from ..scenes.generators import GlossDistribution
 from ..scenes.generators.world_defaults import GLOSSY_FRACTION, METALLIC_FRACTION, TEXTURE_FRACTION
+from ..scenes.mitsuba_xml import render_hints_line, xml_notes
 from ..scenes.sources import FileSource
 from ..scenes.spectrum_refs import resolve_spectrum
 from ..scenes.yaml_limits import load_yaml_file
@@ -153,6 +156,12 @@ def _add_scene_file_options(src: Any) -> None:
         "baseColorFactor, Principled Base Color) as an rgb: reflectance (default: an error)",
     )
     src.add_argument(
+        "--approximate",
+        action="store_true",
+        help="Mitsuba XML scenes: approximate what has no exact ground truth (glass, masks, "
+        "bump maps, bitmaps, environment maps...) instead of refusing it, one line saying what",
+    )
+    src.add_argument(
         "--new-sample",
         action="store_true",
         help="render scenes a generated build saved (<dataset>/scenes/*.yaml) as new "
@@ -282,6 +291,7 @@ def source_from_args(args: argparse.Namespace) -> str | None:
             resolution=size,
             new_sample=getattr(args, "new_sample", False),
             colours_from_asset=args.colours_from_asset,
+            approximate=args.approximate,
         )
     return None
 
@@ -319,10 +329,11 @@ def parse_resolution(text: str) -> tuple[int, int]:
     return int(w), int(h)
 
 
-def check_scene_files(config: Any, data_dir: str | None) -> None:
+def check_scene_files(config: Any, data_dir: str | None, *, quiet: bool = False) -> None:
     """``--scenes``: every file reads as a valid scene with this material map and default
     spectrum, before the folder is stamped with the config (a bad file is an input error, not
-    a failed sample)."""
+    a failed sample); what a Mitsuba XML read fixed or approximated, and the spp and depth that
+    apply to it (the preset's), are said on stderr unless *quiet*."""
 
     spec = json.loads(config.source or "{}")
     if "scenes" not in spec:
@@ -337,12 +348,21 @@ def check_scene_files(config: Any, data_dir: str | None) -> None:
         except SpectrinsicError as exc:
             raise DatasetError(f"{option} {name!r}: {exc}") from exc
     width, height = spec.get("resolution") or (None, None)
+    import_mitsuba()  # set up before a Mitsuba XML read imports it (the libLLVM Dr.Jit loads)
     for entry in spec["scenes"]:
-        FileSource(
+        scene = FileSource(
             entry["path"],
             width,
             height,
             tuple(sorted(materials.items())),
             spec.get("default_spectrum"),
             colours_from_asset=bool(spec.get("colours_from_asset")),
+            approximate=bool(spec.get("approximate")),
         ).build(data_dir)
+        if not quiet:
+            for note in xml_notes(scene):
+                print(f"spectrinsic dataset: {note}", file=sys.stderr)
+            given = f"the dataset's settings (preset {config.preset!r} and options)"
+            line = render_hints_line(scene, config.render.spp, config.render.max_depth, given)
+            if line is not None:
+                print(f"spectrinsic dataset: {line}", file=sys.stderr)

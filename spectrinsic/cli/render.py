@@ -12,6 +12,7 @@ the render settings, variants, timings and the scene. Ground-truth layers are wr
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 from pathlib import Path
 from typing import Any
@@ -36,6 +37,7 @@ from ..render.base.plugins import MAX_PATH_DEPTH
 from ..render.budget import check_render_size
 from ..render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
 from ..render.settings import DEFAULT_MODES as RENDER_DEFAULT_MODES
+from ..scenes.mitsuba_xml import render_hints_line, xml_notes
 from ..scenes.model import Scene
 from ..scenes.sample_id import SampleId
 from ..scenes.sources import FILE_SIZE, is_scene_file
@@ -145,8 +147,9 @@ def _add_pass_options(p: Any, default: DatasetConfig) -> None:
     p.add_argument(
         "--max-depth",
         type=int,
-        default=default.render.max_depth,
-        help=f"longest path, 2 = direct light only (default: {default.render.max_depth})",
+        default=None,
+        help="longest path, 2 = direct light only (default: a Mitsuba XML file's max_depth, "
+        f"else {default.render.max_depth})",
     )
     p.add_argument(
         "--variant", default=None, help="Mitsuba backend or variant (default: best usable)"
@@ -211,6 +214,12 @@ def _add_material_options(p: Any) -> None:
         help="give unmapped glTF and .blend materials their base colour (glTF "
         "baseColorFactor, Principled Base Color) as an rgb: reflectance (default: an error)",
     )
+    p.add_argument(
+        "--approximate",
+        action="store_true",
+        help="Mitsuba XML: approximate what has no exact ground truth (glass, masks, bump "
+        "maps, bitmaps, environment maps...) instead of refusing it, one line saying what",
+    )
 
 
 #: Largest sampler seed and samples per pixel Mitsuba takes (both are unsigned 32-bit).
@@ -226,7 +235,7 @@ def _check_size_options(args: argparse.Namespace) -> None:
         raise RenderError(f"--spp {args.spp}; expected at most {UINT32_MAX}")
     if not 0 <= args.seed <= UINT32_MAX:
         raise RenderError(f"--seed {args.seed}; expected a whole number from 0 to {UINT32_MAX}")
-    if not 1 <= args.max_depth <= MAX_PATH_DEPTH:
+    if args.max_depth is not None and not 1 <= args.max_depth <= MAX_PATH_DEPTH:
         raise RenderError(
             f"--max-depth {args.max_depth}; expected 1 to {MAX_PATH_DEPTH} (2 = direct light only)"
         )
@@ -246,6 +255,8 @@ def _check_source_options(args: argparse.Namespace) -> None:
         "--default-spectrum": args.default_spectrum is not None,
     }
     library_only, file_only = ("--condition", "--view"), ("--material-map", "--default-spectrum")
+    if args.approximate and Path(args.scene).suffix.lower() != ".xml":
+        raise RenderError(f"--approximate applies to Mitsuba XML scenes; {args.scene!r} is not one")
     for option in library_only if file else file_only:
         if given[option]:
             kind = "a scene file" if file else "a library scene"
@@ -290,6 +301,7 @@ def _ground_truth(args: argparse.Namespace) -> int:
             resolution=size,
             new_sample=args.new_sample,
             colours_from_asset=args.colours_from_asset,
+            approximate=args.approximate,
         )
     else:
         only = str(SampleId(args.scene, args.view, args.condition))
@@ -297,7 +309,12 @@ def _ground_truth(args: argparse.Namespace) -> int:
     if not is_scene_file(args.scene) and not getattr(args, "quiet", False):
         why = "--resolution" if size else f"preset {args.preset!r}"
         print(f"spectrinsic render: {config.width}x{config.height} ({why})", file=sys.stderr)
-    cli_dataset.preflight(args.out, config, data_dir=getattr(args, "data_dir", None))
+    cli_dataset.preflight(
+        args.out,
+        config,
+        data_dir=getattr(args, "data_dir", None),
+        quiet=getattr(args, "quiet", False),
+    )
     return cli_dataset.build(
         args.out,
         config,
@@ -317,7 +334,7 @@ def _render_settings(args: argparse.Namespace, modes: list[str]) -> RenderSettin
         spp,
         spectral_spp=spectral,
         modes=tuple(modes),
-        max_depth=args.max_depth,
+        max_depth=default.max_depth if args.max_depth is None else args.max_depth,
         variant=args.variant,
         per_light=args.per_light,
         direct=args.direct,
@@ -342,6 +359,7 @@ def run(args: argparse.Namespace) -> int:
     check_output_folder(Path(args.out))
     data_dir = getattr(args, "data_dir", None)
     scene = _load_scene(args, data_dir)
+    settings = _file_settings(args, scene, settings)
     given = _given_size(args)
     if not getattr(args, "quiet", False):
         why = given or (
@@ -392,7 +410,33 @@ def _load_scene(args: argparse.Namespace, data_dir: str | None) -> Scene:
         default_spectrum=args.default_spectrum,
         data_dir=data_dir,
         colours_from_asset=args.colours_from_asset,
+        approximate=args.approximate,
     )
+
+
+def _file_settings(
+    args: argparse.Namespace, scene: Scene, settings: RenderSettings
+) -> RenderSettings:
+    """*settings* with a Mitsuba XML file's ``sample_count`` and ``max_depth`` where the
+    command line gave no ``--spp`` / ``--max-depth``; says what it read and which applies."""
+    if not getattr(args, "quiet", False):
+        for note in xml_notes(scene):
+            print(f"spectrinsic render: {note}", file=sys.stderr)
+        line = render_hints_line(scene, args.spp, args.max_depth)
+        if line is not None:
+            print(f"spectrinsic render: {line}", file=sys.stderr)
+    hints = scene.metadata.get("render_hints") or {}
+    changes: dict[str, Any] = {}
+    if args.spp is None and "spp" in hints:
+        changes |= {"spp": int(hints["spp"]), "spectral_spp": None}
+    if args.max_depth is None and "max_depth" in hints:
+        if not 1 <= int(hints["max_depth"]) <= MAX_PATH_DEPTH:
+            raise RenderError(
+                f"{args.scene}: max_depth {hints['max_depth']}; expected 1 to {MAX_PATH_DEPTH} "
+                "(give --max-depth)"
+            )
+        changes["max_depth"] = int(hints["max_depth"])
+    return dataclasses.replace(settings, **changes) if changes else settings
 
 
 def _given_size(args: argparse.Namespace) -> str:

@@ -148,11 +148,13 @@ def files_source(
     resolution: tuple[int, int] | None = None,
     new_sample: bool = False,
     colours_from_asset: bool = False,
+    approximate: bool = False,
 ) -> str:
     """The canonical ``source`` JSON of a set of scene files (each must exist): rendered at
     *resolution* ``(W, H)``, else at each file's own camera size; a saved generated scene as
     its own sample unless *new_sample*; *colours_from_asset* (in the JSON only when set, so
-    older configs keep their hash): base colours of glTF and ``.blend`` materials as spectra."""
+    older configs keep their hash): base colours of glTF and ``.blend`` materials as spectra;
+    *approximate* (likewise): Mitsuba XML content without exact ground truth approximated."""
     entries = []
     for p in paths:
         path = Path(p).resolve()
@@ -173,6 +175,12 @@ def files_source(
     }
     if colours_from_asset:
         spec["colours_from_asset"] = True
+    if approximate:
+        if not any(scene_file_kind(e["path"]) == "mitsuba" for e in entries):
+            raise DatasetError(
+                "--approximate applies to Mitsuba XML scenes; no --scenes file is one"
+            )
+        spec["approximate"] = True
     ids = [str(file_sample(e["path"], new_sample=new_sample)[0]) for e in entries]
     dupes = sorted({i for i in ids if ids.count(i) > 1})
     if dupes:
@@ -322,6 +330,7 @@ def _file_tasks(
             materials,
             spec.get("default_spectrum"),
             colours_from_asset=bool(spec.get("colours_from_asset")),
+            approximate=bool(spec.get("approximate")),
         )
         sid, seed = file_sample(entry["path"], new_sample=bool(spec.get("new_sample")))
         task = SampleTask.planned(

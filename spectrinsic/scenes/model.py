@@ -49,7 +49,7 @@ __all__ = [
     "scene_hash",
 ]
 
-LightKind = Literal["point", "spot", "area", "directional", "sky"]
+LightKind = Literal["point", "spot", "area", "directional", "sky", "sphere"]
 #: The one table of light kinds: the placement fields each kind uses (the others are ignored,
 #: and records such as meta.json leave them out).
 LIGHT_FIELDS: dict[str, tuple[str, ...]] = {
@@ -58,11 +58,15 @@ LIGHT_FIELDS: dict[str, tuple[str, ...]] = {
     "area": ("position", "direction", "size"),
     "directional": ("direction",),
     "sky": (),
+    "sphere": ("position", "radius"),
 }
 #: The light kinds, in the table's order (``typing.get_args(LightKind)`` is the same).
 LIGHT_KINDS: tuple[LightKind, ...] = tuple(LIGHT_FIELDS)  # type: ignore[arg-type]
-#: The kinds the scene generators draw (a sky comes from scene files and daylight rooms).
-DRAWN_LIGHT_KINDS: tuple[LightKind, ...] = tuple(k for k in LIGHT_KINDS if k != "sky")
+#: The kinds the scene generators draw (a sky comes from scene files and daylight rooms, a
+#: sphere from Mitsuba XML files).
+DRAWN_LIGHT_KINDS: tuple[LightKind, ...] = tuple(
+    k for k in LIGHT_KINDS if k not in ("sky", "sphere")
+)
 #: Every placement field some kind uses (the union of :data:`LIGHT_FIELDS`).
 LIGHT_PLACEMENT: tuple[str, ...] = tuple(
     dict.fromkeys(f for fs in LIGHT_FIELDS.values() for f in fs)
@@ -172,14 +176,15 @@ class Light:
     ----------
     kind
         One of :data:`LIGHT_KINDS`: ``"point"``, ``"spot"``, ``"area"`` (a rectangle),
-        ``"directional"`` or ``"sky"`` (a uniform sky dome at infinity, Mitsuba ``constant``);
+        ``"directional"``, ``"sky"`` (a uniform sky dome at infinity, Mitsuba ``constant``) or
+        ``"sphere"`` (a sphere of uniform radiance, emitting on its outside);
         :data:`LIGHT_FIELDS` lists the placement fields each uses.
     spectrum
         Registry name of an illuminant, e.g. ``"planck:2800K"``. The registry normalises every
         illuminant to unit luminance-weighted mean, so *power* alone sets brightness.
     power
         Scale on the normalised SPD: radiant intensity for point and spot lights, radiance for
-        area lights and the sky (an unoccluded surface then receives irradiance π × power),
+        area and sphere lights and the sky (an unoccluded surface then receives irradiance π × power),
         irradiance for directional lights (relative units). Must be > 0.
     position
         World position (point, spot, area centre); unused for directional lights.
@@ -189,6 +194,8 @@ class Light:
         ``(width, height)`` of an area light in scene units.
     cutoff_deg
         Spot cone half-angle in degrees.
+    radius
+        Radius of a sphere light in scene units (left out of records at its default).
     """
 
     kind: LightKind
@@ -199,6 +206,7 @@ class Light:
     size: tuple[float, float] = (1.0, 1.0)
     cutoff_deg: float = 30.0
     name: str = "light"
+    radius: float = field(default=1.0, metadata=_OPTIONAL)
 
 
 def unknown_light_kind(kind: object) -> str:

@@ -131,6 +131,7 @@ def load_scene_file(
     default_spectrum: str | None = None,
     data_dir: str | None = None,
     colours_from_asset: bool = False,
+    approximate: bool = False,
 ) -> Scene:
     """Read any scene file (:func:`scene_file_kind`) into a validated scene: the one dispatch
     over YAML, ``.blend`` and mesh files, for ``dataset --scenes`` and ``render``.
@@ -147,6 +148,10 @@ def load_scene_file(
     colours_from_asset
         Give glTF and ``.blend`` materials without a spectrum the file's base colour as an
         ``rgb:`` reflectance (``--colours-from-asset``); False: they are an error.
+    approximate
+        Approximate what a Mitsuba XML file holds without exact ground truth instead of
+        refusing it (``--approximate``); other kinds of file have nothing to approximate (the
+        command line refuses the option where no scene file is XML).
     """
     kind = scene_file_kind(path)
     mapping = dict(materials or {})
@@ -171,7 +176,7 @@ def load_scene_file(
             colours_from_asset=colours_from_asset,
         )
     if kind == "mitsuba":
-        scene = load_mitsuba_xml(path, data_dir=data_dir)
+        scene = load_mitsuba_xml(path, data_dir=data_dir, approximate=approximate)
     else:
         scene = load_scene(path, data_dir=data_dir)
     camera = dataclasses.replace(
@@ -195,6 +200,8 @@ class FileSource:
         Reflectance of mesh or ``.blend`` materials not in *materials*.
     colours_from_asset
         Base colours of glTF and ``.blend`` materials without a spectrum as ``rgb:`` spectra.
+    approximate
+        Approximate what a Mitsuba XML file holds without exact ground truth.
     """
 
     path: str
@@ -203,6 +210,7 @@ class FileSource:
     materials: tuple[tuple[str, str], ...] = ()
     default_spectrum: str | None = None
     colours_from_asset: bool = False
+    approximate: bool = False
 
     def build(self, data_dir: str | None = None) -> Scene:
         """Read and validate the file; one-line :class:`SceneError` naming it on bad input."""
@@ -214,4 +222,5 @@ class FileSource:
             default_spectrum=self.default_spectrum,
             data_dir=data_dir,
             colours_from_asset=self.colours_from_asset,
+            approximate=self.approximate,
         )
