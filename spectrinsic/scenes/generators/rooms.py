@@ -9,6 +9,7 @@ total light spans roughly 0.3 (closed, light walls, lit indirectly) to 0.9 (open
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 
@@ -31,6 +32,9 @@ _PLACED_KINDS = tuple(k for k in LIGHT_KINDS if "position" in LIGHT_FIELDS[k])
 #: Placed kinds that can be aimed: the uplights of indirectly lit rooms.
 _AIMED_KINDS = tuple(k for k in _PLACED_KINDS if "direction" in LIGHT_FIELDS[k])
 _T = 0.1  # wall thickness, m
+#: The semantic class of each kind of furniture (:mod:`~spectrinsic.scenes.semantic`; the
+#: others are their own class). Rooms draw no window part: a window is an opening.
+_FURNITURE_CLASS = {"round-table": "table"}
 #: Least fraction of a room view's rays on furniture and objects (not walls, floor, ceiling).
 FRAMED_COVERAGE = 0.3
 
@@ -94,10 +98,13 @@ def _shell(
     parts = [
         (
             "floor",
-            _slab(
-                np.array([-_T, -_T, -_T]),
-                np.array([w + _T, d + _T, 0.0]),
-                draw_reflectance(rng, walls),
+            replace(
+                _slab(
+                    np.array([-_T, -_T, -_T]),
+                    np.array([w + _T, d + _T, 0.0]),
+                    draw_reflectance(rng, walls),
+                ),
+                semantic="floor",
             ),
         )
     ]
@@ -105,10 +112,13 @@ def _shell(
         parts.append(
             (
                 "ceiling",
-                _slab(
-                    np.array([-_T, -_T, h]),
-                    np.array([w + _T, d + _T, h + _T]),
-                    draw_reflectance(rng, walls),
+                replace(
+                    _slab(
+                        np.array([-_T, -_T, h]),
+                        np.array([w + _T, d + _T, h + _T]),
+                        draw_reflectance(rng, walls),
+                    ),
+                    semantic="ceiling",
                 ),
             )
         )
@@ -125,7 +135,8 @@ def _shell(
             )
         if day is not None:
             hole, windows = (day.hole if key == day.wall else None), 1
-        parts.append((f"wall-{key}", _wall(key, size, draw_reflectance(rng, walls), hole)))
+        wall = _wall(key, size, draw_reflectance(rng, walls), hole)
+        parts.append((f"wall-{key}", replace(wall, semantic="wall")))
     return parts, {
         "missing_walls": missing,
         "ceiling": ceiling,
@@ -194,7 +205,9 @@ def _furniture(
                 [0.05 + half[0], 0.05 + half[1]], [w - 0.05 - half[0], d - 0.05 - half[1]]
             )
             if floor.try_add(c, half, gap=0.05):
-                parts.append((f"{kind}-{i}", moved(part, translate=(c[0], c[1], 0.0))))
+                placed = moved(part, translate=(c[0], c[1], 0.0))
+                semantic = _FURNITURE_CLASS.get(kind, kind)
+                parts.append((f"{kind}-{i}", replace(placed, semantic=semantic)))
                 tops += [(c + inner_lo, c + inner_hi, z, room) for z, room in levels]
                 break
     return parts, tops
@@ -223,7 +236,8 @@ def _objects(
                 continue
             c = rng.uniform(lo + half, hi - half)
             if taken.try_add(c, half):
-                parts.append((f"{shape}-{i}", moved(part, translate=(c[0], c[1], z))))
+                placed = moved(part, translate=(c[0], c[1], z))
+                parts.append((f"{shape}-{i}", replace(placed, semantic="object")))
                 patterns += [pattern] if pattern else []
                 break
     return parts, patterns
