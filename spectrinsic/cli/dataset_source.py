@@ -13,9 +13,10 @@ from typing import Any
 
 from ..errors import DatasetError, SceneError, SpectrinsicError
 from ..pipeline.presets import DatasetConfig
-from ..pipeline.source_plan import file_sample, files_source, generator_source
+from ..pipeline.source_plan import file_sample, files_source, generator_source, semantic_rules
 from ..scenes.generators import GlossDistribution
 from ..scenes.generators.world_defaults import GLOSSY_FRACTION, METALLIC_FRACTION, TEXTURE_FRACTION
+from ..scenes.semantic import SemanticRules, read_semantic_map
 from ..scenes.sources import FileSource
 from ..scenes.spectrum_refs import resolve_spectrum
 from ..scenes.yaml_limits import load_yaml_file
@@ -25,6 +26,7 @@ __all__ = [
     "add_source_options",
     "check_scene_files",
     "material_map",
+    "semantic_map",
     "parse_resolution",
     "source_from_args",
     "source_notes",
@@ -152,6 +154,13 @@ def _add_scene_file_options(src: Any) -> None:
         "baseColorFactor, Principled Base Color) as an rgb: reflectance (default: an error)",
     )
     src.add_argument(
+        "--semantic-map",
+        metavar="FILE",
+        default=None,
+        help="YAML/JSON rules regex -> semantic class, tried before the default name map "
+        "(spectrinsic/scenes/FORMAT.md, Semantic classes)",
+    )
+    src.add_argument(
         "--new-sample",
         action="store_true",
         help="render scenes a generated build saved (<dataset>/scenes/*.yaml) as new "
@@ -172,6 +181,16 @@ def _range(option: str, text: str) -> tuple[float, float]:
     if lo > hi:
         raise DatasetError(f"{option} {text!r}; expected LO <= HI")
     return lo, hi
+
+
+def semantic_map(path: str | None) -> SemanticRules | None:
+    """The ``--semantic-map`` file's rules (None for none); DatasetError naming it if bad."""
+    if path is None:
+        return None
+    try:
+        return read_semantic_map(path)
+    except SceneError as exc:
+        raise DatasetError(f"--semantic-map: {exc}") from None
 
 
 def material_map(path: str | None) -> dict[str, str]:
@@ -216,7 +235,7 @@ GENERATOR_DEFAULTS: dict[str, Any] = {
     "roughness_range": "0,0.3",
 }
 #: The options of scene files (``--scenes``).
-FILE_OPTIONS = ("material_map", "default_spectrum", "new_sample")
+FILE_OPTIONS = ("material_map", "default_spectrum", "new_sample", "semantic_map")
 
 
 def _given(value: object) -> bool:
@@ -281,6 +300,7 @@ def source_from_args(args: argparse.Namespace) -> str | None:
             resolution=size,
             new_sample=getattr(args, "new_sample", False),
             colours_from_asset=args.colours_from_asset,
+            semantic=semantic_map(getattr(args, "semantic_map", None)),
         )
     return None
 
@@ -344,4 +364,5 @@ def check_scene_files(config: Any, data_dir: str | None) -> None:
             tuple(sorted(materials.items())),
             spec.get("default_spectrum"),
             colours_from_asset=bool(spec.get("colours_from_asset")),
+            semantic=semantic_rules(spec),
         ).build(data_dir)

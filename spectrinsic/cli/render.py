@@ -40,7 +40,7 @@ from ..scenes.model import Scene
 from ..scenes.sample_id import SampleId
 from ..scenes.sources import FILE_SIZE, is_scene_file
 from . import dataset as cli_dataset
-from .dataset_source import material_map, parse_resolution
+from .dataset_source import material_map, parse_resolution, semantic_map
 from .render_files import write_render
 from .render_scene import load_scene_argument
 
@@ -200,6 +200,13 @@ def _add_material_options(p: Any) -> None:
         help="reflectance of unmapped materials in .blend and mesh files",
     )
     p.add_argument(
+        "--semantic-map",
+        metavar="FILE",
+        default=None,
+        help="YAML/JSON rules regex -> semantic class for a scene file's meshes, tried before "
+        "the default name map (spectrinsic/scenes/FORMAT.md, Semantic classes)",
+    )
+    p.add_argument(
         "--colours-from-asset",
         action="store_true",
         help="give unmapped glTF and .blend materials their base colour (glTF "
@@ -238,12 +245,14 @@ def _check_source_options(args: argparse.Namespace) -> None:
         "--view": args.view is not None,
         "--material-map": args.material_map is not None,
         "--default-spectrum": args.default_spectrum is not None,
+        "--semantic-map": args.semantic_map is not None,
     }
-    library_only, file_only = ("--condition", "--view"), ("--material-map", "--default-spectrum")
+    library_only = ("--condition", "--view")
+    file_only = ("--material-map", "--default-spectrum", "--semantic-map")
     for option in library_only if file else file_only:
         if given[option]:
             kind = "a scene file" if file else "a library scene"
-            applies = "library scenes" if file else ".blend and mesh files"
+            applies = "library scenes" if file else "scene files"
             raise RenderError(f"{option} applies to {applies}; {args.scene!r} is {kind}")
     args.condition = "white" if args.condition is None else args.condition
     args.view = 0 if args.view is None else args.view
@@ -283,6 +292,7 @@ def _ground_truth(args: argparse.Namespace) -> int:
             resolution=size,
             new_sample=args.new_sample,
             colours_from_asset=args.colours_from_asset,
+            semantic=semantic_map(args.semantic_map),
         )
     else:
         only = str(SampleId(args.scene, args.view, args.condition))
@@ -381,6 +391,7 @@ def _load_scene(args: argparse.Namespace, data_dir: str | None) -> Scene:
         default_spectrum=args.default_spectrum,
         data_dir=data_dir,
         colours_from_asset=args.colours_from_asset,
+        semantic=semantic_map(args.semantic_map),
     )
 
 

@@ -11,6 +11,7 @@ their names through a :class:`SemanticMap`: ordered regular expressions → clas
 case-insensitively in the object name, then in the mesh's material names, else the map's
 fallback (``object``). The default map is package data (``semantic_map.yaml`` beside this
 module); a user's map (``--semantic-map FILE``, :func:`read_semantic_map`) is tried first.
+A mesh's name decides before its materials' names, whichever map's rule matches it.
 
 >>> classify(["floor_lamp"]), classify(["Cube.001", "Oak table top"]), classify(["Mesh.7"])
 ('lamp', 'table', 'object')
@@ -36,11 +37,13 @@ __all__ = [
     "FALLBACK_CLASS",
     "SemanticRule",
     "SemanticMap",
+    "SemanticRules",
     "class_id",
     "class_table",
     "classify",
     "default_map",
     "read_semantic_map",
+    "rules_from_record",
 ]
 
 #: The class table: a class's id is its index (stable across datasets; new classes are appended).
@@ -105,8 +108,28 @@ class SemanticMap:
         return SemanticMap(first.rules + self.rules, fallback or self.fallback)
 
 
-def _parse(document: object, source: str) -> tuple[SemanticMap, str | None]:
-    """The rules and the fallback (None when left out) of a parsed map document."""
+@dataclass(frozen=True)
+class SemanticRules:
+    """A map file's content as plain data (what a build's config records): ordered
+    ``(regex, class)`` pairs and the fallback class (None: keep the default's)."""
+
+    rules: tuple[tuple[str, str], ...] = ()
+    fallback: str | None = None
+
+    def record(self) -> dict[str, object]:
+        """As plain JSON (a build's ``source`` records it; :func:`rules_from_record` reads it)."""
+        return {"rules": [list(r) for r in self.rules], "fallback": self.fallback}
+
+    def compiled(self) -> SemanticMap:
+        """The default map with these rules tried first (and this fallback, if any)."""
+        own = SemanticMap(
+            tuple(SemanticRule(re.compile(p, re.IGNORECASE), c) for p, c in self.rules)
+        )
+        return default_map().extended(own, self.fallback)
+
+
+def _parse(document: object, source: str) -> SemanticRules:
+    """The validated rules of a parsed map document (one-line SceneError naming *source*)."""
     if not isinstance(document, Mapping) or set(document) - {"format", "fallback", "rules"}:
         raise SceneError(f"{source}: expected a mapping with keys format, rules and fallback")
     if document.get("format", _FORMAT) != _FORMAT:
@@ -114,7 +137,7 @@ def _parse(document: object, source: str) -> tuple[SemanticMap, str | None]:
     rules = document.get("rules") or {}
     if not isinstance(rules, Mapping) or len(rules) > MAX_RULES:
         raise SceneError(f"{source}: rules: expected a mapping of at most {MAX_RULES} regex: class")
-    compiled = []
+    pairs = []
     for pattern, semantic in rules.items():
         if not isinstance(pattern, str) or not pattern or len(pattern) > MAX_PATTERN:
             raise SceneError(
@@ -122,34 +145,48 @@ def _parse(document: object, source: str) -> tuple[SemanticMap, str | None]:
             )
         try:
             class_id(str(semantic))
-            compiled.append(SemanticRule(re.compile(pattern, re.IGNORECASE), str(semantic)))
+            re.compile(pattern)
         except (re.error, SceneError) as exc:
             raise SceneError(f"{source}: rule {pattern!r}: {exc}") from None
+        pairs.append((pattern, str(semantic)))
     fallback = document.get("fallback")
     if fallback is not None:
         try:
             class_id(str(fallback))
         except SceneError as exc:
             raise SceneError(f"{source}: fallback: {exc}") from None
-    return SemanticMap(tuple(compiled)), None if fallback is None else str(fallback)
+    return SemanticRules(tuple(pairs), None if fallback is None else str(fallback))
 
 
 @functools.cache
 def default_map() -> SemanticMap:
     """The shipped map (``semantic_map.yaml``), read once."""
     text = resources.files(__package__).joinpath("semantic_map.yaml").read_text("utf-8")
-    rules, fallback = _parse(load_yaml_text(text, "semantic_map.yaml"), "semantic_map.yaml")
-    return SemanticMap(rules.rules, fallback or FALLBACK_CLASS)
+    parsed = _parse(load_yaml_text(text, "semantic_map.yaml"), "semantic_map.yaml")
+    rules = tuple(SemanticRule(re.compile(p, re.IGNORECASE), c) for p, c in parsed.rules)
+    return SemanticMap(rules, parsed.fallback or FALLBACK_CLASS)
 
 
-def read_semantic_map(path: str | os.PathLike[str]) -> SemanticMap:
-    """The default map extended by the user's map file *path* (YAML or JSON, the form of
-    ``semantic_map.yaml``: ``rules`` (regex: class, in order) and an optional ``fallback``).
-    One-line :class:`SceneError` naming the file on bad input."""
+def rules_from_record(record: object, source: str = "semantic_map") -> SemanticRules:
+    """The :class:`SemanticRules` of their :meth:`~SemanticRules.record` (validated again)."""
+    if not isinstance(record, Mapping) or not isinstance(record.get("rules"), list):
+        raise SceneError(f"{source}: expected {{rules: [[regex, class], ...], fallback}}")
+    pairs = {}
+    for pair in record["rules"]:
+        if not isinstance(pair, list) or len(pair) != 2:
+            raise SceneError(f"{source}: rules: expected [regex, class] pairs, got {pair!r}")
+        pairs[pair[0]] = pair[1]
+    return _parse({"rules": pairs, "fallback": record.get("fallback")}, source)
+
+
+def read_semantic_map(path: str | os.PathLike[str]) -> SemanticRules:
+    """The rules of the user's map file *path* (YAML or JSON, the form of
+    ``semantic_map.yaml``: ``rules``, regex: class in order, and an optional ``fallback``),
+    validated; :meth:`SemanticRules.compiled` puts them before the default rules. One-line
+    :class:`SceneError` naming the file on bad input."""
     if not Path(path).is_file():
         raise SceneError(f"{path}: semantic map not found (expected a YAML or JSON file)")
-    rules, fallback = _parse(load_yaml_file(path), str(path))
-    return default_map().extended(rules, fallback)
+    return _parse(load_yaml_file(path), str(path))
 
 
 def classify(names: Iterable[str], semantic_map: SemanticMap | None = None) -> str:

@@ -21,6 +21,8 @@ from .meshes import MESH_SUFFIXES, load_mesh_scene
 from .mitsuba_xml import load_mitsuba_xml
 from .model import Scene
 from .scene_reader import load_scene
+from .semantic import SemanticRules, classify
+from .validate import check_classes
 
 __all__ = [
     "GeneratedSource",
@@ -28,6 +30,7 @@ __all__ = [
     "scene_file_kind",
     "is_scene_file",
     "load_scene_file",
+    "labelled",
     "FILE_SIZE",
 ]
 
@@ -131,6 +134,7 @@ def load_scene_file(
     default_spectrum: str | None = None,
     data_dir: str | None = None,
     colours_from_asset: bool = False,
+    semantic: SemanticRules | None = None,
 ) -> Scene:
     """Read any scene file (:func:`scene_file_kind`) into a validated scene: the one dispatch
     over YAML, ``.blend`` and mesh files, for ``dataset --scenes`` and ``render``.
@@ -147,7 +151,42 @@ def load_scene_file(
     colours_from_asset
         Give glTF and ``.blend`` materials without a spectrum the file's base colour as an
         ``rgb:`` reflectance (``--colours-from-asset``); False: they are an error.
+    semantic
+        The user's semantic rules (``--semantic-map``), tried before the default map's
+        (:func:`labelled`); None: the default map alone.
     """
+    scene = _read_scene_file(
+        path, width, height, materials, default_spectrum, data_dir, colours_from_asset
+    )
+    return labelled(scene, semantic or SemanticRules(), str(path))
+
+
+def labelled(scene: Scene, semantic: SemanticRules, source: str) -> Scene:
+    """*scene* with each mesh's class taken from its object name, then its material names (in
+    the order its faces use them), by *semantic*'s rules and then the default map's
+    (:func:`~spectrinsic.scenes.semantic.classify`); SceneError naming *source* if meshes
+    sharing an object id get different classes."""
+    chosen = semantic.compiled()
+    meshes = []
+    for mesh in scene.meshes:
+        used = dict.fromkeys(int(i) for i in mesh.face_materials)
+        names = [mesh.name, *(scene.materials[i].name for i in used)]
+        meshes.append(dataclasses.replace(mesh, semantic=classify(names, chosen)))
+    out = dataclasses.replace(scene, meshes=tuple(meshes))
+    check_classes(out, source)
+    return out
+
+
+def _read_scene_file(
+    path: str | Path,
+    width: int | None,
+    height: int | None,
+    materials: Mapping[str, str] | None,
+    default_spectrum: str | None,
+    data_dir: str | None,
+    colours_from_asset: bool,
+) -> Scene:
+    """The scene of *path* as its reader builds it (see :func:`load_scene_file`)."""
     kind = scene_file_kind(path)
     mapping = dict(materials or {})
     given = width is not None or height is not None
@@ -195,6 +234,8 @@ class FileSource:
         Reflectance of mesh or ``.blend`` materials not in *materials*.
     colours_from_asset
         Base colours of glTF and ``.blend`` materials without a spectrum as ``rgb:`` spectra.
+    semantic
+        The user's semantic rules (``--semantic-map``), before the default map's.
     """
 
     path: str
@@ -203,6 +244,7 @@ class FileSource:
     materials: tuple[tuple[str, str], ...] = ()
     default_spectrum: str | None = None
     colours_from_asset: bool = False
+    semantic: SemanticRules = SemanticRules()
 
     def build(self, data_dir: str | None = None) -> Scene:
         """Read and validate the file; one-line :class:`SceneError` naming it on bad input."""
@@ -214,4 +256,5 @@ class FileSource:
             default_spectrum=self.default_spectrum,
             data_dir=data_dir,
             colours_from_asset=self.colours_from_asset,
+            semantic=self.semantic,
         )

@@ -82,6 +82,13 @@ def _spectral_provenance(metas: Sequence[SampleMeta], data_dir: Any) -> dict[str
     return out
 
 
+def _semantic_classes(metas: Sequence[SampleMeta]) -> dict[str, Any]:
+    """``{"semantic_classes": table}`` of the samples with a ``semantic`` layer (one table, as
+    every sample of a build records the same), else nothing (samples from before issue 41)."""
+    tables = [m.raw["semantic_classes"] for m in metas if "semantic_classes" in m.raw]
+    return {"semantic_classes": tables[0]} if tables else {}
+
+
 def _sample_files(sample: Path) -> list[Path]:
     return sorted(p for p in sample.rglob("*") if p.is_file())
 
@@ -113,6 +120,7 @@ def write_manifest(
         "n_samples": len(samples),
         "noise": noise_summary(metas),
         "residual_share": residual_summary([m.raw for m in metas]),
+        **_semantic_classes(metas),
         "split_by": "scene",
         "split_fractions": dict(split_fractions),
         "splits": splits_by_scene({m.sample_id: m.scene for m in metas}, split_fractions),

@@ -29,7 +29,7 @@ __all__ = [
     "EXPOSURE_PERCENTILE",
 ]
 
-_INT_LAYERS = ("material_id", "object_id")
+_INT_LAYERS = ("material_id", "object_id", "semantic")
 
 
 def _verified(meta: SampleMeta, file: str) -> Path:
