@@ -146,6 +146,13 @@ class Mesh:
         A spectral :class:`~spectrinsic.scenes.textures.Texture` over every face (whose
         ``face_materials`` are then all ``texture.basis[0]``), or ``None``: each face one exact
         spectrum. Left out of :func:`scene_to_dict` when ``None``.
+    semantic
+        Its class in :data:`~spectrinsic.scenes.semantic.SEMANTIC_CLASSES`; left empty, the
+        class its name maps to by the default map
+        (:func:`~spectrinsic.scenes.semantic.classify`). Left out of :func:`scene_to_dict`
+        when it is that class, so the records and hashes of scenes from before classes existed
+        are unchanged. ``dataclasses.replace(mesh, name=...)`` keeps the class; add
+        ``semantic=""`` to take the new name's.
     """
 
     name: str
