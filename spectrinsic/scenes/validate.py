@@ -226,12 +226,8 @@ def check_classes(scene: Scene, source: str) -> None:
             raise _fail(source, where, f"expected one of {', '.join(SEMANTIC_CLASSES)}")
         other = classes.setdefault(int(m.object_id), m.semantic)
         if other != m.semantic:
-            raise _fail(
-                source,
-                where,
-                f"{m.semantic!r}, but another mesh of object id {m.object_id} is {other!r}; "
-                "meshes sharing an object id share a class",
-            )
+            why = f"meshes sharing an object id share a class (object {m.object_id}: {other!r})"
+            raise _fail(source, where, f"{m.semantic!r}; {why}")
 
 
 def _check_textures(scene: Scene, source: str) -> None:

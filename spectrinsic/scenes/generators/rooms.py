@@ -39,10 +39,12 @@ _FURNITURE_CLASS = {"round-table": "table"}
 FRAMED_COVERAGE = 0.3
 
 
-def _slab(lo: np.ndarray, hi: np.ndarray, spectrum: str) -> Part:
+def _slab(lo: np.ndarray, hi: np.ndarray, spectrum: str, semantic: str = "") -> Part:
+    """The box from corner *lo* to corner *hi*, of semantic class *semantic*."""
     size = np.maximum(hi - lo, 1e-3)
     div = tuple(max(1, int(round(s * 2))) for s in size)
-    return box(tuple(size), spectrum, center=tuple((lo + hi) / 2), divisions=div)
+    part = box(tuple(size), spectrum, center=tuple((lo + hi) / 2), divisions=div)
+    return replace(part, semantic=semantic)
 
 
 def _wall(
@@ -71,7 +73,7 @@ def _wall(
         lo[axis], hi[axis], lo[2], hi[2] = a, b, c, e
         if b - a > 1e-3 and e - c > 1e-3:
             pieces.append(_slab(lo.copy(), hi.copy(), spectrum))
-    return merge(*pieces)
+    return replace(merge(*pieces), semantic="wall")
 
 
 def _shell(
@@ -98,13 +100,11 @@ def _shell(
     parts = [
         (
             "floor",
-            replace(
-                _slab(
-                    np.array([-_T, -_T, -_T]),
-                    np.array([w + _T, d + _T, 0.0]),
-                    draw_reflectance(rng, walls),
-                ),
-                semantic="floor",
+            _slab(
+                np.array([-_T, -_T, -_T]),
+                np.array([w + _T, d + _T, 0.0]),
+                draw_reflectance(rng, walls),
+                "floor",
             ),
         )
     ]
@@ -112,13 +112,11 @@ def _shell(
         parts.append(
             (
                 "ceiling",
-                replace(
-                    _slab(
-                        np.array([-_T, -_T, h]),
-                        np.array([w + _T, d + _T, h + _T]),
-                        draw_reflectance(rng, walls),
-                    ),
-                    semantic="ceiling",
+                _slab(
+                    np.array([-_T, -_T, h]),
+                    np.array([w + _T, d + _T, h + _T]),
+                    draw_reflectance(rng, walls),
+                    "ceiling",
                 ),
             )
         )
@@ -135,8 +133,7 @@ def _shell(
             )
         if day is not None:
             hole, windows = (day.hole if key == day.wall else None), 1
-        wall = _wall(key, size, draw_reflectance(rng, walls), hole)
-        parts.append((f"wall-{key}", replace(wall, semantic="wall")))
+        parts.append((f"wall-{key}", _wall(key, size, draw_reflectance(rng, walls), hole)))
     return parts, {
         "missing_walls": missing,
         "ceiling": ceiling,
