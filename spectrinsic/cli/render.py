@@ -203,8 +203,9 @@ def _add_material_options(p: Any) -> None:
         "--semantic-map",
         metavar="FILE",
         default=None,
-        help="YAML/JSON rules regex -> semantic class for a scene file's meshes, tried before "
-        "the default name map (spectrinsic/scenes/FORMAT.md, Semantic classes)",
+        help="with --ground-truth: YAML/JSON rules regex -> semantic class for a scene file's "
+        "meshes, tried before the default name map (spectrinsic/scenes/FORMAT.md, Semantic "
+        "classes)",
     )
     p.add_argument(
         "--colours-from-asset",
@@ -337,6 +338,8 @@ def run(args: argparse.Namespace) -> int:
         return _ground_truth(args)
     if args.ignore_disk_space:  # a plain render's files are small: never estimated
         raise RenderError("--ignore-disk-space applies only with --ground-truth")
+    if args.semantic_map is not None:  # a plain render writes no semantic layer
+        raise RenderError("--semantic-map applies only with --ground-truth")
     settings = _render_settings(args, _parse_modes(args))
     check_output_folder(Path(args.out))
     data_dir = getattr(args, "data_dir", None)
@@ -391,7 +394,6 @@ def _load_scene(args: argparse.Namespace, data_dir: str | None) -> Scene:
         default_spectrum=args.default_spectrum,
         data_dir=data_dir,
         colours_from_asset=args.colours_from_asset,
-        semantic=semantic_map(args.semantic_map),
     )
 
 

@@ -8,7 +8,6 @@ from collections.abc import Mapping
 from ..pipeline.presets import get_preset
 from ..scenes import library
 from ..scenes.model import Scene
-from ..scenes.semantic import SemanticRules
 from ..scenes.sources import is_scene_file, load_scene_file
 
 __all__ = ["load_scene_argument"]
@@ -26,7 +25,6 @@ def load_scene_argument(
     default_spectrum: str | None = None,
     data_dir: str | None = None,
     colours_from_asset: bool = False,
-    semantic: SemanticRules | None = None,
 ) -> Scene:
     """The Scene named by the ``SCENE`` argument: a scene file (YAML, ``.blend`` or mesh,
     :func:`spectrinsic.scenes.sources.load_scene_file`, the dispatch ``dataset --scenes`` uses),
@@ -40,7 +38,6 @@ def load_scene_argument(
             default_spectrum=default_spectrum,
             data_dir=data_dir,
             colours_from_asset=colours_from_asset,
-            semantic=semantic,
         )
     default = get_preset("default")
     return library.build(

@@ -38,7 +38,8 @@ def test_a_user_map_labels_the_rendered_semantic_layer(tmp_path, capsys):
 @pytest.mark.parametrize(
     "argv, expected",
     [
-        (["render", "SCENE", "--semantic-map", "MAP"], "unknown semantic class 'tabel'"),
+        (["render", "SCENE", "--ground-truth", "--semantic-map", "MAP"], "class 'tabel'"),
+        (["render", "SCENE", "--semantic-map", "MAP"], "applies only with --ground-truth"),
         (["dataset", "--scenes", "SCENE", "--semantic-map", "MAP"], "--semantic-map: "),
         (["render", "obj-apple", "--semantic-map", "MAP"], "--semantic-map applies to scene files"),
         (["dataset", "--generator", "rooms", "--semantic-map", "MAP"], "--semantic-map"),
