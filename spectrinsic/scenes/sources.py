@@ -165,12 +165,16 @@ def labelled(scene: Scene, semantic: SemanticRules, source: str) -> Scene:
     """*scene* with each mesh's class taken from its object name, then its material names (in
     the order its faces use them), by *semantic*'s rules and then the default map's
     (:func:`~spectrinsic.scenes.semantic.classify`); SceneError naming *source* if meshes
-    sharing an object id get different classes."""
+    sharing an object id get different classes.
+
+    A material named after its own spectrum (as every generated material is, and unnamed mesh
+    materials) says nothing of the object and is passed over, so a saved generated scene read
+    back gets its generator's classes (``sfu:sfu_lab_wall/1`` on a vase is no wall)."""
     chosen = semantic.compiled()
     meshes = []
     for mesh in scene.meshes:
-        used = dict.fromkeys(int(i) for i in mesh.face_materials)
-        names = [mesh.name, *(scene.materials[i].name for i in used)]
+        used = [scene.materials[i] for i in dict.fromkeys(int(i) for i in mesh.face_materials)]
+        names = [mesh.name, *(m.name for m in used if m.name != m.spectrum)]
         meshes.append(dataclasses.replace(mesh, semantic=classify(names, chosen)))
     out = dataclasses.replace(scene, meshes=tuple(meshes))
     check_classes(out, source)

@@ -14,16 +14,17 @@ from spectrinsic.scenes.generators import GENERATORS, GeneratorOptions, generate
 from spectrinsic.scenes.generators.base import scene_rngs
 from spectrinsic.scenes.generators.camera import first_hits
 from spectrinsic.scenes.geometry import camera_rays
-from spectrinsic.scenes.model import Camera, Mesh, Scene, scene_from_dict, scene_to_dict
+from spectrinsic.scenes.model import Camera, Material, Mesh, Scene, scene_from_dict, scene_to_dict
 from spectrinsic.scenes.parts import to_meshes
 from spectrinsic.scenes.semantic import (
     SEMANTIC_CLASSES,
+    SemanticRules,
     class_id,
     class_table,
     classify,
     read_semantic_map,
 )
-from spectrinsic.scenes.sources import load_scene_file
+from spectrinsic.scenes.sources import labelled, load_scene_file
 from tests.conftest import QUAD_YAML
 
 #: The classes the rooms generator gives (no window: a room's window is an opening).
@@ -183,3 +184,15 @@ def test_a_mesh_record_without_a_class_takes_its_names():
     mesh = Mesh("sofa-2", np.eye(3), np.array([[0, 1, 2]]), np.array([0]), 0)
     assert mesh.semantic == "sofa"
     assert mesh != dataclasses.replace(mesh, semantic="object")
+
+
+def test_a_saved_generated_scene_reads_back_with_the_generators_classes():
+    """Generated materials are named after their spectra; one that a rule would match
+    (``sfu:sfu_lab_wall/1``) does not make the vase it paints a wall."""
+    vase = Mesh("vessel-3", np.eye(3), np.array([[0, 1, 2]]), np.array([0]), 0)
+    wall = Material("sfu:sfu_lab_wall/1", "sfu:sfu_lab_wall/1")
+    named = Material("Wall paint", "munsell:5Y 8/2")
+    scene = Scene("s", (vase,), (wall,), (), Camera((0, 0, 1), (0, 1, 1)))
+    assert labelled(scene, SemanticRules(), "s").meshes[0].semantic == "object"
+    scene = dataclasses.replace(scene, materials=(named,))
+    assert labelled(scene, SemanticRules(), "s").meshes[0].semantic == "wall"
