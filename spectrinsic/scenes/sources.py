@@ -155,10 +155,12 @@ def load_scene_file(
         The user's semantic rules (``--semantic-map``), tried before the default map's
         (:func:`labelled`); None: the default map alone.
     """
+    rules = semantic or SemanticRules()
     scene = _read_scene_file(
-        path, width, height, materials, default_spectrum, data_dir, colours_from_asset
+        path, width, height, materials, default_spectrum, data_dir, colours_from_asset, rules
     )
-    return labelled(scene, semantic or SemanticRules(), str(path))
+    # a mesh file's reader labels its meshes itself: its materials keep only their spectra's names
+    return scene if scene_file_kind(path) == "mesh" else labelled(scene, rules, str(path))
 
 
 def labelled(scene: Scene, semantic: SemanticRules, source: str) -> Scene:
@@ -189,6 +191,7 @@ def _read_scene_file(
     default_spectrum: str | None,
     data_dir: str | None,
     colours_from_asset: bool,
+    semantic: SemanticRules,
 ) -> Scene:
     """The scene of *path* as its reader builds it (see :func:`load_scene_file`)."""
     kind = scene_file_kind(path)
@@ -203,6 +206,7 @@ def _read_scene_file(
             default_spectrum=default_spectrum,
             data_dir=data_dir,
             colours_from_asset=colours_from_asset,
+            semantic=semantic.compiled(),
         )
     if kind == "blend":
         return load_blend(

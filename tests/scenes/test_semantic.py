@@ -196,3 +196,11 @@ def test_a_saved_generated_scene_reads_back_with_the_generators_classes():
     assert labelled(scene, SemanticRules(), "s").meshes[0].semantic == "object"
     scene = dataclasses.replace(scene, materials=(named,))
     assert labelled(scene, SemanticRules(), "s").meshes[0].semantic == "wall"
+
+
+def test_an_obj_mesh_takes_its_class_from_its_material_name(tmp_path):
+    obj = tmp_path / "thing.obj"
+    (tmp_path / "thing.mtl").write_text("newmtl Oak_Desk_top\nKd 0.5 0.3 0.1\n")
+    obj.write_text("mtllib thing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl Oak_Desk_top\nf 1 2 3\n")
+    scene = load_scene_file(obj, materials={"Oak_Desk_top": "munsell:10YR 6/6"})
+    assert [m.semantic for m in scene.meshes] == ["table"]  # "desk" in its material's name
