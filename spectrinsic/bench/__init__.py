@@ -24,6 +24,7 @@ BENCHMARKS = (
     "crop_reference",
     "relight",
     "residual",
+    "storage",
 )
 
 

@@ -18,7 +18,7 @@ from ..pipeline.presets import PRESETS, DatasetConfig, get_preset, preset_names
 from ..pipeline.source_plan import check_integrator_plan
 from ..render.budget import check_render_size
 from ..render.settings import INTEGRATORS
-from .dataset_layers import add_extra_layer_options
+from .dataset_layers import add_extra_layer_options, layer_changes
 from .dataset_source import (
     add_source_options,
     check_scene_files,
@@ -211,16 +211,12 @@ _VALUE_OPTIONS: tuple[tuple[str, str], ...] = (
     ("noise_target", "noise_target"),
     ("max_batches", "max_batches"),
     ("integrator", "integrator"),
-    ("camera", "camera"),
     ("variant", "variant"),
-    ("working_space", "working_space"),
 )
 #: Switches and the config value each sets when given (option dest -> (config key, value)).
 _SWITCHES: tuple[tuple[str, str, bool], ...] = (
     ("no_denoise", "denoise", False),
     ("direct", "direct", True),
-    ("store_transport", "store_transport", True),
-    ("spectral_layers", "spectral_layers", True),
 )
 
 
@@ -237,6 +233,7 @@ def _overrides(args: argparse.Namespace) -> dict[str, Any]:
     for dest, key, value in _SWITCHES:
         if getattr(args, dest, False):
             changes[key] = value
+    changes.update(layer_changes(args))
     if args.resolution is not None:
         changes["width"], changes["height"] = parse_resolution(args.resolution)
     if getattr(args, "split_fractions", None) is not None:

@@ -133,7 +133,8 @@ def _add_scene_file_options(src: Any) -> None:
         nargs="+",
         metavar="PATH",
         default=None,
-        help="render your own scene files (.yaml, .blend, .obj/.ply/.glb) with full ground truth",
+        help="render your own scene files (.yaml, Mitsuba 3 .xml, .blend, .obj/.ply/.glb) with "
+        "full ground truth",
     )
     src.add_argument(
         "--material-map",

@@ -1,7 +1,7 @@
 """``spectrinsic render``: render one scene in several modes and write the raw passes as EXR.
 
 ``SCENE`` is a library scene name (``spectrinsic.scenes.library``) or a scene file (YAML,
-``.blend`` or mesh, read as ``dataset --scenes`` reads them). For
+Mitsuba 3 XML, ``.blend`` or mesh, read as ``dataset --scenes`` reads them). For
 every mode ``DIR/<mode>.exr`` holds float32 layers ``raw`` (the K raw channels, named after the
 sensors, e.g. ``raw.B400``), ``xyz`` (CIE 1931 XYZ), and when asked ``direct`` and
 ``light<i>`` (XYZ), and ``DIR/<mode>.png`` its sRGB preview; ``DIR/aovs.exr`` holds coverage, ids, depth and normals; ``DIR/meta.json``
@@ -40,6 +40,7 @@ from ..scenes.model import Scene
 from ..scenes.sample_id import SampleId
 from ..scenes.sources import FILE_SIZE, is_scene_file
 from . import dataset as cli_dataset
+from .dataset_layers import add_layer_options, given_layer_options, layer_changes
 from .dataset_source import material_map, parse_resolution, semantic_map
 from .render_files import write_render
 from .render_scene import load_scene_argument
@@ -75,6 +76,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     _add_size_options(p, default)
     _add_pass_options(p, default)
     _add_ground_truth_options(p)
+    add_layer_options(
+        p.add_argument_group(
+            "ground-truth layers (with --ground-truth; the layer options of `spectrinsic dataset`)"
+        )
+    )
     _add_material_options(p)
     p.set_defaults(func=run)
 
@@ -284,6 +290,7 @@ def _ground_truth(args: argparse.Namespace) -> int:
     size = requested_size(args)
     if size is not None:
         changes["width"], changes["height"] = size
+    changes.update(layer_changes(args))  # the layer options shared with `dataset`
     only = None
     if is_scene_file(args.scene):
         changes["source"] = files_source(
@@ -338,6 +345,10 @@ def run(args: argparse.Namespace) -> int:
         return _ground_truth(args)
     if args.ignore_disk_space:  # a plain render's files are small: never estimated
         raise RenderError("--ignore-disk-space applies only with --ground-truth")
+    for option in given_layer_options(args):  # ground-truth layers: a plain render has none
+        raise RenderError(
+            f"{option} applies only with --ground-truth (a ground-truth layer option)"
+        )
     if args.semantic_map is not None:  # a plain render writes no semantic layer
         raise RenderError("--semantic-map applies only with --ground-truth")
     settings = _render_settings(args, _parse_modes(args))

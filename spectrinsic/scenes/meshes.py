@@ -18,6 +18,7 @@ count as matte (not glTF's default of 1), so files without them import as before
 
 from __future__ import annotations
 
+import io
 import json
 import math
 import os
@@ -151,14 +152,60 @@ def _pbr_gloss(material: Any) -> dict[str, Any]:
     return {}
 
 
+#: The in-memory material library that names an OBJ's ``usemtl`` materials when it has none.
+_USEMTL_LIBRARY = "__spectrinsic_usemtl__.mtl"
+
+
+def _usemtl_names(text: str) -> list[str]:
+    """An OBJ's ``usemtl`` names in order of first use, when it names no ``mtllib`` (trimesh
+    drops the names of materials no library defines and calls the parts ``<file>_1``...)."""
+    names: list[str] = []
+    for line in text.splitlines():
+        words = line.split(maxsplit=1)
+        if words[:1] == ["mtllib"]:
+            return []
+        if words[:1] == ["usemtl"] and len(words) == 2 and words[1].strip() not in names:
+            names.append(words[1].strip())
+    return names
+
+
+def _load_mesh_file(path: Path) -> Any:
+    """*path* as a trimesh scene; an OBJ whose ``usemtl`` materials no library defines is read
+    with an in-memory library of those names (``newmtl NAME`` each, no colour), so its parts
+    keep the names the file gives them, which ``--material-map`` then maps."""
+    import trimesh
+    from trimesh.resolvers import FilePathResolver
+
+    names = (
+        _usemtl_names(path.read_text(encoding="utf-8", errors="replace"))
+        if (path.suffix.lower() == ".obj")
+        else []
+    )
+    if not names:
+        return trimesh.load(str(path), force="scene", process=False)
+    library = "".join(f"newmtl {name}\n" for name in names).encode()
+
+    class _Resolver(FilePathResolver):  # type: ignore[misc]
+        def get(self, name: str) -> bytes:
+            return library if name == _USEMTL_LIBRARY else bytes(super().get(name))
+
+    text = f"mtllib {_USEMTL_LIBRARY}\n".encode() + path.read_bytes()
+    return trimesh.load(
+        io.BytesIO(text),
+        file_type="obj",
+        force="scene",
+        process=False,
+        resolver=_Resolver(str(path)),
+    )
+
+
 def _geometries(path: Path) -> list[tuple[str, str, np.ndarray, np.ndarray, dict[str, Any]]]:
     """``(geometry name, material name, vertices, faces, gloss)`` of every triangle mesh in the
     file, in world space, sorted by geometry name (file order is not stable across formats)."""
-    import trimesh
 
     check_mesh_size(path)
     try:
-        loaded: Any = trimesh.load(str(path), force="scene", process=False)
+        loaded: Any = _load_mesh_file(path)
     except Exception as exc:  # noqa: BLE001 - trimesh raises many types for corrupt files
         raise SceneError(f"{path}: cannot read it as a mesh ({type(exc).__name__}: {exc})") from exc
     out = []

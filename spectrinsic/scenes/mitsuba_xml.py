@@ -40,6 +40,7 @@ import numpy as np
 
 from ..errors import SceneError, SpectrinsicError
 from ..spectra.io import read_spd
+from ..spectra.user_spectra import sha256
 from . import mitsuba_parts as parts
 from .materials import METAL_SPECTRUM
 from .meshes import check_mesh_size
@@ -88,7 +89,6 @@ def _parse(path: Path) -> ET.Element:
                 el.set(
                     key, re.sub(r"\$(\w+)", lambda m: defaults.get(m.group(1), m.group(0)), value)
                 )
-    _read_spectrum_files(root, path.parent)
     return root
 
 
@@ -101,9 +101,11 @@ _BSDF_PARAMS = {
 }
 
 
-def _read_spectrum_files(root: ET.Element, base: Path) -> None:
+def _read_spectrum_files(root: ET.Element, base: Path) -> list[dict[str, str]]:
     """Every ``<spectrum filename=...>`` (a Mitsuba ``.spd`` inside the scene's folder) made a
-    ``value`` of its samples, so the rest of the reader sees written-out spectra."""
+    ``value`` of its samples, so the rest of the reader sees written-out spectra; one record
+    per file read (its path and SHA-256), for ``meta.json["spectrum_files"]``."""
+    records: dict[str, dict[str, str]] = {}
     for el in root.iter("spectrum"):
         if "filename" not in el.attrib:
             continue
@@ -115,6 +117,8 @@ def _read_spectrum_files(root: ET.Element, base: Path) -> None:
             )
         wl, values = read_spd(path)
         el.set("value", ", ".join(f"{w!r}:{v!r}" for w, v in zip(wl.tolist(), values.tolist())))
+        records[str(path)] = {"spectrum": f"spd:{path}", "file": str(path), "sha256": sha256(path)}
+    return [records[k] for k in sorted(records)]
 
 
 def _bsdf(el: ET.Element, where: str) -> Material:
@@ -357,7 +361,10 @@ def load_mitsuba_xml(path: str | os.PathLike[str], *, data_dir: str | None = Non
         root = _parse(path)
         if any(el.tag == "include" for el in root.iter()):
             raise SceneError("unsupported element <include>")
+        spd_files = _read_spectrum_files(root, path.parent)
         scene = _scene(root, path.parent, path.stem)
+        if spd_files:  # recorded beside the csv: files in each sample's meta.json
+            scene.metadata["spectrum_files"] = spd_files
     except SpectrinsicError as exc:
         raise SceneError(f"{path}: {exc}") from None
     except (ValueError, OSError) as exc:

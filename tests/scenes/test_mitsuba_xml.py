@@ -3,6 +3,9 @@ as YAML by hand, full ground truth, and one-line refusals."""
 
 from __future__ import annotations
 
+import hashlib
+import json
+
 import numpy as np
 import pytest
 import yaml
@@ -153,10 +156,19 @@ def test_a_cornell_box_in_xml_equals_the_same_box_in_yaml(cornell):
 
 
 def test_the_xml_box_renders_with_full_ground_truth(cornell):
+    """The box with its green read from a .spd file (the same spectrum, test below), which the
+    sample's meta.json records with its SHA-256 (issue 47)."""
+    lines = "".join(f"{w} {v}\n" for w, v in zip(GREEN["wavelengths"], GREEN["values"]))
+    (cornell / "green.spd").write_text(lines)
+    spd = XML.replace(f'value="{_spectrum(GREEN)}"', 'filename="green.spd"')
+    (cornell / "spd.xml").write_text(spd)
     out = cornell / "out"
     args = ["--ground-truth", "--preset", "preview", "--spp", "2", "--out", str(out)]
-    assert main(["-q", "render", str(cornell / "cornell.xml"), *args]) == 0
+    assert main(["-q", "render", str(cornell / "spd.xml"), *args]) == 0
     assert main(["-q", "check", str(out)]) == 0
+    (meta,) = [json.loads(p.read_text()) for p in out.glob("*/meta.json")]
+    digest = hashlib.sha256((cornell / "green.spd").read_bytes()).hexdigest()
+    assert [r["sha256"] for r in meta["spectrum_files"]] == [digest]
 
 
 @pytest.mark.parametrize(
@@ -278,6 +290,14 @@ def test_a_spectrum_from_an_spd_file_equals_the_written_out_one(cornell):
     (cornell / "spd.xml").write_text(spd)
     plain, from_file = (load_mitsuba_xml(cornell / n) for n in ("cornell.xml", "spd.xml"))
     assert [m.spectrum for m in plain.materials] == [m.spectrum for m in from_file.materials]
+    (record,) = from_file.metadata["spectrum_files"]  # issue 47: .spd files recorded too
+    digest = hashlib.sha256((cornell / "green.spd").read_bytes()).hexdigest()
+    assert record == {
+        "spectrum": f"spd:{(cornell / 'green.spd').resolve()}",
+        "file": str((cornell / "green.spd").resolve()),
+        "sha256": digest,
+    }
+    assert "spectrum_files" not in plain.metadata
     (cornell / "out.xml").write_text(spd.replace('"green.spd"', '"../green.spd"'))
     with pytest.raises(
         SceneError, match="spectrum filename '../green.spd'; expected a path inside"

@@ -151,11 +151,13 @@ def load_dataset(
     verify: bool = True,
     max_residual_share: float | None = None,
     space: str | None = None,
+    split: str | None = None,
 ) -> Iterator[dict[str, Any]]:
     """Iterate :func:`load_sample` over the complete samples of *dataset_dir*, sorted by id;
-    with *max_residual_share*, only those whose RGB residual share is at most that
-    (:func:`filter_residual_share`); *space* as :func:`load_sample`'s."""
-    for sample in filter_residual_share(sample_dirs(dataset_dir), max_residual_share):
+    with *split* (``"train"``, ``"val"``, ``"test"``), only that split's, as ``torch_dataset``
+    (:func:`split_samples`); with *max_residual_share*, only those whose RGB residual share
+    is at most that (:func:`filter_residual_share`); *space* as :func:`load_sample`'s."""
+    for sample in filter_residual_share(split_samples(dataset_dir, split), max_residual_share):
         yield load_sample(sample, layers=layers, verify=verify, space=space)
 
 

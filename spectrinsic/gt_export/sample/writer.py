@@ -127,7 +127,7 @@ def _meta(
     height, width = gt.layers["image"].data.shape[:2]
     files_used = spectrum_files(
         [m.spectrum for m in scene.materials] + [li.spectrum for li in scene.lights]
-    )
+    ) + list(scene.metadata.get("spectrum_files", []))  # the .spd files a Mitsuba XML read
     extra: dict[str, Any] = {"spectrum_files": files_used} if files_used else {}
     if "semantic" in gt.layers:  # the class table of the semantic layer's ids
         extra["semantic_classes"] = class_table()
