@@ -27,6 +27,7 @@ __all__ = [
     "check_scene_files",
     "material_map",
     "semantic_map",
+    "add_semantic_map_option",
     "parse_resolution",
     "source_from_args",
     "source_notes",
@@ -154,13 +155,7 @@ def _add_scene_file_options(src: Any) -> None:
         help="give unmapped glTF and .blend materials their base colour (glTF "
         "baseColorFactor, Principled Base Color) as an rgb: reflectance (default: an error)",
     )
-    src.add_argument(
-        "--semantic-map",
-        metavar="FILE",
-        default=None,
-        help="YAML/JSON rules regex -> semantic class, tried before the default name map "
-        "(spectrinsic/scenes/FORMAT.md, Semantic classes)",
-    )
+    add_semantic_map_option(src)
     src.add_argument(
         "--new-sample",
         action="store_true",
@@ -182,6 +177,17 @@ def _range(option: str, text: str) -> tuple[float, float]:
     if lo > hi:
         raise DatasetError(f"{option} {text!r}; expected LO <= HI")
     return lo, hi
+
+
+def add_semantic_map_option(group: Any) -> None:
+    """``--semantic-map FILE``, for ``dataset --scenes`` and ``render FILE --ground-truth``."""
+    group.add_argument(
+        "--semantic-map",
+        metavar="FILE",
+        default=None,
+        help="scene files with ground truth: YAML/JSON rules regex -> semantic class, tried "
+        "before the default name map (spectrinsic/scenes/FORMAT.md, Semantic classes)",
+    )
 
 
 def semantic_map(path: str | None) -> SemanticRules | None:

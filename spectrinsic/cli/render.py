@@ -41,7 +41,7 @@ from ..scenes.sample_id import SampleId
 from ..scenes.sources import FILE_SIZE, is_scene_file
 from . import dataset as cli_dataset
 from .dataset_layers import add_layer_options, given_layer_options, layer_changes
-from .dataset_source import material_map, parse_resolution, semantic_map
+from .dataset_source import add_semantic_map_option, material_map, parse_resolution, semantic_map
 from .render_files import write_render
 from .render_scene import load_scene_argument
 
@@ -205,14 +205,7 @@ def _add_material_options(p: Any) -> None:
         default=None,
         help="reflectance of unmapped materials in .blend and mesh files",
     )
-    p.add_argument(
-        "--semantic-map",
-        metavar="FILE",
-        default=None,
-        help="with --ground-truth: YAML/JSON rules regex -> semantic class for a scene file's "
-        "meshes, tried before the default name map (spectrinsic/scenes/FORMAT.md, Semantic "
-        "classes)",
-    )
+    add_semantic_map_option(p)
     p.add_argument(
         "--colours-from-asset",
         action="store_true",
