@@ -14,11 +14,12 @@ from typing import Any
 
 from ..errors import DatasetError, SceneError, SpectrinsicError
 from ..pipeline.presets import DatasetConfig
-from ..pipeline.source_plan import file_sample, files_source, generator_source
+from ..pipeline.source_plan import file_sample, files_source, generator_source, semantic_rules
 from ..render.base.variants import import_mitsuba
 from ..scenes.generators import GlossDistribution
 from ..scenes.generators.world_defaults import GLOSSY_FRACTION, METALLIC_FRACTION, TEXTURE_FRACTION
 from ..scenes.mitsuba_xml import render_hints_line, xml_notes
+from ..scenes.semantic import SemanticRules, read_semantic_map
 from ..scenes.sources import FileSource
 from ..scenes.spectrum_refs import resolve_spectrum
 from ..scenes.yaml_limits import load_yaml_file
@@ -28,6 +29,8 @@ __all__ = [
     "add_source_options",
     "check_scene_files",
     "material_map",
+    "semantic_map",
+    "add_semantic_map_option",
     "parse_resolution",
     "source_from_args",
     "source_notes",
@@ -155,6 +158,7 @@ def _add_scene_file_options(src: Any) -> None:
         help="give unmapped glTF and .blend materials their base colour (glTF "
         "baseColorFactor, Principled Base Color) as an rgb: reflectance (default: an error)",
     )
+    add_semantic_map_option(src)
     src.add_argument(
         "--approximate",
         action="store_true",
@@ -182,6 +186,27 @@ def _range(option: str, text: str) -> tuple[float, float]:
     if lo > hi:
         raise DatasetError(f"{option} {text!r}; expected LO <= HI")
     return lo, hi
+
+
+def add_semantic_map_option(group: Any) -> None:
+    """``--semantic-map FILE``, for ``dataset --scenes`` and ``render FILE --ground-truth``."""
+    group.add_argument(
+        "--semantic-map",
+        metavar="FILE",
+        default=None,
+        help="scene files with ground truth: YAML/JSON rules regex -> semantic class, tried "
+        "before the default name map (spectrinsic/scenes/FORMAT.md, Semantic classes)",
+    )
+
+
+def semantic_map(path: str | None) -> SemanticRules | None:
+    """The ``--semantic-map`` file's rules (None for none); DatasetError naming it if bad."""
+    if path is None:
+        return None
+    try:
+        return read_semantic_map(path)
+    except SceneError as exc:
+        raise DatasetError(f"--semantic-map: {exc}") from None
 
 
 def material_map(path: str | None) -> dict[str, str]:
@@ -226,7 +251,7 @@ GENERATOR_DEFAULTS: dict[str, Any] = {
     "roughness_range": "0,0.3",
 }
 #: The options of scene files (``--scenes``).
-FILE_OPTIONS = ("material_map", "default_spectrum", "new_sample")
+FILE_OPTIONS = ("material_map", "default_spectrum", "new_sample", "semantic_map")
 
 
 def _given(value: object) -> bool:
@@ -292,6 +317,7 @@ def source_from_args(args: argparse.Namespace) -> str | None:
             new_sample=getattr(args, "new_sample", False),
             colours_from_asset=args.colours_from_asset,
             approximate=args.approximate,
+            semantic=semantic_map(getattr(args, "semantic_map", None)),
         )
     return None
 
@@ -358,6 +384,7 @@ def check_scene_files(config: Any, data_dir: str | None, *, quiet: bool = False)
             spec.get("default_spectrum"),
             colours_from_asset=bool(spec.get("colours_from_asset")),
             approximate=bool(spec.get("approximate")),
+            semantic=semantic_rules(spec),
         ).build(data_dir)
         if not quiet:
             for note in xml_notes(scene):

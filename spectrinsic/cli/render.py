@@ -43,7 +43,7 @@ from ..scenes.sample_id import SampleId
 from ..scenes.sources import FILE_SIZE, is_scene_file
 from . import dataset as cli_dataset
 from .dataset_layers import add_layer_options, given_layer_options, layer_changes
-from .dataset_source import material_map, parse_resolution
+from .dataset_source import add_semantic_map_option, material_map, parse_resolution, semantic_map
 from .render_files import write_render
 from .render_scene import load_scene_argument
 
@@ -208,6 +208,7 @@ def _add_material_options(p: Any) -> None:
         default=None,
         help="reflectance of unmapped materials in .blend and mesh files",
     )
+    add_semantic_map_option(p)
     p.add_argument(
         "--colours-from-asset",
         action="store_true",
@@ -253,14 +254,16 @@ def _check_source_options(args: argparse.Namespace) -> None:
         "--view": args.view is not None,
         "--material-map": args.material_map is not None,
         "--default-spectrum": args.default_spectrum is not None,
+        "--semantic-map": args.semantic_map is not None,
     }
-    library_only, file_only = ("--condition", "--view"), ("--material-map", "--default-spectrum")
+    library_only = ("--condition", "--view")
+    file_only = ("--material-map", "--default-spectrum", "--semantic-map")
     if args.approximate and Path(args.scene).suffix.lower() != ".xml":
         raise RenderError(f"--approximate applies to Mitsuba XML scenes; {args.scene!r} is not one")
     for option in library_only if file else file_only:
         if given[option]:
             kind = "a scene file" if file else "a library scene"
-            applies = "library scenes" if file else ".blend and mesh files"
+            applies = "library scenes" if file else "scene files"
             raise RenderError(f"{option} applies to {applies}; {args.scene!r} is {kind}")
     args.condition = "white" if args.condition is None else args.condition
     args.view = 0 if args.view is None else args.view
@@ -302,6 +305,7 @@ def _ground_truth(args: argparse.Namespace) -> int:
             new_sample=args.new_sample,
             colours_from_asset=args.colours_from_asset,
             approximate=args.approximate,
+            semantic=semantic_map(args.semantic_map),
         )
     else:
         only = str(SampleId(args.scene, args.view, args.condition))
@@ -355,6 +359,8 @@ def run(args: argparse.Namespace) -> int:
         raise RenderError(
             f"{option} applies only with --ground-truth (a ground-truth layer option)"
         )
+    if args.semantic_map is not None:  # a plain render writes no semantic layer
+        raise RenderError("--semantic-map applies only with --ground-truth")
     settings = _render_settings(args, _parse_modes(args))
     check_output_folder(Path(args.out))
     data_dir = getattr(args, "data_dir", None)

@@ -34,6 +34,7 @@ from ..errors import SceneError
 from .gltf_colours import gltf_base_colours
 from .materials import METAL_SPECTRUM
 from .model import Camera, Light, Material, Mesh, Scene
+from .semantic import SemanticMap, classify
 from .validate import validate_scene
 
 __all__ = [
@@ -267,6 +268,7 @@ def load_mesh_scene(
     default_spectrum: str | None = None,
     data_dir: str | None = None,
     colours_from_asset: bool = False,
+    semantic: SemanticMap | None = None,
 ) -> Scene:
     """Read a mesh file into a validated :class:`~spectrinsic.scenes.model.Scene`.
 
@@ -284,6 +286,9 @@ def load_mesh_scene(
     colours_from_asset
         Give glTF materials not in *materials* their ``baseColorFactor`` as an ``rgb:``
         reflectance before *default_spectrum* (module docstring).
+    semantic
+        The names → class map (:mod:`~spectrinsic.scenes.semantic`; None: the default) each
+        mesh's class comes from: its node's name, then the file's name of its material.
 
     Raises
     ------
@@ -316,6 +321,7 @@ def load_mesh_scene(
                 faces=faces,
                 face_materials=np.full(len(faces), list(table).index(name), dtype=np.int64),
                 object_id=i,
+                semantic=classify([f"{node}", material], semantic),
             )
         )
     camera, light = _frame(np.concatenate([m.vertices for m in meshes]), width, height)

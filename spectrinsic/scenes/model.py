@@ -23,6 +23,7 @@ from typing import Any, Literal
 import numpy as np
 
 from ..errors import SceneError, did_you_mean
+from .semantic import classify
 from .textures import Texture, texture_from_record
 
 __all__ = [
@@ -123,6 +124,11 @@ class Material:
         return self.kind != "diffuse"
 
 
+def _named_class(mesh: Mesh) -> bool:
+    """Whether *mesh*'s class is the one its name gives (left out of its record then)."""
+    return mesh.semantic == classify([mesh.name])
+
+
 @dataclass(frozen=True, eq=False)
 class Mesh:
     """A triangle mesh in world space with one material index per face.
@@ -144,6 +150,13 @@ class Mesh:
         A spectral :class:`~spectrinsic.scenes.textures.Texture` over every face (whose
         ``face_materials`` are then all ``texture.basis[0]``), or ``None``: each face one exact
         spectrum. Left out of :func:`scene_to_dict` when ``None``.
+    semantic
+        Its class in :data:`~spectrinsic.scenes.semantic.SEMANTIC_CLASSES`; left empty, the
+        class its name maps to by the default map
+        (:func:`~spectrinsic.scenes.semantic.classify`). Left out of :func:`scene_to_dict`
+        when it is that class, so the records and hashes of scenes from before classes existed
+        are unchanged. ``dataclasses.replace(mesh, name=...)`` keeps the class; add
+        ``semantic=""`` to take the new name's.
     """
 
     name: str
@@ -152,6 +165,11 @@ class Mesh:
     face_materials: np.ndarray
     object_id: int
     texture: Texture | None = field(default=None, metadata=_OPTIONAL)
+    semantic: str = field(default="", metadata={"omit_when": _named_class})
+
+    def __post_init__(self) -> None:
+        if not self.semantic:  # the class of its name (frozen: set once, here)
+            object.__setattr__(self, "semantic", classify([self.name]))
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Mesh):
@@ -163,6 +181,7 @@ class Mesh:
             and np.array_equal(self.faces, other.faces)
             and np.array_equal(self.face_materials, other.face_materials)
             and self.texture == other.texture
+            and self.semantic == other.semantic
         )
 
     __hash__ = None  # type: ignore[assignment]
@@ -355,6 +374,7 @@ def _mesh_from_dict(m: Mapping[str, Any]) -> Mesh:
         face_materials=np.asarray(m["face_materials"], np.int64).reshape(-1),
         object_id=int(m["object_id"]),
         texture=texture_from_record(m["texture"]) if m.get("texture") else None,
+        semantic=str(m.get("semantic") or ""),
     )
 
 

@@ -30,10 +30,12 @@ from ..spectra import get_spectrum
 from .geometry import VISIBILITY_GRID, camera_rays, is_closed, winding_numbers
 from .materials import material_problem
 from .model import LIGHT_FIELDS, LIGHT_KINDS, Mesh, Scene, unknown_light_kind
+from .semantic import SEMANTIC_CLASSES
 from .textures import texture_problem
 
 __all__ = [
     "validate_scene",
+    "check_classes",
     "Problems",
     "POWER_RANGE",
     "MAX_COORDINATE",
@@ -211,6 +213,20 @@ def _check_meshes(scene: Scene, source: str) -> None:
                 f"{where}.object_id",
                 f"expected an integer from 0 to 2**31 - 1, got {m.object_id!r}",
             )
+
+
+def check_classes(scene: Scene, source: str) -> None:
+    """Every mesh's class is in the table, and meshes sharing an object id share it (the
+    semantic layer is read through the object-id layer)."""
+    classes: dict[int, str] = {}
+    for i, m in enumerate(scene.meshes):
+        where = f"meshes[{i}] ({m.name!r}).semantic"
+        if m.semantic not in SEMANTIC_CLASSES:
+            raise _fail(source, where, f"expected one of {', '.join(SEMANTIC_CLASSES)}")
+        other = classes.setdefault(int(m.object_id), m.semantic)
+        if other != m.semantic:
+            why = f"meshes sharing an object id share a class (object {m.object_id}: {other!r})"
+            raise _fail(source, where, f"{m.semantic!r}; {why}")
 
 
 def _check_textures(scene: Scene, source: str) -> None:
@@ -410,7 +426,14 @@ def validate_scene(
     """
     source = source or f"scene {scene.name!r}"
     problems = Problems(source)
-    for check in (_check_meshes, _check_lights, _check_camera, _check_materials, _check_textures):
+    for check in (
+        _check_meshes,
+        check_classes,
+        _check_lights,
+        _check_camera,
+        _check_materials,
+        _check_textures,
+    ):
         problems.get(check, scene, source)
     if check_spectra:
         cache: dict[str, object] = {}

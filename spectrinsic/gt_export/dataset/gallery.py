@@ -83,6 +83,7 @@ GALLERY_LAYERS: tuple[str, ...] = (
     "normals",
     "material_id",
     "object_id",
+    "semantic",
     "mask",
     "non_diffuse",
     "metallic",

@@ -86,6 +86,13 @@ def _spectral_provenance(metas: Sequence[SampleMeta], data_dir: Any) -> dict[str
     return out
 
 
+def _semantic_classes(metas: Sequence[SampleMeta]) -> dict[str, Any]:
+    """``{"semantic_classes": table}`` of the samples with a ``semantic`` layer (one table, as
+    every sample of a build records the same), else nothing (samples from before issue 41)."""
+    tables = [m.raw["semantic_classes"] for m in metas if "semantic_classes" in m.raw]
+    return {"semantic_classes": tables[0]} if tables else {}
+
+
 def working_spaces(metas: Sequence[SampleMeta]) -> dict[str, dict[str, Any]]:
     """The samples' RGB working spaces by name: colour-science's name, the perfect white's
     colour under D65 (``white_d65``), the sign of the shading (negative channels kept, or set
@@ -147,6 +154,7 @@ def write_manifest(
             },
             "transport_layout": COMPACT_LAYOUT,
         },
+        **_semantic_classes(metas),
         "split_by": "scene",
         "split_fractions": dict(split_fractions),
         "splits": splits_by_scene({m.sample_id: m.scene for m in metas}, split_fractions),
