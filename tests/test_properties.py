@@ -127,12 +127,14 @@ def _lights() -> st.SearchStrategy[dict]:
         "direction": st.sampled_from([[0, 0, -1], [0.3, 0.2, -1]]),
         "size": st.sampled_from([[1, 1], [0.5, 2]]),
         "cutoff_deg": st.sampled_from([30, 90]),
+        "radius": st.sampled_from([0.1, 0.4]),
     }
     odd = {
         "position": VECTORS,
         "direction": VECTORS,
         "size": st.lists(NUMBERS, min_size=2, max_size=2),
         "cutoff_deg": NUMBERS,
+        "radius": NUMBERS,
     }
 
     @st.composite

@@ -24,6 +24,8 @@ BENCHMARKS = (
     "crop_reference",
     "relight",
     "residual",
+    "storage",
+    "real_scene",
 )
 
 

@@ -16,7 +16,8 @@ One two-light room of the default set (``room-living``, view 0, ``two-colour-a``
   timed once), against the transport sample's render time (goal: relighting ≥ 100× faster);
 * exactness: the largest relative difference, layer by layer (to the layer's largest
   magnitude), between the relit sample and a direct per-light render of the new spectra with
-  the same seeds and spp (goal: ≤ 1e-5).
+  the same seeds and spp (goal: ≤ 1e-5; the noise layers, from the compact transport's
+  float16 batch deviations, ≤ 1e-3).
 """
 
 from __future__ import annotations
@@ -46,6 +47,8 @@ NEW_LIGHTS = {0: "cie:LED-RGB1", 1: "planck:3000K"}
 #: Goals of issue 20.
 SPEEDUP_GOAL = 100.0
 EXACT_GOAL = 1e-5
+#: The noise layers come from the transport's float16 batch deviations (issue 45).
+NOISE_GOAL = 1e-3
 SEED = 3
 #: Runs of each relighting whose median is reported (one run varies by ±30 % on a shared machine).
 REPEATS = 5
@@ -96,6 +99,8 @@ def _record(
     plain_s, transport_s, direct_s = render_s
     memory_s, compose_s, layers_s, folder_s = relight_s
     transport_bytes, rest_bytes = disk
+    noise = {k: v for k, v in errors.items() if k.startswith("noise_")}
+    errors = {k: v for k, v in errors.items() if k not in noise}
     worst = max(errors, key=errors.__getitem__)
     return {
         "scene": f"{SCENE}__v{VIEW}__{CONDITION}",
@@ -136,6 +141,11 @@ def _record(
             "goal": EXACT_GOAL,
             "layers_compared": len(errors),
             "met": errors[worst] <= EXACT_GOAL,
+        },
+        "noise_layers_max_relative": {
+            "value": max(noise.values(), default=0.0),
+            "goal": NOISE_GOAL,
+            "met": max(noise.values(), default=0.0) <= NOISE_GOAL,
         },
     }
 

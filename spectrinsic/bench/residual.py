@@ -38,6 +38,7 @@ def _meta_of(scene: Any, gt: Any) -> dict[str, Any]:
         "lights": [{"spectrum": li.spectrum} for li in scene.lights],
         "residual_share": gt.residual_share,
         "shading_clipping": gt.clipping,
+        "working_space": gt.working_space.record(),  # clipped_pixels or out_of_gamut_share
     }
 
 
@@ -91,7 +92,7 @@ def run(out_dir: Path) -> dict[str, Any]:
         "working_space": DEFAULT_WORKING_SPACE,
         "rgb_residual_share": overall["rgb"],
         "band_residual_share": overall["spectral"],
-        "shading_out_of_gamut_pixels": overall.get("clipped_pixels", {}),
+        "shading_out_of_gamut_pixels": overall.get("out_of_gamut_share", {}),
         "srgb_residual_share": srgb["rgb"],
         "srgb_shading_clipped_pixels": srgb.get("clipped_pixels", {}),
         "default_over_srgb": {
@@ -104,6 +105,6 @@ def run(out_dir: Path) -> dict[str, Any]:
             "band_median": 0.005,
             "band_p95": 0.02,
             "default_over_srgb": 0.5,
-            "default_clipped_pixels": 0.01,
+            "default_out_of_gamut_share": 0.01,
         },
     }

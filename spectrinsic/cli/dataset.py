@@ -18,7 +18,7 @@ from ..pipeline.presets import PRESETS, DatasetConfig, get_preset, preset_names
 from ..pipeline.source_plan import check_integrator_plan
 from ..render.budget import check_render_size
 from ..render.settings import INTEGRATORS
-from .dataset_layers import add_extra_layer_options
+from .dataset_layers import add_extra_layer_options, layer_changes
 from .dataset_source import (
     add_source_options,
     check_scene_files,
@@ -211,16 +211,12 @@ _VALUE_OPTIONS: tuple[tuple[str, str], ...] = (
     ("noise_target", "noise_target"),
     ("max_batches", "max_batches"),
     ("integrator", "integrator"),
-    ("camera", "camera"),
     ("variant", "variant"),
-    ("working_space", "working_space"),
 )
 #: Switches and the config value each sets when given (option dest -> (config key, value)).
 _SWITCHES: tuple[tuple[str, str, bool], ...] = (
     ("no_denoise", "denoise", False),
     ("direct", "direct", True),
-    ("store_transport", "store_transport", True),
-    ("spectral_layers", "spectral_layers", True),
 )
 
 
@@ -237,6 +233,7 @@ def _overrides(args: argparse.Namespace) -> dict[str, Any]:
     for dest, key, value in _SWITCHES:
         if getattr(args, dest, False):
             changes[key] = value
+    changes.update(layer_changes(args))
     if args.resolution is not None:
         changes["width"], changes["height"] = parse_resolution(args.resolution)
     if getattr(args, "split_fractions", None) is not None:
@@ -266,8 +263,10 @@ def preflight(
     scheduler: str | None = None,
     rebuild: bool = False,
     data_dir: str | None = None,
+    quiet: bool = False,
 ) -> None:
-    """Every refusal that needs no rendering, before anything is written or started."""
+    """Every refusal that needs no rendering, before anything is written or started (what a
+    scene file's read fixed or approximated said on stderr unless *quiet*)."""
     if workers is not None and workers < 1:
         raise DatasetError(f"--workers {workers}; expected a positive integer")
     if threads is not None and threads < 1:
@@ -279,7 +278,7 @@ def preflight(
             f"to {UINT32_MAX} and at most {UINT32_MAX} samples per pixel"
         )
     check_build_folder(Path(out), config.config_hash(), rebuild=rebuild)
-    check_scene_files(config, data_dir)
+    check_scene_files(config, data_dir, quiet=quiet)
     check_integrator_plan(config)  # integrator x materials: every sample would fail
     if scheduler:
         check_scheduler(scheduler)
@@ -305,6 +304,7 @@ def run(args: argparse.Namespace) -> int:
         scheduler=args.scheduler,
         rebuild=args.rebuild,
         data_dir=args.data_dir,
+        quiet=getattr(args, "quiet", False),
     )
     return build(
         args.out,

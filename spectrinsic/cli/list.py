@@ -22,6 +22,7 @@ from ..scenes.generators import GENERATORS
 from ..scenes.library import CONDITION_DESCRIPTIONS, CONDITIONS, n_views, scene_names
 from ..scenes.library_gloss import GLOSSY_SUFFIX
 from ..spectra import get_sensors, list_spectra
+from ..spectra.camera_model import CAMERA_PRESETS
 from ..spectra.registry import SPECTRUM_FAMILIES, SPECTRUM_FAMILY_NOTES
 
 __all__ = ["register", "run", "catalogue", "CATALOGUES"]
@@ -64,7 +65,17 @@ def _spectra(_data_dir: str | None) -> list[Row]:
 
 
 def _cameras(data_dir: str | None) -> list[Row]:
-    return [
+    """The ``--camera`` presets (a whole camera: curves, noise, ADC), then every sensor set."""
+    presets = [
+        (
+            name,
+            f"--camera preset: {model.sensitivities}, {model.adc_bits}-bit, full well "
+            f"{model.full_well_e:.0f} e-, read noise {model.read_noise_e:g} e-, ISO {model.iso:g}"
+            f" (files sensor-{name}.*, layers */{model.sensitivities.split(':', 1)[-1]})",
+        )
+        for name, model in CAMERA_PRESETS.items()
+    ]
+    return presets + [
         (name, get_sensors(name, data_dir=data_dir).source or "")
         for name in list_spectra("camera", data_dir=data_dir)
     ]
@@ -102,7 +113,10 @@ CATALOGUES: dict[str, tuple[Callable[[str | None], list[Row]], str]] = {
     "scenes": (_scenes, "library scenes (spectrinsic.scenes.library)"),
     "conditions": (_conditions, "illumination conditions of the library scenes"),
     "spectra": (_spectra, "spectrum families; 'list spectra FAMILY' names a family's spectra"),
-    "cameras": (_cameras, "camera sensitivities (more with --data-dir)"),
+    "cameras": (
+        _cameras,
+        "camera presets (dataset --camera), then camera sensitivities (more with --data-dir)",
+    ),
     "methods": (_methods, "decomposers, bundled then plugins"),
     "generators": (_generators, "procedural scene generators (dataset --generator)"),
     "presets": (_presets, "dataset presets (dataset --preset)"),

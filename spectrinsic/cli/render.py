@@ -1,7 +1,7 @@
 """``spectrinsic render``: render one scene in several modes and write the raw passes as EXR.
 
 ``SCENE`` is a library scene name (``spectrinsic.scenes.library``) or a scene file (YAML,
-``.blend`` or mesh, read as ``dataset --scenes`` reads them). For
+Mitsuba 3 XML, ``.blend`` or mesh, read as ``dataset --scenes`` reads them). For
 every mode ``DIR/<mode>.exr`` holds float32 layers ``raw`` (the K raw channels, named after the
 sensors, e.g. ``raw.B400``), ``xyz`` (CIE 1931 XYZ), and when asked ``direct`` and
 ``light<i>`` (XYZ), and ``DIR/<mode>.png`` its sRGB preview; ``DIR/aovs.exr`` holds coverage, ids, depth and normals; ``DIR/meta.json``
@@ -12,6 +12,7 @@ the render settings, variants, timings and the scene. Ground-truth layers are wr
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 from pathlib import Path
 from typing import Any
@@ -36,11 +37,13 @@ from ..render.base.plugins import MAX_PATH_DEPTH
 from ..render.budget import check_render_size
 from ..render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
 from ..render.settings import DEFAULT_MODES as RENDER_DEFAULT_MODES
+from ..scenes.mitsuba_xml import render_hints_line, xml_notes
 from ..scenes.model import Scene
 from ..scenes.sample_id import SampleId
 from ..scenes.sources import FILE_SIZE, is_scene_file
 from . import dataset as cli_dataset
-from .dataset_source import material_map, parse_resolution
+from .dataset_layers import add_layer_options, given_layer_options, layer_changes
+from .dataset_source import add_semantic_map_option, material_map, parse_resolution, semantic_map
 from .render_files import write_render
 from .render_scene import load_scene_argument
 
@@ -75,6 +78,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     _add_size_options(p, default)
     _add_pass_options(p, default)
     _add_ground_truth_options(p)
+    add_layer_options(
+        p.add_argument_group(
+            "ground-truth layers (with --ground-truth; the layer options of `spectrinsic dataset`)"
+        )
+    )
     _add_material_options(p)
     p.set_defaults(func=run)
 
@@ -139,8 +147,9 @@ def _add_pass_options(p: Any, default: DatasetConfig) -> None:
     p.add_argument(
         "--max-depth",
         type=int,
-        default=default.render.max_depth,
-        help=f"longest path, 2 = direct light only (default: {default.render.max_depth})",
+        default=None,
+        help="longest path, 2 = direct light only (default: a Mitsuba XML file's max_depth, "
+        f"else {default.render.max_depth})",
     )
     p.add_argument(
         "--variant", default=None, help="Mitsuba backend or variant (default: best usable)"
@@ -199,12 +208,19 @@ def _add_material_options(p: Any) -> None:
         default=None,
         help="reflectance of unmapped materials in .blend and mesh files",
     )
+    add_semantic_map_option(p)
     p.add_argument(
         "--colours-from-asset",
         action=argparse.BooleanOptionalAction,
         default=True,
         help="give unmapped materials the colour or texture their file states (glTF base "
         "colour and texture, OBJ/MTL Kd and map_Kd, Principled Base Color; default: on)",
+    )
+    p.add_argument(
+        "--approximate",
+        action="store_true",
+        help="Mitsuba XML: approximate what has no exact ground truth (glass, masks, bump "
+        "maps, bitmaps, environment maps...) instead of refusing it, one line saying what",
     )
 
 
@@ -221,7 +237,7 @@ def _check_size_options(args: argparse.Namespace) -> None:
         raise RenderError(f"--spp {args.spp}; expected at most {UINT32_MAX}")
     if not 0 <= args.seed <= UINT32_MAX:
         raise RenderError(f"--seed {args.seed}; expected a whole number from 0 to {UINT32_MAX}")
-    if not 1 <= args.max_depth <= MAX_PATH_DEPTH:
+    if args.max_depth is not None and not 1 <= args.max_depth <= MAX_PATH_DEPTH:
         raise RenderError(
             f"--max-depth {args.max_depth}; expected 1 to {MAX_PATH_DEPTH} (2 = direct light only)"
         )
@@ -239,12 +255,16 @@ def _check_source_options(args: argparse.Namespace) -> None:
         "--view": args.view is not None,
         "--material-map": args.material_map is not None,
         "--default-spectrum": args.default_spectrum is not None,
+        "--semantic-map": args.semantic_map is not None,
     }
-    library_only, file_only = ("--condition", "--view"), ("--material-map", "--default-spectrum")
+    library_only = ("--condition", "--view")
+    file_only = ("--material-map", "--default-spectrum", "--semantic-map")
+    if args.approximate and Path(args.scene).suffix.lower() != ".xml":
+        raise RenderError(f"--approximate applies to Mitsuba XML scenes; {args.scene!r} is not one")
     for option in library_only if file else file_only:
         if given[option]:
             kind = "a scene file" if file else "a library scene"
-            applies = "library scenes" if file else ".blend and mesh files"
+            applies = "library scenes" if file else "scene files"
             raise RenderError(f"{option} applies to {applies}; {args.scene!r} is {kind}")
     args.condition = "white" if args.condition is None else args.condition
     args.view = 0 if args.view is None else args.view
@@ -275,6 +295,7 @@ def _ground_truth(args: argparse.Namespace) -> int:
     size = requested_size(args)
     if size is not None:
         changes["width"], changes["height"] = size
+    changes.update(layer_changes(args))  # the layer options shared with `dataset`
     only = None
     if is_scene_file(args.scene):
         changes["source"] = files_source(
@@ -284,6 +305,8 @@ def _ground_truth(args: argparse.Namespace) -> int:
             resolution=size,
             new_sample=args.new_sample,
             colours_from_asset=args.colours_from_asset,
+            approximate=args.approximate,
+            semantic=semantic_map(args.semantic_map),
         )
     else:
         only = str(SampleId(args.scene, args.view, args.condition))
@@ -291,7 +314,12 @@ def _ground_truth(args: argparse.Namespace) -> int:
     if not is_scene_file(args.scene) and not getattr(args, "quiet", False):
         why = "--resolution" if size else f"preset {args.preset!r}"
         print(f"spectrinsic render: {config.width}x{config.height} ({why})", file=sys.stderr)
-    cli_dataset.preflight(args.out, config, data_dir=getattr(args, "data_dir", None))
+    cli_dataset.preflight(
+        args.out,
+        config,
+        data_dir=getattr(args, "data_dir", None),
+        quiet=getattr(args, "quiet", False),
+    )
     return cli_dataset.build(
         args.out,
         config,
@@ -311,7 +339,7 @@ def _render_settings(args: argparse.Namespace, modes: list[str]) -> RenderSettin
         spp,
         spectral_spp=spectral,
         modes=tuple(modes),
-        max_depth=args.max_depth,
+        max_depth=default.max_depth if args.max_depth is None else args.max_depth,
         variant=args.variant,
         per_light=args.per_light,
         direct=args.direct,
@@ -328,10 +356,17 @@ def run(args: argparse.Namespace) -> int:
         return _ground_truth(args)
     if args.ignore_disk_space:  # a plain render's files are small: never estimated
         raise RenderError("--ignore-disk-space applies only with --ground-truth")
+    for option in given_layer_options(args):  # ground-truth layers: a plain render has none
+        raise RenderError(
+            f"{option} applies only with --ground-truth (a ground-truth layer option)"
+        )
+    if args.semantic_map is not None:  # a plain render writes no semantic layer
+        raise RenderError("--semantic-map applies only with --ground-truth")
     settings = _render_settings(args, _parse_modes(args))
     check_output_folder(Path(args.out))
     data_dir = getattr(args, "data_dir", None)
     scene = _load_scene(args, data_dir)
+    settings = _file_settings(args, scene, settings)
     given = _given_size(args)
     if not getattr(args, "quiet", False):
         why = given or (
@@ -382,7 +417,33 @@ def _load_scene(args: argparse.Namespace, data_dir: str | None) -> Scene:
         default_spectrum=args.default_spectrum,
         data_dir=data_dir,
         colours_from_asset=args.colours_from_asset,
+        approximate=args.approximate,
     )
+
+
+def _file_settings(
+    args: argparse.Namespace, scene: Scene, settings: RenderSettings
+) -> RenderSettings:
+    """*settings* with a Mitsuba XML file's ``sample_count`` and ``max_depth`` where the
+    command line gave no ``--spp`` / ``--max-depth``; says what it read and which applies."""
+    if not getattr(args, "quiet", False):
+        for note in xml_notes(scene):
+            print(f"spectrinsic render: {note}", file=sys.stderr)
+        line = render_hints_line(scene, args.spp, args.max_depth)
+        if line is not None:
+            print(f"spectrinsic render: {line}", file=sys.stderr)
+    hints = scene.metadata.get("render_hints") or {}
+    changes: dict[str, Any] = {}
+    if args.spp is None and "spp" in hints:
+        changes |= {"spp": int(hints["spp"]), "spectral_spp": None}
+    if args.max_depth is None and "max_depth" in hints:
+        if not 1 <= int(hints["max_depth"]) <= MAX_PATH_DEPTH:
+            raise RenderError(
+                f"{args.scene}: max_depth {hints['max_depth']}; expected 1 to {MAX_PATH_DEPTH} "
+                "(give --max-depth)"
+            )
+        changes["max_depth"] = int(hints["max_depth"])
+    return dataclasses.replace(settings, **changes) if changes else settings
 
 
 def _given_size(args: argparse.Namespace) -> str:

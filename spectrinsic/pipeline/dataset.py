@@ -45,6 +45,7 @@ from ..gt_export.sample.integrity import (
     write_marker,
 )
 from ..render import render_batches, set_thread_count
+from ..render.base.variants import import_mitsuba
 from ..render.transport_render import render_transport_batches
 from ..scenes.library import build
 from ..scenes.sources import GeneratedSource
@@ -187,6 +188,7 @@ def _task_scene(task: SampleTask) -> Any:
             height=cfg.height,
         )
 
+    import_mitsuba()  # set up before a Mitsuba XML read imports it (the libLLVM Dr.Jit loads)
     scene = task.source.build(task.data_dir)
     if isinstance(task.source, GeneratedSource):
         save_generated(task.out_dir, task.sample_id, scene, task.seed)

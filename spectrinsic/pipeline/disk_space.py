@@ -13,8 +13,10 @@ default layers           320            21 MB for a 256² two-light room (README
                                         64² plane
 without ``bands31``      160            the preview preset: half of the default's (477 kB
                                         against 943 kB for the same 64² plane)
-``--store-transport``    360 per light  47 MB for a 256² two-light room (README); 325 for a
-                                        64² plane
+``--store-transport``    300 per light  the compact transport (issue 45, ``make bench``
+                                        ``storage``): 28.9 MB for a 256² two-light matte room
+                                        (220 per light), 19.5 MB for a one-light glossy room
+                                        (297, its glossy parts included)
 ``--spectral-layers``    370            +24 MB per 256² sample (``--help``); 270 for a 64² plane
 ``--write-cube``         124            31 float32 bands, uncompressed (an upper bound)
 ``--camera``             100            raw mosaic and DNG (16 bit), processed layers
@@ -64,7 +66,7 @@ def estimate_sample_bytes(config: DatasetConfig) -> int:
     per_pixel += 100 if config.camera else 0
     pixels = config.width * config.height
     sample = SAMPLE_FIXED_BYTES + pixels * per_pixel
-    transport = pixels * 360 * _LIGHTS if config.store_transport else 0
+    transport = pixels * 300 * _LIGHTS if config.store_transport else 0
     return sample * (1 + config.relight) + transport
 
 

@@ -115,11 +115,15 @@ def _check_relit_reference(relight: int, modes: tuple[str, ...]) -> None:
     reference mode (the first of the render's modes in ``REFERENCE_MODES``) must be one the
     stored transport relights (a diagonal mode); the preview preset's ``spectral`` is not."""
     reference = next((m for m in REFERENCE_MODES if m in modes), None)
-    if relight and reference is not None and reference not in diagonal_mode_names(modes):
+    diagonal = diagonal_mode_names(modes)
+    if relight and reference is not None and reference not in diagonal:
+        glossy = next((m for m in REFERENCE_MODES if m in diagonal), None)
         raise DatasetError(
-            f"--relight {relight} with modes {list(modes)}: the reference image is the "
-            f"{reference!r} render, which the stored transport cannot relight (variants would "
-            "come from another mode than their base samples); use the default preset"
+            f"--relight {relight} with modes {list(modes)}: a matte sample's reference image "
+            f"is the {reference!r} render, which the stored transport cannot relight (variants "
+            "would come from another mode than their base samples)"
+            + (f" (only glossy samples take {glossy!r} as reference)" if glossy else "")
+            + "; use the default preset"
         )
 
 

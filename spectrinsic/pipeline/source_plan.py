@@ -41,6 +41,7 @@ from ..scenes.generators.materials import check_ranges
 from ..scenes.model import Scene
 from ..scenes.sample_id import SampleId
 from ..scenes.scene_writer import save_scene
+from ..scenes.semantic import SemanticRules, rules_from_record
 from ..scenes.sources import FileSource, GeneratedSource, scene_file_kind
 from ..scenes.yaml_limits import load_yaml_file
 from ..spectra import list_spectra
@@ -56,6 +57,7 @@ __all__ = [
     "save_generated",
     "saved_sample",
     "file_sample",
+    "semantic_rules",
 ]
 
 #: Folder of a dataset holding the generated scenes' YAML files.
@@ -148,12 +150,17 @@ def files_source(
     resolution: tuple[int, int] | None = None,
     new_sample: bool = False,
     colours_from_asset: bool = True,
+    approximate: bool = False,
+    semantic: SemanticRules | None = None,
 ) -> str:
     """The canonical ``source`` JSON of a set of scene files (each must exist): rendered at
     *resolution* ``(W, H)``, else at each file's own camera size; a saved generated scene as
-    its own sample unless *new_sample*; *colours_from_asset* (always in the JSON since issue 41,
-    when it became the default; a config without it was written before and means False, so
-    older datasets rebuild as they were): the colours and textures the files state."""
+    its own sample unless *new_sample*; *colours_from_asset* (always in the JSON since issue 41
+    made it the default; a config without it was written before and means False, so older
+    datasets rebuild as they were): the colours and textures the files state;
+    *approximate* (in the JSON only when set, so older configs keep their hash): Mitsuba XML
+    content without exact ground truth approximated; *semantic* (likewise): the
+    ``--semantic-map`` rules, before the default map's."""
     entries = []
     for p in paths:
         path = Path(p).resolve()
@@ -165,7 +172,7 @@ def files_source(
     dupes = sorted({s for s in stems if stems.count(s) > 1})
     if dupes:
         raise DatasetError(f"--scenes: several scenes named {dupes}; scene names must be unique")
-    spec = {
+    spec: dict[str, Any] = {
         "scenes": entries,
         "materials": dict(sorted((materials or {}).items())),
         "default_spectrum": default_spectrum,
@@ -173,6 +180,14 @@ def files_source(
         "resolution": None if resolution is None else [int(v) for v in resolution],
     }
     spec["colours_from_asset"] = bool(colours_from_asset)
+    if approximate:
+        if not any(scene_file_kind(e["path"]) == "mitsuba" for e in entries):
+            raise DatasetError(
+                "--approximate applies to Mitsuba XML scenes; no --scenes file is one"
+            )
+        spec["approximate"] = True
+    if semantic is not None:  # --semantic-map's rules themselves (in the JSON only when given)
+        spec["semantic_map"] = semantic.record()
     ids = [str(file_sample(e["path"], new_sample=new_sample)[0]) for e in entries]
     dupes = sorted({i for i in ids if ids.count(i) > 1})
     if dupes:
@@ -301,6 +316,12 @@ def plan_source_samples(
     ]
 
 
+def semantic_rules(spec: Mapping[str, Any]) -> SemanticRules:
+    """The ``--semantic-map`` rules a files source records (none: the default map alone)."""
+    record = spec.get("semantic_map")
+    return SemanticRules() if record is None else rules_from_record(record, "--semantic-map")
+
+
 def _file_tasks(
     spec: Mapping[str, Any],
     out: str,
@@ -322,6 +343,8 @@ def _file_tasks(
             materials,
             spec.get("default_spectrum"),
             colours_from_asset=bool(spec.get("colours_from_asset", False)),
+            approximate=bool(spec.get("approximate")),
+            semantic=semantic_rules(spec),
         )
         sid, seed = file_sample(entry["path"], new_sample=bool(spec.get("new_sample")))
         task = SampleTask.planned(

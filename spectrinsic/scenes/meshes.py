@@ -24,9 +24,11 @@ A textured material must be matte (a glossy one is refused: its basis would not 
 
 from __future__ import annotations
 
+import io
 import json
 import math
 import os
+import re
 import struct
 from collections.abc import Mapping
 from pathlib import Path
@@ -40,6 +42,7 @@ from .image_textures import AssetColour, ImageTexture, corner_spectra
 from .materials import METAL_SPECTRUM
 from .model import Camera, Light, Material, Mesh, Scene
 from .mtl_colours import mtl_colours
+from .semantic import SemanticMap, classify
 from .textures import Texture, make_image_texture
 from .validate import validate_scene
 
@@ -79,14 +82,22 @@ def _ply_counts(head: bytes) -> tuple[int, int]:
 
 
 def _text_counts(path: Path, vertex: bytes, face: bytes) -> tuple[int, int]:
-    """Lines starting with *vertex* / *face*, streamed (no more than one line in memory)."""
-    n_v = n_f = 0
+    """Lines starting (after blanks) with *vertex* / *face*, streamed in 1 MiB blocks (a line
+    cut by a block's end is carried into the next whole); counted by regular expressions,
+    not line by line in Python (a 300-file OBJ scene's count went from 1.2 s to 0.1 s)."""
+    patterns = [re.compile(rb"^[ \t\r\f\v]*" + re.escape(p), re.M) for p in (vertex, face)]
+    counts = [0, 0]
+    carry = b""
     with path.open("rb") as fh:
-        for line in fh:
-            stripped = line.lstrip()
-            n_v += stripped.startswith(vertex)
-            n_f += stripped.startswith(face)
-    return n_v, n_f
+        while True:
+            block = fh.read(1 << 20)
+            text = carry + block
+            cut = len(text) if not block else text.rfind(b"\n") + 1
+            for k, pattern in enumerate(patterns):
+                counts[k] += sum(1 for _ in pattern.finditer(text, 0, cut))
+            carry = text[cut:]
+            if not block:
+                return counts[0], counts[1]
 
 
 def _gltf_vertices(document: dict[str, Any]) -> int:
@@ -159,6 +170,53 @@ def _pbr_gloss(material: Any) -> dict[str, Any]:
     return {}
 
 
+#: The in-memory material library that names an OBJ's ``usemtl`` materials when it has none.
+_USEMTL_LIBRARY = "__spectrinsic_usemtl__.mtl"
+
+
+def _usemtl_names(text: str) -> list[str]:
+    """An OBJ's ``usemtl`` names in order of first use, when it names no ``mtllib`` (trimesh
+    drops the names of materials no library defines and calls the parts ``<file>_1``...)."""
+    names: list[str] = []
+    for line in text.splitlines():
+        words = line.split(maxsplit=1)
+        if words[:1] == ["mtllib"]:
+            return []
+        if words[:1] == ["usemtl"] and len(words) == 2 and words[1].strip() not in names:
+            names.append(words[1].strip())
+    return names
+
+
+def _load_mesh_file(path: Path) -> Any:
+    """*path* as a trimesh scene; an OBJ whose ``usemtl`` materials no library defines is read
+    with an in-memory library of those names (``newmtl NAME`` each, no colour), so its parts
+    keep the names the file gives them, which ``--material-map`` then maps."""
+    import trimesh
+    from trimesh.resolvers import FilePathResolver
+
+    names = (
+        _usemtl_names(path.read_text(encoding="utf-8", errors="replace"))
+        if (path.suffix.lower() == ".obj")
+        else []
+    )
+    if not names:
+        return trimesh.load(str(path), force="scene", process=False)
+    library = "".join(f"newmtl {name}\n" for name in names).encode()
+
+    class _Resolver(FilePathResolver):  # type: ignore[misc]
+        def get(self, name: str) -> bytes:
+            return library if name == _USEMTL_LIBRARY else bytes(super().get(name))
+
+    text = f"mtllib {_USEMTL_LIBRARY}\n".encode() + path.read_bytes()
+    return trimesh.load(
+        io.BytesIO(text),
+        file_type="obj",
+        force="scene",
+        process=False,
+        resolver=_Resolver(str(path)),
+    )
+
+
 _Geometry = tuple[str, str, np.ndarray, np.ndarray, dict[str, Any], "np.ndarray | None"]
 
 
@@ -166,11 +224,10 @@ def _geometries(path: Path) -> list[_Geometry]:
     """``(geometry name, material name, vertices, faces, gloss, uv)`` of every triangle mesh in
     the file, in world space, sorted by geometry name (file order is not stable across formats);
     ``uv`` ``(F, 3, 2)`` are the face corners' texture coordinates (v up), ``None`` without."""
-    import trimesh
 
     check_mesh_size(path)
     try:
-        loaded: Any = trimesh.load(str(path), force="scene", process=False)
+        loaded: Any = _load_mesh_file(path)
     except Exception as exc:  # noqa: BLE001 - trimesh raises many types for corrupt files
         raise SceneError(f"{path}: cannot read it as a mesh ({type(exc).__name__}: {exc})") from exc
     out = []
@@ -257,6 +314,7 @@ def load_mesh_scene(
     default_spectrum: str | None = None,
     data_dir: str | None = None,
     colours_from_asset: bool = True,
+    semantic: SemanticMap | None = None,
 ) -> Scene:
     """Read a mesh file into a validated :class:`~spectrinsic.scenes.model.Scene`.
 
@@ -275,6 +333,9 @@ def load_mesh_scene(
     colours_from_asset
         Give materials not in *materials* the colour or texture the file states (glTF base
         colour, MTL ``Kd``/``map_Kd``) before *default_spectrum* (module docstring).
+    semantic
+        The names → class map (:mod:`~spectrinsic.scenes.semantic`; None: the default) each
+        mesh's class comes from: its node's name, then the file's name of its material.
 
     Raises
     ------
@@ -316,6 +377,7 @@ def load_mesh_scene(
                 face_materials=np.full(len(faces), face, dtype=np.int64),
                 object_id=i,
                 texture=texture,
+                semantic=classify([f"{node}", material], semantic),
             )
         )
     camera, light = _frame(np.concatenate([m.vertices for m in meshes]), width, height)

@@ -291,6 +291,8 @@ def _light(doc: _Doc, entry: Any, i: int) -> Light:
         kw["size"] = doc.vector(entry["size"], f"{field}.size", 2)
     if "cutoff_deg" in entry:
         kw["cutoff_deg"] = doc.number(entry["cutoff_deg"], f"{field}.cutoff_deg")
+    if "radius" in entry:
+        kw["radius"] = doc.number(entry["radius"], f"{field}.radius")
     # an unnamed light is named by its spectrum, so labels read "planck:2800K 60 %"
     kw["name"] = doc.string(entry["name"], f"{field}.name") if "name" in entry else kw["spectrum"]
     return Light(**kw)

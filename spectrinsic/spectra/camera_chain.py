@@ -3,8 +3,9 @@ linear stages applied to the ground truth.
 
 Stages, each recorded in :class:`ChainResult`:
 
-1. exposure: electrons per unit of the camera image (fixed, or the 99th percentile brought to
-   ``exposure_target`` of the full well);
+1. exposure: electrons per unit of the camera image (fixed, or metered as a camera meters: the
+   median luminance of the lit pixels brought to ``exposure_target`` of the full well, middle
+   grey by default, so highlights may saturate; :func:`exposure_scale`);
 2. mosaic (Bayer ``cfa``) and sensor noise (:func:`spectrinsic.spectra.camera_noise.capture`),
    seeded per sample: the raw frame in DN and its predicted variance;
 3. black level removed and DN brought back to camera units (``× gain / electrons per unit``);
@@ -38,10 +39,19 @@ from .camera_noise import capture
 from .colorimetry import white_normalised_responses
 from .registry import get_spectrum
 
-__all__ = ["ChainResult", "exposure_scale", "run_chain", "carry", "camera_white_d65"]
+__all__ = [
+    "ChainResult",
+    "EXPOSURE_PERCENTILE",
+    "exposure_scale",
+    "run_chain",
+    "carry",
+    "camera_white_d65",
+]
 
-#: Percentile of the clean camera image that the automatic exposure places on the target.
-EXPOSURE_PERCENTILE = 99.0
+#: Percentile of the lit pixels' luminance that the automatic exposure places on the target: the
+#: median, as a camera's centre-weighted or evaluative meter aims the scene's typical
+#: luminance at middle grey (ISO 2720's reflected-light calibration), whatever its highlights.
+EXPOSURE_PERCENTILE = 50.0
 
 
 @dataclass(frozen=True)
@@ -117,12 +127,17 @@ def camera_white_d65(curves: np.ndarray, wavelengths: np.ndarray) -> np.ndarray:
 
 
 def exposure_scale(model: CameraModel, image: np.ndarray) -> float:
-    """Electrons per unit of *image*: fixed, or the 99th percentile of its largest channel at
-    ``exposure_target`` of the full well (1 e⁻ per unit for a black image)."""
+    """Electrons per unit of *image*: fixed, or metered: the :data:`EXPOSURE_PERCENTILE` of the
+    luminance of the lit pixels (the mean over channels, the camera's curves being scaled so
+    the perfect white under D65 has mean channel 1) at ``exposure_target`` of the full well.
+    A scene of saturated lights around one bright patch is metered on its typical pixel, not on
+    the patch, which saturates as it would in a photograph. 1 e⁻ per unit for a black image."""
     if model.electrons_per_unit is not None:
         return float(model.electrons_per_unit)
-    top = float(np.percentile(np.max(image, axis=-1), EXPOSURE_PERCENTILE))
-    return model.exposure_target * model.full_well_e / top if top > 0 else 1.0
+    luminance = np.asarray(image, np.float64).mean(axis=-1).ravel()
+    lit = luminance[luminance > 0]
+    level = float(np.percentile(lit, EXPOSURE_PERCENTILE)) if lit.size else 0.0
+    return model.exposure_target * model.full_well_e / level if level > 0 else 1.0
 
 
 def run_chain(

@@ -33,6 +33,7 @@ __all__ = [
     "GENERIC_FIGURES",
     "camera_model",
     "camera_model_names",
+    "PRESET_ALIASES",
 ]
 
 #: Bayer layouts, read row by row over the 2 × 2 tile (colour-demosaicing's names).
@@ -77,8 +78,9 @@ class CameraModel:
         The ISO used and the sensor's base ISO: the gain in e⁻/DN is
         ``gain_e_per_dn · iso_base / iso`` (analogue gain; read noise in electrons kept).
     exposure_target
-        Fraction of the full well the 99th percentile of the clean camera image reaches (an
-        auto exposure); used when ``electrons_per_unit`` is ``None``.
+        Fraction of the full well the metered luminance reaches (an auto exposure, as a camera
+        meters: :func:`spectrinsic.spectra.camera_chain.exposure_scale`); 0.18, middle grey, by
+        default. Used when ``electrons_per_unit`` is ``None``.
     electrons_per_unit
         A fixed exposure instead: electrons per unit of the camera image (render units), i.e.
         the product of shutter time, aperture area and quantum efficiency for this render.
@@ -116,7 +118,7 @@ class CameraModel:
     cfa: str = "RGGB"
     iso: float = 100.0
     iso_base: float = 100.0
-    exposure_target: float = 0.5
+    exposure_target: float = 0.18
     electrons_per_unit: float | None = None
     exposure_time_s: float = 0.01
     dark_current_e_per_s: float = 0.0
@@ -230,12 +232,14 @@ GENERIC_FIGURES: dict[str, float] = {
     "read_noise_e": 4.13,
 }
 
-#: Real cameras, every number with its source. The NPL curves belong to a Nikon D5100; no
+#: Real cameras, every number with its source, each named by the slug of its sensor set's name,
+#: so one name runs through preset, files and layers: ``--camera nikon-5100-npl`` writes
+#: ``sensor-nikon-5100-npl.*`` with layers ``raw_sensor/Nikon 5100 (NPL)``. The NPL curves belong to a Nikon D5100; no
 #: photon-transfer measurement of that body is cited here, so its preset borrows those of the
 #: D800E (a Nikon of the same sensor generation), as its sources say.
 CAMERA_PRESETS: dict[str, CameraModel] = {
-    "nikon-d5100-npl": CameraModel(
-        name="nikon-d5100-npl",
+    "nikon-5100-npl": CameraModel(
+        name="nikon-5100-npl",
         sensitivities="camera:Nikon 5100 (NPL)",
         adc_bits=14,
         gain_e_per_dn=GENERIC_FIGURES["gain_e_per_dn"],
@@ -268,6 +272,10 @@ CAMERA_PRESETS: dict[str, CameraModel] = {
 }
 
 
+#: Former preset names, still accepted (issue 47 renamed the preset after its sensor set).
+PRESET_ALIASES: dict[str, str] = {"nikon-d5100-npl": "nikon-5100-npl"}
+
+
 def camera_model_names() -> list[str]:
     """The preset names (:data:`CAMERA_PRESETS`)."""
     return list(CAMERA_PRESETS)
@@ -276,6 +284,7 @@ def camera_model_names() -> list[str]:
 def camera_model(name: str) -> CameraModel:
     """A preset by name, or a registry sensor set (``camera:…``, ``csv:…``) with
     :data:`GENERIC_FIGURES`; anything else raises :class:`CameraModelError` (one line)."""
+    name = PRESET_ALIASES.get(name, name)
     if name in CAMERA_PRESETS:
         return CAMERA_PRESETS[name]
     if name.startswith(("camera:", "csv:")):

@@ -1,4 +1,5 @@
-"""Readers for spectral data files: the only module of :mod:`spectrinsic.spectra` that reads files.
+"""Readers for spectral data files: with :mod:`~spectrinsic.spectra.csv_spectra` (a user's CSV
+spectra, in any layout) the only modules of :mod:`spectrinsic.spectra` that read files.
 
 Sources
 -------
@@ -16,7 +17,6 @@ from __future__ import annotations
 import csv
 import functools
 import importlib.util
-import math
 import os
 from collections.abc import Mapping
 from pathlib import Path
@@ -26,7 +26,8 @@ from typing import NamedTuple
 import numpy as np
 
 from ..data_dir import require_data_file
-from ..errors import DataDirectoryError, SpectralDataError, did_you_mean
+from ..errors import DataDirectoryError, SpectralDataError
+from .csv_spectra import CSV_MAX_BYTES
 from .grid import validate_wavelengths
 
 __all__ = [
@@ -38,14 +39,9 @@ __all__ = [
     "read_sfu_illuminants",
     "read_camera_table",
     "read_user_csv",
-    "read_csv_column",
     "read_spd",
-    "Column",
     "CSV_MAX_BYTES",
 ]
-
-#: Largest spectrum CSV read (bytes): a 1 nm table of hundreds of spectra is far smaller.
-CSV_MAX_BYTES = 16 * 1024 * 1024
 
 
 class Table(NamedTuple):
@@ -259,82 +255,6 @@ def read_user_csv(path: str | os.PathLike[str], *, kind: str) -> Table:
             f"{path}: expected at least one {kind} column after the wavelengths"
         )
     return table
-
-
-class Column(NamedTuple):
-    """One spectrum column of a CSV: ``wavelengths`` (W,) nm, ``values`` (W,) as written,
-    ``label`` its full header (unit included) and ``rows`` (W,) the 1-based file row of each."""
-
-    wavelengths: np.ndarray
-    values: np.ndarray
-    label: str
-    rows: tuple[int, ...]
-
-
-def _cell(path: Path, text: str, row: int, column: str) -> float:
-    try:
-        value = float(text) if text.strip() else math.nan
-    except ValueError:
-        raise SpectralDataError(
-            f"{path}: row {row}, column {column!r}: {text!r} is not a number"
-        ) from None
-    if not math.isfinite(value):
-        what = "empty cell" if not text.strip() else f"non-finite value {text.strip()!r}"
-        raise SpectralDataError(
-            f"{path}: row {row}, column {column!r}: {what}; expected a finite number"
-        )
-    return value
-
-
-def read_csv_column(path: str | os.PathLike[str], column: str) -> Column:
-    """Column *column* of a wide spectra CSV: a header row, wavelengths (nm) in the first column.
-
-    *column* matches a header exactly or its name before a bracketed unit (``red`` matches
-    ``red [%]``). Checked cell by cell: the file at most :data:`CSV_MAX_BYTES`, every wavelength
-    and value a finite number, wavelengths strictly increasing; other columns are not read.
-
-    Raises
-    ------
-    SpectralDataError
-        One line naming the file and, for a bad cell, its row (1 = header) and column.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise SpectralDataError(f"spectrum file {str(path)!r} does not exist")
-    size = path.stat().st_size
-    if size > CSV_MAX_BYTES:
-        raise SpectralDataError(
-            f"{path}: {size} bytes; expected a spectrum CSV of at most {CSV_MAX_BYTES} bytes"
-        )
-    rows = _read_rows(path)
-    if not rows or len(rows[0]) < 2:
-        raise SpectralDataError(f"{path}: expected a header row with wavelengths and spectra")
-    header = [h.strip() for h in rows[0]]
-    names = [h.split("[")[0].strip() for h in header]
-    want = column.strip()
-    hits = [i for i in range(1, len(header)) if want in (header[i], names[i])]
-    if not hits:
-        raise SpectralDataError(
-            f"{path}: no column {want!r}; expected one of {header[1:]}"
-            + did_you_mean(want, names[1:])
-        )
-    col = hits[0]
-    body = [(n + 1, r) for n, r in enumerate(rows) if n > 0 and any(c.strip() for c in r)]
-    if len(body) < 2:
-        raise SpectralDataError(f"{path}: expected at least 2 wavelength rows under the header")
-    wl, values = [], []
-    for n, r in body:
-        if len(r) <= col:
-            raise SpectralDataError(f"{path}: row {n} has {len(r)} cells; expected {len(header)}")
-        wl.append(_cell(path, r[0], n, header[0]))
-        values.append(_cell(path, r[col], n, header[col]))
-    for i in range(1, len(wl)):
-        if not wl[i] > wl[i - 1]:
-            raise SpectralDataError(
-                f"{path}: row {body[i][0]}, column {header[0]!r}: wavelength {wl[i]:g} nm "
-                f"follows {wl[i - 1]:g} nm; expected strictly increasing wavelengths"
-            )
-    return Column(np.array(wl), np.array(values), header[col], tuple(n for n, _ in body))
 
 
 def read_spd(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray]:

@@ -2,11 +2,13 @@
 
 Registry families (:func:`spectrinsic.spectra.get_spectrum`):
 
-- ``csv:PATH#COLUMN``: column *COLUMN* of a wide CSV (first column wavelengths in nm). The
-  column's header states its unit in brackets, and the unit says what the column is:
-  ``[%]`` (reflectance in percent, divided by 100) or ``[1]`` (reflectance as a fraction) make
-  a reflectance; a spectral power unit (``[W/m2/nm]``, ``[mW/(m2 nm)]``, ``[W/sr/m2/nm]``...)
-  or ``[a.u.]`` (relative power) make an illuminant, normalised like every illuminant. A header
+- ``csv:PATH#COLUMN``: a spectrum of a CSV in the wide, pair or long layout
+  (:mod:`spectrinsic.spectra.csv_spectra`), *COLUMN* its name or its number from 1. The
+  header states the unit (``name [%]``, ``name (%)``, ``Refl. %``), or the name gives it when
+  the header has none (``csv:PATH#3?unit=%``); the unit says what the spectrum is:
+  ``%`` (reflectance in percent, divided by 100) or ``1`` (reflectance as a fraction) make
+  a reflectance; a spectral power unit (``W/m2/nm``, ``mW/(m2 nm)``, ``W/sr/m2/nm``...)
+  or ``a.u.`` (relative power) make an illuminant, normalised like every illuminant. A spectrum
   without a unit is refused: ``45`` could be percent or a fraction. *PATH* is absolute or
   relative to the working folder; in scene files it is relative to the scene's folder
   (:mod:`spectrinsic.scenes.spectrum_refs`).
@@ -17,10 +19,12 @@ Registry families (:func:`spectrinsic.spectra.get_spectrum`):
   spectral primary decomposition, ``ρ(λ) = R b_R(λ) + G b_G(λ) + B b_B(λ)`` with colour-science's
   ``MSDS_BASIS_FUNCTIONS_sRGB_MALLETT2019``: a non-negative mix of three fixed spectra summing
   to about one, so it stays in [0, 1]. Colours outside the sRGB gamut (a channel outside
-  [0, 1]) are refused, not clipped. Round trip: the spectrum's linear sRGB under D65
-  (colour-science, CIE 1931 2°, on the basis' 5 nm grid) differs from the input by at most
-  2.4e-4 on an 11³ grid of the sRGB cube (measured; ``tests/spectra/test_user_spectra.py``
-  checks 1e-3 on a 5³ grid).
+  [0, 1]) are refused, not clipped. Round trip: the spectrum's linear sRGB under D65 differs
+  from the input by at most 1.2e-3 over an 11³ grid of the sRGB cube (which holds the
+  primaries), worst at the blue primary ``rgb:0,0,1``, on spectrinsic's own 1 nm colorimetry
+  (the ``reflectance`` layer's: the basis interpolated to 1 nm); colour-science's integration
+  on the basis' 5 nm grid gives 2.4e-4 there (measured; ``tests/spectra/test_user_spectra.py``
+  checks both, the first on the primaries).
 
 Every file spectrum is checked before any work: finite numbers, strictly increasing
 wavelengths covering :data:`REQUIRED_RANGE`, reflectances in [0, 1]; errors name the file, the
@@ -38,7 +42,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import SpectralDataError, SpectrumNotFoundError
-from . import io
+from .csv_spectra import read_csv_column
 from .illuminants import normalise_illuminant
 from .records import Spectrum, SpectrumKind
 
@@ -51,6 +55,7 @@ __all__ = [
     "rgb_spectrum",
     "srgb_spectrum",
     "split_csv_key",
+    "column_unit",
     "spectrum_files",
 ]
 
@@ -59,7 +64,6 @@ __all__ = [
 REQUIRED_RANGE = (400.0, 700.0)
 _REFLECTANCE_UNITS = {"%": 0.01, "1": 1.0, "fraction": 1.0}
 _POWER_UNIT = re.compile(r"^(a\.u\.|relative|[munµμk]?W\b.*)$")
-_UNIT = re.compile(r"\[([^\]]*)\]\s*$")
 MALLETT2019 = "Mallett & Yuksel 2019 spectral primary decomposition (colour-science)"
 
 
@@ -73,18 +77,39 @@ def split_csv_key(key: str) -> tuple[str, str]:
     return path.strip(), column.strip()
 
 
-def _kind_of(path: Path, label: str) -> tuple[SpectrumKind, float]:
-    """The spectrum kind and the factor to fractions that the header *label*'s unit states."""
-    match = _UNIT.search(label)
-    unit = match.group(1).strip() if match else ""
+def column_unit(column: str) -> tuple[str, str | None]:
+    """A ``csv:`` name's ``COLUMN[?unit=U]`` part as ``(COLUMN, U or None)``."""
+    column, sep, query = column.partition("?")
+    if not sep:
+        return column.strip(), None
+    key, eq, unit = query.partition("=")
+    if key.strip() != "unit" or not eq or not unit.strip():
+        raise SpectrumNotFoundError(
+            f"csv spectrum column {column!r}?{query}; expected '?unit=UNIT' (e.g. '#3?unit=%')"
+        )
+    return column.strip(), unit.strip()
+
+
+def _kind_of(
+    path: Path, label: str, unit: str | None, given: str | None
+) -> tuple[SpectrumKind, float]:
+    """The spectrum kind and the factor to fractions that the header's *unit* (or the name's
+    ``?unit=`` *given*, when the header states none) says."""
+    if unit is not None and given is not None and unit != given:
+        raise SpectralDataError(
+            f"{path}: column {label!r} states the unit [{unit}], and the name ?unit={given}; "
+            "expected ?unit= only for a header without a unit"
+        )
+    unit = unit if unit is not None else given
     if unit in _REFLECTANCE_UNITS:
         return "reflectance", _REFLECTANCE_UNITS[unit]
-    if _POWER_UNIT.match(unit):
+    if unit is not None and _POWER_UNIT.match(unit):
         return "illuminant", 1.0
-    said = f"unit [{unit}]" if match else "no unit"
+    said = f"unit [{unit}]" if unit is not None else "no unit"
     raise SpectralDataError(
         f"{path}: column {label!r} has {said}; expected a header like 'name [%]' or 'name [1]' "
-        "(reflectance in percent or as a fraction) or 'name [W/m2/nm]' (spectral power)"
+        "(reflectance in percent or as a fraction) or 'name [W/m2/nm]' (spectral power), or "
+        "the unit in the name: 'csv:FILE#COLUMN?unit=%'"
     )
 
 
@@ -122,14 +147,15 @@ def sha256(path: str | Path) -> str:
 
 @functools.lru_cache(maxsize=64)
 def _csv_cached(path: str, column: str, _stamp: tuple[int, int]) -> Spectrum:
-    col = io.read_csv_column(path, column)
-    kind, scale = _kind_of(Path(path), col.label)
+    name, given = column_unit(column)
+    col = read_csv_column(path, name)
+    kind, scale = _kind_of(Path(path), col.label, col.unit, given)
     values = col.values * scale
-    where = f"{path}: column {col.label!r}"
+    where = f"{path}: {col.position} {col.label!r}"
     _check(where, col.wavelengths, values, kind, [f"row {r}" for r in col.rows])
     if kind == "illuminant":
         values = normalise_illuminant(col.wavelengths, values)
-    source = f"user file {path}, column {col.label!r}, sha256 {sha256(path)}"
+    source = f"user file {path}, {col.position} {col.label!r}, sha256 {sha256(path)}"
     return Spectrum(f"csv:{path}#{column}", kind, col.wavelengths, values, source)
 
 
@@ -260,6 +286,8 @@ def spectrum_files(names: Any) -> list[dict[str, str]]:
     file's SHA-256, for ``meta.json`` (``spectrum_files``)."""
     out = []
     for name in sorted({n for n in names if isinstance(n, str) and n.startswith("csv:")}):
-        path, column = split_csv_key(name.removeprefix("csv:"))
-        out.append({"spectrum": name, "file": path, "column": column, "sha256": sha256(path)})
+        path, key = split_csv_key(name.removeprefix("csv:"))
+        column, unit = column_unit(key)
+        record = {"spectrum": name, "file": path, "column": column, "sha256": sha256(path)}
+        out.append(record | ({"unit": unit} if unit is not None else {}))
     return out

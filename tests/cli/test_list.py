@@ -85,3 +85,17 @@ def test_the_data_directory_families_examples_resolve(data_dir):
     for family in ("sfu", "sfu-illum"):
         example = SPECTRUM_FAMILY_NOTES[family].split(";")[0]
         assert get_spectrum(example, data_dir=data_dir).name == example
+
+
+def test_camera_presets_are_listed_under_their_one_name(capsys):
+    """Issue 47: ``list cameras`` names the --camera presets first, each named by the slug of
+    its sensor set, the name of its files (``sensor-<slug>.*``); the old name still works."""
+    from spectrinsic.gt_export.formats.names import camera_slug
+    from spectrinsic.spectra.camera_model import CAMERA_PRESETS, PRESET_ALIASES, camera_model
+
+    listed = _listed(capsys, "cameras")
+    assert listed[: len(CAMERA_PRESETS)] == list(CAMERA_PRESETS)
+    for name, model in CAMERA_PRESETS.items():
+        assert camera_slug(model.sensitivities) == name
+    for old, new in PRESET_ALIASES.items():
+        assert camera_model(old) is CAMERA_PRESETS[new]

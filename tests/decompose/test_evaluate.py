@@ -55,7 +55,16 @@ def test_scores_csv_and_progress(result):
     res, out, seen = result
     assert seen == ["obj-a__v0__white", "obj-a__v0__one-colour", "room-b__v1__two-colour-a"]
     rows = list(csv.DictReader((out / "scores.csv").open()))
-    assert set(rows[0]) == {"sample", "method", "scenario", "layer", "metric", "value"}
+    assert set(rows[0]) == {"sample", "method", "scenario", "layer", "metric", "value"} | {
+        "lighting",  # issue 47: the sample's lighting group and its dataset's config hash
+        "config_hash",
+    }
+    groups = {r["sample"]: r["lighting"] for r in rows}
+    assert groups == {
+        "obj-a__v0__white": "WL",
+        "obj-a__v0__one-colour": "1L",
+        "room-b__v1__two-colour-a": "2L",
+    }
     assert {r["metric"] for r in rows if r["layer"] == "reflectance"} >= {"lmse", "whdr", "dssim"}
     assert {r["scenario"] for r in rows} == {
         "srgb",

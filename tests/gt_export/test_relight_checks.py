@@ -84,15 +84,20 @@ def test_the_transport_header_must_declare_the_samples_size_and_channels(sample)
     record, (h, w) = meta["transport"], meta["size"]
     path = sample / TRANSPORT_NAME
     check_transport_header(path, record, (h, w))  # the file as written: accepted
-    # 2 lights x 2 batches x rgb3's X, Y, Z
+    # 2 lights x rgb3's X, Y, Z: the batch mean, and batch 0's deviation (of 2 batches)
     assert transport_channels(record) == {
+        f"{name}.{c}" for j in (0, 1) for name in (f"L{j}_rgb3", f"D{j}_b0_rgb3") for c in "XYZ"
+    }
+    # the layout before issue 45: every batch in full
+    old = {k: v for k, v in record.items() if k != "layout"}
+    assert transport_channels(old) == {
         f"L{j}_b{b}_rgb3.{c}" for j in (0, 1) for b in (0, 1) for c in "XYZ"
     }
     with pytest.raises(DatasetError, match=rf"{TRANSPORT_NAME}: declares {w}x{h} pixels"):
         check_transport_header(path, record, (h + 1, w))
-    with pytest.raises(DatasetError, match="missing \\['L2_b0_rgb3.X'"):
+    with pytest.raises(DatasetError, match="missing \\['D2_b0_rgb3.X'"):
         check_transport_header(path, {**record, "lights": 3}, (h, w))
-    with pytest.raises(DatasetError, match="unexpected \\['L1_b0_rgb3.X'"):
+    with pytest.raises(DatasetError, match="unexpected \\['D1_b0_rgb3.X'"):
         check_transport_header(path, {**record, "lights": 1}, (h, w))
 
 

@@ -21,10 +21,24 @@ from spectrinsic.scenes.model import Material
 
 #: A relit layer and the direct render's agree to float rounding (as tests/gt_export/test_relight.py).
 RELIGHT_RTOL = 1e-5
+#: The noise layers come from float16 batch deviations (as tests/gt_export/test_relight.py).
+NOISE_RTOL = 1e-3
 NEW_LIGHTS = {0: "cie:LED-RGB1", 1: "planck:3000K"}
 SEED = 13
 SETTINGS = RenderSettings(spp=4, modes=("rgb3", "bands31"), batches=2, max_depth=4)
 CONFIG = {"test": "relight-gloss"}
+
+
+def _disagreeing(a: dict[str, np.ndarray], b: dict[str, np.ndarray]) -> dict[str, float]:
+    """The layers of *a* farther from *b*'s (relative to its largest magnitude) than their
+    tolerance (:data:`NOISE_RTOL` for the noise estimates, else :data:`RELIGHT_RTOL`)."""
+    errors = {
+        k: float(np.abs(a[k].astype(np.float64) - b[k]).max())
+        / max(float(np.abs(b[k]).max()), 1e-30)
+        for k in a
+    }
+    tolerance = {k: NOISE_RTOL if k.startswith("noise_") else RELIGHT_RTOL for k in a}
+    return {k: e for k, e in errors.items() if e > tolerance[k]}
 
 
 @pytest.fixture(scope="module")
@@ -84,14 +98,7 @@ def test_relit_glossy_sample_equals_a_direct_render_with_the_new_spectra(glossy)
     )
     a, b = _arrays(load_sample(relit)), _arrays(load_sample(reference))
     assert set(a) == set(b) and {"specular", "metallic", "shading", "image_denoised"} <= set(a)
-    errors = {
-        k: float(np.abs(a[k].astype(np.float64) - b[k]).max())
-        / max(float(np.abs(b[k]).max()), 1e-30)
-        for k in a
-    }
-    assert max(errors.values()) <= RELIGHT_RTOL, {
-        k: e for k, e in errors.items() if e > RELIGHT_RTOL
-    }
+    assert _disagreeing(a, b) == {}
     metal = a["metallic"] == 1
     assert metal.any() and np.all(a["shading"][metal].mean(axis=-1) > 0)
     before = load_sample(sample, layers=["specular"])["specular"]
@@ -105,5 +112,5 @@ def test_relighting_a_glossy_sample_with_its_own_spectra_gives_it_back(glossy):
     )
     original, again = _arrays(load_sample(sample)), _arrays(load_sample(same))
     assert set(original) == set(again)
-    for key, value in again.items():
-        np.testing.assert_array_equal(value, original[key], err_msg=key)
+    # not bit for bit: the transport holds the batches' float32 mean and float16 deviations
+    assert _disagreeing(again, original) == {}

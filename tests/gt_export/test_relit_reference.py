@@ -56,3 +56,16 @@ def test_the_plan_allows_relighting_where_the_reference_is_stored():
         DatasetConfig.from_settings(
             "tiny", **TINY, modes=("spectral", "rgb3"), store_transport=True, relight=2
         )
+
+
+def test_the_preview_relight_refusal_says_which_samples_it_is_about():
+    """Issue 47: the refusal names the matte samples' spectral reference and the glossy ones'
+    diagonal reference, instead of saying every sample's reference is the spectral render."""
+    from spectrinsic.errors import DatasetError
+    from spectrinsic.pipeline.presets import get_preset
+
+    with pytest.raises(DatasetError) as info:
+        get_preset("preview").with_options(store_transport=True, relight=1)
+    message = str(info.value)
+    assert "a matte sample's reference image is the 'spectral' render" in message
+    assert "only glossy samples take 'rgb3' as reference" in message

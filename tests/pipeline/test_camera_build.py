@@ -31,7 +31,7 @@ SETTINGS = dict(
     store_transport=True,
     relight=1,
 )
-CAMERA = "nikon-d5100-npl"
+CAMERA = "nikon-5100-npl"
 SAMPLE = "room-living__v0__two-colour-a"
 RELIT = SAMPLE + "-relit1"
 KEY = "Nikon 5100 (NPL)"
@@ -51,7 +51,7 @@ def test_camera_without_bands31_or_unknown_is_refused_in_one_line():
     with pytest.raises(DatasetError, match="needs the 'bands31' mode") as err:
         get_preset("preview").with_options(camera=CAMERA)
     assert "\n" not in str(err.value)
-    with pytest.raises(SpectrinsicError, match="did you mean 'nikon-d5100-npl'"):
+    with pytest.raises(SpectrinsicError, match="did you mean 'nikon-5100-npl'"):
         get_preset("default").with_options(camera="nikon-d5100")
 
 

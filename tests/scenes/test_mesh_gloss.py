@@ -45,3 +45,20 @@ def test_gltf_metallic_roughness_factors(tmp_path):
     assert (
         by_kind["diffuse"].name == "flat:0.5"
     )  # matte materials are named after their spectrum, as before
+
+
+def test_an_obj_usemtl_without_a_library_keeps_its_names(tmp_path):
+    """Issue 47: ``usemtl paint`` with no ``mtllib`` names the material ``paint``, not
+    ``cube.obj_1`` (trimesh drops names no library defines)."""
+    from spectrinsic.scenes.meshes import load_mesh_scene
+
+    obj = tmp_path / "cube.obj"
+    obj.write_text(
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\n"
+        "usemtl paint\nf 1 2 3\nf 1 3 4\nusemtl wood\nf 1 2 5\n"
+    )
+    mapping = {"paint": "munsell:5R 4/14", "wood": "munsell:5YR 5/6"}
+    scene = load_mesh_scene(obj, materials=mapping, width=16, height=16)
+    assert sorted(m.spectrum for m in scene.materials) == ["munsell:5R 4/14", "munsell:5YR 5/6"]
+    faces = {m.name: len(m.faces) for m in scene.meshes}
+    assert faces == {"paint": 2, "wood": 1}

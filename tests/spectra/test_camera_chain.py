@@ -246,7 +246,7 @@ def test_tone_curve_is_the_srgb_encoding():
 
 
 def test_presets_and_bad_models():
-    assert camera_model("nikon-d5100-npl") is CAMERA_PRESETS["nikon-d5100-npl"]
+    assert camera_model("nikon-5100-npl") is CAMERA_PRESETS["nikon-5100-npl"]
     for preset in CAMERA_PRESETS.values():
         fields = " ".join(k for k, _ in preset.sources)
         assert "sensitivities" in fields and "read_noise_e" in fields and "full_well_e" in fields
@@ -277,3 +277,18 @@ def test_sixteen_bit_output_and_fixed_exposure():
     assert out.processed.dtype == np.uint16 and out.electrons_per_unit == 1000.0
     raw_mean = out.raw.astype(float).mean() - BLACK
     assert raw_mean == pytest.approx(2000.0 / GAIN, rel=0.01)
+
+
+def test_auto_exposure_meters_the_typical_pixel_not_the_bright_patch():
+    """Issue 47: a dark room around one bright patch (5 % of the pixels, 400x brighter) is
+    metered on its median luminance, at 18 % of the full well, as a camera meters."""
+    from spectrinsic.spectra.camera_chain import exposure_scale
+
+    model = _model()
+    image = np.full((20, 20, 3), 0.01)
+    image[:2, :10] = 4.0  # the patch: 20 of 400 pixels
+    image[-1, -1] = 0.0  # unlit pixels are not metered
+    scale = exposure_scale(model, image)
+    assert scale * 0.01 == pytest.approx(model.exposure_target * model.full_well_e)
+    assert model.exposure_target == pytest.approx(0.18)
+    assert exposure_scale(model, np.zeros((4, 4, 3))) == 1.0

@@ -20,7 +20,7 @@ Predictions`, a user's estimates read from files. For each sample and method:
   the camera chain's processed image, scored against the ground truth carried through it.
 
 Outputs in ``out_dir`` (:func:`spectrinsic.decompose.report.write_report`): ``scores.csv``
-(sample, method, scenario, layer, metric, value), the condition tables like Tables 5.3/5.4,
+(sample, method, scenario, layer, metric, value, lighting group, dataset config hash), the condition tables like Tables 5.3/5.4,
 the scenario table like Table 5.1, ``summary.png`` (method x condition), ``REPORT.md`` (every
 table's numbers inline, abbreviations, the summary figure, methods and their parameters),
 ``figures/<sample>.png`` and ``estimates/<method>/<scenario>/<sample>/{reflectance,shading}.exr``
@@ -404,6 +404,7 @@ def evaluate(
         methods = {name: get_decomposer(name) for name in methods}
     scores: list[Score] = []
     samples_info: dict[str, tuple[str, str]] = {}
+    hashes: dict[str, str] = {}  # each sample's dataset config hash, for scores.csv
     inputs: set[str] = set()
     glossy = False
     for stored in samples:
@@ -411,6 +412,7 @@ def evaluate(
         glossy = glossy or SPECULAR_LAYER in sample
         sid = sample_id_of(sample)
         samples_info[sid] = (sample_kind(sample), sample_condition(sample))
+        hashes[sid] = str((sample.get("meta") or {}).get("config_hash") or "")
         inputs.add(input_image(sample)[0])
         scores += evaluate_sample(
             sample,
@@ -429,6 +431,12 @@ def evaluate(
     if not scores:
         raise DatasetError("no samples to evaluate")
     files = write_report(
-        out, scores, samples_info, methods, sorted(inputs), note=target_note(target, glossy)
+        out,
+        scores,
+        samples_info,
+        methods,
+        sorted(inputs),
+        note=target_note(target, glossy),
+        config_hashes=hashes,
     )
     return EvaluationResult(tuple(scores), files)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import json
 from collections import Counter
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +22,7 @@ import numpy as np
 from ...errors import DatasetError
 from ...gt_export.dataset.check import NOISE_THRESHOLD
 from ...gt_export.sample import MANIFEST_NAME
+from ...gt_export.sample.working_view import space_of
 from ...scenes.lighting import GROUPS
 from .sample_fields import sample_condition
 from .scores import condition_group
@@ -48,6 +49,11 @@ class ScoredSet:
     groups: dict[str, int]
     lights: dict[str, int]
     noise_median: float | None
+    #: Each scored sample's lighting group (WL/1L/2L), by sample folder name.
+    lighting: dict[str, str] = field(default_factory=dict)
+    #: The samples' working spaces (colour-science names) and each one's perfect white under
+    #: D65 (``meta.json["working_space"]["white_d65"]``).
+    working_spaces: dict[str, list[float]] = field(default_factory=dict)
 
     @property
     def preview_grade(self) -> bool:
@@ -64,22 +70,40 @@ def _json(path: Path) -> dict[str, Any]:
     return data if isinstance(data, dict) else {}
 
 
+def _manifest_of(dataset: Path) -> dict[str, Any]:
+    """The ``manifest.json`` of *dataset*, or of the dataset a sample folder lies in (its
+    parent, when that manifest lists the folder); ``{}`` when there is none."""
+    if (dataset / MANIFEST_NAME).is_file():
+        return _json(dataset / MANIFEST_NAME)
+    parent = dataset.resolve().parent / MANIFEST_NAME
+    if parent.is_file():
+        manifest = _json(parent)
+        if dataset.resolve().name in (manifest.get("samples") or {}):
+            return manifest
+    return {}
+
+
 def describe_scored(dataset: Path, folders: Sequence[Path]) -> ScoredSet:
     """The :class:`ScoredSet` of the sample *folders* of *dataset* (a dataset folder, or a
-    sample folder itself); reads ``manifest.json`` when there is one and each ``meta.json``."""
-    manifest_path = dataset / MANIFEST_NAME
-    manifest = _json(manifest_path) if manifest_path.is_file() else {}
+    sample folder itself); reads ``manifest.json`` when there is one (for a sample folder, its
+    dataset's) and each ``meta.json``."""
+    manifest = _manifest_of(dataset)
     config = manifest.get("config") if isinstance(manifest.get("config"), dict) else {}
     groups: Counter[str] = Counter()
     lights: Counter[str] = Counter()
     noise = []
     hashes = set()
+    lighting: dict[str, str] = {}
+    spaces: dict[str, list[float]] = {}
     for folder in folders:
         meta = _json(folder / "meta.json")
         hashes.add(meta.get("config_hash") if isinstance(meta.get("config_hash"), str) else "")
         # the evaluation's own grouping; refuses a sample it could not group, before any work
         sample = {"meta": {"sample_id": folder.name, **meta}}
-        groups[condition_group(sample_condition(sample))] += 1
+        lighting[folder.name] = condition_group(sample_condition(sample))
+        space = space_of(meta)
+        spaces[space.colourspace] = [round(float(v), 4) for v in space.white]
+        groups[lighting[folder.name]] += 1
         lights[str(len(meta.get("lights") or []))] += 1
         median = (meta.get("noise") or {}).get("image", {}).get("median")
         if isinstance(median, int | float):
@@ -97,6 +121,8 @@ def describe_scored(dataset: Path, folders: Sequence[Path]) -> ScoredSet:
         groups={g: groups[g] for g in GROUPS if groups[g]},
         lights=dict(sorted(lights.items())),
         noise_median=float(np.median(noise)) if noise else None,
+        lighting=lighting,
+        working_spaces=spaces,
     )
 
 
@@ -107,12 +133,18 @@ def scored_section(s: ScoredSet) -> list[str]:
         "## What was scored",
         "",
         f"* dataset: `{s.dataset}`",
-        f"* preset: `{s.preset or 'not recorded (no manifest.json)'}`; config hash: "
+        f"* preset: `{s.preset or 'not recorded (no manifest.json with the samples)'}`; config hash: "
         f"`{s.config_hash or 'not recorded'}`",
         f"* samples scored: {s.n_scored}{listed}",
         "* lighting, measured from each sample's lights (WL: white light, 1L: one coloured "
         "light colour, 2L: two or more light colours): "
         + ", ".join(f"{g} {n}" for g, n in s.groups.items()),
+        "* working space of the samples: "
+        + "; ".join(
+            f"{name}, perfect white under D65 = ({', '.join(f'{v:.3f}' for v in white)})"
+            for name, white in s.working_spaces.items()
+        )
+        + " (scored in their linear sRGB view, where that white is (1, 1, 1))",
         "* lights per sample: "
         + ", ".join(f"{n} with {k} light{'s' * (k != '1')}" for k, n in s.lights.items()),
     ]

@@ -50,6 +50,10 @@ all of them off):
 * ``merge_shading``: touching regions whose shared boundary is mostly Case C (one ridge, step
   along it: shading) are one region (:mod:`spectrinsic.decompose.methods.shade_cases`);
 * ``pale_vs_chromatic``: white/grey-to-chromatic name edges are Case A (a white light's shading);
+* ``sharp_edges="achromatic"``: sharp, high-contrast edges between achromatic names are Case A
+  (the Retinex cue where the colour cues are silent; :mod:`spectrinsic.decompose.methods.
+  sharp_edges`), and ``collapse_guard``: a collapsed result is re-solved or replaced
+  (:mod:`spectrinsic.decompose.methods.collapse`; docs/names-shades-mit.md, round 5);
 * ``colour_constancy``, ``gamma=3`` (the thesis gives only ratios; ``gamma_over_alpha=100``
   and ``gamma_over_beta=2`` are the thesis' own), the cut's angle and the RAD parameters the
   thesis does not state (``creaseness=1.5``, ``sigma=2`` bins) chosen by :data:`PROTOCOL`
@@ -57,12 +61,14 @@ all of them off):
 * ``expansion_cycles=2`` and ``name_bits=8``: speed (same scores on Mondrians).
 """
 
+# long module: one method (thesis chapter 3), its five steps and the deviations acting in them
+
 from __future__ import annotations
 
 import logging
 import time
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar, Literal
 
 import numpy as np
@@ -73,15 +79,18 @@ from ...spectra.colorimetry import decode_srgb as _srgb_decode
 from ...spectra.colorimetry import encode_srgb as _srgb_encode
 from ..decomposition import Decomposition, finish, prepare_input
 from .coherence import global_coherence, grid_edges
+from .collapse import guard_collapse
 from .colour_naming import (
     appendix_a_labels,
     label_centroids,
     observed_labels,
 )
 from .constancy import discount_illuminant
+from .retinex import ColourRetinex
 from .ridges import RIDGE_DETECTORS, ColourShades, colour_shades
 from .shade_cases import CASE_C, edge_cases, merge_shading_boundaries
 from .shade_cases import split_pale_from_chromatic as _split_pale
+from .sharp_edges import log_luminance, sharp_contrast_edges, split_sharp_achromatic
 
 __all__ = ["Labelling", "NamesAndShades", "global_coherence", "grid_edges"]
 
@@ -112,7 +121,10 @@ PROTOCOL = (
     "0.0295, 7 of 10). Round 4 (issue 33) chooses no parameter: structure only, on by default, "
     "off in thesis(), at round 3's values: RAD's flooding and regions joined across mostly-Case-C "
     "boundaries (LMSE 0.0277, hold-one-out 0.0277), then white/grey-to-chromatic name edges as "
-    "Case A (round 4b: LMSE 0.0257, hold-one-out 0.0276 over 240 points), 8 of 10 below baseline"
+    "Case A (round 4b: LMSE 0.0257, hold-one-out 0.0276 over 240 points), 8 of 10 below "
+    "baseline. Round 5 (issue 48) chooses no parameter either: sharp (one-pixel step at least "
+    "half the change over six pixels), high-contrast (one achromatic name, x3.7) edges between "
+    "achromatic names are Case A, and a collapse guard re-solves or falls back (LMSE 0.0256)"
 )
 #: Linear values are normalised so that this percentile of the brightest channel maps to 1
 #: before sRGB encoding for the naming model (which expects display values).
@@ -218,6 +230,15 @@ class NamesAndShades:
     pale_vs_chromatic
         Edges between a white/grey name and a chromatic one are Case A whatever the ridges say
         (:func:`spectrinsic.decompose.methods.shade_cases.split_pale_from_chromatic`).
+    sharp_edges
+        Sharp, high-contrast edges (1-2 px, one achromatic name step in one pixel) are Case A:
+        ``"achromatic"`` those between two achromatic names (default), ``"all"`` every one,
+        ``"none"`` none (:mod:`spectrinsic.decompose.methods.sharp_edges`).
+    collapse_guard
+        A result whose reflectance lost almost all (more than 90 %) of the image's sharp,
+        high-contrast steps is re-solved with
+        ``sharp_edges="all"``, else replaced by colour Retinex; ``info["collapse"]`` says which
+        (:mod:`spectrinsic.decompose.methods.collapse`).
     global_coherence
         Apply sec. 3.4 (off reproduces Fig. 3.7(c)).
     reflectance_colour
@@ -253,6 +274,8 @@ class NamesAndShades:
     flooding: bool = True
     merge_shading: bool = True
     pale_vs_chromatic: bool = True
+    sharp_edges: Literal["none", "achromatic", "all"] = "achromatic"
+    collapse_guard: bool = True
     global_coherence: bool = True
     reflectance_colour: Literal["label-centroid", "region-mean"] = "region-mean"
     split_by_ridge: bool = True
@@ -288,6 +311,8 @@ class NamesAndShades:
             flooding=False,
             merge_shading=False,
             pale_vs_chromatic=False,
+            sharp_edges="none",
+            collapse_guard=False,
             name="names-shades-thesis",
         )
 
@@ -295,9 +320,15 @@ class NamesAndShades:
         """Decompose a linear ``(H, W, 3)`` image into reflectance and shading.
 
         The five steps of the module docstring (:meth:`labelling` then :meth:`reflectance`);
-        ``info`` records each step's time in seconds.
+        ``info`` records each step's time in seconds and the collapse guard's check.
         """
-        return self.reflectance(self.labelling(image, mask))
+        result = self.reflectance(self.labelling(image, mask))
+        if not self.collapse_guard:
+            return result
+        img, m = prepare_input(image, mask)
+        again = replace(self, sharp_edges="all", collapse_guard=False)
+        fallback = ("colour-retinex", lambda: ColourRetinex()(img, m))
+        return guard_collapse(result, img, m, lambda: again(img, m), fallback)
 
     def labelling(self, image: npt.ArrayLike, mask: npt.ArrayLike | None = None) -> Labelling:
         """Steps 1-3 (names, shades, MRF) of a linear ``(H, W, 3)`` image (:class:`Labelling`)."""
@@ -309,6 +340,9 @@ class NamesAndShades:
         )
         validate_choice(
             self.ridge_detector, RIDGE_DETECTORS, "ridge_detector", error=DecomposeError
+        )
+        validate_choice(
+            self.sharp_edges, ("none", "achromatic", "all"), "sharp_edges", error=DecomposeError
         )
         gco = _import_gco()
         t0 = time.perf_counter()
@@ -335,12 +369,16 @@ class NamesAndShades:
         t2 = time.perf_counter()
 
         # 3. MRF (Eq. 3.4) by alpha-expansion
-        edges, _ = grid_edges(m)
+        edges, flat = grid_edges(m)
         cases = edge_cases(
             edges, log_colours, shades.ridge, shades.tangent, self.parallel_threshold_deg
         )
         if self.pale_vs_chromatic:  # a white light keeps a white or grey surface achromatic
             cases = _split_pale(cases, edges, appendix_a_labels()[candidates[y]])
+        if self.sharp_edges != "none":  # the Retinex cue where the names are achromatic
+            strong = sharp_contrast_edges(log_luminance(img, m), flat, m)
+            names = appendix_a_labels()[candidates[y]] if self.sharp_edges == "achromatic" else None
+            cases = split_sharp_achromatic(cases, edges, names, strong)
         w = self.gamma / np.array([self.gamma_over_alpha, self.gamma_over_beta, 1.0])
         labels = self._mrf(gco, edges, w[cases], y, distance)
         timings = {"names_s": t1 - t0, "shades_s": t2 - t1, "mrf_s": time.perf_counter() - t2}

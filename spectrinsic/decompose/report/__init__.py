@@ -16,10 +16,11 @@ import numpy as np
 
 from ...results import write_csv, write_json
 from ..evaluation.photometric import SCENARIOS
-from ..evaluation.scores import INPUT_LAYERS, SCORED_LAYERS, Score
+from ..evaluation.scores import INPUT_LAYERS, SCORED_LAYERS, Score, condition_group
 from ..metrics import METRICS
 from .figure import SUMMARY_FIGURE, summary_heatmap
 from .markdown import Column, glossary_section, markdown_table
+from .sensor import sensor_md, sensor_table
 from .tables import (
     COLOUR_COLUMNS,
     GROUP_ORDER,
@@ -210,6 +211,7 @@ def _report_md(
             "",
         ]
     md += _scenario_md(tables["scenario"])
+    md += sensor_md(tables["sensor"])
     md += _methods_md(methods)
     md += ["## Files", ""] + [f"* `{p.name}`" for p in files.values()]
     md += [f"* `{SUMMARY_FIGURE}`"] if summary else []
@@ -298,13 +300,18 @@ def write_report(
     methods: Mapping[str, Any],
     inputs: Sequence[str],
     note: str = "",
+    config_hashes: Mapping[str, str] | None = None,
 ) -> dict[str, Path]:
     """Write ``scores.csv``, the summary, condition and scenario tables, ``methods.json``, the
     summary figure (:data:`~spectrinsic.decompose.report.figure.SUMMARY_FIGURE`) and
     ``REPORT.md``, which holds every table's numbers inline
     (:mod:`spectrinsic.decompose.report.markdown`). *note*
-    (:func:`spectrinsic.decompose.evaluation.targets.target_note`) is printed under every title."""
+    (:func:`spectrinsic.decompose.evaluation.targets.target_note`) is printed under every title.
+    Each ``scores.csv`` row names its sample's lighting group (WL/1L/2L, measured from its
+    lights: *samples*' condition) and, where *config_hashes* gives it, the sample's dataset
+    config hash."""
     files: dict[str, Path] = {"scores": out / "scores.csv"}
+    hashes = config_hashes or {}
     _write_csv(
         files["scores"],
         [
@@ -315,16 +322,19 @@ def write_report(
                 "layer": s.layer,
                 "metric": s.metric,
                 "value": s.value,
+                "lighting": condition_group(samples[s.sample][1]) if s.sample in samples else "",
+                "config_hash": hashes.get(s.sample, ""),
             }
             for s in scores
         ],
-        ("sample", "method", "scenario", "layer", "metric", "value"),
+        ("sample", "method", "scenario", "layer", "metric", "value", "lighting", "config_hash"),
     )
     tables = {
         "summary": summary_table(scores, samples),
         "lmse": condition_table(scores, samples, columns=LMSE_COLUMNS),
         "colour": condition_table(scores, samples, columns=COLOUR_COLUMNS),
         "scenario": scenario_table(scores),
+        "sensor": sensor_table(scores),
         "t32": table_3_2(scores, samples),
     }
     files.update(_summary_files(out, tables["summary"]))

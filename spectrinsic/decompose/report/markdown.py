@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from ...scenes.lighting import SAME_COLOUR_XY, WHITE_XY_TOLERANCE
 from ..evaluation.photometric import SCENARIOS
 from ..evaluation.scores import SCORED_LAYERS
 
@@ -24,12 +25,20 @@ __all__ = ["Column", "GLOSSARY", "markdown_table", "glossary_section", "fmt_numb
 
 #: Every abbreviation the report uses, defined once (its "Abbreviations" section).
 GLOSSARY: tuple[tuple[str, str], ...] = (
-    ("WL", "white light: the `white` condition (one D65-like light)"),
-    ("1L", "one coloured light: the `one-colour` condition"),
+    (
+        "WL",
+        "white light, measured from each sample's lights: one light colour within "
+        f"{WHITE_XY_TOLERANCE:g} of D65 in CIE 1931 xy (the library's `white` condition)",
+    ),
+    (
+        "1L",
+        "one coloured light, measured: one light colour, further than "
+        f"{WHITE_XY_TOLERANCE:g} from D65 in xy (the library's `one-colour` condition)",
+    ),
     (
         "2L",
-        "two lights of different colours: the `two-colour-a` and `two-colour-b` conditions "
-        "(their mean)",
+        f"two or more light colours, measured: lights more than {SAME_COLOUR_XY:g} apart in xy "
+        "(the library's `two-colour-a` and `two-colour-b` conditions)",
     ),
     ("all", "every lighting condition together"),
     ("refl.", "reflectance (`reflectance`, linear sRGB under D65, in colour)"),

@@ -27,6 +27,8 @@ __all__ = [
     "table_3_2",
     "scenario_table",
     "summary_table",
+    "mean_finite",
+    "method_order",
 ]
 
 #: The lighting groups of the condition tables, in column order.
@@ -48,12 +50,12 @@ COLOUR_COLUMNS: tuple[tuple[str, str, str, str], ...] = (
 )
 
 
-def _mean(values: list[float]) -> float:
+def mean_finite(values: list[float]) -> float:
     finite = [v for v in values if np.isfinite(v)]
     return float(np.mean(finite)) if finite else float("nan")
 
 
-def _method_order(name: str) -> tuple[int, str]:
+def method_order(name: str) -> tuple[int, str]:
     """Bundled methods in registry order, then the others (plugins, predictions) by name."""
     order = list(DECOMPOSERS)
     return (order.index(name) if name in order else len(order), name)
@@ -78,11 +80,13 @@ def condition_table(
             groups[(kind, s.method, s.layer, s.metric, condition_group(cond))].append(s.value)
     rows = []
     for kind in SCENE_KINDS:
-        for method in sorted({k[1] for k in groups if k[0] == kind}, key=_method_order):
+        for method in sorted({k[1] for k in groups if k[0] == kind}, key=method_order):
             row: dict[str, Any] = {"scene_kind": kind, "method": method}
             for prefix, layer, metric, _ in columns:
                 for g in GROUP_ORDER:
-                    row[f"{prefix}_{g}"] = _mean(groups.get((kind, method, layer, metric, g), []))
+                    row[f"{prefix}_{g}"] = mean_finite(
+                        groups.get((kind, method, layer, metric, g), [])
+                    )
             rows.append(row)
     return rows
 
@@ -95,10 +99,10 @@ def scenario_table(scores: Iterable[Score], *, metric: str = "lmse") -> list[dic
             groups[(s.camera, s.method, s.photometric)].append(s.value)
     rows = []
     for camera in sorted({k[0] for k in groups}):
-        for method in sorted({k[1] for k in groups if k[0] == camera}, key=_method_order):
+        for method in sorted({k[1] for k in groups if k[0] == camera}, key=method_order):
             row: dict[str, Any] = {"camera": camera, "method": method}
             for sc in _PHOTOMETRIC:
-                row[sc] = _mean(groups.get((camera, method, sc), []))
+                row[sc] = mean_finite(groups.get((camera, method, sc), []))
             rows.append(row)
     return rows
 
@@ -132,11 +136,11 @@ def table_3_2(
             for g in (condition_group(samples[sid][1]), "all"):
                 groups[(method, metric, g)].append(value)
     rows = []
-    for method in sorted({k[0] for k in groups}, key=_method_order):
+    for method in sorted({k[0] for k in groups}, key=method_order):
         for g in (*GROUP_ORDER, "all"):
             row: dict[str, Any] = {"method": method, "lighting": g}
             for key, metric, _ in TABLE_3_2_COLUMNS:
-                row[key] = _mean(groups.get((method, metric, g), []))
+                row[key] = mean_finite(groups.get((method, metric, g), []))
             rows.append(row)
     return rows
 
@@ -153,6 +157,6 @@ def summary_table(
             per[(s.method, "all")].append(s.value)
     conditions = [c for c in (*CONDITION_GROUPS, *GROUP_ORDER) if any(k[1] == c for k in per)]
     return [
-        {"method": m, **{c: _mean(per.get((m, c), [])) for c in (*conditions, "all")}}
-        for m in sorted({k[0] for k in per}, key=_method_order)
+        {"method": m, **{c: mean_finite(per.get((m, c), [])) for c in (*conditions, "all")}}
+        for m in sorted({k[0] for k in per}, key=method_order)
     ]

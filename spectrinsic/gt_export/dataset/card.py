@@ -18,12 +18,13 @@ from typing import Any
 
 from ...errors import DatasetError
 from ...provenance import software_versions
-from ..layers.spectral_intrinsics import residual_summary
+from ..layers.spectral_intrinsics import gamut_key, residual_summary
 from ..sample import CARD_NAME, META_NAME, config_hash, plain_data, sample_dirs
 from ..sample.integrity import guarded_write
 from ..sample.meta import LayerRecord, SampleMeta, read_meta
 from ..sample.working_view import space_of
 from .card_residual import write_residual_figure
+from .card_text import colour_conventions, percent
 from .colour_spread import shown, spread_summary
 from .diversity import DIVERSITY_NAME, spread_record, write_diversity
 from .manifest import noise_summary, read_manifest, splits_by_scene, variants_of
@@ -104,15 +105,20 @@ def _residual_table(summary: Mapping[str, Any], root: Path, metas: Sequence[Samp
     spaces = sorted({space_of(m.raw).colourspace for m in metas})
     space = spaces[0] if len(spaces) == 1 else "working space"
     figure = write_residual_figure(root, [m.raw for m in metas], space)
+    clips = any(gamut_key(m.raw) == "clipped_pixels" for m in metas)
+    gamut = (
+        "linear sRGB clips it into the residual"
+        if clips
+        else f"{_text(', '.join(spaces))} keeps it in the shading"
+    )
     lines = [
         "Share of the image the intrinsic product does not explain, Σ|residual| / Σ|image| over "
         "the mask, per sample; median / 95th percentile / max over the samples of each light "
         "family (a sample's family is its most saturated light's). The RGB layers' residual "
         f"(working space: {_text(', '.join(spaces))}) holds the spectral non-commutativity a "
         "3-channel product cannot represent; out-of-gamut pixels are the share of lit pixels "
-        "whose shading has a negative channel in the working space (linear sRGB clips it into "
-        "the residual; ACEScg keeps it in the shading). The per-band layers "
-        "(`--spectral-layers`) multiply out band by band. `spectrinsic check "
+        f"whose shading has a negative channel in the working space ({gamut}). The per-band "
+        "layers (`--spectral-layers`) multiply out band by band. `spectrinsic check "
         "--max-residual-share F` and the loaders' `max_residual_share` select samples by the "
         "RGB figure.",
         "",
@@ -122,16 +128,16 @@ def _residual_table(summary: Mapping[str, Any], root: Path, metas: Sequence[Samp
         "|---|---|---|---|---|",
     ]
 
-    def cell(row: Mapping[str, Any], key: str) -> str:
-        fig = row.get(key)
+    def cell(row: Mapping[str, Any], *keys: str) -> str:
+        fig = next((row[k] for k in keys if row.get(k)), None)
         if not fig:
             return "–"
-        return " / ".join(f"{100 * fig[k]:.2g} %" for k in ("median", "p95", "max"))
+        return " / ".join(percent(fig[k]) for k in ("median", "p95", "max"))
 
     for family, row in summary.items():
         lines.append(
             f"| {_text(family)} | {row['samples']} | {cell(row, 'rgb')} | "
-            f"{cell(row, 'spectral')} | {cell(row, 'clipped_pixels')} |"
+            f"{cell(row, 'spectral')} | {cell(row, 'out_of_gamut_share', 'clipped_pixels')} |"
         )
     return "\n".join(lines)
 
@@ -158,6 +164,7 @@ def write_dataset_card(
     metas = [read_meta(s) for s in samples]
     scenes = sorted({m.scene for m in metas})
     text = string.Template(read_template("DATASET.md")).substitute(
+        **colour_conventions([space_of(m.raw) for m in metas]),
         noise_table=_noise_table(noise_summary(metas)),
         residual_table=_residual_table(residual_summary([m.raw for m in metas]), root, metas),
         n_samples=len(samples),

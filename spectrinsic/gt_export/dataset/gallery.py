@@ -49,6 +49,8 @@ __all__ = [
     "contact_sheet",
     "gallery_index",
     "scene_kind",
+    "sensor_panel",
+    "SENSOR_PANEL",
     "GALLERY_DIRS",
     "GALLERY_LAYERS",
     "INDEX_VARIABLE",
@@ -81,6 +83,7 @@ GALLERY_LAYERS: tuple[str, ...] = (
     "normals",
     "material_id",
     "object_id",
+    "semantic",
     "mask",
     "non_diffuse",
     "metallic",
@@ -148,6 +151,45 @@ def _layer_order(names: Iterable[str]) -> list[str]:
     return sorted(names, key=lambda n: ("/" in n, rank.get(n, len(rank)), n))
 
 
+#: The camera chain's layers in the order light goes through it, with what each one shows.
+SENSOR_PANEL: tuple[tuple[str, str], ...] = (
+    ("raw_sensor", "1. raw Bayer mosaic (DN)"),
+    ("image_sensor_noisy", "2. processed linear image, noise included"),
+    ("processed_sensor", "3. tone-mapped output (display only)"),
+    ("image_sensor", "ground truth: noise-free processed image"),
+    ("reflectance_sensor", "ground truth: reflectance, carried through the chain"),
+    ("shading_sensor", "ground truth: shading, carried through the chain"),
+    ("residual_sensor", "ground truth: residual"),
+)
+
+
+def sensor_panel(layers: Iterable[str], sensor: Mapping[str, Any] | None) -> dict[str, Any] | None:
+    """The gallery's camera-chain panel of a sample: its camera, the metered exposure
+    (electrons per unit of the camera image) and its sensor layers in :data:`SENSOR_PANEL`
+    order with their captions; ``None`` for a sample built without ``--camera``.
+
+    >>> panel = sensor_panel(["image", "raw_sensor/Nikon D3", "shading_sensor/Nikon D3"],
+    ...                      {"camera": "nikon-d3", "stages": {"exposure": {"electrons_per_unit": 9.5}}})
+    >>> panel["camera"], [name for name, _ in panel["layers"]]
+    ('nikon-d3', ['raw_sensor/Nikon D3', 'shading_sensor/Nikon D3'])
+    """
+    if not sensor:
+        return None
+    names = list(layers)
+    ordered = [
+        [name, caption]
+        for base, caption in SENSOR_PANEL
+        for name in names
+        if name.split("/", 1)[0] == base
+    ]
+    exposure = (sensor.get("stages") or {}).get("exposure") or {}
+    return {
+        "camera": sensor.get("camera"),
+        "electrons_per_unit": exposure.get("electrons_per_unit"),
+        "layers": ordered,
+    }
+
+
 def _sample_entry(sample: Path, meta: SampleMeta, split: str | None) -> dict[str, Any]:
     """One sample's record in the index (paths relative to the dataset folder)."""
     smeta = meta.scene_metadata
@@ -187,6 +229,7 @@ def _sample_entry(sample: Path, meta: SampleMeta, split: str | None) -> dict[str
         "size": list(meta.size),
         "reference_mode": meta.reference_mode,
         "layers": layers,
+        "sensor": sensor_panel(layers, meta.raw.get("sensor")),
         "lights": lights,
         "files": sorted(
             {f"{sample.name}/{r.file}" for r in records.values()}

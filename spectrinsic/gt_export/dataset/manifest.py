@@ -22,6 +22,7 @@ from ...errors import DatasetError, SampleMetaError
 from ...provenance import software_versions
 from ...rng import seed_from_key
 from ...scenes.material_labels import label_spectrum
+from ..formats.exr import DEFAULT_COMPRESSION
 from ..layers.spectral_intrinsics import residual_summary
 from ..sample import (
     FORMAT_VERSION,
@@ -37,6 +38,8 @@ from ..sample import (
 from ..sample.integrity import guarded_write
 from ..sample.json_fields import JsonFields, load_json
 from ..sample.meta import SampleMeta, read_meta
+from ..sample.transport_exr import COMPACT_LAYOUT, TRANSPORT_COMPRESSION, TRANSPORT_NAME
+from ..sample.working_view import space_of
 
 __all__ = [
     "SPLIT_FRACTIONS",
@@ -50,6 +53,7 @@ __all__ = [
     "splits_by_scene",
     "noise_summary",
     "variants_of",
+    "working_spaces",
 ]
 
 #: ``(split name, share of the scenes)`` pairs, in the order the splits are filled.
@@ -79,6 +83,35 @@ def _spectral_provenance(metas: Sequence[SampleMeta], data_dir: Any) -> dict[str
     root = resolve_data_dir(data_dir)
     if root is not None and (root / "PROVENANCE.md").is_file():
         out["data_directory_provenance_sha256"] = file_sha256(root / "PROVENANCE.md")
+    return out
+
+
+def _semantic_classes(metas: Sequence[SampleMeta]) -> dict[str, Any]:
+    """``{"semantic_classes": table}`` of the samples with a ``semantic`` layer (one table, as
+    every sample of a build records the same), else nothing (samples from before issue 41)."""
+    tables = [m.raw["semantic_classes"] for m in metas if "semantic_classes" in m.raw]
+    return {"semantic_classes": tables[0]} if tables else {}
+
+
+def working_spaces(metas: Sequence[SampleMeta]) -> dict[str, dict[str, Any]]:
+    """The samples' RGB working spaces by name: colour-science's name, the perfect white's
+    colour under D65 (``white_d65``), the sign of the shading (negative channels kept, or set
+    to 0 in ``srgb``), and the sample count."""
+    out: dict[str, dict[str, Any]] = {}
+    for meta in metas:
+        space = space_of(meta.raw)
+        entry = out.setdefault(
+            space.name,
+            {
+                "colourspace": space.colourspace,
+                "white_d65": [round(float(v), 6) for v in space.white],
+                "shading": "negative channels set to 0 (into the residual)"
+                if space.clip_shading
+                else "negative channels kept",
+                "samples": 0,
+            },
+        )
+        entry["samples"] += 1
     return out
 
 
@@ -113,6 +146,15 @@ def write_manifest(
         "n_samples": len(samples),
         "noise": noise_summary(metas),
         "residual_share": residual_summary([m.raw for m in metas]),
+        "working_space": working_spaces(metas),
+        "storage": {
+            "exr_compression": {
+                "*.exr": DEFAULT_COMPRESSION,
+                TRANSPORT_NAME: TRANSPORT_COMPRESSION,
+            },
+            "transport_layout": COMPACT_LAYOUT,
+        },
+        **_semantic_classes(metas),
         "split_by": "scene",
         "split_fractions": dict(split_fractions),
         "splits": splits_by_scene({m.sample_id: m.scene for m in metas}, split_fractions),

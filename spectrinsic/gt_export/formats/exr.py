@@ -2,7 +2,8 @@
 
 A *layer* is a named array: ``(H, W)`` for one channel, ``(H, W, C)`` for several. It is stored
 as EXR channels ``<layer>.<channel>`` (``reflectance.R``, ``depth.Z``, ``cube.b05``), as 32-bit
-float (ground truth is never written as half floats), or, for integer layers (material and
+float (ground truth is never written as half floats; only a noise estimate that is part of no
+identity may be, when its writer names it in ``half``), or, for integer layers (material and
 object ids), as 32-bit UINT channels holding the int32 bits, so every id up to 2**31 - 1 reads
 back exactly (float32 stops at 2**24: id 16777217 came back 16777216). The channel order of
 every layer is kept in a header attribute so that reading gives back the arrays bit for bit.
@@ -19,7 +20,7 @@ import os
 import sys
 import tempfile
 import threading
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -38,6 +39,11 @@ __all__ = [
     "exr_size",
     "default_channel_names",
 ]
+
+#: The lossless EXR compressions :func:`write_exr` offers, by name (the OpenEXR constant).
+COMPRESSIONS = {"zip": "ZIP_COMPRESSION", "zips": "ZIPS_COMPRESSION", "none": "NO_COMPRESSION"}
+#: The compression of every EXR file but the transport's (lossless zlib, 16 scanlines a block).
+DEFAULT_COMPRESSION = "zip"
 
 log = logging.getLogger(__name__)
 #: Serialises :func:`_c_output_held` (file descriptors are shared by all threads).
@@ -70,9 +76,14 @@ def _as_int32_bits(name: str, array: np.ndarray) -> np.ndarray:
     return array.astype(np.int32).view(np.uint32)
 
 
-def _as_stored(name: str, array: np.ndarray) -> np.ndarray:
-    """*array* as it is stored: integers as int32 bits (uint32), everything else as float32."""
+def _as_stored(name: str, array: np.ndarray, half: bool = False) -> np.ndarray:
+    """*array* as it is stored: integers as int32 bits (uint32), a *half* layer as float16
+    (finite values only), everything else as float32."""
     array = np.asarray(array)
+    if half:
+        if array.dtype != np.float16 or not np.isfinite(array).all():
+            raise DatasetError(f"layer {name!r}: a half layer must be finite float16")
+        return array
     if array.dtype == np.float16:
         raise DatasetError(f"layer {name!r} is float16; ground truth is stored as float32 only")
     if array.dtype.kind in "iu":
@@ -87,50 +98,20 @@ def _as_stored(name: str, array: np.ndarray) -> np.ndarray:
     return array.astype(np.float32, copy=False)
 
 
-def write_exr(
-    path: str | os.PathLike[str],
+def _channels(
     layers: Mapping[str, np.ndarray],
-    *,
-    channel_names: Mapping[str, Sequence[str]] | None = None,
-    attributes: Mapping[str, str] | None = None,
-    compressed: bool = True,
-) -> Path:
-    """Write *layers* as float32 channels ``<layer>.<channel>`` of one scanline EXR file.
-
-    Parameters
-    ----------
-    path
-        Destination ``.exr`` file.
-    layers
-        ``{name: array}`` with arrays ``(H, W)`` or ``(H, W, C)``, all of the same ``H, W``.
-        Floats and bools are stored as float32 (float16 is refused); integer arrays (ids) as
-        UINT channels holding their int32 bits (values outside int32 are refused), listed in
-        the header attribute :data:`INT32_ATTRIBUTE`, so they read back as exact int32.
-    channel_names
-        Channel names per layer, e.g. ``{"normals": ("X", "Y", "Z")}``; default
-        :func:`default_channel_names`.
-    attributes
-        Extra string header attributes (provenance).
-    compressed
-        ZIP compression (lossless); ``False`` for Monte Carlo noise that ZIP cannot shrink
-        (the per-light transport: ZIP made it 12 % smaller, most of it on its coverage layer,
-        and 30× slower to write and 3× slower to read).
-
-    Returns
-    -------
-    Path
-        *path*.
-    """
-    import OpenEXR
-
-    channel_names = dict(channel_names or {})
+    channel_names: Mapping[str, Sequence[str]],
+    half: Collection[str],
+) -> tuple[dict[str, np.ndarray], dict[str, list[str]]]:
+    """The EXR channels ``<layer>.<channel>`` of *layers* as stored (:func:`_as_stored`), and
+    each layer's channel order; one-line errors for names, shapes and sizes that do not fit."""
     channels: dict[str, np.ndarray] = {}
     order: dict[str, list[str]] = {}
     shape: tuple[int, int] | None = None
     for name, array in layers.items():
         if "." in name:
             raise DatasetError(f"layer name {name!r} contains '.'; expected a plain name")
-        data = _as_stored(name, array)
+        data = _as_stored(name, array, name in half)
         if data.ndim == 2:
             data = data[..., None]
         if data.ndim != 3:
@@ -153,10 +134,57 @@ def write_exr(
             # The bindings read the buffer as C-contiguous regardless of strides: a channel
             # slice a[..., i] written directly comes back scrambled.
             channels[f"{name}.{channel}"] = np.ascontiguousarray(data[..., i])
+    return channels, order
+
+
+def write_exr(
+    path: str | os.PathLike[str],
+    layers: Mapping[str, np.ndarray],
+    *,
+    channel_names: Mapping[str, Sequence[str]] | None = None,
+    attributes: Mapping[str, str] | None = None,
+    compression: str = DEFAULT_COMPRESSION,
+    half: Collection[str] = (),
+) -> Path:
+    """Write *layers* as float32 channels ``<layer>.<channel>`` of one scanline EXR file.
+
+    Parameters
+    ----------
+    path
+        Destination ``.exr`` file.
+    layers
+        ``{name: array}`` with arrays ``(H, W)`` or ``(H, W, C)``, all of the same ``H, W``.
+        Floats and bools are stored as float32 (float16 is refused); integer arrays (ids) as
+        UINT channels holding their int32 bits (values outside int32 are refused), listed in
+        the header attribute :data:`INT32_ATTRIBUTE`, so they read back as exact int32.
+    channel_names
+        Channel names per layer, e.g. ``{"normals": ("X", "Y", "Z")}``; default
+        :func:`default_channel_names`.
+    attributes
+        Extra string header attributes (provenance).
+    compression
+        One of :data:`COMPRESSIONS`, all lossless: ``"zip"`` (zlib over blocks of 16 scanlines,
+        the default), ``"zips"`` (zlib per scanline: as small on Monte Carlo noise, and 4x
+        faster to read back than ``"zip"`` on a 256² room's transport, 0.09 s against 0.35 s,
+        which is why the transport uses it) or ``"none"``.
+    half
+        Layers given as float16 arrays and stored as HALF channels: only estimates that are
+        part of no identity (the transport's batch deviations, which feed the noise layer).
+
+    Returns
+    -------
+    Path
+        *path*.
+    """
+    import OpenEXR
+
+    channels, order = _channels(layers, dict(channel_names or {}), half)
     if not channels:
         raise DatasetError(f"no layers to write to {str(path)!r}")
+    if compression not in COMPRESSIONS:
+        raise DatasetError(f"EXR compression {compression!r}; expected one of {list(COMPRESSIONS)}")
     header = {
-        "compression": OpenEXR.ZIP_COMPRESSION if compressed else OpenEXR.NO_COMPRESSION,
+        "compression": getattr(OpenEXR, COMPRESSIONS[compression]),
         "type": OpenEXR.scanlineimage,
         CHANNELS_ATTRIBUTE: json.dumps(order, separators=(",", ":"), allow_nan=False),
     }

@@ -217,13 +217,36 @@ def unlit_masked(
     estimate: WhiteRadiance, raw: WhiteRadiance, batches: tuple[np.ndarray, ...] = ()
 ) -> WhiteRadiance:
     """*estimate* (a denoised ``W``) set to exactly 0 at the pixels where no light arrives: the
-    raw ``W`` and the raw channels of every independent batch are 0 in every band there. A
-    denoiser spreads light from lit neighbours into such pixels, and ``illuminant`` divides by
-    the tiny luminance it leaves (saturated colours); the layers are documented as 0 there."""
-    lit = np.any(raw.bands != 0, axis=-1)
+    raw ``W`` and the raw channels of every independent batch are 0 in every band there, and so
+    are most of its 8 neighbours. A denoiser spreads light from lit neighbours into such
+    pixels, and ``illuminant`` divides by the tiny luminance it leaves (saturated colours); the
+    layers are documented as 0 there. A pixel whose samples all missed the light but whose
+    neighbours mostly saw it (:data:`HOLE_NEIGHBOURS` of 8 or more) is a sampling hole of a lit
+    region, not a shadow: it keeps the estimate (``room-corner`` at the preview preset, 4 spp:
+    15 of 2304 covered pixels of ``image_denoised`` were exactly 0, black specks, and 7 are now;
+    the 7 lie in clusters of unlit pixels)."""
+    seen = np.any(raw.bands != 0, axis=-1)
     for batch in batches:
-        lit |= np.any(np.asarray(batch) != 0, axis=-1)
+        seen |= np.any(np.asarray(batch) != 0, axis=-1)
+    lit = seen | (_lit_neighbours(seen) >= HOLE_NEIGHBOURS)
     return estimate.with_bands(np.where(lit[..., None], estimate.bands, 0.0))
+
+
+#: Lit neighbours (of 8) that make an unlit pixel a sampling hole of a lit region.
+HOLE_NEIGHBOURS = 5
+
+
+def _lit_neighbours(lit: np.ndarray) -> np.ndarray:
+    """``(H, W)`` count of the 8 neighbours of each pixel that are lit (outside the image:
+    unlit)."""
+    padded = np.pad(lit.astype(np.int32), 1)
+    h, w = lit.shape
+    return sum(  # type: ignore[return-value]
+        padded[1 + dy : 1 + dy + h, 1 + dx : 1 + dx + w]
+        for dy in (-1, 0, 1)
+        for dx in (-1, 0, 1)
+        if dy or dx
+    )
 
 
 def recompose(radiance: WhiteRadiance, raw: np.ndarray) -> np.ndarray:

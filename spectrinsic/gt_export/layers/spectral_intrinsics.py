@@ -60,6 +60,7 @@ __all__ = [
     "light_family",
     "residual_rows",
     "residual_summary",
+    "gamut_key",
     "WORKING_SPACES",
     "working_space_matrix",
     "bands_to_rgb",
@@ -267,14 +268,32 @@ def _figures(values: list[float]) -> dict[str, float]:
     }
 
 
-_ROW_KEYS = ("rgb", "spectral", "clipped_pixels")
+_ROW_KEYS = ("rgb", "spectral", "clipped_pixels", "out_of_gamut_share")
+
+
+def gamut_key(meta: Any) -> str:
+    """The name of a sample's share of lit pixels whose working-space shading has a negative
+    channel: ``"clipped_pixels"`` where the space clips it into the residual (``srgb``, and
+    samples written before the working space was recorded), else ``"out_of_gamut_share"``
+    (ACEScg, Rec.2020 keep it in the shading: nothing is clipped).
+
+    >>> gamut_key({"working_space": {"name": "acescg", "shading_clipped": False}})
+    'out_of_gamut_share'
+    >>> gamut_key({})
+    'clipped_pixels'
+    """
+    record = meta.get("working_space") if isinstance(meta, Mapping) else None
+    clipped = record.get("shading_clipped", True) if isinstance(record, Mapping) else True
+    return "clipped_pixels" if clipped else "out_of_gamut_share"
 
 
 def residual_rows(metas: Any) -> dict[str, dict[str, list[float]]]:
     """Per light family (:func:`light_family` of each sample's lights): the samples' RGB
     residual shares (``"rgb"``), per-band residual shares where written (``"spectral"``) and
-    shares of lit pixels with clipped sRGB shading (``"clipped_pixels"``), fractions in sample
-    order. *metas* are parsed ``meta.json`` objects; samples without a residual share are skipped.
+    shares of lit pixels whose shading has a negative channel in the working space
+    (:func:`gamut_key`: ``"clipped_pixels"`` in sRGB, ``"out_of_gamut_share"`` where nothing is
+    clipped), fractions in sample order. *metas* are parsed ``meta.json`` objects; samples
+    without a residual share are skipped.
     """
     rows: dict[str, dict[str, list[float]]] = {}
     for meta in metas:
@@ -285,8 +304,8 @@ def residual_rows(metas: Any) -> dict[str, dict[str, list[float]]]:
         row = rows.setdefault(family, {k: [] for k in _ROW_KEYS})
         row["rgb"].append(rgb)
         spectral = (meta.get("residual_share") or {}).get("image_bands")
-        clipped = (meta.get("shading_clipping") or {}).get("pixels")
-        for key, value in (("spectral", spectral), ("clipped_pixels", clipped)):
+        gamut = (meta.get("shading_clipping") or {}).get("pixels")
+        for key, value in (("spectral", spectral), (gamut_key(meta), gamut)):
             if isinstance(value, (int, float)):
                 row[key].append(float(value))
     return rows
@@ -295,7 +314,9 @@ def residual_rows(metas: Any) -> dict[str, dict[str, list[float]]]:
 def residual_summary(metas: Any) -> dict[str, Any]:
     """Per light family (:func:`light_family` of each sample's lights) and ``"all"``: the
     samples' RGB residual share, per-band residual share (where written) and the share of lit
-    pixels whose sRGB shading was clipped, each as median / p95 / max over samples (fractions).
+    pixels whose shading has a negative channel in the working space (``clipped_pixels`` or
+    ``out_of_gamut_share``, :func:`gamut_key`), each as median / p95 / max over samples
+    (fractions).
     *metas* are parsed ``meta.json`` objects; samples without a residual share are skipped.
 
     >>> m = {"lights": [{"spectrum": "cie:D65"}], "residual_share": {"image": 0.01},

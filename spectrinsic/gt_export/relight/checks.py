@@ -32,7 +32,7 @@ from ...render.result import RenderResult
 from ...spectra import get_sensors
 from ..formats.exr import read_exr_attributes
 from ..sample import META_NAME, SCENE_NAME, file_sha256
-from ..sample.transport_exr import COVERAGE_LAYER, TRANSPORT_NAME, transport_layer
+from ..sample.transport_exr import COVERAGE_LAYER, TRANSPORT_NAME, stored_layers
 
 __all__ = [
     "verified_file",
@@ -64,21 +64,18 @@ def verified_file(sample: Path, meta: Mapping[str, Any], file: str) -> Path:
 
 
 def transport_channels(record: Mapping[str, Any]) -> set[str]:
-    """The channel names (``"L0_b1_rgb3.X"``) a transport record implies, coverage excluded."""
+    """The channel names (``"L0_rgb3.X"``; ``"L0_b1_rgb3.X"`` in the per-batch layout before
+    issue 45) a transport record implies, coverage excluded."""
     try:
-        parts = ["transport", *record.get("parts", [])]
-        batches = range(len(record["batch_seeds"]))
-        modes, lights = list(record["modes"]), range(int(record["lights"]))
-        channels = {m: get_sensors(record["sensors"][m]).channels for m in modes}
-    except (KeyError, TypeError, ValueError) as exc:
+        layers = stored_layers(record, int(record["lights"]), len(record["batch_seeds"]))
+        channels = {m: get_sensors(record["sensors"][m]).channels for m in record["modes"]}
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
         raise DatasetError(f"{META_NAME} transport record is malformed ({exc})") from None
     return {
-        f"{transport_layer(j, b, m, part)}.{c}"
-        for part in parts
-        for b in batches
-        for m in modes
-        for j in lights
-        for c in channels[m]
+        f"{name}.{c}"
+        for (_, _, mode), names in layers.items()
+        for name in names
+        for c in channels[mode]
     }
 
 

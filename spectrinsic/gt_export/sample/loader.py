@@ -29,7 +29,7 @@ __all__ = [
     "EXPOSURE_PERCENTILE",
 ]
 
-_INT_LAYERS = ("material_id", "object_id")
+_INT_LAYERS = ("material_id", "object_id", "semantic")
 
 
 def _verified(meta: SampleMeta, file: str) -> Path:
@@ -75,8 +75,9 @@ def load_sample(
     dict
         ``image``, ``reflectance``, ``shading``, ``illuminant`` (``(H, W, 3)`` float32 linear
         RGB of the working space, or sRGB with ``space="srgb"``), ``shading_grey``, ``depth`` (``(H, W)`` float32), ``normals`` (``(H, W, 3)``),
-        ``mask`` (``(H, W)`` bool), ``ids`` (``{"material": (H, W) int32, "object": ...}``, -1
-        background), per-camera keys ``image_camera/<name>`` etc., ``cube`` when written, and
+        ``mask`` (``(H, W)`` bool), ``ids`` (``{"material": (H, W) int32, "object": ...,
+        "semantic": ...}``, -1 background; ``semantic`` indexes ``meta["semantic_classes"]``),
+        per-camera keys ``image_camera/<name>`` etc., ``cube`` when written, and
         ``meta`` (the parsed ``meta.json``). Units are in ``meta["layers"][key]["units"]``.
 
     Raises
@@ -150,11 +151,13 @@ def load_dataset(
     verify: bool = True,
     max_residual_share: float | None = None,
     space: str | None = None,
+    split: str | None = None,
 ) -> Iterator[dict[str, Any]]:
     """Iterate :func:`load_sample` over the complete samples of *dataset_dir*, sorted by id;
-    with *max_residual_share*, only those whose RGB residual share is at most that
-    (:func:`filter_residual_share`); *space* as :func:`load_sample`'s."""
-    for sample in filter_residual_share(sample_dirs(dataset_dir), max_residual_share):
+    with *split* (``"train"``, ``"val"``, ``"test"``), only that split's, as ``torch_dataset``
+    (:func:`split_samples`); with *max_residual_share*, only those whose RGB residual share
+    is at most that (:func:`filter_residual_share`); *space* as :func:`load_sample`'s."""
+    for sample in filter_residual_share(split_samples(dataset_dir, split), max_residual_share):
         yield load_sample(sample, layers=layers, verify=verify, space=space)
 
 
@@ -210,7 +213,7 @@ def prepare_item(
     normalize_exposure: bool = False,
 ) -> dict[str, Any]:
     """A loaded sample as channel-first arrays: every layer ``(C, H, W)`` (depth and masks get
-    ``C = 1``), ``ids`` as ``{"material"|"object": (1, H, W) int32}``, ``sample_id``,
+    ``C = 1``), ``ids`` as ``{"material"|"object"|"semantic": (1, H, W) int32}``, ``sample_id``,
     ``scene`` and ``exposure_scale``.
 
     Parameters

@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any
 from ...errors import DatasetError, WriteError
 from ...provenance import software_versions
 from ...scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash, scene_to_dict
+from ...scenes.semantic import class_table
 from ...spectra import DEFAULT_WAVELENGTHS, get_spectrum
 from ...spectra.user_spectra import spectrum_files
 from ...spectra.working_space import DEFAULT_WORKING_SPACE
@@ -126,7 +127,10 @@ def _meta(
     height, width = gt.layers["image"].data.shape[:2]
     files_used = spectrum_files(
         [m.spectrum for m in scene.materials] + [li.spectrum for li in scene.lights]
-    )
+    ) + list(scene.metadata.get("spectrum_files", []))  # the .spd files a Mitsuba XML read
+    extra: dict[str, Any] = {"spectrum_files": files_used} if files_used else {}
+    if "semantic" in gt.layers:  # the class table of the semantic layer's ids
+        extra["semantic_classes"] = class_table()
     return {
         "format_version": FORMAT_VERSION,
         "sample_id": sample_id,
@@ -159,7 +163,7 @@ def _meta(
         "residual_share": gt.residual_share,
         "files": sorted(files),
         "versions": software_versions(),
-    } | ({"spectrum_files": files_used} if files_used else {})
+    } | extra
 
 
 def _write_layers(folder: Path, gt: GroundTruth, sample_id: str) -> list[str]:

@@ -322,6 +322,13 @@
     const grid = el("div", { class: "layer-grid", id: "layer-grid" }, ...names.map((n) => el("figure", { "data-layer": n,
       on: { click: () => { view.a = n; update(); window.scrollTo(0, 0); } } },
       el("img", { src: s.layers[n][0], loading: "lazy", alt: n }), el("figcaption", { text: n }))));
+    // the camera chain in the order light goes through it (dataset --camera), a click shows a layer as A
+    const sensor = s.sensor && s.sensor.layers.length ? [el("h3", { text: `Camera chain: ${s.sensor.camera}` }),
+      el("p", { class: "meta-line", text: "exposure metered on the lit pixels' median luminance"
+        + (s.sensor.electrons_per_unit != null ? ` (${Number(s.sensor.electrons_per_unit).toPrecision(4)} e- per unit)` : "") }),
+      el("div", { class: "layer-grid", id: "sensor-panel" }, ...s.sensor.layers.map(([n, caption]) => el("figure", { "data-layer": n,
+        on: { click: () => { view.a = n; update(); window.scrollTo(0, 0); } } },
+        el("img", { src: s.layers[n][0], loading: "lazy", alt: n }), el("figcaption", { text: caption }))))] : [];
     app.replaceChildren(el("div", { class: "sample", id: "sample", "data-id": s.id },
       nav,
       el("h2", { text: s.id }),
@@ -331,7 +338,7 @@
       buttons,
       el("div", { class: "ab" }, "A/B: A = the selected layer (left), B =", bSelect, slider),
       el("div", { class: "viewer-row" }, viewer, el("div", { class: "side" }, readout, bars, units)),
-      el("h3", { text: "Lights" }), lights, el("h3", { text: "All layers" }), grid, links));
+      ...sensor, el("h3", { text: "Lights" }), lights, el("h3", { text: "All layers" }), grid, links));
     update();
     size();
   }

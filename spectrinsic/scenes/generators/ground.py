@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -36,7 +37,8 @@ def _place(
         for _ in range(30):
             centre = rng.uniform(-0.35, 0.35, 2)
             if floor.try_add(centre, half):
-                parts.append((f"{shape}-{i}", moved(part, translate=(centre[0], centre[1], 0.0))))
+                placed = moved(part, translate=(centre[0], centre[1], 0.0))
+                parts.append((f"{shape}-{i}", replace(placed, semantic="object")))
                 break
     return parts, patterns
 
@@ -87,7 +89,7 @@ def objects_on_ground(rng: np.random.Generator, options: GeneratorOptions) -> La
         "patterns": patterns,
     }
     return Layout(
-        parts=(*objects, ("ground", _ground(rng, options.materials))),
+        parts=(*objects, ("ground", replace(_ground(rng, options.materials), semantic="floor"))),
         lights=volume,
         propose_camera=propose,
         info=info,

@@ -187,6 +187,8 @@ def _irradiance_by(g: _Geometry, light: Light, p: np.ndarray, n: np.ndarray) -> 
             facing = np.where(cos_out >= math.cos(math.radians(light.cutoff_deg)), facing, 0.0)
         elif light.kind == "area":  # one-sided emitter
             facing = facing * light.size[0] * light.size[1] * np.clip(cos_out, 0.0, None)
+        elif light.kind == "sphere":  # a sphere of radiance L subtends π r² / d² (d > r)
+            facing = facing * math.pi * light.radius**2
     e = facing * np.clip(np.einsum("rk,rk->r", n, to), 0.0, None)
     idx = np.flatnonzero(e > 0)
     if len(idx):

@@ -1,0 +1,169 @@
+"""Benchmark of a relightable sample's bytes on disk (issue 45): the compact transport against
+the per-batch layout written before it, in one run.
+
+One two-light room of the default set (``room-living``, view 0, ``two-colour-a``) at the
+``default`` preset (256², 2 batches), stored with ``--store-transport`` and its spectral
+layers (what issue 45 measured at 235 MB for a five-light generated room). Reported:
+
+* the bytes of every file of the sample folder, and of the sample;
+* the transport in the layout before issue 45 (every batch in full, float32, uncompressed),
+  written by this module from the same in-memory transport, against the compact file (the
+  batches' float32 mean, float16 deviations, ZIP): bytes, and the seconds to read each back
+  (:func:`~spectrinsic.gt_export.sample.transport_exr.read_transport`, the decoding a
+  ``RandomRelight`` pays per sample), median of :data:`REPEATS`;
+* exactness on the compact form: the relit images and raw channels composed from the
+  transport read back against those composed from the in-memory transport (largest difference
+  relative to each array's largest magnitude; goal ≤ 1e-5), and the noise estimate's (goal
+  ≤ 1e-3, its float16 deviations);
+* the same bytes scaled to 10,000 samples.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..gt_export import export_sample
+from ..gt_export.formats.exr import write_exr
+from ..gt_export.relight import relit_scene
+from ..gt_export.sample.meta import read_meta
+from ..gt_export.sample.transport_exr import (
+    COVERAGE_LAYER,
+    PARTS,
+    TRANSPORT_NAME,
+    read_transport,
+    transport_layer,
+)
+from ..pipeline.presets import get_preset
+from ..render.algebra.batch_means import relative_standard_error
+from ..render.algebra.light_transport import LightTransport, relit_result
+from ..render.transport_render import render_transport_batches
+from ..scenes.library import build
+from ..spectra import get_sensors
+
+SCENE, VIEW, CONDITION = "room-living", 0, "two-colour-a"
+NEW_LIGHTS = {0: "cie:LED-RGB1", 1: "planck:3000K"}
+SEED = 3
+REPEATS = 3
+EXACT_GOAL = 1e-5
+NOISE_GOAL = 1e-3
+#: Issue 45's target for a relightable 256² default sample with spectral layers.
+TARGET_SAMPLE_BYTES = 50e6
+
+
+def _per_batch_file(path: Path, transport: LightTransport, coverage: np.ndarray) -> int:
+    """Write *transport* in the layout before issue 45 (every batch of every part, float32,
+    uncompressed) to *path*; its bytes."""
+    layers: dict[str, np.ndarray] = {COVERAGE_LAYER: coverage}
+    names = {COVERAGE_LAYER: tuple(f"m{m}" for m in range(coverage.shape[-1]))}
+    held = {"transport": transport.batches} | {
+        p: transport.parts[p] for p in PARTS if transport.parts.get(p)
+    }
+    for part, batches in held.items():
+        for b, batch in enumerate(batches):
+            for mode in transport.modes:
+                for j in range(transport.n_lights):
+                    layers[transport_layer(j, b, mode, part)] = batch[mode][j]
+                    names[transport_layer(j, b, mode, part)] = get_sensors(
+                        transport.sensors[mode]
+                    ).channels
+    write_exr(path, layers, channel_names=names, compression="none")
+    return path.stat().st_size
+
+
+def _median_seconds(fn: Any, *args: Any) -> float:
+    runs = []
+    for _ in range(REPEATS):
+        start = time.perf_counter()
+        fn(*args)
+        runs.append(time.perf_counter() - start)
+    return float(np.median(runs))
+
+
+def _relative(a: np.ndarray, b: np.ndarray) -> float:
+    scale = float(np.abs(b).max())
+    return float(np.abs(np.asarray(a, np.float64) - b).max()) / scale if scale > 0 else 0.0
+
+
+def _exactness(read: LightTransport, memory: LightTransport, scene: Any) -> dict[str, Any]:
+    """Relit images, raw channels and noise estimate: from the file against from memory."""
+    new_scene = relit_scene(scene, NEW_LIGHTS)
+    a, b = relit_result(read, new_scene), relit_result(memory, new_scene)
+    layers = {f"images/{m}": _relative(a.images[m], b.images[m]) for m in a.images}
+    layers |= {f"raw/{m}": _relative(a.raw[m], b.raw[m]) for m in a.raw}
+    mode = next(iter(a.raw))
+    valid = np.ones(a.raw[mode].shape[:2], bool)
+    noise = _relative(
+        relative_standard_error([r[mode] for r in a.batch_raw], valid),
+        relative_standard_error([r[mode] for r in b.batch_raw], valid),
+    )
+    worst = max(layers.values())
+    return {
+        "worst_relative": worst,
+        "goal": EXACT_GOAL,
+        "met": worst <= EXACT_GOAL,
+        "noise_estimate_relative": noise,
+        "noise_goal": NOISE_GOAL,
+        "noise_met": noise <= NOISE_GOAL,
+        "arrays": layers,
+    }
+
+
+def run(out_dir: Path) -> dict[str, Any]:
+    cfg = get_preset("default")
+    scene = build(SCENE, view=VIEW, condition=CONDITION, seed=0, width=cfg.width, height=cfg.height)
+    transport, result = render_transport_batches(scene, cfg.render, seed=SEED)
+    with tempfile.TemporaryDirectory(dir=out_dir) as tmp:
+        root = Path(tmp)
+        sample = export_sample(
+            root,
+            scene,
+            result,
+            sample_id="storage__v0__x",
+            config=cfg.to_dict(),
+            seed=SEED,
+            cameras=cfg.resolved_cameras(),
+            denoise=cfg.denoise,
+            transport=transport,
+            spectral_layers=True,
+        )
+        files = {p.name: p.stat().st_size for p in sorted(sample.iterdir()) if p.is_file()}
+        record = read_meta(sample).raw["transport"]
+        read, coverage = read_transport(sample, record)
+        old_dir = root / "per_batch"
+        old_dir.mkdir()
+        old_bytes = _per_batch_file(old_dir / TRANSPORT_NAME, transport, coverage)
+        old_record = {k: v for k, v in record.items() if k not in ("layout", "deviation_exponents")}
+        read_old_s = _median_seconds(read_transport, old_dir, old_record)
+        read_new_s = _median_seconds(read_transport, sample, record)
+        exactness = _exactness(read, transport, scene)
+    new_bytes = files[TRANSPORT_NAME]
+    sample_bytes = sum(files.values())
+    old_sample = sample_bytes - new_bytes + old_bytes
+    return {
+        "scene": f"{SCENE}__v{VIEW}__{CONDITION}",
+        "size": [scene.camera.width, scene.camera.height],
+        "lights": len(scene.lights),
+        "batches": len(transport.batches),
+        "modes": list(transport.modes),
+        "parts": record["parts"],
+        "file_bytes": files,
+        "transport_bytes": {"per_batch_layout": old_bytes, "compact": new_bytes},
+        "transport_ratio_old_to_new": old_bytes / new_bytes,
+        "sample_bytes": {"per_batch_layout": old_sample, "compact": sample_bytes},
+        "sample_ratio_old_to_new": old_sample / sample_bytes,
+        "sample_target_bytes": TARGET_SAMPLE_BYTES,
+        "sample_target_met": sample_bytes <= TARGET_SAMPLE_BYTES,
+        "per_10000_samples_gb": {
+            "per_batch_layout": old_sample * 1e4 / 1e9,
+            "compact": sample_bytes * 1e4 / 1e9,
+        },
+        "read_transport_seconds": {"per_batch_layout": read_old_s, "compact": read_new_s},
+        "read_slowdown_new_over_old": read_new_s / read_old_s,
+        "read_slowdown_goal": 1.5,
+        "exactness_compact_vs_memory": exactness,
+    }
