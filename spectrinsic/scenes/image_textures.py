@@ -40,6 +40,7 @@ from typing import Any, Literal
 import numpy as np
 
 from ..errors import SceneError, SpectrinsicWarning
+from ..spectra.colorimetry import decode_srgb
 
 __all__ = [
     "CORNERS",
@@ -178,11 +179,9 @@ def decode_texels(
 ) -> np.ndarray:
     """``(h, w, 3)`` linear texels in [0, 1] of ``(h, w, 3)`` *encoded* values in [0, 1]
     (sRGB-decoded if *srgb*), times the linear *factor*, clipped with one line naming *what*."""
-    import colour
-
     values = np.asarray(encoded, np.float64)
     if srgb:
-        values = np.asarray(colour.cctf_decoding(values, function="sRGB"), np.float64)
+        values = decode_srgb(values)  # the one sRGB decoding (colour-science's)
     values = values * np.asarray(factor, np.float64)
     outside = int(np.count_nonzero(np.any((values < 0) | (values > 1), axis=-1)))
     if outside:
@@ -196,7 +195,7 @@ def decode_texels(
 
 def _read_pixels(data: bytes, what: str) -> np.ndarray:
     """``(h, w, 3)`` values in [0, 1] of the 8-bit image file *data* (top row first)."""
-    from PIL import Image, UnidentifiedImageError
+    from PIL import Image
 
     try:
         with Image.open(io.BytesIO(data)) as img:
@@ -212,7 +211,7 @@ def _read_pixels(data: bytes, what: str) -> np.ndarray:
                 )
             alpha = img.mode in ("LA", "RGBA") and np.asarray(img.getchannel("A")).min() < 255
             pixels = np.asarray(img.convert("RGB"), np.float64) / 255.0
-    except (OSError, UnidentifiedImageError) as exc:
+    except (OSError, Image.UnidentifiedImageError) as exc:
         raise SceneError(f"{what}: cannot read it as an image ({exc})") from None
     if alpha:
         warnings.warn(
