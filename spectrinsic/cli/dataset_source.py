@@ -154,9 +154,10 @@ def _add_scene_file_options(src: Any) -> None:
     )
     src.add_argument(
         "--colours-from-asset",
-        action="store_true",
-        help="give unmapped glTF and .blend materials their base colour (glTF "
-        "baseColorFactor, Principled Base Color) as an rgb: reflectance (default: an error)",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="give unmapped materials the colour or texture their file states (glTF base "
+        "colour and texture, OBJ/MTL Kd and map_Kd, Principled Base Color; default: on)",
     )
     add_semantic_map_option(src)
     src.add_argument(
@@ -382,7 +383,7 @@ def check_scene_files(config: Any, data_dir: str | None, *, quiet: bool = False)
             height,
             tuple(sorted(materials.items())),
             spec.get("default_spectrum"),
-            colours_from_asset=bool(spec.get("colours_from_asset")),
+            colours_from_asset=bool(spec.get("colours_from_asset", False)),
             approximate=bool(spec.get("approximate")),
             semantic=semantic_rules(spec),
         ).build(data_dir)

@@ -211,9 +211,10 @@ def _add_material_options(p: Any) -> None:
     add_semantic_map_option(p)
     p.add_argument(
         "--colours-from-asset",
-        action="store_true",
-        help="give unmapped glTF and .blend materials their base colour (glTF "
-        "baseColorFactor, Principled Base Color) as an rgb: reflectance (default: an error)",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="give unmapped materials the colour or texture their file states (glTF base "
+        "colour and texture, OBJ/MTL Kd and map_Kd, Principled Base Color; default: on)",
     )
     p.add_argument(
         "--approximate",

@@ -25,7 +25,7 @@ def load_scene_argument(
     materials: Mapping[str, str] | None = None,
     default_spectrum: str | None = None,
     data_dir: str | None = None,
-    colours_from_asset: bool = False,
+    colours_from_asset: bool = True,
     approximate: bool = False,
 ) -> Scene:
     """The Scene named by the ``SCENE`` argument: a scene file (YAML, ``.blend`` or mesh,

@@ -149,16 +149,18 @@ def files_source(
     default_spectrum: str | None = None,
     resolution: tuple[int, int] | None = None,
     new_sample: bool = False,
-    colours_from_asset: bool = False,
+    colours_from_asset: bool = True,
     approximate: bool = False,
     semantic: SemanticRules | None = None,
 ) -> str:
     """The canonical ``source`` JSON of a set of scene files (each must exist): rendered at
     *resolution* ``(W, H)``, else at each file's own camera size; a saved generated scene as
-    its own sample unless *new_sample*; *colours_from_asset* (in the JSON only when set, so
-    older configs keep their hash): base colours of glTF and ``.blend`` materials as spectra;
-    *approximate* (likewise): Mitsuba XML content without exact ground truth approximated;
-    *semantic* (likewise): the ``--semantic-map`` rules, before the default map's."""
+    its own sample unless *new_sample*; *colours_from_asset* (always in the JSON since issue 41
+    made it the default; a config without it was written before and means False, so older
+    datasets rebuild as they were): the colours and textures the files state;
+    *approximate* (in the JSON only when set, so older configs keep their hash): Mitsuba XML
+    content without exact ground truth approximated; *semantic* (likewise): the
+    ``--semantic-map`` rules, before the default map's."""
     entries = []
     for p in paths:
         path = Path(p).resolve()
@@ -177,8 +179,7 @@ def files_source(
         "new_sample": bool(new_sample),
         "resolution": None if resolution is None else [int(v) for v in resolution],
     }
-    if colours_from_asset:
-        spec["colours_from_asset"] = True
+    spec["colours_from_asset"] = bool(colours_from_asset)
     if approximate:
         if not any(scene_file_kind(e["path"]) == "mitsuba" for e in entries):
             raise DatasetError(
@@ -341,7 +342,7 @@ def _file_tasks(
             height,
             materials,
             spec.get("default_spectrum"),
-            colours_from_asset=bool(spec.get("colours_from_asset")),
+            colours_from_asset=bool(spec.get("colours_from_asset", False)),
             approximate=bool(spec.get("approximate")),
             semantic=semantic_rules(spec),
         )

@@ -4,16 +4,22 @@ spectrum map.
 A mesh file carries geometry and material names but no spectra, lights or camera: every
 material name must be in the map (or a default spectrum is given), and the scene gets a framing
 camera and one CIE D65 point light above it, so any mesh renders with full ground truth. Only
-the named file is read (no textures, no referenced files outside its folder are needed).
+the named file and the files it names inside its folder (glTF buffers and images, OBJ ``mtllib``
+files and ``map_Kd`` images) are read.
 
 A glTF material's ``pbrMetallicRoughness`` factors set the gloss as for ``.blend`` files: metallic
 ≥ 0.5 makes a metal (``conductor``, Al: the factors name no metal; no spectrum needed), else
 roughness < 0.5 a coated diffuse (``plastic``, η = 1.5); GGX α = roughness². Absent factors
-count as matte (not glTF's default of 1), so files without them import as before. With
-``colours_from_asset=True`` (``--colours-from-asset``), a material not in the map takes its
-``baseColorFactor`` as an ``rgb:`` reflectance if the file states one
-(:mod:`spectrinsic.scenes.gltf_colours`); without it an unmapped material is an error, as for
-``.blend`` files. Textures and every other field are ignored.
+count as matte (not glTF's default of 1), so files without them import as before.
+
+Colours from the asset (``colours_from_asset=True``, the default; ``--no-colours-from-asset``
+turns it off): a material not in the map takes the colour its file states, a glTF
+``baseColorFactor`` or MTL ``Kd`` as an ``rgb:`` reflectance, or a glTF ``baseColorTexture`` /
+MTL ``map_Kd`` image as an exact spectral texture over the 8 RGB-cube corner reflectances,
+mapped by the mesh's own texture coordinates (:mod:`spectrinsic.scenes.gltf_colours`,
+:mod:`spectrinsic.scenes.mtl_colours`, :mod:`spectrinsic.scenes.image_textures`). A material
+with neither a colour nor a mapping (nor a default spectrum) is an error naming the options.
+A textured material must be matte (a glossy one is refused: its basis would not be diffuse).
 """
 
 from __future__ import annotations
@@ -31,10 +37,13 @@ from typing import Any
 import numpy as np
 
 from ..errors import SceneError
-from .gltf_colours import gltf_base_colours
+from .gltf_colours import gltf_colours
+from .image_textures import AssetColour, ImageTexture, corner_spectra
 from .materials import METAL_SPECTRUM
 from .model import Camera, Light, Material, Mesh, Scene
+from .mtl_colours import mtl_colours
 from .semantic import SemanticMap, classify
+from .textures import Texture, make_image_texture
 from .validate import validate_scene
 
 __all__ = [
@@ -208,9 +217,13 @@ def _load_mesh_file(path: Path) -> Any:
     )
 
 
-def _geometries(path: Path) -> list[tuple[str, str, np.ndarray, np.ndarray, dict[str, Any]]]:
-    """``(geometry name, material name, vertices, faces, gloss)`` of every triangle mesh in the
-    file, in world space, sorted by geometry name (file order is not stable across formats)."""
+_Geometry = tuple[str, str, np.ndarray, np.ndarray, dict[str, Any], "np.ndarray | None"]
+
+
+def _geometries(path: Path) -> list[_Geometry]:
+    """``(geometry name, material name, vertices, faces, gloss, uv)`` of every triangle mesh in
+    the file, in world space, sorted by geometry name (file order is not stable across formats);
+    ``uv`` ``(F, 3, 2)`` are the face corners' texture coordinates (v up), ``None`` without."""
 
     check_mesh_size(path)
     try:
@@ -228,7 +241,9 @@ def _geometries(path: Path) -> list[tuple[str, str, np.ndarray, np.ndarray, dict
         verts = verts @ np.asarray(matrix)[:3, :3].T + np.asarray(matrix)[:3, 3]
         pbr = getattr(geom.visual, "material", None)
         material = getattr(pbr, "name", None) or str(key)
-        out.append((str(node), str(material), verts, faces, _pbr_gloss(pbr)))
+        uv = getattr(geom.visual, "uv", None)
+        corner_uv = None if uv is None or len(uv) != len(verts) else np.asarray(uv, float)[faces]
+        out.append((str(node), str(material), verts, faces, _pbr_gloss(pbr), corner_uv))
     if not out:
         raise SceneError(f"{path}: holds no triangles")
     return out
@@ -259,6 +274,37 @@ def _frame(vertices: np.ndarray, width: int, height: int) -> tuple[Camera, Light
     return camera, light
 
 
+def _asset_colours(path: Path) -> dict[str, AssetColour]:
+    return gltf_colours(path) if path.suffix.lower() in (".gltf", ".glb") else mtl_colours(path)
+
+
+def _unmapped(path: Path, material: str, geoms: list[_Geometry]) -> SceneError:
+    known = sorted({g[1] for g in geoms})
+    return SceneError(
+        f"{path}: material {material!r} is not in the material map and the file gives it no "
+        f"colour; the file's materials are {known} (use --material-map or --default-spectrum; "
+        "--colours-from-asset reads the colours the file states)"
+    )
+
+
+class _Table:
+    """The scene's materials by name (matte materials keep their spectrum's name)."""
+
+    def __init__(self) -> None:
+        self.table: dict[str, Material] = {}
+
+    def index(self, name: str, spectrum: str, gloss: dict[str, Any]) -> int:
+        self.table.setdefault(name, Material(name=name, spectrum=spectrum, **gloss))
+        return list(self.table).index(name)
+
+    def texture(self, image: ImageTexture, uv: np.ndarray | None, name: str, where: str) -> Texture:
+        """The texture *name* of *image* over the 8 corner materials, on faces with *uv*."""
+        if uv is None:
+            raise SceneError(f"{where}: material {name!r} has a texture but the mesh has no uv")
+        basis = tuple(self.index(s, s, {}) for s in corner_spectra())
+        return make_image_texture(name, basis, image, uv)
+
+
 def load_mesh_scene(
     path: str | os.PathLike[str],
     *,
@@ -267,7 +313,7 @@ def load_mesh_scene(
     height: int,
     default_spectrum: str | None = None,
     data_dir: str | None = None,
-    colours_from_asset: bool = False,
+    colours_from_asset: bool = True,
     semantic: SemanticMap | None = None,
 ) -> Scene:
     """Read a mesh file into a validated :class:`~spectrinsic.scenes.model.Scene`.
@@ -282,10 +328,11 @@ def load_mesh_scene(
     width, height
         Image size in pixels of the framing camera.
     default_spectrum
-        Reflectance of materials not in *materials*; ``None``: such a material is an error.
+        Reflectance of materials neither in *materials* nor coloured by the file; ``None``:
+        such a material is an error.
     colours_from_asset
-        Give glTF materials not in *materials* their ``baseColorFactor`` as an ``rgb:``
-        reflectance before *default_spectrum* (module docstring).
+        Give materials not in *materials* the colour or texture the file states (glTF base
+        colour, MTL ``Kd``/``map_Kd``) before *default_spectrum* (module docstring).
     semantic
         The names → class map (:mod:`~spectrinsic.scenes.semantic`; None: the default) each
         mesh's class comes from: its node's name, then the file's name of its material.
@@ -297,30 +344,39 @@ def load_mesh_scene(
     """
     path = Path(path)
     geoms = _geometries(path)
-    colours = gltf_base_colours(path) if colours_from_asset else {}
-    table: dict[str, Material] = {}  # matte materials keep their spectrum's name
+    colours = _asset_colours(path) if colours_from_asset else {}
+    table = _Table()
     meshes = []
-    for i, (node, material, verts, faces, gloss) in enumerate(geoms):
-        spectrum = (
-            METAL_SPECTRUM
-            if gloss.get("kind") == "conductor"
-            else materials.get(material, colours.get(material, default_spectrum))
+    for i, (node, material, verts, faces, gloss, uv) in enumerate(geoms):
+        colour = None if material in materials else colours.get(material)
+        texture = None
+        if gloss.get("kind") == "conductor":
+            spectrum: str | None = METAL_SPECTRUM
+        elif colour is not None and colour.image is not None:
+            if gloss:
+                raise SceneError(
+                    f"{path}: material {material!r} is textured and glossy; "
+                    "expected a matte textured material (or map it with --material-map)"
+                )
+            texture = table.texture(colour.image, uv, material, f"{path}: mesh {node!r}")
+            spectrum = None
+        else:
+            spectrum = materials.get(material, colour.spectrum if colour else default_spectrum)
+            if spectrum is None:
+                raise _unmapped(path, material, geoms)
+        face = (
+            texture.basis[0]
+            if texture is not None
+            else table.index(f"{spectrum} ({material})" if gloss else spectrum, spectrum, gloss)  # type: ignore[arg-type]
         )
-        if spectrum is None:
-            known = sorted({g[1] for g in geoms})
-            raise SceneError(
-                f"{path}: material {material!r} is not in the material map; the file's "
-                f"materials are {known}"
-            )
-        name = f"{spectrum} ({material})" if gloss else spectrum
-        table.setdefault(name, Material(name=name, spectrum=spectrum, **gloss))
         meshes.append(
             Mesh(
                 name=f"{node}",
                 vertices=verts,
                 faces=faces,
-                face_materials=np.full(len(faces), list(table).index(name), dtype=np.int64),
+                face_materials=np.full(len(faces), face, dtype=np.int64),
                 object_id=i,
+                texture=texture,
                 semantic=classify([f"{node}", material], semantic),
             )
         )
@@ -328,7 +384,7 @@ def load_mesh_scene(
     scene = Scene(
         name=path.stem,
         meshes=tuple(meshes),
-        materials=tuple(table.values()),
+        materials=tuple(table.table.values()),
         lights=(light,),
         camera=camera,
         metadata={"source": path.name},

@@ -58,6 +58,11 @@ def _materials(scene: Scene) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for i, m in enumerate(scene.materials):
         tex = textures.get(i)
+        if tex is not None and tex.image is not None:
+            raise SceneError(
+                f"scene {scene.name!r}: image texture {tex.name!r} cannot be saved as YAML; "
+                "render its asset file instead"
+            )
         if tex is not None:
             expected = [basis_name(tex.name, b) for b in range(len(tex.basis))]
             if list(tex.basis) != list(range(i, i + len(tex.basis))) or expected != [

@@ -133,7 +133,7 @@ def load_scene_file(
     materials: Mapping[str, str] | None = None,
     default_spectrum: str | None = None,
     data_dir: str | None = None,
-    colours_from_asset: bool = False,
+    colours_from_asset: bool = True,
     approximate: bool = False,
     semantic: SemanticRules | None = None,
 ) -> Scene:
@@ -150,8 +150,9 @@ def load_scene_file(
     default_spectrum
         Reflectance of mesh or ``.blend`` materials not in *materials*.
     colours_from_asset
-        Give glTF and ``.blend`` materials without a spectrum the file's base colour as an
-        ``rgb:`` reflectance (``--colours-from-asset``); False: they are an error.
+        Give mesh and ``.blend`` materials without a spectrum the colour or texture the file
+        states (glTF base colour and texture, MTL ``Kd``/``map_Kd``, Principled Base Color;
+        the default); False (``--no-colours-from-asset``): they are an error.
     approximate
         Approximate what a Mitsuba XML file holds without exact ground truth instead of
         refusing it (``--approximate``); other kinds of file have nothing to approximate (the
@@ -255,7 +256,7 @@ class FileSource:
     default_spectrum
         Reflectance of mesh or ``.blend`` materials not in *materials*.
     colours_from_asset
-        Base colours of glTF and ``.blend`` materials without a spectrum as ``rgb:`` spectra.
+        The colours and textures the file states, for materials without a spectrum.
     approximate
         Approximate what a Mitsuba XML file holds without exact ground truth.
     semantic
@@ -267,7 +268,7 @@ class FileSource:
     height: int | None
     materials: tuple[tuple[str, str], ...] = ()
     default_spectrum: str | None = None
-    colours_from_asset: bool = False
+    colours_from_asset: bool = True
     approximate: bool = False
     semantic: SemanticRules = SemanticRules()
 

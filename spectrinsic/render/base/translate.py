@@ -332,8 +332,8 @@ def _camera(mi: Any, scene: Scene, film: Mapping, sample_count: int) -> dict[str
 @dataclass(frozen=True, eq=False)
 class SurfaceGeometry:
     """Triangles of one surface, ready for Mitsuba: ``corners`` and ``normals`` ``(F, 3, 3)``,
-    and on a textured mesh (its ``mesh`` index) the corners' ``uv`` ``(F, 3, 2)``
-    (:func:`~spectrinsic.scenes.textures.box_uv`)."""
+    and on a textured mesh (its ``mesh`` index) the corners' ``uv`` ``(F, 3, 2)`` (the
+    texture's own, else :func:`~spectrinsic.scenes.textures.box_uv`)."""
 
     key: str
     material: int
@@ -357,7 +357,14 @@ def prepare_geometry(
         corners = np.asarray(mesh.vertices, float)[faces]
         normals = smooth_corner_normals(mesh.vertices, faces, crease_deg)
         face_materials = np.asarray(mesh.face_materials, np.int64)
-        uv = None if mesh.texture is None else box_uv(mesh.vertices, faces)
+        texture = mesh.texture
+        uv = (
+            None
+            if texture is None
+            else box_uv(mesh.vertices, faces)
+            if texture.uv is None
+            else np.asarray(texture.uv, float)  # the asset's own coordinates
+        )
         for m in np.unique(face_materials):
             sel = face_materials == m
             out.append(
