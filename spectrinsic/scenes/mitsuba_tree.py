@@ -162,6 +162,16 @@ def _fix(node: XmlNode, version: str) -> tuple[XmlNode, list[str]]:
     return replace(node, props=props, children=tuple(children)), said
 
 
+def _mitsuba() -> Any:
+    """Mitsuba, with a variant set: the one already chosen (the renderer's), else
+    ``scalar_rgb``, since reading a Transform or a mesh needs the scalar types of some variant."""
+    import mitsuba as mi
+
+    if mi.variant() is None:
+        mi.set_variant("scalar_rgb")
+    return mi
+
+
 def parse_xml(text: str, version: str) -> ParsedXml:
     """*text* (a prepared scene) parsed by Mitsuba's parser into :class:`XmlNode` records.
 
@@ -170,12 +180,8 @@ def parse_xml(text: str, version: str) -> ParsedXml:
     SceneError
         The parser's message, in one line.
     """
-    import mitsuba as mi
-
+    mi = _mitsuba()
     variant = mi.variant()
-    if variant is None:  # reading a Transform needs the scalar types of some variant
-        variant = "scalar_rgb"
-        mi.set_variant(variant)
     p = mi.parser
     config = p.ParserConfig(variant)
     try:
@@ -234,10 +240,7 @@ def mesh_file(plugin: str, path: str, index: int = 0) -> tuple[np.ndarray, np.nd
     """Vertices ``(V, 3)`` and faces ``(F, 3)`` of a mesh file (a ``serialized`` file's mesh
     *index*), read by Mitsuba's own loader of that one built-in shape (the caller checked the
     file and its declared size). Positions come back as Mitsuba stores them, float32."""
-    import mitsuba as mi
-
-    if mi.variant() is None:
-        mi.set_variant("scalar_rgb")
+    mi = _mitsuba()
     spec: dict[str, Any] = {"type": plugin, "filename": path}
     if plugin == "serialized":
         spec["shape_index"] = index
