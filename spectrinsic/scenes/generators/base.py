@@ -146,7 +146,7 @@ def assemble(
     """The scene of *layout* seen from camera *view*, with the lights of its family."""
     meshes, materials = to_meshes(layout.parts)
     family = family_of(seed)
-    drawn = draw_lights(
+    lamps = draw_lights(
         rngs["lights"],
         family,
         layout.lights,
@@ -156,15 +156,14 @@ def assemble(
         max_lights=options.max_lights,
         saturation=options.light_saturation,
     )
-    lights = drawn if layout.room_lights is None else layout.room_lights(drawn)
-    if not {light.name for light in drawn} & {light.name for light in lights}:
+    lights = lamps if layout.room_lights is None else layout.room_lights(lamps)
+    if not {light.name for light in lamps} & {light.name for light in lights}:
         family = "daylight"  # the drawn lights (and their condition) were dropped
     draws = [0, 0]  # cameras judged by the view rule, and passed
 
     def judged(cam: Camera) -> bool:
-        ok = judge_view(
-            meshes, lights, cam, flux_density=layout.flux_density
-        ).ok  # a view worth learning from
+        # a view worth learning from
+        ok = judge_view(meshes, lights, cam, flux_density=layout.flux_density).ok
         draws[0], draws[1] = draws[0] + 1, draws[1] + ok
         return ok
 
