@@ -66,7 +66,13 @@ def _add_daylight_option(src: Any) -> None:
         default=0.0,
         metavar="F",
         help="fraction of generated rooms closed, with a window, and lit also by a sun and a "
-        "sky of CIE daylight spectra shining through it (0)",
+        "sky of CIE daylight spectra shining through it (0); sun and sky carry 20-90 %% of "
+        "such a room's light flux",
+    )
+    src.add_argument(
+        "--daylight-only",
+        action="store_true",
+        help="light the --daylight-share rooms by sun and sky alone, without lamps",
     )
 
 
@@ -307,6 +313,7 @@ def source_from_args(args: argparse.Namespace) -> str | None:
             else _range("--light-saturation", args.light_saturation),
             texture_fraction=args.texture_fraction,
             daylight_share=args.daylight_share,
+            daylight_only=args.daylight_only,
         )
     if args.scenes:
         size = None if args.resolution is None else parse_resolution(args.resolution)

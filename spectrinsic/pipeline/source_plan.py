@@ -36,6 +36,7 @@ from ..scenes.generators import (
     generated_family,
     generated_scene_name,
 )
+from ..scenes.generators.daylight import FLUX_SHARE
 from ..scenes.generators.lights import check_saturation
 from ..scenes.generators.materials import check_ranges
 from ..scenes.model import Scene
@@ -74,6 +75,31 @@ GENERATOR_VERSION = 3
 MAX_VIEWS = 64
 
 
+def _daylight_spec(generator: str, share: float, only: bool) -> dict[str, Any]:
+    """The source entries of ``--daylight-share`` / ``--daylight-only`` (none at share 0, so
+    sets without daylight keep their hash), validated."""
+    if not 0.0 <= share <= 1.0 or (share > 0 and generator != "rooms"):
+        raise DatasetError(
+            f"--daylight-share {share:g}: expected a fraction in 0..1 of the rooms "
+            f"generator's scenes (generator {generator!r})"
+        )
+    if only and share <= 0:
+        raise DatasetError(
+            "--daylight-only: applies to daylight rooms only; expected --daylight-share F > 0"
+        )
+    if share <= 0:
+        return {}
+    # the lamps' balance against the daylight (issue 42): sets of before, whose lamps were
+    # not balanced, keep a config hash of their own
+    spec: dict[str, Any] = {
+        "daylight_share": float(share),
+        "daylight_flux_share": [float(v) for v in FLUX_SHARE],
+    }
+    if only:
+        spec["daylight_only"] = True
+    return spec
+
+
 def generator_source(
     generator: str,
     count: int,
@@ -87,11 +113,13 @@ def generator_source(
     light_saturation: Sequence[float] | None = None,
     texture_fraction: float = 0.0,
     daylight_share: float = 0.0,
+    daylight_only: bool = False,
 ) -> str:
     """The canonical ``source`` JSON of a generated set (validated: an impossible range is
     refused here, before any scene is planned); *gloss*, *light_saturation* and a
     *texture_fraction* above 0 enter it only when given, so matte sets and older configs keep
-    their source and config hash; so does a *daylight_share* (``rooms`` only) above 0."""
+    their source and config hash; so does a *daylight_share* (``rooms`` only) above 0, and
+    *daylight_only* (those rooms lit by sun and sky alone) when set."""
     validate_choice(generator, GENERATORS, "scene generator", error=DatasetError)
     try:
         check_ranges(
@@ -107,11 +135,6 @@ def generator_source(
         raise DatasetError(f"--light-saturation: {exc}") from None
     if not 0.0 <= texture_fraction <= 1.0:
         raise DatasetError(f"--texture-fraction {texture_fraction:g}: expected a fraction in 0..1")
-    if not 0.0 <= daylight_share <= 1.0 or (daylight_share > 0 and generator != "rooms"):
-        raise DatasetError(
-            f"--daylight-share {daylight_share:g}: expected a fraction in 0..1 of the rooms "
-            f"generator's scenes (generator {generator!r})"
-        )
     if not (1 <= count <= MAX_COUNT and 1 <= views <= MAX_VIEWS):
         raise DatasetError(
             f"--count {count} / --views {views}; expected whole numbers from 1 to "
@@ -137,8 +160,7 @@ def generator_source(
         spec["light_saturation"] = [float(v) for v in light_saturation]
     if texture_fraction > 0:
         spec["texture_fraction"] = float(texture_fraction)
-    if daylight_share > 0:
-        spec["daylight_share"] = float(daylight_share)
+    spec |= _daylight_spec(generator, daylight_share, daylight_only)
     return json.dumps(spec, sort_keys=True, allow_nan=False)
 
 
@@ -284,6 +306,7 @@ def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir:
         gloss=gloss,
         light_saturation=None if saturation is None else tuple(saturation),
         daylight_share=float(spec.get("daylight_share", 0.0)),
+        daylight_only=bool(spec.get("daylight_only", False)),
     )
 
 

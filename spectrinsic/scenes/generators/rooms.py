@@ -19,7 +19,7 @@ from ..parts import Part, merge, moved
 from ..primitives import box
 from .base import GeneratorOptions, Layout
 from .camera import Footprints
-from .daylight import Daylight, draw_daylight
+from .daylight import Daylight, draw_daylight, window_flux
 from .lights import LightVolume
 from .materials import MaterialDistribution, draw_reflectance, within
 from .shapes import draw_object
@@ -308,7 +308,7 @@ def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
     day_rng = rng.spawn(1)[0] if options.daylight_share > 0 else None
     day = None
     if day_rng is not None and day_rng.random() < options.daylight_share:
-        day = draw_daylight(day_rng, size, _T)
+        day = draw_daylight(day_rng, size, _T, only=options.daylight_only)
     shell, openness = _shell(rng, size, options.materials, day)
     floor = Footprints([])
     furniture, tops = _furniture(
@@ -337,5 +337,6 @@ def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
         info=info,
         min_coverage=FRAMED_COVERAGE,
         view_rule=True,
-        extra_lights=() if day is None else day.lights,
+        room_lights=None if day is None else day.room_lights,
+        flux_density=0.0 if day is None else window_flux(day) / (2 * (w * d + w * h + d * h)),
     )
