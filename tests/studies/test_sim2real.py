@@ -108,3 +108,12 @@ def test_report_says_which_differences_are_significant(tmp_path):
     assert paths["png"].stat().st_size > 0
     record = json.loads(paths["json"].read_text())
     assert record["config_hash"] == "abc" and len(record["runs"]) == 15
+
+
+def test_preset_is_refused_for_another_study(tmp_path, capsys):
+    from spectrinsic.cli import main
+
+    out = tmp_path / "out"
+    assert main(["study", "photometric", "--preset", "small", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "sim2real only" in err and not out.exists()

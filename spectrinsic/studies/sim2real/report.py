@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from ..glossary import abbreviations
 from .compute import RunScore, Sim2RealResult
 from .settings import FACTORS
 from .stats import CONFIDENCE, Interval, paired_difference, t_interval
@@ -98,7 +99,7 @@ def format_sim2real(result: Sim2RealResult) -> str:
     lines += ["", "| bundled decomposer | MIT LMSE | synthetic test LMSE |", "|---|---|---|"]
     for name, (mit_v, test_v) in result.baselines.items():
         lines.append(f"| {name} | {mit_v:.4f} | {test_v:.4f} |")
-    return "\n".join(lines)
+    return "\n".join(lines) + "\n\n" + abbreviations(["LMSE", "CI", "rgb3"])
 
 
 def _figure(result: Sim2RealResult, path: Path) -> None:
