@@ -85,7 +85,7 @@ def test_evaluate_mit_scores_the_unet(weights, tmp_path, data_dir):
     assert rows and all(math.isfinite(float(r["lmse"])) for r in rows)
 
 
-def test_the_unet_needs_its_file(tmp_path):
+def test_the_unet_needs_its_file(tmp_path, torch):
     with pytest.raises(DecomposeError, match="unet:FILE"):
         get_decomposer("unet")
     with pytest.raises(DecomposeError, match="does not exist"):
