@@ -115,7 +115,9 @@ def run(args: argparse.Namespace) -> int:
     if not args.dataset.is_dir():
         raise DatasetError(f"dataset folder {str(args.dataset)!r} does not exist")
     require_torch("spectrinsic train")  # before any folder is made
-    training_folders(args.dataset, options.split, options.samples, options.layers)
+    training_folders(
+        args.dataset, options.split, options.samples, options.layers, relight=options.relight
+    )
     _check_out(args.out, args.resume)
     with folder_lock(args.out):
         (args.out / TRAINING_MARKER).write_text(

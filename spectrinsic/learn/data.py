@@ -56,15 +56,21 @@ class LogItem:
 
 
 def training_folders(
-    dataset: str | os.PathLike[str], split: str, patterns: Sequence[str] | None, layers: TrainLayers
+    dataset: str | os.PathLike[str],
+    split: str,
+    patterns: Sequence[str] | None,
+    layers: TrainLayers,
+    *,
+    relight: bool = False,
 ) -> list[Path]:
     """The sample folders of *split* whose id matches one of *patterns* (all when None), each
-    checked to hold the layers of *layers*.
+    checked to hold the layers of *layers* (and, with *relight*, its stored transport).
 
     Raises
     ------
     DatasetError
-        No sample selected, or a sample without a needed layer (one line naming both).
+        No sample selected, or a sample without a needed layer or transport (one line naming
+        both).
     """
     folders = split_samples(dataset, split)
     if patterns:
@@ -74,7 +80,13 @@ def training_folders(
             f"{dataset}: no sample of split {split!r} matches {list(patterns or ['*'])}"
         )
     for folder in folders:
-        missing = [k for k in layers.keys() if k not in read_meta(folder).layers]
+        meta = read_meta(folder)
+        if relight and meta.transport is None:
+            raise DatasetError(
+                f"{folder}: --relight needs each sample's light transport; build the set with "
+                "--store-transport"
+            )
+        missing = [k for k in layers.keys() if k not in meta.layers]
         if missing:
             raise DatasetError(
                 f"{folder}: training needs the layers {list(layers.keys())}; this sample "

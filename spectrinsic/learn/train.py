@@ -151,7 +151,9 @@ def train(
         torch is not installed.
     """
     torch = require_torch("spectrinsic train")
-    folders = training_folders(dataset, options.split, options.samples, options.layers)
+    folders = training_folders(
+        dataset, options.split, options.samples, options.layers, relight=options.relight
+    )
     _deterministic(torch, options)
     items = load_items(folders, options.layers)
     crop = _crop(options, items[0].x.shape)

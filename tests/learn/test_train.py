@@ -96,6 +96,8 @@ def test_refusals_are_one_line(tiny_set, tmp_path, capsys, torch, monkeypatch):
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "image_rgb3" in err and "needs the layers" in err
     assert not out.exists()  # refused before any folder was made
+    assert _train(tiny_set, out, "--relight") == 2  # the tiny set stores no transport
+    assert "--store-transport" in capsys.readouterr().err
     assert _train(tiny_set, out, "--steps", "1") == 0
     assert _train(tiny_set, out, "--steps", "1") == 2  # a checkpoint without --resume
     assert "--resume" in capsys.readouterr().err
