@@ -114,7 +114,9 @@ def run(args: argparse.Namespace) -> int:
     options = _options(args)
     if not args.dataset.is_dir():
         raise DatasetError(f"dataset folder {str(args.dataset)!r} does not exist")
-    require_torch("spectrinsic train")  # before any folder is made
+    torch = require_torch("spectrinsic train")  # before any folder is made
+    if options.device == "cuda" and not torch.cuda.is_available():
+        raise DatasetError("--device cuda: this torch sees no CUDA device; use --device cpu")
     training_folders(
         args.dataset, options.split, options.samples, options.layers, relight=options.relight
     )

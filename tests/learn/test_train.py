@@ -98,6 +98,10 @@ def test_refusals_are_one_line(tiny_set, tmp_path, capsys, torch, monkeypatch):
     assert not out.exists()  # refused before any folder was made
     assert _train(tiny_set, out, "--relight") == 2  # the tiny set stores no transport
     assert "--store-transport" in capsys.readouterr().err
+    if not torch.cuda.is_available():
+        assert _train(tiny_set, out, "--device", "cuda") == 2
+        assert "no CUDA device" in capsys.readouterr().err
+    assert not out.exists()
     assert _train(tiny_set, out, "--steps", "1") == 0
     assert _train(tiny_set, out, "--steps", "1") == 2  # a checkpoint without --resume
     assert "--resume" in capsys.readouterr().err
