@@ -71,9 +71,9 @@ class Sim2RealSettings:
 
 
 #: The presets. ``small`` is sized for 2 CPU cores in under an hour (48 scenes at 64², 5 arms x
-#: 3 seeds x 300 steps of 4 crops of 48², about 0.3 s a step on one thread); ``reduced`` is the
-#: run measured on the shared 2-core machine (docs/sim2real.md): 32 scenes, 8 spp, 200 steps;
-#: ``large`` is for a GPU or a cluster.
+#: 3 seeds x 300 steps of 4 crops of 48²; 18.9 min measured on the shared machine,
+#: docs/sim2real.md); ``reduced`` is a smaller run (32 scenes, 8 spp, 200 steps; 22.5 min there
+#: under a heavier load); ``large`` is for a GPU or a cluster.
 PRESETS: dict[str, Sim2RealSettings] = {
     "small": Sim2RealSettings("small"),
     "reduced": Sim2RealSettings("reduced", count=32, spp=8, steps=200),
