@@ -31,6 +31,7 @@ _COMMANDS: tuple[str, ...] = (
     "spectrinsic.cli.export",
     "spectrinsic.cli.study",
     "spectrinsic.cli.evaluate",
+    "spectrinsic.cli.train",
     "spectrinsic.cli.list",
 )
 

@@ -2,7 +2,8 @@
 
 * ``reconstruction-error``: Table 5.2 and its extension (:mod:`spectrinsic.studies.reconstruction`);
 * ``photometric``: Table 4.4 (:mod:`spectrinsic.studies.photometric`);
-* ``rendering``: the rendering study (:mod:`spectrinsic.studies.rendering`).
+* ``rendering``: the rendering study (:mod:`spectrinsic.studies.rendering`);
+* ``sim2real``: the sim-to-real study (:mod:`spectrinsic.studies.sim2real`).
 """
 
 from __future__ import annotations
@@ -18,10 +19,12 @@ from tqdm import tqdm
 
 from ..errors import StudyError
 from ..gt_export.folders.staged_output import staged_output
+from ..learn.torch_import import require_torch
 from ..studies.photometric import CAMERA_BALANCES
 from ..studies.photometric.compute import default_cameras
 from ..studies.registry import STUDIES, StudyOptions, run_study
 from ..studies.rendering import QUALITIES
+from ..studies.sim2real import PRESETS as SIM2REAL_PRESETS
 
 __all__ = ["register", "run"]
 
@@ -69,6 +72,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         choices=tuple(QUALITIES),
         help="rendering: quality preset (default: default, < 10 min on 2 cores)",
     )
+    p.add_argument(
+        "--preset",
+        default=None,
+        choices=tuple(SIM2REAL_PRESETS),
+        help="sim2real: size preset (default: small, about an hour on 2 CPU cores; large for "
+        "a GPU or a cluster)",
+    )
     p.set_defaults(func=run)
 
 
@@ -106,6 +116,7 @@ def run(args: argparse.Namespace) -> int:
             camera_balance=args.camera_balance,
             extension=not args.no_extension,
             quality=args.quality,
+            preset=args.preset,
         )
         with _progress(bool(getattr(args, "quiet", False)), args.study) as progress:
             done = run_study(
@@ -122,6 +133,10 @@ def run(args: argparse.Namespace) -> int:
 
 def _check_options(args: argparse.Namespace) -> None:
     """Refusals that need no computation, before the output folder is made."""
+    if args.preset is not None and args.study != "sim2real":
+        raise StudyError(f"--preset {args.preset}: applies to sim2real only, not {args.study}")
+    if args.study == "sim2real":
+        require_torch("study sim2real")
     if args.study == "photometric" and args.include_ie:
         data_dir = getattr(args, "data_dir", None)
         if not any(n.endswith("[IE]") for n in default_cameras(data_dir=data_dir, include_ie=True)):
