@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ...errors import DatasetError, WriteError
+from ...file_writes import write_text_file
 from ...provenance import software_versions
 from ...scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash, scene_to_dict
 from ...spectra import DEFAULT_WAVELENGTHS, get_spectrum
@@ -54,7 +55,7 @@ from . import (
     meta_seal,
     plain_data,
 )
-from .integrity import guarded_write, remove_owned_temporaries, replaceable_sample, sample_problem
+from .integrity import remove_owned_temporaries, replaceable_sample, sample_problem
 from .previews import preview_maker, preview_path, shown_layers
 from .sensor import SensorOutput, sensor_output, write_sensor_files
 from .transport_exr import TRANSPORT_NAME, write_transport
@@ -80,8 +81,7 @@ _VOLATILE_META = ("timings",)
 
 
 def _dump_json(path: Path, data: Any, *, compact: bool = False) -> None:
-    with guarded_write(path):
-        path.write_text(canonical_json(data, compact=compact), encoding="utf-8")
+    write_text_file(path, canonical_json(data, compact=compact))
 
 
 def _layer_records(
