@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import gzip
+import stat
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -84,11 +85,32 @@ def _compressed_blend(head: bytes, path: Path) -> bool:
     return False
 
 
+def _file_type(path: Path) -> str:
+    """What *path* is, in words, for a refusal (``stat`` follows links, as ``open`` would)."""
+    mode = path.stat().st_mode
+    for test, what in (
+        (stat.S_ISDIR, "a folder"),
+        (stat.S_ISFIFO, "a FIFO (named pipe)"),
+        (stat.S_ISSOCK, "a socket"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+    ):
+        if test(mode):
+            return what
+    return "a special file"
+
+
 def scene_file_kind(path: str | Path) -> str:
     """``"yaml"``, ``"mitsuba"`` (``.xml``), ``"blend"`` or ``"mesh"`` for a scene file, by suffix; a ``.blend`` also by
     its magic bytes, plain or compressed (gzip, zstd), under any name. One-line error for
-    anything else. The one dispatcher of scene files (``render``, ``dataset --scenes``)."""
+    anything else. The one dispatcher of scene files (``render``, ``dataset --scenes``).
+    A path that exists but is not a regular file (a FIFO, a device, a folder) is refused
+    before it is opened: reading a FIFO would wait for a writer forever."""
     p = Path(path)
+    if p.exists() and not p.is_file():
+        raise SceneError(
+            f"scene file {str(p)!r} is {_file_type(p)}, not a regular file; expected a scene file"
+        )
     suffix = p.suffix.lower()
     if suffix in (".yaml", ".yml"):
         return "yaml"

@@ -18,7 +18,10 @@ to DN at ``1 / gain`` DN per electron and quantised. Its variance in DN above bl
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+import math
+from dataclasses import dataclass, field, fields, replace
+
+import numpy as np
 
 from ..errors import SpectrinsicError, did_you_mean
 
@@ -134,6 +137,7 @@ class CameraModel:
     sources: tuple[tuple[str, str], ...] = field(default=(), compare=False)
 
     def __post_init__(self) -> None:
+        self._check_numbers()
         positive = {
             "gain_e_per_dn": self.gain_e_per_dn,
             "full_well_e": self.full_well_e,
@@ -158,6 +162,28 @@ class CameraModel:
                 raise CameraModelError(f"camera {self.name!r}: {key} {value!r}: expected >= 0")
         self._check_choices()
 
+    def _check_numbers(self) -> None:
+        """Every number finite (an infinite gain or exposure would give NaN raw values far
+        downstream); the integers integers (``adc_bits`` 12.5 has no ADC maximum); PRNU, a
+        relative standard deviation of gain, in [0, 1) (at 1 a pixel's gain is as likely
+        negative as not)."""
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                continue
+            if not math.isfinite(value):
+                raise CameraModelError(
+                    f"camera {self.name!r}: {f.name} {value!r}: expected a finite number"
+                )
+        for key in ("adc_bits", "black_level_dn", "output_bits", "fixed_pattern_seed"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, int | np.integer):
+                raise CameraModelError(
+                    f"camera {self.name!r}: {key} {value!r}: expected an integer"
+                )
+        if not 0 <= self.prnu < 1:
+            raise CameraModelError(f"camera {self.name!r}: prnu {self.prnu!r}: expected [0, 1)")
+
     def _check_choices(self) -> None:
         if not 8 <= self.adc_bits <= 16:
             raise CameraModelError(f"camera {self.name!r}: adc_bits {self.adc_bits}: expected 8-16")
@@ -165,6 +191,12 @@ class CameraModel:
             raise CameraModelError(
                 f"camera {self.name!r}: black_level_dn {self.black_level_dn}: expected below "
                 f"the ADC maximum {2**self.adc_bits - 1}"
+            )
+        if self.white_level_dn <= self.black_level_dn:
+            raise CameraModelError(
+                f"camera {self.name!r}: a full well of {self.full_well_e:g} e- at "
+                f"{self.gain:g} e-/DN is under one DN above black; expected a gain below the "
+                "full well"
             )
         if self.output_bits not in (8, 16):
             raise CameraModelError(
