@@ -13,10 +13,15 @@ from typing import Any
 
 from ..errors import DatasetError, SceneError, SpectrinsicError
 from ..pipeline.presets import DatasetConfig
-from ..pipeline.source_plan import file_sample, files_source, generator_source
+from ..pipeline.source_plan import (
+    check_scene_integrator,
+    file_sample,
+    files_source,
+    generator_source,
+)
 from ..scenes.generators import GlossDistribution
 from ..scenes.generators.world_defaults import GLOSSY_FRACTION, METALLIC_FRACTION, TEXTURE_FRACTION
-from ..scenes.sources import FileSource
+from ..scenes.sources import FileSource, takes_asset_colours
 from ..scenes.spectrum_refs import resolve_spectrum
 from ..scenes.yaml_limits import load_yaml_file
 from ..spectra import get_spectrum
@@ -57,7 +62,7 @@ def _add_daylight_option(src: Any) -> None:
     src.add_argument(
         "--daylight-share",
         type=float,
-        default=0.0,
+        default=None,
         metavar="F",
         help="fraction of generated rooms closed, with a window, and lit also by a sun and a "
         "sky of CIE daylight spectra shining through it (0)",
@@ -214,9 +219,10 @@ GENERATOR_DEFAULTS: dict[str, Any] = {
     "glossy": GLOSSY_FRACTION,
     "metallic": METALLIC_FRACTION,
     "roughness_range": "0,0.3",
+    "daylight_share": 0.0,
 }
 #: The options of scene files (``--scenes``).
-FILE_OPTIONS = ("material_map", "default_spectrum", "new_sample")
+FILE_OPTIONS = ("material_map", "default_spectrum", "new_sample", "colours_from_asset")
 
 
 def _given(value: object) -> bool:
@@ -273,6 +279,11 @@ def source_from_args(args: argparse.Namespace) -> str | None:
             daylight_share=args.daylight_share,
         )
     if args.scenes:
+        if args.colours_from_asset and not any(takes_asset_colours(s) for s in args.scenes):
+            raise DatasetError(
+                "--colours-from-asset applies to glTF/GLB and .blend files; none of the "
+                "--scenes is one"
+            )
         size = None if args.resolution is None else parse_resolution(args.resolution)
         return files_source(
             args.scenes,
@@ -337,7 +348,7 @@ def check_scene_files(config: Any, data_dir: str | None) -> None:
             raise DatasetError(f"{option} {name!r}: {exc}") from exc
     width, height = spec.get("resolution") or (None, None)
     for entry in spec["scenes"]:
-        FileSource(
+        scene = FileSource(
             entry["path"],
             width,
             height,
@@ -345,3 +356,4 @@ def check_scene_files(config: Any, data_dir: str | None) -> None:
             spec.get("default_spectrum"),
             colours_from_asset=bool(spec.get("colours_from_asset")),
         ).build(data_dir)
+        check_scene_integrator(config, scene, entry["path"])  # every sample would fail

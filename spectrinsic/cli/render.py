@@ -38,7 +38,7 @@ from ..render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
 from ..render.settings import DEFAULT_MODES as RENDER_DEFAULT_MODES
 from ..scenes.model import Scene
 from ..scenes.sample_id import SampleId
-from ..scenes.sources import FILE_SIZE, is_scene_file
+from ..scenes.sources import FILE_SIZE, is_scene_file, takes_asset_colours
 from . import dataset as cli_dataset
 from .dataset_source import material_map, parse_resolution
 from .render_files import write_render
@@ -100,8 +100,9 @@ def _add_output_options(p: Any) -> None:
     """The render modes and the output folder."""
     p.add_argument(
         "--modes",
-        default=DEFAULT_MODES,
-        help=f"comma-separated render modes (default: {DEFAULT_MODES})",
+        default=None,
+        help=f"comma-separated render modes (default: {DEFAULT_MODES}; with --ground-truth the "
+        "preset's)",
     )
     p.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder")
 
@@ -139,19 +140,28 @@ def _add_pass_options(p: Any, default: DatasetConfig) -> None:
     p.add_argument(
         "--max-depth",
         type=int,
-        default=default.render.max_depth,
-        help=f"longest path, 2 = direct light only (default: {default.render.max_depth})",
+        default=None,
+        help=f"longest path, 2 = direct light only (default: {default.render.max_depth}; with "
+        "--ground-truth the preset's)",
     )
     p.add_argument(
         "--variant", default=None, help="Mitsuba backend or variant (default: best usable)"
     )
-    p.add_argument("--per-light", action="store_true", help="also write one image per light")
+    p.add_argument(
+        "--per-light",
+        action="store_true",
+        help="also write one image per light (a --ground-truth sample always holds its lights' shares)",
+    )
     p.add_argument("--direct", action="store_true", help="also write direct-light-only images")
-    p.add_argument("--no-aovs", action="store_true", help="skip coverage/id/depth/normal maps")
+    p.add_argument(
+        "--no-aovs",
+        action="store_true",
+        help="skip coverage/id/depth/normal maps (not with --ground-truth: its layers need them)",
+    )
     p.add_argument(
         "--integrator",
         choices=INTEGRATORS,
-        default=DEFAULT_INTEGRATOR,
+        default=None,
         help="diagonal modes from one traversal (single) or K/3 passes per mode and "
         f"one scene per light (passes); same images (default: {DEFAULT_INTEGRATOR})",
     )
@@ -167,7 +177,7 @@ def _add_ground_truth_options(p: Any) -> None:
     )
     p.add_argument(
         "--preset",
-        default="default",
+        default=None,
         help="with --ground-truth: quality preset (default: default, the same spp, depth "
         "and library size as a plain render; preview for a quick look)",
     )
@@ -220,7 +230,7 @@ def _check_size_options(args: argparse.Namespace) -> None:
         raise RenderError(f"--spp {args.spp}; expected at most {UINT32_MAX}")
     if not 0 <= args.seed <= UINT32_MAX:
         raise RenderError(f"--seed {args.seed}; expected a whole number from 0 to {UINT32_MAX}")
-    if not 1 <= args.max_depth <= MAX_PATH_DEPTH:
+    if args.max_depth is not None and not 1 <= args.max_depth <= MAX_PATH_DEPTH:
         raise RenderError(
             f"--max-depth {args.max_depth}; expected 1 to {MAX_PATH_DEPTH} (2 = direct light only)"
         )
@@ -245,6 +255,11 @@ def _check_source_options(args: argparse.Namespace) -> None:
             kind = "a scene file" if file else "a library scene"
             applies = "library scenes" if file else ".blend and mesh files"
             raise RenderError(f"{option} applies to {applies}; {args.scene!r} is {kind}")
+    if args.colours_from_asset and not (file and takes_asset_colours(args.scene)):
+        raise RenderError(
+            f"--colours-from-asset applies to glTF/GLB and .blend files; {args.scene!r} states "
+            "no base colours"
+        )
     args.condition = "white" if args.condition is None else args.condition
     args.view = 0 if args.view is None else args.view
 
@@ -265,8 +280,20 @@ def _ground_truth(args: argparse.Namespace) -> int:
     """``render --ground-truth``: a one-sample dataset (library name or scene file), built by
     the same call as ``spectrinsic dataset`` (:func:`spectrinsic.cli.dataset.build`)."""
     changes: dict[str, Any] = {}
+    for option, given in (("--per-light", args.per_light), ("--no-aovs", args.no_aovs)):
+        if given:
+            raise RenderError(
+                f"{option} applies to a raw render; a --ground-truth sample always holds every "
+                "light's share and the AOV layers"
+            )
     if args.spp is not None:
         changes["spp"] = args.spp
+    if args.modes is not None:  # the sample renders (and records) these modes and no others
+        changes["modes"] = tuple(_parse_modes(args))
+    if args.max_depth is not None:
+        changes["max_depth"] = args.max_depth
+    if args.integrator is not None:
+        changes["integrator"] = args.integrator
     if args.direct:
         changes["direct"] = True
     if args.variant is not None:  # the backend of the one-sample dataset too
@@ -286,9 +313,10 @@ def _ground_truth(args: argparse.Namespace) -> int:
         )
     else:
         only = str(SampleId(args.scene, args.view, args.condition))
-    config = get_preset(args.preset, seed=args.seed).with_options(**changes)
+    preset = "default" if args.preset is None else args.preset
+    config = get_preset(preset, seed=args.seed).with_options(**changes)
     if not is_scene_file(args.scene) and not getattr(args, "quiet", False):
-        why = "--resolution" if size else f"preset {args.preset!r}"
+        why = "--resolution" if size else f"preset {preset!r}"
         print(f"spectrinsic render: {config.width}x{config.height} ({why})", file=sys.stderr)
     cli_dataset.preflight(args.out, config, data_dir=getattr(args, "data_dir", None))
     return cli_dataset.build(
@@ -310,12 +338,12 @@ def _render_settings(args: argparse.Namespace, modes: list[str]) -> RenderSettin
         spp,
         spectral_spp=spectral,
         modes=tuple(modes),
-        max_depth=args.max_depth,
+        max_depth=default.max_depth if args.max_depth is None else args.max_depth,
         variant=args.variant,
         per_light=args.per_light,
         direct=args.direct,
         aovs=not args.no_aovs,
-        integrator=args.integrator,
+        integrator=DEFAULT_INTEGRATOR if args.integrator is None else args.integrator,
     )
 
 
@@ -325,8 +353,13 @@ def run(args: argparse.Namespace) -> int:
     _check_source_options(args)
     if args.ground_truth:
         return _ground_truth(args)
-    if args.ignore_disk_space:  # a plain render's files are small: never estimated
-        raise RenderError("--ignore-disk-space applies only with --ground-truth")
+    for option, given in (
+        ("--ignore-disk-space", args.ignore_disk_space),  # a plain render's files are small
+        ("--new-sample", args.new_sample),
+        ("--preset", args.preset is not None),
+    ):
+        if given:
+            raise RenderError(f"{option} applies only with --ground-truth")
     settings = _render_settings(args, _parse_modes(args))
     check_output_folder(Path(args.out))
     data_dir = getattr(args, "data_dir", None)
@@ -357,7 +390,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _parse_modes(args: argparse.Namespace) -> list[str]:
     """The ``--modes`` names, each checked to be a known render mode."""
-    modes = [m.strip() for m in str(args.modes).split(",") if m.strip()]
+    given = DEFAULT_MODES if args.modes is None else args.modes
+    modes = [m.strip() for m in str(given).split(",") if m.strip()]
     if not modes:
         raise SceneError(
             f"--modes {args.modes!r}: expected a comma-separated list such as {DEFAULT_MODES}"

@@ -27,6 +27,7 @@ __all__ = [
     "GeneratedSource",
     "FileSource",
     "scene_file_kind",
+    "takes_asset_colours",
     "is_scene_file",
     "load_scene_file",
     "FILE_SIZE",
@@ -142,6 +143,13 @@ def is_scene_file(argument: str | Path) -> bool:
     """
     p = Path(argument)
     return p.suffix.lower() in (".yaml", ".yml", ".xml", ".blend", *MESH_SUFFIXES) or p.exists()
+
+
+def takes_asset_colours(path: str | Path) -> bool:
+    """Whether ``--colours-from-asset`` applies to the scene file at *path*: a glTF/GLB or a
+    ``.blend`` file (their materials state a base colour); YAML, XML, OBJ, PLY, STL and OFF
+    files state none, so the option would do nothing there."""
+    return Path(path).suffix.lower() in (".glb", ".gltf") or scene_file_kind(path) == "blend"
 
 
 def load_scene_file(

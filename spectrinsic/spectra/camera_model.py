@@ -20,10 +20,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields, replace
+from typing import Any
 
 import numpy as np
 
 from ..errors import SpectrinsicError, did_you_mean
+from .records import SensorSet
+from .registry import get_sensors, get_spectrum
 
 __all__ = [
     "CFA_PATTERNS",
@@ -36,6 +39,7 @@ __all__ = [
     "GENERIC_FIGURES",
     "camera_model",
     "camera_model_names",
+    "camera_sensors",
 ]
 
 #: Bayer layouts, read row by row over the 2 × 2 tile (colour-demosaicing's names).
@@ -327,3 +331,26 @@ def camera_model(name: str) -> CameraModel:
         f"camera {name!r}: expected a preset ({', '.join(CAMERA_PRESETS)}) or a sensor set "
         f"'camera:NAME' or 'csv:PATH'{hint}"
     )
+
+
+def camera_sensors(model: CameraModel, *, data_dir: Any = None) -> SensorSet:
+    """The sensor set of *model*'s colour filter array, checked when the camera is resolved
+    (before any sample): exactly three curves (R, G, B of the CFA), finite and non-negative,
+    each responding to CIE D65 between 380 and 780 nm. A CSV of two curves, or of curves with
+    no visible response, is refused in one line naming it, instead of failing every sample."""
+    sensors = get_sensors(model.sensitivities, data_dir=data_dir)
+    where = f"camera {model.name!r}: sensor set {model.sensitivities!r}"
+    if len(sensors.channels) != 3:
+        raise CameraModelError(
+            f"{where} has {len(sensors.channels)} curves ({', '.join(sensors.channels)}); "
+            "expected three (R, G, B of the colour filter array)"
+        )
+    wavelengths = np.arange(380.0, 781.0, 5.0)
+    curves = np.asarray(sensors.on(wavelengths), float)
+    if not np.isfinite(curves).all() or (curves < 0).any():
+        raise CameraModelError(f"{where}: expected finite, non-negative sensitivities")
+    d65 = get_spectrum("cie:D65").on(wavelengths)
+    dead = [c for c, r in zip(sensors.channels, curves @ d65, strict=True) if not r > 0]
+    if dead:
+        raise CameraModelError(f"{where}: curve {dead[0]!r} has no response to D65 in 380-780 nm")
+    return sensors

@@ -321,4 +321,5 @@ def relight(
         data_dir=data_dir,
         transport=relit.transport if keep_transport else None,
         camera=model_from_meta(meta),  # the camera chain, if any, re-runs on the relit image
+        noise_id=str(meta["sample_id"]),  # its noise: the source's, not the --out folder name's
     )

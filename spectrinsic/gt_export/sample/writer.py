@@ -253,6 +253,7 @@ def export_sample(
     camera: CameraModel | None = None,
     spectral_layers: bool = False,
     working_space: str = DEFAULT_WORKING_SPACE,
+    noise_id: str | None = None,
 ) -> Path:
     """Compute every ground-truth layer of a rendered sample and write it atomically.
 
@@ -295,6 +296,10 @@ def export_sample(
     working_space
         The RGB working space of the RGB layers (``"acescg"``, default, or ``"srgb"``,
         :mod:`spectrinsic.spectra.working_space`); recorded in ``meta.json["working_space"]``.
+    noise_id
+        The sample id the camera chain's noise is seeded from (with *seed*); default
+        *sample_id*. A relit sample passes its source's id, so its raw mosaic carries the same
+        noise as a direct render of that sample under the new lights.
 
     Returns
     -------
@@ -321,7 +326,9 @@ def export_sample(
     )
     sensor = None
     if camera is not None:
-        sensor = sensor_output(gt, camera, seed=seed, sample_id=sample_id, data_dir=data_dir)
+        sensor = sensor_output(
+            gt, camera, seed=seed, sample_id=noise_id or sample_id, data_dir=data_dir
+        )
         gt = sensor.ground_truth
     final = out_dir / sample_id
     tmp = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{sample_id}-", dir=out_dir))
