@@ -276,3 +276,46 @@ def test_a_1e308_spectrum_is_normalised_without_overflow(tmp_path):
     expected = get_spectrum(f"csv:{unit}#lamp [W/m2/nm]").values
     assert np.isfinite(big.values).all()
     np.testing.assert_allclose(big.values, expected, rtol=1e-12)
+
+
+def _glb(path: Path, accessors: list, meshes: list, nodes: list) -> None:
+    import json
+    import struct
+
+    doc = {"asset": {"version": "2.0"}, "accessors": accessors, "meshes": meshes, "nodes": nodes}
+    data = json.dumps(doc).encode()
+    data += b" " * (-len(data) % 4)
+    chunk = struct.pack("<I4s", len(data), b"JSON") + data
+    path.write_bytes(struct.pack("<4sII", b"glTF", 2, 12 + len(chunk)) + chunk)
+
+
+_COUNTS = st.one_of(st.integers(0, 400_000), st.sampled_from([-1, 2**63, "7", None, 1.5]))
+
+
+@SETTINGS
+@hypothesis.given(
+    counts=st.lists(_COUNTS, min_size=1, max_size=4),
+    indexed=st.booleans(),
+    nodes=st.lists(st.integers(-1, 4), max_size=6),
+)
+def test_a_glb_within_the_face_budget_loads_only_as_counted_or_is_refused(counts, indexed, nodes):
+    """Drawn glTF accessor counts and node lists: the counts are whole and non-negative, and
+    the budget refuses exactly the files whose counted faces or vertices pass its limits,
+    before trimesh reads any geometry (here there is none to read)."""
+    from spectrinsic.scenes.budget import MAX_FACES, MAX_VERTICES, SceneBudget
+    from spectrinsic.scenes.meshes import check_mesh_size, mesh_counts
+
+    accessors = [{"count": c} for c in counts]
+    primitive = {"attributes": {"POSITION": 0}} | ({"indices": len(counts) - 1} if indexed else {})
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "drawn.glb"
+        _glb(path, accessors, [{"primitives": [primitive]}], [{"mesh": n} for n in nodes])
+        n_v, n_f = mesh_counts(path)
+        assert isinstance(n_v, int) and isinstance(n_f, int) and n_v >= 0 and n_f >= 0
+        try:
+            check_mesh_size(path, SceneBudget("drawn.glb"))
+        except Exception as exc:  # noqa: BLE001 - the property is about which exceptions escape
+            _refused_in_one_line(exc)
+            assert n_f > MAX_FACES or n_v > MAX_VERTICES
+            return
+    assert n_f <= MAX_FACES and n_v <= MAX_VERTICES
