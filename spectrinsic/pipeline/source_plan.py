@@ -69,7 +69,8 @@ MAX_COUNT = 100_000
 #: version (other light pools, furniture, framing) asks for ``--rebuild`` instead of mixing.
 #: 2: saturated lights, ranges obeyed by every material, framed rooms (issue 22).
 #: 3: cameras pass the view rule (``scenes.generators.view_rule``, issue 31).
-GENERATOR_VERSION = 3
+#: 4: ``objects-on-ground``'s library objects take ``--texture-fraction`` too (issue 44).
+GENERATOR_VERSION = 4
 MAX_VIEWS = 64
 
 
