@@ -224,6 +224,11 @@ def _overrides(args: argparse.Namespace) -> dict[str, Any]:
     """The config changes the options ask for (getattr: ``render --ground-truth`` builds its
     own namespace of dataset options, without some of them)."""
     changes: dict[str, Any] = {}
+    if (
+        getattr(args, "max_batches", None) is not None
+        and getattr(args, "noise_target", None) is None
+    ):
+        raise DatasetError("--max-batches applies to --noise-target (the adaptive batches' cap)")
     source = source_from_args(args)
     if source is not None:
         changes["source"] = source

@@ -14,13 +14,19 @@ from typing import Any
 
 from ..errors import DatasetError, SceneError, SpectrinsicError
 from ..pipeline.presets import DatasetConfig
-from ..pipeline.source_plan import file_sample, files_source, generator_source, semantic_rules
+from ..pipeline.source_plan import (
+    check_scene_integrator,
+    file_sample,
+    files_source,
+    generator_source,
+    semantic_rules,
+)
 from ..render.base.variants import import_mitsuba
 from ..scenes.generators import GlossDistribution
 from ..scenes.generators.world_defaults import GLOSSY_FRACTION, METALLIC_FRACTION, TEXTURE_FRACTION
 from ..scenes.mitsuba_xml import render_hints_line, xml_notes
 from ..scenes.semantic import SemanticRules, read_semantic_map
-from ..scenes.sources import FileSource
+from ..scenes.sources import FileSource, takes_asset_colours
 from ..scenes.spectrum_refs import resolve_spectrum
 from ..scenes.yaml_limits import load_yaml_file
 from ..spectra import get_spectrum
@@ -63,7 +69,7 @@ def _add_daylight_option(src: Any) -> None:
     src.add_argument(
         "--daylight-share",
         type=float,
-        default=0.0,
+        default=None,
         metavar="F",
         help="fraction of generated rooms closed, with a window, and lit also by a sun and a "
         "sky of CIE daylight spectra shining through it (0); sun and sky carry 20-90 %% of "
@@ -161,9 +167,10 @@ def _add_scene_file_options(src: Any) -> None:
     src.add_argument(
         "--colours-from-asset",
         action=argparse.BooleanOptionalAction,
-        default=True,
+        default=None,
         help="give unmapped materials the colour or texture their file states (glTF base "
-        "colour and texture, OBJ/MTL Kd and map_Kd, Principled Base Color; default: on)",
+        "colour and texture, OBJ/MTL Kd and map_Kd, Principled Base Color; default: on where "
+        "the file states one; given explicitly for a file that states none: refused)",
     )
     add_semantic_map_option(src)
     src.add_argument(
@@ -256,9 +263,16 @@ GENERATOR_DEFAULTS: dict[str, Any] = {
     "glossy": GLOSSY_FRACTION,
     "metallic": METALLIC_FRACTION,
     "roughness_range": "0,0.3",
+    "daylight_share": 0.0,
 }
 #: The options of scene files (``--scenes``).
-FILE_OPTIONS = ("material_map", "default_spectrum", "new_sample", "semantic_map")
+FILE_OPTIONS = (
+    "material_map",
+    "default_spectrum",
+    "new_sample",
+    "semantic_map",
+    "colours_from_asset",
+)
 
 
 def _given(value: object) -> bool:
@@ -316,6 +330,11 @@ def source_from_args(args: argparse.Namespace) -> str | None:
             daylight_only=args.daylight_only,
         )
     if args.scenes:
+        if args.colours_from_asset is True and not any(takes_asset_colours(s) for s in args.scenes):
+            raise DatasetError(
+                "--colours-from-asset applies to glTF/GLB, OBJ/MTL and .blend files; none of the "
+                "--scenes is one"
+            )
         size = None if args.resolution is None else parse_resolution(args.resolution)
         return files_source(
             args.scenes,
@@ -323,7 +342,7 @@ def source_from_args(args: argparse.Namespace) -> str | None:
             default_spectrum=args.default_spectrum,
             resolution=size,
             new_sample=getattr(args, "new_sample", False),
-            colours_from_asset=args.colours_from_asset,
+            colours_from_asset=args.colours_from_asset is not False,
             approximate=args.approximate,
             semantic=semantic_map(getattr(args, "semantic_map", None)),
         )
@@ -394,6 +413,7 @@ def check_scene_files(config: Any, data_dir: str | None, *, quiet: bool = False)
             approximate=bool(spec.get("approximate")),
             semantic=semantic_rules(spec),
         ).build(data_dir)
+        check_scene_integrator(config, scene, entry["path"])  # every sample would fail
         if not quiet:
             for note in xml_notes(scene):
                 print(f"spectrinsic dataset: {note}", file=sys.stderr)

@@ -40,7 +40,7 @@ from ..render.settings import DEFAULT_MODES as RENDER_DEFAULT_MODES
 from ..scenes.mitsuba_xml import render_hints_line, xml_notes
 from ..scenes.model import Scene
 from ..scenes.sample_id import SampleId
-from ..scenes.sources import FILE_SIZE, is_scene_file
+from ..scenes.sources import FILE_SIZE, is_scene_file, takes_asset_colours
 from . import dataset as cli_dataset
 from .dataset_layers import add_layer_options, given_layer_options, layer_changes
 from .dataset_source import add_semantic_map_option, material_map, parse_resolution, semantic_map
@@ -108,8 +108,9 @@ def _add_output_options(p: Any) -> None:
     """The render modes and the output folder."""
     p.add_argument(
         "--modes",
-        default=DEFAULT_MODES,
-        help=f"comma-separated render modes (default: {DEFAULT_MODES})",
+        default=None,
+        help=f"comma-separated render modes (default: {DEFAULT_MODES}; with --ground-truth the "
+        "preset's)",
     )
     p.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder")
 
@@ -149,18 +150,26 @@ def _add_pass_options(p: Any, default: DatasetConfig) -> None:
         type=int,
         default=None,
         help="longest path, 2 = direct light only (default: a Mitsuba XML file's max_depth, "
-        f"else {default.render.max_depth})",
+        f"else {default.render.max_depth}; with --ground-truth the preset's)",
     )
     p.add_argument(
         "--variant", default=None, help="Mitsuba backend or variant (default: best usable)"
     )
-    p.add_argument("--per-light", action="store_true", help="also write one image per light")
+    p.add_argument(
+        "--per-light",
+        action="store_true",
+        help="also write one image per light (a --ground-truth sample always holds its lights' shares)",
+    )
     p.add_argument("--direct", action="store_true", help="also write direct-light-only images")
-    p.add_argument("--no-aovs", action="store_true", help="skip coverage/id/depth/normal maps")
+    p.add_argument(
+        "--no-aovs",
+        action="store_true",
+        help="skip coverage/id/depth/normal maps (not with --ground-truth: its layers need them)",
+    )
     p.add_argument(
         "--integrator",
         choices=INTEGRATORS,
-        default=DEFAULT_INTEGRATOR,
+        default=None,
         help="diagonal modes from one traversal (single) or K/3 passes per mode and "
         f"one scene per light (passes); same images (default: {DEFAULT_INTEGRATOR})",
     )
@@ -176,7 +185,7 @@ def _add_ground_truth_options(p: Any) -> None:
     )
     p.add_argument(
         "--preset",
-        default="default",
+        default=None,
         help="with --ground-truth: quality preset (default: default, the same spp, depth "
         "and library size as a plain render; preview for a quick look)",
     )
@@ -212,9 +221,10 @@ def _add_material_options(p: Any) -> None:
     p.add_argument(
         "--colours-from-asset",
         action=argparse.BooleanOptionalAction,
-        default=True,
+        default=None,
         help="give unmapped materials the colour or texture their file states (glTF base "
-        "colour and texture, OBJ/MTL Kd and map_Kd, Principled Base Color; default: on)",
+        "colour and texture, OBJ/MTL Kd and map_Kd, Principled Base Color; default: on where "
+        "the file states one; given explicitly for a file that states none: refused)",
     )
     p.add_argument(
         "--approximate",
@@ -266,6 +276,11 @@ def _check_source_options(args: argparse.Namespace) -> None:
             kind = "a scene file" if file else "a library scene"
             applies = "library scenes" if file else "scene files"
             raise RenderError(f"{option} applies to {applies}; {args.scene!r} is {kind}")
+    if args.colours_from_asset is True and not (file and takes_asset_colours(args.scene)):
+        raise RenderError(
+            f"--colours-from-asset applies to glTF/GLB, OBJ/MTL and .blend files; {args.scene!r} states "
+            "no base colours"
+        )
     args.condition = "white" if args.condition is None else args.condition
     args.view = 0 if args.view is None else args.view
 
@@ -286,8 +301,20 @@ def _ground_truth(args: argparse.Namespace) -> int:
     """``render --ground-truth``: a one-sample dataset (library name or scene file), built by
     the same call as ``spectrinsic dataset`` (:func:`spectrinsic.cli.dataset.build`)."""
     changes: dict[str, Any] = {}
+    for option, given in (("--per-light", args.per_light), ("--no-aovs", args.no_aovs)):
+        if given:
+            raise RenderError(
+                f"{option} applies to a raw render; a --ground-truth sample always holds every "
+                "light's share and the AOV layers"
+            )
     if args.spp is not None:
         changes["spp"] = args.spp
+    if args.modes is not None:  # the sample renders (and records) these modes and no others
+        changes["modes"] = tuple(_parse_modes(args))
+    if args.max_depth is not None:
+        changes["max_depth"] = args.max_depth
+    if args.integrator is not None:
+        changes["integrator"] = args.integrator
     if args.direct:
         changes["direct"] = True
     if args.variant is not None:  # the backend of the one-sample dataset too
@@ -304,15 +331,16 @@ def _ground_truth(args: argparse.Namespace) -> int:
             default_spectrum=args.default_spectrum,
             resolution=size,
             new_sample=args.new_sample,
-            colours_from_asset=args.colours_from_asset,
+            colours_from_asset=args.colours_from_asset is not False,
             approximate=args.approximate,
             semantic=semantic_map(args.semantic_map),
         )
     else:
         only = str(SampleId(args.scene, args.view, args.condition))
-    config = get_preset(args.preset, seed=args.seed).with_options(**changes)
+    preset = "default" if args.preset is None else args.preset
+    config = get_preset(preset, seed=args.seed).with_options(**changes)
     if not is_scene_file(args.scene) and not getattr(args, "quiet", False):
-        why = "--resolution" if size else f"preset {args.preset!r}"
+        why = "--resolution" if size else f"preset {preset!r}"
         print(f"spectrinsic render: {config.width}x{config.height} ({why})", file=sys.stderr)
     cli_dataset.preflight(
         args.out,
@@ -344,7 +372,7 @@ def _render_settings(args: argparse.Namespace, modes: list[str]) -> RenderSettin
         per_light=args.per_light,
         direct=args.direct,
         aovs=not args.no_aovs,
-        integrator=args.integrator,
+        integrator=DEFAULT_INTEGRATOR if args.integrator is None else args.integrator,
     )
 
 
@@ -354,14 +382,18 @@ def run(args: argparse.Namespace) -> int:
     _check_source_options(args)
     if args.ground_truth:
         return _ground_truth(args)
-    if args.ignore_disk_space:  # a plain render's files are small: never estimated
-        raise RenderError("--ignore-disk-space applies only with --ground-truth")
+    for option, given in (
+        ("--ignore-disk-space", args.ignore_disk_space),  # a plain render's files are small
+        ("--new-sample", args.new_sample),
+        ("--preset", args.preset is not None),
+        ("--semantic-map", args.semantic_map is not None),  # a plain render has no layers
+    ):
+        if given:
+            raise RenderError(f"{option} applies only with --ground-truth")
     for option in given_layer_options(args):  # ground-truth layers: a plain render has none
         raise RenderError(
             f"{option} applies only with --ground-truth (a ground-truth layer option)"
         )
-    if args.semantic_map is not None:  # a plain render writes no semantic layer
-        raise RenderError("--semantic-map applies only with --ground-truth")
     settings = _render_settings(args, _parse_modes(args))
     check_output_folder(Path(args.out))
     data_dir = getattr(args, "data_dir", None)
@@ -393,7 +425,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _parse_modes(args: argparse.Namespace) -> list[str]:
     """The ``--modes`` names, each checked to be a known render mode."""
-    modes = [m.strip() for m in str(args.modes).split(",") if m.strip()]
+    given = DEFAULT_MODES if args.modes is None else args.modes
+    modes = [m.strip() for m in str(given).split(",") if m.strip()]
     if not modes:
         raise SceneError(
             f"--modes {args.modes!r}: expected a comma-separated list such as {DEFAULT_MODES}"
@@ -416,7 +449,7 @@ def _load_scene(args: argparse.Namespace, data_dir: str | None) -> Scene:
         materials=material_map(args.material_map),
         default_spectrum=args.default_spectrum,
         data_dir=data_dir,
-        colours_from_asset=args.colours_from_asset,
+        colours_from_asset=args.colours_from_asset is not False,
         approximate=args.approximate,
     )
 

@@ -56,7 +56,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--camera-balance",
-        default="equal-energy-white",
+        default=None,
         choices=CAMERA_BALANCES,
         help="photometric: normalisation of the camera curves (default: "
         "equal-energy-white, the one giving the thesis' SC3 behaviour)",
@@ -68,7 +68,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--quality",
-        default="default",
+        default=None,
         choices=tuple(QUALITIES),
         help="rendering: quality preset (default: default, < 10 min on 2 cores)",
     )
@@ -131,10 +131,28 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Options of one study each (dest -> (study, default)): given to another, one is refused
+#: in one line instead of ignored; not given, it takes its default.
+STUDY_OPTIONS: dict[str, tuple[str, object]] = {
+    "include_ie": ("photometric", False),
+    "camera_balance": ("photometric", "equal-energy-white"),
+    "no_extension": ("reconstruction-error", False),
+    "quality": ("rendering", "default"),
+}
+
+
 def _check_options(args: argparse.Namespace) -> None:
     """Refusals that need no computation, before the output folder is made."""
     if args.preset is not None and args.study != "sim2real":
         raise StudyError(f"--preset {args.preset}: applies to sim2real only, not {args.study}")
+    for dest, (study, default) in STUDY_OPTIONS.items():
+        value = getattr(args, dest)
+        if value not in (None, False) and args.study != study:
+            raise StudyError(
+                f"--{dest.replace('_', '-')} applies to the {study} study; this is {args.study}"
+            )
+        if value is None:
+            setattr(args, dest, default)
     if args.study == "sim2real":
         require_torch("study sim2real")
     if args.study == "photometric" and args.include_ie:

@@ -49,8 +49,7 @@ from ..render.base.variants import import_mitsuba
 from ..render.transport_render import render_transport_batches
 from ..scenes.library import build
 from ..scenes.sources import GeneratedSource
-from ..spectra import get_sensors
-from ..spectra.camera_model import camera_model
+from ..spectra.camera_model import camera_model, camera_sensors
 from .disk_space import check_disk_space
 from .executors import Executor, SerialExecutor
 from .presets import DatasetConfig
@@ -274,8 +273,8 @@ def build_dataset(
     """
 
     out = Path(out_dir)
-    if config.camera:  # its curves exist (a data-directory camera needs --data-dir): one line
-        get_sensors(camera_model(config.camera).sensitivities, data_dir=data_dir)
+    if config.camera:  # three sound curves (a data-directory camera needs --data-dir): one line
+        camera_sensors(camera_model(config.camera), data_dir=data_dir)
     new = check_build_folder(out, config.config_hash(), rebuild=rebuild) is None  # before mkdir
     with folder_lock(out), unmarked_on_error(out, new):  # one build per folder, held
         return _build_locked(

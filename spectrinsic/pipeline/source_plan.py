@@ -51,6 +51,7 @@ from .tasks import SampleTask
 
 __all__ = [
     "check_integrator_plan",
+    "check_scene_integrator",
     "SCENES_FOLDER",
     "generator_source",
     "files_source",
@@ -71,7 +72,8 @@ MAX_COUNT = 100_000
 #: version (other light pools, furniture, framing) asks for ``--rebuild`` instead of mixing.
 #: 2: saturated lights, ranges obeyed by every material, framed rooms (issue 22).
 #: 3: cameras pass the view rule (``scenes.generators.view_rule``, issue 31).
-GENERATOR_VERSION = 3
+#: 4: ``objects-on-ground``'s library objects take ``--texture-fraction`` too (issue 44).
+GENERATOR_VERSION = 4
 MAX_VIEWS = 64
 
 
@@ -387,6 +389,23 @@ def save_generated(
     folder.mkdir(parents=True, exist_ok=True)
     record = {**scene.metadata, "sample": {"id": sample_id, "seed": int(seed)}}
     return save_scene(dataclasses.replace(scene, metadata=record), folder / f"{sample_id}.yaml")
+
+
+def check_scene_integrator(config: DatasetConfig, scene: Scene, path: str) -> None:
+    """Refuse, before the first sample, a scene file (``--scenes``, ``render --ground-truth``)
+    with glossy materials or a spectral texture whose diagonal modes would render with the
+    passes integrator: its sample would fail (the passes render neither)."""
+    if not diagonal_mode_names(config.render.modes):
+        return
+    if resolve_integrator(config.render.integrator, config.render.variant) != "passes":
+        return
+    glossy = any(m.glossy for m in scene.materials)
+    if glossy or scene.textured:
+        what = "glossy or metal materials" if glossy else "a spectral texture"
+        raise DatasetError(
+            f"{path}: holds {what}, which the passes integrator cannot render in the diagonal "
+            "modes; use --integrator single on a JIT (LLVM/CUDA) variant"
+        )
 
 
 def check_integrator_plan(config: DatasetConfig) -> None:

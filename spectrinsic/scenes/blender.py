@@ -49,6 +49,7 @@ import numpy as np
 from ..errors import MissingDependencyError, SceneError, SpectrinsicError, with_article
 from ..spectra import get_spectrum
 from .blender_colours import base_colour, corner_uvs, object_texture, principled_node
+from .budget import SceneBudget
 from .image_textures import corner_spectra
 from .materials import IOR_RANGE, METAL_SPECTRUM, material_problem
 from .model import Camera, Light, Material, Mesh, Scene
@@ -322,10 +323,11 @@ class _MaterialTable:
 _Triangles = tuple[np.ndarray, np.ndarray, np.ndarray, dict[str, np.ndarray]]
 
 
-def _triangles(obj: Any, depsgraph: Any) -> _Triangles | None:
+def _triangles(obj: Any, depsgraph: Any, budget: SceneBudget) -> _Triangles | None:
     """Object-space vertices ``(V, 3)``, triangles ``(F, 3)``, material slots ``(F,)`` and
     corner UVs by map (:func:`~spectrinsic.scenes.blender_colours.corner_uvs`) of *obj* with
-    its modifiers applied; None if it has no faces."""
+    its modifiers applied; None if it has no faces. Its counts are charged to *budget* before
+    its arrays are copied out of Blender."""
     evaluated = obj.evaluated_get(depsgraph)
     me = evaluated.to_mesh()
     try:
@@ -333,6 +335,7 @@ def _triangles(obj: Any, depsgraph: Any) -> _Triangles | None:
         n_tri = len(me.loop_triangles)
         if n_tri == 0:
             return None
+        budget.charge(f"object {obj.name!r}", faces=n_tri, vertices=len(me.vertices))
         co = np.empty(len(me.vertices) * 3, dtype=np.float64)
         me.vertices.foreach_get("co", co)
         tri = np.empty(n_tri * 3, dtype=np.int64)
@@ -347,9 +350,11 @@ def _triangles(obj: Any, depsgraph: Any) -> _Triangles | None:
     return co.reshape(-1, 3), tri.reshape(-1, 3), slot, uvs
 
 
-def _mesh(obj: Any, depsgraph: Any, materials: _MaterialTable, object_id: int) -> Mesh | None:
+def _mesh(
+    obj: Any, depsgraph: Any, materials: _MaterialTable, object_id: int, budget: SceneBudget
+) -> Mesh | None:
     """*obj* as a world-space :class:`Mesh`, each face naming its scene material; None if empty."""
-    triangles = _triangles(obj, depsgraph)
+    triangles = _triangles(obj, depsgraph, budget)
     if triangles is None:
         return None
     co, faces, slot, uvs = triangles
@@ -428,13 +433,14 @@ def load_blend(
     table = _MaterialTable(source, materials or {}, default_spectrum, data_dir, colours_from_asset)
     meshes: list[Mesh] = []
     lights: list[Light] = []
+    budget = SceneBudget(source)
     for obj in sorted(bpy_scene.objects, key=lambda o: o.name):
         if obj.hide_render or not obj.visible_get():
             continue
         if obj.type == "LIGHT":
             lights.append(_light(source, obj, light_spectrum, data_dir))
         elif obj.type in _MESH_LIKE:
-            mesh = _mesh(obj, depsgraph, table, object_id=len(meshes))
+            mesh = _mesh(obj, depsgraph, table, object_id=len(meshes), budget=budget)
             if mesh is not None:
                 meshes.append(mesh)
     scene = Scene(

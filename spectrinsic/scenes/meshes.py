@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import SceneError
+from .budget import MAX_FACES, MAX_VERTICES, SceneBudget
 from .gltf_colours import gltf_colours
 from .image_textures import AssetColour, ImageTexture, corner_spectra
 from .materials import METAL_SPECTRUM
@@ -56,13 +57,8 @@ __all__ = [
 ]
 
 MESH_SUFFIXES = (".obj", ".ply", ".glb", ".gltf", ".stl", ".off")
-#: Largest mesh read, checked from the file's header before loading (and the most faces of
-#: a whole scene file, checked once its meshes are read, before validation). Reading takes
-#: about 2.5 KiB per vertex (a 10^6-vertex PLY took 2.5 GB) and validating the camera's view
-#: (trimesh's ray index) about 5.3 KiB per face (200k faces: 1.2 GB peak, 12 s; 10^6 faces:
-#: 7 GB, 41 s), so these bound a scene near 1.5 GB.
-MAX_VERTICES = 250_000
-MAX_FACES = 250_000
+#: Largest glTF JSON chunk read to count the accessors (the geometry itself is binary).
+_GLTF_JSON_MAX = 64 * 2**20
 #: Irradiance (relative units) at the model's centre from the default light.
 _IRRADIANCE = math.pi
 
@@ -100,22 +96,45 @@ def _text_counts(path: Path, vertex: bytes, face: bytes) -> tuple[int, int]:
                 return counts[0], counts[1]
 
 
-def _gltf_vertices(document: dict[str, Any]) -> int:
+def _accessor_count(accessors: list[Any], index: Any) -> int:
+    if (
+        isinstance(index, int)
+        and 0 <= index < len(accessors)
+        and isinstance(accessors[index], dict)
+    ):
+        count = accessors[index].get("count", 0)
+        return count if isinstance(count, int) and count > 0 else 0
+    return 0
+
+
+def _gltf_counts(document: dict[str, Any]) -> tuple[int, int]:
+    """``(vertices, faces)`` a glTF document declares, from its accessors' ``count`` (indices / 3,
+    or positions / 3 without indices), each mesh counted once per node that places it (trimesh
+    builds one copy per node); a file with no nodes counts each mesh once."""
     accessors = document.get("accessors") or []
-    total = 0
+    per_mesh = []
     for mesh in document.get("meshes") or []:
-        for primitive in mesh.get("primitives") or []:
-            index = (primitive.get("attributes") or {}).get("POSITION")
-            if isinstance(index, int) and 0 <= index < len(accessors):
-                total += int(accessors[index].get("count", 0))
-    return total
+        n_v = n_f = 0
+        for primitive in (mesh.get("primitives") or []) if isinstance(mesh, dict) else []:
+            positions = _accessor_count(
+                accessors, (primitive.get("attributes") or {}).get("POSITION")
+            )
+            indices = _accessor_count(accessors, primitive.get("indices"))
+            n_v += positions
+            n_f += (indices if "indices" in primitive else positions) // 3
+        per_mesh.append((n_v, n_f))
+    nodes = [n for n in document.get("nodes") or [] if isinstance(n, dict) and "mesh" in n]
+    uses = [
+        n["mesh"] for n in nodes if isinstance(n["mesh"], int) and 0 <= n["mesh"] < len(per_mesh)
+    ]
+    placed = [per_mesh[i] for i in uses] if nodes else per_mesh
+    return sum(v for v, _ in placed), sum(f for _, f in placed)
 
 
 def mesh_counts(path: Path) -> tuple[int, int]:
     """``(vertices, faces)`` a mesh file declares, read from its header (PLY, OFF, binary
-    STL, glTF/GLB) or counted line by line (OBJ, ASCII STL) without building the mesh; faces
-    are 0 where a format does not say (glTF). Malformed headers count as 0: trimesh reports
-    them when it reads the file."""
+    STL, glTF/GLB accessors) or counted line by line (OBJ, ASCII STL) without building the
+    mesh. Malformed headers count as 0: trimesh reports them when it reads the file."""
 
     suffix = path.suffix.lower()
     with path.open("rb") as fh:
@@ -139,23 +158,30 @@ def mesh_counts(path: Path) -> tuple[int, int]:
             return _text_counts(path, b"v ", b"f ")
         if suffix == ".glb":
             length = struct.unpack("<I", head[12:16])[0]
-            return _gltf_vertices(json.loads(head[20 : 20 + length])), 0
+            return _gltf_counts(json.loads(_glb_json(path, length)))
         if suffix == ".gltf":
-            return _gltf_vertices(json.loads(path.read_bytes())), 0
-    except (ValueError, IndexError, struct.error, AttributeError):
+            return _gltf_counts(json.loads(path.read_bytes()))
+    except (ValueError, IndexError, struct.error, AttributeError, TypeError, RecursionError):
         pass
     return 0, 0
 
 
-def check_mesh_size(path: Path) -> None:
-    """Refuse a mesh file declaring more than :data:`MAX_VERTICES` vertices or
-    :data:`MAX_FACES` faces, before it is loaded."""
+def _glb_json(path: Path, length: int) -> bytes:
+    """The JSON chunk of a GLB file (its first chunk, *length* bytes after the 20-byte head)."""
+    if not 0 < length <= _GLTF_JSON_MAX:
+        raise ValueError(f"JSON chunk of {length} bytes")
+    with path.open("rb") as fh:
+        fh.seek(20)
+        return fh.read(length)
+
+
+def check_mesh_size(path: Path, budget: SceneBudget | None = None) -> None:
+    """Charge what the mesh file declares to *budget* (a budget of its own if ``None``), before
+    it is loaded: more than :data:`MAX_VERTICES` vertices or :data:`MAX_FACES` faces in the
+    scene is refused in one line naming the file and the count."""
     n_v, n_f = mesh_counts(path)
-    if n_v > MAX_VERTICES or n_f > MAX_FACES:
-        raise SceneError(
-            f"{path}: declares {n_v:,} vertices and {n_f:,} faces; meshes are limited to "
-            f"{MAX_VERTICES:,} vertices and {MAX_FACES:,} faces (simplify it first)"
-        )
+    budget = SceneBudget(str(path)) if budget is None else budget
+    budget.charge(f"{path.name!r} ({n_v:,} vertices, {n_f:,} faces)", faces=n_f, vertices=n_v)
 
 
 def _pbr_gloss(material: Any) -> dict[str, Any]:

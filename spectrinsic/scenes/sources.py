@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import gzip
+import stat
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,6 +29,7 @@ __all__ = [
     "GeneratedSource",
     "FileSource",
     "scene_file_kind",
+    "takes_asset_colours",
     "is_scene_file",
     "load_scene_file",
     "labelled",
@@ -87,11 +89,32 @@ def _compressed_blend(head: bytes, path: Path) -> bool:
     return False
 
 
+def _file_type(path: Path) -> str:
+    """What *path* is, in words, for a refusal (``stat`` follows links, as ``open`` would)."""
+    mode = path.stat().st_mode
+    for test, what in (
+        (stat.S_ISDIR, "a folder"),
+        (stat.S_ISFIFO, "a FIFO (named pipe)"),
+        (stat.S_ISSOCK, "a socket"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+    ):
+        if test(mode):
+            return what
+    return "a special file"
+
+
 def scene_file_kind(path: str | Path) -> str:
     """``"yaml"``, ``"mitsuba"`` (``.xml``), ``"blend"`` or ``"mesh"`` for a scene file, by suffix; a ``.blend`` also by
     its magic bytes, plain or compressed (gzip, zstd), under any name. One-line error for
-    anything else. The one dispatcher of scene files (``render``, ``dataset --scenes``)."""
+    anything else. The one dispatcher of scene files (``render``, ``dataset --scenes``).
+    A path that exists but is not a regular file (a FIFO, a device, a folder) is refused
+    before it is opened: reading a FIFO would wait for a writer forever."""
     p = Path(path)
+    if p.exists() and not p.is_file():
+        raise SceneError(
+            f"scene file {str(p)!r} is {_file_type(p)}, not a regular file; expected a scene file"
+        )
     suffix = p.suffix.lower()
     if suffix in (".yaml", ".yml"):
         return "yaml"
@@ -123,6 +146,14 @@ def is_scene_file(argument: str | Path) -> bool:
     """
     p = Path(argument)
     return p.suffix.lower() in (".yaml", ".yml", ".xml", ".blend", *MESH_SUFFIXES) or p.exists()
+
+
+def takes_asset_colours(path: str | Path) -> bool:
+    """Whether ``--colours-from-asset`` applies to the scene file at *path*: a glTF/GLB, an OBJ
+    (its MTL's ``Kd`` and ``map_Kd``) or a ``.blend`` file (their materials state a base
+    colour); YAML, XML, PLY, STL and OFF files state none, so the option would do nothing there."""
+    suffix = Path(path).suffix.lower()
+    return suffix in (".glb", ".gltf", ".obj") or scene_file_kind(path) == "blend"
 
 
 def load_scene_file(

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from ...errors import DatasetError
+from ...file_writes import replacing
 from ...scenes.sample_id import SEPARATOR
 from ..sample import META_NAME, sample_dirs
 from ..sample.integrity import guarded_write
@@ -59,7 +60,8 @@ def contact_sheet(
     path = Path(out) if out is not None else root / "contact_sheet.png"
     with guarded_write(path):
         path.parent.mkdir(parents=True, exist_ok=True)
-        sheet.save(path, format="PNG")
+    with replacing(path) as tmp:
+        sheet.save(tmp, format="PNG")
     return path
 
 

@@ -19,6 +19,7 @@ import numpy as np
 
 from ...data_dir import resolve_data_dir
 from ...errors import DatasetError, SampleMetaError
+from ...file_writes import write_text_file
 from ...provenance import software_versions
 from ...rng import seed_from_key
 from ...scenes.material_labels import label_spectrum
@@ -27,7 +28,6 @@ from ..layers.spectral_intrinsics import residual_summary
 from ..sample import (
     FORMAT_VERSION,
     MANIFEST_NAME,
-    TMP_PREFIX,
     canonical_json,
     config_hash,
     confined_path,
@@ -35,7 +35,6 @@ from ..sample import (
     plain_data,
     sample_dirs,
 )
-from ..sample.integrity import guarded_write
 from ..sample.json_fields import JsonFields, load_json
 from ..sample.meta import SampleMeta, read_meta
 from ..sample.transport_exr import COMPACT_LAYOUT, TRANSPORT_COMPRESSION, TRANSPORT_NAME
@@ -172,10 +171,7 @@ def write_manifest(
         },
     }
     path = root / MANIFEST_NAME
-    tmp = path.with_name(f"{TMP_PREFIX}{MANIFEST_NAME}")
-    with guarded_write(tmp):
-        tmp.write_text(canonical_json(plain_data(manifest)), encoding="utf-8")
-    tmp.replace(path)
+    write_text_file(path, canonical_json(plain_data(manifest)))
     return path
 
 

@@ -32,7 +32,9 @@ def _place(
     parts: list[tuple[str, Part]] = []
     patterns: list[str] = []
     for i in range(int(rng.integers(1, 6))):
-        shape, part, pattern, half = draw_object(rng, options.materials, options.sfu_reflectances)
+        shape, part, pattern, half = draw_object(
+            rng, options.materials, options.sfu_reflectances, texture_library=True
+        )
         patterns += [pattern] if pattern else []
         for _ in range(30):
             centre = rng.uniform(-0.35, 0.35, 2)
