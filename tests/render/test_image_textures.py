@@ -98,16 +98,24 @@ _XML = """<scene version="3.0.0">
 
 
 def _xml(folder, shape: str) -> str:
-    """A Mitsuba XML file of the checker (no factor: a bitmap has none) on an OBJ plane (the
-    file's ``vt``, as ``_obj``) or on Mitsuba's ``rectangle`` (its own uv)."""
+    """A Mitsuba XML file of the checker (no factor: a bitmap has none) on Mitsuba's
+    ``rectangle`` (its own uv), an OBJ plane (the ``vt`` of ``_obj``: Mitsuba's OBJ loader
+    stores 1 - vt) or a PLY plane (the same uv, which Mitsuba's PLY loader stores as they are)."""
     image, _ = _checker()
     image.save(folder / "checker.png")
-    filename = ""
+    filename = "" if shape == "rectangle" else f'<string name="filename" value="plane.{shape}"/>'
+    corners = [(-1, -1), (1, -1), (1, 1), (-1, 1)]
     if shape == "obj":
-        lines = ["v -1 -1 0", "v 1 -1 0", "v 1 1 0", "v -1 1 0"]
+        lines = [f"v {x} {y} 0" for x, y in corners]
         lines += ["vt 0 0", "vt 1 0", "vt 1 1", "vt 0 1", "f 1/1 2/2 3/3", "f 1/1 3/3 4/4"]
         (folder / "plane.obj").write_text("\n".join(lines) + "\n")
-        filename = '<string name="filename" value="plane.obj"/>'
+    if shape == "ply":
+        lines = ["ply", "format ascii 1.0", "element vertex 4"]
+        lines += [f"property float {p}" for p in ("x", "y", "z", "u", "v")]
+        lines += ["element face 2", "property list uchar int vertex_indices", "end_header"]
+        lines += [f"{x} {y} 0 {(x + 1) / 2} {(y + 1) / 2}" for x, y in corners]
+        lines += ["3 0 1 2", "3 0 2 3"]
+        (folder / "plane.ply").write_text("\n".join(lines) + "\n")
     text = _XML.format(fov=FOV, distance=DISTANCE, size=SIZE, shape=shape, filename=filename)
     (folder / "scene.xml").write_text(text)
     return str(folder / "scene.xml")
@@ -173,16 +181,17 @@ def _render(path: str, modes: tuple[str, ...]):
     return scene, result, compute_ground_truth(scene, result, spectral=True, working_space="srgb")
 
 
-@pytest.fixture(scope="module", params=["gltf", "obj", "xml", "xml-rectangle"])
+@pytest.fixture(scope="module", params=["gltf", "obj", "xml-obj", "xml-ply", "xml-rectangle"])
 def rendered(request, tmp_path_factory):
     """The scene, its render, its ground truth, the colour factor and the texel colour index
-    with row 0 at the *pixels'* bottom (the rectangle's v runs top-down: Mitsuba's uv)."""
+    with row 0 at the *pixels'* bottom (the rectangle's and the PLY's v run top-down in
+    Mitsuba's bitmap lookup)."""
     folder = tmp_path_factory.mktemp(request.param)
     index = _checker()[1]
     if request.param.startswith("xml"):
-        path = _xml(folder, "rectangle" if request.param.endswith("rectangle") else "obj")
-        index = index[::-1] if request.param.endswith("rectangle") else index
-        return (*_render(path, ("bands31",)), (1.0, 1.0, 1.0), index)
+        shape = request.param.removeprefix("xml-")
+        index = index if shape == "obj" else index[::-1]
+        return (*_render(_xml(folder, shape), ("bands31",)), (1.0, 1.0, 1.0), index)
     with pytest.warns(UserWarning, match="nearest texel"):
         if request.param == "gltf":  # with Mitsuba's spectral pass, once
             return (*_render(_gltf(folder), ("spectral", "bands31")), FACTOR, index)
@@ -219,7 +228,7 @@ def test_mitsuba_spectral_pass_renders_the_same_texels(rendered):
         np.testing.assert_allclose(a, b, rtol=SPECTRAL_RTOL, atol=SPECTRAL_RTOL * b.max())
 
 
-@pytest.mark.parametrize("rendered", ["xml", "xml-rectangle"], indirect=True)
+@pytest.mark.parametrize("rendered", ["xml-obj", "xml-ply", "xml-rectangle"], indirect=True)
 def test_xml_checker_lands_where_mitsuba_renders_it(rendered, request, tmp_path):
     """Mitsuba's own render of the same XML file (its albedo AOV: its bitmap lookup, its OBJ
     loader's or its rectangle's uv) puts each checker colour on the pixels where our ground
@@ -228,7 +237,7 @@ def test_xml_checker_lands_where_mitsuba_renders_it(rendered, request, tmp_path)
     import mitsuba as mi
 
     _, _, gt, _, index = rendered
-    shape = "rectangle" if request.node.callspec.params["rendered"].endswith("rectangle") else "obj"
+    shape = request.node.callspec.params["rendered"].removeprefix("xml-")
     mi.set_variant(choose_variant("rgb"))
     loaded = mi.load_file(_xml(tmp_path, shape))
     albedo = mi.load_dict({"type": "aov", "aovs": "a:albedo"})
