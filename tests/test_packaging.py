@@ -23,6 +23,7 @@ CORE_BASE = {
     "interrupts",
     "threads",
     "file_writes",
+    "mitsuba_import",
 }
 ORDER = ["spectra", "scenes", "render", "gt_export", "learn", "decompose"]
 #: The top layer, left to right: a study may run the pipeline, a benchmark a study, the CLI all.
@@ -98,8 +99,9 @@ def _imports(path: Path) -> set[str]:
     return names
 
 
-#: The modules outside spectrinsic.render that may import Mitsuba: the XML scene reader's parser.
-MITSUBA_READERS = frozenset({Path("scenes") / "mitsuba_tree.py"})
+#: The module outside spectrinsic.render that imports Mitsuba: the set-up step, a base module
+#: below the renderer and the XML scene reader, which both import Mitsuba through it.
+MITSUBA_READERS = frozenset({Path("mitsuba_import.py")})
 
 
 def _files():
@@ -131,9 +133,8 @@ def test_imports_flow_one_way(folder, path):
             continue  # the root package's own entry points
         sub = name.split(".")[1]
         assert _layer(sub) <= _layer(own), f"{path}: {own} must not import {name}"
-    # Besides the renderer, only the reader of Mitsuba XML files may import Mitsuba: it reads a
-    # file with Mitsuba's own parser (issue 41), which instantiates no plugin but the one
-    # built-in shape whose triangles it asks for.
+    # Besides the renderer, only the set-up step imports Mitsuba: the reader of Mitsuba XML
+    # files (issue 41) parses them with Mitsuba's own parser, through that step.
     if folder != "render" and path.relative_to(PACKAGE_DIR) not in MITSUBA_READERS:
         assert not {"mitsuba", "drjit"} & {n.split(".")[0] for n in _imports(path)}, (
             f"{path}: only spectrinsic.render may import mitsuba/drjit"

@@ -26,6 +26,7 @@ from typing import Any, Union
 import numpy as np
 
 from ..errors import SceneError
+from ..mitsuba_import import import_mitsuba
 
 __all__ = ["Spectrum", "Value", "XmlNode", "ParsedXml", "parse_xml", "mesh_file", "mesh_file_uv"]
 
@@ -163,10 +164,11 @@ def _fix(node: XmlNode, version: str) -> tuple[XmlNode, list[str]]:
 
 
 def _mitsuba() -> Any:
-    """Mitsuba, with a variant set: the one already chosen (the renderer's), else
-    ``scalar_rgb``, since reading a Transform or a mesh needs the scalar types of some variant."""
-    import mitsuba as mi
-
+    """Mitsuba, imported through spectrinsic's set-up step (so Dr.Jit loads a suitable
+    ``libLLVM`` even when a scene is read before any render), with a variant set: the one
+    already chosen (the renderer's), else ``scalar_rgb``, since reading a Transform or a mesh
+    needs the scalar types of some variant."""
+    mi = import_mitsuba()
     if mi.variant() is None:
         mi.set_variant("scalar_rgb")
     return mi
