@@ -27,7 +27,8 @@ import numpy as np
 
 from ..errors import SceneError
 from . import mitsuba_parts as parts
-from .meshes import MAX_FACES, MAX_VERTICES, mesh_counts
+from .budget import SceneBudget
+from .meshes import mesh_counts
 from .mitsuba_files import confined_file
 from .mitsuba_tree import XmlNode, mesh_file, mesh_file_uv
 
@@ -146,7 +147,7 @@ def _counts(p: Placed, base: Path) -> tuple[int, int]:
     plugin = p.node.plugin
     if plugin in BUILT_IN:
         faces = parts.faces_of(plugin)
-        return faces * 3, faces  # a generous bound on the vertices
+        return faces + 2, faces  # indexed: a closed sphere has F/2 + 2, a disk F + 1
     path = _file(p, base)
     if plugin == "serialized":
         index = p.node.integer("shape_index", 0)
@@ -156,17 +157,13 @@ def _counts(p: Placed, base: Path) -> tuple[int, int]:
 
 def check_budget(placed: list[Placed], base: Path) -> None:
     """Refuse the scene, before anything is loaded, if its shapes hold more faces or vertices
-    than one scene may (module docstring)."""
-    n_v = n_f = 0
+    than one scene may: each shape, every placement of it, is charged to the one scene budget
+    of every format (:class:`~spectrinsic.scenes.budget.SceneBudget`)."""
+    budget = SceneBudget(f"{len(placed)} shapes")
     for p in placed:
         _check_params(p)
         v, f = _counts(p, base)
-        n_v, n_f = n_v + v, n_f + f
-    if n_f > MAX_FACES or n_v > MAX_VERTICES:
-        raise SceneError(
-            f"{len(placed)} shapes declare {n_f:,} faces and {n_v:,} vertices in all; a scene "
-            f"holds at most {MAX_FACES:,} faces and {MAX_VERTICES:,} vertices"
-        )
+        budget.charge(p.where, faces=f, vertices=v)
 
 
 def _mesh_file(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray]:
