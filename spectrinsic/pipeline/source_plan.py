@@ -68,7 +68,8 @@ MAX_COUNT = 100_000
 #: version (other light pools, furniture, framing) asks for ``--rebuild`` instead of mixing.
 #: 2: saturated lights, ranges obeyed by every material, framed rooms (issue 22).
 #: 3: cameras pass the view rule (``scenes.generators.view_rule``, issue 31).
-GENERATOR_VERSION = 3
+#: 4: views are also judged on their rendered light (a probe render, issue 47).
+GENERATOR_VERSION = 4
 MAX_VIEWS = 64
 
 

@@ -19,6 +19,14 @@ Judged when the camera is drawn, before any render, from a low-resolution ray ca
 Measured on 50 rooms (root seed 11): 50 of 92 judged cameras pass (acceptance 54 %), about
 0.4 s per judged camera on one core (``tests/scenes/test_view_rule.py``).
 
+**The rendered light** (issue 47): the estimate above misses what it does not trace (a sky,
+glossy paths, more than one bounce), so where the build gives a probe render
+(:data:`FrameProbe`, :func:`spectrinsic.render.probe.probe_luminance`: a
+:data:`~spectrinsic.render.probe.PROBE_SIZE`-pixel CIE Y render), a camera that passes is also
+judged on it by :func:`judge_frame`: the frame's median luminance must be at least
+:data:`MIN_FRAME_MEDIAN` of its 99th percentile. A dark frame around one bright patch fails.
+The threshold and its measurement are in ``docs/view_rule.md``.
+
 A camera that fails is re-drawn from the scene's seeded camera generator
 (:func:`spectrinsic.scenes.generators.camera.sample_camera`), so a build stays reproducible.
 The rule's own bounce rays come from a fixed seed: the same camera always gets the same verdict.
@@ -27,24 +35,29 @@ The rule's own bounce rays come from a fixed seed: the same camera always gets t
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..geometry import camera_rays
 from ..library import TARGET_IRRADIANCE
-from ..model import Camera, Light, Mesh
+from ..model import Camera, Light, Mesh, Scene
 from .camera import ray_triangle_hits
 
 __all__ = [
     "BOUNCE_RAYS",
+    "FRAME_PERCENTILE",
+    "FrameJudgement",
+    "FrameProbe",
+    "MIN_FRAME_MEDIAN",
     "MAX_CONTRAST",
     "MAX_SHARE",
     "MIN_LIT_SHARE",
     "MIN_MATERIALS",
     "VIEW_GRID",
     "ViewJudgement",
+    "judge_frame",
     "judge_view",
 ]
 
@@ -68,6 +81,13 @@ MIN_MEDIAN_LIGHT = 0.05
 #: Bounce rays per visible surface point, and the albedo the bounce is weighted with.
 BOUNCE_RAYS = 8
 BOUNCE_ALBEDO = 0.5
+#: Least median luminance of a probe render, as a fraction of its :data:`FRAME_PERCENTILE` th
+#: percentile (``docs/view_rule.md``: measured on the probes of generated rooms).
+MIN_FRAME_MEDIAN = 0.02
+FRAME_PERCENTILE = 99.0
+#: A probe render: the scene (seen from the camera to judge) -> its luminance ``(H, W)``,
+#: linear, any unit (only ratios are judged).
+FrameProbe = Callable[[Scene], np.ndarray]
 #: Offset of secondary rays from a surface (metres).
 _EPS = 1e-4
 
@@ -256,3 +276,33 @@ def judge_view(meshes: Sequence[Mesh], lights: Sequence[Light], camera: Camera) 
         lit_share=float(lit.mean()),
         median_light=float(np.median(light)) / TARGET_IRRADIANCE,
     )
+
+
+@dataclass(frozen=True)
+class FrameJudgement:
+    """The rendered light of a view: the frame's median luminance over its
+    :data:`FRAME_PERCENTILE` th percentile (0 for a black frame)."""
+
+    median_share: float
+
+    @property
+    def reasons(self) -> tuple[str, ...]:
+        """Why the frame fails (empty: it passes)."""
+        if self.median_share >= MIN_FRAME_MEDIAN:
+            return ()
+        return (
+            f"the rendered frame's median is {self.median_share:.2%} of its "
+            f"{FRAME_PERCENTILE:g}th percentile (< {MIN_FRAME_MEDIAN:.0%})",
+        )
+
+    @property
+    def ok(self) -> bool:
+        return not self.reasons
+
+
+def judge_frame(luminance: np.ndarray) -> FrameJudgement:
+    """Judge a rendered frame's light from its linear luminance ``(H, W)`` (every pixel counts:
+    one that sees nothing is dark, as in the photograph). Non-finite values count as 0."""
+    y = np.nan_to_num(np.asarray(luminance, np.float64), nan=0.0, posinf=0.0, neginf=0.0)
+    bright = float(np.percentile(y, FRAME_PERCENTILE))
+    return FrameJudgement(median_share=float(np.median(y)) / bright if bright > 0 else 0.0)
