@@ -5,8 +5,10 @@ Judged when the camera is drawn, before any render, from a low-resolution ray ca
 
 * **several materials**: at least :data:`MIN_MATERIALS` materials each cover
   :data:`MIN_MATERIAL_SHARE` of the frame (not a close-up of one surface);
-* **no single surface or material fills the frame**: no mesh and no material covers more than
-  :data:`MAX_SHARE` of it (not one face of one box, not 98 % one material);
+* **no single surface, object or material fills the frame**: no mesh, no object (the meshes of
+  one ``object_id``, so an object built of several meshes counts whole) and no material covers
+  more than :data:`MAX_SHARE` of it (not one face of one box, not one table top, not 98 % one
+  material);
 * **enough light reaches the camera**: at least :data:`MIN_LIT_SHARE` of the frame receives
   at least 1/:data:`MAX_CONTRAST` of the irradiance of the frame's bright end, counting the
   lights' direct irradiance (a shadow ray per light, spot cones and one-sided area lights
@@ -100,6 +102,8 @@ class ViewJudgement:
     max_material_share: float
     n_materials: int
     lit_share: float
+    #: Share of the frame covered by the largest object (all meshes of one ``object_id``).
+    max_object_share: float = 0.0
     #: Median over the frame of the estimated irradiance, relative to the generators' target
     #: irradiance at the lights' focus (``TARGET_IRRADIANCE``).
     median_light: float = 1.0
@@ -112,6 +116,8 @@ class ViewJudgement:
             out.append(f"{self.n_materials} materials visible (< {MIN_MATERIALS})")
         if self.max_mesh_share > MAX_SHARE:
             out.append(f"one surface fills {self.max_mesh_share:.0%} of the frame")
+        if self.max_object_share > MAX_SHARE:
+            out.append(f"one object fills {self.max_object_share:.0%} of the frame")
         if self.max_material_share > MAX_SHARE:
             out.append(f"one material fills {self.max_material_share:.0%} of the frame")
         if self.lit_share < MIN_LIT_SHARE:
@@ -133,6 +139,7 @@ class _Geometry:
 
     tri: np.ndarray
     mesh: np.ndarray
+    obj: np.ndarray
     material: np.ndarray
     normal: np.ndarray
     starts: np.ndarray
@@ -168,6 +175,7 @@ def _geometry(meshes: Sequence[Mesh]) -> _Geometry:
     return _Geometry(
         tri=tri,
         mesh=np.concatenate([np.full(len(m.faces), i) for i, m in enumerate(meshes)]),
+        obj=np.concatenate([np.full(len(m.faces), m.object_id) for m in meshes]),
         material=np.concatenate([np.asarray(m.face_materials).reshape(-1) for m in meshes]),
         normal=n,
         starts=np.cumsum([0] + [len(m.faces) for m in meshes]),
@@ -262,6 +270,7 @@ def judge_view(meshes: Sequence[Mesh], lights: Sequence[Light], camera: Camera) 
     total = len(hit)
     meshes_seen = np.bincount(g.mesh[hit[some]], minlength=1)
     materials_seen = np.bincount(g.material[hit[some]], minlength=1)
+    objects_seen = np.unique(g.obj[hit[some]], return_counts=True)[1] if some.any() else [0]
     light = np.zeros(total)
     if some.any():
         p = o[some] + t[some, None] * d[some]
@@ -272,6 +281,7 @@ def judge_view(meshes: Sequence[Mesh], lights: Sequence[Light], camera: Camera) 
     return ViewJudgement(
         max_mesh_share=float(meshes_seen.max()) / total,
         max_material_share=float(materials_seen.max()) / total,
+        max_object_share=float(np.max(objects_seen)) / total,
         n_materials=int((materials_seen >= MIN_MATERIAL_SHARE * total).sum()),
         lit_share=float(lit.mean()),
         median_light=float(np.median(light)) / TARGET_IRRADIANCE,
