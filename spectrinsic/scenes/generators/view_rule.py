@@ -85,7 +85,7 @@ BOUNCE_RAYS = 8
 BOUNCE_ALBEDO = 0.5
 #: Least median luminance of a probe render, as a fraction of its :data:`FRAME_PERCENTILE` th
 #: percentile (``docs/view_rule.md``: measured on the probes of generated rooms).
-MIN_FRAME_MEDIAN = 0.02
+MIN_FRAME_MEDIAN = 0.01
 FRAME_PERCENTILE = 99.0
 #: A probe render: the scene (seen from the camera to judge) -> its luminance ``(H, W)``,
 #: linear, any unit (only ratios are judged).
