@@ -5,7 +5,7 @@ The rooms of ``dataset --generator rooms --count N --seed 11 --preset preview --
 :mod:`spectrinsic.render.probe`), then each view is rendered at 64 x 64 (CIE XYZ through the
 spectral pass, 16 spp; exposed so its 99th-percentile luminance is white, sRGB-encoded) and
 tiled with :func:`spectrinsic.gt_export.dataset.contact_sheet.tile_sheet`. The probes' verdicts
-go to ``OUT.json``. Run: ``python scripts/view_rule_sheet.py [N] [OUT] [SEED]`` (about 6 s a view on one
+go to ``OUT.json``. Run: ``python scripts/view_rule_sheet.py [N] [OUT] [SEED] [DATASET OPTIONS...]`` (about 6 s a view on one
 core). The tiles are not the dataset's denoised previews (a 64² preview sample takes 4-5 s of
 Mitsuba alone): the framing and the light are the same, the noise is not.
 """
@@ -43,10 +43,12 @@ def _tile(xyz: np.ndarray) -> Image.Image:
 _PREVIEW_64 = ("--preset", "preview", "--resolution", "64x64")
 
 
-def main(n: int = 50, out: str = "docs/figures/view-rule-50.png", seed: int = 11) -> None:
+def main(
+    n: int = 50, out: str = "docs/figures/view-rule-50.png", seed: int = 11, *extra: str
+) -> None:
     found = resolve_data_dir()  # $SPECTRINSIC_DATA, as the CLI finds it
     data = None if found is None else str(found)
-    args = [*f"dataset --generator rooms --count {n} --seed {seed}".split(), *_PREVIEW_64]
+    args = [*f"dataset --generator rooms --count {n} --seed {seed}".split(), *_PREVIEW_64, *extra]
     config = config_from_args(build_parser().parse_args([*args, "--out", "unused"]))
     stats: dict[str, dict[str, object]] = {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -84,4 +86,4 @@ def main(n: int = 50, out: str = "docs/figures/view-rule-50.png", seed: int = 11
 
 
 if __name__ == "__main__":
-    main(*(a if i == 1 else int(a) for i, a in enumerate(sys.argv[1:])))  # type: ignore[arg-type]
+    main(*(int(a) if i in (0, 2) else a for i, a in enumerate(sys.argv[1:])))  # type: ignore[arg-type]
