@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import SpectrinsicError
+from .file_writes import replacing, write_text_file
 from .provenance import provenance
 
 __all__ = ["write_json", "write_csv", "json_safe", "provenance"]
@@ -43,7 +44,7 @@ def write_json(
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     text = json.dumps(payload, indent=2, allow_nan=not strict, default=default)
-    path.write_text(text + end, encoding="utf-8")
+    write_text_file(path, text + end)
     return path
 
 
@@ -70,7 +71,7 @@ def write_csv(
             raise SpectrinsicError(f"{path.name}: no rows and no columns to write")
         columns = list(rows[0])
     path.parent.mkdir(parents=True, exist_ok=True)
-    with path.open("w", newline="", encoding="utf-8") as fh:
+    with replacing(path) as tmp, tmp.open("w", newline="", encoding="utf-8") as fh:
         writer = csv.DictWriter(fh, fieldnames=list(columns))
         writer.writeheader()
         for row in rows:

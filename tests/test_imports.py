@@ -201,8 +201,10 @@ def test_imports_inside_functions_are_only_heavy_optional_ones(folder):
 
 
 #: Imported names inside functions (one per name): 248 before issue 18, of which 192 of light
-#: modules; since then only heavy optional ones (:data:`HEAVY`). A ratchet: lower it.
-MAX_FUNCTION_IMPORTS = 104
+#: modules; since then only heavy optional ones (:data:`HEAVY`). A ratchet: lower it. Issue 43
+#: added 4 heavy ones: torch (learn/torch_import.py), matplotlib for the training curve and the
+#: sim2real figure, scipy for the sim2real t-intervals.
+MAX_FUNCTION_IMPORTS = 108
 
 
 def test_function_level_imports_are_counted():

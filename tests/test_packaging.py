@@ -22,8 +22,9 @@ CORE_BASE = {
     "results",
     "interrupts",
     "threads",
+    "file_writes",
 }
-ORDER = ["spectra", "scenes", "render", "gt_export", "decompose"]
+ORDER = ["spectra", "scenes", "render", "gt_export", "learn", "decompose"]
 #: The top layer, left to right: a study may run the pipeline, a benchmark a study, the CLI all.
 TOP = ["pipeline", "studies", "bench", "cli"]
 

@@ -127,12 +127,14 @@ def _lights() -> st.SearchStrategy[dict]:
         "direction": st.sampled_from([[0, 0, -1], [0.3, 0.2, -1]]),
         "size": st.sampled_from([[1, 1], [0.5, 2]]),
         "cutoff_deg": st.sampled_from([30, 90]),
+        "radius": st.sampled_from([0.1, 0.4]),
     }
     odd = {
         "position": VECTORS,
         "direction": VECTORS,
         "size": st.lists(NUMBERS, min_size=2, max_size=2),
         "cutoff_deg": NUMBERS,
+        "radius": NUMBERS,
     }
 
     @st.composite
@@ -196,3 +198,126 @@ def test_a_light_mapping_builds_or_is_refused_in_one_line(light):
 def test_a_material_mapping_builds_or_is_refused_in_one_line(material):
     light = {"kind": "point", "spectrum": "cie:D65", "power": 4, "position": [0, 0, 2]}
     _load({**BASE, "materials": {"m": material}, "lights": [light]})
+
+
+#: The numeric fields of a camera model, each drawn valid or as an edge case.
+_CAMERA_NUMBERS = {
+    "gain_e_per_dn": st.one_of(st.just(0.5), NUMBERS),
+    "full_well_e": st.one_of(st.just(40000.0), NUMBERS),
+    "read_noise_e": st.one_of(st.just(3.0), NUMBERS),
+    "adc_bits": st.one_of(st.sampled_from([12, 14, 12.5, 16.0, 7, 17]), NUMBERS),
+    "iso": st.one_of(st.just(100.0), NUMBERS),
+    "exposure_target": st.one_of(st.just(0.5), NUMBERS),
+    "electrons_per_unit": st.one_of(st.none(), NUMBERS),
+    "exposure_time_s": st.one_of(st.just(0.01), NUMBERS),
+    "prnu": st.one_of(st.sampled_from([0.0, 0.01, 0.999, 1.0, 1e9]), NUMBERS),
+    "dsnu_e": st.one_of(st.just(0.0), NUMBERS),
+}
+
+
+@SETTINGS
+@hypothesis.given(values=st.fixed_dictionaries({}, optional=_CAMERA_NUMBERS))
+def test_a_camera_model_is_finite_and_whole_or_refused_in_one_line(values):
+    from spectrinsic.spectra.camera_model import CameraModel
+
+    try:
+        model = CameraModel(
+            name="drawn",
+            sensitivities="camera:Nikon 5100 (NPL)",
+            **{"gain_e_per_dn": 0.5, "full_well_e": 4e4, "read_noise_e": 3.0, **values},
+        )
+    except Exception as exc:  # noqa: BLE001 - the property is about which exceptions escape
+        _refused_in_one_line(exc)
+        return
+    numbers = [v for v in vars(model).values() if isinstance(v, int | float)]
+    assert all(math.isfinite(v) for v in numbers)
+    assert isinstance(model.adc_bits, int) and 0 <= model.prnu < 1
+    assert 0 < model.gain < math.inf and 0 < model.white_level_dn <= 2**model.adc_bits - 1
+
+
+#: One CSV spectrum file: a wavelength column and one value column, cells drawn as text.
+_CSV_UNITS = st.sampled_from(["[%]", "[1]", "[W/m2/nm]", "[a.u.]", "", "[furlongs]"])
+
+
+@SETTINGS
+@hypothesis.given(
+    unit=_CSV_UNITS,
+    start=st.sampled_from(["380", "400", "420", "nan", "x"]),
+    cells=st.lists(NUMBER_TEXT, min_size=0, max_size=8),
+)
+def test_a_csv_spectrum_gives_a_valid_spectrum_or_one_line(unit, start, cells):
+    rows = [f"{start},{cells[0] if cells else '50'}"]
+    rows += [f"{450 + 50 * i},{c}" for i, c in enumerate(cells[1:])]
+    rows.append(f"720,{cells[-1] if cells else '50'}")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "drawn.csv"
+        path.write_text(f"wavelength [nm],paint {unit}\n" + "\n".join(rows) + "\n")
+        try:
+            spectrum = get_spectrum(f"csv:{path}#paint")
+        except Exception as exc:  # noqa: BLE001 - the property is about which exceptions escape
+            _refused_in_one_line(exc)
+            return
+    values = np.asarray(spectrum.values, float)
+    assert np.isfinite(values).all() and values.min() >= 0
+    if spectrum.kind == "reflectance":
+        assert values.max() <= 1 + 1e-9
+
+
+def test_a_1e308_spectrum_is_normalised_without_overflow(tmp_path):
+    """Sums of values near float64's largest overflowed (a RuntimeWarning, then a visible
+    share of NaN); an illuminant is divided by its peak first, and only its shape counts."""
+    import warnings
+
+    path = tmp_path / "big.csv"
+    path.write_text("wavelength [nm],lamp [W/m2/nm]\n380,1e308\n550,1e308\n780,1e308\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a RuntimeWarning fails the test
+        big = get_spectrum(f"csv:{path}#lamp [W/m2/nm]")
+    unit = tmp_path / "unit.csv"  # another file: spectra are cached by name
+    unit.write_text("wavelength [nm],lamp [W/m2/nm]\n380,1\n550,1\n780,1\n")
+    expected = get_spectrum(f"csv:{unit}#lamp [W/m2/nm]").values
+    assert np.isfinite(big.values).all()
+    np.testing.assert_allclose(big.values, expected, rtol=1e-12)
+
+
+def _glb(path: Path, accessors: list, meshes: list, nodes: list) -> None:
+    import json
+    import struct
+
+    doc = {"asset": {"version": "2.0"}, "accessors": accessors, "meshes": meshes, "nodes": nodes}
+    data = json.dumps(doc).encode()
+    data += b" " * (-len(data) % 4)
+    chunk = struct.pack("<I4s", len(data), b"JSON") + data
+    path.write_bytes(struct.pack("<4sII", b"glTF", 2, 12 + len(chunk)) + chunk)
+
+
+_COUNTS = st.one_of(st.integers(0, 400_000), st.sampled_from([-1, 2**63, "7", None, 1.5]))
+
+
+@SETTINGS
+@hypothesis.given(
+    counts=st.lists(_COUNTS, min_size=1, max_size=4),
+    indexed=st.booleans(),
+    nodes=st.lists(st.integers(-1, 4), max_size=6),
+)
+def test_a_glb_within_the_face_budget_loads_only_as_counted_or_is_refused(counts, indexed, nodes):
+    """Drawn glTF accessor counts and node lists: the counts are whole and non-negative, and
+    the budget refuses exactly the files whose counted faces or vertices pass its limits,
+    before trimesh reads any geometry (here there is none to read)."""
+    from spectrinsic.scenes.budget import MAX_FACES, MAX_VERTICES, SceneBudget
+    from spectrinsic.scenes.meshes import check_mesh_size, mesh_counts
+
+    accessors = [{"count": c} for c in counts]
+    primitive = {"attributes": {"POSITION": 0}} | ({"indices": len(counts) - 1} if indexed else {})
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "drawn.glb"
+        _glb(path, accessors, [{"primitives": [primitive]}], [{"mesh": n} for n in nodes])
+        n_v, n_f = mesh_counts(path)
+        assert isinstance(n_v, int) and isinstance(n_f, int) and n_v >= 0 and n_f >= 0
+        try:
+            check_mesh_size(path, SceneBudget("drawn.glb"))
+        except Exception as exc:  # noqa: BLE001 - the property is about which exceptions escape
+            _refused_in_one_line(exc)
+            assert n_f > MAX_FACES or n_v > MAX_VERTICES
+            return
+    assert n_f <= MAX_FACES and n_v <= MAX_VERTICES

@@ -25,6 +25,7 @@ BENCHMARKS = (
     "relight",
     "residual",
     "storage",
+    "real_scene",
 )
 
 

@@ -7,12 +7,14 @@ Each sub-command lives in its own ``spectrinsic.cli.<name>`` module exposing
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import logging
 import sys
 import traceback
-from collections.abc import Sequence
-from typing import Any, NoReturn
+import warnings
+from collections.abc import Iterator, Sequence
+from typing import Any, NoReturn, TextIO
 
 from ..data_dir import one_data_dir
 from ..errors import SpectrinsicError
@@ -20,6 +22,8 @@ from ..interrupts import exit_status, interrupts_reach_python
 from ..provenance import software_versions
 
 __all__ = ["main", "build_parser"]
+
+log = logging.getLogger(__name__)
 
 #: Sub-command modules, in the order ``--help`` lists them.
 _COMMANDS: tuple[str, ...] = (
@@ -31,6 +35,7 @@ _COMMANDS: tuple[str, ...] = (
     "spectrinsic.cli.export",
     "spectrinsic.cli.study",
     "spectrinsic.cli.evaluate",
+    "spectrinsic.cli.train",
     "spectrinsic.cli.list",
 )
 
@@ -126,7 +131,7 @@ def _main(argv: Sequence[str] | None) -> int:
     try:
         # one data directory for the whole run (--data-dir, else $SPECTRINSIC_DATA), resolved
         # once, before any work (a wrong one is an input error), and seen by every worker
-        with one_data_dir(args.data_dir) as data_dir:
+        with one_data_dir(args.data_dir) as data_dir, _arithmetic_warnings_logged():
             args.data_dir = data_dir
             return int(args.func(args) or 0)
     except SpectrinsicError as exc:
@@ -138,6 +143,27 @@ def _main(argv: Sequence[str] | None) -> int:
         return _error(
             args, "out of memory; try a smaller --resolution/--width/--height or fewer --workers"
         )
+
+
+@contextlib.contextmanager
+def _arithmetic_warnings_logged() -> Iterator[None]:
+    """numpy's arithmetic ``RuntimeWarning`` (overflow, invalid value: ``relight --power 1e20``,
+    a NaN in a mesh file) go to the debug log (``-vv``) instead of stderr. Every result is
+    checked finite before it is written and every bad input is refused in one line that says
+    what was wrong, so the warning only added lines before that one line. spectrinsic's own
+    warnings (:class:`~spectrinsic.errors.SpectrinsicWarning`) are shown as before."""
+    shown = warnings.showwarning
+
+    def show(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+             file: TextIO | None = None, line: str | None = None) -> None:  # fmt: skip
+        if issubclass(category, RuntimeWarning):
+            log.debug("%s:%d: %s: %s", filename, lineno, category.__name__, message)
+        else:
+            shown(message, category, filename, lineno, file, line)
+
+    with warnings.catch_warnings():
+        warnings.showwarning = show
+        yield
 
 
 def _error(args: argparse.Namespace, message: str) -> int:

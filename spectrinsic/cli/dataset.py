@@ -224,6 +224,11 @@ def _overrides(args: argparse.Namespace) -> dict[str, Any]:
     """The config changes the options ask for (getattr: ``render --ground-truth`` builds its
     own namespace of dataset options, without some of them)."""
     changes: dict[str, Any] = {}
+    if (
+        getattr(args, "max_batches", None) is not None
+        and getattr(args, "noise_target", None) is None
+    ):
+        raise DatasetError("--max-batches applies to --noise-target (the adaptive batches' cap)")
     source = source_from_args(args)
     if source is not None:
         changes["source"] = source
@@ -263,8 +268,10 @@ def preflight(
     scheduler: str | None = None,
     rebuild: bool = False,
     data_dir: str | None = None,
+    quiet: bool = False,
 ) -> None:
-    """Every refusal that needs no rendering, before anything is written or started."""
+    """Every refusal that needs no rendering, before anything is written or started (what a
+    scene file's read fixed or approximated said on stderr unless *quiet*)."""
     if workers is not None and workers < 1:
         raise DatasetError(f"--workers {workers}; expected a positive integer")
     if threads is not None and threads < 1:
@@ -276,7 +283,7 @@ def preflight(
             f"to {UINT32_MAX} and at most {UINT32_MAX} samples per pixel"
         )
     check_build_folder(Path(out), config.config_hash(), rebuild=rebuild)
-    check_scene_files(config, data_dir)
+    check_scene_files(config, data_dir, quiet=quiet)
     check_integrator_plan(config)  # integrator x materials: every sample would fail
     if scheduler:
         check_scheduler(scheduler)
@@ -302,6 +309,7 @@ def run(args: argparse.Namespace) -> int:
         scheduler=args.scheduler,
         rebuild=args.rebuild,
         data_dir=args.data_dir,
+        quiet=getattr(args, "quiet", False),
     )
     return build(
         args.out,

@@ -8,15 +8,25 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from pathlib import Path
 from typing import Any
 
 from ..errors import DatasetError, SceneError, SpectrinsicError
 from ..pipeline.presets import DatasetConfig
-from ..pipeline.source_plan import file_sample, files_source, generator_source
+from ..pipeline.source_plan import (
+    check_scene_integrator,
+    file_sample,
+    files_source,
+    generator_source,
+    semantic_rules,
+)
+from ..render.base.variants import import_mitsuba
 from ..scenes.generators import GlossDistribution
 from ..scenes.generators.world_defaults import GLOSSY_FRACTION, METALLIC_FRACTION, TEXTURE_FRACTION
-from ..scenes.sources import FileSource
+from ..scenes.mitsuba_xml import render_hints_line, xml_notes
+from ..scenes.semantic import SemanticRules, read_semantic_map
+from ..scenes.sources import FileSource, takes_asset_colours
 from ..scenes.spectrum_refs import resolve_spectrum
 from ..scenes.yaml_limits import load_yaml_file
 from ..spectra import get_spectrum
@@ -25,6 +35,8 @@ __all__ = [
     "add_source_options",
     "check_scene_files",
     "material_map",
+    "semantic_map",
+    "add_semantic_map_option",
     "parse_resolution",
     "source_from_args",
     "source_notes",
@@ -57,10 +69,16 @@ def _add_daylight_option(src: Any) -> None:
     src.add_argument(
         "--daylight-share",
         type=float,
-        default=0.0,
+        default=None,
         metavar="F",
         help="fraction of generated rooms closed, with a window, and lit also by a sun and a "
-        "sky of CIE daylight spectra shining through it (0)",
+        "sky of CIE daylight spectra shining through it (0); sun and sky carry 20-90 %% of "
+        "such a room's light flux",
+    )
+    src.add_argument(
+        "--daylight-only",
+        action="store_true",
+        help="light the --daylight-share rooms by sun and sky alone, without lamps",
     )
 
 
@@ -148,9 +166,18 @@ def _add_scene_file_options(src: Any) -> None:
     )
     src.add_argument(
         "--colours-from-asset",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="give unmapped materials the colour or texture their file states (glTF base "
+        "colour and texture, OBJ/MTL Kd and map_Kd, Principled Base Color; default: on where "
+        "the file states one; given explicitly for a file that states none: refused)",
+    )
+    add_semantic_map_option(src)
+    src.add_argument(
+        "--approximate",
         action="store_true",
-        help="give unmapped glTF and .blend materials their base colour (glTF "
-        "baseColorFactor, Principled Base Color) as an rgb: reflectance (default: an error)",
+        help="Mitsuba XML scenes: approximate what has no exact ground truth (glass, masks, "
+        "bump maps, bitmaps, environment maps...) instead of refusing it, one line saying what",
     )
     src.add_argument(
         "--new-sample",
@@ -173,6 +200,27 @@ def _range(option: str, text: str) -> tuple[float, float]:
     if lo > hi:
         raise DatasetError(f"{option} {text!r}; expected LO <= HI")
     return lo, hi
+
+
+def add_semantic_map_option(group: Any) -> None:
+    """``--semantic-map FILE``, for ``dataset --scenes`` and ``render FILE --ground-truth``."""
+    group.add_argument(
+        "--semantic-map",
+        metavar="FILE",
+        default=None,
+        help="scene files with ground truth: YAML/JSON rules regex -> semantic class, tried "
+        "before the default name map (spectrinsic/scenes/FORMAT.md, Semantic classes)",
+    )
+
+
+def semantic_map(path: str | None) -> SemanticRules | None:
+    """The ``--semantic-map`` file's rules (None for none); DatasetError naming it if bad."""
+    if path is None:
+        return None
+    try:
+        return read_semantic_map(path)
+    except SceneError as exc:
+        raise DatasetError(f"--semantic-map: {exc}") from None
 
 
 def material_map(path: str | None) -> dict[str, str]:
@@ -215,9 +263,16 @@ GENERATOR_DEFAULTS: dict[str, Any] = {
     "glossy": GLOSSY_FRACTION,
     "metallic": METALLIC_FRACTION,
     "roughness_range": "0,0.3",
+    "daylight_share": 0.0,
 }
 #: The options of scene files (``--scenes``).
-FILE_OPTIONS = ("material_map", "default_spectrum", "new_sample")
+FILE_OPTIONS = (
+    "material_map",
+    "default_spectrum",
+    "new_sample",
+    "semantic_map",
+    "colours_from_asset",
+)
 
 
 def _given(value: object) -> bool:
@@ -272,8 +327,14 @@ def source_from_args(args: argparse.Namespace) -> str | None:
             else _range("--light-saturation", args.light_saturation),
             texture_fraction=args.texture_fraction,
             daylight_share=args.daylight_share,
+            daylight_only=args.daylight_only,
         )
     if args.scenes:
+        if args.colours_from_asset is True and not any(takes_asset_colours(s) for s in args.scenes):
+            raise DatasetError(
+                "--colours-from-asset applies to glTF/GLB, OBJ/MTL and .blend files; none of the "
+                "--scenes is one"
+            )
         size = None if args.resolution is None else parse_resolution(args.resolution)
         return files_source(
             args.scenes,
@@ -281,7 +342,9 @@ def source_from_args(args: argparse.Namespace) -> str | None:
             default_spectrum=args.default_spectrum,
             resolution=size,
             new_sample=getattr(args, "new_sample", False),
-            colours_from_asset=args.colours_from_asset,
+            colours_from_asset=args.colours_from_asset is not False,
+            approximate=args.approximate,
+            semantic=semantic_map(getattr(args, "semantic_map", None)),
         )
     return None
 
@@ -319,10 +382,11 @@ def parse_resolution(text: str) -> tuple[int, int]:
     return int(w), int(h)
 
 
-def check_scene_files(config: Any, data_dir: str | None) -> None:
+def check_scene_files(config: Any, data_dir: str | None, *, quiet: bool = False) -> None:
     """``--scenes``: every file reads as a valid scene with this material map and default
     spectrum, before the folder is stamped with the config (a bad file is an input error, not
-    a failed sample)."""
+    a failed sample); what a Mitsuba XML read fixed or approximated, and the spp and depth that
+    apply to it (the preset's), are said on stderr unless *quiet*."""
 
     spec = json.loads(config.source or "{}")
     if "scenes" not in spec:
@@ -337,12 +401,23 @@ def check_scene_files(config: Any, data_dir: str | None) -> None:
         except SpectrinsicError as exc:
             raise DatasetError(f"{option} {name!r}: {exc}") from exc
     width, height = spec.get("resolution") or (None, None)
+    import_mitsuba()  # set up before a Mitsuba XML read imports it (the libLLVM Dr.Jit loads)
     for entry in spec["scenes"]:
-        FileSource(
+        scene = FileSource(
             entry["path"],
             width,
             height,
             tuple(sorted(materials.items())),
             spec.get("default_spectrum"),
-            colours_from_asset=bool(spec.get("colours_from_asset")),
+            colours_from_asset=bool(spec.get("colours_from_asset", False)),
+            approximate=bool(spec.get("approximate")),
+            semantic=semantic_rules(spec),
         ).build(data_dir)
+        check_scene_integrator(config, scene, entry["path"])  # every sample would fail
+        if not quiet:
+            for note in xml_notes(scene):
+                print(f"spectrinsic dataset: {note}", file=sys.stderr)
+            given = f"the dataset's settings (preset {config.preset!r} and options)"
+            line = render_hints_line(scene, config.render.spp, config.render.max_depth, given)
+            if line is not None:
+                print(f"spectrinsic dataset: {line}", file=sys.stderr)

@@ -7,7 +7,7 @@ import csv
 import fnmatch
 import logging
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from tqdm import tqdm
 
@@ -60,7 +60,7 @@ def _add_folder_options(p: Any) -> None:
     p.add_argument(
         "--dataset",
         metavar="DIR",
-        default=DEFAULT_DATASET,
+        default=None,
         help=f"dataset folder built by `spectrinsic dataset` ({DEFAULT_DATASET})",
     )
     p.add_argument(
@@ -95,7 +95,7 @@ def _add_method_options(p: Any) -> None:
     p.add_argument(
         "--png-encoding",
         choices=("linear", "srgb"),
-        default="linear",
+        default=None,
         help="encoding of 16-bit PNG predictions (linear)",
     )
 
@@ -111,12 +111,12 @@ def _add_scoring_options(p: Any) -> None:
     p.add_argument(
         "--target",
         choices=TARGETS,
-        default="full",
+        default=None,
         help="image the methods decompose: the full image, or the diffuse image "
         "(image - specular) of glossy samples (full); see "
         "spectrinsic.decompose.evaluation.targets",
     )
-    p.add_argument("--seed", type=int, default=0, help="root seed of the WHDR judgements (0)")
+    p.add_argument("--seed", type=int, default=None, help="root seed of the WHDR judgements (0)")
     p.add_argument(
         "--no-cameras",
         action="store_true",
@@ -127,6 +127,7 @@ def _add_scoring_options(p: Any) -> None:
 
 
 def _methods(args: argparse.Namespace) -> dict[str, Any]:
+    encoding: Literal["linear", "srgb"] = "srgb" if args.png_encoding == "srgb" else "linear"
     names = (
         args.methods.split(",")
         if args.methods is not None
@@ -148,7 +149,7 @@ def _methods(args: argparse.Namespace) -> dict[str, Any]:
                 f"--predictions {spec!r}: the name {name!r} is already used; "
                 f"give another as NAME=DIR"
             )
-        methods[name] = Predictions(Path(folder), encoding=args.png_encoding, name=name)
+        methods[name] = Predictions(Path(folder), encoding=encoding, name=name)
     if not methods:
         raise DatasetError("nothing to evaluate: --methods is empty and no --predictions given")
     return methods
@@ -199,7 +200,35 @@ def _run_mit(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Options of a rendered dataset's evaluation and their defaults: given with --mit, which scores
+#: an MIT folder by its own protocol, one is refused in one line instead of ignored.
+DATASET_OPTIONS: dict[str, object] = {
+    "dataset": DEFAULT_DATASET,
+    "target": "full",
+    "seed": 0,
+    "no_cameras": False,
+    "no_figures": False,
+    "no_estimates": False,
+}
+
+
+def _check_mode_options(args: argparse.Namespace) -> None:
+    """Refuse an option given to a mode it does not apply to (before any folder is read)."""
+    if args.png_encoding is not None and not args.predictions:
+        raise DatasetError("--png-encoding applies to --predictions (16-bit PNG predictions)")
+    for dest, default in DATASET_OPTIONS.items():
+        value = getattr(args, dest)
+        if args.mit is not None and value not in (None, False):
+            raise DatasetError(
+                f"--{dest.replace('_', '-')} applies to a rendered dataset; --mit scores an "
+                "MIT folder by the thesis' protocol"
+            )
+        if value is None:
+            setattr(args, dest, default)
+
+
 def run(args: argparse.Namespace) -> int:
+    _check_mode_options(args)
     if args.mit is not None:
         return _run_mit(args)
     folders = _folders(Path(args.dataset), args.samples)

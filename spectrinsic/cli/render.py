@@ -12,6 +12,7 @@ the render settings, variants, timings and the scene. Ground-truth layers are wr
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 from pathlib import Path
 from typing import Any
@@ -36,12 +37,13 @@ from ..render.base.plugins import MAX_PATH_DEPTH
 from ..render.budget import check_render_size
 from ..render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
 from ..render.settings import DEFAULT_MODES as RENDER_DEFAULT_MODES
+from ..scenes.mitsuba_xml import render_hints_line, xml_notes
 from ..scenes.model import Scene
 from ..scenes.sample_id import SampleId
-from ..scenes.sources import FILE_SIZE, is_scene_file
+from ..scenes.sources import FILE_SIZE, is_scene_file, takes_asset_colours
 from . import dataset as cli_dataset
 from .dataset_layers import add_layer_options, given_layer_options, layer_changes
-from .dataset_source import material_map, parse_resolution
+from .dataset_source import add_semantic_map_option, material_map, parse_resolution, semantic_map
 from .render_files import write_render
 from .render_scene import load_scene_argument
 
@@ -106,8 +108,9 @@ def _add_output_options(p: Any) -> None:
     """The render modes and the output folder."""
     p.add_argument(
         "--modes",
-        default=DEFAULT_MODES,
-        help=f"comma-separated render modes (default: {DEFAULT_MODES})",
+        default=None,
+        help=f"comma-separated render modes (default: {DEFAULT_MODES}; with --ground-truth the "
+        "preset's)",
     )
     p.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder")
 
@@ -145,19 +148,28 @@ def _add_pass_options(p: Any, default: DatasetConfig) -> None:
     p.add_argument(
         "--max-depth",
         type=int,
-        default=default.render.max_depth,
-        help=f"longest path, 2 = direct light only (default: {default.render.max_depth})",
+        default=None,
+        help="longest path, 2 = direct light only (default: a Mitsuba XML file's max_depth, "
+        f"else {default.render.max_depth}; with --ground-truth the preset's)",
     )
     p.add_argument(
         "--variant", default=None, help="Mitsuba backend or variant (default: best usable)"
     )
-    p.add_argument("--per-light", action="store_true", help="also write one image per light")
+    p.add_argument(
+        "--per-light",
+        action="store_true",
+        help="also write one image per light (a --ground-truth sample always holds its lights' shares)",
+    )
     p.add_argument("--direct", action="store_true", help="also write direct-light-only images")
-    p.add_argument("--no-aovs", action="store_true", help="skip coverage/id/depth/normal maps")
+    p.add_argument(
+        "--no-aovs",
+        action="store_true",
+        help="skip coverage/id/depth/normal maps (not with --ground-truth: its layers need them)",
+    )
     p.add_argument(
         "--integrator",
         choices=INTEGRATORS,
-        default=DEFAULT_INTEGRATOR,
+        default=None,
         help="diagonal modes from one traversal (single) or K/3 passes per mode and "
         f"one scene per light (passes); same images (default: {DEFAULT_INTEGRATOR})",
     )
@@ -173,7 +185,7 @@ def _add_ground_truth_options(p: Any) -> None:
     )
     p.add_argument(
         "--preset",
-        default="default",
+        default=None,
         help="with --ground-truth: quality preset (default: default, the same spp, depth "
         "and library size as a plain render; preview for a quick look)",
     )
@@ -205,11 +217,20 @@ def _add_material_options(p: Any) -> None:
         default=None,
         help="reflectance of unmapped materials in .blend and mesh files",
     )
+    add_semantic_map_option(p)
     p.add_argument(
         "--colours-from-asset",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="give unmapped materials the colour or texture their file states (glTF base "
+        "colour and texture, OBJ/MTL Kd and map_Kd, Principled Base Color; default: on where "
+        "the file states one; given explicitly for a file that states none: refused)",
+    )
+    p.add_argument(
+        "--approximate",
         action="store_true",
-        help="give unmapped glTF and .blend materials their base colour (glTF "
-        "baseColorFactor, Principled Base Color) as an rgb: reflectance (default: an error)",
+        help="Mitsuba XML: approximate what has no exact ground truth (glass, masks, bump "
+        "maps, bitmaps, environment maps...) instead of refusing it, one line saying what",
     )
 
 
@@ -226,7 +247,7 @@ def _check_size_options(args: argparse.Namespace) -> None:
         raise RenderError(f"--spp {args.spp}; expected at most {UINT32_MAX}")
     if not 0 <= args.seed <= UINT32_MAX:
         raise RenderError(f"--seed {args.seed}; expected a whole number from 0 to {UINT32_MAX}")
-    if not 1 <= args.max_depth <= MAX_PATH_DEPTH:
+    if args.max_depth is not None and not 1 <= args.max_depth <= MAX_PATH_DEPTH:
         raise RenderError(
             f"--max-depth {args.max_depth}; expected 1 to {MAX_PATH_DEPTH} (2 = direct light only)"
         )
@@ -244,13 +265,22 @@ def _check_source_options(args: argparse.Namespace) -> None:
         "--view": args.view is not None,
         "--material-map": args.material_map is not None,
         "--default-spectrum": args.default_spectrum is not None,
+        "--semantic-map": args.semantic_map is not None,
     }
-    library_only, file_only = ("--condition", "--view"), ("--material-map", "--default-spectrum")
+    library_only = ("--condition", "--view")
+    file_only = ("--material-map", "--default-spectrum", "--semantic-map")
+    if args.approximate and Path(args.scene).suffix.lower() != ".xml":
+        raise RenderError(f"--approximate applies to Mitsuba XML scenes; {args.scene!r} is not one")
     for option in library_only if file else file_only:
         if given[option]:
             kind = "a scene file" if file else "a library scene"
-            applies = "library scenes" if file else ".blend and mesh files"
+            applies = "library scenes" if file else "scene files"
             raise RenderError(f"{option} applies to {applies}; {args.scene!r} is {kind}")
+    if args.colours_from_asset is True and not (file and takes_asset_colours(args.scene)):
+        raise RenderError(
+            f"--colours-from-asset applies to glTF/GLB, OBJ/MTL and .blend files; {args.scene!r} states "
+            "no base colours"
+        )
     args.condition = "white" if args.condition is None else args.condition
     args.view = 0 if args.view is None else args.view
 
@@ -271,8 +301,20 @@ def _ground_truth(args: argparse.Namespace) -> int:
     """``render --ground-truth``: a one-sample dataset (library name or scene file), built by
     the same call as ``spectrinsic dataset`` (:func:`spectrinsic.cli.dataset.build`)."""
     changes: dict[str, Any] = {}
+    for option, given in (("--per-light", args.per_light), ("--no-aovs", args.no_aovs)):
+        if given:
+            raise RenderError(
+                f"{option} applies to a raw render; a --ground-truth sample always holds every "
+                "light's share and the AOV layers"
+            )
     if args.spp is not None:
         changes["spp"] = args.spp
+    if args.modes is not None:  # the sample renders (and records) these modes and no others
+        changes["modes"] = tuple(_parse_modes(args))
+    if args.max_depth is not None:
+        changes["max_depth"] = args.max_depth
+    if args.integrator is not None:
+        changes["integrator"] = args.integrator
     if args.direct:
         changes["direct"] = True
     if args.variant is not None:  # the backend of the one-sample dataset too
@@ -289,15 +331,23 @@ def _ground_truth(args: argparse.Namespace) -> int:
             default_spectrum=args.default_spectrum,
             resolution=size,
             new_sample=args.new_sample,
-            colours_from_asset=args.colours_from_asset,
+            colours_from_asset=args.colours_from_asset is not False,
+            approximate=args.approximate,
+            semantic=semantic_map(args.semantic_map),
         )
     else:
         only = str(SampleId(args.scene, args.view, args.condition))
-    config = get_preset(args.preset, seed=args.seed).with_options(**changes)
+    preset = "default" if args.preset is None else args.preset
+    config = get_preset(preset, seed=args.seed).with_options(**changes)
     if not is_scene_file(args.scene) and not getattr(args, "quiet", False):
-        why = "--resolution" if size else f"preset {args.preset!r}"
+        why = "--resolution" if size else f"preset {preset!r}"
         print(f"spectrinsic render: {config.width}x{config.height} ({why})", file=sys.stderr)
-    cli_dataset.preflight(args.out, config, data_dir=getattr(args, "data_dir", None))
+    cli_dataset.preflight(
+        args.out,
+        config,
+        data_dir=getattr(args, "data_dir", None),
+        quiet=getattr(args, "quiet", False),
+    )
     return cli_dataset.build(
         args.out,
         config,
@@ -317,12 +367,12 @@ def _render_settings(args: argparse.Namespace, modes: list[str]) -> RenderSettin
         spp,
         spectral_spp=spectral,
         modes=tuple(modes),
-        max_depth=args.max_depth,
+        max_depth=default.max_depth if args.max_depth is None else args.max_depth,
         variant=args.variant,
         per_light=args.per_light,
         direct=args.direct,
         aovs=not args.no_aovs,
-        integrator=args.integrator,
+        integrator=DEFAULT_INTEGRATOR if args.integrator is None else args.integrator,
     )
 
 
@@ -332,8 +382,14 @@ def run(args: argparse.Namespace) -> int:
     _check_source_options(args)
     if args.ground_truth:
         return _ground_truth(args)
-    if args.ignore_disk_space:  # a plain render's files are small: never estimated
-        raise RenderError("--ignore-disk-space applies only with --ground-truth")
+    for option, given in (
+        ("--ignore-disk-space", args.ignore_disk_space),  # a plain render's files are small
+        ("--new-sample", args.new_sample),
+        ("--preset", args.preset is not None),
+        ("--semantic-map", args.semantic_map is not None),  # a plain render has no layers
+    ):
+        if given:
+            raise RenderError(f"{option} applies only with --ground-truth")
     for option in given_layer_options(args):  # ground-truth layers: a plain render has none
         raise RenderError(
             f"{option} applies only with --ground-truth (a ground-truth layer option)"
@@ -342,6 +398,7 @@ def run(args: argparse.Namespace) -> int:
     check_output_folder(Path(args.out))
     data_dir = getattr(args, "data_dir", None)
     scene = _load_scene(args, data_dir)
+    settings = _file_settings(args, scene, settings)
     given = _given_size(args)
     if not getattr(args, "quiet", False):
         why = given or (
@@ -368,7 +425,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _parse_modes(args: argparse.Namespace) -> list[str]:
     """The ``--modes`` names, each checked to be a known render mode."""
-    modes = [m.strip() for m in str(args.modes).split(",") if m.strip()]
+    given = DEFAULT_MODES if args.modes is None else args.modes
+    modes = [m.strip() for m in str(given).split(",") if m.strip()]
     if not modes:
         raise SceneError(
             f"--modes {args.modes!r}: expected a comma-separated list such as {DEFAULT_MODES}"
@@ -391,8 +449,34 @@ def _load_scene(args: argparse.Namespace, data_dir: str | None) -> Scene:
         materials=material_map(args.material_map),
         default_spectrum=args.default_spectrum,
         data_dir=data_dir,
-        colours_from_asset=args.colours_from_asset,
+        colours_from_asset=args.colours_from_asset is not False,
+        approximate=args.approximate,
     )
+
+
+def _file_settings(
+    args: argparse.Namespace, scene: Scene, settings: RenderSettings
+) -> RenderSettings:
+    """*settings* with a Mitsuba XML file's ``sample_count`` and ``max_depth`` where the
+    command line gave no ``--spp`` / ``--max-depth``; says what it read and which applies."""
+    if not getattr(args, "quiet", False):
+        for note in xml_notes(scene):
+            print(f"spectrinsic render: {note}", file=sys.stderr)
+        line = render_hints_line(scene, args.spp, args.max_depth)
+        if line is not None:
+            print(f"spectrinsic render: {line}", file=sys.stderr)
+    hints = scene.metadata.get("render_hints") or {}
+    changes: dict[str, Any] = {}
+    if args.spp is None and "spp" in hints:
+        changes |= {"spp": int(hints["spp"]), "spectral_spp": None}
+    if args.max_depth is None and "max_depth" in hints:
+        if not 1 <= int(hints["max_depth"]) <= MAX_PATH_DEPTH:
+            raise RenderError(
+                f"{args.scene}: max_depth {hints['max_depth']}; expected 1 to {MAX_PATH_DEPTH} "
+                "(give --max-depth)"
+            )
+        changes["max_depth"] = int(hints["max_depth"])
+    return dataclasses.replace(settings, **changes) if changes else settings
 
 
 def _given_size(args: argparse.Namespace) -> str:

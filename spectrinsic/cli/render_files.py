@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from ..file_writes import write_text_file
 from ..gt_export.formats.exr import write_exr
 from ..gt_export.formats.png import encode_srgb8, exposure, write_png
 from ..render import RenderResult
@@ -79,7 +80,5 @@ def write_render(
         {"name": m.name, "object_id": m.object_id, "faces": len(m.faces)} for m in scene.meshes
     ]
     paths["meta"] = out / "meta.json"
-    paths["meta"].write_text(
-        json.dumps(meta, indent=2, default=str, allow_nan=False) + "\n", encoding="utf-8"
-    )
+    write_text_file(paths["meta"], json.dumps(meta, indent=2, default=str, allow_nan=False) + "\n")
     return paths

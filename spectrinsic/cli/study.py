@@ -2,7 +2,8 @@
 
 * ``reconstruction-error``: Table 5.2 and its extension (:mod:`spectrinsic.studies.reconstruction`);
 * ``photometric``: Table 4.4 (:mod:`spectrinsic.studies.photometric`);
-* ``rendering``: the rendering study (:mod:`spectrinsic.studies.rendering`).
+* ``rendering``: the rendering study (:mod:`spectrinsic.studies.rendering`);
+* ``sim2real``: the sim-to-real study (:mod:`spectrinsic.studies.sim2real`).
 """
 
 from __future__ import annotations
@@ -18,10 +19,12 @@ from tqdm import tqdm
 
 from ..errors import StudyError
 from ..gt_export.folders.staged_output import staged_output
+from ..learn.torch_import import require_torch
 from ..studies.photometric import CAMERA_BALANCES
 from ..studies.photometric.compute import default_cameras
 from ..studies.registry import STUDIES, StudyOptions, run_study
 from ..studies.rendering import QUALITIES
+from ..studies.sim2real import PRESETS as SIM2REAL_PRESETS
 
 __all__ = ["register", "run"]
 
@@ -53,7 +56,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--camera-balance",
-        default="equal-energy-white",
+        default=None,
         choices=CAMERA_BALANCES,
         help="photometric: normalisation of the camera curves (default: "
         "equal-energy-white, the one giving the thesis' SC3 behaviour)",
@@ -65,9 +68,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--quality",
-        default="default",
+        default=None,
         choices=tuple(QUALITIES),
         help="rendering: quality preset (default: default, < 10 min on 2 cores)",
+    )
+    p.add_argument(
+        "--preset",
+        default=None,
+        choices=tuple(SIM2REAL_PRESETS),
+        help="sim2real: size preset (default: small, about an hour on 2 CPU cores; large for "
+        "a GPU or a cluster)",
     )
     p.set_defaults(func=run)
 
@@ -106,6 +116,7 @@ def run(args: argparse.Namespace) -> int:
             camera_balance=args.camera_balance,
             extension=not args.no_extension,
             quality=args.quality,
+            preset=args.preset,
         )
         with _progress(bool(getattr(args, "quiet", False)), args.study) as progress:
             done = run_study(
@@ -120,8 +131,30 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Options of one study each (dest -> (study, default)): given to another, one is refused
+#: in one line instead of ignored; not given, it takes its default.
+STUDY_OPTIONS: dict[str, tuple[str, object]] = {
+    "include_ie": ("photometric", False),
+    "camera_balance": ("photometric", "equal-energy-white"),
+    "no_extension": ("reconstruction-error", False),
+    "quality": ("rendering", "default"),
+}
+
+
 def _check_options(args: argparse.Namespace) -> None:
     """Refusals that need no computation, before the output folder is made."""
+    if args.preset is not None and args.study != "sim2real":
+        raise StudyError(f"--preset {args.preset}: applies to sim2real only, not {args.study}")
+    for dest, (study, default) in STUDY_OPTIONS.items():
+        value = getattr(args, dest)
+        if value not in (None, False) and args.study != study:
+            raise StudyError(
+                f"--{dest.replace('_', '-')} applies to the {study} study; this is {args.study}"
+            )
+        if value is None:
+            setattr(args, dest, default)
+    if args.study == "sim2real":
+        require_torch("study sim2real")
     if args.study == "photometric" and args.include_ie:
         data_dir = getattr(args, "data_dir", None)
         if not any(n.endswith("[IE]") for n in default_cameras(data_dir=data_dir, include_ie=True)):

@@ -46,12 +46,12 @@ from ..gt_export.sample.integrity import (
     write_marker,
 )
 from ..render import render_batches, set_thread_count
+from ..render.base.variants import import_mitsuba
 from ..render.probe import probe_luminance
 from ..render.transport_render import render_transport_batches
 from ..scenes.library import build
 from ..scenes.sources import GeneratedSource
-from ..spectra import get_sensors
-from ..spectra.camera_model import camera_model
+from ..spectra.camera_model import camera_model, camera_sensors
 from .disk_space import check_disk_space
 from .executors import Executor, SerialExecutor
 from .presets import DatasetConfig
@@ -187,6 +187,7 @@ def _task_scene(task: SampleTask) -> Any:
             height=cfg.height,
         )
 
+    import_mitsuba()  # set up before a Mitsuba XML read imports it (the libLLVM Dr.Jit loads)
     if not isinstance(task.source, GeneratedSource):
         return task.source.build(task.data_dir)
     probe = partial(probe_luminance, data_dir=task.data_dir, variant=task.config.render.variant)
@@ -274,8 +275,8 @@ def build_dataset(
     """
 
     out = Path(out_dir)
-    if config.camera:  # its curves exist (a data-directory camera needs --data-dir): one line
-        get_sensors(camera_model(config.camera).sensitivities, data_dir=data_dir)
+    if config.camera:  # three sound curves (a data-directory camera needs --data-dir): one line
+        camera_sensors(camera_model(config.camera), data_dir=data_dir)
     new = check_build_folder(out, config.config_hash(), rebuild=rebuild) is None  # before mkdir
     with folder_lock(out), unmarked_on_error(out, new):  # one build per folder, held
         return _build_locked(

@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any, Protocol, TypeVar
 
 from ..errors import DatasetError, MissingDependencyError, validate_choice
+from ..file_writes import write_text_file
 from ..interrupts import raise_if_requested
 
 __all__ = [
@@ -208,7 +209,7 @@ class ProcessExecutor:
 def _run_recorded(fn: Callable[[T], R], item: T, index: int, running_dir: str) -> R:
     """Run ``fn(item)`` in a worker, leaving a file naming *index* while it runs."""
     record = Path(running_dir, str(os.getpid()))
-    record.write_text(str(index))
+    write_text_file(record, str(index))
     try:
         return fn(item)
     finally:

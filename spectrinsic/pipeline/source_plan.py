@@ -36,11 +36,13 @@ from ..scenes.generators import (
     generated_family,
     generated_scene_name,
 )
+from ..scenes.generators.daylight import FLUX_SHARE
 from ..scenes.generators.lights import check_saturation
 from ..scenes.generators.materials import check_ranges
 from ..scenes.model import Scene
 from ..scenes.sample_id import SampleId
 from ..scenes.scene_writer import save_scene
+from ..scenes.semantic import SemanticRules, rules_from_record
 from ..scenes.sources import FileSource, GeneratedSource, scene_file_kind
 from ..scenes.yaml_limits import load_yaml_file
 from ..spectra import list_spectra
@@ -49,6 +51,7 @@ from .tasks import SampleTask
 
 __all__ = [
     "check_integrator_plan",
+    "check_scene_integrator",
     "SCENES_FOLDER",
     "generator_source",
     "files_source",
@@ -56,6 +59,7 @@ __all__ = [
     "save_generated",
     "saved_sample",
     "file_sample",
+    "semantic_rules",
 ]
 
 #: Folder of a dataset holding the generated scenes' YAML files.
@@ -68,9 +72,35 @@ MAX_COUNT = 100_000
 #: version (other light pools, furniture, framing) asks for ``--rebuild`` instead of mixing.
 #: 2: saturated lights, ranges obeyed by every material, framed rooms (issue 22).
 #: 3: cameras pass the view rule (``scenes.generators.view_rule``, issue 31).
-#: 4: views are also judged on their rendered light (a probe render, issue 47).
-GENERATOR_VERSION = 4
+#: 4: ``objects-on-ground``'s library objects take ``--texture-fraction`` too (issue 44).
+#: 5: views are also judged on their rendered light (a probe render, issue 47).
+GENERATOR_VERSION = 5
 MAX_VIEWS = 64
+
+
+def _daylight_spec(generator: str, share: float, only: bool) -> dict[str, Any]:
+    """The source entries of ``--daylight-share`` / ``--daylight-only`` (none at share 0, so
+    sets without daylight keep their hash), validated."""
+    if not 0.0 <= share <= 1.0 or (share > 0 and generator != "rooms"):
+        raise DatasetError(
+            f"--daylight-share {share:g}: expected a fraction in 0..1 of the rooms "
+            f"generator's scenes (generator {generator!r})"
+        )
+    if only and share <= 0:
+        raise DatasetError(
+            "--daylight-only: applies to daylight rooms only; expected --daylight-share F > 0"
+        )
+    if share <= 0:
+        return {}
+    # the lamps' balance against the daylight (issue 42): sets of before, whose lamps were
+    # not balanced, keep a config hash of their own
+    spec: dict[str, Any] = {
+        "daylight_share": float(share),
+        "daylight_flux_share": [float(v) for v in FLUX_SHARE],
+    }
+    if only:
+        spec["daylight_only"] = True
+    return spec
 
 
 def generator_source(
@@ -86,11 +116,13 @@ def generator_source(
     light_saturation: Sequence[float] | None = None,
     texture_fraction: float = 0.0,
     daylight_share: float = 0.0,
+    daylight_only: bool = False,
 ) -> str:
     """The canonical ``source`` JSON of a generated set (validated: an impossible range is
     refused here, before any scene is planned); *gloss*, *light_saturation* and a
     *texture_fraction* above 0 enter it only when given, so matte sets and older configs keep
-    their source and config hash; so does a *daylight_share* (``rooms`` only) above 0."""
+    their source and config hash; so does a *daylight_share* (``rooms`` only) above 0, and
+    *daylight_only* (those rooms lit by sun and sky alone) when set."""
     validate_choice(generator, GENERATORS, "scene generator", error=DatasetError)
     try:
         check_ranges(
@@ -106,11 +138,6 @@ def generator_source(
         raise DatasetError(f"--light-saturation: {exc}") from None
     if not 0.0 <= texture_fraction <= 1.0:
         raise DatasetError(f"--texture-fraction {texture_fraction:g}: expected a fraction in 0..1")
-    if not 0.0 <= daylight_share <= 1.0 or (daylight_share > 0 and generator != "rooms"):
-        raise DatasetError(
-            f"--daylight-share {daylight_share:g}: expected a fraction in 0..1 of the rooms "
-            f"generator's scenes (generator {generator!r})"
-        )
     if not (1 <= count <= MAX_COUNT and 1 <= views <= MAX_VIEWS):
         raise DatasetError(
             f"--count {count} / --views {views}; expected whole numbers from 1 to "
@@ -136,8 +163,7 @@ def generator_source(
         spec["light_saturation"] = [float(v) for v in light_saturation]
     if texture_fraction > 0:
         spec["texture_fraction"] = float(texture_fraction)
-    if daylight_share > 0:
-        spec["daylight_share"] = float(daylight_share)
+    spec |= _daylight_spec(generator, daylight_share, daylight_only)
     return json.dumps(spec, sort_keys=True, allow_nan=False)
 
 
@@ -148,12 +174,18 @@ def files_source(
     default_spectrum: str | None = None,
     resolution: tuple[int, int] | None = None,
     new_sample: bool = False,
-    colours_from_asset: bool = False,
+    colours_from_asset: bool = True,
+    approximate: bool = False,
+    semantic: SemanticRules | None = None,
 ) -> str:
     """The canonical ``source`` JSON of a set of scene files (each must exist): rendered at
     *resolution* ``(W, H)``, else at each file's own camera size; a saved generated scene as
-    its own sample unless *new_sample*; *colours_from_asset* (in the JSON only when set, so
-    older configs keep their hash): base colours of glTF and ``.blend`` materials as spectra."""
+    its own sample unless *new_sample*; *colours_from_asset* (always in the JSON since issue 41
+    made it the default; a config without it was written before and means False, so older
+    datasets rebuild as they were): the colours and textures the files state;
+    *approximate* (in the JSON only when set, so older configs keep their hash): Mitsuba XML
+    content without exact ground truth approximated; *semantic* (likewise): the
+    ``--semantic-map`` rules, before the default map's."""
     entries = []
     for p in paths:
         path = Path(p).resolve()
@@ -165,15 +197,22 @@ def files_source(
     dupes = sorted({s for s in stems if stems.count(s) > 1})
     if dupes:
         raise DatasetError(f"--scenes: several scenes named {dupes}; scene names must be unique")
-    spec = {
+    spec: dict[str, Any] = {
         "scenes": entries,
         "materials": dict(sorted((materials or {}).items())),
         "default_spectrum": default_spectrum,
         "new_sample": bool(new_sample),
         "resolution": None if resolution is None else [int(v) for v in resolution],
     }
-    if colours_from_asset:
-        spec["colours_from_asset"] = True
+    spec["colours_from_asset"] = bool(colours_from_asset)
+    if approximate:
+        if not any(scene_file_kind(e["path"]) == "mitsuba" for e in entries):
+            raise DatasetError(
+                "--approximate applies to Mitsuba XML scenes; no --scenes file is one"
+            )
+        spec["approximate"] = True
+    if semantic is not None:  # --semantic-map's rules themselves (in the JSON only when given)
+        spec["semantic_map"] = semantic.record()
     ids = [str(file_sample(e["path"], new_sample=new_sample)[0]) for e in entries]
     dupes = sorted({i for i in ids if ids.count(i) > 1})
     if dupes:
@@ -270,6 +309,7 @@ def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir:
         gloss=gloss,
         light_saturation=None if saturation is None else tuple(saturation),
         daylight_share=float(spec.get("daylight_share", 0.0)),
+        daylight_only=bool(spec.get("daylight_only", False)),
     )
 
 
@@ -302,6 +342,12 @@ def plan_source_samples(
     ]
 
 
+def semantic_rules(spec: Mapping[str, Any]) -> SemanticRules:
+    """The ``--semantic-map`` rules a files source records (none: the default map alone)."""
+    record = spec.get("semantic_map")
+    return SemanticRules() if record is None else rules_from_record(record, "--semantic-map")
+
+
 def _file_tasks(
     spec: Mapping[str, Any],
     out: str,
@@ -322,7 +368,9 @@ def _file_tasks(
             height,
             materials,
             spec.get("default_spectrum"),
-            colours_from_asset=bool(spec.get("colours_from_asset")),
+            colours_from_asset=bool(spec.get("colours_from_asset", False)),
+            approximate=bool(spec.get("approximate")),
+            semantic=semantic_rules(spec),
         )
         sid, seed = file_sample(entry["path"], new_sample=bool(spec.get("new_sample")))
         task = SampleTask.planned(
@@ -342,6 +390,23 @@ def save_generated(
     folder.mkdir(parents=True, exist_ok=True)
     record = {**scene.metadata, "sample": {"id": sample_id, "seed": int(seed)}}
     return save_scene(dataclasses.replace(scene, metadata=record), folder / f"{sample_id}.yaml")
+
+
+def check_scene_integrator(config: DatasetConfig, scene: Scene, path: str) -> None:
+    """Refuse, before the first sample, a scene file (``--scenes``, ``render --ground-truth``)
+    with glossy materials or a spectral texture whose diagonal modes would render with the
+    passes integrator: its sample would fail (the passes render neither)."""
+    if not diagonal_mode_names(config.render.modes):
+        return
+    if resolve_integrator(config.render.integrator, config.render.variant) != "passes":
+        return
+    glossy = any(m.glossy for m in scene.materials)
+    if glossy or scene.textured:
+        what = "glossy or metal materials" if glossy else "a spectral texture"
+        raise DatasetError(
+            f"{path}: holds {what}, which the passes integrator cannot render in the diagonal "
+            "modes; use --integrator single on a JIT (LLVM/CUDA) variant"
+        )
 
 
 def check_integrator_plan(config: DatasetConfig) -> None:

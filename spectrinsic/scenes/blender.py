@@ -22,13 +22,15 @@ spectrum needed), else Roughness < 0.5 a coated diffuse (``plastic``, the node's
 Roughness² (Blender's convention). Everything else of the node (coat, sheen, subsurface,
 transmission, emission, textures) is ignored; other materials are Lambertian.
 
-With ``colours_from_asset=True`` (``--colours-from-asset``), a material that the mapping, its
+With ``colours_from_asset=True`` (the default; ``--no-colours-from-asset`` turns it off), a
+material that the mapping, its
 custom property and its name leave without a spectrum takes the Principled node's Base Color
 (scene-linear Rec. 709, as Blender stores it; alpha ignored) as the reflectance ``rgb:R,G,B``
 (:mod:`spectrinsic.spectra.user_spectra`, Mallett & Yuksel 2019); a colour outside [0, 1] is
 refused when validated, not clipped, and a Base Color fed by a node (an image texture) is not
-read, so that material still needs a spectrum. Without the option such a material is an error,
-so no colour is taken from a file unless asked for.
+read, so that material still needs a spectrum, unless the node is an Image Texture on a UV
+map: that image becomes an exact spectral texture (:mod:`spectrinsic.scenes.blender_colours`;
+the object must hold that material alone). Without the option such a material is an error.
 
 Opening a file replaces the data of the running ``bpy`` session (Blender has one global state).
 """
@@ -46,8 +48,12 @@ import numpy as np
 
 from ..errors import MissingDependencyError, SceneError, SpectrinsicError, with_article
 from ..spectra import get_spectrum
+from .blender_colours import base_colour, corner_uvs, object_texture, principled_node
+from .budget import SceneBudget
+from .image_textures import corner_spectra
 from .materials import IOR_RANGE, METAL_SPECTRUM, material_problem
 from .model import Camera, Light, Material, Mesh, Scene
+from .textures import Texture, make_image_texture
 from .validate import validate_scene
 
 __all__ = ["load_blend", "SPECTRUM_PROPERTY", "METAL_PROPERTY", "base_colour", "principled_gloss"]
@@ -77,28 +83,10 @@ def _matrix(obj: Any) -> np.ndarray:
     return np.array([list(row) for row in obj.matrix_world], dtype=np.float64)
 
 
-def _principled(mat: Any) -> Any:
-    """*mat*'s first Principled BSDF node, or None."""
-    tree = getattr(mat, "node_tree", None)
-    if tree is None:
-        return None
-    return next((n for n in tree.nodes if n.type == "BSDF_PRINCIPLED"), None)
-
-
-def base_colour(mat: Any) -> str | None:
-    """``"rgb:R,G,B"`` of *mat*'s Principled Base Color (module docstring); None without the
-    node or when a texture (any link) feeds the colour."""
-    node = _principled(mat)
-    if node is None or node.inputs["Base Color"].is_linked:
-        return None
-    rgba = node.inputs["Base Color"].default_value
-    return "rgb:" + ",".join(f"{float(c):.9g}" for c in list(rgba)[:3])
-
-
 def principled_gloss(mat: Any) -> dict[str, Any]:
     """Gloss fields of :class:`Material` from *mat*'s first Principled BSDF node (module
     docstring); ``{}`` (Lambertian) without one or when it is matte."""
-    node = _principled(mat)
+    node = principled_node(mat)
     if node is None:
         return {}
     rough = float(node.inputs["Roughness"].default_value)
@@ -254,7 +242,7 @@ class _MaterialTable:
         mapping: Mapping[str, str],
         default_spectrum: str | None,
         data_dir: str | None,
-        colours_from_asset: bool = False,
+        colours_from_asset: bool = True,
     ) -> None:
         self.source = source
         self.colours_from_asset = colours_from_asset
@@ -288,26 +276,58 @@ class _MaterialTable:
                 spectrum,
                 "reflectance",
                 f"name the material after a spectrum, set its custom property {SPECTRUM_PROPERTY!r}, "
-                f"or pass materials={{{name!r}: ...}}",
+                f"or pass materials={{{name!r}: ...}} (--material-map, --default-spectrum; "
+                "--colours-from-asset reads a Base Color or image texture)",
                 self.data_dir,
             )
             self.table[name] = Material(name=name, spectrum=spectrum, **gloss)
         return list(self.table).index(name)
 
-    def _colour(self, mat: Any) -> str | None:
-        """The base colour when asked for and the name is no spectrum (module docstring)."""
-        if not self.colours_from_asset:
-            return None
+    def _from_asset(self, mat: Any) -> bool:
+        """Whether *mat* takes the file's colour: asked for, and neither mapped, nor given a
+        spectrum property, nor named after a spectrum (module docstring)."""
+        if not self.colours_from_asset or mat is None:
+            return False
+        if mat.name in self.mapping or _prop(mat) is not None:
+            return False
         try:
             get_spectrum(mat.name, data_dir=self.data_dir)
         except SpectrinsicError:
-            return base_colour(mat)
-        return None
+            return True
+        return False
+
+    def _colour(self, mat: Any) -> str | None:
+        """The base colour when the material takes the file's colour."""
+        return base_colour(mat) if self._from_asset(mat) else None
+
+    def texture(
+        self, mats: Mapping[int, Any], uvs: Mapping[str, np.ndarray], obj: str
+    ) -> Texture | None:
+        """The image texture of object *obj* whose slots hold *mats*, or None
+        (:func:`~spectrinsic.scenes.blender_colours.object_texture`)."""
+        chosen = [m for m in mats.values() if self._from_asset(m)]
+        where = f"{self.source}: object {obj!r}"
+        hit = object_texture(chosen, len(mats), uvs, Path(self.source), where)
+        if hit is None:
+            return None
+        mat, image, uv = hit
+        if principled_gloss(mat):
+            raise SceneError(f"{self.source}: material {mat.name!r} is textured and glossy")
+        basis = []
+        for spectrum in corner_spectra():
+            self.table.setdefault(spectrum, Material(name=spectrum, spectrum=spectrum))
+            basis.append(list(self.table).index(spectrum))
+        return make_image_texture(mat.name, tuple(basis), image, uv)
 
 
-def _triangles(obj: Any, depsgraph: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """Object-space vertices ``(V, 3)``, triangles ``(F, 3)`` and material slots ``(F,)`` of
-    *obj* with its modifiers applied; None if it has no faces."""
+_Triangles = tuple[np.ndarray, np.ndarray, np.ndarray, dict[str, np.ndarray]]
+
+
+def _triangles(obj: Any, depsgraph: Any, budget: SceneBudget) -> _Triangles | None:
+    """Object-space vertices ``(V, 3)``, triangles ``(F, 3)``, material slots ``(F,)`` and
+    corner UVs by map (:func:`~spectrinsic.scenes.blender_colours.corner_uvs`) of *obj* with
+    its modifiers applied; None if it has no faces. Its counts are charged to *budget* before
+    its arrays are copied out of Blender."""
     evaluated = obj.evaluated_get(depsgraph)
     me = evaluated.to_mesh()
     try:
@@ -315,38 +335,49 @@ def _triangles(obj: Any, depsgraph: Any) -> tuple[np.ndarray, np.ndarray, np.nda
         n_tri = len(me.loop_triangles)
         if n_tri == 0:
             return None
+        budget.charge(f"object {obj.name!r}", faces=n_tri, vertices=len(me.vertices))
         co = np.empty(len(me.vertices) * 3, dtype=np.float64)
         me.vertices.foreach_get("co", co)
         tri = np.empty(n_tri * 3, dtype=np.int64)
         me.loop_triangles.foreach_get("vertices", tri)
         slot = np.empty(n_tri, dtype=np.int64)
         me.loop_triangles.foreach_get("material_index", slot)
+        loops = np.empty(n_tri * 3, dtype=np.int64)
+        me.loop_triangles.foreach_get("loops", loops)
+        uvs = corner_uvs(me, loops.reshape(-1, 3))
     finally:
         evaluated.to_mesh_clear()
-    return co.reshape(-1, 3), tri.reshape(-1, 3), slot
+    return co.reshape(-1, 3), tri.reshape(-1, 3), slot, uvs
 
 
-def _mesh(obj: Any, depsgraph: Any, materials: _MaterialTable, object_id: int) -> Mesh | None:
+def _mesh(
+    obj: Any, depsgraph: Any, materials: _MaterialTable, object_id: int, budget: SceneBudget
+) -> Mesh | None:
     """*obj* as a world-space :class:`Mesh`, each face naming its scene material; None if empty."""
-    triangles = _triangles(obj, depsgraph)
+    triangles = _triangles(obj, depsgraph, budget)
     if triangles is None:
         return None
-    co, faces, slot = triangles
+    co, faces, slot, uvs = triangles
     m = _matrix(obj)
     vertices = co @ m[:3, :3].T + m[:3, 3]
     if np.linalg.det(m[:3, :3]) < 0:  # a mirroring transform reverses the winding
         faces = faces[:, ::-1].copy()
+        uvs = {k: uv[:, ::-1] for k, uv in uvs.items()}
     slots = [s.material for s in obj.material_slots] or [None]
     used = np.unique(slot)
+    # Blender clamps indices past the last slot to it
+    mats = {int(s): slots[min(int(s), len(slots) - 1)] for s in used}
+    texture = materials.texture(mats, uvs, obj.name)
     lookup = np.zeros(int(used.max()) + 1, dtype=np.int64)
-    for s in used:  # Blender clamps indices past the last slot to it
-        lookup[s] = materials.index(slots[min(int(s), len(slots) - 1)], obj.name)
+    for s in used if texture is None else ():
+        lookup[s] = materials.index(mats[int(s)], obj.name)
     return Mesh(
         name=obj.name,
         vertices=vertices,
         faces=faces,
-        face_materials=lookup[slot],
+        face_materials=np.full(len(faces), texture.basis[0]) if texture else lookup[slot],
         object_id=object_id,
+        texture=texture,
     )
 
 
@@ -359,7 +390,7 @@ def load_blend(
     resolution: tuple[int, int] | None = None,
     data_dir: str | None = None,
     validate: bool = True,
-    colours_from_asset: bool = False,
+    colours_from_asset: bool = True,
 ) -> Scene:
     """Read a ``.blend`` file into a :class:`~spectrinsic.scenes.model.Scene`.
 
@@ -382,7 +413,7 @@ def load_blend(
         Run :func:`~spectrinsic.scenes.validate.validate_scene` on the result.
     colours_from_asset
         Give materials without a spectrum their Principled Base Color as an ``rgb:``
-        reflectance (module docstring); False: they are an error.
+        reflectance (module docstring, the default); False: they are an error.
 
     Raises
     ------
@@ -402,13 +433,14 @@ def load_blend(
     table = _MaterialTable(source, materials or {}, default_spectrum, data_dir, colours_from_asset)
     meshes: list[Mesh] = []
     lights: list[Light] = []
+    budget = SceneBudget(source)
     for obj in sorted(bpy_scene.objects, key=lambda o: o.name):
         if obj.hide_render or not obj.visible_get():
             continue
         if obj.type == "LIGHT":
             lights.append(_light(source, obj, light_spectrum, data_dir))
         elif obj.type in _MESH_LIKE:
-            mesh = _mesh(obj, depsgraph, table, object_id=len(meshes))
+            mesh = _mesh(obj, depsgraph, table, object_id=len(meshes), budget=budget)
             if mesh is not None:
                 meshes.append(mesh)
     scene = Scene(

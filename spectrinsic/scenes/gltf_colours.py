@@ -1,61 +1,133 @@
-"""glTF base colours as reflectance spectra.
+"""glTF base colours and base-colour textures as reflectance spectra.
 
 A glTF material's ``pbrMetallicRoughness.baseColorFactor`` is a linear-sRGB colour (glTF 2.0
-spec, section 3.9.2); :func:`gltf_base_colours` turns each one the file states into the
-registry name ``rgb:R,G,B`` (:mod:`spectrinsic.spectra.user_spectra`: Mallett & Yuksel 2019),
-so a coloured asset renders in its colours without a material map when asked for
-(``colours_from_asset=True``, ``--colours-from-asset``; without it an unmapped material is an
-error, :mod:`spectrinsic.scenes.meshes`). Alpha is ignored (surfaces
-are opaque). A factor outside [0, 1] is refused when the scene is validated, not clipped.
-Materials without an explicit factor get none (glTF's default white is not assumed), and
-``baseColorTexture`` images are not read: such materials still need the map or a default.
+spec, section 3.9.2) and its ``baseColorTexture`` an sRGB-encoded image that the factor
+multiplies (section 3.9.2, 3.8.4). :func:`gltf_colours` reads both for every named material:
+a factor alone becomes the registry name ``rgb:R,G,B`` (:mod:`spectrinsic.spectra.user_spectra`:
+Mallett & Yuksel 2019), a texture an :class:`~spectrinsic.scenes.image_textures.ImageTexture`
+(decoded, times the factor, with the sampler's wrap mode and filter), which the mesh reader maps
+by the primitive's own ``TEXCOORD_0``. Alpha is not read (surfaces are opaque). A factor outside
+[0, 1] is refused when the scene is validated, not clipped. Materials with neither get nothing
+(glTF's default white is not assumed): such a material still needs the map or a default.
 
-Why textures are not read (yet): the uplift is linear in linear RGB, so a texel's reflectance
-is exactly the trilinear mix of the 8 spectra ``rgb:`` of the RGB cube's corners (weights
-``Π x_i or 1 - x_i``, non-negative, summing to 1), which is the convex per-texel mix the
-textured-material route (:mod:`spectrinsic.scenes.textures`) keeps exact. Two limits of that
-route stand in the way: a texture has at most ``BASIS_MAX`` = 4 basis spectra (an arbitrary
-image needs all 8 corners; the 3 primaries alone are not convex, their weights sum to
-R + G + B), and texels are placed by its one box projection (``box_uv``), not by the asset's
-own ``TEXCOORD_0``, so the image would land in the wrong places. Raising ``BASIS_MAX`` to 8 and
-carrying per-vertex UVs in :class:`~spectrinsic.scenes.textures.Texture` (scene format and
-renderer lookup) would make sRGB-decoded ``baseColorTexture`` images exact.
+Images are read from the file's own binary chunk (``.glb``), a ``data:`` URI or a file beside
+the ``.gltf`` (inside its folder; a path escaping it is refused).
 """
 
 from __future__ import annotations
 
+import base64
 import json
 import struct
 from pathlib import Path
 from typing import Any
 
 from ..errors import SceneError
+from .image_textures import AssetColour, Filter, Wrap, image_texture_from_bytes
 
-__all__ = ["gltf_base_colours"]
+__all__ = ["gltf_colours"]
+
+#: glTF sampler codes (spec 5.26): wrapS/wrapT and magFilter.
+_WRAP = {10497: "repeat", 33071: "clamp", 33648: "mirror"}
+_NEAREST = 9728
 
 
-def _document(path: Path) -> dict[str, Any]:
+def _chunks(path: Path) -> tuple[dict[str, Any], bytes]:
+    """The glTF JSON and, for ``.glb``, its binary chunk (``b""`` otherwise)."""
     data = path.read_bytes()
     try:
         if path.suffix.lower() == ".glb":
             length = struct.unpack("<I", data[12:16])[0]
-            return json.loads(data[20 : 20 + length])
-        return json.loads(data)
+            document = json.loads(data[20 : 20 + length])
+            rest = data[20 + length :]
+            binary = rest[8 : 8 + struct.unpack("<I", rest[:4])[0]] if len(rest) >= 8 else b""
+            return document, binary
+        return json.loads(data), b""
     except (ValueError, struct.error) as exc:
         raise SceneError(f"{path}: cannot read its glTF JSON ({exc})") from None
 
 
-def gltf_base_colours(path: str | Path) -> dict[str, str]:
-    """``{material name: "rgb:R,G,B"}`` for every named material of the ``.gltf``/``.glb``
-    file at *path* with a ``baseColorFactor`` (module docstring); ``{}`` for other files."""
+def _uri_bytes(path: Path, uri: str) -> bytes:
+    """The bytes a glTF *uri* names: a ``data:`` URI or a file inside *path*'s folder."""
+    if uri.startswith("data:"):
+        return base64.b64decode(uri.split(",", 1)[-1])
+    base = path.parent.resolve()
+    full = (base / uri).resolve()
+    if not full.is_relative_to(base) or not full.is_file():
+        raise SceneError(f"{path}: image or buffer {uri!r} is not a file inside {base}")
+    return full.read_bytes()
+
+
+def _image_bytes(path: Path, doc: dict[str, Any], binary: bytes, index: int) -> bytes:
+    image = (doc.get("images") or [])[index]
+    if "uri" in image:
+        return _uri_bytes(path, str(image["uri"]))
+    view = doc["bufferViews"][int(image["bufferView"])]
+    buffer = doc["buffers"][int(view.get("buffer", 0))]
+    data = _uri_bytes(path, str(buffer["uri"])) if "uri" in buffer else binary
+    offset = int(view.get("byteOffset", 0))
+    return data[offset : offset + int(view["byteLength"])]
+
+
+def _texture(path: Path, doc: dict[str, Any], binary: bytes, ref: Any, factor: Any) -> Any:
+    """The ImageTexture of a ``baseColorTexture`` reference *ref*, times *factor*."""
+    try:
+        texture = doc["textures"][int(ref["index"])]
+        index = int(texture["source"])
+        data = _image_bytes(path, doc, binary, index)
+        sampler = (
+            (doc.get("samplers") or [{}])[int(texture["sampler"])] if "sampler" in texture else {}
+        )
+    except SceneError:
+        raise
+    except (KeyError, IndexError, TypeError, ValueError) as exc:
+        raise SceneError(
+            f"{path}: baseColorTexture {ref!r} names nothing readable ({exc!r})"
+        ) from None
+    if ref.get("extensions"):  # KHR_texture_transform and the like would move the texels
+        raise SceneError(
+            f"{path}: baseColorTexture extensions {sorted(ref['extensions'])} are not supported"
+        )
+    if int(ref.get("texCoord", 0)) != 0:
+        raise SceneError(f"{path}: baseColorTexture uses TEXCOORD_{ref['texCoord']}; expected 0")
+    wraps = {_WRAP.get(int(sampler.get(k, 10497)), "repeat") for k in ("wrapS", "wrapT")}
+    if len(wraps) > 1:
+        raise SceneError(
+            f"{path}: sampler wraps S and T differently ({sorted(wraps)}); expected one mode"
+        )
+    wrap: Wrap = wraps.pop()  # type: ignore[assignment]
+    filt: Filter = "nearest" if sampler.get("magFilter") == _NEAREST else "bilinear"
+    return image_texture_from_bytes(
+        data,
+        source=f"{path.name}#images/{index}",
+        srgb=True,
+        wrap=wrap,
+        filter=filt,
+        factor=tuple(float(c) for c in factor[:3]),  # type: ignore[arg-type]
+    )
+
+
+def gltf_colours(path: str | Path) -> dict[str, AssetColour]:
+    """``{material name: AssetColour}`` for every named material of the ``.gltf``/``.glb``
+    file at *path* with a ``baseColorFactor`` or a ``baseColorTexture`` (module docstring);
+    ``{}`` for other files."""
     path = Path(path)
     if path.suffix.lower() not in (".gltf", ".glb"):
         return {}
+    doc, binary = _chunks(path)
     out = {}
-    for material in _document(path).get("materials") or []:
+    for material in doc.get("materials") or []:
         if not isinstance(material, dict) or not isinstance(material.get("name"), str):
             continue
-        factor = (material.get("pbrMetallicRoughness") or {}).get("baseColorFactor")
-        if isinstance(factor, list) and len(factor) == 4:
-            out[material["name"]] = "rgb:" + ",".join(f"{float(c):.9g}" for c in factor[:3])
+        pbr = material.get("pbrMetallicRoughness") or {}
+        factor = pbr.get("baseColorFactor")
+        stated = isinstance(factor, list) and len(factor) == 4
+        if "baseColorTexture" in pbr:
+            image = _texture(
+                path, doc, binary, pbr["baseColorTexture"], factor if stated else [1, 1, 1]
+            )
+            out[material["name"]] = AssetColour(image=image)
+        elif isinstance(factor, list) and len(factor) == 4:
+            rgb = "rgb:" + ",".join(f"{float(c):.9g}" for c in factor[:3])
+            out[material["name"]] = AssetColour(spectrum=rgb)
     return out

@@ -14,7 +14,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .materials import METAL_SPECTRUM
-from .model import Material, Mesh, Scene
+from .model import Material, Scene
 
 __all__ = ["GLOSSY_SUFFIX", "Gloss", "GLOSSY_MESHES", "base_name", "glossy_variant"]
 
@@ -95,7 +95,7 @@ def glossy_variant(scene: Scene, base: str) -> Scene:
             remap[int(m)] = len(materials)
             materials.append(_material(scene.materials[int(m)], gloss, mesh.name))
         new = np.array([remap[int(m)] for m in fm], np.int64)
-        meshes.append(Mesh(mesh.name, mesh.vertices, mesh.faces, new, mesh.object_id))
+        meshes.append(replace(mesh, face_materials=new))
     used = sorted({int(m) for mesh in meshes for m in np.unique(mesh.face_materials)})
     index = {old: i for i, old in enumerate(used)}  # drop materials no face uses any more
     meshes = [

@@ -4,16 +4,22 @@ spectrum map.
 A mesh file carries geometry and material names but no spectra, lights or camera: every
 material name must be in the map (or a default spectrum is given), and the scene gets a framing
 camera and one CIE D65 point light above it, so any mesh renders with full ground truth. Only
-the named file is read (no textures, no referenced files outside its folder are needed).
+the named file and the files it names inside its folder (glTF buffers and images, OBJ ``mtllib``
+files and ``map_Kd`` images) are read.
 
 A glTF material's ``pbrMetallicRoughness`` factors set the gloss as for ``.blend`` files: metallic
 ≥ 0.5 makes a metal (``conductor``, Al: the factors name no metal; no spectrum needed), else
 roughness < 0.5 a coated diffuse (``plastic``, η = 1.5); GGX α = roughness². Absent factors
-count as matte (not glTF's default of 1), so files without them import as before. With
-``colours_from_asset=True`` (``--colours-from-asset``), a material not in the map takes its
-``baseColorFactor`` as an ``rgb:`` reflectance if the file states one
-(:mod:`spectrinsic.scenes.gltf_colours`); without it an unmapped material is an error, as for
-``.blend`` files. Textures and every other field are ignored.
+count as matte (not glTF's default of 1), so files without them import as before.
+
+Colours from the asset (``colours_from_asset=True``, the default; ``--no-colours-from-asset``
+turns it off): a material not in the map takes the colour its file states, a glTF
+``baseColorFactor`` or MTL ``Kd`` as an ``rgb:`` reflectance, or a glTF ``baseColorTexture`` /
+MTL ``map_Kd`` image as an exact spectral texture over the 8 RGB-cube corner reflectances,
+mapped by the mesh's own texture coordinates (:mod:`spectrinsic.scenes.gltf_colours`,
+:mod:`spectrinsic.scenes.mtl_colours`, :mod:`spectrinsic.scenes.image_textures`). A material
+with neither a colour nor a mapping (nor a default spectrum) is an error naming the options.
+A textured material must be matte (a glossy one is refused: its basis would not be diffuse).
 """
 
 from __future__ import annotations
@@ -22,6 +28,7 @@ import io
 import json
 import math
 import os
+import re
 import struct
 from collections.abc import Mapping
 from pathlib import Path
@@ -30,9 +37,14 @@ from typing import Any
 import numpy as np
 
 from ..errors import SceneError
-from .gltf_colours import gltf_base_colours
+from .budget import MAX_FACES, MAX_VERTICES, SceneBudget
+from .gltf_colours import gltf_colours
+from .image_textures import AssetColour, ImageTexture, corner_spectra
 from .materials import METAL_SPECTRUM
 from .model import Camera, Light, Material, Mesh, Scene
+from .mtl_colours import mtl_colours
+from .semantic import SemanticMap, classify
+from .textures import Texture, make_image_texture
 from .validate import validate_scene
 
 __all__ = [
@@ -45,13 +57,8 @@ __all__ = [
 ]
 
 MESH_SUFFIXES = (".obj", ".ply", ".glb", ".gltf", ".stl", ".off")
-#: Largest mesh read, checked from the file's header before loading (and the most faces of
-#: a whole scene file, checked once its meshes are read, before validation). Reading takes
-#: about 2.5 KiB per vertex (a 10^6-vertex PLY took 2.5 GB) and validating the camera's view
-#: (trimesh's ray index) about 5.3 KiB per face (200k faces: 1.2 GB peak, 12 s; 10^6 faces:
-#: 7 GB, 41 s), so these bound a scene near 1.5 GB.
-MAX_VERTICES = 250_000
-MAX_FACES = 250_000
+#: Largest glTF JSON chunk read to count the accessors (the geometry itself is binary).
+_GLTF_JSON_MAX = 64 * 2**20
 #: Irradiance (relative units) at the model's centre from the default light.
 _IRRADIANCE = math.pi
 
@@ -71,32 +78,63 @@ def _ply_counts(head: bytes) -> tuple[int, int]:
 
 
 def _text_counts(path: Path, vertex: bytes, face: bytes) -> tuple[int, int]:
-    """Lines starting with *vertex* / *face*, streamed (no more than one line in memory)."""
-    n_v = n_f = 0
+    """Lines starting (after blanks) with *vertex* / *face*, streamed in 1 MiB blocks (a line
+    cut by a block's end is carried into the next whole); counted by regular expressions,
+    not line by line in Python (a 300-file OBJ scene's count went from 1.2 s to 0.1 s)."""
+    patterns = [re.compile(rb"^[ \t\r\f\v]*" + re.escape(p), re.M) for p in (vertex, face)]
+    counts = [0, 0]
+    carry = b""
     with path.open("rb") as fh:
-        for line in fh:
-            stripped = line.lstrip()
-            n_v += stripped.startswith(vertex)
-            n_f += stripped.startswith(face)
-    return n_v, n_f
+        while True:
+            block = fh.read(1 << 20)
+            text = carry + block
+            cut = len(text) if not block else text.rfind(b"\n") + 1
+            for k, pattern in enumerate(patterns):
+                counts[k] += sum(1 for _ in pattern.finditer(text, 0, cut))
+            carry = text[cut:]
+            if not block:
+                return counts[0], counts[1]
 
 
-def _gltf_vertices(document: dict[str, Any]) -> int:
+def _accessor_count(accessors: list[Any], index: Any) -> int:
+    if (
+        isinstance(index, int)
+        and 0 <= index < len(accessors)
+        and isinstance(accessors[index], dict)
+    ):
+        count = accessors[index].get("count", 0)
+        return count if isinstance(count, int) and count > 0 else 0
+    return 0
+
+
+def _gltf_counts(document: dict[str, Any]) -> tuple[int, int]:
+    """``(vertices, faces)`` a glTF document declares, from its accessors' ``count`` (indices / 3,
+    or positions / 3 without indices), each mesh counted once per node that places it (trimesh
+    builds one copy per node); a file with no nodes counts each mesh once."""
     accessors = document.get("accessors") or []
-    total = 0
+    per_mesh = []
     for mesh in document.get("meshes") or []:
-        for primitive in mesh.get("primitives") or []:
-            index = (primitive.get("attributes") or {}).get("POSITION")
-            if isinstance(index, int) and 0 <= index < len(accessors):
-                total += int(accessors[index].get("count", 0))
-    return total
+        n_v = n_f = 0
+        for primitive in (mesh.get("primitives") or []) if isinstance(mesh, dict) else []:
+            positions = _accessor_count(
+                accessors, (primitive.get("attributes") or {}).get("POSITION")
+            )
+            indices = _accessor_count(accessors, primitive.get("indices"))
+            n_v += positions
+            n_f += (indices if "indices" in primitive else positions) // 3
+        per_mesh.append((n_v, n_f))
+    nodes = [n for n in document.get("nodes") or [] if isinstance(n, dict) and "mesh" in n]
+    uses = [
+        n["mesh"] for n in nodes if isinstance(n["mesh"], int) and 0 <= n["mesh"] < len(per_mesh)
+    ]
+    placed = [per_mesh[i] for i in uses] if nodes else per_mesh
+    return sum(v for v, _ in placed), sum(f for _, f in placed)
 
 
 def mesh_counts(path: Path) -> tuple[int, int]:
     """``(vertices, faces)`` a mesh file declares, read from its header (PLY, OFF, binary
-    STL, glTF/GLB) or counted line by line (OBJ, ASCII STL) without building the mesh; faces
-    are 0 where a format does not say (glTF). Malformed headers count as 0: trimesh reports
-    them when it reads the file."""
+    STL, glTF/GLB accessors) or counted line by line (OBJ, ASCII STL) without building the
+    mesh. Malformed headers count as 0: trimesh reports them when it reads the file."""
 
     suffix = path.suffix.lower()
     with path.open("rb") as fh:
@@ -120,23 +158,30 @@ def mesh_counts(path: Path) -> tuple[int, int]:
             return _text_counts(path, b"v ", b"f ")
         if suffix == ".glb":
             length = struct.unpack("<I", head[12:16])[0]
-            return _gltf_vertices(json.loads(head[20 : 20 + length])), 0
+            return _gltf_counts(json.loads(_glb_json(path, length)))
         if suffix == ".gltf":
-            return _gltf_vertices(json.loads(path.read_bytes())), 0
-    except (ValueError, IndexError, struct.error, AttributeError):
+            return _gltf_counts(json.loads(path.read_bytes()))
+    except (ValueError, IndexError, struct.error, AttributeError, TypeError, RecursionError):
         pass
     return 0, 0
 
 
-def check_mesh_size(path: Path) -> None:
-    """Refuse a mesh file declaring more than :data:`MAX_VERTICES` vertices or
-    :data:`MAX_FACES` faces, before it is loaded."""
+def _glb_json(path: Path, length: int) -> bytes:
+    """The JSON chunk of a GLB file (its first chunk, *length* bytes after the 20-byte head)."""
+    if not 0 < length <= _GLTF_JSON_MAX:
+        raise ValueError(f"JSON chunk of {length} bytes")
+    with path.open("rb") as fh:
+        fh.seek(20)
+        return fh.read(length)
+
+
+def check_mesh_size(path: Path, budget: SceneBudget | None = None) -> None:
+    """Charge what the mesh file declares to *budget* (a budget of its own if ``None``), before
+    it is loaded: more than :data:`MAX_VERTICES` vertices or :data:`MAX_FACES` faces in the
+    scene is refused in one line naming the file and the count."""
     n_v, n_f = mesh_counts(path)
-    if n_v > MAX_VERTICES or n_f > MAX_FACES:
-        raise SceneError(
-            f"{path}: declares {n_v:,} vertices and {n_f:,} faces; meshes are limited to "
-            f"{MAX_VERTICES:,} vertices and {MAX_FACES:,} faces (simplify it first)"
-        )
+    budget = SceneBudget(str(path)) if budget is None else budget
+    budget.charge(f"{path.name!r} ({n_v:,} vertices, {n_f:,} faces)", faces=n_f, vertices=n_v)
 
 
 def _pbr_gloss(material: Any) -> dict[str, Any]:
@@ -198,9 +243,13 @@ def _load_mesh_file(path: Path) -> Any:
     )
 
 
-def _geometries(path: Path) -> list[tuple[str, str, np.ndarray, np.ndarray, dict[str, Any]]]:
-    """``(geometry name, material name, vertices, faces, gloss)`` of every triangle mesh in the
-    file, in world space, sorted by geometry name (file order is not stable across formats)."""
+_Geometry = tuple[str, str, np.ndarray, np.ndarray, dict[str, Any], "np.ndarray | None"]
+
+
+def _geometries(path: Path) -> list[_Geometry]:
+    """``(geometry name, material name, vertices, faces, gloss, uv)`` of every triangle mesh in
+    the file, in world space, sorted by geometry name (file order is not stable across formats);
+    ``uv`` ``(F, 3, 2)`` are the face corners' texture coordinates (v up), ``None`` without."""
 
     check_mesh_size(path)
     try:
@@ -218,7 +267,9 @@ def _geometries(path: Path) -> list[tuple[str, str, np.ndarray, np.ndarray, dict
         verts = verts @ np.asarray(matrix)[:3, :3].T + np.asarray(matrix)[:3, 3]
         pbr = getattr(geom.visual, "material", None)
         material = getattr(pbr, "name", None) or str(key)
-        out.append((str(node), str(material), verts, faces, _pbr_gloss(pbr)))
+        uv = getattr(geom.visual, "uv", None)
+        corner_uv = None if uv is None or len(uv) != len(verts) else np.asarray(uv, float)[faces]
+        out.append((str(node), str(material), verts, faces, _pbr_gloss(pbr), corner_uv))
     if not out:
         raise SceneError(f"{path}: holds no triangles")
     return out
@@ -249,6 +300,37 @@ def _frame(vertices: np.ndarray, width: int, height: int) -> tuple[Camera, Light
     return camera, light
 
 
+def _asset_colours(path: Path) -> dict[str, AssetColour]:
+    return gltf_colours(path) if path.suffix.lower() in (".gltf", ".glb") else mtl_colours(path)
+
+
+def _unmapped(path: Path, material: str, geoms: list[_Geometry]) -> SceneError:
+    known = sorted({g[1] for g in geoms})
+    return SceneError(
+        f"{path}: material {material!r} is not in the material map and the file gives it no "
+        f"colour; the file's materials are {known} (use --material-map or --default-spectrum; "
+        "--colours-from-asset reads the colours the file states)"
+    )
+
+
+class _Table:
+    """The scene's materials by name (matte materials keep their spectrum's name)."""
+
+    def __init__(self) -> None:
+        self.table: dict[str, Material] = {}
+
+    def index(self, name: str, spectrum: str, gloss: dict[str, Any]) -> int:
+        self.table.setdefault(name, Material(name=name, spectrum=spectrum, **gloss))
+        return list(self.table).index(name)
+
+    def texture(self, image: ImageTexture, uv: np.ndarray | None, name: str, where: str) -> Texture:
+        """The texture *name* of *image* over the 8 corner materials, on faces with *uv*."""
+        if uv is None:
+            raise SceneError(f"{where}: material {name!r} has a texture but the mesh has no uv")
+        basis = tuple(self.index(s, s, {}) for s in corner_spectra())
+        return make_image_texture(name, basis, image, uv)
+
+
 def load_mesh_scene(
     path: str | os.PathLike[str],
     *,
@@ -257,7 +339,8 @@ def load_mesh_scene(
     height: int,
     default_spectrum: str | None = None,
     data_dir: str | None = None,
-    colours_from_asset: bool = False,
+    colours_from_asset: bool = True,
+    semantic: SemanticMap | None = None,
 ) -> Scene:
     """Read a mesh file into a validated :class:`~spectrinsic.scenes.model.Scene`.
 
@@ -271,10 +354,14 @@ def load_mesh_scene(
     width, height
         Image size in pixels of the framing camera.
     default_spectrum
-        Reflectance of materials not in *materials*; ``None``: such a material is an error.
+        Reflectance of materials neither in *materials* nor coloured by the file; ``None``:
+        such a material is an error.
     colours_from_asset
-        Give glTF materials not in *materials* their ``baseColorFactor`` as an ``rgb:``
-        reflectance before *default_spectrum* (module docstring).
+        Give materials not in *materials* the colour or texture the file states (glTF base
+        colour, MTL ``Kd``/``map_Kd``) before *default_spectrum* (module docstring).
+    semantic
+        The names → class map (:mod:`~spectrinsic.scenes.semantic`; None: the default) each
+        mesh's class comes from: its node's name, then the file's name of its material.
 
     Raises
     ------
@@ -283,37 +370,47 @@ def load_mesh_scene(
     """
     path = Path(path)
     geoms = _geometries(path)
-    colours = gltf_base_colours(path) if colours_from_asset else {}
-    table: dict[str, Material] = {}  # matte materials keep their spectrum's name
+    colours = _asset_colours(path) if colours_from_asset else {}
+    table = _Table()
     meshes = []
-    for i, (node, material, verts, faces, gloss) in enumerate(geoms):
-        spectrum = (
-            METAL_SPECTRUM
-            if gloss.get("kind") == "conductor"
-            else materials.get(material, colours.get(material, default_spectrum))
+    for i, (node, material, verts, faces, gloss, uv) in enumerate(geoms):
+        colour = None if material in materials else colours.get(material)
+        texture = None
+        if gloss.get("kind") == "conductor":
+            spectrum: str | None = METAL_SPECTRUM
+        elif colour is not None and colour.image is not None:
+            if gloss:
+                raise SceneError(
+                    f"{path}: material {material!r} is textured and glossy; "
+                    "expected a matte textured material (or map it with --material-map)"
+                )
+            texture = table.texture(colour.image, uv, material, f"{path}: mesh {node!r}")
+            spectrum = None
+        else:
+            spectrum = materials.get(material, colour.spectrum if colour else default_spectrum)
+            if spectrum is None:
+                raise _unmapped(path, material, geoms)
+        face = (
+            texture.basis[0]
+            if texture is not None
+            else table.index(f"{spectrum} ({material})" if gloss else spectrum, spectrum, gloss)  # type: ignore[arg-type]
         )
-        if spectrum is None:
-            known = sorted({g[1] for g in geoms})
-            raise SceneError(
-                f"{path}: material {material!r} is not in the material map; the file's "
-                f"materials are {known}"
-            )
-        name = f"{spectrum} ({material})" if gloss else spectrum
-        table.setdefault(name, Material(name=name, spectrum=spectrum, **gloss))
         meshes.append(
             Mesh(
                 name=f"{node}",
                 vertices=verts,
                 faces=faces,
-                face_materials=np.full(len(faces), list(table).index(name), dtype=np.int64),
+                face_materials=np.full(len(faces), face, dtype=np.int64),
                 object_id=i,
+                texture=texture,
+                semantic=classify([f"{node}", material], semantic),
             )
         )
     camera, light = _frame(np.concatenate([m.vertices for m in meshes]), width, height)
     scene = Scene(
         name=path.stem,
         meshes=tuple(meshes),
-        materials=tuple(table.values()),
+        materials=tuple(table.table.values()),
         lights=(light,),
         camera=camera,
         metadata={"source": path.name},

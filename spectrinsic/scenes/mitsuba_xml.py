@@ -1,355 +1,307 @@
-"""Mitsuba 3 XML scene files (``render scene.xml``) read into :class:`Scene` records.
+"""Mitsuba XML scene files (``render scene.xml``) read into :class:`Scene` records.
 
-A safe subset, read with :mod:`xml.etree.ElementTree` (never Mitsuba's loader, which would run
-plugins and read any path): files of at most :data:`MAX_XML_BYTES`, no DOCTYPE or entity
-declarations, no ``<include>``, mesh files only inside the scene's folder
-(:func:`~spectrinsic.scenes.spectrum_refs.confined_csv`'s rules). ``$name`` parameters take
-their ``<default>`` values. Translated:
+The file goes through three steps, each in its own module:
 
-- shapes ``obj``, ``ply`` (``filename``), ``rectangle``, ``cube``, ``disk``, ``sphere``
-  (``center``, ``radius``), each with a ``to_world`` transform; built-in shapes become triangles
-  (:mod:`~spectrinsic.scenes.mitsuba_parts`);
-- BSDFs ``diffuse`` (``reflectance`` as ``rgb``: linear sRGB through Mallett & Yuksel 2019;
-  ``spectrum``: ``"WL:V, ..."``, one number or a ``filename`` of a ``.spd`` file in the
-  scene's folder; ``float``), ``plastic`` and ``roughplastic``
-  (``diffuse_reflectance`` likewise, ``int_ior``/``ext_ior`` as numbers, ``alpha``: taken as the
-  GGX α whatever the ``distribution``), ``conductor`` and ``roughconductor`` (``material`` one
-  of Mitsuba's measured metals), bare or in a ``twosided``, at the top level with an ``id``
-  (``<ref id=.../>``) or inside a shape;
-- emitters ``area`` on a ``rectangle`` (an area light of the rectangle's centre, normal and
-  size), ``point``, ``spot`` (``cutoff_angle``; Mitsuba's default ``beam_width``), ``directional``
-  and ``constant`` (a ``sky`` light), with ``rgb`` (grey: D65)
-  or ``spectrum`` emission (:func:`~spectrinsic.scenes.mitsuba_parts.emission`);
-- the ``perspective`` sensor (``fov``, ``fov_axis`` x or y, ``to_world``) and its film's
-  ``width`` and ``height``.
+1. :func:`~spectrinsic.scenes.mitsuba_files.prepare_xml` checks it before anything is loaded
+   (a regular file of at most 4 MiB, no DOCTYPE, ``<include>`` inlined and every file it names
+   confined to the scene's folder, with its SHA-256 for the provenance);
+2. :func:`~spectrinsic.scenes.mitsuba_tree.parse_xml` parses it with Mitsuba's own parser
+   (``$name`` defaults, every transform and point form, ``<ref>``, the 0.5/0.6 upgrade and the
+   usual fixes, each said);
+3. this module turns the parsed nodes into the scene: shapes
+   (:mod:`~spectrinsic.scenes.mitsuba_shapes`, counted against the scene budget before any is
+   built), BSDFs (:mod:`~spectrinsic.scenes.mitsuba_bsdfs`), emitters (``area`` on a
+   ``rectangle`` or a ``sphere``, ``point``, ``spot``, ``directional``, ``constant`` as a sky;
+   two environment emitters are merged when their spectra agree, refused otherwise), the
+   ``perspective`` sensor and its film (validated before any arithmetic), and the file's
+   ``sample_count`` and ``max_depth`` as render hints.
 
-``integrator``, ``sampler`` and ``rfilter`` elements are ignored (the render's settings apply).
-Anything else is refused in one line naming the element and the file.
+What has no exact ground truth is refused in one line naming the element and the file; with
+``approximate=True`` (``--approximate``) it is approximated instead, each approximation one
+phrase in ``scene.metadata["approximated"]``. Fixes of old files are in ``["fixed"]`` and
+settings that do not reach the render in ``["ignored"]``; the command line prints all three.
 """
 
 from __future__ import annotations
 
 import math
 import os
-import re
-import xml.etree.ElementTree as ET
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..errors import SceneError, SpectrinsicError
-from ..spectra.io import read_spd
-from ..spectra.user_spectra import sha256
-from . import mitsuba_parts as parts
-from .materials import METAL_SPECTRUM
-from .meshes import check_mesh_size
+from . import mitsuba_shapes as shapes
+from .mitsuba_bsdfs import DEFAULT_MATERIAL, material_of
+from .mitsuba_files import MAX_XML_BYTES, SceneFile, prepare_xml
+from .mitsuba_spectra import emission
+from .mitsuba_tree import XmlNode, parse_xml
 from .model import Camera, Light, Material, Mesh, Scene
 from .validate import validate_scene
 
-__all__ = ["MAX_XML_BYTES", "load_mitsuba_xml"]
+__all__ = ["MAX_XML_BYTES", "ENVIRONMENT", "load_mitsuba_xml", "xml_notes", "render_hints_line"]
 
-MAX_XML_BYTES = 4 * 1024 * 1024
-_IGNORED = ("integrator", "sampler", "rfilter")
-_SHAPES = ("obj", "ply", "rectangle", "cube", "disk", "sphere")
-
-
-def _named(el: ET.Element, name: str) -> ET.Element | None:
-    return next((c for c in el if c.get("name") == name), None)
-
-
-def _float(el: ET.Element, name: str, default: float, what: str) -> float:
-    child = _named(el, name)
-    return default if child is None else float(parts.numbers(child.get("value"), 1, what)[0])
+#: Emitters that light the scene from infinity (one per scene in Mitsuba).
+ENVIRONMENT = ("constant", "envmap", "sunsky", "sky", "sun")
+#: Emitters without exact ground truth until the glass-and-environment issue lands.
+_LATER = ("envmap", "sunsky", "sky", "sun")
+#: Mitsuba's default film size.
+_FILM = (768, 576)
 
 
-def _label(el: ET.Element) -> str:
-    attrs = " ".join(f"{k}={v!r}" for k, v in el.attrib.items() if k in ("type", "id", "name"))
-    return f"<{el.tag}{' ' + attrs if attrs else ''}>"
+@dataclass
+class _Reading:
+    """What one read collects besides the scene: its folder, the approximation switch and the
+    phrases said on stderr."""
 
+    base: Path
+    approximate: bool
+    approximated: list[str] = field(default_factory=list)
+    ignored: list[str] = field(default_factory=list)
 
-def _parse(path: Path) -> ET.Element:
-    """The root ``<scene>`` with ``$name`` defaults substituted."""
-    size = path.stat().st_size
-    if size > MAX_XML_BYTES:
-        raise SceneError(f"{size} bytes; expected a scene file of at most {MAX_XML_BYTES} bytes")
-    text = path.read_text(encoding="utf-8", errors="replace")
-    if re.search(r"<!(DOCTYPE|ENTITY)", text):
-        raise SceneError("DOCTYPE and ENTITY declarations are not allowed")
-    try:
-        root = ET.fromstring(text)
-    except ET.ParseError as exc:
-        raise SceneError(f"malformed XML ({exc})") from None
-    if root.tag != "scene":
-        raise SceneError(f"root element <{root.tag}>; expected <scene>")
-    defaults = {d.get("name", ""): d.get("value", "") for d in root.iter("default")}
-    for el in root.iter():
-        for key, value in el.attrib.items():
-            if "$" in value:
-                el.set(
-                    key, re.sub(r"\$(\w+)", lambda m: defaults.get(m.group(1), m.group(0)), value)
-                )
-    return root
+    @property
+    def say(self) -> Callable[[str], None] | None:
+        return self.approximated.append if self.approximate else None
 
-
-_BSDF_PARAMS = {
-    "diffuse": ("reflectance",),
-    "plastic": ("diffuse_reflectance", "int_ior", "ext_ior"),
-    "roughplastic": ("diffuse_reflectance", "int_ior", "ext_ior", "alpha", "distribution"),
-    "conductor": ("material",),
-    "roughconductor": ("material", "alpha", "distribution"),
-}
-
-
-def _read_spectrum_files(root: ET.Element, base: Path) -> list[dict[str, str]]:
-    """Every ``<spectrum filename=...>`` (a Mitsuba ``.spd`` inside the scene's folder) made a
-    ``value`` of its samples, so the rest of the reader sees written-out spectra; one record
-    per file read (its path and SHA-256), for ``meta.json["spectrum_files"]``."""
-    records: dict[str, dict[str, str]] = {}
-    for el in root.iter("spectrum"):
-        if "filename" not in el.attrib:
-            continue
-        rel = el.attrib.pop("filename")
-        path = (base.resolve() / rel).resolve()
-        if Path(rel).is_absolute() or not path.is_relative_to(base.resolve()):
+    def refuse_or_drop(self, node: XmlNode, where: str, what: str) -> None:
+        if not self.approximate:
             raise SceneError(
-                f"spectrum filename {rel!r}; expected a path inside the scene's folder"
+                f"{where}: {node.label()} has no exact ground truth yet; refused "
+                f"(--approximate: {what} left out)"
             )
-        wl, values = read_spd(path)
-        el.set("value", ", ".join(f"{w!r}:{v!r}" for w, v in zip(wl.tolist(), values.tolist())))
-        records[str(path)] = {"spectrum": f"spd:{path}", "file": str(path), "sha256": sha256(path)}
-    return [records[k] for k in sorted(records)]
+        self.approximated.append(f"{where}: {node.label()} left out")  # the refusal says what
 
 
-def _bsdf(el: ET.Element, where: str) -> Material:
-    """The material of a ``diffuse``, ``(rough)plastic`` or ``(rough)conductor`` BSDF, bare or
-    inside a ``twosided``; named after its spectrum (diffuse) or its ``id``."""
-    name = el.get("id", "")
-    if el.get("type") == "twosided":
-        inner = [c for c in el if c.tag == "bsdf"]
-        if len(inner) != 1:
-            raise SceneError(f"{where}: {_label(el)} needs exactly one inner <bsdf>")
-        el = inner[0]
-    kind = el.get("type", "")
-    if kind not in _BSDF_PARAMS:
-        raise SceneError(
-            f"{where}: unsupported element {_label(el)}; expected a bsdf of type "
-            + ", ".join(_BSDF_PARAMS)
-        )
-    for child in el:
-        if child.get("name") not in _BSDF_PARAMS[kind]:
-            raise SceneError(f"{where}: unsupported element {_label(child)} in {_label(el)}")
-    alpha = _float(el, "alpha", 0.1, f"{where} alpha") if kind.startswith("rough") else 0.0
-    if kind == "diffuse":
-        spectrum = parts.reflectance_name(_named(el, "reflectance"), f"{where} reflectance")
-        return Material(spectrum, spectrum)
-    if kind.endswith("conductor"):
-        metal = _named(el, "material")
-        if metal is None:
-            raise SceneError(f"{where}: {_label(el)} needs a 'material' (Au, Cu, Al, ...)")
-        return Material(
-            name or f"{kind} {metal.get('value')}",
-            METAL_SPECTRUM,
-            kind="conductor",
-            roughness=alpha,
-            metal=metal.get("value", ""),
-        )
-    base = parts.reflectance_name(_named(el, "diffuse_reflectance"), f"{where} reflectance")
-    ior = _float(el, "int_ior", 1.49, f"{where} int_ior") / _float(el, "ext_ior", 1.0, where)
-    return Material(name or f"{kind} {base}", base, kind="plastic", roughness=alpha, ior=ior)
+def _vec(value: Any) -> tuple[float, float, float]:
+    return tuple(float(x) for x in np.asarray(value, float).reshape(3))  # type: ignore[return-value]
 
 
-def _mesh_file(el: ET.Element, base: Path, where: str) -> tuple[np.ndarray, np.ndarray]:
-    import trimesh
-
-    child = _named(el, "filename")
-    rel = "" if child is None else child.get("value", "")
-    root = base.resolve()
-    path = (root / rel).resolve()
-    if not rel or Path(rel).is_absolute() or not path.is_relative_to(root):
-        raise SceneError(f"{where}: filename {rel!r}; expected a path inside the scene's folder")
-    if not path.is_file() or path.suffix.lower() != f".{el.get('type')}":
-        raise SceneError(f"{where}: mesh file {rel!r} not found as a .{el.get('type')} file")
-    check_mesh_size(path)
-    try:
-        mesh: Any = trimesh.load(str(path), force="mesh", process=False)
-    except Exception as exc:  # noqa: BLE001 - trimesh raises many types for corrupt files
-        raise SceneError(f"{where}: cannot read {rel!r} ({type(exc).__name__})") from None
-    return np.asarray(mesh.vertices, float), np.asarray(mesh.faces, np.int64)
+def _unit(v: np.ndarray) -> tuple[float, float, float]:
+    return _vec(v / np.linalg.norm(v))
 
 
-def _geometry(el: ET.Element, base: Path, where: str) -> tuple[np.ndarray, np.ndarray]:
-    kind = el.get("type", "")
-    if kind in ("obj", "ply"):
-        v, f = _mesh_file(el, base, where)
-    elif kind == "sphere":
-        c = _named(el, "center")
-        centre = np.zeros(3) if c is None else parts.numbers(c.get("value"), 3, where)
-        if c is not None and "value" not in c.attrib:
-            centre = np.array([float(c.get(k, 0)) for k in "xyz"])
-        v, f = parts.sphere(centre, _float(el, "radius", 1.0, f"{where} radius"))
-    else:
-        v, f = getattr(parts, kind)()
-    flip = _named(el, "flip_normals")
-    if flip is not None and flip.get("value", "false").lower() == "true":
-        f = f[:, ::-1]
-    return parts.apply(parts.transform(_named(el, "to_world"), where), v), f
-
-
-def _area_light(el: ET.Element, emitter: ET.Element, where: str) -> Light:
-    if el.get("type") != "rectangle":
-        raise SceneError(f"{where}: an area emitter on {_label(el)}; only on a rectangle")
-    m = parts.transform(_named(el, "to_world"), where)
+def _area_light(p: shapes.Placed, node: XmlNode, r: _Reading) -> Light | None:
+    """The light of an ``area`` emitter on a rectangle (an area light) or a sphere (a sphere
+    light)."""
+    spectrum, power = emission(node.props.get("radiance"), f"{p.where} radiance", r.base)
+    m = p.matrix @ np.asarray(p.node.props.get("to_world", np.eye(4)), float)
+    if p.node.plugin == "sphere":
+        centre = m[:3, :3] @ np.asarray(p.node.props.get("center", np.zeros(3)), float) + m[:3, 3]
+        scales = np.linalg.norm(m[:3, :3], axis=0)
+        if not np.allclose(scales, scales[0], rtol=1e-9):
+            raise SceneError(f"{p.where}: an area sphere scaled unevenly is not a sphere")
+        radius = p.node.number("radius", 1.0) * float(scales[0])
+        return Light("sphere", spectrum, power, position=_vec(centre), radius=radius, name=p.name)
+    if p.node.plugin != "rectangle":
+        r.refuse_or_drop(node, p.where, "the emitter (the shape stays, unlit)")
+        return None
     u, v = m[:3, 0], m[:3, 1]
-    normal = np.cross(u, v)
-    flip = _named(el, "flip_normals")
-    if flip is not None and flip.get("value", "false").lower() == "true":
-        normal = -normal
-    spectrum, power = parts.emission(_named(emitter, "radiance"), f"{where} radiance")
+    normal = -np.cross(u, v) if shapes.props_true(p.node, "flip_normals") else np.cross(u, v)
     return Light(
         "area",
         spectrum,
         power,
-        position=tuple(float(x) for x in m[:3, 3]),  # type: ignore[arg-type]
-        direction=tuple(float(x) for x in normal / np.linalg.norm(normal)),  # type: ignore[arg-type]
+        position=_vec(m[:3, 3]),
+        direction=_unit(normal),
         size=(2 * float(np.linalg.norm(u)), 2 * float(np.linalg.norm(v))),
-        name=el.get("id", "light"),
+        name=p.name,
     )
 
 
-def _emitter(el: ET.Element, where: str) -> Light:
-    kind = el.get("type")
-    if kind == "point":
-        spectrum, power = parts.emission(_named(el, "intensity"), f"{where} intensity")
-        p = _named(el, "position")
-        pos = (
-            parts.numbers(p.get("value"), 3, where)
-            if p is not None and "value" in p.attrib
-            else np.array([float(p.get(k, 0)) for k in "xyz"])
-            if p is not None
-            else parts.transform(_named(el, "to_world"), where)[:3, 3]
-        )
-        return Light("point", spectrum, power, position=tuple(float(x) for x in pos))  # type: ignore[arg-type]
-    if kind == "directional":
-        spectrum, power = parts.emission(_named(el, "irradiance"), f"{where} irradiance")
-        d = _named(el, "direction")
-        direction = parts.numbers(None if d is None else d.get("value"), 3, f"{where} direction")
-        return Light("directional", spectrum, power, direction=tuple(float(x) for x in direction))  # type: ignore[arg-type]
-    if kind == "spot":
-        spectrum, power = parts.emission(_named(el, "intensity"), f"{where} intensity")
-        m = parts.transform(_named(el, "to_world"), where)
-        return Light(
-            "spot",
-            spectrum,
-            power,
-            position=tuple(float(x) for x in m[:3, 3]),  # type: ignore[arg-type]
-            direction=tuple(float(x) for x in m[:3, 2] / np.linalg.norm(m[:3, 2])),  # type: ignore[arg-type]
-            cutoff_deg=_float(el, "cutoff_angle", 20.0, f"{where} cutoff_angle"),
-        )
+def _emitter(node: XmlNode, where: str, r: _Reading) -> Light | None:
+    """A light of a top-level emitter; ``None`` where an approximation leaves it out."""
+    kind = node.plugin
+    m = np.asarray(node.props.get("to_world", np.eye(4)), float)
+    if kind in _LATER:
+        r.refuse_or_drop(node, where, "this emitter")
+        return None
     if kind == "constant":
-        spectrum, power = parts.emission(_named(el, "radiance"), f"{where} radiance")
-        return Light("sky", spectrum, power)
-    raise SceneError(f"{where}: unsupported element {_label(el)}")
+        spectrum, power = emission(node.props.get("radiance"), f"{where} radiance", r.base)
+        return Light("sky", spectrum, power, name="sky")
+    if kind == "directional":
+        spectrum, power = emission(node.props.get("irradiance"), f"{where} irradiance", r.base)
+        d = node.props.get("direction")
+        direction = m[:3, 2] if d is None else m[:3, :3] @ np.asarray(d, float)
+        return Light("directional", spectrum, power, direction=_unit(direction))
+    spectrum, power = emission(node.props.get("intensity"), f"{where} intensity", r.base)
+    if kind == "point":
+        pos = node.props.get("position")
+        return Light("point", spectrum, power, position=_vec(m[:3, 3] if pos is None else pos))
+    if kind == "spot":
+        cutoff = node.number("cutoff_angle", 20.0)
+        if "beam_width" in node.props:
+            raise SceneError(f"{where}: beam_width in {node.label()}; Mitsuba's default applies")
+        direction = m[:3, 2]
+        return Light(
+            "spot", spectrum, power, position=_vec(m[:3, 3]), direction=_unit(direction),
+            cutoff_deg=cutoff,
+        )  # fmt: skip
+    raise SceneError(f"{where}: unsupported element {node.label()}")
 
 
-def _camera(el: ET.Element, where: str) -> Camera:
-    if el.get("type") != "perspective":
+def _merged_sky(lights: list[Light], where: str) -> list[Light]:
+    """*lights* with every sky merged into one (their radiances add; same spectrum only)."""
+    skies = [light for light in lights if light.kind == "sky"]
+    if len(skies) < 2:
+        return lights
+    if len({s.spectrum for s in skies}) > 1:
         raise SceneError(
-            f"{where}: unsupported element {_label(el)}; expected a perspective sensor"
+            f"{where}: {len(skies)} environment emitters with different spectra; Mitsuba takes "
+            "one (merge them into one <emitter type='constant'>)"
         )
-    film = next((c for c in el if c.tag == "film"), None)
-    width = int(_float(film, "width", 768, where)) if film is not None else 768
-    height = int(_float(film, "height", 576, where)) if film is not None else 576
-    fov = _float(el, "fov", 40.0, f"{where} fov")
-    axis = _named(el, "fov_axis")
-    if axis is not None and axis.get("value") == "y":
-        fov = math.degrees(2 * math.atan(math.tan(math.radians(fov) / 2) * width / height))
-    elif axis is not None and axis.get("value") != "x":
-        raise SceneError(f"{where}: fov_axis {axis.get('value')!r}; expected x or y")
-    m = parts.transform(_named(el, "to_world"), where)
-    origin = m[:3, 3]
+    sky = Light("sky", skies[0].spectrum, sum(s.power for s in skies), name="sky")
+    return [light for light in lights if light.kind != "sky"] + [sky]
+
+
+def _film(sensor: XmlNode, where: str, r: _Reading) -> tuple[int, int]:
+    films = [c for c in sensor.children if c.kind == "film"]
+    if not films:
+        return _FILM
+    film = films[0]
+    size = []
+    for key, default in zip(("width", "height"), _FILM):
+        value = film.props.get(key, default)
+        if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 1 << 16:
+            raise SceneError(
+                f"{where}: film {key} {value!r}; expected a whole number from 1 to 65536"
+            )
+        size.append(value)
+    if any(c.kind == "rfilter" or c.kind == "reconstructionfilter" for c in film.children):
+        r.ignored.append(f"{where}: the film's rfilter (spectrinsic's own filter applies)")
+    return size[0], size[1]
+
+
+def _fov_x(sensor: XmlNode, width: int, height: int, where: str) -> float:
+    """Horizontal field of view in degrees from ``fov`` and ``fov_axis`` (or a 35 mm
+    ``focal_length``, Mitsuba's rule: the film diagonal is 43.27 mm)."""
+    props = sensor.props
+    axis = str(props.get("fov_axis", "x"))
+    if "focal_length" in props:
+        mm = float(str(props["focal_length"]).removesuffix("mm"))
+        fov, axis = math.degrees(2 * math.atan(math.hypot(36, 24) / (2 * mm))), "diagonal"
+    else:
+        fov = sensor.number("fov", 40.0)
+    if not 0 < fov < 180:
+        raise SceneError(f"{where}: fov {fov}; expected 0 < fov < 180 degrees")
+    t = math.tan(math.radians(fov) / 2)
+    ratio = {
+        "x": 1.0,
+        "y": width / height,
+        "diagonal": width / math.hypot(width, height),
+        "smaller": max(width / height, 1.0),
+        "larger": min(width / height, 1.0),
+    }
+    if axis not in ratio:
+        raise SceneError(f"{where}: fov_axis {axis!r}; expected x, y, diagonal, smaller or larger")
+    return math.degrees(2 * math.atan(t * ratio[axis]))
+
+
+def _camera(sensor: XmlNode, where: str, r: _Reading) -> Camera:
+    if sensor.plugin != "perspective":
+        raise SceneError(
+            f"{where}: unsupported element {sensor.label()}; expected a perspective sensor"
+        )
+    width, height = _film(sensor, where, r)
+    for key in ("near_clip", "far_clip", "principal_point_offset_x", "principal_point_offset_y"):
+        if key in sensor.props:
+            r.ignored.append(f"{where}: {key} (a pinhole camera without clipping applies)")
+    m = np.asarray(sensor.props.get("to_world", np.eye(4)), float)
+    # Mitsuba's camera looks along +z with +y up and x to the left: left-handed screen axes
     return Camera(
-        origin=tuple(float(x) for x in origin),  # type: ignore[arg-type]
-        target=tuple(float(x) for x in origin + m[:3, 2]),  # type: ignore[arg-type]
-        up=tuple(float(x) for x in m[:3, 1]),  # type: ignore[arg-type]
-        fov_deg=fov,
+        origin=_vec(m[:3, 3]),
+        target=_vec(m[:3, 3] + m[:3, 2]),
+        up=_vec(m[:3, 1]),
+        fov_deg=_fov_x(sensor, width, height, where),
         width=width,
         height=height,
     )
 
 
-def _shape(
-    el: ET.Element, base: Path, bsdfs: dict[str, Material], where: str
-) -> tuple[Material | None, tuple[np.ndarray, np.ndarray] | None, Light | None]:
-    """``(material, geometry, None)`` of a surface or ``(None, None, light)`` of an area light."""
-    if el.get("type") not in _SHAPES:
-        raise SceneError(f"{where}: unsupported element {_label(el)}")
-    emitters = [c for c in el if c.tag == "emitter"]
+def _hints(root: XmlNode) -> dict[str, int]:
+    """The file's ``sample_count`` and ``max_depth``, where it gives them."""
+    out = {}
+    for node in root.children:
+        if node.kind == "integrator" and "max_depth" in node.props:
+            out["max_depth"] = node.integer("max_depth", 0)
+        for child in node.children if node.kind == "sensor" else ():
+            if child.kind == "sampler" and "sample_count" in child.props:
+                out["spp"] = child.integer("sample_count", 0)
+    return out
+
+
+def _shape_parts(p: shapes.Placed, r: _Reading) -> tuple[Material | None, Light | None]:
+    """The material (``None``: the shape is left out) or the light of shape *p*."""
+    bsdfs = [c for c in p.node.children if c.kind == "bsdf"]
+    emitters = [c for c in p.node.children if c.kind == "emitter"]
+    other = [c for c in p.node.children if c.kind not in ("bsdf", "emitter")]
+    if other:
+        raise SceneError(f"{p.where}: unsupported element {other[0].label()} in a shape")
+    if len(bsdfs) > 1 or len(emitters) > 1:
+        raise SceneError(f"{p.where}: expected at most one bsdf and one emitter")
     if emitters:
-        if emitters[0].get("type") != "area":
-            raise SceneError(f"{where}: unsupported element {_label(emitters[0])} in a shape")
-        return None, None, _area_light(el, emitters[0], where)
-    material = Material("flat:0.5", "flat:0.5")  # Mitsuba's default BSDF
-    for child in el:
-        if child.tag == "ref":
-            if child.get("id") not in bsdfs:
-                raise SceneError(f"{where}: <ref id={child.get('id')!r}> names no bsdf")
-            material = bsdfs[child.get("id", "")]
-        elif child.tag == "bsdf":
-            material = _bsdf(child, where)
-        elif child.tag not in ("string", "float", "point", "transform", "boolean"):
-            raise SceneError(f"{where}: unsupported element {_label(child)}")
-    return material, _geometry(el, base, where), None
+        if emitters[0].plugin != "area":
+            raise SceneError(f"{p.where}: unsupported element {emitters[0].label()} in a shape")
+        light = _area_light(p, emitters[0], r)
+        if light is not None:
+            return None, light
+    if "face_normals" in p.node.props:
+        r.ignored.append(f"{p.where}: face_normals (normals are smoothed below a 30° crease)")
+    if not bsdfs:
+        return DEFAULT_MATERIAL, None
+    return material_of(bsdfs[0], p.where, r.base, r.say), None
 
 
-def _scene(root: ET.Element, base: Path, name: str) -> Scene:
-    bsdfs: dict[str, Material] = {}
+def _scene(root: XmlNode, name: str, r: _Reading) -> Scene:
+    placed = shapes.occurrences(root)
+    shapes.check_budget(placed, r.base)
     materials: dict[Material, int] = {}
     meshes: list[Mesh] = []
     lights: list[Light] = []
-    camera = None
-    for i, el in enumerate(root):
-        where = f"element {i}" + (f" (id {el.get('id')!r})" if el.get("id") else "")
-        if el.tag in _IGNORED or el.tag == "default":
-            continue
-        if el.tag == "bsdf" and el.get("id"):
-            bsdfs[el.get("id", "")] = _bsdf(el, where)
-        elif el.tag == "sensor":
-            camera = _camera(el, where)
-        elif el.tag == "emitter":
-            lights.append(_emitter(el, where))
-        elif el.tag == "shape":
-            material, geometry, light = _shape(el, base, bsdfs, where)
-            if light is not None:
-                lights.append(light)
-            elif material is not None and geometry is not None:
-                index = materials.setdefault(material, len(materials))
-                v, f = geometry
-                meshes.append(
-                    Mesh(
-                        el.get("id", f"shape{i}"),
-                        v,
-                        f,
-                        np.full(len(f), index),
-                        object_id=len(meshes),
-                    )
-                )
-        else:
-            raise SceneError(f"unsupported element {_label(el)}")
-    if camera is None:
+    cameras = []
+    for p in placed:
+        material, light = _shape_parts(p, r)
+        if light is not None:
+            lights.append(light)
+        elif material is not None:
+            v, f = shapes.triangles(p, r.base)
+            index = materials.setdefault(material, len(materials))
+            meshes.append(Mesh(p.name, v, f, np.full(len(f), index), object_id=len(meshes)))
+    for i, node in enumerate(root.children):
+        where = f"element {i} {node.label()}"
+        if node.kind == "emitter":
+            light = _emitter(node, where, r)
+            lights += [] if light is None else [light]
+        elif node.kind == "sensor":
+            cameras.append(_camera(node, where, r))
+        elif node.kind == "integrator" and node.plugin not in ("path", "volpath"):
+            r.ignored.append(f"{where} (spectrinsic's own path tracer applies)")
+        elif node.kind not in ("shape", "bsdf", "texture", "integrator"):
+            raise SceneError(f"{where}: unsupported element {node.label()}")
+    if not cameras:
         raise SceneError("no <sensor type='perspective'>; expected one")
+    if len(cameras) > 1:
+        r.ignored.append(f"{len(cameras) - 1} sensor(s) after the first")
     return Scene(
         name=name,
         meshes=tuple(meshes),
         materials=tuple(materials),
-        lights=tuple(lights),
-        camera=camera,
-        metadata={"source": f"{name}.xml (Mitsuba 3 XML)"},
+        lights=tuple(_merged_sky(lights, "environment emitters")),
+        camera=cameras[0],
     )
 
 
-def load_mitsuba_xml(path: str | os.PathLike[str], *, data_dir: str | None = None) -> Scene:
-    """Read and validate a Mitsuba 3 XML scene (module docstring).
+def load_mitsuba_xml(
+    path: str | os.PathLike[str], *, data_dir: str | None = None, approximate: bool = False
+) -> Scene:
+    """Read and validate a Mitsuba XML scene (module docstring).
+
+    Parameters
+    ----------
+    approximate
+        Approximate what has no exact ground truth instead of refusing it (``--approximate``).
 
     Raises
     ------
@@ -358,15 +310,66 @@ def load_mitsuba_xml(path: str | os.PathLike[str], *, data_dir: str | None = Non
     """
     path = Path(path)
     try:
-        root = _parse(path)
-        if any(el.tag == "include" for el in root.iter()):
-            raise SceneError("unsupported element <include>")
-        spd_files = _read_spectrum_files(root, path.parent)
-        scene = _scene(root, path.parent, path.stem)
-        if spd_files:  # recorded beside the csv: files in each sample's meta.json
-            scene.metadata["spectrum_files"] = spd_files
+        prepared = prepare_xml(path)
+        parsed = parse_xml(prepared.text, prepared.version)
+        reading = _Reading(path.parent, approximate)
+        scene = _scene(parsed.root, path.stem, reading)
     except SpectrinsicError as exc:
         raise SceneError(f"{path}: {exc}") from None
     except (ValueError, OSError) as exc:
         raise SceneError(f"{path}: {exc}") from None
+    metadata: dict[str, Any] = {
+        "source": f"{path.name} (Mitsuba XML {prepared.version})",
+        "approximate": approximate,
+        "files": [{"path": f.path, "role": f.role, "sha256": f.sha256} for f in prepared.files],
+        "render_hints": _hints(parsed.root),
+        "fixed": list(parsed.fixes),
+        "approximated": reading.approximated,
+        "ignored": reading.ignored,
+    }
+    spd = [f for f in prepared.files if f.role == "spd"]
+    if spd:  # recorded beside the csv: files in each sample's meta.json (issue 47)
+        metadata["spectrum_files"] = _spd_records(path.parent, spd)
+    scene = Scene(scene.name, scene.meshes, scene.materials, scene.lights, scene.camera, metadata)
     return validate_scene(scene, source=str(path), data_dir=data_dir)
+
+
+def _spd_records(base: Path, files: list[SceneFile]) -> list[dict[str, str]]:
+    """``meta.json["spectrum_files"]`` records of the ``.spd`` files read (their values are
+    written out in the scene's spectrum names), by path."""
+    out = []
+    for f in sorted(files, key=lambda f: f.path):
+        file = str((base / f.path).resolve())
+        out.append({"spectrum": f"spd:{file}", "file": file, "sha256": f.sha256})
+    return out
+
+
+def xml_notes(scene: Scene) -> list[str]:
+    """One line per fix, approximation and ignored setting a Mitsuba XML read made (from
+    ``scene.metadata``; empty for other scenes), for stderr."""
+    meta = scene.metadata
+    return [
+        f"{meta.get('source', scene.name)}: {what}: {phrase}"
+        for what in ("fixed", "approximated", "ignored")
+        for phrase in meta.get(what, ())
+    ]
+
+
+def render_hints_line(
+    scene: Scene, spp: int | None, max_depth: int | None, given: str = "the command line"
+) -> str | None:
+    """The line saying which spp and path depth apply to a Mitsuba XML scene: the file's
+    (``sample_count``, ``max_depth``) unless *given* (the command line, a dataset's settings)
+    sets *spp* / *max_depth*; ``None`` when the file gives neither."""
+    hints = scene.metadata.get("render_hints") or {}
+    if not hints:
+        return None
+    parts = []
+    for key, label, value in (("spp", "spp", spp), ("max_depth", "max depth", max_depth)):
+        if key in hints:
+            parts.append(
+                f"{label} {hints[key]} from the file"
+                if value is None
+                else f"{label} {value} from {given} (the file says {hints[key]})"
+            )
+    return f"{scene.name}: " + ", ".join(parts)

@@ -23,6 +23,7 @@ from typing import Any, Literal
 import numpy as np
 
 from ..errors import SceneError, did_you_mean
+from .semantic import classify
 from .textures import Texture, texture_from_record
 
 __all__ = [
@@ -49,7 +50,7 @@ __all__ = [
     "scene_hash",
 ]
 
-LightKind = Literal["point", "spot", "area", "directional", "sky"]
+LightKind = Literal["point", "spot", "area", "directional", "sky", "sphere"]
 #: The one table of light kinds: the placement fields each kind uses (the others are ignored,
 #: and records such as meta.json leave them out).
 LIGHT_FIELDS: dict[str, tuple[str, ...]] = {
@@ -58,11 +59,15 @@ LIGHT_FIELDS: dict[str, tuple[str, ...]] = {
     "area": ("position", "direction", "size"),
     "directional": ("direction",),
     "sky": (),
+    "sphere": ("position", "radius"),
 }
 #: The light kinds, in the table's order (``typing.get_args(LightKind)`` is the same).
 LIGHT_KINDS: tuple[LightKind, ...] = tuple(LIGHT_FIELDS)  # type: ignore[arg-type]
-#: The kinds the scene generators draw (a sky comes from scene files and daylight rooms).
-DRAWN_LIGHT_KINDS: tuple[LightKind, ...] = tuple(k for k in LIGHT_KINDS if k != "sky")
+#: The kinds the scene generators draw (a sky comes from scene files and daylight rooms, a
+#: sphere from Mitsuba XML files).
+DRAWN_LIGHT_KINDS: tuple[LightKind, ...] = tuple(
+    k for k in LIGHT_KINDS if k not in ("sky", "sphere")
+)
 #: Every placement field some kind uses (the union of :data:`LIGHT_FIELDS`).
 LIGHT_PLACEMENT: tuple[str, ...] = tuple(
     dict.fromkeys(f for fs in LIGHT_FIELDS.values() for f in fs)
@@ -119,6 +124,11 @@ class Material:
         return self.kind != "diffuse"
 
 
+def _named_class(mesh: Mesh) -> bool:
+    """Whether *mesh*'s class is the one its name gives (left out of its record then)."""
+    return mesh.semantic == classify([mesh.name])
+
+
 @dataclass(frozen=True, eq=False)
 class Mesh:
     """A triangle mesh in world space with one material index per face.
@@ -140,6 +150,13 @@ class Mesh:
         A spectral :class:`~spectrinsic.scenes.textures.Texture` over every face (whose
         ``face_materials`` are then all ``texture.basis[0]``), or ``None``: each face one exact
         spectrum. Left out of :func:`scene_to_dict` when ``None``.
+    semantic
+        Its class in :data:`~spectrinsic.scenes.semantic.SEMANTIC_CLASSES`; left empty, the
+        class its name maps to by the default map
+        (:func:`~spectrinsic.scenes.semantic.classify`). Left out of :func:`scene_to_dict`
+        when it is that class, so the records and hashes of scenes from before classes existed
+        are unchanged. ``dataclasses.replace(mesh, name=...)`` keeps the class; add
+        ``semantic=""`` to take the new name's.
     """
 
     name: str
@@ -148,6 +165,11 @@ class Mesh:
     face_materials: np.ndarray
     object_id: int
     texture: Texture | None = field(default=None, metadata=_OPTIONAL)
+    semantic: str = field(default="", metadata={"omit_when": _named_class})
+
+    def __post_init__(self) -> None:
+        if not self.semantic:  # the class of its name (frozen: set once, here)
+            object.__setattr__(self, "semantic", classify([self.name]))
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Mesh):
@@ -159,6 +181,7 @@ class Mesh:
             and np.array_equal(self.faces, other.faces)
             and np.array_equal(self.face_materials, other.face_materials)
             and self.texture == other.texture
+            and self.semantic == other.semantic
         )
 
     __hash__ = None  # type: ignore[assignment]
@@ -172,14 +195,15 @@ class Light:
     ----------
     kind
         One of :data:`LIGHT_KINDS`: ``"point"``, ``"spot"``, ``"area"`` (a rectangle),
-        ``"directional"`` or ``"sky"`` (a uniform sky dome at infinity, Mitsuba ``constant``);
+        ``"directional"``, ``"sky"`` (a uniform sky dome at infinity, Mitsuba ``constant``) or
+        ``"sphere"`` (a sphere of uniform radiance, emitting on its outside);
         :data:`LIGHT_FIELDS` lists the placement fields each uses.
     spectrum
         Registry name of an illuminant, e.g. ``"planck:2800K"``. The registry normalises every
         illuminant to unit luminance-weighted mean, so *power* alone sets brightness.
     power
         Scale on the normalised SPD: radiant intensity for point and spot lights, radiance for
-        area lights and the sky (an unoccluded surface then receives irradiance π × power),
+        area and sphere lights and the sky (an unoccluded surface then receives irradiance π × power),
         irradiance for directional lights (relative units). Must be > 0.
     position
         World position (point, spot, area centre); unused for directional lights.
@@ -189,6 +213,8 @@ class Light:
         ``(width, height)`` of an area light in scene units.
     cutoff_deg
         Spot cone half-angle in degrees.
+    radius
+        Radius of a sphere light in scene units (left out of records at its default).
     """
 
     kind: LightKind
@@ -199,6 +225,7 @@ class Light:
     size: tuple[float, float] = (1.0, 1.0)
     cutoff_deg: float = 30.0
     name: str = "light"
+    radius: float = field(default=1.0, metadata=_OPTIONAL)
 
 
 def unknown_light_kind(kind: object) -> str:
@@ -347,6 +374,7 @@ def _mesh_from_dict(m: Mapping[str, Any]) -> Mesh:
         face_materials=np.asarray(m["face_materials"], np.int64).reshape(-1),
         object_id=int(m["object_id"]),
         texture=texture_from_record(m["texture"]) if m.get("texture") else None,
+        semantic=str(m.get("semantic") or ""),
     )
 
 

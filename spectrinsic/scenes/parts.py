@@ -44,6 +44,9 @@ class Part:
         ``(pattern, size, seed)`` of a spectral texture over the whole part whose basis is
         :attr:`palette` (:func:`~spectrinsic.scenes.textures.make_texture`; the labels are then
         all 0), or ``None``.
+    semantic
+        The class of the mesh it becomes (:mod:`~spectrinsic.scenes.semantic`), set by the
+        generator on a placed part; empty: the class its name maps to.
     """
 
     vertices: np.ndarray
@@ -51,6 +54,7 @@ class Part:
     labels: np.ndarray
     palette: tuple[str, ...]
     texture: tuple[str, int, int] | None = None
+    semantic: str = ""
 
     @property
     def face_spectra(self) -> np.ndarray:
@@ -163,6 +167,7 @@ def to_meshes(
                 face_materials=face_materials,
                 object_id=first_object_id + k,
                 texture=texture,
+                semantic=p.semantic,
             )
         )
     return tuple(meshes), tuple(materials)

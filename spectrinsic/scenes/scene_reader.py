@@ -23,8 +23,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import SceneError, did_you_mean, with_article
+from .budget import SceneBudget
 from .materials import TexturedMaterial, parse_material
-from .meshes import MAX_FACES, check_mesh_size
+from .meshes import check_mesh_size
 from .model import (
     LIGHT_DEFAULTED,
     LIGHT_FIELDS,
@@ -58,6 +59,7 @@ class _Doc:
 
     def __init__(self, source: str) -> None:
         self.source = source
+        self.budget = SceneBudget(source)  # faces, vertices, texels of the whole scene
 
     def fail(self, field: str, problem: str) -> SceneError:
         return SceneError(f"{self.source}: {field}: {problem}")
@@ -152,7 +154,7 @@ def _resolve(doc: _Doc, base: Path, value: Any, field: str) -> Path:
 def _read_mesh_file(doc: _Doc, path: Path, field: str) -> tuple[np.ndarray, np.ndarray]:
     import trimesh
 
-    check_mesh_size(path)  # from its header, before trimesh builds it
+    check_mesh_size(path, doc.budget)  # from its header, before trimesh builds it
     try:
         # process=False keeps vertex and face order, so face_materials runs stay valid
         mesh = trimesh.load(str(path), force="mesh", process=False)
@@ -253,6 +255,7 @@ def _mesh(doc: _Doc, base: Path, entry: Any, i: int, materials: dict[str, int] |
         # YAML's .nan reaches here as a float: validation reports it with the mesh's name
         vertices = doc.array(entry["vertices"], f"{field}.vertices", np.float64, 3)
         faces = doc.array(entry["faces"], f"{field}.faces", np.int64, 3)
+        doc.budget.charge(f"{field} (inline)", faces=len(faces), vertices=len(vertices))
     object_id = doc.integer(entry.get("object_id", i), f"{field}.object_id")
     face_materials = _face_materials(doc, entry, field, len(faces), materials)
     return Mesh(
@@ -291,6 +294,8 @@ def _light(doc: _Doc, entry: Any, i: int) -> Light:
         kw["size"] = doc.vector(entry["size"], f"{field}.size", 2)
     if "cutoff_deg" in entry:
         kw["cutoff_deg"] = doc.number(entry["cutoff_deg"], f"{field}.cutoff_deg")
+    if "radius" in entry:
+        kw["radius"] = doc.number(entry["radius"], f"{field}.radius")
     # an unnamed light is named by its spectrum, so labels read "planck:2800K 60 %"
     kw["name"] = doc.string(entry["name"], f"{field}.name") if "name" in entry else kw["spectrum"]
     return Light(**kw)
@@ -338,11 +343,6 @@ def scene_from_dict(data: Any, *, base: str | os.PathLike[str], source: str = "<
         )
         for i, m in enumerate(problems.get(_entries, doc, data, "meshes") or [])
     ]
-    faces = sum(len(m.faces) for m in meshes if m is not None)
-    if faces > MAX_FACES:  # several files, each within the limit: the scene is not
-        problems.get(
-            doc._raise, "meshes", f"{faces:,} faces in all; a scene holds at most {MAX_FACES:,}"
-        )
     lights = [
         problems.get(_light, doc, x, i)
         for i, x in enumerate(problems.get(_entries, doc, data, "lights") or [])
@@ -378,6 +378,8 @@ def _materials(doc: _Doc, mats: Any) -> tuple[tuple[Material, ...], dict[str, Te
             raise doc.fail(f"materials.{k}", parsed)
         if isinstance(parsed, TexturedMaterial):
             tex = parsed.texture
+            height, width = tex.weights.shape[:2]
+            doc.budget.charge(f"materials.{k} ({width}x{height} texels)", texels=width * height)
             textures[k] = replace(tex, basis=tuple(len(out) + b for b in tex.basis))
             out.extend(parsed.materials)
         else:

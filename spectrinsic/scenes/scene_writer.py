@@ -19,6 +19,7 @@ import numpy as np
 import yaml
 
 from ..errors import SceneError
+from ..file_writes import refuse_link, replacing, write_text_file
 from .materials import material_entry, textured_entry
 from .model import LIGHT_DEFAULTED, LIGHT_FIELDS, LIGHT_PLACEMENT, Light, Scene, scene_to_dict
 from .scene_format import FORMAT_VERSION
@@ -37,7 +38,7 @@ def _write_ply(path: Path, vertices: np.ndarray, faces: np.ndarray) -> None:
     packed = np.empty(len(faces), dtype=[("n", "u1"), ("v", "<i4", (3,))])
     packed["n"] = 3
     packed["v"] = faces
-    with path.open("wb") as fh:
+    with replacing(path) as tmp, tmp.open("wb") as fh:
         fh.write(header.encode("ascii"))
         fh.write(np.ascontiguousarray(vertices, dtype="<f8").tobytes())
         fh.write(packed.tobytes())
@@ -58,6 +59,11 @@ def _materials(scene: Scene) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for i, m in enumerate(scene.materials):
         tex = textures.get(i)
+        if tex is not None and tex.image is not None:
+            raise SceneError(
+                f"scene {scene.name!r}: image texture {tex.name!r} cannot be saved as YAML; "
+                "render its asset file instead"
+            )
         if tex is not None:
             expected = [basis_name(tex.name, b) for b in range(len(tex.basis))]
             if list(tex.basis) != list(range(i, i + len(tex.basis))) or expected != [
@@ -143,6 +149,7 @@ def save_scene(scene: Scene, path: str | os.PathLike[str], *, inline_max_faces: 
     """Write *scene* as YAML at *path*; meshes with more than *inline_max_faces* faces go to
     float64 binary PLY files in ``<stem>_meshes/`` next to it. Returns *path*."""
     path = Path(path)
+    refuse_link(path)  # before the mesh folder is made beside it
     folder = path.parent / f"{path.stem}_meshes"
     mesh_files: dict[str, str] = {}
     for i, m in enumerate(scene.meshes):
@@ -161,5 +168,5 @@ def save_scene(scene: Scene, path: str | os.PathLike[str], *, inline_max_faces: 
         width=4096,
         allow_unicode=True,
     )
-    path.write_text(header + text, encoding="utf-8")
+    write_text_file(path, header + text)
     return path

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import gzip
+import stat
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,13 +23,17 @@ from .meshes import MESH_SUFFIXES, load_mesh_scene
 from .mitsuba_xml import load_mitsuba_xml
 from .model import Scene
 from .scene_reader import load_scene
+from .semantic import SemanticRules, classify
+from .validate import check_classes
 
 __all__ = [
     "GeneratedSource",
     "FileSource",
     "scene_file_kind",
+    "takes_asset_colours",
     "is_scene_file",
     "load_scene_file",
+    "labelled",
     "FILE_SIZE",
 ]
 
@@ -87,11 +92,32 @@ def _compressed_blend(head: bytes, path: Path) -> bool:
     return False
 
 
+def _file_type(path: Path) -> str:
+    """What *path* is, in words, for a refusal (``stat`` follows links, as ``open`` would)."""
+    mode = path.stat().st_mode
+    for test, what in (
+        (stat.S_ISDIR, "a folder"),
+        (stat.S_ISFIFO, "a FIFO (named pipe)"),
+        (stat.S_ISSOCK, "a socket"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+    ):
+        if test(mode):
+            return what
+    return "a special file"
+
+
 def scene_file_kind(path: str | Path) -> str:
     """``"yaml"``, ``"mitsuba"`` (``.xml``), ``"blend"`` or ``"mesh"`` for a scene file, by suffix; a ``.blend`` also by
     its magic bytes, plain or compressed (gzip, zstd), under any name. One-line error for
-    anything else. The one dispatcher of scene files (``render``, ``dataset --scenes``)."""
+    anything else. The one dispatcher of scene files (``render``, ``dataset --scenes``).
+    A path that exists but is not a regular file (a FIFO, a device, a folder) is refused
+    before it is opened: reading a FIFO would wait for a writer forever."""
     p = Path(path)
+    if p.exists() and not p.is_file():
+        raise SceneError(
+            f"scene file {str(p)!r} is {_file_type(p)}, not a regular file; expected a scene file"
+        )
     suffix = p.suffix.lower()
     if suffix in (".yaml", ".yml"):
         return "yaml"
@@ -125,6 +151,14 @@ def is_scene_file(argument: str | Path) -> bool:
     return p.suffix.lower() in (".yaml", ".yml", ".xml", ".blend", *MESH_SUFFIXES) or p.exists()
 
 
+def takes_asset_colours(path: str | Path) -> bool:
+    """Whether ``--colours-from-asset`` applies to the scene file at *path*: a glTF/GLB, an OBJ
+    (its MTL's ``Kd`` and ``map_Kd``) or a ``.blend`` file (their materials state a base
+    colour); YAML, XML, PLY, STL and OFF files state none, so the option would do nothing there."""
+    suffix = Path(path).suffix.lower()
+    return suffix in (".glb", ".gltf", ".obj") or scene_file_kind(path) == "blend"
+
+
 def load_scene_file(
     path: str | Path,
     *,
@@ -133,7 +167,9 @@ def load_scene_file(
     materials: Mapping[str, str] | None = None,
     default_spectrum: str | None = None,
     data_dir: str | None = None,
-    colours_from_asset: bool = False,
+    colours_from_asset: bool = True,
+    approximate: bool = False,
+    semantic: SemanticRules | None = None,
 ) -> Scene:
     """Read any scene file (:func:`scene_file_kind`) into a validated scene: the one dispatch
     over YAML, ``.blend`` and mesh files, for ``dataset --scenes`` and ``render``.
@@ -148,9 +184,65 @@ def load_scene_file(
     default_spectrum
         Reflectance of mesh or ``.blend`` materials not in *materials*.
     colours_from_asset
-        Give glTF and ``.blend`` materials without a spectrum the file's base colour as an
-        ``rgb:`` reflectance (``--colours-from-asset``); False: they are an error.
+        Give mesh and ``.blend`` materials without a spectrum the colour or texture the file
+        states (glTF base colour and texture, MTL ``Kd``/``map_Kd``, Principled Base Color;
+        the default); False (``--no-colours-from-asset``): they are an error.
+    approximate
+        Approximate what a Mitsuba XML file holds without exact ground truth instead of
+        refusing it (``--approximate``); other kinds of file have nothing to approximate (the
+        command line refuses the option where no scene file is XML).
+    semantic
+        The user's semantic rules (``--semantic-map``), tried before the default map's
+        (:func:`labelled`); None: the default map alone.
     """
+    rules = semantic or SemanticRules()
+    scene = _read_scene_file(
+        path,
+        width,
+        height,
+        materials,
+        default_spectrum,
+        data_dir,
+        colours_from_asset,
+        rules,
+        approximate,
+    )
+    # a mesh file's reader labels its meshes itself: its materials keep only their spectra's names
+    return scene if scene_file_kind(path) == "mesh" else labelled(scene, rules, str(path))
+
+
+def labelled(scene: Scene, semantic: SemanticRules, source: str) -> Scene:
+    """*scene* with each mesh's class taken from its object name, then its material names (in
+    the order its faces use them), by *semantic*'s rules and then the default map's
+    (:func:`~spectrinsic.scenes.semantic.classify`); SceneError naming *source* if meshes
+    sharing an object id get different classes.
+
+    A material named after its own spectrum (as every generated material is, and unnamed mesh
+    materials) says nothing of the object and is passed over, so a saved generated scene read
+    back gets its generator's classes (``sfu:sfu_lab_wall/1`` on a vase is no wall)."""
+    chosen = semantic.compiled()
+    meshes = []
+    for mesh in scene.meshes:
+        used = [scene.materials[i] for i in dict.fromkeys(int(i) for i in mesh.face_materials)]
+        names = [mesh.name, *(m.name for m in used if m.name != m.spectrum)]
+        meshes.append(dataclasses.replace(mesh, semantic=classify(names, chosen)))
+    out = dataclasses.replace(scene, meshes=tuple(meshes))
+    check_classes(out, source)
+    return out
+
+
+def _read_scene_file(
+    path: str | Path,
+    width: int | None,
+    height: int | None,
+    materials: Mapping[str, str] | None,
+    default_spectrum: str | None,
+    data_dir: str | None,
+    colours_from_asset: bool,
+    semantic: SemanticRules,
+    approximate: bool,
+) -> Scene:
+    """The scene of *path* as its reader builds it (see :func:`load_scene_file`)."""
     kind = scene_file_kind(path)
     mapping = dict(materials or {})
     given = width is not None or height is not None
@@ -163,6 +255,7 @@ def load_scene_file(
             default_spectrum=default_spectrum,
             data_dir=data_dir,
             colours_from_asset=colours_from_asset,
+            semantic=semantic.compiled(),
         )
     if kind == "blend":
         return load_blend(
@@ -174,7 +267,7 @@ def load_scene_file(
             colours_from_asset=colours_from_asset,
         )
     if kind == "mitsuba":
-        scene = load_mitsuba_xml(path, data_dir=data_dir)
+        scene = load_mitsuba_xml(path, data_dir=data_dir, approximate=approximate)
     else:
         scene = load_scene(path, data_dir=data_dir)
     camera = dataclasses.replace(
@@ -197,7 +290,11 @@ class FileSource:
     default_spectrum
         Reflectance of mesh or ``.blend`` materials not in *materials*.
     colours_from_asset
-        Base colours of glTF and ``.blend`` materials without a spectrum as ``rgb:`` spectra.
+        The colours and textures the file states, for materials without a spectrum.
+    approximate
+        Approximate what a Mitsuba XML file holds without exact ground truth.
+    semantic
+        The user's semantic rules (``--semantic-map``), before the default map's.
     """
 
     path: str
@@ -205,7 +302,9 @@ class FileSource:
     height: int | None
     materials: tuple[tuple[str, str], ...] = ()
     default_spectrum: str | None = None
-    colours_from_asset: bool = False
+    colours_from_asset: bool = True
+    approximate: bool = False
+    semantic: SemanticRules = SemanticRules()
 
     def build(self, data_dir: str | None = None) -> Scene:
         """Read and validate the file; one-line :class:`SceneError` naming it on bad input."""
@@ -217,4 +316,6 @@ class FileSource:
             default_spectrum=self.default_spectrum,
             data_dir=data_dir,
             colours_from_asset=self.colours_from_asset,
+            approximate=self.approximate,
+            semantic=self.semantic,
         )

@@ -14,6 +14,12 @@ normal is closest to, onto the other two axes, normalised by the mesh's bounding
 ``(u, v)`` lies in [0, 1]. Lookup is nearest-texel (:func:`texel_index`): texel ``(i, j)``
 covers ``u ∈ [j/w, (j+1)/w)``, ``v ∈ [i/h, (i+1)/h)`` (row 0 at v = 0), clamped at the edges.
 
+Image textures (:mod:`spectrinsic.scenes.image_textures`, issue 41) are the same record with
+the 8 RGB-cube corner spectra as basis, the image's trilinear corner weights as ``weights``
+(:func:`make_image_texture`) and the asset's own coordinates in ``uv`` instead of the box
+projection; ``repeat`` and ``mirror`` wrapping outside [0, 1] are made exact by copying the
+image (flipped for ``mirror``) in the texel table and rescaling ``uv`` into [0, 1].
+
 Patterns (:data:`PATTERNS`) are generated here (licence: spectrinsic's own): ``rings`` (wood
 grain: rings around a centre, perturbed by value noise), ``weave`` (fabric: two crossing sets of
 threads) and ``noise`` (fractal value noise, stone). Each gives a field ``t`` in [0, 1], quantised
@@ -22,13 +28,21 @@ to steps of 1/255, mapped onto the basis by piecewise-linear interpolation along
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
-from ..errors import did_you_mean
+from ..errors import SceneError, SpectrinsicWarning, did_you_mean
+from .image_textures import (
+    CORNERS,
+    IMAGE_TEXELS_MAX,
+    ImageTexture,
+    corner_weights,
+    image_from_record,
+)
 
 __all__ = [
     "PATTERNS",
@@ -38,6 +52,8 @@ __all__ = [
     "Texture",
     "basis_name",
     "make_texture",
+    "make_image_texture",
+    "image_weights",
     "texture_from_record",
     "pattern_weights",
     "weights_problem",
@@ -72,15 +88,28 @@ class Texture:
     pattern, size, seed
         The procedural recipe the weights came from (:func:`make_texture`), or ``""`` (and 0)
         for weights given explicitly.
+    uv
+        ``(F, 3, 2)`` texture coordinates in [0, 1] of each face corner of the mesh (an image
+        texture's, from the asset), or ``None``: :func:`box_uv`.
+    image
+        The decoded image the weights came from (:func:`make_image_texture`), or ``None``.
     """
 
     name: str
     basis: tuple[int, ...]
     # a procedural texture's record (scene_to_dict, the scene hash) is its recipe alone
-    weights: np.ndarray = field(metadata={"omit_when": lambda texture: bool(texture.pattern)})
+    weights: np.ndarray = field(
+        metadata={"omit_when": lambda texture: bool(texture.pattern) or texture.image is not None}
+    )
     pattern: str = field(default="", metadata={"omit_default": True})
     size: int = field(default=0, metadata={"omit_default": True})
     seed: int = field(default=0, metadata={"omit_default": True})
+    uv: np.ndarray | None = field(
+        default=None, metadata={"omit_when": lambda texture: texture.uv is None}
+    )
+    image: ImageTexture | None = field(
+        default=None, metadata={"omit_when": lambda texture: texture.image is None}
+    )
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Texture):
@@ -90,9 +119,15 @@ class Texture:
             == (other.name, other.basis, other.pattern, other.size, other.seed)
             and self.weights.shape == other.weights.shape
             and np.array_equal(self.weights, other.weights)
+            and _same_uv(self.uv, other.uv)
+            and self.image == other.image
         )
 
     __hash__ = None  # type: ignore[assignment]
+
+
+def _same_uv(a: np.ndarray | None, b: np.ndarray | None) -> bool:
+    return a is None and b is None or (a is not None and b is not None and np.array_equal(a, b))
 
 
 def basis_name(texture: str, b: int) -> str:
@@ -104,12 +139,16 @@ def basis_name(texture: str, b: int) -> str:
     return f"{texture}[{b}]"
 
 
-def weights_problem(weights: np.ndarray) -> str | None:
-    """What is wrong with ``(h, w, B)`` texel *weights* (one phrase), or ``None``."""
+def weights_problem(weights: np.ndarray, *, image: bool = False) -> str | None:
+    """What is wrong with ``(h, w, B)`` texel *weights* (one phrase), or ``None``; an *image*
+    texture's have the 8 corner weights and at most ``IMAGE_TEXELS_MAX`` texels."""
     w = np.asarray(weights)
-    if w.ndim != 3 or not 2 <= w.shape[2] <= BASIS_MAX:
-        return f"texture weights of shape {w.shape}: expected (h, w, B) with 2 <= B <= {BASIS_MAX}"
-    if not (1 <= w.shape[0] <= TEXTURE_MAX and 1 <= w.shape[1] <= TEXTURE_MAX):
+    most = len(CORNERS) if image else BASIS_MAX
+    if w.ndim != 3 or not 2 <= w.shape[2] <= most:
+        return f"texture weights of shape {w.shape}: expected (h, w, B) with 2 <= B <= {most}"
+    if image and not (1 <= w.shape[0] * w.shape[1] <= IMAGE_TEXELS_MAX):
+        return f"texture of {w.shape[0]}x{w.shape[1]} texels: expected at most {IMAGE_TEXELS_MAX:,}"
+    if not image and not (1 <= w.shape[0] <= TEXTURE_MAX and 1 <= w.shape[1] <= TEXTURE_MAX):
         return (
             f"texture of {w.shape[0]}x{w.shape[1]} texels: expected at most {TEXTURE_MAX} per side"
         )
@@ -129,19 +168,32 @@ def texture_problem(
     """What is wrong with *texture* on a mesh with *face_materials*, in a scene whose materials
     have *kinds* (one phrase), or ``None``."""
     basis = texture.basis
-    if not 2 <= len(basis) <= BASIS_MAX or len(set(basis)) != len(basis):
-        return f"texture basis {basis}: expected 2 to {BASIS_MAX} distinct materials"
+    most = BASIS_MAX if texture.image is None else len(CORNERS)
+    if not 2 <= len(basis) <= most or len(set(basis)) != len(basis):
+        return f"texture basis {basis}: expected 2 to {most} distinct materials"
     if any(not 0 <= b < len(kinds) for b in basis):
         return f"texture basis {basis}: material index out of range 0..{len(kinds) - 1}"
     glossy = [b for b in basis if kinds[b] != "diffuse"]
     if glossy:
         return f"texture basis material {glossy[0]} is {kinds[glossy[0]]}; expected diffuse"
-    problem = weights_problem(texture.weights)
+    problem = weights_problem(texture.weights, image=texture.image is not None)
     if problem is None and texture.weights.shape[2] != len(basis):
         problem = f"texture weights have {texture.weights.shape[2]} channels for {len(basis)} basis spectra"
     if problem is None and np.any(np.asarray(face_materials) != basis[0]):
         problem = f"a textured mesh's faces all take material basis[0] = {basis[0]}"
+    if problem is None and texture.uv is not None:
+        problem = _uv_problem(texture.uv, len(np.asarray(face_materials)))
     return problem
+
+
+def _uv_problem(uv: np.ndarray, n_faces: int) -> str | None:
+    """What is wrong with a texture's corner *uv* on a mesh of *n_faces* faces, or ``None``."""
+    a = np.asarray(uv)
+    if a.shape != (n_faces, 3, 2):
+        return f"texture uv of shape {a.shape}: expected ({n_faces}, 3, 2), one per face corner"
+    if not np.issubdtype(a.dtype, np.number) or not np.all(np.isfinite(a)):
+        return "texture uv: expected finite numbers"
+    return None
 
 
 def _value_noise(rng: np.random.Generator, size: int, cells: int) -> np.ndarray:
@@ -208,9 +260,71 @@ def make_texture(name: str, basis: tuple[int, ...], pattern: str, size: int, see
     return Texture(name, tuple(basis), weights, pattern, int(size), int(seed))
 
 
+def image_weights(image: ImageTexture) -> np.ndarray:
+    """``(h·rows, w·columns, 8)`` corner weights of *image*'s texels
+    (:func:`~spectrinsic.scenes.image_textures.corner_weights`) in ``image.tiles`` copies,
+    from copy ``image.first_tile`` on; under ``mirror`` a copy with an odd index is flipped."""
+    weights = corner_weights(image.texels)
+    rows, cols = (int(t) for t in image.tiles)
+    row0, col0 = (int(t) for t in image.first_tile)
+    mirror = image.wrap == "mirror"
+    line = [weights[:, ::-1] if mirror and (col0 + c) % 2 else weights for c in range(cols)]
+    strip = np.concatenate(line, axis=1)
+    return np.concatenate(
+        [strip[::-1] if mirror and (row0 + r) % 2 else strip for r in range(rows)], axis=0
+    )
+
+
+def _wrapped(uv: np.ndarray, image: ImageTexture, what: str) -> tuple[np.ndarray, ImageTexture]:
+    """*uv* rescaled into [0, 1] and *image* with the copies that make its wrap mode exact
+    under the renderer's clamped nearest lookup (:attr:`ImageTexture.tiles`)."""
+    inside = bool(np.all(uv >= 0.0) and np.all(uv <= 1.0))
+    if inside or image.wrap == "clamp":
+        return uv, replace(image, tiles=(1, 1), first_tile=(0, 0))
+    lo, hi = np.floor(uv.min(axis=(0, 1))), np.ceil(uv.max(axis=(0, 1)))
+    span = np.maximum(hi - lo, 1.0)
+    cols, rows = int(span[0]), int(span[1])
+    h, w = image.texels.shape[:2]
+    if h * w * rows * cols > IMAGE_TEXELS_MAX:
+        raise SceneError(
+            f"{what}: coordinates span {cols}x{rows} copies of a {w}x{h} image, more than "
+            f"{IMAGE_TEXELS_MAX:,} texels"
+        )
+    tiled = replace(image, tiles=(rows, cols), first_tile=(int(lo[1]), int(lo[0])))
+    return (uv - lo) / span, tiled
+
+
+def make_image_texture(
+    name: str, basis: tuple[int, ...], image: ImageTexture, uv: np.ndarray
+) -> Texture:
+    """The :class:`Texture` of *image* on a mesh whose face corners have texture coordinates
+    *uv* ``(F, 3, 2)`` (the asset's; v up, OpenGL convention), over *basis*: the indices of the
+    8 corner materials (:data:`~spectrinsic.scenes.image_textures.CORNERS` order)."""
+    if len(basis) != len(CORNERS):
+        raise ValueError(f"image texture basis {basis}: expected the {len(CORNERS)} corners")
+    uv = np.asarray(uv, np.float64)
+    if uv.ndim != 3 or uv.shape[1:] != (3, 2) or not np.all(np.isfinite(uv)):
+        raise SceneError(f"texture {image.source or name}: expected finite (F, 3, 2) uv")
+    what = f"texture {image.source or name}"
+    scaled, tiled = _wrapped(uv, image, what)
+    if image.filter != "nearest":
+        warnings.warn(
+            f"{what}: {image.filter} filtering approximated by the nearest texel "
+            "(the band path's lookup; the ground truth is exact for what is rendered)",
+            SpectrinsicWarning,
+            stacklevel=2,
+        )
+    return Texture(name, tuple(basis), image_weights(tiled), uv=scaled, image=tiled)
+
+
 def texture_from_record(record: Mapping[str, Any]) -> Texture:
-    """The :class:`Texture` of its ``scene_to_dict`` record (a recipe, or explicit weights)."""
+    """The :class:`Texture` of its ``scene_to_dict`` record (a recipe, an image, or explicit
+    weights)."""
     basis = tuple(int(b) for b in record["basis"])
+    uv = None if record.get("uv") is None else np.asarray(record["uv"], np.float64)
+    if record.get("image"):
+        image = image_from_record(record["image"])
+        return Texture(str(record["name"]), basis, image_weights(image), uv=uv, image=image)
     if record.get("pattern"):
         return make_texture(
             str(record["name"]),
@@ -219,7 +333,7 @@ def texture_from_record(record: Mapping[str, Any]) -> Texture:
             int(record.get("size", 0)),
             int(record.get("seed", 0)),  # left out of the record at its default, 0
         )
-    return Texture(str(record["name"]), basis, np.asarray(record["weights"], np.float64))
+    return Texture(str(record["name"]), basis, np.asarray(record["weights"], np.float64), uv=uv)
 
 
 def box_uv(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:

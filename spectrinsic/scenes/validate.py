@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import TypeVar
 
 import numpy as np
@@ -29,11 +29,13 @@ from ..errors import SceneError, SpectrinsicError, with_article
 from ..spectra import get_spectrum
 from .geometry import VISIBILITY_GRID, camera_rays, is_closed, winding_numbers
 from .materials import material_problem
-from .model import LIGHT_FIELDS, LIGHT_KINDS, Scene, unknown_light_kind
+from .model import LIGHT_FIELDS, LIGHT_KINDS, Mesh, Scene, unknown_light_kind
+from .semantic import SEMANTIC_CLASSES
 from .textures import texture_problem
 
 __all__ = [
     "validate_scene",
+    "check_classes",
     "Problems",
     "POWER_RANGE",
     "MAX_COORDINATE",
@@ -44,7 +46,6 @@ log = logging.getLogger(__name__)
 #: A point is inside a closed mesh when its winding number exceeds this (exactly 1 inside,
 #: 0 outside for a closed outward-oriented surface; overlapping parts add up).
 _INSIDE_WINDING = 0.5
-_RAY_BATCHES = 16
 #: A light's power, in the scene's relative units, must lie in this closed range: the renderer
 #: carries power × spectrum (unit luminance-weighted mean) × geometry in float32 (largest
 #: 3.4e38, smallest normal 1.2e-38), so 1e±20 leaves 18 orders of magnitude for the spectrum's
@@ -214,6 +215,20 @@ def _check_meshes(scene: Scene, source: str) -> None:
             )
 
 
+def check_classes(scene: Scene, source: str) -> None:
+    """Every mesh's class is in the table, and meshes sharing an object id share it (the
+    semantic layer is read through the object-id layer)."""
+    classes: dict[int, str] = {}
+    for i, m in enumerate(scene.meshes):
+        where = f"meshes[{i}] ({m.name!r}).semantic"
+        if m.semantic not in SEMANTIC_CLASSES:
+            raise _fail(source, where, f"expected one of {', '.join(SEMANTIC_CLASSES)}")
+        other = classes.setdefault(int(m.object_id), m.semantic)
+        if other != m.semantic:
+            why = f"meshes sharing an object id share a class (object {m.object_id}: {other!r})"
+            raise _fail(source, where, f"{m.semantic!r}; {why}")
+
+
 def _check_textures(scene: Scene, source: str) -> None:
     kinds = [m.kind for m in scene.materials]
     for i, m in enumerate(scene.meshes):
@@ -267,6 +282,8 @@ def _check_lights(scene: Scene, source: str) -> None:
                 raise _fail(
                     source, f"{where}.size", f"expected (width, height) > 0, got {light.size!r}"
                 )
+        if "radius" in uses and not (math.isfinite(light.radius) and light.radius > 0):
+            raise _fail(source, f"{where}.radius", f"expected a radius > 0, got {light.radius!r}")
         if "cutoff_deg" in uses and not 0 < light.cutoff_deg <= 90:
             raise _fail(
                 source,
@@ -313,8 +330,6 @@ def _check_camera(scene: Scene, source: str) -> None:
 
 
 def _check_placement(scene: Scene, source: str) -> None:
-    import trimesh
-
     points = {
         f"lights[{i}].position ({light.kind} light)": light.position
         for i, light in enumerate(scene.lights)
@@ -323,12 +338,12 @@ def _check_placement(scene: Scene, source: str) -> None:
     points["camera.origin"] = scene.camera.origin
     labels, xyz = list(points), np.asarray(list(points.values()), dtype=np.float64)
     for m in scene.meshes:
-        if not is_closed(m.faces):
-            log.debug("mesh %r is not closed; it has no inside to test", m.name)
-            continue
         lo, hi = m.vertices.min(axis=0), m.vertices.max(axis=0)
         candidates = np.flatnonzero(np.all((xyz >= lo) & (xyz <= hi), axis=1))
-        if len(candidates) == 0:
+        if len(candidates) == 0:  # tested first: cheaper than is_closed on big scenes
+            continue
+        if not is_closed(m.faces):
+            log.debug("mesh %r is not closed; it has no inside to test", m.name)
             continue
         w = winding_numbers(xyz[candidates], m.vertices, m.faces)
         for k, wk in zip(candidates, w, strict=True):
@@ -340,25 +355,42 @@ def _check_placement(scene: Scene, source: str) -> None:
                 )
     cam = scene.camera
     origins, dirs = camera_rays(cam.origin, cam.target, cam.up, cam.fov_deg, cam.width, cam.height)
-    offsets = np.cumsum([0] + [len(m.vertices) for m in scene.meshes])
-    union = trimesh.Trimesh(
-        np.concatenate([m.vertices for m in scene.meshes]),
-        np.concatenate([m.faces + o for m, o in zip(scene.meshes, offsets, strict=False)]),
-        process=False,
-    )
-    # centre rays first, in small batches: a scene in view is found by the first batch
-    order = np.argsort(np.linalg.norm(dirs - dirs.mean(axis=0), axis=1), kind="stable")
-    intersector = union.ray
-    if not any(
-        intersector.intersects_any(origins[batch], dirs[batch]).any()
-        for batch in np.array_split(order, _RAY_BATCHES)
-    ):
+    if not _sees_a_mesh(scene.meshes, origins, dirs):
         raise _fail(
             source,
             "camera",
             f"looks at nothing: none of {VISIBILITY_GRID}x{VISIBILITY_GRID} rays from origin "
             f"{list(cam.origin)} towards target {list(cam.target)} hits a mesh",
         )
+
+
+def _box_hits(origins: np.ndarray, dirs: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Which rays meet the box [lo, hi] ahead of their origin (the slab test)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / dirs
+        t0, t1 = (lo - origins) * inv, (hi - origins) * inv
+    near = np.nanmax(np.minimum(t0, t1), axis=1)
+    far = np.nanmin(np.maximum(t0, t1), axis=1)
+    return (far >= np.maximum(near, 0.0)) & np.isfinite(far)
+
+
+def _sees_a_mesh(meshes: Sequence[Mesh], origins: np.ndarray, dirs: np.ndarray) -> bool:
+    """Whether a ray hits a mesh: each mesh tested with the rays that meet its bounding box,
+    the meshes whose boxes most rays meet first (a scene in view is found by the first one;
+    one mesh at a time keeps a big scene's ray test small)."""
+    import trimesh
+
+    hits = [
+        _box_hits(origins, dirs, m.vertices.min(axis=0), m.vertices.max(axis=0)) for m in meshes
+    ]
+    for k in sorted(range(len(meshes)), key=lambda k: -int(hits[k].sum())):
+        if not hits[k].any():
+            break
+        m = meshes[k]
+        shape = trimesh.Trimesh(m.vertices, m.faces, process=False)
+        if shape.ray.intersects_any(origins[hits[k]], dirs[hits[k]]).any():
+            return True
+    return False
 
 
 def validate_scene(
@@ -394,7 +426,14 @@ def validate_scene(
     """
     source = source or f"scene {scene.name!r}"
     problems = Problems(source)
-    for check in (_check_meshes, _check_lights, _check_camera, _check_materials, _check_textures):
+    for check in (
+        _check_meshes,
+        check_classes,
+        _check_lights,
+        _check_camera,
+        _check_materials,
+        _check_textures,
+    ):
         problems.get(check, scene, source)
     if check_spectra:
         cache: dict[str, object] = {}

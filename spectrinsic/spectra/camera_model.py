@@ -18,9 +18,15 @@ to DN at ``1 / gain`` DN per electron and quantised. Its variance in DN above bl
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+import math
+from dataclasses import dataclass, field, fields, replace
+from typing import Any
+
+import numpy as np
 
 from ..errors import SpectrinsicError, did_you_mean
+from .records import SensorSet
+from .registry import get_sensors, get_spectrum
 
 __all__ = [
     "CFA_PATTERNS",
@@ -34,6 +40,7 @@ __all__ = [
     "camera_model",
     "camera_model_names",
     "PRESET_ALIASES",
+    "camera_sensors",
 ]
 
 #: Bayer layouts, read row by row over the 2 × 2 tile (colour-demosaicing's names).
@@ -136,6 +143,7 @@ class CameraModel:
     sources: tuple[tuple[str, str], ...] = field(default=(), compare=False)
 
     def __post_init__(self) -> None:
+        self._check_numbers()
         positive = {
             "gain_e_per_dn": self.gain_e_per_dn,
             "full_well_e": self.full_well_e,
@@ -160,6 +168,28 @@ class CameraModel:
                 raise CameraModelError(f"camera {self.name!r}: {key} {value!r}: expected >= 0")
         self._check_choices()
 
+    def _check_numbers(self) -> None:
+        """Every number finite (an infinite gain or exposure would give NaN raw values far
+        downstream); the integers integers (``adc_bits`` 12.5 has no ADC maximum); PRNU, a
+        relative standard deviation of gain, in [0, 1) (at 1 a pixel's gain is as likely
+        negative as not)."""
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                continue
+            if not math.isfinite(value):
+                raise CameraModelError(
+                    f"camera {self.name!r}: {f.name} {value!r}: expected a finite number"
+                )
+        for key in ("adc_bits", "black_level_dn", "output_bits", "fixed_pattern_seed"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, int | np.integer):
+                raise CameraModelError(
+                    f"camera {self.name!r}: {key} {value!r}: expected an integer"
+                )
+        if not 0 <= self.prnu < 1:
+            raise CameraModelError(f"camera {self.name!r}: prnu {self.prnu!r}: expected [0, 1)")
+
     def _check_choices(self) -> None:
         if not 8 <= self.adc_bits <= 16:
             raise CameraModelError(f"camera {self.name!r}: adc_bits {self.adc_bits}: expected 8-16")
@@ -167,6 +197,12 @@ class CameraModel:
             raise CameraModelError(
                 f"camera {self.name!r}: black_level_dn {self.black_level_dn}: expected below "
                 f"the ADC maximum {2**self.adc_bits - 1}"
+            )
+        if self.white_level_dn <= self.black_level_dn:
+            raise CameraModelError(
+                f"camera {self.name!r}: a full well of {self.full_well_e:g} e- at "
+                f"{self.gain:g} e-/DN is under one DN above black; expected a gain below the "
+                "full well"
             )
         if self.output_bits not in (8, 16):
             raise CameraModelError(
@@ -304,3 +340,26 @@ def camera_model(name: str) -> CameraModel:
         f"camera {name!r}: expected a preset ({', '.join(CAMERA_PRESETS)}) or a sensor set "
         f"'camera:NAME' or 'csv:PATH'{hint}"
     )
+
+
+def camera_sensors(model: CameraModel, *, data_dir: Any = None) -> SensorSet:
+    """The sensor set of *model*'s colour filter array, checked when the camera is resolved
+    (before any sample): exactly three curves (R, G, B of the CFA), finite and non-negative,
+    each responding to CIE D65 between 380 and 780 nm. A CSV of two curves, or of curves with
+    no visible response, is refused in one line naming it, instead of failing every sample."""
+    sensors = get_sensors(model.sensitivities, data_dir=data_dir)
+    where = f"camera {model.name!r}: sensor set {model.sensitivities!r}"
+    if len(sensors.channels) != 3:
+        raise CameraModelError(
+            f"{where} has {len(sensors.channels)} curves ({', '.join(sensors.channels)}); "
+            "expected three (R, G, B of the colour filter array)"
+        )
+    wavelengths = np.arange(380.0, 781.0, 5.0)
+    curves = np.asarray(sensors.on(wavelengths), float)
+    if not np.isfinite(curves).all() or (curves < 0).any():
+        raise CameraModelError(f"{where}: expected finite, non-negative sensitivities")
+    d65 = get_spectrum("cie:D65").on(wavelengths)
+    dead = [c for c, r in zip(sensors.channels, curves @ d65, strict=True) if not r > 0]
+    if dead:
+        raise CameraModelError(f"{where}: curve {dead[0]!r} has no response to D65 in 380-780 nm")
+    return sensors

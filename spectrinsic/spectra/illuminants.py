@@ -13,6 +13,7 @@ hundred kelvin).
 from __future__ import annotations
 
 import functools
+import math
 
 import numpy as np
 
@@ -101,9 +102,19 @@ def visible_share(wavelengths: np.ndarray, values: np.ndarray) -> float:
     return float(np.sum(v * ybar * dl)) / total if total > 0 else 0.0
 
 
+#: Peak above which an illuminant is divided by its peak before its sums (float64 overflows
+#: near 1.8e308; a sum over 471 samples of values above 1e150 squared would too).
+_RESCALE_ABOVE = 1e150
+
+
 def normalise_illuminant(wavelengths: np.ndarray, values: np.ndarray) -> np.ndarray:
     """Scale *values* so that ``Σ L ȳ = Σ ȳ`` over *wavelengths* (ȳ: CIE 1931 2°); refuse a light
-    with no power where the eye is sensitive, or a visible share below :data:`VISIBLE_SHARE`."""
+    with no power where the eye is sensitive, or a visible share below :data:`VISIBLE_SHARE`.
+    Values above :data:`_RESCALE_ABOVE` are divided by their peak first (the result is the
+    same: only the shape counts), so sums of a 1e308 spectrum stay finite."""
+    peak = float(np.max(np.abs(values))) if np.size(values) else 0.0
+    if math.isfinite(peak) and peak > _RESCALE_ABOVE:
+        values = np.asarray(values, float) / peak
     ybar = ybar_at(wavelengths)
     lum = float(np.sum(values * ybar))
     if not lum > 0:

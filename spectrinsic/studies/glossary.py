@@ -32,6 +32,11 @@ STUDY_TERMS: dict[str, str] = {
     "e6": "the same for rgb6 (6 Gaussian sensors, the two-pass method, regressed to XYZ)",
     "r": "energy ratio of thesis Eq. 5.8: direct light over all bounces, Σ‖p¹‖ / Σ‖p^∞‖",
     "v": "camera viewpoint of the scene",
+    "LMSE": "local mean squared error (Grosse et al. 2009; thesis Table 3.2): 20-pixel windows, "
+    "shift 10, one least-squares scale per window, normalised by the ground truth's energy; "
+    "the mean of shading and grey reflectance",
+    "CI": "confidence interval: mean ± t_{0.975, n-1} s / √n over the seeds (Student's t)",
+    "rgb3": "the 3-sensor render (CIE 1931 CMFs as 3 diagonal sensors) of the same scene",
 }
 
 

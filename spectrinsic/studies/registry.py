@@ -4,7 +4,7 @@ A study turns the command line's options into its own settings record, computes 
 without writing anything, formats it as text and writes its files:
 
 >>> sorted(STUDIES)
-['photometric', 'reconstruction-error', 'rendering']
+['photometric', 'reconstruction-error', 'rendering', 'sim2real']
 >>> get_study("photometric").settings(StudyOptions(seed=3)).seed
 3
 
@@ -14,7 +14,7 @@ with the four methods below and one entry in :data:`STUDIES`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -45,6 +45,14 @@ from .rendering import (
     run_rendering,
     write_rendering_outputs,
 )
+from .sim2real import (
+    Sim2RealResult,
+    Sim2RealSettings,
+    format_sim2real,
+    run_sim2real,
+    write_sim2real,
+)
+from .sim2real import preset as sim2real_preset
 
 __all__ = ["StudyOptions", "Study", "STUDIES", "get_study", "study_names", "StudyRun", "run_study"]
 
@@ -65,6 +73,8 @@ class StudyOptions:
         reconstruction-error: also the extended sweep, beside Table 5.2.
     quality
         rendering: quality preset (:data:`spectrinsic.studies.rendering.QUALITIES`).
+    preset
+        sim2real: size preset (:data:`spectrinsic.studies.sim2real.PRESETS`); None: ``small``.
     """
 
     seed: int = 0
@@ -72,6 +82,7 @@ class StudyOptions:
     camera_balance: str = "equal-energy-white"
     extension: bool = True
     quality: str = "default"
+    preset: str | None = None
 
 
 class Study(Protocol):
@@ -180,8 +191,35 @@ class _Rendering:
         return write_rendering_outputs(result, out_dir)
 
 
+@dataclass(frozen=True)
+class _Sim2Real:
+    """The sim-to-real study: the U-Net trained on matched sets, scored on MIT photographs."""
+
+    name: str = "sim2real"
+    summary: str = (
+        "a U-Net trained on matched generated sets (spectral vs rgb3 image, coloured vs white "
+        "lights, camera chain or not), scored on MIT photographs (needs torch)"
+    )
+
+    def settings(self, options: StudyOptions) -> Sim2RealSettings:
+        return replace(sim2real_preset(options.preset or "small"), seed=options.seed)
+
+    def run(
+        self, settings: Sim2RealSettings, *, data_dir: str | None, progress: StepProgress | None
+    ) -> Sim2RealResult:
+        return run_sim2real(settings, data_dir=data_dir, progress=progress)
+
+    def format(self, result: Sim2RealResult) -> str:
+        return format_sim2real(result)
+
+    def write(self, result: Sim2RealResult, out_dir: Path) -> dict[str, Path]:
+        return write_sim2real(result, out_dir)
+
+
 #: The studies, in the order ``--help`` and ``make study`` list them.
-STUDIES: dict[str, Study] = {s.name: s for s in (_Reconstruction(), _Photometric(), _Rendering())}
+STUDIES: dict[str, Study] = {
+    s.name: s for s in (_Reconstruction(), _Photometric(), _Rendering(), _Sim2Real())
+}
 
 
 def study_names() -> list[str]:

@@ -59,3 +59,22 @@ def test_residual_benchmark_reports_rgb_and_band_shares(monkeypatch, tmp_path):
     assert result["default_over_srgb"]["median"] == pytest.approx(ratio)
     cost = result["spectral_exr_cost"]
     assert cost["folder_bytes_with_bands"] > cost["folder_bytes_without_bands"]
+
+
+@pytest.mark.slow
+def test_real_scene_benchmark_compares_the_xml_reader_with_mitsubas_load_file(
+    monkeypatch, tmp_path
+):
+    from spectrinsic.bench import real_scene
+    from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml
+
+    monkeypatch.setattr(real_scene, "MESHES", 4)
+    scene = load_mitsuba_xml(real_scene.write_interior(tmp_path / "interior"))
+    assert len(scene.meshes) == 4 + 1 and len(scene.lights) == 2
+    assert sum(len(m.faces) for m in scene.meshes) == 4 * real_scene.FACES_PER_MESH + 2
+    assert bench.main(["--out", str(tmp_path), "--only", "real_scene"]) == 0
+    result = json.loads((tmp_path / "bench_real_scene.json").read_text())
+    assert result["spectrinsic_seconds"] > 0 and result["mitsuba_load_file_seconds"] > 0
+    assert result["time_ratio"] == pytest.approx(
+        result["spectrinsic_seconds"] / result["mitsuba_load_file_seconds"]
+    )

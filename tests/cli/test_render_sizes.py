@@ -91,9 +91,14 @@ def test_render_and_ground_truth_share_their_defaults():
     parser = build_parser()
     plain = parser.parse_args(["render", "obj-apple", "--out", "x"])
     gt = parser.parse_args(["render", "obj-apple", "--out", "x", "--ground-truth"])
-    preset = get_preset(gt.preset)
+    # not given, they are None on the parser (so that one given where it does not apply is
+    # refused) and resolve to the default preset's: the plain render's depth, the GT preset
+    from spectrinsic.cli.render import _render_settings
+
+    assert gt.preset is None and plain.max_depth is None
+    preset = get_preset("default")
     default = get_preset("default")
-    assert gt.preset == "default" and plain.max_depth == preset.render.max_depth
+    assert _render_settings(plain, ["rgb3"]).max_depth == preset.render.max_depth
     assert (preset.width, preset.height, preset.render.spp) == (
         default.width,
         default.height,

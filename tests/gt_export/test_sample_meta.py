@@ -189,6 +189,9 @@ def test_object_id_16777217_is_exported_and_loaded_exactly(tmp_path, synth, conf
 
     scene = synth.make_scene(("planck:2800K",))
     result = synth.make_result(scene)
+    # the scene's mesh carries the id too: the semantic layer reads each object's class
+    mesh = dataclasses.replace(scene.meshes[0], object_id=16777217)
+    scene = dataclasses.replace(scene, meshes=(mesh,))
     big = np.where(result.aovs["object_id"] >= 0, 16777217, -1).astype(np.int32)
     result = dataclasses.replace(result, aovs={**result.aovs, "object_id": big})
     folder = export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=1)

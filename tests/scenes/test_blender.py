@@ -139,19 +139,20 @@ def test_blend_with_unknown_spectrum(tmp_path):
     assert "\n" not in str(info.value)
     # an unmapped material named like nothing is reported with the ways to map it
     with pytest.raises(SceneError, match="material 'Paint'.*materials="):
-        load_blend(path, materials={"Floor": "flat:0.5"})
+        load_blend(path, materials={"Floor": "flat:0.5"}, colours_from_asset=False)
 
 
 @pytest.mark.blender
-def test_base_colour_only_when_asked_for(blend_file):
-    """An unmapped material is an error by default; with colours_from_asset its Principled Base
+def test_base_colour_unless_turned_off(blend_file):
+    """An unmapped material is an error without colours_from_asset; with it (the default since
+    issue 41) its Principled Base
     Color becomes an rgb: reflectance, while a name or property that is a spectrum still wins."""
     from spectrinsic.scenes.blender import load_blend
 
     path, _ = blend_file
     with pytest.raises(SceneError, match="material 'Paint'.*materials="):
-        load_blend(path)
-    scene = load_blend(path, colours_from_asset=True)
+        load_blend(path, colours_from_asset=False)
+    scene = load_blend(path)
     spectra = {m.name: m.spectrum for m in scene.materials}
     assert spectra.pop("munsell:5R 4/14") == "munsell:5R 4/14"
     assert spectra.pop("Floor") == "flat:0.5"
@@ -172,11 +173,13 @@ def test_missing_bpy_gives_a_helpful_error(monkeypatch, tmp_path):
 @pytest.mark.blender
 def test_render_routes_a_blend_file_to_the_importer(blend_file, tmp_path, capsys):
     """``spectrinsic render x.blend`` reads it with the importer (not as YAML): here the
-    importer's own one-line error for the material named after no spectrum."""
+    importer's own one-line error for the material named after no spectrum (its base colour
+    not read: ``--no-colours-from-asset``)."""
     from spectrinsic.cli import main
 
     path, _ = blend_file
-    rc = main(["-q", "render", str(path), "--modes", "rgb3", "--out", str(tmp_path / "o")])
+    args = ["-q", "render", str(path), "--modes", "rgb3", "--no-colours-from-asset"]
+    rc = main([*args, "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err.strip()
     assert rc == 2 and len(err.splitlines()) == 1
     assert str(path) in err and "'Paint'" in err and "UnicodeDecodeError" not in err

@@ -1,4 +1,4 @@
-"""glTF base colours become rgb: reflectances (issue 32)."""
+"""glTF base colours become rgb: reflectances (issue 32), by default since issue 41."""
 
 from __future__ import annotations
 
@@ -28,12 +28,14 @@ def test_base_colour_factors_become_rgb_spectra_unless_mapped(tmp_path):
         scene.add_geometry(box, name)
     path = tmp_path / "two.glb"
     scene.export(path)
-    # the file's colours are used only when asked for: by default an unmapped material is refused
-    with pytest.raises(SceneError, match="material 'brick' is not in the material map"):
-        load_mesh_scene(path, materials={"sky": "flat:0.5"}, width=8, height=8)
-    loaded = load_mesh_scene(
-        path, materials={"sky": "flat:0.5"}, width=8, height=8, colours_from_asset=True
-    )
+    # without the file's colours an unmapped material is refused, naming the ways to map it
+    with pytest.raises(SceneError, match="material 'brick' is not in the material map") as info:
+        load_mesh_scene(
+            path, materials={"sky": "flat:0.5"}, width=8, height=8, colours_from_asset=False
+        )
+    for option in ("--material-map", "--default-spectrum", "--colours-from-asset"):
+        assert option in str(info.value)
+    loaded = load_mesh_scene(path, materials={"sky": "flat:0.5"}, width=8, height=8)
     spectra = {m.spectrum for m in loaded.materials}
     assert "flat:0.5" in spectra  # the map wins over the file's colour
     (brick,) = spectra - {"flat:0.5"}
@@ -46,9 +48,9 @@ def test_base_colour_factors_become_rgb_spectra_unless_mapped(tmp_path):
     np.testing.assert_allclose(rgb, np.array([200, 60, 40]) / 255, atol=1e-3)
 
 
-def test_render_takes_gltf_colours_only_with_the_option(tmp_path, capsys):
-    """``render x.glb`` refuses an unmapped material in one line; ``--colours-from-asset``
-    renders it in its base colour."""
+def test_render_takes_gltf_colours_unless_turned_off(tmp_path, capsys):
+    """``render x.glb --no-colours-from-asset`` refuses an unmapped material in one line; by
+    default it renders in its base colour."""
     from spectrinsic.cli import main
 
     box = trimesh.creation.box((1.0, 1.0, 1.0))
@@ -58,7 +60,7 @@ def test_render_takes_gltf_colours_only_with_the_option(tmp_path, capsys):
     path = tmp_path / "one.glb"
     trimesh.Scene({"brick": box}).export(path)
     args = ["-q", "render", str(path), "--modes", "rgb3", "--spp", "2", "--resolution", "8x8"]
-    assert main([*args, "--out", str(tmp_path / "a")]) == 2
+    assert main([*args, "--out", str(tmp_path / "a"), "--no-colours-from-asset"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "'brick'" in err and not (tmp_path / "a").exists()
-    assert main([*args, "--out", str(tmp_path / "b"), "--colours-from-asset"]) == 0
+    assert main([*args, "--out", str(tmp_path / "b")]) == 0

@@ -401,12 +401,13 @@ def test_light_kind_table_is_the_one_list_of_kinds():
     )
 
     assert typing.get_args(LightKind) == LIGHT_KINDS == tuple(LIGHT_FIELDS)
-    assert set(LIGHT_PLACEMENT) == {"position", "direction", "size", "cutoff_deg"}
+    assert set(LIGHT_PLACEMENT) == {"position", "direction", "size", "cutoff_deg", "radius"}
     placement = {
         "position": (1.0, 2.0, 3.0),
         "direction": (0.0, 1.0, 0.0),
         "size": (2.0, 3.0),
         "cutoff_deg": 45.0,
+        "radius": 0.25,
     }
     for kind in LIGHT_KINDS:
         light = make_light(kind, "cie:D65", 1.0, **placement)

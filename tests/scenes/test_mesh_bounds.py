@@ -80,5 +80,5 @@ def test_a_scene_file_whose_meshes_together_pass_the_limit_is_refused(tmp_path):
         "lights:\n  - {kind: point, spectrum: 'cie:D65', power: 4, position: [0, 0, 2]}\n"
         "camera: {origin: [0, -3, 2], target: [0, 0, 0], width: 16, height: 16}\n"
     )
-    with pytest.raises(SceneError, match=r"meshes: 250,002 faces in all.*at most 250,000"):
+    with pytest.raises(SceneError, match=r"half\.ply.*250,002 faces.*at most 250,000"):
         load_scene_file(scene)

@@ -90,3 +90,19 @@ def test_an_object_of_several_meshes_is_judged_whole():
     b = halves[1]
     apart = [halves[0], Mesh("top-b", b.vertices, b.faces, b.face_materials, 8)]  # two objects
     assert judge_view([*apart, *tiles], [LAMP], cam).ok
+
+
+def test_window_flux_is_spread_over_the_room_by_the_split_flux_law():
+    """With no lights, a view's only light is the interreflected window flux: the median
+    irradiance is ρ/(1 - ρ) Φ/A (integrating-sphere law, ρ the rule's bounce albedo) on every
+    visible point, relative to the target irradiance; 0 without it."""
+    from spectrinsic.scenes.generators.view_rule import BOUNCE_ALBEDO
+    from spectrinsic.scenes.library import TARGET_IRRADIANCE
+
+    cam = _camera((0, 0, 1.5), fov=60)
+    dark = judge_view(_floor_with_tiles(), [], cam)
+    lit = judge_view(_floor_with_tiles(), [], cam, flux_density=0.3)
+    assert dark.median_light == 0.0 and not dark.ok
+    rho = BOUNCE_ALBEDO
+    assert lit.median_light == pytest.approx(rho / (1 - rho) * 0.3 / TARGET_IRRADIANCE)
+    assert lit.lit_share == 1.0

@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError, validate_choice
+from ...file_writes import replacing
 from ...gt_export.formats.exr import write_exr
 from ...gt_export.formats.names import camera_slug
 from ...gt_export.sample.working_view import srgb_view
@@ -359,7 +360,8 @@ def _figure(path: Path, sid: str, image, reflectance, shading, rows) -> None:
     fig.suptitle(sid, fontsize=9)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=80)
+    with replacing(path) as tmp:
+        fig.savefig(tmp, dpi=80)
 
 
 def evaluate(

@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError
+from ...file_writes import write_text_file
 from ...results import write_csv
 from ..decomposition import Decomposition
 from ..metrics.scale import almse, correlation, lmse, si_mse
@@ -292,7 +293,7 @@ def evaluate_mit(
         "table_csv": write_csv(out / "mit_table_3_2.csv", rows, float_format=".6g"),
     }
     md = out / "mit_table_3_2.md"
-    md.write_text(mit_markdown(rows), encoding="utf-8")
+    write_text_file(md, mit_markdown(rows))
     files_out["table_md"] = md
     return files_out
 

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError
+from ...file_writes import write_text_file
 from ...gt_export.dataset.check import NOISE_THRESHOLD
 from ...gt_export.sample import MANIFEST_NAME
 from ...gt_export.sample.working_view import space_of
@@ -169,8 +170,8 @@ def add_scored_section(report: Path, s: ScoredSet) -> None:
     head, sep, rest = text.partition("\n\n## ")
     section = "\n".join(scored_section(s))
     tail = "\n## " + rest if sep else ""
-    report.write_text(f"{head}\n\n{section}{tail}".rstrip("\n") + "\n", encoding="utf-8")
+    write_text_file(report, f"{head}\n\n{section}{tail}".rstrip("\n") + "\n")
     record = {**asdict(s), "preview_grade": s.preview_grade}
-    (report.parent / "scored.json").write_text(
-        json.dumps(record, indent=1, sort_keys=True) + "\n", encoding="utf-8"
+    write_text_file(
+        report.parent / "scored.json", json.dumps(record, indent=1, sort_keys=True) + "\n"
     )

@@ -121,7 +121,10 @@ PROTOCOL = (
     "0.0295, 7 of 10). Round 4 (issue 33) chooses no parameter: structure only, on by default, "
     "off in thesis(), at round 3's values: RAD's flooding and regions joined across mostly-Case-C "
     "boundaries (LMSE 0.0277, hold-one-out 0.0277), then white/grey-to-chromatic name edges as "
-    "Case A (round 4b: LMSE 0.0257, hold-one-out 0.0276 over 240 points), 8 of 10 below baseline"
+    "Case A (round 4b: LMSE 0.0257, hold-one-out 0.0276 over 240 points), 8 of 10 below "
+    "baseline. Round 5 (issue 48) chooses no parameter either: sharp (one-pixel step at least "
+    "half the change over six pixels), high-contrast (one achromatic name, x3.7) edges between "
+    "achromatic names are Case A, and a collapse guard re-solves or falls back (LMSE 0.0256)"
 )
 #: Linear values are normalised so that this percentile of the brightest channel maps to 1
 #: before sRGB encoding for the naming model (which expects display values).

@@ -6,6 +6,9 @@ entry-point group :data:`ENTRY_POINT_GROUP`: in its ``pyproject.toml``::
     [project.entry-points."spectrinsic.decomposers"]
     my-method = "my_package.module:MyDecomposer"
 
+A method with a file argument is named ``NAME:ARGUMENT``: ``unet:WEIGHTS`` is the U-Net
+of ``spectrinsic train`` with its ``weights.pt`` (:data:`FILE_DECOMPOSERS`).
+
 The entry point's name is the method's name in the registry and the tables; the object it loads
 is a factory: called with keyword parameters (none for the defaults) it returns a decomposer,
 ``decomposer(image, mask=None) -> Decomposition``
@@ -28,9 +31,11 @@ from ..decomposition import Decomposer, Decomposition
 from .baselines import ImageAsReflectance, ImageAsShading
 from .names_shades import NamesAndShades
 from .retinex import ColourRetinex
+from .unet import UNetDecomposer
 
 __all__ = [
     "DECOMPOSERS",
+    "FILE_DECOMPOSERS",
     "ENTRY_POINT_GROUP",
     "PluginError",
     "available_decomposers",
@@ -48,6 +53,10 @@ DECOMPOSERS: Mapping[str, Callable[..., Any]] = {
     "image-as-reflectance": ImageAsReflectance,
     "image-as-shading": ImageAsShading,
 }
+
+#: Name -> factory of one file argument, used as ``NAME:FILE`` (not in the default methods:
+#: they need their file).
+FILE_DECOMPOSERS: Mapping[str, Callable[[str], Any]] = {"unet": UNetDecomposer}
 
 #: Entry-point group through which installed packages add decomposers.
 ENTRY_POINT_GROUP = "spectrinsic.decomposers"
@@ -128,6 +137,15 @@ def get_decomposer(name: str, **params: Any) -> Decomposer:
         For an unknown *name* (with the known ones), or a parameter the decomposer does not
         take (with the ones it does).
     """
+    base, sep, argument = name.partition(":")
+    if sep and base in FILE_DECOMPOSERS:
+        if not argument or params:
+            raise DecomposeError(
+                f"decomposer {name!r}: expected {base}:FILE with a file and no other parameter"
+            )
+        return FILE_DECOMPOSERS[base](argument)  # type: ignore[no-any-return]
+    if name in FILE_DECOMPOSERS:
+        raise DecomposeError(f"decomposer {name!r} needs its file: {name}:FILE")
     factories = DECOMPOSERS if name in DECOMPOSERS else available_decomposers()
     factory = factories[validate_choice(name, factories, "decomposer", error=DecomposeError)]
     _check_parameters(name, factory, params)

@@ -38,6 +38,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from ...spectra.colorimetry import decode_srgb
 from .colour_naming import appendix_a_labels, label_centroids
 from .shade_cases import CASE_A
 
@@ -66,8 +67,6 @@ def achromatic_contrast() -> float:
     """Least log-luminance step of a high-contrast achromatic edge: the smallest log ratio of
     the linear mean RGB of the white, grey and black label centroids (about 1.3, a factor of
     3.7: white to grey)."""
-    from ...spectra.colorimetry import decode_srgb
-
     labels = appendix_a_labels()
     pure = [int(np.flatnonzero(labels[:, k] == 1.0)[0]) for k in _ACHROMATIC]
     black, white, grey = np.log(decode_srgb(label_centroids()[pure]).mean(axis=1))

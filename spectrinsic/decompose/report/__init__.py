@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from ...file_writes import write_text_file
 from ...results import write_csv, write_json
 from ..evaluation.photometric import SCENARIOS
 from ..evaluation.scores import INPUT_LAYERS, SCORED_LAYERS, Score, condition_group
@@ -94,7 +95,7 @@ def _condition_files(
         sel = [r for r in rows if r["scene_kind"] == kind]
         if sel:
             md += [f"## {name.capitalize()}", "", _markdown(sel, ["method", *keys], headers), ""]
-    (out / f"{stem}.md").write_text("\n".join(md), encoding="utf-8")
+    write_text_file(out / f"{stem}.md", "\n".join(md))
     return {f"{stem}_csv": out / f"{stem}.csv", f"{stem}_md": out / f"{stem}.md"}
 
 
@@ -253,7 +254,7 @@ def _scenario_files(out: Path, rows: list[dict[str, Any]], note: str) -> dict[st
         if rows
         else "No camera renderings scored: Table 5.1 needs `image_camera/<name>`."
     ]
-    (out / "lmse_by_scenario.md").write_text("\n".join(md) + "\n", encoding="utf-8")
+    write_text_file(out / "lmse_by_scenario.md", "\n".join(md) + "\n")
     return {
         "scenario_csv": out / "lmse_by_scenario.csv",
         "scenario_md": out / "lmse_by_scenario.md",
@@ -272,7 +273,7 @@ def _t32_files(out: Path, t32: list[dict[str, Any]], note: str) -> dict[str, Pat
         if t32
         else "No single-object samples scored.",
     ]
-    (out / "table_3_2_objects.md").write_text("\n".join(md) + "\n", encoding="utf-8")
+    write_text_file(out / "table_3_2_objects.md", "\n".join(md) + "\n")
     return {
         "table_3_2_csv": out / "table_3_2_objects.csv",
         "table_3_2_md": out / "table_3_2_objects.md",
@@ -363,7 +364,5 @@ def write_report(
     files["methods"] = out / "methods.json"
     write_json(files["methods"], method_parameters(methods), strict=False, default=str, end="")
     files["report"] = out / "REPORT.md"
-    files["report"].write_text(
-        _report_md(methods, inputs, samples, tables, files, note), encoding="utf-8"
-    )
+    write_text_file(files["report"], _report_md(methods, inputs, samples, tables, files, note))
     return files

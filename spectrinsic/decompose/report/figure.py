@@ -12,6 +12,8 @@ from typing import Any
 
 import numpy as np
 
+from ...file_writes import replacing
+
 __all__ = ["SUMMARY_FIGURE", "summary_heatmap"]
 
 #: File name of the summary figure inside the evaluation folder.
@@ -66,7 +68,8 @@ def summary_heatmap(
     ax.set_title(title, fontsize=9)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=100, metadata={"Software": None})
+    with replacing(path) as tmp:
+        fig.savefig(tmp, dpi=100, metadata={"Software": None})
     return path
 
 

@@ -11,6 +11,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from ...file_writes import replacing, write_text_file
 from ..evaluation.mit import MEASURES, mit_markdown
 
 __all__ = ["COLUMNS", "MIT_FIGURE", "write_mit_report"]
@@ -61,7 +62,8 @@ def _figure(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
     ax.invert_yaxis()
     ax.set_xlabel("mean LMSE over objects (lower is better)")
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    with replacing(path) as tmp:
+        fig.savefig(tmp, dpi=100)
 
 
 def write_mit_report(
@@ -93,5 +95,5 @@ def write_mit_report(
         "Per-object numbers: `mit_scores.csv`; the table as CSV: `mit_table_3_2.csv`.",
     ]
     report = out / "REPORT.md"
-    report.write_text("\n".join(md) + "\n", encoding="utf-8")
+    write_text_file(report, "\n".join(md) + "\n")
     return {"report": report, "figure": figure}

@@ -17,10 +17,10 @@ from pathlib import Path
 from typing import Any
 
 from ...errors import DatasetError
+from ...file_writes import write_text_file
 from ...provenance import software_versions
 from ..layers.spectral_intrinsics import gamut_key, residual_summary
 from ..sample import CARD_NAME, META_NAME, config_hash, plain_data, sample_dirs
-from ..sample.integrity import guarded_write
 from ..sample.meta import LayerRecord, SampleMeta, read_meta
 from ..sample.working_view import space_of
 from .card_residual import write_residual_figure
@@ -179,6 +179,5 @@ def write_dataset_card(
         variants=", ".join(_text(v) for v in variants_of(metas)),
     ) + _diversity_section(root, samples, metas)
     path = root / CARD_NAME
-    with guarded_write(path):
-        path.write_text(text, encoding="utf-8")
+    write_text_file(path, text)
     return path

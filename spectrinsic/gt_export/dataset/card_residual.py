@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from ...file_writes import replacing
 from ..layers.spectral_intrinsics import LIGHT_FAMILIES, residual_rows
 
 __all__ = ["RESIDUAL_FIGURE_NAME", "residual_by_family", "residual_figure", "write_residual_figure"]
@@ -81,5 +82,6 @@ def write_residual_figure(
     if not by_family:
         return None
     path = Path(dataset_dir) / RESIDUAL_FIGURE_NAME
-    residual_figure(by_family, space).savefig(path, dpi=90)
+    with replacing(path) as tmp:
+        residual_figure(by_family, space).savefig(tmp, dpi=90)
     return path

@@ -22,6 +22,7 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -141,7 +142,7 @@ def _layer_problems(key: str, rec: LayerRecord, data: np.ndarray) -> list[str]:
         out.append(f"layer {key!r} has {nan} NaN and {inf} Inf values")
     if rec.nonnegative and (data[finite] < 0).any():
         out.append(f"layer {key!r} has {int((data[finite] < 0).sum())} negative values")
-    if key in ("material_id", "object_id"):
+    if key in ("material_id", "object_id", "semantic"):
         if (data[finite] != np.rint(data[finite])).any() or (data[finite] < -1).any():
             out.append(f"layer {key!r} holds values that are not integer ids >= -1")
     if key == "mask" and not np.isin(data[finite], (0.0, 1.0)).all():
@@ -187,6 +188,27 @@ def _layer_data(meta: SampleMeta, problems: list[str]) -> dict[str, np.ndarray]:
     return data
 
 
+def _semantic_problems(meta: Mapping[str, Any], data: Mapping[str, np.ndarray]) -> list[str]:
+    """The ``semantic`` layer's ids are in the class table (``semantic_classes``), and each
+    object of the ``object_id`` layer has one class."""
+    if "semantic" not in data:
+        return []
+    table = meta.get("semantic_classes")
+    if not table:
+        return ["layer 'semantic' has no class table (semantic_classes) in meta.json"]
+    ids = np.rint(data["semantic"]).astype(np.int64)
+    unknown = sorted({int(v) for v in np.unique(ids)} - {-1} - {int(k) for k in table})
+    out = [f"layer 'semantic' holds ids {unknown} not in semantic_classes"] if unknown else []
+    if "object_id" in data:
+        objects = np.rint(data["object_id"]).astype(np.int64)
+        pairs = np.unique(np.stack([objects.ravel(), ids.ravel()]), axis=1)
+        split = np.unique(pairs[0], return_counts=True)
+        mixed = split[0][split[1] > 1].tolist()
+        if mixed:
+            out.append(f"layer 'semantic': objects {mixed} have more than one class")
+    return out
+
+
 def check_sample(sample: str | os.PathLike[str]) -> list[str]:
     """Problems of one sample folder (empty list: fine). Messages do not repeat the sample id.
 
@@ -210,6 +232,7 @@ def check_sample(sample: str | os.PathLike[str]) -> list[str]:
             "meta.json records no identities (image = reflectance * shading + residual)"
         )
     problems.extend(_identity_problems(meta.identities, data))
+    problems.extend(_semantic_problems(meta.raw, data))
     return problems
 
 

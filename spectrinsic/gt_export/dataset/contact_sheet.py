@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from ...errors import DatasetError
+from ...file_writes import replacing
 from ...scenes.sample_id import SEPARATOR
 from ..sample import META_NAME, sample_dirs
 from ..sample.integrity import guarded_write
@@ -67,7 +68,8 @@ def tile_sheet(tiles: Sequence[tuple[str, Path]], out: str | os.PathLike[str]) -
     path = Path(out)
     with guarded_write(path):
         path.parent.mkdir(parents=True, exist_ok=True)
-        sheet.save(path, format="PNG")
+    with replacing(path) as tmp:
+        sheet.save(tmp, format="PNG")
     return path
 
 

@@ -19,10 +19,10 @@ from typing import Any
 
 import numpy as np
 
+from ...file_writes import replacing
 from ...scenes.generators.materials import PIXEL_TEXTURE
 from ...scenes.material_labels import label_spectrum
 from ..layers import luminance
-from ..sample.integrity import guarded_write
 from ..sample.loader import load_sample
 from ..sample.meta import SampleMeta
 from .colour_spread import material_chroma, shown, spread_summary
@@ -189,6 +189,6 @@ def write_diversity(
     """Compute the statistics and save the figure as ``<dataset>/diversity.png``."""
     path = Path(dataset_dir) / DIVERSITY_NAME
     figure = diversity_figure(diversity_stats(sample_dirs, metas))
-    with guarded_write(path):  # a full disk names the file and leaves no part of it
-        figure.savefig(path, dpi=90)
+    with replacing(path) as tmp:  # a full disk names the file and leaves no part of it
+        figure.savefig(tmp, dpi=90)
     return path

@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError
+from ...file_writes import refuse_link, write_text_file
 from ...scenes.lighting import describe_lighting
 from ...spectra import get_sensors, xyz_to_xy
 from ..formats.names import slug
@@ -83,6 +84,7 @@ GALLERY_LAYERS: tuple[str, ...] = (
     "normals",
     "material_id",
     "object_id",
+    "semantic",
     "mask",
     "non_diffuse",
     "metallic",
@@ -352,17 +354,13 @@ def _written_by_us(path: Path) -> bool:
         return False
 
 
-def _write_text(path: Path, text: str) -> None:
-    with guarded_write(path):  # a full disk names the file
-        path.write_text(text, encoding="utf-8")
-
-
 def _write_pixel_scripts(root: Path, index: Mapping[str, Any]) -> None:
     """Write ``gallery-pixels/<id>.js`` per sample: its value-bearing previews (``srgb`` and
     ``colormap`` encodings) as ``data:`` URLs, which a page opened from ``file://`` may read
     into a canvas (Chromium forbids reading the files themselves); set each entry's ``pixels``.
     Earlier scripts of ours are replaced; no other file in the folder is touched."""
     folder = root / _PIXELS_DIR
+    refuse_link(folder / "index.js")  # the folder itself: never a link planted since the start
     with guarded_write(folder):
         folder.mkdir(exist_ok=True)
     for old in sorted(folder.glob("*.js")):
@@ -382,7 +380,7 @@ def _write_pixel_scripts(root: Path, index: Mapping[str, Any]) -> None:
                 f"{target}: not a gallery file spectrinsic wrote; move it away to "
                 "rebuild the gallery"
             )
-        _write_text(
+        write_text_file(
             target,
             f"{_PIXELS_HEAD}{json.dumps(entry['id'], allow_nan=False)}] = {json.dumps(urls, allow_nan=False)};\n",
         )
@@ -407,15 +405,15 @@ def build_gallery(
     contact_sheet(root)
     index["contact_sheets"] = {"all": "contact_sheet.png", **_condition_sheets(root, index)}
     data = json.dumps(plain_data(index), ensure_ascii=False, separators=(",", ":"), allow_nan=False)
-    _write_text(root / "gallery.json", data + "\n")
-    _write_text(root / "gallery-index.js", f"window.{INDEX_VARIABLE} = {data};\n")
+    write_text_file(root / "gallery.json", data + "\n")
+    write_text_file(root / "gallery-index.js", f"window.{INDEX_VARIABLE} = {data};\n")
     for name in _STATIC:
-        _write_text(root / name, read_template(name))
+        write_text_file(root / name, read_template(name))
     page = string.Template(read_template("gallery.html")).substitute(
         title=_escape(index["title"]), n_samples=len(index["samples"])
     )
     path = root / "index.html"
-    _write_text(path, page)
+    write_text_file(path, page)
     return path
 
 

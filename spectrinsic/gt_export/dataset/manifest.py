@@ -19,6 +19,7 @@ import numpy as np
 
 from ...data_dir import resolve_data_dir
 from ...errors import DatasetError, SampleMetaError
+from ...file_writes import write_text_file
 from ...provenance import software_versions
 from ...rng import seed_from_key
 from ...scenes.material_labels import label_spectrum
@@ -27,7 +28,6 @@ from ..layers.spectral_intrinsics import residual_summary
 from ..sample import (
     FORMAT_VERSION,
     MANIFEST_NAME,
-    TMP_PREFIX,
     canonical_json,
     config_hash,
     confined_path,
@@ -35,7 +35,6 @@ from ..sample import (
     plain_data,
     sample_dirs,
 )
-from ..sample.integrity import guarded_write
 from ..sample.json_fields import JsonFields, load_json
 from ..sample.meta import SampleMeta, read_meta
 from ..sample.transport_exr import COMPACT_LAYOUT, TRANSPORT_COMPRESSION, TRANSPORT_NAME
@@ -84,6 +83,13 @@ def _spectral_provenance(metas: Sequence[SampleMeta], data_dir: Any) -> dict[str
     if root is not None and (root / "PROVENANCE.md").is_file():
         out["data_directory_provenance_sha256"] = file_sha256(root / "PROVENANCE.md")
     return out
+
+
+def _semantic_classes(metas: Sequence[SampleMeta]) -> dict[str, Any]:
+    """``{"semantic_classes": table}`` of the samples with a ``semantic`` layer (one table, as
+    every sample of a build records the same), else nothing (samples from before issue 41)."""
+    tables = [m.raw["semantic_classes"] for m in metas if "semantic_classes" in m.raw]
+    return {"semantic_classes": tables[0]} if tables else {}
 
 
 def working_spaces(metas: Sequence[SampleMeta]) -> dict[str, dict[str, Any]]:
@@ -147,6 +153,7 @@ def write_manifest(
             },
             "transport_layout": COMPACT_LAYOUT,
         },
+        **_semantic_classes(metas),
         "split_by": "scene",
         "split_fractions": dict(split_fractions),
         "splits": splits_by_scene({m.sample_id: m.scene for m in metas}, split_fractions),
@@ -164,10 +171,7 @@ def write_manifest(
         },
     }
     path = root / MANIFEST_NAME
-    tmp = path.with_name(f"{TMP_PREFIX}{MANIFEST_NAME}")
-    with guarded_write(tmp):
-        tmp.write_text(canonical_json(plain_data(manifest)), encoding="utf-8")
-    tmp.replace(path)
+    write_text_file(path, canonical_json(plain_data(manifest)))
     return path
 
 

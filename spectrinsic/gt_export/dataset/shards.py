@@ -32,9 +32,9 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError, MissingDependencyError
+from ...file_writes import replacing, write_text_file
 from ..folders.outfolder import LOCK_NAME, check_out_folder, check_unlocked, folder_lock
 from ..sample import MANIFEST_NAME, META_NAME, TMP_PREFIX, file_sha256, sample_dirs
-from ..sample.integrity import guarded_write
 from ..sample.loader import load_sample, split_samples
 from ..sample.meta import meta_from_bytes
 from .manifest import read_manifest
@@ -152,14 +152,7 @@ def check_shard_folder(out: Path, option: str = "--out") -> set[str]:
 
 
 def _write_index(out: Path, index: dict[str, Any]) -> None:
-    tmp = out / f"{TMP_PREFIX}{SHARD_INDEX}"
-    with guarded_write(out / SHARD_INDEX):
-        try:
-            text = json.dumps(index, indent=2, sort_keys=True, allow_nan=False)
-            tmp.write_text(text, encoding="utf-8")
-            os.replace(tmp, out / SHARD_INDEX)
-        finally:
-            tmp.unlink(missing_ok=True)
+    write_text_file(out / SHARD_INDEX, json.dumps(index, indent=2, sort_keys=True, allow_nan=False))
 
 
 def _plan(source: Path, samples_per_shard: int) -> dict[str, dict[str, list[Path]]]:
@@ -185,26 +178,21 @@ def _write_shard(
 ) -> set[str]:
     """Write one shard under a temporary name, then rename it; return the layer keys seen."""
     wds = _webdataset()
-    tmp = out / f"{TMP_PREFIX}{name}"
     seen: set[str] = set()
-    try:
-        with guarded_write(out / name), open(tmp, "wb") as stream:
-            writer = wds.TarWriter(stream, mtime=0, user="spectrinsic", group="spectrinsic")
-            try:
-                for folder in folders:
-                    sample = load_sample(folder, layers=layers)
-                    seen.update(k for k, v in sample.items() if isinstance(v, np.ndarray))
-                    writer.write(_encode(sample))
-                    if progress is not None:
-                        progress(folder.name)
-            except BaseException:
-                with contextlib.suppress(Exception):  # else tarfile flushes its buffer at
-                    writer.close()  # exit, into the closed file ("Exception ignored ...")
-                raise
-            writer.close()
-        os.replace(tmp, out / name)
-    finally:
-        tmp.unlink(missing_ok=True)
+    with replacing(out / name) as tmp, open(tmp, "wb") as stream:
+        writer = wds.TarWriter(stream, mtime=0, user="spectrinsic", group="spectrinsic")
+        try:
+            for folder in folders:
+                sample = load_sample(folder, layers=layers)
+                seen.update(k for k, v in sample.items() if isinstance(v, np.ndarray))
+                writer.write(_encode(sample))
+                if progress is not None:
+                    progress(folder.name)
+        except BaseException:
+            with contextlib.suppress(Exception):  # else tarfile flushes its buffer at
+                writer.close()  # exit, into the closed file ("Exception ignored ...")
+            raise
+        writer.close()
     return seen
 
 

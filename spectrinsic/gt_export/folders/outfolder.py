@@ -31,6 +31,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from ...errors import DatasetError, FolderLockedError, WriteError
+from ...file_writes import TMP_PREFIX, write_text_file
 
 __all__ = [
     "LOCK_NAME",
@@ -47,8 +48,6 @@ __all__ = [
 LOCK_NAME = ".spectrinsic-lock"
 #: Marker of a ``render``/``evaluate``/``study`` output folder: the files spectrinsic wrote.
 OUTPUT_MARKER = ".spectrinsic-output"
-#: Prefix of spectrinsic's temporaries (as in :mod:`spectrinsic.gt_export.sample.integrity`).
-_TMP_PREFIX = ".spectrinsic-tmp-"
 #: Files whose presence makes a folder a dataset or a shard export (a folder of spectrinsic's).
 _DATASET_MARKERS = (
     (".spectrinsic-dataset", "spectrinsic_dataset"),
@@ -93,8 +92,9 @@ def _is_own_folder(folder: Path) -> bool:
 
 
 def _refuse_inside_dataset(root: Path, option: str) -> None:
-    """A folder inside a dataset would become part of it (a ``meta.json`` reads as a sample)."""
-    for parent in root.absolute().parents:
+    """A folder inside a dataset would become part of it (a ``meta.json`` reads as a sample).
+    ``..`` is resolved first, as the kernel resolves it: ``ds/../o`` lies beside ``ds``."""
+    for parent in root.resolve().parents:
         if parent.is_dir() and _is_dataset(parent):
             raise DatasetError(
                 f"{option} {str(root)!r} lies inside the dataset folder {str(parent)!r}; "
@@ -105,7 +105,7 @@ def _refuse_inside_dataset(root: Path, option: str) -> None:
 def _require_writable(root: Path, option: str) -> None:
     """The folder (or the nearest existing folder above it) must be writable by this user."""
     existing = next(p for p in (root, *root.parents) if p.is_dir())
-    probe = existing / f"{_TMP_PREFIX}probe-{os.getpid()}"
+    probe = existing / f"{TMP_PREFIX}probe-{os.getpid()}"
     try:  # os.access says yes to root even on a read-only mount; only a write answers truly
         probe.mkdir()
         probe.rmdir()
@@ -124,7 +124,7 @@ def _entries(root: Path) -> list[Path]:
 def _stale_probe(path: Path) -> bool:
     """An empty folder named as :func:`_require_writable`'s probe (``<prefix>probe-<pid>``)."""
     return (
-        path.name.startswith(f"{_TMP_PREFIX}probe-")
+        path.name.startswith(f"{TMP_PREFIX}probe-")
         and path.is_dir()
         and not path.is_symlink()
         and not any(path.iterdir())
@@ -146,6 +146,11 @@ def check_out_folder(
         One line naming *option*, *root* and what was expected.
     """
     require_folder_path(root, option)
+    if root.is_symlink():
+        raise DatasetError(
+            f"{option} {str(root)!r} is a symbolic link; spectrinsic never writes through a "
+            "link: name the folder it points to, or choose another folder"
+        )
     _refuse_inside_dataset(root, option)
     check_unlocked(root, option)
     if not root.is_dir() or not _entries(root):
@@ -284,10 +289,10 @@ def _files_below(root: Path) -> set[str]:
     for dirpath, dirnames, filenames in os.walk(root):
         here = Path(dirpath)
         dirnames[:] = sorted(
-            d for d in dirnames if not d.startswith(_TMP_PREFIX) and not _is_own_folder(here / d)
+            d for d in dirnames if not d.startswith(TMP_PREFIX) and not _is_own_folder(here / d)
         )
         for name in filenames:
-            if name in (LOCK_NAME, OUTPUT_MARKER) or name.startswith(_TMP_PREFIX):
+            if name in (LOCK_NAME, OUTPUT_MARKER) or name.startswith(TMP_PREFIX):
                 continue
             found.add((here / name).relative_to(root).as_posix())
     return found
@@ -344,16 +349,8 @@ def check_output_folder(root: Path, option: str = "--out") -> None:
 
 
 def _write_marker(root: Path, files: set[str], writing: dict[str, object] | None) -> None:
-    tmp = root / f"{_TMP_PREFIX}{OUTPUT_MARKER.lstrip('.')}"
     record = {"spectrinsic_output": 1, "files": sorted(files), "writing": writing}
-    try:
-        tmp.write_text(json.dumps(record, indent=1, allow_nan=False) + "\n", encoding="utf-8")
-        tmp.replace(root / OUTPUT_MARKER)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)  # no zero-byte temporary left by a full disk
-        raise WriteError(
-            f"cannot write {str(root / OUTPUT_MARKER)!r}: {exc.strerror or exc}"
-        ) from exc
+    write_text_file(root / OUTPUT_MARKER, json.dumps(record, indent=1, allow_nan=False) + "\n")
 
 
 @contextlib.contextmanager

@@ -25,6 +25,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from ...errors import DiskFullError, SpectrinsicError, WriteError
+from ...file_writes import refuse_link
 from ..sample.integrity import disk_full, guarded_write
 from .outfolder import LOCK_NAME, OUTPUT_MARKER, output_folder
 
@@ -41,6 +42,7 @@ def _move_into(stage: Path, root: Path) -> None:
         target_dir = root / here.relative_to(stage)
         target_dir.mkdir(parents=True, exist_ok=True)
         for name in filenames:
+            refuse_link(target_dir / name)  # a link planted in --out while the run ran
             os.replace(here / name, target_dir / name)
 
 

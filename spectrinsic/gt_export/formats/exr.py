@@ -28,8 +28,8 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError
+from ...file_writes import replacing
 from ...threads import array_threads, thread_map
-from ..sample.integrity import guarded_write
 
 __all__ = [
     "write_exr",
@@ -194,8 +194,8 @@ def write_exr(
     for key, value in (attributes or {}).items():
         header[str(key)] = str(value)
     path = Path(path)
-    with guarded_write(path):
-        OpenEXR.File(header, channels).write(str(path))
+    with replacing(path) as tmp:
+        OpenEXR.File(header, channels).write(str(tmp))
     return path
 
 

@@ -14,9 +14,9 @@ import numpy as np
 import png
 
 from ...errors import DatasetError
+from ...file_writes import replacing
 from ...spectra.colorimetry import encode_srgb
 from ..layers.imaging import luminance
-from ..sample.integrity import guarded_write
 
 __all__ = [
     "EXPOSURE_PERCENTILE",
@@ -132,8 +132,8 @@ def write_png(path: str | os.PathLike[str], rgb8: np.ndarray) -> Path:
             f"PNG {str(path)!r}: expected (H, W[, 3]) uint8, got {rgb8.dtype} {rgb8.shape}"
         )
     path = Path(path)
-    with guarded_write(path):
-        Image.fromarray(np.ascontiguousarray(rgb8)).save(path, format="PNG", optimize=False)
+    with replacing(path) as tmp:
+        Image.fromarray(np.ascontiguousarray(rgb8)).save(tmp, format="PNG", optimize=False)
     return path
 
 
@@ -152,7 +152,7 @@ def write_png16(path: str | os.PathLike[str], image: np.ndarray) -> Path:
     grey = codes.ndim == 2
     writer = png.Writer(w, h, greyscale=grey, bitdepth=16)
     path = Path(path)
-    with guarded_write(path), path.open("wb") as fh:
+    with replacing(path) as tmp, tmp.open("wb") as fh:
         writer.write(fh, codes.reshape(h, -1).tolist())
     return path
 

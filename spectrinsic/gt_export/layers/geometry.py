@@ -1,5 +1,5 @@
-"""The geometry family: ``mask``, ``depth``, ``normals`` and the integer ids, and the material
-coverage the other families weight by.
+"""The geometry family: ``mask``, ``depth``, ``normals`` and the integer ids (material, object
+and semantic class), and the material coverage the other families weight by.
 """
 
 from __future__ import annotations
@@ -9,11 +9,13 @@ import logging
 import numpy as np
 
 from ...errors import DatasetError
+from ...scenes.model import Scene
+from ...scenes.semantic import class_id
 from .records import Layer, SampleInputs, aov, make_layer
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 
-__all__ = ["coverage_of", "geometry_layers"]
+__all__ = ["coverage_of", "geometry_layers", "semantic_ids", "SEMANTIC_UNITS"]
 
 log = logging.getLogger(__name__)
 
@@ -37,6 +39,10 @@ _GEOMETRY = (
 
 
 _ID_LAYERS = ("material_id", "object_id")
+SEMANTIC_UNITS = (
+    "semantic class id of the object seen (the object_id layer's), an index into "
+    "meta['semantic_classes'], int32 (an EXR UINT channel holding the int32 bits); -1 background"
+)
 
 
 def _ids(name: str, value: np.ndarray) -> np.ndarray:
@@ -46,6 +52,19 @@ def _ids(name: str, value: np.ndarray) -> np.ndarray:
     if value.size and ((ints != value).any() or ints.min() < -1 or ints.max() >= 2**31):
         raise DatasetError(f"render AOV {name!r}: expected whole ids from -1 to 2**31 - 1")
     return ints.astype(np.int32)
+
+
+def semantic_ids(scene: Scene, object_id: np.ndarray) -> np.ndarray:
+    """``(H, W)`` int32 class ids (:mod:`~spectrinsic.scenes.semantic`) of an object-id map:
+    each pixel's object's class, -1 background. The scene check gives an object id one class, so
+    every pixel of one object has one class and the layers agree by construction."""
+    ids = np.asarray(object_id, np.int64)
+    out = np.full(ids.shape, -1, np.int32)
+    for mesh in scene.meshes:
+        out[ids == mesh.object_id] = class_id(mesh.semantic)
+    if ((ids >= 0) & (out < 0)).any():
+        raise DatasetError("render AOV 'object_id' holds an id that no scene mesh has")
+    return out
 
 
 def coverage_of(s: SampleInputs, shape: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
@@ -79,6 +98,9 @@ def geometry_layers(s: SampleInputs, mask: np.ndarray) -> list[Layer]:
             continue
         if name in _ID_LAYERS:
             out.append(Layer(name, _ids(name, value), channels, units, "geometry"))
+            if name == "object_id":
+                semantic = semantic_ids(s.scene, out[-1].data)
+                out.append(Layer("semantic", semantic, ("id",), SEMANTIC_UNITS, "geometry"))
         else:
             out.append(
                 make_layer(name, value, channels, units, "geometry", nonnegative=name == "depth")

@@ -41,6 +41,7 @@ def light_records(
                 direction=tuple(map(float, light.direction)),
                 size=tuple(map(float, light.size)),
                 cutoff_deg=float(light.cutoff_deg),
+                radius=float(light.radius),
                 xy=(float(xy[0]), float(xy[1])),
                 srgb=tuple(float(v) for v in colour["srgb"]),
                 camera={camera_key(c): tuple(float(v) for v in colour[c]) for c in cameras},

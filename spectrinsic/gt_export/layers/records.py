@@ -127,6 +127,8 @@ class LightRecord:
     direction: tuple[float, ...]
     size: tuple[float, ...]
     cutoff_deg: float
+    #: Radius of a sphere light (scene units).
+    radius: float
     #: CIE 1931 xy chromaticity.
     xy: tuple[float, ...]
     #: Linear sRGB colour at unit luminance (Y = 1).

@@ -46,7 +46,7 @@ from ..sample.sensor import model_from_meta
 from ..sample.transport_exr import read_transport
 from ..sample.working_view import space_of
 from ..sample.writer import export_sample, remove_sample_temporaries
-from .checks import check_finite_result, check_relight_inputs
+from .checks import check_finite_result, check_relight_inputs, check_spectrum_files
 
 __all__ = [
     "RelitSample",
@@ -225,8 +225,11 @@ def relit_render(
     if stray:
         raise DatasetError(f"--power {stray[0]!r}: the sample has lights 0..{n_lights - 1}")
     check_relight_inputs(sample, meta)  # every file read matches meta.json; the EXR's header
+    source = read_sample_scene(sample)
+    used = [m.spectrum for m in source.materials] + [li.spectrum for li in source.lights]
+    check_spectrum_files(sample, meta, used)  # CSVs read again: as they were at build time
     transport, coverage = read_transport(sample, meta["transport"])
-    scene = relit_scene(read_sample_scene(sample), lights, powers, source=str(meta["sample_id"]))
+    scene = relit_scene(source, lights, powers, source=str(meta["sample_id"]))
     relit = {
         "from": meta["sample_id"],
         "from_meta_sha256": file_sha256(sample / META_NAME),
@@ -318,4 +321,5 @@ def relight(
         data_dir=data_dir,
         transport=relit.transport if keep_transport else None,
         camera=model_from_meta(meta),  # the camera chain, if any, re-runs on the relit image
+        noise_id=str(meta["sample_id"]),  # its noise: the source's, not the --out folder name's
     )

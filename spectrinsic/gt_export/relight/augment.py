@@ -136,7 +136,7 @@ def relit_layers(
     if "mask" in out:
         out["mask"] = out["mask"] > 0.5
     ids = {}
-    for key in ("material_id", "object_id"):
+    for key in ("material_id", "object_id", "semantic"):
         if key in out:
             out[key] = np.rint(out[key]).astype(np.int32)
             ids[key.removesuffix("_id")] = out[key]

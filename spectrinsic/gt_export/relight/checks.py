@@ -12,6 +12,12 @@ be laundered: ``check`` could no longer find the damage. Before anything is deco
   with its sensors' channels, and the coverage's ``m0`` ... ``m<M-1>``), so a file that would
   decode to something else is refused from its header alone.
 
+The spectra the relighting reads again from files (``csv:`` names of the scene's materials and
+lights, read when the layers are computed) must be listed in ``meta.json["spectrum_files"]``
+and match the SHA-256 recorded there (:func:`check_spectrum_files`): an edited CSV would
+otherwise change every layer of the relit sample with rc 0. A scene holds no other external
+file: its meshes and texture weights are in ``scene.json``, its lights' SPDs in ``meta.json``.
+
 After composing, :func:`check_finite_result` refuses a relit render holding a NaN or an
 infinity (powers that overflow float32) before anything is written.
 
@@ -36,6 +42,7 @@ from ..sample.transport_exr import COVERAGE_LAYER, TRANSPORT_NAME, stored_layers
 
 __all__ = [
     "verified_file",
+    "check_spectrum_files",
     "transport_channels",
     "check_transport_header",
     "check_relight_inputs",
@@ -131,6 +138,34 @@ def check_relight_inputs(sample: Path, meta: Mapping[str, Any]) -> None:
     if not (isinstance(size, list) and len(size) == 2):
         raise DatasetError(f"{sample / META_NAME}: size {size!r}; expected [height, width]")
     check_transport_header(sample / TRANSPORT_NAME, record, (int(size[0]), int(size[1])))
+
+
+def check_spectrum_files(sample: Path, meta: Mapping[str, Any], names: Iterable[str]) -> None:
+    """Refuse unless every ``csv:`` spectrum among *names* (the source scene's) is listed in
+    ``meta["spectrum_files"]`` and its file still matches the SHA-256 recorded there."""
+    records = meta.get("spectrum_files") or []
+    listed = {
+        r.get("spectrum"): r
+        for r in records
+        if isinstance(records, list) and isinstance(r, Mapping)
+    }
+    for name in sorted({n for n in names if n.lower().startswith("csv:")}):
+        record = listed.get(name)
+        if record is None or not isinstance(record.get("file"), str):
+            raise DatasetError(
+                f"{sample / META_NAME}: spectrum {name!r} is read from a file that "
+                "spectrum_files does not list with a SHA-256; cannot verify it"
+            )
+        path = Path(record["file"])
+        if not path.is_file():
+            raise DatasetError(
+                f"{path}: the spectrum file of {name!r} listed in {sample / META_NAME} is missing"
+            )
+        if file_sha256(path) != record.get("sha256"):
+            raise DatasetError(
+                f"{path}: does not match its SHA-256 in {sample / META_NAME} (spectrum_files); "
+                "the spectra changed since the sample was built; refusing to relight it"
+            )
 
 
 def check_finite_result(result: RenderResult, sample: Path) -> None:

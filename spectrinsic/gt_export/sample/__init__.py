@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError
+from ...file_writes import TMP_PREFIX  # one home: every sweep of temporaries knows it
 from ...scenes.model import record_fields
 
 __all__ = [
@@ -64,9 +65,6 @@ SCENE_NAME = "scene.json"
 TRANSPORT_NAME = "transport.exr"
 CARD_NAME = "DATASET.md"
 PREVIEW_DIR = "previews"
-#: Prefix of every temporary file or folder spectrinsic creates inside a dataset folder. Only
-#: names with this prefix are ever cleaned up: ``.tmp-*`` belongs to other programs.
-TMP_PREFIX = ".spectrinsic-tmp-"
 #: Key of ``meta.json`` holding ``{relative path: SHA-256}`` of every file it lists.
 HASHES_KEY = "sha256"
 #: Key of ``meta.json`` holding :func:`meta_seal` of the rest of the file.

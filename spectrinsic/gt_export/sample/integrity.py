@@ -26,6 +26,7 @@ from collections.abc import Iterator
 from pathlib import Path, PurePosixPath
 
 from ...errors import DatasetError, DiskFullError, SampleMetaError, SpectrinsicError, WriteError
+from ...file_writes import NO_SPACE, disk_full, write_text_file
 from ..folders.outfolder import LOCK_NAME, check_out_folder, require_folder_path
 from . import FORMAT_VERSION, MANIFEST_NAME, META_NAME, TMP_PREFIX, file_sha256
 from .meta import owned_files, read_meta
@@ -48,24 +49,13 @@ __all__ = [
 
 #: Written first into every dataset folder: ``{"spectrinsic_dataset": 1, "config_hash": ...}``.
 MARKER_NAME = ".spectrinsic-dataset"
-#: errno values that mean "no space": retrying another sample cannot help.
-NO_SPACE = frozenset({errno.ENOSPC, errno.EDQUOT})
-#: How C libraries (OpenEXR) word a full disk in the ``RuntimeError`` they raise.
-_NO_SPACE_TEXT = tuple(os.strerror(code) for code in sorted(NO_SPACE))
-
-
-def disk_full(exc: BaseException) -> bool:
-    """Whether *exc* says the disk (or the user's quota) is full: an ``OSError`` with
-    ``ENOSPC``/``EDQUOT``, or a C library's ``RuntimeError`` quoting that error's text."""
-    if isinstance(exc, OSError):
-        return exc.errno in NO_SPACE
-    return isinstance(exc, RuntimeError) and any(t in str(exc) for t in _NO_SPACE_TEXT)
 
 
 @contextlib.contextmanager
 def guarded_write(path: str | os.PathLike[str]) -> Iterator[None]:
-    """Turn a failure while writing *path* into a one-line error naming *path*, and remove
-    what was written of it (a full disk leaves no partial or zero-byte file behind).
+    """Turn a failure while making *path* (a folder) into a one-line error naming *path*, and
+    remove what was written of it (a full disk leaves no partial or zero-byte file behind).
+    Files are written with :func:`spectrinsic.file_writes.replacing`, never in place.
 
     ``write()`` failures (a full disk) carry no file name of their own, so without this the
     message would not say which file could not be written. An ``OSError`` becomes a
@@ -200,14 +190,8 @@ def write_marker(root: Path, config_hash: str) -> None:
         root.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise WriteError(f"--out {str(root)!r}: cannot create the folder ({exc.strerror})") from exc
-    tmp = root / f"{TMP_PREFIX}{MARKER_NAME.lstrip('.')}"
-    with guarded_write(root / MARKER_NAME):
-        tmp.write_text(
-            json.dumps({"spectrinsic_dataset": 1, "config_hash": config_hash}, allow_nan=False)
-            + "\n",
-            encoding="utf-8",
-        )
-        tmp.replace(root / MARKER_NAME)
+    record = {"spectrinsic_dataset": 1, "config_hash": config_hash}
+    write_text_file(root / MARKER_NAME, json.dumps(record, allow_nan=False) + "\n")
 
 
 def remove_owned_temporaries(root: Path) -> list[Path]:

@@ -29,7 +29,7 @@ __all__ = [
     "EXPOSURE_PERCENTILE",
 ]
 
-_INT_LAYERS = ("material_id", "object_id")
+_INT_LAYERS = ("material_id", "object_id", "semantic")
 
 
 def _verified(meta: SampleMeta, file: str) -> Path:
@@ -75,8 +75,9 @@ def load_sample(
     dict
         ``image``, ``reflectance``, ``shading``, ``illuminant`` (``(H, W, 3)`` float32 linear
         RGB of the working space, or sRGB with ``space="srgb"``), ``shading_grey``, ``depth`` (``(H, W)`` float32), ``normals`` (``(H, W, 3)``),
-        ``mask`` (``(H, W)`` bool), ``ids`` (``{"material": (H, W) int32, "object": ...}``, -1
-        background), per-camera keys ``image_camera/<name>`` etc., ``cube`` when written, and
+        ``mask`` (``(H, W)`` bool), ``ids`` (``{"material": (H, W) int32, "object": ...,
+        "semantic": ...}``, -1 background; ``semantic`` indexes ``meta["semantic_classes"]``),
+        per-camera keys ``image_camera/<name>`` etc., ``cube`` when written, and
         ``meta`` (the parsed ``meta.json``). Units are in ``meta["layers"][key]["units"]``.
 
     Raises
@@ -212,7 +213,7 @@ def prepare_item(
     normalize_exposure: bool = False,
 ) -> dict[str, Any]:
     """A loaded sample as channel-first arrays: every layer ``(C, H, W)`` (depth and masks get
-    ``C = 1``), ``ids`` as ``{"material"|"object": (1, H, W) int32}``, ``sample_id``,
+    ``C = 1``), ``ids`` as ``{"material"|"object"|"semantic": (1, H, W) int32}``, ``sample_id``,
     ``scene`` and ``exposure_scale``.
 
     Parameters

@@ -83,9 +83,10 @@ META_FIELDS = frozenset(
 #: Fields written only by some builds: ``transport`` (``--store-transport``, see
 #: :func:`~spectrinsic.gt_export.sample.transport_exr.write_transport`), ``sensor`` (``--camera``),
 #: ``spectrum_files`` (``csv:`` spectra, :func:`~spectrinsic.spectra.user_spectra.spectrum_files`),
-#: ``residual_share``, ``working_space`` (since issue 30; no working space: linear sRGB).
+#: ``residual_share``, ``working_space`` (since issue 30; no working space: linear sRGB),
+#: ``semantic_classes`` (the class table of the ``semantic`` layer, since issue 41).
 OPTIONAL_META_FIELDS = frozenset(
-    {"transport", "sensor", "spectrum_files", "residual_share", "working_space"}
+    {"transport", "sensor", "spectrum_files", "residual_share", "working_space", "semantic_classes"}
 )
 _LAYER_FIELDS = frozenset(
     {
@@ -324,8 +325,8 @@ def _check_records(f: JsonFields, meta: Mapping[str, object]) -> None:
         f.numeric_tree(f.mapping(meta[name], name), name)
     for name in ("residual_share", "working_space"):  # samples since issue 30
         f.numeric_tree(f.mapping(meta.get(name, {}), name), name)
-    for name in ("objects", "versions"):
-        for key, value in f.mapping(meta[name], name).items():
+    for name in ("objects", "versions", "semantic_classes"):
+        for key, value in f.mapping(meta.get(name, {}), name).items():
             f.text(value, f"{name}.{key}")
     f.texts(meta["denoised_layers"], "denoised_layers")
     f.text(meta["scene_hash"], "scene_hash")

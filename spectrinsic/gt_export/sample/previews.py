@@ -154,6 +154,7 @@ _PREVIEWS: tuple[tuple[str, Callable[[Layer, Mapping[str, Layer]], Preview]], ..
     ("normals", _normals_preview),
     ("material_id", _ids_preview),
     ("object_id", _ids_preview),
+    ("semantic", _ids_preview),
     ("mask", _mask_preview),
     ("processed_sensor", _processed_preview),
     ("raw_sensor", _raw_preview),

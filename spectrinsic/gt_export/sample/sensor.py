@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError
+from ...file_writes import write_bytes_file
 from ...spectra.camera_chain import ChainResult, carry, run_chain
 from ...spectra.camera_isp import camera_to_xyz
 from ...spectra.camera_model import CameraModel
@@ -41,7 +42,6 @@ from ..formats import png
 from ..formats.names import camera_slug
 from ..layers import GroundTruth, Layer, camera_curves
 from ..layers.records import RGB, camera_key, grid, make_layer
-from .integrity import guarded_write
 
 __all__ = ["SensorOutput", "sensor_output", "write_sensor_files", "model_from_meta", "noise_seed"]
 
@@ -225,8 +225,7 @@ def write_dng(path: Path, out: SensorOutput) -> None:
     writer = RAW2DNG()
     writer.options(t, path="", compress=False)
     data = writer.convert(np.ascontiguousarray(chain.raw, dtype=np.uint16))
-    with guarded_write(path):
-        path.write_bytes(bytes(data))
+    write_bytes_file(path, bytes(data))
 
 
 def _xyz_to_camera(out: SensorOutput) -> np.ndarray:

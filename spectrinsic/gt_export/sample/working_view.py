@@ -101,7 +101,8 @@ def srgb_view(sample: Mapping[str, Any], meta: Any) -> dict[str, Any]:
         return dict(sample)
     out = dict(sample)
     if isinstance(sample.get("meta"), Mapping):
-        record = working_space("srgb").record() | {"view_of": space.name}
+        # the view keeps out-of-gamut light's negative components: its shading is not clipped
+        record = working_space("srgb").record() | {"view_of": space.name, "shading_clipped": False}
         out["meta"] = {**sample["meta"], "working_space": record}
     for name, value in sample.items():
         if isinstance(value, np.ndarray) and value.ndim == 3 and value.shape[-1] == 3:

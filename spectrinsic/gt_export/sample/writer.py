@@ -31,8 +31,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ...errors import DatasetError, WriteError
+from ...file_writes import write_text_file
 from ...provenance import software_versions
 from ...scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash, scene_to_dict
+from ...scenes.semantic import class_table
 from ...spectra import DEFAULT_WAVELENGTHS, get_spectrum
 from ...spectra.user_spectra import spectrum_files
 from ...spectra.working_space import DEFAULT_WORKING_SPACE
@@ -54,7 +56,7 @@ from . import (
     meta_seal,
     plain_data,
 )
-from .integrity import guarded_write, remove_owned_temporaries, replaceable_sample, sample_problem
+from .integrity import remove_owned_temporaries, replaceable_sample, sample_problem
 from .previews import preview_maker, preview_path, shown_layers
 from .sensor import SensorOutput, sensor_output, write_sensor_files
 from .transport_exr import TRANSPORT_NAME, write_transport
@@ -80,8 +82,7 @@ _VOLATILE_META = ("timings",)
 
 
 def _dump_json(path: Path, data: Any, *, compact: bool = False) -> None:
-    with guarded_write(path):
-        path.write_text(canonical_json(data, compact=compact), encoding="utf-8")
+    write_text_file(path, canonical_json(data, compact=compact))
 
 
 def _layer_records(
@@ -127,6 +128,9 @@ def _meta(
     files_used = spectrum_files(
         [m.spectrum for m in scene.materials] + [li.spectrum for li in scene.lights]
     ) + list(scene.metadata.get("spectrum_files", []))  # the .spd files a Mitsuba XML read
+    extra: dict[str, Any] = {"spectrum_files": files_used} if files_used else {}
+    if "semantic" in gt.layers:  # the class table of the semantic layer's ids
+        extra["semantic_classes"] = class_table()
     return {
         "format_version": FORMAT_VERSION,
         "sample_id": sample_id,
@@ -159,7 +163,7 @@ def _meta(
         "residual_share": gt.residual_share,
         "files": sorted(files),
         "versions": software_versions(),
-    } | ({"spectrum_files": files_used} if files_used else {})
+    } | extra
 
 
 def _write_layers(folder: Path, gt: GroundTruth, sample_id: str) -> list[str]:
@@ -253,6 +257,7 @@ def export_sample(
     camera: CameraModel | None = None,
     spectral_layers: bool = False,
     working_space: str = DEFAULT_WORKING_SPACE,
+    noise_id: str | None = None,
 ) -> Path:
     """Compute every ground-truth layer of a rendered sample and write it atomically.
 
@@ -295,6 +300,10 @@ def export_sample(
     working_space
         The RGB working space of the RGB layers (``"acescg"``, default, or ``"srgb"``,
         :mod:`spectrinsic.spectra.working_space`); recorded in ``meta.json["working_space"]``.
+    noise_id
+        The sample id the camera chain's noise is seeded from (with *seed*); default
+        *sample_id*. A relit sample passes its source's id, so its raw mosaic carries the same
+        noise as a direct render of that sample under the new lights.
 
     Returns
     -------
@@ -321,7 +330,9 @@ def export_sample(
     )
     sensor = None
     if camera is not None:
-        sensor = sensor_output(gt, camera, seed=seed, sample_id=sample_id, data_dir=data_dir)
+        sensor = sensor_output(
+            gt, camera, seed=seed, sample_id=noise_id or sample_id, data_dir=data_dir
+        )
         gt = sensor.ground_truth
     final = out_dir / sample_id
     tmp = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{sample_id}-", dir=out_dir))

@@ -57,7 +57,10 @@ _EMISSION_PARAM = {
     "directional": "irradiance",
     "area": "radiance",
     "sky": "radiance",
+    "sphere": "radiance",
 }
+#: Light kinds that are shapes carrying an ``area`` emitter.
+_SHAPE_LIGHTS = ("area", "sphere")
 
 
 @dataclass(frozen=True)
@@ -94,7 +97,7 @@ def surfaces(scene: Scene) -> list[Surface]:
         for m in np.unique(np.asarray(mesh.face_materials)):
             out.append(Surface(f"surf_{i}_{int(m)}", i, int(m)))
     for j, light in enumerate(scene.lights):
-        if light.kind == "area":
+        if light.kind in _SHAPE_LIGHTS:
             out.append(Surface(light_key(j), -1, -1, j))
     return out
 
@@ -107,7 +110,9 @@ def reflectance_key(surface: Surface, *, spectral: bool) -> str:
 def emission_key(scene: Scene, index: int, *, spectral: bool) -> str:
     """``mi.traverse`` key of light *index*'s emitted spectrum."""
     light = scene.lights[index]
-    prefix = f"{light_key(index)}.emitter." if light.kind == "area" else f"{light_key(index)}."
+    prefix = (
+        f"{light_key(index)}.emitter." if light.kind in _SHAPE_LIGHTS else f"{light_key(index)}."
+    )
     return prefix + _EMISSION_PARAM[light.kind] + (".values" if spectral else ".value")
 
 
@@ -284,16 +289,24 @@ def _light(mi: Any, light: Light, emission: Mapping | None, what: str) -> dict[s
         )
     if light.kind == "sky":
         return None if emission is None else {"type": "constant", "radiance": dict(emission)}
-    if light.kind == "area":
+    if light.kind in _SHAPE_LIGHTS:
         w, h = (float(s) for s in light.size)
-        shape: dict[str, Any] = {
-            "type": "rectangle",
-            "to_world": _look_at(mi, light.position, light.direction, what)
-            @ mi.ScalarTransform4f().scale([w / 2, h / 2, 1.0]),
-            # an instance, not a dict: load_dict merges identical dicts into one shared BSDF,
-            # and every surface needs its own for the per-surface coverage passes
-            "bsdf": mi.load_dict(black_bsdf()),
-        }
+        shape: dict[str, Any] = (
+            {
+                "type": "rectangle",
+                "to_world": _look_at(mi, light.position, light.direction, what)
+                @ mi.ScalarTransform4f().scale([w / 2, h / 2, 1.0]),
+            }
+            if light.kind == "area"
+            else {
+                "type": "sphere",
+                "center": list(map(float, light.position)),
+                "radius": float(light.radius),
+            }
+        )
+        # an instance, not a dict: load_dict merges identical dicts into one shared BSDF,
+        # and every surface needs its own for the per-surface coverage passes
+        shape["bsdf"] = mi.load_dict(black_bsdf())
         if emission is not None:
             shape["emitter"] = {"type": "area", "radiance": dict(emission)}
         return shape
@@ -319,8 +332,8 @@ def _camera(mi: Any, scene: Scene, film: Mapping, sample_count: int) -> dict[str
 @dataclass(frozen=True, eq=False)
 class SurfaceGeometry:
     """Triangles of one surface, ready for Mitsuba: ``corners`` and ``normals`` ``(F, 3, 3)``,
-    and on a textured mesh (its ``mesh`` index) the corners' ``uv`` ``(F, 3, 2)``
-    (:func:`~spectrinsic.scenes.textures.box_uv`)."""
+    and on a textured mesh (its ``mesh`` index) the corners' ``uv`` ``(F, 3, 2)`` (the
+    texture's own, else :func:`~spectrinsic.scenes.textures.box_uv`)."""
 
     key: str
     material: int
@@ -344,7 +357,14 @@ def prepare_geometry(
         corners = np.asarray(mesh.vertices, float)[faces]
         normals = smooth_corner_normals(mesh.vertices, faces, crease_deg)
         face_materials = np.asarray(mesh.face_materials, np.int64)
-        uv = None if mesh.texture is None else box_uv(mesh.vertices, faces)
+        texture = mesh.texture
+        uv = (
+            None
+            if texture is None
+            else box_uv(mesh.vertices, faces)
+            if texture.uv is None
+            else np.asarray(texture.uv, float)  # the asset's own coordinates
+        )
         for m in np.unique(face_materials):
             sel = face_materials == m
             out.append(

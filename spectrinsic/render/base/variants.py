@@ -333,7 +333,9 @@ def variant_scope(variant: str, *, restore: bool = True) -> Iterator[ModuleType]
     ``set_variant(name)`` replaces (``set_variant(None)`` raises ``TypeError``), so there is no
     way back to "no variant". When no variant was active before the block, *variant* stays
     active after it: ``mi.variant()`` returns it until another variant is set. This happens
-    at most once per process, at the first scope; spectrinsic sets variants nowhere else.
+    at most once per process, at the first scope; spectrinsic sets variants nowhere else but
+    in :mod:`spectrinsic.scenes.mitsuba_tree`, which needs some variant (``scalar_rgb``) to read a
+    parsed XML scene's transforms when none is active.
     """
     mi = import_mitsuba()
     previous = mi.variant()

@@ -56,6 +56,9 @@ class GeneratorOptions:
     daylight_share
         Fraction of ``rooms`` lit also by sun and sky through a window, 0..1
         (:mod:`~spectrinsic.scenes.generators.daylight`); 0 leaves every room as before.
+    daylight_only
+        Whether those rooms are lit by sun and sky alone (no lamps); otherwise sun and sky
+        carry a drawn share of the room's flux (``daylight.FLUX_SHARE``).
     """
 
     width: int
@@ -70,6 +73,7 @@ class GeneratorOptions:
     gloss: GlossDistribution = field(default_factory=GlossDistribution)
     light_saturation: tuple[float, float] | None = None
     daylight_share: float = 0.0
+    daylight_only: bool = False
 
 
 @dataclass(frozen=True)
@@ -93,9 +97,14 @@ class Layout:
         Cameras must also pass :func:`~spectrinsic.scenes.generators.view_rule.judge_view`
         (rooms: several materials, no surface filling the frame, enough light). Objects on a
         ground are MIT-like: the ground fills most of the frame by design.
-    extra_lights
-        Lights of the layout itself, added to the condition's drawn lights (a daylight
-        room's sun and sky).
+    room_lights
+        ``drawn -> lights``: the layout's own lights joined to the condition's drawn lights
+        (a daylight room's sun and sky, with the lamps scaled to the daylight's flux share or
+        dropped, :meth:`~spectrinsic.scenes.generators.daylight.Daylight.room_lights`); None
+        keeps the drawn lights.
+    flux_density
+        Flux per m² of the room's surfaces that the layout's own lights send in through its
+        openings (a daylight room's window), for the view rule's interreflection estimate.
     """
 
     parts: tuple[tuple[str, Part], ...]
@@ -104,7 +113,8 @@ class Layout:
     info: dict[str, Any]
     min_coverage: float = 0.0
     view_rule: bool = False
-    extra_lights: tuple[Light, ...] = ()
+    room_lights: Callable[[tuple[Light, ...]], tuple[Light, ...]] | None = None
+    flux_density: float = 0.0
 
 
 def scene_rngs(seed: int) -> dict[str, np.random.Generator]:
@@ -141,7 +151,7 @@ def assemble(
     scene (the gloss is drawn afterwards; light, not sheen, is judged)."""
     meshes, materials = to_meshes(layout.parts)
     family = family_of(seed)
-    lights = draw_lights(
+    lamps = draw_lights(
         rngs["lights"],
         family,
         layout.lights,
@@ -150,11 +160,15 @@ def assemble(
         data_dir=options.data_dir,
         max_lights=options.max_lights,
         saturation=options.light_saturation,
-    ) + tuple(layout.extra_lights)
+    )
+    lights = lamps if layout.room_lights is None else layout.room_lights(lamps)
+    if not {light.name for light in lamps} & {light.name for light in lights}:
+        family = "daylight"  # the drawn lights (and their condition) were dropped
     draws = [0, 0]  # cameras judged by the view rule, and passed
 
     def judged(cam: Camera) -> bool:
-        ok = judge_view(meshes, lights, cam).ok  # a view worth learning from
+        # a view worth learning from
+        ok = judge_view(meshes, lights, cam, flux_density=layout.flux_density).ok
         if ok and probe is not None:  # and lit so, once rendered
             seen = Scene(name=name, meshes=meshes, materials=materials, lights=lights, camera=cam)
             ok = judge_frame(probe(seen)).ok

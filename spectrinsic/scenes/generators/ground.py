@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -31,12 +32,15 @@ def _place(
     parts: list[tuple[str, Part]] = []
     patterns: list[str] = []
     for i in range(int(rng.integers(1, 6))):
-        shape, part, pattern, half = draw_object(rng, options.materials, options.sfu_reflectances)
+        shape, part, pattern, half = draw_object(
+            rng, options.materials, options.sfu_reflectances, texture_library=True
+        )
         patterns += [pattern] if pattern else []
         for _ in range(30):
             centre = rng.uniform(-0.35, 0.35, 2)
             if floor.try_add(centre, half):
-                parts.append((f"{shape}-{i}", moved(part, translate=(centre[0], centre[1], 0.0))))
+                placed = moved(part, translate=(centre[0], centre[1], 0.0))
+                parts.append((f"{shape}-{i}", replace(placed, semantic="object")))
                 break
     return parts, patterns
 
@@ -87,7 +91,7 @@ def objects_on_ground(rng: np.random.Generator, options: GeneratorOptions) -> La
         "patterns": patterns,
     }
     return Layout(
-        parts=(*objects, ("ground", _ground(rng, options.materials))),
+        parts=(*objects, ("ground", replace(_ground(rng, options.materials), semantic="floor"))),
         lights=volume,
         propose_camera=propose,
         info=info,

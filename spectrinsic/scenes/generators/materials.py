@@ -31,6 +31,7 @@ __all__ = [
     "munsell_chips",
     "check_ranges",
     "within",
+    "pixel_texture",
     "obeys",
     "repaint_outside",
     "draw_reflectance",
@@ -297,7 +298,7 @@ PIXEL_TEXTURE = "pixel-texture"
 PIXEL_TEXTURE_SIZE = 64
 
 
-def _pixel_texture(
+def pixel_texture(
     part: Part, rng: np.random.Generator, dist: MaterialDistribution, sfu: Sequence[str]
 ) -> Part:
     """*part* under a per-pixel texture: a generated pattern over 2-3 distinct palette spectra
@@ -325,7 +326,7 @@ def paint(
         The painted part and the pattern's name (``"plain"`` for one spectrum).
     """
     if dist.texture_fraction > 0 and rng.random() < dist.texture_fraction:
-        return _pixel_texture(part, rng, dist, sfu), PIXEL_TEXTURE
+        return pixel_texture(part, rng, dist, sfu), PIXEL_TEXTURE
     if rng.random() >= dist.pattern_probability:
         return _labelled(
             part, [draw_reflectance(rng, dist, sfu)], np.zeros(len(part.faces))

@@ -9,6 +9,7 @@ total light spans roughly 0.3 (closed, light walls, lit indirectly) to 0.9 (open
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 
@@ -18,7 +19,7 @@ from ..parts import Part, merge, moved
 from ..primitives import box
 from .base import GeneratorOptions, Layout
 from .camera import Footprints
-from .daylight import Daylight, draw_daylight
+from .daylight import Daylight, draw_daylight, window_flux
 from .lights import LightVolume
 from .materials import MaterialDistribution, draw_reflectance, within
 from .shapes import draw_object
@@ -31,14 +32,19 @@ _PLACED_KINDS = tuple(k for k in LIGHT_KINDS if "position" in LIGHT_FIELDS[k])
 #: Placed kinds that can be aimed: the uplights of indirectly lit rooms.
 _AIMED_KINDS = tuple(k for k in _PLACED_KINDS if "direction" in LIGHT_FIELDS[k])
 _T = 0.1  # wall thickness, m
+#: The semantic class of each kind of furniture (:mod:`~spectrinsic.scenes.semantic`; the
+#: others are their own class). Rooms draw no window part: a window is an opening.
+_FURNITURE_CLASS = {"round-table": "table"}
 #: Least fraction of a room view's rays on furniture and objects (not walls, floor, ceiling).
 FRAMED_COVERAGE = 0.3
 
 
-def _slab(lo: np.ndarray, hi: np.ndarray, spectrum: str) -> Part:
+def _slab(lo: np.ndarray, hi: np.ndarray, spectrum: str, semantic: str = "") -> Part:
+    """The box from corner *lo* to corner *hi*, of semantic class *semantic*."""
     size = np.maximum(hi - lo, 1e-3)
     div = tuple(max(1, int(round(s * 2))) for s in size)
-    return box(tuple(size), spectrum, center=tuple((lo + hi) / 2), divisions=div)
+    part = box(tuple(size), spectrum, center=tuple((lo + hi) / 2), divisions=div)
+    return replace(part, semantic=semantic)
 
 
 def _wall(
@@ -67,7 +73,7 @@ def _wall(
         lo[axis], hi[axis], lo[2], hi[2] = a, b, c, e
         if b - a > 1e-3 and e - c > 1e-3:
             pieces.append(_slab(lo.copy(), hi.copy(), spectrum))
-    return merge(*pieces)
+    return replace(merge(*pieces), semantic="wall")
 
 
 def _shell(
@@ -98,6 +104,7 @@ def _shell(
                 np.array([-_T, -_T, -_T]),
                 np.array([w + _T, d + _T, 0.0]),
                 draw_reflectance(rng, walls),
+                "floor",
             ),
         )
     ]
@@ -109,6 +116,7 @@ def _shell(
                     np.array([-_T, -_T, h]),
                     np.array([w + _T, d + _T, h + _T]),
                     draw_reflectance(rng, walls),
+                    "ceiling",
                 ),
             )
         )
@@ -194,7 +202,9 @@ def _furniture(
                 [0.05 + half[0], 0.05 + half[1]], [w - 0.05 - half[0], d - 0.05 - half[1]]
             )
             if floor.try_add(c, half, gap=0.05):
-                parts.append((f"{kind}-{i}", moved(part, translate=(c[0], c[1], 0.0))))
+                placed = moved(part, translate=(c[0], c[1], 0.0))
+                semantic = _FURNITURE_CLASS.get(kind, kind)
+                parts.append((f"{kind}-{i}", replace(placed, semantic=semantic)))
                 tops += [(c + inner_lo, c + inner_hi, z, room) for z, room in levels]
                 break
     return parts, tops
@@ -223,7 +233,8 @@ def _objects(
                 continue
             c = rng.uniform(lo + half, hi - half)
             if taken.try_add(c, half):
-                parts.append((f"{shape}-{i}", moved(part, translate=(c[0], c[1], z))))
+                placed = moved(part, translate=(c[0], c[1], z))
+                parts.append((f"{shape}-{i}", replace(placed, semantic="object")))
                 patterns += [pattern] if pattern else []
                 break
     return parts, patterns
@@ -297,7 +308,7 @@ def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
     day_rng = rng.spawn(1)[0] if options.daylight_share > 0 else None
     day = None
     if day_rng is not None and day_rng.random() < options.daylight_share:
-        day = draw_daylight(day_rng, size, _T)
+        day = draw_daylight(day_rng, size, _T, only=options.daylight_only)
     shell, openness = _shell(rng, size, options.materials, day)
     floor = Footprints([])
     furniture, tops = _furniture(
@@ -326,5 +337,6 @@ def rooms(rng: np.random.Generator, options: GeneratorOptions) -> Layout:
         info=info,
         min_coverage=FRAMED_COVERAGE,
         view_rule=True,
-        extra_lights=() if day is None else day.lights,
+        room_lights=None if day is None else day.room_lights,
+        flux_density=0.0 if day is None else window_flux(day) / (2 * (w * d + w * h + d * h)),
     )

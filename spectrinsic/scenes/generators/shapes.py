@@ -14,7 +14,7 @@ import numpy as np
 from ..objects import OBJECTS
 from ..parts import Part, moved
 from ..primitives import box, capsule, cone, cylinder, ellipsoid, revolve, torus
-from .materials import MaterialDistribution, paint, repaint_outside
+from .materials import PIXEL_TEXTURE, MaterialDistribution, paint, pixel_texture, repaint_outside
 
 __all__ = ["SHAPES", "shape_names", "make_shape", "draw_object", "on_ground"]
 
@@ -116,10 +116,17 @@ def make_shape(name: str, rng: np.random.Generator, spectrum: str) -> Part:
 
 
 def draw_object(
-    rng: np.random.Generator, materials: MaterialDistribution, sfu: Sequence[str] = ()
+    rng: np.random.Generator,
+    materials: MaterialDistribution,
+    sfu: Sequence[str] = (),
+    *,
+    texture_library: bool = False,
 ) -> tuple[str, Part, str | None, np.ndarray]:
     """A random shape, painted from *materials* (library objects keep those of their own
-    colours that lie in *materials*' ranges; the others are redrawn from it).
+    colours that lie in *materials*' ranges; the others are redrawn from it). With
+    *texture_library* a library object too takes a per-pixel texture with probability
+    ``materials.texture_fraction`` (``objects-on-ground``, which draws mostly library
+    objects, so that ``--texture-fraction`` applies to it; drawn only when above 0).
 
     Returns
     -------
@@ -132,6 +139,12 @@ def draw_object(
     pattern = None
     if not shape.startswith("lib-"):
         part, pattern = paint(part, rng, materials, sfu)
+    elif (
+        texture_library
+        and materials.texture_fraction > 0
+        and rng.random() < materials.texture_fraction
+    ):
+        part, pattern = pixel_texture(part, rng, materials, sfu), PIXEL_TEXTURE
     else:
         part = repaint_outside(part, rng, materials)
     return shape, part, pattern, np.ptp(part.vertices[:, :2], axis=0) / 2

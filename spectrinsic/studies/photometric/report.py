@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from ...arrays import StepProgress
+from ...file_writes import replacing
 from ...results import provenance, write_csv, write_json
 from ...spectra import ESTIMATE_SCENARIOS
 from ..glossary import abbreviations, versus_thesis
@@ -116,7 +117,8 @@ def write_photometric_outputs(result: PhotometricResult, out_dir: Path) -> dict[
         "csv": write_csv(out_dir / "photometric.csv", rows),
         "png": out_dir / "photometric.png",
     }
-    photometric_figure(result).savefig(paths["png"], dpi=DPI)
+    with replacing(paths["png"]) as tmp:
+        photometric_figure(result).savefig(tmp, dpi=DPI)
     return paths
 
 

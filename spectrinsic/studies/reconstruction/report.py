@@ -12,6 +12,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
+from ...file_writes import replacing
 from ...results import provenance, write_csv, write_json
 from ..glossary import abbreviations
 from .compute import THESIS_TABLE_5_2, ErrorRow, ExtensionResult, TableResult
@@ -137,7 +138,8 @@ def write_table_outputs(result: TableResult, out_dir: Path) -> dict[str, Path]:
         "csv": write_csv(out_dir / "reconstruction_error.csv", rows),
         "png": out_dir / "reconstruction_error.png",
     }
-    table_figure(result).savefig(paths["png"], dpi=DPI)
+    with replacing(paths["png"]) as tmp:
+        table_figure(result).savefig(tmp, dpi=DPI)
     return paths
 
 
@@ -170,5 +172,6 @@ def write_extension_outputs(result: ExtensionResult, out_dir: Path) -> dict[str,
         "delta_e_csv": write_csv(out_dir / "reconstruction_error_delta_e.csv", de_rows),
         "png": out_dir / "reconstruction_error_extended.png",
     }
-    extension_figure(result).savefig(paths["png"], dpi=DPI)
+    with replacing(paths["png"]) as tmp:
+        extension_figure(result).savefig(tmp, dpi=DPI)
     return paths

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from ...arrays import StepProgress
+from ...file_writes import replacing
 from ...results import json_safe, provenance, write_csv, write_json
 from ..glossary import abbreviations, versus_thesis
 from .compute import (
@@ -156,9 +157,10 @@ def _write(result: RenderingResult, out_dir: Path) -> dict[str, Any]:
     for found in result.samples:
         path = out_dir / "rendering" / f"{found.sample}.png"
         path.parent.mkdir(parents=True, exist_ok=True)
-        error_figure(found.sample.replace("__", "  "), found.reference, found.errors).savefig(
-            path, dpi=DPI
-        )
+        with replacing(path) as tmp:
+            error_figure(found.sample.replace("__", "  "), found.reference, found.errors).savefig(
+                tmp, dpi=DPI
+            )
         figures.append(str(path))
     payload = rendering_payload(result)
     json_path = out_dir / "rendering.json"

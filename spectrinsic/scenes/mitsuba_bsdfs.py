@@ -1,0 +1,157 @@
+"""Mitsuba XML BSDFs as :class:`~spectrinsic.scenes.model.Material` records.
+
+Read exactly: ``diffuse`` (``reflectance``), ``plastic`` and ``roughplastic``
+(``diffuse_reflectance``, numeric ``int_ior``/``ext_ior``, Mitsuba's defaults 1.49 and air's
+1.000277), ``conductor`` and ``roughconductor`` (``material``, one of Mitsuba's measured
+metals), the rough ones with ``alpha`` and the ``ggx`` distribution (Mitsuba's default,
+``beckmann``, is refused: the renderer's microfacets are GGX), bare or in a ``twosided`` with one BSDF (or two equal
+ones). A ``specular_reflectance`` other than 1 has no exact counterpart and is refused.
+
+Without exact ground truth until the glass-and-environment issue lands: ``dielectric``,
+``thindielectric``, ``roughdielectric`` (:data:`GLASS`), ``mask``, ``bumpmap``, ``normalmap``
+(:data:`WRAPPERS`) and ``bitmap`` textures. Each is refused in one line naming it; under
+``--approximate`` glass drops its shape, a wrapper gives way to the BSDF it wraps (the mask's
+opacity, the bump or normal map ignored) and a bitmap becomes Mitsuba's default 0.5 grey, each
+said in one line.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import SceneError
+from .materials import METAL_SPECTRUM
+from .mitsuba_spectra import reflectance_name
+from .mitsuba_tree import Value, XmlNode
+from .model import Material
+
+__all__ = ["GLASS", "WRAPPERS", "DEFAULT_MATERIAL", "material_of"]
+
+#: Transmissive BSDFs, dropped with their shape under ``--approximate``.
+GLASS = ("dielectric", "thindielectric", "roughdielectric")
+#: BSDFs wrapping another, which gives way to the inner one under ``--approximate``.
+WRAPPERS = ("mask", "bumpmap", "normalmap")
+#: Mitsuba's BSDF of a shape that names none: diffuse 0.5.
+DEFAULT_MATERIAL = Material("flat:0.5", "flat:0.5")
+
+_PARAMS = {
+    "diffuse": {"reflectance"},
+    "plastic": {"diffuse_reflectance", "specular_reflectance", "int_ior", "ext_ior"},
+    "conductor": {"material", "specular_reflectance"},
+}
+_PARAMS["roughplastic"] = _PARAMS["plastic"] | {"alpha", "distribution", "sample_visible"}
+_PARAMS["roughconductor"] = _PARAMS["conductor"] | {"alpha", "distribution", "sample_visible"}
+
+#: ``say(phrase)`` records an approximation; ``None`` where approximations are refused.
+Say = Callable[[str], None] | None
+
+
+def _number(node: XmlNode, key: str, default: float, what: str) -> float:
+    value = node.props.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise SceneError(f"{what}: {key} {value!r} in {node.label()}; expected a number")
+    return float(value)
+
+
+def _unsupported(node: XmlNode, what: str, say: Say, instead: str) -> None:
+    if say is None:
+        raise SceneError(
+            f"{what}: {node.label()} has no exact ground truth yet; refused "
+            f"(--approximate: {instead})"
+        )
+    say(f"{what}: {node.label()} {instead}")
+
+
+def _colour(node: XmlNode, key: str, what: str, base: Path, say: Say) -> str:
+    value: Value | None = node.props.get(key)
+    if isinstance(value, XmlNode) and value.plugin == "bitmap":
+        _unsupported(value, f"{what} {key}", say, "replaced by a uniform 0.5 reflectance")
+        return "flat:0.5"
+    return reflectance_name(value, f"{what} {key}", base)
+
+
+def _unit_specular(node: XmlNode, what: str, say: Say) -> None:
+    value = node.props.get("specular_reflectance", 1.0)
+    unit = isinstance(value, (int, float)) and value == 1.0
+    unit = unit or (isinstance(value, np.ndarray) and bool(np.all(value == 1.0)))
+    if not unit:
+        shown = value.tolist() if isinstance(value, np.ndarray) else value
+        if say is None:
+            raise SceneError(
+                f"{what}: specular_reflectance {shown!r} in {node.label()}; only 1 has exact "
+                "ground truth (--approximate would use 1)"
+            )
+        say(f"{what}: {node.label()} specular_reflectance {shown!r} taken as 1")
+
+
+def _inner(node: XmlNode, what: str) -> XmlNode:
+    inner = [c for c in node.children if c.kind == "bsdf"]
+    if len(inner) == 2 and material_key(inner[0]) == material_key(inner[1]):
+        inner = inner[:1]
+    if len(inner) != 1:
+        raise SceneError(f"{what}: {node.label()} needs exactly one inner <bsdf>")
+    return inner[0]
+
+
+def material_key(node: XmlNode) -> tuple[str, str]:
+    """Plugin and id, enough to tell a twosided's two sides apart when they are references."""
+    return node.plugin, node.id
+
+
+def material_of(node: XmlNode, what: str, base: Path, say: Say) -> Material | None:
+    """The material of BSDF *node*; ``None`` where an approximation drops the shape (glass)."""
+    name = node.id if node.id and not node.id.startswith("_unnamed") else ""
+    while node.plugin == "twosided" or node.plugin in WRAPPERS:
+        if node.plugin in WRAPPERS:
+            _unsupported(node, what, say, "replaced by the BSDF it wraps")
+        node = _inner(node, what)
+        name = name or (node.id if not node.id.startswith("_unnamed") else "")
+    kind = node.plugin
+    if kind in GLASS:
+        _unsupported(node, what, say, "left out with its shape")
+        return None
+    if kind not in _PARAMS:
+        raise SceneError(
+            f"{what}: unsupported element {node.label()}; expected a bsdf of type "
+            + ", ".join([*_PARAMS, "twosided"])
+        )
+    extra = set(node.props) - _PARAMS[kind]
+    if extra:
+        raise SceneError(f"{what}: unsupported parameter {sorted(extra)[0]!r} in {node.label()}")
+    if node.children:
+        raise SceneError(
+            f"{what}: unsupported element {node.children[0].label()} in {node.label()}"
+        )
+    rough = kind.startswith("rough")
+    alpha = _number(node, "alpha", 0.1, what) if rough else 0.0
+    if rough and node.props.get("distribution", "beckmann") != "ggx":
+        shown = node.props.get("distribution", "beckmann (the default)")
+        if say is None:
+            raise SceneError(
+                f"{what}: distribution {shown} in {node.label()}; only ggx has exact ground "
+                "truth (--approximate would use ggx of the same alpha)"
+            )
+        say(f"{what}: {node.label()} distribution {shown} taken as ggx of the same alpha")
+    if kind == "diffuse":
+        spectrum = _colour(node, "reflectance", what, base, say)
+        return Material(name or spectrum, spectrum)
+    _unit_specular(node, what, say)
+    if kind.endswith("conductor"):
+        metal = node.props.get("material")
+        if not isinstance(metal, str) or not metal:
+            raise SceneError(f"{what}: {node.label()} needs a 'material' (Au, Cu, Al, ...)")
+        return Material(
+            name or f"{kind} {metal}",
+            METAL_SPECTRUM,
+            kind="conductor",
+            roughness=alpha,
+            metal=metal,
+        )
+    spectrum = _colour(node, "diffuse_reflectance", what, base, say)
+    ior = _number(node, "int_ior", 1.49, what) / _number(node, "ext_ior", 1.000277, what)
+    return Material(
+        name or f"{kind} {spectrum}", spectrum, kind="plastic", roughness=alpha, ior=ior
+    )
