@@ -5,9 +5,10 @@ The rooms of ``dataset --generator rooms --count N --seed 11 --preset preview --
 :mod:`spectrinsic.render.probe`), then each view is rendered at 64 x 64 (CIE XYZ through the
 spectral pass, 16 spp; exposed so its 99th-percentile luminance is white, sRGB-encoded) and
 tiled with :func:`spectrinsic.gt_export.dataset.contact_sheet.tile_sheet`. The probes' verdicts
-go to ``OUT.json``. Run: ``python scripts/view_rule_sheet.py [N] [OUT] [SEED] [DATASET OPTIONS...]`` (about 6 s a view on one
-core). The tiles are not the dataset's denoised previews (a 64² preview sample takes 4-5 s of
-Mitsuba alone): the framing and the light are the same, the noise is not.
+go to ``OUT.json``. Run: ``python scripts/view_rule_sheet.py [N] [OUT] [SEED] [DATASET
+OPTIONS...]`` (about 6 s a view on one core). The tiles are not the dataset's denoised previews
+(a 64² preview sample takes 4-5 s of Mitsuba alone): the framing and the light are the same,
+the noise is not.
 """
 
 from __future__ import annotations
