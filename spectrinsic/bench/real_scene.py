@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from ..file_writes import write_text_file
 from ..render.base.variants import import_mitsuba
 from ..scenes.mitsuba_xml import load_mitsuba_xml
 
@@ -89,7 +90,7 @@ def write_interior(folder: Path, meshes: int | None = None) -> Path:
             )
     side = int(np.ceil(np.sqrt(meshes)))
     for i in range(meshes):
-        (folder / "meshes" / f"obj{i:03d}.obj").write_text(box)
+        write_text_file(folder / "meshes" / f"obj{i:03d}.obj", box)
         x, y = (i % side) / side * 8 - 4, (i // side) / side * 8 - 4
         parts.append(
             f'<shape type="obj" id="obj{i:03d}"><string name="filename" value="meshes/obj{i:03d}.obj"/>'
@@ -109,7 +110,7 @@ def write_interior(folder: Path, meshes: int | None = None) -> Path:
         "</scene>",
     ]
     path = folder / "interior.xml"
-    path.write_text("\n".join(parts))
+    write_text_file(path, "\n".join(parts))
     return path
 
 

@@ -264,6 +264,7 @@ GENERATOR_DEFAULTS: dict[str, Any] = {
     "metallic": METALLIC_FRACTION,
     "roughness_range": "0,0.3",
     "daylight_share": 0.0,
+    "daylight_only": False,
 }
 #: The options of scene files (``--scenes``).
 FILE_OPTIONS = (
@@ -272,6 +273,7 @@ FILE_OPTIONS = (
     "new_sample",
     "semantic_map",
     "colours_from_asset",
+    "approximate",
 )
 
 

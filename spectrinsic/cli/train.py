@@ -14,6 +14,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from ..errors import DatasetError
+from ..file_writes import write_text_file
 from ..gt_export.folders.outfolder import LOCK_NAME, check_out_folder, folder_lock
 from ..learn import card
 from ..learn.data import TrainLayers, training_folders
@@ -122,9 +123,7 @@ def run(args: argparse.Namespace) -> int:
     )
     _check_out(args.out, args.resume)
     with folder_lock(args.out):
-        (args.out / TRAINING_MARKER).write_text(
-            json.dumps(options.to_dict(), indent=1) + "\n", encoding="utf-8"
-        )
+        write_text_file(args.out / TRAINING_MARKER, json.dumps(options.to_dict(), indent=1) + "\n")
         bar = tqdm(
             total=options.steps,
             desc="train",

@@ -5,6 +5,7 @@ time and the software)."""
 from __future__ import annotations
 
 import csv
+import io
 import json
 import os
 import time
@@ -12,6 +13,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from ..file_writes import replacing, write_text_file
 from ..gt_export.sample.meta import read_meta
 from ..provenance import provenance
 from .torch_import import require_torch
@@ -62,7 +64,8 @@ def _curve_png(path: Path, curve: Sequence[tuple[int, float]]) -> None:
     ax.set(xlabel="step", ylabel="loss (scale-invariant, R + S)", yscale="log")
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    with replacing(path) as tmp:
+        fig.savefig(tmp, dpi=120)
 
 
 def _card_md(record: dict[str, Any]) -> str:
@@ -112,14 +115,14 @@ def write_outputs(
         "state_dict": result.state_dict,
         "card": record,
     }
-    tmp = paths["weights"].with_name(WEIGHTS + ".tmp")
-    torch.save(weights, tmp)
-    os.replace(tmp, paths["weights"])
-    with paths["curve_csv"].open("w", newline="", encoding="utf-8") as f:
-        writer = csv.writer(f)
-        writer.writerow(["step", "loss"])
-        writer.writerows((s, f"{v:.9g}") for s, v in result.curve)
+    with replacing(paths["weights"]) as tmp:
+        torch.save(weights, tmp)
+    text = io.StringIO(newline="")
+    writer = csv.writer(text)
+    writer.writerow(["step", "loss"])
+    writer.writerows((s, f"{v:.9g}") for s, v in result.curve)
+    write_text_file(paths["curve_csv"], text.getvalue())
     _curve_png(paths["curve_png"], result.curve)
-    paths["card_json"].write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
-    paths["card_md"].write_text(_card_md(record), encoding="utf-8")
+    write_text_file(paths["card_json"], json.dumps(record, indent=1) + "\n")
+    write_text_file(paths["card_md"], _card_md(record))
     return paths

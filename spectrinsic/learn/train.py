@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import DatasetError
+from ..file_writes import replacing
 from ..gt_export.relight.augment import RandomRelight
 from .data import TrainLayers, draw_batch, load_items, training_folders
 from .loss import scale_invariant_loss
@@ -116,9 +117,8 @@ def _crop(options: TrainOptions, shape: tuple[int, ...]) -> int:
 
 
 def _save(torch: Any, path: Path, record: dict[str, Any]) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    torch.save(record, tmp)
-    os.replace(tmp, path)
+    with replacing(path) as tmp:  # a killed run leaves the previous checkpoint whole
+        torch.save(record, tmp)
 
 
 def _load_checkpoint(torch: Any, out: Path, options: TrainOptions) -> dict[str, Any]:

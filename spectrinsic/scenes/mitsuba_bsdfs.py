@@ -9,10 +9,11 @@ ones). A ``specular_reflectance`` other than 1 has no exact counterpart and is r
 
 Without exact ground truth until the glass-and-environment issue lands: ``dielectric``,
 ``thindielectric``, ``roughdielectric`` (:data:`GLASS`), ``mask``, ``bumpmap``, ``normalmap``
-(:data:`WRAPPERS`) and ``bitmap`` textures. Each is refused in one line naming it; under
-``--approximate`` glass drops its shape, a wrapper gives way to the BSDF it wraps (the mask's
-opacity, the bump or normal map ignored) and a bitmap becomes Mitsuba's default 0.5 grey, each
-said in one line.
+(:data:`WRAPPERS`) and ``bitmap`` textures anywhere but a matte ``diffuse`` reflectance (that
+one is an exact image texture, :mod:`~spectrinsic.scenes.mitsuba_bitmaps`). Each is refused in
+one line naming it; under ``--approximate`` glass drops its shape, a wrapper gives way to the
+BSDF it wraps (the mask's opacity, the bump or normal map ignored) and a bitmap becomes
+Mitsuba's default 0.5 grey, each said in one line.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from .mitsuba_spectra import reflectance_name
 from .mitsuba_tree import Value, XmlNode
 from .model import Material
 
-__all__ = ["GLASS", "WRAPPERS", "DEFAULT_MATERIAL", "material_of"]
+__all__ = ["GLASS", "WRAPPERS", "DEFAULT_MATERIAL", "inner_bsdf", "material_of"]
 
 #: Transmissive BSDFs, dropped with their shape under ``--approximate``.
 GLASS = ("dielectric", "thindielectric", "roughdielectric")
@@ -87,7 +88,8 @@ def _unit_specular(node: XmlNode, what: str, say: Say) -> None:
         say(f"{what}: {node.label()} specular_reflectance {shown!r} taken as 1")
 
 
-def _inner(node: XmlNode, what: str) -> XmlNode:
+def inner_bsdf(node: XmlNode, what: str) -> XmlNode:
+    """The one BSDF a ``twosided`` or a wrapper *node* holds (two equal sides count once)."""
     inner = [c for c in node.children if c.kind == "bsdf"]
     if len(inner) == 2 and material_key(inner[0]) == material_key(inner[1]):
         inner = inner[:1]
@@ -107,7 +109,7 @@ def material_of(node: XmlNode, what: str, base: Path, say: Say) -> Material | No
     while node.plugin == "twosided" or node.plugin in WRAPPERS:
         if node.plugin in WRAPPERS:
             _unsupported(node, what, say, "replaced by the BSDF it wraps")
-        node = _inner(node, what)
+        node = inner_bsdf(node, what)
         name = name or (node.id if not node.id.startswith("_unnamed") else "")
     kind = node.plugin
     if kind in GLASS:

@@ -29,9 +29,17 @@ from ..errors import SceneError
 from . import mitsuba_parts as parts
 from .meshes import MAX_FACES, MAX_VERTICES, mesh_counts
 from .mitsuba_files import confined_file
-from .mitsuba_tree import XmlNode, mesh_file
+from .mitsuba_tree import XmlNode, mesh_file, mesh_file_uv
 
-__all__ = ["BUILT_IN", "FILE_SHAPES", "Placed", "occurrences", "check_budget", "triangles"]
+__all__ = [
+    "BUILT_IN",
+    "FILE_SHAPES",
+    "Placed",
+    "occurrences",
+    "check_budget",
+    "triangles",
+    "textured_triangles",
+]
 
 #: Shapes made of triangles here, and shapes read from a file.
 BUILT_IN = ("rectangle", "cube", "disk", "sphere", "cylinder")
@@ -221,6 +229,41 @@ def triangles(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray]:
     if props_true(p.node, "flip_normals"):
         f = f[:, ::-1]
     return parts.apply(p.matrix @ _matrix(p.node), v), f
+
+
+def textured_triangles(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`triangles` of *p* and the ``(F, 3, 2)`` texture coordinates of each face
+    corner in our convention (v up: v = 0 is the image's bottom row), the ones Mitsuba's
+    bitmap lookup uses: a ``rectangle``'s ``((x + 1) / 2, (y + 1) / 2)`` and a mesh file's
+    texture coordinates as Mitsuba's own loader reads them (then the geometry is that loader's
+    too), each Mitsuba ``(u, v)`` turned to ours ``(u, 1 - v)``.
+
+    Raises
+    ------
+    SceneError
+        A shape without texture coordinates (other built-in shapes, a mesh file without them).
+    """
+    plugin = p.node.plugin
+    if plugin == "rectangle":
+        v, f = parts.rectangle()
+        uv = np.stack([(v[:, 0] + 1) / 2, (v[:, 1] + 1) / 2], axis=1)
+    elif plugin in FILE_SHAPES:
+        path = _file(p, base)
+        try:
+            v, f, uv = mesh_file_uv(plugin, str(path), p.node.integer("shape_index", 0))
+        except SceneError as exc:
+            raise SceneError(f"{p.where}: {exc}") from None
+    else:
+        uv = np.zeros((0, 0))
+    if uv.shape[1:] != (2,):
+        raise SceneError(
+            f"{p.where}: a bitmap texture on {p.node.label()} needs texture coordinates; "
+            "expected a rectangle or a mesh file with them"
+        )
+    corners = np.stack([uv[:, 0], 1.0 - uv[:, 1]], axis=1)[f]
+    if props_true(p.node, "flip_normals"):
+        f, corners = f[:, ::-1], corners[:, ::-1]
+    return parts.apply(p.matrix @ _matrix(p.node), v), f, corners
 
 
 def props_true(node: XmlNode, key: str) -> bool:

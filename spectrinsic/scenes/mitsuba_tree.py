@@ -26,8 +26,9 @@ from typing import Any, Union
 import numpy as np
 
 from ..errors import SceneError
+from ..mitsuba_import import import_mitsuba
 
-__all__ = ["Spectrum", "Value", "XmlNode", "ParsedXml", "parse_xml", "mesh_file"]
+__all__ = ["Spectrum", "Value", "XmlNode", "ParsedXml", "parse_xml", "mesh_file", "mesh_file_uv"]
 
 
 @dataclass(frozen=True)
@@ -163,10 +164,11 @@ def _fix(node: XmlNode, version: str) -> tuple[XmlNode, list[str]]:
 
 
 def _mitsuba() -> Any:
-    """Mitsuba, with a variant set: the one already chosen (the renderer's), else
-    ``scalar_rgb``, since reading a Transform or a mesh needs the scalar types of some variant."""
-    import mitsuba as mi
-
+    """Mitsuba, imported through spectrinsic's set-up step (so Dr.Jit loads a suitable
+    ``libLLVM`` even when a scene is read before any render), with a variant set: the one
+    already chosen (the renderer's), else ``scalar_rgb``, since reading a Transform or a mesh
+    needs the scalar types of some variant."""
+    mi = import_mitsuba()
     if mi.variant() is None:
         mi.set_variant("scalar_rgb")
     return mi
@@ -236,21 +238,38 @@ def _order(mi: Any, state: Any) -> list[int]:
     return out
 
 
-def mesh_file(plugin: str, path: str, index: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """Vertices ``(V, 3)`` and faces ``(F, 3)`` of a mesh file (a ``serialized`` file's mesh
-    *index*), read by Mitsuba's own loader of that one built-in shape (the caller checked the
-    file and its declared size). Positions come back as Mitsuba stores them, float32."""
+def _load_mesh(plugin: str, path: str, index: int) -> Any:
     mi = _mitsuba()
     spec: dict[str, Any] = {"type": plugin, "filename": path}
     if plugin == "serialized":
         spec["shape_index"] = index
     try:
-        shape: Any = mi.load_dict(spec)
+        return mi.traverse(mi.load_dict(spec))
     except RuntimeError as exc:
         message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise SceneError(
             f"cannot read {Path(path).name!r} ({message.split('] ', 1)[-1]})"
         ) from None
-    params = mi.traverse(shape)
+
+
+def mesh_file(plugin: str, path: str, index: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices ``(V, 3)`` and faces ``(F, 3)`` of a mesh file (a ``serialized`` file's mesh
+    *index*), read by Mitsuba's own loader of that one built-in shape (the caller checked the
+    file and its declared size). Positions come back as Mitsuba stores them, float32."""
+    params = _load_mesh(plugin, path, index)
     v = np.array(params["vertex_positions"], dtype=np.float64).reshape(-1, 3)
     return v, np.array(params["faces"], dtype=np.int64).reshape(-1, 3)
+
+
+def mesh_file_uv(
+    plugin: str, path: str, index: int = 0
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`mesh_file` and the texture coordinates ``(V, 2)`` Mitsuba's loader gives each
+    vertex, in Mitsuba's convention (its OBJ loader stores ``1 - vt``: v = 0 is the image's
+    top row); ``(V, 0)`` where the file has none."""
+    params = _load_mesh(plugin, path, index)
+    v = np.array(params["vertex_positions"], dtype=np.float64).reshape(-1, 3)
+    f = np.array(params["faces"], dtype=np.int64).reshape(-1, 3)
+    has_uv = "vertex_texcoords" in params.keys()
+    uv = np.array(params["vertex_texcoords"], dtype=np.float64) if has_uv else np.zeros(0)
+    return v, f, uv.reshape(len(v), -1) if uv.size else np.zeros((len(v), 0))

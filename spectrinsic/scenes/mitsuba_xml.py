@@ -35,11 +35,14 @@ import numpy as np
 
 from ..errors import SceneError, SpectrinsicError
 from . import mitsuba_shapes as shapes
+from .image_textures import ImageTexture, corner_spectra
+from .mitsuba_bitmaps import diffuse_bitmap
 from .mitsuba_bsdfs import DEFAULT_MATERIAL, material_of
 from .mitsuba_files import MAX_XML_BYTES, SceneFile, prepare_xml
 from .mitsuba_spectra import emission
 from .mitsuba_tree import XmlNode, parse_xml
 from .model import Camera, Light, Material, Mesh, Scene
+from .textures import make_image_texture
 from .validate import validate_scene
 
 __all__ = ["MAX_XML_BYTES", "ENVIRONMENT", "load_mitsuba_xml", "xml_notes", "render_hints_line"]
@@ -232,8 +235,11 @@ def _hints(root: XmlNode) -> dict[str, int]:
     return out
 
 
-def _shape_parts(p: shapes.Placed, r: _Reading) -> tuple[Material | None, Light | None]:
-    """The material (``None``: the shape is left out) or the light of shape *p*."""
+def _shape_parts(
+    p: shapes.Placed, r: _Reading
+) -> tuple[Material | ImageTexture | None, Light | None]:
+    """The material or bitmap image (``None``: the shape is left out) or the light of shape
+    *p*."""
     bsdfs = [c for c in p.node.children if c.kind == "bsdf"]
     emitters = [c for c in p.node.children if c.kind == "emitter"]
     other = [c for c in p.node.children if c.kind not in ("bsdf", "emitter")]
@@ -251,7 +257,20 @@ def _shape_parts(p: shapes.Placed, r: _Reading) -> tuple[Material | None, Light 
         r.ignored.append(f"{p.where}: face_normals (normals are smoothed below a 30° crease)")
     if not bsdfs:
         return DEFAULT_MATERIAL, None
+    image = diffuse_bitmap(bsdfs[0], p.where, r.base)
+    if image is not None:
+        return image, None
     return material_of(bsdfs[0], p.where, r.base, r.say), None
+
+
+def _textured_mesh(
+    p: shapes.Placed, image: ImageTexture, r: _Reading, materials: dict[Material, int], i: int
+) -> Mesh:
+    """Shape *p* under bitmap *image*: its faces take the 8 RGB-cube corner materials."""
+    v, f, uv = shapes.textured_triangles(p, r.base)
+    basis = tuple(materials.setdefault(Material(s, s), len(materials)) for s in corner_spectra())
+    texture = make_image_texture(p.name, basis, image, uv)
+    return Mesh(p.name, v, f, np.full(len(f), basis[0]), object_id=i, texture=texture)
 
 
 def _scene(root: XmlNode, name: str, r: _Reading) -> Scene:
@@ -265,6 +284,8 @@ def _scene(root: XmlNode, name: str, r: _Reading) -> Scene:
         material, light = _shape_parts(p, r)
         if light is not None:
             lights.append(light)
+        elif isinstance(material, ImageTexture):
+            meshes.append(_textured_mesh(p, material, r, materials, len(meshes)))
         elif material is not None:
             v, f = shapes.triangles(p, r.base)
             index = materials.setdefault(material, len(materials))

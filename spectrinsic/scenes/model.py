@@ -232,7 +232,7 @@ def unknown_light_kind(kind: object) -> str:
     """The message for a light kind not in :data:`LIGHT_KINDS`, with a did-you-mean.
 
     >>> unknown_light_kind("spto")
-    "unknown light kind 'spto'; expected one of point, spot, area, directional, sky (did you mean 'spot'?)"
+    "unknown light kind 'spto'; expected one of point, spot, area, directional, sky, sphere (did you mean 'spot'?)"
     """
     return f"unknown light kind {kind!r}; expected one of {', '.join(LIGHT_KINDS)}" + did_you_mean(
         str(kind), LIGHT_KINDS

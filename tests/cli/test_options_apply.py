@@ -25,6 +25,10 @@ EVERYWHERE: dict[str, set[str]] = {
     "relight": {"--keep-transport", "--light", "--out", "--power"},
     "export": {"--layers", "--out", "--samples-per-shard"},
     "study": {"--out", "--seed"},
+    "train": {
+        "--batch", "--checkpoint-every", "--crop", "--device", "--layers", "--lr", "--out",
+        "--relight", "--resume", "--samples", "--seed", "--steps",
+    },
     "evaluate": {"--methods", "--mit", "--out", "--predictions", "--samples"},
     "render": {
         "--direct", "--ground-truth", "--height", "--integrator", "--max-depth", "--modes",
@@ -56,6 +60,12 @@ ONLY_IN: dict[str, dict[str, list[str]]] = {
         "--preset": [*_RENDER_LIB, "--preset", "preview"],
         "--per-light": [*_RENDER_LIB, "--ground-truth", "--per-light"],
         "--no-aovs": [*_RENDER_LIB, "--ground-truth", "--no-aovs"],
+        "--approximate": [*_RENDER_FILE, "--approximate"],
+        "--semantic-map": [*_RENDER_LIB, "--ground-truth", "--semantic-map", "{map}"],
+        "--camera": [*_RENDER_LIB, "--camera", "nikon-5100-npl"],
+        "--spectral-layers": [*_RENDER_LIB, "--spectral-layers"],
+        "--working-space": [*_RENDER_LIB, "--working-space", "srgb"],
+        "--store-transport": [*_RENDER_LIB, "--store-transport"],
     },
     "dataset": {
         "--count": [*_LIBRARY_BUILD, "--count", "3"],
@@ -74,6 +84,9 @@ ONLY_IN: dict[str, dict[str, list[str]]] = {
         "--new-sample": [*_LIBRARY_BUILD, "--new-sample"],
         "--colours-from-asset": [*_LIBRARY_BUILD, "--colours-from-asset"],
         "--max-batches": [*_LIBRARY_BUILD, "--max-batches", "4"],
+        "--approximate": [*_LIBRARY_BUILD, "--approximate"],
+        "--semantic-map": [*_LIBRARY_BUILD, "--semantic-map", "{map}"],
+        "--daylight-only": [*_LIBRARY_BUILD, "--daylight-only"],
     },
     "evaluate": {
         "--png-encoding": ["--dataset", "{out}-ds", "--out", "{out}", "--png-encoding", "srgb"],
@@ -94,6 +107,7 @@ ONLY_IN: dict[str, dict[str, list[str]]] = {
         "--camera-balance": ["rendering", "--out", "{out}", "--camera-balance", "equal-energy-white"],
         "--no-extension": ["photometric", "--out", "{out}", "--no-extension"],
         "--quality": ["photometric", "--out", "{out}", "--quality", "default"],
+        "--preset": ["photometric", "--out", "{out}", "--preset", "small"],
     },
 }  # fmt: skip
 
@@ -113,7 +127,13 @@ def _verbs() -> dict[str, argparse.ArgumentParser]:
 
 
 def _options(parser: argparse.ArgumentParser) -> set[str]:
-    return {max(a.option_strings, key=len) for a in parser._actions if a.option_strings}
+    """Each option's longest name (the positive one of a ``--x``/``--no-x`` pair)."""
+    names = [
+        [o for o in a.option_strings if not o.startswith("--no-")] or a.option_strings
+        for a in parser._actions
+        if a.option_strings
+    ]
+    return {max(n, key=len) for n in names}
 
 
 def test_every_option_of_every_verb_is_placed_in_the_walk():

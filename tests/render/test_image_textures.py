@@ -1,12 +1,14 @@
-"""Image textures from glTF and OBJ/MTL assets rendered with exact per-texel ground truth
-(issue 41, item 2).
+"""Image textures from glTF, OBJ/MTL and Mitsuba XML ``bitmap`` assets rendered with exact
+per-texel ground truth (issue 41, item 2).
 
 Independent values: the texel under each pixel is found by geometry alone (a quad facing the
 camera, its uv mapped by hand), the texel's colour from the 8-bit value written into the image
 (decoded here with colour-science's sRGB transfer function, times the material's factor), its
 spectrum as ``B · rgb`` with colour-science's Mallett & Yuksel 2019 basis, and that spectrum is
 integrated under D65 with colour-science's ``sd_to_XYZ``/``XYZ_to_RGB`` (the sRGB view) and
-averaged over each 10 nm band (the ``reflectance_bands`` layer).
+averaged over each 10 nm band (the ``reflectance_bands`` layer). The XML files' orientation is
+checked against Mitsuba's own render of the same file (its ``bitmap`` lookup, its OBJ loader,
+its ``rectangle``'s uv): each texel's colour lands on the same pixels.
 """
 
 from __future__ import annotations
@@ -21,7 +23,9 @@ from PIL import Image
 
 from spectrinsic.gt_export.layers import compute_ground_truth
 from spectrinsic.render import RenderSettings, render_scene
+from spectrinsic.render.base.variants import choose_variant, import_mitsuba
 from spectrinsic.scenes.meshes import load_mesh_scene
+from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml
 from spectrinsic.scenes.model import Camera, Light
 
 #: Done-when of issue 41: the sRGB view within 1e-3, the bands within 1e-5.
@@ -75,6 +79,48 @@ def _obj(folder) -> str:
     return str(folder / "plane.obj")
 
 
+_XML = """<scene version="3.0.0">
+  <sensor type="perspective">
+    <float name="fov" value="{fov}"/>
+    <transform name="to_world"><lookat origin="0,0,{distance}" target="0,0,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="{size}"/>
+      <integer name="height" value="{size}"/><rfilter type="box"/></film>
+  </sensor>
+  <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+  <shape type="{shape}">{filename}
+    <bsdf type="twosided"><bsdf type="diffuse">
+      <texture type="bitmap" name="reflectance"><string name="filename" value="checker.png"/>
+        <string name="filter_type" value="nearest"/></texture>
+    </bsdf></bsdf>
+  </shape>
+</scene>
+"""
+
+
+def _xml(folder, shape: str) -> str:
+    """A Mitsuba XML file of the checker (no factor: a bitmap has none) on Mitsuba's
+    ``rectangle`` (its own uv), an OBJ plane (the ``vt`` of ``_obj``: Mitsuba's OBJ loader
+    stores 1 - vt) or a PLY plane (the same uv, which Mitsuba's PLY loader stores as they are)."""
+    image, _ = _checker()
+    image.save(folder / "checker.png")
+    filename = "" if shape == "rectangle" else f'<string name="filename" value="plane.{shape}"/>'
+    corners = [(-1, -1), (1, -1), (1, 1), (-1, 1)]
+    if shape == "obj":
+        lines = [f"v {x} {y} 0" for x, y in corners]
+        lines += ["vt 0 0", "vt 1 0", "vt 1 1", "vt 0 1", "f 1/1 2/2 3/3", "f 1/1 3/3 4/4"]
+        (folder / "plane.obj").write_text("\n".join(lines) + "\n")
+    if shape == "ply":
+        lines = ["ply", "format ascii 1.0", "element vertex 4"]
+        lines += [f"property float {p}" for p in ("x", "y", "z", "u", "v")]
+        lines += ["element face 2", "property list uchar int vertex_indices", "end_header"]
+        lines += [f"{x} {y} 0 {(x + 1) / 2} {(y + 1) / 2}" for x, y in corners]
+        lines += ["3 0 1 2", "3 0 2 3"]
+        (folder / "plane.ply").write_text("\n".join(lines) + "\n")
+    text = _XML.format(fov=FOV, distance=DISTANCE, size=SIZE, shape=shape, filename=filename)
+    (folder / "scene.xml").write_text(text)
+    return str(folder / "scene.xml")
+
+
 def _texel_of_pixels() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Row (from v = 0), column of the texel under each pixel, and whether the pixel's
     footprint lies in that one texel (pixel row 0 at the top, +y)."""
@@ -89,11 +135,11 @@ def _texel_of_pixels() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return rows.astype(int), cols.astype(int), inside
 
 
-def _expected() -> tuple[np.ndarray, np.ndarray]:
+def _expected(factor: tuple[float, float, float]) -> tuple[np.ndarray, np.ndarray]:
     """``(2, 3)`` linear sRGB (D65) and ``(2, 31)`` band means of the two texel spectra."""
     import colour
 
-    linear = colour.cctf_decoding(COLOURS / 255.0, function="sRGB") * np.array(FACTOR)
+    linear = colour.cctf_decoding(COLOURS / 255.0, function="sRGB") * np.array(factor)
     basis = colour.recovery.MSDS_BASIS_FUNCTIONS_sRGB_MALLETT2019
     shape = colour.SpectralShape(360, 830, 1)  # the CMFs' range, as the layers integrate
     cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape)
@@ -120,7 +166,11 @@ def _expected() -> tuple[np.ndarray, np.ndarray]:
 
 
 def _render(path: str, modes: tuple[str, ...]):
-    scene = load_mesh_scene(path, materials={}, width=SIZE, height=SIZE)
+    if path.endswith(".xml"):
+        import_mitsuba()  # the reader imports Mitsuba as found: set it up first, as the CLI does
+        scene = load_mitsuba_xml(path)
+    else:
+        scene = load_mesh_scene(path, materials={}, width=SIZE, height=SIZE)
     scene = replace(
         scene,
         camera=Camera((0, 0, DISTANCE), (0, 0, 0), (0, 1, 0), FOV, SIZE, SIZE),
@@ -131,21 +181,28 @@ def _render(path: str, modes: tuple[str, ...]):
     return scene, result, compute_ground_truth(scene, result, spectral=True, working_space="srgb")
 
 
-@pytest.fixture(scope="module", params=["gltf", "obj"])
+@pytest.fixture(scope="module", params=["gltf", "obj", "xml-obj", "xml-ply", "xml-rectangle"])
 def rendered(request, tmp_path_factory):
+    """The scene, its render, its ground truth, the colour factor and the texel colour index
+    with row 0 at the *pixels'* bottom (the rectangle's and the PLY's v run top-down in
+    Mitsuba's bitmap lookup)."""
     folder = tmp_path_factory.mktemp(request.param)
+    index = _checker()[1]
+    if request.param.startswith("xml"):
+        shape = request.param.removeprefix("xml-")
+        index = index if shape == "obj" else index[::-1]
+        return (*_render(_xml(folder, shape), ("bands31",)), (1.0, 1.0, 1.0), index)
     with pytest.warns(UserWarning, match="nearest texel"):
         if request.param == "gltf":  # with Mitsuba's spectral pass, once
-            return _render(_gltf(folder), ("spectral", "bands31"))
-        return _render(_obj(folder), ("bands31",))
+            return (*_render(_gltf(folder), ("spectral", "bands31")), FACTOR, index)
+        return (*_render(_obj(folder), ("bands31",)), FACTOR, index)
 
 
 def test_per_texel_reflectance_is_the_upsampled_spectrum_integrated_by_colour_science(rendered):
-    scene, _, gt = rendered
+    scene, _, gt, factor, index = rendered
     rows, cols, inside = _texel_of_pixels()
-    _, index = _checker()
     which = index[rows[inside], cols[inside]]
-    srgb, bands = _expected()
+    srgb, bands = _expected(factor)
     assert inside.sum() >= 400 and set(which.tolist()) == {0, 1}
     got = gt.layers["reflectance"].data[inside]
     assert np.abs(got - srgb[which]).max() < SRGB_TOL
@@ -161,11 +218,39 @@ def test_per_texel_reflectance_is_the_upsampled_spectrum_integrated_by_colour_sc
 def test_mitsuba_spectral_pass_renders_the_same_texels(rendered):
     """The spectral reference (Mitsuba's own BSDFs: the corners blended per texel) agrees with
     the band image on each checker colour: the texture is mapped alike by both renderers."""
-    _, result, _ = rendered
+    _, result, _, _, index = rendered
     rows, cols, inside = _texel_of_pixels()
-    which = _checker()[1][rows, cols]
+    which = index[rows, cols]
     spectral, bands = result.images["spectral"], result.images["bands31"]
     for colour_index in (0, 1):
         sel = inside & (which == colour_index)
         a, b = spectral[sel].mean(axis=0), bands[sel].mean(axis=0)
         np.testing.assert_allclose(a, b, rtol=SPECTRAL_RTOL, atol=SPECTRAL_RTOL * b.max())
+
+
+@pytest.mark.parametrize("rendered", ["xml-obj", "xml-ply", "xml-rectangle"], indirect=True)
+def test_xml_checker_lands_where_mitsuba_renders_it(rendered, request, tmp_path):
+    """Mitsuba's own render of the same XML file (its albedo AOV: its bitmap lookup, its OBJ
+    loader's or its rectangle's uv) puts each checker colour on the pixels where our ground
+    truth has it: the nearest colour of every pixel inside a texel."""
+    import colour
+    import mitsuba as mi
+
+    _, _, gt, _, index = rendered
+    shape = request.node.callspec.params["rendered"].removeprefix("xml-")
+    mi.set_variant(choose_variant("rgb"))
+    loaded = mi.load_file(_xml(tmp_path, shape))
+    albedo = mi.load_dict({"type": "aov", "aovs": "a:albedo"})
+    image = np.asarray(mi.render(loaded, integrator=albedo, spp=4, seed=1))[..., :3]
+    linear = colour.cctf_decoding(COLOURS / 255.0, function="sRGB")
+    rows, cols, inside = _texel_of_pixels()
+
+    def nearest(pixels: np.ndarray, colours: np.ndarray) -> np.ndarray:
+        return np.argmin(np.linalg.norm(pixels[:, None] - colours[None], axis=-1), axis=1)
+
+    theirs = nearest(image[inside], linear)
+    ours = nearest(gt.layers["reflectance"].data[inside], _expected((1.0, 1.0, 1.0))[0])
+    np.testing.assert_allclose(image[inside], linear[theirs], atol=1e-4)  # one texel each
+    assert set(theirs.tolist()) == {0, 1}
+    np.testing.assert_array_equal(theirs, ours)
+    np.testing.assert_array_equal(theirs, index[rows[inside], cols[inside]])

@@ -8,6 +8,7 @@ import os
 
 import numpy as np
 import pytest
+from PIL import Image
 
 from spectrinsic.cli import main
 from spectrinsic.errors import SceneError
@@ -147,11 +148,12 @@ OLD = """<?xml version="1.0"?>
 
 
 def test_a_mitsuba_05_file_loads_and_says_what_it_fixed(tmp_path, capsys):
-    (tmp_path / "wood.png").write_bytes(b"\x89PNG not read")
+    Image.fromarray(np.full((2, 2, 3), 128, np.uint8)).save(tmp_path / "wood.png")
     path = _write(tmp_path, OLD)
-    with pytest.raises(SceneError, match="<texture type='bitmap'> has no exact ground truth"):
-        load_mitsuba_xml(path)
-    scene = load_mitsuba_xml(path, approximate=True)
+    with pytest.warns(UserWarning, match="bilinear filtering approximated by the nearest texel"):
+        scene = load_mitsuba_xml(path)  # the bitmap on a diffuse is an exact image texture
+    (wood,) = [m for m in scene.meshes if m.texture is not None]
+    assert wood.texture.image.srgb and wood.texture.image.filter == "bilinear"
     plastic = next(m for m in scene.materials if m.kind == "plastic")
     assert plastic.ior == pytest.approx(1.6) and plastic.spectrum == "rgb:0.5,0.2,0.1"
     fixed = " | ".join(scene.metadata["fixed"])
@@ -161,14 +163,14 @@ def test_a_mitsuba_05_file_loads_and_says_what_it_fixed(tmp_path, capsys):
         "gamma 2.2 -> raw=False",
     ):
         assert phrase in fixed
-    assert scene.metadata["approximate"] is True and len(scene.metadata["approximated"]) == 1
+    assert scene.metadata["approximated"] == []
     assert scene.metadata["render_hints"] == {"max_depth": 3, "spp": 2}
     # fov 45 on the y axis of an 8x6 film is the x fov of tan(x/2) = tan(22.5°) 8/6
     assert scene.camera.fov_deg == pytest.approx(
         np.degrees(2 * np.arctan(np.tan(np.radians(22.5)) * 8 / 6))
     )
     notes = xml_notes(scene)
-    assert all("\n" not in n for n in notes) and len(notes) == len(scene.metadata["fixed"]) + 1
+    assert all("\n" not in n for n in notes) and len(notes) == len(scene.metadata["fixed"])
     assert (
         render_hints_line(scene, None, 5)
         == "scene: spp 2 from the file, max depth 5 from the command line (the file says 3)"

@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import csv
+import io
 import json
 from pathlib import Path
 from typing import Any
 
+from ...file_writes import replacing, write_text_file
 from ..glossary import abbreviations
 from .compute import RunScore, Sim2RealResult
 from .settings import FACTORS
@@ -130,7 +132,8 @@ def _figure(result: Sim2RealResult, path: Path) -> None:
         ax.set(title=title, ylabel="LMSE (lower is better)")
     fig.axes[0].legend(fontsize=6)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    with replacing(path) as tmp:
+        fig.savefig(tmp, dpi=120)
 
 
 def write_sim2real(result: Sim2RealResult, out_dir: Path) -> dict[str, Path]:
@@ -142,22 +145,23 @@ def write_sim2real(result: Sim2RealResult, out_dir: Path) -> dict[str, Path]:
         k: out_dir / f"sim2real{s}"
         for k, s in (("md", ".md"), ("png", ".png"), ("csv", "_runs.csv"), ("json", ".json"))
     }
-    paths["md"].write_text(format_sim2real(result) + "\n", encoding="utf-8")
+    write_text_file(paths["md"], format_sim2real(result) + "\n")
     _figure(result, paths["png"])
-    with paths["csv"].open("w", newline="", encoding="utf-8") as f:
-        writer = csv.writer(f)
-        writer.writerow(["arm", "seed", "mit_lmse", "test_lmse", "samples", "seconds"])
-        for r in result.runs:
-            writer.writerow(
-                [
-                    r.arm,
-                    r.seed,
-                    f"{r.mit_lmse:.6g}",
-                    f"{r.test_lmse:.6g}",
-                    r.samples,
-                    f"{r.seconds:.1f}",
-                ]
-            )
+    text = io.StringIO(newline="")
+    writer = csv.writer(text)
+    writer.writerow(["arm", "seed", "mit_lmse", "test_lmse", "samples", "seconds"])
+    for r in result.runs:
+        writer.writerow(
+            [
+                r.arm,
+                r.seed,
+                f"{r.mit_lmse:.6g}",
+                f"{r.test_lmse:.6g}",
+                r.samples,
+                f"{r.seconds:.1f}",
+            ]
+        )
+    write_text_file(paths["csv"], text.getvalue())
     record = {
         "settings": result.settings.to_dict(),
         "dataset_config": result.config,
@@ -171,5 +175,5 @@ def write_sim2real(result: Sim2RealResult, out_dir: Path) -> dict[str, Path]:
         "factors": factor_rows(result),
         "seconds": result.seconds,
     }
-    paths["json"].write_text(json.dumps(record, indent=1, allow_nan=True) + "\n", "utf-8")
+    write_text_file(paths["json"], json.dumps(record, indent=1, allow_nan=True) + "\n")
     return paths
