@@ -21,6 +21,7 @@ import resource
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -46,6 +47,7 @@ from ..gt_export.sample.integrity import (
 )
 from ..render import render_batches, set_thread_count
 from ..render.base.variants import import_mitsuba
+from ..render.probe import probe_luminance
 from ..render.transport_render import render_transport_batches
 from ..scenes.library import build
 from ..scenes.sources import GeneratedSource
@@ -138,9 +140,7 @@ def build_sample(task: SampleTask) -> SampleOutcome:
     else:
         result = render_batches(scene, cfg.render, seed=task.seed, data_dir=task.data_dir)
     render_seconds = time.perf_counter() - t_render
-    if (
-        cfg.render.direct
-    ):  # the energy ratio r of Eq. 5.8, recorded for the dataset card's diversity plots
+    if cfg.render.direct:  # the energy ratio r of Eq. 5.8, for the card's diversity plots
         mode = "spectral" if "spectral" in result.direct else next(iter(result.direct))
         scene.metadata["energy_ratio_r"] = float(result.energy_ratio(mode))
     path = export_sample(
@@ -174,8 +174,8 @@ def build_sample(task: SampleTask) -> SampleOutcome:
 
 
 def _task_scene(task: SampleTask) -> Any:
-    """The task's scene: from its source (a generated one is saved as a scene file), else the
-    library."""
+    """The task's scene: from its source (a generated one is saved as a scene file; its views
+    are judged on a probe render, issue 47), else the library."""
     if task.source is None:
         cfg = task.config
         return build(
@@ -188,9 +188,11 @@ def _task_scene(task: SampleTask) -> Any:
         )
 
     import_mitsuba()  # set up before a Mitsuba XML read imports it (the libLLVM Dr.Jit loads)
-    scene = task.source.build(task.data_dir)
-    if isinstance(task.source, GeneratedSource):
-        save_generated(task.out_dir, task.sample_id, scene, task.seed)
+    if not isinstance(task.source, GeneratedSource):
+        return task.source.build(task.data_dir)
+    probe = partial(probe_luminance, data_dir=task.data_dir, variant=task.config.render.variant)
+    scene = task.source.build(task.data_dir, probe=probe)
+    save_generated(task.out_dir, task.sample_id, scene, task.seed)
     return scene
 
 

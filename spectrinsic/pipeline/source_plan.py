@@ -73,7 +73,8 @@ MAX_COUNT = 100_000
 #: 2: saturated lights, ranges obeyed by every material, framed rooms (issue 22).
 #: 3: cameras pass the view rule (``scenes.generators.view_rule``, issue 31).
 #: 4: ``objects-on-ground``'s library objects take ``--texture-fraction`` too (issue 44).
-GENERATOR_VERSION = 4
+#: 5: views are also judged on their rendered light (a probe render, issue 47).
+GENERATOR_VERSION = 5
 MAX_VIEWS = 64
 
 

@@ -18,6 +18,7 @@ from pathlib import Path
 from ..errors import SceneError
 from .blender import load_blend
 from .generators import GeneratorOptions, generate
+from .generators.view_rule import FrameProbe
 from .meshes import MESH_SUFFIXES, load_mesh_scene
 from .mitsuba_xml import load_mitsuba_xml
 from .model import Scene
@@ -56,8 +57,9 @@ class GeneratedSource:
     view: int
     options: GeneratorOptions
 
-    def build(self, data_dir: str | None = None) -> Scene:
-        """Generate the scene (deterministic: same record, same scene)."""
+    def build(self, data_dir: str | None = None, probe: FrameProbe | None = None) -> Scene:
+        """Generate the scene (deterministic: same record and *probe*, same scene); *probe*
+        judges the rendered light of the views (:func:`~.generators.generate`)."""
         options = dataclasses.replace(self.options, data_dir=data_dir)
         return generate(
             self.generator,
@@ -65,6 +67,7 @@ class GeneratedSource:
             index=self.index,
             view=self.view,
             options=options,
+            probe=probe,
         )
 
 

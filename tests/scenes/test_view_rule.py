@@ -72,6 +72,26 @@ def test_fifty_generated_rooms_all_pass_the_view_rule(capsys):
         print(f"\nview rule: acceptance {passed / judged:.0%} ({passed} of {judged} cameras)")
 
 
+def _rect(name, x0, x1, material, object_id, z=0.0):
+    v = np.array([[x0, -2, z], [x1, -2, z], [x1, 2, z], [x0, 2, z]], float)
+    return Mesh(name, v, np.array([[0, 1, 2], [0, 2, 3]]), np.full(2, material), object_id)
+
+
+def test_an_object_of_several_meshes_is_judged_whole():
+    """Two halves of one table top (one object_id, two meshes and materials) fill the frame:
+    each mesh and material stays under the limit, the object does not (issue 47)."""
+    halves = [_rect("top-a", -2, 0, 1, 7), _rect("top-b", 0, 2, 2, 7)]
+    tiles = [_rect(f"tile{i}", x, x + 0.3, 3 + i, 20 + i, z=0.01) for i, x in enumerate((-1, 0.5))]
+    cam = _camera((0, 0, 1.5), fov=60)
+    split = judge_view([*halves, *tiles], [LAMP], cam)
+    assert split.max_mesh_share <= MAX_SHARE and split.max_material_share <= MAX_SHARE
+    assert split.max_object_share > MAX_SHARE and not split.ok
+    assert any("one object fills" in r for r in split.reasons)
+    b = halves[1]
+    apart = [halves[0], Mesh("top-b", b.vertices, b.faces, b.face_materials, 8)]  # two objects
+    assert judge_view([*apart, *tiles], [LAMP], cam).ok
+
+
 def test_window_flux_is_spread_over_the_room_by_the_split_flux_law():
     """With no lights, a view's only light is the interreflected window flux: the median
     irradiance is ρ/(1 - ρ) Φ/A (integrating-sphere law, ρ the rule's bounce albedo) on every

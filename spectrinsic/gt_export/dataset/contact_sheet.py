@@ -15,7 +15,7 @@ from ..sample import META_NAME, sample_dirs
 from ..sample.integrity import guarded_write
 from ..sample.meta import read_meta
 
-__all__ = ["contact_sheet", "COLUMNS", "TILE"]
+__all__ = ["contact_sheet", "tile_sheet", "COLUMNS", "TILE"]
 
 #: Tile size in pixels (the preview is scaled to fill it) and tiles per row.
 TILE = 160
@@ -34,30 +34,38 @@ def contact_sheet(
 
     Ids longer than a tile are written on two lines, never truncated.
     """
-    from PIL import Image, ImageDraw, ImageFont
-
     root = Path(dataset_dir)
     samples = sample_dirs(root) if samples is None else list(samples)
     if not samples:
         raise DatasetError(
             f"dataset folder {str(root)!r} has no complete samples for a contact sheet"
         )
+    tiles = [(sample.name, sample / _sheet_preview(sample)) for sample in samples]
+    return tile_sheet(tiles, root / "contact_sheet.png" if out is None else out)
+
+
+def tile_sheet(tiles: Sequence[tuple[str, Path]], out: str | os.PathLike[str]) -> Path:
+    """Tile the PNG images of *tiles* (``(caption, path)``, in order) into one PNG at *out*,
+    :data:`COLUMNS` to a row, each scaled to fill a :data:`TILE`-pixel tile over its caption
+    (two lines where it is long, never truncated)."""
+    from PIL import Image, ImageDraw, ImageFont
+
     font = ImageFont.load_default()
-    cols = min(COLUMNS, len(samples))
-    rows = -(-len(samples) // cols)
+    cols = min(COLUMNS, len(tiles))
+    rows = -(-len(tiles) // cols)
     cell = TILE + 2 * _CAPTION_HEIGHT
     sheet = Image.new("RGB", (cols * TILE, rows * cell), (255, 255, 255))
     draw = ImageDraw.Draw(sheet)
-    for i, sample in enumerate(samples):
-        with Image.open(sample / _sheet_preview(sample)) as img:
+    for i, (caption, image) in enumerate(tiles):
+        with Image.open(image) as img:
             tile = _fit(img.convert("RGB"), Image.Resampling)
         x0, y0 = (i % cols) * TILE, (i // cols) * cell
         sheet.paste(tile, (x0 + (TILE - tile.width) // 2, y0 + (TILE - tile.height) // 2))
-        for line_no, line in enumerate(_wrap(sample.name, draw, font)):
+        for line_no, line in enumerate(_wrap(caption, draw, font)):
             draw.text(
                 (x0 + 2, y0 + TILE + 1 + line_no * _CAPTION_HEIGHT), line, fill=(0, 0, 0), font=font
             )
-    path = Path(out) if out is not None else root / "contact_sheet.png"
+    path = Path(out)
     with guarded_write(path):
         path.parent.mkdir(parents=True, exist_ok=True)
     with replacing(path) as tmp:

@@ -23,6 +23,7 @@ from .gloss import GlossDistribution, apply_gloss
 from .ground import objects_on_ground
 from .materials import MaterialDistribution
 from .rooms import rooms
+from .view_rule import FrameProbe
 
 __all__ = [
     "GENERATORS",
@@ -67,7 +68,13 @@ def generated_family(root_seed: int, generator: str, index: int) -> str:
 
 
 def generate(
-    generator: str, *, root_seed: int, index: int, view: int, options: GeneratorOptions
+    generator: str,
+    *,
+    root_seed: int,
+    index: int,
+    view: int,
+    options: GeneratorOptions,
+    probe: FrameProbe | None = None,
 ) -> Scene:
     """Generate scene *index* of *generator* seen from camera *view*.
 
@@ -83,6 +90,10 @@ def generate(
         Camera number, ``0 <= view < options.views``.
     options
         Image size, views, material distribution, coverage threshold, SFU names.
+    probe
+        A probe render judging the rendered light of the views of generators with the view
+        rule (:func:`~spectrinsic.scenes.generators.view_rule.judge_frame`); None: the rule's
+        estimate alone. A build passes one, so its scenes depend on it.
 
     Returns
     -------
@@ -104,7 +115,7 @@ def generate(
         rngs = scene_rngs(seed if attempt == 0 else seed_from_key(seed, f"layout-{attempt}"))
         layout = GENERATORS[generator](rngs["layout"], options)
         try:
-            scene = assemble(name, layout, seed, view, options, rngs)
+            scene = assemble(name, layout, seed, view, options, rngs, probe)
         except SceneError as exc:  # this layout cannot be lit or seen: draw another
             problems.append(str(exc))
             continue

@@ -21,7 +21,7 @@ from .camera import is_free, sample_camera
 from .gloss import GlossDistribution
 from .lights import FAMILIES, LightVolume, draw_lights
 from .materials import MaterialDistribution
-from .view_rule import judge_view
+from .view_rule import FrameProbe, judge_frame, judge_view
 
 __all__ = ["GeneratorOptions", "Layout", "assemble", "family_of", "scene_rngs"]
 
@@ -142,8 +142,13 @@ def assemble(
     view: int,
     options: GeneratorOptions,
     rngs: dict[str, np.random.Generator],
+    probe: FrameProbe | None = None,
 ) -> Scene:
-    """The scene of *layout* seen from camera *view*, with the lights of its family."""
+    """The scene of *layout* seen from camera *view*, with the lights of its family.
+
+    With a *probe* render, a camera that passes the view rule must also pass
+    :func:`~spectrinsic.scenes.generators.view_rule.judge_frame` on the probe of the matte
+    scene (the gloss is drawn afterwards; light, not sheen, is judged)."""
     meshes, materials = to_meshes(layout.parts)
     family = family_of(seed)
     lamps = draw_lights(
@@ -164,6 +169,9 @@ def assemble(
     def judged(cam: Camera) -> bool:
         # a view worth learning from
         ok = judge_view(meshes, lights, cam, flux_density=layout.flux_density).ok
+        if ok and probe is not None:  # and lit so, once rendered
+            seen = Scene(name=name, meshes=meshes, materials=materials, lights=lights, camera=cam)
+            ok = judge_frame(probe(seen)).ok
         draws[0], draws[1] = draws[0] + 1, draws[1] + ok
         return ok
 

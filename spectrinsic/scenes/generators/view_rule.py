@@ -5,8 +5,10 @@ Judged when the camera is drawn, before any render, from a low-resolution ray ca
 
 * **several materials**: at least :data:`MIN_MATERIALS` materials each cover
   :data:`MIN_MATERIAL_SHARE` of the frame (not a close-up of one surface);
-* **no single surface or material fills the frame**: no mesh and no material covers more than
-  :data:`MAX_SHARE` of it (not one face of one box, not 98 % one material);
+* **no single surface, object or material fills the frame**: no mesh, no object (the meshes of
+  one ``object_id``, so an object built of several meshes counts whole) and no material covers
+  more than :data:`MAX_SHARE` of it (not one face of one box, not one table top, not 98 % one
+  material);
 * **enough light reaches the camera**: at least :data:`MIN_LIT_SHARE` of the frame receives
   at least 1/:data:`MAX_CONTRAST` of the irradiance of the frame's bright end, counting the
   lights' direct irradiance (a shadow ray per light, spot cones and one-sided area lights
@@ -24,6 +26,14 @@ Judged when the camera is drawn, before any render, from a low-resolution ray ca
 Measured on 50 rooms (root seed 11): 50 of 92 judged cameras pass (acceptance 54 %), about
 0.4 s per judged camera on one core (``tests/scenes/test_view_rule.py``).
 
+**The rendered light** (issue 47): the estimate above misses what it does not trace (a sky,
+glossy paths, more than one bounce), so where the build gives a probe render
+(:data:`FrameProbe`, :func:`spectrinsic.render.probe.probe_luminance`: a
+:data:`~spectrinsic.render.probe.PROBE_SIZE`-pixel CIE Y render), a camera that passes is also
+judged on it by :func:`judge_frame`: the frame's median luminance must be at least
+:data:`MIN_FRAME_MEDIAN` of its 99th percentile. A dark frame around one bright patch fails.
+The threshold and its measurement are in ``docs/view_rule.md``.
+
 A camera that fails is re-drawn from the scene's seeded camera generator
 (:func:`spectrinsic.scenes.generators.camera.sample_camera`), so a build stays reproducible.
 The rule's own bounce rays come from a fixed seed: the same camera always gets the same verdict.
@@ -32,24 +42,29 @@ The rule's own bounce rays come from a fixed seed: the same camera always gets t
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..geometry import camera_rays
 from ..library import TARGET_IRRADIANCE
-from ..model import Camera, Light, Mesh
+from ..model import Camera, Light, Mesh, Scene
 from .camera import ray_triangle_hits
 
 __all__ = [
     "BOUNCE_RAYS",
+    "FRAME_PERCENTILE",
+    "FrameJudgement",
+    "FrameProbe",
+    "MIN_FRAME_MEDIAN",
     "MAX_CONTRAST",
     "MAX_SHARE",
     "MIN_LIT_SHARE",
     "MIN_MATERIALS",
     "VIEW_GRID",
     "ViewJudgement",
+    "judge_frame",
     "judge_view",
 ]
 
@@ -73,6 +88,13 @@ MIN_MEDIAN_LIGHT = 0.05
 #: Bounce rays per visible surface point, and the albedo the bounce is weighted with.
 BOUNCE_RAYS = 8
 BOUNCE_ALBEDO = 0.5
+#: Least median luminance of a probe render, as a fraction of its :data:`FRAME_PERCENTILE` th
+#: percentile (``docs/view_rule.md``: measured on the probes of generated rooms).
+MIN_FRAME_MEDIAN = 0.01
+FRAME_PERCENTILE = 99.0
+#: A probe render: the scene (seen from the camera to judge) -> its luminance ``(H, W)``,
+#: linear, any unit (only ratios are judged).
+FrameProbe = Callable[[Scene], np.ndarray]
 #: Offset of secondary rays from a surface (metres).
 _EPS = 1e-4
 
@@ -85,6 +107,8 @@ class ViewJudgement:
     max_material_share: float
     n_materials: int
     lit_share: float
+    #: Share of the frame covered by the largest object (all meshes of one ``object_id``).
+    max_object_share: float = 0.0
     #: Median over the frame of the estimated irradiance, relative to the generators' target
     #: irradiance at the lights' focus (``TARGET_IRRADIANCE``).
     median_light: float = 1.0
@@ -97,6 +121,8 @@ class ViewJudgement:
             out.append(f"{self.n_materials} materials visible (< {MIN_MATERIALS})")
         if self.max_mesh_share > MAX_SHARE:
             out.append(f"one surface fills {self.max_mesh_share:.0%} of the frame")
+        if self.max_object_share > MAX_SHARE:
+            out.append(f"one object fills {self.max_object_share:.0%} of the frame")
         if self.max_material_share > MAX_SHARE:
             out.append(f"one material fills {self.max_material_share:.0%} of the frame")
         if self.lit_share < MIN_LIT_SHARE:
@@ -118,6 +144,7 @@ class _Geometry:
 
     tri: np.ndarray
     mesh: np.ndarray
+    obj: np.ndarray
     material: np.ndarray
     normal: np.ndarray
     starts: np.ndarray
@@ -153,6 +180,7 @@ def _geometry(meshes: Sequence[Mesh]) -> _Geometry:
     return _Geometry(
         tri=tri,
         mesh=np.concatenate([np.full(len(m.faces), i) for i, m in enumerate(meshes)]),
+        obj=np.concatenate([np.full(len(m.faces), m.object_id) for m in meshes]),
         material=np.concatenate([np.asarray(m.face_materials).reshape(-1) for m in meshes]),
         normal=n,
         starts=np.cumsum([0] + [len(m.faces) for m in meshes]),
@@ -257,6 +285,7 @@ def judge_view(
     total = len(hit)
     meshes_seen = np.bincount(g.mesh[hit[some]], minlength=1)
     materials_seen = np.bincount(g.material[hit[some]], minlength=1)
+    objects_seen = np.unique(g.obj[hit[some]], return_counts=True)[1] if some.any() else [0]
     light = np.zeros(total)
     if some.any():
         p = o[some] + t[some, None] * d[some]
@@ -268,7 +297,38 @@ def judge_view(
     return ViewJudgement(
         max_mesh_share=float(meshes_seen.max()) / total,
         max_material_share=float(materials_seen.max()) / total,
+        max_object_share=float(np.max(objects_seen)) / total,
         n_materials=int((materials_seen >= MIN_MATERIAL_SHARE * total).sum()),
         lit_share=float(lit.mean()),
         median_light=float(np.median(light)) / TARGET_IRRADIANCE,
     )
+
+
+@dataclass(frozen=True)
+class FrameJudgement:
+    """The rendered light of a view: the frame's median luminance over its
+    :data:`FRAME_PERCENTILE` th percentile (0 for a black frame)."""
+
+    median_share: float
+
+    @property
+    def reasons(self) -> tuple[str, ...]:
+        """Why the frame fails (empty: it passes)."""
+        if self.median_share >= MIN_FRAME_MEDIAN:
+            return ()
+        return (
+            f"the rendered frame's median is {self.median_share:.2%} of its "
+            f"{FRAME_PERCENTILE:g}th percentile (< {MIN_FRAME_MEDIAN:.0%})",
+        )
+
+    @property
+    def ok(self) -> bool:
+        return not self.reasons
+
+
+def judge_frame(luminance: np.ndarray) -> FrameJudgement:
+    """Judge a rendered frame's light from its linear luminance ``(H, W)`` (every pixel counts:
+    one that sees nothing is dark, as in the photograph). Non-finite values count as 0."""
+    y = np.nan_to_num(np.asarray(luminance, np.float64), nan=0.0, posinf=0.0, neginf=0.0)
+    bright = float(np.percentile(y, FRAME_PERCENTILE))
+    return FrameJudgement(median_share=float(np.median(y)) / bright if bright > 0 else 0.0)
