@@ -1,7 +1,7 @@
 """The view rule of generated scenes: a camera is kept only if its view is worth learning from.
 
 Judged when the camera is drawn, before any render, from a low-resolution ray cast
-(:data:`VIEW_GRID`² first hits, :func:`spectrinsic.scenes.generators.camera.ray_triangle_hits`):
+(:data:`VIEW_GRID`² first hits, :class:`spectrinsic.scenes.generators.camera.MeshBoxes`):
 
 * **several materials**: at least :data:`MIN_MATERIALS` materials each cover
   :data:`MIN_MATERIAL_SHARE` of the frame (not a close-up of one surface);
@@ -50,7 +50,7 @@ import numpy as np
 from ..geometry import camera_rays
 from ..library import TARGET_IRRADIANCE
 from ..model import Camera, Light, Mesh, Scene
-from .camera import ray_triangle_hits
+from .camera import MeshBoxes
 
 __all__ = [
     "BOUNCE_RAYS",
@@ -138,54 +138,31 @@ class ViewJudgement:
 
 @dataclass(frozen=True)
 class _Geometry:
-    """Every triangle of a scene with its mesh, material and unit normal, and each mesh's
-    triangle range and bounding box (rays are tested only against the meshes whose box they
-    cross: the furniture's many small triangles cost only the rays that come near them)."""
+    """Every triangle of a scene (:class:`MeshBoxes`, for the culled ray cast) with its mesh,
+    material and unit normal."""
 
-    tri: np.ndarray
+    boxes: MeshBoxes
     mesh: np.ndarray
     obj: np.ndarray
     material: np.ndarray
     normal: np.ndarray
-    starts: np.ndarray
-    lo: np.ndarray
-    hi: np.ndarray
 
     def hits(self, origins: np.ndarray, dirs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """First triangle hit by each ray (-1: none) and its distance (inf: none)."""
-        hit = np.full(len(origins), -1)
-        best = np.full(len(origins), np.inf)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            inv = 1.0 / dirs
-        for k in range(len(self.starts) - 1):
-            with np.errstate(invalid="ignore"):
-                t1, t2 = (self.lo[k] - origins) * inv, (self.hi[k] - origins) * inv
-            near = np.nanmax(np.minimum(t1, t2), axis=1)
-            far = np.nanmin(np.maximum(t1, t2), axis=1)
-            rays = np.flatnonzero((far >= np.maximum(near, 0.0)) & (near < best))
-            if not len(rays):
-                continue
-            a, b = self.starts[k], self.starts[k + 1]
-            h, t = ray_triangle_hits(self.tri[a:b], origins[rays], dirs[rays])
-            closer = (h >= 0) & (t < best[rays])
-            hit[rays[closer]], best[rays[closer]] = a + h[closer], t[closer]
-        return hit, best
+        return self.boxes.hits(origins, dirs)
 
 
 def _geometry(meshes: Sequence[Mesh]) -> _Geometry:
-    tri = np.concatenate([m.vertices[m.faces] for m in meshes]).astype(np.float64)
+    boxes = MeshBoxes.of(meshes)
+    tri = boxes.tri
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
-    pad = 1e-6
     return _Geometry(
-        tri=tri,
+        boxes=boxes,
         mesh=np.concatenate([np.full(len(m.faces), i) for i, m in enumerate(meshes)]),
         obj=np.concatenate([np.full(len(m.faces), m.object_id) for m in meshes]),
         material=np.concatenate([np.asarray(m.face_materials).reshape(-1) for m in meshes]),
         normal=n,
-        starts=np.cumsum([0] + [len(m.faces) for m in meshes]),
-        lo=np.array([np.asarray(m.vertices, float).min(axis=0) - pad for m in meshes]),
-        hi=np.array([np.asarray(m.vertices, float).max(axis=0) + pad for m in meshes]),
     )
 
 
