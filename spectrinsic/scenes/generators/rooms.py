@@ -14,7 +14,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..furniture import chair, floor_lamp, round_table, shelf, shelf_boards, sofa, table
-from ..model import DRAWN_LIGHT_KINDS, LIGHT_FIELDS, LIGHT_KINDS
+from ..model import DRAWN_LIGHT_KINDS, LIGHT_FIELDS
 from ..parts import Part, merge, moved
 from ..primitives import box
 from .base import GeneratorOptions, Layout
@@ -28,7 +28,7 @@ __all__ = ["rooms"]
 
 _WALLS = ("left", "right", "back", "front")
 #: The light kinds with a position, which can hang inside a room with a ceiling.
-_PLACED_KINDS = tuple(k for k in LIGHT_KINDS if "position" in LIGHT_FIELDS[k])
+_PLACED_KINDS = tuple(k for k in DRAWN_LIGHT_KINDS if "position" in LIGHT_FIELDS[k])
 #: Placed kinds that can be aimed: the uplights of indirectly lit rooms.
 _AIMED_KINDS = tuple(k for k in _PLACED_KINDS if "direction" in LIGHT_FIELDS[k])
 _T = 0.1  # wall thickness, m
