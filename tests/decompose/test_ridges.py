@@ -117,3 +117,24 @@ def test_cutting_crests_across_the_diagonal_separates_bridged_surfaces(seed):
     for paint in (0, 1):
         _, counts = np.unique(cut.ridge[pure & (which == paint)], return_counts=True)
         assert counts.size <= 3 and counts.max() > 0.6 * counts.sum()
+
+
+def test_principal_axes_do_not_depend_on_how_lapack_breaks_a_tie():
+    """A tie between the two largest eigenvalues leaves eigh free to return any vector of the
+    tied plane (OPENBLAS_CORETYPE changed it, and with it a grey checker's regions); the axis is
+    then the grey diagonal projected onto that plane, whatever eigh returned."""
+    from spectrinsic.decompose.methods.ridges import principal_axes
+
+    diagonal = np.ones(3) / np.sqrt(3.0)
+    rotation = np.linalg.qr(np.array([[1.0, 2.0, 0.5], [0.3, -1.0, 2.0], [2.0, 0.1, -0.7]]))[0]
+    tied = np.diag([1.0, 2.0, 2.0])
+    matrices = np.stack([tied, rotation @ tied @ rotation.T, np.diag([3.0, 1.0, 0.5])])
+    axes = principal_axes(matrices, diagonal)
+    np.testing.assert_allclose(axes[0], [0.0, 1.0, 1.0] / np.sqrt(2.0), atol=1e-12)
+    # the tied plane turned: the projection of the diagonal onto the turned plane
+    plane = rotation[:, 1:]
+    expected = plane @ (plane.T @ diagonal)
+    np.testing.assert_allclose(axes[1], expected / np.linalg.norm(expected), atol=1e-9)
+    # no tie: eigh's own axis, signed along the diagonal
+    np.testing.assert_allclose(axes[2], [1.0, 0.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(axes, axis=1), 1.0, atol=1e-12)

@@ -124,7 +124,8 @@ PROTOCOL = (
     "Case A (round 4b: LMSE 0.0257, hold-one-out 0.0276 over 240 points), 8 of 10 below "
     "baseline. Round 5 (issue 48) chooses no parameter either: sharp (one-pixel step at least "
     "half the change over six pixels), high-contrast (one achromatic name, x3.7) edges between "
-    "achromatic names are Case A, and a collapse guard re-solves or falls back (LMSE 0.0256)"
+    "achromatic names are Case A, and a collapse guard re-solves or falls back (LMSE 0.0256; "
+    "0.0255 once RAD's tied eigenvectors were made independent of the BLAS kernel)"
 )
 #: Linear values are normalised so that this percentile of the brightest channel maps to 1
 #: before sRGB encoding for the naming model (which expects display values).

@@ -220,12 +220,18 @@ def _rad_ridges(
             )
     support = density >= min_density
     field = np.zeros(hist.shape + (3,))
-    _, vecs = np.linalg.eigh(tensor[support])
-    dominant = vecs[:, :, 2]
-    side = np.sign((dominant * grad[support]).sum(axis=1))
+    dominant = principal_axes(tensor[support], _DIAGONAL)
+    g = grad[support]
+    dot = (dominant * g).sum(axis=1)
+    # the gradient's side of the axis; where the gradient is orthogonal to it (to rounding),
+    # the axis keeps principal_axes' deterministic sign rather than the sign of rounding noise
+    level = 1e-9 * np.sqrt((g * g).sum(axis=1))
+    side = np.where(np.abs(dot) > level, np.sign(dot), 1.0)
     field[support] = side[:, None] * dominant
     kappa = -sum(np.gradient(field[..., k], axis=k) for k in range(3))
-    crest = support & (kappa >= creaseness)
+    # compared at 1e-9: a symmetric histogram can put kappa on the threshold, where rounding
+    # in the last bits would decide
+    crest = support & (np.round(kappa, 9) >= creaseness)
     return np.asarray(skeletonize(crest), dtype=bool)
 
 
@@ -239,14 +245,14 @@ def _cut_across_diagonal(components: np.ndarray, max_angle_deg: float) -> np.nda
     from scipy.sparse.csgraph import connected_components
 
     axes = _local_axes(components, _AXIS_RADIUS)
-    along = np.abs(axes @ _DIAGONAL)
+    along = np.abs((axes * _DIAGONAL).sum(axis=-1))  # elementwise: no BLAS kernel in the bits
     keep = (components > 0) & (along >= np.cos(np.radians(max_angle_deg)))
     if not keep.any():
         return components
     pieces, n = ndimage.label(keep, structure=np.ones((3, 3, 3)))
     points = np.argwhere(pieces > 0).astype(np.float64)
     piece = pieces[pieces > 0]
-    across = points - np.outer(points @ _DIAGONAL, _DIAGONAL)  # chromaticity, in bins
+    across = points - np.outer((points * _DIAGONAL).sum(axis=1), _DIAGONAL)  # chromaticity
     count = np.bincount(piece, minlength=n + 1)[1:]
     centre = (
         np.stack(
@@ -310,6 +316,39 @@ def _prune(components: np.ndarray, index: np.ndarray, min_share: float) -> np.nd
     return renumber[components]
 
 
+def principal_axes(matrices: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """Unit eigenvector of the largest eigenvalue of each symmetric ``(N, 3, 3)`` matrix, the same
+    whatever the LAPACK kernel: where that eigenvalue ties with the next (within 1e-9 of it, as
+    in a symmetric histogram), eigh's vector inside the tied eigenspace follows the kernel
+    (``OPENBLAS_CORETYPE`` changed the regions of a grey checker), so the axis is the first of
+    *reference*, x, y projected onto that eigenspace that is not orthogonal to it (*reference*
+    itself where all three tie); each axis is signed to point along *reference* (or, orthogonal
+    to it, along the first such vector)."""
+    vals, vecs = np.linalg.eigh(matrices)
+    tol = 1e-9 * np.abs(vals[:, 2:3])
+    top, second = vecs[:, :, 2], vecs[:, :, 1]
+    ties_second = (vals[:, 2:3] - vals[:, 1:2]) <= tol
+    ties_all = ties_second & ((vals[:, 2:3] - vals[:, 0:1]) <= tol)
+    references = (np.asarray(reference, np.float64), np.eye(3)[0], np.eye(3)[1])
+    axes = top.copy()
+    chosen = ~ties_second[:, 0]
+    for ref in references:
+        on = (top * ref).sum(axis=1, keepdims=True) * top
+        on = on + (second * ref).sum(axis=1, keepdims=True) * second
+        on = np.where(ties_all, ref, on)
+        length = np.sqrt((on * on).sum(axis=1, keepdims=True))
+        take = ~chosen & (length[:, 0] > 1e-6)
+        axes[take] = (on / np.maximum(length, 1e-300))[take]
+        chosen |= take
+    signed = np.zeros(len(axes), bool)
+    for ref in references:  # the sign of the first reference the axis is not orthogonal to
+        along = (axes * ref).sum(axis=1)
+        use = ~signed & (np.abs(along) > 1e-9)
+        axes[use & (along < 0)] *= -1.0
+        signed |= use
+    return axes
+
+
 def _local_axes(components: np.ndarray, radius: float) -> np.ndarray:
     """Unit principal axis of each ridge bin's same-ridge neighbours within *radius* bins
     (the ridge's local direction); the grey diagonal where a bin has no neighbour."""
@@ -329,8 +368,7 @@ def _local_axes(components: np.ndarray, radius: float) -> np.ndarray:
     mean = adjacency @ p / count[:, None]
     second = adjacency @ (p[:, :, None] * p[:, None, :]).reshape(m, 9) / count[:, None]
     cov = second.reshape(m, 3, 3) - mean[:, :, None] * mean[:, None, :]
-    _, vecs = np.linalg.eigh(cov)
-    axes = np.where((count > 1)[:, None], vecs[:, :, 2], _DIAGONAL)
+    axes = np.where((count > 1)[:, None], principal_axes(cov, _DIAGONAL), _DIAGONAL)
     tangent_grid = np.zeros(components.shape + (3,))
     tangent_grid[tuple(points.T)] = axes
     return tangent_grid
