@@ -60,18 +60,6 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             item.add_marker(pytest.mark.render)
 
 
-@pytest.fixture(autouse=True)
-def _mitsuba_set_up(request: pytest.FixtureRequest) -> None:
-    """Set Mitsuba up as the command line does (Dr.Jit on spectrinsic's libLLVM) before every
-    ``render`` test: a test that only parses a Mitsuba XML file would otherwise import Dr.Jit
-    bare, and every later render in that worker would fall back to the scalar variants, which
-    refuse textured scenes (spectrinsic/scenes/mitsuba_tree.py: callers set Mitsuba up)."""
-    if request.node.get_closest_marker("render") and os.environ.get(UNIT_ENV) != "1":
-        from spectrinsic.render.base.variants import import_mitsuba
-
-        import_mitsuba()
-
-
 def _data_dir() -> Path | None:
     env = os.environ.get("SPECTRINSIC_DATA", "").strip()
     candidates = [Path(env)] if env else []
