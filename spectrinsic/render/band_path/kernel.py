@@ -33,6 +33,15 @@ Mitsuba's ``prb.py`` switches its features), so each traced kernel holds only it
   unchanged) makes a metal first hit a white ``diffuse`` vertex (ρ_k = 1) and goes on through the
   true scene with (G1); elsewhere the lane stops at once. Its accumulators ``M`` average over all
   of a pixel's samples, so ``M = c_metal · W`` with ``c_metal`` the pixel's metal coverage.
+  Mirrors and glass have no diffuse lobe either and are swapped alike (``non_diffuse_rows``).
+* **glass** (with gloss): clear glass is loaded as Mitsuba's ``dielectric`` /
+  ``roughdielectric`` / ``thindielectric`` of its constant index, which is the same in every
+  band, so Mitsuba's BSDF weight already holds the Fresnel choice between reflection and
+  transmission and ``s_k = 1`` on both lobes (a row of ones in the specular table; μ, which
+  means nothing for a refracted direction, is then unused). ``f_d = 0`` makes ``a = 0``: the
+  whole of what the camera sees in and through glass is specular transport ``S``. Mitsuba's BSDF
+  handles both sides (``si.wi`` inside the glass) and ``spawn_ray`` offsets the refracted ray
+  to the far side, as in ``path.cpp``.
 * **first-hit maps** (``n_surfaces`` > 0, not in the white loop): the camera ray's surface, ray
   distance, shading normal (and texel) are kept in the loop state.
 
@@ -328,9 +337,9 @@ class BandKernel:
         mi, dr = self.mi, self.dr
         si = self.scene.ray_intersect(s.ray, ray_flags=mi.RayFlags.All, coherent=s.depth == 0)
         now, valid, swap = s.depth == 0, si.is_valid(), None
-        if self.white:  # the camera ray's metal hit becomes a white Lambertian vertex
+        if self.white:  # the camera ray's metal or glass hit becomes a white Lambertian vertex
             row = self.row(si)
-            swap = now & (dr.gather(mi.UInt32, self.it.metal_rows, row, valid) != 0)
+            swap = now & (dr.gather(mi.UInt32, self.it.non_diffuse_rows, row, valid) != 0)
         else:
             s.first = self.first_hit(si, s.depth, s.first)
         light, weight, hit = self.emitter_hit(si, s)

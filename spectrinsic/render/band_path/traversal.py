@@ -151,12 +151,13 @@ class _Dims:
     n_bands: int
     n_lights: int
     glossy: bool
-    #: Per albedo-table row (materials, then the black row): whether it is a metal.
-    metal_rows: tuple[bool, ...] = ()
+    #: Per albedo-table row (materials, then the black row): whether it has no diffuse lobe
+    #: (metal, mirror, glass: the white-at-metal loop's rows).
+    non_diffuse_rows: tuple[bool, ...] = ()
 
     @property
     def metals(self) -> bool:
-        return any(self.metal_rows)
+        return any(self.non_diffuse_rows)
 
 
 @dataclass(frozen=True, eq=False)
@@ -202,7 +203,7 @@ def _trace(
     if spec_table is not None:
         integrator.set_specular(spec_table)
     if metals:
-        integrator.set_metals(np.array(dims.metal_rows, bool))
+        integrator.set_non_diffuse(np.array(dims.non_diffuse_rows, bool))
     n_t = dims.n_bands * dims.n_lights
     n_spec = n_t if dims.glossy else 0
     n_white = n_t if metals else 0
@@ -324,8 +325,8 @@ def render_traversal(
             )
         )
         tables = _tables(scene, value_sets, light_of_emitters(mi, loaded), aovs)
-        metal_rows = tuple(m.kind == "conductor" for m in scene.materials) + (False,)
-        dims = _Dims(h, w, n_bands, n_lights, glossy, metal_rows)
+        non_diffuse_rows = tuple(m.non_diffuse for m in scene.materials) + (False,)
+        dims = _Dims(h, w, n_bands, n_lights, glossy, non_diffuse_rows)
         spec_table = _specular_table(scene, value_sets) if glossy else None
         traced: list[_Traced] = []
         for depth in [int(max_depth)] + ([DIRECT_DEPTH] if direct else []):

@@ -193,6 +193,15 @@ def _lambertian(reflectance: Mapping) -> dict[str, Any]:
     return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": dict(reflectance)}}
 
 
+def _glass_bsdf(material: Material) -> dict[str, Any]:
+    """Mitsuba's ``dielectric``/``roughdielectric``/``thindielectric`` of clear glass
+    *material* (``material_bsdf``)."""
+    bsdf: dict[str, Any] = {"type": material.kind, "int_ior": float(material.ior), "ext_ior": 1.0}
+    if material.roughness > 0.0:  # a thindielectric is always smooth (materials.py)
+        bsdf |= {"type": "roughdielectric", "distribution": "ggx", "alpha": float(material.roughness)}
+    return bsdf
+
+
 def material_bsdf(
     material: Material, reflectance: Mapping, *, white_metal: bool = False
 ) -> dict[str, Any]:
@@ -203,11 +212,17 @@ def material_bsdf(
     base reflectance) and ``int_ior`` = the coat's index over air. ``conductor``: Mitsuba's
     ``conductor``/``roughconductor`` with its measured η/k of ``material.metal``, or with
     *white_metal* a perfect mirror (``material: none``, F = 1) whose Fresnel factor the band
-    integrator applies per band. Lambertian otherwise.
+    integrator applies per band. ``dielectric``: Mitsuba's ``dielectric`` (smooth) or
+    ``roughdielectric`` (GGX), ``thindielectric`` Mitsuba's ``thindielectric``, with
+    ``int_ior`` = the glass's index over air's 1; not wrapped in ``twosided`` (glass has two
+    sides of its own), band-independent (no tint, no dispersion), so the same in every load.
+    Lambertian otherwise.
     """
     if material.kind == "diffuse":
         return _lambertian(reflectance)
     rough = material.roughness > 0.0
+    if material.transmissive:
+        return _glass_bsdf(material)
     bsdf: dict[str, Any]
     if material.kind == "plastic":
         bsdf = {
