@@ -104,7 +104,9 @@ def material_problem(m: Material) -> str | None:
     if not _number(m.ior) or not IOR_RANGE[0] < m.ior <= IOR_RANGE[1]:
         return f"ior {m.ior!r}: expected an index of refraction in ({IOR_RANGE[0]:g}, {IOR_RANGE[1]:g}]"
     if m.non_diffuse and m.spectrum != METAL_SPECTRUM:
-        return f"a {m.kind} has no diffuse spectrum (expected {METAL_SPECTRUM!r}, got {m.spectrum!r})"
+        return (
+            f"a {m.kind} has no diffuse spectrum (expected {METAL_SPECTRUM!r}, got {m.spectrum!r})"
+        )
     if m.kind == "thindielectric" and m.roughness != 0.0:
         return f"roughness {m.roughness!r}: a thindielectric is smooth (Mitsuba has no rough one)"
     if m.kind == "conductor":

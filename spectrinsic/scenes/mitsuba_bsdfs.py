@@ -34,7 +34,7 @@ from ..spectra.conductors import PERFECT_MIRROR
 from .materials import METAL_SPECTRUM
 from .mitsuba_spectra import reflectance_name
 from .mitsuba_tree import Value, XmlNode, named_ior
-from .model import Material
+from .model import Material, MaterialKind
 
 __all__ = ["GLASS", "WRAPPERS", "DEFAULT_MATERIAL", "inner_bsdf", "material_of"]
 
@@ -194,7 +194,7 @@ def _glass(node: XmlNode, name: str, alpha: float, what: str, say: Say) -> Mater
     _unit_specular(node, what, say, "specular_transmittance")
     inside, outside = _GLASS_IORS
     ior = _ior(node, "int_ior", inside, what) / _ior(node, "ext_ior", outside, what)
-    kind = "thindielectric" if node.plugin == "thindielectric" else "dielectric"
+    kind: MaterialKind = "thindielectric" if node.plugin == "thindielectric" else "dielectric"
     return Material(
         name or f"{node.plugin} {ior:.4g}", METAL_SPECTRUM, kind=kind, roughness=alpha, ior=ior
     )

@@ -194,11 +194,10 @@ def _lambertian(reflectance: Mapping) -> dict[str, Any]:
 
 
 def _glass_bsdf(material: Material) -> dict[str, Any]:
-    """Mitsuba's ``dielectric``/``roughdielectric``/``thindielectric`` of clear glass
-    *material* (``material_bsdf``)."""
+    """Clear glass (``material_bsdf``), GGX when rough (a thindielectric is always smooth)."""
     bsdf: dict[str, Any] = {"type": material.kind, "int_ior": float(material.ior), "ext_ior": 1.0}
-    if material.roughness > 0.0:  # a thindielectric is always smooth (materials.py)
-        bsdf |= {"type": "roughdielectric", "distribution": "ggx", "alpha": float(material.roughness)}
+    if material.roughness > 0.0:
+        bsdf |= {"type": "roughdielectric", "distribution": "ggx", "alpha": material.roughness}
     return bsdf
 
 
@@ -212,11 +211,9 @@ def material_bsdf(
     base reflectance) and ``int_ior`` = the coat's index over air. ``conductor``: Mitsuba's
     ``conductor``/``roughconductor`` with its measured η/k of ``material.metal``, or with
     *white_metal* a perfect mirror (``material: none``, F = 1) whose Fresnel factor the band
-    integrator applies per band. ``dielectric``: Mitsuba's ``dielectric`` (smooth) or
-    ``roughdielectric`` (GGX), ``thindielectric`` Mitsuba's ``thindielectric``, with
-    ``int_ior`` = the glass's index over air's 1; not wrapped in ``twosided`` (glass has two
-    sides of its own), band-independent (no tint, no dispersion), so the same in every load.
-    Lambertian otherwise.
+    integrator applies per band. Glass: Mitsuba's ``dielectric``/``roughdielectric``/
+    ``thindielectric`` of index ``ior`` over air's 1, not in a ``twosided`` (it has both sides)
+    and band-independent (no tint or dispersion), so the same in every load. Else Lambertian.
     """
     if material.kind == "diffuse":
         return _lambertian(reflectance)
