@@ -402,7 +402,7 @@ def check_scene_integrator(config: DatasetConfig, scene: Scene, path: str) -> No
         return
     glossy = any(m.glossy for m in scene.materials)
     if glossy or scene.textured:
-        what = "glossy or metal materials" if glossy else "a spectral texture"
+        what = "glossy, metal or glass materials" if glossy else "a spectral texture"
         raise DatasetError(
             f"{path}: holds {what}, which the passes integrator cannot render in the diagonal "
             "modes; use --integrator single on a JIT (LLVM/CUDA) variant"

@@ -292,3 +292,12 @@ def test_named_and_numeric_iors_and_a_rough_ggx_glass_are_read_exactly(glass_box
     )
     (glass,) = [m for m in load_mitsuba_xml(path).materials if m.name == "glass"]
     assert (glass.kind, glass.roughness, glass.ior) == ("dielectric", 0.2, pytest.approx(1.33))
+
+
+def test_the_passes_integrator_refuses_glass_in_one_line_before_any_work(glass_box, capsys):
+    out = glass_box.parent / "passes"
+    args = ["--ground-truth", "--integrator", "passes", "--out", str(out)]
+    assert main(["render", str(glass_box), *args]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "glass materials" in err and "passes" in err
+    assert not out.exists()
