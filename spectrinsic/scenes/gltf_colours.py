@@ -25,14 +25,14 @@ from typing import Any
 from ..errors import SceneError
 from .image_textures import AssetColour, Filter, Wrap, image_texture_from_bytes
 
-__all__ = ["gltf_colours"]
+__all__ = ["gltf_colours", "gltf_chunks"]
 
 #: glTF sampler codes (spec 5.26): wrapS/wrapT and magFilter.
 _WRAP = {10497: "repeat", 33071: "clamp", 33648: "mirror"}
 _NEAREST = 9728
 
 
-def _chunks(path: Path) -> tuple[dict[str, Any], bytes]:
+def gltf_chunks(path: Path) -> tuple[dict[str, Any], bytes]:
     """The glTF JSON and, for ``.glb``, its binary chunk (``b""`` otherwise)."""
     data = path.read_bytes()
     try:
@@ -114,7 +114,7 @@ def gltf_colours(path: str | Path) -> dict[str, AssetColour]:
     path = Path(path)
     if path.suffix.lower() not in (".gltf", ".glb"):
         return {}
-    doc, binary = _chunks(path)
+    doc, binary = gltf_chunks(path)
     out = {}
     for material in doc.get("materials") or []:
         if not isinstance(material, dict) or not isinstance(material.get("name"), str):
