@@ -135,6 +135,20 @@ def _add_generated_draw_options(src: Any) -> None:
         help=f"fraction of generated materials made metal (Ag, Al, Au, Cu, Cr) ({METALLIC_FRACTION:g})",
     )
     src.add_argument(
+        "--glass",
+        type=float,
+        default=None,
+        metavar="F",
+        help="fraction of single-material objects' materials made clear glass (0)",
+    )
+    src.add_argument(
+        "--mirrors",
+        type=float,
+        default=None,
+        metavar="F",
+        help="fraction of single-material objects' materials made perfect mirrors (0)",
+    )
+    src.add_argument(
         "--roughness-range",
         default=None,
         metavar="LO,HI",
@@ -263,6 +277,8 @@ GENERATOR_DEFAULTS: dict[str, Any] = {
     "glossy": GLOSSY_FRACTION,
     "metallic": METALLIC_FRACTION,
     "roughness_range": "0,0.3",
+    "glass": 0.0,
+    "mirrors": 0.0,
     "daylight_share": 0.0,
     "daylight_only": False,
 }
@@ -312,10 +328,16 @@ def source_from_args(args: argparse.Namespace) -> str | None:
     if args.generator:
         try:
             gloss = GlossDistribution(
-                args.glossy, args.metallic, _range("--roughness-range", args.roughness_range)
+                args.glossy,
+                args.metallic,
+                _range("--roughness-range", args.roughness_range),
+                glass_fraction=args.glass,
+                mirror_fraction=args.mirrors,
             )
         except SceneError as exc:
-            raise DatasetError(f"--glossy/--metallic/--roughness-range: {exc}") from None
+            raise DatasetError(
+                f"--glossy/--metallic/--roughness-range/--glass/--mirrors: {exc}"
+            ) from None
         return generator_source(
             args.generator,
             args.count,
