@@ -47,6 +47,7 @@ def add_source_options(src: Any) -> None:
     """Where the scenes come from: the library (default), a generator, or scene files."""
     _add_generator_options(src)
     _add_generated_draw_options(src)
+    _add_glass_options(src)
     _add_scene_file_options(src)
 
 
@@ -135,6 +136,16 @@ def _add_generated_draw_options(src: Any) -> None:
         help=f"fraction of generated materials made metal (Ag, Al, Au, Cu, Cr) ({METALLIC_FRACTION:g})",
     )
     src.add_argument(
+        "--roughness-range",
+        default=None,
+        metavar="LO,HI",
+        help="GGX roughness range of glossy and metal materials (0,0.3)",
+    )
+
+
+def _add_glass_options(src: Any) -> None:
+    """Glass and mirror objects in generated scenes (off by default)."""
+    src.add_argument(
         "--glass",
         type=float,
         default=None,
@@ -147,12 +158,6 @@ def _add_generated_draw_options(src: Any) -> None:
         default=None,
         metavar="F",
         help="fraction of single-material objects' materials made perfect mirrors (0)",
-    )
-    src.add_argument(
-        "--roughness-range",
-        default=None,
-        metavar="LO,HI",
-        help="GGX roughness range of glossy and metal materials (0,0.3)",
     )
 
 
