@@ -145,20 +145,14 @@ def _add_generated_draw_options(src: Any) -> None:
 
 def _add_glass_options(src: Any) -> None:
     """Glass and mirror objects in generated scenes (off by default)."""
-    src.add_argument(
-        "--glass",
-        type=float,
-        default=None,
-        metavar="F",
-        help="fraction of single-material objects' materials made clear glass (0)",
-    )
-    src.add_argument(
-        "--mirrors",
-        type=float,
-        default=None,
-        metavar="F",
-        help="fraction of single-material objects' materials made perfect mirrors (0)",
-    )
+    for flag, what in (("--glass", "clear glass"), ("--mirrors", "perfect mirrors")):
+        src.add_argument(
+            flag,
+            type=float,
+            default=None,
+            metavar="F",
+            help=f"fraction of single-material objects' materials made {what} (0)",
+        )
 
 
 def _add_scene_file_options(src: Any) -> None:
