@@ -21,7 +21,8 @@ mirror, ``reflectance`` is 0, ``shading`` the white-Lambertian ``W = E/π`` at t
 metals, :mod:`~spectrinsic.gt_export.layers.irradiance`), and everything the camera sees in or
 through the glass or in the mirror (reflection and transmission chains and whatever lies
 behind) is in ``specular``; the identity holds there as everywhere. ``transmissive`` (scenes
-with glass only, so other samples are unchanged) and ``metallic`` (metals and mirrors) say
+with glass only, so other samples are unchanged; its description carries the glass words, the
+other layers' descriptions are those of before) and ``metallic`` (metals and mirrors) say
 where, so a user can exclude or in-paint those pixels (spectrinsic/scenes/FORMAT.md, "Ground
 truth on glass, mirrors and masks").
 """
@@ -76,7 +77,9 @@ def _glass_layers(s: SampleInputs, coverage: np.ndarray) -> list[Layer]:
             coverage_weighted(coverage, glass)[..., 0],
             ("Y",),
             "fraction of the pixel covered by glass (dielectric, thindielectric: no diffuse "
-            "lobe, reflectance 0; what is seen in and through it is in specular); 0 background",
+            "lobe, reflectance 0; all that is seen in and through it, its reflection and "
+            "transmission chains, is in specular; non_diffuse counts it too, metallic counts "
+            "mirrors); 0 background",
             "geometry",
             nonnegative=True,
         )
@@ -97,8 +100,7 @@ def _shared_layers(
             specular,
             RGB,
             UNITS_IMAGE + "; light the first hit returns through its non-diffuse lobes (coat "
-            "reflection, metal, mirror, glass), with everything those lobes reflect or "
-            "transmit; not denoised",
+            "reflection, metal), with everything those lobes reflect; not denoised",
             "intrinsics",
         ),
         make_layer(
@@ -106,7 +108,7 @@ def _shared_layers(
             coverage_weighted(coverage, glossy)[..., 0],
             ("Y",),
             "fraction of the pixel covered by materials with a non-diffuse lobe (plastic, "
-            "conductor, glass); 0 background",
+            "conductor); 0 background",
             "geometry",
             nonnegative=True,
         ),
@@ -114,8 +116,8 @@ def _shared_layers(
             "metallic",
             coverage_weighted(coverage, metal)[..., 0],
             ("Y",),
-            "fraction of the pixel covered by metals and mirrors (no diffuse lobe: reflectance "
-            "0 there means metal, not black paint); 0 background",
+            "fraction of the pixel covered by metals (no diffuse lobe: reflectance 0 there "
+            "means metal, not black paint); 0 background",
             "geometry",
             nonnegative=True,
         ),
