@@ -312,3 +312,17 @@ def test_the_passes_integrator_refuses_glass_in_one_line_before_any_work(glass_b
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "glass materials" in err and "passes" in err
     assert not out.exists()
+
+
+def test_approximate_takes_a_tint_as_clear_glass_and_says_so(glass_box):
+    tinted = (
+        '<bsdf type="dielectric" id="glass">'
+        '<rgb name="specular_transmittance" value="0.5, 0.9, 0.5"/></bsdf>'
+    )
+    path = glass_box.with_name("tinted.xml")
+    path.write_text(XML.replace(SMOOTH_GLASS, tinted))
+    scene = load_mitsuba_xml(path, approximate=True)
+    (glass,) = [m for m in scene.materials if m.name == "glass"]
+    assert glass.kind == "dielectric"
+    (said,) = scene.metadata["approximated"]
+    assert "specular_transmittance [0.5, 0.9, 0.5] taken as 1" in said
