@@ -1,4 +1,6 @@
-"""Glass in ``.blend`` materials: a Principled BSDF of Transmission 1, or a Glass BSDF node.
+"""Gloss of ``.blend`` materials: :func:`principled_gloss` (metal, coat, glass; the rules are in
+:mod:`~spectrinsic.scenes.blender`'s docstring) and glass, a Principled BSDF of Transmission 1
+or a Glass BSDF node (:func:`material_glass`).
 
 A Principled BSDF whose ``Transmission Weight`` (Blender 4; ``Transmission`` in 3.x) is 1 and
 ``Metallic`` below 0.5, or a material whose only shader is a Glass BSDF (``BSDF_GLASS``), is clear
@@ -17,9 +19,14 @@ from __future__ import annotations
 from typing import Any
 
 from ..errors import SceneError
+from .blender_colours import principled_node
 from .materials import IOR_RANGE
 
-__all__ = ["material_glass"]
+__all__ = ["METAL_PROPERTY", "DEFAULT_METAL", "principled_gloss", "material_glass"]
+
+#: Custom property of a metallic material naming its conductor (Mitsuba η/k table), and the default.
+METAL_PROPERTY = "metal"
+DEFAULT_METAL = "Al"
 
 #: The Principled BSDF's transmission input, Blender 4 and 3.x names.
 _TRANSMISSION = ("Transmission Weight", "Transmission")
@@ -76,3 +83,24 @@ def material_glass(mat: Any) -> dict[str, Any] | None:
             "ground truth when rough"
         )
     return fields
+
+
+def principled_gloss(mat: Any) -> dict[str, Any]:
+    """Gloss fields of :class:`Material` from *mat*'s first Principled BSDF node (module
+    docstring); ``{}`` (Lambertian) without one or when it is matte."""
+    glass, node = material_glass(mat), principled_node(mat)
+    if glass is not None or node is None:
+        return glass or {}
+    rough = float(node.inputs["Roughness"].default_value)
+    alpha = min(max(rough, 0.0), 1.0) ** 2
+    if float(node.inputs["Metallic"].default_value) >= 0.5:
+        metal = str(mat[METAL_PROPERTY]) if METAL_PROPERTY in mat.keys() else DEFAULT_METAL
+        return {"kind": "conductor", "metal": metal, "roughness": alpha}
+    if rough < 0.5:
+        ior = float(node.inputs["IOR"].default_value) if "IOR" in node.inputs else 1.5
+        return {
+            "kind": "plastic",
+            "roughness": alpha,
+            "ior": min(max(ior, IOR_RANGE[0] + 1e-3), IOR_RANGE[1]),
+        }
+    return {}
