@@ -268,15 +268,16 @@ def test_a_thin_pane_shows_the_wall_behind_it_in_specular_at_its_transmittance()
             '<bsdf type="thindielectric" id="glass"><string name="int_ior" value="glass"/></bsdf>',
             "int_ior 'glass'",
         ),
+        (  # a dimmed mirror gem: Mitsuba's specular_reflectance scales F; refused as a tint
+            '<bsdf type="conductor" id="glass"><string name="material" value="none"/>'
+            '<float name="specular_reflectance" value="0.5"/></bsdf>',
+            "specular_reflectance 0.5",
+        ),
     ],
 )
 def test_beckmann_tinted_or_unknown_glass_is_refused_in_one_line(glass_box, capsys, bsdf, expected):
     bad = glass_box.with_name("bad.xml")
-    bad.write_text(
-        XML.replace(
-            '<bsdf type="dielectric" id="glass"><string name="int_ior" value="bk7"/></bsdf>', bsdf
-        )
-    )
+    bad.write_text(XML.replace(SMOOTH_GLASS, bsdf))
     with pytest.raises(SceneError, match="glass"):
         load_mitsuba_xml(bad)
     assert main(["render", str(bad), "--out", str(glass_box.parent / "o")]) == 2
