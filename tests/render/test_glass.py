@@ -297,11 +297,7 @@ def test_named_and_numeric_iors_and_a_rough_ggx_glass_are_read_exactly(glass_box
         '<float name="ext_ior" value="1"/></bsdf>'
     )
     path = glass_box.with_name("rough.xml")
-    path.write_text(
-        XML.replace(
-            '<bsdf type="dielectric" id="glass"><string name="int_ior" value="bk7"/></bsdf>', rough
-        )
-    )
+    path.write_text(XML.replace(SMOOTH_GLASS, rough))
     (glass,) = [m for m in load_mitsuba_xml(path).materials if m.name == "glass"]
     assert (glass.kind, glass.roughness, glass.ior) == ("dielectric", 0.2, pytest.approx(1.33))
 
