@@ -17,14 +17,11 @@ The import graph is :func:`tests.test_imports.import_graph`'s.
 from __future__ import annotations
 
 import functools
-import sys
 from collections.abc import Iterator
-from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_imports import PACKAGE_DIR, cycles, import_graph  # noqa: E402
+from tests.test_imports import PACKAGE_DIR, cycles, import_graph
 
 #: The package's import graph, built once for every test here.
 _graph = functools.cache(import_graph)

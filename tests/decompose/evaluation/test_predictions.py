@@ -15,7 +15,7 @@ from spectrinsic.decompose.report import write_report
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.formats.exr import write_exr
 from spectrinsic.gt_export.formats.png import PNG16_MAX, write_png16
-from tests.decompose.test_evaluate import _sample
+from tests.decompose.evaluation.test_evaluate import _sample
 
 BASELINE = "image-as-reflectance"
 

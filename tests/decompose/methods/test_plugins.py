@@ -16,7 +16,7 @@ from spectrinsic.decompose.methods.registry import (
     get_decomposer,
 )
 from spectrinsic.decompose.report import write_report
-from tests.decompose.test_evaluate import _sample
+from tests.decompose.evaluation.test_evaluate import _sample
 
 TOY_MODULE = '''
 from dataclasses import dataclass
