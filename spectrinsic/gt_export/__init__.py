@@ -10,11 +10,12 @@ Its modules, by stage (no import cycle among them: tests/gt_export/test_imports.
   ``layers.compose.compute_ground_truth``), ``irradiance``, ``denoise``;
 * the sample folder's format: ``sample`` (file names, canonical JSON, hashes, the seal of
   ``meta.json``, listing), ``json_fields`` and ``sample_meta`` (the one validated reader of
-  ``meta.json``: :class:`SampleMeta`), ``exr``, ``png``, ``names``, ``integrity`` (what may be
-  resumed, replaced or removed);
-* writing a sample: ``previews``, ``writer``; reading one: ``loader`` (``load_sample``);
+  ``meta.json``: :class:`SampleMeta`), ``exr``, ``png``, ``names``, ``integrity`` (which
+  samples may be resumed, replaced or removed);
+* writing a sample: ``previews``, ``writer``; output folders: ``folders/`` (the ``--out``
+  rule, staging, the dataset marker in ``build_folder``);
 * dataset products: ``manifest`` (hashes, splits, noise summary), ``card`` (``DATASET.md``),
-  ``diversity``, ``check``, ``shards``;
+  ``diversity``, ``check``, ``shards``, ``loader`` (``load_sample``, ``load_dataset``);
 * the viewer: ``gallery``.
 """
 
