@@ -319,11 +319,8 @@ def _scene_from_yaml_data(
     data: Any, *, base: str | os.PathLike[str], source: str = "<scene>"
 ) -> Scene:
     """Build a scene from a scene file's parsed YAML *data*; mesh files are resolved inside
-    folder *base*. (The record of a built scene, ``scene.json``, is read back by
-    :func:`spectrinsic.scenes.model.scene_from_dict`: one public name, one meaning.)
-
-    Only the structure and types are checked here; see :func:`load_scene` for validation.
-    """
+    folder *base*. Only the structure and types are checked here; see :func:`load_scene` for
+    validation (``scene.json`` is read by :func:`~spectrinsic.scenes.model.scene_from_dict`)."""
     doc = _Doc(source)
     problems = Problems(source)
     if not isinstance(data, dict):
