@@ -28,11 +28,11 @@ from ...spectra import get_sensors
 from ..algebra.modes import ChannelValues, RenderMode, channel_values, get_mode
 from ..algebra.shares import TransportOutput
 from ..base import translate as tr
+from ..base.aov_maps import assemble_aovs
 from ..base.one_pass import DIRECT_DEPTH, PassOutput, PassProgress, timed_render
 from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
 from ..base.textures import shape_slots, texture_tables
 from ..base.variants import choose_variant, variant_scope
-from ..passes.aovs import assemble_aovs
 from ..settings import DEFAULT_INTEGRATOR, INTEGRATORS
 from .integrator import BandTables, band_path, first_hit_channels
 
@@ -230,7 +230,7 @@ def _trace(
 
 
 def _first_hit_maps(scene: Scene, tables: BandTables, hits: np.ndarray) -> dict[str, np.ndarray]:
-    """:func:`~spectrinsic.render.passes.aovs.assemble_aovs` of the traversal's first-hit channels
+    """:func:`~spectrinsic.render.base.aov_maps.assemble_aovs` of the traversal's first-hit channels
     (coverage, texture columns, ray distance, normal)."""
     columns = None if tables.textures is None else tables.textures.columns
     surfaces = tr.surfaces(scene)
