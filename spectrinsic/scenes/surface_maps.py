@@ -30,7 +30,6 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import SceneError
 from .image_textures import ImageTexture, image_from_record
 
 __all__ = ["MeshMaps", "maps_problem", "maps_from_record", "luminance"]

@@ -29,6 +29,7 @@ SIZE, FOV, DISTANCE = 32, 30.0, 3.0
 #: The mask's checker: TEXELS × TEXELS, 1 = opaque (row 0 at v = 0).
 TEXELS = 4
 QUAD, WALL = Material("red", "munsell:5R 4/14"), Material("blue", "munsell:5PB 4/10")
+SKY = (Light("sky", "cie:D65", 1.0),)
 
 
 def _quad(z: float, half: float, material: int, oid: int, name: str, maps=None) -> Mesh:
@@ -47,7 +48,7 @@ def _checker() -> np.ndarray:
     return index
 
 
-def _scene(maps, lights=(Light("sky", "cie:D65", 1.0),), wall: bool = True) -> Scene:
+def _scene(maps, lights=SKY, wall: bool = True) -> Scene:
     meshes = (_quad(0.0, 1.0, 0, 0, "quad", maps),) + (
         (_quad(-1.0, 3.0, 1, 1, "wall"),) if wall else ()
     )
@@ -75,7 +76,9 @@ def checker():
     spectral path) and ground truth."""
     image = ImageTexture("", "", np.repeat(_checker()[..., None], 3, -1), "clamp", "nearest")
     scene = _scene(lambda uv: MeshMaps(uv, opacity_image=image))
-    result = render_scene(scene, RenderSettings(64, max_depth=3, modes=("spectral", "bands31")), seed=1)
+    result = render_scene(
+        scene, RenderSettings(64, max_depth=3, modes=("spectral", "bands31")), seed=1
+    )
     return scene, result, compute_ground_truth(scene, result, spectral=True, working_space="srgb")
 
 
@@ -104,8 +107,12 @@ def test_checker_mask_first_hits_show_the_wall_through_the_holes(checker):
     np.testing.assert_allclose(depth[solid], (DISTANCE / cos)[solid], atol=0.03)
     np.testing.assert_allclose(depth[hole], ((DISTANCE + 1.0) / cos)[hole], atol=0.03)
     refl = gt.layers["reflectance"].data
-    np.testing.assert_allclose(refl[solid], np.broadcast_to(_plain_reflectance(0), refl[solid].shape), atol=1e-6)
-    np.testing.assert_allclose(refl[hole], np.broadcast_to(_plain_reflectance(1), refl[hole].shape), atol=1e-6)
+    np.testing.assert_allclose(
+        refl[solid], np.broadcast_to(_plain_reflectance(0), refl[solid].shape), atol=1e-6
+    )
+    np.testing.assert_allclose(
+        refl[hole], np.broadcast_to(_plain_reflectance(1), refl[hole].shape), atol=1e-6
+    )
 
 
 def test_checker_mask_identity_and_check(checker, tmp_path):
@@ -148,7 +155,9 @@ def test_half_opacity_plane_mixes_reflectance_by_coverage():
     expected = cover[..., None] * rq + (1 - cover[..., None]) * rw  # the mix by coverage
     np.testing.assert_allclose(gt.layers["reflectance"].data, expected, atol=1e-5)
     mean = gt.layers["reflectance"].data.reshape(-1, 3).mean(axis=0)
-    np.testing.assert_allclose(mean, 0.5 * (rq + rw), atol=4 * sigma / SIZE * np.abs(rq - rw).max() + 1e-6)
+    np.testing.assert_allclose(
+        mean, 0.5 * (rq + rw), atol=4 * sigma / SIZE * np.abs(rq - rw).max() + 1e-6
+    )
 
 
 def _lit_plane(maps) -> tuple[np.ndarray, np.ndarray]:
@@ -162,8 +171,12 @@ def _lit_plane(maps) -> tuple[np.ndarray, np.ndarray]:
 def _assert_lambert(maps, expected: np.ndarray, where: np.ndarray) -> None:
     flat, flat_normals = _lit_plane(None)
     image, normals = _lit_plane(maps)
-    np.testing.assert_allclose(flat_normals[where], np.broadcast_to([0, 0, 1.0], normals[where].shape), atol=1e-6)
-    np.testing.assert_allclose(normals[where], np.broadcast_to(expected, normals[where].shape), atol=1e-4)
+    np.testing.assert_allclose(
+        flat_normals[where], np.broadcast_to([0, 0, 1.0], normals[where].shape), atol=1e-6
+    )
+    np.testing.assert_allclose(
+        normals[where], np.broadcast_to(expected, normals[where].shape), atol=1e-4
+    )
     ratio = image[where].sum(-1) / flat[where].sum(-1)  # ρ E cos θ' / π over ρ E / π
     np.testing.assert_allclose(ratio, expected[2], rtol=1e-4)
 
@@ -186,4 +199,8 @@ def test_bump_map_height_ramp_gives_the_analytic_tilt():
     # ∂p/∂u = (2, 0, 0) (u spans the quad's 2 units), ∂p/∂v = (0, 2, 0), ∂h/∂u = 1:
     # n' ∝ (∂p/∂u + scale n) × ∂p/∂v = (−2 scale, 0, 4)
     expected = np.array([-2 * scale, 0.0, 4.0]) / math.hypot(2 * scale, 4.0)
-    _assert_lambert(lambda uv: MeshMaps(uv, bump_image=image, bump_scale=scale), expected, np.ones((SIZE, SIZE), bool))
+    _assert_lambert(
+        lambda uv: MeshMaps(uv, bump_image=image, bump_scale=scale),
+        expected,
+        np.ones((SIZE, SIZE), bool),
+    )

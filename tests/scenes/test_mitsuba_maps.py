@@ -113,7 +113,10 @@ def test_bump_and_normal_maps_are_read_raw(tmp_path):
             '<bsdf type="mask"><texture type="checkerboard" name="opacity"/><bsdf type="diffuse"/></bsdf>',
             "expected a <texture type='bitmap'>",
         ),
-        ('<bsdf type="bumpmap"><bsdf type="diffuse"/></bsdf>', "expected one <texture type='bitmap'>, found 0"),
+        (
+            '<bsdf type="bumpmap"><bsdf type="diffuse"/></bsdf>',
+            "expected one <texture type='bitmap'>, found 0",
+        ),
     ],
 )
 def test_bad_wrappers_are_refused_in_one_line_with_rc_2(tmp_path, capsys, bsdf, expected):
@@ -142,7 +145,8 @@ def test_mask_lands_where_mitsuba_renders_it(tmp_path):
     mi = import_mitsuba()
     mi.set_variant(choose_variant("rgb"))
     path_tracer = mi.load_dict({"type": "path", "max_depth": 3})
-    image = np.asarray(mi.render(mi.load_file(path), integrator=path_tracer, spp=16, seed=1))[..., :3]
+    image = np.asarray(mi.render(mi.load_file(path), integrator=path_tracer, spp=16, seed=1))
+    image = image[..., :3]
     red = image[..., 0] > image[..., 2]  # the leaf (0.7, 0.1, 0.1) against the wall's blue
     sure = (leaf == 0.0) | (leaf == 1.0)  # pixels inside one texel
     assert sure.sum() > 600 and 0.3 < red.mean() < 0.7

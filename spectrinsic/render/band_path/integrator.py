@@ -189,6 +189,27 @@ def _init_gloss(mi: Any, it: Any, props: Any) -> None:
         )
 
 
+def _init_maps(mi: Any, it: Any, props: Any) -> None:
+    """The mask flag of integrator *it* and no bump or normal maps yet."""
+    it.masks = bool(props.get("masks", False))
+    it.map_lut = mi.UInt32(np.zeros(1, np.uint32))
+    #: (kind, texture, bump scale) of each bump- or normal-mapped shape (surface_maps)
+    it.surface_maps = []
+
+
+def _init_features(mi: Any, it: Any, props: Any) -> None:
+    """The glossy (:func:`_init_gloss`) and mask and map (:func:`_init_maps`) properties."""
+    _init_gloss(mi, it, props)
+    _init_maps(mi, it, props)
+
+
+def _set_maps(mi: Any, dr: Any, it: Any, scene: Any, tables: BandTables) -> None:
+    """Point integrator *it* at the bump and normal maps of the loaded *scene*'s shapes
+    named in *tables* (their texture objects, shape id -> map index)."""
+    lut, it.surface_maps = map_textures(mi, scene, tables.map_scales)
+    it.map_lut = mi.UInt32(shape_id_table(mi, dr, scene, lut, len(lut)))
+
+
 def _check_specular(it: Any, table: np.ndarray) -> None:
     """Raise unless *table* is ``(R, n_nodes, K)`` for integrator *it*."""
     shape = np.shape(table)
@@ -217,9 +238,7 @@ def _make_class(mi: Any, dr: Any) -> type:
             self.albedo = mi.Float(np.zeros(self.n_bands, np.float32))
             self.shape_lut = mi.UInt32(np.zeros(1, np.uint32))
             self.emitter_lut = mi.UInt32(np.zeros(1, np.uint32))
-            self.masks = bool(props.get("masks", False))
-            self.map_lut, self.surface_maps = mi.UInt32(np.zeros(1, np.uint32)), []
-            _init_gloss(mi, self, props)
+            _init_features(mi, self, props)
 
         def set_tables(self, scene: Any, tables: BandTables) -> None:
             """Point the lookups at *tables* for the loaded *scene* (no recompilation)."""
@@ -230,8 +249,7 @@ def _make_class(mi: Any, dr: Any) -> type:
             lookups = texture_lookups(mi, dr, scene, tables.textures, tables.shape_textures)
             self.slot_lut, self.tex_widths, self.tex_heights, self.tex_offsets = lookups[:4]
             self.texel_albedo, self.texel_weights = lookups[4:]
-            lut, self.surface_maps = map_textures(mi, scene, tables.map_scales)
-            self.map_lut = mi.UInt32(shape_id_table(mi, dr, scene, lut, len(lut)))
+            _set_maps(mi, dr, self, scene, tables)
 
         def set_metals(self, rows: np.ndarray) -> None:
             """``(R,)`` bool: which albedo-table rows are metals (no diffuse lobe)."""

@@ -261,7 +261,8 @@ class BandKernel:
             mi.UInt32, self.it.surface_lut, dr.reinterpret_array(mi.UInt32, si.shape), valid
         )
         surface = dr.select(valid, surface, self.it.n_surfaces)
-        distance = dr.select(valid, si.t, 0.0)
+        # through null events the ray distance adds up (a hole's wall lies behind the mask)
+        distance = dr.select(valid, first[1] + si.t, 0.0)
         normal = dr.select(valid, self.shading_normal(si), mi.Vector3f(0.0))
         hit = (surface, distance, normal) + (
             texel_of(mi, dr, self.it, si) if self.it.n_texcols else ()

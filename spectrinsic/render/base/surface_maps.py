@@ -62,7 +62,11 @@ def wrap_bsdf(mi: Any, maps: MeshMaps, bsdf: dict[str, Any]) -> dict[str, Any]:
     out = bsdf
     if maps.normal_image is not None:
         texels = np.asarray(maps.normal_image.texels, np.float64)
-        out = {"type": "normalmap", "normalmap": _bitmap(mi, maps.normal_image, texels), "bsdf": out}
+        out = {
+            "type": "normalmap",
+            "normalmap": _bitmap(mi, maps.normal_image, texels),
+            "bsdf": out,
+        }
     elif maps.bump_image is not None:
         height = luminance(maps.bump_image.texels)[..., None]
         out = {
