@@ -204,3 +204,28 @@ def test_bump_map_height_ramp_gives_the_analytic_tilt():
         expected,
         np.ones((SIZE, SIZE), bool),
     )
+
+
+@pytest.mark.parametrize("wall", [True, False])
+def test_specular_starts_at_the_first_vertex_that_is_no_null_event(wall):
+    """A checker-masked glossy plastic before a matte wall or the sky: the holes show only the
+    wall or the sky, so their specular layer is exactly 0 (a null event is no first vertex and
+    its band factor is 1, not the (G1) factor of a delta lobe); the plastic's texels have a
+    coat highlight. The identity holds with the specular part."""
+    image = ImageTexture("", "", np.repeat(_checker()[..., None], 3, -1), "clamp", "nearest")
+    scene = _scene(lambda uv: MeshMaps(uv, opacity_image=image), wall=wall)
+    coat = Material("coat", "munsell:5R 4/14", kind="plastic", roughness=0.2, ior=1.5)
+    scene = replace(scene, materials=(coat, WALL))
+    result = render_scene(scene, RenderSettings(16, max_depth=3, modes=("bands31",)), seed=2)
+    gt = compute_ground_truth(scene, result, spectral=True, working_space="srgb")
+    rows, cols, inside, _ = _pixels_in_texels()
+    opaque = _checker()[rows, cols] == 1.0
+    specular = gt.layers["specular"].data
+    assert np.all(specular[inside & ~opaque] == 0.0)
+    assert np.all(specular[inside & opaque].sum(-1) > 0.0)
+    composed = (
+        gt.layers["reflectance"].data * gt.layers["shading"].data
+        + gt.layers["specular"].data
+        + gt.layers["residual"].data
+    )
+    np.testing.assert_allclose(composed, gt.layers["image"].data, atol=1e-5)
