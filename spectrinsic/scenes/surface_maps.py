@@ -63,6 +63,9 @@ class MeshMaps:
     bump_scale
         Height per unit of the bump image's value, in scene units per unit of texture
         coordinate gradient (Mitsuba's ``scale``).
+    normal_scale
+        Scale on a normal map's tangent components (glTF ``normalTexture.scale``): the normal
+        is ``normalize((2 t − 1) ⊙ (s, s, 1))``.
     """
 
     uv: np.ndarray
@@ -71,6 +74,7 @@ class MeshMaps:
     normal_image: ImageTexture | None = field(default=None, metadata=_OPTIONAL)
     bump_image: ImageTexture | None = field(default=None, metadata=_OPTIONAL)
     bump_scale: float = field(default=1.0, metadata=_OPTIONAL)
+    normal_scale: float = field(default=1.0, metadata=_OPTIONAL)
 
     @property
     def masked(self) -> bool:
@@ -87,7 +91,8 @@ class MeshMaps:
             return NotImplemented
         return (
             np.array_equal(self.uv, other.uv)
-            and (self.opacity, self.bump_scale) == (other.opacity, other.bump_scale)
+            and (self.opacity, self.bump_scale, self.normal_scale)
+            == (other.opacity, other.bump_scale, other.normal_scale)
             and self.opacity_image == other.opacity_image
             and self.normal_image == other.normal_image
             and self.bump_image == other.bump_image
@@ -105,8 +110,8 @@ def maps_problem(maps: MeshMaps, n_faces: int) -> str | None:
         return f"opacity {maps.opacity}; expected a number in [0, 1]"
     if maps.normal_image is not None and maps.bump_image is not None:
         return "both a normal map and a bump map; expected at most one"
-    if not math.isfinite(maps.bump_scale):
-        return f"bump scale {maps.bump_scale}; expected a finite number"
+    if not (math.isfinite(maps.bump_scale) and math.isfinite(maps.normal_scale)):
+        return f"bump scale {maps.bump_scale}, normal scale {maps.normal_scale}; expected finite numbers"
     if not (maps.masked or maps.perturbed):
         return "neither an opacity below 1 nor a bump or normal map; leave the maps out"
     return None
@@ -127,4 +132,5 @@ def maps_from_record(record: Mapping[str, Any]) -> MeshMaps:
         normal_image=image("normal_image"),
         bump_image=image("bump_image"),
         bump_scale=float(record.get("bump_scale", 1.0)),
+        normal_scale=float(record.get("normal_scale", 1.0)),
     )

@@ -61,7 +61,9 @@ def wrap_bsdf(mi: Any, maps: MeshMaps, bsdf: dict[str, Any]) -> dict[str, Any]:
     (module docstring); *bsdf* itself where *maps* change nothing."""
     out = bsdf
     if maps.normal_image is not None:
-        texels = np.asarray(maps.normal_image.texels, np.float64)
+        scale = np.array([maps.normal_scale, maps.normal_scale, 1.0])
+        texels = (np.asarray(maps.normal_image.texels, np.float64) * 2.0 - 1.0) * scale
+        texels = (texels + 1.0) / 2.0  # Mitsuba normalises 2 t − 1 itself
         out = {
             "type": "normalmap",
             "normalmap": _bitmap(mi, maps.normal_image, texels),
