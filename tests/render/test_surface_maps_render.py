@@ -229,3 +229,27 @@ def test_specular_starts_at_the_first_vertex_that_is_no_null_event(wall):
         + gt.layers["residual"].data
     )
     np.testing.assert_allclose(composed, gt.layers["image"].data, atol=1e-5)
+
+
+def test_a_metal_seen_through_a_hole_has_its_white_surface_shading():
+    """The white-at-metal loop's first vertex is also the first that is no null event: a
+    gold wall seen through the checker's holes gets the white-surface shading ``E / π`` there
+    (0 if the loop stopped at the mask), about that of the wall seen directly beside the
+    quad (the quad shades part of the holes' sky: within a factor of 3)."""
+    image = ImageTexture("", "", np.repeat(_checker()[..., None], 3, -1), "clamp", "nearest")
+    scene = _scene(lambda uv: MeshMaps(uv, opacity_image=image))
+    gold = Material("gold", "flat:0", kind="conductor", roughness=0.3, metal="Au")
+    quad = replace(scene.meshes[0], vertices=scene.meshes[0].vertices * [0.5, 0.5, 1.0])
+    scene = replace(scene, meshes=(quad, scene.meshes[1]), materials=(QUAD, gold))
+    result = render_scene(scene, RenderSettings(16, max_depth=3, modes=("bands31",)), seed=4)
+    gt = compute_ground_truth(scene, result, spectral=True, working_space="srgb")
+    cover = result.aovs["coverage"]
+    shading = gt.layers["shading"].data.sum(-1)
+    through = cover[..., 1] == 1.0  # gold first hit: through a hole or beside the quad
+    centre = np.zeros((SIZE, SIZE), bool)
+    centre[SIZE // 4 : 3 * SIZE // 4, SIZE // 4 : 3 * SIZE // 4] = True  # the quad's footprint
+    holes, beside = through & centre, through & ~centre
+    assert holes.sum() > 50 and beside.sum() > 50
+    assert np.all(shading[holes] > 0.0)
+    ratio = shading[holes].mean() / shading[beside].mean()
+    assert 1 / 3 < ratio <= 1.05, ratio

@@ -44,7 +44,10 @@ Mitsuba's ``prb.py`` switches its features), so each traced kernel holds only it
   (first-hit maps, the start of the specular throughput) is its first vertex that is not a
   null event (``PathState.seen``). Depths count null events as ``path.cpp`` does, so the
   image stays Mitsuba's. A partly opaque hit is first with probability α, so the first-hit
-  maps mix the surface and what lies behind it by coverage, over the pixel's samples.
+  maps mix the surface and what lies behind it by coverage, over the pixel's samples. The
+  white-at-metal loop's first vertex is the same (a metal behind a hole gets its ``W``); a
+  *masked metal* is swapped whole for the white BSDF, so its ``W`` there is over-estimated by
+  1/α (a known limit: masks are for leaves and cut-outs, not metals).
 
 Where to add a glossy part (a new per-light accumulator): a flag and its step here, its
 channel names and AOV order in :mod:`~spectrinsic.render.band_path.integrator`, and its cut into the
@@ -360,9 +363,8 @@ class BandKernel:
         mi, dr = self.mi, self.dr
         si = self.scene.ray_intersect(s.ray, ray_flags=mi.RayFlags.All, coherent=s.depth == 0)
         # the camera ray's first vertex: the first that is not a null event (masks)
-        now, valid, swap = ~s.seen, si.is_valid(), None
+        now, valid, swap, keep = ~s.seen, si.is_valid(), None, None
         if self.white:  # the camera ray's metal hit becomes a white Lambertian vertex
-            now = s.depth == 0  # this loop stops at its first vertex (masks: not seen through)
             row = self.row(si)
             swap = now & (dr.gather(mi.UInt32, self.it.metal_rows, row, valid) != 0)
         else:
@@ -376,8 +378,10 @@ class BandKernel:
             s.sacc = self.deposit(s.sacc, light, s.beta * weight, s.sbands, hit)
         active_next = (s.depth + 1 < self.it.max_depth) & valid
         bsdf = si.bsdf(s.ray)
-        if swap is not None:
-            active_next &= ~now | swap
+        if swap is not None:  # the white loop goes on only from a metal first vertex ...
+            keep = ~now | swap
+            if not self.masks:  # ... or through a null event (masks: known once sampled)
+                active_next &= keep
             bsdf = dr.select(swap, mi.BSDFPtr(self.it.white_bsdf), bsdf)
         v = self.vertex(s.sampler, si, bsdf, active_next)
         c_em = c_bs = rho = self.albedo(si)
@@ -399,12 +403,15 @@ class BandKernel:
             pairs = zip(s.bands, s_bs, s.sbands, c_bs, strict=True)
             s.sbands = [dr.select(now, b * x, sb * c) for b, x, sb, c in pairs]
         nee_bands = [b * c for b, c in zip(s.bands, c_em, strict=True)]
-        s.acc = self.deposit(s.acc, v.light, s.beta * v.nee, nee_bands, v.active_em)
+        active_em = v.active_em if keep is None or not self.masks else v.active_em & keep
+        s.acc = self.deposit(s.acc, v.light, s.beta * v.nee, nee_bands, active_em)
         if self.spec:
             s.sacc = self.deposit(s.sacc, v.light, s.beta * v.nee, s_nee, v.active_em)
         bands = nee_bands if c_bs is c_em else [b * c for b, c in zip(s.bands, c_bs, strict=True)]
         s, go_on = self.step(s, si, v, bands)
         s.alive = active_next & go_on
+        if keep is not None and self.masks:
+            s.alive &= keep | null
         s.seen = s.seen | ~null
         return s
 
