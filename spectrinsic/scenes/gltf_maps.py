@@ -18,7 +18,6 @@ Textures use ``TEXCOORD_0`` and the sampler's wrap mode and filter, as base colo
 
 from __future__ import annotations
 
-import io
 import warnings
 from dataclasses import replace
 from pathlib import Path
@@ -28,35 +27,18 @@ import numpy as np
 
 from ..errors import SceneError, SpectrinsicWarning
 from .gltf_colours import gltf_document, gltf_image, gltf_image_bytes
-from .image_textures import IMAGE_TEXELS_MAX, ImageTexture, image_texture_from_bytes
-from .surface_maps import MeshMaps
+from .image_textures import ImageTexture
+from .surface_maps import MeshMaps, alpha_values, opacity_image
 
 __all__ = ["gltf_maps", "warn_mirrored_uv"]
 
 _MODES = ("OPAQUE", "MASK", "BLEND")
 
 
-def _alpha_png(data: bytes, what: str) -> np.ndarray:
-    """``(h, w)`` 8-bit alpha of the image file *data* (255 where it has no alpha)."""
-    from PIL import Image
-
-    try:
-        with Image.open(io.BytesIO(data)) as img:
-            if img.size[0] * img.size[1] > IMAGE_TEXELS_MAX:
-                raise SceneError(f"{what}: image of {img.size} texels; too large")
-            if img.mode in ("LA", "RGBA") or (img.mode == "P" and "transparency" in img.info):
-                return np.asarray(img.convert("RGBA").getchannel("A"), np.uint8)
-            return np.full(img.size[::-1], 255, np.uint8)
-    except (OSError, Image.UnidentifiedImageError) as exc:
-        raise SceneError(f"{what}: cannot read it as an image ({exc})") from None
-
-
 def _opacity(
     path: Path, doc: dict[str, Any], binary: bytes, material: dict[str, Any]
 ) -> MeshMaps | None:
     """The opacity part of *material*'s maps (module docstring), or ``None`` (opaque)."""
-    from PIL import Image
-
     name = material["name"]
     mode = material.get("alphaMode", "OPAQUE")
     if mode not in _MODES:
@@ -72,21 +54,15 @@ def _opacity(
         opacity = float(alpha >= cutoff) if mode == "MASK" else alpha
         return None if opacity >= 1.0 else MeshMaps(empty, opacity=opacity)
     data, index, wrap, filt = gltf_image_bytes(path, doc, binary, pbr["baseColorTexture"])
-    values = _alpha_png(data, f"{path}: material {name!r} baseColorTexture")
+    where = f"{path}: material {name!r} baseColorTexture"
+    values = alpha_values(data, where, luminance_without_alpha=False)
     if mode == "MASK":  # the cut-out's test on the 8-bit alpha times the factor
         values = np.where(alpha * values / 255.0 >= cutoff, 255, 0).astype(np.uint8)
         alpha = 1.0
     if alpha >= 1.0 and values.min() == 255:
         return None
-    buffer = io.BytesIO()
-    Image.fromarray(values, "L").save(buffer, format="PNG")
-    image = image_texture_from_bytes(
-        buffer.getvalue(),
-        source=f"{path.name}#images/{index}/alpha" + ("-mask" if mode == "MASK" else ""),
-        srgb=False,
-        wrap=wrap,
-        filter=filt,
-    )
+    source = f"{path.name}#images/{index}/alpha" + ("-mask" if mode == "MASK" else "")
+    image = opacity_image(values, source, wrap, filt)
     return MeshMaps(empty, opacity=alpha, opacity_image=image)
 
 

@@ -20,8 +20,9 @@ mapped by the mesh's own texture coordinates (:mod:`spectrinsic.scenes.gltf_colo
 :mod:`spectrinsic.scenes.mtl_colours`, :mod:`spectrinsic.scenes.image_textures`). A material
 with neither a colour nor a mapping (nor a default spectrum) is an error naming the options.
 A textured material must be matte (a glossy one is refused: its basis would not be diffuse).
-A glTF material's ``alphaMode`` (``MASK``, ``BLEND``) and ``normalTexture`` become the mesh's
-opacity mask and normal map whatever the colours (:mod:`spectrinsic.scenes.gltf_maps`).
+A glTF material's ``alphaMode`` (``MASK``, ``BLEND``) and ``normalTexture``, and an MTL
+material's ``d``/``map_d``, become the mesh's opacity mask and normal map whatever the colours
+(:mod:`spectrinsic.scenes.gltf_maps`, :mod:`spectrinsic.scenes.mtl_maps`).
 """
 
 from __future__ import annotations
@@ -47,6 +48,7 @@ from .image_textures import AssetColour, ImageTexture, corner_spectra
 from .materials import METAL_SPECTRUM
 from .model import Camera, Light, Material, Mesh, Scene
 from .mtl_colours import mtl_colours
+from .mtl_maps import mtl_maps
 from .semantic import SemanticMap, classify
 from .surface_maps import MeshMaps
 from .textures import Texture, make_image_texture
@@ -389,7 +391,7 @@ def load_mesh_scene(
     path = Path(path)
     geoms = _geometries(path)
     colours = _asset_colours(path) if colours_from_asset else {}
-    surface_maps = gltf_maps(path)  # masks are geometry: read whatever the colours
+    surface_maps = gltf_maps(path) or mtl_maps(path)  # masks are geometry: whatever the colours
     table = _Table()
     meshes = []
     for i, (node, material, verts, faces, gloss, uv) in enumerate(geoms):

@@ -23,6 +23,7 @@ truth on masks and bump maps").
 
 from __future__ import annotations
 
+import io
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -30,9 +31,24 @@ from typing import Any
 
 import numpy as np
 
-from .image_textures import ImageTexture, image_from_record
+from ..errors import SceneError
+from .image_textures import (
+    IMAGE_TEXELS_MAX,
+    Filter,
+    ImageTexture,
+    Wrap,
+    image_from_record,
+    image_texture_from_bytes,
+)
 
-__all__ = ["MeshMaps", "maps_problem", "maps_from_record", "luminance"]
+__all__ = [
+    "MeshMaps",
+    "maps_problem",
+    "maps_from_record",
+    "luminance",
+    "alpha_values",
+    "opacity_image",
+]
 
 _OPTIONAL = {"omit_default": True}
 #: Rec. 709 luminance weights, the ones Mitsuba's ``eval_1`` of an RGB bitmap uses.
@@ -133,4 +149,38 @@ def maps_from_record(record: Mapping[str, Any]) -> MeshMaps:
         bump_image=image("bump_image"),
         bump_scale=float(record.get("bump_scale", 1.0)),
         normal_scale=float(record.get("normal_scale", 1.0)),
+    )
+
+
+def alpha_values(data: bytes, what: str, *, luminance_without_alpha: bool) -> np.ndarray:
+    """``(h, w)`` 8-bit alpha of the image file *data* (row 0 the image's top); an image
+    without alpha gives 255 everywhere, or with *luminance_without_alpha* its 8-bit grey
+    (PIL's ``L``). One line names *what* for an unreadable or too large image."""
+    from PIL import Image
+
+    try:
+        with Image.open(io.BytesIO(data)) as img:
+            if img.size[0] * img.size[1] > IMAGE_TEXELS_MAX:
+                raise SceneError(
+                    f"{what}: image of {img.size[0]}x{img.size[1]} texels; expected at most "
+                    f"{IMAGE_TEXELS_MAX:,}"
+                )
+            if img.mode in ("LA", "RGBA") or (img.mode == "P" and "transparency" in img.info):
+                return np.asarray(img.convert("RGBA").getchannel("A"), np.uint8)
+            if luminance_without_alpha:
+                return np.asarray(img.convert("L"), np.uint8)
+            return np.full(img.size[::-1], 255, np.uint8)
+    except (OSError, Image.UnidentifiedImageError) as exc:
+        raise SceneError(f"{what}: cannot read it as an image ({exc})") from None
+
+
+def opacity_image(values: np.ndarray, source: str, wrap: Wrap, filter: Filter) -> ImageTexture:  # noqa: A002
+    """The raw opacity image of ``(h, w)`` 8-bit *values* (row 0 the top), kept as the bytes
+    of a one-channel PNG written here, named *source*."""
+    from PIL import Image
+
+    buffer = io.BytesIO()
+    Image.fromarray(np.ascontiguousarray(values, np.uint8), "L").save(buffer, format="PNG")
+    return image_texture_from_bytes(
+        buffer.getvalue(), source=source, srgb=False, wrap=wrap, filter=filter
     )
