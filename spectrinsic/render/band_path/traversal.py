@@ -31,6 +31,7 @@ from ..base import translate as tr
 from ..base.aov_maps import assemble_aovs
 from ..base.one_pass import DIRECT_DEPTH, PassOutput, PassProgress, timed_render
 from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
+from ..base.surface_maps import map_scales
 from ..base.textures import shape_slots, texture_tables
 from ..base.variants import choose_variant, variant_scope
 from ..settings import DEFAULT_INTEGRATOR, INTEGRATORS
@@ -114,6 +115,8 @@ def _tables(
         shape_surfaces={s.key: i for i, s in enumerate(surfaces)} if aovs else {},
         textures=textures,
         shape_textures=shape_slots(textures, surfaces),
+        map_scales=map_scales(scene, surfaces),
+        masks=any(m.maps is not None and m.maps.masked for m in scene.meshes),
     )
 
 
@@ -197,6 +200,7 @@ def _trace(
         n_texcols=n_texcols,
         gloss=dims.glossy,
         metals=metals,
+        masks=tables.masks,
     )
     integrator.set_tables(loaded, tables if n_surfaces else replace(tables, shape_surfaces={}))
     if spec_table is not None:
