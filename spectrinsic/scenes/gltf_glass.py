@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SceneError
-from .gltf_colours import gltf_chunks
+from .gltf_colours import gltf_document
 
 __all__ = ["TRANSMISSION", "gltf_glass"]
 
@@ -76,7 +76,7 @@ def gltf_glass(path: str | Path) -> dict[str, dict[str, Any]]:
     path = Path(path)
     if path.suffix.lower() not in (".gltf", ".glb"):
         return {}
-    doc, _ = gltf_chunks(path)
+    doc, _ = gltf_document(path)
     out = {}
     for material in doc.get("materials") or []:
         if isinstance(material, dict) and isinstance(material.get("name"), str):

@@ -323,3 +323,28 @@ def test_approximate_takes_a_tint_as_clear_glass_and_says_so(glass_box):
     assert glass.kind == "dielectric"
     (said,) = scene.metadata["approximated"]
     assert "specular_transmittance [0.5, 0.9, 0.5] taken as 1" in said
+
+
+def test_a_thin_pane_stays_the_first_hit_in_a_scene_with_masks(glass_box):
+    """Mitsuba's ``thindielectric`` transmits with a null event, as a mask's hole does; with a
+    masked floor in the scene, the thin gem's pixels still have the gem as first hit (all in
+    specular, reflectance 0), not the box behind it."""
+    thin = '<bsdf type="thindielectric" id="glass"/>'
+    masked = (
+        '<bsdf type="mask" id="holey"><float name="opacity" value="0.5"/><ref id="white"/></bsdf>'
+    )
+    text = XML.replace(SMOOTH_GLASS, thin).replace(
+        '<shape type="rectangle" id="floor"><ref id="white"/>',
+        masked + '<shape type="rectangle" id="floor"><ref id="holey"/>',
+    )
+    glass_box.write_text(text)
+    scene = load_mitsuba_xml(glass_box)
+    assert any(m.maps is not None and m.maps.masked for m in scene.meshes)
+    result = render_scene(scene, RenderSettings(8, modes=("bands31",), max_depth=4), seed=2)
+    layers = {
+        k: v.data.astype(np.float64) for k, v in compute_ground_truth(scene, result).layers.items()
+    }
+    glass = layers["transmissive"] == 1.0
+    assert glass.sum() > 40
+    assert np.all(layers["reflectance"][glass] == 0.0)
+    np.testing.assert_allclose(layers["specular"][glass], layers["image"][glass], atol=1e-4)

@@ -31,10 +31,12 @@ from ..base import translate as tr
 from ..base.aov_maps import assemble_aovs
 from ..base.one_pass import DIRECT_DEPTH, PassOutput, PassProgress, timed_render
 from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
+from ..base.surface_maps import map_scales
 from ..base.textures import shape_slots, texture_tables
 from ..base.variants import choose_variant, variant_scope
 from ..settings import DEFAULT_INTEGRATOR, INTEGRATORS
 from .integrator import BandTables, band_path, first_hit_channels
+from .kernel import GLASS_ROW, MIRROR_ROW
 
 __all__ = [
     "PARTS",
@@ -114,6 +116,8 @@ def _tables(
         shape_surfaces={s.key: i for i, s in enumerate(surfaces)} if aovs else {},
         textures=textures,
         shape_textures=shape_slots(textures, surfaces),
+        map_scales=map_scales(scene, surfaces),
+        masks=any(m.maps is not None and m.maps.masked for m in scene.meshes),
     )
 
 
@@ -151,9 +155,9 @@ class _Dims:
     n_bands: int
     n_lights: int
     glossy: bool
-    #: Per albedo-table row (materials, then the black row): whether it has no diffuse lobe
-    #: (metal, mirror, glass: the white-at-metal loop's rows).
-    non_diffuse_rows: tuple[bool, ...] = ()
+    #: Per albedo-table row (materials, then the black row): 0 with a diffuse lobe, else
+    #: MIRROR_ROW or GLASS_ROW (the white-at-metal loop's rows; ``set_non_diffuse``).
+    non_diffuse_rows: tuple[int, ...] = ()
 
     @property
     def metals(self) -> bool:
@@ -198,12 +202,13 @@ def _trace(
         n_texcols=n_texcols,
         gloss=dims.glossy,
         metals=metals,
+        masks=tables.masks,
     )
     integrator.set_tables(loaded, tables if n_surfaces else replace(tables, shape_surfaces={}))
     if spec_table is not None:
         integrator.set_specular(spec_table)
-    if metals:
-        integrator.set_non_diffuse(np.array(dims.non_diffuse_rows, bool))
+    if dims.glossy:  # every traversal: a glass row's null event is no mask cut-out
+        integrator.set_non_diffuse(np.array(dims.non_diffuse_rows, np.uint32))
     n_t = dims.n_bands * dims.n_lights
     n_spec = n_t if dims.glossy else 0
     n_white = n_t if metals else 0
@@ -325,7 +330,10 @@ def render_traversal(
             )
         )
         tables = _tables(scene, value_sets, light_of_emitters(mi, loaded), aovs)
-        non_diffuse_rows = tuple(m.non_diffuse for m in scene.materials) + (False,)
+        non_diffuse_rows = tuple(
+            GLASS_ROW if m.transmissive else MIRROR_ROW if m.non_diffuse else 0
+            for m in scene.materials
+        ) + (0,)
         dims = _Dims(h, w, n_bands, n_lights, glossy, non_diffuse_rows)
         spec_table = _specular_table(scene, value_sets) if glossy else None
         traced: list[_Traced] = []

@@ -19,6 +19,7 @@ from ..base.one_pass import (
     timed_render,
 )
 from ..base.plugins import aov_integrator, hdr_film, rgb_spectrum
+from ..base.surface_maps import refuse_maps
 from ..base.textures import refuse_textures
 from ..base.variants import choose_variant, variant_scope
 
@@ -57,6 +58,7 @@ def render_aovs(
     if int(spp) < 1:
         raise SceneError(f"spp {spp}: expected at least 1 sample per pixel")
     refuse_textures(scene, "the coverage passes")
+    refuse_maps(scene, "the coverage passes")
     surfaces = tr.surfaces(scene)
     n_pass = max(1, -(-len(surfaces) // 3))
     chosen = choose_variant("rgb", variant)
