@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from PIL import Image
 
 from ..errors import SceneError
 from .image_textures import (
@@ -156,8 +157,6 @@ def alpha_values(data: bytes, what: str, *, luminance_without_alpha: bool) -> np
     """``(h, w)`` 8-bit alpha of the image file *data* (row 0 the image's top); an image
     without alpha gives 255 everywhere, or with *luminance_without_alpha* its 8-bit grey
     (PIL's ``L``). One line names *what* for an unreadable or too large image."""
-    from PIL import Image
-
     try:
         with Image.open(io.BytesIO(data)) as img:
             if img.size[0] * img.size[1] > IMAGE_TEXELS_MAX:
@@ -177,8 +176,6 @@ def alpha_values(data: bytes, what: str, *, luminance_without_alpha: bool) -> np
 def opacity_image(values: np.ndarray, source: str, wrap: Wrap, filter: Filter) -> ImageTexture:  # noqa: A002
     """The raw opacity image of ``(h, w)`` 8-bit *values* (row 0 the top), kept as the bytes
     of a one-channel PNG written here, named *source*."""
-    from PIL import Image
-
     buffer = io.BytesIO()
     Image.fromarray(np.ascontiguousarray(values, np.uint8), "L").save(buffer, format="PNG")
     return image_texture_from_bytes(
