@@ -50,7 +50,7 @@ from ..render.base.variants import import_mitsuba
 from ..render.probe import probe_luminance
 from ..render.transport_render import render_transport_batches
 from ..scenes.library import build
-from ..scenes.sources import GeneratedSource
+from ..scenes.sources import FileSource, GeneratedSource
 from ..spectra.camera_model import camera_model, camera_sensors
 from .disk_space import check_disk_space
 from .executors import Executor, SerialExecutor
@@ -131,6 +131,7 @@ def build_sample(task: SampleTask) -> SampleOutcome:
     cfg = task.config
     t0 = time.perf_counter()
     scene = _task_scene(task)
+    folder = Path(task.source.path).parent if isinstance(task.source, FileSource) else None
     t_render = time.perf_counter()
     transport = None
     if cfg.store_transport:  # the per-light transport kept (split by light) for relighting
@@ -158,9 +159,12 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         camera=camera_model(cfg.camera) if cfg.camera else None,
         spectral_layers=cfg.spectral_layers,
         working_space=cfg.working_space,
+        scene_folder=folder,  # csv: spectra recorded relative to it
     )
     if cfg.relight:
-        write_relit_variants(path, cfg.relight, seed=task.seed, data_dir=task.data_dir)
+        write_relit_variants(
+            path, cfg.relight, seed=task.seed, data_dir=task.data_dir, scene_dir=folder
+        )
     seconds = time.perf_counter() - t0
     return SampleOutcome(
         sample_id=task.sample_id,

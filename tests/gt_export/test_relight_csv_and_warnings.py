@@ -34,13 +34,15 @@ def source(tmp_path_factory, make_room) -> tuple[Path, Path]:
     scene = dataclasses.replace(room, materials=(first, *room.materials[1:]))
     transport, result = render_transport_batches(scene, SETTINGS, seed=3)
     sample = export_sample(
-        out / "ds", scene, result, sample_id="s", config={"t": 44}, seed=3, transport=transport
-    )
+        out / "ds", scene, result, sample_id="s", config={"t": 44}, seed=3, transport=transport,
+        scene_folder=out,
+    )  # fmt: skip
     return sample, csv
 
 
-def _relight(sample: Path, out: Path, capsys) -> tuple[int, str]:
-    rc = main(["relight", str(sample), "--light", "0=planck:3000K", "--out", str(out)])
+def _relight(sample: Path, out: Path, capsys, *options: str) -> tuple[int, str]:
+    scene_dir = ["--scene-dir", str(sample.parent.parent)]  # where paints.csv lies
+    rc = main(["relight", str(sample), "--light", "0=planck:3000K", "--out", str(out), *scene_dir])
     return rc, capsys.readouterr().err.strip()
 
 
@@ -48,6 +50,7 @@ def test_the_csv_a_sample_read_is_recorded_with_its_sha256(source):
     sample, csv = source
     files = read_meta(sample).raw["spectrum_files"]
     assert [f["column"] for f in files] == ["paint [%]"]
+    assert files[0]["file"] == "paints.csv"  # relative to the scene's folder
     import hashlib
 
     assert files[0]["sha256"] == hashlib.sha256(csv.read_bytes()).hexdigest()
@@ -67,13 +70,43 @@ def test_an_edited_spectrum_csv_is_refused_by_relight_naming_the_file(source, tm
     assert not (tmp_path / "after").exists()
 
 
+def test_relight_needs_the_scene_folder_of_a_sample_with_csv_spectra(source, tmp_path, capsys):
+    """The sample names its CSV relative to the scene file's folder; without --scene-dir the
+    file cannot be found (and verified), so relight refuses in one line naming the option."""
+    sample, _ = source
+    rc = main(["relight", str(sample), "--light", "0=planck:3000K", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "\n" not in err and "--scene-dir" in err and "paints.csv" in err, err
+    assert not (tmp_path / "o").exists()
+    rc, err = _relight(sample, tmp_path / "o", capsys)  # --scene-dir: the folder of the CSV
+    assert rc == 0, err
+    relit = read_meta(tmp_path / "o").raw["spectrum_files"]
+    assert [(f["spectrum"], f["file"]) for f in relit] == [
+        ("csv:paints.csv#paint [%]", "paints.csv")
+    ]
+
+
+def test_a_scene_dir_cannot_lead_a_recorded_name_outside_it(source, tmp_path, capsys):
+    """A recorded name resolves inside --scene-dir only, as a scene file's names do: a folder
+    without the CSV is refused in one line (nothing read from elsewhere)."""
+    sample, _ = source
+    empty = tmp_path / "elsewhere"
+    empty.mkdir()
+    rc = main(
+        ["relight", str(sample), "--light", "0=planck:3000K", "--out", str(tmp_path / "o"),
+         "--scene-dir", str(empty)]
+    )  # fmt: skip
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "\n" not in err and "not found" in err, err
+
+
 def test_a_power_in_the_documented_range_prints_one_line_at_most(source, tmp_path, capsys):
     """``--power 1e20`` lies inside the documented range: its float32 overflow warnings went
     to stderr before the result; now stderr holds at most the one-line result or refusal."""
     sample, _ = source
     rc = main(
         ["relight", str(sample), "--light", "0=planck:3000K", "--power", "0=1e20",
-         "--out", str(tmp_path / "bright")]
+         "--out", str(tmp_path / "bright"), "--scene-dir", str(sample.parent.parent)]
     )  # fmt: skip
     err = capsys.readouterr().err.strip()
     assert rc in (0, 2) and err.count("\n") == 0 and "RuntimeWarning" not in err, err

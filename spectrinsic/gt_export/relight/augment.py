@@ -75,9 +75,15 @@ def _variant_lights(n_lights: int, k: int, seed: int) -> dict[int, str]:
 
 
 def write_relit_variants(
-    sample_dir: str | os.PathLike[str], n: int, *, seed: int, data_dir: Any = None
+    sample_dir: str | os.PathLike[str],
+    n: int,
+    *,
+    seed: int,
+    data_dir: Any = None,
+    scene_dir: str | os.PathLike[str] | None = None,
 ) -> list[Path]:
-    """Write *n* relit variants of a sample that stores its transport, beside it."""
+    """Write *n* relit variants of a sample that stores its transport, beside it (*scene_dir*:
+    the scene file's folder, for a sample with ``csv:`` spectra)."""
     sample = Path(sample_dir)
     n_lights = len(read_meta(sample).lights)
     return [
@@ -86,6 +92,7 @@ def write_relit_variants(
             _variant_lights(n_lights, k, seed),
             sample.parent / relit_variant_id(sample.name, k),
             data_dir=data_dir,
+            scene_dir=scene_dir,
         )
         for k in range(1, int(n) + 1)
     ]
