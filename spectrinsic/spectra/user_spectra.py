@@ -291,10 +291,13 @@ def portable_csv(name: str, base: str | Path | None = None) -> str:
     (:func:`spectrinsic.scenes.spectrum_refs.confined_csv`)."""
     if not name.strip().lower().startswith("csv:"):
         return name
-    path, column = split_csv_key(name.strip()[4:])
-    if not Path(path).is_absolute():
+    path, sep, column = name.strip()[4:].rpartition("#")
+    file = Path(path.strip())
+    if not sep or not file.is_absolute():
+        # a sensor set (``csv:PATH``, no column) stays as the command line gave it: its name
+        # also names the sample's camera layers and files (give it relative to the working
+        # folder to keep it portable)
         return name
-    file = Path(path)
     root = Path(base).resolve() if base is not None else None
     rel = file.relative_to(root) if root is not None and file.is_relative_to(root) else None
     return f"csv:{(rel or Path(file.name)).as_posix()}#{column}"
