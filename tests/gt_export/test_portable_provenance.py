@@ -218,3 +218,16 @@ def test_a_rerun_from_the_other_copy_resumes_the_set(two_builds, capsys):
     args = ["dataset", "--scenes", *map(str, files), *BUILD, "--out", str(ds)]
     assert main(args) == 0, capsys.readouterr().err
     assert (ds / "box__v0__file" / "meta.json").stat().st_mtime_ns == before
+
+
+@pytest.mark.slow  # two dataset builds of three scenes (about 20 s)
+def test_the_files_export_and_evaluate_write_hold_no_absolute_path(two_builds, tmp_path):
+    """The shards, their index and an evaluation's REPORT.md and records name the dataset by
+    its folder's name, never by its path."""
+    ds = two_builds / "a" / "ds"
+    assert main(["-q", "export", str(ds), "--out", str(tmp_path / "shards")]) == 0
+    args = ["-q", "evaluate", "--dataset", str(ds), "--methods", "image-as-shading"]
+    assert main([*args, "--no-figures", "--out", str(tmp_path / "ev")]) == 0
+    assert "* dataset: `ds`" in (tmp_path / "ev" / "REPORT.md").read_text()
+    folders = [two_builds, tmp_path, Path(os.path.expanduser("~"))]
+    assert _absolute_paths(tmp_path, folders) == []
