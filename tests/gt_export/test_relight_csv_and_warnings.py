@@ -14,6 +14,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from spectrinsic.cli import main
@@ -121,3 +122,20 @@ def test_a_power_in_the_documented_range_prints_one_line_at_most(source, tmp_pat
     err = proc.stderr.strip()
     assert proc.returncode in (0, 2) and len(err.splitlines()) == 1, err
     assert "Warning" not in err and ("wrote" in err if proc.returncode == 0 else "error" in err)
+
+
+def test_on_the_fly_relighting_reads_the_csv_from_the_scene_dir(source):
+    """The loaders' relighting (RandomRelight) takes the scene folder as relight does: with it
+    the layers are those of the CSV reflectance; without it, a one-line refusal."""
+    from spectrinsic.errors import DatasetError
+    from spectrinsic.gt_export.relight.augment import RandomRelight
+
+    sample, csv = source
+    with pytest.raises(DatasetError, match="--scene-dir"):
+        RandomRelight(seed=0, cameras=False)(sample, 0)
+    layers = RandomRelight(seed=0, cameras=False, scene_dir=str(csv.parent))(sample, 0)
+    assert read_meta(sample).raw["materials"]["0"] == "csv:paints.csv#paint [%]"
+    from spectrinsic.gt_export.sample.loader import load_sample
+
+    # reflectance does not depend on the light: the CSV read again gives the stored layer
+    np.testing.assert_allclose(layers["reflectance"], load_sample(sample)["reflectance"], atol=1e-6)
