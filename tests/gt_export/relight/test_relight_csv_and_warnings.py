@@ -135,7 +135,7 @@ def test_on_the_fly_relighting_reads_the_csv_from_the_scene_dir(source):
         RandomRelight(seed=0, cameras=False)(sample, 0)
     layers = RandomRelight(seed=0, cameras=False, scene_dir=str(csv.parent))(sample, 0)
     assert read_meta(sample).raw["materials"]["0"] == "csv:paints.csv#paint [%]"
-    from spectrinsic.gt_export.sample.loader import load_sample
+    from spectrinsic.gt_export.dataset.loader import load_sample
 
     # reflectance does not depend on the light: the CSV read again gives the stored layer
     np.testing.assert_allclose(layers["reflectance"], load_sample(sample)["reflectance"], atol=1e-6)
