@@ -17,7 +17,9 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).parents[2]
+import spectrinsic
+
+ROOT = Path(spectrinsic.__file__).parents[1]  # the package under test, wherever tests lie
 XML = """<scene version="3.0.0">
   <sensor type="perspective"><float name="fov" value="40"/>
     <transform name="to_world"><lookat origin="0,0,4" target="0,0,0" up="0,1,0"/></transform>

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import spectrinsic
 from spectrinsic.cli import main
 from spectrinsic.gt_export import export_sample
 from spectrinsic.gt_export.sample.meta import read_meta
@@ -116,7 +117,7 @@ def test_a_power_in_the_documented_range_prints_one_line_at_most(source, tmp_pat
         capture_output=True,
         text=True,
         check=False,
-        env={**os.environ, "PYTHONPATH": str(Path(__file__).parents[2])},
+        env={**os.environ, "PYTHONPATH": str(Path(spectrinsic.__file__).parents[1])},
         timeout=300,
     )
     err = proc.stderr.strip()
