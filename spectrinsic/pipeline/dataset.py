@@ -47,7 +47,7 @@ from ..render.base.variants import import_mitsuba
 from ..render.probe import probe_luminance
 from ..render.transport_render import render_transport_batches
 from ..scenes.library import build
-from ..scenes.sources import FileSource, GeneratedSource
+from ..scenes.sources import GeneratedSource
 from ..spectra.camera_model import camera_model, camera_sensors
 from .disk_space import check_disk_space
 from .executors import Executor, SerialExecutor
@@ -128,7 +128,6 @@ def build_sample(task: SampleTask) -> SampleOutcome:
     cfg = task.config
     t0 = time.perf_counter()
     scene = _task_scene(task)
-    folder = Path(task.source.path).parent if isinstance(task.source, FileSource) else None
     t_render = time.perf_counter()
     transport = None
     if cfg.store_transport:  # the per-light transport kept (split by light) for relighting
@@ -156,11 +155,11 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         camera=camera_model(cfg.camera) if cfg.camera else None,
         spectral_layers=cfg.spectral_layers,
         working_space=cfg.working_space,
-        scene_folder=folder,  # csv: spectra recorded relative to it
+        scene_folder=task.scene_folder,  # csv: spectra recorded relative to it
     )
     if cfg.relight:
         write_relit_variants(
-            path, cfg.relight, seed=task.seed, data_dir=task.data_dir, scene_dir=folder
+            path, cfg.relight, seed=task.seed, data_dir=task.data_dir, scene_dir=task.scene_folder
         )
     seconds = time.perf_counter() - t0
     return SampleOutcome(
