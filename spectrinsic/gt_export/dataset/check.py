@@ -31,6 +31,7 @@ from ..formats.exr import read_exr
 from ..layers import REFLECTANCE_FLOOR
 from ..layers.spectral_intrinsics import rgb_residual_share
 from ..sample import MANIFEST_NAME, META_NAME, SEAL_KEY, TMP_PREFIX, file_sha256, sample_dirs
+from ..sample.layer_storage import COVERAGE_LAYER, rebuild_layers, storage_forms
 from ..sample.meta import Identity, LayerRecord, SampleMeta, read_meta
 from .manifest import ManifestRecord, read_manifest
 
@@ -170,20 +171,39 @@ def _layer_data(meta: SampleMeta, problems: list[str]) -> dict[str, np.ndarray]:
     """Every layer's array (read file by file); unreadable files and layers go to *problems*."""
     data: dict[str, np.ndarray] = {}
     by_file: dict[str, list[str]] = {}
+    coverage: dict[str, np.ndarray] = {}
+    try:
+        forms = storage_forms(meta.raw, meta.layers)
+    except DatasetError as exc:
+        problems.append(str(exc))
+        return data
     for key, rec in meta.layers.items():
-        by_file.setdefault(rec.file, []).append(key)
+        if key not in forms:  # stored as its factors: rebuilt below
+            by_file.setdefault(rec.file, []).append(key)
     for file, keys in by_file.items():
         try:
             arrays = read_exr(meta.folder / file)
         except DatasetError as exc:
             problems.append(str(exc).replace(str(meta.folder) + os.sep, ""))
             continue
+        if COVERAGE_LAYER in arrays:  # the factor of a layer stored as coverage @ table
+            coverage[file] = arrays[COVERAGE_LAYER]
         for key in keys:
             exr_layer = meta.layers[key].exr_layer
             if exr_layer not in arrays:
                 problems.append(f"layer {key!r} is missing from {file}")
                 continue
             data[key] = arrays[exr_layer]
+            problems.extend(_layer_problems(key, meta.layers[key], data[key]))
+    if forms:
+        try:
+            rebuild_layers(
+                meta.raw, meta.layers, data, lambda file: meta.folder / file, coverage=coverage
+            )
+        except DatasetError as exc:
+            problems.append(str(exc).replace(str(meta.folder) + os.sep, ""))
+            return data
+        for key in forms:
             problems.extend(_layer_problems(key, meta.layers[key], data[key]))
     return data
 

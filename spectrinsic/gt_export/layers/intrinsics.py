@@ -17,6 +17,7 @@ from .imaging import shading_ratio
 from .records import REFLECTANCE_FLOOR, RGB, UNITS_IMAGE, Layer, SampleInputs, make_layer
 
 __all__ = [
+    "band_albedos",
     "white_radiance",
     "rgb_white",
     "rgb_of",
@@ -38,14 +39,20 @@ _RESIDUAL_UNITS_GLOSSY = (
 )
 
 
+def band_albedos(s: SampleInputs) -> np.ndarray:
+    """``(M, K)`` channel albedo of every material in the reference mode's channels, the values
+    the renderer gave them (Eq. 5.4 normalised); a pixel's is ``coverage @ band_albedos``."""
+    sensors = (s.result.meta or {}).get("sensors", {}).get(s.ref, get_mode(s.ref).sensors)
+    return channel_values(
+        s.scene, get_sensors(sensors, data_dir=s.data_dir), data_dir=s.data_dir
+    ).materials
+
+
 def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
     """``W = E/π`` from the reference render, Eq. 1 of
     :mod:`~spectrinsic.gt_export.layers.irradiance`, with the band albedos the renderer used."""
     mode = get_mode(s.ref)
-    sensors = (s.result.meta or {}).get("sensors", {}).get(s.ref, mode.sensors)
-    albedos = channel_values(
-        s.scene, get_sensors(sensors, data_dir=s.data_dir), data_dir=s.data_dir
-    ).materials
+    albedos = band_albedos(s)
     matrices = (s.result.meta or {}).get("to_xyz", {})
     to_xyz = (
         np.asarray(matrices[s.ref], float)

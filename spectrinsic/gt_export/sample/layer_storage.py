@@ -1,0 +1,362 @@
+"""How a sample's layers lie in its EXR files (issue 45): in full, or as the factors they are
+made of, rebuilt bit for bit by every reader (``load_sample``, ``spectrinsic check``).
+
+``meta.json["storage"]["layers"]`` names the *form* of every layer that is not stored in full:
+
+* ``"coverage_table"`` (``reflectance_bands``): ``float32(coverage @ table)``, the writer's own
+  product (:func:`~spectrinsic.gt_export.layers.irradiance.white_radiance`). ``coverage``
+  ``(H, W, M)`` is the render's per-material pixel coverage (a textured hit's share split over
+  its basis materials by the texel's weights), stored as the float32 layer :data:`COVERAGE_LAYER`
+  of the same file (channels ``m0 …``); ``table`` ``(M, K)`` is every material's band albedo,
+  stored once as the file's header attribute ``spectrinsic.table.<layer>`` (JSON; float64
+  written as its shortest repr, so it reads back exactly).
+* ``"band_image"`` (``image_bands`` of a denoised sample):
+  :func:`~spectrinsic.gt_export.layers.spectral_intrinsics.band_image` of that albedo (float64),
+  ``shading_bands``, the pixels surfaces cover (coverage sum ≥
+  :data:`~spectrinsic.gt_export.layers.irradiance.COVERAGE_MIN`), ``image_bands_raw`` and
+  ``specular_bands``.
+* ``"identity_residual"`` (the residual of an identity in ``meta.json["identities"]``):
+  :func:`~spectrinsic.gt_export.layers.irradiance.residual` of the identity's stored terms, which
+  is how the writer computes it.
+
+The writer stores a layer as its factors only where rebuilding it from the float32 values it
+writes gives the layer back bit for bit (:func:`stored_layers` checks every sample), else in
+full. The files' SHA-256 in ``meta.json`` cover the coverage and the table, so ``check`` finds a
+tampered table. Samples without a storage record (before issue 45) hold every layer in full.
+An identity whose residual is rebuilt holds by construction on the stored factors; ``check``
+still recomputes it.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ...errors import DatasetError
+from ..formats.exr import read_exr, read_exr_attributes
+from ..layers.irradiance import COVERAGE_MIN, residual
+from ..layers.records import GroundTruth
+from ..layers.spectral_intrinsics import band_image
+
+__all__ = [
+    "FORMS",
+    "COVERAGE_LAYER",
+    "StoredLayers",
+    "stored_layers",
+    "storage_forms",
+    "read_layers",
+    "rebuild_layers",
+]
+
+#: The forms a layer may be stored in besides in full (module notes).
+FORMS = ("coverage_table", "band_image", "identity_residual")
+#: EXR layer holding the per-material coverage behind a ``coverage_table`` layer.
+COVERAGE_LAYER = "coverage"
+_TABLE_ATTRIBUTE = "spectrinsic.table.{layer}"
+_BAND_FACTORS = ("reflectance_bands", "shading_bands", "image_bands_raw")
+#: Largest table a header may declare (materials × bands), so a damaged file cannot make the
+#: reader allocate without bound.
+_TABLE_MAX = 1 << 20
+
+
+@dataclass(frozen=True)
+class StoredLayers:
+    """What :func:`stored_layers` decided: per file the EXR layers to write, their channel names
+    and header attributes, and the form of every layer not stored in full."""
+
+    arrays: dict[str, dict[str, np.ndarray]]
+    channels: dict[str, dict[str, tuple[str, ...]]]
+    attributes: dict[str, dict[str, str]]
+    forms: dict[str, str] = field(default_factory=dict)
+
+    def record(self) -> dict[str, Any]:
+        """``meta.json["storage"]``."""
+        return {"layers": dict(sorted(self.forms.items()))}
+
+
+def _file(group: str) -> str:
+    return f"{group}.exr"
+
+
+def _identity_terms(identities: Sequence[Mapping[str, Any]], key: str) -> list[str] | None:
+    """``[image, reflectance, shading(, specular)]`` of the identity whose residual is *key*."""
+    for ident in identities:
+        if isinstance(ident, Mapping) and ident.get("residual") == key:
+            terms = [ident.get(k) for k in ("image", "reflectance", "shading", "specular")]
+            return [str(t) for t in terms if t is not None]
+    return None
+
+
+def _table_product(coverage: np.ndarray, table: np.ndarray) -> np.ndarray:
+    """``coverage @ table`` in float64, the writer's einsum (same order, same bits)."""
+    return np.einsum("hwm,mk->hwk", np.asarray(coverage, np.float64), table)
+
+
+def _valid(coverage: np.ndarray) -> np.ndarray:
+    return np.asarray(coverage, np.float64).sum(axis=-1) >= COVERAGE_MIN
+
+
+def _rebuild(
+    key: str,
+    form: str,
+    values: Mapping[str, np.ndarray],
+    factors: tuple[np.ndarray, np.ndarray] | None,
+    identities: Sequence[Mapping[str, Any]],
+) -> np.ndarray:
+    """The float32 layer *key* of *form* from the float32 *values* of its factors and, for the
+    band layers, ``(coverage, table)``."""
+    if form == "identity_residual":
+        terms = _identity_terms(identities, key) or []
+        out = residual(*(values[t] for t in terms))
+    else:
+        if factors is None:
+            raise DatasetError(f"layer {key!r} ({form}) needs its coverage and table")
+        albedo = _table_product(*factors)
+        if form == "coverage_table":
+            out = albedo
+        else:
+            spec = values.get("specular_bands")
+            out = band_image(
+                albedo,
+                np.asarray(values["shading_bands"], np.float64),
+                _valid(factors[0]),
+                np.asarray(values["image_bands_raw"], np.float64),
+                None if spec is None else np.asarray(spec, np.float64),
+            )
+    return np.asarray(out, np.float32)
+
+
+def _needs(key: str, form: str, identities: Sequence[Mapping[str, Any]], have: Any) -> list[str]:
+    """The layers *key* of *form* is rebuilt from (besides coverage and table)."""
+    if form == "identity_residual":
+        return _identity_terms(identities, key) or []
+    if form == "band_image":
+        return [*_BAND_FACTORS, *(["specular_bands"] if "specular_bands" in have else [])]
+    return []
+
+
+def stored_layers(
+    gt: GroundTruth, coverage: np.ndarray | None, identities: Sequence[Mapping[str, Any]]
+) -> StoredLayers:
+    """The EXR content of *gt*: every layer in full, except those whose factors rebuild them
+    bit for bit (module notes). *coverage* is the render's ``(H, W, M)`` AOV."""
+    arrays: dict[str, dict[str, np.ndarray]] = {}
+    channels: dict[str, dict[str, tuple[str, ...]]] = {}
+    attributes: dict[str, dict[str, str]] = {}
+    values = {k: layer.data for k, layer in gt.layers.items()}
+    forms: dict[str, str] = {}
+    factors = None
+    table = gt.band_albedos
+    if coverage is not None and table is not None and "reflectance_bands" in values:
+        factors = (np.asarray(coverage, np.float32), np.asarray(table, np.float64))
+    candidates = [("reflectance_bands", "coverage_table"), ("image_bands", "band_image")]
+    candidates += [(str(i["residual"]), "identity_residual") for i in identities]
+    for key, form in candidates:
+        needs = _needs(key, form, identities, values)
+        if key not in values or key in needs or any(n not in values for n in needs):
+            continue
+        if form != "identity_residual" and factors is None:
+            continue
+        if np.array_equal(_rebuild(key, form, values, factors, identities), values[key]):
+            forms[key] = form
+    for key, layer in gt.layers.items():
+        file = _file(layer.group)
+        arrays.setdefault(file, {})
+        channels.setdefault(file, {})
+        if key not in forms:
+            name = key.split("/", 1)[0]
+            arrays[file][name] = layer.data
+            channels[file][name] = layer.channels
+        elif forms[key] == "coverage_table" and factors is not None:
+            arrays[file][COVERAGE_LAYER] = factors[0]
+            channels[file][COVERAGE_LAYER] = tuple(f"m{m}" for m in range(factors[0].shape[-1]))
+            attributes.setdefault(file, {})[_TABLE_ATTRIBUTE.format(layer=key)] = json.dumps(
+                factors[1].tolist(), separators=(",", ":"), allow_nan=False
+            )
+    return StoredLayers(arrays, channels, attributes, forms)
+
+
+def storage_forms(meta: Mapping[str, Any], layers: Mapping[str, Any]) -> dict[str, str]:
+    """``{layer: form}`` of the layers a ``meta.json`` says are stored as factors (empty for
+    samples before issue 45); one-line :class:`DatasetError` for an unknown form or layer."""
+    record = meta.get("storage")
+    if record is None:
+        return {}
+    forms = record.get("layers") if isinstance(record, Mapping) else None
+    if not isinstance(forms, Mapping):
+        raise DatasetError("meta.json: storage.layers: expected an object of layer -> form")
+    for key, form in forms.items():
+        if form not in FORMS or key not in layers:
+            raise DatasetError(
+                f"meta.json: storage.layers.{key}: {form!r}; expected a listed layer stored "
+                f"as one of {list(FORMS)}"
+            )
+    return {str(k): str(v) for k, v in forms.items()}
+
+
+def _table(path: Path, key: str, coverage: np.ndarray, bands: int) -> np.ndarray:
+    """The ``(M, K)`` table of *key* from *path*'s header, checked against its coverage."""
+    name = _TABLE_ATTRIBUTE.format(layer=key)
+    text = read_exr_attributes(path).get(name)
+    try:
+        table = (
+            np.asarray(json.loads(str(text)), np.float64)
+            if len(str(text)) < _TABLE_MAX * 32
+            else None
+        )
+    except (ValueError, TypeError, RecursionError):
+        table = None
+    if table is None or table.shape != (coverage.shape[-1], bands) or not np.isfinite(table).all():
+        raise DatasetError(
+            f"EXR file {str(path)!r}: header attribute {name!r} is not a "
+            f"{coverage.shape[-1]} x {bands} table of finite band albedos"
+        )
+    return table
+
+
+def _closure(
+    keys: Sequence[str] | None,
+    forms: Mapping[str, str],
+    identities: Sequence[Mapping[str, Any]],
+    records: Mapping[str, Any],
+) -> set[str]:
+    """The factor-stored layers that *keys* (default all) need, themselves included."""
+    needed = set(forms if keys is None else (k for k in keys if k in forms))
+    stack = list(needed)
+    while stack:
+        key = stack.pop()
+        for dep in _needs(key, forms[key], identities, records):
+            if dep in forms and dep not in needed:
+                needed.add(dep)
+                stack.append(dep)
+    return needed
+
+
+def _field(record: Any, name: str) -> Any:
+    return record[name] if isinstance(record, Mapping) else getattr(record, name)
+
+
+def rebuild_layers(
+    meta: Mapping[str, Any],
+    records: Mapping[str, Any],
+    values: dict[str, np.ndarray],
+    path_of: Callable[[str], Path],
+    *,
+    wanted: Sequence[str] | None = None,
+    coverage: Mapping[str, np.ndarray] | None = None,
+) -> dict[str, np.ndarray]:
+    """Add to *values* (stored layers already read, by key) the layers of *meta*'s storage
+    record that *wanted* need (default all), rebuilt from their factors. Factors not in
+    *values*, and coverage layers not in *coverage* (by file), are read through *path_of* (file
+    name -> path, e.g. after a hash check). Returns *values*."""
+    forms = storage_forms(meta, records)
+    identities = meta.get("identities") or []
+    pending = {
+        k: forms[k] for k in sorted(_closure(wanted, forms, identities, records)) if k not in values
+    }
+    factors: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    while pending:
+        ready = [
+            k
+            for k, f in pending.items()
+            if not set(_needs(k, f, identities, records)) & set(pending)
+        ]
+        if not ready:
+            raise DatasetError(f"meta.json: storage.layers {sorted(pending)} depend on each other")
+        for key in ready:
+            form = pending.pop(key)
+            needs = _needs(key, form, identities, records)
+            if form == "identity_residual" and not needs:
+                raise DatasetError(
+                    f"meta.json: storage.layers.{key}: no identity has it as residual"
+                )
+            _read_missing(records, values, [n for n in needs if n not in values], path_of)
+            file_factors = None
+            if form != "identity_residual":
+                file = str(_field(records[key], "file"))
+                if file not in factors:
+                    factors[file] = _factors(path_of(file), file, records, forms, coverage)
+                file_factors = factors[file]
+            values[key] = _rebuild(key, form, values, file_factors, identities)
+    return values
+
+
+def _factors(
+    path: Path,
+    file: str,
+    records: Mapping[str, Any],
+    forms: Mapping[str, str],
+    coverage: Mapping[str, np.ndarray] | None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(coverage, table)`` of the ``coverage_table`` layer stored in *file* (at *path*)."""
+    table_key = next(
+        (
+            k
+            for k, f in forms.items()
+            if f == "coverage_table" and _field(records[k], "file") == file
+        ),
+        None,
+    )
+    if table_key is None:
+        raise DatasetError(f"meta.json: storage.layers: no coverage_table layer in {file}")
+    cov = (coverage or {}).get(file)
+    if cov is None:
+        cov = read_exr(path, layers=[COVERAGE_LAYER])[COVERAGE_LAYER]
+    cov = cov[..., None] if cov.ndim == 2 else cov
+    bands = len(_field(records[table_key], "channels"))
+    return cov, _table(path, table_key, cov, bands)
+
+
+def _read_missing(
+    records: Mapping[str, Any],
+    values: dict[str, np.ndarray],
+    keys: Sequence[str],
+    path_of: Callable[[str], Path],
+    coverage: dict[str, np.ndarray] | None = None,
+    with_coverage: frozenset[str] = frozenset(),
+) -> None:
+    """Read the stored layers *keys* into *values*, file by file; and the coverage layer of the
+    files in *with_coverage* into *coverage*, in the same decoding."""
+    by_file: dict[str, list[str]] = {file: [] for file in with_coverage}
+    for key in keys:
+        if key not in records:
+            raise DatasetError(f"meta.json: a stored-as-factors layer needs {key!r}, not listed")
+        by_file.setdefault(str(_field(records[key], "file")), []).append(key)
+    for file, names in by_file.items():
+        extra = [COVERAGE_LAYER] if file in with_coverage and coverage is not None else []
+        layers = [_field(records[k], "exr_layer") for k in names] + extra
+        arrays = read_exr(path_of(file), layers=layers)
+        values.update({k: arrays[_field(records[k], "exr_layer")] for k in names})
+        if extra and coverage is not None:
+            coverage[file] = arrays[COVERAGE_LAYER]
+
+
+def read_layers(
+    meta: Mapping[str, Any],
+    records: Mapping[str, Any],
+    keys: Sequence[str],
+    path_of: Callable[[str], Path],
+) -> dict[str, np.ndarray]:
+    """The arrays of the layers *keys* (``meta.json["layers"]`` *records*), the stored ones read
+    file by file through *path_of* (each file decoded once), the others rebuilt from their
+    factors; the factors read only for that are not returned."""
+    forms = storage_forms(meta, records)
+    identities = meta.get("identities") or []
+    derived = _closure(keys, forms, identities, records)
+    stored = {k for k in keys if k not in forms}
+    for key in derived:
+        stored.update(n for n in _needs(key, forms[key], identities, records) if n not in forms)
+    with_coverage = frozenset(
+        str(_field(records[k], "file")) for k in derived if forms[k] != "identity_residual"
+    )
+    values: dict[str, np.ndarray] = {}
+    coverage: dict[str, np.ndarray] = {}
+    _read_missing(records, values, sorted(stored), path_of, coverage, with_coverage)
+    if derived:
+        rebuild_layers(meta, records, values, path_of, wanted=keys, coverage=coverage)
+    return {k: values[k] for k in keys}
