@@ -31,7 +31,12 @@ from ..formats.exr import read_exr
 from ..layers import REFLECTANCE_FLOOR
 from ..layers.spectral_intrinsics import rgb_residual_share
 from ..sample import MANIFEST_NAME, META_NAME, SEAL_KEY, TMP_PREFIX, file_sha256, sample_dirs
-from ..sample.layer_storage import COVERAGE_LAYER, rebuild_layers, storage_forms
+from ..sample.layer_storage import (
+    COVERAGE_LAYER,
+    rebuild_layers,
+    rebuilt_mismatches,
+    storage_forms,
+)
 from ..sample.meta import Identity, LayerRecord, SampleMeta, read_meta
 from .manifest import ManifestRecord, read_manifest
 
@@ -130,6 +135,28 @@ def _identity_problems(
         )
         if issue:
             out.append(f"image: {issue}")
+    return out
+
+
+def _rebuilt_problems(meta: SampleMeta, data: Mapping[str, np.ndarray]) -> list[str]:
+    """Layers rebuilt from their stored factors that are not the layers the writer computed
+    (their SHA-256 in ``meta.json["storage"]``). A residual rebuilt from its identity's terms
+    satisfies the identity by construction, so a wrong term shows here, named as the identity."""
+    wrong = set(rebuilt_mismatches(meta.raw, data))
+    out = []
+    for ident in meta.identities:
+        if ident.residual in wrong:
+            wrong.discard(ident.residual)
+            terms = " + ".join(t for t in (ident.specular, ident.residual) if t)
+            out.append(
+                f"{ident.image}: {ident.image} != {ident.reflectance} * {ident.shading} + "
+                f"{terms}: the residual rebuilt from the stored terms is not the one written "
+                "(its SHA-256 in meta.json)"
+            )
+    out += [
+        f"layer {k!r} rebuilt from its stored factors does not match its SHA-256 in meta.json"
+        for k in sorted(wrong)
+    ]
     return out
 
 
@@ -252,6 +279,7 @@ def check_sample(sample: str | os.PathLike[str]) -> list[str]:
             "meta.json records no identities (image = reflectance * shading + residual)"
         )
     problems.extend(_identity_problems(meta.identities, data))
+    problems.extend(_rebuilt_problems(meta, data))
     problems.extend(_semantic_problems(meta.raw, data))
     return problems
 

@@ -29,6 +29,7 @@ still recomputes it.
 
 from __future__ import annotations
 
+import hashlib
 import json
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -42,6 +43,7 @@ from ..formats.exr import read_exr, read_exr_attributes
 from ..layers.irradiance import COVERAGE_MIN, residual
 from ..layers.records import GroundTruth
 from ..layers.spectral_intrinsics import band_image
+from .transport_exr import COVERAGE_LAYER  # one name for the per-material coverage layer
 
 __all__ = [
     "FORMS",
@@ -49,14 +51,14 @@ __all__ = [
     "StoredLayers",
     "stored_layers",
     "storage_forms",
+    "layer_sha256",
+    "rebuilt_mismatches",
     "read_layers",
     "rebuild_layers",
 ]
 
 #: The forms a layer may be stored in besides in full (module notes).
 FORMS = ("coverage_table", "band_image", "identity_residual")
-#: EXR layer holding the per-material coverage behind a ``coverage_table`` layer.
-COVERAGE_LAYER = "coverage"
 _TABLE_ATTRIBUTE = "spectrinsic.table.{layer}"
 _BAND_FACTORS = ("reflectance_bands", "shading_bands", "image_bands_raw")
 #: Largest table a header may declare (materials × bands), so a damaged file cannot make the
@@ -73,10 +75,21 @@ class StoredLayers:
     channels: dict[str, dict[str, tuple[str, ...]]]
     attributes: dict[str, dict[str, str]]
     forms: dict[str, str] = field(default_factory=dict)
+    #: :func:`layer_sha256` of every layer in *forms*, as the writer computed it.
+    hashes: dict[str, str] = field(default_factory=dict)
 
     def record(self) -> dict[str, Any]:
         """``meta.json["storage"]``."""
-        return {"layers": dict(sorted(self.forms.items()))}
+        return {
+            "layers": dict(sorted(self.forms.items())),
+            "sha256": dict(sorted(self.hashes.items())),
+        }
+
+
+def layer_sha256(array: np.ndarray) -> str:
+    """SHA-256 of a layer's values: float32 little-endian, C order ``(H, W[, C])`` (of a
+    rebuilt layer, recorded in ``meta.json["storage"]["sha256"]``)."""
+    return hashlib.sha256(np.ascontiguousarray(array, "<f4").tobytes()).hexdigest()
 
 
 def _file(group: str) -> str:
@@ -178,7 +191,8 @@ def stored_layers(
             attributes.setdefault(file, {})[_TABLE_ATTRIBUTE.format(layer=key)] = json.dumps(
                 factors[1].tolist(), separators=(",", ":"), allow_nan=False
             )
-    return StoredLayers(arrays, channels, attributes, forms)
+    hashes = {k: layer_sha256(values[k]) for k in forms}
+    return StoredLayers(arrays, channels, attributes, forms, hashes)
 
 
 def storage_forms(meta: Mapping[str, Any], layers: Mapping[str, Any]) -> dict[str, str]:
@@ -196,7 +210,19 @@ def storage_forms(meta: Mapping[str, Any], layers: Mapping[str, Any]) -> dict[st
                 f"meta.json: storage.layers.{key}: {form!r}; expected a listed layer stored "
                 f"as one of {list(FORMS)}"
             )
+    hashes = record.get("sha256")
+    if not (isinstance(hashes, Mapping) and set(hashes) == set(forms)):
+        raise DatasetError(
+            "meta.json: storage.sha256: expected the SHA-256 of every layer in storage.layers"
+        )
     return {str(k): str(v) for k, v in forms.items()}
+
+
+def rebuilt_mismatches(meta: Mapping[str, Any], values: Mapping[str, np.ndarray]) -> list[str]:
+    """The rebuilt layers among *values* whose :func:`layer_sha256` is not the one
+    ``meta.json["storage"]["sha256"]`` records (the layer the writer computed)."""
+    hashes = (meta.get("storage") or {}).get("sha256") or {}
+    return [k for k in sorted(hashes) if k in values and layer_sha256(values[k]) != hashes[k]]
 
 
 def _table(path: Path, key: str, coverage: np.ndarray, bands: int) -> np.ndarray:
@@ -341,10 +367,13 @@ def read_layers(
     records: Mapping[str, Any],
     keys: Sequence[str],
     path_of: Callable[[str], Path],
+    *,
+    verify: bool = True,
 ) -> dict[str, np.ndarray]:
     """The arrays of the layers *keys* (``meta.json["layers"]`` *records*), the stored ones read
     file by file through *path_of* (each file decoded once), the others rebuilt from their
-    factors; the factors read only for that are not returned."""
+    factors and, with *verify*, checked against their recorded SHA-256 (one-line
+    :class:`DatasetError`); the factors read only for that are not returned."""
     forms = storage_forms(meta, records)
     identities = meta.get("identities") or []
     derived = _closure(keys, forms, identities, records)
@@ -359,4 +388,10 @@ def read_layers(
     _read_missing(records, values, sorted(stored), path_of, coverage, with_coverage)
     if derived:
         rebuild_layers(meta, records, values, path_of, wanted=keys, coverage=coverage)
+    wrong = rebuilt_mismatches(meta, values) if verify else []
+    if wrong:
+        raise DatasetError(
+            f"layers {wrong} rebuilt from their stored factors do not match their SHA-256 in "
+            "meta.json; the sample is damaged (spectrinsic check finds every such layer)"
+        )
     return {k: values[k] for k in keys}

@@ -105,7 +105,7 @@ def load_sample(
             paths[file] = _verified(meta, file) if verify else meta.folder / file
         return paths[file]
 
-    out: dict[str, Any] = read_layers(meta.raw, records, wanted, path_of)
+    out: dict[str, Any] = read_layers(meta.raw, records, wanted, path_of, verify=verify)
     if "mask" in out:
         out["mask"] = out["mask"] > 0.5
     ids = {}
