@@ -39,6 +39,12 @@ _RESIDUAL_UNITS_GLOSSY = (
 )
 
 
+def _as_stored(values: np.ndarray) -> np.ndarray:
+    """*values* as a float32 layer stores them, in float64: a layer computed from stored
+    layers this way is rebuilt bit for bit from them (:mod:`spectrinsic.gt_export.sample.layer_storage`)."""
+    return np.asarray(values, np.float32).astype(np.float64)
+
+
 def band_albedos(s: SampleInputs) -> np.ndarray:
     """``(M, K)`` channel albedo of every material in the reference mode's channels, the values
     the renderer gave them (Eq. 5.4 normalised); a pixel's is ``coverage @ band_albedos``."""
@@ -127,7 +133,8 @@ def shading_set(
         layers.append(
             make_layer(
                 names[2],
-                irr.unit_luminance(shading, grey),
+                # of the stored (float32) shading and grey: readers rebuild it bit for bit
+                irr.unit_luminance(_as_stored(shading), _as_stored(grey)),
                 RGB,
                 f"{space} colour of the light arriving at unit luminance "
                 "(D65 = (1, 1, 1)); 0 where none arrives",
@@ -223,7 +230,7 @@ def intrinsic_layers(
     out.append(
         make_layer(
             "shading_ratio",
-            shading_ratio(image, reflectance),
+            shading_ratio(_as_stored(image), _as_stored(reflectance)),
             RGB,
             "image / reflectance per channel (thesis Fig. 5.8; ill-conditioned where a "
             f"reflectance channel is small); 0 where |reflectance| <= {REFLECTANCE_FLOOR:g}",

@@ -15,9 +15,18 @@ made of, rebuilt bit for bit by every reader (``load_sample``, ``spectrinsic che
   ``shading_bands``, the pixels surfaces cover (coverage sum ≥
   :data:`~spectrinsic.gt_export.layers.irradiance.COVERAGE_MIN`), ``image_bands_raw`` and
   ``specular_bands``.
+* ``"ratio"`` (``shading_ratio``): :func:`~spectrinsic.gt_export.layers.imaging.shading_ratio`
+  of ``image`` and ``reflectance``.
+* ``"unit_luminance"`` (``illuminant``, ``illuminant_camera/<name>``):
+  :func:`~spectrinsic.gt_export.layers.irradiance.unit_luminance` of the space's shading and
+  ``shading_grey``.
 * ``"identity_residual"`` (the residual of an identity in ``meta.json["identities"]``):
-  :func:`~spectrinsic.gt_export.layers.irradiance.residual` of the identity's stored terms, which
-  is how the writer computes it.
+  :func:`~spectrinsic.gt_export.layers.irradiance.residual` of the identity's terms.
+
+``meta.json["storage"]["terms"]`` lists the layers each is rebuilt from (in that order) and
+``["sha256"]`` the SHA-256 of its float32 values (:func:`layer_sha256`) as the writer computed
+them, which the readers compare the rebuild with. The writer computes these layers from the
+float32 values of their terms, as stored.
 
 The writer stores a layer as its factors only where rebuilding it from the float32 values it
 writes gives the layer back bit for bit (:func:`stored_layers` checks every sample), else in
@@ -40,7 +49,8 @@ import numpy as np
 
 from ...errors import DatasetError
 from ..formats.exr import read_exr, read_exr_attributes
-from ..layers.irradiance import COVERAGE_MIN, residual
+from ..layers.imaging import shading_ratio
+from ..layers.irradiance import COVERAGE_MIN, residual, unit_luminance
 from ..layers.records import GroundTruth
 from ..layers.spectral_intrinsics import band_image
 from .transport_exr import COVERAGE_LAYER  # one name for the per-material coverage layer
@@ -58,7 +68,9 @@ __all__ = [
 ]
 
 #: The forms a layer may be stored in besides in full (module notes).
-FORMS = ("coverage_table", "band_image", "identity_residual")
+FORMS = ("coverage_table", "band_image", "ratio", "unit_luminance", "identity_residual")
+#: The forms rebuilt from the coverage and the band table of their file.
+_BAND_FORMS = ("coverage_table", "band_image")
 _TABLE_ATTRIBUTE = "spectrinsic.table.{layer}"
 _BAND_FACTORS = ("reflectance_bands", "shading_bands", "image_bands_raw")
 #: Largest table a header may declare (materials × bands), so a damaged file cannot make the
@@ -77,11 +89,14 @@ class StoredLayers:
     forms: dict[str, str] = field(default_factory=dict)
     #: :func:`layer_sha256` of every layer in *forms*, as the writer computed it.
     hashes: dict[str, str] = field(default_factory=dict)
+    #: The layers every layer in *forms* is rebuilt from, in the form's order.
+    terms: dict[str, list[str]] = field(default_factory=dict)
 
     def record(self) -> dict[str, Any]:
         """``meta.json["storage"]``."""
         return {
             "layers": dict(sorted(self.forms.items())),
+            "terms": dict(sorted(self.terms.items())),
             "sha256": dict(sorted(self.hashes.items())),
         }
 
@@ -96,13 +111,13 @@ def _file(group: str) -> str:
     return f"{group}.exr"
 
 
-def _identity_terms(identities: Sequence[Mapping[str, Any]], key: str) -> list[str] | None:
+def _identity_terms(identities: Sequence[Mapping[str, Any]], key: str) -> list[str]:
     """``[image, reflectance, shading(, specular)]`` of the identity whose residual is *key*."""
     for ident in identities:
         if isinstance(ident, Mapping) and ident.get("residual") == key:
             terms = [ident.get(k) for k in ("image", "reflectance", "shading", "specular")]
             return [str(t) for t in terms if t is not None]
-    return None
+    return []
 
 
 def _table_product(coverage: np.ndarray, table: np.ndarray) -> np.ndarray:
@@ -114,43 +129,74 @@ def _valid(coverage: np.ndarray) -> np.ndarray:
     return np.asarray(coverage, np.float64).sum(axis=-1) >= COVERAGE_MIN
 
 
+def _f64(values: Mapping[str, np.ndarray], key: str) -> np.ndarray:
+    return np.asarray(values[key], np.float64)
+
+
 def _rebuild(
     key: str,
     form: str,
+    terms: Sequence[str],
     values: Mapping[str, np.ndarray],
     factors: tuple[np.ndarray, np.ndarray] | None,
-    identities: Sequence[Mapping[str, Any]],
 ) -> np.ndarray:
-    """The float32 layer *key* of *form* from the float32 *values* of its factors and, for the
+    """The float32 layer *key* of *form* from the float32 *values* of its *terms* and, for the
     band layers, ``(coverage, table)``."""
     if form == "identity_residual":
-        terms = _identity_terms(identities, key) or []
         out = residual(*(values[t] for t in terms))
+    elif form == "ratio":
+        out = shading_ratio(values[terms[0]], values[terms[1]])
+    elif form == "unit_luminance":
+        out = unit_luminance(_f64(values, terms[0]), _f64(values, terms[1]))
     else:
         if factors is None:
             raise DatasetError(f"layer {key!r} ({form}) needs its coverage and table")
         albedo = _table_product(*factors)
         if form == "coverage_table":
             out = albedo
-        else:
-            spec = values.get("specular_bands")
+        else:  # band_image: terms reflectance, shading, raw cube (, specular)
             out = band_image(
                 albedo,
-                np.asarray(values["shading_bands"], np.float64),
+                _f64(values, terms[1]),
                 _valid(factors[0]),
-                np.asarray(values["image_bands_raw"], np.float64),
-                None if spec is None else np.asarray(spec, np.float64),
+                _f64(values, terms[2]),
+                _f64(values, terms[3]) if len(terms) > 3 else None,
             )
     return np.asarray(out, np.float32)
 
 
-def _needs(key: str, form: str, identities: Sequence[Mapping[str, Any]], have: Any) -> list[str]:
-    """The layers *key* of *form* is rebuilt from (besides coverage and table)."""
-    if form == "identity_residual":
-        return _identity_terms(identities, key) or []
-    if form == "band_image":
-        return [*_BAND_FACTORS, *(["specular_bands"] if "specular_bands" in have else [])]
-    return []
+@dataclass(frozen=True)
+class Candidate:
+    """A layer the writer may store as *form* of the layers *terms*."""
+
+    key: str
+    form: str
+    terms: tuple[str, ...]
+
+
+def _candidates(gt: GroundTruth, identities: Sequence[Mapping[str, Any]]) -> list[Candidate]:
+    """Every ``(layer, form, terms)`` the writer tries, in an order where a layer's terms come
+    first; an identity's residual last, so its terms may be rebuilt ones."""
+    have = gt.layers
+    spec = ["specular_bands"] if "specular_bands" in have else []
+    out = [
+        Candidate("reflectance_bands", "coverage_table", ()),
+        Candidate("image_bands", "band_image", (*_BAND_FACTORS, *spec)),
+        Candidate("shading_ratio", "ratio", ("image", "reflectance")),
+    ]
+    for key in have:  # illuminant, illuminant_camera/<name>: shading / shading_grey
+        if key.split("/", 1)[0] in ("illuminant", "illuminant_camera"):
+            shading = key.replace("illuminant", "shading", 1)
+            out.append(Candidate(key, "unit_luminance", (shading, "shading_grey")))
+    out += [
+        Candidate(
+            str(i["residual"]),
+            "identity_residual",
+            tuple(_identity_terms(identities, str(i["residual"]))),
+        )
+        for i in identities
+    ]
+    return out
 
 
 def stored_layers(
@@ -158,25 +204,24 @@ def stored_layers(
 ) -> StoredLayers:
     """The EXR content of *gt*: every layer in full, except those whose factors rebuild them
     bit for bit (module notes). *coverage* is the render's ``(H, W, M)`` AOV."""
+    values = {k: layer.data for k, layer in gt.layers.items()}
+    factors = None
+    if coverage is not None and gt.band_albedos is not None and "reflectance_bands" in values:
+        factors = (np.asarray(coverage, np.float32), np.asarray(gt.band_albedos, np.float64))
+    forms: dict[str, str] = {}
+    terms: dict[str, list[str]] = {}
+    for c in _candidates(gt, identities):
+        if c.key not in values or c.key in c.terms or any(t not in values for t in c.terms):
+            continue
+        if c.form in _BAND_FORMS and factors is None:
+            continue
+        if c.form == "identity_residual" and not c.terms:
+            continue
+        if np.array_equal(_rebuild(c.key, c.form, c.terms, values, factors), values[c.key]):
+            forms[c.key], terms[c.key] = c.form, list(c.terms)
     arrays: dict[str, dict[str, np.ndarray]] = {}
     channels: dict[str, dict[str, tuple[str, ...]]] = {}
     attributes: dict[str, dict[str, str]] = {}
-    values = {k: layer.data for k, layer in gt.layers.items()}
-    forms: dict[str, str] = {}
-    factors = None
-    table = gt.band_albedos
-    if coverage is not None and table is not None and "reflectance_bands" in values:
-        factors = (np.asarray(coverage, np.float32), np.asarray(table, np.float64))
-    candidates = [("reflectance_bands", "coverage_table"), ("image_bands", "band_image")]
-    candidates += [(str(i["residual"]), "identity_residual") for i in identities]
-    for key, form in candidates:
-        needs = _needs(key, form, identities, values)
-        if key not in values or key in needs or any(n not in values for n in needs):
-            continue
-        if form != "identity_residual" and factors is None:
-            continue
-        if np.array_equal(_rebuild(key, form, values, factors, identities), values[key]):
-            forms[key] = form
     for key, layer in gt.layers.items():
         file = _file(layer.group)
         arrays.setdefault(file, {})
@@ -192,12 +237,13 @@ def stored_layers(
                 factors[1].tolist(), separators=(",", ":"), allow_nan=False
             )
     hashes = {k: layer_sha256(values[k]) for k in forms}
-    return StoredLayers(arrays, channels, attributes, forms, hashes)
+    return StoredLayers(arrays, channels, attributes, forms, hashes, terms)
 
 
 def storage_forms(meta: Mapping[str, Any], layers: Mapping[str, Any]) -> dict[str, str]:
     """``{layer: form}`` of the layers a ``meta.json`` says are stored as factors (empty for
-    samples before issue 45); one-line :class:`DatasetError` for an unknown form or layer."""
+    samples before issue 45); one-line :class:`DatasetError` for an unknown form or layer, or
+    a record without every such layer's terms and SHA-256."""
     record = meta.get("storage")
     if record is None:
         return {}
@@ -210,12 +256,29 @@ def storage_forms(meta: Mapping[str, Any], layers: Mapping[str, Any]) -> dict[st
                 f"meta.json: storage.layers.{key}: {form!r}; expected a listed layer stored "
                 f"as one of {list(FORMS)}"
             )
-    hashes = record.get("sha256")
+    hashes, terms = record.get("sha256"), record.get("terms")
     if not (isinstance(hashes, Mapping) and set(hashes) == set(forms)):
         raise DatasetError(
             "meta.json: storage.sha256: expected the SHA-256 of every layer in storage.layers"
         )
+    if not (
+        isinstance(terms, Mapping)
+        and set(terms) == set(forms)
+        and all(
+            isinstance(t, list) and all(isinstance(x, str) and x in layers and x != k for x in t)
+            for k, t in terms.items()
+        )
+    ):
+        raise DatasetError(
+            "meta.json: storage.terms: expected for every layer in storage.layers the list of "
+            "listed layers it is rebuilt from"
+        )
     return {str(k): str(v) for k, v in forms.items()}
+
+
+def _terms(meta: Mapping[str, Any]) -> dict[str, list[str]]:
+    """``meta.json["storage"]["terms"]`` (validated by :func:`storage_forms` first)."""
+    return {str(k): list(v) for k, v in ((meta.get("storage") or {}).get("terms") or {}).items()}
 
 
 def rebuilt_mismatches(meta: Mapping[str, Any], values: Mapping[str, np.ndarray]) -> list[str]:
@@ -248,15 +311,14 @@ def _table(path: Path, key: str, coverage: np.ndarray, bands: int) -> np.ndarray
 def _closure(
     keys: Sequence[str] | None,
     forms: Mapping[str, str],
-    identities: Sequence[Mapping[str, Any]],
-    records: Mapping[str, Any],
+    terms: Mapping[str, Sequence[str]],
 ) -> set[str]:
     """The factor-stored layers that *keys* (default all) need, themselves included."""
     needed = set(forms if keys is None else (k for k in keys if k in forms))
     stack = list(needed)
     while stack:
         key = stack.pop()
-        for dep in _needs(key, forms[key], identities, records):
+        for dep in terms[key]:
             if dep in forms and dep not in needed:
                 needed.add(dep)
                 stack.append(dep)
@@ -281,34 +343,23 @@ def rebuild_layers(
     *values*, and coverage layers not in *coverage* (by file), are read through *path_of* (file
     name -> path, e.g. after a hash check). Returns *values*."""
     forms = storage_forms(meta, records)
-    identities = meta.get("identities") or []
-    pending = {
-        k: forms[k] for k in sorted(_closure(wanted, forms, identities, records)) if k not in values
-    }
+    terms = _terms(meta)
+    pending = {k: forms[k] for k in sorted(_closure(wanted, forms, terms)) if k not in values}
     factors: dict[str, tuple[np.ndarray, np.ndarray]] = {}
     while pending:
-        ready = [
-            k
-            for k, f in pending.items()
-            if not set(_needs(k, f, identities, records)) & set(pending)
-        ]
+        ready = [k for k, f in pending.items() if not set(terms[k]) & set(pending)]
         if not ready:
             raise DatasetError(f"meta.json: storage.layers {sorted(pending)} depend on each other")
         for key in ready:
             form = pending.pop(key)
-            needs = _needs(key, form, identities, records)
-            if form == "identity_residual" and not needs:
-                raise DatasetError(
-                    f"meta.json: storage.layers.{key}: no identity has it as residual"
-                )
-            _read_missing(records, values, [n for n in needs if n not in values], path_of)
+            _read_missing(records, values, [n for n in terms[key] if n not in values], path_of)
             file_factors = None
-            if form != "identity_residual":
+            if form in _BAND_FORMS:
                 file = str(_field(records[key], "file"))
                 if file not in factors:
                     factors[file] = _factors(path_of(file), file, records, forms, coverage)
                 file_factors = factors[file]
-            values[key] = _rebuild(key, form, values, file_factors, identities)
+            values[key] = _rebuild(key, form, terms[key], values, file_factors)
     return values
 
 
@@ -375,13 +426,13 @@ def read_layers(
     factors and, with *verify*, checked against their recorded SHA-256 (one-line
     :class:`DatasetError`); the factors read only for that are not returned."""
     forms = storage_forms(meta, records)
-    identities = meta.get("identities") or []
-    derived = _closure(keys, forms, identities, records)
+    terms = _terms(meta)
+    derived = _closure(keys, forms, terms)
     stored = {k for k in keys if k not in forms}
     for key in derived:
-        stored.update(n for n in _needs(key, forms[key], identities, records) if n not in forms)
+        stored.update(n for n in terms[key] if n not in forms)
     with_coverage = frozenset(
-        str(_field(records[k], "file")) for k in derived if forms[k] != "identity_residual"
+        str(_field(records[k], "file")) for k in derived if forms[k] in _BAND_FORMS
     )
     values: dict[str, np.ndarray] = {}
     coverage: dict[str, np.ndarray] = {}
