@@ -101,9 +101,14 @@ def test_factored_layers_are_not_stored_and_load_back_bit_for_bit(written):
         len(gt.band_albedos),
     )
     loaded = load_sample(sample)
+    half = meta["storage"]["half"]
+    assert {"error_rgb3"} <= set(half) and all(k.startswith(("noise_", "error_")) for k in half)
     for key, layer in gt.layers.items():
         value = loaded[key] if key != "mask" else loaded[key].astype(np.float32)
-        assert np.array_equal(value, layer.data), key  # every layer, bit for bit
+        if key in half:  # estimates outside every identity, float16: to 2**-11 of the value
+            np.testing.assert_allclose(value, layer.data, rtol=2.0**-11, atol=0)
+        else:  # every other layer, bit for bit
+            assert np.array_equal(value, layer.data), key
     # the table is each material's band albedo, and reflectance_bands is coverage @ table
     table = json.loads(
         read_exr_attributes(sample / "spectral.exr")["spectrinsic.table.reflectance_bands"]
@@ -175,8 +180,10 @@ def test_an_old_form_sample_loads_and_checks_as_before(written, tmp_path):
     old = _as_old_form(sample, gt, tmp_path / sample.name)
     assert check_sample(old) == []
     loaded, compact = load_sample(old), load_sample(sample)
-    for key in gt.layers:
-        assert np.array_equal(loaded[key], compact[key]), key
+    for key, layer in gt.layers.items():
+        value = layer.data if layer.data.dtype != bool else layer.data.astype(np.float32)
+        assert np.array_equal(loaded[key].astype(value.dtype), value), key  # as written
+        assert loaded[key].shape == compact[key].shape, key
     # the compact spectral file is the smaller one
     assert (sample / "spectral.exr").stat().st_size < 0.75 * (old / "spectral.exr").stat().st_size
 

@@ -23,6 +23,10 @@ made of, rebuilt bit for bit by every reader (``load_sample``, ``spectrinsic che
 * ``"identity_residual"`` (the residual of an identity in ``meta.json["identities"]``):
   :func:`~spectrinsic.gt_export.layers.irradiance.residual` of the identity's terms.
 
+Estimates outside every identity (:data:`HALF_PREFIXES`: the noise and error maps) are stored
+as float16 where their values fit (``meta.json["storage"]["half"]``); readers return them as
+float32, within 2**-11 of the computed values.
+
 ``meta.json["storage"]["terms"]`` lists the layers each is rebuilt from (in that order) and
 ``["sha256"]`` the SHA-256 of its float32 values (:func:`layer_sha256`) as the writer computed
 them, which the readers compare the rebuild with. The writer computes these layers from the
@@ -69,6 +73,11 @@ __all__ = [
 
 #: The forms a layer may be stored in besides in full (module notes).
 FORMS = ("coverage_table", "band_image", "ratio", "unit_luminance", "identity_residual")
+#: Layers outside every identity, estimates rather than ground truth, stored as float16 (their
+#: relative rounding, 4.9e-4, is far below their own Monte Carlo error): the noise maps (relative
+#: standard error) and the error maps of the 3- and 6-sensor images.
+HALF_PREFIXES = ("noise_", "error_")
+_HALF_MAX = float(np.finfo(np.float16).max)
 #: The forms rebuilt from the coverage and the band table of their file.
 _BAND_FORMS = ("coverage_table", "band_image")
 _TABLE_ATTRIBUTE = "spectrinsic.table.{layer}"
@@ -91,6 +100,8 @@ class StoredLayers:
     hashes: dict[str, str] = field(default_factory=dict)
     #: The layers every layer in *forms* is rebuilt from, in the form's order.
     terms: dict[str, list[str]] = field(default_factory=dict)
+    #: Layers stored as float16 (:func:`_half_layers`).
+    half: list[str] = field(default_factory=list)
 
     def record(self) -> dict[str, Any]:
         """``meta.json["storage"]``."""
@@ -98,6 +109,7 @@ class StoredLayers:
             "layers": dict(sorted(self.forms.items())),
             "terms": dict(sorted(self.terms.items())),
             "sha256": dict(sorted(self.hashes.items())),
+            "half": list(self.half),
         }
 
 
@@ -236,8 +248,31 @@ def stored_layers(
             attributes.setdefault(file, {})[_TABLE_ATTRIBUTE.format(layer=key)] = json.dumps(
                 factors[1].tolist(), separators=(",", ":"), allow_nan=False
             )
+    half = _half_layers(gt, forms, terms, identities)
+    for key in half:
+        arrays[_file(gt.layers[key].group)][key] = gt.layers[key].data.astype(np.float16)
     hashes = {k: layer_sha256(values[k]) for k in forms}
-    return StoredLayers(arrays, channels, attributes, forms, hashes, terms)
+    return StoredLayers(arrays, channels, attributes, forms, hashes, terms, half)
+
+
+def _half_layers(
+    gt: GroundTruth,
+    forms: Mapping[str, str],
+    terms: Mapping[str, Sequence[str]],
+    identities: Sequence[Mapping[str, Any]],
+) -> list[str]:
+    """The estimates (:data:`HALF_PREFIXES`) that no identity and no rebuilt layer uses, whose
+    values float16 holds (finite, at most 65504)."""
+    used = {str(v) for i in identities for v in i.values()}
+    used |= {t for ts in terms.values() for t in ts}
+    out = []
+    for key, layer in gt.layers.items():
+        if not key.startswith(HALF_PREFIXES) or key in forms or key in used or "/" in key:
+            continue
+        data = np.asarray(layer.data)
+        if data.dtype == np.float32 and np.isfinite(data).all() and np.abs(data).max() <= _HALF_MAX:
+            out.append(key)
+    return sorted(out)
 
 
 def storage_forms(meta: Mapping[str, Any], layers: Mapping[str, Any]) -> dict[str, str]:

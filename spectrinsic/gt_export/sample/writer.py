@@ -181,6 +181,7 @@ def _write_layers(
             arrays,
             channel_names=stored.channels[name],
             attributes={"spectrinsic.sample": sample_id} | stored.attributes.get(name, {}),
+            half=[k for k in stored.half if k in arrays],
         )
         files.append(name)
     return files, stored.record()
