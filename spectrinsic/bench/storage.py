@@ -141,8 +141,11 @@ def _layer_storage(sample: Path, work: Path) -> dict[str, Any]:
     values = read_layers(meta.raw, records, list(records), lambda f: sample / f)
     one = work / "one.exr"
 
-    def alone(name: str, array: np.ndarray, channels: Any) -> int:
-        write_exr(one, {name: array}, channel_names={name: channels})
+    half = set((meta.raw.get("storage") or {}).get("half") or ())
+
+    def alone(name: str, array: np.ndarray, channels: Any, *, as_half: bool = False) -> int:
+        data = array.astype(np.float16) if as_half else array
+        write_exr(one, {name: data}, channel_names={name: channels}, half=[name] if as_half else [])
         return one.stat().st_size
 
     layers: dict[str, Any] = {}
@@ -150,10 +153,13 @@ def _layer_storage(sample: Path, work: Path) -> dict[str, Any]:
     for key, rec in records.items():
         full = alone(rec.exr_layer, values[key], rec.channels)
         stored = 0 if key in forms else full
+        if key in half:  # its float32 values read back from float16: "full" is a lower bound
+            stored = alone(rec.exr_layer, values[key], rec.channels, as_half=True)
         if forms.get(key) == "coverage_table":
             coverage = read_exr(sample / rec.file, layers=[COVERAGE_LAYER])[COVERAGE_LAYER]
             stored = alone(COVERAGE_LAYER, coverage, [f"m{m}" for m in range(coverage.shape[-1])])
-        layers[key] = {"full": full, "stored": stored, "form": forms.get(key, "full")}
+        form = forms.get(key, "float16" if key in half else "full")
+        layers[key] = {"full": full, "stored": stored, "form": form}
         groups.setdefault(rec.file, {})[rec.exr_layer] = (values[key], rec.channels)
     full_dir = work / "full"
     full_dir.mkdir()
@@ -245,9 +251,6 @@ def run(out_dir: Path) -> dict[str, Any]:
         layer_storage = _layer_storage(sample, root / "work")
         previews = sum(v for k, v in _files(sample).items() if "/" in k)
         plain = _plain_sample(root, scene, result, cfg)
-    new_bytes = files[TRANSPORT_NAME]
-    sample_bytes = sum(files.values())
-    old_sample = sample_bytes - new_bytes + old_bytes
     return {
         "scene": f"{SCENE}__v{VIEW}__{CONDITION}",
         "size": [scene.camera.width, scene.camera.height],
@@ -256,24 +259,35 @@ def run(out_dir: Path) -> dict[str, Any]:
         "modes": list(transport.modes),
         "parts": record["parts"],
         "file_bytes": files,
-        "transport_bytes": {"per_batch_layout": old_bytes, "compact": new_bytes},
-        "transport_ratio_old_to_new": old_bytes / new_bytes,
-        "sample_bytes": {"per_batch_layout": old_sample, "compact": sample_bytes},
-        "sample_ratio_old_to_new": old_sample / sample_bytes,
-        "sample_target_bytes": TARGET_SAMPLE_BYTES,
-        "sample_target_met": sample_bytes <= TARGET_SAMPLE_BYTES,
-        "per_10000_samples_gb": {
-            "per_batch_layout": old_sample * 1e4 / 1e9,
-            "compact": sample_bytes * 1e4 / 1e9,
-        },
+        "previews_bytes": previews,
+        **_sizes(files, old_bytes, layer_storage),
         "read_transport_seconds": {"per_batch_layout": read_old_s, "compact": read_new_s},
         "read_slowdown_new_over_old": read_new_s / read_old_s,
         "read_slowdown_goal": 1.5,
         "exactness_compact_vs_memory": exactness,
-        "previews_bytes": previews,
         "layer_storage": layer_storage,
-        "sample_bytes_full_layers": sample_bytes
-        + layer_storage["exr_bytes"]["full"]
-        - layer_storage["exr_bytes"]["stored"],
         "default_sample_without_transport": plain,
+    }
+
+
+def _sizes(files: dict[str, int], old_transport: int, layers: dict[str, Any]) -> dict[str, Any]:
+    """The sample's bytes (its files, previews aside) in three layouts: before issue 45 (the
+    per-batch transport, every layer in full), with the compact transport alone (every layer
+    in full), and as written (compact transport, layers as stored)."""
+    transport, now = files[TRANSPORT_NAME], sum(files.values())
+    full_layers = now + layers["exr_bytes"]["full"] - layers["exr_bytes"]["stored"]
+    sizes = {
+        "before_issue_45": full_layers - transport + old_transport,
+        "compact_transport_full_layers": full_layers,
+        "compact": now,
+    }
+    return {
+        "transport_bytes": {"per_batch_layout": old_transport, "compact": transport},
+        "transport_ratio_old_to_new": old_transport / transport,
+        "sample_bytes": sizes,
+        "sample_ratio_before_to_now": sizes["before_issue_45"] / now,
+        "sample_ratio_full_layers_to_now": full_layers / now,
+        "sample_target_bytes": TARGET_SAMPLE_BYTES,
+        "sample_target_met": now <= TARGET_SAMPLE_BYTES,
+        "per_10000_samples_gb": {k: v * 1e4 / 1e9 for k, v in sizes.items()},
     }

@@ -19,7 +19,8 @@ from spectrinsic.gt_export import check_sample, export_sample, load_sample
 from spectrinsic.gt_export.formats.exr import read_exr, read_exr_attributes, write_exr
 from spectrinsic.gt_export.layers import compute_ground_truth, identities
 from spectrinsic.gt_export.sample import HASHES_KEY, SEAL_KEY, file_sha256, meta_seal
-from spectrinsic.gt_export.sample.layer_storage import COVERAGE_LAYER, stored_layers
+from spectrinsic.gt_export.sample.layer_storage import COVERAGE_LAYER
+from spectrinsic.gt_export.sample.stored_layers import stored_layers
 from spectrinsic.gt_export.sample.writer import DEFAULT_CAMERAS
 from spectrinsic.render import RenderSettings, render_scene
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene

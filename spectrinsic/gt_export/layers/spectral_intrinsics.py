@@ -105,8 +105,11 @@ def band_image(
 
 
 def _image(w: irr.WhiteRadiance, cube: np.ndarray, specular: np.ndarray | None) -> np.ndarray:
-    """The cube rebuilt from a denoised ``W`` (plus the raw specular) where it is valid."""
-    return band_image(w.albedo, w.bands, w.valid, cube, specular)
+    """The cube rebuilt from a denoised ``W`` (plus the raw specular) where it is valid, from
+    ``W`` as stored (float32, ``shading_bands``), so readers rebuild it bit for bit."""
+    return band_image(
+        w.albedo, w.bands.astype(np.float32).astype(np.float64), w.valid, cube, specular
+    )
 
 
 def spectral_layers(
@@ -131,9 +134,6 @@ def spectral_layers(
     cube = np.asarray(s.result.raw[SPECTRAL_MODE], np.float64)
     specular = specular_raw(dataclasses.replace(s, ref=SPECTRAL_MODE))
     rebuilt = denoised and used_w is not raw_w
-    if rebuilt:  # the image is the product of the shading as stored (float32), so a reader
-        # rebuilds it bit for bit from the stored factors
-        used_w = used_w.with_bands(used_w.bands.astype(np.float32).astype(np.float64))
     image = _image(used_w, cube, specular) if rebuilt else cube
 
     def layer(name: str, data: np.ndarray, what: str, nonnegative: bool = False) -> Layer:

@@ -23,29 +23,27 @@ made of, rebuilt bit for bit by every reader (``load_sample``, ``spectrinsic che
 * ``"identity_residual"`` (the residual of an identity in ``meta.json["identities"]``):
   :func:`~spectrinsic.gt_export.layers.irradiance.residual` of the identity's terms.
 
-Estimates outside every identity (:data:`HALF_PREFIXES`: the noise and error maps) are stored
-as float16 where their values fit (``meta.json["storage"]["half"]``); readers return them as
-float32, within 2**-11 of the computed values.
+Estimates outside every identity (the noise and error maps,
+:data:`~spectrinsic.gt_export.sample.stored_layers.HALF_PREFIXES`) are stored as float16 where
+their values fit (``meta.json["storage"]["half"]``); readers return them as float32, within
+2**-11 of the computed values.
 
-``meta.json["storage"]["terms"]`` lists the layers each is rebuilt from (in that order) and
-``["sha256"]`` the SHA-256 of its float32 values (:func:`layer_sha256`) as the writer computed
-them, which the readers compare the rebuild with. The writer computes these layers from the
-float32 values of their terms, as stored.
-
-The writer stores a layer as its factors only where rebuilding it from the float32 values it
-writes gives the layer back bit for bit (:func:`stored_layers` checks every sample), else in
-full. The files' SHA-256 in ``meta.json`` cover the coverage and the table, so ``check`` finds a
-tampered table. Samples without a storage record (before issue 45) hold every layer in full.
-An identity whose residual is rebuilt holds by construction on the stored factors; ``check``
-still recomputes it.
+``meta.json["storage"]["terms"]`` lists the layers each rebuilt layer is made of (in that
+order) and ``["sha256"]`` the SHA-256 of its float32 values (:func:`layer_sha256`) as the writer
+computed them (from the float32 values of its terms, as stored); readers compare the rebuild
+with it. The writer stores a layer as its factors only where the rebuild gives it back bit for
+bit (:mod:`~spectrinsic.gt_export.sample.stored_layers` tries every sample), else in full. The
+files' SHA-256 cover the coverage and the table, the seal of ``meta.json`` the layers' hashes,
+so ``check`` finds a tampered table or term. Samples without a storage record (before issue 45)
+hold every layer in full and read as before. A residual rebuilt from its identity's terms
+satisfies the identity by construction; its recorded hash is what ``check`` verifies.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -55,81 +53,39 @@ from ...errors import DatasetError
 from ..formats.exr import read_exr, read_exr_attributes
 from ..layers.imaging import shading_ratio
 from ..layers.irradiance import COVERAGE_MIN, residual, unit_luminance
-from ..layers.records import GroundTruth
 from ..layers.spectral_intrinsics import band_image
 from .transport_exr import COVERAGE_LAYER  # one name for the per-material coverage layer
 
 __all__ = [
     "FORMS",
     "COVERAGE_LAYER",
-    "StoredLayers",
-    "stored_layers",
+    "BAND_FACTORS",
+    "BAND_FORMS",
+    "TABLE_ATTRIBUTE",
+    "rebuild",
     "storage_forms",
     "layer_sha256",
     "rebuilt_mismatches",
+    "storage_summary",
     "read_layers",
     "rebuild_layers",
 ]
 
 #: The forms a layer may be stored in besides in full (module notes).
 FORMS = ("coverage_table", "band_image", "ratio", "unit_luminance", "identity_residual")
-#: Layers outside every identity, estimates rather than ground truth, stored as float16 (their
-#: relative rounding, 4.9e-4, is far below their own Monte Carlo error): the noise maps (relative
-#: standard error) and the error maps of the 3- and 6-sensor images.
-HALF_PREFIXES = ("noise_", "error_")
-_HALF_MAX = float(np.finfo(np.float16).max)
 #: The forms rebuilt from the coverage and the band table of their file.
-_BAND_FORMS = ("coverage_table", "band_image")
-_TABLE_ATTRIBUTE = "spectrinsic.table.{layer}"
-_BAND_FACTORS = ("reflectance_bands", "shading_bands", "image_bands_raw")
+BAND_FORMS = ("coverage_table", "band_image")
+TABLE_ATTRIBUTE = "spectrinsic.table.{layer}"
+BAND_FACTORS = ("reflectance_bands", "shading_bands", "image_bands_raw")
 #: Largest table a header may declare (materials × bands), so a damaged file cannot make the
 #: reader allocate without bound.
 _TABLE_MAX = 1 << 20
-
-
-@dataclass(frozen=True)
-class StoredLayers:
-    """What :func:`stored_layers` decided: per file the EXR layers to write, their channel names
-    and header attributes, and the form of every layer not stored in full."""
-
-    arrays: dict[str, dict[str, np.ndarray]]
-    channels: dict[str, dict[str, tuple[str, ...]]]
-    attributes: dict[str, dict[str, str]]
-    forms: dict[str, str] = field(default_factory=dict)
-    #: :func:`layer_sha256` of every layer in *forms*, as the writer computed it.
-    hashes: dict[str, str] = field(default_factory=dict)
-    #: The layers every layer in *forms* is rebuilt from, in the form's order.
-    terms: dict[str, list[str]] = field(default_factory=dict)
-    #: Layers stored as float16 (:func:`_half_layers`).
-    half: list[str] = field(default_factory=list)
-
-    def record(self) -> dict[str, Any]:
-        """``meta.json["storage"]``."""
-        return {
-            "layers": dict(sorted(self.forms.items())),
-            "terms": dict(sorted(self.terms.items())),
-            "sha256": dict(sorted(self.hashes.items())),
-            "half": list(self.half),
-        }
 
 
 def layer_sha256(array: np.ndarray) -> str:
     """SHA-256 of a layer's values: float32 little-endian, C order ``(H, W[, C])`` (of a
     rebuilt layer, recorded in ``meta.json["storage"]["sha256"]``)."""
     return hashlib.sha256(np.ascontiguousarray(array, "<f4").tobytes()).hexdigest()
-
-
-def _file(group: str) -> str:
-    return f"{group}.exr"
-
-
-def _identity_terms(identities: Sequence[Mapping[str, Any]], key: str) -> list[str]:
-    """``[image, reflectance, shading(, specular)]`` of the identity whose residual is *key*."""
-    for ident in identities:
-        if isinstance(ident, Mapping) and ident.get("residual") == key:
-            terms = [ident.get(k) for k in ("image", "reflectance", "shading", "specular")]
-            return [str(t) for t in terms if t is not None]
-    return []
 
 
 def _table_product(coverage: np.ndarray, table: np.ndarray) -> np.ndarray:
@@ -145,7 +101,7 @@ def _f64(values: Mapping[str, np.ndarray], key: str) -> np.ndarray:
     return np.asarray(values[key], np.float64)
 
 
-def _rebuild(
+def rebuild(
     key: str,
     form: str,
     terms: Sequence[str],
@@ -175,104 +131,6 @@ def _rebuild(
                 _f64(values, terms[3]) if len(terms) > 3 else None,
             )
     return np.asarray(out, np.float32)
-
-
-@dataclass(frozen=True)
-class Candidate:
-    """A layer the writer may store as *form* of the layers *terms*."""
-
-    key: str
-    form: str
-    terms: tuple[str, ...]
-
-
-def _candidates(gt: GroundTruth, identities: Sequence[Mapping[str, Any]]) -> list[Candidate]:
-    """Every ``(layer, form, terms)`` the writer tries, in an order where a layer's terms come
-    first; an identity's residual last, so its terms may be rebuilt ones."""
-    have = gt.layers
-    spec = ["specular_bands"] if "specular_bands" in have else []
-    out = [
-        Candidate("reflectance_bands", "coverage_table", ()),
-        Candidate("image_bands", "band_image", (*_BAND_FACTORS, *spec)),
-        Candidate("shading_ratio", "ratio", ("image", "reflectance")),
-    ]
-    for key in have:  # illuminant, illuminant_camera/<name>: shading / shading_grey
-        if key.split("/", 1)[0] in ("illuminant", "illuminant_camera"):
-            shading = key.replace("illuminant", "shading", 1)
-            out.append(Candidate(key, "unit_luminance", (shading, "shading_grey")))
-    out += [
-        Candidate(
-            str(i["residual"]),
-            "identity_residual",
-            tuple(_identity_terms(identities, str(i["residual"]))),
-        )
-        for i in identities
-    ]
-    return out
-
-
-def stored_layers(
-    gt: GroundTruth, coverage: np.ndarray | None, identities: Sequence[Mapping[str, Any]]
-) -> StoredLayers:
-    """The EXR content of *gt*: every layer in full, except those whose factors rebuild them
-    bit for bit (module notes). *coverage* is the render's ``(H, W, M)`` AOV."""
-    values = {k: layer.data for k, layer in gt.layers.items()}
-    factors = None
-    if coverage is not None and gt.band_albedos is not None and "reflectance_bands" in values:
-        factors = (np.asarray(coverage, np.float32), np.asarray(gt.band_albedos, np.float64))
-    forms: dict[str, str] = {}
-    terms: dict[str, list[str]] = {}
-    for c in _candidates(gt, identities):
-        if c.key not in values or c.key in c.terms or any(t not in values for t in c.terms):
-            continue
-        if c.form in _BAND_FORMS and factors is None:
-            continue
-        if c.form == "identity_residual" and not c.terms:
-            continue
-        if np.array_equal(_rebuild(c.key, c.form, c.terms, values, factors), values[c.key]):
-            forms[c.key], terms[c.key] = c.form, list(c.terms)
-    arrays: dict[str, dict[str, np.ndarray]] = {}
-    channels: dict[str, dict[str, tuple[str, ...]]] = {}
-    attributes: dict[str, dict[str, str]] = {}
-    for key, layer in gt.layers.items():
-        file = _file(layer.group)
-        arrays.setdefault(file, {})
-        channels.setdefault(file, {})
-        if key not in forms:
-            name = key.split("/", 1)[0]
-            arrays[file][name] = layer.data
-            channels[file][name] = layer.channels
-        elif forms[key] == "coverage_table" and factors is not None:
-            arrays[file][COVERAGE_LAYER] = factors[0]
-            channels[file][COVERAGE_LAYER] = tuple(f"m{m}" for m in range(factors[0].shape[-1]))
-            attributes.setdefault(file, {})[_TABLE_ATTRIBUTE.format(layer=key)] = json.dumps(
-                factors[1].tolist(), separators=(",", ":"), allow_nan=False
-            )
-    half = _half_layers(gt, forms, terms, identities)
-    for key in half:
-        arrays[_file(gt.layers[key].group)][key] = gt.layers[key].data.astype(np.float16)
-    hashes = {k: layer_sha256(values[k]) for k in forms}
-    return StoredLayers(arrays, channels, attributes, forms, hashes, terms, half)
-
-
-def _half_layers(
-    gt: GroundTruth,
-    forms: Mapping[str, str],
-    terms: Mapping[str, Sequence[str]],
-    identities: Sequence[Mapping[str, Any]],
-) -> list[str]:
-    """The estimates (:data:`HALF_PREFIXES`) that no identity and no rebuilt layer uses, whose
-    values float16 holds (finite, at most 65504)."""
-    used = {str(v) for i in identities for v in i.values()}
-    used |= {t for ts in terms.values() for t in ts}
-    out = []
-    for key, layer in gt.layers.items():
-        if not key.startswith(HALF_PREFIXES) or key in forms or key in used or "/" in key:
-            continue
-        data = np.asarray(layer.data)
-        if data.dtype == np.float32 and np.isfinite(data).all() and np.abs(data).max() <= _HALF_MAX:
-            out.append(key)
-    return sorted(out)
 
 
 def storage_forms(meta: Mapping[str, Any], layers: Mapping[str, Any]) -> dict[str, str]:
@@ -311,6 +169,29 @@ def storage_forms(meta: Mapping[str, Any], layers: Mapping[str, Any]) -> dict[st
     return {str(k): str(v) for k, v in forms.items()}
 
 
+def storage_summary(metas: Iterable[Mapping[str, Any]]) -> dict[str, Any]:
+    """The manifest's record of how its samples' layers are stored: ``{form: [layer, ...]}``
+    over every sample (``"full"`` for the rest), the float16 layers, and how many samples
+    have no storage record (written before issue 45: every layer in full)."""
+    forms: dict[str, set[str]] = {}
+    half: set[str] = set()
+    old = 0
+    for meta in metas:
+        record = meta.get("storage")
+        if not isinstance(record, Mapping):
+            old += 1
+            continue
+        for key, form in (record.get("layers") or {}).items():
+            forms.setdefault(str(form), set()).add(str(key))
+        half.update(str(k) for k in record.get("half") or ())
+    return {
+        "as_factors": {form: sorted(keys) for form, keys in sorted(forms.items())},
+        "float16": sorted(half),
+        "samples_without_record": old,
+        "doc": "docs/sample-storage.md",
+    }
+
+
 def _terms(meta: Mapping[str, Any]) -> dict[str, list[str]]:
     """``meta.json["storage"]["terms"]`` (validated by :func:`storage_forms` first)."""
     return {str(k): list(v) for k, v in ((meta.get("storage") or {}).get("terms") or {}).items()}
@@ -325,7 +206,7 @@ def rebuilt_mismatches(meta: Mapping[str, Any], values: Mapping[str, np.ndarray]
 
 def _table(path: Path, key: str, coverage: np.ndarray, bands: int) -> np.ndarray:
     """The ``(M, K)`` table of *key* from *path*'s header, checked against its coverage."""
-    name = _TABLE_ATTRIBUTE.format(layer=key)
+    name = TABLE_ATTRIBUTE.format(layer=key)
     text = read_exr_attributes(path).get(name)
     try:
         table = (
@@ -389,12 +270,12 @@ def rebuild_layers(
             form = pending.pop(key)
             _read_missing(records, values, [n for n in terms[key] if n not in values], path_of)
             file_factors = None
-            if form in _BAND_FORMS:
+            if form in BAND_FORMS:
                 file = str(_field(records[key], "file"))
                 if file not in factors:
                     factors[file] = _factors(path_of(file), file, records, forms, coverage)
                 file_factors = factors[file]
-            values[key] = _rebuild(key, form, terms[key], values, file_factors)
+            values[key] = rebuild(key, form, terms[key], values, file_factors)
     return values
 
 
@@ -467,7 +348,7 @@ def read_layers(
     for key in derived:
         stored.update(n for n in terms[key] if n not in forms)
     with_coverage = frozenset(
-        str(_field(records[k], "file")) for k in derived if forms[k] in _BAND_FORMS
+        str(_field(records[k], "file")) for k in derived if forms[k] in BAND_FORMS
     )
     values: dict[str, np.ndarray] = {}
     coverage: dict[str, np.ndarray] = {}

@@ -57,9 +57,9 @@ from . import (
     plain_data,
 )
 from .integrity import remove_owned_temporaries, replaceable_sample, sample_problem
-from .layer_storage import stored_layers
 from .previews import preview_maker, preview_path, shown_layers
 from .sensor import SensorOutput, sensor_output, write_sensor_files
+from .stored_layers import compression_of, stored_layers
 from .transport_exr import TRANSPORT_NAME, write_transport
 
 if TYPE_CHECKING:
@@ -182,6 +182,7 @@ def _write_layers(
             channel_names=stored.channels[name],
             attributes={"spectrinsic.sample": sample_id} | stored.attributes.get(name, {}),
             half=[k for k in stored.half if k in arrays],
+            compression=compression_of(name),
         )
         files.append(name)
     return files, stored.record()
