@@ -23,7 +23,7 @@ made of, rebuilt bit for bit by every reader (``load_sample``, ``spectrinsic che
 * ``"identity_residual"`` (the residual of an identity in ``meta.json["identities"]``):
   :func:`~spectrinsic.gt_export.layers.irradiance.residual` of the identity's terms.
 
-Estimates outside every identity (the noise and error maps,
+Estimates outside every identity (the noise maps,
 :data:`~spectrinsic.gt_export.sample.stored_layers.HALF_PREFIXES`) are stored as float16 where
 their values fit (``meta.json["storage"]["half"]``); readers return them as float32, within
 2**-11 of the computed values.

@@ -26,10 +26,12 @@ from .layer_storage import (
 
 __all__ = ["HALF_PREFIXES", "PIZ_FILES", "StoredLayers", "compression_of", "stored_layers"]
 
-#: Layers outside every identity, estimates rather than ground truth, stored as float16 (their
-#: relative rounding, 4.9e-4, is far below their own Monte Carlo error): the noise maps (relative
-#: standard error) and the error maps of the 3- and 6-sensor images.
-HALF_PREFIXES = ("noise_", "error_")
+#: Layers outside every identity, estimates rather than ground truth, stored as float16: the
+#: noise maps (relative standard error of the batches; their float16 rounding, 4.9e-4 of the
+#: value, is far below their own sampling error, and they come from the transport's float16
+#: deviations in relit samples anyway). The error maps of the 3- and 6-sensor images stay
+#: float32: relit ones must equal a direct render's within 1e-5 like every other layer.
+HALF_PREFIXES = ("noise_",)
 _HALF_MAX = float(np.finfo(np.float16).max)
 #: Files written with PIZ instead of ZIP (lossless both), chosen by measurement on the default
 #: 256² two-light room (``make bench``, storage): Monte Carlo noise in float32 images packs
