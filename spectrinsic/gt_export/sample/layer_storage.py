@@ -26,7 +26,7 @@ made of, rebuilt bit for bit by every reader (``load_sample``, ``spectrinsic che
 Estimates outside every identity (the noise maps,
 :data:`~spectrinsic.gt_export.sample.stored_layers.HALF_PREFIXES`) are stored as float16 where
 their values fit (``meta.json["storage"]["half"]``); readers return them as float32, within
-2**-11 of the computed values.
+2**-11 of the computed values (2**-24 absolute below 6.1e-5, where float16 is subnormal).
 
 ``meta.json["storage"]["terms"]`` lists the layers each rebuilt layer is made of (in that
 order) and ``["sha256"]`` the SHA-256 of its float32 values (:func:`layer_sha256`) as the writer
