@@ -240,7 +240,7 @@ def test_check_finds_a_wrong_factor_by_the_rebuilt_layers_sha256(room, tmp_path)
         load_sample(copy, layers=["image_bands"])
 
 
-def test_an_unknown_storage_form_is_refused_in_one_line(room, tmp_path):
+def test_an_unknown_form_or_wrong_terms_are_refused_in_one_line(room, tmp_path):
     sample, _, _ = room
     copy = tmp_path / sample.name
     shutil.copytree(sample, copy)
@@ -251,3 +251,9 @@ def test_an_unknown_storage_form_is_refused_in_one_line(room, tmp_path):
     with pytest.raises(DatasetError, match=r"storage\.layers\.residual_bands: 'zip-magic'"):
         load_sample(copy)
     assert any("zip-magic" in p for p in check_sample(copy))
+    meta["storage"]["layers"]["residual_bands"] = "identity_residual"
+    meta["storage"]["terms"]["residual_bands"] = ["image_bands"]  # a residual of one term
+    (copy / "meta.json").write_text(json.dumps(meta))
+    _renew_seal(copy)
+    with pytest.raises(DatasetError, match=r"storage\.terms: .* as many as its form takes"):
+        load_sample(copy, layers=["residual_bands"])

@@ -73,9 +73,19 @@ __all__ = [
 
 #: The forms a layer may be stored in besides in full (module notes).
 FORMS = ("coverage_table", "band_image", "ratio", "unit_luminance", "identity_residual")
+#: How many terms each form is rebuilt from (besides a file's coverage and table).
+_TERM_COUNTS = {
+    "coverage_table": (0,),
+    "band_image": (3, 4),
+    "ratio": (2,),
+    "unit_luminance": (2,),
+    "identity_residual": (3, 4),
+}
 #: The forms rebuilt from the coverage and the band table of their file.
 BAND_FORMS = ("coverage_table", "band_image")
+#: Header attribute of the file holding a ``coverage_table`` layer: its ``(M, K)`` table.
 TABLE_ATTRIBUTE = "spectrinsic.table.{layer}"
+#: The terms of ``image_bands`` (``band_image``), then ``specular_bands`` in glossy scenes.
 BAND_FACTORS = ("reflectance_bands", "shading_bands", "image_bands_raw")
 #: Largest table a header may declare (materials × bands), so a damaged file cannot make the
 #: reader allocate without bound.
@@ -158,21 +168,23 @@ def storage_forms(meta: Mapping[str, Any], layers: Mapping[str, Any]) -> dict[st
         isinstance(terms, Mapping)
         and set(terms) == set(forms)
         and all(
-            isinstance(t, list) and all(isinstance(x, str) and x in layers and x != k for x in t)
+            isinstance(t, list)
+            and len(t) in _TERM_COUNTS[str(forms[k])]
+            and all(isinstance(x, str) and x in layers and x != k for x in t)
             for k, t in terms.items()
         )
     ):
         raise DatasetError(
             "meta.json: storage.terms: expected for every layer in storage.layers the list of "
-            "listed layers it is rebuilt from"
+            "listed layers it is rebuilt from, as many as its form takes"
         )
     return {str(k): str(v) for k, v in forms.items()}
 
 
 def storage_summary(metas: Iterable[Mapping[str, Any]]) -> dict[str, Any]:
     """The manifest's record of how its samples' layers are stored: ``{form: [layer, ...]}``
-    over every sample (``"full"`` for the rest), the float16 layers, and how many samples
-    have no storage record (written before issue 45: every layer in full)."""
+    of the rebuilt layers over every sample (the others are stored in full), the float16
+    layers, and how many samples have no storage record (before issue 45: all in full)."""
     forms: dict[str, set[str]] = {}
     half: set[str] = set()
     old = 0
@@ -275,7 +287,12 @@ def rebuild_layers(
                 if file not in factors:
                     factors[file] = _factors(path_of(file), file, records, forms, coverage)
                 file_factors = factors[file]
-            values[key] = rebuild(key, form, terms[key], values, file_factors)
+            try:
+                values[key] = rebuild(key, form, terms[key], values, file_factors)
+            except ValueError as exc:  # terms of other shapes than the layer (a damaged file)
+                raise DatasetError(
+                    f"layer {key!r} cannot be rebuilt from {terms[key]}: {exc}"
+                ) from exc
     return values
 
 
