@@ -3,8 +3,9 @@ made of, rebuilt bit for bit by every reader (``load_sample``, ``spectrinsic che
 
 ``meta.json["storage"]["layers"]`` names the *form* of every layer that is not stored in full:
 
-* ``"coverage_table"`` (``reflectance_bands``): ``float32(coverage @ table)``, the writer's own
-  product (:func:`~spectrinsic.gt_export.layers.irradiance.white_radiance`). ``coverage``
+* ``"coverage_table"`` (``reflectance_bands``): ``float32(coverage @ table)`` summed in
+  material order (:func:`~spectrinsic.gt_export.layers.irradiance.coverage_albedo`, the
+  writer's own product: the same bits on every machine). ``coverage``
   ``(H, W, M)`` is the render's per-material pixel coverage (a textured hit's share split over
   its basis materials by the texel's weights), stored as the float32 layer :data:`COVERAGE_LAYER`
   of the same file (channels ``m0 …``); ``table`` ``(M, K)`` is every material's band albedo,
@@ -52,7 +53,7 @@ import numpy as np
 from ...errors import DatasetError
 from ..formats.exr import read_exr, read_exr_attributes
 from ..layers.imaging import shading_ratio
-from ..layers.irradiance import COVERAGE_MIN, residual, unit_luminance
+from ..layers.irradiance import coverage_albedo, covered, residual, unit_luminance
 from ..layers.spectral_intrinsics import band_image
 from .transport_exr import COVERAGE_LAYER  # one name for the per-material coverage layer
 
@@ -98,15 +99,6 @@ def layer_sha256(array: np.ndarray) -> str:
     return hashlib.sha256(np.ascontiguousarray(array, "<f4").tobytes()).hexdigest()
 
 
-def _table_product(coverage: np.ndarray, table: np.ndarray) -> np.ndarray:
-    """``coverage @ table`` in float64, the writer's einsum (same order, same bits)."""
-    return np.einsum("hwm,mk->hwk", np.asarray(coverage, np.float64), table)
-
-
-def _valid(coverage: np.ndarray) -> np.ndarray:
-    return np.asarray(coverage, np.float64).sum(axis=-1) >= COVERAGE_MIN
-
-
 def _f64(values: Mapping[str, np.ndarray], key: str) -> np.ndarray:
     return np.asarray(values[key], np.float64)
 
@@ -129,14 +121,14 @@ def rebuild(
     else:
         if factors is None:
             raise DatasetError(f"layer {key!r} ({form}) needs its coverage and table")
-        albedo = _table_product(*factors)
+        albedo = coverage_albedo(*factors)
         if form == "coverage_table":
             out = albedo
         else:  # band_image: terms reflectance, shading, raw cube (, specular)
             out = band_image(
                 albedo,
                 _f64(values, terms[1]),
-                _valid(factors[0]),
+                covered(factors[0]),
                 _f64(values, terms[2]),
                 _f64(values, terms[3]) if len(terms) > 3 else None,
             )
