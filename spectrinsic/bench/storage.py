@@ -15,7 +15,14 @@ layers (what issue 45 measured at 235 MB for a five-light generated room). Repor
   transport read back against those composed from the in-memory transport (largest difference
   relative to each array's largest magnitude; goal ≤ 1e-5), and the noise estimate's (goal
   ≤ 1e-3, its float16 deviations);
-* the same bytes scaled to 10,000 samples.
+* the same bytes scaled to 10,000 samples;
+* the layers (issue 45, :mod:`~spectrinsic.gt_export.sample.layer_storage`): every layer's bytes
+  alone (ZIP) in full and as stored (its coverage for a per-material table, nothing for one
+  rebuilt from the others), every EXR file in full (the layout before it, written by this
+  module from the layers the loader rebuilds) against as written, the seconds to read every
+  layer back (rebuilt ones included) against reading the full files, ``check`` on the compact
+  form; for this sample and for the same render written as a default sample (no transport,
+  no spectral layers), whose issue-45 goal is 12 MB.
 """
 
 from __future__ import annotations
@@ -27,9 +34,10 @@ from typing import Any
 
 import numpy as np
 
-from ..gt_export import export_sample
-from ..gt_export.formats.exr import write_exr
+from ..gt_export import check_sample, export_sample
+from ..gt_export.formats.exr import read_exr, write_exr
 from ..gt_export.relight import relit_scene
+from ..gt_export.sample.layer_storage import read_layers
 from ..gt_export.sample.meta import read_meta
 from ..gt_export.sample.transport_exr import (
     COVERAGE_LAYER,
@@ -53,6 +61,8 @@ EXACT_GOAL = 1e-5
 NOISE_GOAL = 1e-3
 #: Issue 45's target for a relightable 256² default sample with spectral layers.
 TARGET_SAMPLE_BYTES = 50e6
+#: Issue 45's target for a default sample without transport (and without spectral layers).
+TARGET_PLAIN_BYTES = 12e6
 
 
 def _per_batch_file(path: Path, transport: LightTransport, coverage: np.ndarray) -> int:
@@ -113,6 +123,102 @@ def _exactness(read: LightTransport, memory: LightTransport, scene: Any) -> dict
     }
 
 
+def _files(sample: Path) -> dict[str, int]:
+    """Bytes of every file of a sample folder, previews included (by relative path)."""
+    return {
+        p.relative_to(sample).as_posix(): p.stat().st_size
+        for p in sorted(sample.rglob("*"))
+        if p.is_file()
+    }
+
+
+def _layer_storage(sample: Path, work: Path) -> dict[str, Any]:
+    """Bytes per layer and per EXR file of *sample* in full against as written, the seconds to
+    read every layer back, and ``check`` on it (module notes)."""
+    meta = read_meta(sample)
+    records = meta.layers
+    forms = (meta.raw.get("storage") or {}).get("layers", {})
+    values = read_layers(meta.raw, records, list(records), lambda f: sample / f)
+    one = work / "one.exr"
+
+    half = set((meta.raw.get("storage") or {}).get("half") or ())
+
+    def alone(name: str, array: np.ndarray, channels: Any, *, as_half: bool = False) -> int:
+        data = array.astype(np.float16) if as_half else array
+        write_exr(one, {name: data}, channel_names={name: channels}, half=[name] if as_half else [])
+        return one.stat().st_size
+
+    layers: dict[str, Any] = {}
+    groups: dict[str, dict[str, Any]] = {}
+    for key, rec in records.items():
+        full = alone(rec.exr_layer, values[key], rec.channels)
+        stored = 0 if key in forms else full
+        if key in half:  # its float32 values read back from float16: "full" is a lower bound
+            stored = alone(rec.exr_layer, values[key], rec.channels, as_half=True)
+        if forms.get(key) == "coverage_table":
+            coverage = read_exr(sample / rec.file, layers=[COVERAGE_LAYER])[COVERAGE_LAYER]
+            stored = alone(COVERAGE_LAYER, coverage, [f"m{m}" for m in range(coverage.shape[-1])])
+        form = forms.get(key, "float16" if key in half else "full")
+        layers[key] = {"full": full, "stored": stored, "form": form}
+        groups.setdefault(rec.file, {})[rec.exr_layer] = (values[key], rec.channels)
+    full_dir = work / "full"
+    full_dir.mkdir()
+    for file, members in groups.items():
+        write_exr(
+            full_dir / file,
+            {k: v for k, (v, _) in members.items()},
+            channel_names={k: c for k, (_, c) in members.items()},
+        )
+    files = {
+        f: {"full": (full_dir / f).stat().st_size, "stored": (sample / f).stat().st_size}
+        for f in groups
+    }
+    read_full = _median_seconds(lambda: [read_exr(full_dir / f) for f in groups])
+    read_stored = _median_seconds(
+        lambda: read_layers(meta.raw, records, list(records), lambda f: sample / f)
+    )
+    return {
+        "layers": layers,
+        "exr_files": files,
+        "exr_bytes": {k: sum(v[k] for v in files.values()) for k in ("full", "stored")},
+        "read_all_layers_seconds": {"full": read_full, "stored": read_stored},
+        "read_slowdown_stored_over_full": read_stored / read_full,
+        "check_problems": check_sample(sample),
+    }
+
+
+def _plain_sample(root: Path, scene: Any, result: Any, cfg: Any) -> dict[str, Any]:
+    """The same render written as a default sample (no transport, no spectral layers)."""
+    sample = export_sample(
+        root,
+        scene,
+        result,
+        sample_id="storage__v0__plain",
+        config=cfg.to_dict(),
+        seed=SEED,
+        cameras=cfg.resolved_cameras(),
+        denoise=cfg.denoise,
+    )
+    files = _files(sample)
+    work = root / "plain_work"
+    work.mkdir()
+    layer_storage = _layer_storage(sample, work)
+    top = sum(v for k, v in files.items() if "/" not in k)
+    saved = layer_storage["exr_bytes"]["full"] - layer_storage["exr_bytes"]["stored"]
+    return {
+        "file_bytes": files,
+        "sample_bytes": {"full_layers": top + saved, "compact": top},
+        "previews_bytes": sum(v for k, v in files.items() if "/" in k),
+        "target_bytes": TARGET_PLAIN_BYTES,
+        "target_met": top <= TARGET_PLAIN_BYTES,
+        "per_10000_samples_gb": {
+            "full_layers": (top + saved) * 1e4 / 1e9,
+            "compact": top * 1e4 / 1e9,
+        },
+        "layer_storage": layer_storage,
+    }
+
+
 def run(out_dir: Path) -> dict[str, Any]:
     cfg = get_preset("default")
     scene = build(SCENE, view=VIEW, condition=CONDITION, seed=0, width=cfg.width, height=cfg.height)
@@ -141,9 +247,10 @@ def run(out_dir: Path) -> dict[str, Any]:
         read_old_s = _median_seconds(read_transport, old_dir, old_record)
         read_new_s = _median_seconds(read_transport, sample, record)
         exactness = _exactness(read, transport, scene)
-    new_bytes = files[TRANSPORT_NAME]
-    sample_bytes = sum(files.values())
-    old_sample = sample_bytes - new_bytes + old_bytes
+        (root / "work").mkdir()
+        layer_storage = _layer_storage(sample, root / "work")
+        previews = sum(v for k, v in _files(sample).items() if "/" in k)
+        plain = _plain_sample(root, scene, result, cfg)
     return {
         "scene": f"{SCENE}__v{VIEW}__{CONDITION}",
         "size": [scene.camera.width, scene.camera.height],
@@ -152,18 +259,35 @@ def run(out_dir: Path) -> dict[str, Any]:
         "modes": list(transport.modes),
         "parts": record["parts"],
         "file_bytes": files,
-        "transport_bytes": {"per_batch_layout": old_bytes, "compact": new_bytes},
-        "transport_ratio_old_to_new": old_bytes / new_bytes,
-        "sample_bytes": {"per_batch_layout": old_sample, "compact": sample_bytes},
-        "sample_ratio_old_to_new": old_sample / sample_bytes,
-        "sample_target_bytes": TARGET_SAMPLE_BYTES,
-        "sample_target_met": sample_bytes <= TARGET_SAMPLE_BYTES,
-        "per_10000_samples_gb": {
-            "per_batch_layout": old_sample * 1e4 / 1e9,
-            "compact": sample_bytes * 1e4 / 1e9,
-        },
+        "previews_bytes": previews,
+        **_sizes(files, old_bytes, layer_storage),
         "read_transport_seconds": {"per_batch_layout": read_old_s, "compact": read_new_s},
         "read_slowdown_new_over_old": read_new_s / read_old_s,
         "read_slowdown_goal": 1.5,
         "exactness_compact_vs_memory": exactness,
+        "layer_storage": layer_storage,
+        "default_sample_without_transport": plain,
+    }
+
+
+def _sizes(files: dict[str, int], old_transport: int, layers: dict[str, Any]) -> dict[str, Any]:
+    """The sample's bytes (its files, previews aside) in three layouts: before issue 45 (the
+    per-batch transport, every layer in full), with the compact transport alone (every layer
+    in full), and as written (compact transport, layers as stored)."""
+    transport, now = files[TRANSPORT_NAME], sum(files.values())
+    full_layers = now + layers["exr_bytes"]["full"] - layers["exr_bytes"]["stored"]
+    sizes = {
+        "before_issue_45": full_layers - transport + old_transport,
+        "compact_transport_full_layers": full_layers,
+        "compact": now,
+    }
+    return {
+        "transport_bytes": {"per_batch_layout": old_transport, "compact": transport},
+        "transport_ratio_old_to_new": old_transport / transport,
+        "sample_bytes": sizes,
+        "sample_ratio_before_to_now": sizes["before_issue_45"] / now,
+        "sample_ratio_full_layers_to_now": full_layers / now,
+        "sample_target_bytes": TARGET_SAMPLE_BYTES,
+        "sample_target_met": now <= TARGET_SAMPLE_BYTES,
+        "per_10000_samples_gb": {k: v * 1e4 / 1e9 for k, v in sizes.items()},
     }

@@ -42,7 +42,7 @@ def add_layer_options(p: Any) -> None:
         help="also write per-band intrinsic layers of the 31-band cube (spectral.exr: "
         "image, reflectance, shading, specular, residual per 10 nm band, float32), where "
         "image = reflectance * shading + specular + residual holds band by band; needs the "
-        "bands31 mode (default preset); about +24 MB and +2.3 s per 256x256 sample",
+        "bands31 mode (default preset); about +13.5 MB and +2.3 s per 256x256 sample",
     )
     p.add_argument(
         "--working-space",

@@ -9,15 +9,18 @@ plain scene, so the room's figures are used):
 =======================  =============  ===============================================
 what                     bytes / pixel  measured
 =======================  =============  ===============================================
-default layers           320            21 MB for a 256² two-light room (README); 215 for a
-                                        64² plane
-without ``bands31``      160            the preview preset: half of the default's (477 kB
-                                        against 943 kB for the same 64² plane)
+default layers           180            11.3 MB of EXR for a 256² two-light room with the
+                                        layers stored as their factors (issue 45, ``make
+                                        bench`` ``storage``; 320 before)
+without ``bands31``      160            the preview preset: half of the default's before
+                                        issue 45 (477 kB against 943 kB for a 64² plane; not
+                                        re-measured since: an upper bound)
 ``--store-transport``    300 per light  the compact transport (issue 45, ``make bench``
                                         ``storage``): 28.9 MB for a 256² two-light matte room
                                         (220 per light), 19.5 MB for a one-light glossy room
                                         (297, its glossy parts included)
-``--spectral-layers``    370            +24 MB per 256² sample (``--help``); 270 for a 64² plane
+``--spectral-layers``    210            +13.5 MB per 256² sample (``spectral.exr``, ``make
+                                        bench`` ``storage``; 370 before issue 45)
 ``--write-cube``         124            31 float32 bands, uncompressed (an upper bound)
 ``--camera``             100            raw mosaic and DNG (16 bit), processed layers
 =======================  =============  ===============================================
@@ -60,8 +63,8 @@ def estimate_sample_bytes(config: DatasetConfig) -> int:
     """Bytes one sample folder of *config* takes on disk, relit variants included (module
     table)."""
     bands31 = "bands31" in config.render.modes
-    per_pixel = 320 if bands31 else 160
-    per_pixel += 370 if config.spectral_layers else 0
+    per_pixel = 180 if bands31 else 160
+    per_pixel += 210 if config.spectral_layers else 0
     per_pixel += 124 if config.write_cube else 0
     per_pixel += 100 if config.camera else 0
     pixels = config.width * config.height

@@ -31,6 +31,12 @@ from ..formats.exr import read_exr
 from ..layers import REFLECTANCE_FLOOR
 from ..layers.spectral_intrinsics import rgb_residual_share
 from ..sample import MANIFEST_NAME, META_NAME, SEAL_KEY, TMP_PREFIX, file_sha256, sample_dirs
+from ..sample.layer_storage import (
+    COVERAGE_LAYER,
+    rebuild_layers,
+    rebuilt_mismatches,
+    storage_forms,
+)
 from ..sample.meta import Identity, LayerRecord, SampleMeta, read_meta
 from .manifest import ManifestRecord, read_manifest
 
@@ -132,6 +138,28 @@ def _identity_problems(
     return out
 
 
+def _rebuilt_problems(meta: SampleMeta, data: Mapping[str, np.ndarray]) -> list[str]:
+    """Layers rebuilt from their stored factors that are not the layers the writer computed
+    (their SHA-256 in ``meta.json["storage"]``). A residual rebuilt from its identity's terms
+    satisfies the identity by construction, so a wrong term shows here, named as the identity."""
+    wrong = set(rebuilt_mismatches(meta.raw, data))
+    out = []
+    for ident in meta.identities:
+        if ident.residual in wrong:
+            wrong.discard(ident.residual)
+            terms = " + ".join(t for t in (ident.specular, ident.residual) if t)
+            out.append(
+                f"{ident.image}: {ident.image} != {ident.reflectance} * {ident.shading} + "
+                f"{terms}: the residual rebuilt from the stored terms is not the one written "
+                "(its SHA-256 in meta.json)"
+            )
+    out += [
+        f"layer {k!r} rebuilt from its stored factors does not match its SHA-256 in meta.json"
+        for k in sorted(wrong)
+    ]
+    return out
+
+
 def _layer_problems(key: str, rec: LayerRecord, data: np.ndarray) -> list[str]:
     out = []
     if data.shape != rec.shape:
@@ -170,20 +198,39 @@ def _layer_data(meta: SampleMeta, problems: list[str]) -> dict[str, np.ndarray]:
     """Every layer's array (read file by file); unreadable files and layers go to *problems*."""
     data: dict[str, np.ndarray] = {}
     by_file: dict[str, list[str]] = {}
+    coverage: dict[str, np.ndarray] = {}
+    try:
+        forms = storage_forms(meta.raw, meta.layers)
+    except DatasetError as exc:
+        problems.append(str(exc))
+        return data
     for key, rec in meta.layers.items():
-        by_file.setdefault(rec.file, []).append(key)
+        if key not in forms:  # stored as its factors: rebuilt below
+            by_file.setdefault(rec.file, []).append(key)
     for file, keys in by_file.items():
         try:
             arrays = read_exr(meta.folder / file)
         except DatasetError as exc:
             problems.append(str(exc).replace(str(meta.folder) + os.sep, ""))
             continue
+        if COVERAGE_LAYER in arrays:  # the factor of a layer stored as coverage @ table
+            coverage[file] = arrays[COVERAGE_LAYER]
         for key in keys:
             exr_layer = meta.layers[key].exr_layer
             if exr_layer not in arrays:
                 problems.append(f"layer {key!r} is missing from {file}")
                 continue
             data[key] = arrays[exr_layer]
+            problems.extend(_layer_problems(key, meta.layers[key], data[key]))
+    if forms:
+        try:
+            rebuild_layers(
+                meta.raw, meta.layers, data, lambda file: meta.folder / file, coverage=coverage
+            )
+        except DatasetError as exc:
+            problems.append(str(exc).replace(str(meta.folder) + os.sep, ""))
+            return data
+        for key in forms:
             problems.extend(_layer_problems(key, meta.layers[key], data[key]))
     return data
 
@@ -232,6 +279,7 @@ def check_sample(sample: str | os.PathLike[str]) -> list[str]:
             "meta.json records no identities (image = reflectance * shading + residual)"
         )
     problems.extend(_identity_problems(meta.identities, data))
+    problems.extend(_rebuilt_problems(meta, data))
     problems.extend(_semantic_problems(meta.raw, data))
     return problems
 

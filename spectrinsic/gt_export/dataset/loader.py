@@ -10,10 +10,10 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError, MissingDependencyError
-from ..formats.exr import read_exr
 from ..formats.png import EXPOSURE_PERCENTILE, exposure
 from ..layers.spectral_intrinsics import bands_to_rgb, rgb_residual_share, working_space_matrix
 from ..sample import META_NAME, file_sha256, sample_dirs
+from ..sample.layer_storage import read_layers
 from ..sample.meta import SampleMeta, read_meta
 from ..sample.working_view import space_of, srgb_view, view_kind
 from .manifest import read_splits
@@ -98,15 +98,14 @@ def load_sample(
         )
     asked = wanted
     wanted = _with_identity_members(wanted, meta.raw, records) if space == "srgb" else wanted
-    by_file: dict[str, list[str]] = {}
-    for key in wanted:
-        by_file.setdefault(records[key].file, []).append(key)
-    out: dict[str, Any] = {}
-    for file, keys in by_file.items():
-        source = _verified(meta, file) if verify else meta.folder / file
-        arrays = read_exr(source, layers=[records[k].exr_layer for k in keys])
-        for key in keys:
-            out[key] = arrays[records[key].exr_layer]
+    paths: dict[str, Path] = {}
+
+    def path_of(file: str) -> Path:  # each file hashed once, however many layers it gives
+        if file not in paths:
+            paths[file] = _verified(meta, file) if verify else meta.folder / file
+        return paths[file]
+
+    out: dict[str, Any] = read_layers(meta.raw, records, wanted, path_of, verify=verify)
     if "mask" in out:
         out["mask"] = out["mask"] > 0.5
     ids = {}

@@ -36,7 +36,9 @@ from ..sample import (
     sample_dirs,
 )
 from ..sample.json_fields import JsonFields, load_json
+from ..sample.layer_storage import storage_summary
 from ..sample.meta import SampleMeta, read_meta
+from ..sample.stored_layers import PIZ_FILES
 from ..sample.transport_exr import COMPACT_LAYOUT, TRANSPORT_COMPRESSION, TRANSPORT_NAME
 from ..sample.working_view import space_of
 
@@ -149,9 +151,11 @@ def write_manifest(
         "storage": {
             "exr_compression": {
                 "*.exr": DEFAULT_COMPRESSION,
+                **{f: "piz" for f in PIZ_FILES},
                 TRANSPORT_NAME: TRANSPORT_COMPRESSION,
             },
             "transport_layout": COMPACT_LAYOUT,
+            "layers": storage_summary(m.raw for m in metas),
         },
         **_semantic_classes(metas),
         "split_by": "scene",

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from typing import Any
 
@@ -21,6 +22,7 @@ from .gloss import gloss_layers, specular_rgb
 from .images import cube_layer, image_layers
 from .imaging import coverage_weighted
 from .intrinsics import (
+    band_albedos,
     clipping_of,
     from_denoised,
     intrinsic_layers,
@@ -44,7 +46,12 @@ from .records import (
     reference_mode,
 )
 from .spectral import camera_curves
-from .spectral_intrinsics import residual_shares, spectral_identity, spectral_layers
+from .spectral_intrinsics import (
+    SPECTRAL_MODE,
+    residual_shares,
+    spectral_identity,
+    spectral_layers,
+)
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 
@@ -191,6 +198,7 @@ def compute_ground_truth(
         clipping=clipping_of(rgb_of(s, w) / rgb_white(s), w.valid & (irr.luminance_of(w) > 0)),
         working_space=s.space,
         residual_share=residual_shares(_identities(by_name, cameras), by_name, mask),
+        band_albedos=band_albedos(dataclasses.replace(s, ref=SPECTRAL_MODE)) if spectral else None,
     )
 
 

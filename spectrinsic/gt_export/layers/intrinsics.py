@@ -17,6 +17,7 @@ from .imaging import shading_ratio
 from .records import REFLECTANCE_FLOOR, RGB, UNITS_IMAGE, Layer, SampleInputs, make_layer
 
 __all__ = [
+    "band_albedos",
     "white_radiance",
     "rgb_white",
     "rgb_of",
@@ -38,14 +39,26 @@ _RESIDUAL_UNITS_GLOSSY = (
 )
 
 
+def _as_stored(values: np.ndarray) -> np.ndarray:
+    """*values* as a float32 layer stores them, in float64: a layer computed from stored
+    layers this way is rebuilt bit for bit from them (:mod:`spectrinsic.gt_export.sample.layer_storage`)."""
+    return np.asarray(values, np.float32).astype(np.float64)
+
+
+def band_albedos(s: SampleInputs) -> np.ndarray:
+    """``(M, K)`` channel albedo of every material in the reference mode's channels, the values
+    the renderer gave them (Eq. 5.4 normalised); a pixel's is ``coverage @ band_albedos``."""
+    sensors = (s.result.meta or {}).get("sensors", {}).get(s.ref, get_mode(s.ref).sensors)
+    return channel_values(
+        s.scene, get_sensors(sensors, data_dir=s.data_dir), data_dir=s.data_dir
+    ).materials
+
+
 def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
     """``W = E/π`` from the reference render, Eq. 1 of
     :mod:`~spectrinsic.gt_export.layers.irradiance`, with the band albedos the renderer used."""
     mode = get_mode(s.ref)
-    sensors = (s.result.meta or {}).get("sensors", {}).get(s.ref, mode.sensors)
-    albedos = channel_values(
-        s.scene, get_sensors(sensors, data_dir=s.data_dir), data_dir=s.data_dir
-    ).materials
+    albedos = band_albedos(s)
     matrices = (s.result.meta or {}).get("to_xyz", {})
     to_xyz = (
         np.asarray(matrices[s.ref], float)
@@ -120,7 +133,8 @@ def shading_set(
         layers.append(
             make_layer(
                 names[2],
-                irr.unit_luminance(shading, grey),
+                # of the stored (float32) shading and grey: readers rebuild it bit for bit
+                irr.unit_luminance(_as_stored(shading), _as_stored(grey)),
                 RGB,
                 f"{space} colour of the light arriving at unit luminance "
                 "(D65 = (1, 1, 1)); 0 where none arrives",
@@ -216,7 +230,7 @@ def intrinsic_layers(
     out.append(
         make_layer(
             "shading_ratio",
-            shading_ratio(image, reflectance),
+            shading_ratio(_as_stored(image), _as_stored(reflectance)),
             RGB,
             "image / reflectance per channel (thesis Fig. 5.8; ill-conditioned where a "
             f"reflectance channel is small); 0 where |reflectance| <= {REFLECTANCE_FLOOR:g}",

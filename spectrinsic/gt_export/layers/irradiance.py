@@ -49,6 +49,8 @@ __all__ = [
     "ALBEDO_FLOOR",
     "WhiteRadiance",
     "white_radiance",
+    "coverage_albedo",
+    "covered",
     "relative_shading",
     "luminance_of",
     "unit_luminance",
@@ -156,8 +158,8 @@ def white_radiance(
             f"irradiance from {mode!r}: raw {raw.shape}, coverage {coverage.shape} and band "
             f"albedos {band_albedos.shape} do not match"
         )
-    albedo = np.einsum("hwm,mk->hwk", coverage, band_albedos)
-    valid = coverage.sum(axis=-1) >= COVERAGE_MIN
+    albedo = coverage_albedo(coverage, band_albedos)
+    valid = covered(coverage)
     if metal_white is None or metal_coverage is None:
         bands = np.where(valid[..., None], raw / np.maximum(albedo, ALBEDO_FLOOR), 0.0)
     else:
@@ -165,6 +167,33 @@ def white_radiance(
         weight = albedo + np.asarray(metal_coverage, np.float64)[..., None]
         bands = np.where(valid[..., None], total / np.maximum(weight, ALBEDO_FLOOR), 0.0)
     return WhiteRadiance(mode, bands, albedo, valid, np.asarray(to_xyz, np.float64))
+
+
+def coverage_albedo(coverage: np.ndarray, band_albedos: np.ndarray) -> np.ndarray:
+    """``(H, W, K)`` coverage-weighted band albedo ``Σ_m c_m ρ_mk`` in float64, summed material
+    by material in index order with elementwise operations only, so every machine and numpy
+    build gives the same bits (readers rebuild ``reflectance_bands`` from it and compare its
+    SHA-256; an ``einsum``'s summation order depends on the SIMD width).
+
+    >>> coverage_albedo(np.array([[[0.25, 0.75]]]), np.array([[1.0, 0.0], [0.5, 1.0]])).tolist()
+    [[[0.625, 0.75]]]
+    """
+    coverage = np.asarray(coverage, np.float64)
+    band_albedos = np.asarray(band_albedos, np.float64)
+    out = np.zeros((*coverage.shape[:-1], band_albedos.shape[-1]))
+    for m in range(band_albedos.shape[0]):
+        out += coverage[..., m, None] * band_albedos[m]
+    return out
+
+
+def covered(coverage: np.ndarray) -> np.ndarray:
+    """``(H, W)`` whether surfaces cover at least :data:`COVERAGE_MIN` of each pixel (the
+    coverage summed material by material in index order, as :func:`coverage_albedo`)."""
+    coverage = np.asarray(coverage, np.float64)
+    total = np.zeros(coverage.shape[:-1])
+    for m in range(coverage.shape[-1]):
+        total += coverage[..., m]
+    return total >= COVERAGE_MIN
 
 
 def relative_shading(

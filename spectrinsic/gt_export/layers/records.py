@@ -166,6 +166,10 @@ class GroundTruth:
     working_space: WorkingSpace = field(
         default_factory=lambda: working_space(DEFAULT_WORKING_SPACE)
     )
+    #: ``(M, K)`` band albedo of every material in the 31-band cube's bands, the table behind
+    #: ``reflectance_bands = coverage @ band_albedos`` (stored once per material, issue 45);
+    #: ``None`` without spectral layers.
+    band_albedos: np.ndarray | None = field(default=None, repr=False)
 
 
 def grid() -> np.ndarray:

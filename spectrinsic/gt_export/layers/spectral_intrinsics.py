@@ -44,7 +44,7 @@ from ...errors import DatasetError
 from ...spectra import COLORIMETRIC_WAVELENGTHS, get_sensors, get_spectrum, responses
 from ...spectra.working_space import WORKING_SPACES, working_space
 from . import irradiance as irr
-from .gloss import diffuse_raw, specular_raw
+from .gloss import specular_raw
 from .intrinsics import white_radiance
 from .records import Layer, SampleInputs, cube_sensor_name, make_layer
 
@@ -64,6 +64,7 @@ __all__ = [
     "WORKING_SPACES",
     "working_space_matrix",
     "bands_to_rgb",
+    "band_image",
 ]
 
 #: The render mode whose raw cube the spectral layers come from.
@@ -85,12 +86,30 @@ def _band_white(
     return band, band
 
 
-def _image(
-    s: SampleInputs, w: irr.WhiteRadiance, cube: np.ndarray, specular: np.ndarray | None
+def band_image(
+    albedo: np.ndarray,
+    shading: np.ndarray,
+    valid: np.ndarray,
+    cube: np.ndarray,
+    specular: np.ndarray | None,
 ) -> np.ndarray:
-    """The cube rebuilt from a denoised ``W`` (plus the raw specular) where it is valid."""
-    image = irr.recompose(w, diffuse_raw(dataclasses.replace(s, ref=SPECTRAL_MODE), cube))
+    """``image_bands`` of a denoised sample: ``albedo ∘ shading`` (Eq. 1 of
+    :mod:`~spectrinsic.gt_export.layers.irradiance`) where *valid*, the cube's diffuse part
+    elsewhere, plus the raw *specular*; float64 ``(H, W, K)``. One formula for the writer and
+    for the readers that rebuild the layer from its stored factors
+    (:mod:`~spectrinsic.gt_export.sample.layer_storage`)."""
+    cube = np.asarray(cube, np.float64)
+    diffuse = cube if specular is None else cube - specular
+    image = np.where(np.asarray(valid, bool)[..., None], albedo * shading, diffuse)
     return image if specular is None else image + specular
+
+
+def _image(w: irr.WhiteRadiance, cube: np.ndarray, specular: np.ndarray | None) -> np.ndarray:
+    """The cube rebuilt from a denoised ``W`` (plus the raw specular) where it is valid, from
+    ``W`` as stored (float32, ``shading_bands``), so readers rebuild it bit for bit."""
+    return band_image(
+        w.albedo, w.bands.astype(np.float32).astype(np.float64), w.valid, cube, specular
+    )
 
 
 def spectral_layers(
@@ -115,7 +134,7 @@ def spectral_layers(
     cube = np.asarray(s.result.raw[SPECTRAL_MODE], np.float64)
     specular = specular_raw(dataclasses.replace(s, ref=SPECTRAL_MODE))
     rebuilt = denoised and used_w is not raw_w
-    image = _image(s, used_w, cube, specular) if rebuilt else cube
+    image = _image(used_w, cube, specular) if rebuilt else cube
 
     def layer(name: str, data: np.ndarray, what: str, nonnegative: bool = False) -> Layer:
         return make_layer(name, data, channels, what, SPECTRAL_GROUP, nonnegative=nonnegative)

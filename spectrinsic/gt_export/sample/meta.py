@@ -83,10 +83,10 @@ META_FIELDS = frozenset(
 #: Fields written only by some builds: ``transport`` (``--store-transport``, see
 #: :func:`~spectrinsic.gt_export.sample.transport_exr.write_transport`), ``sensor`` (``--camera``),
 #: ``spectrum_files`` (``csv:`` spectra, :func:`~spectrinsic.spectra.user_spectra.spectrum_files`),
-#: ``residual_share``, ``working_space`` (since issue 30; no working space: linear sRGB),
-#: ``semantic_classes`` (the class table of the ``semantic`` layer, since issue 41).
+#: ``residual_share``, ``working_space`` (issue 30; none: linear sRGB), ``semantic_classes``
+#: (issue 41), ``storage`` (issue 45, :mod:`~spectrinsic.gt_export.sample.layer_storage`).
 OPTIONAL_META_FIELDS = frozenset(
-    {"transport", "sensor", "spectrum_files", "residual_share", "working_space", "semantic_classes"}
+    "transport sensor spectrum_files residual_share working_space semantic_classes storage".split()
 )
 _LAYER_FIELDS = frozenset(
     {

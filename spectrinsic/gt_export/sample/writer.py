@@ -46,7 +46,7 @@ from ...spectra.user_spectra import portable_names, spectrum_files
 from ...spectra.working_space import DEFAULT_WORKING_SPACE
 from ..formats import png
 from ..formats.exr import write_exr
-from ..layers import GroundTruth, Layer, compute_ground_truth, identities
+from ..layers import GroundTruth, compute_ground_truth, identities
 from . import (
     FORMAT_VERSION,
     HASHES_KEY,
@@ -65,6 +65,7 @@ from . import (
 from .integrity import replaceable_sample, sample_problem
 from .previews import preview_maker, preview_path, shown_layers
 from .sensor import SensorOutput, sensor_output, write_sensor_files
+from .stored_layers import compression_of, stored_layers
 from .transport_exr import TRANSPORT_NAME, write_transport
 
 if TYPE_CHECKING:
@@ -173,22 +174,25 @@ def _meta(
     } | extra
 
 
-def _write_layers(folder: Path, gt: GroundTruth, sample_id: str) -> list[str]:
-    """One EXR file per layer group; return the file names."""
-    groups: dict[str, list[Layer]] = {}
-    for layer in gt.layers.values():
-        groups.setdefault(layer.group, []).append(layer)
+def _write_layers(
+    folder: Path, gt: GroundTruth, sample_id: str, coverage: Any
+) -> tuple[list[str], dict[str, Any]]:
+    """One EXR file per layer group, layers that their stored factors rebuild bit for bit
+    stored as those (:mod:`~spectrinsic.gt_export.sample.layer_storage`); return the file
+    names and ``meta.json["storage"]``."""
+    stored = stored_layers(gt, coverage, identities(gt))
     files = []
-    for group, members in groups.items():
-        name = f"{group}.exr"
+    for name, arrays in stored.arrays.items():
         write_exr(
             folder / name,
-            {layer.name.split("/", 1)[0]: layer.data for layer in members},
-            channel_names={layer.name.split("/", 1)[0]: layer.channels for layer in members},
-            attributes={"spectrinsic.sample": sample_id},
+            arrays,
+            channel_names=stored.channels[name],
+            attributes={"spectrinsic.sample": sample_id} | stored.attributes.get(name, {}),
+            half=[k for k in stored.half if k in arrays],
+            compression=compression_of(name),
         )
         files.append(name)
-    return files
+    return files, stored.record()
 
 
 def _write_previews(folder: Path, gt: GroundTruth) -> dict[str, tuple[str, dict[str, Any]]]:
@@ -218,7 +222,9 @@ def _fill_folder(
     scene_folder: Path | None = None,
     **meta_kw: Any,
 ) -> None:
-    files = _write_layers(folder, gt, meta_kw["sample_id"])
+    files, storage = _write_layers(
+        folder, gt, meta_kw["sample_id"], (getattr(result, "aovs", None) or {}).get("coverage")
+    )
     if sensor is not None:  # the camera chain's raw DNG and processed PNG (gt_export.sensor)
         files += write_sensor_files(folder, sensor)
     previews = _write_previews(folder, gt)
@@ -251,6 +257,7 @@ def _fill_folder(
     )
     if record is not None:  # before the hashes and the seal, which cover it
         meta["transport"] = record
+    meta["storage"] = storage
     if sensor is not None:
         meta["sensor"] = sensor.meta
         meta["identities"].append(sensor.identity)

@@ -201,10 +201,17 @@ def test_doubling_every_power_doubles_radiometric_layers_only(built):
 
 def test_in_memory_relighting_equals_the_written_relit_sample(built):
     out, _, sample = built
-    written = _arrays(load_sample(relight(sample, NEW_LIGHTS, out / "mem__v0__two")))
+    relit = load_sample(relight(sample, NEW_LIGHTS, out / "mem__v0__two"))
+    written, half = _arrays(relit), relit["meta"]["storage"]["half"]
     memory = relit_layers(sample, NEW_LIGHTS)
+    assert half == ["noise_image", "noise_shading_raw"]
     for key, value in written.items():
-        np.testing.assert_array_equal(memory[key], value, err_msg=key)
+        if key in half:  # the noise maps are stored as float16 (issue 45)
+            np.testing.assert_allclose(
+                value, memory[key], rtol=2.0**-11, atol=2.0**-24, err_msg=key
+            )
+        else:
+            np.testing.assert_array_equal(memory[key], value, err_msg=key)
 
 
 def test_random_relight_is_seeded_per_item_and_epoch(built):
