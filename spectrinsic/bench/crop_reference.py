@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ..gt_export.layers import compute_ground_truth
+from ..gt_export.layers import LayerSettings, compute_ground_truth
 from ..gt_export.layers.denoise import Guides, denoise_blocks, denoise_rgb
 from ..gt_export.layers.irradiance import WhiteRadiance
 from ..pipeline.presets import get_preset
@@ -118,7 +118,7 @@ def crop_reference(
     seconds = time.perf_counter() - start
     merged = merge_batches(parts)
     edges = edge_pixels(merged.aovs["material_id"], merged.aovs["coverage"])
-    return compute_ground_truth(scene, merged, cameras=()), edges, seconds
+    return compute_ground_truth(scene, merged, LayerSettings(cameras=())), edges, seconds
 
 
 def edge_pixels(material_id: np.ndarray, coverage: np.ndarray) -> np.ndarray:
@@ -194,7 +194,7 @@ def _denoised(scene: Scene, noisy: RenderResult) -> dict[str, tuple[np.ndarray, 
     out = {}
     for name, kwargs in variants.items():
         start = time.perf_counter()
-        gt = compute_ground_truth(scene, noisy, cameras=(), denoise=True, **kwargs)
+        gt = compute_ground_truth(scene, noisy, LayerSettings(cameras=(), denoise=True), **kwargs)
         out[name] = (gt.layers["shading"].data, time.perf_counter() - start)
     out["raw"] = (gt.layers["shading_raw"].data, 0.0)
     return out

@@ -29,6 +29,7 @@ import numpy as np
 
 from ..gt_export import export_sample
 from ..gt_export.formats.exr import write_exr
+from ..gt_export.layers import LayerSettings
 from ..gt_export.relight import relit_scene
 from ..gt_export.sample.meta import read_meta
 from ..gt_export.sample.transport_exr import (
@@ -123,13 +124,13 @@ def run(out_dir: Path) -> dict[str, Any]:
             root,
             scene,
             result,
+            LayerSettings(
+                cameras=cfg.resolved_cameras(), denoise=cfg.denoise, spectral_layers=True
+            ),
             sample_id="storage__v0__x",
             config=cfg.to_dict(),
             seed=SEED,
-            cameras=cfg.resolved_cameras(),
-            denoise=cfg.denoise,
             transport=transport,
-            spectral_layers=True,
         )
         files = {p.name: p.stat().st_size for p in sorted(sample.iterdir()) if p.is_file()}
         record = read_meta(sample).raw["transport"]

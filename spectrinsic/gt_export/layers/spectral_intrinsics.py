@@ -42,7 +42,6 @@ import numpy as np
 
 from ...errors import DatasetError
 from ...spectra import COLORIMETRIC_WAVELENGTHS, get_sensors, get_spectrum, responses
-from ...spectra.working_space import WORKING_SPACES, working_space
 from . import irradiance as irr
 from .gloss import diffuse_raw, specular_raw
 from .intrinsics import white_radiance
@@ -61,8 +60,6 @@ __all__ = [
     "residual_rows",
     "residual_summary",
     "gamut_key",
-    "WORKING_SPACES",
-    "working_space_matrix",
     "bands_to_rgb",
 ]
 
@@ -331,14 +328,6 @@ def residual_summary(metas: Any) -> dict[str, Any]:
         family: {"samples": len(row["rgb"])} | {k: _figures(v) for k, v in row.items() if v}
         for family, row in sorted(rows.items())
     }
-
-
-def working_space_matrix(space: str) -> np.ndarray:
-    """``(3, 3)`` CIE XYZ -> linear RGB of a :data:`WORKING_SPACES` space
-    (:func:`spectrinsic.spectra.working_space.working_space`)."""
-    if space not in WORKING_SPACES:
-        raise DatasetError(f"working space {space!r}; expected one of {sorted(WORKING_SPACES)}")
-    return np.asarray(working_space(space).from_xyz, np.float64)
 
 
 def bands_to_rgb(

@@ -10,10 +10,11 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError, MissingDependencyError
+from ...spectra.working_space import working_space
 from ..dataset.manifest import read_splits
 from ..formats.exr import read_exr
 from ..formats.png import EXPOSURE_PERCENTILE, exposure
-from ..layers.spectral_intrinsics import bands_to_rgb, rgb_residual_share, working_space_matrix
+from ..layers.spectral_intrinsics import bands_to_rgb, rgb_residual_share
 from . import META_NAME, file_sha256, sample_dirs
 from .meta import SampleMeta, read_meta
 from .working_view import space_of, srgb_view, view_kind
@@ -348,4 +349,5 @@ def working_space_view(
             "working_space_view needs the band layers: build the set with --spectral-layers"
         )
     to_xyz = sample["meta"]["render"]["to_xyz"]["bands31"]
-    return bands_to_rgb(sample, to_xyz, working_space_matrix(space), clip=clip)
+    matrix = np.asarray(working_space(space, "space").from_xyz, np.float64)
+    return bands_to_rgb(sample, to_xyz, matrix, clip=clip)

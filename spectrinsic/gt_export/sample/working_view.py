@@ -25,8 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import DatasetError
-from ...spectra.working_space import WORKING_SPACES, WorkingSpace, working_space
+from ...spectra.working_space import WorkingSpace, working_space
 from ..layers.records import REFLECTANCE_FLOOR
 
 __all__ = ["space_of", "view_kind", "srgb_layer", "srgb_view"]
@@ -38,14 +37,10 @@ _RECOMPUTED = ("residual", "residual_raw", "shading_ratio")
 
 def space_of(meta: Any) -> WorkingSpace:
     """The working space a parsed ``meta.json`` records (``srgb`` for samples written before
-    it was recorded); :class:`DatasetError` for an unknown name."""
+    it was recorded); :class:`~spectrinsic.errors.WorkingSpaceError` for an unknown name."""
     record = meta.get("working_space") if isinstance(meta, Mapping) else None
     name = record.get("name", "srgb") if isinstance(record, Mapping) else "srgb"
-    if name not in WORKING_SPACES:
-        raise DatasetError(
-            f"meta.json working_space {name!r}; expected one of {sorted(WORKING_SPACES)}"
-        )
-    return working_space(str(name))
+    return working_space(name, "meta.json working_space")
 
 
 def view_kind(name: str) -> str | None:
