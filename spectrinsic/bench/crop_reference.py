@@ -42,6 +42,7 @@ from ..render.algebra.batch_means import batch_seeds, merge_batches
 from ..render.algebra.modes import channel_values, get_mode, raw_to_xyz, to_xyz_matrix
 from ..render.band_path.traversal import render_traversal
 from ..render.result import RenderResult
+from ..render.settings import PassRequest
 from ..scenes.library import build
 from ..scenes.model import Scene
 from ..spectra import get_sensors
@@ -77,9 +78,7 @@ def _window(
     (out,), aovs, seconds, variant = render_traversal(
         scene,
         [channel_values(scene, sensors)],
-        spp=spp,
-        seed=seed,
-        max_depth=max_depth,
+        PassRequest(spp, seed, max_depth),
         aovs=True,
         crop=crop,
     )

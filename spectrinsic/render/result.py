@@ -109,7 +109,7 @@ def render_meta(
     variants: dict[str, str],
     timings: dict[str, list[float]],
     *,
-    spp: int,
+    batch_spp: int,
     seed: int,
     max_depth: int,
     per_light: bool,
@@ -122,7 +122,7 @@ def render_meta(
     return {
         "mitsuba": import_mitsuba().__version__,
         "variants": variants,
-        "spp": int(spp),
+        "spp": int(batch_spp),  # one batch's: merge_batches makes it the total
         "seed": int(seed),
         "max_depth": int(max_depth),
         "modes": names,

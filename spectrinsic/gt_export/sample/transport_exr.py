@@ -179,7 +179,7 @@ def write_transport(
         "lights": transport.n_lights,
         "batches": len(transport.batches),
         "batch_seeds": list(transport.seeds),
-        "batch_spp": transport.spp,
+        "batch_spp": transport.batch_spp,
         "max_depth": transport.max_depth,
         "parts": [p for p in _parts(transport) if p in PARTS],
         "deviation_exponents": exponents,
@@ -282,7 +282,7 @@ def read_transport(
         sensors={str(k): str(v) for k, v in sensors.items()},
         batches=held["transport"],
         seeds=tuple(int(s) for s in seeds),
-        spp=_field(record, "batch_spp", int, where),
+        batch_spp=_field(record, "batch_spp", int, where),
         max_depth=_field(record, "max_depth", int, where),
         parts={p: held[p] for p in PARTS if p in held},
     )

@@ -45,8 +45,8 @@ class LightTransport:
         channels light l gives alone with the flat unit spectrum at power 1 (render units).
     seeds
         Sampler seed of each batch.
-    spp
-        Samples per pixel of each batch.
+    batch_spp
+        Samples per pixel of each batch (the total is ``batch_spp * len(batches)``).
     max_depth
         Longest path of the passes.
     seconds
@@ -64,7 +64,7 @@ class LightTransport:
     sensors: dict[str, str]
     batches: tuple[dict[str, np.ndarray], ...] = field(repr=False)
     seeds: tuple[int, ...]
-    spp: int
+    batch_spp: int
     max_depth: int
     seconds: dict[str, tuple[float, ...]] = field(default_factory=dict, repr=False)
     parts: dict[str, tuple[dict[str, np.ndarray], ...]] = field(default_factory=dict, repr=False)
@@ -230,7 +230,7 @@ def _meta(
     out: dict[str, Any] = dict(meta or {})
     out.update(
         seed=int(transport.seeds[0]),
-        spp=int(transport.spp) * n,
+        spp=int(transport.batch_spp) * n,
         modes=modes,
         per_light=True,
         per_light_modes=modes,
@@ -239,7 +239,7 @@ def _meta(
     )
     out.setdefault("timings", {})
     if n > 1:
-        out.update(batches=n, batch_spp=int(transport.spp), batch_seeds=list(transport.seeds))
+        out.update(batches=n, batch_spp=int(transport.batch_spp), batch_seeds=list(transport.seeds))
     return out
 
 

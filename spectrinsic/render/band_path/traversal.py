@@ -28,12 +28,12 @@ from ...spectra import get_sensors
 from ..algebra.modes import ChannelValues, RenderMode, channel_values, get_mode
 from ..algebra.shares import TransportOutput
 from ..base import translate as tr
-from ..base.one_pass import DIRECT_DEPTH, PassOutput, PassProgress, timed_render
+from ..base.one_pass import DIRECT_DEPTH, PassOutput, timed_render
 from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
 from ..base.textures import shape_slots, texture_tables
 from ..base.variants import choose_variant, variant_scope
 from ..passes.aovs import assemble_aovs
-from ..settings import DEFAULT_INTEGRATOR, INTEGRATORS
+from ..settings import DEFAULT_INTEGRATOR, INTEGRATORS, PassRequest
 from .integrator import BandTables, band_path, first_hit_channels
 
 __all__ = [
@@ -130,9 +130,10 @@ def _specular_table(scene: Scene, value_sets: Sequence[ChannelValues]) -> np.nda
 
 
 def _render(
-    mi: Any, loaded: Any, integrator: Any, *, spp: int, seed: int, n: int
+    mi: Any, loaded: Any, integrator: Any, request: PassRequest, n: int
 ) -> tuple[np.ndarray, float]:
     """The traversal's last *n* AOV channels (the band transport) and the render's seconds."""
+    spp, seed = request.batch_spp, request.seed
     image, seconds = timed_render(mi, loaded, spp=spp, seed=seed, integrator=integrator)
     if image.shape[-1] < n:
         raise RenderError(
@@ -177,11 +178,10 @@ def _trace(
     tables: BandTables,
     dims: _Dims,
     spec_table: np.ndarray | None,
+    request: PassRequest,
     *,
     depth: int,
     first: bool,
-    spp: int,
-    seed: int,
 ) -> _Traced:
     """One traversal at path *depth*; the *first* one also takes the first-hit maps and, in
     scenes with metals, the white-at-metal radiance."""
@@ -207,9 +207,7 @@ def _trace(
     n_spec = n_t if dims.glossy else 0
     n_white = n_t if metals else 0
     n_first = len(first_hit_channels(n_surfaces, n_texcols))
-    image, dt = _render(
-        mi, loaded, integrator, spp=spp, seed=seed, n=n_t + n_spec + n_white + n_first
-    )
+    image, dt = _render(mi, loaded, integrator, request, n_t + n_spec + n_white + n_first)
 
     def per_light(channels: np.ndarray) -> np.ndarray:
         return channels.reshape(dims.h, dims.w, dims.n_lights, dims.n_bands).transpose(2, 0, 1, 3)
@@ -258,15 +256,10 @@ def _outputs(
 def render_traversal(
     scene: Scene,
     value_sets: Sequence[ChannelValues],
+    request: PassRequest,
     *,
-    spp: int,
-    seed: int,
-    max_depth: int = 8,
     direct: bool = False,
     aovs: bool = False,
-    variant: str | None = None,
-    progress: PassProgress | None = None,
-    geometry: Sequence[tr.SurfaceGeometry] | None = None,
     crop: tuple[int, int, int, int] | None = None,
 ) -> tuple[list[TransportOutput], dict[str, np.ndarray], tuple[float, ...], str]:
     """Per-light band transport of every value set, in one traversal (two with *direct*).
@@ -276,6 +269,9 @@ def render_traversal(
     value_sets
         Channel values (:func:`spectrinsic.render.algebra.modes.channel_values`) of each diagonal mode;
         their bands are traced together.
+    request
+        Samples, seed, path depth, variant, progress and prepared geometry
+        (:class:`~spectrinsic.render.settings.PassRequest`).
     direct
         Also trace direct light only (path depth 2), for the energy ratio r of Eq. 5.8.
     aovs
@@ -296,15 +292,13 @@ def render_traversal(
     variant
         The Mitsuba variant used.
     """
-    if int(spp) < 1 or int(max_depth) < 1:
-        raise SceneError(f"spp {spp}, max_depth {max_depth}: expected at least 1 each")
     if not scene.lights:
         raise SceneError(f"scene {scene.name!r} has no lights: nothing to render")
     if not value_sets:
         raise SceneError("render_traversal: expected at least one set of channel values")
     widths = [np.asarray(v.materials).shape[1] for v in value_sets]
     n_bands, n_lights = sum(widths), len(scene.lights)
-    chosen = choose_variant("rgb", variant)
+    chosen = choose_variant("rgb", request.variant)
     h, w = (
         (scene.camera.height, scene.camera.width) if crop is None else (int(crop[3]), int(crop[2]))
     )
@@ -317,9 +311,9 @@ def render_traversal(
                 materials=[white] * len(scene.materials),
                 lights=[white] * n_lights,
                 film=hdr_film(scene.camera.width, scene.camera.height, crop),
-                integrator=path_integrator(max_depth),
-                sample_count=spp,
-                geometry=geometry,
+                integrator=path_integrator(request.max_depth),
+                sample_count=request.batch_spp,
+                geometry=request.geometry,
                 white_metal=True,
             )
         )
@@ -328,23 +322,12 @@ def render_traversal(
         dims = _Dims(h, w, n_bands, n_lights, glossy, metal_rows)
         spec_table = _specular_table(scene, value_sets) if glossy else None
         traced: list[_Traced] = []
-        for depth in [int(max_depth)] + ([DIRECT_DEPTH] if direct else []):
+        for depth in [request.max_depth] + ([DIRECT_DEPTH] if direct else []):
             first = not traced
             traced.append(
-                _trace(
-                    mi,
-                    loaded,
-                    tables,
-                    dims,
-                    spec_table,
-                    depth=depth,
-                    first=first,
-                    spp=spp,
-                    seed=seed,
-                )
+                _trace(mi, loaded, tables, dims, spec_table, request, depth=depth, first=first)
             )
-            if progress is not None:
-                progress(1)
+            request.tick()
     outputs = _outputs(value_sets, widths, traced, direct)
     hits = traced[0].first
     aov_maps = _first_hit_maps(scene, tables, hits) if aovs and hits is not None else {}
@@ -374,14 +357,9 @@ class SingleTraversal:
 def render_jobs(
     scene: Scene,
     jobs: Sequence[tuple[Sequence[RenderMode], Sequence[int] | None, bool]],
+    request: PassRequest,
     *,
     wanted: set[str],
-    spp: int,
-    seed: int,
-    max_depth: int,
-    variant: str | None,
-    progress: PassProgress | None,
-    geometry: Sequence[tr.SurfaceGeometry] | None,
     data_dir: str | None,
     aovs: bool = False,
 ) -> tuple[list[dict[str, PassOutput]], SingleTraversal]:
@@ -409,16 +387,7 @@ def render_jobs(
         for m in diagonal
     ]
     outs, aov_maps, seconds, chosen = render_traversal(
-        scene,
-        values,
-        spp=spp,
-        seed=seed,
-        max_depth=max_depth,
-        direct=want_direct,
-        aovs=aovs,
-        variant=variant,
-        progress=progress,
-        geometry=geometry,
+        scene, values, request, direct=want_direct, aovs=aovs
     )
     transport = {} if maps_only else {m.name: o for m, o in zip(diagonal, outs, strict=True)}
     parts = []
