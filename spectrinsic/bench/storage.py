@@ -34,7 +34,6 @@ from ..gt_export.relight import relit_scene
 from ..gt_export.sample.meta import read_meta
 from ..gt_export.sample.transport_exr import (
     COVERAGE_LAYER,
-    PARTS,
     TRANSPORT_NAME,
     read_transport,
     transport_layer,
@@ -42,6 +41,7 @@ from ..gt_export.sample.transport_exr import (
 from ..pipeline.presets import get_preset
 from ..render.algebra.batch_means import relative_standard_error
 from ..render.algebra.light_transport import LightTransport, relit_result
+from ..render.algebra.shares import PARTS
 from ..render.transport_render import render_transport_batches
 from ..scenes.library import build
 from ..spectra import get_sensors

@@ -12,6 +12,7 @@ from ..errors import RenderError
 from ..scenes.model import Scene
 from ..spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
 from .algebra.modes import RenderMode
+from .algebra.shares import METAL_WHITE, SPECULAR
 from .base.variants import import_mitsuba
 
 __all__ = ["RenderResult", "render_meta"]
@@ -53,7 +54,7 @@ class RenderResult:
         ``raw[mode][..., k] = Σ_l E_{l,k} transport[mode][l, ..., k]``, with E the lights'
         channel values (:func:`spectrinsic.render.algebra.modes.channel_values`). Empty otherwise.
     parts
-        Single traversal: part name (:data:`spectrinsic.render.band_path.traversal.PARTS`) -> mode ->
+        Single traversal: part name (:data:`spectrinsic.render.algebra.shares.PARTS`) -> mode ->
         ``(H, W, K)`` float32 raw channels of that part, summed over the lights as ``raw`` is;
         only the parts the scene has. ``"specular"`` (glossy materials): the light the camera
         rays' first hits return through their non-diffuse lobes (coat reflection, metal), with
@@ -80,12 +81,12 @@ class RenderResult:
     @property
     def specular(self) -> dict[str, np.ndarray]:
         """``parts["specular"]``: mode -> ``(H, W, K)`` raw specular part (empty: matte scene)."""
-        return self.parts.get("specular", {})
+        return self.parts.get(SPECULAR, {})
 
     @property
     def metal_white(self) -> dict[str, np.ndarray]:
         """``parts["metal_white"]``: mode -> ``(H, W, K)`` raw white-at-metal radiance."""
-        return self.parts.get("metal_white", {})
+        return self.parts.get(METAL_WHITE, {})
 
     @property
     def shape(self) -> tuple[int, int]:

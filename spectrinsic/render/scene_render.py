@@ -13,7 +13,8 @@ from ..errors import RenderError, SceneError
 from ..scenes.model import Scene
 from ..spectra import get_sensors
 from .algebra.modes import RenderMode, channel_values, get_mode, n_passes, raw_to_xyz, to_xyz_matrix
-from .band_path.traversal import PARTS, SingleTraversal, render_jobs, resolve_integrator
+from .algebra.shares import PARTS
+from .band_path.traversal import SingleTraversal, render_jobs, resolve_integrator
 from .base.one_pass import PassOutput, PassProgress
 from .base.translate import prepare_geometry, surfaces
 from .base.variants import choose_variant, import_mitsuba, variant_scope
@@ -386,7 +387,7 @@ def _part_raw(
     groups: Sequence[Sequence[int] | None],
     part: str,
 ) -> dict[str, np.ndarray]:
-    """Mode -> raw channels of a traversal's *part* (one of :data:`~spectrinsic.render.band_path.traversal.PARTS`), summed
+    """Mode -> raw channels of a traversal's *part* (one of :data:`~spectrinsic.render.algebra.shares.PARTS`), summed
     over the main jobs' light *groups* as ``raw`` is; modes without the part are left out."""
     out = {}
     for name, t in single.transport.items():

@@ -18,7 +18,7 @@ from ...threads import thread_map
 from ..result import RenderResult
 from .batch_means import batch_mean
 from .modes import get_mode, light_spectra, lights_to_xyz_matrix, raw_to_xyz
-from .shares import compose, light_shares, sum_lights
+from .shares import METAL_WHITE, SPECULAR, compose, light_shares, sum_lights
 
 __all__ = [
     "LightTransport",
@@ -53,7 +53,7 @@ class LightTransport:
         Seconds of each Mitsuba pass, per mode, and under ``"single"`` those of the traversals
         carrying every mode at once (empty when read from a file).
     parts
-        Part name (:data:`spectrinsic.render.band_path.traversal.PARTS`) -> one dict per batch as
+        Part name (:data:`spectrinsic.render.algebra.shares.PARTS`) -> one dict per batch as
         :attr:`batches`, for the same unit spectrum: glossy scenes' ``"specular"`` part of ``T``
         (first camera-ray vertex through a non-diffuse lobe) and metals' ``"metal_white"``
         white-surface radiance at metal first hits (not part of ``T``)
@@ -87,12 +87,12 @@ class LightTransport:
     @property
     def specular(self) -> tuple[dict[str, np.ndarray], ...]:
         """``parts["specular"]`` (empty for a matte scene)."""
-        return self.parts.get("specular", ())
+        return self.parts.get(SPECULAR, ())
 
     @property
     def metal_white(self) -> tuple[dict[str, np.ndarray], ...]:
         """``parts["metal_white"]`` (empty without metals)."""
-        return self.parts.get("metal_white", ())
+        return self.parts.get(METAL_WHITE, ())
 
     @property
     def n_lights(self) -> int:

@@ -26,7 +26,7 @@ from ...errors import RenderError, SceneError, validate_choice
 from ...scenes.model import Scene
 from ...spectra import get_sensors
 from ..algebra.modes import ChannelValues, RenderMode, channel_values, get_mode
-from ..algebra.shares import TransportOutput
+from ..algebra.shares import METAL_WHITE, SPECULAR, TransportOutput
 from ..base import translate as tr
 from ..base.one_pass import DIRECT_DEPTH, PassOutput, timed_render
 from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
@@ -37,7 +37,6 @@ from ..settings import DEFAULT_INTEGRATOR, INTEGRATORS, PassRequest
 from .integrator import BandTables, band_path, first_hit_channels
 
 __all__ = [
-    "PARTS",
     "SingleTraversal",
     "render_traversal",
     "render_jobs",
@@ -45,17 +44,6 @@ __all__ = [
     "single_traversal_runs",
     "resolve_integrator",
 ]
-
-
-#: The parts a traversal splits off beside its transport, in the order of its AOV channels
-#: (:func:`~spectrinsic.render.band_path.integrator.aov_channels`), and the letter of their layers in ``transport.exr``
-#: (:mod:`spectrinsic.gt_export.sample.transport_exr`; the transport's is L): glossy scenes'
-#: ``"specular"`` part of the transport (the light whose first camera-ray vertex went through
-#: a non-diffuse lobe) and metals' ``"metal_white"`` radiance (not part of the transport). Each
-#: is ``(L, H, W, K)`` per unit emission, composed as the transport is; every record below the
-#: traversal (:class:`TransportOutput`, ``RenderResult.parts``, ``LightTransport.parts``, the
-#: batches, the file) holds the parts by these names.
-PARTS: dict[str, str] = {"specular": "S", "metal_white": "W"}
 
 
 def single_traversal_runs(variant: str | None) -> bool:
@@ -162,7 +150,7 @@ class _Dims:
 
 @dataclass(frozen=True, eq=False)
 class _Traced:
-    """One traversal: transport ``(L, H, W, K)``, the parts of :data:`PARTS`
+    """One traversal: transport ``(L, H, W, K)``, the parts of :data:`~spectrinsic.render.algebra.shares.PARTS`
     it rendered (same shape; the first traversal only), the first-hit maps (first traversal
     with surfaces) and its seconds."""
 
@@ -215,9 +203,9 @@ def _trace(
     end = n_t + n_spec + n_white
     parts = {}
     if dims.glossy and first:
-        parts["specular"] = per_light(image[..., n_t : n_t + n_spec])
+        parts[SPECULAR] = per_light(image[..., n_t : n_t + n_spec])
     if metals:
-        parts["metal_white"] = per_light(image[..., n_t + n_spec : end])
+        parts[METAL_WHITE] = per_light(image[..., n_t + n_spec : end])
     return _Traced(
         transport=per_light(image[..., :n_t]),
         parts=parts,
@@ -346,7 +334,7 @@ class SingleTraversal:
 
     def per_light(self, part: str) -> dict[str, np.ndarray]:
         """Mode -> ``(L, H, W, K)`` per-light *part* (``"transport"`` or one of
-        :data:`PARTS`); modes without it left out."""
+        :data:`~spectrinsic.render.algebra.shares.PARTS`); modes without it left out."""
         arrays = {
             n: t.transport if part == "transport" else t.parts.get(part)
             for n, t in self.transport.items()
