@@ -16,7 +16,7 @@ from . import irradiance as irr
 from .cameras import camera_layers, matrices_of
 from .denoise import Denoiser, Guides, denoise_white_radiance
 from .geometry import coverage_of, geometry_layers
-from .gloss import gloss_layers, specular_rgb
+from .gloss import SPECULAR, gloss_layers, specular_rgb
 from .images import cube_layer, image_layers
 from .imaging import coverage_weighted
 from .intrinsics import (
@@ -194,8 +194,8 @@ def identities(gt: GroundTruth) -> list[dict[str, str]]:
 def _identities(layers: dict[str, Any], cameras: Sequence[str]) -> list[dict[str, str]]:
     out = []
     denoised = "image_denoised" in layers
-    glossy = "specular" in layers
-    spec = {"specular": "specular"} if glossy else {}
+    glossy = SPECULAR in layers
+    spec = {SPECULAR: SPECULAR} if glossy else {}
     out.append(
         {
             "image": "image_denoised" if denoised else "image",
@@ -225,7 +225,7 @@ def _identities(layers: dict[str, Any], cameras: Sequence[str]) -> list[dict[str
                 "shading": f"shading_camera/{key}",
                 "residual": f"residual_camera/{key}",
             }
-            | ({"specular": f"specular_camera/{key}"} if glossy else {})
+            | ({SPECULAR: f"{SPECULAR}_camera/{key}"} if glossy else {})
         )
     spectral = spectral_identity(layers)
     return out if spectral is None else [*out, spectral]

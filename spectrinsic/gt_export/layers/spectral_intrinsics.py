@@ -43,7 +43,7 @@ import numpy as np
 from ...errors import DatasetError
 from ...spectra import COLORIMETRIC_WAVELENGTHS, get_sensors, get_spectrum, responses
 from . import irradiance as irr
-from .gloss import diffuse_raw, specular_raw
+from .gloss import SPECULAR, SPECULAR_BANDS, diffuse_raw, specular_raw
 from .intrinsics import white_radiance
 from .records import Layer, SampleInputs, cube_sensor_name, make_layer
 
@@ -149,7 +149,7 @@ def spectral_layers(
     if rebuilt:
         out.append(layer("image_bands_raw", cube, units + "; the rendered cube", True))
     if specular is not None:
-        out.append(layer("specular_bands", specular, units + "; non-diffuse lobes"))
+        out.append(layer(SPECULAR_BANDS, specular, units + "; non-diffuse lobes"))
     out.append(
         layer(
             "residual_bands",
@@ -172,7 +172,7 @@ def spectral_identity(layers: Any) -> dict[str, str] | None:
         "shading": "shading_bands",
         "residual": "residual_bands",
     }
-    return out | ({"specular": "specular_bands"} if "specular_bands" in layers else {})
+    return out | ({SPECULAR: SPECULAR_BANDS} if SPECULAR_BANDS in layers else {})
 
 
 def residual_share(image: np.ndarray, residual: np.ndarray, mask: np.ndarray) -> float:
@@ -365,8 +365,8 @@ def bands_to_rgb(
     if clip:
         out["shading"] = np.clip(out["shading"], 0.0, None)
     rest = out["image"] - out["reflectance"] * out["shading"]
-    if "specular_bands" in layers:
-        out["specular"] = rgb("specular_bands")
-        rest = rest - out["specular"]
+    if SPECULAR_BANDS in layers:
+        out[SPECULAR] = rgb(SPECULAR_BANDS)
+        rest = rest - out[SPECULAR]
     out["residual"] = rest
     return out

@@ -14,6 +14,7 @@ from ...spectra.working_space import working_space
 from ..dataset.manifest import read_splits
 from ..formats.exr import read_exr
 from ..formats.png import EXPOSURE_PERCENTILE, exposure
+from ..layers.gloss import SPECULAR
 from ..layers.spectral_intrinsics import bands_to_rgb, rgb_residual_share
 from . import META_NAME, file_sha256, sample_dirs
 from .meta import SampleMeta, read_meta
@@ -181,7 +182,7 @@ def filter_residual_share(folders: Sequence[Path], limit: float | None) -> list[
 
 
 #: Layers in radiometric units that exposure normalisation scales (reflectance is unitless).
-EXPOSED_PREFIXES = ("image", "shading", "illuminant", "residual", "specular", "cube")
+EXPOSED_PREFIXES = ("image", "shading", "illuminant", "residual", SPECULAR, "cube")
 
 
 def split_samples(dataset_dir: str | os.PathLike[str], split: str | None) -> list[Path]:

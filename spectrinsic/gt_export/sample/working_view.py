@@ -26,11 +26,12 @@ from typing import Any
 import numpy as np
 
 from ...spectra.working_space import WorkingSpace, working_space
+from ..layers.gloss import SPECULAR
 from ..layers.records import REFLECTANCE_FLOOR
 
 __all__ = ["space_of", "view_kind", "srgb_layer", "srgb_view"]
 
-_COLOURS = ("image", "image_denoised", "reflectance", "specular")
+_COLOURS = ("image", "image_denoised", "reflectance", SPECULAR)
 _LIGHTS = ("shading", "shading_raw", "illuminant")
 _RECOMPUTED = ("residual", "residual_raw", "shading_ratio")
 
@@ -76,8 +77,8 @@ def _recompute(out: dict[str, Any], identities: Any) -> None:
         if not all(ident.get(k) in out for k in ("image", "reflectance", "shading")):
             continue
         rest = out[ident["image"]] - out[ident["reflectance"]] * out[ident["shading"]]
-        if ident.get("specular") in out:
-            rest = rest - out[ident["specular"]]
+        if ident.get(SPECULAR) in out:
+            rest = rest - out[ident[SPECULAR]]
         out[ident["residual"]] = rest.astype(np.float32)
     if "shading_ratio" in out and "image" in out and "reflectance" in out:
         refl = np.asarray(out["reflectance"], np.float64)
