@@ -24,11 +24,12 @@ from .dataset.gallery import build_gallery, contact_sheet
 from .dataset.manifest import write_manifest
 from .formats.exr import read_exr, write_exr
 from .layers import GroundTruth, Layer, LightRecord, compute_ground_truth
+from .layers.settings import DEFAULT_CAMERAS
 from .relight import relight
 from .sample import config_hash, sample_dirs
 from .sample.loader import load_dataset, load_sample, torch_dataset
 from .sample.meta import SampleMeta, read_meta
-from .sample.writer import DEFAULT_CAMERAS, export_sample, is_complete, remove_stale_temporaries
+from .sample.writer import export_sample, is_complete, remove_stale_temporaries
 
 __all__ = [
     "DEFAULT_CAMERAS",

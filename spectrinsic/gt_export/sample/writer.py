@@ -40,7 +40,6 @@ from ...spectra.user_spectra import spectrum_files
 from ..formats import png
 from ..formats.exr import write_exr
 from ..layers import (
-    DEFAULT_CAMERAS,
     GroundTruth,
     Layer,
     LayerSettings,
@@ -71,7 +70,6 @@ if TYPE_CHECKING:
     from ...render.algebra.light_transport import LightTransport
 
 __all__ = [
-    "DEFAULT_CAMERAS",
     "export_sample",
     "is_complete",
     "remove_sample_temporaries",
@@ -269,14 +267,14 @@ def export_sample(
         never a live renderer.
     settings
         The layers to write (:class:`~spectrinsic.gt_export.layers.settings.LayerSettings`,
-        default ``LayerSettings()``):
-        cameras (default :data:`DEFAULT_CAMERAS` when the render has the 31-band cube, none
-        otherwise), the cube, denoising, the per-band layers (``spectral.exr``,
-        :mod:`~spectrinsic.gt_export.layers.spectral_intrinsics`), the working space
-        (recorded in ``meta.json["working_space"]``), and a camera chain to run the sample
-        through (:mod:`~spectrinsic.gt_export.sample.sensor`: raw mosaic, DNG, processed
-        image and the ground truth in the processed linear space), its noise seeded from
-        *seed* and ``settings.noise_id`` (default *sample_id*).
+        default ``LayerSettings()``): cameras (default
+        :data:`~spectrinsic.gt_export.layers.settings.DEFAULT_CAMERAS` when the render has the
+        31-band cube, none otherwise), the cube, denoising, the per-band layers
+        (``spectral.exr``, :mod:`~spectrinsic.gt_export.layers.spectral_intrinsics`), the
+        working space (recorded in ``meta.json["working_space"]``), and a camera chain to run
+        the sample through (:mod:`~spectrinsic.gt_export.sample.sensor`: raw mosaic, DNG,
+        processed image and the ground truth in the processed linear space), its noise seeded
+        from *seed* and ``settings.noise_id`` (default *sample_id*).
     sample_id
         Folder name, e.g. ``"obj-vase__v0__two-colour-a"``.
     config
