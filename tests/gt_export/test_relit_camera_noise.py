@@ -16,7 +16,10 @@ RAW = "raw_sensor/nikon-5100-npl"
 
 def _raw(tmp_path, one_light_sample, config, sample_id, noise_id=None):
     scene, result = one_light_sample
-    folder = export_sample(tmp_path, scene, result, LayerSettings(camera=camera_model("nikon-d5100-npl"), noise_id=noise_id), sample_id=sample_id, config=config, seed=1)  # fmt: skip
+    settings = LayerSettings(camera=camera_model("nikon-d5100-npl"), noise_id=noise_id)
+    folder = export_sample(
+        tmp_path, scene, result, settings, sample_id=sample_id, config=config, seed=1
+    )
     layers = read_exr(folder / "sensor-nikon-5100-npl.exr")
     return np.asarray(layers[RAW.split("/")[0]] if RAW not in layers else layers[RAW])
 

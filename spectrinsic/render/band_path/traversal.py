@@ -28,7 +28,7 @@ from ...spectra import get_sensors
 from ..algebra.modes import ChannelValues, RenderMode, channel_values, get_mode
 from ..algebra.shares import METAL_WHITE, SPECULAR, TransportOutput
 from ..base import translate as tr
-from ..base.one_pass import DIRECT_DEPTH, PassOutput, timed_render
+from ..base.one_pass import DIRECT_DEPTH, PassOutput, check_scene_lights, timed_render
 from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
 from ..base.textures import shape_slots, texture_tables
 from ..base.variants import choose_variant, variant_scope
@@ -280,8 +280,7 @@ def render_traversal(
     variant
         The Mitsuba variant used.
     """
-    if not scene.lights:
-        raise SceneError(f"scene {scene.name!r} has no lights: nothing to render")
+    check_scene_lights(scene)
     if not value_sets:
         raise SceneError("render_traversal: expected at least one set of channel values")
     widths = [np.asarray(v.materials).shape[1] for v in value_sets]
