@@ -69,24 +69,23 @@ REFERENCE_BATCHES = 16
 MODE = "bands31"
 
 
-def _window(
-    scene: Scene, *, spp: int, seed: int, max_depth: int, crop: tuple[int, int, int, int]
-) -> RenderResult:
-    """One batch of the 31-band cube and the first-hit maps of the *crop*, as a render result."""
+def _window(scene: Scene, request: PassRequest, crop: tuple[int, int, int, int]) -> RenderResult:
+    """One batch (*request*) of the 31-band cube and the first-hit maps of the *crop*, as a
+    render result."""
     mode = get_mode(MODE)
     sensors = get_sensors(mode.sensors)
     (out,), aovs, seconds, variant = render_traversal(
         scene,
         [channel_values(scene, sensors)],
-        PassRequest(spp, seed, max_depth),
+        request,
         aovs=True,
         crop=crop,
     )
     raw = out.image()
     matrix = to_xyz_matrix(mode, scene)
     meta = {
-        "spp": spp,
-        "seed": seed,
+        "spp": request.batch_spp,
+        "seed": request.seed,
         "sensors": {MODE: sensors.name},
         "to_xyz": {MODE: matrix.tolist()},
         "variants": {MODE: variant},
@@ -111,7 +110,7 @@ def crop_reference(
     render seconds."""
     start = time.perf_counter()
     parts = [
-        _window(scene, spp=spp // batches, seed=s, max_depth=max_depth, crop=crop)
+        _window(scene, PassRequest(spp // batches, s, max_depth), crop)
         for s in batch_seeds(seed, batches)
     ]
     seconds = time.perf_counter() - start
