@@ -41,7 +41,7 @@ from ..gt_export.sample.transport_exr import (
 from ..pipeline.presets import get_preset
 from ..render.algebra.batch_means import relative_standard_error
 from ..render.algebra.light_transport import LightTransport, relit_result
-from ..render.algebra.shares import PARTS
+from ..render.result import PARTS
 from ..render.transport_render import render_transport_batches
 from ..scenes.library import build
 from ..spectra import get_sensors

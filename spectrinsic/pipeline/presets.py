@@ -356,17 +356,11 @@ class DatasetConfig:
         return cams
 
     def layer_settings(self, data_dir: str | None = None) -> LayerSettings:
-        """The :class:`LayerSettings` of every sample of this dataset (*data_dir*: the spectral
-        data directory the build reads)."""
-        return LayerSettings(
-            cameras=self.resolved_cameras(),
-            camera=camera_model(self.camera) if self.camera else None,
-            write_cube=self.write_cube,
-            denoise=self.denoise,
-            spectral_layers=self.spectral_layers,
-            working_space=working_space(self.working_space),
-            data_dir=data_dir,
-        )
+        """The :class:`LayerSettings` of every sample of this dataset (*data_dir*: the build's)."""
+        camera = camera_model(self.camera) if self.camera else None
+        flags = (self.write_cube, self.denoise, self.spectral_layers)
+        space = working_space(self.working_space)
+        return LayerSettings(self.resolved_cameras(), camera, *flags, space, data_dir)
 
     def to_dict(self) -> dict[str, Any]:
         """The record written with the dataset (``export_sample``, manifest): preset name,

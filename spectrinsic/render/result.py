@@ -1,21 +1,33 @@
-"""The record a render returns: arrays and metadata, no live renderer."""
+"""The record a render returns: arrays and metadata, no live renderer (numpy only: the render
+records sit below ``algebra/``; the ``meta`` record is made by
+:mod:`spectrinsic.render.scene_render`)."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from ..errors import RenderError
-from ..scenes.model import Scene
-from ..spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
-from .algebra.modes import RenderMode
-from .algebra.shares import METAL_WHITE, SPECULAR
-from .base.variants import import_mitsuba
 
-__all__ = ["RenderResult", "render_meta"]
+__all__ = ["METAL_WHITE", "PARTS", "SPECULAR", "RenderResult"]
+
+#: Glossy scenes' part of the transport: the light whose first camera-ray vertex went through a
+#: non-diffuse lobe (it becomes the ``specular`` layer).
+SPECULAR = "specular"
+#: Metals' white-surface radiance at their first hits (not part of the transport; it enters
+#: the shading of metal pixels).
+METAL_WHITE = "metal_white"
+#: The parts a band-path traversal splits off beside its transport, in the order of its AOV
+#: channels (:func:`~spectrinsic.render.band_path.integrator.aov_channels`), and the one letter
+#: of each: its AOV channels are ``<letter lower-case><light>_<band>`` and its layers in
+#: ``transport.exr`` ``<letter><light>...`` (:mod:`spectrinsic.gt_export.sample.transport_exr`;
+#: the transport's own are ``t`` and ``L``). Each is ``(L, H, W, K)`` per unit emission,
+#: composed as the transport is; every record below the traversal (``TransportOutput``,
+#: ``RenderResult.parts``, ``LightTransport.parts``, the batches, the file) holds the parts by
+#: these names.
+PARTS: dict[str, str] = {SPECULAR: "S", METAL_WHITE: "W"}
 
 
 @dataclass(frozen=True, eq=False)
@@ -54,7 +66,7 @@ class RenderResult:
         ``raw[mode][..., k] = Σ_l E_{l,k} transport[mode][l, ..., k]``, with E the lights'
         channel values (:func:`spectrinsic.render.algebra.modes.channel_values`). Empty otherwise.
     parts
-        Single traversal: part name (:data:`spectrinsic.render.algebra.shares.PARTS`) -> mode ->
+        Single traversal: part name (:data:`spectrinsic.render.result.PARTS`) -> mode ->
         ``(H, W, K)`` float32 raw channels of that part, summed over the lights as ``raw`` is;
         only the parts the scene has. ``"specular"`` (glossy materials): the light the camera
         rays' first hits return through their non-diffuse lobes (coat reflection, metal), with
@@ -101,45 +113,3 @@ class RenderResult:
         full = float(np.linalg.norm(self.images[mode].astype(np.float64), axis=-1).sum())
         one = float(np.linalg.norm(self.direct[mode].astype(np.float64), axis=-1).sum())
         return one / full if full > 0 else float("nan")
-
-
-def render_meta(
-    scene: Scene,
-    objs: Sequence[RenderMode],
-    matrices: dict[str, np.ndarray],
-    variants: dict[str, str],
-    timings: dict[str, list[float]],
-    *,
-    batch_spp: int,
-    seed: int,
-    max_depth: int,
-    per_light: bool,
-    wanted: set[str],
-    data_dir: str | None,
-) -> dict[str, Any]:
-    """The ``meta`` record of one batch's render: versions, variants, samples, modes, their
-    sensors and XYZ matrices, the spectral grid, which modes have direct light, and timings (s)."""
-    names = [m.name for m in objs]
-    return {
-        "mitsuba": import_mitsuba().__version__,
-        "variants": variants,
-        "spp": int(batch_spp),  # one batch's: merge_batches makes it the total
-        "seed": int(seed),
-        "max_depth": int(max_depth),
-        "modes": names,
-        "sensors": {m.name: get_sensors(m.sensors, data_dir=data_dir).name for m in objs},
-        "to_xyz": {n: np.asarray(matrices[n]).tolist() for n in names},
-        "wavelengths": {
-            "start": float(COLORIMETRIC_WAVELENGTHS[0]),
-            "end": float(COLORIMETRIC_WAVELENGTHS[-1]),
-            "step": float(COLORIMETRIC_WAVELENGTHS[1] - COLORIMETRIC_WAVELENGTHS[0]),
-            "unit": "nm",
-        },
-        "per_light": bool(per_light),
-        "direct_modes": sorted(wanted),
-        "timings": {
-            k: {"passes": len(v), "seconds": float(sum(v)), "per_pass": [float(x) for x in v]}
-            for k, v in timings.items()
-        },
-        "units": "XYZ = integral of radiance times CIE 1931 CMF over nm; raw = integral of radiance times S_k",
-    }

@@ -24,12 +24,15 @@ import numpy as np
 
 from ..errors import SceneError, did_you_mean
 from .semantic import classify
+from .surface_maps import MeshMaps, maps_from_record
 from .textures import Texture, texture_from_record
 
 __all__ = [
     "Material",
     "MaterialKind",
     "MATERIAL_KINDS",
+    "NON_DIFFUSE_KINDS",
+    "TRANSMISSIVE_KINDS",
     "GLOSS_FIELDS",
     "Mesh",
     "Light",
@@ -77,10 +80,21 @@ LIGHT_PLACEMENT: tuple[str, ...] = tuple(
 LIGHT_DEFAULTED: tuple[str, ...] = ("cutoff_deg",)
 
 
-MaterialKind = Literal["diffuse", "plastic", "conductor"]
+MaterialKind = Literal["diffuse", "plastic", "conductor", "dielectric", "thindielectric"]
 #: Material kinds: Lambertian; a diffuse base under a dielectric coat (Mitsuba ``plastic`` /
-#: ``roughplastic``); a metal (``conductor`` / ``roughconductor``).
-MATERIAL_KINDS: tuple[MaterialKind, ...] = ("diffuse", "plastic", "conductor")
+#: ``roughplastic``); a metal (``conductor`` / ``roughconductor``); clear glass, a solid
+#: (``dielectric`` / ``roughdielectric``) or a thin pane (``thindielectric``).
+MATERIAL_KINDS: tuple[MaterialKind, ...] = (
+    "diffuse",
+    "plastic",
+    "conductor",
+    "dielectric",
+    "thindielectric",
+)
+#: Kinds without a diffuse lobe (reflectance 0; shading the white-Lambertian ``W = E/π``).
+NON_DIFFUSE_KINDS: tuple[MaterialKind, ...] = ("conductor", "dielectric", "thindielectric")
+#: Kinds that transmit light (clear glass).
+TRANSMISSIVE_KINDS: tuple[MaterialKind, ...] = ("dielectric", "thindielectric")
 #: The optional fields of :class:`Material`; at their defaults they are left out of
 #: :func:`scene_to_dict`, so a matte scene's record and hash are those of before they existed.
 GLOSS_FIELDS = ("kind", "roughness", "ior", "metal")
@@ -89,7 +103,7 @@ _OPTIONAL = {"omit_default": True}
 
 @dataclass(frozen=True)
 class Material:
-    """A material: Lambertian (default), coated diffuse or metal.
+    """A material: Lambertian (default), coated diffuse, metal or clear glass.
 
     Attributes
     ----------
@@ -97,18 +111,20 @@ class Material:
         Human-readable name (``"wall"``, ``"stripe 2"``).
     spectrum
         Registry name of the diffuse reflectance spectrum, e.g. ``"munsell:5R 4/14"`` (the base
-        under the coat of a ``plastic``; ``"flat:0"`` for a ``conductor``, which has no diffuse
-        lobe).
+        under the coat of a ``plastic``; ``"flat:0"`` for a ``conductor`` or glass, which have
+        no diffuse lobe).
     kind
         One of :data:`MATERIAL_KINDS`.
     roughness
-        GGX α of the coat or metal surface (dimensionless, 0 = smooth, i.e. a delta lobe);
-        ignored for ``diffuse``.
+        GGX α of the coat, metal or glass surface (dimensionless, 0 = smooth, i.e. a delta
+        lobe); ignored for ``diffuse``; 0 for ``thindielectric``.
     ior
-        Index of refraction of a ``plastic``'s coat (the base medium has index 1).
+        Index of refraction of a ``plastic``'s coat or of glass, relative to the outside
+        (Mitsuba's ``int_ior / ext_ior``); constant over wavelength (no dispersion).
     metal
         Name of a conductor whose measured η/k Mitsuba ships (``Au``, ``Cu``, ``Al``, ``Ag``...),
-        for ``conductor``.
+        or ``none`` for a perfect mirror (F = 1, Mitsuba's ``material: none``), for
+        ``conductor``.
     """
 
     name: str
@@ -122,6 +138,16 @@ class Material:
     def glossy(self) -> bool:
         """Whether the material has a non-diffuse lobe."""
         return self.kind != "diffuse"
+
+    @property
+    def non_diffuse(self) -> bool:
+        """Whether the material has no diffuse lobe (metal, mirror, glass)."""
+        return self.kind in NON_DIFFUSE_KINDS
+
+    @property
+    def transmissive(self) -> bool:
+        """Whether the material is glass (transmits light)."""
+        return self.kind in TRANSMISSIVE_KINDS
 
 
 def _named_class(mesh: Mesh) -> bool:
@@ -157,6 +183,9 @@ class Mesh:
         when it is that class, so the records and hashes of scenes from before classes existed
         are unchanged. ``dataclasses.replace(mesh, name=...)`` keeps the class; add
         ``semantic=""`` to take the new name's.
+    maps
+        Its opacity mask and bump or normal map (:class:`~spectrinsic.scenes.surface_maps.MeshMaps`),
+        or ``None``: opaque, unperturbed. Left out of :func:`scene_to_dict` when ``None``.
     """
 
     name: str
@@ -166,6 +195,7 @@ class Mesh:
     object_id: int
     texture: Texture | None = field(default=None, metadata=_OPTIONAL)
     semantic: str = field(default="", metadata={"omit_when": _named_class})
+    maps: MeshMaps | None = field(default=None, metadata=_OPTIONAL)
 
     def __post_init__(self) -> None:
         if not self.semantic:  # the class of its name (frozen: set once, here)
@@ -182,6 +212,7 @@ class Mesh:
             and np.array_equal(self.face_materials, other.face_materials)
             and self.texture == other.texture
             and self.semantic == other.semantic
+            and self.maps == other.maps
         )
 
     __hash__ = None  # type: ignore[assignment]
@@ -375,6 +406,7 @@ def _mesh_from_dict(m: Mapping[str, Any]) -> Mesh:
         object_id=int(m["object_id"]),
         texture=texture_from_record(m["texture"]) if m.get("texture") else None,
         semantic=str(m.get("semantic") or ""),
+        maps=maps_from_record(m["maps"]) if m.get("maps") else None,
     )
 
 

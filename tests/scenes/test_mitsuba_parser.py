@@ -180,12 +180,6 @@ def test_a_mitsuba_05_file_loads_and_says_what_it_fixed(tmp_path, capsys):
 @pytest.mark.parametrize(
     ("body", "bsdf", "named"),
     [
-        ("", '<bsdf type="dielectric"/>', "<bsdf type='dielectric'>"),
-        ("", '<bsdf type="thindielectric"/>', "<bsdf type='thindielectric'>"),
-        ("", '<bsdf type="roughdielectric"/>', "<bsdf type='roughdielectric'>"),
-        ("", '<bsdf type="mask"><bsdf type="diffuse"/></bsdf>', "<bsdf type='mask'>"),
-        ("", '<bsdf type="bumpmap"><bsdf type="diffuse"/></bsdf>', "<bsdf type='bumpmap'>"),
-        ("", '<bsdf type="normalmap"><bsdf type="diffuse"/></bsdf>', "<bsdf type='normalmap'>"),
         (
             '<emitter type="envmap"><string name="filename" value="sky.exr"/></emitter>',
             "",
@@ -205,15 +199,14 @@ def test_what_has_no_exact_ground_truth_is_refused_or_approximated(tmp_path, bod
     assert f"{named} has no exact ground truth yet" in message
     scene = load_mitsuba_xml(path, approximate=True)
     assert named in " ".join(scene.metadata["approximated"])
-    glass = "dielectric" in bsdf
-    assert [m.name for m in scene.meshes] == (["box"] if glass else ["floor", "box"])
+    assert [m.name for m in scene.meshes] == ["floor", "box"]
 
 
 def test_an_unsupported_element_refuses_in_one_line_through_the_cli(tmp_path, capsys):
-    path = _write(tmp_path, _scene(LAMP, bsdf='<bsdf type="dielectric" id="glass"/>'))
+    path = _write(tmp_path, _scene(LAMP, bsdf='<bsdf type="roughdielectric" id="glass"/>'))
     assert main(["render", str(path), "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "<bsdf type='dielectric' id='glass'>" in err
+    assert len(err.splitlines()) == 1 and "<bsdf type='roughdielectric' id='glass'>" in err
     assert not (tmp_path / "out").exists()
     yaml_scene = _write(tmp_path, "name: x\n", "x.yaml")
     assert main(["render", str(yaml_scene), "--approximate", "--out", str(tmp_path / "o")]) == 2
@@ -316,19 +309,19 @@ def test_the_files_spp_and_depth_apply_unless_the_command_line_gives_them(tmp_pa
 def test_approximate_is_said_and_recorded_in_the_samples_meta(tmp_path, capsys):
     import json
 
-    bump = '<bsdf type="bumpmap" id="bumpy"><bsdf type="diffuse"/></bsdf>'
+    bump = '<bsdf type="roughplastic" id="bumpy"/>'  # Beckmann, Mitsuba's default: as GGX
     path, out = _write(tmp_path, _scene(LAMP, bsdf=bump)), tmp_path / "gt"
     args = ["--preset", "preview", "--spp", "2", "--resolution", "8x6", "--out", str(out)]
     assert main(["render", str(path), "--ground-truth", "--approximate", *args]) == 0
     err = capsys.readouterr().err
     floor = "element 0 <shape type='rectangle' id='floor'>"
-    assert f"approximated: {floor}: <bsdf type='bumpmap' id='bumpy'> replaced by the BSDF" in err
+    assert f"approximated: {floor}: <bsdf type='roughplastic' id='bumpy'> distribution" in err
     assert (
         "spp 2 from the dataset's settings (preset 'preview' and options) (the file says 4)" in err
     )
     (meta_path,) = out.glob("**/meta.json")
     record = json.loads(meta_path.read_text())["scene_metadata"]
-    assert record["approximate"] is True and "bumpmap" in record["approximated"][0]
+    assert record["approximate"] is True and "roughplastic" in record["approximated"][0]
 
 
 def _serialized(meshes) -> bytes:

@@ -41,7 +41,7 @@ import numpy as np
 from ...errors import DatasetError
 from ...render.algebra.batch_means import batch_mean
 from ...render.algebra.light_transport import LightTransport
-from ...render.algebra.shares import PARTS
+from ...render.result import PARTS
 from ...spectra import get_sensors
 from ..formats.exr import read_exr_stacks, write_exr
 from . import TRANSPORT_NAME
@@ -66,7 +66,7 @@ COMPACT_LAYOUT = "batch-mean+half-deviations"
 #: The EXR compression of ``transport.exr`` (:data:`~spectrinsic.gt_export.formats.exr.COMPRESSIONS`):
 #: zlib per scanline, as small as ``"zip"`` on Monte Carlo noise and 4x faster to read back.
 TRANSPORT_COMPRESSION = "zips"
-#: The letter of the batch deviations' layers (a part's letters are in :data:`~spectrinsic.render.algebra.shares.PARTS`).
+#: The letter of the batch deviations' layers (a part's letters are in :data:`~spectrinsic.render.result.PARTS`).
 DEVIATION_LETTER = "D"
 #: The largest float16 magnitude a deviation is scaled to: 2^14, below float16's 65504, so
 #: a scaled deviation never overflows and keeps 11 significant bits down to 2^-14 of it.
@@ -78,7 +78,7 @@ TRANSPORT_UNITS = (
 
 
 def transport_layer(light: int, batch: int | None, mode: str, part: str = "transport") -> str:
-    """EXR layer name of light *light*'s transport (or its *part*, :data:`~spectrinsic.render.algebra.shares.PARTS`) for
+    """EXR layer name of light *light*'s transport (or its *part*, :data:`~spectrinsic.render.result.PARTS`) for
     *mode*: the batch mean (*batch* ``None``, the compact layout) or batch *batch* (the layout
     before issue 45).
 

@@ -15,10 +15,10 @@ from ...errors import RenderError
 from ...scenes.model import Scene
 from ...spectra import COLORIMETRIC_WAVELENGTHS, diagonal_values, get_sensors
 from ...threads import thread_map
-from ..result import RenderResult
+from ..result import METAL_WHITE, SPECULAR, RenderResult
 from .batch_means import batch_mean
 from .modes import get_mode, light_spectra, lights_to_xyz_matrix, raw_to_xyz
-from .shares import METAL_WHITE, SPECULAR, compose, light_shares, sum_lights
+from .shares import compose, light_shares, sum_lights
 
 __all__ = [
     "LightTransport",
@@ -53,7 +53,7 @@ class LightTransport:
         Seconds of each Mitsuba pass, per mode, and under ``"single"`` those of the traversals
         carrying every mode at once (empty when read from a file).
     parts
-        Part name (:data:`spectrinsic.render.algebra.shares.PARTS`) -> one dict per batch as
+        Part name (:data:`spectrinsic.render.result.PARTS`) -> one dict per batch as
         :attr:`batches`, for the same unit spectrum: glossy scenes' ``"specular"`` part of ``T``
         (first camera-ray vertex through a non-diffuse lobe) and metals' ``"metal_white"``
         white-surface radiance at metal first hits (not part of ``T``)

@@ -15,30 +15,11 @@ import numpy as np
 from ...errors import RenderError
 
 __all__ = [
-    "METAL_WHITE",
-    "PARTS",
-    "SPECULAR",
     "TransportOutput",
     "compose",
     "light_shares",
     "sum_lights",
 ]
-
-#: Glossy scenes' part of the transport: the light whose first camera-ray vertex went through a
-#: non-diffuse lobe (it becomes the ``specular`` layer).
-SPECULAR = "specular"
-#: Metals' white-surface radiance at their first hits (not part of the transport; it enters
-#: the shading of metal pixels).
-METAL_WHITE = "metal_white"
-#: The parts a band-path traversal splits off beside its transport, in the order of its AOV
-#: channels (:func:`~spectrinsic.render.band_path.integrator.aov_channels`), and the one letter
-#: of each: its AOV channels are ``<letter lower-case><light>_<band>`` and its layers in
-#: ``transport.exr`` ``<letter><light>...`` (:mod:`spectrinsic.gt_export.sample.transport_exr`;
-#: the transport's own are ``t`` and ``L``). Each is ``(L, H, W, K)`` per unit emission,
-#: composed as the transport is; every record below the traversal (:class:`TransportOutput`,
-#: ``RenderResult.parts``, ``LightTransport.parts``, the batches, the file) holds the parts by
-#: these names.
-PARTS: dict[str, str] = {SPECULAR: "S", METAL_WHITE: "W"}
 
 
 def light_shares(parts: np.ndarray, emission: np.ndarray) -> np.ndarray:
@@ -88,7 +69,7 @@ class TransportOutput:
     emission
         ``(L, K)`` float64 the lights' channel values ``E_{l,k}`` (:class:`ChannelValues`).
     parts
-        Part name (:data:`~spectrinsic.render.algebra.shares.PARTS`) -> ``(L, H, W, K)`` float32, the parts the traversal rendered:
+        Part name (:data:`~spectrinsic.render.result.PARTS`) -> ``(L, H, W, K)`` float32, the parts the traversal rendered:
         ``"specular"``, the part of :attr:`transport` whose first camera-ray vertex went through
         a non-diffuse lobe (glossy scenes; 0 in matte ones); ``"metal_white"``, the radiance a
         white Lambertian surface would reflect at the pixel's metal first hits, times their
@@ -112,7 +93,7 @@ class TransportOutput:
         return sum_lights(self.per_light(direct=direct), lights)
 
     def part_image(self, part: str, lights: Sequence[int] | None = None) -> np.ndarray | None:
-        """``(H, W, K)`` float32 image of *part* (:data:`~spectrinsic.render.algebra.shares.PARTS`) for the *lights* (default all),
+        """``(H, W, K)`` float32 image of *part* (:data:`~spectrinsic.render.result.PARTS`) for the *lights* (default all),
         composed as :meth:`image` composes the transport (so both agree bit for bit where all
         light is specular), or ``None`` where the traversal did not render it."""
         held = self.parts.get(part)

@@ -10,7 +10,8 @@ heuristic MIS, the same sampler calls in the same order) written in Python on Dr
 throughput is a list of K band products gathered from a per-material table, and whose
 contributions go to one accumulator per (light, band). Its loop is the one body of
 :class:`~spectrinsic.render.band_path.kernel.BandKernel`; ``gloss`` and ``metals`` switch on its
-glossy (G1) factors with the specular part and the white-at-metal loop when it is traced.
+glossy (G1) factors with the specular part and the white-at-metal loop when it is traced
+("metal" there: any first hit without a diffuse lobe, metal, mirror or glass).
 
 The scene is loaded with white Lambertian surfaces (area-light shapes black) and unit white
 emitters, so Mitsuba's own BSDF and emitter sampling give the band-independent factors
@@ -36,9 +37,10 @@ import numpy as np
 
 from ...errors import RenderError
 from ...spectra.conductors import FRESNEL_NODES
-from ..algebra.shares import METAL_WHITE, PARTS, SPECULAR
+from ..base.surface_maps import map_textures
 from ..base.textures import TextureTables, shape_id_table, texture_lookups
 from ..base.variants import import_mitsuba
+from ..result import METAL_WHITE, PARTS, SPECULAR
 from .kernel import BandKernel
 
 __all__ = [
@@ -77,6 +79,11 @@ class BandTables:
         The texel tables of textured meshes (:mod:`~spectrinsic.render.base.textures`), or ``None``.
     shape_textures
         ``{Mitsuba shape id: texture slot}`` of textured shapes.
+    map_scales
+        ``{Mitsuba shape id: bump scale}`` of shapes with a bump or normal map, whose perturbed
+        normal the first-hit maps hold (:mod:`~spectrinsic.render.base.surface_maps`).
+    masks
+        Whether a shape has an opacity mask (null events: :mod:`~spectrinsic.render.band_path.kernel`).
     """
 
     albedo: np.ndarray
@@ -86,11 +93,13 @@ class BandTables:
     shape_surfaces: dict[str, int] = field(default_factory=dict)
     textures: TextureTables | None = None
     shape_textures: dict[str, int] = field(default_factory=dict)
+    map_scales: dict[str, float] = field(default_factory=dict)
+    masks: bool = False
 
 
 def part_channels(part: str, n_lights: int, n_bands: int) -> list[str]:
     """AOV names of the transport's (*part* ``"transport"``: ``t<l>_<k>``) or a part's
-    channels, light-major, by the part's letter in :data:`~spectrinsic.render.algebra.shares.PARTS`
+    channels, light-major, by the part's letter in :data:`~spectrinsic.render.result.PARTS`
     (``s<l>_<k>`` specular, ``w<l>_<k>`` white at metals)."""
     letter = "t" if part == "transport" else PARTS[part].lower()
     return [f"{letter}{j:02d}_{k:02d}" for j in range(n_lights) for k in range(n_bands)]
@@ -160,17 +169,38 @@ def _check_fit(it: Any, tables: BandTables) -> None:
 
 def _init_gloss(mi: Any, it: Any, props: Any) -> None:
     """The glossy properties of integrator *it*: flags, μ nodes, a specular table of ones, no
-    metal rows, and the white BSDF the white-at-metal loop swaps in."""
+    non-diffuse rows, and the white BSDF the white-at-metal loop swaps in."""
     it.metals = bool(props.get("metals", False))
     it.gloss = bool(props.get("gloss", False)) or it.metals
     it.n_nodes = int(props.get("n_nodes", FRESNEL_NODES))
     if it.gloss:
         it.specular = mi.Float(np.ones(it.n_nodes * it.n_bands, np.float32))
-        it.metal_rows = mi.UInt32(np.zeros(1, np.uint32))
+        it.non_diffuse_rows = mi.UInt32(np.zeros(1, np.uint32))
         # two-sided as every material of the scene; Mitsuba's diffuse defaults to 0.5
         it.white_bsdf = mi.load_dict(
             {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": 1.0}}
         )
+
+
+def _init_maps(mi: Any, it: Any, props: Any) -> None:
+    """The mask flag of integrator *it* and no bump or normal maps yet."""
+    it.masks = bool(props.get("masks", False))
+    it.map_lut = mi.UInt32(np.zeros(1, np.uint32))
+    #: (kind, texture, bump scale) of each bump- or normal-mapped shape (surface_maps)
+    it.surface_maps = []
+
+
+def _init_features(mi: Any, it: Any, props: Any) -> None:
+    """The glossy (:func:`_init_gloss`) and mask and map (:func:`_init_maps`) properties."""
+    _init_gloss(mi, it, props)
+    _init_maps(mi, it, props)
+
+
+def _set_maps(mi: Any, dr: Any, it: Any, scene: Any, tables: BandTables) -> None:
+    """Point integrator *it* at the bump and normal maps of the loaded *scene*'s shapes
+    named in *tables* (their texture objects, shape id -> map index)."""
+    lut, it.surface_maps = map_textures(mi, scene, tables.map_scales)
+    it.map_lut = mi.UInt32(shape_id_table(mi, dr, scene, lut, len(lut)))
 
 
 def _check_specular(it: Any, table: np.ndarray) -> None:
@@ -201,7 +231,7 @@ def _make_class(mi: Any, dr: Any) -> type:
             self.albedo = mi.Float(np.zeros(self.n_bands, np.float32))
             self.shape_lut = mi.UInt32(np.zeros(1, np.uint32))
             self.emitter_lut = mi.UInt32(np.zeros(1, np.uint32))
-            _init_gloss(mi, self, props)
+            _init_features(mi, self, props)
 
         def set_tables(self, scene: Any, tables: BandTables) -> None:
             """Point the lookups at *tables* for the loaded *scene* (no recompilation)."""
@@ -212,10 +242,11 @@ def _make_class(mi: Any, dr: Any) -> type:
             lookups = texture_lookups(mi, dr, scene, tables.textures, tables.shape_textures)
             self.slot_lut, self.tex_widths, self.tex_heights, self.tex_offsets = lookups[:4]
             self.texel_albedo, self.texel_weights = lookups[4:]
+            _set_maps(mi, dr, self, scene, tables)
 
-        def set_metals(self, rows: np.ndarray) -> None:
-            """``(R,)`` bool: which albedo-table rows are metals (no diffuse lobe)."""
-            self.metal_rows = mi.UInt32(np.asarray(rows, bool).astype(np.uint32))
+        def set_non_diffuse(self, rows: np.ndarray) -> None:
+            """``(R,)`` per row: 0, ``MIRROR_ROW`` or ``GLASS_ROW`` (kernel: ``non_diffuse_rows``)."""
+            self.non_diffuse_rows = mi.UInt32(np.asarray(rows, np.uint32))
 
         def set_specular(self, table: np.ndarray) -> None:
             """``(R, n_nodes, K)`` band factors ``s_k(μ_j)`` per albedo-table row."""
@@ -252,7 +283,7 @@ def band_path_class(variant: str) -> type:
     since ``mi.SamplingIntegrator`` is the variant's), registered as :data:`INTEGRATOR_NAME`.
 
     Properties: ``max_depth``, ``rr_depth`` (as ``path``), ``n_bands`` (K), ``n_lights`` (L),
-    ``n_surfaces``, ``n_texcols``, ``gloss``, ``metals``, ``n_nodes`` (μ nodes of the band
+    ``n_surfaces``, ``n_texcols``, ``gloss``, ``metals``, ``masks``, ``n_nodes`` (μ nodes of the band
     Fresnel tables). Its AOVs are :func:`aov_channels`; its RGB output is zero.
     """
     mi = import_mitsuba()
@@ -275,12 +306,14 @@ def band_path(
     n_texcols: int = 0,
     gloss: bool = False,
     metals: bool = False,
+    masks: bool = False,
 ) -> Any:
     """A :class:`BandPath` instance for the active variant (rr off: ``rr_depth`` > ``max_depth``),
     with first-hit maps of *n_surfaces* surfaces if not 0, textures of *n_texcols* coverage
     columns (:class:`TextureTables`) if not 0, the glossy (G1) factors and specular part with
     *gloss*, and the white-surface radiance at metal first hits with *metals* (implies *gloss*;
-    :mod:`~spectrinsic.render.band_path.kernel`)."""
+    :mod:`~spectrinsic.render.band_path.kernel`), and null events through opacity masks with
+    *masks*."""
     band_path_class(mi.variant())
     return mi.load_dict(
         {
@@ -293,5 +326,6 @@ def band_path(
             "n_texcols": int(n_texcols),
             "gloss": bool(gloss),
             "metals": bool(metals),
+            "masks": bool(masks),
         }
     )

@@ -26,15 +26,18 @@ from ...errors import RenderError, SceneError, validate_choice
 from ...scenes.model import Scene
 from ...spectra import get_sensors
 from ..algebra.modes import ChannelValues, RenderMode, channel_values, get_mode
-from ..algebra.shares import METAL_WHITE, SPECULAR, TransportOutput
+from ..algebra.shares import TransportOutput
 from ..base import translate as tr
+from ..base.aov_maps import assemble_aovs
 from ..base.one_pass import DIRECT_DEPTH, PassOutput, check_scene_lights, timed_render
 from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
+from ..base.surface_maps import map_scales
 from ..base.textures import shape_slots, texture_tables
 from ..base.variants import choose_variant, variant_scope
-from ..passes.aovs import assemble_aovs
+from ..result import METAL_WHITE, SPECULAR
 from ..settings import DEFAULT_INTEGRATOR, INTEGRATORS, PassRequest
 from .integrator import BandTables, band_path, first_hit_channels
+from .kernel import GLASS_ROW, MIRROR_ROW
 
 __all__ = [
     "SingleTraversal",
@@ -102,6 +105,8 @@ def _tables(
         shape_surfaces={s.key: i for i, s in enumerate(surfaces)} if aovs else {},
         textures=textures,
         shape_textures=shape_slots(textures, surfaces),
+        map_scales=map_scales(scene, surfaces),
+        masks=any(m.maps is not None and m.maps.masked for m in scene.meshes),
     )
 
 
@@ -140,17 +145,18 @@ class _Dims:
     n_bands: int
     n_lights: int
     glossy: bool
-    #: Per albedo-table row (materials, then the black row): whether it is a metal.
-    metal_rows: tuple[bool, ...] = ()
+    #: Per albedo-table row (materials, then the black row): 0 with a diffuse lobe, else
+    #: MIRROR_ROW or GLASS_ROW (the white-at-metal loop's rows; ``set_non_diffuse``).
+    non_diffuse_rows: tuple[int, ...] = ()
 
     @property
     def metals(self) -> bool:
-        return any(self.metal_rows)
+        return any(self.non_diffuse_rows)
 
 
 @dataclass(frozen=True, eq=False)
 class _Traced:
-    """One traversal: transport ``(L, H, W, K)``, the parts of :data:`~spectrinsic.render.algebra.shares.PARTS`
+    """One traversal: transport ``(L, H, W, K)``, the parts of :data:`~spectrinsic.render.result.PARTS`
     it rendered (same shape; the first traversal only), the first-hit maps (first traversal
     with surfaces) and its seconds."""
 
@@ -185,12 +191,13 @@ def _trace(
         n_texcols=n_texcols,
         gloss=dims.glossy,
         metals=metals,
+        masks=tables.masks,
     )
     integrator.set_tables(loaded, tables if n_surfaces else replace(tables, shape_surfaces={}))
     if spec_table is not None:
         integrator.set_specular(spec_table)
-    if metals:
-        integrator.set_metals(np.array(dims.metal_rows, bool))
+    if dims.glossy:  # every traversal: a glass row's null event is no mask cut-out
+        integrator.set_non_diffuse(np.array(dims.non_diffuse_rows, np.uint32))
     n_t = dims.n_bands * dims.n_lights
     n_spec = n_t if dims.glossy else 0
     n_white = n_t if metals else 0
@@ -215,7 +222,7 @@ def _trace(
 
 
 def _first_hit_maps(scene: Scene, tables: BandTables, hits: np.ndarray) -> dict[str, np.ndarray]:
-    """:func:`~spectrinsic.render.passes.aovs.assemble_aovs` of the traversal's first-hit channels
+    """:func:`~spectrinsic.render.base.aov_maps.assemble_aovs` of the traversal's first-hit channels
     (coverage, texture columns, ray distance, normal)."""
     columns = None if tables.textures is None else tables.textures.columns
     surfaces = tr.surfaces(scene)
@@ -305,8 +312,11 @@ def render_traversal(
             )
         )
         tables = _tables(scene, value_sets, light_of_emitters(mi, loaded), aovs)
-        metal_rows = tuple(m.kind == "conductor" for m in scene.materials) + (False,)
-        dims = _Dims(h, w, n_bands, n_lights, glossy, metal_rows)
+        non_diffuse_rows = tuple(
+            GLASS_ROW if m.transmissive else MIRROR_ROW if m.non_diffuse else 0
+            for m in scene.materials
+        ) + (0,)
+        dims = _Dims(h, w, n_bands, n_lights, glossy, non_diffuse_rows)
         spec_table = _specular_table(scene, value_sets) if glossy else None
         traced: list[_Traced] = []
         for depth in [request.max_depth] + ([DIRECT_DEPTH] if direct else []):
@@ -333,7 +343,7 @@ class SingleTraversal:
 
     def per_light(self, part: str) -> dict[str, np.ndarray]:
         """Mode -> ``(L, H, W, K)`` per-light *part* (``"transport"`` or one of
-        :data:`~spectrinsic.render.algebra.shares.PARTS`); modes without it left out."""
+        :data:`~spectrinsic.render.result.PARTS`); modes without it left out."""
         arrays = {
             n: t.transport if part == "transport" else t.parts.get(part)
             for n, t in self.transport.items()

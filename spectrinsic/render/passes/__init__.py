@@ -32,6 +32,7 @@ from ..base.one_pass import (
     timed_render,
 )
 from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
+from ..base.surface_maps import refuse_maps
 from ..base.textures import refuse_textures
 from ..base.variants import choose_variant, variant_scope
 from ..settings import PassRequest
@@ -73,6 +74,7 @@ def render_diagonal(
     """
     check_scene_lights(scene)
     refuse_textures(scene, "the diagonal passes")
+    refuse_maps(scene, "the diagonal passes")
     active = active_light_set(scene, active_lights)
     flags = (
         [bool(direct)] * len(value_sets) if isinstance(direct, bool) else [bool(d) for d in direct]
