@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from spectrinsic.gt_export.layers import compute_ground_truth
+from spectrinsic.gt_export.layers import LayerSettings, compute_ground_truth
 from spectrinsic.gt_export.layers.spectral_intrinsics import light_family
 from spectrinsic.render import RenderSettings, render_batches
 from spectrinsic.scenes.generators import generate
@@ -51,9 +51,15 @@ def _room(index: int, args: argparse.Namespace) -> dict:
     ref = render_batches(
         scene, RenderSettings(args.ref_spp // 2, batches=2, **base), seed=index + 101
     )
-    denoised = compute_ground_truth(scene, low, cameras=(), denoise=True, spectral=True)
-    truth = compute_ground_truth(scene, ref, cameras=(), denoise=False, spectral=True)
-    raw = compute_ground_truth(scene, low, cameras=(), denoise=False, spectral=True)
+    denoised = compute_ground_truth(
+        scene, low, LayerSettings(cameras=(), denoise=True, spectral_layers=True)
+    )
+    truth = compute_ground_truth(
+        scene, ref, LayerSettings(cameras=(), denoise=False, spectral_layers=True)
+    )
+    raw = compute_ground_truth(
+        scene, low, LayerSettings(cameras=(), denoise=False, spectral_layers=True)
+    )
     reference = truth.layers["shading_bands"].data
     valid = (
         (reference.sum(axis=-1) > 0)

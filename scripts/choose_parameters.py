@@ -33,19 +33,28 @@ from spectrinsic.decompose.methods.constancy import with_constancy
 from spectrinsic.decompose.methods.names_shades import NamesAndShades
 from spectrinsic.decompose.methods.protocol import hold_one_out, scene_group, score_grid
 from spectrinsic.decompose.methods.retinex import ColourRetinex
-from spectrinsic.gt_export.sample import sample_dirs
 from spectrinsic.gt_export.dataset.loader import load_sample
+from spectrinsic.gt_export.sample import sample_dirs
 
-LAYERS = ["image", "image_denoised", "reflectance", "shading", "shading_grey", "mask",
-          "object_id", "material_id"]
+LAYERS = [
+    "image",
+    "image_denoised",
+    "reflectance",
+    "shading",
+    "shading_grey",
+    "mask",
+    "object_id",
+    "material_id",
+]
 CONSTANCY = ["none", "grey-world", "shades-of-grey", "max-rgb"]
 #: Grosse et al.'s grid for both thresholds, logspace(-1.5, 0, 5).
 RETINEX_THRESHOLDS = [round(float(v), 4) for v in np.logspace(-1.5, 0.0, 5)]
 GRIDS = {
-    "retinex": (ColourRetinex, {"threshold_grey": RETINEX_THRESHOLDS,
-                                "threshold_colour": RETINEX_THRESHOLDS}),
-    "names-shades": (NamesAndShades, {"gamma_over_alpha": [10.0, 100.0],
-                                      "mu": [1.0 / 3.0, 0.5]}),
+    "retinex": (
+        ColourRetinex,
+        {"threshold_grey": RETINEX_THRESHOLDS, "threshold_colour": RETINEX_THRESHOLDS},
+    ),
+    "names-shades": (NamesAndShades, {"gamma_over_alpha": [10.0, 100.0], "mu": [1.0 / 3.0, 0.5]}),
 }
 #: Applied after each decomposition (with_constancy), so not decomposed again.
 POST_GRID = {"colour_constancy": CONSTANCY}
@@ -66,8 +75,9 @@ def mit_choice(record: Path) -> int:
     """Print names-shades' MIT choice (scripts/mit_ablation.py's protocol) from its record."""
     import importlib.util
 
-    spec = importlib.util.spec_from_file_location("mit_ablation",
-                                                  Path(__file__).with_name("mit_ablation.py"))
+    spec = importlib.util.spec_from_file_location(
+        "mit_ablation", Path(__file__).with_name("mit_ablation.py")
+    )
     ablation = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(ablation)
     scores = json.loads(record.read_text())["scores"]
@@ -75,9 +85,14 @@ def mit_choice(record: Path) -> int:
     base = scores["image-as-reflectance"]
     per = scores[ablation.key(choice["chosen"])]
     wins = sum(v["lmse"] < base[o]["lmse"] for o, v in per.items())
-    print("names-shades (MIT development half)", choice["chosen"],
-          f"all {choice['chosen_lmse']:.4f}", f"held-out {choice['held_out_lmse']:.4f}",
-          f"beats image-as-reflectance on {wins}/{len(per)}", flush=True)
+    print(
+        "names-shades (MIT development half)",
+        choice["chosen"],
+        f"all {choice['chosen_lmse']:.4f}",
+        f"held-out {choice['held_out_lmse']:.4f}",
+        f"beats image-as-reflectance on {wins}/{len(per)}",
+        flush=True,
+    )
     return 0
 
 
@@ -96,17 +111,28 @@ def main(argv: list[str]) -> int:
         table = score_grid(data, make, grid, post_grid=POST_GRID, post=with_constancy)
         res = hold_one_out(table, groups)
         report[name] = {
-            "grid": {**grid, **POST_GRID}, "samples": len(data), "groups": sorted(set(groups.values())),
-            "chosen": dict(res.chosen), "chosen_score": res.chosen_score,
+            "grid": {**grid, **POST_GRID},
+            "samples": len(data),
+            "groups": sorted(set(groups.values())),
+            "chosen": dict(res.chosen),
+            "chosen_score": res.chosen_score,
             "held_out_score": res.held_out_score,
-            "folds": [{"held_out": f.held_out, "chosen": dict(f.chosen), "score": f.score}
-                      for f in res.folds],
+            "folds": [
+                {"held_out": f.held_out, "chosen": dict(f.chosen), "score": f.score}
+                for f in res.folds
+            ],
             "table": {json.dumps(dict(p)): v for p, v in table.items()},
             "seconds": round(time.perf_counter() - t0, 1),
         }
         target.write_text(json.dumps(report, indent=1))
-        print(name, dict(res.chosen), f"all {res.chosen_score:.4f}",
-              f"held-out {res.held_out_score:.4f}", f"{time.perf_counter() - t0:.0f}s", flush=True)
+        print(
+            name,
+            dict(res.chosen),
+            f"all {res.chosen_score:.4f}",
+            f"held-out {res.held_out_score:.4f}",
+            f"{time.perf_counter() - t0:.0f}s",
+            flush=True,
+        )
     return 0
 
 

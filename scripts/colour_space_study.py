@@ -35,7 +35,7 @@ import colour
 import numpy as np
 from scipy.optimize import minimize
 
-from spectrinsic.gt_export.layers import compute_ground_truth
+from spectrinsic.gt_export.layers import LayerSettings, compute_ground_truth
 from spectrinsic.gt_export.layers.spectral_intrinsics import (
     LIGHT_FAMILIES,
     bands_to_rgb,
@@ -182,7 +182,7 @@ def room_rows(args: argparse.Namespace, matrices: dict[str, np.ndarray]) -> list
     for index, scene in enumerate(scenes):
         t0 = time.perf_counter()
         result = render_scene(scene, settings, seed=args.seed + index)
-        gt = compute_ground_truth(scene, result, spectral=True)
+        gt = compute_ground_truth(scene, result, LayerSettings(spectral_layers=True))
         to_xyz = np.asarray(result.meta["to_xyz"]["bands31"], np.float64)
         row = {
             "scene": scene.name,

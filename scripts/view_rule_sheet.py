@@ -28,6 +28,7 @@ from spectrinsic.data_dir import resolve_data_dir
 from spectrinsic.gt_export.dataset.contact_sheet import tile_sheet
 from spectrinsic.pipeline.sample_plan import plan_samples
 from spectrinsic.render.probe import probe_luminance
+from spectrinsic.render.settings import PassRequest
 from spectrinsic.render.spectral import render_spectral
 from spectrinsic.scenes.generators.view_rule import judge_frame, judge_view
 from spectrinsic.spectra import get_sensors
@@ -63,7 +64,7 @@ def main(
                 return y
 
             scene = task.source.build(data, probe=probe)
-            xyz = render_spectral(scene, get_sensors("cie1931"), spp=16, seed=0, data_dir=data)
+            xyz = render_spectral(scene, get_sensors("cie1931"), PassRequest(16, 0), data_dir=data)
             path = Path(tmp) / f"{task.sample_id}.png"
             _tile(xyz.image).save(path)
             tiles.append((task.sample_id, path))

@@ -19,6 +19,7 @@ __all__ = [
     "RenderError",
     "DatasetError",
     "SampleMetaError",
+    "WorkingSpaceError",
     "WriteError",
     "DiskFullError",
     "DecomposeError",
@@ -66,6 +67,12 @@ class SampleMetaError(DatasetError):
     """A sample's ``meta.json`` that cannot be trusted: not JSON, a field missing, misnamed or of
     the wrong type, a non-finite number, or content that no longer matches its seal. The message
     names the file and the field."""
+
+
+class WorkingSpaceError(DatasetError, ValueError):
+    """An RGB working space name no table knows (``--working-space``, a dataset config,
+    ``meta.json["working_space"]``); raised by :func:`spectrinsic.spectra.working_space.working_space`,
+    the one place a name is checked."""
 
 
 class WriteError(DatasetError):

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ..gt_export.layers import compute_ground_truth
+from ..gt_export.layers import LayerSettings, compute_ground_truth
 from ..gt_export.layers.denoise import Guides, denoise_blocks, denoise_rgb
 from ..gt_export.layers.irradiance import WhiteRadiance
 from ..pipeline.presets import get_preset
@@ -42,6 +42,7 @@ from ..render.algebra.batch_means import batch_seeds, merge_batches
 from ..render.algebra.modes import channel_values, get_mode, raw_to_xyz, to_xyz_matrix
 from ..render.band_path.traversal import render_traversal
 from ..render.result import RenderResult
+from ..render.settings import PassRequest
 from ..scenes.library import build
 from ..scenes.model import Scene
 from ..spectra import get_sensors
@@ -68,26 +69,23 @@ REFERENCE_BATCHES = 16
 MODE = "bands31"
 
 
-def _window(
-    scene: Scene, *, spp: int, seed: int, max_depth: int, crop: tuple[int, int, int, int]
-) -> RenderResult:
-    """One batch of the 31-band cube and the first-hit maps of the *crop*, as a render result."""
+def _window(scene: Scene, request: PassRequest, crop: tuple[int, int, int, int]) -> RenderResult:
+    """One batch (*request*) of the 31-band cube and the first-hit maps of the *crop*, as a
+    render result."""
     mode = get_mode(MODE)
     sensors = get_sensors(mode.sensors)
     (out,), aovs, seconds, variant = render_traversal(
         scene,
         [channel_values(scene, sensors)],
-        spp=spp,
-        seed=seed,
-        max_depth=max_depth,
+        request,
         aovs=True,
         crop=crop,
     )
     raw = out.image()
     matrix = to_xyz_matrix(mode, scene)
     meta = {
-        "spp": spp,
-        "seed": seed,
+        "spp": request.batch_spp,
+        "seed": request.seed,
         "sensors": {MODE: sensors.name},
         "to_xyz": {MODE: matrix.tolist()},
         "variants": {MODE: variant},
@@ -112,13 +110,13 @@ def crop_reference(
     render seconds."""
     start = time.perf_counter()
     parts = [
-        _window(scene, spp=spp // batches, seed=s, max_depth=max_depth, crop=crop)
+        _window(scene, PassRequest(spp // batches, s, max_depth), crop)
         for s in batch_seeds(seed, batches)
     ]
     seconds = time.perf_counter() - start
     merged = merge_batches(parts)
     edges = edge_pixels(merged.aovs["material_id"], merged.aovs["coverage"])
-    return compute_ground_truth(scene, merged, cameras=()), edges, seconds
+    return compute_ground_truth(scene, merged, LayerSettings(cameras=())), edges, seconds
 
 
 def edge_pixels(material_id: np.ndarray, coverage: np.ndarray) -> np.ndarray:
@@ -194,7 +192,7 @@ def _denoised(scene: Scene, noisy: RenderResult) -> dict[str, tuple[np.ndarray, 
     out = {}
     for name, kwargs in variants.items():
         start = time.perf_counter()
-        gt = compute_ground_truth(scene, noisy, cameras=(), denoise=True, **kwargs)
+        gt = compute_ground_truth(scene, noisy, LayerSettings(cameras=(), denoise=True), **kwargs)
         out[name] = (gt.layers["shading"].data, time.perf_counter() - start)
     out["raw"] = (gt.layers["shading_raw"].data, 0.0)
     return out

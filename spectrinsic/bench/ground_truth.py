@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ..gt_export.layers import compute_ground_truth
+from ..gt_export.layers import LayerSettings, compute_ground_truth
 from ..pipeline.presets import get_preset
 from ..render import render_batches
 from ..scenes.library import build
@@ -61,7 +61,9 @@ def _sample_seconds(cfg: Any, name: str, view: int, condition: str) -> float:
     scene = build(name, view=view, condition=condition, seed=0, width=cfg.width, height=cfg.height)
     start = time.perf_counter()
     result, _ = _render(cfg, scene, spp=cfg.render.spp, batches=cfg.render.batches, seed=1)
-    compute_ground_truth(scene, result, cameras=cfg.resolved_cameras(), denoise=cfg.denoise)
+    compute_ground_truth(
+        scene, result, LayerSettings(cameras=cfg.resolved_cameras(), denoise=cfg.denoise)
+    )
     return time.perf_counter() - start
 
 
@@ -70,7 +72,7 @@ def run(out_dir: Path) -> dict[str, Any]:
     scene = build(SCENE, view=VIEW, condition=CONDITION, seed=0, width=cfg.width, height=cfg.height)
     noisy, t_render = _render(cfg, scene, spp=cfg.render.spp, batches=cfg.render.batches, seed=1)
     start = time.perf_counter()
-    gt = compute_ground_truth(scene, noisy, denoise=True)
+    gt = compute_ground_truth(scene, noisy, LayerSettings(denoise=True))
     t_gt = time.perf_counter() - start
     # the shading needs only the cube: the reference renders nothing else
     reference, t_ref = _render(
@@ -83,7 +85,7 @@ def run(out_dir: Path) -> dict[str, Any]:
     raw = _errors(gt.layers["shading_raw"].data, s_ref, ref_se, valid)
     ours = _errors(gt.layers["shading"].data, s_ref, ref_se, valid)
     high = (
-        compute_ground_truth(scene, noisy, denoise=True, denoise_quality="high")
+        compute_ground_truth(scene, noisy, LayerSettings(denoise=True), denoise_quality="high")
         .layers["shading"]
         .data
     )

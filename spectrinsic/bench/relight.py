@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from ..gt_export import export_sample, load_sample
+from ..gt_export.layers import LayerSettings
 from ..gt_export.relight import relight, relit_render, relit_scene
 from ..gt_export.relight.augment import relit_layers
 from ..gt_export.sample.transport_exr import TRANSPORT_NAME
@@ -168,16 +169,23 @@ def run(out_dir: Path) -> dict[str, Any]:
         modes=diagonal_mode_names(settings.modes), per_light=True, share_mode=None, direct=False
     )
     direct, direct_s = _timed(render_batches, new_scene, light_by_light, seed=SEED)
-    cameras = cfg.resolved_cameras()
+    layers = LayerSettings(cameras=cfg.resolved_cameras(), denoise=cfg.denoise)
     with tempfile.TemporaryDirectory(dir=out_dir) as tmp:
         root = Path(tmp)
-        common: dict[str, Any] = dict(
-            config=cfg.to_dict(), seed=SEED, cameras=cameras, denoise=cfg.denoise
-        )
+        config = cfg.to_dict()
         sample = export_sample(
-            root, scene, result, sample_id="source__v0__x", transport=transport, **common
+            root,
+            scene,
+            result,
+            layers,
+            sample_id="source__v0__x",
+            config=config,
+            seed=SEED,
+            transport=transport,
         )
-        reference = export_sample(root, new_scene, direct, sample_id="direct__v0__x", **common)
+        reference = export_sample(
+            root, new_scene, direct, layers, sample_id="direct__v0__x", config=config, seed=SEED
+        )
         _, memory_s = _median_timed(relit_result, transport, new_scene)
         _, compose_s = _median_timed(_compose_only, sample)
         _, layers_s = _median_timed(relit_layers, sample, NEW_LIGHTS)

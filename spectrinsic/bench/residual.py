@@ -20,12 +20,12 @@ from pathlib import Path
 from typing import Any
 
 from ..gt_export import export_sample
-from ..gt_export.layers import compute_ground_truth
+from ..gt_export.layers import LayerSettings, compute_ground_truth
 from ..gt_export.layers.spectral_intrinsics import light_family, residual_summary
 from ..render import RenderSettings, render_scene
 from ..scenes.generators import generate
 from ..scenes.generators.base import GeneratorOptions
-from ..spectra.working_space import DEFAULT_WORKING_SPACE
+from ..spectra.working_space import DEFAULT_WORKING_SPACE, working_space
 
 ROOMS = 12
 SIZE = 48
@@ -52,11 +52,10 @@ def _export_cost(scene: Any, result: Any) -> dict[str, float]:
                 tmp,
                 scene,
                 result,
+                LayerSettings(cameras=(), spectral_layers=spectral),
                 sample_id=f"s{int(spectral)}",
                 config={"bench": "residual"},
                 seed=SEED,
-                cameras=(),
-                spectral_layers=spectral,
             )
             key = "with_bands" if spectral else "without_bands"
             out[f"export_seconds_{key}"] = time.perf_counter() - start
@@ -73,9 +72,11 @@ def run(out_dir: Path) -> dict[str, Any]:
     for index in range(ROOMS):
         scene = generate("rooms", root_seed=SEED, index=index, view=0, options=options)
         result = render_scene(scene, settings, seed=SEED + index)
-        gt = compute_ground_truth(scene, result, spectral=True)
+        gt = compute_ground_truth(scene, result, LayerSettings(spectral_layers=True))
         metas.append(_meta_of(scene, gt))
-        srgb = compute_ground_truth(scene, result, working_space="srgb")
+        srgb = compute_ground_truth(
+            scene, result, LayerSettings(working_space=working_space("srgb"))
+        )
         srgb_metas.append(_meta_of(scene, srgb))
         families.append(light_family(li.spectrum for li in scene.lights))
         if index == 0:

@@ -36,12 +36,12 @@ import numpy as np
 
 from ..gt_export import check_sample, export_sample
 from ..gt_export.formats.exr import read_exr, write_exr
+from ..gt_export.layers import LayerSettings
 from ..gt_export.relight import relit_scene
 from ..gt_export.sample.layer_storage import read_layers
 from ..gt_export.sample.meta import read_meta
 from ..gt_export.sample.transport_exr import (
     COVERAGE_LAYER,
-    PARTS,
     TRANSPORT_NAME,
     read_transport,
     transport_layer,
@@ -49,6 +49,7 @@ from ..gt_export.sample.transport_exr import (
 from ..pipeline.presets import get_preset
 from ..render.algebra.batch_means import relative_standard_error
 from ..render.algebra.light_transport import LightTransport, relit_result
+from ..render.result import PARTS
 from ..render.transport_render import render_transport_batches
 from ..scenes.library import build
 from ..spectra import get_sensors
@@ -193,11 +194,10 @@ def _plain_sample(root: Path, scene: Any, result: Any, cfg: Any) -> dict[str, An
         root,
         scene,
         result,
+        LayerSettings(cameras=cfg.resolved_cameras(), denoise=cfg.denoise),
         sample_id="storage__v0__plain",
         config=cfg.to_dict(),
         seed=SEED,
-        cameras=cfg.resolved_cameras(),
-        denoise=cfg.denoise,
     )
     files = _files(sample)
     work = root / "plain_work"
@@ -229,13 +229,13 @@ def run(out_dir: Path) -> dict[str, Any]:
             root,
             scene,
             result,
+            LayerSettings(
+                cameras=cfg.resolved_cameras(), denoise=cfg.denoise, spectral_layers=True
+            ),
             sample_id="storage__v0__x",
             config=cfg.to_dict(),
             seed=SEED,
-            cameras=cfg.resolved_cameras(),
-            denoise=cfg.denoise,
             transport=transport,
-            spectral_layers=True,
         )
         files = {p.name: p.stat().st_size for p in sorted(sample.iterdir()) if p.is_file()}
         record = read_meta(sample).raw["transport"]

@@ -17,7 +17,7 @@ from ..pipeline.executors import check_scheduler, choose_executor
 from ..pipeline.presets import PRESETS, DatasetConfig, get_preset, preset_names
 from ..pipeline.source_plan import check_integrator_plan
 from ..render.budget import check_render_size
-from ..render.settings import INTEGRATORS
+from ..render.settings import INTEGRATORS, UINT32_MAX
 from .dataset_layers import add_extra_layer_options, layer_changes
 from .dataset_source import (
     add_source_options,
@@ -37,8 +37,6 @@ __all__ = [
 ]
 
 DEFAULT_OUT = "data/dataset"
-#: Largest root seed and samples per pixel (Mitsuba's sampler takes unsigned 32-bit values).
-UINT32_MAX = 2**32 - 1
 
 
 def _presets_help() -> str:

@@ -35,7 +35,7 @@ from ..render import (
 from ..render.algebra.modes import RENDER_MODES
 from ..render.base.plugins import MAX_PATH_DEPTH
 from ..render.budget import check_render_size
-from ..render.settings import DEFAULT_INTEGRATOR, INTEGRATORS
+from ..render.settings import DEFAULT_INTEGRATOR, INTEGRATORS, UINT32_MAX
 from ..render.settings import DEFAULT_MODES as RENDER_DEFAULT_MODES
 from ..scenes.mitsuba_xml import render_hints_line, xml_notes
 from ..scenes.model import Scene
@@ -233,10 +233,6 @@ def _add_material_options(p: Any) -> None:
         "than a diffuse reflectance, environment maps...) instead of refusing it, one line "
         "saying what",
     )
-
-
-#: Largest sampler seed and samples per pixel Mitsuba takes (both are unsigned 32-bit).
-UINT32_MAX = 2**32 - 1
 
 
 def _check_size_options(args: argparse.Namespace) -> None:

@@ -27,10 +27,11 @@ from .dataset.manifest import write_manifest
 from .folders.build_folder import remove_owned_temporaries
 from .formats.exr import read_exr, write_exr
 from .layers import GroundTruth, Layer, LightRecord, compute_ground_truth
+from .layers.settings import DEFAULT_CAMERAS
 from .relight import relight
 from .sample import config_hash, sample_dirs
 from .sample.meta import SampleMeta, read_meta
-from .sample.writer import DEFAULT_CAMERAS, export_sample, is_complete
+from .sample.writer import export_sample, is_complete
 
 __all__ = [
     "DEFAULT_CAMERAS",

@@ -144,18 +144,11 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         task.out_dir,
         scene,
         result,
+        cfg.layer_settings(task.data_dir).for_scene_folder(task.scene_folder),
         sample_id=task.sample_id,
         config=cfg.to_dict(),
         seed=task.seed,
-        cameras=cfg.resolved_cameras(),
-        write_cube=cfg.write_cube,
-        denoise=cfg.denoise,
-        data_dir=task.data_dir,
         transport=transport,
-        camera=camera_model(cfg.camera) if cfg.camera else None,
-        spectral_layers=cfg.spectral_layers,
-        working_space=cfg.working_space,
-        scene_folder=task.scene_folder,  # csv: spectra recorded relative to it
     )
     if cfg.relight:
         write_relit_variants(

@@ -16,13 +16,14 @@ from .. import provenance
 from ..errors import DatasetError, RenderError, validate_choice
 from ..gt_export import DEFAULT_CAMERAS
 from ..gt_export.dataset.manifest import SPLIT_FRACTIONS, SplitFractions, check_split_fractions
+from ..gt_export.layers import LayerSettings
 from ..gt_export.layers.records import REFERENCE_MODES
 from ..gt_export.sample import config_hash
 from ..render.algebra.light_transport import diagonal_mode_names
 from ..render.algebra.modes import RENDER_MODES
 from ..render.settings import RenderSettings
 from ..spectra.camera_model import camera_model
-from ..spectra.working_space import DEFAULT_WORKING_SPACE, WORKING_SPACES, working_space_names
+from ..spectra.working_space import DEFAULT_WORKING_SPACE, working_space
 from .source_record import recorded_source
 
 __all__ = [
@@ -226,10 +227,7 @@ class DatasetConfig:
         if not isinstance(self.seed, int) or self.seed < 0:
             raise DatasetError(f"dataset seed {self.seed!r}; expected a non-negative integer")
         object.__setattr__(self, "split_fractions", check_split_fractions(self.split_fractions))
-        if self.working_space not in WORKING_SPACES:
-            raise DatasetError(
-                f"--working-space {self.working_space!r}; expected one of {working_space_names()}"
-            )
+        working_space(self.working_space, "--working-space")  # the one check of a name
         self._check_transport()
         if self.camera is not None:
             camera_model(self.camera)  # a one-line CameraModelError for an unknown name
@@ -357,6 +355,13 @@ class DatasetConfig:
             sensor = camera_model(self.camera).sensitivities
             cams += () if sensor in cams else (sensor,)
         return cams
+
+    def layer_settings(self, data_dir: str | None = None) -> LayerSettings:
+        """The :class:`LayerSettings` of every sample of this dataset (*data_dir*: the build's)."""
+        camera = camera_model(self.camera) if self.camera else None
+        flags = (self.write_cube, self.denoise, self.spectral_layers)
+        space = working_space(self.working_space)
+        return LayerSettings(self.resolved_cameras(), camera, *flags, space, data_dir)
 
     def to_dict(self) -> dict[str, Any]:
         """The record written with the dataset (``export_sample``, manifest): preset name,

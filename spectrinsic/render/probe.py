@@ -16,6 +16,7 @@ import numpy as np
 
 from ..scenes.model import Scene
 from ..spectra import get_sensors
+from .settings import PassRequest
 from .spectral import render_spectral
 
 __all__ = ["PROBE_DEPTH", "PROBE_SIZE", "PROBE_SPP", "probe_luminance"]
@@ -43,10 +44,7 @@ def probe_luminance(
     out = render_spectral(
         replace(scene, camera=small),
         get_sensors("cie1931", data_dir=data_dir),
-        spp=PROBE_SPP,
-        seed=_SEED,
-        max_depth=PROBE_DEPTH,
-        variant=variant,
+        PassRequest(PROBE_SPP, _SEED, PROBE_DEPTH, variant),
         data_dir=data_dir,
     )
     return np.asarray(out.image[..., 1], np.float64)

@@ -11,7 +11,23 @@ import numpy as np
 
 from ..errors import RenderError
 
-__all__ = ["RenderResult"]
+__all__ = ["METAL_WHITE", "PARTS", "SPECULAR", "RenderResult"]
+
+#: Glossy scenes' part of the transport: the light whose first camera-ray vertex went through a
+#: non-diffuse lobe (it becomes the ``specular`` layer).
+SPECULAR = "specular"
+#: Metals' white-surface radiance at their first hits (not part of the transport; it enters
+#: the shading of metal pixels).
+METAL_WHITE = "metal_white"
+#: The parts a band-path traversal splits off beside its transport, in the order of its AOV
+#: channels (:func:`~spectrinsic.render.band_path.integrator.aov_channels`), and the one letter
+#: of each: its AOV channels are ``<letter lower-case><light>_<band>`` and its layers in
+#: ``transport.exr`` ``<letter><light>...`` (:mod:`spectrinsic.gt_export.sample.transport_exr`;
+#: the transport's own are ``t`` and ``L``). Each is ``(L, H, W, K)`` per unit emission,
+#: composed as the transport is; every record below the traversal (``TransportOutput``,
+#: ``RenderResult.parts``, ``LightTransport.parts``, the batches, the file) holds the parts by
+#: these names.
+PARTS: dict[str, str] = {SPECULAR: "S", METAL_WHITE: "W"}
 
 
 @dataclass(frozen=True, eq=False)
@@ -50,7 +66,7 @@ class RenderResult:
         ``raw[mode][..., k] = Σ_l E_{l,k} transport[mode][l, ..., k]``, with E the lights'
         channel values (:func:`spectrinsic.render.algebra.modes.channel_values`). Empty otherwise.
     parts
-        Single traversal: part name (:data:`spectrinsic.render.band_path.traversal.PARTS`) -> mode ->
+        Single traversal: part name (:data:`spectrinsic.render.result.PARTS`) -> mode ->
         ``(H, W, K)`` float32 raw channels of that part, summed over the lights as ``raw`` is;
         only the parts the scene has. ``"specular"`` (glossy materials): the light the camera
         rays' first hits return through their non-diffuse lobes (coat reflection, metal), with
@@ -77,12 +93,12 @@ class RenderResult:
     @property
     def specular(self) -> dict[str, np.ndarray]:
         """``parts["specular"]``: mode -> ``(H, W, K)`` raw specular part (empty: matte scene)."""
-        return self.parts.get("specular", {})
+        return self.parts.get(SPECULAR, {})
 
     @property
     def metal_white(self) -> dict[str, np.ndarray]:
         """``parts["metal_white"]``: mode -> ``(H, W, K)`` raw white-at-metal radiance."""
-        return self.parts.get("metal_white", {})
+        return self.parts.get(METAL_WHITE, {})
 
     @property
     def shape(self) -> tuple[int, int]:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -13,14 +13,14 @@ from ..errors import RenderError, SceneError
 from ..scenes.model import Scene
 from ..spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
 from .algebra.modes import RenderMode, channel_values, get_mode, n_passes, raw_to_xyz, to_xyz_matrix
-from .band_path.traversal import PARTS, SingleTraversal, render_jobs, resolve_integrator
+from .band_path.traversal import SingleTraversal, render_jobs, resolve_integrator
 from .base.one_pass import PassOutput, PassProgress
-from .base.translate import SurfaceGeometry, prepare_geometry, surfaces
+from .base.translate import prepare_geometry, surfaces
 from .base.variants import choose_variant, import_mitsuba, variant_scope
 from .passes import render_diagonal
 from .passes.aovs import render_aovs
-from .result import RenderResult
-from .settings import DEFAULT_MODES, RenderSettings
+from .result import PARTS, RenderResult
+from .settings import DEFAULT_MODES, PassRequest, RenderSettings
 from .spectral import render_spectral
 
 __all__ = [
@@ -93,14 +93,12 @@ class _Job:
 @dataclass(frozen=True)
 class _Run:
     """What every pass of one :func:`_run_jobs` call shares: the plan (with its settings), the
-    batch's seed, the progress callback, the data directory and the prepared geometry."""
+    batch's pass request (seed, samples, progress, prepared geometry) and the data directory."""
 
     scene: Scene
     plan: _Plan
-    seed: int
-    progress: PassProgress | None
+    request: PassRequest
     data_dir: str | None
-    geometry: Sequence[SurfaceGeometry]
     #: One dict mode -> pass output per job, filled by the parts.
     outputs: list[dict[str, PassOutput]]
 
@@ -114,18 +112,14 @@ def _rgb_part(
 ) -> tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
     """The diagonal modes of every job (one traversal, or the passes) and the AOVs."""
     scene, plan, settings, single = run.scene, run.plan, run.settings, SingleTraversal({}, ())
+    request = replace(run.request, variant=rgb_variant)
     aov_maps: dict[str, np.ndarray] = {}
     if plan.traversal:
         parts, single = render_jobs(
             scene,
             [(j.modes, j.group, j.with_direct) for j in plan.jobs],
+            request,
             wanted=plan.wanted,
-            spp=settings.batch_spp,
-            seed=run.seed,
-            max_depth=settings.max_depth,
-            variant=rgb_variant,
-            progress=run.progress,
-            geometry=run.geometry,
             data_dir=run.data_dir,
             aovs=settings.aovs,
         )
@@ -147,14 +141,9 @@ def _rgb_part(
                 render_diagonal(
                     scene,
                     values,
-                    spp=settings.batch_spp,
-                    seed=run.seed,
-                    max_depth=settings.max_depth,
+                    request,
                     direct=[job.with_direct and m.name in plan.wanted for m in diagonal],
                     active_lights=job.group,
-                    variant=rgb_variant,
-                    progress=run.progress,
-                    geometry=run.geometry,
                 ),
                 strict=True,
             )
@@ -163,32 +152,22 @@ def _rgb_part(
         )
     if not settings.aovs:
         return aov_maps, (), single
-    aov_maps, aov_seconds = render_aovs(
-        scene,
-        spp=settings.batch_spp,
-        seed=run.seed,
-        variant=rgb_variant,
-        progress=run.progress,
-        geometry=run.geometry,
-    )
+    aov_maps, aov_seconds = render_aovs(scene, request)
     return aov_maps, aov_seconds, single
 
 
 def _spectral_part(run: _Run, spectral_variant: str) -> None:
     """The spectral passes of every job (``settings.spectral_batch_spp`` samples each)."""
+    spp = run.settings.spectral_batch_spp
+    request = replace(run.request, batch_spp=spp, variant=spectral_variant)
     for out, job in zip(run.outputs, run.plan.jobs, strict=True):
         for m in (m for m in job.modes if m.kind == "spectral"):
             out[m.name] = render_spectral(
                 run.scene,
                 get_sensors(m.sensors, data_dir=run.data_dir),
-                spp=run.settings.spectral_batch_spp,
-                seed=run.seed,
-                max_depth=run.settings.max_depth,
+                request,
                 direct=job.with_direct and m.name in run.plan.wanted,
                 active_lights=job.group,
-                variant=spectral_variant,
-                progress=run.progress,
-                geometry=run.geometry,
                 data_dir=run.data_dir,
             )
 
@@ -212,9 +191,8 @@ def _run_jobs(
     With ``plan.traversal`` the diagonal modes of every job, and a textured scene's AOVs even
     without them, come from one band-path traversal (:func:`~spectrinsic.render.band_path.traversal.render_jobs`).
     """
-    run = _Run(
-        scene, plan, seed, progress, data_dir, prepare_geometry(scene), [{} for _ in plan.jobs]
-    )
+    request = PassRequest.of(plan.settings, seed, progress, prepare_geometry(scene))
+    run = _Run(scene, plan, request, data_dir, [{} for _ in plan.jobs])
     found: tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]
     found = ({}, (), SingleTraversal({}, ()))
     variant, parts = plan.settings.variant, []
@@ -238,7 +216,7 @@ def render_meta(
     variants: dict[str, str],
     timings: dict[str, list[float]],
     *,
-    spp: int,
+    batch_spp: int,
     seed: int,
     max_depth: int,
     per_light: bool,
@@ -251,7 +229,7 @@ def render_meta(
     return {
         "mitsuba": import_mitsuba().__version__,
         "variants": variants,
-        "spp": int(spp),
+        "spp": int(batch_spp),  # one batch's: merge_batches makes it the total
         "seed": int(seed),
         "max_depth": int(max_depth),
         "modes": names,
@@ -325,7 +303,7 @@ def render_scene(
         plan.matrices,
         variants,
         timings,
-        spp=settings.batch_spp,
+        batch_spp=settings.batch_spp,
         seed=seed,
         max_depth=settings.max_depth,
         per_light=settings.per_light,
@@ -452,7 +430,7 @@ def _part_raw(
     groups: Sequence[Sequence[int] | None],
     part: str,
 ) -> dict[str, np.ndarray]:
-    """Mode -> raw channels of a traversal's *part* (one of :data:`~spectrinsic.render.band_path.traversal.PARTS`), summed
+    """Mode -> raw channels of a traversal's *part* (one of :data:`~spectrinsic.render.result.PARTS`), summed
     over the main jobs' light *groups* as ``raw`` is; modes without the part are left out."""
     out = {}
     for name, t in single.transport.items():

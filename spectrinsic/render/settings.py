@@ -9,12 +9,24 @@ directory) stays outside: the same settings render every sample of a dataset.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import RenderError
 
-__all__ = ["DEFAULT_INTEGRATOR", "DEFAULT_MODES", "INTEGRATORS", "RenderSettings"]
+if TYPE_CHECKING:
+    from .base.one_pass import PassProgress
+    from .base.translate import SurfaceGeometry
+
+__all__ = [
+    "DEFAULT_INTEGRATOR",
+    "DEFAULT_MODES",
+    "INTEGRATORS",
+    "UINT32_MAX",
+    "PassRequest",
+    "RenderSettings",
+]
 
 #: Every colour mode: the spectral Monte Carlo reference and the 3-, 6- and 31-channel
 #: diagonal renders (:data:`spectrinsic.render.algebra.modes.RENDER_MODES`).
@@ -28,7 +40,12 @@ INTEGRATORS: tuple[str, ...] = ("passes", "single")
 DEFAULT_INTEGRATOR = "single"
 
 
+#: Mitsuba's sampler seed and sample count are 32-bit unsigned.
+UINT32_MAX = 2**32 - 1
+
+
 def _positive(name: str, value: Any) -> None:
+    """The one "at least 1" check of a count (samples, depth, batches)."""
     if not isinstance(value, int) or isinstance(value, bool) or value < 1:
         raise RenderError(f"render setting {name}={value!r}; expected a positive integer")
 
@@ -161,3 +178,58 @@ class RenderSettings:
     def with_options(self, **changes: Any) -> RenderSettings:
         """A copy with some settings changed (validated like new settings)."""
         return replace(self, **changes)
+
+
+@dataclass(frozen=True, eq=False)
+class PassRequest:
+    """What every Mitsuba pass of one batch shares, checked once: every pass (the band-path
+    traversal, the diagonal passes, the spectral pass, the first-hit maps) takes this record.
+
+    Attributes
+    ----------
+    batch_spp
+        Samples per pixel of this pass (one batch's: :attr:`RenderSettings.batch_spp`, or
+        :attr:`RenderSettings.spectral_batch_spp` for the spectral pass).
+    seed
+        The sampler seed (the batch's); every pass of a batch uses it, so passes trace the
+        same paths (common random numbers).
+    max_depth
+        Longest path (Mitsuba convention: 2 = direct light only).
+    variant
+        Backend or variant name (:func:`spectrinsic.render.base.variants.choose_variant`);
+        ``None``: the best usable.
+    progress
+        Called with 1 after each Mitsuba pass (e.g. ``tqdm.update``), or ``None``.
+    geometry
+        :func:`spectrinsic.render.base.translate.prepare_geometry` of the scene, if already
+        computed (the batches of one scene share it).
+    """
+
+    batch_spp: int
+    seed: int
+    max_depth: int = 8
+    variant: str | None = None
+    progress: PassProgress | None = None
+    geometry: Sequence[SurfaceGeometry] | None = None
+
+    def __post_init__(self) -> None:
+        _positive("batch_spp", self.batch_spp)
+        _positive("max_depth", self.max_depth)
+
+    @classmethod
+    def of(
+        cls,
+        settings: RenderSettings,
+        seed: int,
+        progress: PassProgress | None = None,
+        geometry: Sequence[SurfaceGeometry] | None = None,
+    ) -> PassRequest:
+        """The request of one batch of *settings* with sampler seed *seed*."""
+        return cls(
+            settings.batch_spp, seed, settings.max_depth, settings.variant, progress, geometry
+        )
+
+    def tick(self) -> None:
+        """Report one finished Mitsuba pass to :attr:`progress`."""
+        if self.progress is not None:
+            self.progress(1)

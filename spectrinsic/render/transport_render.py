@@ -52,7 +52,7 @@ from .passes import render_diagonal
 from .passes.aovs import render_aovs
 from .result import RenderResult
 from .scene_render import render_scene
-from .settings import RenderSettings
+from .settings import PassRequest, RenderSettings
 
 __all__ = ["render_transport", "render_transport_batches"]
 
@@ -86,12 +86,7 @@ def render_transport(
     ``settings.max_depth`` and Russian roulette off, so its paths are those of a per-light
     render with the same settings; only the diagonal ones of ``settings.modes`` are rendered.
     """
-    modes, spp, max_depth, variant = (
-        settings.modes,
-        settings.batch_spp,
-        settings.max_depth,
-        settings.variant,
-    )
+    modes = settings.modes
     names = diagonal_mode_names(modes)
     if not names:
         raise SceneError(
@@ -101,23 +96,15 @@ def render_transport(
         raise SceneError(f"scene {scene.name!r} has no lights: no transport to render")
     sensors = [get_mode(m).sensors for m in names]
     values = [_unit_values(scene, s, data_dir) for s in sensors]
-    geometry = prepare_geometry(scene)
-    chosen = choose_variant("rgb", variant)
+    chosen = choose_variant("rgb", settings.variant)
+    request = replace(
+        PassRequest.of(settings, seed, progress, prepare_geometry(scene)), variant=chosen
+    )
     per_light: list[list[np.ndarray]] = [[] for _ in names]
     seconds: dict[str, list[float]] = {m: [] for m in names}
     with variant_scope(chosen):  # one scope: switching variants reloads Mitsuba's modules
         for j in range(len(scene.lights)):
-            outputs = render_diagonal(
-                scene,
-                values,
-                spp=spp,
-                seed=seed,
-                max_depth=max_depth,
-                active_lights=[j],
-                variant=chosen,
-                progress=progress,
-                geometry=geometry,
-            )
+            outputs = render_diagonal(scene, values, request, active_lights=[j])
             for i, out in enumerate(outputs):
                 per_light[i].append(out.image)
                 seconds[names[i]].extend(out.seconds)
@@ -140,7 +127,7 @@ def _one_batch(
         sensors={m: get_mode(m).sensors for m in names},
         batches=(t,),
         seeds=(int(seed),),
-        spp=int(settings.batch_spp),
+        batch_spp=int(settings.batch_spp),
         max_depth=int(settings.max_depth),
         parts={p: (held,) for p, held in (parts or {}).items() if held},
     )
@@ -252,7 +239,7 @@ def _batch(
     :func:`render_transport_batches`), else one set of passes per light."""
     if settings.integrator == "single":
         return _traversal_batch(scene, settings, seed, progress=progress, data_dir=data_dir)
-    modes, spp, variant = settings.modes, settings.batch_spp, settings.variant
+    modes, variant = settings.modes, settings.variant
     names = diagonal_mode_names(modes)
     others = tuple(m for m in dict.fromkeys(modes) if m not in names)
     t, seconds = render_transport(scene, settings, seed=seed, progress=progress, data_dir=data_dir)
@@ -286,9 +273,7 @@ def _batch(
         )
         aovs = other.aovs
     else:
-        aovs, aov_seconds = render_aovs(
-            scene, spp=spp, seed=seed, variant=variant, progress=progress
-        )
+        aovs, aov_seconds = render_aovs(scene, PassRequest.of(settings, seed, progress))
         timing["aovs"] = {
             "passes": len(aov_seconds),
             "seconds": float(sum(aov_seconds)),
@@ -342,7 +327,7 @@ def render_transport_batches(
         sensors={m: get_mode(m).sensors for m in names},
         batches=tuple(t.batches[0] for t, _ in done),
         seeds=tuple(int(s) for s in seeds[: len(done)]),
-        spp=int(settings.batch_spp),
+        batch_spp=int(settings.batch_spp),
         max_depth=int(settings.max_depth),
         seconds=seconds,
         parts={p: tuple(t.parts[p][0] for t, _ in done) for p in done[0][0].parts},

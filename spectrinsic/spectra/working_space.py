@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import WorkingSpaceError
 from .colorimetry import white_normalised_responses
 from .colourspace import srgb_matrices
 from .grid import COLORIMETRIC_WAVELENGTHS
@@ -73,10 +74,10 @@ class WorkingSpace:
 
     name: str
     colourspace: str
-    from_xyz: np.ndarray = field(repr=False)
-    to_xyz: np.ndarray = field(repr=False)
-    to_srgb: np.ndarray = field(repr=False)
-    white: np.ndarray = field(repr=False)
+    from_xyz: np.ndarray = field(repr=False, compare=False)  # set by the name
+    to_xyz: np.ndarray = field(repr=False, compare=False)  # set by the name
+    to_srgb: np.ndarray = field(repr=False, compare=False)  # set by the name
+    white: np.ndarray = field(repr=False, compare=False)  # set by the name
     clip_shading: bool
 
     def rgb(self, xyz: np.ndarray) -> np.ndarray:
@@ -114,17 +115,23 @@ def _d65_white(from_xyz: np.ndarray) -> np.ndarray:
     return white_normalised_responses(np.ones(wl.size), get_spectrum("cie:D65").on(wl), curves, wl)
 
 
-@functools.cache
-def working_space(name: str) -> WorkingSpace:
-    """The :class:`WorkingSpace` of an option name (computed once); ``ValueError`` naming the
-    choices for an unknown one.
+def working_space(name: str, source: str = "working space") -> WorkingSpace:
+    """The :class:`WorkingSpace` of an option name (computed once): the one place a name is
+    checked. :class:`~spectrinsic.errors.WorkingSpaceError` naming *source* (where the name
+    came from: ``"--working-space"``, ``"meta.json working_space"``) and the choices for an
+    unknown one.
 
     >>> ws = working_space("srgb")
     >>> ws.colourspace, ws.clip_shading, bool(abs(ws.white - 1).max() < 1e-3)
     ('sRGB', True, True)
     """
-    if name not in WORKING_SPACES:
-        raise ValueError(f"working space {name!r}; expected one of {working_space_names()}")
+    if not isinstance(name, str) or name not in WORKING_SPACES:
+        raise WorkingSpaceError(f"{source} {name!r}; expected one of {working_space_names()}")
+    return _working_space(name)
+
+
+@functools.cache
+def _working_space(name: str) -> WorkingSpace:
     if name == "srgb":
         from_xyz, to_xyz = (np.array(m, np.float64) for m in srgb_matrices())
     else:

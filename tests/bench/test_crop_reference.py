@@ -11,6 +11,7 @@ from spectrinsic.errors import SceneError
 from spectrinsic.render.algebra.modes import channel_values, get_mode
 from spectrinsic.render.band_path.traversal import render_traversal
 from spectrinsic.render.base.plugins import hdr_film
+from spectrinsic.render.settings import PassRequest
 from spectrinsic.spectra import get_sensors
 
 CROP = (5, 3, 7, 6)  # x, y, width, height: not square, not centred, odd sizes
@@ -21,9 +22,9 @@ def test_a_film_crop_renders_the_window_of_the_full_image(make_room):
     31-band image agrees with the full image's window within the Monte Carlo error."""
     scene = make_room(size=16)
     values = [channel_values(scene, get_sensors(get_mode("bands31").sensors))]
-    (full,), full_aovs, _, _ = render_traversal(scene, values, spp=256, seed=1, aovs=True)
+    (full,), full_aovs, _, _ = render_traversal(scene, values, PassRequest(256, 1), aovs=True)
     (part,), part_aovs, _, _ = render_traversal(
-        scene, values, spp=256, seed=2, aovs=True, crop=CROP
+        scene, values, PassRequest(256, 2), aovs=True, crop=CROP
     )
     x, y, w, h = CROP
     assert part.transport.shape[1:3] == (h, w)

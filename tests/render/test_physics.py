@@ -18,6 +18,7 @@ from spectrinsic.render import (
     render_scene,
     to_xyz_matrix,
 )
+from spectrinsic.render.settings import PassRequest
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as WL
 from spectrinsic.spectra import get_sensors, get_spectrum, responses
 
@@ -125,7 +126,7 @@ def test_common_random_numbers(make_room):
     changed_lights = values.lights.copy()
     changed_lights[:, 0] *= 3.0
     changed = type(values)(materials=changed_materials, lights=changed_lights)
-    a, b = render_diagonal(scene, [values, changed], spp=8, seed=7)
+    a, b = render_diagonal(scene, [values, changed], PassRequest(8, 7))
     np.testing.assert_array_equal(a.image[..., 1:], b.image[..., 1:])
     assert not np.allclose(a.image[..., 0], b.image[..., 0])
 

@@ -19,11 +19,12 @@ import numpy as np
 import pytest
 
 from spectrinsic.gt_export import check_dataset, export_sample, write_manifest
-from spectrinsic.gt_export.layers import compute_ground_truth
+from spectrinsic.gt_export.layers import LayerSettings, compute_ground_truth
 from spectrinsic.render import RenderSettings, render_scene
 from spectrinsic.scenes.image_textures import ImageTexture
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.scenes.surface_maps import MeshMaps
+from spectrinsic.spectra.working_space import working_space
 
 SIZE, FOV, DISTANCE = 32, 30.0, 3.0
 #: The mask's checker: TEXELS × TEXELS, 1 = opaque (row 0 at v = 0).
@@ -79,7 +80,13 @@ def checker():
     result = render_scene(
         scene, RenderSettings(64, max_depth=3, modes=("spectral", "bands31")), seed=1
     )
-    return scene, result, compute_ground_truth(scene, result, spectral=True, working_space="srgb")
+    return (
+        scene,
+        result,
+        compute_ground_truth(
+            scene, result, LayerSettings(spectral_layers=True, working_space=working_space("srgb"))
+        ),
+    )
 
 
 def _plain_reflectance(material: int) -> np.ndarray:
@@ -87,7 +94,9 @@ def _plain_reflectance(material: int) -> np.ndarray:
     scene = _scene(None, wall=False)
     scene = replace(scene, meshes=(replace(scene.meshes[0], face_materials=np.full(2, material)),))
     result = render_scene(scene, RenderSettings(1, max_depth=1, modes=("bands31",)), seed=1)
-    gt = compute_ground_truth(scene, result, spectral=True, working_space="srgb")
+    gt = compute_ground_truth(
+        scene, result, LayerSettings(spectral_layers=True, working_space=working_space("srgb"))
+    )
     return gt.layers["reflectance"].data[SIZE // 2, SIZE // 2]
 
 
@@ -146,7 +155,9 @@ def test_half_opacity_plane_mixes_reflectance_by_coverage():
     scene = _scene(lambda uv: MeshMaps(uv, opacity=0.5))
     spp = 64
     result = render_scene(scene, RenderSettings(spp, max_depth=2, modes=("bands31",)), seed=3)
-    gt = compute_ground_truth(scene, result, spectral=True, working_space="srgb")
+    gt = compute_ground_truth(
+        scene, result, LayerSettings(spectral_layers=True, working_space=working_space("srgb"))
+    )
     cover = result.aovs["coverage"][..., 0]
     sigma = math.sqrt(0.25 / spp)  # a binomial coverage of p = 1/2 over spp samples
     assert abs(cover.mean() - 0.5) < 4 * sigma / SIZE
@@ -217,7 +228,9 @@ def test_specular_starts_at_the_first_vertex_that_is_no_null_event(wall):
     coat = Material("coat", "munsell:5R 4/14", kind="plastic", roughness=0.2, ior=1.5)
     scene = replace(scene, materials=(coat, WALL))
     result = render_scene(scene, RenderSettings(16, max_depth=3, modes=("bands31",)), seed=2)
-    gt = compute_ground_truth(scene, result, spectral=True, working_space="srgb")
+    gt = compute_ground_truth(
+        scene, result, LayerSettings(spectral_layers=True, working_space=working_space("srgb"))
+    )
     rows, cols, inside, _ = _pixels_in_texels()
     opaque = _checker()[rows, cols] == 1.0
     specular = gt.layers["specular"].data
@@ -242,7 +255,9 @@ def test_a_metal_seen_through_a_hole_has_its_white_surface_shading():
     quad = replace(scene.meshes[0], vertices=scene.meshes[0].vertices * [0.5, 0.5, 1.0])
     scene = replace(scene, meshes=(quad, scene.meshes[1]), materials=(QUAD, gold))
     result = render_scene(scene, RenderSettings(16, max_depth=3, modes=("bands31",)), seed=4)
-    gt = compute_ground_truth(scene, result, spectral=True, working_space="srgb")
+    gt = compute_ground_truth(
+        scene, result, LayerSettings(spectral_layers=True, working_space=working_space("srgb"))
+    )
     cover = result.aovs["coverage"]
     shading = gt.layers["shading"].data.sum(-1)
     through = cover[..., 1] == 1.0  # gold first hit: through a hole or beside the quad

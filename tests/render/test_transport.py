@@ -46,4 +46,4 @@ def test_noise_target_adds_batches_to_the_transport_as_to_the_render(make_room):
     assert transport.seeds == tuple(result.meta["batch_seeds"])
     assert result.meta["noise_target"]["max_batches"] == 3
     assert result.meta["spp"] == 3 * SETTINGS.batch_spp
-    assert transport.spp == SETTINGS.batch_spp
+    assert transport.batch_spp == SETTINGS.batch_spp

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError, validate_choice
+from ...gt_export.layers.gloss import SPECULAR
 
 __all__ = [
     "TARGETS",
@@ -40,7 +41,7 @@ __all__ = [
 #: Images an evaluation may decompose (module docstring).
 TARGETS = ("full", "diffuse")
 #: The ground-truth layer a predicted specular image is scored against.
-SPECULAR_LAYER = "specular"
+SPECULAR_LAYER = SPECULAR
 #: Metrics of a predicted ``specular`` layer: scale-invariant MSE (Eq. 2.4) and LMSE, both fit
 #: a scale as for the other layers.
 SPECULAR_METRICS = ("si_mse", "lmse")

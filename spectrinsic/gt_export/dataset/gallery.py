@@ -37,6 +37,7 @@ from ...file_writes import guarded_write, refuse_link, write_text_file
 from ...scenes.lighting import describe_lighting
 from ...spectra import get_sensors, xyz_to_xy
 from ..formats.names import slug
+from ..layers.gloss import SPECULAR
 from ..layers.spectral_intrinsics import rgb_residual_share
 from ..sample import META_NAME, SCENE_NAME, plain_data, sample_dirs
 from ..sample.meta import SampleMeta, read_meta
@@ -72,7 +73,7 @@ GALLERY_LAYERS: tuple[str, ...] = (
     "shading_ratio",
     "residual",
     "residual_raw",
-    "specular",
+    SPECULAR,
     "illuminant",
     "error_rgb3",
     "error_rgb6",

@@ -10,8 +10,10 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError, MissingDependencyError
+from ...spectra.working_space import working_space
 from ..formats.png import EXPOSURE_PERCENTILE, exposure
-from ..layers.spectral_intrinsics import bands_to_rgb, rgb_residual_share, working_space_matrix
+from ..layers.gloss import SPECULAR
+from ..layers.spectral_intrinsics import bands_to_rgb, rgb_residual_share
 from ..sample import META_NAME, file_sha256, sample_dirs
 from ..sample.layer_storage import read_layers
 from ..sample.meta import SampleMeta, read_meta
@@ -179,7 +181,7 @@ def filter_residual_share(folders: Sequence[Path], limit: float | None) -> list[
 
 
 #: Layers in radiometric units that exposure normalisation scales (reflectance is unitless).
-EXPOSED_PREFIXES = ("image", "shading", "illuminant", "residual", "specular", "cube")
+EXPOSED_PREFIXES = ("image", "shading", "illuminant", "residual", SPECULAR, "cube")
 
 
 def split_samples(dataset_dir: str | os.PathLike[str], split: str | None) -> list[Path]:
@@ -347,4 +349,5 @@ def working_space_view(
             "working_space_view needs the band layers: build the set with --spectral-layers"
         )
     to_xyz = sample["meta"]["render"]["to_xyz"]["bands31"]
-    return bands_to_rgb(sample, to_xyz, working_space_matrix(space), clip=clip)
+    matrix = np.asarray(working_space(space, "space").from_xyz, np.float64)
+    return bands_to_rgb(sample, to_xyz, matrix, clip=clip)

@@ -36,9 +36,12 @@ from .records import (
     RenderRecord,
     reference_mode,
 )
+from .settings import DEFAULT_CAMERAS, LayerSettings
 from .spectral import camera_curves, canonical_responses, cube_to_sensors, photometric_matrices
 
 __all__ = [
+    "DEFAULT_CAMERAS",
+    "LayerSettings",
     "RenderRecord",
     "Layer",
     "LightRecord",

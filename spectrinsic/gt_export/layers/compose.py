@@ -12,13 +12,12 @@ from ...errors import DatasetError
 from ...scenes.material_labels import material_label
 from ...scenes.model import Scene
 from ...spectra import get_sensors, get_spectrum, white_normalised_responses
-from ...spectra.working_space import DEFAULT_WORKING_SPACE, WorkingSpace
-from ...spectra.working_space import working_space as working_space_of
+from ...spectra.working_space import WorkingSpace
 from . import irradiance as irr
 from .cameras import camera_layers, matrices_of
 from .denoise import Denoiser, Guides, denoise_white_radiance
 from .geometry import coverage_of, geometry_layers
-from .gloss import gloss_layers, specular_rgb
+from .gloss import SPECULAR, gloss_layers, specular_rgb
 from .images import cube_layer, image_layers
 from .imaging import coverage_weighted
 from .intrinsics import (
@@ -45,6 +44,7 @@ from .records import (
     make_layer,
     reference_mode,
 )
+from .settings import LayerSettings
 from .spectral import camera_curves
 from .spectral_intrinsics import (
     SPECTRAL_MODE,
@@ -98,16 +98,11 @@ def _reflectance(s: SampleInputs, coverage: np.ndarray) -> tuple[Layer, Any]:
 def compute_ground_truth(
     scene: Scene,
     result: RenderRecord,
+    settings: LayerSettings | None = None,
     *,
-    cameras: Sequence[str] = (),
-    write_cube: bool = False,
-    denoise: bool = False,
     denoise_quality: str = "fast",
     denoiser: Denoiser | None = None,
-    data_dir: Any = None,
     training: np.ndarray | None = None,
-    spectral: bool = False,
-    working_space: str = DEFAULT_WORKING_SPACE,
 ) -> GroundTruth:
     """Compute every ground-truth layer of one rendered sample.
 
@@ -117,35 +112,30 @@ def compute_ground_truth(
         The scene that was rendered (names every material and light spectrum).
     result
         The render (:class:`RenderRecord`).
-    cameras
-        Sensor-set names (``"camera:Nikon 5100 (NPL)"``); each adds an image integrated from
-        the 31-band cube, a relative reflectance, shading, residual and illuminant in that
-        camera's RGB.
-    write_cube
-        Add the raw multispectral cube as layer ``cube``.
-    denoise
-        Denoise the white-surface radiance with OIDN (:mod:`~spectrinsic.gt_export.layers.denoise`):
+    settings
+        The layers asked for (:class:`~spectrinsic.gt_export.layers.settings.LayerSettings`,
+        default ``LayerSettings()``):
+        per-camera layers of ``settings.cameras`` (none when ``None``), the cube, the per-band
+        layers, the working space of the RGB layers (ACEScg by default, shading negatives
+        kept; ``srgb``: the layers of before, shading clipped at 0). With ``denoise`` the
+        white-surface radiance is denoised with OIDN (:mod:`~spectrinsic.gt_export.layers.denoise`):
         ``shading``, ``residual``, ``illuminant``, ``shading_grey`` and the camera shading
         come from it, ``image_denoised = reflectance ∘ shading + residual`` is rebuilt from it,
-        and the raw ``shading_raw``/``residual_raw`` are kept beside ``image``.
+        and the raw ``shading_raw``/``residual_raw`` are kept beside ``image``. Its camera
+        chain and noise id are the writer's (:func:`~spectrinsic.gt_export.sample.writer.export_sample`).
     denoise_quality
         OIDN quality, ``"fast"`` (the dataset's, :data:`~spectrinsic.gt_export.layers.denoise.DENOISE_QUALITY`)
         or ``"high"``.
     denoiser
-        With *denoise*, the function that denoises ``W`` given its guides, instead of
+        With ``settings.denoise``, the function that denoises ``W`` given its guides, instead of
         :func:`~spectrinsic.gt_export.layers.denoise.denoise_white_radiance` (``make bench`` scores
         alternatives with it).
     training
         ``(N, 471)`` reflectances on the 1 nm grid for the matrix fits (default: all Munsell chips).
-    spectral
-        Add the per-band intrinsic layers of the 31-band cube (``spectral.exr``,
-        :mod:`~spectrinsic.gt_export.layers.spectral_intrinsics`).
-    working_space
-        The RGB working space of the RGB layers (:mod:`spectrinsic.spectra.working_space`):
-        ``"acescg"`` (default; shading negatives kept) or ``"srgb"`` (the layers of before,
-        shading clipped at 0).
     """
-    s = _sample(scene, result, data_dir, working_space_of(working_space))
+    settings = settings or LayerSettings()
+    cameras, denoise, data_dir = settings.cameras or (), settings.denoise, settings.data_dir
+    s = _sample(scene, result, data_dir, settings.working_space)
     layers = image_layers(s)
     image = layers[0].data.astype(np.float64)
     coverage, mask = coverage_of(s, (image.shape[0], image.shape[1]))
@@ -178,9 +168,9 @@ def compute_ground_truth(
     for cam in cameras:
         layers += camera_layers(s, cam, spaces[cam], coverage, w, denoised=denoise)
     cube_name = cube_sensor_name(result) if "bands31" in result.raw else None
-    if write_cube:
+    if settings.write_cube:
         layers.append(cube_layer(s, cube_name))
-    if spectral:
+    if settings.spectral_layers:
         layers += spectral_layers(s, coverage, w_raw, w, denoised=denoise)
     by_name = {layer.name: layer for layer in layers}
     return GroundTruth(
@@ -198,7 +188,11 @@ def compute_ground_truth(
         clipping=clipping_of(rgb_of(s, w) / rgb_white(s), w.valid & (irr.luminance_of(w) > 0)),
         working_space=s.space,
         residual_share=residual_shares(_identities(by_name, cameras), by_name, mask),
-        band_albedos=band_albedos(dataclasses.replace(s, ref=SPECTRAL_MODE)) if spectral else None,
+        band_albedos=(
+            band_albedos(dataclasses.replace(s, ref=SPECTRAL_MODE))
+            if settings.spectral_layers
+            else None
+        ),
     )
 
 
@@ -212,8 +206,8 @@ def identities(gt: GroundTruth) -> list[dict[str, str]]:
 def _identities(layers: dict[str, Any], cameras: Sequence[str]) -> list[dict[str, str]]:
     out = []
     denoised = "image_denoised" in layers
-    glossy = "specular" in layers
-    spec = {"specular": "specular"} if glossy else {}
+    glossy = SPECULAR in layers
+    spec = {SPECULAR: SPECULAR} if glossy else {}
     out.append(
         {
             "image": "image_denoised" if denoised else "image",
@@ -243,7 +237,7 @@ def _identities(layers: dict[str, Any], cameras: Sequence[str]) -> list[dict[str
                 "shading": f"shading_camera/{key}",
                 "residual": f"residual_camera/{key}",
             }
-            | ({"specular": f"specular_camera/{key}"} if glossy else {})
+            | ({SPECULAR: f"{SPECULAR}_camera/{key}"} if glossy else {})
         )
     spectral = spectral_identity(layers)
     return out if spectral is None else [*out, spectral]

@@ -31,10 +31,25 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...render.result import SPECULAR as SPECULAR_PART
 from .imaging import coverage_weighted
 from .records import RGB, UNITS_IMAGE, Layer, SampleInputs, make_layer
 
-__all__ = ["specular_raw", "diffuse_raw", "specular_rgb", "gloss_layers"]
+__all__ = [
+    "SPECULAR",
+    "SPECULAR_BANDS",
+    "specular_raw",
+    "diffuse_raw",
+    "specular_rgb",
+    "gloss_layers",
+]
+
+#: The layer the glossy part becomes (a part that becomes a layer keeps its part name,
+#: :data:`~spectrinsic.render.result.SPECULAR`), and the specular term's role in an
+#: identity (``meta.json["identities"]``); every module naming the layer imports it from here.
+SPECULAR = SPECULAR_PART
+#: The per-band specular layer (``spectral.exr``).
+SPECULAR_BANDS = f"{SPECULAR}_bands"
 
 
 def specular_raw(s: SampleInputs) -> np.ndarray | None:
@@ -96,7 +111,7 @@ def _shared_layers(
     """``specular``, ``non_diffuse``, ``metallic`` and ``roughness``."""
     return [
         make_layer(
-            "specular",
+            SPECULAR,
             specular,
             RGB,
             UNITS_IMAGE + "; light the first hit returns through its non-diffuse lobes (coat "

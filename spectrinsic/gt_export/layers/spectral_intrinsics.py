@@ -42,9 +42,8 @@ import numpy as np
 
 from ...errors import DatasetError
 from ...spectra import COLORIMETRIC_WAVELENGTHS, get_sensors, get_spectrum, responses
-from ...spectra.working_space import WORKING_SPACES, working_space
 from . import irradiance as irr
-from .gloss import specular_raw
+from .gloss import SPECULAR, SPECULAR_BANDS, specular_raw
 from .intrinsics import white_radiance
 from .records import Layer, SampleInputs, cube_sensor_name, make_layer
 
@@ -61,8 +60,6 @@ __all__ = [
     "residual_rows",
     "residual_summary",
     "gamut_key",
-    "WORKING_SPACES",
-    "working_space_matrix",
     "bands_to_rgb",
     "band_image",
 ]
@@ -171,7 +168,7 @@ def spectral_layers(
     if rebuilt:
         out.append(layer("image_bands_raw", cube, units + "; the rendered cube", True))
     if specular is not None:
-        out.append(layer("specular_bands", specular, units + "; non-diffuse lobes"))
+        out.append(layer(SPECULAR_BANDS, specular, units + "; non-diffuse lobes"))
     out.append(
         layer(
             "residual_bands",
@@ -194,7 +191,7 @@ def spectral_identity(layers: Any) -> dict[str, str] | None:
         "shading": "shading_bands",
         "residual": "residual_bands",
     }
-    return out | ({"specular": "specular_bands"} if "specular_bands" in layers else {})
+    return out | ({SPECULAR: SPECULAR_BANDS} if SPECULAR_BANDS in layers else {})
 
 
 def residual_share(image: np.ndarray, residual: np.ndarray, mask: np.ndarray) -> float:
@@ -352,14 +349,6 @@ def residual_summary(metas: Any) -> dict[str, Any]:
     }
 
 
-def working_space_matrix(space: str) -> np.ndarray:
-    """``(3, 3)`` CIE XYZ -> linear RGB of a :data:`WORKING_SPACES` space
-    (:func:`spectrinsic.spectra.working_space.working_space`)."""
-    if space not in WORKING_SPACES:
-        raise DatasetError(f"working space {space!r}; expected one of {sorted(WORKING_SPACES)}")
-    return np.asarray(working_space(space).from_xyz, np.float64)
-
-
 def bands_to_rgb(
     layers: Mapping[str, np.ndarray],
     to_xyz: np.ndarray,
@@ -395,8 +384,8 @@ def bands_to_rgb(
     if clip:
         out["shading"] = np.clip(out["shading"], 0.0, None)
     rest = out["image"] - out["reflectance"] * out["shading"]
-    if "specular_bands" in layers:
-        out["specular"] = rgb("specular_bands")
-        rest = rest - out["specular"]
+    if SPECULAR_BANDS in layers:
+        out[SPECULAR] = rgb(SPECULAR_BANDS)
+        rest = rest - out[SPECULAR]
     out["residual"] = rest
     return out

@@ -38,6 +38,7 @@ from ...scenes.model import Scene, scene_from_dict
 from ...scenes.validate import POWER_RANGE
 from ...spectra import get_spectrum
 from ..formats.exr import read_exr
+from ..layers import LayerSettings
 from ..layers.records import reference_mode
 from ..sample import META_NAME, SCENE_NAME, file_sha256
 from ..sample.integrity import replaceable_sample
@@ -60,6 +61,7 @@ __all__ = [
     "relit_render",
     "relight",
     "check_light_spectra",
+    "settings_of",
 ]
 
 log = logging.getLogger(__name__)
@@ -335,22 +337,35 @@ def relight(
     meta = relit.meta
     if _empty_folder(out):
         out.rmdir()  # an empty --out is allowed, as for `dataset`; rmdir removes nothing else
-    cameras = meta["transport"].get("cameras") or [f"camera:{c}" for c in meta.get("cameras", [])]
     return export_sample(
         out.parent,
         relit.scene,
         relit.result,
+        settings_of(meta, None if data_dir is None else str(data_dir)).for_scene_folder(scene_dir),
         sample_id=out.name,
         config={"config_hash": meta["config_hash"]},
         seed=int(meta["seed"]),
-        cameras=cameras,
-        write_cube="cube" in meta.get("layers", {}),
-        spectral_layers="shading_bands" in meta.get("layers", {}),
-        working_space=space_of(meta).name,  # the source's (srgb for samples before issue 30)
-        denoise=bool(meta.get("denoised_layers")),
-        data_dir=data_dir,
         transport=relit.transport if keep_transport else None,
-        camera=model_from_meta(meta),  # the camera chain, if any, re-runs on the relit image
-        noise_id=str(meta["sample_id"]),  # its noise: the source's, not the --out folder name's
-        scene_folder=scene_dir,
+    )
+
+
+def settings_of(meta: Mapping[str, Any], data_dir: str | None = None) -> LayerSettings:
+    """The :class:`LayerSettings` a sample was written with, from its ``meta.json``: its
+    cameras (full sensor-set names, from the stored transport), cube, per-band layers,
+    denoising, working space (``srgb`` for samples before issue 30) and camera chain, which
+    re-runs on the relit image. The noise id is the sample's own id, so a relit sample's raw
+    mosaic carries the noise of the source, not of the ``--out`` folder's name."""
+    layers = meta.get("layers", {})
+    cameras = meta.get("transport", {}).get("cameras") or [
+        f"camera:{c}" for c in meta.get("cameras", [])
+    ]
+    return LayerSettings(
+        cameras=tuple(cameras),
+        camera=model_from_meta(meta),
+        write_cube="cube" in layers,
+        denoise=bool(meta.get("denoised_layers")),
+        spectral_layers="shading_bands" in layers,
+        working_space=space_of(meta),
+        data_dir=data_dir,
+        noise_id=str(meta["sample_id"]),
     )

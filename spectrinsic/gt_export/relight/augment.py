@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -31,8 +31,7 @@ from ...scenes.generators.lights import draw_illuminant
 from ..layers import compute_ground_truth
 from ..sample.integrity import sample_problem
 from ..sample.meta import read_meta
-from ..sample.working_view import space_of
-from . import relight, relit_render
+from . import relight, relit_render, settings_of
 
 __all__ = [
     "RELIT_TAG",
@@ -131,16 +130,14 @@ def relit_layers(
     """
     relit = relit_render(sample_dir, lights, powers=powers, data_dir=data_dir, scene_dir=scene_dir)
     meta = relit.meta
-    gt = compute_ground_truth(
-        relit.scene,
-        relit.result,
-        cameras=(meta["transport"].get("cameras") or ()) if cameras else (),
-        write_cube="cube" in meta.get("layers", {}),
-        denoise=bool(meta.get("denoised_layers")) if denoise is None else denoise,
-        data_dir=data_dir,
-        spectral="shading_bands" in meta.get("layers", {}),
-        working_space=space_of(meta).name,
+    settings = settings_of(meta, None if data_dir is None else str(data_dir))
+    settings = replace(  # cameras off: no camera layers, and no chain's camera added back
+        settings,
+        cameras=settings.cameras if cameras else (),
+        camera=settings.camera if cameras else None,
+        denoise=settings.denoise if denoise is None else denoise,
     )
+    gt = compute_ground_truth(relit.scene, relit.result, settings)
     out: dict[str, Any] = {name: layer.data for name, layer in gt.layers.items()}
     if "mask" in out:
         out["mask"] = out["mask"] > 0.5

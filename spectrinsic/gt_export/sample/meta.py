@@ -26,6 +26,7 @@ from types import MappingProxyType
 from typing import Any
 
 from ...errors import SampleMetaError
+from ..layers.gloss import SPECULAR
 from . import (
     HASHES_KEY,
     META_NAME,
@@ -269,15 +270,13 @@ def _light(f: JsonFields, light: object, name: str) -> LightEntry:
     )
 
 
-def _identity(
-    f: JsonFields, ident: object, name: str, layers: Mapping[str, LayerRecord]
-) -> Identity:
+def _identity(f: JsonFields, ident: object, name: str, held: Mapping[str, LayerRecord]) -> Identity:
     ident = f.mapping(ident, name)
-    fields = _IDENTITY_FIELDS + (("specular",) if "specular" in ident else ())
+    fields = _IDENTITY_FIELDS + ((SPECULAR,) if SPECULAR in ident else ())
     f.exact_keys(ident, name, frozenset(fields))
     keys = [f.text(ident[k], f"{name}.{k}") for k in fields]
     for k, key in zip(fields, keys, strict=True):
-        if key not in layers:
+        if key not in held:
             raise f.fail(f"{name}.{k}", "a layer of this sample", key)
     return Identity(*keys)
 

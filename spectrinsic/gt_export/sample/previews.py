@@ -16,6 +16,7 @@ import numpy as np
 from ...spectra.working_space import WorkingSpace
 from ..formats import png
 from ..layers import Layer
+from ..layers.gloss import SPECULAR
 from . import PREVIEW_DIR
 from .working_view import srgb_layer, view_kind
 
@@ -30,7 +31,7 @@ Preview = tuple[np.ndarray, dict[str, Any]]
 
 #: Layers that share one exposure per sample, so brightness differences between them are real:
 #: every image mode and camera image uses ``image``'s, every shading ``shading``'s.
-_EXPOSURE_OF = (("image", "image"), ("shading", "shading"), ("specular", "image"))
+_EXPOSURE_OF = (("image", "image"), ("shading", "shading"), (SPECULAR, "image"))
 
 
 def _srgb(data: np.ndarray, scale: float) -> Preview:
@@ -145,7 +146,7 @@ _PREVIEWS: tuple[tuple[str, Callable[[Layer, Mapping[str, Layer]], Preview]], ..
     ("illuminant", _illuminant_preview),
     ("error_", _error_preview),
     ("residual", _residual_preview),
-    ("specular", _colour_preview),
+    (SPECULAR, _colour_preview),
     ("non_diffuse", _unit_preview),
     ("metallic", _unit_preview),
     ("transmissive", _unit_preview),

@@ -41,6 +41,7 @@ from ...spectra.camera_model import CameraModel
 from ..formats import png
 from ..formats.names import camera_slug
 from ..layers import GroundTruth, Layer, camera_curves
+from ..layers.gloss import SPECULAR
 from ..layers.records import RGB, camera_key, grid, make_layer
 
 __all__ = ["SensorOutput", "sensor_output", "write_sensor_files", "model_from_meta", "noise_seed"]
@@ -120,7 +121,7 @@ def _layers(
         "shading": "shading in the processed space: white-balance gains x camera white under D65 x camera shading",
         "residual": "image_sensor - reflectance_sensor * shading_sensor [- specular_sensor]; "
         + _LINEAR,
-        "specular": "specular layer through white balance and colour matrix; " + _LINEAR,
+        SPECULAR: "specular layer through white balance and colour matrix; " + _LINEAR,
     }
     for name, data in gt_space.items():
         out.append(
@@ -179,7 +180,7 @@ def sensor_output(
     )
     identity = {k: f"{k}_sensor/{key}" for k in ("image", "reflectance", "shading", "residual")}
     if spec is not None:
-        identity["specular"] = f"specular_sensor/{key}"
+        identity[SPECULAR] = f"{SPECULAR}_sensor/{key}"
     meta = {
         "camera": model.name,
         "model": model.settings(),

@@ -41,7 +41,7 @@ import numpy as np
 from ...errors import DatasetError
 from ...render.algebra.batch_means import batch_mean
 from ...render.algebra.light_transport import LightTransport
-from ...render.band_path.traversal import PARTS as TRAVERSAL_PARTS
+from ...render.result import PARTS
 from ...spectra import get_sensors
 from ..formats.exr import read_exr_stacks, write_exr
 from . import TRANSPORT_NAME
@@ -66,7 +66,7 @@ COMPACT_LAYOUT = "batch-mean+half-deviations"
 #: The EXR compression of ``transport.exr`` (:data:`~spectrinsic.gt_export.formats.exr.COMPRESSIONS`):
 #: zlib per scanline, as small as ``"zip"`` on Monte Carlo noise and 4x faster to read back.
 TRANSPORT_COMPRESSION = "zips"
-#: The letter of the batch deviations' layers (a part's letters are in :data:`PARTS`).
+#: The letter of the batch deviations' layers (a part's letters are in :data:`~spectrinsic.render.result.PARTS`).
 DEVIATION_LETTER = "D"
 #: The largest float16 magnitude a deviation is scaled to: 2^14, below float16's 65504, so
 #: a scaled deviation never overflows and keeps 11 significant bits down to 2^-14 of it.
@@ -77,13 +77,8 @@ TRANSPORT_UNITS = (
 )
 
 
-#: Glossy parts of the transport, and the letter their layers start with (the transport's: L);
-#: their one home is the traversal's (:data:`spectrinsic.render.band_path.traversal.PARTS`).
-PARTS = TRAVERSAL_PARTS
-
-
 def transport_layer(light: int, batch: int | None, mode: str, part: str = "transport") -> str:
-    """EXR layer name of light *light*'s transport (or its glossy *part*, :data:`PARTS`) for
+    """EXR layer name of light *light*'s transport (or its *part*, :data:`~spectrinsic.render.result.PARTS`) for
     *mode*: the batch mean (*batch* ``None``, the compact layout) or batch *batch* (the layout
     before issue 45).
 
@@ -179,7 +174,7 @@ def write_transport(
         "lights": transport.n_lights,
         "batches": len(transport.batches),
         "batch_seeds": list(transport.seeds),
-        "batch_spp": transport.spp,
+        "batch_spp": transport.batch_spp,
         "max_depth": transport.max_depth,
         "parts": [p for p in _parts(transport) if p in PARTS],
         "deviation_exponents": exponents,
@@ -282,7 +277,7 @@ def read_transport(
         sensors={str(k): str(v) for k, v in sensors.items()},
         batches=held["transport"],
         seeds=tuple(int(s) for s in seeds),
-        spp=_field(record, "batch_spp", int, where),
+        batch_spp=_field(record, "batch_spp", int, where),
         max_depth=_field(record, "max_depth", int, where),
         parts={p: held[p] for p in PARTS if p in held},
     )

@@ -25,27 +25,23 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import DatasetError
-from ...spectra.working_space import WORKING_SPACES, WorkingSpace, working_space
+from ...spectra.working_space import WorkingSpace, working_space
+from ..layers.gloss import SPECULAR
 from ..layers.records import REFLECTANCE_FLOOR
 
 __all__ = ["space_of", "view_kind", "srgb_layer", "srgb_view"]
 
-_COLOURS = ("image", "image_denoised", "reflectance", "specular")
+_COLOURS = ("image", "image_denoised", "reflectance", SPECULAR)
 _LIGHTS = ("shading", "shading_raw", "illuminant")
 _RECOMPUTED = ("residual", "residual_raw", "shading_ratio")
 
 
 def space_of(meta: Any) -> WorkingSpace:
     """The working space a parsed ``meta.json`` records (``srgb`` for samples written before
-    it was recorded); :class:`DatasetError` for an unknown name."""
+    it was recorded); :class:`~spectrinsic.errors.WorkingSpaceError` for an unknown name."""
     record = meta.get("working_space") if isinstance(meta, Mapping) else None
     name = record.get("name", "srgb") if isinstance(record, Mapping) else "srgb"
-    if name not in WORKING_SPACES:
-        raise DatasetError(
-            f"meta.json working_space {name!r}; expected one of {sorted(WORKING_SPACES)}"
-        )
-    return working_space(str(name))
+    return working_space(name, "meta.json working_space")
 
 
 def view_kind(name: str) -> str | None:
@@ -81,8 +77,8 @@ def _recompute(out: dict[str, Any], identities: Any) -> None:
         if not all(ident.get(k) in out for k in ("image", "reflectance", "shading")):
             continue
         rest = out[ident["image"]] - out[ident["reflectance"]] * out[ident["shading"]]
-        if ident.get("specular") in out:
-            rest = rest - out[ident["specular"]]
+        if ident.get(SPECULAR) in out:
+            rest = rest - out[ident[SPECULAR]]
         out[ident["residual"]] = rest.astype(np.float32)
     if "shading_ratio" in out and "image" in out and "reflectance" in out:
         refl = np.asarray(out["reflectance"], np.float64)

@@ -43,10 +43,14 @@ from ...scenes.model import (
 from ...scenes.semantic import class_table
 from ...spectra import DEFAULT_WAVELENGTHS, get_spectrum
 from ...spectra.user_spectra import portable_names, spectrum_files
-from ...spectra.working_space import DEFAULT_WORKING_SPACE
 from ..formats import png
 from ..formats.exr import write_exr
-from ..layers import GroundTruth, compute_ground_truth, identities
+from ..layers import (
+    GroundTruth,
+    LayerSettings,
+    compute_ground_truth,
+    identities,
+)
 from . import (
     FORMAT_VERSION,
     HASHES_KEY,
@@ -70,10 +74,8 @@ from .transport_exr import TRANSPORT_NAME, write_transport
 
 if TYPE_CHECKING:
     from ...render.algebra.light_transport import LightTransport
-    from ...spectra.camera_model import CameraModel
 
 __all__ = [
-    "DEFAULT_CAMERAS",
     "export_sample",
     "is_complete",
     "remove_sample_temporaries",
@@ -81,8 +83,6 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-#: Cameras exported by default when the 31-band cube is available (shipped by colour-science).
-DEFAULT_CAMERAS: tuple[str, ...] = ("camera:Nikon 5100 (NPL)", "camera:Sigma SDMerill (NPL)")
 #: Render metadata that varies from run to run and so is not written (files stay reproducible).
 _VOLATILE_META = ("timings",)
 
@@ -272,20 +272,12 @@ def export_sample(
     out_dir: str | os.PathLike[str],
     scene: Scene,
     result: Any,
+    settings: LayerSettings | None = None,
     *,
     sample_id: str,
     config: Mapping[str, Any],
     seed: int,
-    cameras: Sequence[str] | None = None,
-    write_cube: bool = False,
-    denoise: bool = False,
-    data_dir: str | os.PathLike[str] | None = None,
     transport: LightTransport | None = None,
-    camera: CameraModel | None = None,
-    spectral_layers: bool = False,
-    working_space: str = DEFAULT_WORKING_SPACE,
-    noise_id: str | None = None,
-    scene_folder: str | os.PathLike[str] | None = None,
 ) -> Path:
     """Compute every ground-truth layer of a rendered sample and write it atomically.
 
@@ -299,45 +291,26 @@ def export_sample(
         A :class:`~spectrinsic.render.result.RenderResult`, or any record with its fields
         (``images``, ``raw``, ``per_light``, ``direct``, ``aovs``, ``meta``, ``batch_raw``);
         never a live renderer.
+    settings
+        The layers to write (:class:`~spectrinsic.gt_export.layers.settings.LayerSettings`,
+        default ``LayerSettings()``): cameras (default
+        :data:`~spectrinsic.gt_export.layers.settings.DEFAULT_CAMERAS` when the render has the
+        31-band cube, none otherwise), the cube, denoising, the per-band layers
+        (``spectral.exr``, :mod:`~spectrinsic.gt_export.layers.spectral_intrinsics`), the
+        working space (recorded in ``meta.json["working_space"]``), and a camera chain to run
+        the sample through (:mod:`~spectrinsic.gt_export.sample.sensor`: raw mosaic, DNG,
+        processed image and the ground truth in the processed linear space), its noise seeded
+        from *seed* and ``settings.noise_id`` (default *sample_id*).
     sample_id
         Folder name, e.g. ``"obj-vase__v0__two-colour-a"``.
     config
         The settings the sample was built with; ``meta.json`` records :func:`config_hash` of it.
     seed
         The sample's render seed.
-    cameras
-        Camera sensor sets for per-camera layers; default :data:`DEFAULT_CAMERAS` when the
-        render has the 31-band cube, none otherwise.
-    write_cube
-        Also write the multispectral cube (``cube.exr``).
-    denoise
-        Compute shading, residual and illuminant from the OIDN-denoised irradiance.
-    data_dir
-        Spectral data directory (for ``sfu:``/data-directory cameras).
     transport
         A :class:`~spectrinsic.render.algebra.light_transport.LightTransport` of this render to store as
         ``transport.exr`` (:mod:`~spectrinsic.gt_export.sample.transport_exr`), for exact
         relighting (:func:`spectrinsic.gt_export.relight.relight`).
-    camera
-        A :class:`~spectrinsic.spectra.camera_model.CameraModel` to run the sample through
-        (:mod:`~spectrinsic.gt_export.sample.sensor`): raw mosaic, DNG, processed image and the ground
-        truth in the processed linear space; its sensitivities must be among *cameras*.
-    spectral_layers
-        Also write the per-band intrinsic layers (``spectral.exr``,
-        :mod:`~spectrinsic.gt_export.layers.spectral_intrinsics`); needs the 31-band cube.
-    working_space
-        The RGB working space of the RGB layers (``"acescg"``, default, or ``"srgb"``,
-        :mod:`spectrinsic.spectra.working_space`); recorded in ``meta.json["working_space"]``.
-    noise_id
-        The sample id the camera chain's noise is seeded from (with *seed*); default
-        *sample_id*. A relit sample passes its source's id, so its raw mosaic carries the same
-        noise as a direct render of that sample under the new lights.
-    scene_folder
-        The folder of the scene file the scene was read from: every ``csv:`` spectrum the
-        sample records (``scene.json``, ``meta.json``) is named by its path relative to it
-        (a file outside it, or with no folder given, by its file name), so no written file
-        holds a path of the machine that built it
-        (:func:`~spectrinsic.spectra.user_spectra.portable_csv`).
 
     Returns
     -------
@@ -348,24 +321,14 @@ def export_sample(
     out_dir.mkdir(parents=True, exist_ok=True)
     if not sample_id or "/" in sample_id or sample_id.startswith("."):
         raise DatasetError(f"sample id {sample_id!r}: expected a plain folder name")
-    if cameras is None:
-        cameras = DEFAULT_CAMERAS if "bands31" in (getattr(result, "raw", None) or {}) else ()
-    if camera is not None and camera.sensitivities not in cameras:
-        cameras = (*cameras, camera.sensitivities)  # the chain runs on that camera's image
-    gt = compute_ground_truth(
-        scene,
-        result,
-        cameras=cameras,
-        write_cube=write_cube,
-        denoise=denoise,
-        data_dir=data_dir,
-        spectral=spectral_layers,
-        working_space=working_space,
-    )
+    settings = settings or LayerSettings()
+    settings = settings.with_cube("bands31" in (getattr(result, "raw", None) or {}))
+    gt = compute_ground_truth(scene, result, settings)
     sensor = None
-    if camera is not None:
+    if settings.camera is not None:
+        noise_id = settings.noise_id or sample_id
         sensor = sensor_output(
-            gt, camera, seed=seed, sample_id=noise_id or sample_id, data_dir=data_dir
+            gt, settings.camera, seed=seed, sample_id=noise_id, data_dir=settings.data_dir
         )
         gt = sensor.ground_truth
     final = out_dir / sample_id
@@ -382,7 +345,7 @@ def export_sample(
             seed=seed,
             transport=transport,
             sensor=sensor,
-            scene_folder=None if scene_folder is None else Path(scene_folder),
+            scene_folder=None if settings.scene_folder is None else Path(settings.scene_folder),
         )
         _move_into_place(tmp, final, config_hash(config))
     except WriteError as exc:  # named as the file will be (a full disk): not the temporary

@@ -15,7 +15,7 @@ from ...errors import RenderError
 from ...scenes.model import Scene
 from ...spectra import COLORIMETRIC_WAVELENGTHS, diagonal_values, get_sensors
 from ...threads import thread_map
-from ..result import RenderResult
+from ..result import METAL_WHITE, SPECULAR, RenderResult
 from .batch_means import batch_mean
 from .modes import get_mode, light_spectra, lights_to_xyz_matrix, raw_to_xyz
 from .shares import compose, light_shares, sum_lights
@@ -45,15 +45,15 @@ class LightTransport:
         channels light l gives alone with the flat unit spectrum at power 1 (render units).
     seeds
         Sampler seed of each batch.
-    spp
-        Samples per pixel of each batch.
+    batch_spp
+        Samples per pixel of each batch (the total is ``batch_spp * len(batches)``).
     max_depth
         Longest path of the passes.
     seconds
         Seconds of each Mitsuba pass, per mode, and under ``"single"`` those of the traversals
         carrying every mode at once (empty when read from a file).
     parts
-        Part name (:data:`spectrinsic.render.band_path.traversal.PARTS`) -> one dict per batch as
+        Part name (:data:`spectrinsic.render.result.PARTS`) -> one dict per batch as
         :attr:`batches`, for the same unit spectrum: glossy scenes' ``"specular"`` part of ``T``
         (first camera-ray vertex through a non-diffuse lobe) and metals' ``"metal_white"``
         white-surface radiance at metal first hits (not part of ``T``)
@@ -64,7 +64,7 @@ class LightTransport:
     sensors: dict[str, str]
     batches: tuple[dict[str, np.ndarray], ...] = field(repr=False)
     seeds: tuple[int, ...]
-    spp: int
+    batch_spp: int
     max_depth: int
     seconds: dict[str, tuple[float, ...]] = field(default_factory=dict, repr=False)
     parts: dict[str, tuple[dict[str, np.ndarray], ...]] = field(default_factory=dict, repr=False)
@@ -87,12 +87,12 @@ class LightTransport:
     @property
     def specular(self) -> tuple[dict[str, np.ndarray], ...]:
         """``parts["specular"]`` (empty for a matte scene)."""
-        return self.parts.get("specular", ())
+        return self.parts.get(SPECULAR, ())
 
     @property
     def metal_white(self) -> tuple[dict[str, np.ndarray], ...]:
         """``parts["metal_white"]`` (empty without metals)."""
-        return self.parts.get("metal_white", ())
+        return self.parts.get(METAL_WHITE, ())
 
     @property
     def n_lights(self) -> int:
@@ -230,7 +230,7 @@ def _meta(
     out: dict[str, Any] = dict(meta or {})
     out.update(
         seed=int(transport.seeds[0]),
-        spp=int(transport.spp) * n,
+        spp=int(transport.batch_spp) * n,
         modes=modes,
         per_light=True,
         per_light_modes=modes,
@@ -239,7 +239,7 @@ def _meta(
     )
     out.setdefault("timings", {})
     if n > 1:
-        out.update(batches=n, batch_spp=int(transport.spp), batch_seeds=list(transport.seeds))
+        out.update(batches=n, batch_spp=int(transport.batch_spp), batch_seeds=list(transport.seeds))
     return out
 
 

@@ -14,7 +14,12 @@ import numpy as np
 
 from ...errors import RenderError
 
-__all__ = ["TransportOutput", "compose", "light_shares", "sum_lights"]
+__all__ = [
+    "TransportOutput",
+    "compose",
+    "light_shares",
+    "sum_lights",
+]
 
 
 def light_shares(parts: np.ndarray, emission: np.ndarray) -> np.ndarray:
@@ -64,7 +69,7 @@ class TransportOutput:
     emission
         ``(L, K)`` float64 the lights' channel values ``E_{l,k}`` (:class:`ChannelValues`).
     parts
-        Part name (:data:`~spectrinsic.render.band_path.traversal.PARTS`) -> ``(L, H, W, K)`` float32, the parts the traversal rendered:
+        Part name (:data:`~spectrinsic.render.result.PARTS`) -> ``(L, H, W, K)`` float32, the parts the traversal rendered:
         ``"specular"``, the part of :attr:`transport` whose first camera-ray vertex went through
         a non-diffuse lobe (glossy scenes; 0 in matte ones); ``"metal_white"``, the radiance a
         white Lambertian surface would reflect at the pixel's metal first hits, times their
@@ -88,7 +93,7 @@ class TransportOutput:
         return sum_lights(self.per_light(direct=direct), lights)
 
     def part_image(self, part: str, lights: Sequence[int] | None = None) -> np.ndarray | None:
-        """``(H, W, K)`` float32 image of *part* (:data:`~spectrinsic.render.band_path.traversal.PARTS`) for the *lights* (default all),
+        """``(H, W, K)`` float32 image of *part* (:data:`~spectrinsic.render.result.PARTS`) for the *lights* (default all),
         composed as :meth:`image` composes the transport (so both agree bit for bit where all
         light is specular), or ``None`` where the traversal did not render it."""
         held = self.parts.get(part)

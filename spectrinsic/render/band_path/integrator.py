@@ -40,6 +40,7 @@ from ...spectra.conductors import FRESNEL_NODES
 from ..base.surface_maps import map_textures
 from ..base.textures import TextureTables, shape_id_table, texture_lookups
 from ..base.variants import import_mitsuba
+from ..result import METAL_WHITE, PARTS, SPECULAR
 from .kernel import BandKernel
 
 __all__ = [
@@ -48,9 +49,7 @@ __all__ = [
     "band_path_class",
     "band_path",
     "aov_channels",
-    "transport_channels",
-    "specular_channels",
-    "metal_white_channels",
+    "part_channels",
     "first_hit_channels",
 ]
 
@@ -98,19 +97,12 @@ class BandTables:
     masks: bool = False
 
 
-def transport_channels(n_lights: int, n_bands: int) -> list[str]:
-    """AOV names of the transport channels, light-major: ``t<l>_<k>``."""
-    return [f"t{j:02d}_{k:02d}" for j in range(n_lights) for k in range(n_bands)]
-
-
-def specular_channels(n_lights: int, n_bands: int) -> list[str]:
-    """AOV names of the specular transport channels, light-major: ``s<l>_<k>``."""
-    return [f"s{j:02d}_{k:02d}" for j in range(n_lights) for k in range(n_bands)]
-
-
-def metal_white_channels(n_lights: int, n_bands: int) -> list[str]:
-    """AOV names of the white-at-metal channels, light-major: ``m<l>_<k>``."""
-    return [f"m{j:02d}_{k:02d}" for j in range(n_lights) for k in range(n_bands)]
+def part_channels(part: str, n_lights: int, n_bands: int) -> list[str]:
+    """AOV names of the transport's (*part* ``"transport"``: ``t<l>_<k>``) or a part's
+    channels, light-major, by the part's letter in :data:`~spectrinsic.render.result.PARTS`
+    (``s<l>_<k>`` specular, ``w<l>_<k>`` white at metals)."""
+    letter = "t" if part == "transport" else PARTS[part].lower()
+    return [f"{letter}{j:02d}_{k:02d}" for j in range(n_lights) for k in range(n_bands)]
 
 
 def aov_channels(
@@ -126,9 +118,9 @@ def aov_channels(
     *metals*) the L·K specular ones, with *metals* the L·K white-at-metal ones, then the
     first-hit maps."""
     return (
-        transport_channels(n_lights, n_bands)
-        + (specular_channels(n_lights, n_bands) if gloss or metals else [])
-        + (metal_white_channels(n_lights, n_bands) if metals else [])
+        part_channels("transport", n_lights, n_bands)
+        + (part_channels(SPECULAR, n_lights, n_bands) if gloss or metals else [])
+        + (part_channels(METAL_WHITE, n_lights, n_bands) if metals else [])
         + first_hit_channels(n_surfaces, n_texcols)
     )
 

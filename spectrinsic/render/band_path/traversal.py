@@ -29,17 +29,17 @@ from ..algebra.modes import ChannelValues, RenderMode, channel_values, get_mode
 from ..algebra.shares import TransportOutput
 from ..base import translate as tr
 from ..base.aov_maps import assemble_aovs
-from ..base.one_pass import DIRECT_DEPTH, PassOutput, PassProgress, timed_render
+from ..base.one_pass import DIRECT_DEPTH, PassOutput, check_scene_lights, timed_render
 from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
 from ..base.surface_maps import map_scales
 from ..base.textures import shape_slots, texture_tables
 from ..base.variants import choose_variant, variant_scope
-from ..settings import DEFAULT_INTEGRATOR, INTEGRATORS
+from ..result import METAL_WHITE, SPECULAR
+from ..settings import DEFAULT_INTEGRATOR, INTEGRATORS, PassRequest
 from .integrator import BandTables, band_path, first_hit_channels
 from .kernel import GLASS_ROW, MIRROR_ROW
 
 __all__ = [
-    "PARTS",
     "SingleTraversal",
     "render_traversal",
     "render_jobs",
@@ -47,17 +47,6 @@ __all__ = [
     "single_traversal_runs",
     "resolve_integrator",
 ]
-
-
-#: The parts a traversal splits off beside its transport, in the order of its AOV channels
-#: (:func:`~spectrinsic.render.band_path.integrator.aov_channels`), and the letter of their layers in ``transport.exr``
-#: (:mod:`spectrinsic.gt_export.sample.transport_exr`; the transport's is L): glossy scenes'
-#: ``"specular"`` part of the transport (the light whose first camera-ray vertex went through
-#: a non-diffuse lobe) and metals' ``"metal_white"`` radiance (not part of the transport). Each
-#: is ``(L, H, W, K)`` per unit emission, composed as the transport is; every record below the
-#: traversal (:class:`TransportOutput`, ``RenderResult.parts``, ``LightTransport.parts``, the
-#: batches, the file) holds the parts by these names.
-PARTS: dict[str, str] = {"specular": "S", "metal_white": "W"}
 
 
 def single_traversal_runs(variant: str | None) -> bool:
@@ -134,9 +123,10 @@ def _specular_table(scene: Scene, value_sets: Sequence[ChannelValues]) -> np.nda
 
 
 def _render(
-    mi: Any, loaded: Any, integrator: Any, *, spp: int, seed: int, n: int
+    mi: Any, loaded: Any, integrator: Any, request: PassRequest, n: int
 ) -> tuple[np.ndarray, float]:
     """The traversal's last *n* AOV channels (the band transport) and the render's seconds."""
+    spp, seed = request.batch_spp, request.seed
     image, seconds = timed_render(mi, loaded, spp=spp, seed=seed, integrator=integrator)
     if image.shape[-1] < n:
         raise RenderError(
@@ -166,7 +156,7 @@ class _Dims:
 
 @dataclass(frozen=True, eq=False)
 class _Traced:
-    """One traversal: transport ``(L, H, W, K)``, the parts of :data:`PARTS`
+    """One traversal: transport ``(L, H, W, K)``, the parts of :data:`~spectrinsic.render.result.PARTS`
     it rendered (same shape; the first traversal only), the first-hit maps (first traversal
     with surfaces) and its seconds."""
 
@@ -182,11 +172,10 @@ def _trace(
     tables: BandTables,
     dims: _Dims,
     spec_table: np.ndarray | None,
+    request: PassRequest,
     *,
     depth: int,
     first: bool,
-    spp: int,
-    seed: int,
 ) -> _Traced:
     """One traversal at path *depth*; the *first* one also takes the first-hit maps and, in
     scenes with metals, the white-at-metal radiance."""
@@ -213,9 +202,7 @@ def _trace(
     n_spec = n_t if dims.glossy else 0
     n_white = n_t if metals else 0
     n_first = len(first_hit_channels(n_surfaces, n_texcols))
-    image, dt = _render(
-        mi, loaded, integrator, spp=spp, seed=seed, n=n_t + n_spec + n_white + n_first
-    )
+    image, dt = _render(mi, loaded, integrator, request, n_t + n_spec + n_white + n_first)
 
     def per_light(channels: np.ndarray) -> np.ndarray:
         return channels.reshape(dims.h, dims.w, dims.n_lights, dims.n_bands).transpose(2, 0, 1, 3)
@@ -223,9 +210,9 @@ def _trace(
     end = n_t + n_spec + n_white
     parts = {}
     if dims.glossy and first:
-        parts["specular"] = per_light(image[..., n_t : n_t + n_spec])
+        parts[SPECULAR] = per_light(image[..., n_t : n_t + n_spec])
     if metals:
-        parts["metal_white"] = per_light(image[..., n_t + n_spec : end])
+        parts[METAL_WHITE] = per_light(image[..., n_t + n_spec : end])
     return _Traced(
         transport=per_light(image[..., :n_t]),
         parts=parts,
@@ -264,15 +251,10 @@ def _outputs(
 def render_traversal(
     scene: Scene,
     value_sets: Sequence[ChannelValues],
+    request: PassRequest,
     *,
-    spp: int,
-    seed: int,
-    max_depth: int = 8,
     direct: bool = False,
     aovs: bool = False,
-    variant: str | None = None,
-    progress: PassProgress | None = None,
-    geometry: Sequence[tr.SurfaceGeometry] | None = None,
     crop: tuple[int, int, int, int] | None = None,
 ) -> tuple[list[TransportOutput], dict[str, np.ndarray], tuple[float, ...], str]:
     """Per-light band transport of every value set, in one traversal (two with *direct*).
@@ -282,6 +264,9 @@ def render_traversal(
     value_sets
         Channel values (:func:`spectrinsic.render.algebra.modes.channel_values`) of each diagonal mode;
         their bands are traced together.
+    request
+        Samples, seed, path depth, variant, progress and prepared geometry
+        (:class:`~spectrinsic.render.settings.PassRequest`).
     direct
         Also trace direct light only (path depth 2), for the energy ratio r of Eq. 5.8.
     aovs
@@ -302,15 +287,12 @@ def render_traversal(
     variant
         The Mitsuba variant used.
     """
-    if int(spp) < 1 or int(max_depth) < 1:
-        raise SceneError(f"spp {spp}, max_depth {max_depth}: expected at least 1 each")
-    if not scene.lights:
-        raise SceneError(f"scene {scene.name!r} has no lights: nothing to render")
+    check_scene_lights(scene)
     if not value_sets:
         raise SceneError("render_traversal: expected at least one set of channel values")
     widths = [np.asarray(v.materials).shape[1] for v in value_sets]
     n_bands, n_lights = sum(widths), len(scene.lights)
-    chosen = choose_variant("rgb", variant)
+    chosen = choose_variant("rgb", request.variant)
     h, w = (
         (scene.camera.height, scene.camera.width) if crop is None else (int(crop[3]), int(crop[2]))
     )
@@ -323,9 +305,9 @@ def render_traversal(
                 materials=[white] * len(scene.materials),
                 lights=[white] * n_lights,
                 film=hdr_film(scene.camera.width, scene.camera.height, crop),
-                integrator=path_integrator(max_depth),
-                sample_count=spp,
-                geometry=geometry,
+                integrator=path_integrator(request.max_depth),
+                sample_count=request.batch_spp,
+                geometry=request.geometry,
                 white_metal=True,
             )
         )
@@ -337,23 +319,12 @@ def render_traversal(
         dims = _Dims(h, w, n_bands, n_lights, glossy, non_diffuse_rows)
         spec_table = _specular_table(scene, value_sets) if glossy else None
         traced: list[_Traced] = []
-        for depth in [int(max_depth)] + ([DIRECT_DEPTH] if direct else []):
+        for depth in [request.max_depth] + ([DIRECT_DEPTH] if direct else []):
             first = not traced
             traced.append(
-                _trace(
-                    mi,
-                    loaded,
-                    tables,
-                    dims,
-                    spec_table,
-                    depth=depth,
-                    first=first,
-                    spp=spp,
-                    seed=seed,
-                )
+                _trace(mi, loaded, tables, dims, spec_table, request, depth=depth, first=first)
             )
-            if progress is not None:
-                progress(1)
+            request.tick()
     outputs = _outputs(value_sets, widths, traced, direct)
     hits = traced[0].first
     aov_maps = _first_hit_maps(scene, tables, hits) if aovs and hits is not None else {}
@@ -372,7 +343,7 @@ class SingleTraversal:
 
     def per_light(self, part: str) -> dict[str, np.ndarray]:
         """Mode -> ``(L, H, W, K)`` per-light *part* (``"transport"`` or one of
-        :data:`PARTS`); modes without it left out."""
+        :data:`~spectrinsic.render.result.PARTS`); modes without it left out."""
         arrays = {
             n: t.transport if part == "transport" else t.parts.get(part)
             for n, t in self.transport.items()
@@ -383,14 +354,9 @@ class SingleTraversal:
 def render_jobs(
     scene: Scene,
     jobs: Sequence[tuple[Sequence[RenderMode], Sequence[int] | None, bool]],
+    request: PassRequest,
     *,
     wanted: set[str],
-    spp: int,
-    seed: int,
-    max_depth: int,
-    variant: str | None,
-    progress: PassProgress | None,
-    geometry: Sequence[tr.SurfaceGeometry] | None,
     data_dir: str | None,
     aovs: bool = False,
 ) -> tuple[list[dict[str, PassOutput]], SingleTraversal]:
@@ -418,16 +384,7 @@ def render_jobs(
         for m in diagonal
     ]
     outs, aov_maps, seconds, chosen = render_traversal(
-        scene,
-        values,
-        spp=spp,
-        seed=seed,
-        max_depth=max_depth,
-        direct=want_direct,
-        aovs=aovs,
-        variant=variant,
-        progress=progress,
-        geometry=geometry,
+        scene, values, request, direct=want_direct, aovs=aovs
     )
     transport = {} if maps_only else {m.name: o for m, o in zip(diagonal, outs, strict=True)}
     parts = []

@@ -24,7 +24,7 @@ __all__ = [
     "PassProgress",
     "PassOutput",
     "AOV_NAMES",
-    "check_render_args",
+    "check_scene_lights",
     "active_light_set",
     "timed_render",
     "placeholder_light",
@@ -62,11 +62,9 @@ class PassOutput:
     variant: str
 
 
-def check_render_args(scene: Scene, spp: int, max_depth: int) -> None:
-    if int(spp) < 1:
-        raise SceneError(f"spp {spp}: expected at least 1 sample per pixel")
-    if int(max_depth) < 1:
-        raise SceneError(f"max_depth {max_depth}: expected >= 1")
+def check_scene_lights(scene: Scene) -> None:
+    """A pass needs a light (its samples and depth are checked once, by its
+    :class:`~spectrinsic.render.settings.PassRequest`)."""
     if not scene.lights:
         raise SceneError(f"scene {scene.name!r} has no lights: nothing to render")
 

@@ -24,9 +24,8 @@ from ..base import translate as tr
 from ..base.one_pass import (
     DIRECT_DEPTH,
     PassOutput,
-    PassProgress,
     active_light_set,
-    check_render_args,
+    check_scene_lights,
     placeholder_light,
     scene_parameters,
     set_rgb,
@@ -36,6 +35,7 @@ from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
 from ..base.surface_maps import refuse_maps
 from ..base.textures import refuse_textures
 from ..base.variants import choose_variant, variant_scope
+from ..settings import PassRequest
 
 __all__ = ["render_diagonal"]
 
@@ -45,15 +45,10 @@ logger = logging.getLogger(__name__)
 def render_diagonal(
     scene: Scene,
     value_sets: Sequence[ChannelValues],
+    request: PassRequest,
     *,
-    spp: int,
-    seed: int,
-    max_depth: int = 8,
     direct: Sequence[bool] | bool = False,
     active_lights: Sequence[int] | None = None,
-    variant: str | None = None,
-    progress: PassProgress | None = None,
-    geometry: Sequence[tr.SurfaceGeometry] | None = None,
 ) -> list[PassOutput]:
     """Diagonal renders of *scene*, one per entry of *value_sets*, all on one loaded scene.
 
@@ -64,21 +59,20 @@ def render_diagonal(
     ----------
     value_sets
         Channel values (:func:`spectrinsic.render.algebra.modes.channel_values`) of each render.
+    request
+        Samples, seed, path depth, variant, progress and prepared geometry
+        (:class:`~spectrinsic.render.settings.PassRequest`).
     direct
         Per value set (or for all): also render direct light only (``max_depth`` 2), for the
         energy ratio r of Eq. 5.8.
     active_lights
         Indices of the lights to render (default all); others are left out (per-light renders).
-    variant
-        Backend or variant name (:func:`spectrinsic.render.base.variants.choose_variant`).
-    geometry
-        :func:`spectrinsic.render.base.translate.prepare_geometry` of *scene*, if already computed.
 
     Returns
     -------
     One :class:`PassOutput` per value set, ``(H, W, K)`` float32 raw channels.
     """
-    check_render_args(scene, spp, max_depth)
+    check_scene_lights(scene)
     refuse_textures(scene, "the diagonal passes")
     refuse_maps(scene, "the diagonal passes")
     active = active_light_set(scene, active_lights)
@@ -90,7 +84,7 @@ def render_diagonal(
     if not value_sets:
         return []
     surfaces = [s for s in tr.surfaces(scene) if s.material >= 0]
-    chosen = choose_variant("rgb", variant)
+    chosen = choose_variant("rgb", request.variant)
     outputs = []
     with variant_scope(chosen) as mi:
         mitsuba_dict = tr.scene_to_mitsuba(
@@ -101,9 +95,9 @@ def render_diagonal(
                 placeholder_light(j) if j in active else None for j in range(len(scene.lights))
             ],
             film=hdr_film(scene.camera.width, scene.camera.height),
-            integrator=path_integrator(max_depth),
-            sample_count=spp,
-            geometry=geometry,
+            integrator=path_integrator(request.max_depth),
+            sample_count=request.batch_spp,
+            geometry=request.geometry,
         )
         loaded = mi.load_dict(mitsuba_dict)
         params = scene_parameters(
@@ -114,7 +108,7 @@ def render_diagonal(
         )
         direct_integrator = mi.load_dict(path_integrator(DIRECT_DEPTH)) if any(flags) else None
         for values, want_direct in zip(value_sets, flags, strict=True):
-            passes = _DiagonalPasses(mi, loaded, params, direct_integrator, spp, seed, progress)
+            passes = _DiagonalPasses(mi, loaded, params, direct_integrator, request)
             outputs.append(
                 passes.render(scene, surfaces, sorted(active), values, want_direct, chosen)
             )
@@ -123,22 +117,20 @@ def render_diagonal(
 
 @dataclass(frozen=True)
 class _DiagonalPasses:
-    """One loaded RGB scene and what every diagonal pass on it shares (seed, spp, integrators)."""
+    """One loaded RGB scene and what every diagonal pass on it shares (the request, integrators)."""
 
     mi: Any
     loaded: Any
     params: Any
     direct_integrator: Any
-    spp: int
-    seed: int
-    progress: PassProgress | None
+    request: PassRequest
 
     def _render(self, integrator: Any = None) -> tuple[np.ndarray, float]:
+        r = self.request
         image, dt = timed_render(
-            self.mi, self.loaded, spp=self.spp, seed=self.seed, integrator=integrator
+            self.mi, self.loaded, spp=r.batch_spp, seed=r.seed, integrator=integrator
         )
-        if self.progress is not None:
-            self.progress(1)
+        self.request.tick()
         return image, dt
 
     def render(

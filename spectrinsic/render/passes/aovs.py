@@ -3,16 +3,13 @@ and normals, from Mitsuba's ``aov`` integrator (the single traversal makes them 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
 import numpy as np
 
-from ...errors import RenderError, SceneError
+from ...errors import RenderError
 from ...scenes.model import Scene
 from ..base import translate as tr
 from ..base.aov_maps import assemble_aovs
 from ..base.one_pass import (
-    PassProgress,
     placeholder_light,
     scene_parameters,
     set_rgb,
@@ -22,18 +19,13 @@ from ..base.plugins import aov_integrator, hdr_film, rgb_spectrum
 from ..base.surface_maps import refuse_maps
 from ..base.textures import refuse_textures
 from ..base.variants import choose_variant, variant_scope
+from ..settings import PassRequest
 
 __all__ = ["render_aovs"]
 
 
 def render_aovs(
-    scene: Scene,
-    *,
-    spp: int,
-    seed: int,
-    variant: str | None = None,
-    progress: PassProgress | None = None,
-    geometry: Sequence[tr.SurfaceGeometry] | None = None,
+    scene: Scene, request: PassRequest
 ) -> tuple[dict[str, np.ndarray], tuple[float, ...]]:
     """Coverage, id, depth and normal maps, box-filtered over the same pixel samples as a render.
 
@@ -42,6 +34,8 @@ def render_aovs(
     it; with the seed and sample count of the colour passes these are the very samples those
     passes averaged, so ``Σ_m coverage_m ρ_m`` is the ground-truth reflectance of each pixel.
     Mitsuba's own albedo of the real materials is not used (it assumes RGB wavelengths).
+    *request* (:class:`~spectrinsic.render.settings.PassRequest`) gives samples, seed, variant,
+    progress and prepared geometry (the path depth is the ``aov`` integrator's first hit).
 
     Returns
     -------
@@ -55,13 +49,11 @@ def render_aovs(
     seconds
         Seconds per pass.
     """
-    if int(spp) < 1:
-        raise SceneError(f"spp {spp}: expected at least 1 sample per pixel")
     refuse_textures(scene, "the coverage passes")
     refuse_maps(scene, "the coverage passes")
     surfaces = tr.surfaces(scene)
     n_pass = max(1, -(-len(surfaces) // 3))
-    chosen = choose_variant("rgb", variant)
+    chosen = choose_variant("rgb", request.variant)
     h, w = scene.camera.height, scene.camera.width
     cover = np.zeros((h, w, len(surfaces)), np.float64)
     seconds = []
@@ -73,8 +65,8 @@ def render_aovs(
             lights=[placeholder_light(j) for j in range(len(scene.lights))],
             film=hdr_film(w, h),
             integrator=aov_integrator(),
-            sample_count=spp,
-            geometry=geometry,
+            sample_count=request.batch_spp,
+            geometry=request.geometry,
         )
         loaded = mi.load_dict(mitsuba_dict)
         params = scene_parameters(
@@ -88,10 +80,9 @@ def render_aovs(
                     onehot[i % 3] = 1.0
                 set_rgb(mi, params, tr.reflectance_key(s, spectral=False), onehot)
             params.update()
-            image, dt = timed_render(mi, loaded, spp=spp, seed=seed)
+            image, dt = timed_render(mi, loaded, spp=request.batch_spp, seed=request.seed)
             seconds.append(dt)
-            if progress is not None:
-                progress(1)
+            request.tick()
             if image.shape[-1] != 7:
                 raise RenderError(
                     f"AOV pass returned {image.shape[-1]} channels; expected 7 (depth, normal, albedo)"

@@ -14,6 +14,7 @@ import pytest
 from spectrinsic.gt_export import build_gallery, export_sample, load_sample
 from spectrinsic.gt_export.dataset.contact_sheet import COLUMNS, TILE
 from spectrinsic.gt_export.dataset.gallery import INDEX_VARIABLE, gallery_index
+from spectrinsic.gt_export.layers import LayerSettings
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 CHROMEDRIVER = shutil.which("chromedriver")
@@ -371,10 +372,10 @@ def denoised_gallery(tmp_path, one_light_sample, two_light_sample, config):
             root,
             dataclasses.replace(scene, metadata=meta),
             result,
+            LayerSettings(denoise=denoise),
             sample_id=sid,
             config=config,
             seed=1,
-            denoise=denoise,
         )
     return build_gallery(root)
 

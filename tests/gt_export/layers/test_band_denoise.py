@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from spectrinsic.gt_export.layers import compute_ground_truth
+from spectrinsic.gt_export.layers import LayerSettings, compute_ground_truth
 from spectrinsic.render import RenderSettings, render_batches
 from spectrinsic.scenes.generators import generate
 from spectrinsic.scenes.generators.base import GeneratorOptions
@@ -26,9 +26,11 @@ def test_denoised_band_shading_is_closer_to_the_converged_render_than_the_raw_on
     base = {"max_depth": 5, "modes": ("bands31", "rgb3"), "per_light": True, "share_mode": "rgb3"}
     low = render_batches(scene, RenderSettings(8, batches=2, **base), seed=1)
     high = render_batches(scene, RenderSettings(256, batches=2, **base), seed=101)
-    denoised = compute_ground_truth(scene, low, cameras=(), denoise=True, spectral=True)
-    raw = compute_ground_truth(scene, low, cameras=(), spectral=True)
-    truth = compute_ground_truth(scene, high, cameras=(), spectral=True)
+    denoised = compute_ground_truth(
+        scene, low, LayerSettings(cameras=(), denoise=True, spectral_layers=True)
+    )
+    raw = compute_ground_truth(scene, low, LayerSettings(cameras=(), spectral_layers=True))
+    truth = compute_ground_truth(scene, high, LayerSettings(cameras=(), spectral_layers=True))
     reference = truth.layers["shading_bands"].data
     valid = (reference.sum(-1) > 0) & (raw.layers["shading_bands"].data.sum(-1) > 0)
     assert valid.sum() > 100

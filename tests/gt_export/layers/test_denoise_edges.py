@@ -23,7 +23,7 @@ from collections.abc import Sequence
 import numpy as np
 import pytest
 
-from spectrinsic.gt_export.layers import compute_ground_truth
+from spectrinsic.gt_export.layers import LayerSettings, compute_ground_truth
 from spectrinsic.gt_export.layers.denoise import Guides, denoise_blocks
 from spectrinsic.gt_export.layers.irradiance import WhiteRadiance
 from spectrinsic.render import RenderSettings, render_batches
@@ -164,7 +164,9 @@ def test_denoised_shading_beside_an_outline_stays_near_the_closed_form(card):
     the closed form; the raw one is not."""
     scene, result, expected, _, near = card
     raw = _errors(compute_ground_truth(scene, result), expected, near)
-    stored = _errors(compute_ground_truth(scene, result, denoise=True), expected, near)
+    stored = _errors(
+        compute_ground_truth(scene, result, LayerSettings(denoise=True)), expected, near
+    )
     assert near.sum() > 300
     assert np.median(raw) > 0.08  # the render is noisy there
     assert np.median(stored) < MEDIAN_MAX
@@ -180,7 +182,7 @@ def test_the_previous_denoiser_blurred_the_outline(card):
         bands = denoise_blocks(radiance.bands, guides.normals, quality="fast", clean_aux=False)
         return radiance.with_bands(bands)
 
-    gt = compute_ground_truth(scene, result, denoise=True, denoiser=previous)
+    gt = compute_ground_truth(scene, result, LayerSettings(denoise=True), denoiser=previous)
     old = _errors(gt, expected, near)
     assert np.median(old) > MEDIAN_MAX or np.percentile(old, 95) > P95_MAX
 
@@ -198,7 +200,7 @@ def test_denoised_bands_of_a_third_sum_to_its_denoised_broad_band(card):
         seen["out"] = dn.denoise_white_radiance(radiance, guides)
         return seen["out"]
 
-    compute_ground_truth(scene, result, denoise=True, denoiser=spy)
+    compute_ground_truth(scene, result, LayerSettings(denoise=True), denoiser=spy)
     raw, out = seen["raw"], seen["out"]
     thirds = dn.band_thirds(raw.bands.shape[-1])
     broad = dn.denoise_rgb(
@@ -268,6 +270,8 @@ def test_denoised_shading_beside_a_crease_stays_near_the_closed_form():
     raw = compute_ground_truth(scene, result)
     ratio = raw.layers["shading_grey"].data[inside] / expected[inside]
     assert ratio.mean() == pytest.approx(1.0, abs=0.015)  # the closed form is the expectation
-    stored = _errors(compute_ground_truth(scene, result, denoise=True), expected, near)
+    stored = _errors(
+        compute_ground_truth(scene, result, LayerSettings(denoise=True)), expected, near
+    )
     assert near.sum() > 250
     assert np.median(stored) < 0.015 and np.percentile(stored, 95) < 0.05

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from spectrinsic.gt_export import check_dataset, export_sample, write_manifest
-from spectrinsic.gt_export.layers import compute_ground_truth, identities
+from spectrinsic.gt_export.layers import LayerSettings, compute_ground_truth, identities
 from spectrinsic.render import RenderSettings, render_batches
 from spectrinsic.scenes.model import Material
 
@@ -39,7 +39,7 @@ def test_d_identity_with_the_specular_term_raw_denoised_and_per_camera(glossy_ro
     """(d) image = reflectance ∘ shading + specular + residual to float precision, raw and
     denoised, in sRGB and camera RGB; every layer finite; shading ≥ 0."""
     scene, result = glossy_room
-    gt = compute_ground_truth(scene, result, cameras=(CAMERA,), denoise=True)
+    gt = compute_ground_truth(scene, result, LayerSettings(cameras=(CAMERA,), denoise=True))
     checked = identities(gt)
     assert len(checked) == 3 and all("specular" in i for i in checked)
     for ident in checked:

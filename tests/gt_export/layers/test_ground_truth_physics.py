@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from spectrinsic.gt_export.layers import compute_ground_truth, identities
+from spectrinsic.gt_export.layers import LayerSettings, compute_ground_truth, identities
 from spectrinsic.render import RenderSettings, render_batches, render_scene
 from spectrinsic.scenes.model import Material, Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as WL
@@ -111,7 +111,9 @@ def test_d_e_identity_and_shading_sign_in_a_room_with_interreflections(make_room
         RenderSettings(8, batches=2, modes=("bands31", "rgb3"), per_light=True, share_mode="rgb3"),
         seed=5,
     )
-    gt = compute_ground_truth(scene, result, cameras=("camera:Nikon 5100 (NPL)",), denoise=True)
+    gt = compute_ground_truth(
+        scene, result, LayerSettings(cameras=("camera:Nikon 5100 (NPL)",), denoise=True)
+    )
     for ident in identities(gt):
         image, refl, shading, res = (
             gt.layers[ident[k]].data.astype(np.float64)
@@ -175,7 +177,7 @@ def test_g_the_noise_estimate_is_calibrated(noisy_and_converged):
 def test_h_denoised_shading_is_closer_to_the_converged_render(noisy_and_converged):
     """(h) OIDN on the white-surface radiance beats the raw Monte Carlo shading."""
     scene, noisy, reference = noisy_and_converged
-    gt = compute_ground_truth(scene, noisy, denoise=True)
+    gt = compute_ground_truth(scene, noisy, LayerSettings(denoise=True))
     ref = compute_ground_truth(scene, reference)
     valid = ref.layers["shading_grey"].data > 0
     raw = _relative_error(gt.layers["shading_raw"].data, ref.layers["shading"].data, valid)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from spectrinsic.gt_export.layers import REFLECTANCE_FLOOR, compute_ground_truth
+from spectrinsic.gt_export.layers import REFLECTANCE_FLOOR, LayerSettings, compute_ground_truth
 from spectrinsic.spectra.working_space import DEFAULT_WORKING_SPACE, WORKING_SPACES
 
 #: The issue's bound for reflectance against colour-science.
@@ -70,7 +70,7 @@ def test_interior_and_edge_reflectance_match_colour_science(one_light_sample, sy
     from spectrinsic.spectra import get_spectrum
 
     scene, result = one_light_sample
-    gt = compute_ground_truth(scene, result, cameras=())
+    gt = compute_ground_truth(scene, result, LayerSettings(cameras=()))
     refl = gt.layers["reflectance"].data
     wl = np.arange(360.0, 831.0)
     spectra = [get_spectrum(m).on(wl) for m in synth.MATERIALS]
@@ -92,7 +92,7 @@ def test_image_equals_reflectance_times_shading_plus_residual(two_light_sample):
     from spectrinsic.gt_export.layers import identities
 
     scene, result = two_light_sample
-    gt = compute_ground_truth(scene, result, cameras=(CAMERA,))
+    gt = compute_ground_truth(scene, result, LayerSettings(cameras=(CAMERA,)))
     assert len(identities(gt)) == 2
     for ident in identities(gt):
         image, refl, shading, res = (
@@ -116,7 +116,7 @@ def test_image_equals_reflectance_times_shading_plus_residual(two_light_sample):
 
 def test_shading_of_a_flat_grey_is_geometry_times_light_colour(one_light_sample):
     scene, result = one_light_sample
-    gt = compute_ground_truth(scene, result, cameras=())
+    gt = compute_ground_truth(scene, result, LayerSettings(cameras=()))
     block = (slice(6, 11), slice(8, 15))  # material 3 = flat:0.8
     shading = gt.layers["shading"].data[block]
     light = _cs_light_rgb(scene.lights[0].spectrum)
@@ -135,7 +135,7 @@ def test_one_light_illuminant_map_has_the_light_chromaticity(synth):
     geometry = np.ones((1, synth.H, synth.W))
     geometry[0, :, :5] = 0.0  # a shadow: no light arrives there
     result = synth.make_result(scene, geometry)
-    gt = compute_ground_truth(scene, result, cameras=())
+    gt = compute_ground_truth(scene, result, LayerSettings(cameras=()))
     illum = gt.layers["illuminant"].data
     lit = result.aovs["mask"] & (geometry[0] > 0)
     expected = _cs_light_rgb("planck:2800K")
@@ -158,7 +158,7 @@ def test_two_lights_mix_by_their_share_of_the_light(synth):
     geometry[1, :, 10:] = 1.0  # light 1 only on the right
     geometry[:, :, 6:10] = 1.0  # both in the middle, equal unit-luminance power
     result = synth.make_result(scene, geometry)
-    gt = compute_ground_truth(scene, result, cameras=())
+    gt = compute_ground_truth(scene, result, LayerSettings(cameras=()))
     illum = gt.layers["illuminant"].data
     mask = result.aovs["mask"]
     c0, c1 = _cs_light_rgb("planck:2800K"), _cs_light_rgb("cie:FL11")
@@ -186,7 +186,7 @@ def test_camera_image_from_the_cube_matches_spectral_integration(one_light_sampl
     from spectrinsic.spectra import get_sensors, get_spectrum
 
     scene, result = one_light_sample
-    gt = compute_ground_truth(scene, result, cameras=(CAMERA,))
+    gt = compute_ground_truth(scene, result, LayerSettings(cameras=(CAMERA,)))
     wl = np.arange(360.0, 831.0)
     curves = get_sensors(CAMERA).on(wl)
     d65 = get_spectrum("cie:D65").on(wl)
@@ -212,7 +212,7 @@ def test_photometric_matrices(synth):
     from spectrinsic.spectra import absolute_reflectance, angular_error
 
     scene = synth.make_scene(("cie:D65", "planck:2800K"))
-    gt = compute_ground_truth(scene, synth.make_result(scene), cameras=(CAMERA,))
+    gt = compute_ground_truth(scene, synth.make_result(scene), LayerSettings(cameras=(CAMERA,)))
     m = gt.matrices
     # D65 is the canonical light: L_CLig is the identity in every sensor space
     for space in ("srgb", "Nikon 5100 (NPL)"):
@@ -245,7 +245,7 @@ def test_photometric_matrices(synth):
 
 def test_error_maps_measure_the_relative_difference(two_light_sample):
     scene, result = two_light_sample
-    gt = compute_ground_truth(scene, result, cameras=())
+    gt = compute_ground_truth(scene, result, LayerSettings(cameras=()))
     err = gt.layers["error_rgb3"].data  # the fixture's rgb3 image is the reference × 1.02
     lit = result.aovs["mask"]
     np.testing.assert_allclose(err[lit], 0.02, rtol=1e-4)
@@ -258,7 +258,7 @@ def test_error_maps_measure_the_relative_difference(two_light_sample):
 def test_camera_illuminant_is_relative_to_the_cameras_d65_white(synth):
     scene = synth.make_scene(("cie:D65",))
     result = synth.make_result(scene, modes=("bands31",))
-    gt = compute_ground_truth(scene, result, cameras=(CAMERA,))
+    gt = compute_ground_truth(scene, result, LayerSettings(cameras=(CAMERA,)))
     lit = gt.layers["mask"].data > 0
     illum = gt.layers[f"illuminant_camera/{CAMERA.removeprefix('camera:')}"].data[lit]
     # D65 light is the camera's own white; 1.3e-4 is the 10 nm band integration of D65's spikes
@@ -272,6 +272,6 @@ def test_missing_inputs_raise_clear_errors(synth):
     result = synth.make_result(scene, modes=("spectral",))
     no_split = synth.FakeResult(images=result.images, aovs=result.aovs)
     with pytest.raises(DatasetError, match="per_light=True"):
-        compute_ground_truth(scene, no_split, cameras=())
+        compute_ground_truth(scene, no_split, LayerSettings(cameras=()))
     with pytest.raises(DatasetError, match="bands31"):
-        compute_ground_truth(scene, result, cameras=(CAMERA,))
+        compute_ground_truth(scene, result, LayerSettings(cameras=(CAMERA,)))

@@ -18,7 +18,7 @@ import pytest
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import check_sample, export_sample, load_sample
 from spectrinsic.gt_export.dataset.loader import filter_residual_share, working_space_view
-from spectrinsic.gt_export.layers import compute_ground_truth, identities
+from spectrinsic.gt_export.layers import LayerSettings, compute_ground_truth, identities
 from spectrinsic.gt_export.relight import relight, relit_scene
 from spectrinsic.render import RenderSettings, render_batches, render_scene
 from spectrinsic.render.transport_render import render_transport_batches
@@ -51,7 +51,9 @@ def _band_means_by_colour(name: str) -> np.ndarray:
 def test_a_plane_under_a_narrow_led_has_the_exact_band_identity_and_reflectance(make_plane):
     scene = make_plane(CHIP, "led:540/31", size=8)
     settings = RenderSettings(spp=4, max_depth=2, modes=("spectral", "bands31"))
-    gt = compute_ground_truth(scene, render_scene(scene, settings, seed=1), spectral=True)
+    gt = compute_ground_truth(
+        scene, render_scene(scene, settings, seed=1), LayerSettings(spectral_layers=True)
+    )
     # Mitsuba's spectral image keeps its own name beside the band layers
     assert (
         gt.layers["image_spectral"].group == "image"
@@ -104,7 +106,9 @@ def test_b_band_shading_of_one_bounce_between_coloured_planes_is_the_closed_form
     light, power = "cie:FL11", 3.0
     scene = _facing_planes("munsell:5PB 4/10", "munsell:5R 5/12", light, power, size=16)
     settings = RenderSettings(spp=64, max_depth=3, modes=("bands31",))
-    gt = compute_ground_truth(scene, render_scene(scene, settings, seed=7), spectral=True)
+    gt = compute_ground_truth(
+        scene, render_scene(scene, settings, seed=7), LayerSettings(spectral_layers=True)
+    )
     inside = gt.layers["mask"].data > 0
     inside[[0, -1], :] = inside[:, [0, -1]] = False
     assert inside.sum() > 150
@@ -139,12 +143,11 @@ def room_sample(tmp_path_factory, make_room):
         out,
         scene,
         result,
+        LayerSettings(denoise=True, spectral_layers=True),
         sample_id="room__v0__two",
         config={"test": "spectral"},
         seed=5,
-        denoise=True,
         transport=transport,
-        spectral_layers=True,
     )
     return out, scene, sample, settings
 
@@ -198,11 +201,10 @@ def test_d_relit_spectral_layers_equal_a_direct_render(room_sample):
             out,
             new_scene,
             direct,
+            LayerSettings(denoise=True, spectral_layers=True),
             sample_id="direct__v0__two",
             config={"test": "spectral"},
             seed=5,
-            denoise=True,
-            spectral_layers=True,
         )
     )
     before = load_sample(sample, layers=["image_bands"])["image_bands"]
@@ -219,7 +221,7 @@ def test_spectral_layers_without_the_cube_are_refused(make_plane):
     scene = make_plane(CHIP, "cie:D65", size=4)
     result = render_scene(scene, RenderSettings(spp=1, max_depth=2, modes=("rgb3",)), seed=1)
     with pytest.raises(DatasetError, match="31-band cube"):
-        compute_ground_truth(scene, result, spectral=True)
+        compute_ground_truth(scene, result, LayerSettings(spectral_layers=True))
 
 
 def test_glossy_band_layers_take_the_specular_term(make_room):
@@ -231,7 +233,9 @@ def test_glossy_band_layers_take_the_specular_term(make_room):
     mats[4] = Material("floor", "munsell:5Y 8/2", kind="plastic", ior=1.5)
     scene = dataclasses.replace(scene, materials=tuple(mats))
     settings = RenderSettings(4, modes=("bands31", "rgb3"), per_light=True, share_mode="rgb3")
-    gt = compute_ground_truth(scene, render_scene(scene, settings, seed=5), spectral=True)
+    gt = compute_ground_truth(
+        scene, render_scene(scene, settings, seed=5), LayerSettings(spectral_layers=True)
+    )
     spec = gt.layers["specular_bands"].data
     assert np.abs(spec).max() > 0
     ident = [i for i in identities(gt) if i["image"] == "image_bands"][0]

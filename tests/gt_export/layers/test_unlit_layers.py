@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from spectrinsic.gt_export.layers import compute_ground_truth
+from spectrinsic.gt_export.layers import LayerSettings, compute_ground_truth
 from spectrinsic.render import RenderSettings, render_batches
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from tests.conftest import quad
@@ -44,7 +44,7 @@ def _dark_scene() -> Scene:
 def test_a_light_pointing_away_leaves_denoised_shading_and_illuminant_exactly_zero():
     scene = _dark_scene()
     result = render_batches(scene, RenderSettings(4, batches=2, modes=("rgb3",)), seed=3)
-    gt = compute_ground_truth(scene, result, denoise=True)
+    gt = compute_ground_truth(scene, result, LayerSettings(denoise=True))
     # the raw passes: nothing arrives anywhere (what makes the rest a test of the masking)
     assert not np.any(gt.layers["image"].data)
     assert not np.any(gt.layers["shading_raw"].data)

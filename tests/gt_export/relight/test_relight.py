@@ -15,6 +15,7 @@ import pytest
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import check_sample, export_sample, load_sample
+from spectrinsic.gt_export.layers import LayerSettings
 from spectrinsic.gt_export.relight import relight, relit_scene
 from spectrinsic.gt_export.relight.augment import RandomRelight, relit_layers
 from spectrinsic.gt_export.sample.transport_exr import TRANSPORT_NAME
@@ -47,10 +48,10 @@ def built(tmp_path_factory, make_room):
         out,
         scene,
         result,
+        LayerSettings(denoise=True),
         sample_id="room__v0__two",
         config=CONFIG,
         seed=SEED,
-        denoise=True,
         transport=transport,
     )
     return out, scene, sample
@@ -94,10 +95,10 @@ def _relit_and_direct(out, scene, sample, settings: RenderSettings, tag: str) ->
         out,
         new_scene,
         direct,
+        LayerSettings(denoise=True),
         sample_id=f"direct__v0__{tag}",
         config=CONFIG,
         seed=SEED,
-        denoise=True,
     )
     a, b = _arrays(load_sample(relit)), _arrays(load_sample(reference))
     assert set(a) == set(b)
@@ -164,10 +165,10 @@ def test_relit_sample_equals_a_direct_render_with_the_passes(tmp_path, make_room
         tmp_path,
         scene,
         result,
+        LayerSettings(denoise=True),
         sample_id="room__v0__passes",
         config=CONFIG,
         seed=SEED,
-        denoise=True,
         transport=transport,
     )
     _relit_and_direct(tmp_path, scene, sample, settings, "passes")

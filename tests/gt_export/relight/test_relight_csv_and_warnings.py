@@ -20,6 +20,7 @@ import pytest
 import spectrinsic
 from spectrinsic.cli import main
 from spectrinsic.gt_export import export_sample
+from spectrinsic.gt_export.layers import LayerSettings
 from spectrinsic.gt_export.sample.meta import read_meta
 from spectrinsic.render import RenderSettings
 from spectrinsic.render.transport_render import render_transport_batches
@@ -39,8 +40,8 @@ def source(tmp_path_factory, make_room) -> tuple[Path, Path]:
     scene = dataclasses.replace(room, materials=(first, *room.materials[1:]))
     transport, result = render_transport_batches(scene, SETTINGS, seed=3)
     sample = export_sample(
-        out / "ds", scene, result, sample_id="s", config={"t": 44}, seed=3, transport=transport,
-        scene_folder=out,
+        out / "ds", scene, result, LayerSettings().for_scene_folder(out),
+        sample_id="s", config={"t": 44}, seed=3, transport=transport,
     )  # fmt: skip
     return sample, csv
 

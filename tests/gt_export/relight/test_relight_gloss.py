@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from spectrinsic.gt_export import check_sample, export_sample, load_sample
+from spectrinsic.gt_export.layers import LayerSettings
 from spectrinsic.gt_export.relight import relight, relit_scene
 from spectrinsic.render import RenderSettings, render_batches
 from spectrinsic.render.transport_render import render_transport_batches
@@ -57,10 +58,10 @@ def glossy(tmp_path_factory, make_room):
         out,
         scene,
         result,
+        LayerSettings(denoise=True),
         sample_id="gloss__v0__two",
         config=CONFIG,
         seed=SEED,
-        denoise=True,
         transport=transport,
     )
     return out, scene, sample, transport
@@ -91,10 +92,10 @@ def test_relit_glossy_sample_equals_a_direct_render_with_the_new_spectra(glossy)
         out,
         new_scene,
         direct,
+        LayerSettings(denoise=True),
         sample_id="direct__v0__two",
         config=CONFIG,
         seed=SEED,
-        denoise=True,
     )
     a, b = _arrays(load_sample(relit)), _arrays(load_sample(reference))
     assert set(a) == set(b) and {"specular", "metallic", "shading", "image_denoised"} <= set(a)

@@ -8,6 +8,7 @@ import numpy as np
 
 from spectrinsic.gt_export import export_sample
 from spectrinsic.gt_export.formats.exr import read_exr
+from spectrinsic.gt_export.layers import LayerSettings
 from spectrinsic.spectra.camera_model import camera_model
 
 RAW = "raw_sensor/nikon-5100-npl"
@@ -15,10 +16,10 @@ RAW = "raw_sensor/nikon-5100-npl"
 
 def _raw(tmp_path, one_light_sample, config, sample_id, noise_id=None):
     scene, result = one_light_sample
+    settings = LayerSettings(camera=camera_model("nikon-d5100-npl"), noise_id=noise_id)
     folder = export_sample(
-        tmp_path, scene, result, sample_id=sample_id, config=config, seed=1,
-        camera=camera_model("nikon-d5100-npl"), noise_id=noise_id,
-    )  # fmt: skip
+        tmp_path, scene, result, settings, sample_id=sample_id, config=config, seed=1
+    )
     layers = read_exr(folder / "sensor-nikon-5100-npl.exr")
     return np.asarray(layers[RAW.split("/")[0]] if RAW not in layers else layers[RAW])
 
@@ -46,6 +47,8 @@ def test_relight_seeds_the_noise_from_the_source_sample(monkeypatch, tmp_path):
     monkeypatch.setattr(relight_module, "relit_render", lambda *a, **k: Relit())
     monkeypatch.setattr(relight_module, "check_finite_result", lambda *a: None)
     monkeypatch.setattr(relight_module, "model_from_meta", lambda meta: None)
-    monkeypatch.setattr(relight_module, "export_sample", lambda *a, **k: seen.update(k))
+    monkeypatch.setattr(
+        relight_module, "export_sample", lambda *a, **k: seen.update(k, settings=a[3])
+    )
     relight_module.relight(tmp_path / "src", {0: "planck:3000K"}, tmp_path / "any-name")
-    assert seen["noise_id"] == "room__v0__two" and seen["sample_id"] == "any-name"
+    assert seen["settings"].noise_id == "room__v0__two" and seen["sample_id"] == "any-name"

@@ -17,14 +17,17 @@ import pytest
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import check_sample, export_sample, load_sample
 from spectrinsic.gt_export.formats.exr import read_exr, read_exr_attributes, write_exr
-from spectrinsic.gt_export.layers import compute_ground_truth, identities
+from spectrinsic.gt_export.layers import LayerSettings, compute_ground_truth, identities
+from spectrinsic.gt_export.layers.settings import DEFAULT_CAMERAS
 from spectrinsic.gt_export.sample import HASHES_KEY, SEAL_KEY, file_sha256, meta_seal
 from spectrinsic.gt_export.sample.layer_storage import COVERAGE_LAYER
 from spectrinsic.gt_export.sample.stored_layers import stored_layers
-from spectrinsic.gt_export.sample.writer import DEFAULT_CAMERAS
 from spectrinsic.render import RenderSettings, render_batches
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.scenes.textures import basis_name, make_texture
+
+#: The layers every sample here gets: the default cameras, denoised, per band.
+SETTINGS = LayerSettings(cameras=DEFAULT_CAMERAS, denoise=True, spectral_layers=True)
 
 #: What the writer now stores as factors in a denoised sample with spectral layers.
 FACTORED = {
@@ -65,13 +68,12 @@ def _export(root, scene):
         root,
         scene,
         result,
+        SETTINGS,
         sample_id=f"{scene.name}__v0__x",
         config={"test": "layer_storage"},
         seed=3,
-        denoise=True,
-        spectral_layers=True,
     )
-    gt = compute_ground_truth(scene, result, cameras=DEFAULT_CAMERAS, denoise=True, spectral=True)
+    gt = compute_ground_truth(scene, result, SETTINGS)
     return sample, gt, result
 
 

@@ -14,6 +14,7 @@ from PIL import Image
 from spectrinsic.gt_export import export_sample, load_sample
 from spectrinsic.gt_export.dataset.check import check_sample
 from spectrinsic.gt_export.formats.exr import read_exr
+from spectrinsic.gt_export.layers import LayerSettings
 from spectrinsic.gt_export.sample.sensor import model_from_meta
 from spectrinsic.spectra.camera_model import camera_model
 
@@ -25,7 +26,13 @@ def _export(tmp_path, sample, config, *, sample_id="s", seed=1, **changes):
     scene, result = sample
     model = camera_model("nikon-5100-npl").with_options(black_level_dn=600, **changes)
     return export_sample(
-        tmp_path, scene, result, sample_id=sample_id, config=config, seed=seed, camera=model
+        tmp_path,
+        scene,
+        result,
+        LayerSettings(camera=model),
+        sample_id=sample_id,
+        config=config,
+        seed=seed,
     )
 
 

@@ -11,7 +11,7 @@ import pytest
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import export_sample, load_sample
-from spectrinsic.gt_export.layers import compute_ground_truth, identities
+from spectrinsic.gt_export.layers import LayerSettings, compute_ground_truth, identities
 from spectrinsic.spectra import xyz_to_linear_srgb
 from spectrinsic.spectra.working_space import working_space
 
@@ -51,8 +51,10 @@ def test_srgb_space_is_the_layers_of_before_and_acescg_the_same_light(synth):
     render's XYZ, its shading clipped; the sRGB view of the ACEScg layers is the srgb layers."""
     scene = synth.make_scene((NARROW, "planck:2800K"))
     result = synth.make_result(scene)
-    srgb = compute_ground_truth(scene, result, cameras=(), working_space="srgb")
-    aces = compute_ground_truth(scene, result, cameras=())
+    srgb = compute_ground_truth(
+        scene, result, LayerSettings(cameras=(), working_space=working_space("srgb"))
+    )
+    aces = compute_ground_truth(scene, result, LayerSettings(cameras=()))
     assert aces.working_space.name == "acescg" and srgb.working_space.name == "srgb"
     xyz = np.asarray(result.images["bands31"], np.float64)
     scale = np.abs(srgb.layers["image"].data).max()
@@ -84,8 +86,10 @@ def test_acescg_keeps_out_of_gamut_light_that_srgb_clips_into_the_residual(synth
     and its residual share is smaller."""
     scene = synth.make_scene((NARROW,))
     result = synth.make_result(scene)
-    srgb = compute_ground_truth(scene, result, cameras=(), working_space="srgb")
-    aces = compute_ground_truth(scene, result, cameras=())
+    srgb = compute_ground_truth(
+        scene, result, LayerSettings(cameras=(), working_space=working_space("srgb"))
+    )
+    aces = compute_ground_truth(scene, result, LayerSettings(cameras=()))
     assert srgb.clipping["pixels"] > 0.5
     assert aces.clipping["pixels"] == 0.0
     assert aces.residual_share["image"] < srgb.residual_share["image"]
@@ -96,7 +100,13 @@ def test_meta_records_the_space_and_the_loader_gives_the_srgb_view(tmp_path, syn
     result = synth.make_result(scene)
     folder = export_sample(tmp_path, scene, result, sample_id="a", config=config, seed=1)
     old = export_sample(
-        tmp_path, scene, result, sample_id="s", config=config, seed=1, working_space="srgb"
+        tmp_path,
+        scene,
+        result,
+        LayerSettings(working_space=working_space("srgb")),
+        sample_id="s",
+        config=config,
+        seed=1,
     )
     record = json.loads((folder / "meta.json").read_text())["working_space"]
     assert record["name"] == "acescg" and record["shading_clipped"] is False

@@ -19,6 +19,7 @@ from spectrinsic.gt_export import (
     sample_dirs,
     torch_dataset,
 )
+from spectrinsic.gt_export.layers import LayerSettings
 
 FLOAT32_RTOL = 4 * float(np.finfo(np.float32).eps)
 
@@ -29,11 +30,10 @@ def test_sample_round_trips_through_the_loader(tmp_path, two_light_sample, confi
         tmp_path,
         scene,
         result,
+        LayerSettings(cameras=("camera:Nikon 5100 (NPL)",), write_cube=True),
         sample_id="s",
         config=config,
         seed=5,
-        cameras=("camera:Nikon 5100 (NPL)",),
-        write_cube=True,
     )
     sample = load_sample(folder)
     for key in (

@@ -79,7 +79,7 @@ def test_a_relighting_is_the_same_on_one_thread_and_on_several(monkeypatch):
         sensors={"rgb3": "rgb3", "bands31": "bands:31@400-700"},
         batches=batches,
         seeds=(1, 2, 3),
-        spp=4,
+        batch_spp=4,
         max_depth=3,
     )
     lights = (Light("point", "planck:3000K", 2.0), Light("point", "cie:D65", 0.5))
@@ -121,7 +121,7 @@ def test_a_relit_image_is_the_sum_of_its_lights_and_the_xyz_of_its_raw_channels(
         sensors={"rgb6": "gaussian:6@400-700"},
         batches=batches,
         seeds=(1, 2),
-        spp=4,
+        batch_spp=4,
         max_depth=3,
     )
     lights = (Light("point", "planck:2700K", 2.0), Light("point", "cie:LED-RGB1", 0.7))

@@ -17,6 +17,7 @@ from spectrinsic.render.band_path.traversal import _tables, light_of_emitters, r
 from spectrinsic.render.base import translate as tr
 from spectrinsic.render.base.plugins import hdr_film, path_integrator, rgb_spectrum
 from spectrinsic.render.base.variants import choose_variant, variant_scope
+from spectrinsic.render.settings import PassRequest
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import get_sensors
 
@@ -93,7 +94,7 @@ def test_a_coated_plane_diffuse_part_and_fresnel_highlight():
         Material("coat", "munsell:5R 5/12", kind="plastic", ior=IOR), (sun,), camera=OBLIQUE
     )
     values = channel_values(scene, get_sensors("bands:31@400-700"))
-    (out,), aovs, _, _ = render_traversal(scene, [values], spp=4, seed=3, max_depth=2, aovs=True)
+    (out,), aovs, _, _ = render_traversal(scene, [values], PassRequest(4, 3, 2), aovs=True)
     cos_o = _cos_view(aovs, OBLIQUE)
     assert cos_o.min() < 0.45 and cos_o.max() > 0.55  # a range of angles, so Fresnel varies
     t_o = 1.0 - fresnel_dielectric(cos_o, IOR)
@@ -121,9 +122,7 @@ def test_a_coated_plane_diffuse_part_and_fresnel_highlight():
         (o,), _, _, _ = render_traversal(
             coat,
             [channel_values(coat, get_sensors("bands:31@400-700"))],
-            spp=1024,
-            seed=5,
-            max_depth=2,
+            PassRequest(1024, 5, 2),
         )
         highlight = o.parts["specular"][0]
         assert np.all(highlight == highlight[..., :1])  # band-independent: the ior is scalar
@@ -156,7 +155,7 @@ def test_b_metal_band_fresnel_is_the_normal_incidence_reflectance(metal):
     scene = _plane(Material("metal", "flat:0", kind="conductor", metal=metal), (SKY,), camera=top)
     sensors = get_sensors("bands:31@400-700")
     values = channel_values(scene, sensors)
-    (out,), _, _, _ = render_traversal(scene, [values], spp=2, seed=1, max_depth=3)
+    (out,), _, _, _ = render_traversal(scene, [values], PassRequest(2, 1, 3))
     assert np.array_equal(
         out.transport, out.parts["specular"]
     )  # all of it through the metal's lobe

@@ -22,7 +22,7 @@ from spectrinsic.render import (
     render_scene,
 )
 from spectrinsic.render.band_path.traversal import render_traversal
-from spectrinsic.render.settings import RenderSettings
+from spectrinsic.render.settings import PassRequest, RenderSettings
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import get_sensors
 
@@ -77,8 +77,8 @@ def test_render_traversal_matches_render_diagonal(make_room):
     """Lower level: the transport times the lights' channel values is render_diagonal's image."""
     scene = make_room(size=12)
     values = [channel_values(scene, get_sensors(get_mode(m).sensors)) for m in DIAGONAL]
-    outs, aovs, seconds, _ = render_traversal(scene, values, spp=8, seed=9)
-    passes = render_diagonal(scene, values, spp=8, seed=9)
+    outs, aovs, seconds, _ = render_traversal(scene, values, PassRequest(8, 9))
+    passes = render_diagonal(scene, values, PassRequest(8, 9))
     assert len(seconds) == 1 and not aovs
     for out, ref, v in zip(outs, passes, values, strict=True):
         assert out.transport.shape == (2, 12, 12, v.materials.shape[1])

@@ -21,12 +21,13 @@ import pytest
 import trimesh
 from PIL import Image
 
-from spectrinsic.gt_export.layers import compute_ground_truth
+from spectrinsic.gt_export.layers import LayerSettings, compute_ground_truth
 from spectrinsic.render import RenderSettings, render_scene
 from spectrinsic.render.base.variants import choose_variant, import_mitsuba
 from spectrinsic.scenes.meshes import load_mesh_scene
 from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml
 from spectrinsic.scenes.model import Camera, Light
+from spectrinsic.spectra.working_space import working_space
 
 #: Done-when of issue 41: the sRGB view within 1e-3, the bands within 1e-5.
 SRGB_TOL = 1e-3
@@ -178,7 +179,13 @@ def _render(path: str, modes: tuple[str, ...]):
     )
     settings = RenderSettings(16, max_depth=2, modes=modes)
     result = render_scene(scene, settings, seed=1)
-    return scene, result, compute_ground_truth(scene, result, spectral=True, working_space="srgb")
+    return (
+        scene,
+        result,
+        compute_ground_truth(
+            scene, result, LayerSettings(spectral_layers=True, working_space=working_space("srgb"))
+        ),
+    )
 
 
 @pytest.fixture(scope="module", params=["gltf", "obj", "xml-obj", "xml-ply", "xml-rectangle"])

@@ -15,6 +15,7 @@ from spectrinsic.render import (
 )
 from spectrinsic.render.base.plugins import hdr_film, path_integrator, rgb_spectrum
 from spectrinsic.render.base.translate import smooth_corner_normals
+from spectrinsic.render.settings import PassRequest
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 
 #: float32 round-off.
@@ -95,7 +96,7 @@ def _marker_scene(x_offset: float) -> Scene:
 
 
 def test_camera_is_not_mirrored_and_area_light_points_down():
-    aovs, _ = render_aovs(_marker_scene(1.2), spp=16, seed=0)
+    aovs, _ = render_aovs(_marker_scene(1.2), PassRequest(16, 0))
     ys, xs = np.nonzero(aovs["material_id"] == 1)
     assert xs.size > 0 and xs.mean() > 16, (
         "a patch at +x (camera right) must appear in the right half"
@@ -121,7 +122,7 @@ def test_wrong_number_of_colours_is_a_scene_error(make_plane):
 
 def test_plane_aovs(make_plane):
     scene = make_plane("flat:0.5", "cie:D65", size=9)
-    aovs, seconds = render_aovs(scene, spp=16, seed=0)
+    aovs, seconds = render_aovs(scene, PassRequest(16, 0))
     assert len(seconds) == 1
     np.testing.assert_allclose(aovs["coverage"][..., 0], 1.0, atol=FLOAT32_ATOL)
     assert (
