@@ -11,8 +11,10 @@ The file goes through three steps, each in its own module:
 3. this module turns the parsed nodes into the scene: shapes
    (:mod:`~spectrinsic.scenes.mitsuba_shapes`, counted against the scene budget before any is
    built), BSDFs (:mod:`~spectrinsic.scenes.mitsuba_bsdfs`), emitters (``area`` on a
-   ``rectangle`` or a ``sphere``, ``point``, ``spot``, ``directional``, ``constant`` as a sky;
-   two environment emitters are merged when their spectra agree, refused otherwise), the
+   ``rectangle`` or a ``sphere``, ``point``, ``spot``, ``directional``, ``constant`` as a sky,
+   ``envmap`` as an environment map's three channel lights (:mod:`~spectrinsic.scenes.envmaps`);
+   two skies are merged when their spectra agree, refused otherwise, and an environment map
+   beside another environment emitter is refused), the
    ``perspective`` sensor and its film (validated before any arithmetic), and the file's
    ``sample_count`` and ``max_depth`` as render hints.
 
@@ -35,10 +37,12 @@ import numpy as np
 
 from ..errors import SceneError, SpectrinsicError
 from . import mitsuba_shapes as shapes
+from .budget import SceneBudget
+from .envmaps import check_map_file, envmap_lights
 from .image_textures import ImageTexture, corner_spectra
 from .mitsuba_bitmaps import diffuse_bitmap
 from .mitsuba_bsdfs import DEFAULT_MATERIAL, material_of
-from .mitsuba_files import MAX_XML_BYTES, SceneFile, prepare_xml
+from .mitsuba_files import MAX_XML_BYTES, SceneFile, confined_file, file_sha256, prepare_xml
 from .mitsuba_spectra import emission
 from .mitsuba_tree import XmlNode, parse_xml
 from .model import Camera, Light, Material, Mesh, Scene
@@ -50,7 +54,9 @@ __all__ = ["MAX_XML_BYTES", "ENVIRONMENT", "load_mitsuba_xml", "xml_notes", "ren
 #: Emitters that light the scene from infinity (one per scene in Mitsuba).
 ENVIRONMENT = ("constant", "envmap", "sunsky", "sky", "sun")
 #: Emitters without exact ground truth until the glass-and-environment issue lands.
-_LATER = ("envmap", "sunsky", "sky", "sun")
+_LATER = ("sunsky", "sky", "sun")
+#: The parameters of an ``envmap`` read (:func:`_envmap`).
+_ENVMAP_PARAMS = {"filename", "scale", "to_world"}
 #: Mitsuba's default film size.
 _FILM = (768, 576)
 
@@ -114,22 +120,55 @@ def _area_light(p: shapes.Placed, node: XmlNode, r: _Reading) -> Light | None:
     )
 
 
-def _emitter(node: XmlNode, where: str, r: _Reading) -> Light | None:
-    """A light of a top-level emitter; ``None`` where an approximation leaves it out."""
+def _envmap(node: XmlNode, where: str, r: _Reading) -> list[Light]:
+    """The three channel lights of an ``envmap`` (:mod:`~spectrinsic.scenes.envmaps`): its
+    file confined to the scene's folder and checked (OpenEXR or Radiance HDR, size, texels),
+    ``scale`` and the rotation ``to_world``."""
+    extra = set(node.props) - _ENVMAP_PARAMS
+    if extra:
+        raise SceneError(
+            f"{where}: unsupported parameter {sorted(extra)[0]!r} in {node.label()}; "
+            f"expected {', '.join(sorted(_ENVMAP_PARAMS))}"
+        )
+    rel = node.props.get("filename")
+    if not isinstance(rel, str):
+        raise SceneError(f"{where}: {node.label()} has no filename")
+    path = confined_file(rel, r.base, where)
+    check_map_file(path, where, SceneBudget(where))
+    scale = node.number("scale", 1.0)
+    if not (math.isfinite(scale) and scale > 0):
+        raise SceneError(f"{where}: scale {scale!r}; expected a finite number > 0")
+    m = np.asarray(node.props.get("to_world", np.eye(4)), float)
+    rot = m[:3, :3]
+    if not (np.allclose(rot @ rot.T, np.eye(3), atol=1e-6) and np.linalg.det(rot) > 0):
+        raise SceneError(f"{where}: to_world of {node.label()} is not a rotation")
+    return list(envmap_lights("envmap", str(path), file_sha256(path), scale, rot.ravel()))
+
+
+def _emitter(node: XmlNode, where: str, r: _Reading) -> list[Light]:
+    """The lights of a top-level emitter (none where an approximation leaves it out; three
+    for an environment map)."""
     kind = node.plugin
     m = np.asarray(node.props.get("to_world", np.eye(4)), float)
     if kind in _LATER:
         r.refuse_or_drop(node, where, "this emitter")
-        return None
+        return []
+    if kind == "envmap":
+        return _envmap(node, where, r)
+    return [_single_emitter(node, kind, m, where, r.base)]
+
+
+def _single_emitter(node: XmlNode, kind: str, m: np.ndarray, where: str, base: Path) -> Light:
+    """The light of a top-level emitter other than an environment map."""
     if kind == "constant":
-        spectrum, power = emission(node.props.get("radiance"), f"{where} radiance", r.base)
+        spectrum, power = emission(node.props.get("radiance"), f"{where} radiance", base)
         return Light("sky", spectrum, power, name="sky")
     if kind == "directional":
-        spectrum, power = emission(node.props.get("irradiance"), f"{where} irradiance", r.base)
+        spectrum, power = emission(node.props.get("irradiance"), f"{where} irradiance", base)
         d = node.props.get("direction")
         direction = m[:3, 2] if d is None else m[:3, :3] @ np.asarray(d, float)
         return Light("directional", spectrum, power, direction=_unit(direction))
-    spectrum, power = emission(node.props.get("intensity"), f"{where} intensity", r.base)
+    spectrum, power = emission(node.props.get("intensity"), f"{where} intensity", base)
     if kind == "point":
         pos = node.props.get("position")
         return Light("point", spectrum, power, position=_vec(m[:3, 3] if pos is None else pos))
@@ -293,8 +332,7 @@ def _scene(root: XmlNode, name: str, r: _Reading) -> Scene:
     for i, node in enumerate(root.children):
         where = f"element {i} {node.label()}"
         if node.kind == "emitter":
-            light = _emitter(node, where, r)
-            lights += [] if light is None else [light]
+            lights += _emitter(node, where, r)
         elif node.kind == "sensor":
             cameras.append(_camera(node, where, r))
         elif node.kind == "integrator" and node.plugin not in ("path", "volpath"):

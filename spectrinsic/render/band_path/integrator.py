@@ -78,6 +78,10 @@ class BandTables:
         The texel tables of textured meshes (:mod:`~spectrinsic.render.base.textures`), or ``None``.
     shape_textures
         ``{Mitsuba shape id: texture slot}`` of textured shapes.
+    light_channels
+        Per light j, ``(o_j, c_j)``: it takes RGB component ``c_j`` of the emitter loaded as
+        light ``o_j`` (an environment map's channel lights share one ``envmap``); empty:
+        ``(j, 0)`` for every light.
     """
 
     albedo: np.ndarray
@@ -87,6 +91,11 @@ class BandTables:
     shape_surfaces: dict[str, int] = field(default_factory=dict)
     textures: TextureTables | None = None
     shape_textures: dict[str, int] = field(default_factory=dict)
+    light_channels: tuple[tuple[int, int], ...] = ()
+
+    def channels(self) -> tuple[tuple[int, int], ...]:
+        """:attr:`light_channels`, or ``(j, 0)`` per light where empty."""
+        return self.light_channels or tuple((j, 0) for j in range(self.n_lights))
 
 
 def transport_channels(n_lights: int, n_bands: int) -> list[str]:
@@ -158,6 +167,8 @@ def _check_fit(it: Any, tables: BandTables) -> None:
         or tables.n_lights != it.n_lights
         or len(tables.shape_surfaces) != it.n_surfaces
         or n_texcols != it.n_texcols
+        or len(tables.channels()) != it.n_lights
+        or any(not (0 <= o < it.n_lights and 0 <= c < 3) for o, c in tables.channels())
     ):
         raise RenderError(
             f"band tables {shape} for {tables.n_lights} lights and {n_texcols} texture columns "
@@ -209,6 +220,7 @@ def _make_class(mi: Any, dr: Any) -> type:
             self.albedo = mi.Float(np.zeros(self.n_bands, np.float32))
             self.shape_lut = mi.UInt32(np.zeros(1, np.uint32))
             self.emitter_lut = mi.UInt32(np.zeros(1, np.uint32))
+            self.light_channels = tuple((j, 0) for j in range(self.n_lights))
             _init_gloss(mi, self, props)
 
         def set_tables(self, scene: Any, tables: BandTables) -> None:
@@ -220,6 +232,7 @@ def _make_class(mi: Any, dr: Any) -> type:
             lookups = texture_lookups(mi, dr, scene, tables.textures, tables.shape_textures)
             self.slot_lut, self.tex_widths, self.tex_heights, self.tex_offsets = lookups[:4]
             self.texel_albedo, self.texel_weights = lookups[4:]
+            self.light_channels = tables.channels()
 
         def set_metals(self, rows: np.ndarray) -> None:
             """``(R,)`` bool: which albedo-table rows are metals (no diffuse lobe)."""

@@ -151,10 +151,16 @@ class BandKernel:
         ]
 
     def deposit(self, acc: list, light: Any, weight: Any, bands: Sequence, mask: Any) -> list:
-        """``acc[l·K + k] += bands[k]·weight`` on the lanes whose light is l."""
+        """``acc[j·K + k] += bands[k]·weight[c_j]`` on the lanes whose emitter is light j's
+        owner: *weight* is the emitter's RGB value (``Color3f``), and light j takes its
+        component ``c_j`` of the emitter loaded as light ``o_j``, ``(o_j, c_j)`` =
+        ``it.light_channels[j]`` (Python ints, read when traced): ``(j, 0)`` for every light
+        but an environment map's channel lights, which share one Mitsuba ``envmap`` (the
+        emitters are loaded white, so today's components are equal and component 0 is
+        exactly the scalar of before)."""
         k, out = self.it.n_bands, list(acc)
-        for j in range(self.it.n_lights):
-            w = self.dr.select(mask & (light == j), weight, 0.0)
+        for j, (owner, channel) in enumerate(self.it.light_channels):
+            w = self.dr.select(mask & (light == owner), weight[channel], 0.0)
             for b in range(k):
                 out[j * k + b] = self.dr.fma(bands[b], w, out[j * k + b])
         return out
@@ -162,7 +168,7 @@ class BandKernel:
     # -- the steps of a vertex -------------------------------------------------------------
 
     def emitter_hit(self, si: Any, s: PathState) -> tuple[Any, Any, Any]:
-        """Light, weight (radiance x BSDF-sampling MIS weight) and mask of an emitter hit."""
+        """Light, weight (RGB radiance x BSDF-sampling MIS weight) and mask of an emitter hit."""
         mi, dr = self.mi, self.dr
         emitter = si.emitter(self.scene)
         hit = emitter != None  # noqa: E711 (a Dr.Jit pointer array, compared lane by lane)
@@ -170,7 +176,7 @@ class BandKernel:
         em_pdf = dr.select(
             s.prev_delta, 0.0, self.scene.pdf_emitter_direction(s.prev_si, ds, ~s.prev_delta)
         )
-        radiance = emitter.eval(si, (s.prev_pdf > 0.0) & hit)[0]
+        radiance = emitter.eval(si, (s.prev_pdf > 0.0) & hit)
         return self.light_of(emitter, hit), radiance * mis_weight(dr, mi, s.prev_pdf, em_pdf), hit
 
     def lobes(self, si: Any, bsdf: Any, wo: Any, delta: Any, active: Any) -> tuple[Any, Any]:
@@ -203,7 +209,7 @@ class BandKernel:
             mi.BSDFContext(), si, wo_em, sample_1, sample_2
         )
         mis_em = dr.select(ds.delta, 1.0, mis_weight(dr, mi, ds.pdf, bsdf_pdf))
-        nee = bsdf_val[0] * em_weight[0] * mis_em
+        nee = bsdf_val[0] * em_weight * mis_em  # RGB: an environment map's channels
         if not self.gloss:
             light = self.light_of(ds.emitter, active_em)
             return _Vertex(light, nee, active_em, bsdf_sample, bsdf_weight[0])

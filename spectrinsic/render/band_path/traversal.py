@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import RenderError, SceneError, validate_choice
+from ...scenes.envmaps import envmap_groups
 from ...scenes.model import Scene
 from ...spectra import get_sensors
 from ..algebra.modes import ChannelValues, RenderMode, channel_values, get_mode
@@ -114,7 +115,24 @@ def _tables(
         shape_surfaces={s.key: i for i, s in enumerate(surfaces)} if aovs else {},
         textures=textures,
         shape_textures=shape_slots(textures, surfaces),
+        light_channels=light_channels(scene, emitters),
     )
+
+
+def light_channels(scene: Scene, emitters: dict[int, int]) -> tuple[tuple[int, int], ...]:
+    """Per light, ``(light loaded as its emitter, RGB component)``: ``(j, 0)``, or for an
+    environment map's channel light the map's one loaded ``envmap`` (the light among its three
+    that *emitters* names) and its channel."""
+    loaded = set(emitters.values())
+    out = []
+    for j, light in enumerate(scene.lights):
+        if light.kind != "envmap":
+            out.append((j, 0))
+            continue
+        group = [g for g in envmap_groups(scene) if j in g.lights][0]
+        owner = [i for i in group.lights if i in loaded]
+        out.append((owner[0] if owner else j, int(light.channel)))
+    return tuple(out)
 
 
 def _specular_table(scene: Scene, value_sets: Sequence[ChannelValues]) -> np.ndarray:
