@@ -186,11 +186,6 @@ def test_a_mitsuba_05_file_loads_and_says_what_it_fixed(tmp_path, capsys):
         ("", '<bsdf type="mask"><bsdf type="diffuse"/></bsdf>', "<bsdf type='mask'>"),
         ("", '<bsdf type="bumpmap"><bsdf type="diffuse"/></bsdf>', "<bsdf type='bumpmap'>"),
         ("", '<bsdf type="normalmap"><bsdf type="diffuse"/></bsdf>', "<bsdf type='normalmap'>"),
-        (
-            '<emitter type="envmap"><string name="filename" value="sky.exr"/></emitter>',
-            "",
-            "<emitter type='envmap'>",
-        ),
         ('<emitter type="sunsky"/>', "", "<emitter type='sunsky'>"),
     ],
 )
