@@ -145,7 +145,7 @@ def render_spectral(
             )
             passes.append(_render_pass(mi, mi.load_dict(mitsuba_dict), spp, seed, direct, progress))
     image = np.sum([p[0] for p in passes], axis=0)
-    direct_image = np.sum([p[1] for p in passes], axis=0) if direct else None
+    direct_image = np.sum([p[1] for p in passes if p[1] is not None], axis=0) if direct else None
     seconds = [sum(p[2][i] for p in passes) for i in range(len(passes[0][2]))]
     k = sensors.n
     if image.shape[-1] < k:

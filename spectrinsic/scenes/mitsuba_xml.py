@@ -142,7 +142,7 @@ def _envmap(node: XmlNode, where: str, r: _Reading) -> list[Light]:
     rot = m[:3, :3]
     if not (np.allclose(rot @ rot.T, np.eye(3), atol=1e-6) and np.linalg.det(rot) > 0):
         raise SceneError(f"{where}: to_world of {node.label()} is not a rotation")
-    return list(envmap_lights("envmap", str(path), file_sha256(path), scale, rot.ravel()))
+    return list(envmap_lights("envmap", str(path), file_sha256(path), scale, rot.ravel().tolist()))
 
 
 def _emitter(node: XmlNode, where: str, r: _Reading) -> list[Light]:

@@ -220,7 +220,7 @@ def _make_class(mi: Any, dr: Any) -> type:
             self.albedo = mi.Float(np.zeros(self.n_bands, np.float32))
             self.shape_lut = mi.UInt32(np.zeros(1, np.uint32))
             self.emitter_lut = mi.UInt32(np.zeros(1, np.uint32))
-            self.light_channels = tuple((j, 0) for j in range(self.n_lights))
+            self.light_channels: tuple[tuple[int, int], ...] = ()
             _init_gloss(mi, self, props)
 
         def set_tables(self, scene: Any, tables: BandTables) -> None:

@@ -154,12 +154,13 @@ class BandKernel:
         """``acc[j·K + k] += bands[k]·weight[c_j]`` on the lanes whose emitter is light j's
         owner: *weight* is the emitter's RGB value (``Color3f``), and light j takes its
         component ``c_j`` of the emitter loaded as light ``o_j``, ``(o_j, c_j)`` =
-        ``it.light_channels[j]`` (Python ints, read when traced): ``(j, 0)`` for every light
+        ``it.light_channels[j]`` (Python ints, read when traced; empty: all ``(j, 0)``): ``(j, 0)`` for every light
         but an environment map's channel lights, which share one Mitsuba ``envmap`` (the
         emitters are loaded white, so today's components are equal and component 0 is
         exactly the scalar of before)."""
         k, out = self.it.n_bands, list(acc)
-        for j, (owner, channel) in enumerate(self.it.light_channels):
+        pairs = self.it.light_channels or [(j, 0) for j in range(self.it.n_lights)]
+        for j, (owner, channel) in enumerate(pairs):
             w = self.dr.select(mask & (light == owner), weight[channel], 0.0)
             for b in range(k):
                 out[j * k + b] = self.dr.fma(bands[b], w, out[j * k + b])
