@@ -29,6 +29,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SceneError
+from ..mitsuba_import import import_mitsuba
+from ..spectra.user_spectra import rgb_light_power
 from .budget import SceneBudget
 from .model import ENVMAP_CHANNELS, IDENTITY_ROTATION, Light, Scene
 
@@ -65,8 +67,6 @@ def envmap_lights(
     name: str, file: str, sha256: str, scale: float, rotation: Sequence[float] = IDENTITY_ROTATION
 ) -> tuple[Light, Light, Light]:
     """The three channel lights of a map of *scale* (module docstring)."""
-    from ..spectra.user_spectra import rgb_light_power
-
     rot = tuple(float(x) for x in rotation)
     unit = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
     return tuple(  # type: ignore[return-value]
@@ -151,8 +151,6 @@ def check_map_file(path: Path, what: str, budget: SceneBudget | None = None) -> 
             f"{what}: {path.name!r} is not an OpenEXR or Radiance HDR file; expected a linear "
             "HDR radiance map (.exr or .hdr)"
         )
-    from ..mitsuba_import import import_mitsuba
-
     mi = import_mitsuba()
     if mi.variant() is None:  # Bitmap is the same in every variant; one must be set
         mi.set_variant("scalar_rgb")

@@ -49,7 +49,7 @@ import numpy as np
 
 from ..errors import SpectralDataError, SpectrumNotFoundError
 from .csv_spectra import read_csv_column
-from .illuminants import normalise_illuminant
+from .illuminants import cie_illuminant, normalise_illuminant
 from .records import Spectrum, SpectrumKind
 
 __all__ = [
@@ -281,8 +281,6 @@ def rgb_spectrum(key: str) -> Spectrum:
 
 def _rgb_light_values(rgb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Wavelengths of the registry's D65 and ``(rgb · b)(λ) · D65(λ)``, D65 at unit luminance."""
-    from .illuminants import cie_illuminant
-
     d65 = cie_illuminant("D65")
     wl, basis = _mallett_basis()
     colour = np.stack([np.interp(d65.wavelengths, wl, b) for b in basis])  # edge values beyond
@@ -291,8 +289,6 @@ def _rgb_light_values(rgb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def rgb_light_spectrum(key: str) -> Spectrum:
     """The illuminant of linear sRGB ``R,G,B`` in [0, 1] under D65 (module docstring)."""
-    from .illuminants import normalise_illuminant
-
     rgb = _triple(key, "rgb")
     wl, values = _rgb_light_values(rgb)
     name = "rgblight:" + ",".join(f"{c:g}" for c in rgb)
@@ -305,8 +301,6 @@ def rgb_light_power(rgb: tuple[float, float, float]) -> float:
     luminance: the luminance of that product relative to D65's (``Σ`` over the channels of a
     unit colour is 1). With it a map texel (R, G, B) of a unit-scale environment map has the
     radiance spectrum ``Σ_c rgb_c · power_c · rgblight_c = (rgb · b) · D65``."""
-    from .illuminants import normalise_illuminant
-
     wl, values = _rgb_light_values(np.asarray(rgb, float))
     return float(values.sum() / normalise_illuminant(wl, values).sum())
 
