@@ -14,8 +14,10 @@ the map's file, SHA-256 and rotation. The three are named ``<name>.r``, ``<name>
 ``<name>.b``; :func:`envmap_groups` gathers them back into one map (for the renderer, which
 loads the file once, and for people reading shares: the map's share is its three lights').
 
-A scene holds at most one map and no ``sky`` beside it: Mitsuba takes one environment emitter
-per scene (``docs/envmap_design.md``, fact 1).
+A scene may hold several maps, whose radiances add (candidates for relighting: set one map's
+three lights to a negligible power, ``relight --power``, to swap it for another); no ``sky``
+beside a map (Mitsuba takes one environment emitter per scene, ``docs/envmap_design.md``
+fact 1; the renderer loads the first map and the band path evaluates the others itself).
 """
 
 from __future__ import annotations
@@ -112,22 +114,22 @@ def _rotation_problem(rotation: Sequence[float]) -> str | None:
 
 def check_envmaps(scene: Scene) -> str | None:
     """The first problem of *scene*'s environment maps, or ``None``: each map exactly the three
-    channels 0, 1, 2, a rotation, an existing file; at most one map and no ``sky`` beside it."""
+    channels 0, 1, 2, a rotation, an existing file; no ``sky`` beside a map."""
     groups = envmap_groups(scene)
     if not groups:
         return None
-    if len(groups) > 1:
-        return f"{len(groups)} environment maps; Mitsuba takes one environment emitter per scene"
     if any(light.kind == "sky" for light in scene.lights):
         return "an environment map and a sky; Mitsuba takes one environment emitter per scene"
-    (env,) = groups
-    channels = sorted(scene.lights[i].channel for i in env.lights)
-    if channels != [0, 1, 2]:
-        return f"environment map {env.file!r} has channel lights {channels}; expected 0, 1, 2"
-    problem = _rotation_problem(env.rotation)
-    if problem is None and not Path(env.file).is_file():
-        problem = f"environment map {env.file!r} not found"
-    return problem
+    for env in groups:
+        channels = sorted(scene.lights[i].channel for i in env.lights)
+        if channels != [0, 1, 2]:
+            return f"environment map {env.file!r} has channel lights {channels}; expected 0, 1, 2"
+        problem = _rotation_problem(env.rotation)
+        if problem is None and not Path(env.file).is_file():
+            problem = f"environment map {env.file!r} not found"
+        if problem is not None:
+            return problem
+    return None
 
 
 def check_map_file(path: Path, what: str, budget: SceneBudget | None = None) -> tuple[int, int]:

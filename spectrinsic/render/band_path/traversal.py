@@ -119,20 +119,31 @@ def _tables(
     )
 
 
-def light_channels(scene: Scene, emitters: dict[int, int]) -> tuple[tuple[int, int], ...]:
-    """Per light, ``(light loaded as its emitter, RGB component)``: ``(j, 0)``, or for an
-    environment map's channel light the map's one loaded ``envmap`` (the light among its three
-    that *emitters* names) and its channel."""
+def light_channels(scene: Scene, emitters: dict[int, int]) -> tuple[tuple[int, int, int], ...]:
+    """Per light, ``(light loaded as its emitter, RGB component, source)``: ``(j, 0, 0)``, or
+    for a channel light of the scene's environment map i the one loaded ``envmap`` (the light
+    *emitters* names), its channel and source 0 for the loaded map (i = 0), ``i`` for extra
+    map ``i - 1`` (:func:`extra_maps`)."""
     loaded = set(emitters.values())
+    maps = envmap_groups(scene)
+    owner = next((j for j in maps[0].lights if j in loaded), 0) if maps else 0
     out = []
     for j, light in enumerate(scene.lights):
-        if light.kind != "envmap":
-            out.append((j, 0))
-            continue
-        group = [g for g in envmap_groups(scene) if j in g.lights][0]
-        owner = [i for i in group.lights if i in loaded]
-        out.append((owner[0] if owner else j, int(light.channel)))
+        source = next((i for i, g in enumerate(maps) if j in g.lights), None)
+        if source is None:
+            out.append((j, 0, 0))
+        else:
+            out.append((owner, int(light.channel), source))
     return tuple(out)
+
+
+def extra_maps(mi: Any, scene: Scene) -> tuple[object, ...]:
+    """Standalone Mitsuba ``envmap`` emitters of the scene's environment maps after the first
+    (Mitsuba loads one per scene; the band path evaluates these itself)."""
+    return tuple(
+        mi.load_dict(tr.envmap_entry(mi, scene.lights[g.lights[0]], {}))
+        for g in envmap_groups(scene)[1:]
+    )
 
 
 def _specular_table(scene: Scene, value_sets: Sequence[ChannelValues]) -> np.ndarray:
@@ -342,6 +353,7 @@ def render_traversal(
             )
         )
         tables = _tables(scene, value_sets, light_of_emitters(mi, loaded), aovs)
+        tables = replace(tables, extra_maps=extra_maps(mi, scene))
         metal_rows = tuple(m.kind == "conductor" for m in scene.materials) + (False,)
         dims = _Dims(h, w, n_bands, n_lights, glossy, metal_rows)
         spec_table = _specular_table(scene, value_sets) if glossy else None

@@ -12,9 +12,10 @@ Naming, which :mod:`spectrinsic.render.passes` relies on to update parameters be
   ``diffuse_reflectance`` under the coat) or ``conductor``/``roughconductor``;
 * light ``i`` is ``light_<i>``; an area light is a rectangle shape with an ``area`` emitter and a
   black two-sided BSDF, so it occludes and reflects nothing;
-* an environment map's three channel lights are **one** Mitsuba ``envmap`` (Mitsuba takes one
-  environment emitter per scene), keyed by the first of them given an emission
-  (:func:`envmap_entry`).
+* an environment map's three channel lights are **one** Mitsuba ``envmap`` keyed by the first
+  of them given an emission (:func:`envmap_entry`); Mitsuba takes one environment emitter per
+  scene, so only the first map given an emission is loaded (the band path evaluates the
+  others itself, :mod:`spectrinsic.render.band_path.kernel`).
 
 Two-sided BSDFs make face winding irrelevant (a room's walls render from inside whichever way
 they were wound). Vertex normals are smoothed across edges whose faces meet at less than
@@ -455,13 +456,12 @@ def scene_to_mitsuba(
     }
     for part in prepare_geometry(scene, crease_deg) if geometry is None else geometry:
         out[part.key] = _mitsuba_mesh(mi, part, _surface_bsdf(scene, part, materials, white_metal))
-    maps: set[tuple[str, str, tuple[float, ...]]] = set()  # environment maps loaded
+    loaded_map = False  # Mitsuba takes one environment emitter: the first map given one
     for j, (light, emission) in enumerate(zip(scene.lights, lights, strict=True)):
         if light.kind == "envmap" and emission is not None:
-            group = (light.file, light.sha256, tuple(light.rotation))
-            if group in maps:
+            if loaded_map:
                 continue
-            maps.add(group)
+            loaded_map = True
         entry = _light(mi, light, emission, f"scene {scene.name!r} light {j} ({light.name})")
         if entry is not None:
             out[light_key(j)] = entry
