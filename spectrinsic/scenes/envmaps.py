@@ -42,6 +42,7 @@ __all__ = [
     "EnvMap",
     "envmap_lights",
     "envmap_groups",
+    "map_name",
     "check_envmaps",
     "check_map_file",
 ]
@@ -86,15 +87,22 @@ def envmap_lights(
     )
 
 
+def map_name(light: Light) -> str:
+    """The name of the map *light* is a channel of: its name without ``.r``/``.g``/``.b``."""
+    suffix = ENVMAP_CHANNELS[light.channel] if 0 <= light.channel < 3 else ""
+    return light.name.removesuffix(suffix) if suffix else light.name
+
+
 def envmap_groups(scene: Scene) -> tuple[EnvMap, ...]:
-    """The scene's environment maps (lights of kind ``envmap`` gathered by file, SHA-256 and
-    rotation), in the order of their first light. :func:`check_envmaps` makes each complete."""
-    groups: dict[tuple[str, str, tuple[float, ...]], list[int]] = {}
+    """The scene's environment maps (lights of kind ``envmap`` gathered by map name
+    (:func:`map_name`), file, SHA-256 and rotation), in the order of their first light. :func:`check_envmaps` makes each complete."""
+    groups: dict[tuple[str, str, str, tuple[float, ...]], list[int]] = {}
     for i, light in enumerate(scene.lights):
         if light.kind == "envmap":
-            groups.setdefault((light.file, light.sha256, tuple(light.rotation)), []).append(i)
+            key = (map_name(light), light.file, light.sha256, tuple(light.rotation))
+            groups.setdefault(key, []).append(i)
     out = []
-    for (file, sha, rot), idx in groups.items():
+    for (_, file, sha, rot), idx in groups.items():
         by_channel = sorted(idx, key=lambda i: scene.lights[i].channel)
         out.append(EnvMap(file, sha, rot, tuple(by_channel)))  # type: ignore[arg-type]
     return tuple(out)

@@ -70,6 +70,8 @@ class _Reading:
     approximate: bool
     approximated: list[str] = field(default_factory=list)
     ignored: list[str] = field(default_factory=list)
+    #: Environment maps read so far.
+    maps: int = 0
 
     @property
     def say(self) -> Callable[[str], None] | None:
@@ -142,7 +144,10 @@ def _envmap(node: XmlNode, where: str, r: _Reading) -> list[Light]:
     rot = m[:3, :3]
     if not (np.allclose(rot @ rot.T, np.eye(3), atol=1e-6) and np.linalg.det(rot) > 0):
         raise SceneError(f"{where}: to_world of {node.label()} is not a rotation")
-    return list(envmap_lights("envmap", str(path), file_sha256(path), scale, rot.ravel().tolist()))
+    name = node.id if node.id and not node.id.startswith("_unnamed") else "envmap"
+    name += "" if r.maps == 0 else f"_{r.maps + 1}"  # unnamed maps stay told apart
+    r.maps += 1
+    return list(envmap_lights(name, str(path), file_sha256(path), scale, rot.ravel().tolist()))
 
 
 def _emitter(node: XmlNode, where: str, r: _Reading) -> list[Light]:

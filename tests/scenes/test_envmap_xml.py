@@ -78,3 +78,11 @@ def test_a_bad_envmap_is_refused_in_one_line(tmp_path, capsys, emitters, expecte
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and expected in err
     assert not (tmp_path / "out").exists()
+
+
+def test_two_envmaps_add_as_two_maps_of_three_lights_each(tmp_path):
+    two = ENVMAP.format(file="sky.exr") + ENVMAP.format(file="sky.exr").replace("2.5", "1")
+    scene = load_mitsuba_xml(write_scene(tmp_path, two))
+    names = [li.name for li in scene.lights]
+    assert names == ["envmap.r", "envmap.g", "envmap.b", "envmap_2.r", "envmap_2.g", "envmap_2.b"]
+    assert scene.lights[3].power == pytest.approx(scene.lights[0].power / 2.5, rel=1e-12)
