@@ -129,6 +129,11 @@ def check_envmaps(scene: Scene) -> str | None:
     if any(light.kind == "sky" for light in scene.lights):
         return "an environment map and a sky; Mitsuba takes one environment emitter per scene"
     for env in groups:
+        if not env.file:
+            return (
+                "an envmap light without a map file; environment maps are read from Mitsuba "
+                "XML (<emitter type='envmap'>, scenes/FORMAT.md)"
+            )
         channels = sorted(scene.lights[i].channel for i in env.lights)
         if channels != [0, 1, 2]:
             return f"environment map {env.file!r} has channel lights {channels}; expected 0, 1, 2"

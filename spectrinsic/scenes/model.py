@@ -62,7 +62,7 @@ LIGHT_FIELDS: dict[str, tuple[str, ...]] = {
     "directional": ("direction",),
     "sky": (),
     "sphere": ("position", "radius"),
-    "envmap": ("file", "channel", "rotation"),
+    "envmap": (),  # placed at infinity; its map's file record: Light.file ... rotation
 }
 #: The light kinds, in the table's order (``typing.get_args(LightKind)`` is the same).
 LIGHT_KINDS: tuple[LightKind, ...] = tuple(LIGHT_FIELDS)  # type: ignore[arg-type]
@@ -76,8 +76,8 @@ LIGHT_PLACEMENT: tuple[str, ...] = tuple(
     dict.fromkeys(f for fs in LIGHT_FIELDS.values() for f in fs)
 )
 #: Placement fields with a default that a scene file may leave out (a spot's cone half-angle,
-#: :attr:`Light.cutoff_deg`; an environment map's rotation).
-LIGHT_DEFAULTED: tuple[str, ...] = ("cutoff_deg", "rotation")
+#: :attr:`Light.cutoff_deg`).
+LIGHT_DEFAULTED: tuple[str, ...] = ("cutoff_deg",)
 #: The identity rotation of an environment map (:attr:`Light.rotation`).
 IDENTITY_ROTATION = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
 #: Suffixes of the three channel lights of one environment map (:attr:`Light.channel`).
