@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import RenderError, SceneError
-from ..scenes.envmaps import envmap_groups
+from ..scenes.envmaps import envmap_groups, verified_map
 from ..scenes.model import Scene
 from ..spectra import COLORIMETRIC_WAVELENGTHS, SensorSet, get_spectrum
 from .algebra.modes import light_spectra
@@ -78,7 +78,7 @@ def _light_passes(
         return out
     d65 = _mitsuba_d65(mi, wl)
     for group in maps:
-        data = np.asarray(mi.Bitmap(group.file), np.float32)
+        data = np.asarray(mi.Bitmap(verified_map(scene.lights[group.lights[0]])), np.float32)
         for c, j in enumerate(group.lights):
             if j in active:
                 grey = np.repeat(data[..., c : c + 1], 3, axis=-1)

@@ -34,6 +34,7 @@ from ..errors import SceneError
 from ..mitsuba_import import import_mitsuba
 from ..spectra.user_spectra import rgb_light_power
 from .budget import SceneBudget
+from .mitsuba_files import file_sha256
 from .model import ENVMAP_CHANNELS, IDENTITY_ROTATION, Light, Scene
 
 __all__ = [
@@ -45,6 +46,7 @@ __all__ = [
     "map_name",
     "check_envmaps",
     "check_map_file",
+    "verified_map",
 ]
 
 #: Largest environment map file read, in bytes (a 2048 x 1024 float RGB EXR is 24 MiB).
@@ -143,6 +145,20 @@ def check_envmaps(scene: Scene) -> str | None:
         if problem is not None:
             return problem
     return None
+
+
+def verified_map(light: Light) -> str:
+    """The map file of envmap light *light*, refused in one line if its SHA-256 is no longer
+    the one recorded when the scene was read (the ground truth would describe another map)."""
+    path = Path(light.file)
+    if not path.is_file():
+        raise SceneError(f"light {light.name!r}: environment map {light.file!r} not found")
+    if light.sha256 and file_sha256(path) != light.sha256:
+        raise SceneError(
+            f"light {light.name!r}: environment map {light.file!r} changed since the scene was "
+            "read (its SHA-256 differs); read the scene again"
+        )
+    return str(path)
 
 
 def check_map_file(path: Path, what: str, budget: SceneBudget | None = None) -> tuple[int, int]:

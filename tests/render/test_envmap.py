@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from spectrinsic.errors import RenderError
+from spectrinsic.errors import RenderError, SceneError
 from spectrinsic.mitsuba_import import import_mitsuba
 from spectrinsic.render import RenderSettings, render_scene
 from spectrinsic.render.algebra.light_transport import relit_result
@@ -164,3 +164,11 @@ def test_relighting_swaps_one_map_for_another(tmp_path, make_plane):
     assert np.abs(relit - direct).max() <= 1e-5 * np.abs(direct).max()
     only_a = render_scene(both, settings, seed=6).images["rgb3"].astype(np.float64)
     assert np.abs(only_a - direct).max() > 0.1 * np.abs(direct).max()  # the swap changed it
+
+
+def test_a_map_changed_since_the_scene_was_read_is_refused(tmp_path, make_plane):
+    path, sha = write_map(tmp_path / "m.exr", np.ones((4, 8, 3)))
+    scene = lit_by_map(make_plane("flat:0.5", "cie:D65"), path, sha)
+    write_map(tmp_path / "m.exr", np.full((4, 8, 3), 2.0))
+    with pytest.raises(SceneError, match="changed since the scene was read"):
+        render_scene(scene, RenderSettings(4, modes=("rgb3",), aovs=False), seed=1)

@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import SceneError
+from ...scenes.envmaps import verified_map
 from ...scenes.model import Light, Material, Scene, unknown_light_kind
 from ...scenes.textures import box_uv
 from .plugins import black_bsdf
@@ -277,7 +278,7 @@ def envmap_entry(mi: Any, light: Light, emission: Mapping) -> dict[str, Any]:
     if "bitmap" in emission:
         entry["bitmap"] = emission["bitmap"]
     else:
-        entry["filename"] = str(light.file)
+        entry["filename"] = verified_map(light)
     return entry
 
 
