@@ -37,13 +37,13 @@ import numpy as np
 
 from ..errors import SceneError, SpectrinsicError
 from . import mitsuba_shapes as shapes
-from .budget import SceneBudget
-from .envmaps import check_map_file, envmap_lights
 from .image_textures import ImageTexture, corner_spectra
 from .mitsuba_bitmaps import diffuse_bitmap
 from .mitsuba_bsdfs import DEFAULT_MATERIAL, material_of
-from .mitsuba_files import MAX_XML_BYTES, SceneFile, confined_file, file_sha256, prepare_xml
+from .mitsuba_environment import envmap_emitter
+from .mitsuba_files import MAX_XML_BYTES, SceneFile, prepare_xml
 from .mitsuba_spectra import emission
+from .mitsuba_sunsky import SKY_ROWS, sunsky_lights
 from .mitsuba_tree import XmlNode, parse_xml
 from .model import Camera, Light, Material, Mesh, Scene
 from .textures import make_image_texture
@@ -54,9 +54,7 @@ __all__ = ["MAX_XML_BYTES", "ENVIRONMENT", "load_mitsuba_xml", "xml_notes", "ren
 #: Emitters that light the scene from infinity (one per scene in Mitsuba).
 ENVIRONMENT = ("constant", "envmap", "sunsky", "sky", "sun")
 #: Emitters without exact ground truth until the glass-and-environment issue lands.
-_LATER = ("sunsky", "sky", "sun")
-#: The parameters of an ``envmap`` read (:func:`_envmap`).
-_ENVMAP_PARAMS = {"filename", "scale", "to_world"}
+_LATER = ("sky", "sun")
 #: Mitsuba's default film size.
 _FILM = (768, 576)
 
@@ -122,34 +120,6 @@ def _area_light(p: shapes.Placed, node: XmlNode, r: _Reading) -> Light | None:
     )
 
 
-def _envmap(node: XmlNode, where: str, r: _Reading) -> list[Light]:
-    """The three channel lights of an ``envmap`` (:mod:`~spectrinsic.scenes.envmaps`): its
-    file confined to the scene's folder and checked (OpenEXR or Radiance HDR, size, texels),
-    ``scale`` and the rotation ``to_world``."""
-    extra = set(node.props) - _ENVMAP_PARAMS
-    if extra:
-        raise SceneError(
-            f"{where}: unsupported parameter {sorted(extra)[0]!r} in {node.label()}; "
-            f"expected {', '.join(sorted(_ENVMAP_PARAMS))}"
-        )
-    rel = node.props.get("filename")
-    if not isinstance(rel, str):
-        raise SceneError(f"{where}: {node.label()} has no filename")
-    path = confined_file(rel, r.base, where)
-    check_map_file(path, where, SceneBudget(where))
-    scale = node.number("scale", 1.0)
-    if not (math.isfinite(scale) and scale > 0):
-        raise SceneError(f"{where}: scale {scale!r}; expected a finite number > 0")
-    m = np.asarray(node.props.get("to_world", np.eye(4)), float)
-    rot = m[:3, :3]
-    if not (np.allclose(rot @ rot.T, np.eye(3), atol=1e-6) and np.linalg.det(rot) > 0):
-        raise SceneError(f"{where}: to_world of {node.label()} is not a rotation")
-    name = node.id if node.id and not node.id.startswith("_unnamed") else "envmap"
-    name += "" if r.maps == 0 else f"_{r.maps + 1}"  # unnamed maps stay told apart
-    r.maps += 1
-    return list(envmap_lights(name, str(path), file_sha256(path), scale, rot.ravel().tolist()))
-
-
 def _emitter(node: XmlNode, where: str, r: _Reading) -> list[Light]:
     """The lights of a top-level emitter (none where an approximation leaves it out; three
     for an environment map)."""
@@ -159,7 +129,19 @@ def _emitter(node: XmlNode, where: str, r: _Reading) -> list[Light]:
         r.refuse_or_drop(node, where, "this emitter")
         return []
     if kind == "envmap":
-        return _envmap(node, where, r)
+        r.maps += 1
+        return envmap_emitter(node, where, r.base, r.maps)
+    if kind == "sunsky":
+        if not r.approximate:
+            raise SceneError(
+                f"{where}: {node.label()} has no exact ground truth yet; refused "
+                "(--approximate: its sky baked into an RGB map, its sun a directional light)"
+            )
+        r.approximated.append(
+            f"{where}: {node.label()} as Mitsuba's RGB sunsky: its sky baked into a "
+            f"{SKY_ROWS} x {2 * SKY_ROWS} map, its sun a directional light"
+        )
+        return sunsky_lights(node, where, r.base)
     return [_single_emitter(node, kind, m, where, r.base)]
 
 
