@@ -34,7 +34,7 @@ from spectrinsic.decompose.methods.names_shades import NamesAndShades
 from spectrinsic.decompose.methods.protocol import hold_one_out, scene_group, score_grid
 from spectrinsic.decompose.methods.retinex import ColourRetinex
 from spectrinsic.gt_export.sample import sample_dirs
-from spectrinsic.gt_export.sample.loader import load_sample
+from spectrinsic.gt_export.dataset.loader import load_sample
 
 LAYERS = ["image", "image_denoised", "reflectance", "shading", "shading_grey", "mask",
           "object_id", "material_id"]

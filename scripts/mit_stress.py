@@ -7,7 +7,8 @@ Every object of MIT_DIR (``$SPECTRINSIC_DATA/mit_intrinsic_dev``; all by default
 variant of :data:`spectrinsic.decompose.evaluation.mit_variants.VARIANTS` (all by default) is
 decomposed by three methods and scored with the thesis' protocol (MIT LMSE,
 :mod:`spectrinsic.decompose.evaluation.mit`): ``before`` (names-and-shades without the sharp
-achromatic edge rule and the collapse guard, i.e. main before issue 48), ``after`` (the
+achromatic edge rule, the collapse guard and round 6's blurred-step reads, i.e. main before
+issue 48), ``after`` (the
 defaults) and ``image-as-reflectance``. OUT.json keeps every score and the guard's action;
 ``--table`` merges parts (runs on disjoint objects can share the cores) into a markdown table
 per variant with each object's ratio to image-as-reflectance and the worst case.
@@ -28,7 +29,7 @@ from spectrinsic.decompose.methods.names_shades import NamesAndShades
 from spectrinsic.errors import DatasetError
 
 METHODS = {
-    "before": NamesAndShades(sharp_edges="none", collapse_guard=False),
+    "before": NamesAndShades(sharp_edges="none", collapse_guard=False, blurred_steps=False),
     "after": NamesAndShades(),
     "image-as-reflectance": ImageAsReflectance(),
 }

@@ -36,6 +36,7 @@ __all__ = [
     "disk_full",
     "refuse_link",
     "replacing",
+    "guarded_write",
     "write_text_file",
     "write_bytes_file",
 ]
@@ -106,6 +107,28 @@ def replacing(path: str | os.PathLike[str]) -> Iterator[Path]:
                 tmp.unlink(missing_ok=True)
         if isinstance(exc, SpectrinsicError) or not (isinstance(exc, OSError) or disk_full(exc)):
             raise
+        raise _one_line(target, exc) from exc
+
+
+@contextlib.contextmanager
+def guarded_write(path: str | os.PathLike[str]) -> Iterator[None]:
+    """Turn a failure while making *path* (a folder, or a file a library writes itself) into a
+    one-line error naming *path*, and remove what was written of it (a full disk leaves no
+    partial or zero-byte file behind). Files are written with :func:`replacing`, never in place.
+
+    ``write()`` failures (a full disk) carry no file name of their own, so without this the
+    message would not say which file could not be written. An ``OSError`` becomes a
+    :class:`~spectrinsic.errors.WriteError`, a full disk (also as a C library's
+    ``RuntimeError``, :func:`disk_full`) a :class:`~spectrinsic.errors.DiskFullError`.
+    """
+    try:
+        yield
+    except (OSError, RuntimeError) as exc:
+        if isinstance(exc, SpectrinsicError) or not (isinstance(exc, OSError) or disk_full(exc)):
+            raise  # already one line (a nested guard), or not a write failure
+        target = Path(path)
+        if disk_full(exc) and target.is_file() and not target.is_symlink():
+            target.unlink(missing_ok=True)  # the file this block was writing: partial at best
         raise _one_line(target, exc) from exc
 
 

@@ -11,7 +11,7 @@ from tqdm import tqdm
 
 from ..errors import DatasetError
 from ..gt_export.dataset.manifest import SPLIT_FRACTIONS
-from ..gt_export.sample.integrity import check_build_folder
+from ..gt_export.folders.build_folder import check_build_folder
 from ..pipeline.dataset import SampleFailure, build_dataset
 from ..pipeline.executors import check_scheduler, choose_executor
 from ..pipeline.presets import PRESETS, DatasetConfig, get_preset, preset_names

@@ -11,18 +11,19 @@ from typing import Any, Literal
 
 from tqdm import tqdm
 
-from ..decompose.evaluation.evaluate import evaluate
+from ..decompose.evaluation.evaluate import EvaluationResult, evaluate
 from ..decompose.evaluation.mit import evaluate_mit, mit_folder_objects
 from ..decompose.evaluation.predictions import Predictions
 from ..decompose.evaluation.scored import add_scored_section, describe_scored
 from ..decompose.evaluation.targets import TARGETS
 from ..decompose.methods.registry import available_decomposers, get_decomposer
+from ..decompose.report import write_report
 from ..decompose.report.mit import MIT_FIGURE, write_mit_report
 from ..errors import DatasetError
+from ..gt_export.dataset.loader import load_sample
 from ..gt_export.folders.outfolder import check_output_folder
 from ..gt_export.folders.staged_output import staged_output
 from ..gt_export.sample import sample_dirs
-from ..gt_export.sample.loader import load_sample
 
 __all__ = ["register", "run", "DEFAULT_DATASET", "DEFAULT_OUT"]
 
@@ -237,9 +238,10 @@ def run(args: argparse.Namespace) -> int:
     scored = describe_scored(Path(args.dataset), folders)  # refuses a bad sample before work
     with staged_output(Path(args.out)) as stage:  # a failed run leaves --out as it was
         result = _evaluate(args, folders, methods, stage)
-        add_scored_section(result.files["report"], scored)
+        files = write_report(stage, result)  # the tables and REPORT.md, from the scores
+        add_scored_section(files["report"], scored)
         for key in ("lmse_by_condition_md", "colour_by_condition_md", "scenario_md"):
-            print(result.files[key].read_text(encoding="utf-8"))
+            print(files[key].read_text(encoding="utf-8"))
     written = ["REPORT.md with every table and summary.png", "scored.json", "scores.csv"]
     written += [] if args.no_figures else ["figures/"]
     written += [] if args.no_estimates else ["estimates/"]
@@ -253,7 +255,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _evaluate(
     args: argparse.Namespace, folders: list[Path], methods: dict[str, Any], out: Path
-) -> Any:
+) -> EvaluationResult:
     """Score every sample with a progress bar; return the evaluation result."""
     bar = tqdm(total=len(folders), desc="evaluate", unit="sample", disable=args.quiet)
 

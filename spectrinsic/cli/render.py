@@ -229,8 +229,9 @@ def _add_material_options(p: Any) -> None:
     p.add_argument(
         "--approximate",
         action="store_true",
-        help="Mitsuba XML: approximate what has no exact ground truth (glass, masks, bump "
-        "maps, bitmaps, environment maps...) instead of refusing it, one line saying what",
+        help="Mitsuba XML: approximate what has no exact ground truth (glass, bitmaps other "
+        "than a diffuse reflectance, environment maps...) instead of refusing it, one line "
+        "saying what",
     )
 
 

@@ -17,8 +17,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import DatasetError
+from ..gt_export.dataset.loader import load_sample, split_samples
 from ..gt_export.relight.augment import RandomRelight
-from ..gt_export.sample.loader import load_sample, split_samples
 from ..gt_export.sample.meta import read_meta
 from ..gt_export.sample.working_view import srgb_view
 from .logspace import log_input, log_layer

@@ -29,22 +29,19 @@ from ..errors import DiskFullError
 from ..gt_export import (
     build_gallery,
     export_sample,
-    remove_stale_temporaries,
     sample_dirs,
     write_dataset_card,
     write_manifest,
 )
-from ..gt_export.folders.outfolder import folder_lock
-from ..gt_export.relight.augment import RELIT_TAG, relit_problem, write_relit_variants
-from ..gt_export.sample.integrity import (
+from ..gt_export.folders.build_folder import (
     check_build_folder,
     remove_owned_temporaries,
-    remove_sample,
-    replaceable_sample,
-    sample_problem,
     unmarked_on_error,
     write_marker,
 )
+from ..gt_export.folders.outfolder import folder_lock
+from ..gt_export.relight.augment import RELIT_TAG, relit_problem, write_relit_variants
+from ..gt_export.sample.integrity import remove_sample, replaceable_sample, sample_problem
 from ..render import render_batches, set_thread_count
 from ..render.base.variants import import_mitsuba
 from ..render.probe import probe_luminance
@@ -264,7 +261,7 @@ def build_dataset(
     ------
     DatasetError
         Before anything is written, if *out_dir* is not a folder this build may write into
-        (see :func:`spectrinsic.gt_export.sample.integrity.check_build_folder`) or a sample's folder
+        (see :func:`spectrinsic.gt_export.folders.build_folder.check_build_folder`) or a sample's folder
         holds files spectrinsic did not write.
     FolderLockedError
         Another build holds *out_dir* (its advisory lock); the message names its pid, host and
@@ -439,7 +436,7 @@ def finalize_dataset(
     A folder without any complete sample gets nothing (``{}``): no empty manifest.
     """
     out = Path(out_dir)
-    for path in remove_stale_temporaries(out):
+    for path in remove_owned_temporaries(out):
         log.info("removed %s, left by a worker that died", path.name)
     if not sample_dirs(out):
         return {}

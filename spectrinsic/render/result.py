@@ -1,20 +1,17 @@
-"""The record a render returns: arrays and metadata, no live renderer."""
+"""The record a render returns: arrays and metadata, no live renderer (numpy only: the render
+records sit below ``algebra/``; the ``meta`` record is made by
+:mod:`spectrinsic.render.scene_render`)."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from ..errors import RenderError
-from ..scenes.model import Scene
-from ..spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
-from .algebra.modes import RenderMode
-from .base.variants import import_mitsuba
 
-__all__ = ["RenderResult", "render_meta"]
+__all__ = ["RenderResult"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -100,45 +97,3 @@ class RenderResult:
         full = float(np.linalg.norm(self.images[mode].astype(np.float64), axis=-1).sum())
         one = float(np.linalg.norm(self.direct[mode].astype(np.float64), axis=-1).sum())
         return one / full if full > 0 else float("nan")
-
-
-def render_meta(
-    scene: Scene,
-    objs: Sequence[RenderMode],
-    matrices: dict[str, np.ndarray],
-    variants: dict[str, str],
-    timings: dict[str, list[float]],
-    *,
-    spp: int,
-    seed: int,
-    max_depth: int,
-    per_light: bool,
-    wanted: set[str],
-    data_dir: str | None,
-) -> dict[str, Any]:
-    """The ``meta`` record of one batch's render: versions, variants, samples, modes, their
-    sensors and XYZ matrices, the spectral grid, which modes have direct light, and timings (s)."""
-    names = [m.name for m in objs]
-    return {
-        "mitsuba": import_mitsuba().__version__,
-        "variants": variants,
-        "spp": int(spp),
-        "seed": int(seed),
-        "max_depth": int(max_depth),
-        "modes": names,
-        "sensors": {m.name: get_sensors(m.sensors, data_dir=data_dir).name for m in objs},
-        "to_xyz": {n: np.asarray(matrices[n]).tolist() for n in names},
-        "wavelengths": {
-            "start": float(COLORIMETRIC_WAVELENGTHS[0]),
-            "end": float(COLORIMETRIC_WAVELENGTHS[-1]),
-            "step": float(COLORIMETRIC_WAVELENGTHS[1] - COLORIMETRIC_WAVELENGTHS[0]),
-            "unit": "nm",
-        },
-        "per_light": bool(per_light),
-        "direct_modes": sorted(wanted),
-        "timings": {
-            k: {"passes": len(v), "seconds": float(sum(v)), "per_pass": [float(x) for x in v]}
-            for k, v in timings.items()
-        },
-        "units": "XYZ = integral of radiance times CIE 1931 CMF over nm; raw = integral of radiance times S_k",
-    }

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import RenderError, SceneError
 from ..scenes.model import Scene
-from ..spectra import get_sensors
+from ..spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
 from .algebra.modes import RenderMode, channel_values, get_mode, n_passes, raw_to_xyz, to_xyz_matrix
 from .band_path.traversal import PARTS, SingleTraversal, render_jobs, resolve_integrator
 from .base.one_pass import PassOutput, PassProgress
@@ -19,7 +19,7 @@ from .base.translate import SurfaceGeometry, prepare_geometry, surfaces
 from .base.variants import choose_variant, import_mitsuba, variant_scope
 from .passes import render_diagonal
 from .passes.aovs import render_aovs
-from .result import RenderResult, render_meta
+from .result import RenderResult
 from .settings import DEFAULT_MODES, RenderSettings
 from .spectral import render_spectral
 
@@ -29,6 +29,8 @@ __all__ = [
     "count_passes",
 ]
 
+# long module: one driver (plan, run, assemble every mode of one scene) and the meta record it
+# writes of the render (issue 46 moved render_meta here, out of the numpy-only result record)
 logger = logging.getLogger(__name__)
 
 
@@ -227,6 +229,48 @@ def _run_jobs(
             else:
                 _spectral_part(run, chosen)
     return run.outputs, *found
+
+
+def render_meta(
+    scene: Scene,
+    objs: Sequence[RenderMode],
+    matrices: dict[str, np.ndarray],
+    variants: dict[str, str],
+    timings: dict[str, list[float]],
+    *,
+    spp: int,
+    seed: int,
+    max_depth: int,
+    per_light: bool,
+    wanted: set[str],
+    data_dir: str | None,
+) -> dict[str, Any]:
+    """The ``meta`` record of one batch's render: versions, variants, samples, modes, their
+    sensors and XYZ matrices, the spectral grid, which modes have direct light, and timings (s)."""
+    names = [m.name for m in objs]
+    return {
+        "mitsuba": import_mitsuba().__version__,
+        "variants": variants,
+        "spp": int(spp),
+        "seed": int(seed),
+        "max_depth": int(max_depth),
+        "modes": names,
+        "sensors": {m.name: get_sensors(m.sensors, data_dir=data_dir).name for m in objs},
+        "to_xyz": {n: np.asarray(matrices[n]).tolist() for n in names},
+        "wavelengths": {
+            "start": float(COLORIMETRIC_WAVELENGTHS[0]),
+            "end": float(COLORIMETRIC_WAVELENGTHS[-1]),
+            "step": float(COLORIMETRIC_WAVELENGTHS[1] - COLORIMETRIC_WAVELENGTHS[0]),
+            "unit": "nm",
+        },
+        "per_light": bool(per_light),
+        "direct_modes": sorted(wanted),
+        "timings": {
+            k: {"passes": len(v), "seconds": float(sum(v)), "per_pass": [float(x) for x in v]}
+            for k, v in timings.items()
+        },
+        "units": "XYZ = integral of radiance times CIE 1931 CMF over nm; raw = integral of radiance times S_k",
+    }
 
 
 def render_scene(

@@ -6,7 +6,8 @@ multiplies (section 3.9.2, 3.8.4). :func:`gltf_colours` reads both for every nam
 a factor alone becomes the registry name ``rgb:R,G,B`` (:mod:`spectrinsic.spectra.user_spectra`:
 Mallett & Yuksel 2019), a texture an :class:`~spectrinsic.scenes.image_textures.ImageTexture`
 (decoded, times the factor, with the sampler's wrap mode and filter), which the mesh reader maps
-by the primitive's own ``TEXCOORD_0``. Alpha is not read (surfaces are opaque). A factor outside
+by the primitive's own ``TEXCOORD_0``. Alpha is read only under an ``alphaMode`` of ``MASK`` or
+``BLEND`` (as an opacity mask, :mod:`~spectrinsic.scenes.gltf_maps`). A factor outside
 [0, 1] is refused when the scene is validated, not clipped. Materials with neither get nothing
 (glTF's default white is not assumed): such a material still needs the map or a default.
 
@@ -19,20 +20,21 @@ from __future__ import annotations
 import base64
 import json
 import struct
+import warnings
 from pathlib import Path
 from typing import Any
 
-from ..errors import SceneError
-from .image_textures import AssetColour, Filter, Wrap, image_texture_from_bytes
+from ..errors import SceneError, SpectrinsicWarning
+from .image_textures import AssetColour, Filter, ImageTexture, Wrap, image_texture_from_bytes
 
-__all__ = ["gltf_colours"]
+__all__ = ["gltf_colours", "gltf_document", "gltf_image", "gltf_image_bytes"]
 
 #: glTF sampler codes (spec 5.26): wrapS/wrapT and magFilter.
 _WRAP = {10497: "repeat", 33071: "clamp", 33648: "mirror"}
 _NEAREST = 9728
 
 
-def _chunks(path: Path) -> tuple[dict[str, Any], bytes]:
+def gltf_document(path: Path) -> tuple[dict[str, Any], bytes]:
     """The glTF JSON and, for ``.glb``, its binary chunk (``b""`` otherwise)."""
     data = path.read_bytes()
     try:
@@ -69,8 +71,11 @@ def _image_bytes(path: Path, doc: dict[str, Any], binary: bytes, index: int) -> 
     return data[offset : offset + int(view["byteLength"])]
 
 
-def _texture(path: Path, doc: dict[str, Any], binary: bytes, ref: Any, factor: Any) -> Any:
-    """The ImageTexture of a ``baseColorTexture`` reference *ref*, times *factor*."""
+def gltf_image_bytes(
+    path: Path, doc: dict[str, Any], binary: bytes, ref: Any, key: str = "baseColorTexture"
+) -> tuple[bytes, int, Wrap, Filter]:
+    """The image file's bytes, image index, wrap mode and filter of a texture reference *ref*
+    (a material's *key*, such as ``normalTexture``)."""
     try:
         texture = doc["textures"][int(ref["index"])]
         index = int(texture["source"])
@@ -81,15 +86,11 @@ def _texture(path: Path, doc: dict[str, Any], binary: bytes, ref: Any, factor: A
     except SceneError:
         raise
     except (KeyError, IndexError, TypeError, ValueError) as exc:
-        raise SceneError(
-            f"{path}: baseColorTexture {ref!r} names nothing readable ({exc!r})"
-        ) from None
+        raise SceneError(f"{path}: {key} {ref!r} names nothing readable ({exc!r})") from None
     if ref.get("extensions"):  # KHR_texture_transform and the like would move the texels
-        raise SceneError(
-            f"{path}: baseColorTexture extensions {sorted(ref['extensions'])} are not supported"
-        )
+        raise SceneError(f"{path}: {key} extensions {sorted(ref['extensions'])} are not supported")
     if int(ref.get("texCoord", 0)) != 0:
-        raise SceneError(f"{path}: baseColorTexture uses TEXCOORD_{ref['texCoord']}; expected 0")
+        raise SceneError(f"{path}: {key} uses TEXCOORD_{ref['texCoord']}; expected 0")
     wraps = {_WRAP.get(int(sampler.get(k, 10497)), "repeat") for k in ("wrapS", "wrapT")}
     if len(wraps) > 1:
         raise SceneError(
@@ -97,10 +98,26 @@ def _texture(path: Path, doc: dict[str, Any], binary: bytes, ref: Any, factor: A
         )
     wrap: Wrap = wraps.pop()  # type: ignore[assignment]
     filt: Filter = "nearest" if sampler.get("magFilter") == _NEAREST else "bilinear"
+    return data, index, wrap, filt
+
+
+def gltf_image(
+    path: Path,
+    doc: dict[str, Any],
+    binary: bytes,
+    ref: Any,
+    factor: Any,
+    *,
+    key: str = "baseColorTexture",
+    srgb: bool = True,
+) -> ImageTexture:
+    """The ImageTexture of a texture reference *ref* (a material's *key*), times *factor*;
+    sRGB-decoded if *srgb* (a base colour), else raw (data: normals)."""
+    data, index, wrap, filt = gltf_image_bytes(path, doc, binary, ref, key)
     return image_texture_from_bytes(
         data,
         source=f"{path.name}#images/{index}",
-        srgb=True,
+        srgb=srgb,
         wrap=wrap,
         filter=filt,
         factor=tuple(float(c) for c in factor[:3]),  # type: ignore[arg-type]
@@ -114,7 +131,7 @@ def gltf_colours(path: str | Path) -> dict[str, AssetColour]:
     path = Path(path)
     if path.suffix.lower() not in (".gltf", ".glb"):
         return {}
-    doc, binary = _chunks(path)
+    doc, binary = gltf_document(path)
     out = {}
     for material in doc.get("materials") or []:
         if not isinstance(material, dict) or not isinstance(material.get("name"), str):
@@ -123,9 +140,12 @@ def gltf_colours(path: str | Path) -> dict[str, AssetColour]:
         factor = pbr.get("baseColorFactor")
         stated = isinstance(factor, list) and len(factor) == 4
         if "baseColorTexture" in pbr:
-            image = _texture(
-                path, doc, binary, pbr["baseColorTexture"], factor if stated else [1, 1, 1]
-            )
+            with warnings.catch_warnings():  # alpha is read where alphaMode uses it (gltf_maps)
+                if material.get("alphaMode", "OPAQUE") != "OPAQUE":
+                    warnings.filterwarnings("ignore", ".*alpha below 1", SpectrinsicWarning)
+                image = gltf_image(
+                    path, doc, binary, pbr["baseColorTexture"], factor if stated else [1, 1, 1]
+                )
             out[material["name"]] = AssetColour(image=image)
         elif isinstance(factor, list) and len(factor) == 4:
             rgb = "rgb:" + ",".join(f"{float(c):.9g}" for c in factor[:3])

@@ -20,6 +20,9 @@ mapped by the mesh's own texture coordinates (:mod:`spectrinsic.scenes.gltf_colo
 :mod:`spectrinsic.scenes.mtl_colours`, :mod:`spectrinsic.scenes.image_textures`). A material
 with neither a colour nor a mapping (nor a default spectrum) is an error naming the options.
 A textured material must be matte (a glossy one is refused: its basis would not be diffuse).
+A glTF material's ``alphaMode`` (``MASK``, ``BLEND``) and ``normalTexture``, and an MTL
+material's ``d``/``map_d``, become the mesh's opacity mask and normal map whatever the colours
+(:mod:`spectrinsic.scenes.gltf_maps`, :mod:`spectrinsic.scenes.mtl_maps`).
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ import os
 import re
 import struct
 from collections.abc import Mapping
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -39,11 +43,14 @@ import numpy as np
 from ..errors import SceneError
 from .budget import MAX_FACES, MAX_VERTICES, SceneBudget
 from .gltf_colours import gltf_colours
+from .gltf_maps import gltf_maps, warn_mirrored_uv
 from .image_textures import AssetColour, ImageTexture, corner_spectra
 from .materials import METAL_SPECTRUM
 from .model import Camera, Light, Material, Mesh, Scene
 from .mtl_colours import mtl_colours
+from .mtl_maps import mtl_maps
 from .semantic import SemanticMap, classify
+from .surface_maps import MeshMaps
 from .textures import Texture, make_image_texture
 from .validate import validate_scene
 
@@ -304,6 +311,19 @@ def _asset_colours(path: Path) -> dict[str, AssetColour]:
     return gltf_colours(path) if path.suffix.lower() in (".gltf", ".glb") else mtl_colours(path)
 
 
+def _mesh_maps(maps: MeshMaps | None, uv: np.ndarray | None, where: str) -> MeshMaps | None:
+    """*maps* of a material on a mesh's faces with texture coordinates *uv*."""
+    if maps is None:
+        return None
+    if uv is None:
+        raise SceneError(
+            f"{where}: its material has a mask or normal texture but the mesh has no uv"
+        )
+    maps = replace(maps, uv=uv)
+    warn_mirrored_uv(maps, where)
+    return maps
+
+
 def _unmapped(path: Path, material: str, geoms: list[_Geometry]) -> SceneError:
     known = sorted({g[1] for g in geoms})
     return SceneError(
@@ -371,6 +391,7 @@ def load_mesh_scene(
     path = Path(path)
     geoms = _geometries(path)
     colours = _asset_colours(path) if colours_from_asset else {}
+    surface_maps = gltf_maps(path) or mtl_maps(path)  # masks are geometry: whatever the colours
     table = _Table()
     meshes = []
     for i, (node, material, verts, faces, gloss, uv) in enumerate(geoms):
@@ -404,6 +425,7 @@ def load_mesh_scene(
                 object_id=i,
                 texture=texture,
                 semantic=classify([f"{node}", material], semantic),
+                maps=_mesh_maps(surface_maps.get(material), uv, f"{path}: mesh {node!r}"),
             )
         )
     camera, light = _frame(np.concatenate([m.vertices for m in meshes]), width, height)

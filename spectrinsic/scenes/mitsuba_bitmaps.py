@@ -25,17 +25,17 @@ import numpy as np
 
 from ..errors import SceneError
 from .image_textures import FILTERS, WRAP_MODES, ImageTexture, image_texture_from_file
-from .mitsuba_bsdfs import inner_bsdf
+from .mitsuba_bsdfs import WRAPPERS, inner_bsdf
 from .mitsuba_files import confined_file
 from .mitsuba_tree import XmlNode
 
-__all__ = ["diffuse_bitmap"]
+__all__ = ["diffuse_bitmap", "read_bitmap"]
 
 _PARAMS = {"filename", "raw", "wrap_mode", "filter_type", "to_uv", "accel"}
 
 
 def diffuse_bitmap(bsdf: XmlNode, what: str, base: Path) -> ImageTexture | None:
-    """The image of *bsdf* when it is a ``diffuse`` (bare or two-sided) whose ``reflectance``
+    """The image of *bsdf* when it is a ``diffuse`` (bare, two-sided or wrapped) whose ``reflectance``
     is a ``bitmap``; ``None`` for any other BSDF (read by
     :func:`~spectrinsic.scenes.mitsuba_bsdfs.material_of`).
 
@@ -46,14 +46,29 @@ def diffuse_bitmap(bsdf: XmlNode, what: str, base: Path) -> ImageTexture | None:
         Mitsuba does not have, or the image file (outside the folder, unreadable, too large).
     """
     node = bsdf
-    while node.plugin == "twosided":
+    while node.plugin == "twosided" or node.plugin in WRAPPERS:  # wrappers: mitsuba_maps
         node = inner_bsdf(node, what)
     texture = node.props.get("reflectance")
     if node.plugin != "diffuse" or not isinstance(texture, XmlNode):
         return None
     if texture.plugin != "bitmap" or set(node.props) != {"reflectance"} or node.children:
         return None  # material_of refuses it in its own words
-    where = f"{what} {texture.label()}"
+    return read_bitmap(texture, f"{what} {texture.label()}", base)
+
+
+def read_bitmap(texture: XmlNode, where: str, base: Path) -> ImageTexture:
+    """The image of ``bitmap`` *texture* (module docstring: its parameters as Mitsuba reads
+    them, ``raw`` included), named *where* in messages.
+
+    Raises
+    ------
+    SceneError
+        One line naming the bitmap: not a bitmap, an unknown parameter, a ``to_uv``, a wrap
+        mode or filter Mitsuba does not have, or the image file (outside the folder,
+        unreadable, too large).
+    """
+    if texture.kind != "texture" or texture.plugin != "bitmap":
+        raise SceneError(f"{where}: expected a <texture type='bitmap'>")
     extra = set(texture.props) - _PARAMS
     if extra:
         raise SceneError(f"{where}: unsupported parameter {sorted(extra)[0]!r}")

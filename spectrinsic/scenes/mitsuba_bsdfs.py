@@ -7,13 +7,17 @@ metals), the rough ones with ``alpha`` and the ``ggx`` distribution (Mitsuba's d
 ``beckmann``, is refused: the renderer's microfacets are GGX), bare or in a ``twosided`` with one BSDF (or two equal
 ones). A ``specular_reflectance`` other than 1 has no exact counterpart and is refused.
 
+The wrappers ``mask``, ``bumpmap`` and ``normalmap`` (:data:`WRAPPERS`, in any order with
+``twosided``) are read exactly: the material is the BSDF they wrap, and the wrappers' opacity
+and bump or normal map become the mesh's
+:class:`~spectrinsic.scenes.surface_maps.MeshMaps` (:mod:`~spectrinsic.scenes.mitsuba_maps`).
+
 Without exact ground truth until the glass-and-environment issue lands: ``dielectric``,
-``thindielectric``, ``roughdielectric`` (:data:`GLASS`), ``mask``, ``bumpmap``, ``normalmap``
-(:data:`WRAPPERS`) and ``bitmap`` textures anywhere but a matte ``diffuse`` reflectance (that
-one is an exact image texture, :mod:`~spectrinsic.scenes.mitsuba_bitmaps`). Each is refused in
-one line naming it; under ``--approximate`` glass drops its shape, a wrapper gives way to the
-BSDF it wraps (the mask's opacity, the bump or normal map ignored) and a bitmap becomes
-Mitsuba's default 0.5 grey, each said in one line.
+``thindielectric``, ``roughdielectric`` (:data:`GLASS`) and ``bitmap`` textures anywhere but a
+matte ``diffuse`` reflectance (that one is an exact image texture,
+:mod:`~spectrinsic.scenes.mitsuba_bitmaps`). Each is refused in one line naming it; under
+``--approximate`` glass drops its shape and a bitmap becomes Mitsuba's default 0.5 grey, each
+said in one line.
 """
 
 from __future__ import annotations
@@ -33,7 +37,8 @@ __all__ = ["GLASS", "WRAPPERS", "DEFAULT_MATERIAL", "inner_bsdf", "material_of"]
 
 #: Transmissive BSDFs, dropped with their shape under ``--approximate``.
 GLASS = ("dielectric", "thindielectric", "roughdielectric")
-#: BSDFs wrapping another, which gives way to the inner one under ``--approximate``.
+#: BSDFs wrapping another: the material is the inner one, the wrapper a mesh's map
+#: (:mod:`~spectrinsic.scenes.mitsuba_maps`).
 WRAPPERS = ("mask", "bumpmap", "normalmap")
 #: Mitsuba's BSDF of a shape that names none: diffuse 0.5.
 DEFAULT_MATERIAL = Material("flat:0.5", "flat:0.5")
@@ -106,9 +111,7 @@ def material_key(node: XmlNode) -> tuple[str, str]:
 def material_of(node: XmlNode, what: str, base: Path, say: Say) -> Material | None:
     """The material of BSDF *node*; ``None`` where an approximation drops the shape (glass)."""
     name = node.id if node.id and not node.id.startswith("_unnamed") else ""
-    while node.plugin == "twosided" or node.plugin in WRAPPERS:
-        if node.plugin in WRAPPERS:
-            _unsupported(node, what, say, "replaced by the BSDF it wraps")
+    while node.plugin == "twosided" or node.plugin in WRAPPERS:  # wrappers: mitsuba_maps
         node = inner_bsdf(node, what)
         name = name or (node.id if not node.id.startswith("_unnamed") else "")
     kind = node.plugin

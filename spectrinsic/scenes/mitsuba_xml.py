@@ -10,11 +10,12 @@ The file goes through three steps, each in its own module:
    usual fixes, each said);
 3. this module turns the parsed nodes into the scene: shapes
    (:mod:`~spectrinsic.scenes.mitsuba_shapes`, counted against the scene budget before any is
-   built), BSDFs (:mod:`~spectrinsic.scenes.mitsuba_bsdfs`), emitters (``area`` on a
+   built), BSDFs (:mod:`~spectrinsic.scenes.mitsuba_bsdfs`; their ``mask``, ``bumpmap`` and
+   ``normalmap`` wrappers :mod:`~spectrinsic.scenes.mitsuba_maps`), emitters (``area`` on a
    ``rectangle`` or a ``sphere``, ``point``, ``spot``, ``directional``, ``constant`` as a sky,
    ``envmap`` as an environment map's three channel lights (:mod:`~spectrinsic.scenes.envmaps`);
    two skies are merged when their spectra agree, refused otherwise, and an environment map
-   beside another environment emitter is refused), the
+   beside a sky is refused), the
    ``perspective`` sensor and its film (validated before any arithmetic), and the file's
    ``sample_count`` and ``max_depth`` as render hints.
 
@@ -29,7 +30,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -42,10 +43,12 @@ from .mitsuba_bitmaps import diffuse_bitmap
 from .mitsuba_bsdfs import DEFAULT_MATERIAL, material_of
 from .mitsuba_environment import envmap_emitter
 from .mitsuba_files import MAX_XML_BYTES, SceneFile, prepare_xml
+from .mitsuba_maps import shape_maps
 from .mitsuba_spectra import emission
 from .mitsuba_sunsky import SKY_ROWS, sunsky_lights
 from .mitsuba_tree import XmlNode, parse_xml
 from .model import Camera, Light, Material, Mesh, Scene
+from .surface_maps import MeshMaps
 from .textures import make_image_texture
 from .validate import validate_scene
 
@@ -296,7 +299,25 @@ def _textured_mesh(
     v, f, uv = shapes.textured_triangles(p, r.base)
     basis = tuple(materials.setdefault(Material(s, s), len(materials)) for s in corner_spectra())
     texture = make_image_texture(p.name, basis, image, uv)
-    return Mesh(p.name, v, f, np.full(len(f), basis[0]), object_id=i, texture=texture)
+    mesh = Mesh(p.name, v, f, np.full(len(f), basis[0]), object_id=i, texture=texture)
+    maps = _maps(p, r)
+    return mesh if maps is None else replace(mesh, maps=replace(maps, uv=uv))
+
+
+def _maps(p: shapes.Placed, r: _Reading) -> MeshMaps | None:
+    """The mask and bump or normal map of shape *p*'s BSDF wrappers, without uv."""
+    bsdfs = [c for c in p.node.children if c.kind == "bsdf"]
+    return shape_maps(bsdfs[0], p.where, r.base) if bsdfs else None
+
+
+def _mesh(p: shapes.Placed, r: _Reading, index: int, i: int) -> Mesh:
+    """Shape *p* of one material *index* (by its texture coordinates where it has maps)."""
+    maps = _maps(p, r)
+    if maps is None:
+        v, f = shapes.triangles(p, r.base)
+        return Mesh(p.name, v, f, np.full(len(f), index), object_id=i)
+    v, f, uv = shapes.textured_triangles(p, r.base)
+    return Mesh(p.name, v, f, np.full(len(f), index), object_id=i, maps=replace(maps, uv=uv))
 
 
 def _scene(root: XmlNode, name: str, r: _Reading) -> Scene:
@@ -313,9 +334,8 @@ def _scene(root: XmlNode, name: str, r: _Reading) -> Scene:
         elif isinstance(material, ImageTexture):
             meshes.append(_textured_mesh(p, material, r, materials, len(meshes)))
         elif material is not None:
-            v, f = shapes.triangles(p, r.base)
             index = materials.setdefault(material, len(materials))
-            meshes.append(Mesh(p.name, v, f, np.full(len(f), index), object_id=len(meshes)))
+            meshes.append(_mesh(p, r, index, len(meshes)))
     for i, node in enumerate(root.children):
         where = f"element {i} {node.label()}"
         if node.kind == "emitter":

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import SceneError, did_you_mean
 from .semantic import classify
+from .surface_maps import MeshMaps, maps_from_record
 from .textures import Texture, texture_from_record
 
 __all__ = [
@@ -164,6 +165,9 @@ class Mesh:
         when it is that class, so the records and hashes of scenes from before classes existed
         are unchanged. ``dataclasses.replace(mesh, name=...)`` keeps the class; add
         ``semantic=""`` to take the new name's.
+    maps
+        Its opacity mask and bump or normal map (:class:`~spectrinsic.scenes.surface_maps.MeshMaps`),
+        or ``None``: opaque, unperturbed. Left out of :func:`scene_to_dict` when ``None``.
     """
 
     name: str
@@ -173,6 +177,7 @@ class Mesh:
     object_id: int
     texture: Texture | None = field(default=None, metadata=_OPTIONAL)
     semantic: str = field(default="", metadata={"omit_when": _named_class})
+    maps: MeshMaps | None = field(default=None, metadata=_OPTIONAL)
 
     def __post_init__(self) -> None:
         if not self.semantic:  # the class of its name (frozen: set once, here)
@@ -189,6 +194,7 @@ class Mesh:
             and np.array_equal(self.face_materials, other.face_materials)
             and self.texture == other.texture
             and self.semantic == other.semantic
+            and self.maps == other.maps
         )
 
     __hash__ = None  # type: ignore[assignment]
@@ -399,6 +405,7 @@ def _mesh_from_dict(m: Mapping[str, Any]) -> Mesh:
         object_id=int(m["object_id"]),
         texture=texture_from_record(m["texture"]) if m.get("texture") else None,
         semantic=str(m.get("semantic") or ""),
+        maps=maps_from_record(m["maps"]) if m.get("maps") else None,
     )
 
 

@@ -25,7 +25,7 @@ import numpy as np
 from ..errors import SceneError, SpectrinsicWarning
 from .image_textures import AssetColour, Wrap, image_texture_from_file
 
-__all__ = ["MTL_BYTES_MAX", "mtl_colours"]
+__all__ = ["MTL_BYTES_MAX", "mtl_colours", "mtl_files"]
 
 #: Largest MTL file read (bytes).
 MTL_BYTES_MAX = 4 << 20
@@ -38,7 +38,7 @@ def _inside(base: Path, name: str, what: str) -> Path:
     return full
 
 
-def _libraries(obj: Path) -> list[Path]:
+def mtl_files(obj: Path) -> list[Path]:
     """The MTL files the OBJ's ``mtllib`` lines name (streamed, one line at a time)."""
     base = obj.parent.resolve()
     out = []
@@ -107,7 +107,7 @@ def mtl_colours(path: str | Path) -> dict[str, AssetColour]:
         return {}
     base = path.parent.resolve()
     out = {}
-    for mtl in _libraries(path):
+    for mtl in mtl_files(path):
         for name, (kd, image, wrap) in _parse(mtl).items():
             if image:
                 full = _inside(base, image, f"{mtl.name} (material {name!r})")

@@ -45,7 +45,7 @@ from .textures import Texture
 from .validate import Problems, validate_scene
 from .yaml_limits import load_yaml_file
 
-__all__ = ["load_scene", "scene_from_dict"]
+__all__ = ["load_scene"]
 
 _TOP = ("format", "name", "materials", "meshes", "lights", "camera", "metadata")
 _MESH = tuple("name object_id file transform vertices faces material face_materials".split())
@@ -315,11 +315,12 @@ def _camera(doc: _Doc, entry: Any) -> Camera:
     return Camera(**kw)
 
 
-def scene_from_dict(data: Any, *, base: str | os.PathLike[str], source: str = "<scene>") -> Scene:
-    """Build a scene from parsed YAML *data*; mesh files are resolved inside folder *base*.
-
-    Only the structure and types are checked here; see :func:`load_scene` for validation.
-    """
+def _scene_from_yaml_data(
+    data: Any, *, base: str | os.PathLike[str], source: str = "<scene>"
+) -> Scene:
+    """Build a scene from a scene file's parsed YAML *data*; mesh files are resolved inside
+    folder *base*. Only the structure and types are checked here; see :func:`load_scene` for
+    validation (``scene.json`` is read by :func:`~spectrinsic.scenes.model.scene_from_dict`)."""
     doc = _Doc(source)
     problems = Problems(source)
     if not isinstance(data, dict):
@@ -445,7 +446,7 @@ def load_scene(
     path = Path(path)
     source = str(path)
     data = resolve_spectrum_refs(load_yaml_file(path), path.parent, source)
-    scene = scene_from_dict(data, base=path.parent, source=source)
+    scene = _scene_from_yaml_data(data, base=path.parent, source=source)
     if validate:
         validate_scene(scene, source=source, data_dir=data_dir)
     return scene

@@ -32,6 +32,7 @@ from .geometry import VISIBILITY_GRID, camera_rays, is_closed, winding_numbers
 from .materials import material_problem
 from .model import LIGHT_FIELDS, LIGHT_KINDS, Mesh, Scene, unknown_light_kind
 from .semantic import SEMANTIC_CLASSES
+from .surface_maps import maps_problem
 from .textures import texture_problem
 
 __all__ = [
@@ -236,6 +237,9 @@ def _check_textures(scene: Scene, source: str) -> None:
         problem = None if m.texture is None else texture_problem(m.texture, m.face_materials, kinds)
         if problem is not None:
             raise _fail(source, f"meshes[{i}] ({m.name!r}).texture", problem)
+        problem = None if m.maps is None else maps_problem(m.maps, len(m.faces))
+        if problem is not None:
+            raise _fail(source, f"meshes[{i}] ({m.name!r}).maps", problem)
 
 
 def _check_power(power: object, source: str, field: str) -> None:

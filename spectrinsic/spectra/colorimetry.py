@@ -25,6 +25,7 @@ __all__ = [
     "diagonal_values",
     "xyz_to_linear_srgb",
     "linear_srgb_to_xyz",
+    "luminance",
     "xyz_to_xy",
     "xy_to_duv",
     "white_normalised_responses",
@@ -115,6 +116,12 @@ def xyz_to_linear_srgb(xyz: np.ndarray) -> np.ndarray:
 def linear_srgb_to_xyz(rgb: np.ndarray) -> np.ndarray:
     """Linear sRGB (..., 3) to CIE XYZ (..., 3) (einsum, as :func:`xyz_to_linear_srgb`)."""
     return np.einsum("...j,kj->...k", np.asarray(rgb, float), srgb_matrices()[1])
+
+
+def luminance(rgb: np.ndarray) -> np.ndarray:
+    """CIE Y of linear sRGB ``(..., 3)`` -> ``(...)``: the one definition of luminance, the
+    second row of the sRGB-to-XYZ matrix (:data:`LINEAR_SRGB_TO_XYZ`)."""
+    return np.asarray(rgb, float) @ srgb_matrices()[1][1]
 
 
 def xyz_to_xy(xyz: np.ndarray) -> np.ndarray:

@@ -18,7 +18,7 @@ import pytest
 
 from spectrinsic.cli import main
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export.sample.integrity import MARKER_NAME, write_marker
+from spectrinsic.gt_export.folders.build_folder import MARKER_NAME, write_marker
 from spectrinsic.pipeline.presets import get_preset
 from tests.conftest import QUAD_YAML
 

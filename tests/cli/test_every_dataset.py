@@ -119,7 +119,7 @@ def test_a_relit_sample_checks_and_evaluates(tmp_path, capsys):
     data = tmp_path / "set"
     only = "obj-apple__v0__two-colour-a"
     # the default preset: its reference image (bands31) is one the stored transport relights
-    # (preview's spectral reference is refused, tests/gt_export/test_relit_reference.py)
+    # (preview's spectral reference is refused, tests/gt_export/relight/test_relit_reference.py)
     small = ["--preset", "default", "--resolution", "16x16", "--spp", "2", "--workers", "1"]
     args = ["-q", "dataset", *small, "--only", only, "--store-transport", "--out", str(data)]
     assert main(args) == 0

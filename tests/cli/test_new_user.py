@@ -57,7 +57,7 @@ def test_preview_build_checks_loads_batches_and_scores(preview, tmp_path, capsys
     from spectrinsic.decompose import write_predictions
     from spectrinsic.gt_export import load_dataset
     from spectrinsic.gt_export.dataset.collate import collate_arrays
-    from spectrinsic.gt_export.sample.loader import prepare_item
+    from spectrinsic.gt_export.dataset.loader import prepare_item
 
     capsys.readouterr()
     assert (

@@ -14,7 +14,7 @@ READERS = (
     "sample.meta",
     "sample.json_fields",
     "sample.integrity",
-    "sample.loader",
+    "dataset.loader",
     "dataset.check",
     "dataset.gallery",
     "dataset.shards",

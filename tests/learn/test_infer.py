@@ -28,7 +28,7 @@ def weights(tiny_set, tmp_path_factory, torch) -> Path:
 
 
 def test_unet_predicts_the_right_shapes_and_the_identity(weights, tiny_set):
-    from spectrinsic.gt_export.sample.loader import load_sample
+    from spectrinsic.gt_export.dataset.loader import load_sample
 
     sample = load_sample(tiny_set / "beta__v0", space="srgb")  # the test split
     unet = get_decomposer(f"unet:{weights}")

@@ -1,7 +1,7 @@
 """``dataset --spectral-layers`` (issue 30): the opt-in setting, its refusal without the cube, a
 real one-sample build that ``check`` passes, the manifest's summary and
 ``check --max-residual-share``. 12 x 12 pixels at 2 spp: bookkeeping, not physics (that is
-``tests/gt_export/test_spectral_layers.py``)."""
+``tests/gt_export/layers/test_spectral_layers.py``)."""
 
 from __future__ import annotations
 

@@ -10,7 +10,7 @@ import pytest
 
 from spectrinsic.cli import main
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export.sample.loader import split_samples
+from spectrinsic.gt_export.dataset.loader import split_samples
 
 THREE = "obj-apple__v0__white,obj-cup__v0__white,obj-deer__v0__white"
 TINY = ["--preset", "preview", "--resolution", "12x12", "--spp", "2", "--workers", "1"]

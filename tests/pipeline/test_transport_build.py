@@ -1,7 +1,7 @@
 """``dataset --store-transport --relight N``: a real two-light sample, its relit variant, resume.
 
 12 x 12 pixels at 2 spp: these check the bookkeeping (files, manifest, check, resume, config
-hash); exactness against direct renders is tested in ``tests/gt_export/test_relight.py``.
+hash); exactness against direct renders is tested in ``tests/gt_export/relight/test_relight.py``.
 """
 
 from __future__ import annotations

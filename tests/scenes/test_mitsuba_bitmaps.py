@@ -1,7 +1,7 @@
 """Mitsuba XML ``bitmap`` reflectances read as exact image textures (issue 41): decoding as
 Mitsuba does, the shapes that carry texture coordinates, and the refusals, each one line.
 The rendered per-texel check against colour-science and Mitsuba's own render is in
-tests/render/test_image_textures.py. Reading the XML imports mitsuba (its parser and mesh
+tests/render/base/test_image_textures.py. Reading the XML imports mitsuba (its parser and mesh
 loader), so these tests are marked render."""
 
 from __future__ import annotations

@@ -4,8 +4,10 @@ hash leaves out, and a pattern texture of seed 0 could not be read back)."""
 
 from __future__ import annotations
 
+import ast
 import json
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -96,3 +98,16 @@ def test_plain_data_keeps_what_scene_to_dict_keeps():
     """The sample files' JSON follows the record's rule (the weights of a pattern texture out)."""
     scene = _textured(make_texture("wood", (0, 1), "rings", 8, 0))
     assert plain_data(scene) == scene_to_dict(scene)
+
+
+def test_one_public_scene_from_dict():
+    """Issue 46: one name, one meaning. The YAML reader's builder is private; the package
+    defines ``scene_from_dict`` once, the inverse of ``scene_to_dict``."""
+    package = Path(__file__).resolve().parents[2] / "spectrinsic"
+    defined = [
+        str(path.relative_to(package))
+        for path in sorted(package.rglob("*.py"))
+        for node in ast.parse(path.read_text(encoding="utf-8")).body
+        if isinstance(node, ast.FunctionDef) and node.name == "scene_from_dict"
+    ]
+    assert defined == [str(Path("scenes", "model.py"))]

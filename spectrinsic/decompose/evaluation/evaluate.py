@@ -19,7 +19,9 @@ Predictions`, a user's estimates read from files. For each sample and method:
 * scenario ``sensor_<camera>`` (``dataset --camera``; :mod:`~spectrinsic.decompose.evaluation.processed`):
   the camera chain's processed image, scored against the ground truth carried through it.
 
-Outputs in ``out_dir`` (:func:`spectrinsic.decompose.report.write_report`): ``scores.csv``
+Outputs in ``out_dir`` (:func:`evaluate` writes the figures and estimates; the CLI then
+passes its :class:`EvaluationResult` to :func:`spectrinsic.decompose.report.write_report`,
+which writes the rest): ``scores.csv``
 (sample, method, scenario, layer, metric, value, lighting group, dataset config hash), the condition tables like Tables 5.3/5.4,
 the scenario table like Table 5.1, ``summary.png`` (method x condition), ``REPORT.md`` (every
 table's numbers inline, abbreviations, the summary figure, methods and their parameters),
@@ -48,7 +50,6 @@ from ..decomposition import Decomposer, Decomposition
 from ..methods.registry import available_decomposers, get_decomposer
 from ..metrics import METRICS, WHDR_DELTA, get_metric, whdr
 from ..metrics.judgements import Judgements, sample_judgements
-from ..report import write_report
 from .photometric import SCENARIOS, photometric_correction
 from .predictions import Predictions
 from .processed import processed_inputs
@@ -88,10 +89,31 @@ _PHOTOMETRIC = tuple(SCENARIOS)
 
 @dataclass(frozen=True)
 class EvaluationResult:
-    """Scores and the files written."""
+    """The scores of a run and what its report
+    (:func:`spectrinsic.decompose.report.write_report`, called by the CLI) says of it.
+
+    Attributes
+    ----------
+    scores
+        Every score, in the order they were computed.
+    samples
+        sample id -> ``(kind, lighting condition)``.
+    methods
+        The decomposers (or predictions) scored, by name; their parameters go in ``methods.json``.
+    inputs
+        The image layers the methods decomposed (:data:`INPUT_LAYERS`), sorted.
+    note
+        The evaluation target's note (:func:`~spectrinsic.decompose.evaluation.targets.target_note`).
+    config_hashes
+        sample id -> its dataset's config hash (for ``scores.csv``).
+    """
 
     scores: tuple[Score, ...]
-    files: dict[str, Path] = field(default_factory=dict)
+    samples: Mapping[str, tuple[str, str]]
+    methods: Mapping[str, Decomposer | Predictions]
+    inputs: tuple[str, ...]
+    note: str = ""
+    config_hashes: Mapping[str, str] = field(default_factory=dict)
 
 
 def _grey(a: np.ndarray) -> np.ndarray:
@@ -378,7 +400,9 @@ def evaluate(
     progress: Callable[[str], None] | None = None,
     target: str = "full",
 ) -> EvaluationResult:
-    """Evaluate decomposers (or predictions) on *samples* and write scores, tables and figures.
+    """Evaluate decomposers (or predictions) on *samples*: the scores, with the figures and
+    estimates written as they are made; the tables and ``REPORT.md`` are
+    :func:`spectrinsic.decompose.report.write_report`'s, from the record returned.
 
     Parameters
     ----------
@@ -432,13 +456,7 @@ def evaluate(
             progress(sid)
     if not scores:
         raise DatasetError("no samples to evaluate")
-    files = write_report(
-        out,
-        scores,
-        samples_info,
-        methods,
-        sorted(inputs),
-        note=target_note(target, glossy),
-        config_hashes=hashes,
+    note = target_note(target, glossy)
+    return EvaluationResult(
+        tuple(scores), samples_info, methods, tuple(sorted(inputs)), note, hashes
     )
-    return EvaluationResult(tuple(scores), files)

@@ -16,8 +16,9 @@ import numpy as np
 
 from ...file_writes import write_text_file
 from ...results import write_csv, write_json
+from ..evaluation.evaluate import EvaluationResult
 from ..evaluation.photometric import SCENARIOS
-from ..evaluation.scores import INPUT_LAYERS, SCORED_LAYERS, Score, condition_group
+from ..evaluation.scores import INPUT_LAYERS, SCORED_LAYERS, condition_group
 from ..metrics import METRICS
 from .figure import SUMMARY_FIGURE, summary_heatmap
 from .markdown import Column, glossary_section, markdown_table
@@ -294,25 +295,18 @@ def _summary_files(out: Path, summary: list[dict[str, Any]]) -> dict[str, Path]:
     return {"summary_csv": out / "summary_by_condition.csv"}
 
 
-def write_report(
-    out: Path,
-    scores: Sequence[Score],
-    samples: Mapping[str, tuple[str, str]],
-    methods: Mapping[str, Any],
-    inputs: Sequence[str],
-    note: str = "",
-    config_hashes: Mapping[str, str] | None = None,
-) -> dict[str, Path]:
+def write_report(out: Path, run: EvaluationResult) -> dict[str, Path]:
     """Write ``scores.csv``, the summary, condition and scenario tables, ``methods.json``, the
     summary figure (:data:`~spectrinsic.decompose.report.figure.SUMMARY_FIGURE`) and
     ``REPORT.md``, which holds every table's numbers inline
-    (:mod:`spectrinsic.decompose.report.markdown`). *note*
+    (:mod:`spectrinsic.decompose.report.markdown`). ``run.note``
     (:func:`spectrinsic.decompose.evaluation.targets.target_note`) is printed under every title.
     Each ``scores.csv`` row names its sample's lighting group (WL/1L/2L, measured from its
-    lights: *samples*' condition) and, where *config_hashes* gives it, the sample's dataset
-    config hash."""
+    lights: the condition in ``run.samples``) and, where ``run.config_hashes`` gives it, the sample's dataset
+    config hash. *run* is :func:`~spectrinsic.decompose.evaluation.evaluate.evaluate`'s record."""
+    scores, samples, methods, note = run.scores, run.samples, run.methods, run.note
     files: dict[str, Path] = {"scores": out / "scores.csv"}
-    hashes = config_hashes or {}
+    hashes = run.config_hashes
     _write_csv(
         files["scores"],
         [
@@ -364,5 +358,5 @@ def write_report(
     files["methods"] = out / "methods.json"
     write_json(files["methods"], method_parameters(methods), strict=False, default=str, end="")
     files["report"] = out / "REPORT.md"
-    write_text_file(files["report"], _report_md(methods, inputs, samples, tables, files, note))
+    write_text_file(files["report"], _report_md(methods, run.inputs, samples, tables, files, note))
     return files

@@ -118,7 +118,7 @@ def collate_arrays(
         (fix it, e.g. 4, for one size in every batch).
     channel_first
         Layout of the items' layers; ``None``: channel-first for items made by
-        :func:`~spectrinsic.gt_export.sample.loader.prepare_item` (``torch_dataset``; they carry
+        :func:`~spectrinsic.gt_export.dataset.loader.prepare_item` (``torch_dataset``; they carry
         ``exposure_scale``), else channel-last (``load_sample`` and ``shard_dataset`` items).
 
     Returns

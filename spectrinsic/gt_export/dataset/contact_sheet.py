@@ -9,10 +9,9 @@ from pathlib import Path
 from typing import Any
 
 from ...errors import DatasetError
-from ...file_writes import replacing
+from ...file_writes import guarded_write, replacing
 from ...scenes.sample_id import SEPARATOR
 from ..sample import META_NAME, sample_dirs
-from ..sample.integrity import guarded_write
 from ..sample.meta import read_meta
 
 __all__ = ["contact_sheet", "tile_sheet", "COLUMNS", "TILE"]

@@ -22,10 +22,10 @@ import numpy as np
 from ...file_writes import replacing
 from ...scenes.generators.materials import PIXEL_TEXTURE
 from ...scenes.material_labels import label_spectrum
-from ..layers import luminance
-from ..sample.loader import load_sample
+from ...spectra.colorimetry import luminance
 from ..sample.meta import SampleMeta
 from .colour_spread import material_chroma, shown, spread_summary
+from .loader import load_sample
 
 __all__ = [
     "DIVERSITY_NAME",

@@ -33,13 +33,12 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError
-from ...file_writes import refuse_link, write_text_file
+from ...file_writes import guarded_write, refuse_link, write_text_file
 from ...scenes.lighting import describe_lighting
 from ...spectra import get_sensors, xyz_to_xy
 from ..formats.names import slug
 from ..layers.spectral_intrinsics import rgb_residual_share
 from ..sample import META_NAME, SCENE_NAME, plain_data, sample_dirs
-from ..sample.integrity import guarded_write
 from ..sample.meta import SampleMeta, read_meta
 from .card import read_template
 from .contact_sheet import contact_sheet

@@ -35,8 +35,8 @@ from ...errors import DatasetError, MissingDependencyError
 from ...file_writes import replacing, write_text_file
 from ..folders.outfolder import LOCK_NAME, check_out_folder, check_unlocked, folder_lock
 from ..sample import MANIFEST_NAME, META_NAME, TMP_PREFIX, file_sha256, sample_dirs
-from ..sample.loader import load_sample, split_samples
 from ..sample.meta import meta_from_bytes
+from .loader import load_sample, split_samples
 from .manifest import read_manifest
 
 __all__ = [

@@ -7,7 +7,7 @@ one another spectrinsic run holds. Nothing the program did not write is replaced
 A folder holding a symbolic link (to a file or a folder, at any depth) is refused: nothing is
 ever written through a link, so nothing lands outside ``--out``.
 
-* A dataset knows itself by its marker (:mod:`spectrinsic.gt_export.sample.integrity`), a shard
+* A dataset knows itself by its marker (:mod:`spectrinsic.gt_export.folders.build_folder`), a shard
   export by its index (:mod:`spectrinsic.gt_export.dataset.shards`).
 * ``render``, ``evaluate`` and ``study`` know their folders by :data:`OUTPUT_MARKER`, which
   lists every file they wrote there (:func:`output_folder`). Such a folder holding a file the

@@ -10,7 +10,7 @@ The staging folders of runs that were killed (``kill -9``, a power cut) are swep
 run, under the folder's lock (no other run can be using them then).
 
 A full disk is reported in one line naming the file that could not be written: writers that
-name their file themselves (:func:`~spectrinsic.gt_export.sample.integrity.guarded_write`) do; for
+name their file themselves (:func:`~spectrinsic.gt_export.file_writes.guarded_write`) do; for
 the others (a figure, a CSV table), the newest file in the staging folder is the one that was
 being written when the disk filled.
 """
@@ -25,8 +25,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from ...errors import DiskFullError, SpectrinsicError, WriteError
-from ...file_writes import refuse_link
-from ..sample.integrity import disk_full, guarded_write
+from ...file_writes import disk_full, guarded_write, refuse_link
 from .outfolder import LOCK_NAME, OUTPUT_MARKER, output_folder
 
 __all__ = ["STAGE_PREFIX", "staged_output"]

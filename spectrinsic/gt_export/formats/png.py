@@ -15,8 +15,7 @@ import png
 
 from ...errors import DatasetError
 from ...file_writes import replacing
-from ...spectra.colorimetry import encode_srgb
-from ..layers.imaging import luminance
+from ...spectra.colorimetry import encode_srgb, luminance
 
 __all__ = [
     "EXPOSURE_PERCENTILE",
@@ -46,8 +45,8 @@ def exposure(rgb: np.ndarray, *, percentile: float = EXPOSURE_PERCENTILE) -> flo
     spectrinsic's one exposure: previews and the loader's ``normalize_exposure`` both use it.
     Only positive finite luminances count, so an object on a black background is exposed for
     the object (the background's zeros would pull a percentile of all pixels down). Returns 1.0
-    for an image with no positive finite luminance. Luminance: :func:`~spectrinsic.gt_export.
-    layers.luminance` (CIE Y of linear sRGB).
+    for an image with no positive finite luminance. Luminance: :func:`~spectrinsic.spectra.
+    colorimetry.luminance` (CIE Y of linear sRGB).
     """
     rgb = np.asarray(rgb, float)
     y = luminance(rgb) if rgb.ndim == 3 else rgb

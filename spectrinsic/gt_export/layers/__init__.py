@@ -25,7 +25,7 @@ same XYZ; linear sRGB with ``working_space="srgb"``); the chapter-4 matrices sta
 """
 
 from .compose import compute_ground_truth, identities
-from .imaging import coverage_weighted, light_shares, luminance, relative_error_map, shading_ratio
+from .imaging import coverage_weighted, light_shares, relative_error_map, shading_ratio
 from .records import (
     DEFAULT_CUBE_SENSORS,
     REFERENCE_MODES,
@@ -53,7 +53,6 @@ __all__ = [
     "cube_to_sensors",
     "coverage_weighted",
     "shading_ratio",
-    "luminance",
     "relative_error_map",
     "light_shares",
     "photometric_matrices",

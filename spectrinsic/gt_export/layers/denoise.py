@@ -30,7 +30,7 @@ Against a 16384-spp crop of a room at 2 × 32 spp (``make bench``,
 ``bench_crop_reference.json`` at that preset) the 95th percentile of the shading error went from 14.3 %
 (every band through ``fast``, normals only, not marked clean) to 12.0 %, the median from
 2.2 % to 2.0 %, for one more OIDN call per image; on an analytic outline (a lit card above a
-floor, tests/gt_export/test_denoise_edges.py) the 95th percentile beside the outline went
+floor, tests/gt_export/layers/test_denoise_edges.py) the 95th percentile beside the outline went
 from 10–12 % to 5–7 %.
 """
 

@@ -1,5 +1,6 @@
-"""Image-space helpers of ground truth: luminance (the one definition), coverage-weighted colour,
-the ratio shading, relative error maps and light shares (pure functions on arrays).
+"""Image-space helpers of ground truth: coverage-weighted colour, the ratio shading, relative
+error maps and light shares (pure functions on arrays). Luminance is
+:func:`spectrinsic.spectra.colorimetry.luminance`.
 """
 
 from __future__ import annotations
@@ -7,17 +8,12 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import DatasetError
-from ...spectra import LINEAR_SRGB_TO_XYZ, relative_error
+from ...spectra import relative_error
 from .records import ERROR_FLOOR, REFLECTANCE_FLOOR
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
 
-__all__ = ["luminance", "coverage_weighted", "shading_ratio", "relative_error_map", "light_shares"]
-
-
-def luminance(rgb: np.ndarray) -> np.ndarray:
-    """CIE Y of linear sRGB ``(..., 3)`` -> ``(...)``."""
-    return np.asarray(rgb, float) @ LINEAR_SRGB_TO_XYZ[1]
+__all__ = ["coverage_weighted", "shading_ratio", "relative_error_map", "light_shares"]
 
 
 def coverage_weighted(coverage: np.ndarray, colours: np.ndarray) -> np.ndarray:

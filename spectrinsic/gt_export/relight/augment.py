@@ -112,7 +112,7 @@ def relit_layers(
     cameras: bool = True,
 ) -> dict[str, Any]:
     """Every layer of a sample under new light spectra, in memory, keyed as
-    :func:`~spectrinsic.gt_export.sample.loader.load_sample` returns them (``mask`` bool, ids int32
+    :func:`~spectrinsic.gt_export.dataset.loader.load_sample` returns them (``mask`` bool, ids int32
     under ``ids``, ``meta`` the source's ``meta.json`` with the new ``lights`` spectra).
 
     By default the layers are those the sample has, exactly as :func:`~spectrinsic.gt_export.relight.relight`

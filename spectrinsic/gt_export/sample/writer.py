@@ -56,7 +56,7 @@ from . import (
     meta_seal,
     plain_data,
 )
-from .integrity import remove_owned_temporaries, replaceable_sample, sample_problem
+from .integrity import replaceable_sample, sample_problem
 from .previews import preview_maker, preview_path, shown_layers
 from .sensor import SensorOutput, sensor_output, write_sensor_files
 from .transport_exr import TRANSPORT_NAME, write_transport
@@ -70,7 +70,6 @@ __all__ = [
     "export_sample",
     "is_complete",
     "remove_sample_temporaries",
-    "remove_stale_temporaries",
 ]
 
 log = logging.getLogger(__name__)
@@ -403,12 +402,3 @@ def remove_sample_temporaries(out_dir: Path, sample_id: str) -> list[Path]:
     for path in stale:
         shutil.rmtree(path, ignore_errors=True)
     return stale
-
-
-def remove_stale_temporaries(dataset_dir: str | os.PathLike[str]) -> list[Path]:
-    """Delete spectrinsic's temporaries left by interrupted writes; return what was removed.
-
-    Only names starting with :data:`TMP_PREFIX`, and only in a recognised dataset folder. Call
-    it only when no other writer works on *dataset_dir*.
-    """
-    return remove_owned_temporaries(Path(dataset_dir))

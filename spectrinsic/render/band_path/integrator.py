@@ -36,6 +36,7 @@ import numpy as np
 
 from ...errors import RenderError
 from ...spectra.conductors import FRESNEL_NODES
+from ..base.surface_maps import map_textures
 from ..base.textures import TextureTables, shape_id_table, texture_lookups
 from ..base.variants import import_mitsuba
 from .kernel import BandKernel
@@ -86,6 +87,11 @@ class BandTables:
     extra_maps
         Standalone Mitsuba ``envmap`` emitters of the scene's other environment maps (Mitsuba
         loads one per scene), evaluated by the kernel where the loaded one is hit or sampled.
+    map_scales
+        ``{Mitsuba shape id: bump scale}`` of shapes with a bump or normal map, whose perturbed
+        normal the first-hit maps hold (:mod:`~spectrinsic.render.base.surface_maps`).
+    masks
+        Whether a shape has an opacity mask (null events: :mod:`~spectrinsic.render.band_path.kernel`).
     """
 
     albedo: np.ndarray
@@ -97,6 +103,8 @@ class BandTables:
     shape_textures: dict[str, int] = field(default_factory=dict)
     light_channels: tuple[tuple[int, int, int], ...] = ()
     extra_maps: tuple[object, ...] = ()
+    map_scales: dict[str, float] = field(default_factory=dict)
+    masks: bool = False
 
     def channels(self) -> tuple[tuple[int, int, int], ...]:
         """:attr:`light_channels`, or ``(j, 0, 0)`` per light where empty."""
@@ -217,6 +225,27 @@ def _set_envmaps(it: Any, tables: BandTables | None) -> None:
     it.extra_maps = () if tables is None else tuple(tables.extra_maps)
 
 
+def _init_maps(mi: Any, it: Any, props: Any) -> None:
+    """The mask flag of integrator *it* and no bump or normal maps yet."""
+    it.masks = bool(props.get("masks", False))
+    it.map_lut = mi.UInt32(np.zeros(1, np.uint32))
+    #: (kind, texture, bump scale) of each bump- or normal-mapped shape (surface_maps)
+    it.surface_maps = []
+
+
+def _init_features(mi: Any, it: Any, props: Any) -> None:
+    """The glossy (:func:`_init_gloss`) and mask and map (:func:`_init_maps`) properties."""
+    _init_gloss(mi, it, props)
+    _init_maps(mi, it, props)
+
+
+def _set_maps(mi: Any, dr: Any, it: Any, scene: Any, tables: BandTables) -> None:
+    """Point integrator *it* at the bump and normal maps of the loaded *scene*'s shapes
+    named in *tables* (their texture objects, shape id -> map index)."""
+    lut, it.surface_maps = map_textures(mi, scene, tables.map_scales)
+    it.map_lut = mi.UInt32(shape_id_table(mi, dr, scene, lut, len(lut)))
+
+
 def _check_specular(it: Any, table: np.ndarray) -> None:
     """Raise unless *table* is ``(R, n_nodes, K)`` for integrator *it*."""
     shape = np.shape(table)
@@ -242,7 +271,7 @@ def _make_class(mi: Any, dr: Any) -> type:
             self.n_surfaces = int(props.get("n_surfaces", 0))
             self.n_texcols = int(props.get("n_texcols", 0))
             _empty_tables(mi, self)
-            _init_gloss(mi, self, props)
+            _init_features(mi, self, props)
 
         def set_tables(self, scene: Any, tables: BandTables) -> None:
             """Point the lookups at *tables* for the loaded *scene* (no recompilation)."""
@@ -254,6 +283,7 @@ def _make_class(mi: Any, dr: Any) -> type:
             self.slot_lut, self.tex_widths, self.tex_heights, self.tex_offsets = lookups[:4]
             self.texel_albedo, self.texel_weights = lookups[4:]
             _set_envmaps(self, tables)
+            _set_maps(mi, dr, self, scene, tables)
 
         def set_metals(self, rows: np.ndarray) -> None:
             """``(R,)`` bool: which albedo-table rows are metals (no diffuse lobe)."""
@@ -294,7 +324,7 @@ def band_path_class(variant: str) -> type:
     since ``mi.SamplingIntegrator`` is the variant's), registered as :data:`INTEGRATOR_NAME`.
 
     Properties: ``max_depth``, ``rr_depth`` (as ``path``), ``n_bands`` (K), ``n_lights`` (L),
-    ``n_surfaces``, ``n_texcols``, ``gloss``, ``metals``, ``n_nodes`` (μ nodes of the band
+    ``n_surfaces``, ``n_texcols``, ``gloss``, ``metals``, ``masks``, ``n_nodes`` (μ nodes of the band
     Fresnel tables). Its AOVs are :func:`aov_channels`; its RGB output is zero.
     """
     mi = import_mitsuba()
@@ -317,12 +347,14 @@ def band_path(
     n_texcols: int = 0,
     gloss: bool = False,
     metals: bool = False,
+    masks: bool = False,
 ) -> Any:
     """A :class:`BandPath` instance for the active variant (rr off: ``rr_depth`` > ``max_depth``),
     with first-hit maps of *n_surfaces* surfaces if not 0, textures of *n_texcols* coverage
     columns (:class:`TextureTables`) if not 0, the glossy (G1) factors and specular part with
     *gloss*, and the white-surface radiance at metal first hits with *metals* (implies *gloss*;
-    :mod:`~spectrinsic.render.band_path.kernel`)."""
+    :mod:`~spectrinsic.render.band_path.kernel`), and null events through opacity masks with
+    *masks*."""
     band_path_class(mi.variant())
     return mi.load_dict(
         {
@@ -335,5 +367,6 @@ def band_path(
             "n_texcols": int(n_texcols),
             "gloss": bool(gloss),
             "metals": bool(metals),
+            "masks": bool(masks),
         }
     )

@@ -34,7 +34,20 @@ Mitsuba's ``prb.py`` switches its features), so each traced kernel holds only it
   true scene with (G1); elsewhere the lane stops at once. Its accumulators ``M`` average over all
   of a pixel's samples, so ``M = c_metal · W`` with ``c_metal`` the pixel's metal coverage.
 * **first-hit maps** (``n_surfaces`` > 0, not in the white loop): the camera ray's surface, ray
-  distance, shading normal (and texel) are kept in the loop state.
+  distance, shading normal (and texel) are kept in the loop state. Under a bump or normal map
+  the normal is the perturbed one Mitsuba's wrapper shades with
+  (:func:`~spectrinsic.render.base.surface_maps.perturbed_normal`).
+* **masks** (``it.masks``): an opacity mask (Mitsuba's ``mask`` BSDF) lets a ray pass with a
+  *null* event (``sampled_type`` ``BSDFFlags.Null``, weight 1, direction unchanged). A cut-out
+  is geometry, not material: a null event's band factor is 1 on every band (not ρ_k nor
+  (G1), whose ``a`` is 0 there, as for any delta lobe), and the camera ray's *first vertex*
+  (first-hit maps, the start of the specular throughput) is its first vertex that is not a
+  null event (``PathState.seen``). Depths count null events as ``path.cpp`` does, so the
+  image stays Mitsuba's. A partly opaque hit is first with probability α, so the first-hit
+  maps mix the surface and what lies behind it by coverage, over the pixel's samples. The
+  white-at-metal loop's first vertex is the same (a metal behind a hole gets its ``W``); a
+  *masked metal* is swapped whole for the white BSDF, so its ``W`` there is over-estimated by
+  1/α (a known limit: masks are for leaves and cut-outs, not metals).
 
 Where to add a glossy part (a new per-light accumulator): a flag and its step here, its
 channel names and AOV order in :mod:`~spectrinsic.render.band_path.integrator`, and its cut into the
@@ -47,6 +60,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from ..base.surface_maps import perturbed_normal
 from ..base.textures import texel_of
 
 __all__ = ["PathState", "BandKernel", "mis_weight", "band_max"]
@@ -88,6 +102,8 @@ class PathState:
     #: First-hit state (surface, distance, normal[, texel, textured]); empty without maps.
     first: tuple
     alive: Any
+    #: Whether the camera ray has had its first vertex that is not a null event (masks).
+    seen: Any
     #: Specular band throughputs and accumulators (gloss loop only).
     sbands: list = field(default_factory=list)
     sacc: list = field(default_factory=list)
@@ -99,7 +115,7 @@ class _Vertex:
     Mitsuba's BSDF sample and weight, and (gloss) ``(a, μ)`` of both directions."""
 
     light: Any
-    nee: tuple
+    nee: tuple  # RGB weights (emitter, then extra maps) times the path throughput
     active_em: Any
     bsdf_sample: Any
     bsdf_weight: Any
@@ -118,6 +134,7 @@ class BandKernel:
         self.mi, self.dr, self.it, self.scene = mi, dr, it, scene
         self.gloss, self.white = gloss or white, white
         self.spec = gloss and not white
+        self.masks = bool(getattr(it, "masks", False))
 
     # -- lookups ---------------------------------------------------------------------------
 
@@ -175,8 +192,8 @@ class BandKernel:
     # -- the steps of a vertex -------------------------------------------------------------
 
     def emitter_hit(self, si: Any, s: PathState) -> tuple[Any, tuple, Any]:
-        """Light, weights (RGB radiance x BSDF-sampling MIS weight, of the emitter then of the
-        extra maps) and mask of an emitter hit."""
+        """Light, weights (the path's throughput x RGB radiance x BSDF-sampling MIS weight, of
+        the emitter then of the extra maps) and mask of an emitter hit."""
         mi, dr = self.mi, self.dr
         emitter = si.emitter(self.scene)
         hit = emitter != None  # noqa: E711 (a Dr.Jit pointer array, compared lane by lane)
@@ -187,7 +204,7 @@ class BandKernel:
         active = (s.prev_pdf > 0.0) & hit
         mis = mis_weight(dr, mi, s.prev_pdf, em_pdf)
         weights = (emitter.eval(si, active) * mis, *self.extra_maps_at(si, mis, active))
-        return self.light_of(emitter, hit), weights, hit
+        return self.light_of(emitter, hit), tuple(s.beta * w for w in weights), hit
 
     def lobes(self, si: Any, bsdf: Any, wo: Any, delta: Any, active: Any) -> tuple[Any, Any]:
         """``a = f_d / f`` at local direction *wo* (0 where *delta*; exactly 1 for a BSDF
@@ -206,9 +223,11 @@ class BandKernel:
         mu = dr.select(norm > 0.0, dr.abs(dr.dot(si.wi, h)) / norm, 1.0)
         return a, dr.clip(mu, 0.0, 1.0)
 
-    def vertex(self, sampler: Any, si: Any, bsdf: Any, active_next: Any) -> _Vertex:
-        """Emitter sample, then BSDF evaluation and sample (``eval_pdf_sample``); with gloss
-        also ``a`` and ``μ`` of both directions."""
+    def vertex(self, s: PathState, si: Any, bsdf: Any, active_next: Any) -> _Vertex:
+        """Emitter sample (its weights times the path's throughput ``s.beta``), then BSDF
+        evaluation and sample (``eval_pdf_sample``); with gloss also ``a`` and ``μ`` of both
+        directions."""
+        sampler = s.sampler
         mi, dr = self.mi, self.dr
         active_em = active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth)
         ds, em_weight = self.scene.sample_emitter_direction(si, sampler.next_2d(), True, active_em)
@@ -224,6 +243,7 @@ class BandKernel:
             towards = dr.zeros(mi.SurfaceInteraction3f)
             towards.wi = -ds.d
             nee += self.extra_maps_at(towards, bsdf_val[0] * mis_em / ds.pdf, active_em)
+        nee = tuple(s.beta * w for w in nee)
         if not self.gloss:
             light = self.light_of(ds.emitter, active_em)
             return _Vertex(light, nee, active_em, bsdf_sample, bsdf_weight[0])
@@ -255,22 +275,39 @@ class BandKernel:
 
     # -- first-hit maps --------------------------------------------------------------------
 
-    def first_hit(self, si: Any, depth: Any, first: tuple) -> tuple:
-        """Surface index, ray distance and shading normal of the camera ray's hit."""
+    def first_hit(self, si: Any, now: Any, first: tuple) -> tuple:
+        """Surface index, ray distance and shading normal of the hit *si* on the lanes where
+        it is the camera ray's first vertex so far (*now*; a later one replaces it after a
+        null event)."""
         mi, dr = self.mi, self.dr
         if not self.it.n_surfaces:
             return first
-        now, valid = depth == 0, si.is_valid()
+        valid = si.is_valid()
         surface = dr.gather(
             mi.UInt32, self.it.surface_lut, dr.reinterpret_array(mi.UInt32, si.shape), valid
         )
         surface = dr.select(valid, surface, self.it.n_surfaces)
-        distance = dr.select(valid, si.t, 0.0)
-        normal = dr.select(valid, si.sh_frame.n, mi.Vector3f(0.0))
+        # through null events the ray distance adds up (a hole's wall lies behind the mask)
+        distance = dr.select(valid, first[1] + si.t, 0.0)
+        normal = dr.select(valid, self.shading_normal(si), mi.Vector3f(0.0))
         hit = (surface, distance, normal) + (
             texel_of(mi, dr, self.it, si) if self.it.n_texcols else ()
         )
         return tuple(dr.select(now, h, f) for h, f in zip(hit, first, strict=True))
+
+    def shading_normal(self, si: Any) -> Any:
+        """The hit's shading normal, perturbed on shapes with a bump or normal map."""
+        mi, dr = self.mi, self.dr
+        normal = si.sh_frame.n
+        if not self.it.surface_maps:
+            return normal
+        ids = dr.reinterpret_array(mi.UInt32, si.shape)
+        index = dr.gather(mi.UInt32, self.it.map_lut, ids, si.is_valid())
+        for j, (kind, texture, scale) in enumerate(self.it.surface_maps):
+            on = si.is_valid() & (index == j)
+            bent = perturbed_normal(mi, dr, kind, texture, scale, si)
+            normal = dr.select(on, bent, normal)
+        return normal
 
     def first_state(self) -> tuple:
         """The first-hit state before any hit: no surface, no distance, no normal (no texel)."""
@@ -318,6 +355,7 @@ class BandKernel:
             mi.Bool(True),
             self.first_state(),
             mi.Bool(active),
+            mi.Bool(False),
             [mi.Float(0.0) for _ in range(k)] if self.spec else [],
             [mi.Float(0.0) for _ in range(n)] if self.spec else [],
         )
@@ -339,7 +377,7 @@ class BandKernel:
         delta = mi.has_flag(v.bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
         state = PathState(
             s.sampler, ray, depth, beta, bands, s.acc, mi.Interaction3f(si),
-            v.bsdf_sample.pdf, delta, s.first, s.alive, s.sbands, s.sacc,
+            v.bsdf_sample.pdf, delta, s.first, s.alive, s.seen, s.sbands, s.sacc,
         )  # fmt: skip
         return state, go_on
 
@@ -347,24 +385,26 @@ class BandKernel:
         """One vertex: emitter hit, emitter sample, BSDF sample, in ``path.cpp``'s order."""
         mi, dr = self.mi, self.dr
         si = self.scene.ray_intersect(s.ray, ray_flags=mi.RayFlags.All, coherent=s.depth == 0)
-        now, valid, swap = s.depth == 0, si.is_valid(), None
+        # the camera ray's first vertex: the first that is not a null event (masks)
+        now, valid, swap, keep = ~s.seen, si.is_valid(), None, None
         if self.white:  # the camera ray's metal hit becomes a white Lambertian vertex
             row = self.row(si)
             swap = now & (dr.gather(mi.UInt32, self.it.metal_rows, row, valid) != 0)
         else:
-            s.first = self.first_hit(si, s.depth, s.first)
+            s.first = self.first_hit(si, now, s.first)
         light, weight, hit = self.emitter_hit(si, s)
-        weight = tuple(s.beta * w for w in weight)
         # the white loop: what the camera sees directly is not reflected by the white surface
         s.acc = self.deposit(s.acc, light, weight, s.bands, hit if swap is None else hit & ~now)
         if self.spec:
             s.sacc = self.deposit(s.sacc, light, weight, s.sbands, hit)
         active_next = (s.depth + 1 < self.it.max_depth) & valid
         bsdf = si.bsdf(s.ray)
-        if swap is not None:
-            active_next &= ~now | swap
+        if swap is not None:  # the white loop goes on only from a metal first vertex ...
+            keep = ~now | swap
+            if not self.masks:  # ... or through a null event (masks: known once sampled)
+                active_next &= keep
             bsdf = dr.select(swap, mi.BSDFPtr(self.it.white_bsdf), bsdf)
-        v = self.vertex(s.sampler, si, bsdf, active_next)
+        v = self.vertex(s, si, bsdf, active_next)
         c_em = c_bs = rho = self.albedo(si)
         if swap is not None:
             rho = [dr.select(swap, 1.0, r) for r in rho]
@@ -372,19 +412,28 @@ class BandKernel:
             row = row if self.white else self.row(si)
             c_em, s_em = self.factors(rho, row, v.em_lobes, valid)
             c_bs, s_bs = self.factors(rho, row, v.bs_lobes, valid)
+        null = mi.Bool(False)
+        if self.masks:  # a null event passes every band unchanged and is no first vertex
+            null = valid & mi.has_flag(v.bsdf_sample.sampled_type, mi.BSDFFlags.Null)
+            c_bs = [dr.select(null, 1.0, c) for c in c_bs]
+            if self.spec:
+                s_bs = [dr.select(null, 0.0, x) for x in s_bs]
         if self.spec:  # the first vertex starts the specular throughput; later ones scale it
             pairs = zip(s.bands, s_em, s.sbands, c_em, strict=True)
             s_nee = [dr.select(now, b * x, sb * c) for b, x, sb, c in pairs]
             pairs = zip(s.bands, s_bs, s.sbands, c_bs, strict=True)
             s.sbands = [dr.select(now, b * x, sb * c) for b, x, sb, c in pairs]
         nee_bands = [b * c for b, c in zip(s.bands, c_em, strict=True)]
-        nee = tuple(s.beta * w for w in v.nee)
-        s.acc = self.deposit(s.acc, v.light, nee, nee_bands, v.active_em)
+        active_em = v.active_em if keep is None or not self.masks else v.active_em & keep
+        s.acc = self.deposit(s.acc, v.light, v.nee, nee_bands, active_em)
         if self.spec:
-            s.sacc = self.deposit(s.sacc, v.light, nee, s_nee, v.active_em)
+            s.sacc = self.deposit(s.sacc, v.light, v.nee, s_nee, v.active_em)
         bands = nee_bands if c_bs is c_em else [b * c for b, c in zip(s.bands, c_bs, strict=True)]
         s, go_on = self.step(s, si, v, bands)
         s.alive = active_next & go_on
+        if keep is not None and self.masks:
+            s.alive &= keep | null
+        s.seen = s.seen | ~null
         return s
 
     def run(self, sampler: Any, ray: Any, active: Any) -> tuple[PathState, list]:

@@ -29,11 +29,12 @@ from ...spectra import get_sensors
 from ..algebra.modes import ChannelValues, RenderMode, channel_values, get_mode
 from ..algebra.shares import TransportOutput
 from ..base import translate as tr
+from ..base.aov_maps import assemble_aovs
 from ..base.one_pass import DIRECT_DEPTH, PassOutput, PassProgress, timed_render
 from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
+from ..base.surface_maps import map_scales
 from ..base.textures import shape_slots, texture_tables
 from ..base.variants import choose_variant, variant_scope
-from ..passes.aovs import assemble_aovs
 from ..settings import DEFAULT_INTEGRATOR, INTEGRATORS
 from .integrator import BandTables, band_path, first_hit_channels
 
@@ -116,6 +117,8 @@ def _tables(
         textures=textures,
         shape_textures=shape_slots(textures, surfaces),
         light_channels=light_channels(scene, emitters),
+        map_scales=map_scales(scene, surfaces),
+        masks=any(m.maps is not None and m.maps.masked for m in scene.meshes),
     )
 
 
@@ -226,6 +229,7 @@ def _trace(
         n_texcols=n_texcols,
         gloss=dims.glossy,
         metals=metals,
+        masks=tables.masks,
     )
     integrator.set_tables(loaded, tables if n_surfaces else replace(tables, shape_surfaces={}))
     if spec_table is not None:
@@ -258,7 +262,7 @@ def _trace(
 
 
 def _first_hit_maps(scene: Scene, tables: BandTables, hits: np.ndarray) -> dict[str, np.ndarray]:
-    """:func:`~spectrinsic.render.passes.aovs.assemble_aovs` of the traversal's first-hit channels
+    """:func:`~spectrinsic.render.base.aov_maps.assemble_aovs` of the traversal's first-hit channels
     (coverage, texture columns, ray distance, normal)."""
     columns = None if tables.textures is None else tables.textures.columns
     surfaces = tr.surfaces(scene)

@@ -35,6 +35,7 @@ from ...scenes.envmaps import verified_map
 from ...scenes.model import Light, Material, Scene, unknown_light_kind
 from ...scenes.textures import box_uv
 from .plugins import black_bsdf
+from .surface_maps import wrap_bsdf
 from .textures import textured_bsdf
 from .variants import import_mitsuba
 
@@ -239,15 +240,20 @@ def _surface_bsdf(
 ) -> dict[str, Any]:
     """The BSDF of one surface: its material's, or on a textured mesh the texel-weighted mix of
     its basis materials (a mix of equal reflectances, such as the band path's white load, is
-    that reflectance)."""
-    texture = scene.meshes[part.mesh].texture if part.mesh >= 0 else None
+    that reflectance), wrapped by the mesh's mask and bump or normal map
+    (:func:`~spectrinsic.render.base.surface_maps.wrap_bsdf`)."""
+    mesh = scene.meshes[part.mesh] if part.mesh >= 0 else None
+    texture = None if mesh is None else mesh.texture
+    bsdf = material_bsdf(
+        scene.materials[part.material], materials[part.material], white_metal=white_metal
+    )
     if texture is not None:
         basis = [materials[b] for b in texture.basis]
         if any(dict(b) != dict(basis[0]) for b in basis[1:]):
-            return textured_bsdf(import_mitsuba(), texture, basis)
-    return material_bsdf(
-        scene.materials[part.material], materials[part.material], white_metal=white_metal
-    )
+            bsdf = textured_bsdf(import_mitsuba(), texture, basis)
+    if mesh is not None and mesh.maps is not None:  # cut-outs and perturbed normals
+        bsdf = wrap_bsdf(import_mitsuba(), mesh.maps, bsdf)
+    return bsdf
 
 
 def _look_at(mi: Any, origin: Sequence[float], direction: Sequence[float], what: str) -> Any:
@@ -394,6 +400,8 @@ def prepare_geometry(
             if texture.uv is None
             else np.asarray(texture.uv, float)  # the asset's own coordinates
         )
+        if uv is None and mesh.maps is not None:
+            uv = np.asarray(mesh.maps.uv, float)
         for m in np.unique(face_materials):
             sel = face_materials == m
             out.append(

@@ -33,6 +33,7 @@ from ..base.one_pass import (
     timed_render,
 )
 from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
+from ..base.surface_maps import refuse_maps
 from ..base.textures import refuse_textures
 from ..base.variants import choose_variant, variant_scope
 
@@ -85,6 +86,7 @@ def render_diagonal(
             "an llvm or cuda variant)"
         )
     refuse_textures(scene, "the diagonal passes")
+    refuse_maps(scene, "the diagonal passes")
     active = active_light_set(scene, active_lights)
     flags = (
         [bool(direct)] * len(value_sets) if isinstance(direct, bool) else [bool(d) for d in direct]

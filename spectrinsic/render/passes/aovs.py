@@ -10,6 +10,7 @@ import numpy as np
 from ...errors import RenderError, SceneError
 from ...scenes.model import Scene
 from ..base import translate as tr
+from ..base.aov_maps import assemble_aovs
 from ..base.one_pass import (
     PassProgress,
     placeholder_light,
@@ -18,10 +19,11 @@ from ..base.one_pass import (
     timed_render,
 )
 from ..base.plugins import aov_integrator, hdr_film, rgb_spectrum
+from ..base.surface_maps import refuse_maps
 from ..base.textures import refuse_textures
 from ..base.variants import choose_variant, variant_scope
 
-__all__ = ["render_aovs", "assemble_aovs"]
+__all__ = ["render_aovs"]
 
 
 def render_aovs(
@@ -56,6 +58,7 @@ def render_aovs(
     if int(spp) < 1:
         raise SceneError(f"spp {spp}: expected at least 1 sample per pixel")
     refuse_textures(scene, "the coverage passes")
+    refuse_maps(scene, "the coverage passes")
     surfaces = tr.surfaces(scene)
     n_pass = max(1, -(-len(surfaces) // 3))
     chosen = choose_variant("rgb", variant)
@@ -101,65 +104,3 @@ def render_aovs(
             block = surfaces[3 * p : 3 * p + 3]
             cover[..., 3 * p : 3 * p + len(block)] = image[..., 4 : 4 + len(block)]
     return assemble_aovs(scene, surfaces, cover, depth_sum, normal_sum), tuple(seconds)
-
-
-def _majority(coverage: np.ndarray) -> np.ndarray:
-    """Index of the largest coverage per pixel, -1 where the uncovered rest is larger."""
-    if coverage.shape[-1] == 0:
-        return np.full(coverage.shape[:2], -1, np.int32)
-    rest = 1.0 - coverage.sum(axis=-1, keepdims=True)
-    winner = np.argmax(np.concatenate([coverage, rest], axis=-1), axis=-1)
-    return np.where(winner == coverage.shape[-1], -1, winner).astype(np.int32)
-
-
-def assemble_aovs(
-    scene: Scene,
-    surfaces: Sequence[tr.Surface],
-    cover: np.ndarray,
-    depth_sum: np.ndarray | None,
-    normal_sum: np.ndarray | None,
-    texture_columns: np.ndarray | None = None,
-) -> dict[str, np.ndarray]:
-    """The maps :func:`render_aovs` returns, from the box-filtered per-surface coverage
-    ``(H, W, S)``, ray distance ``(H, W)`` and shading normal ``(H, W, 3)`` of the camera rays'
-    first hits (0 where they miss).
-
-    With *texture_columns* ``(G,)`` (material indices), *cover* has ``S + G`` channels: the last
-    G hold the box-filtered texel weights of textured hits on those basis materials
-    (:mod:`~spectrinsic.render.base.textures`), which take the place of the textured surfaces'
-    own coverage in the material coverage."""
-    columns = np.zeros(0, np.int64) if texture_columns is None else np.asarray(texture_columns)
-    h, w = cover.shape[:2]
-    n_mat = len(scene.materials)
-    material_cov = np.zeros((h, w, n_mat))
-    object_ids = sorted({m.object_id for m in scene.meshes})
-    object_cov = np.zeros((h, w, len(object_ids)))
-    for i, s in enumerate(surfaces):
-        if s.material >= 0:
-            if scene.meshes[s.mesh].texture is None:
-                material_cov[..., s.material] += cover[..., i]
-            object_cov[..., object_ids.index(scene.meshes[s.mesh].object_id)] += cover[..., i]
-    for g, m in enumerate(columns):
-        material_cov[..., int(m)] += cover[..., len(surfaces) + g]
-    hit = cover[..., : len(surfaces)].sum(axis=-1)
-    material_id = _majority(material_cov)
-    winner = _majority(object_cov)
-    object_id = np.where(winner >= 0, np.asarray(object_ids + [-1], np.int64)[winner], -1).astype(
-        np.int32
-    )
-    depth = (
-        np.zeros((h, w))
-        if depth_sum is None
-        else np.divide(depth_sum, hit, out=np.zeros((h, w)), where=hit > 1e-6)
-    )
-    normals = np.zeros((h, w, 3)) if normal_sum is None else normal_sum
-    length = np.linalg.norm(normals, axis=-1, keepdims=True)
-    normals = np.divide(normals, length, out=np.zeros_like(normals), where=length > 1e-6)
-    return {
-        "coverage": np.clip(material_cov, 0.0, 1.0).astype(np.float32),
-        "material_id": material_id,
-        "object_id": object_id,
-        "depth": depth.astype(np.float32),
-        "normals": normals.astype(np.float32),
-        "mask": material_id >= 0,
-    }

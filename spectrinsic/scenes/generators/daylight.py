@@ -11,7 +11,7 @@ is a fraction in :data:`SKY_TO_SUN` of that, the diffuse-to-direct ratio of clea
 A daylight room is closed (four walls, a ceiling) with this one opening, so sun and sky come
 in through the window only. The window is an axis-aligned box through the wall,
 :attr:`Daylight.opening`; the sun patch on the floor follows from it and the sun direction in
-closed form (``tests/scenes/test_daylight_rooms.py``).
+closed form (``tests/scenes/generators/test_daylight_rooms.py``).
 
 How much of the room's light is daylight: each daylight room draws a target share of the
 radiant flux entering the room, :data:`FLUX_SHARE` (``--daylight-only``: 1), and

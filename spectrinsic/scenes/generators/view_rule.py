@@ -24,7 +24,7 @@ Judged when the camera is drawn, before any render, from a low-resolution ray ca
   have Φ = 0 and are judged as before.
 
 Measured on 50 rooms (root seed 11): 50 of 92 judged cameras pass (acceptance 54 %), about
-0.4 s per judged camera on one core (``tests/scenes/test_view_rule.py``).
+0.4 s per judged camera on one core (``tests/scenes/generators/test_view_rule.py``).
 
 **The rendered light** (issue 47): the estimate above misses what it does not trace (a sky,
 glossy paths, more than one bounce), so where the build gives a probe render

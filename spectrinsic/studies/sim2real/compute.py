@@ -19,8 +19,8 @@ from ...arrays import StepProgress
 from ...decompose.evaluation.mit import MitObject, load_mit_object, mit_measures
 from ...decompose.methods.registry import get_decomposer
 from ...errors import StudyError
+from ...gt_export.dataset.loader import load_sample, split_samples
 from ...gt_export.sample import sample_dirs
-from ...gt_export.sample.loader import load_sample, split_samples
 from ...gt_export.sample.meta import read_meta
 from ...learn.card import write_outputs
 from ...learn.train import TrainOptions, train

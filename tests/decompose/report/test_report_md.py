@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from spectrinsic.decompose.evaluation.evaluate import EvaluationResult
 from spectrinsic.decompose.evaluation.scores import Score
 from spectrinsic.decompose.report import write_report
 from spectrinsic.decompose.report.markdown import GLOSSARY
@@ -78,7 +79,8 @@ def _number(cell: str) -> float:
 def report(tmp_path_factory) -> tuple[Path, str, list[Score]]:
     out = tmp_path_factory.mktemp("report")
     scores = _scores()
-    write_report(out, scores, SAMPLES, {"flat": Flat(), "noisy": Noisy()}, ["image_denoised"])
+    methods = {"flat": Flat(), "noisy": Noisy()}
+    write_report(out, EvaluationResult(tuple(scores), SAMPLES, methods, ("image_denoised",)))
     return out, (out / "REPORT.md").read_text(encoding="utf-8"), scores
 
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from spectrinsic.errors import DatasetError
+from spectrinsic.gt_export.dataset.loader import EXPOSURE_PERCENTILE, prepare_item, split_samples
 from spectrinsic.gt_export.dataset.manifest import split_counts, splits_by_scene
-from spectrinsic.gt_export.sample.loader import EXPOSURE_PERCENTILE, prepare_item, split_samples
 
 
 def _sample(h=6, w=8):

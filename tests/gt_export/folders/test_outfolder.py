@@ -14,7 +14,8 @@ import pytest
 
 from spectrinsic.cli import main
 from spectrinsic.errors import DatasetError, FolderLockedError
-from spectrinsic.gt_export import remove_stale_temporaries
+from spectrinsic.gt_export import remove_owned_temporaries
+from spectrinsic.gt_export.folders.build_folder import check_build_folder, write_marker
 from spectrinsic.gt_export.folders.outfolder import (
     LOCK_NAME,
     OUTPUT_MARKER,
@@ -22,7 +23,6 @@ from spectrinsic.gt_export.folders.outfolder import (
     folder_lock,
     output_folder,
 )
-from spectrinsic.gt_export.sample.integrity import check_build_folder, write_marker
 
 #: Longest wait for the helper process to take the lock, seconds.
 HOLDER_START_S = 60.0
@@ -175,7 +175,7 @@ def test_a_write_probe_left_by_a_killed_run_does_not_block_the_next(tmp_path):
     check_output_folder(out)
     assert check_build_folder(out, "h" * 64, rebuild=False) is None
     write_marker(out, "h" * 64)  # what a build does first; its clean-up then takes the probe
-    assert probe in remove_stale_temporaries(out) and not probe.exists()
+    assert probe in remove_owned_temporaries(out) and not probe.exists()
     other = tmp_path / "other"
     (other / ".spectrinsic-tmp-probe-4242").mkdir(parents=True)
     (other / ".spectrinsic-tmp-probe-4242" / "mine.txt").write_text("mine")

@@ -15,7 +15,8 @@ from spectrinsic.decompose.methods.registry import (
     available_decomposers,
     get_decomposer,
 )
-from tests.decompose.test_evaluate import _sample
+from spectrinsic.decompose.report import write_report
+from tests.decompose.evaluation.test_evaluate import _sample
 
 TOY_MODULE = '''
 from dataclasses import dataclass
@@ -69,7 +70,7 @@ def test_entry_point_adds_a_method_to_the_registry_and_the_tables(plugin_dir, tm
 
     samples = [_sample("obj-a__v0__white", 0, (1, 1, 1), False)]
     out = tmp_path / "evaluation"
-    evaluate(
+    run = evaluate(
         samples,
         out,
         methods=["image-as-reflectance", "toy-half"],
@@ -78,6 +79,7 @@ def test_entry_point_adds_a_method_to_the_registry_and_the_tables(plugin_dir, tm
         figures=False,
         save_estimates=False,
     )
+    write_report(out, run)
     rows = {r["method"]: r for r in csv.DictReader((out / "lmse_by_condition.csv").open())}
     assert set(rows) == {"image-as-reflectance", "toy-half"}
     # image / 2 is the image up to scale: every scale-invariant score equals the baseline's

@@ -14,6 +14,7 @@ from spectrinsic.decompose.evaluation.predictions import Predictions, write_pred
 from spectrinsic.decompose.evaluation.sample_fields import input_image
 from spectrinsic.decompose.evaluation.targets import target_image, target_note
 from spectrinsic.decompose.metrics import get_metric
+from spectrinsic.decompose.report import write_report
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import export_sample, load_sample, write_manifest
 from spectrinsic.render import RenderSettings, render_batches
@@ -50,7 +51,8 @@ def _scores(out) -> dict[tuple[str, str, str], float]:
 
 
 def _run(sample, out, preds: dict[str, Predictions], target: str) -> dict:
-    evaluate([sample], out, methods=preds, cameras=False, figures=False, target=target)
+    run = evaluate([sample], out, methods=preds, cameras=False, figures=False, target=target)
+    write_report(out, run)
     return _scores(out)
 
 

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from spectrinsic.decompose.evaluation.evaluate import evaluate
+from spectrinsic.decompose.report import write_report
 from spectrinsic.decompose.synthetic import mondrian
 
 METHODS = ["colour-retinex", "image-as-reflectance"]
@@ -48,6 +49,7 @@ def result(tmp_path_factory):
     ]
     seen = []
     res = evaluate(samples, out, methods=METHODS, seed=3, progress=seen.append)
+    write_report(out, res)  # as the CLI does
     return res, out, seen
 
 

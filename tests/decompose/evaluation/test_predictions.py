@@ -11,10 +11,11 @@ from spectrinsic.decompose.evaluation.evaluate import evaluate
 from spectrinsic.decompose.evaluation.predictions import Predictions, read_layer
 from spectrinsic.decompose.evaluation.sample_fields import input_image
 from spectrinsic.decompose.methods.registry import get_decomposer
+from spectrinsic.decompose.report import write_report
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.formats.exr import write_exr
 from spectrinsic.gt_export.formats.png import PNG16_MAX, write_png16
-from tests.decompose.test_evaluate import _sample
+from tests.decompose.evaluation.test_evaluate import _sample
 
 BASELINE = "image-as-reflectance"
 
@@ -49,6 +50,7 @@ def _write_baseline_as_files(root, result_dir):
 
 def test_predictions_folder_scores_exactly_like_the_builtin_baseline(tmp_path):
     builtin = evaluate(_samples(), tmp_path / "builtin", methods=[BASELINE], seed=5, figures=False)
+    write_report(tmp_path / "builtin", builtin)
     root = tmp_path / "mine"
     _write_baseline_as_files(root, tmp_path / "builtin")
     mine = evaluate(
@@ -59,6 +61,7 @@ def test_predictions_folder_scores_exactly_like_the_builtin_baseline(tmp_path):
         figures=False,
         save_estimates=False,
     )
+    write_report(tmp_path / "scored", mine)
 
     def key(s):
         return (s.sample, s.method, s.scenario, s.layer, s.metric)

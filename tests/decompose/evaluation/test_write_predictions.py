@@ -10,7 +10,7 @@ from spectrinsic.decompose import Predictions, evaluate, write_predictions
 from spectrinsic.decompose.evaluation.predictions import read_layer
 from spectrinsic.decompose.evaluation.sample_fields import input_image
 from spectrinsic.errors import DatasetError
-from tests.decompose.test_evaluate import _sample
+from tests.decompose.evaluation.test_evaluate import _sample
 
 #: Half a 16-bit code: the largest error of rounding a value in [0, 1] to code / 65535.
 HALF_CODE = 0.5 / 65535

@@ -15,7 +15,7 @@ from spectrinsic.errors import DatasetError, SampleMetaError
 from spectrinsic.gt_export import export_sample, load_sample, read_meta, write_manifest
 from spectrinsic.gt_export.sample import SEAL_KEY, meta_seal
 
-PACKAGE = Path(__file__).resolve().parents[2]
+PACKAGE = Path(__file__).resolve().parents[3]
 
 
 @pytest.fixture

@@ -10,13 +10,13 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError, MissingDependencyError
-from ..dataset.manifest import read_splits
 from ..formats.exr import read_exr
 from ..formats.png import EXPOSURE_PERCENTILE, exposure
 from ..layers.spectral_intrinsics import bands_to_rgb, rgb_residual_share, working_space_matrix
-from . import META_NAME, file_sha256, sample_dirs
-from .meta import SampleMeta, read_meta
-from .working_view import space_of, srgb_view, view_kind
+from ..sample import META_NAME, file_sha256, sample_dirs
+from ..sample.meta import SampleMeta, read_meta
+from ..sample.working_view import space_of, srgb_view, view_kind
+from .manifest import read_splits
 
 __all__ = [
     "load_sample",

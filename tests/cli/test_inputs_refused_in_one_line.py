@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from spectrinsic.cli import main
-from spectrinsic.gt_export.sample.integrity import write_marker
+from spectrinsic.gt_export.folders.build_folder import write_marker
 from spectrinsic.pipeline.presets import get_preset
 from tests.conftest import QUAD_YAML
 

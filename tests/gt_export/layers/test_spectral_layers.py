@@ -17,9 +17,9 @@ import pytest
 
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import check_sample, export_sample, load_sample
+from spectrinsic.gt_export.dataset.loader import filter_residual_share, working_space_view
 from spectrinsic.gt_export.layers import compute_ground_truth, identities
 from spectrinsic.gt_export.relight import relight, relit_scene
-from spectrinsic.gt_export.sample.loader import filter_residual_share, working_space_view
 from spectrinsic.render import RenderSettings, render_batches, render_scene
 from spectrinsic.render.transport_render import render_transport_batches
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene

@@ -19,9 +19,9 @@ from spectrinsic.render import RenderSettings, render_batches
 from spectrinsic.render.transport_render import render_transport_batches
 from spectrinsic.scenes.model import Material
 
-#: A relit layer and the direct render's agree to float rounding (as tests/gt_export/test_relight.py).
+#: A relit layer and the direct render's agree to float rounding (as tests/gt_export/relight/test_relight.py).
 RELIGHT_RTOL = 1e-5
-#: The noise layers come from float16 batch deviations (as tests/gt_export/test_relight.py).
+#: The noise layers come from float16 batch deviations (as tests/gt_export/relight/test_relight.py).
 NOISE_RTOL = 1e-3
 NEW_LIGHTS = {0: "cie:LED-RGB1", 1: "planck:3000K"}
 SEED = 13

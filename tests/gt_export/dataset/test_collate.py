@@ -9,7 +9,7 @@ import pytest
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export import load_sample
 from spectrinsic.gt_export.dataset.collate import LIGHT_MASK, collate_arrays, pad_lights
-from spectrinsic.gt_export.sample.loader import prepare_item
+from spectrinsic.gt_export.dataset.loader import prepare_item
 
 
 def test_pad_lights_keeps_the_real_channels_and_zeroes_the_rest():

@@ -8,7 +8,7 @@ import scipy.sparse as sp
 from scipy.optimize import lsq_linear
 
 import spectrinsic.decompose.methods.coherence as coherence
-from spectrinsic.decompose.methods.coherence import bounded_minimum, global_coherence
+from spectrinsic.decompose.methods.coherence import bounded_minimum, global_coherence, grid_edges
 
 
 @pytest.fixture(autouse=True)
@@ -61,3 +61,40 @@ def test_coherence_scales_a_two_region_image_to_the_image_ratio():
     image = np.where(regions == 1, 0.2, 0.8)
     lam = global_coherence(regions, np.array([0.0, 0.5, 0.5]), image)
     assert lam[2] / lam[1] == pytest.approx(4.0, rel=1e-9) and lam[1:].min() == 1.0
+
+
+def _lens(profile: np.ndarray, side: float = 0.15) -> np.ndarray:
+    """A symmetric 3-tap point spread ``(side, 1 - 2 side, side)`` along the row."""
+    padded = np.concatenate([profile[:1], profile, profile[-1:]])
+    return side * padded[:-2] + (1.0 - 2.0 * side) * padded[1:-1] + side * padded[2:]
+
+
+def _two_regions(row: np.ndarray, step_at: int, blurred: bool) -> float:
+    """Reflectance ratio left/right that global_coherence gives a 3-row image of *row* split
+    into two regions at *step_at*, each region's ``L`` its mean image intensity (the
+    names-and-shades default); every edge marked *blurred* or none."""
+    image = np.repeat(row[None, :], 3, axis=0)
+    regions = np.where(np.arange(row.size) < step_at, 1, 2)[None, :].repeat(3, axis=0)
+    means = np.array([0.0, image[regions == 1].mean(), image[regions == 2].mean()])
+    marks = np.ones(grid_edges(regions > 0)[1].shape[0], bool) if blurred else None
+    lam = global_coherence(regions, means, image, marks)
+    return float(lam[1] * means[1] / (lam[2] * means[2]))
+
+
+def test_coherence_reads_a_blurred_step_past_its_mixed_pixels():
+    # paper 0.8 beside print 0.05 (ratio 16) under uniform light, through a lens that mixes
+    # 15 % into each neighbour: the boundary pixels hold 0.6875 and 0.1625 (ratio 4.2)
+    row = _lens(np.where(np.arange(16) < 8, 0.8, 0.05))
+    assert _two_regions(row, 8, blurred=False) == pytest.approx(4.23, abs=0.01)  # before
+    assert _two_regions(row, 8, blurred=True) == pytest.approx(16.0, rel=1e-6)
+
+
+def test_a_shading_gradient_at_a_sharp_step_is_not_taken_for_blur():
+    # the same step, unblurred, under a light falling 10 % per pixel: stepping inside would
+    # add the gradient to the ratio; the boundary pixels (one pixel of gradient) are read
+    x = np.arange(16)
+    row = np.where(x < 8, 0.8, 0.05) * 0.9**x
+    assert _two_regions(row, 8, blurred=True) == pytest.approx(
+        _two_regions(row, 8, blurred=False), rel=1e-9
+    )
+    assert _two_regions(row, 8, blurred=False) == pytest.approx(16 / 0.9, rel=1e-6)
