@@ -47,6 +47,7 @@ def add_source_options(src: Any) -> None:
     """Where the scenes come from: the library (default), a generator, or scene files."""
     _add_generator_options(src)
     _add_generated_draw_options(src)
+    _add_glass_options(src)
     _add_scene_file_options(src)
 
 
@@ -140,6 +141,18 @@ def _add_generated_draw_options(src: Any) -> None:
         metavar="LO,HI",
         help="GGX roughness range of glossy and metal materials (0,0.3)",
     )
+
+
+def _add_glass_options(src: Any) -> None:
+    """Glass and mirror objects in generated scenes (off by default)."""
+    for flag, what in (("--glass", "clear glass"), ("--mirrors", "perfect mirrors")):
+        src.add_argument(
+            flag,
+            type=float,
+            default=None,
+            metavar="F",
+            help=f"fraction of single-material objects' materials made {what} (0)",
+        )
 
 
 def _add_scene_file_options(src: Any) -> None:
@@ -263,6 +276,8 @@ GENERATOR_DEFAULTS: dict[str, Any] = {
     "glossy": GLOSSY_FRACTION,
     "metallic": METALLIC_FRACTION,
     "roughness_range": "0,0.3",
+    "glass": 0.0,
+    "mirrors": 0.0,
     "daylight_share": 0.0,
     "daylight_only": False,
 }
@@ -312,10 +327,16 @@ def source_from_args(args: argparse.Namespace) -> str | None:
     if args.generator:
         try:
             gloss = GlossDistribution(
-                args.glossy, args.metallic, _range("--roughness-range", args.roughness_range)
+                args.glossy,
+                args.metallic,
+                _range("--roughness-range", args.roughness_range),
+                glass_fraction=args.glass,
+                mirror_fraction=args.mirrors,
             )
         except SceneError as exc:
-            raise DatasetError(f"--glossy/--metallic/--roughness-range: {exc}") from None
+            raise DatasetError(
+                f"--glossy/--metallic/--roughness-range/--glass/--mirrors: {exc}"
+            ) from None
         return generator_source(
             args.generator,
             args.count,

@@ -154,11 +154,16 @@ def generator_source(
         "generator_version": GENERATOR_VERSION,
     }
     if gloss is not None and gloss.active:
+        glass = (  # absent when off: older configs keep their hash
+            {"glass": float(gloss.glass_fraction), "mirrors": float(gloss.mirror_fraction)}
+            if gloss.glass_active
+            else {}
+        )
         spec["gloss"] = {
             "glossy": float(gloss.glossy_fraction),
             "metallic": float(gloss.metal_fraction),
             "roughness_range": [float(v) for v in gloss.roughness_range],
-        }
+        } | glass
     if light_saturation is not None:  # absent when not given: older configs keep their hash
         spec["light_saturation"] = [float(v) for v in light_saturation]
     if texture_fraction > 0:
@@ -294,6 +299,8 @@ def _generator_options(spec: Mapping[str, Any], config: DatasetConfig, data_dir:
             float(g.get("glossy", 0.0)),
             float(g.get("metallic", 0.0)),
             tuple(g.get("roughness_range", (0.0, 0.3))),
+            glass_fraction=float(g.get("glass", 0.0)),
+            mirror_fraction=float(g.get("mirrors", 0.0)),
         )  # type: ignore[arg-type]
     except (SceneError, TypeError, ValueError) as exc:
         raise DatasetError(f"source gloss {g!r}: {exc}") from exc
@@ -402,7 +409,7 @@ def check_scene_integrator(config: DatasetConfig, scene: Scene, path: str) -> No
         return
     glossy = any(m.glossy for m in scene.materials)
     if glossy or scene.textured:
-        what = "glossy or metal materials" if glossy else "a spectral texture"
+        what = "glossy, metal or glass materials" if glossy else "a spectral texture"
         raise DatasetError(
             f"{path}: holds {what}, which the passes integrator cannot render in the diagonal "
             "modes; use --integrator single on a JIT (LLVM/CUDA) variant"

@@ -19,8 +19,9 @@ spectrum chosen by, in order: the *materials* mapping passed in, the material's 
 else is needed). A Principled BSDF node sets the gloss (:func:`principled_gloss`): Metallic
 ≥ 0.5 makes a metal (``conductor``, η/k of the custom property ``"metal"``, default ``Al``; no
 spectrum needed), else Roughness < 0.5 a coated diffuse (``plastic``, the node's IOR); GGX α is
-Roughness² (Blender's convention). Everything else of the node (coat, sheen, subsurface,
-transmission, emission, textures) is ignored; other materials are Lambertian.
+Roughness² (Blender's convention); Transmission 1 or a Glass BSDF is clear glass
+(:mod:`~spectrinsic.scenes.blender_gloss`). Everything else of the node (coat, sheen,
+subsurface, emission, textures) is ignored; other materials are Lambertian.
 
 With ``colours_from_asset=True`` (the default; ``--no-colours-from-asset`` turns it off), a
 material that the mapping, its
@@ -48,11 +49,12 @@ import numpy as np
 
 from ..errors import MissingDependencyError, SceneError, SpectrinsicError, with_article
 from ..spectra import get_spectrum
-from .blender_colours import base_colour, corner_uvs, object_texture, principled_node
+from .blender_colours import base_colour, corner_uvs, object_texture
+from .blender_gloss import METAL_PROPERTY, principled_gloss
 from .budget import SceneBudget
 from .image_textures import corner_spectra
-from .materials import IOR_RANGE, METAL_SPECTRUM, material_problem
-from .model import Camera, Light, Material, Mesh, Scene
+from .materials import METAL_SPECTRUM, material_problem
+from .model import NON_DIFFUSE_KINDS, Camera, Light, Material, Mesh, Scene
 from .textures import Texture, make_image_texture
 from .validate import validate_scene
 
@@ -62,9 +64,6 @@ log = logging.getLogger(__name__)
 
 #: Custom property naming a material's or a light's spectrum.
 SPECTRUM_PROPERTY = "spectrum"
-#: Custom property of a metallic material naming its conductor (Mitsuba η/k table), and the default.
-METAL_PROPERTY = "metal"
-DEFAULT_METAL = "Al"
 _MESH_LIKE = {"MESH", "CURVE", "SURFACE", "META", "FONT"}
 
 
@@ -81,27 +80,6 @@ def _require_bpy() -> Any:
 
 def _matrix(obj: Any) -> np.ndarray:
     return np.array([list(row) for row in obj.matrix_world], dtype=np.float64)
-
-
-def principled_gloss(mat: Any) -> dict[str, Any]:
-    """Gloss fields of :class:`Material` from *mat*'s first Principled BSDF node (module
-    docstring); ``{}`` (Lambertian) without one or when it is matte."""
-    node = principled_node(mat)
-    if node is None:
-        return {}
-    rough = float(node.inputs["Roughness"].default_value)
-    alpha = min(max(rough, 0.0), 1.0) ** 2
-    if float(node.inputs["Metallic"].default_value) >= 0.5:
-        metal = str(mat[METAL_PROPERTY]) if METAL_PROPERTY in mat.keys() else DEFAULT_METAL
-        return {"kind": "conductor", "metal": metal, "roughness": alpha}
-    if rough < 0.5:
-        ior = float(node.inputs["IOR"].default_value) if "IOR" in node.inputs else 1.5
-        return {
-            "kind": "plastic",
-            "roughness": alpha,
-            "ior": min(max(ior, IOR_RANGE[0] + 1e-3), IOR_RANGE[1]),
-        }
-    return {}
 
 
 def _prop(*owners: Any) -> str | None:
@@ -262,8 +240,11 @@ class _MaterialTable:
         else:
             name = mat.name
             spectrum = self.mapping.get(name) or _prop(mat) or self._colour(mat) or name
-        gloss = principled_gloss(mat) if mat is not None else {}
-        if name not in self.table and gloss.get("kind") == "conductor":
+        try:
+            gloss = principled_gloss(mat) if mat is not None else {}
+        except SceneError as exc:  # glass without exact ground truth: name the file
+            raise SceneError(f"{self.source}: {exc}") from None
+        if name not in self.table and gloss.get("kind") in NON_DIFFUSE_KINDS:
             material = Material(name=name, spectrum=METAL_SPECTRUM, **gloss)
             problem = material_problem(material)
             if problem:

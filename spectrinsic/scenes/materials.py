@@ -7,11 +7,18 @@ A material is a spectrum name (Lambertian, as before) or a mapping::
       wall: "munsell:5Y 8/2"                         # Lambertian
       cup: {kind: plastic, spectrum: "munsell:5R 4/14", ior: 1.5, roughness: 0.1}
       lamp: {kind: conductor, metal: Au, roughness: 0.05}
+      mirror: {kind: conductor, metal: none}            # perfect mirror, F = 1
+      vase: {kind: dielectric, ior: 1.5, roughness: 0}  # clear glass, solid
+      pane: {kind: thindielectric, ior: 1.5}            # clear glass, a thin sheet
 
 ``plastic`` is a diffuse base under a dielectric coat of index ``ior`` (Mitsuba ``plastic``,
 or ``roughplastic`` when ``roughness`` > 0); ``conductor`` is a metal with Mitsuba's measured
-η/k of ``metal`` (``conductor`` / ``roughconductor``) and no diffuse lobe (spectrum
-``flat:0``). ``roughness`` is the GGX α in [0, 1] (0 = smooth); ``ior`` lies in (1, 3].
+η/k of ``metal`` (``conductor`` / ``roughconductor``; ``none`` is Mitsuba's perfect mirror) and
+no diffuse lobe (spectrum ``flat:0``). ``dielectric`` is a clear glass solid of index ``ior``
+relative to the outside (Mitsuba ``dielectric``, or ``roughdielectric`` with GGX when
+``roughness`` > 0); ``thindielectric`` a smooth thin pane (Mitsuba ``thindielectric``); glass has
+no diffuse lobe either and is untinted (no absorption, a constant ``ior``: no dispersion).
+``roughness`` is the GGX α in [0, 1] (0 = smooth); ``ior`` lies in (1, 3].
 
 A ``textured`` material is a spectral texture (:mod:`spectrinsic.scenes.textures`): per texel a
 convex mix of 2–4 ``basis`` reflectances, from a generated ``pattern`` (``rings``, ``weave``,
@@ -68,6 +75,8 @@ _KEYS = {
     "diffuse": ("kind", "spectrum"),
     "plastic": ("kind", "spectrum", "ior", "roughness"),
     "conductor": ("kind", "metal", "roughness"),
+    "dielectric": ("kind", "ior", "roughness"),
+    "thindielectric": ("kind", "ior"),
 }
 
 
@@ -94,9 +103,13 @@ def material_problem(m: Material) -> str | None:
         return f"roughness {m.roughness!r}: expected a GGX alpha in [0, 1]"
     if not _number(m.ior) or not IOR_RANGE[0] < m.ior <= IOR_RANGE[1]:
         return f"ior {m.ior!r}: expected an index of refraction in ({IOR_RANGE[0]:g}, {IOR_RANGE[1]:g}]"
+    if m.non_diffuse and m.spectrum != METAL_SPECTRUM:
+        return (
+            f"a {m.kind} has no diffuse spectrum (expected {METAL_SPECTRUM!r}, got {m.spectrum!r})"
+        )
+    if m.kind == "thindielectric" and m.roughness != 0.0:
+        return f"roughness {m.roughness!r}: a thindielectric is smooth (Mitsuba has no rough one)"
     if m.kind == "conductor":
-        if m.spectrum != METAL_SPECTRUM:
-            return f"a conductor has no diffuse spectrum (expected {METAL_SPECTRUM!r}, got {m.spectrum!r})"
         try:
             check_conductor(m.metal)
         except SpectralDataError as exc:
@@ -168,15 +181,15 @@ def parse_material(name: str, value: Any) -> Material | TexturedMaterial | str:
     unknown = [k for k in value if k not in _KEYS[kind]]
     if unknown:
         return f"unknown key {unknown[0]!r} for kind {kind}; expected {', '.join(_KEYS[kind])}"
-    need = "metal" if kind == "conductor" else "spectrum"
-    if not isinstance(value.get(need), str) or not value[need].strip():
+    need = {"conductor": "metal", "diffuse": "spectrum", "plastic": "spectrum"}.get(kind)
+    if need and (not isinstance(value.get(need), str) or not value[need].strip()):
         return f"kind {kind} needs a non-empty '{need}'"
     for key in ("ior", "roughness"):
         if key in value and not _number(value[key]):
             return f"{key}: expected a number, got {value[key]!r}"
     m = Material(
         name=name,
-        spectrum=METAL_SPECTRUM if kind == "conductor" else value["spectrum"],
+        spectrum=value["spectrum"] if "spectrum" in _KEYS[kind] else METAL_SPECTRUM,
         kind=kind,
         roughness=float(value.get("roughness", 0.0)),
         ior=float(value.get("ior", 1.5)),
@@ -192,9 +205,12 @@ def material_entry(m: Material) -> str | dict[str, Any]:
     entry: dict[str, Any] = {"kind": m.kind}
     if m.kind == "conductor":
         entry["metal"] = m.metal
-    else:
-        entry |= {"spectrum": m.spectrum, "ior": float(m.ior)}
-    entry["roughness"] = float(m.roughness)
+    elif m.kind == "plastic":
+        entry["spectrum"] = m.spectrum
+    if "ior" in _KEYS[m.kind]:
+        entry["ior"] = float(m.ior)
+    if "roughness" in _KEYS[m.kind]:
+        entry["roughness"] = float(m.roughness)
     return entry
 
 

@@ -10,7 +10,9 @@ files and ``map_Kd`` images) are read.
 A glTF material's ``pbrMetallicRoughness`` factors set the gloss as for ``.blend`` files: metallic
 ≥ 0.5 makes a metal (``conductor``, Al: the factors name no metal; no spectrum needed), else
 roughness < 0.5 a coated diffuse (``plastic``, η = 1.5); GGX α = roughness². Absent factors
-count as matte (not glTF's default of 1), so files without them import as before.
+count as matte (not glTF's default of 1), so files without them import as before. A material
+with ``KHR_materials_transmission`` factor 1 is clear glass (:mod:`~spectrinsic.scenes.gltf_glass`;
+a partial factor is refused in one line).
 
 Colours from the asset (``colours_from_asset=True``, the default; ``--no-colours-from-asset``
 turns it off): a material not in the map takes the colour its file states, a glTF
@@ -43,10 +45,11 @@ import numpy as np
 from ..errors import SceneError
 from .budget import MAX_FACES, MAX_VERTICES, SceneBudget
 from .gltf_colours import gltf_colours
+from .gltf_glass import gltf_glass
 from .gltf_maps import gltf_maps, warn_mirrored_uv
 from .image_textures import AssetColour, ImageTexture, corner_spectra
 from .materials import METAL_SPECTRUM
-from .model import Camera, Light, Material, Mesh, Scene
+from .model import NON_DIFFUSE_KINDS, Camera, Light, Material, Mesh, Scene
 from .mtl_colours import mtl_colours
 from .mtl_maps import mtl_maps
 from .semantic import SemanticMap, classify
@@ -394,10 +397,12 @@ def load_mesh_scene(
     surface_maps = gltf_maps(path) or mtl_maps(path)  # masks are geometry: whatever the colours
     table = _Table()
     meshes = []
+    glass = gltf_glass(path)
     for i, (node, material, verts, faces, gloss, uv) in enumerate(geoms):
-        colour = None if material in materials else colours.get(material)
+        gloss = glass.get(material, gloss)
+        colour = None if material in materials or material in glass else colours.get(material)
         texture = None
-        if gloss.get("kind") == "conductor":
+        if gloss.get("kind") in NON_DIFFUSE_KINDS:
             spectrum: str | None = METAL_SPECTRUM
         elif colour is not None and colour.image is not None:
             if gloss:

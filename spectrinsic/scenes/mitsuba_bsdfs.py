@@ -5,19 +5,24 @@ Read exactly: ``diffuse`` (``reflectance``), ``plastic`` and ``roughplastic``
 1.000277), ``conductor`` and ``roughconductor`` (``material``, one of Mitsuba's measured
 metals), the rough ones with ``alpha`` and the ``ggx`` distribution (Mitsuba's default,
 ``beckmann``, is refused: the renderer's microfacets are GGX), bare or in a ``twosided`` with one BSDF (or two equal
-ones). A ``specular_reflectance`` other than 1 has no exact counterpart and is refused.
+ones). A ``specular_reflectance`` other than 1 has no exact counterpart and is refused. A
+``conductor`` with ``material`` ``none`` (or none given, Mitsuba's default) is the perfect mirror.
+
+Glass (:data:`GLASS`) is read exactly as clear glass: ``dielectric``, ``thindielectric`` and
+``roughdielectric`` (``alpha``, ``ggx`` only, as above) with ``int_ior``/``ext_ior`` numbers or
+the names of Mitsuba's own table (``bk7``, ``water``, ``air``..., Mitsuba's defaults ``bk7`` and
+``air``), whose ratio is the material's ``ior``. A ``specular_reflectance`` or
+``specular_transmittance`` other than 1 (tinted glass) is refused (``--approximate``: taken as 1).
 
 The wrappers ``mask``, ``bumpmap`` and ``normalmap`` (:data:`WRAPPERS`, in any order with
 ``twosided``) are read exactly: the material is the BSDF they wrap, and the wrappers' opacity
 and bump or normal map become the mesh's
 :class:`~spectrinsic.scenes.surface_maps.MeshMaps` (:mod:`~spectrinsic.scenes.mitsuba_maps`).
 
-Without exact ground truth until the glass-and-environment issue lands: ``dielectric``,
-``thindielectric``, ``roughdielectric`` (:data:`GLASS`) and ``bitmap`` textures anywhere but a
-matte ``diffuse`` reflectance (that one is an exact image texture,
-:mod:`~spectrinsic.scenes.mitsuba_bitmaps`). Each is refused in one line naming it; under
-``--approximate`` glass drops its shape and a bitmap becomes Mitsuba's default 0.5 grey, each
-said in one line.
+Without exact ground truth: ``bitmap`` textures anywhere but a matte ``diffuse`` reflectance
+(that one is an exact image texture, :mod:`~spectrinsic.scenes.mitsuba_bitmaps`), refused in one
+line naming it; under ``--approximate`` a bitmap becomes Mitsuba's default 0.5 grey, said in one
+line.
 """
 
 from __future__ import annotations
@@ -28,14 +33,15 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SceneError
+from ..spectra.conductors import PERFECT_MIRROR
 from .materials import METAL_SPECTRUM
 from .mitsuba_spectra import reflectance_name
-from .mitsuba_tree import Value, XmlNode
-from .model import Material
+from .mitsuba_tree import Value, XmlNode, named_ior
+from .model import Material, MaterialKind
 
 __all__ = ["GLASS", "WRAPPERS", "DEFAULT_MATERIAL", "inner_bsdf", "material_of"]
 
-#: Transmissive BSDFs, dropped with their shape under ``--approximate``.
+#: Transmissive BSDFs, read as clear glass.
 GLASS = ("dielectric", "thindielectric", "roughdielectric")
 #: BSDFs wrapping another: the material is the inner one, the wrapper a mesh's map
 #: (:mod:`~spectrinsic.scenes.mitsuba_maps`).
@@ -48,8 +54,13 @@ _PARAMS = {
     "plastic": {"diffuse_reflectance", "specular_reflectance", "int_ior", "ext_ior"},
     "conductor": {"material", "specular_reflectance"},
 }
+_PARAMS["dielectric"] = {"int_ior", "ext_ior", "specular_reflectance", "specular_transmittance"}
+_PARAMS["thindielectric"] = _PARAMS["dielectric"]
 _PARAMS["roughplastic"] = _PARAMS["plastic"] | {"alpha", "distribution", "sample_visible"}
 _PARAMS["roughconductor"] = _PARAMS["conductor"] | {"alpha", "distribution", "sample_visible"}
+_PARAMS["roughdielectric"] = _PARAMS["dielectric"] | {"alpha", "distribution", "sample_visible"}
+#: Mitsuba's default indices of a dielectric's inside and outside (its ``ior.h`` names).
+_GLASS_IORS = ("bk7", "air")
 
 #: ``say(phrase)`` records an approximation; ``None`` where approximations are refused.
 Say = Callable[[str], None] | None
@@ -79,18 +90,18 @@ def _colour(node: XmlNode, key: str, what: str, base: Path, say: Say) -> str:
     return reflectance_name(value, f"{what} {key}", base)
 
 
-def _unit_specular(node: XmlNode, what: str, say: Say) -> None:
-    value = node.props.get("specular_reflectance", 1.0)
+def _unit_specular(node: XmlNode, what: str, say: Say, key: str = "specular_reflectance") -> None:
+    value = node.props.get(key, 1.0)
     unit = isinstance(value, (int, float)) and value == 1.0
     unit = unit or (isinstance(value, np.ndarray) and bool(np.all(value == 1.0)))
     if not unit:
         shown = value.tolist() if isinstance(value, np.ndarray) else value
         if say is None:
             raise SceneError(
-                f"{what}: specular_reflectance {shown!r} in {node.label()}; only 1 has exact "
+                f"{what}: {key} {shown!r} in {node.label()}; only 1 has exact "
                 "ground truth (--approximate would use 1)"
             )
-        say(f"{what}: {node.label()} specular_reflectance {shown!r} taken as 1")
+        say(f"{what}: {node.label()} {key} {shown!r} taken as 1")
 
 
 def inner_bsdf(node: XmlNode, what: str) -> XmlNode:
@@ -115,9 +126,6 @@ def material_of(node: XmlNode, what: str, base: Path, say: Say) -> Material | No
         node = inner_bsdf(node, what)
         name = name or (node.id if not node.id.startswith("_unnamed") else "")
     kind = node.plugin
-    if kind in GLASS:
-        _unsupported(node, what, say, "left out with its shape")
-        return None
     if kind not in _PARAMS:
         raise SceneError(
             f"{what}: unsupported element {node.label()}; expected a bsdf of type "
@@ -144,10 +152,14 @@ def material_of(node: XmlNode, what: str, base: Path, say: Say) -> Material | No
         spectrum = _colour(node, "reflectance", what, base, say)
         return Material(name or spectrum, spectrum)
     _unit_specular(node, what, say)
+    if kind in GLASS:
+        return _glass(node, name, alpha, what, say)
     if kind.endswith("conductor"):
-        metal = node.props.get("material")
+        metal = node.props.get("material", PERFECT_MIRROR)
         if not isinstance(metal, str) or not metal:
-            raise SceneError(f"{what}: {node.label()} needs a 'material' (Au, Cu, Al, ...)")
+            raise SceneError(
+                f"{what}: {node.label()} needs a 'material' (Au, Cu, Al, ..., none: a mirror)"
+            )
         return Material(
             name or f"{kind} {metal}",
             METAL_SPECTRUM,
@@ -159,4 +171,32 @@ def material_of(node: XmlNode, what: str, base: Path, say: Say) -> Material | No
     ior = _number(node, "int_ior", 1.49, what) / _number(node, "ext_ior", 1.000277, what)
     return Material(
         name or f"{kind} {spectrum}", spectrum, kind="plastic", roughness=alpha, ior=ior
+    )
+
+
+def _ior(node: XmlNode, key: str, default: str, what: str) -> float:
+    """``int_ior``/``ext_ior`` of *node*: a positive number, or a name in Mitsuba's table."""
+    value = node.props.get(key, default)
+    if isinstance(value, str):
+        ior = named_ior(value)
+        if ior is None:
+            raise SceneError(
+                f"{what}: {key} {value!r} in {node.label()}; expected a number or one of "
+                "Mitsuba's named indices (bk7, water, air, acrylic glass, fused quartz, ...)"
+            )
+        return ior
+    ior = _number(node, key, 0.0, what)
+    if not ior > 0.0:
+        raise SceneError(f"{what}: {key} {ior!r} in {node.label()}; expected a positive index")
+    return ior
+
+
+def _glass(node: XmlNode, name: str, alpha: float, what: str, say: Say) -> Material:
+    """Clear glass of *node* (module docstring); *alpha* already read for ``roughdielectric``."""
+    _unit_specular(node, what, say, "specular_transmittance")
+    inside, outside = _GLASS_IORS
+    ior = _ior(node, "int_ior", inside, what) / _ior(node, "ext_ior", outside, what)
+    kind: MaterialKind = "thindielectric" if node.plugin == "thindielectric" else "dielectric"
+    return Material(
+        name or f"{node.plugin} {ior:.4g}", METAL_SPECTRUM, kind=kind, roughness=alpha, ior=ior
     )

@@ -28,7 +28,16 @@ import numpy as np
 from ..errors import SceneError
 from ..mitsuba_import import import_mitsuba
 
-__all__ = ["Spectrum", "Value", "XmlNode", "ParsedXml", "parse_xml", "mesh_file", "mesh_file_uv"]
+__all__ = [
+    "Spectrum",
+    "Value",
+    "XmlNode",
+    "ParsedXml",
+    "parse_xml",
+    "named_ior",
+    "mesh_file",
+    "mesh_file_uv",
+]
 
 
 @dataclass(frozen=True)
@@ -172,6 +181,18 @@ def _mitsuba() -> Any:
     if mi.variant() is None:
         mi.set_variant("scalar_rgb")
     return mi
+
+
+def named_ior(name: str) -> float | None:
+    """The index of refraction Mitsuba's own table (``ior.h``, as its ``dielectric`` plugins
+    read ``int_ior``/``ext_ior``) gives *name* (``"bk7"``, ``"water"``, ``"air"``...), or
+    ``None`` where Mitsuba knows no such name."""
+    mi = _mitsuba()
+    try:  # the one public door to the table: a dielectric of that index against a vacuum
+        bsdf = mi.load_dict({"type": "dielectric", "int_ior": name, "ext_ior": 1.0})
+    except RuntimeError:
+        return None
+    return float(mi.traverse(bsdf)["eta"])
 
 
 def parse_xml(text: str, version: str) -> ParsedXml:

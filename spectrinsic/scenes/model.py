@@ -31,6 +31,8 @@ __all__ = [
     "Material",
     "MaterialKind",
     "MATERIAL_KINDS",
+    "NON_DIFFUSE_KINDS",
+    "TRANSMISSIVE_KINDS",
     "GLOSS_FIELDS",
     "Mesh",
     "Light",
@@ -85,10 +87,21 @@ IDENTITY_ROTATION = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
 ENVMAP_CHANNELS = (".r", ".g", ".b")
 
 
-MaterialKind = Literal["diffuse", "plastic", "conductor"]
+MaterialKind = Literal["diffuse", "plastic", "conductor", "dielectric", "thindielectric"]
 #: Material kinds: Lambertian; a diffuse base under a dielectric coat (Mitsuba ``plastic`` /
-#: ``roughplastic``); a metal (``conductor`` / ``roughconductor``).
-MATERIAL_KINDS: tuple[MaterialKind, ...] = ("diffuse", "plastic", "conductor")
+#: ``roughplastic``); a metal (``conductor`` / ``roughconductor``); clear glass, a solid
+#: (``dielectric`` / ``roughdielectric``) or a thin pane (``thindielectric``).
+MATERIAL_KINDS: tuple[MaterialKind, ...] = (
+    "diffuse",
+    "plastic",
+    "conductor",
+    "dielectric",
+    "thindielectric",
+)
+#: Kinds without a diffuse lobe (reflectance 0; shading the white-Lambertian ``W = E/π``).
+NON_DIFFUSE_KINDS: tuple[MaterialKind, ...] = ("conductor", "dielectric", "thindielectric")
+#: Kinds that transmit light (clear glass).
+TRANSMISSIVE_KINDS: tuple[MaterialKind, ...] = ("dielectric", "thindielectric")
 #: The optional fields of :class:`Material`; at their defaults they are left out of
 #: :func:`scene_to_dict`, so a matte scene's record and hash are those of before they existed.
 GLOSS_FIELDS = ("kind", "roughness", "ior", "metal")
@@ -97,7 +110,7 @@ _OPTIONAL = {"omit_default": True}
 
 @dataclass(frozen=True)
 class Material:
-    """A material: Lambertian (default), coated diffuse or metal.
+    """A material: Lambertian (default), coated diffuse, metal or clear glass.
 
     Attributes
     ----------
@@ -105,18 +118,20 @@ class Material:
         Human-readable name (``"wall"``, ``"stripe 2"``).
     spectrum
         Registry name of the diffuse reflectance spectrum, e.g. ``"munsell:5R 4/14"`` (the base
-        under the coat of a ``plastic``; ``"flat:0"`` for a ``conductor``, which has no diffuse
-        lobe).
+        under the coat of a ``plastic``; ``"flat:0"`` for a ``conductor`` or glass, which have
+        no diffuse lobe).
     kind
         One of :data:`MATERIAL_KINDS`.
     roughness
-        GGX α of the coat or metal surface (dimensionless, 0 = smooth, i.e. a delta lobe);
-        ignored for ``diffuse``.
+        GGX α of the coat, metal or glass surface (dimensionless, 0 = smooth, i.e. a delta
+        lobe); ignored for ``diffuse``; 0 for ``thindielectric``.
     ior
-        Index of refraction of a ``plastic``'s coat (the base medium has index 1).
+        Index of refraction of a ``plastic``'s coat or of glass, relative to the outside
+        (Mitsuba's ``int_ior / ext_ior``); constant over wavelength (no dispersion).
     metal
         Name of a conductor whose measured η/k Mitsuba ships (``Au``, ``Cu``, ``Al``, ``Ag``...),
-        for ``conductor``.
+        or ``none`` for a perfect mirror (F = 1, Mitsuba's ``material: none``), for
+        ``conductor``.
     """
 
     name: str
@@ -130,6 +145,16 @@ class Material:
     def glossy(self) -> bool:
         """Whether the material has a non-diffuse lobe."""
         return self.kind != "diffuse"
+
+    @property
+    def non_diffuse(self) -> bool:
+        """Whether the material has no diffuse lobe (metal, mirror, glass)."""
+        return self.kind in NON_DIFFUSE_KINDS
+
+    @property
+    def transmissive(self) -> bool:
+        """Whether the material is glass (transmits light)."""
+        return self.kind in TRANSMISSIVE_KINDS
 
 
 def _named_class(mesh: Mesh) -> bool:

@@ -10,6 +10,8 @@ A diagonal band render cannot carry F(μ, λ) itself, so it carries its band val
 over μ: ``F_k(μ_j) = ∫ F(μ_j, λ) S_k dλ / ∫ S_k dλ`` (Eq. 5.4, as a material's band albedo),
 on :data:`FRESNEL_NODES` equally spaced μ in [0, 1], interpolated linearly by the renderer.
 At normal incidence ``F(1, λ) = ((η − 1)² + k²) / ((η + 1)² + k²)``.
+
+:data:`PERFECT_MIRROR` (``none``, Mitsuba's name) is the ideal mirror, F = 1 at every μ and λ.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from .io import mitsuba_ior_dir, read_conductor_ior
 
 __all__ = [
     "FRESNEL_NODES",
+    "PERFECT_MIRROR",
     "conductor_names",
     "check_conductor",
     "conductor_ior",
@@ -34,6 +37,8 @@ __all__ = [
 
 #: Number of equally spaced μ = cos θ nodes of a band Fresnel table (0 and 1 included).
 FRESNEL_NODES = 65
+#: Mitsuba's ``material`` of a perfect mirror (``conductor`` with F = 1).
+PERFECT_MIRROR = "none"
 
 
 @functools.cache
@@ -48,10 +53,11 @@ def conductor_names() -> tuple[str, ...]:
 def check_conductor(name: str, what: str = "metal") -> str:
     """*name* if Mitsuba ships its η/k tables, else a one-line :class:`SpectralDataError`."""
     names = conductor_names()
-    if name not in names:
+    if name not in names and name != PERFECT_MIRROR:
         raise SpectralDataError(
             f"{what}: unknown conductor {name!r}; expected one of Mitsuba's "
-            f"tables such as Ag, Al, Au, Cu, Cr, W" + did_you_mean(name, names)
+            f"tables such as Ag, Al, Au, Cu, Cr, W, or {PERFECT_MIRROR!r} (a perfect mirror)"
+            + did_you_mean(name, names)
         )
     return name
 
@@ -94,6 +100,8 @@ def fresnel_table(name: str, curves: SensorCurves, wavelengths: Wavelengths) -> 
         raise SpectralDataError(
             f"fresnel_table({name!r}): expected (K, W) sensor curves, got {np.shape(curves)}"
         )
+    if name == PERFECT_MIRROR:
+        return np.ones((FRESNEL_NODES, np.shape(curves)[0]))
     eta, k = conductor_ior(name, wavelengths)
     mu = np.linspace(0.0, 1.0, FRESNEL_NODES)
     spectra = fresnel_conductor(mu[:, None], eta[None, :], k[None, :])

@@ -78,6 +78,8 @@ ONLY_IN: dict[str, dict[str, list[str]]] = {
         "--glossy": [*_LIBRARY_BUILD, "--glossy", "0.5"],
         "--metallic": [*_LIBRARY_BUILD, "--metallic", "0.5"],
         "--roughness-range": [*_LIBRARY_BUILD, "--roughness-range", "0,0.2"],
+        "--glass": [*_LIBRARY_BUILD, "--glass", "0.5"],
+        "--mirrors": [*_LIBRARY_BUILD, "--mirrors", "0.5"],
         "--daylight-share": [*_LIBRARY_BUILD, "--daylight-share", "0.5"],
         "--material-map": [*_LIBRARY_BUILD, "--material-map", "{map}"],
         "--default-spectrum": [*_LIBRARY_BUILD, "--default-spectrum", "flat:0.5"],

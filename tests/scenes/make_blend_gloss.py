@@ -4,8 +4,8 @@
 Usage: python make_blend_gloss.py -- OUT.blend
 
 Three quads side by side: "Copper" (Metallic 1, Roughness 0.3, custom property metal = "Cu"),
-"munsell:5R 4/14" (Metallic 0, Roughness 0.2, IOR 1.45) and "flat:0.5" (Roughness 0.8); a
-camera above and a sun.
+"munsell:5R 4/14" (Metallic 0, Roughness 0.2, IOR 1.45), "flat:0.5" (Roughness 0.8) and
+"Glass" (Transmission 1, Roughness 0, IOR 1.52); a camera above and a sun.
 """
 
 import sys
@@ -29,7 +29,17 @@ def principled(name, metallic, roughness, ior=1.5):
 
 copper = principled("Copper", 1.0, 0.3)
 copper["metal"] = "Cu"
-mats = [copper, principled("munsell:5R 4/14", 0.0, 0.2, 1.45), principled("flat:0.5", 0.0, 0.8)]
+glass = principled("Glass", 0.0, 0.0, 1.52)
+node = next(n for n in glass.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+key = "Transmission Weight" if "Transmission Weight" in node.inputs else "Transmission"
+node.inputs[key].default_value = 1.0
+node.inputs["Base Color"].default_value = (1.0, 1.0, 1.0, 1.0)  # Blender's 0.8 would tint it
+mats = [
+    copper,
+    principled("munsell:5R 4/14", 0.0, 0.2, 1.45),
+    principled("flat:0.5", 0.0, 0.8),
+    glass,
+]
 for i, mat in enumerate(mats):
     me = bpy.data.meshes.new(f"quad{i}")
     x = 2.0 * i - 2.0

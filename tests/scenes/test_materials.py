@@ -48,6 +48,31 @@ def test_glossy_materials_load_and_round_trip(tmp_path):
     assert again == scene and scene_hash(again) == scene_hash(scene)
 
 
+def test_glass_and_a_perfect_mirror_load_and_round_trip(tmp_path):
+    """``dielectric`` (rough or smooth), ``thindielectric`` and the mirror ``metal: none``:
+    no diffuse lobe (spectrum ``flat:0``), written back to the same entries."""
+    entries = {
+        "red": {"kind": "dielectric", "ior": 1.5, "roughness": 0.1},
+        "ground": {"kind": "thindielectric", "ior": 1.52},
+        "mirror": {"kind": "conductor", "metal": "none", "roughness": 0.0},
+    }
+    scene = load_scene(write(tmp_path, _doc(entries)))
+    vase, pane, _ = scene.materials
+    assert (vase.kind, vase.ior, vase.roughness, vase.spectrum) == (
+        "dielectric",
+        1.5,
+        0.1,
+        "flat:0",
+    )
+    assert (pane.kind, pane.ior, pane.spectrum) == ("thindielectric", 1.52, "flat:0")
+    assert all(m.non_diffuse for m in scene.materials)
+    assert [m.transmissive for m in scene.materials] == [True, True, False]
+    saved = yaml.safe_load(save_scene(scene, tmp_path / "saved.yaml").read_text())
+    assert saved["materials"] == entries
+    again = load_scene(tmp_path / "saved.yaml")
+    assert again == scene and scene_hash(again) == scene_hash(scene)
+
+
 def test_matte_records_have_no_gloss_keys(tmp_path):
     """Lambertian materials are written as before (a spectrum name; no new keys in the scene
     record), so matte scenes keep their hashes and seeds."""
@@ -73,6 +98,9 @@ def test_matte_records_have_no_gloss_keys(tmp_path):
         ({"kind": "glass", "spectrum": "munsell:5R 4/14"}, "kind 'glass'"),
         ({"kind": "conductor", "metal": "Au", "spectrum": "flat:0.5"}, "unknown key 'spectrum'"),
         ({"kind": "plastic", "ior": 1.5}, "needs a non-empty 'spectrum'"),
+        ({"kind": "dielectric", "spectrum": "flat:0.5"}, "unknown key 'spectrum'"),
+        ({"kind": "dielectric", "ior": 1.0}, "ior 1.0"),
+        ({"kind": "thindielectric", "roughness": 0.2}, "unknown key 'roughness'"),
         (["munsell:5R 4/14"], "expected a spectrum name or a mapping"),
     ],
 )

@@ -62,3 +62,70 @@ def test_an_obj_usemtl_without_a_library_keeps_its_names(tmp_path):
     assert sorted(m.spectrum for m in scene.materials) == ["munsell:5R 4/14", "munsell:5YR 5/6"]
     faces = {m.name: len(m.faces) for m in scene.meshes}
     assert faces == {"paint": 2, "wood": 1}
+
+
+def _gltf_with(tmp_path, extensions: dict, pbr: dict | None = None):
+    """A .gltf of one box whose material 'glass' carries *extensions* (and *pbr* factors)."""
+    import json
+
+    scene = trimesh.Scene()
+    scene.add_geometry(_box("pane", 0.0, PBRMaterial(name="glass", roughnessFactor=0.0)), "pane")
+    files = scene.export(file_type="gltf")
+    doc = json.loads(files.pop("model.gltf"))
+    for name, data in files.items():
+        (tmp_path / name).write_bytes(data)
+    (material,) = doc["materials"]
+    material["extensions"] = extensions
+    material["pbrMetallicRoughness"] = pbr or {"roughnessFactor": 0.0}
+    path = tmp_path / "glass.gltf"
+    path.write_text(json.dumps(doc))
+    return path
+
+
+def test_gltf_transmission_1_is_clear_glass_thin_without_a_volume(tmp_path):
+    """``KHR_materials_transmission`` 1: a thin pane without ``KHR_materials_volume`` (glTF's
+    thin-walled default), a solid dielectric of ``KHR_materials_ior``'s index with one."""
+    full = {"KHR_materials_transmission": {"transmissionFactor": 1.0}}
+    (pane,) = load_mesh_scene(_gltf_with(tmp_path, full), materials={}, width=8, height=8).materials
+    assert (pane.kind, pane.ior, pane.spectrum) == ("thindielectric", 1.5, "flat:0")
+    solid = full | {
+        "KHR_materials_volume": {"thicknessFactor": 0.1},
+        "KHR_materials_ior": {"ior": 1.33},
+    }
+    pbr = {"roughnessFactor": 0.3}
+    path = _gltf_with(tmp_path, solid, pbr)
+    (glass,) = load_mesh_scene(path, materials={}, width=8, height=8).materials
+    assert (glass.kind, glass.ior) == ("dielectric", 1.33)
+    assert glass.roughness == pytest.approx(0.09)
+
+
+@pytest.mark.parametrize(
+    ("extensions", "pbr", "expected"),
+    [
+        (
+            {"KHR_materials_transmission": {"transmissionFactor": 0.5}},
+            None,
+            "transmissionFactor 0.5",
+        ),
+        (
+            {"KHR_materials_transmission": {"transmissionFactor": 1.0}},
+            {"baseColorFactor": [0.2, 0.9, 0.2, 1.0], "roughnessFactor": 0.0},
+            "tinted base colour",
+        ),
+        (
+            {"KHR_materials_transmission": {"transmissionFactor": 1.0}},
+            {"roughnessFactor": 0.5},
+            "thin-walled",
+        ),
+    ],
+)
+def test_gltf_partial_or_tinted_transmission_is_refused_in_one_line(
+    tmp_path, extensions, pbr, expected
+):
+    from spectrinsic.errors import SceneError
+
+    path = _gltf_with(tmp_path, extensions, pbr)
+    with pytest.raises(SceneError) as info:
+        load_mesh_scene(path, materials={}, width=8, height=8)
+    message = str(info.value)
+    assert "\n" not in message and "'glass'" in message and expected in message

@@ -180,9 +180,6 @@ def test_a_mitsuba_05_file_loads_and_says_what_it_fixed(tmp_path, capsys):
 @pytest.mark.parametrize(
     ("body", "bsdf", "named"),
     [
-        ("", '<bsdf type="dielectric"/>', "<bsdf type='dielectric'>"),
-        ("", '<bsdf type="thindielectric"/>', "<bsdf type='thindielectric'>"),
-        ("", '<bsdf type="roughdielectric"/>', "<bsdf type='roughdielectric'>"),
         ('<emitter type="sunsky"/>', "", "<emitter type='sunsky'>"),
     ],
 )
@@ -200,15 +197,14 @@ def test_what_has_no_exact_ground_truth_is_refused_or_approximated(
     assert f"{named} has no exact ground truth yet" in message
     scene = load_mitsuba_xml(path, approximate=True)
     assert named in " ".join(scene.metadata["approximated"])
-    glass = "dielectric" in bsdf
-    assert [m.name for m in scene.meshes] == (["box"] if glass else ["floor", "box"])
+    assert [m.name for m in scene.meshes] == ["floor", "box"]
 
 
 def test_an_unsupported_element_refuses_in_one_line_through_the_cli(tmp_path, capsys):
-    path = _write(tmp_path, _scene(LAMP, bsdf='<bsdf type="dielectric" id="glass"/>'))
+    path = _write(tmp_path, _scene(LAMP, bsdf='<bsdf type="roughdielectric" id="glass"/>'))
     assert main(["render", str(path), "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "<bsdf type='dielectric' id='glass'>" in err
+    assert len(err.splitlines()) == 1 and "<bsdf type='roughdielectric' id='glass'>" in err
     assert not (tmp_path / "out").exists()
     yaml_scene = _write(tmp_path, "name: x\n", "x.yaml")
     assert main(["render", str(yaml_scene), "--approximate", "--out", str(tmp_path / "o")]) == 2

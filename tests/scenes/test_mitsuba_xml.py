@@ -176,8 +176,8 @@ def test_the_xml_box_renders_with_full_ground_truth(cornell):
     [
         (
             '<bsdf type="diffuse" id="red">',
-            '<bsdf type="dielectric" id="red">',
-            "<bsdf type='dielectric' id='red'> has no exact ground truth yet",
+            '<bsdf type="roughdielectric" id="red">',
+            "unsupported parameter 'reflectance' in <bsdf type='roughdielectric' id='red'>",
         ),
         (
             '<scene version="3.0.0">',

@@ -87,6 +87,7 @@ GALLERY_LAYERS: tuple[str, ...] = (
     "mask",
     "non_diffuse",
     "metallic",
+    "transmissive",
     "roughness",
 )
 #: The JavaScript variable ``gallery-index.js`` assigns the index to.

@@ -1,5 +1,7 @@
-"""The gloss family: ``specular``, ``non_diffuse``, ``metallic`` and ``roughness``, for scenes
-with glossy materials (:class:`~spectrinsic.scenes.model.Material` ``plastic``/``conductor``).
+"""The gloss family: ``specular``, ``non_diffuse``, ``metallic``, ``roughness`` and (scenes with
+glass) ``transmissive``, for scenes with glossy materials
+(:class:`~spectrinsic.scenes.model.Material` ``plastic``/``conductor``/``dielectric``/
+``thindielectric``).
 
 The single traversal returns, per diagonal mode, the raw channels ``P_spec`` of the light the
 camera rays' first hits return through their non-diffuse lobes (coat reflection, metal), with
@@ -13,6 +15,16 @@ With ``P`` the raw image, ρ the pixel's band albedo and X the mode's raw → XY
 
 Scenes without glossy materials get none of these layers (their specular part is 0, every
 surface is diffuse with roughness 1), so their samples are those of before.
+
+**Glass and mirrors** (no diffuse lobe, like metals): at a pixel whose first hit is glass or a
+mirror, ``reflectance`` is 0, ``shading`` the white-Lambertian ``W = E/π`` at that hit (as at
+metals, :mod:`~spectrinsic.gt_export.layers.irradiance`), and everything the camera sees in or
+through the glass or in the mirror (reflection and transmission chains and whatever lies
+behind) is in ``specular``; the identity holds there as everywhere. ``transmissive`` (scenes
+with glass only, so other samples are unchanged; its description carries the glass words, the
+other layers' descriptions are those of before) and ``metallic`` (metals and mirrors) say
+where, so a user can exclude or in-paint those pixels (spectrinsic/scenes/FORMAT.md, "Ground
+truth on glass, mirrors and masks").
 """
 
 from __future__ import annotations
@@ -51,6 +63,37 @@ def gloss_layers(s: SampleInputs, coverage: np.ndarray, specular: np.ndarray | N
     glossy = np.array([[float(m.kind != "diffuse")] for m in mats])
     metal = np.array([[float(m.kind == "conductor")] for m in mats])
     alpha = np.array([[m.roughness if m.kind != "diffuse" else 1.0] for m in mats])
+    return _shared_layers(specular, coverage, glossy, metal, alpha) + _glass_layers(s, coverage)
+
+
+def _glass_layers(s: SampleInputs, coverage: np.ndarray) -> list[Layer]:
+    """``transmissive``, in scenes with glass only."""
+    glass = np.array([[float(m.transmissive)] for m in s.scene.materials])
+    if not glass.any():
+        return []
+    return [
+        make_layer(
+            "transmissive",
+            coverage_weighted(coverage, glass)[..., 0],
+            ("Y",),
+            "fraction of the pixel covered by glass (dielectric, thindielectric: no diffuse "
+            "lobe, reflectance 0; all that is seen in and through it, its reflection and "
+            "transmission chains, is in specular; non_diffuse counts it too, metallic counts "
+            "mirrors); 0 background",
+            "geometry",
+            nonnegative=True,
+        )
+    ]
+
+
+def _shared_layers(
+    specular: np.ndarray,
+    coverage: np.ndarray,
+    glossy: np.ndarray,
+    metal: np.ndarray,
+    alpha: np.ndarray,
+) -> list[Layer]:
+    """``specular``, ``non_diffuse``, ``metallic`` and ``roughness``."""
     return [
         make_layer(
             "specular",

@@ -53,7 +53,7 @@ def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
         else to_xyz_matrix(mode, s.scene, data_dir=s.data_dir)
     )
     raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
-    metals = np.array([m.kind == "conductor" for m in s.scene.materials], bool)
+    metals = np.array([m.non_diffuse for m in s.scene.materials], bool)
     metal_white = (getattr(s.result, "metal_white", None) or {}).get(s.ref)
     # W of the first hits' diffuse lobes only: the specular part is its own layer; at metals
     # the renderer's white-surface estimate

@@ -148,6 +148,7 @@ _PREVIEWS: tuple[tuple[str, Callable[[Layer, Mapping[str, Layer]], Preview]], ..
     ("specular", _colour_preview),
     ("non_diffuse", _unit_preview),
     ("metallic", _unit_preview),
+    ("transmissive", _unit_preview),
     ("roughness", _unit_preview),
     ("noise_", _noise_preview),
     ("depth", _depth_preview),

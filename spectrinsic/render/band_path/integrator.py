@@ -10,7 +10,8 @@ heuristic MIS, the same sampler calls in the same order) written in Python on Dr
 throughput is a list of K band products gathered from a per-material table, and whose
 contributions go to one accumulator per (light, band). Its loop is the one body of
 :class:`~spectrinsic.render.band_path.kernel.BandKernel`; ``gloss`` and ``metals`` switch on its
-glossy (G1) factors with the specular part and the white-at-metal loop when it is traced.
+glossy (G1) factors with the specular part and the white-at-metal loop when it is traced
+("metal" there: any first hit without a diffuse lobe, metal, mirror or glass).
 
 The scene is loaded with white Lambertian surfaces (area-light shapes black) and unit white
 emitters, so Mitsuba's own BSDF and emitter sampling give the band-independent factors
@@ -195,13 +196,13 @@ def _check_fit(it: Any, tables: BandTables) -> None:
 
 def _init_gloss(mi: Any, it: Any, props: Any) -> None:
     """The glossy properties of integrator *it*: flags, μ nodes, a specular table of ones, no
-    metal rows, and the white BSDF the white-at-metal loop swaps in."""
+    non-diffuse rows, and the white BSDF the white-at-metal loop swaps in."""
     it.metals = bool(props.get("metals", False))
     it.gloss = bool(props.get("gloss", False)) or it.metals
     it.n_nodes = int(props.get("n_nodes", FRESNEL_NODES))
     if it.gloss:
         it.specular = mi.Float(np.ones(it.n_nodes * it.n_bands, np.float32))
-        it.metal_rows = mi.UInt32(np.zeros(1, np.uint32))
+        it.non_diffuse_rows = mi.UInt32(np.zeros(1, np.uint32))
         # two-sided as every material of the scene; Mitsuba's diffuse defaults to 0.5
         it.white_bsdf = mi.load_dict(
             {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": 1.0}}
@@ -285,9 +286,9 @@ def _make_class(mi: Any, dr: Any) -> type:
             _set_envmaps(self, tables)
             _set_maps(mi, dr, self, scene, tables)
 
-        def set_metals(self, rows: np.ndarray) -> None:
-            """``(R,)`` bool: which albedo-table rows are metals (no diffuse lobe)."""
-            self.metal_rows = mi.UInt32(np.asarray(rows, bool).astype(np.uint32))
+        def set_non_diffuse(self, rows: np.ndarray) -> None:
+            """``(R,)`` per row: 0, ``MIRROR_ROW`` or ``GLASS_ROW`` (kernel: ``non_diffuse_rows``)."""
+            self.non_diffuse_rows = mi.UInt32(np.asarray(rows, np.uint32))
 
         def set_specular(self, table: np.ndarray) -> None:
             """``(R, n_nodes, K)`` band factors ``s_k(μ_j)`` per albedo-table row."""

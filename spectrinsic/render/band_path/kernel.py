@@ -33,6 +33,12 @@ Mitsuba's ``prb.py`` switches its features), so each traced kernel holds only it
   unchanged) makes a metal first hit a white ``diffuse`` vertex (ρ_k = 1) and goes on through the
   true scene with (G1); elsewhere the lane stops at once. Its accumulators ``M`` average over all
   of a pixel's samples, so ``M = c_metal · W`` with ``c_metal`` the pixel's metal coverage.
+  Mirrors and glass have no diffuse lobe either and are swapped alike (``non_diffuse_rows``).
+* **glass** (with gloss): Mitsuba's ``(rough)dielectric`` / ``thindielectric`` of one index in
+  every band, so its BSDF weight holds the Fresnel choice of reflection or transmission and
+  ``s_k = 1`` on both lobes (a row of ones; μ, meaningless when refracted, is unused). ``a = 0``:
+  all the camera sees in and through glass is ``S``. Mitsuba's BSDF handles both sides
+  (``si.wi`` inside) and ``spawn_ray`` offsets the refracted ray, as in ``path.cpp``.
 * **first-hit maps** (``n_surfaces`` > 0, not in the white loop): the camera ray's surface, ray
   distance, shading normal (and texel) are kept in the loop state. Under a bump or normal map
   the normal is the perturbed one Mitsuba's wrapper shades with
@@ -63,7 +69,13 @@ from typing import Any
 from ..base.surface_maps import perturbed_normal
 from ..base.textures import texel_of
 
-__all__ = ["PathState", "BandKernel", "mis_weight", "band_max"]
+#: Values of the ``non_diffuse_rows`` table (``BandPath.set_non_diffuse``) other than 0 (a
+#: diffuse lobe): no diffuse lobe (metal, mirror), and glass. Non-zero rows are the first hits
+#: the white-at-metal loop makes white Lambertian; a glass row's null event (a
+#: ``thindielectric``'s straight transmission) is no mask cut-out.
+MIRROR_ROW, GLASS_ROW = 1, 2
+
+__all__ = ["PathState", "BandKernel", "mis_weight", "band_max", "MIRROR_ROW", "GLASS_ROW"]
 
 
 def mis_weight(dr: Any, mi: Any, pdf_a: Any, pdf_b: Any) -> Any:
@@ -381,15 +393,24 @@ class BandKernel:
         )  # fmt: skip
         return state, go_on
 
+    def null_event(self, v: _Vertex, row: Any, valid: Any) -> Any:
+        """Whether the BSDF sample is a mask's null event: ``BSDFFlags.Null``, but not on a glass
+        row (*row*, with gloss), where it is a ``thindielectric``'s straight transmission."""
+        mi, dr = self.mi, self.dr
+        null = valid & mi.has_flag(v.bsdf_sample.sampled_type, mi.BSDFFlags.Null)
+        if row is not None:
+            null &= dr.gather(mi.UInt32, self.it.non_diffuse_rows, row, valid) != GLASS_ROW
+        return null
+
     def body(self, s: PathState) -> PathState:
         """One vertex: emitter hit, emitter sample, BSDF sample, in ``path.cpp``'s order."""
         mi, dr = self.mi, self.dr
         si = self.scene.ray_intersect(s.ray, ray_flags=mi.RayFlags.All, coherent=s.depth == 0)
         # the camera ray's first vertex: the first that is not a null event (masks)
         now, valid, swap, keep = ~s.seen, si.is_valid(), None, None
-        if self.white:  # the camera ray's metal hit becomes a white Lambertian vertex
+        if self.white:  # the camera ray's metal or glass hit becomes a white Lambertian vertex
             row = self.row(si)
-            swap = now & (dr.gather(mi.UInt32, self.it.metal_rows, row, valid) != 0)
+            swap = now & (dr.gather(mi.UInt32, self.it.non_diffuse_rows, row, valid) != 0)
         else:
             s.first = self.first_hit(si, now, s.first)
         light, weight, hit = self.emitter_hit(si, s)
@@ -414,7 +435,7 @@ class BandKernel:
             c_bs, s_bs = self.factors(rho, row, v.bs_lobes, valid)
         null = mi.Bool(False)
         if self.masks:  # a null event passes every band unchanged and is no first vertex
-            null = valid & mi.has_flag(v.bsdf_sample.sampled_type, mi.BSDFFlags.Null)
+            null = self.null_event(v, row if self.gloss else None, valid)
             c_bs = [dr.select(null, 1.0, c) for c in c_bs]
             if self.spec:
                 s_bs = [dr.select(null, 0.0, x) for x in s_bs]

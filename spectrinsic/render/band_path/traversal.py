@@ -37,6 +37,7 @@ from ..base.textures import shape_slots, texture_tables
 from ..base.variants import choose_variant, variant_scope
 from ..settings import DEFAULT_INTEGRATOR, INTEGRATORS
 from .integrator import BandTables, band_path, first_hit_channels
+from .kernel import GLASS_ROW, MIRROR_ROW
 
 __all__ = [
     "PARTS",
@@ -183,12 +184,13 @@ class _Dims:
     n_bands: int
     n_lights: int
     glossy: bool
-    #: Per albedo-table row (materials, then the black row): whether it is a metal.
-    metal_rows: tuple[bool, ...] = ()
+    #: Per albedo-table row (materials, then the black row): 0 with a diffuse lobe, else
+    #: MIRROR_ROW or GLASS_ROW (the white-at-metal loop's rows; ``set_non_diffuse``).
+    non_diffuse_rows: tuple[int, ...] = ()
 
     @property
     def metals(self) -> bool:
-        return any(self.metal_rows)
+        return any(self.non_diffuse_rows)
 
 
 @dataclass(frozen=True, eq=False)
@@ -234,8 +236,8 @@ def _trace(
     integrator.set_tables(loaded, tables if n_surfaces else replace(tables, shape_surfaces={}))
     if spec_table is not None:
         integrator.set_specular(spec_table)
-    if metals:
-        integrator.set_metals(np.array(dims.metal_rows, bool))
+    if dims.glossy:  # every traversal: a glass row's null event is no mask cut-out
+        integrator.set_non_diffuse(np.array(dims.non_diffuse_rows, np.uint32))
     n_t = dims.n_bands * dims.n_lights
     n_spec = n_t if dims.glossy else 0
     n_white = n_t if metals else 0
@@ -358,8 +360,11 @@ def render_traversal(
         )
         tables = _tables(scene, value_sets, light_of_emitters(mi, loaded), aovs)
         tables = replace(tables, extra_maps=extra_maps(mi, scene))
-        metal_rows = tuple(m.kind == "conductor" for m in scene.materials) + (False,)
-        dims = _Dims(h, w, n_bands, n_lights, glossy, metal_rows)
+        non_diffuse_rows = tuple(
+            GLASS_ROW if m.transmissive else MIRROR_ROW if m.non_diffuse else 0
+            for m in scene.materials
+        ) + (0,)
+        dims = _Dims(h, w, n_bands, n_lights, glossy, non_diffuse_rows)
         spec_table = _specular_table(scene, value_sets) if glossy else None
         traced: list[_Traced] = []
         for depth in [int(max_depth)] + ([DIRECT_DEPTH] if direct else []):

@@ -211,11 +211,16 @@ def material_bsdf(
     base reflectance) and ``int_ior`` = the coat's index over air. ``conductor``: Mitsuba's
     ``conductor``/``roughconductor`` with its measured η/k of ``material.metal``, or with
     *white_metal* a perfect mirror (``material: none``, F = 1) whose Fresnel factor the band
-    integrator applies per band. Lambertian otherwise.
+    integrator applies per band. Glass: Mitsuba's ``(rough)dielectric``/``thindielectric`` of
+    index ``ior`` over air's 1, band-independent, not in a ``twosided``. Else Lambertian.
     """
     if material.kind == "diffuse":
         return _lambertian(reflectance)
     rough = material.roughness > 0.0
+    if material.transmissive:  # a thindielectric is always smooth (materials.py)
+        glass = {"type": material.kind, "int_ior": float(material.ior), "ext_ior": 1.0}
+        ggx = {"type": "roughdielectric", "distribution": "ggx", "alpha": material.roughness}
+        return glass | (ggx if rough else {})
     bsdf: dict[str, Any]
     if material.kind == "plastic":
         bsdf = {

@@ -64,8 +64,32 @@ def test_default_options_change_nothing():
         ((0.8, 0.4), "summing to <= 1"),
         ((-0.1, 0.0), "fractions in [0, 1]"),
         ((0.1, 0.1, (0.5, 0.2)), "roughness range"),
+        ((0.0, 0.0, (0.0, 0.3), (1.4, 1.6), 0.7, 0.5), "glass fraction 0.7, mirror fraction 0.5"),
     ],
 )
 def test_bad_distributions_are_one_line_errors(args, expected):
     with pytest.raises(SceneError, match=expected.replace("[", r"\[").replace("]", r"\]")):
         GlossDistribution(*args)
+
+
+def test_glass_and_mirrors_go_to_object_materials_only_and_change_no_other_draw():
+    """With every object material made glass or a mirror, walls, floors and furniture keep
+    their materials, and the scene is the one without them but for those materials."""
+    base = GlossDistribution(glossy_fraction=0.3, metal_fraction=0.1)
+    glassy = replace(base, glass_fraction=0.5, mirror_fraction=0.5)
+    for index in range(3):
+        a = generate("rooms", root_seed=11, index=index, view=0, options=replace(OPTS, gloss=base))
+        b = generate(
+            "rooms", root_seed=11, index=index, view=0, options=replace(OPTS, gloss=glassy)
+        )
+        validate_scene(b)
+        assert a.camera == b.camera and a.lights == b.lights
+        changed = {i for i, (x, y) in enumerate(zip(a.materials, b.materials)) if x != y}
+        for mesh in b.meshes:
+            used = set(mesh.face_materials.tolist())
+            if mesh.semantic != "object" or len(used) > 1:
+                assert not used & changed, mesh.name
+        new = [b.materials[i] for i in changed]
+        assert new and all(m.transmissive or m.metal == "none" for m in new)
+        assert b.metadata["glass_materials"] + b.metadata["mirror_materials"] == len(new)
+        assert "glass_materials" not in a.metadata
