@@ -54,6 +54,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--out", type=Path, required=True, metavar="DIR", help="the relit sample folder to write"
     )
     p.add_argument(
+        "--scene-dir",
+        type=Path,
+        metavar="DIR",
+        help="the folder of the scene file the sample was built from: a sample names its "
+        "csv: spectra relative to it (no path of the building machine is recorded), and they "
+        "are read and checked against their SHA-256 there; needed only for such samples",
+    )
+    p.add_argument(
         "--keep-transport",
         action="store_true",
         help="store the transport in the relit sample too (so it can be relit itself)",
@@ -97,6 +105,11 @@ def run(args: argparse.Namespace) -> int:
     sample = Path(args.sample)
     if not sample.is_dir():
         raise DatasetError(f"SAMPLE {str(sample)!r} is not a folder; expected a sample folder")
+    if args.scene_dir is not None and not args.scene_dir.is_dir():
+        raise DatasetError(
+            f"--scene-dir {str(args.scene_dir)!r} is not a folder; expected the folder of the "
+            "scene file the sample was built from"
+        )
     # the --out rule of every writing verb: new, empty or a sample spectrinsic wrote
     check_out_folder(
         args.out, own=lambda p: owned_files(p) is not None, what="a sample folder spectrinsic wrote"
@@ -114,6 +127,7 @@ def run(args: argparse.Namespace) -> int:
             powers=powers,  # type: ignore[arg-type]
             data_dir=args.data_dir,
             keep_transport=args.keep_transport,
+            scene_dir=args.scene_dir,
         )
     if not args.quiet:
         print(

@@ -40,7 +40,7 @@ def card_record(
     torch = require_torch("the model card")
     return {
         "format": FORMAT,
-        "dataset": str(Path(dataset).resolve()),
+        "dataset": Path(dataset).resolve().name,  # its folder's name: no absolute path written
         "config_hashes": _config_hashes(result.folders),
         "samples": len(result.folders),
         "sample_ids": [f.name for f in result.folders],

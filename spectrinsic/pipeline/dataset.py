@@ -155,9 +155,12 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         camera=camera_model(cfg.camera) if cfg.camera else None,
         spectral_layers=cfg.spectral_layers,
         working_space=cfg.working_space,
+        scene_folder=task.scene_folder,  # csv: spectra recorded relative to it
     )
     if cfg.relight:
-        write_relit_variants(path, cfg.relight, seed=task.seed, data_dir=task.data_dir)
+        write_relit_variants(
+            path, cfg.relight, seed=task.seed, data_dir=task.data_dir, scene_dir=task.scene_folder
+        )
     seconds = time.perf_counter() - t0
     return SampleOutcome(
         sample_id=task.sample_id,

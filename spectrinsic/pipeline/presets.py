@@ -23,6 +23,7 @@ from ..render.algebra.modes import RENDER_MODES
 from ..render.settings import RenderSettings
 from ..spectra.camera_model import camera_model
 from ..spectra.working_space import DEFAULT_WORKING_SPACE, WORKING_SPACES, working_space_names
+from .source_record import recorded_source
 
 __all__ = [
     "DatasetConfig",
@@ -332,8 +333,8 @@ class DatasetConfig:
             "variant": r.variant,
             "seed": self.seed,
         }
-        if self.source is not None:
-            d["source"] = self.source
+        if self.source is not None:  # scene files by name: the same hash on any machine
+            d["source"] = recorded_source(self.source)
         if self.store_transport:  # off: out of the hash, as before these settings existed
             d["store_transport"] = True
         if self.relight:

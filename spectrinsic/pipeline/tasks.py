@@ -8,10 +8,12 @@ Plain picklable records (no live objects), below both the planner of the library
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Literal
 
 from ..rng import seed_from_key
 from ..scenes.sample_id import SampleId
+from ..scenes.sources import FileSource
 from .presets import DatasetConfig
 
 __all__ = ["SampleTask", "SampleOutcome", "SampleFailure"]
@@ -60,6 +62,12 @@ class SampleTask:
     def scene(self) -> str:
         """The scene's name, ``self.id.scene``."""
         return self.id.scene
+
+    @property
+    def scene_folder(self) -> Path | None:
+        """The folder of the task's scene file (``None`` for library and generated scenes):
+        the sample records its ``csv:`` spectra relative to it (``export_sample``)."""
+        return Path(self.source.path).parent if isinstance(self.source, FileSource) else None
 
     @classmethod
     def planned(

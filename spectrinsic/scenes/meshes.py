@@ -433,7 +433,14 @@ def load_mesh_scene(
                 maps=_mesh_maps(surface_maps.get(material), uv, f"{path}: mesh {node!r}"),
             )
         )
-    camera, light = _frame(np.concatenate([m.vertices for m in meshes]), width, height)
+    points = np.concatenate([m.vertices for m in meshes])
+    bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
+    if bad.size:  # before the framing, whose sums would only spread the NaN (and warn)
+        raise SceneError(
+            f"{path}: {bad.size} vertices are NaN or infinite (first: vertex {int(bad[0])} "
+            "over the file's meshes); expected finite coordinates"
+        )
+    camera, light = _frame(points, width, height)
     scene = Scene(
         name=path.stem,
         meshes=tuple(meshes),

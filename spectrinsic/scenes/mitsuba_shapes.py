@@ -225,7 +225,13 @@ def triangles(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray]:
     v, f = _local(p, base)
     if props_true(p.node, "flip_normals"):
         f = f[:, ::-1]
-    return parts.apply(p.matrix @ _matrix(p.node), v), f
+    local = _matrix(p.node)
+    if not (np.isfinite(local).all() and np.isfinite(p.matrix).all()):  # before the product
+        raise SceneError(
+            f"{p.where}: its to_world transform holds a non-finite number (a value beyond "
+            "float range, e.g. 1e400); expected finite numbers"
+        )
+    return parts.apply(p.matrix @ local, v), f
 
 
 def textured_triangles(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

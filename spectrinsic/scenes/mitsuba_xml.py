@@ -112,6 +112,11 @@ def _area_light(p: shapes.Placed, node: XmlNode, r: _Reading) -> Light | None:
         return None
     u, v = m[:3, 0], m[:3, 1]
     normal = -np.cross(u, v) if shapes.props_true(p.node, "flip_normals") else np.cross(u, v)
+    if not np.linalg.norm(normal) > 0:  # a rectangle scaled to a line or a point (or NaN)
+        raise SceneError(
+            f"{p.where}: an area emitter on a rectangle of zero area (its to_world scales it "
+            "to a line or a point); expected a rectangle of positive area"
+        )
     return Light(
         "area",
         spectrum,
@@ -395,18 +400,18 @@ def load_mitsuba_xml(
     }
     spd = [f for f in prepared.files if f.role == "spd"]
     if spd:  # recorded beside the csv: files in each sample's meta.json (issue 47)
-        metadata["spectrum_files"] = _spd_records(path.parent, spd)
+        metadata["spectrum_files"] = _spd_records(spd)
     scene = Scene(scene.name, scene.meshes, scene.materials, scene.lights, scene.camera, metadata)
     return validate_scene(scene, source=str(path), data_dir=data_dir)
 
 
-def _spd_records(base: Path, files: list[SceneFile]) -> list[dict[str, str]]:
+def _spd_records(files: list[SceneFile]) -> list[dict[str, str]]:
     """``meta.json["spectrum_files"]`` records of the ``.spd`` files read (their values are
-    written out in the scene's spectrum names), by path."""
+    written out in the scene's spectrum names), by their path relative to the XML file's
+    folder (:class:`SceneFile`; no path of the machine that built the sample is recorded)."""
     out = []
     for f in sorted(files, key=lambda f: f.path):
-        file = str((base / f.path).resolve())
-        out.append({"spectrum": f"spd:{file}", "file": file, "sha256": f.sha256})
+        out.append({"spectrum": f"spd:{f.path}", "file": f.path, "sha256": f.sha256})
     return out
 
 

@@ -53,6 +53,7 @@ __all__ = [
     "scene_to_dict",
     "scene_from_dict",
     "scene_hash",
+    "scene_record_hash",
 ]
 
 LightKind = Literal["point", "spot", "area", "directional", "sky", "sphere", "envmap"]
@@ -463,7 +464,12 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
 
 def scene_hash(scene: Scene) -> str:
     """SHA-256 of the scene's canonical JSON (metadata excluded): equal scenes, equal hashes."""
-    data = scene_to_dict(scene)
-    data.pop("metadata", None)
-    blob = json.dumps(data, sort_keys=True, separators=(",", ":")).encode()
+    return scene_record_hash(scene_to_dict(scene))
+
+
+def scene_record_hash(data: Mapping[str, Any]) -> str:
+    """:func:`scene_hash` of a scene record (:func:`scene_to_dict`'s output, e.g. with its
+    ``csv:`` names made portable as a sample writes them)."""
+    record = {k: v for k, v in data.items() if k != "metadata"}
+    blob = json.dumps(record, sort_keys=True, separators=(",", ":")).encode()
     return hashlib.sha256(blob).hexdigest()

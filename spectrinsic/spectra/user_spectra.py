@@ -65,6 +65,8 @@ __all__ = [
     "split_csv_key",
     "column_unit",
     "spectrum_files",
+    "portable_csv",
+    "portable_names",
 ]
 
 #: Wavelengths (nm) a user's spectrum must cover. Outside it the CIE 1931 2° x̄, ȳ, z̄ (360-830 nm
@@ -315,13 +317,48 @@ def srgb_spectrum(key: str) -> Spectrum:
     return _from_linear("srgb:" + ",".join(f"{c:g}" for c in encoded), linear)
 
 
-def spectrum_files(names: Any) -> list[dict[str, str]]:
-    """One record per distinct ``csv:`` spectrum among *names*: its name, file, column and the
-    file's SHA-256, for ``meta.json`` (``spectrum_files``)."""
+def portable_csv(name: str, base: str | Path | None = None) -> str:
+    """*name* as a sample records it: a ``csv:`` name's absolute path made relative to *base*
+    (the scene file's folder) when the file lies inside it, else its file name alone; other
+    names, and relative ``csv:`` names, unchanged. No file a build writes then holds a path of
+    the machine that built it, and readers resolve the name against the scene's folder again
+    (:func:`spectrinsic.scenes.spectrum_refs.confined_csv`)."""
+    if not name.strip().lower().startswith("csv:"):
+        return name
+    path, sep, column = name.strip()[4:].rpartition("#")
+    file = Path(path.strip())
+    if not sep or not file.is_absolute():
+        # a sensor set (``csv:PATH``, no column) stays as the command line gave it: its name
+        # also names the sample's camera layers and files (give it relative to the working
+        # folder to keep it portable)
+        return name
+    root = Path(base).resolve() if base is not None else None
+    rel = file.relative_to(root) if root is not None and file.is_relative_to(root) else None
+    return f"csv:{(rel or Path(file.name)).as_posix()}#{column}"
+
+
+def portable_names(data: Any, base: str | Path | None = None) -> Any:
+    """A copy of the plain data *data* (dicts, lists, strings) with every ``csv:`` name made
+    portable (:func:`portable_csv`), wherever it stands (materials, lights, records)."""
+    if isinstance(data, str):
+        return portable_csv(data, base) if data[:4].lower() == "csv:" else data
+    if isinstance(data, dict):
+        return {k: portable_names(v, base) for k, v in data.items()}
+    if isinstance(data, (list, tuple)):
+        return [portable_names(v, base) for v in data]
+    return data
+
+
+def spectrum_files(names: Any, base: str | Path | None = None) -> list[dict[str, str]]:
+    """One record per distinct ``csv:`` spectrum among *names* (paths the build can read): its
+    portable name and file (:func:`portable_csv`, relative to *base*), column and the file's
+    SHA-256, for ``meta.json`` (``spectrum_files``)."""
     out = []
     for name in sorted({n for n in names if isinstance(n, str) and n.startswith("csv:")}):
         path, key = split_csv_key(name.removeprefix("csv:"))
         column, unit = column_unit(key)
-        record = {"spectrum": name, "file": path, "column": column, "sha256": sha256(path)}
+        portable = portable_csv(name, base)
+        file = split_csv_key(portable.removeprefix("csv:"))[0]
+        record = {"spectrum": portable, "file": file, "column": column, "sha256": sha256(path)}
         out.append(record | ({"unit": unit} if unit is not None else {}))
     return out

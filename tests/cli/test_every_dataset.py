@@ -84,7 +84,8 @@ def _checks_and_evaluates(dataset, out, capsys, *, preview=True):
     )
     report = (out / "REPORT.md").read_text()
     scored = json.loads((out / "scored.json").read_text())
-    assert "## What was scored" in report and str(dataset.resolve()) in report
+    assert "## What was scored" in report and f"* dataset: `{dataset.resolve().name}`" in report
+    assert str(dataset.resolve().parent) not in report  # issue 44: no absolute path written
     assert scored["config_hash"] and scored["config_hash"] in report
     if preview:  # a preview set (its manifest names the preset) is scored with a warning
         assert "preview-grade" in report

@@ -22,7 +22,7 @@ EVERYWHERE: dict[str, set[str]] = {
     "info": set(),
     "list": set(),
     "check": {"--max-per-sample", "--noise", "--noise-threshold", "--max-residual-share"},
-    "relight": {"--keep-transport", "--light", "--out", "--power"},
+    "relight": {"--keep-transport", "--light", "--out", "--power", "--scene-dir"},
     "export": {"--layers", "--out", "--samples-per-shard"},
     "study": {"--out", "--seed"},
     "train": {

@@ -7,7 +7,13 @@ import pytest
 
 from spectrinsic.errors import SpectralDataError, SpectrinsicError
 from spectrinsic.spectra import get_spectrum
-from spectrinsic.spectra.user_spectra import REQUIRED_RANGE, inline_name, spectrum_files
+from spectrinsic.spectra.user_spectra import (
+    REQUIRED_RANGE,
+    inline_name,
+    portable_csv,
+    portable_names,
+    spectrum_files,
+)
 
 WL = np.arange(380.0, 781.0, 10.0)
 
@@ -114,7 +120,28 @@ def test_spectrum_files_records_the_hash_of_each_file(paints):
     name = get_spectrum(f"csv:{path}#red").name
     (record,) = spectrum_files([name, name, "munsell:5R 4/14"])
     assert record["sha256"] == hashlib.sha256(path.read_bytes()).hexdigest()
-    assert record["column"] == "red" and record["file"] == str(path.resolve())
+    # no folder given: the file by its name (no absolute path is recorded)
+    assert record["column"] == "red" and record["file"] == path.name
+    (inside,) = spectrum_files([name], path.parent.parent)  # relative to the scene's folder
+    assert inside["file"] == f"{path.parent.name}/{path.name}"
+    assert inside["spectrum"] == f"csv:{path.parent.name}/{path.name}#red"
+
+
+def test_portable_csv_names_files_relative_to_the_scene_folder(tmp_path):
+    """Relative to *base* when inside it, else the file name; a sensor set (no column), a
+    relative name and other families as they are."""
+    base = tmp_path / "scene"
+    assert portable_csv(f"csv:{base}/sub/p.csv#red [%]", base) == "csv:sub/p.csv#red [%]"
+    assert portable_csv(f"csv:{tmp_path}/elsewhere/p.csv#3?unit=%", base) == "csv:p.csv#3?unit=%"
+    sensors = f"csv:{tmp_path}/cam.csv"  # a sensor set names camera layers: kept as given
+    assert portable_csv(sensors, base) == sensors
+    assert portable_csv("csv:sub/p.csv#red", base) == "csv:sub/p.csv#red"
+    assert portable_csv("munsell:5R 4/14", base) == "munsell:5R 4/14"
+    record = {"lights": [{"spectrum": f"csv:{base}/l.csv#lamp", "power": 2.0}], "n": 1}
+    assert portable_names(record, base) == {
+        "lights": [{"spectrum": "csv:l.csv#lamp", "power": 2.0}],
+        "n": 1,
+    }
 
 
 def _srgb_under_d65(values: np.ndarray, wl: np.ndarray) -> np.ndarray:

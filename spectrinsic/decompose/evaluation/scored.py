@@ -42,6 +42,7 @@ class ScoredSet:
     standard error (``meta.json["noise"]["image"]``, a fraction; ``None`` when not measured).
     """
 
+    #: The dataset folder's name (no absolute path is written; the config hash identifies it).
     dataset: str
     preset: str | None
     config_hash: str | None
@@ -111,7 +112,7 @@ def describe_scored(dataset: Path, folders: Sequence[Path]) -> ScoredSet:
             noise.append(float(median))
     n_listed = manifest.get("n_samples")
     return ScoredSet(
-        dataset=str(dataset.resolve()),
+        dataset=dataset.resolve().name,  # no path of the machine in the REPORT
         preset=config.get("preset") if isinstance(config, dict) else None,
         # without a manifest (a sample folder), the samples' own hash when they share one
         config_hash=manifest.get("config_hash")

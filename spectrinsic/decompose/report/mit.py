@@ -80,7 +80,7 @@ def write_mit_report(
         "",
         "## What was scored",
         "",
-        f"* folder: `{folder.resolve()}`",
+        f"* folder: `{folder.resolve().name}` (the MIT data set's folder)",
         f"* objects: {n_objects}; methods: {', '.join(str(r['method']) for r in rows)}",
         "* protocol: the thesis' (sec. 3.5): grey shading and reflectance, each measure the mean "
         "of the two layers, means over objects",

@@ -17,6 +17,7 @@ import functools
 import itertools
 import math
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -31,6 +32,7 @@ __all__ = [
     "TINTED_DUV",
     "light_xy",
     "material_chroma",
+    "recorded_chromas",
     "hull_area",
     "spread_summary",
 ]
@@ -68,6 +70,20 @@ def material_chroma(name: str, data_dir: str | None = None) -> float:
     white = responses(d65, cmf.curves, cmf.wavelengths)
     lab = colour.XYZ_to_Lab(xyz / white[1], colour.XYZ_to_xy(white / white[1]))
     return float(np.hypot(lab[1], lab[2]))
+
+
+def recorded_chromas(names: Any) -> list[float]:
+    """:func:`material_chroma` of each recorded material label in *names*, leaving out ``csv:``
+    spectra named relative to their scene file's folder (a sample records no absolute path,
+    and a dataset does not know where its scene files lie): the card's chroma statistics and
+    plot are over the other materials."""
+    out = []
+    for name in names:
+        spectrum = label_spectrum(name)
+        if spectrum[:4].lower() == "csv:" and not Path(spectrum[4:].strip()).is_absolute():
+            continue
+        out.append(material_chroma(spectrum))
+    return out
 
 
 def hull_area(points: np.ndarray) -> float:
@@ -124,9 +140,7 @@ def spread_summary(samples: Sequence[Mapping[str, Any]]) -> dict[str, float]:
         for s in samples
         if len(pts := {tuple(p) for p in s["lights"]}) >= 2
     ]
-    chroma = np.array(
-        [material_chroma(label_spectrum(n)) for s in samples for n in s["materials"]], float
-    )
+    chroma = np.array(recorded_chromas(n for s in samples for n in s["materials"]), float)
     objects = sum(int(s.get("objects", 0)) for s in samples)
     covs = [float(s["coverage"]) for s in samples if s.get("coverage") is not None]
 

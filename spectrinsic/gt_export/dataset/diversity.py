@@ -21,10 +21,9 @@ import numpy as np
 
 from ...file_writes import replacing
 from ...scenes.generators.materials import PIXEL_TEXTURE
-from ...scenes.material_labels import label_spectrum
 from ...spectra.colorimetry import luminance
 from ..sample.meta import SampleMeta
-from .colour_spread import material_chroma, shown, spread_summary
+from .colour_spread import recorded_chromas, shown, spread_summary
 from .loader import load_sample
 
 __all__ = [
@@ -106,9 +105,7 @@ def diversity_stats(
             out["light_xy"].append(light.xy)
             out["light_cct"].append(_cct(light.xy))
         out["n_materials"].append(len(meta.materials))
-        out["material_chroma"] += [
-            material_chroma(label_spectrum(n)) for n in meta.materials.values()
-        ]
+        out["material_chroma"] += recorded_chromas(meta.materials.values())
         out["samples"].append(spread_record(meta))
         if isinstance(extra.get("object_coverage"), float):
             out["coverage"].append(extra["object_coverage"])

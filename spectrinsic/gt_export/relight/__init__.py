@@ -46,7 +46,12 @@ from ..sample.sensor import model_from_meta
 from ..sample.transport_exr import read_transport
 from ..sample.working_view import space_of
 from ..sample.writer import export_sample, remove_sample_temporaries
-from .checks import check_finite_result, check_relight_inputs, check_spectrum_files
+from .checks import (
+    check_finite_result,
+    check_relight_inputs,
+    check_spectrum_files,
+    readable_names,
+)
 
 __all__ = [
     "RelitSample",
@@ -91,17 +96,33 @@ def _fail(sample: Path, what: str) -> DatasetError:
     return DatasetError(f"{sample / SCENE_NAME}: {what}; not a scene spectrinsic wrote")
 
 
-def read_sample_scene(sample_dir: str | os.PathLike[str]) -> Scene:
-    """The :class:`Scene` a sample was rendered from, read from its ``scene.json``
-    (:func:`~spectrinsic.scenes.model.scene_from_dict`, the inverse of the writer's
-    :func:`~spectrinsic.scenes.model.scene_to_dict`)."""
-    sample = Path(sample_dir)
+def _scene_record(sample: Path) -> Any:
     try:
-        data = json.loads((sample / SCENE_NAME).read_text(encoding="utf-8"))
+        return json.loads((sample / SCENE_NAME).read_text(encoding="utf-8"))
     except OSError as exc:
         raise DatasetError(f"sample {str(sample)!r} has no readable {SCENE_NAME}") from exc
     except (ValueError, RecursionError) as exc:
         raise _fail(sample, f"not valid JSON ({exc})") from exc
+
+
+def _csv_names(data: Any) -> set[str]:
+    """Every ``csv:`` name in the plain data *data*."""
+    if isinstance(data, str):
+        return {data} if data[:4].lower() == "csv:" else set()
+    values = data.values() if isinstance(data, dict) else data if isinstance(data, list) else ()
+    return set().union(*(_csv_names(v) for v in values))
+
+
+def read_sample_scene(
+    sample_dir: str | os.PathLike[str], scene_dir: str | os.PathLike[str] | None = None
+) -> Scene:
+    """The :class:`Scene` a sample was rendered from, read from its ``scene.json``
+    (:func:`~spectrinsic.scenes.model.scene_from_dict`, the inverse of the writer's
+    :func:`~spectrinsic.scenes.model.scene_to_dict`), its ``csv:`` names (relative to the scene
+    file's folder) resolved inside *scene_dir* (:func:`~.checks.readable_names`)."""
+    sample = Path(sample_dir)
+    folder = None if scene_dir is None else Path(scene_dir)
+    data = readable_names(_scene_record(sample), sample, folder)
     try:
         return scene_from_dict(data)
     except SceneError as exc:
@@ -204,6 +225,7 @@ def relit_render(
     *,
     powers: Mapping[int, float] | None = None,
     data_dir: Any = None,
+    scene_dir: str | os.PathLike[str] | None = None,
 ) -> RelitSample:
     """The sample's scene and render under new light spectra (and powers), in memory.
 
@@ -216,6 +238,10 @@ def relit_render(
         their spectrum. Names go through :func:`spectrinsic.spectra.get_spectrum`.
     powers
         ``{light index: power}`` to change brightness too (default: each light's own).
+    scene_dir
+        The folder of the scene file the sample was built from: the ``csv:`` spectra its
+        records name relative to it are read (and verified) there; needed only by samples
+        with such spectra.
     """
     sample = Path(sample_dir)
     meta = _source_meta(sample)
@@ -225,9 +251,10 @@ def relit_render(
     if stray:
         raise DatasetError(f"--power {stray[0]!r}: the sample has lights 0..{n_lights - 1}")
     check_relight_inputs(sample, meta)  # every file read matches meta.json; the EXR's header
-    source = read_sample_scene(sample)
-    used = [m.spectrum for m in source.materials] + [li.spectrum for li in source.lights]
-    check_spectrum_files(sample, meta, used)  # CSVs read again: as they were at build time
+    folder = None if scene_dir is None else Path(scene_dir)
+    used = _csv_names(_scene_record(sample))  # as recorded: relative to the scene's folder
+    check_spectrum_files(sample, meta, used, folder)  # CSVs read again: as at build time
+    source = read_sample_scene(sample, folder)
     transport, coverage = read_transport(sample, meta["transport"])
     scene = relit_scene(source, lights, powers, source=str(meta["sample_id"]))
     relit = {
@@ -281,6 +308,7 @@ def relight(
     powers: Mapping[int, float] | None = None,
     data_dir: Any = None,
     keep_transport: bool = False,
+    scene_dir: str | os.PathLike[str] | None = None,
 ) -> Path:
     """Write *sample_dir* relit with new light spectra as a complete sample folder *out_dir*.
 
@@ -290,6 +318,8 @@ def relight(
     must be new, empty, or a sample folder spectrinsic wrote (then it is replaced); its name is
     the relit sample's id. *keep_transport* stores the transport again (the relit sample can
     then be relit itself; by default it is not copied, as relighting the source is the same).
+    *scene_dir*: the scene file's folder, for a sample with ``csv:`` spectra
+    (:func:`relit_render`); the relit sample names them relative to it too.
 
     Returns
     -------
@@ -300,7 +330,7 @@ def relight(
     _check_out(sample, out)
     for path in remove_sample_temporaries(out.parent, out.name):
         log.info("removed %s, left by a relight that was killed", path.name)
-    relit = relit_render(sample, lights, powers=powers, data_dir=data_dir)
+    relit = relit_render(sample, lights, powers=powers, data_dir=data_dir, scene_dir=scene_dir)
     check_finite_result(relit.result, sample)  # before anything is written
     meta = relit.meta
     if _empty_folder(out):
@@ -322,4 +352,5 @@ def relight(
         transport=relit.transport if keep_transport else None,
         camera=model_from_meta(meta),  # the camera chain, if any, re-runs on the relit image
         noise_id=str(meta["sample_id"]),  # its noise: the source's, not the --out folder name's
+        scene_folder=scene_dir,
     )

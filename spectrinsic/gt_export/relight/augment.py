@@ -75,9 +75,15 @@ def _variant_lights(n_lights: int, k: int, seed: int) -> dict[int, str]:
 
 
 def write_relit_variants(
-    sample_dir: str | os.PathLike[str], n: int, *, seed: int, data_dir: Any = None
+    sample_dir: str | os.PathLike[str],
+    n: int,
+    *,
+    seed: int,
+    data_dir: Any = None,
+    scene_dir: str | os.PathLike[str] | None = None,
 ) -> list[Path]:
-    """Write *n* relit variants of a sample that stores its transport, beside it."""
+    """Write *n* relit variants of a sample that stores its transport, beside it (*scene_dir*:
+    the scene file's folder, for a sample with ``csv:`` spectra)."""
     sample = Path(sample_dir)
     n_lights = len(read_meta(sample).lights)
     return [
@@ -86,6 +92,7 @@ def write_relit_variants(
             _variant_lights(n_lights, k, seed),
             sample.parent / relit_variant_id(sample.name, k),
             data_dir=data_dir,
+            scene_dir=scene_dir,
         )
         for k in range(1, int(n) + 1)
     ]
@@ -110,6 +117,7 @@ def relit_layers(
     data_dir: Any = None,
     denoise: bool | None = None,
     cameras: bool = True,
+    scene_dir: str | os.PathLike[str] | None = None,
 ) -> dict[str, Any]:
     """Every layer of a sample under new light spectra, in memory, keyed as
     :func:`~spectrinsic.gt_export.dataset.loader.load_sample` returns them (``mask`` bool, ids int32
@@ -118,9 +126,10 @@ def relit_layers(
     By default the layers are those the sample has, exactly as :func:`~spectrinsic.gt_export.relight.relight`
     writes them. For cheaper augmentation, ``denoise=False`` leaves out OIDN (the denoised
     layers then come from the raw irradiance, as in a ``--no-denoise`` build; about half the
-    time at 256²) and ``cameras=False`` the camera layers.
+    time at 256²) and ``cameras=False`` the camera layers. *scene_dir*: the scene file's
+    folder, for a sample with ``csv:`` spectra (:func:`~spectrinsic.gt_export.relight.relit_render`).
     """
-    relit = relit_render(sample_dir, lights, powers=powers, data_dir=data_dir)
+    relit = relit_render(sample_dir, lights, powers=powers, data_dir=data_dir, scene_dir=scene_dir)
     meta = relit.meta
     gt = compute_ground_truth(
         relit.scene,
@@ -174,6 +183,9 @@ class RandomRelight:
     denoise, cameras
         As :func:`relit_layers`: ``None``/``True`` keep the sample's layers exactly;
         ``denoise=False`` and ``cameras=False`` trade them for speed.
+    scene_dir
+        The folder of the scene files the samples were built from, for samples with ``csv:``
+        spectra (named relative to it; :func:`relit_layers`).
     """
 
     seed: int
@@ -181,6 +193,7 @@ class RandomRelight:
     data_dir: str | None = None
     denoise: bool | None = None
     cameras: bool = True
+    scene_dir: str | None = None
 
     def lights(self, n_lights: int, index: int, epoch: int = 0) -> dict[int, str]:
         """The spectra item *index* gets in *epoch*."""
@@ -193,5 +206,10 @@ class RandomRelight:
         """Every layer of the sample in *sample_dir* under this item's random spectra."""
         lights = self.lights(len(read_meta(sample_dir).lights), index, epoch)
         return relit_layers(
-            sample_dir, lights, data_dir=self.data_dir, denoise=self.denoise, cameras=self.cameras
+            sample_dir,
+            lights,
+            data_dir=self.data_dir,
+            denoise=self.denoise,
+            cameras=self.cameras,
+            scene_dir=self.scene_dir,
         )

@@ -15,7 +15,11 @@ be laundered: ``check`` could no longer find the damage. Before anything is deco
 The spectra the relighting reads again from files (``csv:`` names of the scene's materials and
 lights, read when the layers are computed) must be listed in ``meta.json["spectrum_files"]``
 and match the SHA-256 recorded there (:func:`check_spectrum_files`): an edited CSV would
-otherwise change every layer of the relit sample with rc 0. A scene holds no other external
+otherwise change every layer of the relit sample with rc 0. A sample names those files relative
+to its scene file's folder (no written file holds a path of the machine that built it), so
+relighting one needs that folder (``relight --scene-dir``, ``scene_dir=``): the names resolve
+inside it only, as a scene file's do (:func:`readable_names`); a sample written before names
+were portable records absolute paths, read as they are. A scene holds no other external
 file: its meshes and texture weights are in ``scene.json``, its lights' SPDs in ``meta.json``.
 
 After composing, :func:`check_finite_result` refuses a relit render holding a NaN or an
@@ -33,9 +37,11 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import DatasetError
+from ...errors import DatasetError, SpectrinsicError
 from ...render.result import RenderResult
+from ...scenes.spectrum_refs import confined_csv
 from ...spectra import get_sensors
+from ...spectra.user_spectra import split_csv_key
 from ..formats.exr import read_exr_attributes
 from ..sample import META_NAME, SCENE_NAME, file_sha256
 from ..sample.transport_exr import COVERAGE_LAYER, TRANSPORT_NAME, stored_layers
@@ -43,6 +49,7 @@ from ..sample.transport_exr import COVERAGE_LAYER, TRANSPORT_NAME, stored_layers
 __all__ = [
     "verified_file",
     "check_spectrum_files",
+    "readable_names",
     "transport_channels",
     "check_transport_header",
     "check_relight_inputs",
@@ -140,9 +147,42 @@ def check_relight_inputs(sample: Path, meta: Mapping[str, Any]) -> None:
     check_transport_header(sample / TRANSPORT_NAME, record, (int(size[0]), int(size[1])))
 
 
-def check_spectrum_files(sample: Path, meta: Mapping[str, Any], names: Iterable[str]) -> None:
-    """Refuse unless every ``csv:`` spectrum among *names* (the source scene's) is listed in
-    ``meta["spectrum_files"]`` and its file still matches the SHA-256 recorded there."""
+def _readable_csv(sample: Path, name: str, scene_dir: Path | None) -> str:
+    """The recorded ``csv:`` *name* with a path the process can read: a relative one resolved
+    inside *scene_dir* (:func:`~spectrinsic.scenes.spectrum_refs.confined_csv`), an absolute
+    one (a sample from before portable names) as it is."""
+    path, _ = split_csv_key(name.strip()[4:])
+    if Path(path).is_absolute():
+        return name
+    if scene_dir is None:
+        raise DatasetError(
+            f"{sample / SCENE_NAME}: spectrum {name!r} is read from a file relative to the "
+            "scene file's folder; give that folder (relight --scene-dir DIR)"
+        )
+    try:
+        return confined_csv(name, scene_dir)
+    except SpectrinsicError as exc:
+        raise DatasetError(f"--scene-dir {str(scene_dir)!r}: spectrum {name!r}: {exc}") from None
+
+
+def readable_names(data: Any, sample: Path, scene_dir: Path | None) -> Any:
+    """A copy of the scene record *data* (``scene.json``) with every ``csv:`` name made
+    readable (:func:`_readable_csv`), so the registry reads the files the sample names."""
+    if isinstance(data, str):
+        return _readable_csv(sample, data, scene_dir) if data[:4].lower() == "csv:" else data
+    if isinstance(data, dict):
+        return {k: readable_names(v, sample, scene_dir) for k, v in data.items()}
+    if isinstance(data, list):
+        return [readable_names(v, sample, scene_dir) for v in data]
+    return data
+
+
+def check_spectrum_files(
+    sample: Path, meta: Mapping[str, Any], names: Iterable[str], scene_dir: Path | None = None
+) -> None:
+    """Refuse unless every ``csv:`` spectrum among *names* (the source scene's, as recorded) is
+    listed in ``meta["spectrum_files"]`` and its file (relative names: in *scene_dir*) still
+    matches the SHA-256 recorded there."""
     records = meta.get("spectrum_files") or []
     listed = {
         r.get("spectrum"): r
@@ -156,7 +196,7 @@ def check_spectrum_files(sample: Path, meta: Mapping[str, Any], names: Iterable[
                 f"{sample / META_NAME}: spectrum {name!r} is read from a file that "
                 "spectrum_files does not list with a SHA-256; cannot verify it"
             )
-        path = Path(record["file"])
+        path = Path(split_csv_key(_readable_csv(sample, name, scene_dir)[4:])[0])
         if not path.is_file():
             raise DatasetError(
                 f"{path}: the spectrum file of {name!r} listed in {sample / META_NAME} is missing"

@@ -33,10 +33,16 @@ from typing import TYPE_CHECKING, Any
 from ...errors import DatasetError, WriteError
 from ...file_writes import write_text_file
 from ...provenance import software_versions
-from ...scenes.model import LIGHT_FIELDS, LIGHT_PLACEMENT, Scene, scene_hash, scene_to_dict
+from ...scenes.model import (
+    LIGHT_FIELDS,
+    LIGHT_PLACEMENT,
+    Scene,
+    scene_record_hash,
+    scene_to_dict,
+)
 from ...scenes.semantic import class_table
 from ...spectra import DEFAULT_WAVELENGTHS, get_spectrum
-from ...spectra.user_spectra import spectrum_files
+from ...spectra.user_spectra import portable_names, spectrum_files
 from ...spectra.working_space import DEFAULT_WORKING_SPACE
 from ..formats import png
 from ..formats.exr import write_exr
@@ -113,6 +119,8 @@ def _meta(
     seed: int,
     previews: Mapping[str, tuple[str, dict[str, Any]]],
     files: Sequence[str],
+    scene_record: Mapping[str, Any],
+    scene_folder: Path | None,
 ) -> dict[str, Any]:
     render_meta = {
         k: v for k, v in (getattr(result, "meta", None) or {}).items() if k not in _VOLATILE_META
@@ -125,7 +133,7 @@ def _meta(
         lights.append(entry)
     height, width = gt.layers["image"].data.shape[:2]
     files_used = spectrum_files(
-        [m.spectrum for m in scene.materials] + [li.spectrum for li in scene.lights]
+        [m.spectrum for m in scene.materials] + [li.spectrum for li in scene.lights], scene_folder
     ) + list(scene.metadata.get("spectrum_files", []))  # the .spd files a Mitsuba XML read
     extra: dict[str, Any] = {"spectrum_files": files_used} if files_used else {}
     if "semantic" in gt.layers:  # the class table of the semantic layer's ids
@@ -134,7 +142,7 @@ def _meta(
         "format_version": FORMAT_VERSION,
         "sample_id": sample_id,
         "scene": scene.name,
-        "scene_hash": scene_hash(scene),
+        "scene_hash": scene_record_hash(scene_record),
         "scene_metadata": scene.metadata,
         "config_hash": config_hash(config),
         "seed": int(seed),
@@ -207,6 +215,7 @@ def _fill_folder(
     *,
     transport: LightTransport | None = None,
     sensor: SensorOutput | None = None,
+    scene_folder: Path | None = None,
     **meta_kw: Any,
 ) -> None:
     files = _write_layers(folder, gt, meta_kw["sample_id"])
@@ -216,7 +225,9 @@ def _fill_folder(
     files += [rel for rel, _ in previews.values()]
     # scene_to_dict, the record the scene hash is taken of (a procedural texture's recipe, not
     # its texel weights); scene_from_dict reads it back
-    _dump_json(folder / SCENE_NAME, plain_data(scene_to_dict(scene)), compact=True)
+    # its csv: names relative to the scene's folder, as every record of the sample holds them
+    scene_record = portable_names(plain_data(scene_to_dict(scene)), scene_folder)
+    _dump_json(folder / SCENE_NAME, scene_record, compact=True)
     files.append(SCENE_NAME)
     # meta.json last: its presence (with the right config hash) marks the folder complete; it
     # records the SHA-256 of every other file, so a resumed build can tell an intact sample,
@@ -228,12 +239,22 @@ def _fill_folder(
         )
         record["cameras"] = list(gt.cameras)  # full sensor-set names, to relight the camera layers
         files.append(TRANSPORT_NAME)
-    meta = _meta(scene, result, gt, previews=previews, files=files, **meta_kw)
+    meta = _meta(
+        scene,
+        result,
+        gt,
+        previews=previews,
+        files=files,
+        scene_record=scene_record,
+        scene_folder=scene_folder,
+        **meta_kw,
+    )
     if record is not None:  # before the hashes and the seal, which cover it
         meta["transport"] = record
     if sensor is not None:
         meta["sensor"] = sensor.meta
         meta["identities"].append(sensor.identity)
+    meta = portable_names(meta, scene_folder)  # csv: names of materials, lights and sensors
     meta[HASHES_KEY] = {rel: file_sha256(folder / rel) for rel in sorted(files)}
     meta = plain_data(meta, META_DIGITS)
     meta[SEAL_KEY] = meta_seal(meta)
@@ -257,6 +278,7 @@ def export_sample(
     spectral_layers: bool = False,
     working_space: str = DEFAULT_WORKING_SPACE,
     noise_id: str | None = None,
+    scene_folder: str | os.PathLike[str] | None = None,
 ) -> Path:
     """Compute every ground-truth layer of a rendered sample and write it atomically.
 
@@ -303,6 +325,12 @@ def export_sample(
         The sample id the camera chain's noise is seeded from (with *seed*); default
         *sample_id*. A relit sample passes its source's id, so its raw mosaic carries the same
         noise as a direct render of that sample under the new lights.
+    scene_folder
+        The folder of the scene file the scene was read from: every ``csv:`` spectrum the
+        sample records (``scene.json``, ``meta.json``) is named by its path relative to it
+        (a file outside it, or with no folder given, by its file name), so no written file
+        holds a path of the machine that built it
+        (:func:`~spectrinsic.spectra.user_spectra.portable_csv`).
 
     Returns
     -------
@@ -347,6 +375,7 @@ def export_sample(
             seed=seed,
             transport=transport,
             sensor=sensor,
+            scene_folder=None if scene_folder is None else Path(scene_folder),
         )
         _move_into_place(tmp, final, config_hash(config))
     except WriteError as exc:  # named as the file will be (a full disk): not the temporary

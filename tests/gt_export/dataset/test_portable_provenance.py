@@ -1,15 +1,28 @@
 """No file of a built set holds an absolute path of the machine that built it (the builder's
 file system would leak, and a set's provenance would depend on where it was built): every
-file is read back and searched for the build's folders, gallery included."""
+file is read back and searched for the build's folders, gallery included.
+
+Scene-file sets name their ``csv:`` and ``.spd`` spectra relative to the scene file's folder and
+their scene files by name, each with its SHA-256; so two copies of one scene folder build
+byte-identical sets with one config hash, and a rerun from the other copy resumes the set
+(relight reads the CSVs again from the folder given by ``--scene-dir``:
+``test_relight_csv_and_warnings.py``).
+"""
 
 from __future__ import annotations
 
 import dataclasses
+import hashlib
+import json
 import os
 from pathlib import Path
 
+import numpy as np
 import pytest
+import trimesh
+from PIL import Image
 
+from spectrinsic.cli import main
 from spectrinsic.gt_export import build_gallery, export_sample
 from spectrinsic.gt_export.dataset.card import write_dataset_card
 from spectrinsic.gt_export.dataset.manifest import write_manifest
@@ -50,12 +63,8 @@ def test_a_built_set_holds_no_absolute_path(
     assert _absolute_paths(root, [tmp_path, home, Path(os.getcwd())]) == []
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="csv: spectra are recorded by their resolved path (scene.json, meta.json, "
-    "gallery.json); relative names need relight to resolve them (issue 44, open)",
-)
 def test_a_set_with_csv_spectra_holds_no_absolute_path(tmp_path, one_light_sample, config):
+    """Through the API, with no scene folder: the CSV is named by its file name."""
     csv = tmp_path / "scene" / "paints.csv"
     csv.parent.mkdir()
     csv.write_text("wavelength [nm],paint [%]\n380,40\n550,60\n780,20\n")
@@ -65,3 +74,160 @@ def test_a_set_with_csv_spectra_holds_no_absolute_path(tmp_path, one_light_sampl
     root = tmp_path / "ds"
     _build(root, {"one": (scene, result)}, config)
     assert _absolute_paths(root, [tmp_path]) == []
+    (record,) = json.loads((root / "one" / "meta.json").read_text())["spectrum_files"]
+    digest = hashlib.sha256(csv.read_bytes()).hexdigest()
+    assert (record["spectrum"], record["file"], record["sha256"]) == (
+        "csv:paints.csv#paint [%]",
+        "paints.csv",
+        digest,
+    )
+
+
+# --- three scene files built by the command line, from two copies of their folder ---------
+
+PAINTS = "wavelength [nm],paint [%],lamp [W/m2/nm]\n380,40,1\n550,60,2\n780,20,1.5\n"
+YAML = """name: box
+materials:
+  m: {spectrum: 'csv:spectra/paints.csv#paint [%]'}
+meshes:
+  - {name: q, vertices: [[-1,-1,0],[1,-1,0],[1,1,0],[-1,1,0]], faces: [[0,1,2],[0,2,3]], material: m}
+lights:
+  - {kind: point, spectrum: 'csv:spectra/paints.csv#lamp [W/m2/nm]', power: 4, position: [0, 0, 2]}
+camera: {origin: [0, -3, 2], target: [0, 0, 0], width: 8, height: 8}
+"""
+XML = """<scene version="3.0.0">
+  <sensor type="perspective"><float name="fov" value="40"/>
+    <transform name="to_world"><lookat origin="0,0,4" target="0,0,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film>
+  </sensor>
+  <emitter type="point"><point name="position" x="0" y="0" z="3"/>
+    <spectrum name="intensity" filename="lamp.spd"/></emitter>
+  <shape type="rectangle"><bsdf type="diffuse">
+    <texture type="bitmap" name="reflectance"><string name="filename" value="checker.png"/></texture>
+  </bsdf></shape>
+  <shape type="sphere"><float name="radius" value="0.4"/><point name="center" x="0" y="0" z="0.5"/>
+    <bsdf type="diffuse"><string name="reflectance" value="csv:spectra/paints.csv#paint [%]"/></bsdf>
+  </shape>
+</scene>
+"""
+
+
+def _checker() -> Image.Image:
+    colours = np.array([[230, 40, 25], [20, 90, 200]], np.uint8)
+    return Image.fromarray(colours[np.indices((4, 4)).sum(axis=0) % 2])
+
+
+def _scene_folder(folder: Path) -> list[Path]:
+    """A YAML scene with csv: spectra in a subfolder, a Mitsuba XML scene (a bitmap texture,
+    a .spd emission, a csv: reflectance) and a GLB with an embedded texture."""
+    (folder / "spectra").mkdir(parents=True)
+    (folder / "spectra" / "paints.csv").write_text(PAINTS)
+    (folder / "box.yaml").write_text(YAML)
+    (folder / "lamp.spd").write_text("".join(f"{w} {1 + w / 1000}\n" for w in range(360, 831, 10)))
+    _checker().save(folder / "checker.png")
+    (folder / "room.xml").write_text(XML)
+    v = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0.0]])
+    material = trimesh.visual.material.PBRMaterial(name="checker", baseColorTexture=_checker())
+    visual = trimesh.visual.TextureVisuals(uv=(v[:, :2] + 1) / 2, material=material)
+    plane = trimesh.Trimesh(v, [[0, 1, 2], [0, 2, 3]], visual=visual, process=False)
+    trimesh.Scene({"plane": plane}).export(folder / "plane.glb")
+    return [folder / "box.yaml", folder / "room.xml", folder / "plane.glb"]
+
+
+BUILD = [
+    "--preset",
+    "preview",
+    "--resolution",
+    "8x8",
+    "--spp",
+    "2",
+    "--batches",
+    "1",
+    "--no-denoise",
+]
+
+
+@pytest.fixture(scope="module")
+def two_builds(tmp_path_factory) -> tuple[Path, Path, Path]:
+    """The same three scene files built from two copies of their folder (``a``, ``b``), each
+    run from its own working folder; returns the temporary root."""
+    root = tmp_path_factory.mktemp("portable")
+    cwd = os.getcwd()
+    try:
+        for copy in ("a", "b"):
+            files = _scene_folder(root / copy / "scenes")
+            os.chdir(root / copy)
+            out = root / copy / "ds"
+            args = ["-q", "dataset", "--scenes", *map(str, files), *BUILD, "--out", str(out)]
+            assert main(args) == 0
+    finally:
+        os.chdir(cwd)
+    return root
+
+
+@pytest.mark.slow  # two dataset builds of three scenes (about 20 s)
+def test_a_set_built_from_scene_files_holds_no_absolute_path(two_builds):
+    """YAML with csv: spectra, XML with a bitmap, a .spd and a csv: spectrum, GLB with a
+    texture: no file of the set (samples, manifest, card, gallery) names the scene folder, the
+    working folder, the home or the data directory."""
+    ds = two_builds / "a" / "ds"
+    assert {p.name for p in ds.iterdir() if p.is_dir() and "__v0__" in p.name} == {
+        "box__v0__file",
+        "room__v0__file",
+        "plane__v0__file",
+    }
+    assert (ds / "gallery.json").is_file() and (ds / "DATASET.md").is_file()
+    folders = [two_builds, Path(os.path.expanduser("~"))]
+    folders += [Path(os.environ["SPECTRINSIC_DATA"])] if os.environ.get("SPECTRINSIC_DATA") else []
+    assert _absolute_paths(ds, folders) == []
+    meta = json.loads((ds / "box__v0__file" / "meta.json").read_text())
+    digest = hashlib.sha256(PAINTS.encode()).hexdigest()
+    assert {(r["spectrum"], r["file"], r["sha256"]) for r in meta["spectrum_files"]} == {
+        ("csv:spectra/paints.csv#lamp [W/m2/nm]", "spectra/paints.csv", digest),
+        ("csv:spectra/paints.csv#paint [%]", "spectra/paints.csv", digest),
+    }
+    xml = json.loads((ds / "room__v0__file" / "meta.json").read_text())["spectrum_files"]
+    assert {r["file"] for r in xml} == {"lamp.spd", "spectra/paints.csv"}
+    config = json.loads((ds / "manifest.json").read_text())["config"]
+    scenes = json.loads(config["source"])["scenes"]
+    assert [s["path"] for s in scenes] == ["box.yaml", "room.xml", "plane.glb"]
+    assert all(len(s["sha256"]) == 64 for s in scenes)
+
+
+@pytest.mark.slow  # two dataset builds of three scenes (about 20 s)
+def test_two_copies_of_a_scene_folder_build_byte_identical_sets(two_builds):
+    """Built from ``a/`` and ``b/``: one config hash, and every file byte for byte the same,
+    meta.json and manifest.json included (no field needs to differ: the out folders share
+    their name, which the gallery's title shows)."""
+    a, b = two_builds / "a" / "ds", two_builds / "b" / "ds"
+    files = sorted(p.relative_to(a) for p in a.rglob("*") if p.is_file())
+    assert files == sorted(p.relative_to(b) for p in b.rglob("*") if p.is_file())
+    differ = [str(f) for f in files if (a / f).read_bytes() != (b / f).read_bytes()]
+    assert differ == []
+    hashes = {json.loads((d / "manifest.json").read_text())["config_hash"] for d in (a, b)}
+    assert len(hashes) == 1
+
+
+@pytest.mark.slow  # two dataset builds of three scenes (about 20 s)
+def test_a_rerun_from_the_other_copy_resumes_the_set(two_builds, capsys):
+    """The config hash does not depend on where the scene files lie: the set built from ``a``
+    is complete for the same files in ``b`` (nothing rebuilt, no --rebuild asked for)."""
+    files = [two_builds / "b" / "scenes" / n for n in ("box.yaml", "room.xml", "plane.glb")]
+    ds = two_builds / "a" / "ds"
+    before = (ds / "box__v0__file" / "meta.json").stat().st_mtime_ns
+    args = ["dataset", "--scenes", *map(str, files), *BUILD, "--out", str(ds)]
+    assert main(args) == 0, capsys.readouterr().err
+    assert (ds / "box__v0__file" / "meta.json").stat().st_mtime_ns == before
+
+
+@pytest.mark.slow  # two dataset builds of three scenes (about 20 s)
+def test_the_files_export_and_evaluate_write_hold_no_absolute_path(two_builds, tmp_path):
+    """The shards, their index and an evaluation's REPORT.md and records name the dataset by
+    its folder's name, never by its path."""
+    ds = two_builds / "a" / "ds"
+    assert main(["-q", "export", str(ds), "--out", str(tmp_path / "shards")]) == 0
+    args = ["-q", "evaluate", "--dataset", str(ds), "--methods", "image-as-shading"]
+    assert main([*args, "--no-figures", "--out", str(tmp_path / "ev")]) == 0
+    assert "* dataset: `ds`" in (tmp_path / "ev" / "REPORT.md").read_text()
+    folders = [two_builds, tmp_path, Path(os.path.expanduser("~"))]
+    assert _absolute_paths(tmp_path, folders) == []

@@ -398,8 +398,9 @@ def test_cli_follows_the_out_rule_and_the_lock_of_every_writing_verb(built, tmp_
 
 
 def test_cli_relights_with_a_light_from_a_csv_file(built, tmp_path, monkeypatch):
-    """Issue 32: ``--light 0=csv:PATH#COLUMN`` (PATH from the working folder) relights, the
-    sample names the file by its absolute path and records its SHA-256."""
+    """Issue 32: ``--light 0=csv:PATH#COLUMN`` (PATH from the working folder) relights; the
+    sample names the file by its file name (no --scene-dir holds it; issue 44: no absolute
+    path of the building machine is recorded) and records its SHA-256."""
     import hashlib
 
     from spectrinsic.cli import main
@@ -416,9 +417,10 @@ def test_cli_relights_with_a_light_from_a_csv_file(built, tmp_path, monkeypatch)
     )
     assert check_sample(out) == []
     meta = json.loads((out / "meta.json").read_text())
-    name = f"csv:{(tmp_path / 'lamp.csv').resolve()}#lamp"
+    name = "csv:lamp.csv#lamp"
     assert meta["lights"][0]["spectrum"] == name
     digest = hashlib.sha256((tmp_path / "lamp.csv").read_bytes()).hexdigest()
     assert meta["spectrum_files"] == [
-        {"spectrum": name, "file": name[4:-5], "column": "lamp", "sha256": digest}
+        {"spectrum": name, "file": "lamp.csv", "column": "lamp", "sha256": digest}
     ]
+    assert str(tmp_path) not in (out / "meta.json").read_text()
