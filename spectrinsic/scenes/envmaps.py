@@ -24,9 +24,10 @@ from __future__ import annotations
 
 import math
 import stat
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -47,6 +48,7 @@ __all__ = [
     "check_envmaps",
     "check_map_file",
     "verified_map",
+    "portable_map_files",
 ]
 
 #: Largest environment map file read, in bytes (a 2048 x 1024 float RGB EXR is 24 MiB).
@@ -159,6 +161,24 @@ def verified_map(light: Light) -> str:
             "read (its SHA-256 differs); read the scene again"
         )
     return str(path)
+
+
+def portable_map_files(record: Mapping[str, Any], base: str | Path | None) -> dict[str, Any]:
+    """A copy of scene record *record* (:func:`~spectrinsic.scenes.model.scene_to_dict`) whose
+    environment maps' files are named relative to *base*, the scene file's folder (a file
+    outside it, or with no folder, by its name alone), as the sample's records name ``csv:``
+    files: no written file holds a path of the machine that built it. The map's SHA-256 stays
+    beside it."""
+    root = Path(base).resolve() if base is not None else None
+    lights = []
+    for light in record.get("lights", []):
+        file = Path(str(light.get("file", "")))
+        if light.get("kind") == "envmap" and file.is_absolute():
+            inside = root is not None and file.is_relative_to(root)
+            rel = file.relative_to(root) if root is not None and inside else Path(file.name)
+            light = {**light, "file": rel.as_posix()}
+        lights.append(light)
+    return {**record, "lights": lights}
 
 
 def check_map_file(path: Path, what: str, budget: SceneBudget | None = None) -> tuple[int, int]:
