@@ -8,7 +8,9 @@ import pytest
 from spectrinsic.cli import main
 from spectrinsic.errors import SceneError
 from spectrinsic.mitsuba_import import import_mitsuba
+from spectrinsic.scenes.envmaps import portable_map_files
 from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml
+from spectrinsic.scenes.model import scene_to_dict
 from spectrinsic.spectra.user_spectra import rgb_light_power
 
 ENVMAP = """<emitter type="envmap">
@@ -86,3 +88,12 @@ def test_two_envmaps_add_as_two_maps_of_three_lights_each(tmp_path):
     names = [li.name for li in scene.lights]
     assert names == ["envmap.r", "envmap.g", "envmap.b", "envmap_2.r", "envmap_2.g", "envmap_2.b"]
     assert scene.lights[3].power == pytest.approx(scene.lights[0].power / 2.5, rel=1e-12)
+
+
+def test_the_scene_record_names_the_map_relative_to_the_scene_folder(tmp_path):
+    scene = load_mitsuba_xml(write_scene(tmp_path, ENVMAP.format(file="sky.exr")))
+    record = portable_map_files(scene_to_dict(scene), tmp_path)
+    assert [li["file"] for li in record["lights"]] == ["sky.exr"] * 3
+    elsewhere = portable_map_files(scene_to_dict(scene), tmp_path / "other")
+    assert [li["file"] for li in elsewhere["lights"]] == ["sky.exr"] * 3  # the name alone
+    assert str(tmp_path) not in repr(record)
