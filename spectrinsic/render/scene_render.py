@@ -366,6 +366,11 @@ def _plan(scene: Scene, settings: RenderSettings, data_dir: str | None) -> _Plan
             f"scene {scene.name!r} has glossy materials: diagonal modes render them only with "
             "integrator 'single' on a JIT (LLVM/CUDA) variant; spectral modes render them either way"
         )
+    if integrator == "passes" and any(li.kind == "envmap" for li in scene.lights) and diagonal:
+        raise RenderError(
+            f"scene {scene.name!r} has an environment map: diagonal modes render it only with "
+            "integrator 'single' on a JIT (LLVM/CUDA) variant; spectral modes render it either way"
+        )
     return _Plan(
         settings=settings,
         objs=objs,

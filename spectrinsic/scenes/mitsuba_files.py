@@ -41,6 +41,7 @@ __all__ = [
     "prepare_xml",
     "regular_file",
     "confined_file",
+    "file_sha256",
 ]
 
 #: Largest scene (or included) XML file read, in bytes.
@@ -94,7 +95,8 @@ def confined_file(rel: str, base: Path, what: str) -> Path:
     return path
 
 
-def _sha256(path: Path) -> str:
+def file_sha256(path: Path) -> str:
+    """SHA-256 (hex) of the file *path*, read in 1 MiB blocks."""
     digest = hashlib.sha256()
     with path.open("rb") as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
@@ -139,7 +141,7 @@ class _Reader:
         path = confined_file(rel, self.base, what)
         key = path.relative_to(self.base.resolve()).as_posix()
         if key not in self.files:
-            self.files[key] = SceneFile(key, role, _sha256(path))
+            self.files[key] = SceneFile(key, role, file_sha256(path))
         return path
 
     def expand(self, root: ET.Element, version: str, depth: int) -> None:

@@ -12,8 +12,10 @@ The file goes through three steps, each in its own module:
    (:mod:`~spectrinsic.scenes.mitsuba_shapes`, counted against the scene budget before any is
    built), BSDFs (:mod:`~spectrinsic.scenes.mitsuba_bsdfs`; their ``mask``, ``bumpmap`` and
    ``normalmap`` wrappers :mod:`~spectrinsic.scenes.mitsuba_maps`), emitters (``area`` on a
-   ``rectangle`` or a ``sphere``, ``point``, ``spot``, ``directional``, ``constant`` as a sky;
-   two environment emitters are merged when their spectra agree, refused otherwise), the
+   ``rectangle`` or a ``sphere``, ``point``, ``spot``, ``directional``, ``constant`` as a sky,
+   ``envmap`` as an environment map's three channel lights (:mod:`~spectrinsic.scenes.envmaps`);
+   two skies are merged when their spectra agree, refused otherwise, and an environment map
+   beside a sky is refused), the
    ``perspective`` sensor and its film (validated before any arithmetic), and the file's
    ``sample_count`` and ``max_depth`` as render hints.
 
@@ -39,9 +41,11 @@ from . import mitsuba_shapes as shapes
 from .image_textures import ImageTexture, corner_spectra
 from .mitsuba_bitmaps import diffuse_bitmap
 from .mitsuba_bsdfs import DEFAULT_MATERIAL, material_of
+from .mitsuba_environment import envmap_emitter
 from .mitsuba_files import MAX_XML_BYTES, SceneFile, prepare_xml
 from .mitsuba_maps import shape_maps
 from .mitsuba_spectra import emission
+from .mitsuba_sunsky import SKY_ROWS, sunsky_lights
 from .mitsuba_tree import XmlNode, parse_xml
 from .model import Camera, Light, Material, Mesh, Scene
 from .surface_maps import MeshMaps
@@ -53,7 +57,7 @@ __all__ = ["MAX_XML_BYTES", "ENVIRONMENT", "load_mitsuba_xml", "xml_notes", "ren
 #: Emitters that light the scene from infinity (one per scene in Mitsuba).
 ENVIRONMENT = ("constant", "envmap", "sunsky", "sky", "sun")
 #: Emitters without exact ground truth until the glass-and-environment issue lands.
-_LATER = ("envmap", "sunsky", "sky", "sun")
+_LATER = ("sky", "sun")
 #: Mitsuba's default film size.
 _FILM = (768, 576)
 
@@ -67,6 +71,8 @@ class _Reading:
     approximate: bool
     approximated: list[str] = field(default_factory=list)
     ignored: list[str] = field(default_factory=list)
+    #: Environment maps read so far.
+    maps: int = 0
 
     @property
     def say(self) -> Callable[[str], None] | None:
@@ -122,22 +128,42 @@ def _area_light(p: shapes.Placed, node: XmlNode, r: _Reading) -> Light | None:
     )
 
 
-def _emitter(node: XmlNode, where: str, r: _Reading) -> Light | None:
-    """A light of a top-level emitter; ``None`` where an approximation leaves it out."""
+def _emitter(node: XmlNode, where: str, r: _Reading) -> list[Light]:
+    """The lights of a top-level emitter (none where an approximation leaves it out; three
+    for an environment map)."""
     kind = node.plugin
     m = np.asarray(node.props.get("to_world", np.eye(4)), float)
     if kind in _LATER:
         r.refuse_or_drop(node, where, "this emitter")
-        return None
+        return []
+    if kind == "envmap":
+        r.maps += 1
+        return envmap_emitter(node, where, r.base, r.maps)
+    if kind == "sunsky":
+        if not r.approximate:
+            raise SceneError(
+                f"{where}: {node.label()} has no exact ground truth yet; refused "
+                "(--approximate: its sky baked into an RGB map, its sun a directional light)"
+            )
+        r.approximated.append(
+            f"{where}: {node.label()} as Mitsuba's RGB sunsky: its sky baked into a "
+            f"{SKY_ROWS} x {2 * SKY_ROWS} map, its sun a directional light"
+        )
+        return sunsky_lights(node, where, r.base)
+    return [_single_emitter(node, kind, m, where, r.base)]
+
+
+def _single_emitter(node: XmlNode, kind: str, m: np.ndarray, where: str, base: Path) -> Light:
+    """The light of a top-level emitter other than an environment map."""
     if kind == "constant":
-        spectrum, power = emission(node.props.get("radiance"), f"{where} radiance", r.base)
+        spectrum, power = emission(node.props.get("radiance"), f"{where} radiance", base)
         return Light("sky", spectrum, power, name="sky")
     if kind == "directional":
-        spectrum, power = emission(node.props.get("irradiance"), f"{where} irradiance", r.base)
+        spectrum, power = emission(node.props.get("irradiance"), f"{where} irradiance", base)
         d = node.props.get("direction")
         direction = m[:3, 2] if d is None else m[:3, :3] @ np.asarray(d, float)
         return Light("directional", spectrum, power, direction=_unit(direction))
-    spectrum, power = emission(node.props.get("intensity"), f"{where} intensity", r.base)
+    spectrum, power = emission(node.props.get("intensity"), f"{where} intensity", base)
     if kind == "point":
         pos = node.props.get("position")
         return Light("point", spectrum, power, position=_vec(m[:3, 3] if pos is None else pos))
@@ -318,8 +344,7 @@ def _scene(root: XmlNode, name: str, r: _Reading) -> Scene:
     for i, node in enumerate(root.children):
         where = f"element {i} {node.label()}"
         if node.kind == "emitter":
-            light = _emitter(node, where, r)
-            lights += [] if light is None else [light]
+            lights += _emitter(node, where, r)
         elif node.kind == "sensor":
             cameras.append(_camera(node, where, r))
         elif node.kind == "integrator" and node.plugin not in ("path", "volpath"):

@@ -44,6 +44,8 @@ __all__ = [
     "DRAWN_LIGHT_KINDS",
     "LIGHT_PLACEMENT",
     "LIGHT_DEFAULTED",
+    "IDENTITY_ROTATION",
+    "ENVMAP_CHANNELS",
     "make_light",
     "unknown_light_kind",
     "light_power",
@@ -54,7 +56,7 @@ __all__ = [
     "scene_record_hash",
 ]
 
-LightKind = Literal["point", "spot", "area", "directional", "sky", "sphere"]
+LightKind = Literal["point", "spot", "area", "directional", "sky", "sphere", "envmap"]
 #: The one table of light kinds: the placement fields each kind uses (the others are ignored,
 #: and records such as meta.json leave them out).
 LIGHT_FIELDS: dict[str, tuple[str, ...]] = {
@@ -64,13 +66,14 @@ LIGHT_FIELDS: dict[str, tuple[str, ...]] = {
     "directional": ("direction",),
     "sky": (),
     "sphere": ("position", "radius"),
+    "envmap": (),  # placed at infinity; its map's file record: Light.file ... rotation
 }
 #: The light kinds, in the table's order (``typing.get_args(LightKind)`` is the same).
 LIGHT_KINDS: tuple[LightKind, ...] = tuple(LIGHT_FIELDS)  # type: ignore[arg-type]
 #: The kinds the scene generators draw (a sky comes from scene files and daylight rooms, a
-#: sphere from Mitsuba XML files).
+#: sphere and an environment map from Mitsuba XML files).
 DRAWN_LIGHT_KINDS: tuple[LightKind, ...] = tuple(
-    k for k in LIGHT_KINDS if k not in ("sky", "sphere")
+    k for k in LIGHT_KINDS if k not in ("sky", "sphere", "envmap")
 )
 #: Every placement field some kind uses (the union of :data:`LIGHT_FIELDS`).
 LIGHT_PLACEMENT: tuple[str, ...] = tuple(
@@ -79,6 +82,10 @@ LIGHT_PLACEMENT: tuple[str, ...] = tuple(
 #: Placement fields with a default that a scene file may leave out (a spot's cone half-angle,
 #: :attr:`Light.cutoff_deg`).
 LIGHT_DEFAULTED: tuple[str, ...] = ("cutoff_deg",)
+#: The identity rotation of an environment map (:attr:`Light.rotation`).
+IDENTITY_ROTATION = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+#: Suffixes of the three channel lights of one environment map (:attr:`Light.channel`).
+ENVMAP_CHANNELS = (".r", ".g", ".b")
 
 
 MaterialKind = Literal["diffuse", "plastic", "conductor", "dielectric", "thindielectric"]
@@ -228,8 +235,12 @@ class Light:
     kind
         One of :data:`LIGHT_KINDS`: ``"point"``, ``"spot"``, ``"area"`` (a rectangle),
         ``"directional"``, ``"sky"`` (a uniform sky dome at infinity, Mitsuba ``constant``) or
-        ``"sphere"`` (a sphere of uniform radiance, emitting on its outside);
-        :data:`LIGHT_FIELDS` lists the placement fields each uses.
+        ``"sphere"`` (a sphere of uniform radiance, emitting on its outside) or ``"envmap"``
+        (one RGB channel of an equirectangular radiance map at infinity, Mitsuba ``envmap``:
+        an environment map is three such lights, channels 0, 1, 2 of one file, of spectra
+        ``rgblight:1,0,0`` ... and powers ``scale · rgb_light_power``, named
+        ``<map>.r/.g/.b``; ``docs/envmap_design.md``); :data:`LIGHT_FIELDS` lists the
+        placement fields each uses.
     spectrum
         Registry name of an illuminant, e.g. ``"planck:2800K"``. The registry normalises every
         illuminant to unit luminance-weighted mean, so *power* alone sets brightness.
@@ -247,6 +258,15 @@ class Light:
         Spot cone half-angle in degrees.
     radius
         Radius of a sphere light in scene units (left out of records at its default).
+    file
+        An environment map's file (OpenEXR or Radiance HDR, linear RGB radiance), an absolute
+        path checked when the scene was read; left out of records when empty.
+    sha256
+        SHA-256 of :attr:`file` when read, so the scene's hash changes with the map.
+    channel
+        Which RGB channel of :attr:`file` this light is (0, 1, 2).
+    rotation
+        The map's ``to_world`` rotation, 3 x 3 row-major (Mitsuba's envmap frame: +y up).
     """
 
     kind: LightKind
@@ -258,13 +278,17 @@ class Light:
     cutoff_deg: float = 30.0
     name: str = "light"
     radius: float = field(default=1.0, metadata=_OPTIONAL)
+    file: str = field(default="", metadata=_OPTIONAL)
+    sha256: str = field(default="", metadata=_OPTIONAL)
+    channel: int = field(default=0, metadata=_OPTIONAL)
+    rotation: tuple[float, ...] = field(default=IDENTITY_ROTATION, metadata=_OPTIONAL)
 
 
 def unknown_light_kind(kind: object) -> str:
     """The message for a light kind not in :data:`LIGHT_KINDS`, with a did-you-mean.
 
     >>> unknown_light_kind("spto")
-    "unknown light kind 'spto'; expected one of point, spot, area, directional, sky, sphere (did you mean 'spot'?)"
+    "unknown light kind 'spto'; expected one of point, spot, area, directional, sky, sphere, envmap (did you mean 'spot'?)"
     """
     return f"unknown light kind {kind!r}; expected one of {', '.join(LIGHT_KINDS)}" + did_you_mean(
         str(kind), LIGHT_KINDS

@@ -27,6 +27,7 @@ import numpy as np
 
 from ..errors import SceneError, SpectrinsicError, with_article
 from ..spectra import get_spectrum
+from .envmaps import check_envmaps
 from .geometry import VISIBILITY_GRID, camera_rays, is_closed, winding_numbers
 from .materials import material_problem
 from .model import LIGHT_FIELDS, LIGHT_KINDS, Mesh, Scene, unknown_light_kind
@@ -296,6 +297,12 @@ def _check_lights(scene: Scene, source: str) -> None:
             )
 
 
+def _check_envmaps(scene: Scene, source: str) -> None:
+    problem = check_envmaps(scene)
+    if problem is not None:
+        raise _fail(source, "lights", problem)
+
+
 def _check_camera(scene: Scene, source: str) -> None:
     cam = scene.camera
     for attr in ("origin", "target", "up"):
@@ -437,6 +444,7 @@ def validate_scene(
         _check_camera,
         _check_materials,
         _check_textures,
+        _check_envmaps,
     ):
         problems.get(check, scene, source)
     if check_spectra:

@@ -20,6 +20,7 @@ filtered      ``filtered:cie:A|bandpass:520/80``    a lamp behind a generated co
 csv           ``csv:paints.csv#red``                a user's CSV column, unit in its header
 inline        ``inline:reflectance:400=0.1,...``    written-out samples
 rgb, srgb     ``rgb:0.8,0.2,0.1``, ``srgb:#cc3311``  Mallett & Yuksel 2019 uplift of a colour
+rgblight      ``rgblight:1,0,0``                    that uplift times D65 (an envmap channel)
 ============  ====================================  ===========================================
 
 Sensor sets (:func:`get_sensors`): ``cie1931``, ``srgb``, ``gaussian:6@400-700``,
@@ -74,6 +75,7 @@ SPECTRUM_FAMILIES: dict[str, Callable[[str, str | None], Spectrum]] = {
     "inline": lambda k, d: user_spectra.inline_spectrum(k),
     "rgb": lambda k, d: user_spectra.rgb_spectrum(k),
     "srgb": lambda k, d: user_spectra.srgb_spectrum(k),
+    "rgblight": lambda k, d: user_spectra.rgb_light_spectrum(k),
 }
 
 #: family -> example and source, the module table as data (``spectrinsic list spectra``).
@@ -94,6 +96,7 @@ SPECTRUM_FAMILY_NOTES: dict[str, str] = {
     "inline": "inline:reflectance:400=0.1,700=0.5; samples written out (YAML: wavelengths/values)",
     "rgb": "rgb:0.8,0.2,0.1; linear sRGB as a reflectance (Mallett & Yuksel 2019)",
     "srgb": "srgb:#cc3311 or srgb:0.8,0.2,0.1; sRGB-encoded colour as a reflectance",
+    "rgblight": "rgblight:1,0,0; linear sRGB as a light: Mallett & Yuksel basis times D65",
 }
 
 #: family -> loader(key, data_dir); families without a key take an empty key.

@@ -25,6 +25,12 @@ Registry families (:func:`spectrinsic.spectra.get_spectrum`):
   (the ``reflectance`` layer's: the basis interpolated to 1 nm); colour-science's integration
   on the basis' 5 nm grid gives 2.4e-4 there (measured; ``tests/spectra/test_user_spectra.py``
   checks both, the first on the primaries).
+- ``rgblight:R,G,B``: the light of linear sRGB ``R,G,B`` in [0, 1] under D65,
+  ``E(λ) ∝ (R b_R(λ) + G b_G(λ) + B b_B(λ)) · D65(λ)``, normalised like every illuminant, so
+  ``rgblight:1,1,1`` is D65 (the basis sums to one within 1e-5). The channel lights of an
+  environment map (``envmap``) are ``rgblight:1,0,0``, ``rgblight:0,1,0`` and
+  ``rgblight:0,0,1``; :func:`rgb_light_power` gives the power that makes channel c's light
+  exactly ``b_c · D65`` of the registry's unit-luminance D65.
 
 Every file spectrum is checked before any work: finite numbers, strictly increasing
 wavelengths covering :data:`REQUIRED_RANGE`, reflectances in [0, 1]; errors name the file, the
@@ -43,7 +49,7 @@ import numpy as np
 
 from ..errors import SpectralDataError, SpectrumNotFoundError
 from .csv_spectra import read_csv_column
-from .illuminants import normalise_illuminant
+from .illuminants import cie_illuminant, normalise_illuminant
 from .records import Spectrum, SpectrumKind
 
 __all__ = [
@@ -54,6 +60,8 @@ __all__ = [
     "inline_name",
     "rgb_spectrum",
     "srgb_spectrum",
+    "rgb_light_spectrum",
+    "rgb_light_power",
     "split_csv_key",
     "column_unit",
     "spectrum_files",
@@ -271,6 +279,32 @@ def rgb_spectrum(key: str) -> Spectrum:
     """The reflectance of linear sRGB ``R,G,B`` in [0, 1] (module docstring)."""
     rgb = _triple(key, "rgb")
     return _from_linear("rgb:" + ",".join(f"{c:g}" for c in rgb), rgb)
+
+
+def _rgb_light_values(rgb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Wavelengths of the registry's D65 and ``(rgb · b)(λ) · D65(λ)``, D65 at unit luminance."""
+    d65 = cie_illuminant("D65")
+    wl, basis = _mallett_basis()
+    colour = np.stack([np.interp(d65.wavelengths, wl, b) for b in basis])  # edge values beyond
+    return d65.wavelengths, (rgb @ colour) * d65.values
+
+
+def rgb_light_spectrum(key: str) -> Spectrum:
+    """The illuminant of linear sRGB ``R,G,B`` in [0, 1] under D65 (module docstring)."""
+    rgb = _triple(key, "rgb")
+    wl, values = _rgb_light_values(rgb)
+    name = "rgblight:" + ",".join(f"{c:g}" for c in rgb)
+    source = MALLETT2019 + " times CIE D65"
+    return Spectrum(name, "illuminant", wl, normalise_illuminant(wl, values), source)
+
+
+def rgb_light_power(rgb: tuple[float, float, float]) -> float:
+    """Power of ``rgblight:R,G,B`` whose light is ``(rgb · b) · D65`` with D65 at unit
+    luminance: the luminance of that product relative to D65's (``Σ`` over the channels of a
+    unit colour is 1). With it a map texel (R, G, B) of a unit-scale environment map has the
+    radiance spectrum ``Σ_c rgb_c · power_c · rgblight_c = (rgb · b) · D65``."""
+    wl, values = _rgb_light_values(np.asarray(rgb, float))
+    return float(values.sum() / normalise_illuminant(wl, values).sum())
 
 
 def srgb_spectrum(key: str) -> Spectrum:

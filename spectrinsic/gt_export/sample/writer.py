@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any
 from ...errors import DatasetError, WriteError
 from ...file_writes import write_text_file
 from ...provenance import software_versions
+from ...scenes.envmaps import portable_map_files
 from ...scenes.model import (
     LIGHT_FIELDS,
     LIGHT_PLACEMENT,
@@ -233,6 +234,7 @@ def _fill_folder(
     # its texel weights); scene_from_dict reads it back
     # its csv: names relative to the scene's folder, as every record of the sample holds them
     scene_record = portable_names(plain_data(scene_to_dict(scene)), scene_folder)
+    scene_record = portable_map_files(scene_record, scene_folder)  # environment maps' files
     _dump_json(folder / SCENE_NAME, scene_record, compact=True)
     files.append(SCENE_NAME)
     # meta.json last: its presence (with the right config hash) marks the folder complete; it

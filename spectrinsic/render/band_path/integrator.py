@@ -79,6 +79,14 @@ class BandTables:
         The texel tables of textured meshes (:mod:`~spectrinsic.render.base.textures`), or ``None``.
     shape_textures
         ``{Mitsuba shape id: texture slot}`` of textured shapes.
+    light_channels
+        Per light j, ``(o_j, c_j, m_j)``: it takes RGB component ``c_j`` of source ``m_j`` on
+        the lanes whose emitter was loaded as light ``o_j``; source 0 is that emitter's own
+        value, source ``1 + i`` extra map i. An environment map's channel lights share the one
+        loaded ``envmap``; empty: ``(j, 0, 0)`` for every light.
+    extra_maps
+        Standalone Mitsuba ``envmap`` emitters of the scene's other environment maps (Mitsuba
+        loads one per scene), evaluated by the kernel where the loaded one is hit or sampled.
     map_scales
         ``{Mitsuba shape id: bump scale}`` of shapes with a bump or normal map, whose perturbed
         normal the first-hit maps hold (:mod:`~spectrinsic.render.base.surface_maps`).
@@ -93,8 +101,14 @@ class BandTables:
     shape_surfaces: dict[str, int] = field(default_factory=dict)
     textures: TextureTables | None = None
     shape_textures: dict[str, int] = field(default_factory=dict)
+    light_channels: tuple[tuple[int, int, int], ...] = ()
+    extra_maps: tuple[object, ...] = ()
     map_scales: dict[str, float] = field(default_factory=dict)
     masks: bool = False
+
+    def channels(self) -> tuple[tuple[int, int, int], ...]:
+        """:attr:`light_channels`, or ``(j, 0, 0)`` per light where empty."""
+        return self.light_channels or tuple((j, 0, 0) for j in range(self.n_lights))
 
 
 def part_channels(part: str, n_lights: int, n_bands: int) -> list[str]:
@@ -159,6 +173,11 @@ def _check_fit(it: Any, tables: BandTables) -> None:
         or tables.n_lights != it.n_lights
         or len(tables.shape_surfaces) != it.n_surfaces
         or n_texcols != it.n_texcols
+        or len(tables.channels()) != it.n_lights
+        or any(
+            not (0 <= o < it.n_lights and 0 <= c < 3 and 0 <= m <= len(tables.extra_maps))
+            for o, c, m in tables.channels()
+        )
     ):
         raise RenderError(
             f"band tables {shape} for {tables.n_lights} lights and {n_texcols} texture columns "
@@ -180,6 +199,23 @@ def _init_gloss(mi: Any, it: Any, props: Any) -> None:
         it.white_bsdf = mi.load_dict(
             {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": 1.0}}
         )
+
+
+def _empty_tables(mi: Any, it: Any) -> None:
+    """Integrator *it*'s lookups before :meth:`set_tables`: one zero entry each, every light
+    its own emitter's component 0 and no extra map."""
+    it.surface_lut = mi.UInt32(np.zeros(1, np.uint32))
+    it.albedo = mi.Float(np.zeros(it.n_bands, np.float32))
+    it.shape_lut = mi.UInt32(np.zeros(1, np.uint32))
+    it.emitter_lut = mi.UInt32(np.zeros(1, np.uint32))
+    _set_envmaps(it, None)
+
+
+def _set_envmaps(it: Any, tables: BandTables | None) -> None:
+    """Integrator *it*'s light channels and extra environment maps from *tables* (none: every
+    light its own emitter's component 0, no extra map)."""
+    it.light_channels = () if tables is None else tables.channels()
+    it.extra_maps = () if tables is None else tuple(tables.extra_maps)
 
 
 def _init_maps(mi: Any, it: Any, props: Any) -> None:
@@ -227,10 +263,7 @@ def _make_class(mi: Any, dr: Any) -> type:
             self.n_lights = int(props.get("n_lights", 1))
             self.n_surfaces = int(props.get("n_surfaces", 0))
             self.n_texcols = int(props.get("n_texcols", 0))
-            self.surface_lut = mi.UInt32(np.zeros(1, np.uint32))
-            self.albedo = mi.Float(np.zeros(self.n_bands, np.float32))
-            self.shape_lut = mi.UInt32(np.zeros(1, np.uint32))
-            self.emitter_lut = mi.UInt32(np.zeros(1, np.uint32))
+            _empty_tables(mi, self)
             _init_features(mi, self, props)
 
         def set_tables(self, scene: Any, tables: BandTables) -> None:
@@ -242,6 +275,7 @@ def _make_class(mi: Any, dr: Any) -> type:
             lookups = texture_lookups(mi, dr, scene, tables.textures, tables.shape_textures)
             self.slot_lut, self.tex_widths, self.tex_heights, self.tex_offsets = lookups[:4]
             self.texel_albedo, self.texel_weights = lookups[4:]
+            _set_envmaps(self, tables)
             _set_maps(mi, dr, self, scene, tables)
 
         def set_non_diffuse(self, rows: np.ndarray) -> None:

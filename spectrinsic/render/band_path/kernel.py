@@ -127,7 +127,7 @@ class _Vertex:
     Mitsuba's BSDF sample and weight, and (gloss) ``(a, μ)`` of both directions."""
 
     light: Any
-    nee: Any
+    nee: tuple  # RGB weights (emitter, then extra maps) times the path throughput
     active_em: Any
     bsdf_sample: Any
     bsdf_weight: Any
@@ -179,19 +179,33 @@ class BandKernel:
             for b, r in enumerate(rho)
         ]
 
-    def deposit(self, acc: list, light: Any, weight: Any, bands: Sequence, mask: Any) -> list:
-        """``acc[l·K + k] += bands[k]·weight`` on the lanes whose light is l."""
+    def deposit(self, acc: list, light: Any, weights: tuple, bands: Sequence, mask: Any) -> list:
+        """``acc[j·K + k] += bands[k]·weights[m_j][c_j]`` on the lanes whose emitter is light
+        j's owner ``o_j``. *weights* are RGB values (``Color3f``): the emitter's own, then one
+        per extra environment map (:meth:`extra_maps_at`); ``(o_j, c_j, m_j)`` =
+        ``it.light_channels[j]`` (Python ints, read when traced; empty: ``(j, 0, 0)`` for
+        every light). Only an environment map's channel lights take another component or
+        source: the emitters are loaded white, so today's components are equal and component
+        0 of the emitter's own value is exactly the scalar of before."""
         k, out = self.it.n_bands, list(acc)
-        for j in range(self.it.n_lights):
-            w = self.dr.select(mask & (light == j), weight, 0.0)
+        triples = self.it.light_channels or [(j, 0, 0) for j in range(self.it.n_lights)]
+        for j, (owner, channel, source) in enumerate(triples):
+            w = self.dr.select(mask & (light == owner), weights[source][channel], 0.0)
             for b in range(k):
                 out[j * k + b] = self.dr.fma(bands[b], w, out[j * k + b])
         return out
 
+    def extra_maps_at(self, si: Any, scale: Any, active: Any) -> tuple:
+        """The RGB radiance of every extra environment map (``it.extra_maps``, standalone
+        Mitsuba ``envmap`` emitters, not in the scene: it takes one) towards ``-si.wi``, times
+        *scale* (Mitsuba's ``envmap.eval`` reads only the direction)."""
+        return tuple(m.eval(si, active) * scale for m in self.it.extra_maps)
+
     # -- the steps of a vertex -------------------------------------------------------------
 
-    def emitter_hit(self, si: Any, s: PathState) -> tuple[Any, Any, Any]:
-        """Light, weight (radiance x BSDF-sampling MIS weight) and mask of an emitter hit."""
+    def emitter_hit(self, si: Any, s: PathState) -> tuple[Any, tuple, Any]:
+        """Light, weights (the path's throughput x RGB radiance x BSDF-sampling MIS weight, of
+        the emitter then of the extra maps) and mask of an emitter hit."""
         mi, dr = self.mi, self.dr
         emitter = si.emitter(self.scene)
         hit = emitter != None  # noqa: E711 (a Dr.Jit pointer array, compared lane by lane)
@@ -199,8 +213,10 @@ class BandKernel:
         em_pdf = dr.select(
             s.prev_delta, 0.0, self.scene.pdf_emitter_direction(s.prev_si, ds, ~s.prev_delta)
         )
-        radiance = emitter.eval(si, (s.prev_pdf > 0.0) & hit)[0]
-        return self.light_of(emitter, hit), radiance * mis_weight(dr, mi, s.prev_pdf, em_pdf), hit
+        active = (s.prev_pdf > 0.0) & hit
+        mis = mis_weight(dr, mi, s.prev_pdf, em_pdf)
+        weights = (emitter.eval(si, active) * mis, *self.extra_maps_at(si, mis, active))
+        return self.light_of(emitter, hit), tuple(s.beta * w for w in weights), hit
 
     def lobes(self, si: Any, bsdf: Any, wo: Any, delta: Any, active: Any) -> tuple[Any, Any]:
         """``a = f_d / f`` at local direction *wo* (0 where *delta*; exactly 1 for a BSDF
@@ -219,9 +235,11 @@ class BandKernel:
         mu = dr.select(norm > 0.0, dr.abs(dr.dot(si.wi, h)) / norm, 1.0)
         return a, dr.clip(mu, 0.0, 1.0)
 
-    def vertex(self, sampler: Any, si: Any, bsdf: Any, active_next: Any) -> _Vertex:
-        """Emitter sample, then BSDF evaluation and sample (``eval_pdf_sample``); with gloss
-        also ``a`` and ``μ`` of both directions."""
+    def vertex(self, s: PathState, si: Any, bsdf: Any, active_next: Any) -> _Vertex:
+        """Emitter sample (its weights times the path's throughput ``s.beta``), then BSDF
+        evaluation and sample (``eval_pdf_sample``); with gloss also ``a`` and ``μ`` of both
+        directions."""
+        sampler = s.sampler
         mi, dr = self.mi, self.dr
         active_em = active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth)
         ds, em_weight = self.scene.sample_emitter_direction(si, sampler.next_2d(), True, active_em)
@@ -232,7 +250,12 @@ class BandKernel:
             mi.BSDFContext(), si, wo_em, sample_1, sample_2
         )
         mis_em = dr.select(ds.delta, 1.0, mis_weight(dr, mi, ds.pdf, bsdf_pdf))
-        nee = bsdf_val[0] * em_weight[0] * mis_em
+        nee = (bsdf_val[0] * em_weight * mis_em,)  # RGB: an environment map's channels
+        if self.it.extra_maps:  # their radiance over the pdf the loaded emitter sampled by
+            towards = dr.zeros(mi.SurfaceInteraction3f)
+            towards.wi = -ds.d
+            nee += self.extra_maps_at(towards, bsdf_val[0] * mis_em / ds.pdf, active_em)
+        nee = tuple(s.beta * w for w in nee)
         if not self.gloss:
             light = self.light_of(ds.emitter, active_em)
             return _Vertex(light, nee, active_em, bsdf_sample, bsdf_weight[0])
@@ -392,11 +415,9 @@ class BandKernel:
             s.first = self.first_hit(si, now, s.first)
         light, weight, hit = self.emitter_hit(si, s)
         # the white loop: what the camera sees directly is not reflected by the white surface
-        s.acc = self.deposit(
-            s.acc, light, s.beta * weight, s.bands, hit if swap is None else hit & ~now
-        )
+        s.acc = self.deposit(s.acc, light, weight, s.bands, hit if swap is None else hit & ~now)
         if self.spec:
-            s.sacc = self.deposit(s.sacc, light, s.beta * weight, s.sbands, hit)
+            s.sacc = self.deposit(s.sacc, light, weight, s.sbands, hit)
         active_next = (s.depth + 1 < self.it.max_depth) & valid
         bsdf = si.bsdf(s.ray)
         if swap is not None:  # the white loop goes on only from a metal first vertex ...
@@ -404,7 +425,7 @@ class BandKernel:
             if not self.masks:  # ... or through a null event (masks: known once sampled)
                 active_next &= keep
             bsdf = dr.select(swap, mi.BSDFPtr(self.it.white_bsdf), bsdf)
-        v = self.vertex(s.sampler, si, bsdf, active_next)
+        v = self.vertex(s, si, bsdf, active_next)
         c_em = c_bs = rho = self.albedo(si)
         if swap is not None:
             rho = [dr.select(swap, 1.0, r) for r in rho]
@@ -425,9 +446,9 @@ class BandKernel:
             s.sbands = [dr.select(now, b * x, sb * c) for b, x, sb, c in pairs]
         nee_bands = [b * c for b, c in zip(s.bands, c_em, strict=True)]
         active_em = v.active_em if keep is None or not self.masks else v.active_em & keep
-        s.acc = self.deposit(s.acc, v.light, s.beta * v.nee, nee_bands, active_em)
+        s.acc = self.deposit(s.acc, v.light, v.nee, nee_bands, active_em)
         if self.spec:
-            s.sacc = self.deposit(s.sacc, v.light, s.beta * v.nee, s_nee, v.active_em)
+            s.sacc = self.deposit(s.sacc, v.light, v.nee, s_nee, v.active_em)
         bands = nee_bands if c_bs is c_em else [b * c for b, c in zip(s.bands, c_bs, strict=True)]
         s, go_on = self.step(s, si, v, bands)
         s.alive = active_next & go_on

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import RenderError, SceneError, validate_choice
+from ...scenes.envmaps import envmap_groups
 from ...scenes.model import Scene
 from ...spectra import get_sensors
 from ..algebra.modes import ChannelValues, RenderMode, channel_values, get_mode
@@ -105,8 +106,36 @@ def _tables(
         shape_surfaces={s.key: i for i, s in enumerate(surfaces)} if aovs else {},
         textures=textures,
         shape_textures=shape_slots(textures, surfaces),
+        light_channels=light_channels(scene, emitters),
         map_scales=map_scales(scene, surfaces),
         masks=any(m.maps is not None and m.maps.masked for m in scene.meshes),
+    )
+
+
+def light_channels(scene: Scene, emitters: dict[int, int]) -> tuple[tuple[int, int, int], ...]:
+    """Per light, ``(light loaded as its emitter, RGB component, source)``: ``(j, 0, 0)``, or
+    for a channel light of the scene's environment map i the one loaded ``envmap`` (the light
+    *emitters* names), its channel and source 0 for the loaded map (i = 0), ``i`` for extra
+    map ``i - 1`` (:func:`extra_maps`)."""
+    loaded = set(emitters.values())
+    maps = envmap_groups(scene)
+    owner = next((j for j in maps[0].lights if j in loaded), 0) if maps else 0
+    out = []
+    for j, light in enumerate(scene.lights):
+        source = next((i for i, g in enumerate(maps) if j in g.lights), None)
+        if source is None:
+            out.append((j, 0, 0))
+        else:
+            out.append((owner, int(light.channel), source))
+    return tuple(out)
+
+
+def extra_maps(mi: Any, scene: Scene) -> tuple[object, ...]:
+    """Standalone Mitsuba ``envmap`` emitters of the scene's environment maps after the first
+    (Mitsuba loads one per scene; the band path evaluates these itself)."""
+    return tuple(
+        mi.load_dict(tr.envmap_entry(mi, scene.lights[g.lights[0]], {}))
+        for g in envmap_groups(scene)[1:]
     )
 
 
@@ -312,6 +341,7 @@ def render_traversal(
             )
         )
         tables = _tables(scene, value_sets, light_of_emitters(mi, loaded), aovs)
+        tables = replace(tables, extra_maps=extra_maps(mi, scene))
         non_diffuse_rows = tuple(
             GLASS_ROW if m.transmissive else MIRROR_ROW if m.non_diffuse else 0
             for m in scene.materials

@@ -11,7 +11,11 @@ Naming, which :mod:`spectrinsic.render.passes` relies on to update parameters be
   (:func:`material_bsdf`) Mitsuba's ``plastic``/``roughplastic`` (the reflectance is the
   ``diffuse_reflectance`` under the coat) or ``conductor``/``roughconductor``;
 * light ``i`` is ``light_<i>``; an area light is a rectangle shape with an ``area`` emitter and a
-  black two-sided BSDF, so it occludes and reflects nothing.
+  black two-sided BSDF, so it occludes and reflects nothing;
+* an environment map's three channel lights are **one** Mitsuba ``envmap`` keyed by the first
+  of them given an emission (:func:`envmap_entry`); Mitsuba takes one environment emitter per
+  scene, so only the first map given an emission is loaded (the band path evaluates the
+  others itself, :mod:`spectrinsic.render.band_path.kernel`).
 
 Two-sided BSDFs make face winding irrelevant (a room's walls render from inside whichever way
 they were wound). Vertex normals are smoothed across edges whose faces meet at less than
@@ -27,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import SceneError
+from ...scenes.envmaps import verified_map
 from ...scenes.model import Light, Material, Scene, unknown_light_kind
 from ...scenes.textures import box_uv
 from .plugins import black_bsdf
@@ -42,6 +47,7 @@ __all__ = [
     "reflectance_key",
     "material_bsdf",
     "emission_key",
+    "envmap_entry",
     "smooth_corner_normals",
     "SurfaceGeometry",
     "prepare_geometry",
@@ -59,6 +65,7 @@ _EMISSION_PARAM = {
     "area": "radiance",
     "sky": "radiance",
     "sphere": "radiance",
+    "envmap": "scale",
 }
 #: Light kinds that are shapes carrying an ``area`` emitter.
 _SHAPE_LIGHTS = ("area", "sphere")
@@ -266,7 +273,29 @@ def _look_at(mi: Any, origin: Sequence[float], direction: Sequence[float], what:
     )
 
 
+def envmap_entry(mi: Any, light: Light, emission: Mapping) -> dict[str, Any]:
+    """The Mitsuba ``envmap`` of environment-map light *light*: its file's RGB data at unit
+    scale (exact in RGB variants, ``docs/envmap_design.md`` fact 2; the channel lights' powers
+    are applied outside Mitsuba), or the ``mi.Bitmap`` *emission* holds under ``"bitmap"``
+    instead (the spectral pass's grey map of one channel), rotated by the map's ``to_world``."""
+    rot = np.asarray(light.rotation, float).reshape(3, 3)
+    matrix = np.eye(4)
+    matrix[:3, :3] = rot
+    entry: dict[str, Any] = {
+        "type": "envmap",
+        "scale": 1.0,
+        "to_world": mi.ScalarTransform4f(matrix.tolist()),
+    }
+    if "bitmap" in emission:
+        entry["bitmap"] = emission["bitmap"]
+    else:
+        entry["filename"] = verified_map(light)
+    return entry
+
+
 def _light(mi: Any, light: Light, emission: Mapping | None, what: str) -> dict[str, Any] | None:
+    if light.kind == "envmap":
+        return None if emission is None else envmap_entry(mi, light, emission)
     if light.kind == "point":
         return (
             None
@@ -441,7 +470,12 @@ def scene_to_mitsuba(
     }
     for part in prepare_geometry(scene, crease_deg) if geometry is None else geometry:
         out[part.key] = _mitsuba_mesh(mi, part, _surface_bsdf(scene, part, materials, white_metal))
+    loaded_map = False  # Mitsuba takes one environment emitter: the first map given one
     for j, (light, emission) in enumerate(zip(scene.lights, lights, strict=True)):
+        if light.kind == "envmap" and emission is not None:
+            if loaded_map:
+                continue
+            loaded_map = True
         entry = _light(mi, light, emission, f"scene {scene.name!r} light {j} ({light.name})")
         if entry is not None:
             out[light_key(j)] = entry

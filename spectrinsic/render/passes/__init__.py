@@ -73,6 +73,12 @@ def render_diagonal(
     One :class:`PassOutput` per value set, ``(H, W, K)`` float32 raw channels.
     """
     check_scene_lights(scene)
+    if any(light.kind == "envmap" for light in scene.lights):
+        raise SceneError(
+            f"scene {scene.name!r} has an environment map: the passes cannot split its RGB "
+            "channels into lights; render it with the single traversal (--integrator single, "
+            "an llvm or cuda variant)"
+        )
     refuse_textures(scene, "the diagonal passes")
     refuse_maps(scene, "the diagonal passes")
     active = active_light_set(scene, active_lights)
