@@ -188,12 +188,13 @@ def compute_ground_truth(
         clipping=clipping_of(rgb_of(s, w) / rgb_white(s), w.valid & (irr.luminance_of(w) > 0)),
         working_space=s.space,
         residual_share=residual_shares(_identities(by_name, cameras), by_name, mask),
-        band_albedos=(
-            band_albedos(dataclasses.replace(s, ref=SPECTRAL_MODE))
-            if settings.spectral_layers
-            else None
-        ),
+        band_albedos=_band_albedos(s) if settings.spectral_layers else None,
     )
+
+
+def _band_albedos(s: SampleInputs) -> np.ndarray:
+    """The materials' band albedos on the 31-band grid (the per-band layers' factors)."""
+    return band_albedos(dataclasses.replace(s, ref=SPECTRAL_MODE))
 
 
 def identities(gt: GroundTruth) -> list[dict[str, str]]:

@@ -156,17 +156,28 @@ def test_room_coverage_partitions_each_pixel(make_room, integrator, coverage_pas
     assert result.meta["timings"]["aovs"]["passes"] == coverage_passes
 
 
-def test_every_light_kind_of_the_scene_model_translates(make_plane):
-    """The translator covers exactly the scene model's table of light kinds."""
+def test_every_light_kind_of_the_scene_model_translates(make_plane, tmp_path):
+    """The translator covers exactly the scene model's table of light kinds (an environment
+    map with a map file: its red channel light)."""
+    import hashlib
     from dataclasses import replace
 
     from spectrinsic.render.base.translate import emission_key
+    from spectrinsic.scenes.envmaps import envmap_lights
     from spectrinsic.scenes.model import LIGHT_KINDS, make_light
 
     base = make_plane("flat:0.5", "cie:D65")
+    with variant_scope("scalar_rgb") as mi:
+        path = tmp_path / "map.exr"
+        mi.Bitmap(np.full((2, 4, 3), 0.5, np.float32)).write(str(path))
+    sha = hashlib.sha256(path.read_bytes()).hexdigest()
     for kind in LIGHT_KINDS:
-        light = make_light(
-            kind, "cie:D65", 1.0, position=(0.0, 0.0, 1.5), direction=(0.0, 0.0, -1.0)
+        light = (
+            envmap_lights("light", str(path), sha, 1.0)[0]
+            if kind == "envmap"
+            else make_light(
+                kind, "cie:D65", 1.0, position=(0.0, 0.0, 1.5), direction=(0.0, 0.0, -1.0)
+            )
         )
         scene = replace(base, lights=(light,))
         assert emission_key(scene, 0, spectral=True).endswith(".values")
