@@ -39,10 +39,11 @@ from .model import (
     unknown_light_kind,
 )
 from .parts import Part, moved
+from .problems import Problems
 from .scene_format import FORMAT_VERSION, MESH_SUFFIXES
 from .spectrum_refs import resolve_spectrum_refs
 from .textures import Texture
-from .validate import Problems, validate_scene
+from .validate import validate_scene
 from .yaml_limits import load_yaml_file
 
 __all__ = ["load_scene"]

@@ -6,31 +6,26 @@
   range, unique mesh names, positive image size, a field of view in (0, 180) degrees;
 - spectra: every material names a known *reflectance* and every light a known *illuminant*
   (:func:`spectrinsic.spectra.get_spectrum`, whose did-you-mean suggestions are kept);
-- physics: light power > 0; no point, spot or area light (and no camera) inside a closed mesh,
-  decided by the generalised winding number (Jacobson et al. 2013), which is exact for closed
-  meshes and robust to overlapping parts; and a camera that sees something: at least one ray
-  through a coarse grid of pixel centres must hit a mesh (trimesh ray tests: Embree through
-  ``embreex`` when installed, else trimesh's own triangle tests, which need ``rtree``).
+- physics: light power > 0; and, unless asked not to, the placement of the camera and the
+  lights (:func:`spectrinsic.scenes.placement.check_placement`: nothing inside a closed mesh,
+  a camera that sees a mesh), run once the geometry is sound.
 
-Inside tests apply to closed meshes (every edge shared by exactly two faces); an open surface
-has no inside.
+Problems of independent parts are reported together (:class:`~spectrinsic.scenes.problems.Problems`).
 """
 
 from __future__ import annotations
 
-import logging
 import math
-from collections.abc import Callable, Sequence
-from typing import TypeVar
 
 import numpy as np
 
-from ..errors import SceneError, SpectrinsicError, with_article
+from ..errors import SpectrinsicError, with_article
 from ..spectra import get_spectrum
 from .envmaps import check_envmaps
-from .geometry import VISIBILITY_GRID, camera_rays, is_closed, winding_numbers
 from .materials import material_problem
-from .model import LIGHT_FIELDS, LIGHT_KINDS, Mesh, Scene, unknown_light_kind
+from .model import LIGHT_FIELDS, LIGHT_KINDS, Scene, unknown_light_kind
+from .placement import check_placement as _check_placement  # the keyword below has its name
+from .problems import Problems, field_error
 from .semantic import SEMANTIC_CLASSES
 from .surface_maps import maps_problem
 from .textures import texture_problem
@@ -38,16 +33,11 @@ from .textures import texture_problem
 __all__ = [
     "validate_scene",
     "check_classes",
-    "Problems",
     "POWER_RANGE",
     "MAX_COORDINATE",
 ]
 
-log = logging.getLogger(__name__)
 
-#: A point is inside a closed mesh when its winding number exceeds this (exactly 1 inside,
-#: 0 outside for a closed outward-oriented surface; overlapping parts add up).
-_INSIDE_WINDING = 0.5
 #: A light's power, in the scene's relative units, must lie in this closed range: the renderer
 #: carries power × spectrum (unit luminance-weighted mean) × geometry in float32 (largest
 #: 3.4e38, smallest normal 1.2e-38), so 1e±20 leaves 18 orders of magnitude for the spectrum's
@@ -59,49 +49,12 @@ POWER_RANGE = (1e-20, 1e20)
 MAX_COORDINATE = 1e18
 
 
-T = TypeVar("T")
-
-
-class Problems:
-    """Collects the errors of a scene's independent parts, so one run reports all of them.
-
-    Each part runs through :meth:`get`; a :class:`SceneError` there is recorded and ``None``
-    returned. :meth:`raise_if_any` then raises one one-line error listing every problem.
-    """
-
-    def __init__(self, source: str) -> None:
-        self.source = source
-        self.messages: list[str] = []
-
-    def get(self, fn: Callable[..., T], *args: object) -> T | None:
-        """``fn(*args)``, or ``None`` after recording its SceneError."""
-        try:
-            return fn(*args)
-        except SceneError as exc:
-            message = str(exc)
-            self.messages.append(message.removeprefix(f"{self.source}: "))
-            return None
-
-    def raise_if_any(self) -> None:
-        """Raise ``"<source>: <problem>"``, or ``"<source>: N problems: a; b; ..."``."""
-        if len(self.messages) == 1:
-            raise SceneError(f"{self.source}: {self.messages[0]}")
-        if self.messages:
-            raise SceneError(
-                f"{self.source}: {len(self.messages)} problems: " + "; ".join(self.messages)
-            )
-
-
-def _fail(source: str, field: str, problem: str) -> SceneError:
-    return SceneError(f"{source}: {field}: {problem}")
-
-
 def _check_materials(scene: Scene, source: str) -> None:
     """Gloss parameters of every material (:func:`~spectrinsic.scenes.materials.material_problem`)."""
     for i, mat in enumerate(scene.materials):
         problem = material_problem(mat)
         if problem:
-            raise _fail(source, f"materials[{i}] ({mat.name!r})", problem)
+            raise field_error(source, f"materials[{i}] ({mat.name!r})", problem)
 
 
 def _vec(value: object, n: int = 3) -> np.ndarray | None:
@@ -119,7 +72,7 @@ def _check_spectrum(
     source: str, field: str, name: object, kind: str, data_dir: str | None, cache: dict[str, object]
 ) -> None:
     if not isinstance(name, str) or not name:
-        raise _fail(source, field, f"expected a spectrum name string, got {name!r}")
+        raise field_error(source, field, f"expected a spectrum name string, got {name!r}")
     if name not in cache:
         try:
             cache[name] = get_spectrum(name, data_dir=data_dir)
@@ -127,10 +80,10 @@ def _check_spectrum(
             cache[name] = exc
     found = cache[name]
     if isinstance(found, SpectrinsicError):
-        raise _fail(source, field, str(found)) from found
+        raise field_error(source, field, str(found)) from found
     found_kind = getattr(found, "kind", kind)
     if found_kind != kind:
-        raise _fail(
+        raise field_error(
             source,
             field,
             f"{name!r} is {with_article(found_kind)} spectrum; expected {with_article(kind)}",
@@ -142,7 +95,7 @@ def _check_area(v: np.ndarray, f: np.ndarray, source: str, where: str) -> None:
     normal to shade with)."""
     tri = v.astype(np.float64)[f]
     if not np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).any():
-        raise _fail(
+        raise field_error(
             source,
             f"{where}.faces",
             f"all {len(f)} faces have zero area (collinear "
@@ -154,14 +107,14 @@ def _check_coordinates(v: np.ndarray, source: str, where: str) -> None:
     """Vertices finite and within ±:data:`MAX_COORDINATE` (finite once cast to float32)."""
     bad = ~np.isfinite(v).all(axis=1)
     if bad.any():
-        raise _fail(
+        raise field_error(
             source,
             f"{where}.vertices",
             f"{int(bad.sum())} vertices are NaN or infinite (first: vertex {int(np.argmax(bad))})",
         )
     far = ~(np.abs(v.astype(np.float64)) <= MAX_COORDINATE).all(axis=1)
     if far.any():
-        raise _fail(
+        raise field_error(
             source,
             f"{where}.vertices",
             f"{int(far.sum())} vertices have a coordinate beyond ±{MAX_COORDINATE:g} "
@@ -171,46 +124,50 @@ def _check_coordinates(v: np.ndarray, source: str, where: str) -> None:
 
 def _check_meshes(scene: Scene, source: str) -> None:
     if not scene.meshes:
-        raise _fail(source, "meshes", "a scene needs at least one mesh")
+        raise field_error(source, "meshes", "a scene needs at least one mesh")
     seen: set[str] = set()
     n_mat = len(scene.materials)
     for i, m in enumerate(scene.meshes):
         where = f"meshes[{i}] ({m.name!r})"
         if not isinstance(m.name, str) or not m.name:
-            raise _fail(source, f"meshes[{i}].name", f"expected a non-empty string, got {m.name!r}")
+            raise field_error(
+                source, f"meshes[{i}].name", f"expected a non-empty string, got {m.name!r}"
+            )
         if m.name in seen:
-            raise _fail(source, f"{where}.name", "duplicate mesh name; names must be unique")
+            raise field_error(source, f"{where}.name", "duplicate mesh name; names must be unique")
         seen.add(m.name)
         v, f, fm = np.asarray(m.vertices), np.asarray(m.faces), np.asarray(m.face_materials)
         if v.ndim != 2 or v.shape[1] != 3 or not np.issubdtype(v.dtype, np.number) or len(v) < 3:
-            raise _fail(
+            raise field_error(
                 source,
                 f"{where}.vertices",
                 f"expected a (V>=3, 3) float array, got shape {v.shape}",
             )
         _check_coordinates(v, source, where)
         if f.ndim != 2 or f.shape[1] != 3 or len(f) == 0 or not np.issubdtype(f.dtype, np.integer):
-            raise _fail(
+            raise field_error(
                 source,
                 f"{where}.faces",
                 f"expected a (F>=1, 3) integer array, got {f.dtype} {f.shape}",
             )
         if f.min() < 0 or f.max() >= len(v):
-            raise _fail(source, f"{where}.faces", f"vertex index out of range 0..{len(v) - 1}")
+            raise field_error(
+                source, f"{where}.faces", f"vertex index out of range 0..{len(v) - 1}"
+            )
         _check_area(v, f, source, where)
         if fm.shape != (len(f),) or not np.issubdtype(fm.dtype, np.integer):
-            raise _fail(
+            raise field_error(
                 source,
                 f"{where}.face_materials",
                 f"expected ({len(f)},) integers, got {fm.dtype} {fm.shape}",
             )
         if fm.min() < 0 or fm.max() >= n_mat:
-            raise _fail(
+            raise field_error(
                 source, f"{where}.face_materials", f"material index out of range 0..{n_mat - 1}"
             )
         # ids are stored as 32-bit integers (int32 bits in an EXR UINT channel, -1 background)
         if not isinstance(m.object_id, (int, np.integer)) or not 0 <= m.object_id < 2**31:
-            raise _fail(
+            raise field_error(
                 source,
                 f"{where}.object_id",
                 f"expected an integer from 0 to 2**31 - 1, got {m.object_id!r}",
@@ -224,11 +181,11 @@ def check_classes(scene: Scene, source: str) -> None:
     for i, m in enumerate(scene.meshes):
         where = f"meshes[{i}] ({m.name!r}).semantic"
         if m.semantic not in SEMANTIC_CLASSES:
-            raise _fail(source, where, f"expected one of {', '.join(SEMANTIC_CLASSES)}")
+            raise field_error(source, where, f"expected one of {', '.join(SEMANTIC_CLASSES)}")
         other = classes.setdefault(int(m.object_id), m.semantic)
         if other != m.semantic:
             why = f"meshes sharing an object id share a class (object {m.object_id}: {other!r})"
-            raise _fail(source, where, f"{m.semantic!r}; {why}")
+            raise field_error(source, where, f"{m.semantic!r}; {why}")
 
 
 def _check_textures(scene: Scene, source: str) -> None:
@@ -236,21 +193,21 @@ def _check_textures(scene: Scene, source: str) -> None:
     for i, m in enumerate(scene.meshes):
         problem = None if m.texture is None else texture_problem(m.texture, m.face_materials, kinds)
         if problem is not None:
-            raise _fail(source, f"meshes[{i}] ({m.name!r}).texture", problem)
+            raise field_error(source, f"meshes[{i}] ({m.name!r}).texture", problem)
         problem = None if m.maps is None else maps_problem(m.maps, len(m.faces))
         if problem is not None:
-            raise _fail(source, f"meshes[{i}] ({m.name!r}).maps", problem)
+            raise field_error(source, f"meshes[{i}] ({m.name!r}).maps", problem)
 
 
 def _check_power(power: object, source: str, field: str) -> None:
     """A light's power: a finite number in :data:`POWER_RANGE`."""
     if isinstance(power, bool) or not isinstance(power, (int, float, np.floating, np.integer)):
-        raise _fail(source, field, f"expected a number, got {power!r}")
+        raise field_error(source, field, f"expected a number, got {power!r}")
     if not math.isfinite(power) or power <= 0:
-        raise _fail(source, field, f"must be a finite number > 0, got {power!r}")
+        raise field_error(source, field, f"must be a finite number > 0, got {power!r}")
     lo, hi = POWER_RANGE
     if not lo <= power <= hi:
-        raise _fail(
+        raise field_error(
             source,
             field,
             f"{power!r} is outside [{lo:g}, {hi:g}] (a negligible or overflowing light "
@@ -260,14 +217,14 @@ def _check_power(power: object, source: str, field: str) -> None:
 
 def _check_lights(scene: Scene, source: str) -> None:
     if not scene.lights:
-        raise _fail(source, "lights", "a scene needs at least one light")
+        raise field_error(source, "lights", "a scene needs at least one light")
     for i, light in enumerate(scene.lights):
         where = f"lights[{i}]"
         if light.kind not in LIGHT_KINDS:
-            raise _fail(source, f"{where}.kind", unknown_light_kind(light.kind))
+            raise field_error(source, f"{where}.kind", unknown_light_kind(light.kind))
         _check_power(light.power, source, f"{where}.power")
         if _vec(light.position) is None:
-            raise _fail(
+            raise field_error(
                 source,
                 f"{where}.position",
                 f"expected 3 finite numbers within ±{MAX_COORDINATE:g}, got {light.position!r}",
@@ -276,7 +233,7 @@ def _check_lights(scene: Scene, source: str) -> None:
         if "direction" in uses:
             d = _vec(light.direction)
             if d is None or np.linalg.norm(d) == 0:
-                raise _fail(
+                raise field_error(
                     source,
                     f"{where}.direction",
                     f"expected a non-zero 3-vector, got {light.direction!r}",
@@ -284,13 +241,15 @@ def _check_lights(scene: Scene, source: str) -> None:
         if "size" in uses:
             s = _vec(light.size, 2)
             if s is None or np.any(s <= 0):
-                raise _fail(
+                raise field_error(
                     source, f"{where}.size", f"expected (width, height) > 0, got {light.size!r}"
                 )
         if "radius" in uses and not (math.isfinite(light.radius) and light.radius > 0):
-            raise _fail(source, f"{where}.radius", f"expected a radius > 0, got {light.radius!r}")
+            raise field_error(
+                source, f"{where}.radius", f"expected a radius > 0, got {light.radius!r}"
+            )
         if "cutoff_deg" in uses and not 0 < light.cutoff_deg <= 90:
-            raise _fail(
+            raise field_error(
                 source,
                 f"{where}.cutoff_deg",
                 f"expected a cone half-angle in (0, 90], got {light.cutoff_deg!r}",
@@ -300,21 +259,21 @@ def _check_lights(scene: Scene, source: str) -> None:
 def _check_envmaps(scene: Scene, source: str) -> None:
     problem = check_envmaps(scene)
     if problem is not None:
-        raise _fail(source, "lights", problem)
+        raise field_error(source, "lights", problem)
 
 
 def _check_camera(scene: Scene, source: str) -> None:
     cam = scene.camera
     for attr in ("origin", "target", "up"):
         if _vec(getattr(cam, attr)) is None:
-            raise _fail(
+            raise field_error(
                 source,
                 f"camera.{attr}",
                 f"expected 3 finite numbers within ±{MAX_COORDINATE:g}, got {getattr(cam, attr)!r}",
             )
     forward = np.asarray(cam.target, float) - np.asarray(cam.origin, float)
     if np.linalg.norm(forward) == 0:
-        raise _fail(
+        raise field_error(
             source, "camera.target", "equals camera.origin; the camera has no viewing direction"
         )
     up = np.asarray(cam.up, float)
@@ -323,11 +282,11 @@ def _check_camera(scene: Scene, source: str) -> None:
         up_norm == 0
         or np.linalg.norm(np.cross(forward / np.linalg.norm(forward), up)) < 1e-6 * up_norm
     ):
-        raise _fail(
+        raise field_error(
             source, "camera.up", f"{list(cam.up)} is zero or parallel to the viewing direction"
         )
     if not isinstance(cam.fov_deg, (int, float, np.number)) or not 0 < cam.fov_deg < 180:
-        raise _fail(
+        raise field_error(
             source,
             "camera.fov_deg",
             f"expected a horizontal field of view in (0, 180) degrees, got {cam.fov_deg!r}",
@@ -335,73 +294,9 @@ def _check_camera(scene: Scene, source: str) -> None:
     for attr in ("width", "height"):
         value = getattr(cam, attr)
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-            raise _fail(
+            raise field_error(
                 source, f"camera.{attr}", f"expected a positive integer pixel count, got {value!r}"
             )
-
-
-def _check_placement(scene: Scene, source: str) -> None:
-    points = {
-        f"lights[{i}].position ({light.kind} light)": light.position
-        for i, light in enumerate(scene.lights)
-        if "position" in LIGHT_FIELDS[light.kind]
-    }
-    points["camera.origin"] = scene.camera.origin
-    labels, xyz = list(points), np.asarray(list(points.values()), dtype=np.float64)
-    for m in scene.meshes:
-        lo, hi = m.vertices.min(axis=0), m.vertices.max(axis=0)
-        candidates = np.flatnonzero(np.all((xyz >= lo) & (xyz <= hi), axis=1))
-        if len(candidates) == 0:  # tested first: cheaper than is_closed on big scenes
-            continue
-        if not is_closed(m.faces):
-            log.debug("mesh %r is not closed; it has no inside to test", m.name)
-            continue
-        w = winding_numbers(xyz[candidates], m.vertices, m.faces)
-        for k, wk in zip(candidates, w, strict=True):
-            if wk > _INSIDE_WINDING:
-                raise _fail(
-                    source,
-                    labels[k],
-                    f"{list(map(float, xyz[k]))} is inside the closed mesh {m.name!r}; move it into free space",
-                )
-    cam = scene.camera
-    origins, dirs = camera_rays(cam.origin, cam.target, cam.up, cam.fov_deg, cam.width, cam.height)
-    if not _sees_a_mesh(scene.meshes, origins, dirs):
-        raise _fail(
-            source,
-            "camera",
-            f"looks at nothing: none of {VISIBILITY_GRID}x{VISIBILITY_GRID} rays from origin "
-            f"{list(cam.origin)} towards target {list(cam.target)} hits a mesh",
-        )
-
-
-def _box_hits(origins: np.ndarray, dirs: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """Which rays meet the box [lo, hi] ahead of their origin (the slab test)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv = 1.0 / dirs
-        t0, t1 = (lo - origins) * inv, (hi - origins) * inv
-    near = np.nanmax(np.minimum(t0, t1), axis=1)
-    far = np.nanmin(np.maximum(t0, t1), axis=1)
-    return (far >= np.maximum(near, 0.0)) & np.isfinite(far)
-
-
-def _sees_a_mesh(meshes: Sequence[Mesh], origins: np.ndarray, dirs: np.ndarray) -> bool:
-    """Whether a ray hits a mesh: each mesh tested with the rays that meet its bounding box,
-    the meshes whose boxes most rays meet first (a scene in view is found by the first one;
-    one mesh at a time keeps a big scene's ray test small)."""
-    import trimesh
-
-    hits = [
-        _box_hits(origins, dirs, m.vertices.min(axis=0), m.vertices.max(axis=0)) for m in meshes
-    ]
-    for k in sorted(range(len(meshes)), key=lambda k: -int(hits[k].sum())):
-        if not hits[k].any():
-            break
-        m = meshes[k]
-        shape = trimesh.Trimesh(m.vertices, m.faces, process=False)
-        if shape.ray.intersects_any(origins[hits[k]], dirs[hits[k]]).any():
-            return True
-    return False
 
 
 def validate_scene(
