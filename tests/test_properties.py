@@ -305,7 +305,7 @@ def test_a_glb_within_the_face_budget_loads_only_as_counted_or_is_refused(counts
     the budget refuses exactly the files whose counted faces or vertices pass its limits,
     before trimesh reads any geometry (here there is none to read)."""
     from spectrinsic.scenes.budget import MAX_FACES, MAX_VERTICES, SceneBudget
-    from spectrinsic.scenes.meshes import check_mesh_size, mesh_counts
+    from spectrinsic.scenes.mesh_counts import check_mesh_size, mesh_counts
 
     accessors = [{"count": c} for c in counts]
     primitive = {"attributes": {"POSITION": 0}} | ({"indices": len(counts) - 1} if indexed else {})

@@ -27,8 +27,8 @@ import numpy as np
 from ..render import RenderSettings, channel_values, get_mode, render_scene
 from ..render.algebra.modes import RENDER_MODES
 from ..render.base import translate as tr
+from ..render.base.geometry import prepare_geometry
 from ..render.base.plugins import hdr_film, path_integrator, rgb_spectrum
-from ..render.base.translate import prepare_geometry
 from ..render.base.variants import choose_variant, variant_report, variant_scope
 from ..scenes import library
 from ..spectra import get_sensors, relative_error

@@ -14,8 +14,9 @@ from ..scenes.model import Scene
 from ..spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
 from .algebra.modes import RenderMode, channel_values, get_mode, n_passes, raw_to_xyz, to_xyz_matrix
 from .band_path.traversal import SingleTraversal, render_jobs, resolve_integrator
+from .base.geometry import prepare_geometry
 from .base.one_pass import PassOutput, PassProgress
-from .base.translate import prepare_geometry, surfaces
+from .base.translate import surfaces
 from .base.variants import choose_variant, import_mitsuba, variant_scope
 from .passes import render_diagonal
 from .passes.aovs import render_aovs

@@ -16,8 +16,8 @@ from typing import TYPE_CHECKING, Any
 from ..errors import RenderError
 
 if TYPE_CHECKING:
+    from .base.geometry import SurfaceGeometry
     from .base.one_pass import PassProgress
-    from .base.translate import SurfaceGeometry
 
 __all__ = [
     "DEFAULT_INTEGRATOR",
@@ -201,7 +201,7 @@ class PassRequest:
     progress
         Called with 1 after each Mitsuba pass (e.g. ``tqdm.update``), or ``None``.
     geometry
-        :func:`spectrinsic.render.base.translate.prepare_geometry` of the scene, if already
+        :func:`spectrinsic.render.base.geometry.prepare_geometry` of the scene, if already
         computed (the batches of one scene share it).
     """
 

@@ -44,8 +44,8 @@ from ..spectra import COLORIMETRIC_WAVELENGTHS, get_sensors, responses
 from .algebra.light_transport import LightTransport, diagonal_mode_names, relit_result
 from .algebra.modes import ChannelValues, channel_values, get_mode
 from .band_path.traversal import resolve_integrator
+from .base.geometry import prepare_geometry
 from .base.one_pass import PassProgress
-from .base.translate import prepare_geometry
 from .base.variants import choose_variant, variant_scope
 from .batches import run_batches
 from .passes import render_diagonal

@@ -28,7 +28,7 @@ import numpy as np
 from ..errors import SceneError
 from . import mitsuba_parts as parts
 from .budget import SceneBudget
-from .meshes import mesh_counts
+from .mesh_counts import mesh_counts
 from .mitsuba_files import confined_file
 from .mitsuba_tree import XmlNode, mesh_file, mesh_file_uv
 

@@ -11,6 +11,9 @@ Materials are Lambertian by default (as in the thesis dataset); a material may i
 coated diffuse (``plastic``) or a metal (``conductor``), smooth or rough (:class:`Material`).
 """
 
+# long module: one concept, the scene record (materials, meshes, lights, camera) and
+# its one plain-data form (scene_to_dict / scene_from_dict / scene_hash), which must change together
+
 from __future__ import annotations
 
 import hashlib

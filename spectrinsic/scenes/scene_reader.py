@@ -12,6 +12,9 @@ without reading anything outside it. Loaded scenes are checked with
 :func:`spectrinsic.scenes.validate.validate_scene`.
 """
 
+# long module: one format's reader (the YAML scene file), every section's parser reporting
+# through one _Doc so a file's problems come in one line
+
 from __future__ import annotations
 
 import os
@@ -25,7 +28,7 @@ import numpy as np
 from ..errors import SceneError, did_you_mean, with_article
 from .budget import SceneBudget
 from .materials import TexturedMaterial, parse_material
-from .meshes import check_mesh_size
+from .mesh_counts import check_mesh_size
 from .model import (
     LIGHT_DEFAULTED,
     LIGHT_FIELDS,

@@ -958,7 +958,7 @@ def test_yaml_node_count_is_bounded_before_and_while_composing(
     ],
 )
 def test_mesh_counts_come_from_the_header_or_a_line_count(tmp_path, name, text, expected):
-    from spectrinsic.scenes.meshes import mesh_counts
+    from spectrinsic.scenes.mesh_counts import mesh_counts
 
     (tmp_path / name).write_text(text)
     assert mesh_counts(tmp_path / name) == expected

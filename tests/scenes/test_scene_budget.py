@@ -17,7 +17,7 @@ import pytest
 
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes.budget import MAX_FACES, MAX_TEXELS, SceneBudget
-from spectrinsic.scenes.meshes import mesh_counts
+from spectrinsic.scenes.mesh_counts import mesh_counts
 from spectrinsic.scenes.sources import load_scene_file
 
 LIGHT = "lights:\n  - {kind: point, spectrum: 'cie:D65', power: 4, position: [0, 0, 2]}\n"

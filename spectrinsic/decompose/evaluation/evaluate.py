@@ -40,12 +40,10 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError, validate_choice
-from ...file_writes import replacing
 from ...gt_export.formats.exr import write_exr
 from ...gt_export.formats.names import camera_slug
 from ...gt_export.sample.working_view import srgb_view
 from ...rng import seed_from_key
-from ...spectra.colorimetry import encode_srgb
 from ..decomposition import Decomposer, Decomposition
 from ..methods.registry import available_decomposers, get_decomposer
 from ..metrics import METRICS, WHDR_DELTA, get_metric, whdr
@@ -61,6 +59,7 @@ from .sample_fields import (
     sample_id_of,
     sample_kind,
 )
+from .sample_figure import sample_figure
 from .scores import CONDITION_GROUPS, INPUT_LAYERS, SCORED_LAYERS, Score
 from .targets import SPECULAR_LAYER, SPECULAR_METRICS, TARGETS, target_image, target_note
 
@@ -341,7 +340,7 @@ def evaluate_sample(
             if save_estimates and out_dir is not None and not isinstance(decomposer, Predictions):
                 _write_estimate(Path(out_dir) / "estimates" / method / scenario / truth.sid, result)
     if out_dir is not None and figure:
-        _figure(
+        sample_figure(
             Path(out_dir) / "figures" / f"{truth.sid}.png",
             truth.sid,
             inputs[0][3],
@@ -350,40 +349,6 @@ def evaluate_sample(
             figure_rows,
         )
     return scores
-
-
-def _display(a: np.ndarray) -> np.ndarray:
-    """Tone-map a linear image for display: 99th percentile to 1, sRGB encoding."""
-    a = np.asarray(a, dtype=np.float64)
-    if a.ndim == 2:
-        a = np.repeat(a[:, :, None], 3, axis=2)
-    top = np.percentile(a, 99.0)
-    return encode_srgb(a / (top if top > 0 else 1.0))
-
-
-def _figure(path: Path, sid: str, image, reflectance, shading, rows) -> None:
-    from matplotlib.figure import Figure  # no pyplot: no global backend state
-
-    panels = [("ground truth", image, reflectance, shading)]
-    panels += [(m, None, r.reflectance, r.shading) for m, r in rows]
-    fig = Figure(figsize=(7.5, 2.4 * len(panels)))
-    axes = fig.subplots(len(panels), 3, squeeze=False)
-    for row, (label, img, refl, shad) in enumerate(panels):
-        for col, (title, data) in enumerate(
-            (("input", img), ("reflectance", refl), ("shading", shad))
-        ):
-            ax = axes[row, col]
-            ax.set_axis_off()
-            if data is not None:
-                ax.imshow(_display(data), interpolation="nearest")
-                ax.set_title(f"{label}: {title}" if col else f"{title}", fontsize=8)
-            elif col == 0:
-                ax.text(0.5, 0.5, label, ha="center", va="center", fontsize=10)
-    fig.suptitle(sid, fontsize=9)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with replacing(path) as tmp:
-        fig.savefig(tmp, dpi=80)
 
 
 def evaluate(

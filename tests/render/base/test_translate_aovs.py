@@ -13,8 +13,8 @@ from spectrinsic.render import (
     scene_to_mitsuba,
     variant_scope,
 )
+from spectrinsic.render.base.geometry import smooth_corner_normals
 from spectrinsic.render.base.plugins import hdr_film, path_integrator, rgb_spectrum
-from spectrinsic.render.base.translate import smooth_corner_normals
 from spectrinsic.render.settings import PassRequest
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 
