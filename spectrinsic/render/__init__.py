@@ -24,7 +24,6 @@ from .algebra.modes import (
     RenderMode,
     channel_values,
     get_mode,
-    mode_names,
     to_xyz_matrix,
 )
 from .base.translate import scene_to_mitsuba
@@ -61,7 +60,6 @@ __all__ = [
     "image_noise",
     "llvm_library",
     "merge_batches",
-    "mode_names",
     "relative_standard_error",
     "render_aovs",
     "render_batches",

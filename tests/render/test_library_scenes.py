@@ -10,7 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from spectrinsic.render import RenderSettings, mode_names, render_scene
+from spectrinsic.render import RenderSettings, render_scene
+from spectrinsic.render.algebra.modes import RENDER_MODES
 from spectrinsic.scenes import library
 
 #: Small enough to keep the whole library under a minute on 2 cores.
@@ -28,9 +29,9 @@ def test_library_scene_renders_in_every_mode(name):
         height=SIZE,
     )
     result = render_scene(
-        scene, RenderSettings(SPP, modes=mode_names(), max_depth=4, aovs=True), seed=1
+        scene, RenderSettings(SPP, modes=tuple(RENDER_MODES), max_depth=4, aovs=True), seed=1
     )
-    assert set(result.images) == set(mode_names())
+    assert set(result.images) == set(RENDER_MODES)
     for mode, xyz in result.images.items():
         assert xyz.shape == (SIZE, SIZE, 3), mode
         assert np.all(np.isfinite(xyz)), mode

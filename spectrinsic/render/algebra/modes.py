@@ -54,14 +54,12 @@ __all__ = [
     "RENDER_MODES",
     "XYZ_SENSORS",
     "get_mode",
-    "mode_names",
     "n_passes",
     "ChannelValues",
     "channel_values",
     "light_spectra",
     "integration_matrix",
     "regression_matrix",
-    "munsell_reflectances",
     "to_xyz_matrix",
     "lights_to_xyz_matrix",
     "raw_to_xyz",
@@ -144,11 +142,6 @@ RENDER_MODES: dict[str, RenderMode] = {
 def get_mode(name: str) -> RenderMode:
     """The :class:`RenderMode` called *name*; a one-line error with close matches otherwise."""
     return RENDER_MODES[validate_choice(name, RENDER_MODES, "render mode", error=RenderError)]
-
-
-def mode_names() -> list[str]:
-    """Names of every render mode, in the order of the table above."""
-    return list(RENDER_MODES)
 
 
 def n_passes(mode: RenderMode, *, data_dir: str | None = None) -> int:
@@ -278,12 +271,6 @@ def integration_matrix(
     return responses(t, extended, wavelengths) / area[None, :]
 
 
-def munsell_reflectances(wavelengths: Wavelengths = COLORIMETRIC_WAVELENGTHS) -> np.ndarray:
-    """``(1269, W)`` reflectances of the matte Munsell chips on *wavelengths* (nm); read-only,
-    cached per wavelength grid."""
-    return family_values("munsell", wavelengths)
-
-
 def regression_matrix(
     sensors: SensorSet,
     target: SensorSet,
@@ -305,8 +292,8 @@ def regression_matrix(
         ``(J, W)`` spectra of the lights on *wavelengths*; each is normalised to unit maximum so
         every light weighs alike in the fit.
     """
-    rho = (
-        munsell_reflectances(wavelengths)
+    rho = (  # the matte Munsell chips (1269, read-only, cached per grid)
+        family_values("munsell", wavelengths)
         if reflectances is None
         else np.asarray(reflectances, float)
     )

@@ -60,14 +60,24 @@ channel names and AOV order in :mod:`~spectrinsic.render.band_path.integrator`, 
 per-light record in :mod:`~spectrinsic.render.band_path.traversal`.
 """
 
+# long module: one loop (path.cpp on band throughputs), its features switched by trace-time
+# flags in one body, so each step sits beside the others it must stay in step with
+
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from types import ModuleType
+from typing import TYPE_CHECKING, Any, cast
 
 from ..base.surface_maps import perturbed_normal
 from ..base.textures import texel_of
+
+if TYPE_CHECKING:  # the variant is chosen at run time: the caller imports Mitsuba
+    import mitsuba as mi
+
+    # the array types Mitsuba's stubs take and give (the variant's own arrays at run time)
+    from drjit.auto.ad import Bool, Float, UInt
 
 #: Values of the ``non_diffuse_rows`` table (``BandPath.set_non_diffuse``) other than 0 (a
 #: diffuse lobe): no diffuse lobe (metal, mirror), and glass. Non-zero rows are the first hits
@@ -78,14 +88,14 @@ MIRROR_ROW, GLASS_ROW = 1, 2
 __all__ = ["PathState", "BandKernel", "mis_weight", "band_max", "MIRROR_ROW", "GLASS_ROW"]
 
 
-def mis_weight(dr: Any, mi: Any, pdf_a: Any, pdf_b: Any) -> Any:
+def mis_weight(dr: ModuleType, mi: ModuleType, pdf_a: Float, pdf_b: Float) -> Float:
     """Power heuristic exactly as ``path.cpp``'s ``mis_weight`` (pdfs in the same measure)."""
     a, b = pdf_a * pdf_a, pdf_b * pdf_b
     w = a / (a + b)
     return dr.detach(dr.select(dr.isfinite(w), w, mi.Float(0.0)))
 
 
-def band_max(dr: Any, bands: Sequence) -> Any:
+def band_max(dr: ModuleType, bands: Sequence[Float]) -> Float:
     """Largest band value per lane (a balanced tree of ``dr.maximum``)."""
     values = list(bands)
     while len(values) > 1:
@@ -99,26 +109,30 @@ def band_max(dr: Any, bands: Sequence) -> Any:
 @dataclass
 class PathState:
     """The loop state Dr.Jit carries (a dataclass: ``dr.while_loop`` traverses its fields in
-    this order). Band lists hold K entries, accumulators K·L (light-major)."""
+    this order). Band lists hold K entries, accumulators K·L (light-major).
 
-    sampler: Any
-    ray: Any
-    depth: Any
+    The fields are typed ``Any`` (their Mitsuba types in comments): Dr.Jit resolves a loop
+    state's annotations when it traverses it (``typing.get_type_hints``), at run time, where
+    Mitsuba is not imported at module level (the variant is chosen at run time)."""
+
+    sampler: Any  # mi.Sampler
+    ray: Any  # mi.Ray3f
+    depth: Any  # UInt
     #: Band-independent throughput (Mitsuba's BSDF weights and the roulette's scale).
-    beta: Any
-    bands: list
-    acc: list
-    prev_si: Any
-    prev_pdf: Any
-    prev_delta: Any
+    beta: Any  # Float
+    bands: list  # list[Float]
+    acc: list  # list[Float]
+    prev_si: Any  # mi.Interaction3f
+    prev_pdf: Any  # Float
+    prev_delta: Any  # Bool
     #: First-hit state (surface, distance, normal[, texel, textured]); empty without maps.
     first: tuple
-    alive: Any
+    alive: Any  # Bool
     #: Whether the camera ray has had its first vertex that is not a null event (masks).
-    seen: Any
+    seen: Any  # Bool
     #: Specular band throughputs and accumulators (gloss loop only).
-    sbands: list = field(default_factory=list)
-    sacc: list = field(default_factory=list)
+    sbands: list = field(default_factory=list)  # list[Float]
+    sacc: list = field(default_factory=list)  # list[Float]
 
 
 @dataclass(frozen=True)
@@ -126,13 +140,13 @@ class _Vertex:
     """What a vertex's sampling gives: the light and weight of the emitter sample, its mask,
     Mitsuba's BSDF sample and weight, and (gloss) ``(a, μ)`` of both directions."""
 
-    light: Any
-    nee: tuple  # RGB weights (emitter, then extra maps) times the path throughput
-    active_em: Any
-    bsdf_sample: Any
-    bsdf_weight: Any
-    em_lobes: tuple = ()
-    bs_lobes: tuple = ()
+    light: UInt
+    nee: tuple[mi.Spectrum, ...]  # RGB weights (emitter, then extra maps) times the path throughput
+    active_em: Bool
+    bsdf_sample: mi.BSDFSample3f
+    bsdf_weight: mi.SpectrumEntry
+    em_lobes: tuple[Float, ...] = ()
+    bs_lobes: tuple[Float, ...] = ()
 
 
 class BandKernel:
@@ -141,7 +155,14 @@ class BandKernel:
     the specular accumulators; *white* is the white-at-metal loop."""
 
     def __init__(
-        self, mi: Any, dr: Any, it: Any, scene: Any, *, gloss: bool = False, white: bool = False
+        self,
+        mi: ModuleType,
+        dr: ModuleType,
+        it: Any,  # the BandPath integrator, a class made at run time (band_path.integrator)
+        scene: mi.Scene,
+        *,
+        gloss: bool = False,
+        white: bool = False,
     ) -> None:
         self.mi, self.dr, self.it, self.scene = mi, dr, it, scene
         self.gloss, self.white = gloss or white, white
@@ -150,17 +171,17 @@ class BandKernel:
 
     # -- lookups ---------------------------------------------------------------------------
 
-    def light_of(self, emitter: Any, mask: Any) -> Any:
+    def light_of(self, emitter: mi.EmitterPtr, mask: Bool) -> UInt:
         ids = self.dr.reinterpret_array(self.mi.UInt32, emitter)
         return self.dr.gather(self.mi.UInt32, self.it.emitter_lut, ids, mask)
 
-    def row(self, si: Any) -> Any:
+    def row(self, si: mi.SurfaceInteraction3f) -> UInt:
         """Albedo-table row of the shape hit."""
         mi, dr = self.mi, self.dr
         ids = dr.reinterpret_array(mi.UInt32, si.shape)
         return dr.gather(mi.UInt32, self.it.shape_lut, ids, si.is_valid())
 
-    def albedo(self, si: Any) -> list:
+    def albedo(self, si: mi.SurfaceInteraction3f) -> list[Float]:
         """ρ_k of the material of the shape hit (the black row elsewhere), or of the nearest
         texel on a textured shape."""
         mi, dr, k = self.mi, self.dr, self.it.n_bands
@@ -179,7 +200,14 @@ class BandKernel:
             for b, r in enumerate(rho)
         ]
 
-    def deposit(self, acc: list, light: Any, weights: tuple, bands: Sequence, mask: Any) -> list:
+    def deposit(
+        self,
+        acc: list[Float],
+        light: UInt,
+        weights: tuple[mi.Spectrum, ...],
+        bands: Sequence[Float],
+        mask: Bool,
+    ) -> list[Float]:
         """``acc[j·K + k] += bands[k]·weights[m_j][c_j]`` on the lanes whose emitter is light
         j's owner ``o_j``. *weights* are RGB values (``Color3f``): the emitter's own, then one
         per extra environment map (:meth:`extra_maps_at`); ``(o_j, c_j, m_j)`` =
@@ -195,7 +223,9 @@ class BandKernel:
                 out[j * k + b] = self.dr.fma(bands[b], w, out[j * k + b])
         return out
 
-    def extra_maps_at(self, si: Any, scale: Any, active: Any) -> tuple:
+    def extra_maps_at(
+        self, si: mi.SurfaceInteraction3f, scale: Float, active: Bool
+    ) -> tuple[mi.Spectrum, ...]:
         """The RGB radiance of every extra environment map (``it.extra_maps``, standalone
         Mitsuba ``envmap`` emitters, not in the scene: it takes one) towards ``-si.wi``, times
         *scale* (Mitsuba's ``envmap.eval`` reads only the direction)."""
@@ -203,12 +233,15 @@ class BandKernel:
 
     # -- the steps of a vertex -------------------------------------------------------------
 
-    def emitter_hit(self, si: Any, s: PathState) -> tuple[Any, tuple, Any]:
+    def emitter_hit(
+        self, si: mi.SurfaceInteraction3f, s: PathState
+    ) -> tuple[UInt, tuple[mi.Spectrum, ...], Bool]:
         """Light, weights (the path's throughput x RGB radiance x BSDF-sampling MIS weight, of
         the emitter then of the extra maps) and mask of an emitter hit."""
         mi, dr = self.mi, self.dr
         emitter = si.emitter(self.scene)
-        hit = emitter != None  # noqa: E711 (a Dr.Jit pointer array, compared lane by lane)
+        # a Dr.Jit pointer array, compared lane by lane (the stubs give no Bool for it)
+        hit = cast("Bool", emitter != None)  # noqa: E711
         ds = mi.DirectionSample3f(self.scene, si=si, ref=s.prev_si)
         em_pdf = dr.select(
             s.prev_delta, 0.0, self.scene.pdf_emitter_direction(s.prev_si, ds, ~s.prev_delta)
@@ -218,7 +251,14 @@ class BandKernel:
         weights = (emitter.eval(si, active) * mis, *self.extra_maps_at(si, mis, active))
         return self.light_of(emitter, hit), tuple(s.beta * w for w in weights), hit
 
-    def lobes(self, si: Any, bsdf: Any, wo: Any, delta: Any, active: Any) -> tuple[Any, Any]:
+    def lobes(
+        self,
+        si: mi.SurfaceInteraction3f,
+        bsdf: mi.BSDFPtr,
+        wo: mi.Vector3f,
+        delta: Bool,
+        active: Bool,
+    ) -> tuple[Float, Float]:
         """``a = f_d / f`` at local direction *wo* (0 where *delta*; exactly 1 for a BSDF
         without non-diffuse lobes) and ``μ = |wi · h|``."""
         mi, dr = self.mi, self.dr
@@ -235,7 +275,9 @@ class BandKernel:
         mu = dr.select(norm > 0.0, dr.abs(dr.dot(si.wi, h)) / norm, 1.0)
         return a, dr.clip(mu, 0.0, 1.0)
 
-    def vertex(self, s: PathState, si: Any, bsdf: Any, active_next: Any) -> _Vertex:
+    def vertex(
+        self, s: PathState, si: mi.SurfaceInteraction3f, bsdf: mi.BSDFPtr, active_next: Bool
+    ) -> _Vertex:
         """Emitter sample (its weights times the path's throughput ``s.beta``), then BSDF
         evaluation and sample (``eval_pdf_sample``); with gloss also ``a`` and ``μ`` of both
         directions."""
@@ -265,7 +307,7 @@ class BandKernel:
         light = self.light_of(ds.emitter, active_em)
         return _Vertex(light, nee, active_em, bsdf_sample, bsdf_weight[0], em_lobes, bs_lobes)
 
-    def specular_bands(self, row: Any, mu: Any, valid: Any) -> list:
+    def specular_bands(self, row: UInt, mu: Float, valid: Bool) -> list[Float]:
         """``s_k(μ)`` of table row *row*: linear interpolation over the μ nodes."""
         mi, dr, k, n = self.mi, self.dr, self.it.n_bands, self.it.n_nodes
         x = mu * (n - 1)
@@ -279,7 +321,9 @@ class BandKernel:
             out.append(dr.fma(t, hi - lo, lo))
         return out
 
-    def factors(self, rho: list, row: Any, lobes: tuple, valid: Any) -> tuple[list, list]:
+    def factors(
+        self, rho: list[Float], row: UInt, lobes: tuple[Float, ...], valid: Bool
+    ) -> tuple[list[Float], list[Float]]:
         """(G1) ``c_k`` and its non-diffuse part ``s_k (1 − a)`` for ``lobes = (a, μ)``."""
         a, mu = lobes
         spec = [s * (1.0 - a) for s in self.specular_bands(row, mu, valid)]
@@ -287,7 +331,7 @@ class BandKernel:
 
     # -- first-hit maps --------------------------------------------------------------------
 
-    def first_hit(self, si: Any, now: Any, first: tuple) -> tuple:
+    def first_hit(self, si: mi.SurfaceInteraction3f, now: Bool, first: tuple) -> tuple:
         """Surface index, ray distance and shading normal of the hit *si* on the lanes where
         it is the camera ray's first vertex so far (*now*; a later one replaces it after a
         null event)."""
@@ -307,7 +351,7 @@ class BandKernel:
         )
         return tuple(dr.select(now, h, f) for h, f in zip(hit, first, strict=True))
 
-    def shading_normal(self, si: Any) -> Any:
+    def shading_normal(self, si: mi.SurfaceInteraction3f) -> mi.Normal3f:
         """The hit's shading normal, perturbed on shapes with a bump or normal map."""
         mi, dr = self.mi, self.dr
         normal = si.sh_frame.n
@@ -329,7 +373,7 @@ class BandKernel:
         first = (mi.UInt32(self.it.n_surfaces), mi.Float(0.0), mi.Vector3f(0.0))
         return first + ((mi.UInt32(0), mi.Bool(False)) if self.it.n_texcols else ())
 
-    def first_maps(self, first: tuple) -> list:
+    def first_maps(self, first: tuple) -> list[Float]:
         """The first-hit channels (``first_hit_channels``) of the final first-hit state."""
         mi, dr, n = self.mi, self.dr, self.it.n_surfaces
         if not n:
@@ -351,7 +395,7 @@ class BandKernel:
 
     # -- the loop --------------------------------------------------------------------------
 
-    def start(self, sampler: Any, ray: Any, active: Any) -> PathState:
+    def start(self, sampler: mi.Sampler, ray: mi.Ray3f, active: Bool) -> PathState:
         """Depth 0, throughput 1, K band throughputs 1, K·L accumulators 0, no previous vertex
         (pdf 1, delta); the specular ones 0 with gloss."""
         mi, dr, k, n = self.mi, self.dr, self.it.n_bands, self.it.n_bands * self.it.n_lights
@@ -372,7 +416,9 @@ class BandKernel:
             [mi.Float(0.0) for _ in range(n)] if self.spec else [],
         )
 
-    def step(self, s: PathState, si: Any, v: _Vertex, bands: list) -> tuple[PathState, Any]:
+    def step(
+        self, s: PathState, si: mi.SurfaceInteraction3f, v: _Vertex, bands: list[Float]
+    ) -> tuple[PathState, Bool]:
         """Go on to the next vertex with the new band throughputs *bands*: ray, depth, previous
         vertex and the go-on flag. Russian roulette on the largest band (``path.cpp``: largest
         channel); off when ``rr_depth`` > ``max_depth``, but its sample is drawn either way."""
@@ -393,7 +439,7 @@ class BandKernel:
         )  # fmt: skip
         return state, go_on
 
-    def null_event(self, v: _Vertex, row: Any, valid: Any) -> Any:
+    def null_event(self, v: _Vertex, row: UInt | None, valid: Bool) -> Bool:
         """Whether the BSDF sample is a mask's null event: ``BSDFFlags.Null``, but not on a glass
         row (*row*, with gloss), where it is a ``thindielectric``'s straight transmission."""
         mi, dr = self.mi, self.dr
@@ -419,7 +465,8 @@ class BandKernel:
         if self.spec:
             s.sacc = self.deposit(s.sacc, light, weight, s.sbands, hit)
         active_next = (s.depth + 1 < self.it.max_depth) & valid
-        bsdf = si.bsdf(s.ray)
+        # a Ray3f, as prb.py passes; the stubs list only RayDifferential3f
+        bsdf = si.bsdf(s.ray)  # type: ignore[call-overload]
         if swap is not None:  # the white loop goes on only from a metal first vertex ...
             keep = ~now | swap
             if not self.masks:  # ... or through a null event (masks: known once sampled)
@@ -457,7 +504,9 @@ class BandKernel:
         s.seen = s.seen | ~null
         return s
 
-    def run(self, sampler: Any, ray: Any, active: Any) -> tuple[PathState, list]:
+    def run(
+        self, sampler: mi.Sampler, ray: mi.Ray3f, active: Bool
+    ) -> tuple[PathState, list[Float]]:
         """The final state of one wavefront of camera rays, and its accumulators then (gloss)
         the specular ones."""
         label = "spectrinsic " + ("white at metals" if self.white else "band path")

@@ -8,7 +8,7 @@ import pytest
 from spectrinsic.errors import SpectrinsicError
 from spectrinsic.render.algebra import modes
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as WL
-from spectrinsic.spectra import get_sensors, get_spectrum, responses
+from spectrinsic.spectra import family_values, get_sensors, get_spectrum, responses
 
 #: Exact identities in float64.
 EXACT = 1e-10
@@ -60,7 +60,7 @@ def test_regression_matrix_projects_six_sensors_to_xyz():
     g6, cmf = get_sensors("gaussian:6@400-700"), get_sensors("cie1931")
     light = get_spectrum("planck:3500K").on(WL)
     p = modes.regression_matrix(g6, cmf, light[None])
-    rho = modes.munsell_reflectances()
+    rho = family_values("munsell", WL)  # the matte Munsell chips
     xyz = responses(rho * light, cmf.on(WL), WL)
     est = responses(rho * light, g6.on(WL), WL) @ p.T
     err = np.linalg.norm(est - xyz, axis=1) / np.linalg.norm(xyz, axis=1)
