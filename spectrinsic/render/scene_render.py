@@ -212,44 +212,48 @@ def _run_jobs(
 
 def render_meta(
     scene: Scene,
-    objs: Sequence[RenderMode],
-    matrices: dict[str, np.ndarray],
+    plan: _Plan,
     variants: dict[str, str],
     timings: dict[str, list[float]],
     *,
-    batch_spp: int,
     seed: int,
-    max_depth: int,
-    per_light: bool,
-    wanted: set[str],
     data_dir: str | None,
 ) -> dict[str, Any]:
-    """The ``meta`` record of one batch's render: versions, variants, samples, modes, their
-    sensors and XYZ matrices, the spectral grid, which modes have direct light, and timings (s)."""
+    """The ``meta`` record of one batch's render (*plan*'s settings, modes and matrices):
+    versions, variants, samples, modes, their sensors and XYZ matrices, the spectral grid,
+    which modes have direct light and per-light images, the integrator, and timings (s)."""
+    objs, settings = plan.objs, plan.settings
     names = [m.name for m in objs]
-    return {
+    meta = {
         "mitsuba": import_mitsuba().__version__,
         "variants": variants,
-        "spp": int(batch_spp),  # one batch's: merge_batches makes it the total
+        "spp": int(settings.batch_spp),  # one batch's: merge_batches makes it the total
         "seed": int(seed),
-        "max_depth": int(max_depth),
+        "max_depth": int(settings.max_depth),
         "modes": names,
         "sensors": {m.name: get_sensors(m.sensors, data_dir=data_dir).name for m in objs},
-        "to_xyz": {n: np.asarray(matrices[n]).tolist() for n in names},
+        "to_xyz": {n: np.asarray(plan.matrices[n]).tolist() for n in names},
         "wavelengths": {
             "start": float(COLORIMETRIC_WAVELENGTHS[0]),
             "end": float(COLORIMETRIC_WAVELENGTHS[-1]),
             "step": float(COLORIMETRIC_WAVELENGTHS[1] - COLORIMETRIC_WAVELENGTHS[0]),
             "unit": "nm",
         },
-        "per_light": bool(per_light),
-        "direct_modes": sorted(wanted),
+        "per_light": bool(settings.per_light),
+        "direct_modes": sorted(plan.wanted),
         "timings": {
             k: {"passes": len(v), "seconds": float(sum(v)), "per_pass": [float(x) for x in v]}
             for k, v in timings.items()
         },
         "units": "XYZ = integral of radiance times CIE 1931 CMF over nm; raw = integral of radiance times S_k",
+        "per_light_modes": (
+            [m.name for m in plan.share] if plan.split else (names if settings.per_light else [])
+        ),
+        "integrator": plan.integrator,
     }
+    if any(m.kind == "spectral" for m in objs):
+        meta["spectral_spp"] = settings.spectral_batch_spp
+    return meta
 
 
 def render_scene(
@@ -298,26 +302,7 @@ def render_scene(
         timings["aovs"] = list(aov_seconds)
     if single.seconds:
         timings["single"] = list(single.seconds)
-    meta = render_meta(
-        scene,
-        plan.objs,
-        plan.matrices,
-        variants,
-        timings,
-        batch_spp=settings.batch_spp,
-        seed=seed,
-        max_depth=settings.max_depth,
-        per_light=settings.per_light,
-        wanted=plan.wanted,
-        data_dir=data_dir,
-    )
-    names = [m.name for m in plan.objs]
-    meta["per_light_modes"] = (
-        [m.name for m in plan.share] if plan.split else (names if settings.per_light else [])
-    )
-    meta["integrator"] = plan.integrator
-    if any(m.kind == "spectral" for m in plan.objs):
-        meta["spectral_spp"] = settings.spectral_batch_spp
+    meta = render_meta(scene, plan, variants, timings, seed=seed, data_dir=data_dir)
     logger.debug("rendered %s: %s", scene.name, {k: sum(v) for k, v in timings.items()})
     return _assemble(scene, plan, outputs, aov_maps, single, meta, data_dir=data_dir)
 
