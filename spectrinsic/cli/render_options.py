@@ -32,11 +32,30 @@ __all__ = [
 ]
 
 
+#: The ``--modes`` default of a plain render: the render package's default modes.
 DEFAULT_MODES = ",".join(RENDER_DEFAULT_MODES)
 
 
 def modes_help() -> str:
+    """Every render mode and what it is, for ``--help``."""
     return "; ".join(f"{m.name}: {m.description}" for m in RENDER_MODES.values())
+
+
+def add_render_options(p: Any, default: DatasetConfig) -> None:
+    """Every option of ``spectrinsic render``, in the order ``--help`` lists them; *default*
+    (the default preset) gives the documented defaults."""
+    _add_scene_options(p)
+    _add_output_options(p)
+    _add_sampling_options(p, default)
+    _add_size_options(p, default)
+    _add_pass_options(p, default)
+    _add_ground_truth_options(p)
+    add_layer_options(
+        p.add_argument_group(
+            "ground-truth layers (with --ground-truth; the layer options of `spectrinsic dataset`)"
+        )
+    )
+    _add_material_options(p)
 
 
 def _add_scene_options(p: Any) -> None:
@@ -257,20 +276,3 @@ def parse_modes(args: argparse.Namespace) -> list[str]:
     for mode in modes:
         get_mode(mode)
     return modes
-
-
-def add_render_options(p: Any, default: DatasetConfig) -> None:
-    """Every option of ``spectrinsic render``, in the order ``--help`` lists them; *default*
-    (the default preset) gives the documented defaults."""
-    _add_scene_options(p)
-    _add_output_options(p)
-    _add_sampling_options(p, default)
-    _add_size_options(p, default)
-    _add_pass_options(p, default)
-    _add_ground_truth_options(p)
-    add_layer_options(
-        p.add_argument_group(
-            "ground-truth layers (with --ground-truth; the layer options of `spectrinsic dataset`)"
-        )
-    )
-    _add_material_options(p)
