@@ -10,7 +10,6 @@ only when the hash in its ``meta.json`` matches. How the build is run (workers, 
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
-from pathlib import Path
 from typing import Any
 
 from .. import provenance
@@ -24,7 +23,7 @@ from ..render.algebra.light_transport import diagonal_mode_names
 from ..render.algebra.modes import RENDER_MODES
 from ..render.settings import RenderSettings
 from ..spectra.camera_model import camera_model
-from ..spectra.user_spectra import portable_names, spectrum_files
+from ..spectra.user_spectra import portable_names, sensor_files_record
 from ..spectra.working_space import DEFAULT_WORKING_SPACE, working_space
 from .source_record import recorded_source
 
@@ -129,13 +128,6 @@ def _check_relit_reference(relight: int, modes: tuple[str, ...]) -> None:
             + (f" (only glossy samples take {glossy!r} as reference)" if glossy else "")
             + "; use the default preset"
         )
-
-
-def _sensor_files(names: list[str]) -> list[dict[str, str]]:
-    """``{spectrum, file, sha256}`` of each readable sensor CSV among *names*: a sensor set is
-    recorded by its file name, so its SHA-256 keeps the config hash tied to its curves."""
-    readable = [n for n in names if n.startswith("csv:") and Path(n[4:].strip()).is_file()]
-    return spectrum_files(readable)
 
 
 @dataclass(frozen=True)
@@ -348,9 +340,7 @@ class DatasetConfig:
             d["relight"] = self.relight
         if self.camera is not None:  # off: out of the hash
             d["camera"] = portable_names(camera_model(self.camera).settings())
-        sensors = [*d["cameras"], *([d["camera"]["sensitivities"]] if "camera" in d else [])]
-        if any(str(c).startswith("csv:") for c in sensors):  # named by file: keep its content
-            d["sensor_files"] = _sensor_files([*self.resolved_cameras(), self.camera or ""])
+        d.update(sensor_files_record([*self.resolved_cameras(), self.camera or ""]))
         if self.spectral_layers:  # off: out of the hash, as before it existed
             d["spectral_layers"] = True
         if self.working_space != "srgb":  # srgb: the layers of before, their hash

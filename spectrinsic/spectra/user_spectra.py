@@ -68,6 +68,7 @@ __all__ = [
     "spectrum_files",
     "portable_csv",
     "portable_sensor_csv",
+    "sensor_files_record",
     "readable_sensor_csv",
     "portable_names",
 ]
@@ -359,6 +360,14 @@ def readable_sensor_csv(name: str, folder: str | os.PathLike[str] | None) -> str
     if path.is_absolute() or folder is None or not (Path(folder) / path).is_file():
         return name
     return f"csv:{Path(folder) / path}"
+
+
+def sensor_files_record(names: Any) -> dict[str, list[dict[str, str]]]:
+    """``{"sensor_files": [...]}`` (:func:`spectrum_files`) for the sensor CSVs among camera
+    *names* that are readable files, ``{}`` when there are none: a config names a sensor CSV by
+    its file name, so its SHA-256 keeps the config hash tied to the curves."""
+    readable = [n for n in names if n[:4].lower() == "csv:" and Path(n[4:].strip()).is_file()]
+    return {"sensor_files": spectrum_files(readable)} if readable else {}
 
 
 def portable_names(data: Any, base: str | Path | None = None) -> Any:

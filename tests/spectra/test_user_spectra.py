@@ -214,3 +214,15 @@ def test_the_primaries_round_trip_within_the_documented_worst_on_our_colorimetry
         errors[tuple(rgb)] = float(np.abs(working_space("srgb").rgb(xyz) - rgb).max())
     assert max(errors.values()) < 1.3e-3
     assert max(errors, key=errors.get) == (0.0, 0.0, 1.0)
+
+
+def test_a_recorded_sensor_csv_is_read_from_the_folder_that_holds_it(tmp_path):
+    """``csv:cam.csv`` (recorded by file name): in the folder when it holds the file, else as
+    given (the working folder); an absolute name (an older sample) as it is."""
+    from spectrinsic.spectra.user_spectra import readable_sensor_csv
+
+    assert readable_sensor_csv("csv:cam.csv", tmp_path) == "csv:cam.csv"  # not there
+    (tmp_path / "cam.csv").write_text("wavelength [nm],R,G,B\n")
+    assert readable_sensor_csv("csv:cam.csv", tmp_path) == f"csv:{tmp_path / 'cam.csv'}"
+    assert readable_sensor_csv("csv:cam.csv", None) == "csv:cam.csv"
+    assert readable_sensor_csv("csv:/old/cam.csv", tmp_path) == "csv:/old/cam.csv"

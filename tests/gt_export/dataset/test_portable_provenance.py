@@ -270,6 +270,7 @@ def test_a_camera_csv_given_by_absolute_path_is_named_by_its_file(tmp_path, monk
         "spectrum_files"
     ]
     assert _absolute_paths(ds, [tmp_path, Path(os.path.expanduser("~"))]) == []
+    assert digest in (ds / "manifest.json").read_text()  # the config's sensor_files
 
     relit = ["relight", str(sample), "--light", "0=planck:3000K", "--scene-dir", str(box.parent)]
     assert main([*relit, "--out", str(tmp_path / "nowhere")]) == 2  # no cam.csv in work/
