@@ -42,7 +42,7 @@ test-torch: $(PKG) ## install the CPU build of PyTorch, then run the torch adapt
 	SPECTRINSIC_REQUIRE_TORCH=1 $(PY) -m pytest -q -p no:xdist -m torch
 
 test-properties: $(PKG) ## the property-based input tests with 2000 examples each (minutes)
-	SPECTRINSIC_PROPERTY_EXAMPLES=2000 $(PY) -m pytest -p no:xdist -q tests/test_properties.py
+	SPECTRINSIC_PROPERTY_EXAMPLES=2000 $(PY) -m pytest -p no:xdist -q tests/test_properties.py tests/scenes/test_mitsuba_properties.py
 
 test-fast: $(PKG) ## the tests not marked slow (no dataset builds or converged renders)
 	$(PY) -m pytest -n 2 -q --durations=10 -m "not slow"

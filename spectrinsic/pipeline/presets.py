@@ -23,6 +23,7 @@ from ..render.algebra.light_transport import diagonal_mode_names
 from ..render.algebra.modes import RENDER_MODES
 from ..render.settings import RenderSettings
 from ..spectra.camera_model import camera_model
+from ..spectra.user_spectra import portable_names, sensor_files_record
 from ..spectra.working_space import DEFAULT_WORKING_SPACE, working_space
 from .source_record import recorded_source
 
@@ -327,7 +328,7 @@ class DatasetConfig:
             "share_mode": r.share_mode,
             "noise_target": r.noise_target,
             "max_batches": r.max_batches,
-            "cameras": list(self.resolved_cameras()),
+            "cameras": portable_names(list(self.resolved_cameras())),  # sensor CSVs by name
             "variant": r.variant,
             "seed": self.seed,
         }
@@ -338,7 +339,8 @@ class DatasetConfig:
         if self.relight:
             d["relight"] = self.relight
         if self.camera is not None:  # off: out of the hash
-            d["camera"] = camera_model(self.camera).settings()
+            d["camera"] = portable_names(camera_model(self.camera).settings())
+        d.update(sensor_files_record([*self.resolved_cameras(), self.camera or ""]))
         if self.spectral_layers:  # off: out of the hash, as before it existed
             d["spectral_layers"] = True
         if self.working_space != "srgb":  # srgb: the layers of before, their hash

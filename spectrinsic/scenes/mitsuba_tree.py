@@ -229,11 +229,32 @@ def parse_xml(text: str, version: str) -> ParsedXml:
                 props[key] = value
         kind = str(n.type).rsplit(".", 1)[-1].lower()
         node = XmlNode(kind, n.props.plugin_name(), n.props.id(), props, tuple(children))
+        _check_finite(node)
         nodes[index], said = _fix(node, version)
         fixes += said
     root = nodes[0]
     assert root is not None
     return ParsedXml(root, tuple(fixes))
+
+
+def _check_finite(node: XmlNode) -> None:
+    """Refuse a number, point, colour, spectrum or transform of *node* holding infinity or
+    NaN (``inf``, ``nan``, or a value beyond float range such as ``1e400``, which the parser
+    reads as infinity) before any arithmetic with it: one line instead of a RuntimeWarning and
+    a NaN spreading into derived values."""
+    for key, value in node.props.items():
+        if isinstance(value, bool | str | XmlNode):
+            continue
+        if isinstance(value, Spectrum):
+            numbers = np.asarray(value.wavelengths + value.values, float)
+        else:
+            numbers = np.asarray(value, float)
+        if not np.isfinite(numbers).all():
+            what = "transform" if numbers.shape == (4, 4) else "value"
+            raise SceneError(
+                f"{node.label()}: its {key} {what} holds a non-finite number (inf, nan, or a "
+                "value beyond float range such as 1e400); expected finite numbers"
+            )
 
 
 def _order(mi: Any, state: Any) -> list[int]:

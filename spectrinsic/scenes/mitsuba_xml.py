@@ -91,8 +91,12 @@ def _vec(value: Any) -> tuple[float, float, float]:
     return tuple(float(x) for x in np.asarray(value, float).reshape(3))  # type: ignore[return-value]
 
 
-def _unit(v: np.ndarray) -> tuple[float, float, float]:
-    return _vec(v / np.linalg.norm(v))
+def _unit(v: np.ndarray, where: str = "a light") -> tuple[float, float, float]:
+    """*v* scaled to unit length; a zero vector is refused (not divided by zero)."""
+    length = float(np.linalg.norm(v))
+    if not length > 0:
+        raise SceneError(f"{where}: direction {_vec(v)} is a zero vector; expected a non-zero one")
+    return _vec(v / length)
 
 
 def _area_light(p: shapes.Placed, node: XmlNode, r: _Reading) -> Light | None:
@@ -162,7 +166,7 @@ def _single_emitter(node: XmlNode, kind: str, m: np.ndarray, where: str, base: P
         spectrum, power = emission(node.props.get("irradiance"), f"{where} irradiance", base)
         d = node.props.get("direction")
         direction = m[:3, 2] if d is None else m[:3, :3] @ np.asarray(d, float)
-        return Light("directional", spectrum, power, direction=_unit(direction))
+        return Light("directional", spectrum, power, direction=_unit(direction, where))
     spectrum, power = emission(node.props.get("intensity"), f"{where} intensity", base)
     if kind == "point":
         pos = node.props.get("position")
@@ -173,7 +177,7 @@ def _single_emitter(node: XmlNode, kind: str, m: np.ndarray, where: str, base: P
             raise SceneError(f"{where}: beam_width in {node.label()}; Mitsuba's default applies")
         direction = m[:3, 2]
         return Light(
-            "spot", spectrum, power, position=_vec(m[:3, 3]), direction=_unit(direction),
+            "spot", spectrum, power, position=_vec(m[:3, 3]), direction=_unit(direction, where),
             cutoff_deg=cutoff,
         )  # fmt: skip
     raise SceneError(f"{where}: unsupported element {node.label()}")

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import os
 import re
 from pathlib import Path
 from typing import Any
@@ -66,6 +67,9 @@ __all__ = [
     "column_unit",
     "spectrum_files",
     "portable_csv",
+    "portable_sensor_csv",
+    "sensor_files_record",
+    "readable_sensor_csv",
     "portable_names",
 ]
 
@@ -327,14 +331,43 @@ def portable_csv(name: str, base: str | Path | None = None) -> str:
         return name
     path, sep, column = name.strip()[4:].rpartition("#")
     file = Path(path.strip())
-    if not sep or not file.is_absolute():
-        # a sensor set (``csv:PATH``, no column) stays as the command line gave it: its name
-        # also names the sample's camera layers and files (give it relative to the working
-        # folder to keep it portable)
+    if not sep:  # a sensor set (``csv:PATH``, no column): :func:`portable_sensor_csv`
+        return portable_sensor_csv(name)
+    if not file.is_absolute():
         return name
     root = Path(base).resolve() if base is not None else None
     rel = file.relative_to(root) if root is not None and file.is_relative_to(root) else None
     return f"csv:{(rel or Path(file.name)).as_posix()}#{column}"
+
+
+def portable_sensor_csv(name: str) -> str:
+    """A camera's sensor set ``csv:PATH`` (three curves, no column) as samples record it: an
+    absolute PATH by its file name alone (``csv:/home/u/cam.csv`` -> ``csv:cam.csv``), a
+    relative one as given. The name also names the camera's layers (``image_camera/csv:cam.csv``)
+    and files; ``meta.json["spectrum_files"]`` keeps its SHA-256, and relight reads the file
+    from ``--scene-dir`` or the working folder (:func:`readable_sensor_csv`)."""
+    path = Path(name.strip()[4:].strip())
+    return f"csv:{path.name}" if path.is_absolute() else name
+
+
+def readable_sensor_csv(name: str, folder: str | os.PathLike[str] | None) -> str:
+    """A recorded sensor set ``csv:NAME`` (:func:`portable_sensor_csv`) with a path the process
+    can read: a relative NAME in *folder* when it holds that file, else in the working folder;
+    an absolute one (a sample from before portable names) as it is. The caller checks the
+    file's SHA-256 (``meta.json["spectrum_files"]``), so a file of that name elsewhere is
+    refused, never read in its place."""
+    path = Path(name.strip()[4:].strip())
+    if path.is_absolute() or folder is None or not (Path(folder) / path).is_file():
+        return name
+    return f"csv:{Path(folder) / path}"
+
+
+def sensor_files_record(names: Any) -> dict[str, list[dict[str, str]]]:
+    """``{"sensor_files": [...]}`` (:func:`spectrum_files`) for the sensor CSVs among camera
+    *names* that are readable files, ``{}`` when there are none: a config names a sensor CSV by
+    its file name, so its SHA-256 keeps the config hash tied to the curves."""
+    readable = [n for n in names if n[:4].lower() == "csv:" and Path(n[4:].strip()).is_file()]
+    return {"sensor_files": spectrum_files(readable)} if readable else {}
 
 
 def portable_names(data: Any, base: str | Path | None = None) -> Any:
@@ -352,9 +385,15 @@ def portable_names(data: Any, base: str | Path | None = None) -> Any:
 def spectrum_files(names: Any, base: str | Path | None = None) -> list[dict[str, str]]:
     """One record per distinct ``csv:`` spectrum among *names* (paths the build can read): its
     portable name and file (:func:`portable_csv`, relative to *base*), column and the file's
-    SHA-256, for ``meta.json`` (``spectrum_files``)."""
+    SHA-256, for ``meta.json`` (``spectrum_files``); a camera's sensor CSV (no column) by its
+    portable name (:func:`portable_sensor_csv`)."""
     out = []
     for name in sorted({n for n in names if isinstance(n, str) and n.startswith("csv:")}):
+        if "#" not in name:  # a camera's sensor set: by its file name
+            portable = portable_sensor_csv(name)
+            path = name.removeprefix("csv:").strip()
+            out.append({"spectrum": portable, "file": portable[4:], "sha256": sha256(path)})
+            continue
         path, key = split_csv_key(name.removeprefix("csv:"))
         column, unit = column_unit(key)
         portable = portable_csv(name, base)

@@ -399,3 +399,34 @@ def test_a_coloured_rgb_emission_is_a_light_of_that_linear_srgb_colour(tmp_path)
     rgb = colour.XYZ_to_RGB(xyz, colour.RGB_COLOURSPACES["sRGB"], apply_cctf_encoding=False)
     np.testing.assert_allclose(rgb, [10, 8, 6], rtol=1e-3)  # the basis's round trip under D65
     assert light.power == pytest.approx(xyz[1], rel=1e-4)  # power: the luminance (5 nm samples)
+
+
+@pytest.mark.parametrize(
+    ("element", "match"),
+    [
+        ('<shape type="sphere"><float name="radius" value="1e400"/></shape>', "its radius value"),
+        ('<shape type="sphere"><float name="radius" value="inf"/></shape>', "its radius value"),
+        (
+            '<emitter type="directional"><vector name="direction" x="nan" y="0" z="-1"/>'
+            '<rgb name="irradiance" value="1"/></emitter>',
+            "its direction value",
+        ),
+        (
+            '<emitter type="directional"><vector name="direction" value="0"/>'
+            '<rgb name="irradiance" value="1"/></emitter>',
+            r"direction \(0.0, 0.0, 0.0\) is a zero vector",
+        ),
+    ],
+    ids=["radius-1e400", "radius-inf", "direction-nan", "direction-zero"],
+)
+def test_non_finite_values_and_zero_directions_are_refused_before_any_arithmetic(
+    tmp_path, element, match
+):
+    """Found by the XML properties: an infinite sphere radius and a NaN or zero light direction
+    reached numpy (a RuntimeWarning, then a NaN scene or a traceback-free but wrong error)."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        with pytest.raises(SceneError, match=match):
+            load_mitsuba_xml(_write(tmp_path, _scene(LAMP + element)))

@@ -128,13 +128,14 @@ def test_spectrum_files_records_the_hash_of_each_file(paints):
 
 
 def test_portable_csv_names_files_relative_to_the_scene_folder(tmp_path):
-    """Relative to *base* when inside it, else the file name; a sensor set (no column), a
-    relative name and other families as they are."""
+    """Relative to *base* when inside it, else the file name; a sensor set (no column) by its
+    file name; a relative name and other families as they are."""
     base = tmp_path / "scene"
     assert portable_csv(f"csv:{base}/sub/p.csv#red [%]", base) == "csv:sub/p.csv#red [%]"
     assert portable_csv(f"csv:{tmp_path}/elsewhere/p.csv#3?unit=%", base) == "csv:p.csv#3?unit=%"
-    sensors = f"csv:{tmp_path}/cam.csv"  # a sensor set names camera layers: kept as given
-    assert portable_csv(sensors, base) == sensors
+    sensors = f"csv:{base}/cam.csv"  # a sensor set (it names camera layers): its file name
+    assert portable_csv(sensors, base) == "csv:cam.csv"
+    assert portable_csv("csv:sub/cam.csv", base) == "csv:sub/cam.csv"
     assert portable_csv("csv:sub/p.csv#red", base) == "csv:sub/p.csv#red"
     assert portable_csv("munsell:5R 4/14", base) == "munsell:5R 4/14"
     record = {"lights": [{"spectrum": f"csv:{base}/l.csv#lamp", "power": 2.0}], "n": 1}
@@ -213,3 +214,15 @@ def test_the_primaries_round_trip_within_the_documented_worst_on_our_colorimetry
         errors[tuple(rgb)] = float(np.abs(working_space("srgb").rgb(xyz) - rgb).max())
     assert max(errors.values()) < 1.3e-3
     assert max(errors, key=errors.get) == (0.0, 0.0, 1.0)
+
+
+def test_a_recorded_sensor_csv_is_read_from_the_folder_that_holds_it(tmp_path):
+    """``csv:cam.csv`` (recorded by file name): in the folder when it holds the file, else as
+    given (the working folder); an absolute name (an older sample) as it is."""
+    from spectrinsic.spectra.user_spectra import readable_sensor_csv
+
+    assert readable_sensor_csv("csv:cam.csv", tmp_path) == "csv:cam.csv"  # not there
+    (tmp_path / "cam.csv").write_text("wavelength [nm],R,G,B\n")
+    assert readable_sensor_csv("csv:cam.csv", tmp_path) == f"csv:{tmp_path / 'cam.csv'}"
+    assert readable_sensor_csv("csv:cam.csv", None) == "csv:cam.csv"
+    assert readable_sensor_csv("csv:/old/cam.csv", tmp_path) == "csv:/old/cam.csv"

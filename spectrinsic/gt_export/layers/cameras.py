@@ -49,7 +49,8 @@ def camera_layers(
         camera_curves(cam, band_set.wavelengths, data_dir=s.data_dir),
         band_set.wavelengths,
     )
-    key, slug = camera_key(cam), "camera-" + camera_slug(cam)
+    key = camera_key(cam)
+    slug = "camera-" + camera_slug(key)
     image = np.asarray(s.result.raw["bands31"], float) @ weights.T
     refl = coverage_weighted(coverage, canonical_responses(s.material_rho, s.d65, curves, s.wl))
     white = canonical_responses(np.ones(s.wl.size), s.d65, curves, s.wl)

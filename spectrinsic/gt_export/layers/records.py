@@ -14,6 +14,7 @@ import numpy as np
 from ...errors import DatasetError
 from ...scenes.model import Scene
 from ...spectra import COLORIMETRIC_WAVELENGTHS
+from ...spectra.user_spectra import portable_sensor_csv
 from ...spectra.working_space import DEFAULT_WORKING_SPACE, WorkingSpace, working_space
 
 # Responses with the light's white at Y = 1; under D65 with sRGB sensors, the canonical p^{s,c}.
@@ -204,7 +205,11 @@ def cube_sensor_name(result: Any) -> str:
 
 
 def camera_key(name: str) -> str:
-    return name.split(":", 1)[1] if name.startswith("camera:") else name
+    """The key of camera *name*'s layers: ``camera:X`` -> ``X``; a sensor CSV by its portable
+    name (``csv:/abs/cam.csv`` -> ``csv:cam.csv``: no written name holds a builder's path)."""
+    if name.startswith("camera:"):
+        return name.split(":", 1)[1]
+    return portable_sensor_csv(name) if name[:4].lower() == "csv:" else name
 
 
 UNITS_IMAGE = (

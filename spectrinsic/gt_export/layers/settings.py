@@ -15,8 +15,10 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field, replace
 
+from ...errors import DatasetError
 from ...spectra.camera_model import CameraModel
 from ...spectra.working_space import DEFAULT_WORKING_SPACE, WorkingSpace, working_space
+from .records import camera_key
 
 __all__ = ["DEFAULT_CAMERAS", "LayerSettings"]
 
@@ -83,6 +85,13 @@ class LayerSettings:
             if self.camera is not None and self.camera.sensitivities not in cams:
                 cams += (self.camera.sensitivities,)
             object.__setattr__(self, "cameras", cams)
+            keys = {c: camera_key(c) for c in cams}
+            twice = sorted({k for k in keys.values() if list(keys.values()).count(k) > 1})
+            if twice:  # sensor CSVs are keyed by file name: two would share their layers
+                raise DatasetError(
+                    f"cameras {list(cams)}: two name the same layers {twice[0]!r}; give sensor "
+                    "CSVs different file names"
+                )
 
     def with_cube(self, has_cube: bool) -> LayerSettings:
         """These settings with ``cameras=None`` resolved for a render that has (or lacks) the

@@ -37,6 +37,7 @@ from ...render.result import RenderResult
 from ...scenes.model import Scene, scene_from_dict
 from ...scenes.validate import POWER_RANGE
 from ...spectra import get_spectrum
+from ...spectra.user_spectra import readable_sensor_csv
 from ..formats.exr import read_exr
 from ..layers import LayerSettings
 from ..layers.records import reference_mode
@@ -255,6 +256,7 @@ def relit_render(
     check_relight_inputs(sample, meta)  # every file read matches meta.json; the EXR's header
     folder = None if scene_dir is None else Path(scene_dir)
     used = _csv_names(_scene_record(sample))  # as recorded: relative to the scene's folder
+    used |= {c for c in settings_of(meta).cameras or () if c[:4].lower() == "csv:"}  # sensors
     check_spectrum_files(sample, meta, used, folder)  # CSVs read again: as at build time
     source = read_sample_scene(sample, folder)
     transport, coverage = read_transport(sample, meta["transport"])
@@ -341,7 +343,9 @@ def relight(
         out.parent,
         relit.scene,
         relit.result,
-        settings_of(meta, None if data_dir is None else str(data_dir)).for_scene_folder(scene_dir),
+        settings_of(meta, None if data_dir is None else str(data_dir), scene_dir).for_scene_folder(
+            scene_dir
+        ),
         sample_id=out.name,
         config={"config_hash": meta["config_hash"]},
         seed=int(meta["seed"]),
@@ -349,19 +353,31 @@ def relight(
     )
 
 
-def settings_of(meta: Mapping[str, Any], data_dir: str | None = None) -> LayerSettings:
+def settings_of(
+    meta: Mapping[str, Any],
+    data_dir: str | None = None,
+    scene_dir: str | os.PathLike[str] | None = None,
+) -> LayerSettings:
     """The :class:`LayerSettings` a sample was written with, from its ``meta.json``: its
     cameras (full sensor-set names, from the stored transport), cube, per-band layers,
     denoising, working space (``srgb`` for samples before issue 30) and camera chain, which
     re-runs on the relit image. The noise id is the sample's own id, so a relit sample's raw
-    mosaic carries the noise of the source, not of the ``--out`` folder's name."""
+    mosaic carries the noise of the source, not of the ``--out`` folder's name. A sensor CSV,
+    recorded by its file name, is read from *scene_dir* (``None``: the working folder)."""
     layers = meta.get("layers", {})
     cameras = meta.get("transport", {}).get("cameras") or [
         f"camera:{c}" for c in meta.get("cameras", [])
     ]
+
+    def readable(name: str) -> str:
+        return readable_sensor_csv(name, scene_dir) if name[:4].lower() == "csv:" else name
+
+    model = model_from_meta(meta)
+    if model is not None:
+        model = dataclasses.replace(model, sensitivities=readable(model.sensitivities))
     return LayerSettings(
-        cameras=tuple(cameras),
-        camera=model_from_meta(meta),
+        cameras=tuple(readable(c) for c in cameras),
+        camera=model,
         write_cube="cube" in layers,
         denoise=bool(meta.get("denoised_layers")),
         spectral_layers="shading_bands" in layers,

@@ -130,7 +130,7 @@ def relit_layers(
     """
     relit = relit_render(sample_dir, lights, powers=powers, data_dir=data_dir, scene_dir=scene_dir)
     meta = relit.meta
-    settings = settings_of(meta, None if data_dir is None else str(data_dir))
+    settings = settings_of(meta, None if data_dir is None else str(data_dir), scene_dir)
     settings = replace(  # cameras off: no camera layers, and no chain's camera added back
         settings,
         cameras=settings.cameras if cameras else (),

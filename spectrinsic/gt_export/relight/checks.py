@@ -41,7 +41,7 @@ from ...errors import DatasetError, SpectrinsicError
 from ...render.result import RenderResult
 from ...scenes.spectrum_refs import confined_csv
 from ...spectra import get_sensors
-from ...spectra.user_spectra import split_csv_key
+from ...spectra.user_spectra import readable_sensor_csv, split_csv_key
 from ..formats.exr import read_exr_attributes
 from ..sample import META_NAME, SCENE_NAME, file_sha256
 from ..sample.transport_exr import COVERAGE_LAYER, TRANSPORT_NAME, stored_layers
@@ -150,7 +150,10 @@ def check_relight_inputs(sample: Path, meta: Mapping[str, Any]) -> None:
 def _readable_csv(sample: Path, name: str, scene_dir: Path | None) -> str:
     """The recorded ``csv:`` *name* with a path the process can read: a relative one resolved
     inside *scene_dir* (:func:`~spectrinsic.scenes.spectrum_refs.confined_csv`), an absolute
-    one (a sample from before portable names) as it is."""
+    one (a sample from before portable names) as it is; a camera's sensor CSV in *scene_dir*
+    or else the working folder (:func:`~spectrinsic.spectra.user_spectra.readable_sensor_csv`)."""
+    if "#" not in name:  # a camera's sensor set, named by its file name (no column)
+        return readable_sensor_csv(name, scene_dir)
     path, _ = split_csv_key(name.strip()[4:])
     if Path(path).is_absolute():
         return name
@@ -196,7 +199,8 @@ def check_spectrum_files(
                 f"{sample / META_NAME}: spectrum {name!r} is read from a file that "
                 "spectrum_files does not list with a SHA-256; cannot verify it"
             )
-        path = Path(split_csv_key(_readable_csv(sample, name, scene_dir)[4:])[0])
+        readable = _readable_csv(sample, name, scene_dir)[4:]
+        path = Path(split_csv_key(readable)[0] if "#" in name else readable.strip())
         if not path.is_file():
             raise DatasetError(
                 f"{path}: the spectrum file of {name!r} listed in {sample / META_NAME} is missing"

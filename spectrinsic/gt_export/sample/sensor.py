@@ -38,6 +38,7 @@ from ...file_writes import write_bytes_file
 from ...spectra.camera_chain import ChainResult, carry, run_chain
 from ...spectra.camera_isp import camera_to_xyz
 from ...spectra.camera_model import CameraModel
+from ...spectra.user_spectra import portable_names
 from ..formats import png
 from ..formats.names import camera_slug
 from ..layers import GroundTruth, Layer, camera_curves
@@ -218,7 +219,7 @@ def write_dng(path: Path, out: SensorOutput) -> None:
         (Tag.CalibrationIlluminant1, CalibrationIlluminant.D65),
         (Tag.AsShotNeutral, _rationals(1.0 / chain.wb_gains)),
         (Tag.Make, "spectrinsic"),
-        (Tag.Model, model.name),
+        (Tag.Model, portable_names(model.name)),  # a sensor CSV by its file name
         (Tag.DNGVersion, DNGVersion.V1_4),
         (Tag.DNGBackwardVersion, DNGVersion.V1_2),
     ):

@@ -52,6 +52,7 @@ from ..layers import (
     compute_ground_truth,
     identities,
 )
+from ..layers.records import camera_key
 from . import (
     FORMAT_VERSION,
     HASHES_KEY,
@@ -135,7 +136,10 @@ def _meta(
         lights.append(entry)
     height, width = gt.layers["image"].data.shape[:2]
     files_used = spectrum_files(
-        [m.spectrum for m in scene.materials] + [li.spectrum for li in scene.lights], scene_folder
+        [m.spectrum for m in scene.materials]
+        + [li.spectrum for li in scene.lights]
+        + [*gt.cameras],
+        scene_folder,
     ) + list(scene.metadata.get("spectrum_files", []))  # the .spd files a Mitsuba XML read
     extra: dict[str, Any] = {"spectrum_files": files_used} if files_used else {}
     if "semantic" in gt.layers:  # the class table of the semantic layer's ids
@@ -160,7 +164,7 @@ def _meta(
         "materials": gt.materials,
         "objects": {str(m.object_id): m.name for m in scene.meshes},
         "lights": lights,
-        "cameras": [c.split(":", 1)[-1] for c in gt.cameras],
+        "cameras": [camera_key(c).split(":", 1)[-1] for c in gt.cameras],
         "cube_sensors": gt.cube_sensors,
         "matrices": gt.matrices,
         "layers": _layer_records(gt, previews),

@@ -231,3 +231,58 @@ def test_the_files_export_and_evaluate_write_hold_no_absolute_path(two_builds, t
     assert "* dataset: `ds`" in (tmp_path / "ev" / "REPORT.md").read_text()
     folders = [two_builds, tmp_path, Path(os.path.expanduser("~"))]
     assert _absolute_paths(tmp_path, folders) == []
+
+
+def _camera_csv() -> str:
+    """Three smooth sensor curves (R, G, B) over 380-780 nm, each responding to D65."""
+    rows = ["wavelength [nm],R [1],G [1],B [1]"]
+    for w in range(380, 781, 10):
+        r, g, b = (float(np.exp(-(((w - c) / 40.0) ** 2))) for c in (600, 540, 450))
+        rows.append(f"{w},{r:.6f},{g:.6f},{b:.6f}")
+    return "\n".join(rows) + "\n"
+
+
+@pytest.mark.slow  # one dataset build with the camera chain and a relight (about 15 s)
+def test_a_camera_csv_given_by_absolute_path_is_named_by_its_file(tmp_path, monkeypatch, capsys):
+    """``--camera csv:/abs/cam.csv``: its layers, files, the config and the camera chain's
+    record name ``csv:cam.csv``, ``spectrum_files`` keeps its SHA-256, no file of the set holds
+    the build's folders, and relight reads the curves again from the working folder (checked
+    against that SHA-256: an edited CSV is refused in one line)."""
+    (tmp_path / "sensors").mkdir()
+    cam = tmp_path / "sensors" / "cam.csv"
+    cam.write_text(_camera_csv())
+    box = _scene_folder(tmp_path / "scenes")[0]
+    (tmp_path / "work").mkdir()
+    monkeypatch.chdir(tmp_path / "work")
+    ds = tmp_path / "ds"
+    args = ["-q", "dataset", "--scenes", str(box), "--resolution", "8x8", "--spp", "2"]
+    args += ["--batches", "1", "--no-denoise", "--store-transport", "--camera", f"csv:{cam}"]
+    assert main([*args, "--out", str(ds)]) == 0, capsys.readouterr().err
+    sample = ds / "box__v0__file"
+    meta = json.loads((sample / "meta.json").read_text())
+    assert (
+        "image_camera/csv:cam.csv" in meta["layers"]
+        and "csv:cam.csv" in meta["transport"]["cameras"]
+    )
+    assert (sample / "camera-cam-csv.exr").is_file()
+    digest = hashlib.sha256(cam.read_bytes()).hexdigest()
+    assert {"spectrum": "csv:cam.csv", "file": "cam.csv", "sha256": digest} in meta[
+        "spectrum_files"
+    ]
+    assert _absolute_paths(ds, [tmp_path, Path(os.path.expanduser("~"))]) == []
+    assert digest in (ds / "manifest.json").read_text()  # the config's sensor_files
+
+    relit = ["relight", str(sample), "--light", "0=planck:3000K", "--scene-dir", str(box.parent)]
+    assert main([*relit, "--out", str(tmp_path / "nowhere")]) == 2  # no cam.csv in work/
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "csv:cam.csv" in err and "missing" in err, err
+    monkeypatch.chdir(tmp_path / "sensors")  # relight finds cam.csv in the working folder
+    assert main([*relit, "--out", str(tmp_path / "relit")]) == 0, capsys.readouterr().err
+    again = json.loads((tmp_path / "relit" / "meta.json").read_text())
+    assert "image_camera/csv:cam.csv" in again["layers"]
+    assert _absolute_paths(tmp_path / "relit", [tmp_path]) == []
+    capsys.readouterr()
+    cam.write_text(_camera_csv().replace("0.", "0.9", 5))
+    assert main([*relit, "--out", str(tmp_path / "edited")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "cam.csv" in err and "SHA-256" in err, err
