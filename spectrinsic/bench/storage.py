@@ -22,7 +22,10 @@ layers (what issue 45 measured at 235 MB for a five-light generated room). Repor
   module from the layers the loader rebuilds) against as written, the seconds to read every
   layer back (rebuilt ones included) against reading the full files, ``check`` on the compact
   form; for this sample and for the same render written as a default sample (no transport,
-  no spectral layers), whose issue-45 goal is 12 MB.
+  no spectral layers), whose issue-45 goal is 12 MB;
+* the cube the sample defines from its stored transport
+  (:mod:`~spectrinsic.gt_export.sample.transport_cube`, rebuilt by the loader) against the
+  renderer's own (the batches' mean of each batch's sum): float32 rounding.
 """
 
 from __future__ import annotations
@@ -34,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from ..gt_export import check_sample, export_sample
+from ..gt_export import check_sample, export_sample, load_sample
 from ..gt_export.formats.exr import read_exr, write_exr
 from ..gt_export.layers import LayerSettings
 from ..gt_export.relight import relit_scene
@@ -247,6 +250,8 @@ def run(out_dir: Path) -> dict[str, Any]:
         read_old_s = _median_seconds(read_transport, old_dir, old_record)
         read_new_s = _median_seconds(read_transport, sample, record)
         exactness = _exactness(read, transport, scene)
+        cube = load_sample(sample, layers=["image_bands_raw"])["image_bands_raw"]
+        cube_gap = _relative(cube, np.asarray(result.raw["bands31"], np.float64))
         (root / "work").mkdir()
         layer_storage = _layer_storage(sample, root / "work")
         previews = sum(v for k, v in _files(sample).items() if "/" in k)
@@ -265,6 +270,7 @@ def run(out_dir: Path) -> dict[str, Any]:
         "read_slowdown_new_over_old": read_new_s / read_old_s,
         "read_slowdown_goal": 1.5,
         "exactness_compact_vs_memory": exactness,
+        "cube_from_transport_vs_render_relative": cube_gap,
         "layer_storage": layer_storage,
         "default_sample_without_transport": plain,
     }

@@ -113,7 +113,7 @@ def _csv_names(data: Any) -> set[str]:
     if isinstance(data, str):
         return {data} if data[:4].lower() == "csv:" else set()
     values = data.values() if isinstance(data, dict) else data if isinstance(data, list) else ()
-    return set().union(*(_csv_names(v) for v in values))
+    return set().union(*(_csv_names(v) for v in values if isinstance(v, (str, dict, list))))
 
 
 def read_sample_scene(

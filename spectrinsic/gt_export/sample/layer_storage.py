@@ -16,6 +16,10 @@ made of, rebuilt bit for bit by every reader (``load_sample``, ``spectrinsic che
   ``shading_bands``, the pixels surfaces cover (coverage sum ≥
   :data:`~spectrinsic.gt_export.layers.irradiance.COVERAGE_MIN`), ``image_bands_raw`` and
   ``specular_bands``.
+* ``"transport_sum"`` (``image_bands_raw``, or ``image_bands`` where not denoised, of a
+  sample that stores its transport): ``Σ_l T̄_l ∘ ē_l`` of the transport's stored batch means
+  and the lights' band means in the file's header
+  (:mod:`~spectrinsic.gt_export.sample.transport_cube`, which defines the cube so).
 * ``"ratio"`` (``shading_ratio``): :func:`~spectrinsic.gt_export.layers.imaging.shading_ratio`
   of ``image`` and ``reflectance``.
 * ``"unit_luminance"`` (``illuminant``, ``illuminant_camera/<name>``):
@@ -51,10 +55,12 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError
+from ...render.algebra.shares import compose
 from ..formats.exr import read_exr, read_exr_attributes
 from ..layers.imaging import shading_ratio
 from ..layers.irradiance import coverage_albedo, covered, residual, unit_luminance
 from ..layers.spectral_intrinsics import band_image
+from .transport_cube import read_cube_factors
 from .transport_exr import COVERAGE_LAYER  # one name for the per-material coverage layer
 
 __all__ = [
@@ -73,11 +79,19 @@ __all__ = [
 ]
 
 #: The forms a layer may be stored in besides in full (module notes).
-FORMS = ("coverage_table", "band_image", "ratio", "unit_luminance", "identity_residual")
+FORMS = (
+    "coverage_table",
+    "band_image",
+    "transport_sum",
+    "ratio",
+    "unit_luminance",
+    "identity_residual",
+)
 #: How many terms each form is rebuilt from (besides a file's coverage and table).
 _TERM_COUNTS = {
     "coverage_table": (0,),
     "band_image": (3, 4),
+    "transport_sum": (0,),
     "ratio": (2,),
     "unit_luminance": (2,),
     "identity_residual": (3, 4),
@@ -111,8 +125,12 @@ def rebuild(
     factors: tuple[np.ndarray, np.ndarray] | None,
 ) -> np.ndarray:
     """The float32 layer *key* of *form* from the float32 *values* of its *terms* and, for the
-    band layers, ``(coverage, table)``."""
-    if form == "identity_residual":
+    band layers, ``(coverage, table)``; for ``transport_sum``, ``(means, ē)``."""
+    if form == "transport_sum":
+        if factors is None:
+            raise DatasetError(f"layer {key!r} ({form}) needs its transport's means")
+        out = compose(*factors)
+    elif form == "identity_residual":
         out = residual(*(values[t] for t in terms))
     elif form == "ratio":
         out = shading_ratio(values[terms[0]], values[terms[1]])
@@ -274,7 +292,13 @@ def rebuild_layers(
             form = pending.pop(key)
             _read_missing(records, values, [n for n in terms[key] if n not in values], path_of)
             file_factors = None
-            if form in BAND_FORMS:
+            if form == "transport_sum":
+                rec = records[key]
+                cube = read_cube_factors(
+                    meta, path_of, str(_field(rec, "file")), key, len(_field(rec, "channels"))
+                )
+                file_factors = (cube.means, cube.light_means)
+            elif form in BAND_FORMS:
                 file = str(_field(records[key], "file"))
                 if file not in factors:
                     factors[file] = _factors(path_of(file), file, records, forms, coverage)

@@ -23,6 +23,7 @@ from .layer_storage import (
     layer_sha256,
     rebuild,
 )
+from .transport_cube import MEANS_ATTRIBUTE, CubeFactors
 
 __all__ = ["HALF_PREFIXES", "PIZ_FILES", "StoredLayers", "compression_of", "stored_layers"]
 
@@ -100,6 +101,9 @@ def _candidates(gt: GroundTruth, identities: Sequence[Mapping[str, Any]]) -> lis
     have = gt.layers
     spec = ["specular_bands"] if "specular_bands" in have else []
     out = [
+        Candidate("image_bands_raw", "transport_sum", ()),
+        Candidate("image_bands", "transport_sum", ()),  # the cube itself where not denoised
+        Candidate("cube", "transport_sum", ()),
         Candidate("reflectance_bands", "coverage_table", ()),
         Candidate("image_bands", "band_image", (*BAND_FACTORS, *spec)),
         Candidate("shading_ratio", "ratio", ("image", "reflectance")),
@@ -120,10 +124,14 @@ def _candidates(gt: GroundTruth, identities: Sequence[Mapping[str, Any]]) -> lis
 
 
 def stored_layers(
-    gt: GroundTruth, coverage: np.ndarray | None, identities: Sequence[Mapping[str, Any]]
+    gt: GroundTruth,
+    coverage: np.ndarray | None,
+    identities: Sequence[Mapping[str, Any]],
+    cube: CubeFactors | None = None,
 ) -> StoredLayers:
     """The EXR content of *gt*: every layer in full, except those whose factors rebuild them
-    bit for bit (module notes). *coverage* is the render's ``(H, W, M)`` AOV."""
+    bit for bit (module notes). *coverage* is the render's ``(H, W, M)`` AOV, *cube* the
+    factors of the cube of a sample stored with its transport."""
     values = {k: layer.data for k, layer in gt.layers.items()}
     factors = None
     if coverage is not None and gt.band_albedos is not None and "reflectance_bands" in values:
@@ -131,14 +139,13 @@ def stored_layers(
     forms: dict[str, str] = {}
     terms: dict[str, list[str]] = {}
     for c in _candidates(gt, identities):
-        if c.key not in values or c.key in c.terms or any(t not in values for t in c.terms):
-            continue
-        if c.form in BAND_FORMS and factors is None:
-            continue
-        if c.form == "identity_residual" and not c.terms:
-            continue
-        if np.array_equal(rebuild(c.key, c.form, c.terms, values, factors), values[c.key]):
+        if c.key not in forms and _rebuilds(c, values, factors, cube):
             forms[c.key], terms[c.key] = c.form, list(c.terms)
+    # a header needs a file: the cube's ē is kept by a file that stores some layer in full
+    kept = {_file(layer.group) for k, layer in gt.layers.items() if k not in forms}
+    for key in [k for k, f in forms.items() if f == "transport_sum"]:
+        if _file(gt.layers[key].group) not in kept:
+            del forms[key], terms[key]
     arrays: dict[str, dict[str, np.ndarray]] = {}
     channels: dict[str, dict[str, tuple[str, ...]]] = {}
     attributes: dict[str, dict[str, str]] = {}
@@ -150,6 +157,8 @@ def stored_layers(
             name = key.split("/", 1)[0]
             arrays[file][name] = layer.data
             channels[file][name] = layer.channels
+        elif forms[key] == "transport_sum" and cube is not None:
+            attributes.setdefault(file, {})[MEANS_ATTRIBUTE.format(layer=key)] = cube.attribute()
         elif forms[key] == "coverage_table" and factors is not None:
             arrays[file][COVERAGE_LAYER] = factors[0]
             channels[file][COVERAGE_LAYER] = tuple(f"m{m}" for m in range(factors[0].shape[-1]))
@@ -161,6 +170,26 @@ def stored_layers(
         arrays[_file(gt.layers[key].group)][key] = gt.layers[key].data.astype(np.float16)
     hashes = {k: layer_sha256(values[k]) for k in forms}
     return StoredLayers(arrays, channels, attributes, forms, hashes, terms, half)
+
+
+def _rebuilds(
+    c: Candidate,
+    values: Mapping[str, np.ndarray],
+    factors: tuple[np.ndarray, np.ndarray] | None,
+    cube: CubeFactors | None,
+) -> bool:
+    """Whether *c*'s form and terms give its layer back bit for bit; *factors* are the band
+    forms' ``(coverage, table)``, *cube* the ``transport_sum`` form's."""
+    if c.key not in values or c.key in c.terms or any(t not in values for t in c.terms):
+        return False
+    if c.form == "transport_sum":
+        factors = None if cube is None else (cube.means, cube.light_means)
+    elif c.form not in BAND_FORMS:
+        factors = None
+    needs = c.form in BAND_FORMS or c.form == "transport_sum"
+    if (needs and factors is None) or (c.form == "identity_residual" and not c.terms):
+        return False
+    return bool(np.array_equal(rebuild(c.key, c.form, c.terms, values, factors), values[c.key]))
 
 
 def _half_layers(

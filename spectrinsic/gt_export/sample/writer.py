@@ -72,6 +72,7 @@ from .integrity import replaceable_sample, sample_problem
 from .previews import preview_maker, preview_path, shown_layers
 from .sensor import SensorOutput, sensor_output, write_sensor_files
 from .stored_layers import compression_of, stored_layers
+from .transport_cube import CubeFactors, cube_factors, with_cube
 from .transport_exr import TRANSPORT_NAME, write_transport
 
 if TYPE_CHECKING:
@@ -180,12 +181,12 @@ def _meta(
 
 
 def _write_layers(
-    folder: Path, gt: GroundTruth, sample_id: str, coverage: Any
+    folder: Path, gt: GroundTruth, sample_id: str, coverage: Any, cube: CubeFactors | None
 ) -> tuple[list[str], dict[str, Any]]:
     """One EXR file per layer group, layers that their stored factors rebuild bit for bit
     stored as those (:mod:`~spectrinsic.gt_export.sample.layer_storage`); return the file
     names and ``meta.json["storage"]``."""
-    stored = stored_layers(gt, coverage, identities(gt))
+    stored = stored_layers(gt, coverage, identities(gt), cube)
     files = []
     for name, arrays in stored.arrays.items():
         write_exr(
@@ -223,13 +224,13 @@ def _fill_folder(
     gt: GroundTruth,
     *,
     transport: LightTransport | None = None,
+    cube: CubeFactors | None = None,
     sensor: SensorOutput | None = None,
     scene_folder: Path | None = None,
     **meta_kw: Any,
 ) -> None:
-    files, storage = _write_layers(
-        folder, gt, meta_kw["sample_id"], (getattr(result, "aovs", None) or {}).get("coverage")
-    )
+    coverage = (getattr(result, "aovs", None) or {}).get("coverage")
+    files, storage = _write_layers(folder, gt, meta_kw["sample_id"], coverage, cube)
     if sensor is not None:  # the camera chain's raw DNG and processed PNG (gt_export.sensor)
         files += write_sensor_files(folder, sensor)
     previews = _write_previews(folder, gt)
@@ -329,6 +330,10 @@ def export_sample(
         raise DatasetError(f"sample id {sample_id!r}: expected a plain folder name")
     settings = settings or LayerSettings()
     settings = settings.with_cube("bands31" in (getattr(result, "raw", None) or {}))
+    # with the transport stored, the cube is its stored means' sum (transport_cube), which
+    # the readers rebuild bit for bit: every layer is computed from that cube
+    cube = cube_factors(transport, scene, data_dir=settings.data_dir)
+    result = with_cube(result, cube)
     gt = compute_ground_truth(scene, result, settings)
     sensor = None
     if settings.camera is not None:
@@ -350,6 +355,7 @@ def export_sample(
             config=config,
             seed=seed,
             transport=transport,
+            cube=cube,
             sensor=sensor,
             scene_folder=None if settings.scene_folder is None else Path(settings.scene_folder),
         )
