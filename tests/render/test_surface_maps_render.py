@@ -268,3 +268,13 @@ def test_a_metal_seen_through_a_hole_has_its_white_surface_shading():
     assert np.all(shading[holes] > 0.0)
     ratio = shading[holes].mean() / shading[beside].mean()
     assert 1 / 3 < ratio <= 1.05, ratio
+
+
+def test_a_three_row_map_renders_without_a_word_on_stderr(capfd):
+    """A mask whose image has three rows: its texels reach Mitsuba as a Bitmap, so nanobind
+    prints no failed colour conversion (a ``(3, …)`` TensorXf printed three lines per load)."""
+    image = ImageTexture("", "", np.ones((3, 3, 3)), "clamp", "nearest")
+    scene = _scene(lambda uv: MeshMaps(uv, opacity_image=image))
+    capfd.readouterr()
+    render_scene(scene, RenderSettings(1, modes=("rgb3",), aovs=False), seed=1)
+    assert "nanobind" not in capfd.readouterr().err

@@ -49,7 +49,9 @@ def _bitmap(mi: Any, image: ImageTexture, values: np.ndarray) -> dict[str, Any]:
     texture coordinates) with *image*'s wrap mode and filter."""
     return {
         "type": "bitmap",
-        "data": mi.TensorXf(np.ascontiguousarray(values, np.float32)),
+        # a Bitmap, not a TensorXf: nanobind tries a (3, …) tensor as a colour first and
+        # prints each failed conversion on stderr (same texel values, measured)
+        "bitmap": mi.Bitmap(np.ascontiguousarray(values, np.float32)),
         "raw": True,
         "filter_type": "nearest" if image.filter == "nearest" else "bilinear",
         "wrap_mode": image.wrap,

@@ -106,7 +106,9 @@ def shape_slots(tables: TextureTables | None, surfaces: Sequence[Any]) -> dict[s
 def _weight_bitmap(mi: Any, values: np.ndarray) -> dict[str, Any]:
     return {
         "type": "bitmap",
-        "data": mi.TensorXf(np.ascontiguousarray(values[..., None], np.float32)),
+        # a Bitmap, not a TensorXf: nanobind tries a (3, …) tensor as a colour first and
+        # prints each failed conversion on stderr (same texel values, measured)
+        "bitmap": mi.Bitmap(np.ascontiguousarray(values[..., None], np.float32)),
         "raw": True,
         "filter_type": "nearest",
         "wrap_mode": "clamp",
