@@ -182,9 +182,10 @@ def _rss_bytes() -> int:
 
 
 @contextmanager
-def _staged(seconds: dict[str, float]) -> Iterator[None]:
+def _staged(seconds: dict[str, float], passes: dict[str, float]) -> Iterator[None]:
     """Time the sample build's stages into *seconds*, by wrapping the functions it calls
-    (restored on exit): load, render, ground truth; write is the export less the ground truth."""
+    (restored on exit): load, render, ground truth; write is the export less the ground truth.
+    *passes* gets the render's own seconds per pass group (``meta["timings"]``)."""
     from ..gt_export.sample import writer
     from ..pipeline import dataset
 
@@ -194,9 +195,12 @@ def _staged(seconds: dict[str, float]) -> Iterator[None]:
         def wrapper(*args: Any, **kwargs: Any) -> Any:
             start = time.perf_counter()
             try:
-                return inner(*args, **kwargs)
+                out = inner(*args, **kwargs)
             finally:
                 seconds[stage] = seconds.get(stage, 0.0) + time.perf_counter() - start
+            if stage == "render":
+                passes.update({k: t["seconds"] for k, t in out.meta.get("timings", {}).items()})
+            return out
 
         setattr(module, name, wrapper)
         return inner
@@ -221,8 +225,9 @@ def _ours(path: str, out: str, preset: str) -> dict[str, Any]:
     from ..cli import main
 
     seconds: dict[str, float] = {}
+    passes: dict[str, float] = {}
     start = time.perf_counter()
-    with _staged(seconds):
+    with _staged(seconds, passes):
         status = main(
             ["--quiet", "render", path, "--ground-truth", "--approximate"]
             + ["--preset", preset, "--out", out]
@@ -234,7 +239,12 @@ def _ours(path: str, out: str, preset: str) -> dict[str, Any]:
     # the dataset's card, gallery and manifest, and the imports
     seconds["other"] = seconds["total"] - sum(seconds[s] for s in STAGES)
     folder_bytes = sum(f.stat().st_size for f in Path(out).rglob("*") if f.is_file())
-    return {"seconds": seconds, "peak_bytes": _rss_bytes(), "folder_bytes": folder_bytes}
+    return {
+        "seconds": seconds,
+        "render_pass_seconds": passes,
+        "peak_bytes": _rss_bytes(),
+        "folder_bytes": folder_bytes,
+    }
 
 
 def _mitsuba(path: str, kind: str) -> dict[str, Any]:
