@@ -26,6 +26,7 @@ BENCHMARKS = (
     "residual",
     "storage",
     "real_scene",
+    "artist_interior",
 )
 
 

@@ -42,9 +42,11 @@ TIME_GOAL = 2.0
 MEMORY_GOAL_BYTES = 2 * 1024**3
 
 
-def _box_obj(grid: int) -> str:
-    """An OBJ box [-1, 1]³ with each face split into *grid* × *grid* quads (two triangles each)."""
+def box_obj(grid: int, *, uv: bool = False) -> str:
+    """An OBJ box [-1, 1]³ with each face split into *grid* × *grid* quads (two triangles each);
+    with *uv*, each box face spans the texture's unit square (``vt``, one per vertex)."""
     lines: list[str] = []
+    texcoords: list[str] = []
     faces: list[str] = []
     t = np.linspace(-1.0, 1.0, grid + 1)
     for axis in range(3):
@@ -55,14 +57,16 @@ def _box_obj(grid: int) -> str:
                     p = np.empty(3)
                     p[axis], p[(axis + 1) % 3], p[(axis + 2) % 3] = sign, a, b
                     lines.append("v {:.6g} {:.6g} {:.6g}".format(*p))
+                    texcoords.append(f"vt {(a + 1) / 2:.6g} {(b + 1) / 2:.6g}")
             for i in range(grid):
                 for j in range(grid):
                     v00 = base + i * (grid + 1) + j + 1
                     v01, v10, v11 = v00 + 1, v00 + grid + 1, v00 + grid + 2
                     quad = (v00, v10, v11, v01) if sign > 0 else (v00, v01, v11, v10)
-                    faces.append(f"f {quad[0]} {quad[1]} {quad[2]}")
-                    faces.append(f"f {quad[0]} {quad[2]} {quad[3]}")
-    return "\n".join(lines + faces) + "\n"
+                    q = [f"{v}/{v}" if uv else str(v) for v in quad]
+                    faces.append(f"f {q[0]} {q[1]} {q[2]}")
+                    faces.append(f"f {q[0]} {q[2]} {q[3]}")
+    return "\n".join(lines + (texcoords if uv else []) + faces) + "\n"
 
 
 def write_interior(folder: Path, meshes: int | None = None) -> Path:
@@ -70,7 +74,7 @@ def write_interior(folder: Path, meshes: int | None = None) -> Path:
     :data:`MESHES`); the scene file's path."""
     meshes = MESHES if meshes is None else meshes
     (folder / "meshes").mkdir(parents=True, exist_ok=True)
-    box = _box_obj(GRID)
+    box = box_obj(GRID)
     rng = np.random.default_rng(41)
     parts = [
         '<scene version="3.0.0">',

@@ -78,3 +78,26 @@ def test_real_scene_benchmark_compares_the_xml_reader_with_mitsubas_load_file(
     assert result["time_ratio"] == pytest.approx(
         result["spectrinsic_seconds"] / result["mitsuba_load_file_seconds"]
     )
+
+
+def test_artist_interior_has_the_issues_textures_glass_mirror_and_sun_and_sky(
+    monkeypatch, tmp_path
+):
+    """The benchmark's interior (issue 42) read as `render --approximate` reads it: every box,
+    the 20 bitmap textures, the glass, the mirror, and the sunsky as a sun and a sky map."""
+    from spectrinsic.bench import artist_interior as bench_interior
+    from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))  # the baked sky map
+    path = bench_interior.write_interior(tmp_path / "interior", 44, (32, 24), "preview")
+    scene = load_mitsuba_xml(path, approximate=True)
+    assert len(scene.meshes) == 44 + 4  # the boxes, the floor, two walls, the mirror
+    assert (scene.camera.width, scene.camera.height) == (32, 24)
+    textured = {m.name for m in scene.meshes if m.texture is not None}
+    assert len(list((tmp_path / "interior" / "textures").glob("*.png"))) == 20
+    assert len(textured) == 20 + 1  # the 40 non-glass boxes alternate; the floor is textured
+    kinds = [scene.materials[m.face_materials[0]] for m in scene.meshes]
+    assert sum(m.kind == "dielectric" for m in kinds) == bench_interior.GLASS
+    assert sum(m.kind == "conductor" for m in kinds) == 1
+    assert sorted(light.kind for light in scene.lights) == ["directional"] + ["envmap"] * 3
+    assert any("sunsky" in line for line in scene.metadata["approximated"])
