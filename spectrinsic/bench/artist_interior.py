@@ -43,9 +43,13 @@ from typing import Any
 
 import numpy as np
 
+from ..cli import main
 from ..file_writes import write_text_file
 from ..gt_export.formats.png import write_png
+from ..gt_export.sample import writer
+from ..pipeline import dataset
 from ..pipeline.presets import get_preset
+from ..render.base.variants import choose_variant, import_mitsuba
 from .real_scene import GRID, box_obj
 
 MESHES = 300
@@ -186,8 +190,6 @@ def _staged(seconds: dict[str, float], passes: dict[str, float]) -> Iterator[Non
     """Time the sample build's stages into *seconds*, by wrapping the functions it calls
     (restored on exit): load, render, ground truth; write is the export less the ground truth.
     *passes* gets the render's own seconds per pass group (``meta["timings"]``)."""
-    from ..gt_export.sample import writer
-    from ..pipeline import dataset
 
     def timed(module: Any, name: str, stage: str) -> Callable[..., Any]:
         inner = getattr(module, name)
@@ -222,7 +224,6 @@ def _staged(seconds: dict[str, float], passes: dict[str, float]) -> Iterator[Non
 def _ours(path: str, out: str, preset: str) -> dict[str, Any]:
     """``render PATH --ground-truth --approximate --preset PRESET`` in this (fresh) process:
     the stages' seconds, the peak resident memory and the sample folder's size."""
-    from ..cli import main
 
     seconds: dict[str, float] = {}
     passes: dict[str, float] = {}
@@ -249,7 +250,6 @@ def _ours(path: str, out: str, preset: str) -> dict[str, Any]:
 
 def _mitsuba(path: str, kind: str) -> dict[str, Any]:
     """``mitsuba.load_file`` and one ``mitsuba.render`` at the file's spp in this process."""
-    from ..render.base.variants import choose_variant, import_mitsuba
 
     mi = import_mitsuba()
     variant = choose_variant("spectral" if kind == "spectral" else "rgb")
