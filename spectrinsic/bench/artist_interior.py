@@ -43,12 +43,12 @@ from typing import Any
 
 import numpy as np
 
-from ..cli import main
 from ..file_writes import write_text_file
 from ..gt_export.formats.png import write_png
 from ..gt_export.sample import writer
 from ..pipeline import dataset
 from ..pipeline.presets import get_preset
+from ..pipeline.source_plan import files_source
 from ..render.base.variants import choose_variant, import_mitsuba
 from .real_scene import GRID, box_obj
 
@@ -222,20 +222,20 @@ def _staged(seconds: dict[str, float], passes: dict[str, float]) -> Iterator[Non
 
 
 def _ours(path: str, out: str, preset: str) -> dict[str, Any]:
-    """``render PATH --ground-truth --approximate --preset PRESET`` in this (fresh) process:
+    """A one-sample ground-truth build of *path* as ``render PATH --ground-truth --approximate
+    --preset PRESET`` makes it, in this (fresh) process:
     the stages' seconds, the peak resident memory and the sample folder's size."""
-
     seconds: dict[str, float] = {}
     passes: dict[str, float] = {}
     start = time.perf_counter()
     with _staged(seconds, passes):
-        status = main(
-            ["--quiet", "render", path, "--ground-truth", "--approximate"]
-            + ["--preset", preset, "--out", out]
-        )
+        # what ``render PATH --ground-truth --approximate --preset PRESET`` builds (the
+        # pipeline's call, without the command line above it: bench sits below cli)
+        config = get_preset(preset).with_options(source=files_source([path], approximate=True))
+        report = dataset.build_dataset(out, config)
     seconds["total"] = time.perf_counter() - start
-    if status != 0:
-        raise RuntimeError(f"render --ground-truth exited {status}")
+    if report.failed:
+        raise RuntimeError(f"render --ground-truth failed: {report.failed}")
     seconds["write"] = seconds.pop("export") - seconds["ground_truth"]
     # the dataset's card, gallery and manifest, and the imports
     seconds["other"] = seconds["total"] - sum(seconds[s] for s in STAGES)
