@@ -50,7 +50,7 @@ from ..pipeline import dataset
 from ..pipeline.presets import get_preset
 from ..pipeline.source_plan import files_source
 from ..render.base.variants import choose_variant, import_mitsuba
-from .real_scene import GRID, box_obj
+from .real_scene import GRID, box_obj, plain_bsdf
 
 MESHES = 300
 TEXTURES = 20
@@ -85,19 +85,7 @@ def _bsdfs(folder: Path, rng: np.random.Generator) -> list[str]:
             f'<string name="filename" value="textures/t{t:02d}.png"/>'
             '<string name="filter_type" value="nearest"/></texture></bsdf></bsdf>'
         )
-    for m in range(PLAIN):
-        r, g, b = rng.uniform(0.1, 0.8, 3)
-        rgb = f'<rgb name="{{}}" value="{r:.3f}, {g:.3f}, {b:.3f}"/>'
-        if m % 4 == 3:
-            parts.append(
-                f'<bsdf type="roughplastic" id="m{m}">{rgb.format("diffuse_reflectance")}'
-                '<float name="alpha" value="0.2"/><string name="distribution" value="ggx"/></bsdf>'
-            )
-        else:
-            parts.append(
-                f'<bsdf type="twosided" id="m{m}"><bsdf type="diffuse">'
-                f"{rgb.format('reflectance')}</bsdf></bsdf>"
-            )
+    parts += [plain_bsdf(f"m{m}", m % 4 == 3, rng) for m in range(PLAIN)]
     parts.append('<bsdf type="dielectric" id="glass"><float name="int_ior" value="1.5"/></bsdf>')
     parts.append('<bsdf type="conductor" id="mirror"><string name="material" value="none"/></bsdf>')
     return parts

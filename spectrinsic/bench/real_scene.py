@@ -69,6 +69,22 @@ def box_obj(grid: int, *, uv: bool = False) -> str:
     return "\n".join(lines + (texcoords if uv else []) + faces) + "\n"
 
 
+def plain_bsdf(bsdf_id: str, rough: bool, rng: np.random.Generator) -> str:
+    """A material of one random colour (three draws of *rng*): a GGX ``roughplastic`` if
+    *rough*, else a two-sided ``diffuse``."""
+    r, g, b = rng.uniform(0.1, 0.8, 3)
+    rgb = f'<rgb name="{{}}" value="{r:.3f}, {g:.3f}, {b:.3f}"/>'
+    if rough:
+        return (
+            f'<bsdf type="roughplastic" id="{bsdf_id}">{rgb.format("diffuse_reflectance")}'
+            '<float name="alpha" value="0.2"/><string name="distribution" value="ggx"/></bsdf>'
+        )
+    return (
+        f'<bsdf type="twosided" id="{bsdf_id}"><bsdf type="diffuse">'
+        f"{rgb.format('reflectance')}</bsdf></bsdf>"
+    )
+
+
 def write_interior(folder: Path, meshes: int | None = None) -> Path:
     """The synthetic interior (module docstring) in *folder*, of *meshes* meshes (default
     :data:`MESHES`); the scene file's path."""
@@ -80,18 +96,7 @@ def write_interior(folder: Path, meshes: int | None = None) -> Path:
         '<scene version="3.0.0">',
         '<integrator type="path"><integer name="max_depth" value="6"/></integrator>',
     ]
-    for m in range(MATERIALS):
-        r, g, b = rng.uniform(0.1, 0.8, 3)
-        rgb = f'<rgb name="{{}}" value="{r:.3f}, {g:.3f}, {b:.3f}"/>'
-        if m % 4 == 3:
-            parts.append(
-                f'<bsdf type="roughplastic" id="m{m}">{rgb.format("diffuse_reflectance")}'
-                '<float name="alpha" value="0.2"/><string name="distribution" value="ggx"/></bsdf>'
-            )
-        else:
-            parts.append(
-                f'<bsdf type="twosided" id="m{m}"><bsdf type="diffuse">{rgb.format("reflectance")}</bsdf></bsdf>'
-            )
+    parts += [plain_bsdf(f"m{m}", m % 4 == 3, rng) for m in range(MATERIALS)]
     side = int(np.ceil(np.sqrt(meshes)))
     for i in range(meshes):
         write_text_file(folder / "meshes" / f"obj{i:03d}.obj", box)
