@@ -100,11 +100,15 @@ def material_glass(mat: Any) -> dict[str, Any] | None:
     if principled is not None:
         key = next((k for k in _TRANSMISSION if k in principled.inputs), None)
         weight = 0.0 if key is None else float(principled.inputs[key].default_value)
-        if weight == 0.0 or float(principled.inputs["Metallic"].default_value) >= 0.5:
+        if (
+            key is None
+            or weight == 0.0
+            or float(principled.inputs["Metallic"].default_value) >= 0.5
+        ):
             return None
         if weight != 1.0:
             raise SceneError(
-                f"material {mat.name!r}: Principled {key} {weight:g}; only 1 (clear glass) or 0 "
+                f"material {mat.name!r}: Principled {key} {weight:g}; only 1 (glass) or 0 "
                 "has exact ground truth"
             )
         return _fields(principled) | _principled_tint(mat, principled, key)
