@@ -54,8 +54,12 @@ def test_a_tinted_gem_matches_mitsubas_own_spectral_path_render(tinted_box):
     """Per 8 × 8 block and XYZ channel, the band path's image of the box with a tinted glass
     gem equals Mitsuba's spectral ``path`` of the same file (its dielectric's
     ``specular_transmittance`` the tint) within t standard errors from SEEDS independent seeds
-    (as ``test_glass.py``); the ground truth on the gem is reflectance 0 with everything in
-    specular, and the identity holds to float precision on every pixel."""
+    (as ``test_glass.py``, and at most 3.5); the ground truth on the gem is reflectance 0 with
+    everything in specular, and the identity holds to float precision on every pixel.
+
+    Measured (16 seeds, 8 spp ours, 32 spp Mitsuba): |z| ≤ 2.2, block ratios 0.94–1.11,
+    standard errors up to 7 % of the darkest block means. Without the tint in the band path
+    the blocks differ by up to 3 × (the test fails)."""
     from scipy.stats import t as student
 
     scene = load_mitsuba_xml(tinted_box)
@@ -67,7 +71,7 @@ def test_a_tinted_gem_matches_mitsubas_own_spectral_path_render(tinted_box):
     stderr = np.hypot(ours.std(axis=0, ddof=1), theirs.std(axis=0, ddof=1)) / np.sqrt(SEEDS)
     diff = ours.mean(axis=0) - theirs.mean(axis=0)
     bound = student.ppf(1 - FALSE_ALARM / (2 * diff.size), df=SEEDS - 1)
-    assert np.all(np.abs(diff) <= bound * stderr), np.abs(diff / stderr).max()
+    assert np.all(np.abs(diff) <= min(bound, 3.5) * stderr), np.abs(diff / stderr).max()
     assert np.all(stderr < 0.1 * theirs.mean(axis=0)), (stderr / theirs.mean(axis=0)).max()
 
     layers = {
@@ -123,7 +127,8 @@ def test_a_thin_tinted_pane_transmits_its_tint_times_the_thin_film_transmittance
     transmitted lobe only). Per channel, against the render without the pane: bands31 and the
     spectral pass give ``(1 − R') ∫T c̄ / ∫c̄`` (colour-science's CIE 1931 c̄), rgb6 the
     tint's own band values ``(1 − R') ∫T S_k / ∫S_k``, within Monte Carlo error of the lobe
-    choice (about 0.3 % here)."""
+    choice (about 0.3 % here). Measured: within 0.02 % (bands31, rgb6) and 0.13 % (spectral);
+    the spectral pass without the tint is off by up to 3 ×."""
     settings = RenderSettings(64, modes=("rgb6", "bands31", "spectral"), max_depth=3)
     seen = {}
     for pane in (False, True):
