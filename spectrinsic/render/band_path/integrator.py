@@ -245,6 +245,17 @@ def _set_maps(mi: Any, dr: Any, it: Any, scene: Any, tables: BandTables) -> None
     it.map_lut = mi.UInt32(shape_id_table(mi, dr, scene, lut, len(lut)))
 
 
+def _set_transmittance(mi: Any, it: Any, tables: BandTables) -> None:
+    """Integrator *it*'s ``(R, K)`` band transmittances per albedo-table row from *tables*
+    (tinted glass; kept as they are where *tables* have none)."""
+    table = tables.transmittance
+    if table is None:
+        return
+    if np.ndim(table) != 2 or np.shape(table)[1] != it.n_bands:
+        raise RenderError(f"transmittance table {np.shape(table)} does not fit {it.n_bands} bands")
+    it.transmittance = mi.Float(np.asarray(table, np.float32).ravel())
+
+
 def _check_specular(it: Any, table: np.ndarray) -> None:
     """Raise unless *table* is ``(R, n_nodes, K)`` for integrator *it*."""
     shape = np.shape(table)
@@ -283,8 +294,7 @@ def _make_class(mi: Any, dr: Any) -> type:
             self.texel_albedo, self.texel_weights = lookups[4:]
             _set_envmaps(self, tables)
             _set_maps(mi, dr, self, scene, tables)
-            if tables.transmittance is not None:
-                self.set_transmittance(tables.transmittance)
+            _set_transmittance(mi, self, tables)
 
         def set_non_diffuse(self, rows: np.ndarray) -> None:
             """``(R,)`` per row: 0, ``MIRROR_ROW`` or ``GLASS_ROW`` (kernel: ``non_diffuse_rows``)."""
@@ -294,14 +304,6 @@ def _make_class(mi: Any, dr: Any) -> type:
             """``(R, n_nodes, K)`` band factors ``s_k(μ_j)`` per albedo-table row."""
             _check_specular(self, table)
             self.specular = mi.Float(np.asarray(table, np.float32).ravel())
-
-        def set_transmittance(self, table: np.ndarray) -> None:
-            """``(R, K)`` band transmittances per albedo-table row (1 but on tinted glass)."""
-            if np.shape(table)[1:] != (self.n_bands,) or np.ndim(table) != 2:
-                raise RenderError(
-                    f"transmittance table {np.shape(table)} does not fit {self.n_bands} bands"
-                )
-            self.transmittance = mi.Float(np.asarray(table, np.float32).ravel())
 
         def aov_names(self) -> list[str]:
             return aov_channels(
@@ -364,7 +366,8 @@ def band_path(
     columns (:class:`TextureTables`) if not 0, the glossy (G1) factors and specular part with
     *gloss*, and the white-surface radiance at metal first hits with *metals* (implies *gloss*;
     :mod:`~spectrinsic.render.band_path.kernel`), null events through opacity masks with
-    *masks*, and the band transmittance of tinted glass (``set_transmittance``) with *tinted*."""
+    *masks*, and the band transmittance of tinted glass (:attr:`BandTables.transmittance`) with
+    *tinted*."""
     band_path_class(mi.variant())
     return mi.load_dict(
         {
