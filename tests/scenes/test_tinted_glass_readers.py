@@ -291,3 +291,36 @@ def test_blender_a_textured_tint_or_a_tinted_glass_bsdf_is_refused_in_one_line(m
         principled_gloss(mat)
     message = str(info.value)
     assert "\n" not in message and expected in message and repr(mat.name) in message
+
+
+def test_a_csv_tint_is_read_inside_the_scene_folder_and_one_outside_is_refused(tmp_path):
+    """A YAML ``transmittance`` takes ``csv:`` and inline spectra as ``spectrum`` does,
+    confined to the scene's folder."""
+    rows = "\n".join(f"{w},{20 + 60 * (w - 380) / 400:.3f}" for w in range(380, 781, 10))
+    (tmp_path / "tint.csv").write_text("wavelength [nm],bottle [%]\n" + rows + "\n")
+    doc = dict(BASE)
+    doc["materials"] = BASE["materials"] | {
+        "red": {"kind": "dielectric", "transmittance": "csv:tint.csv#bottle"}
+    }
+    (glass,) = [m for m in load_scene(write(tmp_path, doc)).materials if m.transmissive]
+    assert glass.transmittance == f"csv:{(tmp_path / 'tint.csv').resolve()}#bottle"
+    doc["materials"] = BASE["materials"] | {
+        "red": {"kind": "dielectric", "transmittance": "csv:../tint.csv#bottle"}
+    }
+    with pytest.raises(SceneError, match="leads outside the scene's folder"):
+        load_scene(write(tmp_path, doc))
+
+
+def test_an_opacity_mask_on_tinted_glass_is_refused_in_one_line(tmp_path):
+    """The band path cannot tell a mask's hole from a transmission through the glass."""
+    glass = (
+        '<bsdf type="mask" id="glass"><float name="opacity" value="0.5"/>'
+        '<bsdf type="dielectric"><rgb name="specular_transmittance" value="0.5, 0.9, 0.5"/>'
+        "</bsdf></bsdf>"
+    )
+    path = _xml(tmp_path, glass)  # the mask on the floor (a mask needs texture coordinates)
+    text = path.read_text().replace('id="floor"><ref id="white"/>', 'id="floor"><ref id="glass"/>')
+    path.write_text(text.replace('id="gem"><ref id="glass"/>', 'id="gem"><ref id="white"/>'))
+    with pytest.raises(SceneError) as info:
+        load_mitsuba_xml(path)
+    assert "\n" not in str(info.value) and "opacity mask on tinted glass" in str(info.value)
