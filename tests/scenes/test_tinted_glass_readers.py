@@ -324,3 +324,32 @@ def test_an_opacity_mask_on_tinted_glass_is_refused_in_one_line(tmp_path):
     with pytest.raises(SceneError) as info:
         load_mitsuba_xml(path)
     assert "\n" not in str(info.value) and "opacity mask on tinted glass" in str(info.value)
+
+
+def test_a_blend_file_reads_a_principled_tint_and_refuses_a_textured_one(tmp_path, capsys):
+    """Through bpy: Base Color (0.25, 0.5625, 0.0625) under Transmission 1 is the
+    transmittance ``rgb:0.5,0.75,0.25`` (its square roots, exact in float32); an Image Texture
+    feeding the Base Color is refused in one line, rc 2 before any work."""
+    pytest.importorskip("bpy", reason="the optional 'blender' extra (bpy) is not installed")
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from spectrinsic.scenes.blender import load_blend
+
+    make = Path(__file__).with_name("make_blend_gloss.py")
+    for tint in ("0.25,0.5625,0.0625", "textured"):
+        out = tmp_path / f"{tint[:4]}.blend"
+        proc = subprocess.run(
+            [sys.executable, "-P", str(make), "--", str(out), tint],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+        assert proc.returncode == 0 and out.is_file(), proc.stderr[-2000:]
+        if tint == "textured":
+            err = _refused(capsys, out, tmp_path / "out")
+            assert "'Glass'" in err and "fed by a node" in err
+        else:
+            (glass,) = [m for m in load_blend(out).materials if m.transmissive]
+            assert glass.transmittance == "rgb:0.5,0.75,0.25"
