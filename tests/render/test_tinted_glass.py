@@ -94,7 +94,7 @@ def _ramp(wl: np.ndarray) -> np.ndarray:
     return np.interp(wl, RAMP["wavelengths"], RAMP["values"])
 
 
-def _screen_scene(pane: bool, mirror: bool = False) -> Scene:
+def _screen_scene(pane: bool, mirror: bool = False, roughness: float = 0.0) -> Scene:
     """A white area emitter (equal energy) facing the camera at y = 1, seen at normal
     incidence through a thin pane of transmittance :data:`RAMP` at y = 0 (or with the pane
     moved far out of view)."""
@@ -115,7 +115,8 @@ def _screen_scene(pane: bool, mirror: bool = False) -> Scene:
     screen = Light(
         "area", "cie:E", 1.0, position=at, direction=towards, size=(2.0, 2.0), name="screen"
     )
-    pane_material = Material("pane", "flat:0", kind="thindielectric", transmittance=tint)
+    kind = "dielectric" if roughness else "thindielectric"  # rough: one open interface
+    pane_material = Material("pane", "flat:0", kind=kind, roughness=roughness, transmittance=tint)
     meshes = (Mesh("pane", glass, quad, np.zeros(2, np.int64), 0),)
     return Scene("screen", meshes, (pane_material,), (screen,), camera)
 
@@ -170,3 +171,16 @@ def test_a_tinted_pane_reflects_untinted():
     expected = _thin_fresnel(np.cos(np.radians(45)), 1.5)
     assert 0.09 < expected < 0.1
     np.testing.assert_allclose(seen[True] / seen[False], expected, rtol=0.08)
+
+
+def test_a_rough_tinted_interface_matches_the_spectral_pass():
+    """One rough (GGX α 0.3) tinted interface before the screen: emitter samples are
+    transmissions there too (``cos θ_i cos θ_o`` < 0). The band path's bands31 image equals
+    the spectral pass's, Mitsuba's own ``path`` with the tint as ``specular_transmittance``, in
+    each XYZ channel within 2 %. Measured (seeds 6, 7): within 0.5 %; without the tint on
+    emitter samples the band path is 5 to 17 % too bright."""
+    settings = RenderSettings(64, modes=("bands31", "spectral"), max_depth=3)
+    result = render_scene(_screen_scene(True, roughness=0.3), settings, seed=6)
+    to_xyz = np.asarray(result.meta["to_xyz"]["bands31"], float)
+    bands = np.einsum("hwk,ck->hwc", result.raw["bands31"], to_xyz).mean(axis=(0, 1))
+    np.testing.assert_allclose(bands, result.raw["spectral"].mean(axis=(0, 1)), rtol=0.02)
