@@ -119,6 +119,12 @@ def render_spectral(
             regular_spectrum(get_spectrum(m.spectrum, data_dir=data_dir).on(wl), wl)
             for m in scene.materials
         ]
+        tints = [  # tinted glass: Mitsuba's specular_transmittance, the same spectrum
+            regular_spectrum(get_spectrum(m.transmittance, data_dir=data_dir).on(wl), wl)
+            if m.tinted
+            else None
+            for m in scene.materials
+        ]
         passes = []
         for on, bitmap, factor in _light_passes(mi, scene, active, emission, wl):
             mitsuba_dict = tr.scene_to_mitsuba(
@@ -138,6 +144,7 @@ def render_spectral(
                 integrator=path_integrator(request.max_depth),
                 sample_count=request.batch_spp,
                 geometry=request.geometry,
+                transmittances=tints,
             )
             passes.append(_render_pass(mi, mi.load_dict(mitsuba_dict), request, direct))
     image = np.sum([p[0] for p in passes], axis=0)

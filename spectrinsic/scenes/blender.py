@@ -19,8 +19,8 @@ spectrum chosen by, in order: the *materials* mapping passed in, the material's 
 else is needed). A Principled BSDF node sets the gloss (:func:`principled_gloss`): Metallic
 ≥ 0.5 makes a metal (``conductor``, η/k of the custom property ``"metal"``, default ``Al``; no
 spectrum needed), else Roughness < 0.5 a coated diffuse (``plastic``, the node's IOR); GGX α is
-Roughness² (Blender's convention); Transmission 1 or a Glass BSDF is clear glass
-(:mod:`~spectrinsic.scenes.blender_gloss`). Everything else of the node (coat, sheen,
+Roughness² (Blender's convention); Transmission 1 or a Glass BSDF is glass, the Principled's
+tinted by its Base Color (:mod:`~spectrinsic.scenes.blender_gloss`). Everything else of the node (coat, sheen,
 subsurface, emission, textures) is ignored; other materials are Lambertian.
 
 With ``colours_from_asset=True`` (the default; ``--no-colours-from-asset`` turns it off), a

@@ -92,6 +92,9 @@ class BandTables:
         normal the first-hit maps hold (:mod:`~spectrinsic.render.base.surface_maps`).
     masks
         Whether a shape has an opacity mask (null events: :mod:`~spectrinsic.render.band_path.kernel`).
+    transmittance
+        ``(R, K)`` band transmittances per row (tinted glass; 1 on every other row, the black
+        one too), or ``None`` where no glass is tinted.
     """
 
     albedo: np.ndarray
@@ -105,6 +108,7 @@ class BandTables:
     extra_maps: tuple[object, ...] = ()
     map_scales: dict[str, float] = field(default_factory=dict)
     masks: bool = False
+    transmittance: np.ndarray | None = None
 
     def channels(self) -> tuple[tuple[int, int, int], ...]:
         """:attr:`light_channels`, or ``(j, 0, 0)`` per light where empty."""
@@ -187,13 +191,15 @@ def _check_fit(it: Any, tables: BandTables) -> None:
 
 
 def _init_gloss(mi: Any, it: Any, props: Any) -> None:
-    """The glossy properties of integrator *it*: flags, μ nodes, a specular table of ones, no
-    non-diffuse rows, and the white BSDF the white-at-metal loop swaps in."""
+    """The glossy properties of integrator *it*: flags, μ nodes, specular and transmittance
+    tables of ones, no non-diffuse rows, and the white BSDF the white-at-metal loop swaps in."""
     it.metals = bool(props.get("metals", False))
     it.gloss = bool(props.get("gloss", False)) or it.metals
+    it.tinted = bool(props.get("tinted", False)) and it.gloss
     it.n_nodes = int(props.get("n_nodes", FRESNEL_NODES))
     if it.gloss:
         it.specular = mi.Float(np.ones(it.n_nodes * it.n_bands, np.float32))
+        it.transmittance = mi.Float(np.ones(it.n_bands, np.float32))
         it.non_diffuse_rows = mi.UInt32(np.zeros(1, np.uint32))
         # two-sided as every material of the scene; Mitsuba's diffuse defaults to 0.5
         it.white_bsdf = mi.load_dict(
@@ -239,6 +245,17 @@ def _set_maps(mi: Any, dr: Any, it: Any, scene: Any, tables: BandTables) -> None
     it.map_lut = mi.UInt32(shape_id_table(mi, dr, scene, lut, len(lut)))
 
 
+def _set_transmittance(mi: Any, it: Any, tables: BandTables) -> None:
+    """Integrator *it*'s ``(R, K)`` band transmittances per albedo-table row from *tables*
+    (tinted glass; kept as they are where *tables* have none)."""
+    table = tables.transmittance
+    if table is None:
+        return
+    if np.ndim(table) != 2 or np.shape(table)[1] != it.n_bands:
+        raise RenderError(f"transmittance table {np.shape(table)} does not fit {it.n_bands} bands")
+    it.transmittance = mi.Float(np.asarray(table, np.float32).ravel())
+
+
 def _check_specular(it: Any, table: np.ndarray) -> None:
     """Raise unless *table* is ``(R, n_nodes, K)`` for integrator *it*."""
     shape = np.shape(table)
@@ -277,6 +294,7 @@ def _make_class(mi: Any, dr: Any) -> type:
             self.texel_albedo, self.texel_weights = lookups[4:]
             _set_envmaps(self, tables)
             _set_maps(mi, dr, self, scene, tables)
+            _set_transmittance(mi, self, tables)
 
         def set_non_diffuse(self, rows: np.ndarray) -> None:
             """``(R,)`` per row: 0, ``MIRROR_ROW`` or ``GLASS_ROW`` (kernel: ``non_diffuse_rows``)."""
@@ -317,8 +335,8 @@ def band_path_class(variant: str) -> type:
     since ``mi.SamplingIntegrator`` is the variant's), registered as :data:`INTEGRATOR_NAME`.
 
     Properties: ``max_depth``, ``rr_depth`` (as ``path``), ``n_bands`` (K), ``n_lights`` (L),
-    ``n_surfaces``, ``n_texcols``, ``gloss``, ``metals``, ``masks``, ``n_nodes`` (μ nodes of the band
-    Fresnel tables). Its AOVs are :func:`aov_channels`; its RGB output is zero.
+    ``n_surfaces``, ``n_texcols``, ``gloss``, ``metals``, ``masks``, ``tinted``, ``n_nodes``
+    (μ nodes of the band Fresnel tables). Its AOVs are :func:`aov_channels`; its RGB output is zero.
     """
     mi = import_mitsuba()
     if mi.variant() != variant:
@@ -341,13 +359,15 @@ def band_path(
     gloss: bool = False,
     metals: bool = False,
     masks: bool = False,
+    tinted: bool = False,
 ) -> Any:
     """A :class:`BandPath` instance for the active variant (rr off: ``rr_depth`` > ``max_depth``),
     with first-hit maps of *n_surfaces* surfaces if not 0, textures of *n_texcols* coverage
     columns (:class:`TextureTables`) if not 0, the glossy (G1) factors and specular part with
     *gloss*, and the white-surface radiance at metal first hits with *metals* (implies *gloss*;
-    :mod:`~spectrinsic.render.band_path.kernel`), and null events through opacity masks with
-    *masks*."""
+    :mod:`~spectrinsic.render.band_path.kernel`), null events through opacity masks with
+    *masks*, and the band transmittance of tinted glass (:attr:`BandTables.transmittance`) with
+    *tinted*."""
     band_path_class(mi.variant())
     return mi.load_dict(
         {
@@ -361,5 +381,6 @@ def band_path(
             "gloss": bool(gloss),
             "metals": bool(metals),
             "masks": bool(masks),
+            "tinted": bool(tinted),
         }
     )

@@ -151,7 +151,11 @@ def _lambertian(reflectance: Mapping) -> dict[str, Any]:
 
 
 def material_bsdf(
-    material: Material, reflectance: Mapping, *, white_metal: bool = False
+    material: Material,
+    reflectance: Mapping,
+    *,
+    white_metal: bool = False,
+    transmittance: Mapping | None = None,
 ) -> dict[str, Any]:
     """The two-sided Mitsuba BSDF of *material* with diffuse *reflectance*.
 
@@ -161,7 +165,9 @@ def material_bsdf(
     ``conductor``/``roughconductor`` with its measured η/k of ``material.metal``, or with
     *white_metal* a perfect mirror (``material: none``, F = 1) whose Fresnel factor the band
     integrator applies per band. Glass: Mitsuba's ``(rough)dielectric``/``thindielectric`` of
-    index ``ior`` over air's 1, band-independent, not in a ``twosided``. Else Lambertian.
+    index ``ior`` over air's 1, not in a ``twosided``, with *transmittance* (a spectrum dict)
+    as its ``specular_transmittance`` where given (tinted glass; the band path loads it clear
+    and applies the tint per band). Else Lambertian.
     """
     if material.kind == "diffuse":
         return _lambertian(reflectance)
@@ -169,7 +175,8 @@ def material_bsdf(
     if material.transmissive:  # a thindielectric is always smooth (materials.py)
         glass = {"type": material.kind, "int_ior": float(material.ior), "ext_ior": 1.0}
         ggx = {"type": "roughdielectric", "distribution": "ggx", "alpha": material.roughness}
-        return glass | (ggx if rough else {})
+        tint = {} if transmittance is None else {"specular_transmittance": dict(transmittance)}
+        return glass | (ggx if rough else {}) | tint
     bsdf: dict[str, Any]
     if material.kind == "plastic":
         bsdf = {
@@ -190,7 +197,11 @@ def material_bsdf(
 
 
 def _surface_bsdf(
-    scene: Scene, part: SurfaceGeometry, materials: Sequence[Mapping], white_metal: bool
+    scene: Scene,
+    part: SurfaceGeometry,
+    materials: Sequence[Mapping],
+    white_metal: bool,
+    transmittances: Sequence[Mapping | None],
 ) -> dict[str, Any]:
     """The BSDF of one surface: its material's, or on a textured mesh the texel-weighted mix of
     its basis materials (a mix of equal reflectances, such as the band path's white load, is
@@ -199,7 +210,10 @@ def _surface_bsdf(
     mesh = scene.meshes[part.mesh] if part.mesh >= 0 else None
     texture = None if mesh is None else mesh.texture
     bsdf = material_bsdf(
-        scene.materials[part.material], materials[part.material], white_metal=white_metal
+        scene.materials[part.material],
+        materials[part.material],
+        white_metal=white_metal,
+        transmittance=transmittances[part.material] if transmittances else None,
     )
     if texture is not None:
         basis = [materials[b] for b in texture.basis]
@@ -328,6 +342,7 @@ def scene_to_mitsuba(
     sample_count: int,
     geometry: Sequence[SurfaceGeometry] | None = None,
     white_metal: bool = False,
+    transmittances: Sequence[Mapping | None] = (),
 ) -> dict[str, Any]:
     """Translate *scene* into a dict for ``mitsuba.load_dict``.
 
@@ -351,8 +366,17 @@ def scene_to_mitsuba(
         :func:`prepare_geometry` of *scene*, if already computed.
     white_metal
         Metals as perfect mirrors (:func:`material_bsdf`), for the band integrator.
+    transmittances
+        One Mitsuba spectrum dict (or ``None``) per ``scene.materials`` entry: a tinted glass's
+        ``specular_transmittance``; empty (the default): every glass clear, as the band
+        integrator loads it.
     """
     mi = import_mitsuba()
+    if transmittances and len(transmittances) != len(scene.materials):
+        raise SceneError(
+            f"scene {scene.name!r}: got {len(transmittances)} transmittances for "
+            f"{len(scene.materials)} materials"
+        )
     if len(materials) != len(scene.materials) or len(lights) != len(scene.lights):
         raise SceneError(
             f"scene {scene.name!r}: got {len(materials)} material and {len(lights)} light colours for "
@@ -364,7 +388,8 @@ def scene_to_mitsuba(
         "sensor": _camera(mi, scene, film, sample_count),
     }
     for part in prepare_geometry(scene) if geometry is None else geometry:
-        out[part.key] = _mitsuba_mesh(mi, part, _surface_bsdf(scene, part, materials, white_metal))
+        bsdf = _surface_bsdf(scene, part, materials, white_metal, transmittances)
+        out[part.key] = _mitsuba_mesh(mi, part, bsdf)
     loaded_map = False  # Mitsuba takes one environment emitter: the first map given one
     for j, (light, emission) in enumerate(zip(scene.lights, lights, strict=True)):
         if light.kind == "envmap" and emission is not None:
