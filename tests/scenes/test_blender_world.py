@@ -234,6 +234,24 @@ def test_approximate_takes_the_background_colour_and_says_so(worlds):
 
 
 @pytest.mark.blender
+def test_approximate_applies_to_blend_files_on_the_command_line(worlds, tmp_path, capsys):
+    """``render x.blend --approximate`` reads the file with it (here the Mix Shader World is
+    dropped, and the scene, left without light, is refused by validation before any render),
+    and ``dataset --scenes x.blend --approximate`` records it."""
+    import json
+
+    from spectrinsic.cli import main
+    from spectrinsic.pipeline.source_plan import files_source
+
+    path = worlds / "mix.blend"
+    args = ["render", str(path), "--approximate", "--modes", "rgb3", "--out", str(tmp_path / "o")]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert "needs at least one light" in err and "applies to" not in err
+    assert json.loads(files_source([path], approximate=True))["approximate"] is True
+
+
+@pytest.mark.blender
 @pytest.mark.parametrize(
     ("stem", "says"),
     [
