@@ -300,24 +300,20 @@ def world_lights(
     strength = float(_value(background, "Strength", r.where))
     if not (math.isfinite(strength) and strength >= 0):
         raise SceneError(f"{r.where}: Background strength {strength!r}; expected a number >= 0")
+    if strength == 0.0:  # nothing shows, whatever feeds the colour
+        return WorldLights((), tuple(r.approximated))
     colour = background.inputs["Color"]
     link = _source(colour)
-    if (
-        link is not None
-        and link.from_node.type == "TEX_ENVIRONMENT"
-        and link.from_socket.name == "Color"
-    ):
-        lights = (
-            _environment(link.from_node, world.name, strength, blend, r, budget) if strength else ()
-        )
-    else:
+    if link is None or link.from_node.type != "TEX_ENVIRONMENT" or link.from_socket.name != "Color":
         if link is not None:
             r.refuse_or_say(
                 f"its Background's Color comes from a {_label(link.from_node)}",
                 "the Background's own colour",
             )
         sky = _colour_sky(world.name, colour.default_value, strength, r.where)
-        lights = () if sky is None else (sky,)
+        lights: tuple[Light, ...] = () if sky is None else (sky,)
+    else:
+        lights = _environment(link.from_node, world.name, strength, blend, r, budget)
     if lights:
         _visibility(world, r)
     return WorldLights(tuple(lights), tuple(r.approximated))

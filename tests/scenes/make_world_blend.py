@@ -9,7 +9,7 @@ FOLDER, ``outside.exr``. Every file holds the same scene: a unit cube at the ori
 24 x 24 pixels, no lamps. Their Worlds (see :data:`WORLDS`):
 
 - ``colour``: a Background of Color (0.8, 0.4, 0.2) and Strength 2.5;
-- ``zero``: white at Strength 0; ``black``: black at Strength 3;
+- ``zero``: a Sky Texture feeding the Color, at Strength 0; ``black``: black at Strength 3;
 - ``hdri``: an Environment Texture of ``//maps/patch.exr``, its Vector unlinked, Strength 1;
 - ``turned``: ``//maps/smooth.exr`` through Texture Coordinate Generated -> Mapping (POINT,
   rotation Z 90 deg), Strength 2;
@@ -86,8 +86,8 @@ def mapped(name, rotation):
     links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
 
 
-def sky():
-    w = background("Sky", (0.1, 0.2, 0.3), 2.0)
+def sky(name="Sky", strength=2.0):
+    w = background(name, (0.1, 0.2, 0.3), strength)
     tex = w.node_tree.nodes.new("ShaderNodeTexSky")
     w.node_tree.links.new(tex.outputs["Color"], w.node_tree.nodes["Background"].inputs["Color"])
 
@@ -113,7 +113,7 @@ def escape():
 
 WORLDS = {
     "colour": lambda: background("World", (0.8, 0.4, 0.2), 2.5),
-    "zero": lambda: background("Zero", (1.0, 1.0, 1.0), 0.0),
+    "zero": lambda: sky("Zero", 0.0),
     "black": lambda: background("Black", (0.0, 0.0, 0.0), 3.0),
     "hdri": lambda: environment("HDRI", folder / "maps" / "patch.exr"),
     "turned": lambda: mapped("Turned", (0.0, 0.0, math.pi / 2)),
