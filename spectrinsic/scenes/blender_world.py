@@ -51,6 +51,7 @@ from .mitsuba_files import file_sha256
 from .model import Light
 
 __all__ = [
+    "WORKING_SPACE",
     "BLENDER_MAP_FRAME",
     "LINEAR_SPACES",
     "WorldLights",
@@ -65,6 +66,8 @@ BLENDER_MAP_FRAME = (
     1.0, 0.0, 0.0,
     0.0, 1.0, 0.0,
 )  # fmt: skip
+#: The scene-linear space whose colours are read (Blender 5's default working space).
+WORKING_SPACE = "Linear Rec.709"
 #: Image colour spaces read as linear Rec. 709 radiance.
 LINEAR_SPACES = ("Linear Rec.709", "Linear", "Non-Color")
 #: Mapping node types that turn the direction looked up by +angle (the others: ``TEXTURE``,
@@ -268,8 +271,16 @@ def _environment(
     return envmap_lights(name, str(path), file_sha256(path), strength, rotation)
 
 
-def _visibility(world: Any, r: _Reading) -> None:
-    """Refuse a World that some rays do not see (the renderer's World is seen by all)."""
+def _check_lit(world: Any, r: _Reading) -> None:
+    """Refuse a World that some rays do not see (the renderer's World is seen by all), or
+    whose file's colours are not Rec. 709 (Blender 5's per-file working space)."""
+    import bpy
+
+    space = getattr(getattr(bpy.data, "colorspace", None), "working_space", WORKING_SPACE)
+    if space != WORKING_SPACE:
+        raise SceneError(
+            f"{r.where}: the file's working colour space is {space!r}; expected {WORKING_SPACE!r}"
+        )
     flags = getattr(world, "cycles_visibility", None)
     hidden = [ray for ray in _RAYS if flags is not None and not getattr(flags, ray, True)]
     if hidden:
@@ -315,5 +326,5 @@ def world_lights(
     else:
         lights = _environment(link.from_node, world.name, strength, blend, r, budget)
     if lights:
-        _visibility(world, r)
+        _check_lit(world, r)
     return WorldLights(tuple(lights), tuple(r.approximated))
