@@ -160,7 +160,7 @@ def _background(world: Any, r: _Reading) -> Any:
         return None
     node = link.from_node
     if node.type != "BACKGROUND" or node.mute:
-        r.refuse_or_say(f"its Surface is a {_label(node)}", "left out")
+        r.refuse_or_say(f"its Surface comes from {_label(node)}", "left out")
         return None
     return node
 
@@ -256,6 +256,8 @@ def _environment(
 ) -> tuple[Light, ...]:
     """The three channel lights of Environment Texture *node* at scale *strength*."""
     where = r.where
+    if node.mute:
+        raise SceneError(f"{where}: {_label(node)} is muted; unmute or remove it")
     if node.projection != "EQUIRECTANGULAR":
         raise SceneError(
             f"{where}: {_label(node)} projection {node.projection!r}; expected EQUIRECTANGULAR"
@@ -318,7 +320,7 @@ def world_lights(
     if link is None or link.from_node.type != "TEX_ENVIRONMENT" or link.from_socket.name != "Color":
         if link is not None:
             r.refuse_or_say(
-                f"its Background's Color comes from a {_label(link.from_node)}",
+                f"its Background's Color comes from {_label(link.from_node)}",
                 "the Background's own colour",
             )
         sky = _colour_sky(world.name, colour.default_value, strength, r.where)
