@@ -112,6 +112,29 @@ def test_a_background_colour_is_one_sky_of_that_radiance(worlds):
 
 
 @pytest.mark.blender
+def test_a_convex_cube_under_the_background_colour_returns_its_albedo_of_the_sky(worlds):
+    """A furnace: under a uniform sky of radiance L every face of a convex Lambertian cube of
+    albedo 0.8 sees only sky, so it returns 0.8 L, and the camera sees L itself around it
+    (rgb3, 24², 16 spp; pixels whose neighbours all hit the cube, or all miss it, so no pixel
+    blends the two; measured 0.8031 ± 0.0075, the sky exact)."""
+    from scipy.ndimage import binary_erosion
+
+    from spectrinsic.render import RenderSettings, render_scene
+
+    result = render_scene(
+        load(worlds / "colour.blend"), RenderSettings(16, modes=("rgb3",)), seed=1
+    )
+    image, mask = result.images["rgb3"].astype(np.float64), result.aovs["mask"]
+    cube, sky = image[binary_erosion(mask)], image[binary_erosion(~mask)]
+    error = 4 * cube.std(0, ddof=1) / np.sqrt(len(cube)) / cube.mean(0)
+    np.testing.assert_allclose(sky, np.broadcast_to(sky[0], sky.shape), rtol=1e-6)
+    assert np.all(np.abs(cube.mean(0) / sky[0] - 0.8) <= 0.8 * error), (
+        cube.mean(0) / sky[0],
+        error,
+    )
+
+
+@pytest.mark.blender
 @pytest.mark.parametrize("stem", ["zero", "black"])
 def test_a_dark_world_gives_no_light_and_says_nothing(worlds, stem, capsys, caplog):
     scene = load(worlds / f"{stem}.blend", validate=False)  # no light at all: validation refuses
