@@ -21,17 +21,11 @@ from .base.variants import choose_variant, import_mitsuba, variant_scope
 from .passes import render_diagonal
 from .passes.aovs import render_aovs
 from .result import PARTS, RenderResult
-from .settings import DEFAULT_MODES, PassRequest, RenderSettings
+from .settings import PassRequest, RenderSettings
 from .spectral import render_spectral
 
-__all__ = [
-    "DEFAULT_MODES",
-    "render_scene",
-    "count_passes",
-]
+__all__ = ["render_scene", "count_passes"]
 
-# long module: one driver (plan, run, assemble every mode of one scene) and the meta record it
-# writes of the render (issue 46 moved render_meta here, out of the numpy-only result record)
 logger = logging.getLogger(__name__)
 
 

@@ -15,7 +15,7 @@ from ...errors import RenderError
 from ...scenes.model import Scene
 from ...spectra import COLORIMETRIC_WAVELENGTHS, diagonal_values, get_sensors
 from ...threads import thread_map
-from ..result import METAL_WHITE, SPECULAR, RenderResult
+from ..result import RenderResult
 from .batch_means import batch_mean
 from .modes import get_mode, light_spectra, lights_to_xyz_matrix, raw_to_xyz
 from .shares import compose, light_shares, sum_lights
@@ -83,16 +83,6 @@ class LightTransport:
                 f"transport: every batch must hold modes {list(self.modes)} with "
                 f"one (lights, height, width); got shapes {sorted(shapes)}"
             )
-
-    @property
-    def specular(self) -> tuple[dict[str, np.ndarray], ...]:
-        """``parts["specular"]`` (empty for a matte scene)."""
-        return self.parts.get(SPECULAR, ())
-
-    @property
-    def metal_white(self) -> tuple[dict[str, np.ndarray], ...]:
-        """``parts["metal_white"]`` (empty without metals)."""
-        return self.parts.get(METAL_WHITE, ())
 
     @property
     def n_lights(self) -> int:

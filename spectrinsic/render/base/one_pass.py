@@ -23,7 +23,6 @@ __all__ = [
     "DIRECT_DEPTH",
     "PassProgress",
     "PassOutput",
-    "AOV_NAMES",
     "check_scene_lights",
     "active_light_set",
     "timed_render",
@@ -36,8 +35,6 @@ __all__ = [
 DIRECT_DEPTH = 2
 #: Called with 1 after each Mitsuba pass (e.g. ``tqdm.update``).
 PassProgress = Callable[[int], Any]
-#: Keys of the dict :func:`~spectrinsic.render.passes.aovs.render_aovs` returns.
-AOV_NAMES = ("coverage", "material_id", "object_id", "depth", "normals", "mask")
 
 
 @dataclass(frozen=True, eq=False)
