@@ -97,16 +97,12 @@ class _Run:
     #: One dict mode -> pass output per job, filled by the parts.
     outputs: list[dict[str, PassOutput]]
 
-    @property
-    def settings(self) -> RenderSettings:
-        return self.plan.settings
-
 
 def _rgb_part(
     run: _Run, rgb_variant: str
 ) -> tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
     """The diagonal modes of every job (one traversal, or the passes) and the AOVs."""
-    scene, plan, settings, single = run.scene, run.plan, run.settings, SingleTraversal({}, ())
+    scene, plan, single = run.scene, run.plan, SingleTraversal({}, ())
     request = replace(run.request, variant=rgb_variant)
     aov_maps: dict[str, np.ndarray] = {}
     if plan.traversal:
@@ -116,7 +112,7 @@ def _rgb_part(
             request,
             wanted=plan.wanted,
             data_dir=run.data_dir,
-            aovs=settings.aovs,
+            aovs=plan.settings.aovs,
         )
         aov_maps = single.aovs
         for out, part in zip(run.outputs, parts, strict=True):
@@ -145,7 +141,7 @@ def _rgb_part(
             if diagonal
             else ()
         )
-    if not settings.aovs:
+    if not plan.settings.aovs:
         return aov_maps, (), single
     aov_maps, aov_seconds = render_aovs(scene, request)
     return aov_maps, aov_seconds, single
@@ -153,8 +149,8 @@ def _rgb_part(
 
 def _spectral_part(run: _Run, spectral_variant: str) -> None:
     """The spectral passes of every job (``settings.spectral_batch_spp`` samples each)."""
-    spp = run.settings.spectral_batch_spp
-    request = replace(run.request, batch_spp=spp, variant=spectral_variant)
+    batch_spp = run.plan.settings.spectral_batch_spp  # one batch's, as every request holds
+    request = replace(run.request, batch_spp=batch_spp, variant=spectral_variant)
     for out, job in zip(run.outputs, run.plan.jobs, strict=True):
         for m in (m for m in job.modes if m.kind == "spectral"):
             out[m.name] = render_spectral(

@@ -208,14 +208,8 @@ def _empty_tables(mi: Any, it: Any) -> None:
     it.albedo = mi.Float(np.zeros(it.n_bands, np.float32))
     it.shape_lut = mi.UInt32(np.zeros(1, np.uint32))
     it.emitter_lut = mi.UInt32(np.zeros(1, np.uint32))
-    _set_envmaps(it, None)
-
-
-def _set_envmaps(it: Any, tables: BandTables | None) -> None:
-    """Integrator *it*'s light channels and extra environment maps from *tables* (none: every
-    light its own emitter's component 0, no extra map)."""
-    it.light_channels = () if tables is None else tables.channels()
-    it.extra_maps = () if tables is None else tuple(tables.extra_maps)
+    it.light_channels = tuple((j, 0, 0) for j in range(it.n_lights))
+    it.extra_maps = ()
 
 
 def _init_maps(mi: Any, it: Any, props: Any) -> None:
@@ -224,12 +218,6 @@ def _init_maps(mi: Any, it: Any, props: Any) -> None:
     it.map_lut = mi.UInt32(np.zeros(1, np.uint32))
     #: (kind, texture, bump scale) of each bump- or normal-mapped shape (surface_maps)
     it.surface_maps = []
-
-
-def _init_features(mi: Any, it: Any, props: Any) -> None:
-    """The glossy (:func:`_init_gloss`) and mask and map (:func:`_init_maps`) properties."""
-    _init_gloss(mi, it, props)
-    _init_maps(mi, it, props)
 
 
 def _set_maps(mi: Any, dr: Any, it: Any, scene: Any, tables: BandTables) -> None:
@@ -264,7 +252,8 @@ def _make_class(mi: Any, dr: Any) -> type:
             self.n_surfaces = int(props.get("n_surfaces", 0))
             self.n_texcols = int(props.get("n_texcols", 0))
             _empty_tables(mi, self)
-            _init_features(mi, self, props)
+            _init_gloss(mi, self, props)
+            _init_maps(mi, self, props)
 
         def set_tables(self, scene: Any, tables: BandTables) -> None:
             """Point the lookups at *tables* for the loaded *scene* (no recompilation)."""
@@ -275,7 +264,7 @@ def _make_class(mi: Any, dr: Any) -> type:
             lookups = texture_lookups(mi, dr, scene, tables.textures, tables.shape_textures)
             self.slot_lut, self.tex_widths, self.tex_heights, self.tex_offsets = lookups[:4]
             self.texel_albedo, self.texel_weights = lookups[4:]
-            _set_envmaps(self, tables)
+            self.light_channels, self.extra_maps = tables.channels(), tuple(tables.extra_maps)
             _set_maps(mi, dr, self, scene, tables)
 
         def set_non_diffuse(self, rows: np.ndarray) -> None:

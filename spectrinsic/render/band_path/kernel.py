@@ -211,13 +211,12 @@ class BandKernel:
         """``acc[j·K + k] += bands[k]·weights[m_j][c_j]`` on the lanes whose emitter is light
         j's owner ``o_j``. *weights* are RGB values (``Color3f``): the emitter's own, then one
         per extra environment map (:meth:`extra_maps_at`); ``(o_j, c_j, m_j)`` =
-        ``it.light_channels[j]`` (Python ints, read when traced; empty: ``(j, 0, 0)`` for
-        every light). Only an environment map's channel lights take another component or
+        ``it.light_channels[j]`` (Python ints, read when traced; ``(j, 0, 0)`` for a light of
+        its own). Only an environment map's channel lights take another component or
         source: the emitters are loaded white, so today's components are equal and component
         0 of the emitter's own value is exactly the scalar of before."""
         k, out = self.it.n_bands, list(acc)
-        triples = self.it.light_channels or [(j, 0, 0) for j in range(self.it.n_lights)]
-        for j, (owner, channel, source) in enumerate(triples):
+        for j, (owner, channel, source) in enumerate(self.it.light_channels):
             w = self.dr.select(mask & (light == owner), weights[source][channel], 0.0)
             for b in range(k):
                 out[j * k + b] = self.dr.fma(bands[b], w, out[j * k + b])

@@ -45,28 +45,23 @@ __all__ = [
     "render_traversal",
     "render_jobs",
     "light_of_emitters",
-    "single_traversal_runs",
     "resolve_integrator",
 ]
 
 
-def single_traversal_runs(variant: str | None) -> bool:
-    """Whether the band-path traversal runs with *variant*'s RGB variant: a JIT one (LLVM or
-    CUDA), where Dr.Jit traces it into one kernel. On a scalar variant a Python integrator
-    would run once per sample, so :func:`spectrinsic.render.render_scene` uses the passes."""
-    return not choose_variant("rgb", variant).startswith("scalar")
-
-
 def resolve_integrator(name: str | None, variant: str | None = None) -> str:
     """*name* checked against :data:`~spectrinsic.render.settings.INTEGRATORS` (``None``:
-    :data:`~spectrinsic.render.settings.DEFAULT_INTEGRATOR`);
-    ``"passes"`` where the traversal does not run (:func:`single_traversal_runs`)."""
+    :data:`~spectrinsic.render.settings.DEFAULT_INTEGRATOR`); ``"passes"`` where the traversal
+    does not run: on a scalar RGB variant of *variant* a Python integrator would run once per
+    sample (a JIT one, LLVM or CUDA, traces it into one kernel)."""
     chosen = (
         DEFAULT_INTEGRATOR
         if name is None
         else validate_choice(name, INTEGRATORS, "integrator", error=RenderError)
     )
-    return chosen if chosen == "passes" or single_traversal_runs(variant) else "passes"
+    if chosen == "passes" or not choose_variant("rgb", variant).startswith("scalar"):
+        return chosen
+    return "passes"
 
 
 def light_of_emitters(mi: Any, loaded: Any) -> dict[int, int]:

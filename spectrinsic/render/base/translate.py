@@ -146,10 +146,6 @@ def _mitsuba_mesh(mi: Any, part: SurfaceGeometry, bsdf: Mapping) -> Any:
     return mesh
 
 
-def _lambertian(reflectance: Mapping) -> dict[str, Any]:
-    return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": dict(reflectance)}}
-
-
 def material_bsdf(
     material: Material, reflectance: Mapping, *, white_metal: bool = False
 ) -> dict[str, Any]:
@@ -164,7 +160,7 @@ def material_bsdf(
     index ``ior`` over air's 1, band-independent, not in a ``twosided``. Else Lambertian.
     """
     if material.kind == "diffuse":
-        return _lambertian(reflectance)
+        return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": dict(reflectance)}}
     rough = material.roughness > 0.0
     if material.transmissive:  # a thindielectric is always smooth (materials.py)
         glass = {"type": material.kind, "int_ior": float(material.ior), "ext_ior": 1.0}
