@@ -15,7 +15,7 @@ from ..spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
 from .algebra.modes import RenderMode, channel_values, get_mode, n_passes, raw_to_xyz, to_xyz_matrix
 from .band_path.traversal import SingleTraversal, render_jobs, resolve_integrator
 from .base.geometry import prepare_geometry
-from .base.one_pass import PassOutput, PassProgress
+from .base.one_pass import PassOutput, PassProgress, timing
 from .base.translate import surfaces
 from .base.variants import choose_variant, import_mitsuba, variant_scope
 from .passes import render_diagonal
@@ -163,15 +163,8 @@ def _spectral_part(run: _Run, spectral_variant: str) -> None:
             )
 
 
-def _run_jobs(
-    scene: Scene,
-    plan: _Plan,
-    *,
-    seed: int,
-    progress: PassProgress | None,
-    data_dir: str | None,
-) -> tuple[list[dict[str, PassOutput]], dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
-    """Every pass of *plan*'s jobs, grouped by Mitsuba variant, plus the AOVs.
+def _run_jobs(run: _Run) -> tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
+    """Every pass of the run's jobs into ``run.outputs``, grouped by Mitsuba variant, and the AOVs.
 
     Each switch between the RGB and the spectral variant reloads Mitsuba's Python modules
     (0.25 s on the 2-core machine, measured: 8 switches were 2.0 s of a 14.5 s default sample),
@@ -182,8 +175,7 @@ def _run_jobs(
     With ``plan.traversal`` the diagonal modes of every job, and a textured scene's AOVs even
     without them, come from one band-path traversal (:func:`~spectrinsic.render.band_path.traversal.render_jobs`).
     """
-    request = PassRequest.of(plan.settings, seed, progress, prepare_geometry(scene))
-    run = _Run(scene, plan, request, data_dir, [{} for _ in plan.jobs])
+    plan = run.plan
     found: tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]
     found = ({}, (), SingleTraversal({}, ()))
     variant, parts = plan.settings.variant, []
@@ -197,28 +189,23 @@ def _run_jobs(
                 found = _rgb_part(run, chosen)
             else:
                 _spectral_part(run, chosen)
-    return run.outputs, *found
+    return found
 
 
 def render_meta(
-    scene: Scene,
-    plan: _Plan,
-    variants: dict[str, str],
-    timings: dict[str, list[float]],
-    *,
-    seed: int,
-    data_dir: str | None,
+    run: _Run, variants: dict[str, str], timings: dict[str, list[float]]
 ) -> dict[str, Any]:
-    """The ``meta`` record of one batch's render (*plan*'s settings, modes and matrices):
+    """The ``meta`` record of one batch's render (the run's settings, modes, matrices, seed):
     versions, variants, samples, modes, their sensors and XYZ matrices, the spectral grid,
     which modes have direct light and per-light images, the integrator, and timings (s)."""
+    plan, data_dir = run.plan, run.data_dir
     objs, settings = plan.objs, plan.settings
     names = [m.name for m in objs]
     meta = {
         "mitsuba": import_mitsuba().__version__,
         "variants": variants,
         "spp": int(settings.batch_spp),  # one batch's: merge_batches makes it the total
-        "seed": int(seed),
+        "seed": int(run.request.seed),
         "max_depth": int(settings.max_depth),
         "modes": names,
         "sensors": {m.name: get_sensors(m.sensors, data_dir=data_dir).name for m in objs},
@@ -231,10 +218,7 @@ def render_meta(
         },
         "per_light": bool(settings.per_light),
         "direct_modes": sorted(plan.wanted),
-        "timings": {
-            k: {"passes": len(v), "seconds": float(sum(v)), "per_pass": [float(x) for x in v]}
-            for k, v in timings.items()
-        },
+        "timings": {k: timing(v) for k, v in timings.items()},
         "units": "XYZ = integral of radiance times CIE 1931 CMF over nm; raw = integral of radiance times S_k",
         "per_light_modes": (
             [m.name for m in plan.share] if plan.split else (names if settings.per_light else [])
@@ -279,12 +263,12 @@ def render_scene(
         Called with 1 after each Mitsuba pass; :func:`count_passes` gives the total.
     """
     plan = _plan(scene, settings, data_dir)
-    outputs, aov_maps, aov_seconds, single = _run_jobs(
-        scene, plan, seed=seed, progress=progress, data_dir=data_dir
-    )
+    request = PassRequest.of(settings, seed, progress, prepare_geometry(scene))
+    run = _Run(scene, plan, request, data_dir, [{} for _ in plan.jobs])
+    aov_maps, aov_seconds, single = _run_jobs(run)
     timings: dict[str, list[float]] = {m.name: [] for m in plan.objs + plan.share}
     variants: dict[str, str] = {}
-    for out in outputs:
+    for out in run.outputs:
         for name, o in out.items():
             timings[name].extend(o.seconds)
             variants[name] = o.variant
@@ -292,9 +276,9 @@ def render_scene(
         timings["aovs"] = list(aov_seconds)
     if single.seconds:
         timings["single"] = list(single.seconds)
-    meta = render_meta(scene, plan, variants, timings, seed=seed, data_dir=data_dir)
+    meta = render_meta(run, variants, timings)
     logger.debug("rendered %s: %s", scene.name, {k: sum(v) for k, v in timings.items()})
-    return _assemble(scene, plan, outputs, aov_maps, single, meta, data_dir=data_dir)
+    return _assemble(run, aov_maps, single, meta)
 
 
 @dataclass(frozen=True)
@@ -362,16 +346,10 @@ def _plan(scene: Scene, settings: RenderSettings, data_dir: str | None) -> _Plan
 
 
 def _assemble(
-    scene: Scene,
-    plan: _Plan,
-    outputs: Sequence[dict[str, PassOutput]],
-    aov_maps: dict[str, np.ndarray],
-    single: SingleTraversal,
-    meta: dict[str, Any],
-    *,
-    data_dir: str | None,
+    run: _Run, aov_maps: dict[str, np.ndarray], single: SingleTraversal, meta: dict[str, Any]
 ) -> RenderResult:
     """The XYZ images of the jobs' raw outputs: totals, per-light shares and direct light."""
+    scene, plan, outputs = run.scene, run.plan, run.outputs
     main_out, share_out = outputs[: plan.n_main], outputs[plan.n_main :]
     names = [m.name for m in plan.objs]
     matrices, groups = plan.matrices, [job.group for job in plan.jobs[: plan.n_main]]
@@ -381,7 +359,7 @@ def _assemble(
     }
     per_light_images: tuple[dict[str, np.ndarray], ...] = ()
     if plan.split:
-        share_xyz = {m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in plan.share}
+        share_xyz = {m.name: to_xyz_matrix(m, scene, data_dir=run.data_dir) for m in plan.share}
         per_light_images = tuple(
             {n: raw_to_xyz(g[n].image, share_xyz[n]) for n in share_xyz} for g in share_out
         )

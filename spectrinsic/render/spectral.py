@@ -32,16 +32,13 @@ def _render_pass(
     mi: Any, loaded: Any, request: PassRequest, direct: bool
 ) -> tuple[np.ndarray, np.ndarray | None, list[float]]:
     """One loaded scene rendered (and direct light only with *direct*): images and seconds."""
-    spp, seed = request.batch_spp, request.seed
-    image, dt = timed_render(mi, loaded, spp=spp, seed=seed)
+    image, dt = timed_render(mi, loaded, request)
     seconds = [dt]
-    request.tick()
     direct_image = None
     if direct:
         integrator = mi.load_dict(path_integrator(DIRECT_DEPTH))
-        direct_image, dt = timed_render(mi, loaded, spp=spp, seed=seed, integrator=integrator)
+        direct_image, dt = timed_render(mi, loaded, request, integrator)
         seconds.append(dt)
-        request.tick()
     return image, direct_image, seconds
 
 

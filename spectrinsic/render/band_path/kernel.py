@@ -185,10 +185,7 @@ class BandKernel:
         """ρ_k of the material of the shape hit (the black row elsewhere), or of the nearest
         texel on a textured shape."""
         mi, dr, k = self.mi, self.dr, self.it.n_bands
-        valid = si.is_valid()
-        row = dr.gather(
-            mi.UInt32, self.it.shape_lut, dr.reinterpret_array(mi.UInt32, si.shape), valid
-        )
+        valid, row = si.is_valid(), self.row(si)
         rho = [dr.gather(mi.Float, self.it.albedo, row * k + b, valid) for b in range(k)]
         if not self.it.n_texcols:
             return rho
@@ -297,13 +294,12 @@ class BandKernel:
             towards.wi = -ds.d
             nee += self.extra_maps_at(towards, bsdf_val[0] * mis_em / ds.pdf, active_em)
         nee = tuple(s.beta * w for w in nee)
+        light = self.light_of(ds.emitter, active_em)
         if not self.gloss:
-            light = self.light_of(ds.emitter, active_em)
             return _Vertex(light, nee, active_em, bsdf_sample, bsdf_weight[0])
         em_lobes = self.lobes(si, bsdf, wo_em, mi.Bool(False), active_em)
         delta = mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
         bs_lobes = self.lobes(si, bsdf, bsdf_sample.wo, delta, active_next)
-        light = self.light_of(ds.emitter, active_em)
         return _Vertex(light, nee, active_em, bsdf_sample, bsdf_weight[0], em_lobes, bs_lobes)
 
     def specular_bands(self, row: UInt, mu: Float, valid: Bool) -> list[Float]:

@@ -150,8 +150,7 @@ def _render(
     mi: Any, loaded: Any, integrator: Any, request: PassRequest, n: int
 ) -> tuple[np.ndarray, float]:
     """The traversal's last *n* AOV channels (the band transport) and the render's seconds."""
-    spp, seed = request.batch_spp, request.seed
-    image, seconds = timed_render(mi, loaded, spp=spp, seed=seed, integrator=integrator)
+    image, seconds = timed_render(mi, loaded, request, integrator)
     if image.shape[-1] < n:
         raise RenderError(
             f"band-path render returned {image.shape[-1]} channels; expected at least {n}"
@@ -349,7 +348,6 @@ def render_traversal(
             traced.append(
                 _trace(mi, loaded, tables, dims, spec_table, request, depth=depth, first=first)
             )
-            request.tick()
     outputs = _outputs(value_sets, widths, traced, direct)
     hits = traced[0].first
     aov_maps = _first_hit_maps(scene, tables, hits) if aovs and hits is not None else {}
