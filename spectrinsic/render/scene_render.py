@@ -251,12 +251,9 @@ def render_scene(
     Parameters
     ----------
     settings
-        Modes, samples, path depth, variant, per-light, direct and AOV choices
-        (:class:`~spectrinsic.render.settings.RenderSettings`), and the integrator of the
-        diagonal modes: ``"passes"``, ⌈K/3⌉ RGB passes per mode and one scene per light;
-        ``"single"`` (default), one traversal for every diagonal mode, band and light
-        (:mod:`spectrinsic.render.band_path.traversal`): the same images to float rounding, per-light
-        images that are exact shares of the full render, and ``RenderResult.transport``.
+        Modes, samples, path depth, variant, per-light, direct and AOV choices and the
+        integrator (:class:`~spectrinsic.render.settings.RenderSettings`); ``"single"`` also
+        fills ``RenderResult.transport``.
     seed
         Sampler seed, shared by every pass.
     progress

@@ -96,10 +96,8 @@ def render_spectral(
     Materials and lights are their registry spectra on the 1 nm CIE grid (360–830 nm), lights
     scaled by their power; channel k is ``∫ L(λ) S_k(λ) dλ`` (nm), the exact counterpart of a
     diagonal render's channel k. Works with any sensor set (CIE 1931, a camera's curves);
-    negative lobes (``"srgb"``) are not supported by ``specfilm`` and are clipped. *request*
-    (:class:`~spectrinsic.render.settings.PassRequest`) gives samples, seed, depth, variant,
-    progress and prepared geometry. An environment map takes one more pass per channel
-    (:func:`_light_passes`).
+    negative lobes (``"srgb"``) are not supported by ``specfilm`` and are clipped. An
+    environment map takes one more pass per channel (:func:`_light_passes`).
     """
     check_scene_lights(scene)
     active = active_light_set(scene, active_lights)

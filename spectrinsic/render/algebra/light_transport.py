@@ -53,11 +53,9 @@ class LightTransport:
         Seconds of each Mitsuba pass, per mode, and under ``"single"`` those of the traversals
         carrying every mode at once (empty when read from a file).
     parts
-        Part name (:data:`spectrinsic.render.result.PARTS`) -> one dict per batch as
-        :attr:`batches`, for the same unit spectrum: glossy scenes' ``"specular"`` part of ``T``
-        (first camera-ray vertex through a non-diffuse lobe) and metals' ``"metal_white"``
-        white-surface radiance at metal first hits (not part of ``T``)
-        (:mod:`~spectrinsic.render.band_path.kernel`); only the parts held.
+        Part name (:data:`~spectrinsic.render.result.PARTS`: ``"specular"``, a part of ``T``;
+        ``"metal_white"``, not) -> one dict per batch as :attr:`batches`, for the same unit
+        spectrum; only the parts held.
     """
 
     modes: tuple[str, ...]

@@ -4,22 +4,14 @@ Today's diagonal modes render ⌈K/3⌉ RGB passes that trace identical paths (c
 numbers) and differ only in the channel values of materials and lights (Eq. 5.2). A Lambertian
 vertex multiplies the throughput by its material's band albedo ρ_k and a light adds its band
 value E_k; neither changes the path. So one traversal can carry all K bands at once:
-:class:`BandPath` (built by :func:`band_path_class`) is Mitsuba's ``path`` integrator
-(``src/integrators/path.cpp``: emitter hits and next-event estimation with the same power-
-heuristic MIS, the same sampler calls in the same order) written in Python on Dr.Jit, whose
-throughput is a list of K band products gathered from a per-material table, and whose
-contributions go to one accumulator per (light, band). Its loop is the one body of
-:class:`~spectrinsic.render.band_path.kernel.BandKernel`; ``gloss`` and ``metals`` switch on its
-glossy (G1) factors with the specular part and the white-at-metal loop when it is traced
-("metal" there: any first hit without a diffuse lobe, metal, mirror or glass).
-
-The scene is loaded with white Lambertian surfaces (area-light shapes black) and unit white
-emitters, so Mitsuba's own BSDF and emitter sampling give the band-independent factors
-(cosine, pdfs, visibility, spot falloff); the integrator multiplies each by
-``ρ[material(shape), k]`` along the path. Its output is the **light transport** of each light
-for unit emission, ``T_{l,k}`` per pixel, ``(H, W, L·K)``; the K-channel image is
-``Σ_l E_{l,k} T_{l,k}``, equal to the diagonal passes' image to float rounding (same seed, spp
-and paths), and each light's share is exact: the per-light images sum to the total.
+:class:`BandPath` (built by :func:`band_path_class`) runs the one loop of
+:class:`~spectrinsic.render.band_path.kernel.BandKernel` (Mitsuba's ``path`` on K band
+throughputs, its ``gloss`` and ``metals`` features switched on when traced; that module says
+how) on the scene loaded with white Lambertian surfaces (area-light shapes black) and unit
+white emitters. Its output is the **light transport** of each light for unit emission,
+``T_{l,k}`` per pixel, ``(H, W, L·K)``; the K-channel image is ``Σ_l E_{l,k} T_{l,k}``, equal
+to the diagonal passes' image to float rounding (same seed, spp and paths), and each light's
+share is exact: the per-light images sum to the total.
 
 Material and emitter indices come from Mitsuba's registry ids of ``si.shape`` and
 ``ds.emitter`` (``dr.reinterpret_array``), mapped through lookup tables built after loading.

@@ -4,8 +4,9 @@
 emitter hits and next-event estimation with the power-heuristic :func:`mis_weight`, the same
 sampler calls in the same order) whose throughput is a list of K band products and whose
 contributions go to one accumulator per (light, band). The scene is loaded white, so Mitsuba's
-own BSDF and emitter sampling give the band-independent factors; the kernel multiplies each by a
-band factor ``c_k`` of the vertex (:mod:`spectrinsic.render.band_path.integrator` builds the integrator).
+own BSDF and emitter sampling give the band-independent factors (cosine, pdfs, visibility, spot
+falloff); the kernel multiplies each by a band factor ``c_k`` of the vertex
+(:mod:`spectrinsic.render.band_path.integrator` builds the integrator).
 One body, three loops, told apart by Python flags read while Dr.Jit traces the kernel (as
 Mitsuba's ``prb.py`` switches its features), so each traced kernel holds only its own steps:
 

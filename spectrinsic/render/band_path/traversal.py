@@ -288,8 +288,7 @@ def render_traversal(
         Channel values (:func:`spectrinsic.render.algebra.modes.channel_values`) of each diagonal mode;
         their bands are traced together.
     request
-        Samples, seed, path depth, variant, progress and prepared geometry
-        (:class:`~spectrinsic.render.settings.PassRequest`).
+        The batch's :class:`~spectrinsic.render.settings.PassRequest`.
     direct
         Also trace direct light only (path depth 2), for the energy ratio r of Eq. 5.8.
     aovs

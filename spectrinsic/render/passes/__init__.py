@@ -60,8 +60,7 @@ def render_diagonal(
     value_sets
         Channel values (:func:`spectrinsic.render.algebra.modes.channel_values`) of each render.
     request
-        Samples, seed, path depth, variant, progress and prepared geometry
-        (:class:`~spectrinsic.render.settings.PassRequest`).
+        The batch's :class:`~spectrinsic.render.settings.PassRequest`.
     direct
         Per value set (or for all): also render direct light only (``max_depth`` 2), for the
         energy ratio r of Eq. 5.8.
