@@ -57,6 +57,10 @@ def duration(seconds: float) -> str:
     return f"{seconds / 3600:.1f} h"
 
 
+def _folders(n: int) -> str:
+    return f"{n} sample folder" + ("" if n == 1 else "s")
+
+
 def _row(label: str, stats: ByteStats) -> str:
     cells = (stats.mean, stats.smallest, stats.largest, stats.total, stats.projected)
     return f"| {label} | {stats.samples} | " + " | ".join(byte_size(c) for c in cells) + " |"
@@ -101,19 +105,21 @@ def _build_time_line(record: BuildRecord | None, n_samples: int, variants: Seque
             else ""
         )
         text += (
-            f"; the {built} sample folders built took {duration(record.sample_seconds)} summed "
+            f"; the {_folders(built)} built took {duration(record.sample_seconds)} summed "
             f"over samples ({duration(record.sample_seconds / built)} per folder){outside}"
         )
+    machine = f"{cpus} CPU" + ("" if cpus == "1" else "s")
     text += (
-        f"; on {cpus} CPUs, Mitsuba variant(s) {', '.join(variants)} (`{BUILD_TIME_NAME}`; a "
+        f"; on {machine}, Mitsuba variant(s) {', '.join(variants)} (`{BUILD_TIME_NAME}`; a "
         "run's wall time runs from its start through writing `manifest.json`, the samples' "
         "time is their tasks' summed over parallel workers)."
     )
     missing = n_samples - built
     if missing > 0:
+        verb = "has" if missing == 1 else "have"
         text += (
-            f" At least {missing} of the {n_samples} samples have no recorded time (built by a "
-            "run stopped before its end, or before build times were recorded)."
+            f" At least {missing} of the {n_samples} samples {verb} no recorded time (built by "
+            "a run stopped before its end, or before build times were recorded)."
         )
     return text
 
@@ -121,9 +127,10 @@ def _build_time_line(record: BuildRecord | None, n_samples: int, variants: Seque
 def size_section(use: DiskUse, record: BuildRecord | None, variants: Sequence[str]) -> str:
     """The card's "Size and build time" section (Markdown, heading included)."""
     n = len(use.samples)
+    verb = "holds" if n == 1 else "hold"
     return (
         "## Size and build time\n\n"
-        f"Measured from this folder when this card was written: its {n} sample folders hold "
+        f"Measured from this folder when this card was written: its {_folders(n)} {verb} "
         f"**{byte_size(use.total)}**, previews included (file sizes in decimal units, "
         "1 MB = 10⁶ bytes; `manifest.json`, this card and the gallery are not counted). Per "
         "sample:\n\n"

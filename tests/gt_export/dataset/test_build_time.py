@@ -104,7 +104,7 @@ def test_samples_without_a_recorded_time_are_counted(tmp_path, synth):
 
     write_dataset_card(out, CONFIG.to_dict())
     line = _time_line(out)
-    assert "At least 1 of the 2 samples have no recorded time" in line
+    assert "At least 1 of the 2 samples has no recorded time" in line
     assert "finished 2026-12-05T13:00:00+00:00" in line and "on 2 CPUs" in line
 
 
