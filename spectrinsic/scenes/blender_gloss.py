@@ -28,7 +28,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..errors import SceneError
-from .blender_colours import principled_node
+from .blender_colours import check_working_space, principled_node
 from .materials import IOR_RANGE
 
 __all__ = ["METAL_PROPERTY", "DEFAULT_METAL", "principled_gloss", "material_glass"]
@@ -58,6 +58,7 @@ def _colour(mat: Any, node: Any, colour: str) -> list[float]:
         )
     if not all(0.0 <= c <= 1.0 for c in rgb):
         raise SceneError(f"material {mat.name!r}: glass {colour} {rgb}; expected values in [0, 1]")
+    check_working_space(f"material {mat.name!r}: glass {colour}")
     return rgb
 
 

@@ -45,15 +45,14 @@ import numpy as np
 
 from ..errors import SceneError
 from ..spectra.user_spectra import rgb_light_power
+from .blender_colours import LINEAR_SPACES, check_working_space
 from .budget import SceneBudget
 from .envmaps import check_map_file, envmap_lights
 from .mitsuba_files import file_sha256
 from .model import Light
 
 __all__ = [
-    "WORKING_SPACE",
     "BLENDER_MAP_FRAME",
-    "LINEAR_SPACES",
     "WorldLights",
     "blender_map_rotation",
     "world_lights",
@@ -66,10 +65,6 @@ BLENDER_MAP_FRAME = (
     1.0, 0.0, 0.0,
     0.0, 1.0, 0.0,
 )  # fmt: skip
-#: The scene-linear space whose colours are read (Blender 5's default working space).
-WORKING_SPACE = "Linear Rec.709"
-#: Image colour spaces read as linear Rec. 709 radiance.
-LINEAR_SPACES = ("Linear Rec.709", "Linear", "Non-Color")
 #: Mapping node types that turn the direction looked up by +angle (the others: ``TEXTURE``,
 #: the inverse).
 _FORWARD = ("POINT", "VECTOR", "NORMAL")
@@ -102,10 +97,13 @@ def blender_map_rotation(angle_z: float, *, texture: bool = False) -> tuple[floa
 
 
 class _Reading:
-    """One World read: the refusals' prefix, the approximation switch and its phrases."""
+    """One World read: the refusals' prefix (the file and the World), the approximation
+    switch and its phrases (the World alone: the notes name the file,
+    :func:`~spectrinsic.scenes.reading_notes.reading_notes`)."""
 
-    def __init__(self, where: str, approximate: bool) -> None:
-        self.where = where
+    def __init__(self, blend: Path, world: str, approximate: bool) -> None:
+        self.world = f"world {world!r}"
+        self.where = f"{blend}: {self.world}"
         self.approximate = approximate
         self.approximated: list[str] = []
 
@@ -115,7 +113,7 @@ class _Reading:
             raise SceneError(
                 f"{self.where}: {problem}; no exact ground truth (--approximate: {instead})"
             )
-        self.approximated.append(f"{self.where}: {problem}: {instead}")
+        self.approximated.append(f"{self.world}: {problem}: {instead}")
 
 
 def _label(node: Any) -> str:
@@ -276,13 +274,7 @@ def _environment(
 def _check_lit(world: Any, r: _Reading) -> None:
     """Refuse a World that some rays do not see (the renderer's World is seen by all), or
     whose file's colours are not Rec. 709 (Blender 5's per-file working space)."""
-    import bpy
-
-    space = getattr(getattr(bpy.data, "colorspace", None), "working_space", WORKING_SPACE)
-    if space != WORKING_SPACE:
-        raise SceneError(
-            f"{r.where}: the file's working colour space is {space!r}; expected {WORKING_SPACE!r}"
-        )
+    check_working_space(r.where)
     flags = getattr(world, "cycles_visibility", None)
     hidden = [ray for ray in _RAYS if flags is not None and not getattr(flags, ray, True)]
     if hidden:
@@ -303,10 +295,12 @@ def world_lights(
     """
     if world is None:
         return WorldLights()
-    r = _Reading(f"{blend}: world {world.name!r}", approximate)
+    r = _Reading(blend, world.name, approximate)
     if world.node_tree is None:  # a World without nodes: Cycles shows its colour
         sky = _colour_sky(world.name, world.color, 1.0, r.where)
-        return WorldLights(() if sky is None else (sky,))
+        if sky is not None:
+            _check_lit(world, r)
+        return WorldLights(() if sky is None else (sky,), tuple(r.approximated))
     background = _background(world, r)
     if background is None:
         return WorldLights((), tuple(r.approximated))
