@@ -28,7 +28,7 @@ subsurface, emission, textures) is ignored; other materials are Lambertian.
 With ``colours_from_asset=True`` (the default; ``--no-colours-from-asset`` turns it off), a
 material that the mapping, its
 custom property and its name leave without a spectrum takes the Principled node's Base Color
-(scene-linear Rec. 709, the file's working space; alpha ignored) as the reflectance ``rgb:R,G,B``
+(linear Rec. 709, from the file's working space; alpha ignored) as the reflectance ``rgb:R,G,B``
 (:mod:`spectrinsic.spectra.user_spectra`, Mallett & Yuksel 2019); a colour outside [0, 1] is
 refused when validated, not clipped, and a Base Color fed by a node (an image texture) is not
 read, so that material still needs a spectrum, unless the node is an Image Texture on a UV

@@ -1,29 +1,24 @@
-"""Blender colours: the file's working colour space, and a Principled BSDF's Base Color as an
-``rgb:`` colour or, fed by an image-texture node, an exact spectral texture (issue 41).
+"""Blender base colours: a Principled BSDF's Base Color as an ``rgb:`` colour or, fed by an
+image-texture node, an exact spectral texture (issue 41).
 
-Every colour of a ``.blend`` (a Base Color, a glass tint, a World's background, a ``Non-Color``
-texel) is a scene-linear RGB in the file's *working colour space* (Blender 5's per-file
-setting; before it, always Linear Rec. 709). This project's route is linear Rec. 709
-(:mod:`spectrinsic.spectra.user_spectra`), so :func:`check_working_space`, the one check that
-every reader of a colour calls, refuses in one line a file of another working space (Linear
-Rec.2020, ACEScg): its colours would be read in the wrong primaries. They are refused rather
-than converted: ACEScg's white is not D65 (a conversion would choose a chromatic adaptation
-Cycles does not apply to its spectra), and a saturated Rec.2020 colour lies outside Rec. 709.
-
-:func:`base_colour` reads an unlinked Base Color as ``rgb:R,G,B``. An *Image Texture* node linked straight into a Principled BSDF's Base Color is read as an
+:func:`base_colour` reads an unlinked Base Color as ``rgb:R,G,B`` in linear Rec. 709 (converted
+from the file's working colour space, :mod:`~spectrinsic.scenes.blender_working_space`). An
+*Image Texture* node linked straight into a Principled BSDF's Base Color is read as an
 :class:`~spectrinsic.scenes.image_textures.ImageTexture` (the upsampling, limits and decoding of
-that module): the image's colour space says its encoding (``sRGB`` is decoded; ``Non-Color``,
-``Linear Rec.709``, ``Linear`` (Blender 3's name) are read as linear, :data:`LINEAR_SPACES`;
-others, ``Linear CIE-XYZ D65`` among them, are refused), the node's extension
-its wrap (``REPEAT`` → ``repeat``, ``EXTEND`` → ``clamp``, ``MIRROR`` → ``mirror``; ``CLIP``
-is refused) and its interpolation the filter the asset asks for (``Closest`` → ``nearest``,
-``Linear`` → ``bilinear``, ``Cubic``/``Smart`` → ``cubic``; the band path reads the nearest
-texel and says so). The node's coordinates must be a UV map: its Vector input unlinked (the
-mesh's active render UV map), or linked from a *UV Map* node or a *Texture Coordinate* node's
-UV output; its projection must be ``FLAT``. The image is the file's packed copy or a file
-inside the ``.blend``'s folder. The node's Color output must feed the Base Color (its Alpha is
-refused), through a link and a node that are not muted. Anything else feeding the Base Color (a mix, a procedural
-texture) is not read: the material then needs a spectrum, as before.
+that module): the image's colour space says its encoding (``sRGB`` is decoded; ``Linear
+Rec.709``, ``Linear`` (Blender 3's name) and ``Non-Color`` are read as linear,
+:data:`LINEAR_SPACES`, ``Non-Color`` only in a Linear Rec.709 file; others, ``Linear CIE-XYZ
+D65`` among them, are refused; an image's colour does not depend on the working space), the
+node's extension its wrap (``REPEAT`` → ``repeat``, ``EXTEND`` → ``clamp``, ``MIRROR`` →
+``mirror``; ``CLIP`` is refused) and its interpolation the filter the asset asks for
+(``Closest`` → ``nearest``, ``Linear`` → ``bilinear``, ``Cubic``/``Smart`` → ``cubic``; the
+band path reads the nearest texel and says so). The node's coordinates must be a UV map: its
+Vector input unlinked (the mesh's active render UV map), or linked from a *UV Map* node or a
+*Texture Coordinate* node's UV output; its projection must be ``FLAT``. The image is the
+file's packed copy or a file inside the ``.blend``'s folder. The node's Color output must feed
+the Base Color (its Alpha is refused), through a link and a node that are not muted. Anything
+else feeding the Base Color (a mix, a procedural texture) is not read: the material then needs
+a spectrum, as before.
 """
 
 from __future__ import annotations
@@ -35,13 +30,12 @@ from typing import Any
 import numpy as np
 
 from ..errors import SceneError
+from .blender_working_space import check_raw_values, rec709_colour
 from .image_textures import Filter, ImageTexture, Wrap, image_texture_from_bytes
 from .image_textures import image_texture_from_file as _from_file
 
 __all__ = [
-    "WORKING_SPACE",
     "LINEAR_SPACES",
-    "check_working_space",
     "principled_node",
     "base_colour",
     "base_colour_image",
@@ -49,9 +43,8 @@ __all__ = [
     "object_texture",
 ]
 
-#: The scene-linear space whose colours are read (Blender 5's default working space).
-WORKING_SPACE = "Linear Rec.709"
-#: Image colour spaces read as linear Rec. 709 (``Non-Color``: the working space's values).
+#: Image colour spaces read as linear Rec. 709 (``Non-Color``: the working space's values,
+#: :func:`~spectrinsic.scenes.blender_working_space.check_raw_values`).
 LINEAR_SPACES = ("Linear Rec.709", "Linear", "Non-Color")
 
 _WRAP: dict[str, Wrap] = {"REPEAT": "repeat", "EXTEND": "clamp", "MIRROR": "mirror"}
@@ -61,19 +54,6 @@ _FILTER: dict[str, Filter] = {
     "Cubic": "cubic",
     "Smart": "cubic",
 }
-
-
-def check_working_space(where: str) -> None:
-    """Refuse, in one line naming *where*, the open ``.blend`` (the running ``bpy`` session's
-    data) when its working colour space is not :data:`WORKING_SPACE` (module docstring)."""
-    import bpy
-
-    space = getattr(getattr(bpy.data, "colorspace", None), "working_space", WORKING_SPACE)
-    if space != WORKING_SPACE:
-        raise SceneError(
-            f"{where}: the file's working colour space is {space!r}; expected {WORKING_SPACE!r} "
-            "(its colours would be read in the wrong primaries)"
-        )
 
 
 def principled_node(mat: Any) -> Any:
@@ -86,14 +66,12 @@ def principled_node(mat: Any) -> Any:
 
 def base_colour(mat: Any) -> str | None:
     """``"rgb:R,G,B"`` of *mat*'s Principled Base Color (module docstring); None without the
-    node or when a texture (any link) feeds the colour; a :class:`SceneError` naming the
-    material in a file of another working space (:func:`check_working_space`)."""
+    node or when a texture (any link) feeds the colour."""
     node = principled_node(mat)
     if node is None or node.inputs["Base Color"].is_linked:
         return None
-    check_working_space(f"material {mat.name!r}: Base Color")
-    rgba = node.inputs["Base Color"].default_value
-    return "rgb:" + ",".join(f"{float(c):.9g}" for c in list(rgba)[:3])
+    rgb = rec709_colour(node.inputs["Base Color"].default_value, f"material {mat.name!r}")
+    return "rgb:" + ",".join(f"{c:.9g}" for c in rgb)
 
 
 def _uv_map(node: Any, where: str) -> str:
@@ -123,7 +101,8 @@ def _image(node: Any, blend: Path, where: str) -> ImageTexture:
             f"{where}: image {image.name!r} in colour space {space!r}; expected sRGB or "
             f"{', '.join(LINEAR_SPACES)}"
         )
-    check_working_space(f"{where}: image {image.name!r}")
+    if space == "Non-Color":
+        check_raw_values(f"{where}: image {image.name!r}")
     wrap, filt = _WRAP.get(str(node.extension)), _FILTER.get(str(node.interpolation), "bilinear")
     if wrap is None or node.projection != "FLAT":
         raise SceneError(

@@ -282,7 +282,6 @@ def test_approximate_applies_to_blend_files_on_the_command_line(worlds, tmp_path
         ("mix", "Mix Shader"),
         ("packed", "packed in the .blend"),
         ("escape", "inside the .blend's folder"),
-        ("wide", "working colour space is 'Linear Rec.2020'"),
     ],
 )
 def test_other_worlds_are_refused_in_one_line(worlds, stem, says):
