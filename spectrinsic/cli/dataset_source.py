@@ -25,6 +25,7 @@ from ..render.base.variants import import_mitsuba
 from ..scenes.generators import GlossDistribution
 from ..scenes.generators.world_defaults import GLOSSY_FRACTION, METALLIC_FRACTION, TEXTURE_FRACTION
 from ..scenes.mitsuba_xml import render_hints_line, xml_notes
+from ..scenes.model import Scene
 from ..scenes.semantic import SemanticRules, read_semantic_map
 from ..scenes.sources import FileSource, takes_asset_colours
 from ..scenes.spectrum_refs import resolve_spectrum
@@ -405,15 +406,14 @@ def parse_resolution(text: str) -> tuple[int, int]:
     return int(w), int(h)
 
 
-def check_scene_files(config: Any, data_dir: str | None, *, quiet: bool = False) -> None:
+def check_scene_files(config: Any, data_dir: str | None, *, quiet: bool = False) -> list[Scene]:
     """``--scenes``: every file reads as a valid scene with this material map and default
     spectrum, before the folder is stamped with the config (a bad file is an input error, not
     a failed sample); what a Mitsuba XML read fixed or approximated, and the spp and depth that
-    apply to it (the preset's), are said on stderr unless *quiet*."""
-
+    apply to it (the preset's), are said on stderr unless *quiet*. Returns the scenes read."""
     spec = json.loads(config.source or "{}")
     if "scenes" not in spec:
-        return
+        return []
     materials = spec.get("materials") or {}
     named = [("--default-spectrum", spec.get("default_spectrum"))]
     named += [(f"--material-map entry {k!r}", v) for k, v in sorted(materials.items())]
@@ -425,6 +425,7 @@ def check_scene_files(config: Any, data_dir: str | None, *, quiet: bool = False)
             raise DatasetError(f"{option} {name!r}: {exc}") from exc
     width, height = spec.get("resolution") or (None, None)
     import_mitsuba()  # set up before a Mitsuba XML read imports it (the libLLVM Dr.Jit loads)
+    scenes = []
     for entry in spec["scenes"]:
         scene = FileSource(
             entry["path"],
@@ -444,3 +445,5 @@ def check_scene_files(config: Any, data_dir: str | None, *, quiet: bool = False)
             line = render_hints_line(scene, config.render.spp, config.render.max_depth, given)
             if line is not None:
                 print(f"spectrinsic dataset: {line}", file=sys.stderr)
+        scenes.append(scene)
+    return scenes
