@@ -21,16 +21,18 @@ the four default modes (73 values per pixel with the AOVs), spp 16, on the 2-cor
 =========  ===========================  ==========
 size       measured                     estimate
 =========  ===========================  ==========
-8 x 8      277 MiB (passes)             1.0 GiB
-64 x 64    1215 MiB (single, full suite) 1.6 GiB
-192 x 192  1215 MiB (single, full suite) 1.6 GiB
-256 x 256  305 / 348 MiB (passes/single) 1.6 GiB
-512 x 512  488 / 608 MiB (passes/single) 1.9 GiB
-2048^2     5.0 GB (passes)              8.9 GB
+8 x 8      277 MiB (passes)             2.0 GiB
+64 x 64    1215 MiB (single, full suite) 2.0 GiB
+192 x 192  1215 MiB (single, full suite) 2.0 GiB
+256 x 256  305 / 348 MiB (passes/single) 2.2 GiB
+512 x 512  488 / 608 MiB (passes/single) 2.6 GiB
+2048^2     5.0 GB (passes)              13.1 GB
 =========  ===========================  ==========
 
-(the 2048^2 figure from issue 17, where the former count, 684 B/pixel without the process,
-estimated 1.7 GiB). The 1215 MiB rows are the largest of four measurements made inside
+(estimates of this module as it is now, obj-apple's counts, the four modes: the film term adds
+51 channels; the 2048^2 figure from issue 17, where the former count, 684 B/pixel without the
+process, estimated 1.7 GiB; it was rendered with the passes, which have no traversal film, so
+that row over-estimates the passes by 2.6 x). The 1215 MiB rows are the largest of four measurements made inside
 full ``make test`` runs on a loaded machine (1148-1215 MiB, modes spectral, rgb3, rgb6, spp 2;
 the same render alone peaks at 240 MiB warm and 259 MiB with an empty kernel cache; the
 cause, other work in the test process's environment, is not isolated); they set
