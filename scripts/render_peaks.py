@@ -117,11 +117,11 @@ def _child(out: str, argv: list[str]) -> None:
     peak = [0]
     timed = traversal.timed_render
 
-    def recorded(mi, loaded, **kwargs):  # type: ignore[no-untyped-def]
+    def recorded(*args, **kwargs):  # type: ignore[no-untyped-def]
         peak[0] = max(peak[0], _status("VmHWM"))
         before = _status("VmRSS")
         Path("/proc/self/clear_refs").write_text("5")  # VmHWM := VmRSS
-        image, seconds = timed(mi, loaded, **kwargs)
+        image, seconds = timed(*args, **kwargs)
         top = _status("VmHWM")
         peak[0] = max(peak[0], top)
         stages.append(

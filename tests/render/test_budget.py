@@ -128,8 +128,8 @@ def test_the_band_path_film_holds_the_channels_the_estimate_counts(tmp_path, mon
     seen: list[int] = []
     real = traversal.timed_render
 
-    def recorded(mi, loaded, **kwargs):
-        image, seconds = real(mi, loaded, **kwargs)
+    def recorded(*args, **kwargs):
+        image, seconds = real(*args, **kwargs)
         seen.append(image.shape[-1])
         return image, seconds
 
