@@ -191,7 +191,8 @@ def _add_scene_file_options(src: Any) -> None:
         "--approximate",
         action="store_true",
         help="Mitsuba XML scenes: approximate what has no exact ground truth (glass, masks, "
-        "bump maps, bitmaps, environment maps...) instead of refusing it, one line saying what",
+        "bump maps, bitmaps, environment maps...; a .blend World's Sky Texture...) instead of "
+        "refusing it, one line saying what",
     )
     src.add_argument(
         "--new-sample",

@@ -10,6 +10,7 @@ A material is a spectrum name (Lambertian, as before) or a mapping::
       mirror: {kind: conductor, metal: none}            # perfect mirror, F = 1
       vase: {kind: dielectric, ior: 1.5, roughness: 0}  # clear glass, solid
       pane: {kind: thindielectric, ior: 1.5}            # clear glass, a thin sheet
+      bottle: {kind: dielectric, transmittance: "rgb:0.2,0.6,0.3"}  # tinted glass
 
 ``plastic`` is a diffuse base under a dielectric coat of index ``ior`` (Mitsuba ``plastic``,
 or ``roughplastic`` when ``roughness`` > 0); ``conductor`` is a metal with Mitsuba's measured
@@ -17,7 +18,10 @@ or ``roughplastic`` when ``roughness`` > 0); ``conductor`` is a metal with Mitsu
 no diffuse lobe (spectrum ``flat:0``). ``dielectric`` is a clear glass solid of index ``ior``
 relative to the outside (Mitsuba ``dielectric``, or ``roughdielectric`` with GGX when
 ``roughness`` > 0); ``thindielectric`` a smooth thin pane (Mitsuba ``thindielectric``); glass has
-no diffuse lobe either and is untinted (no absorption, a constant ``ior``: no dispersion).
+no diffuse lobe either and a constant ``ior`` (no dispersion). Glass is clear unless given a
+``transmittance``: a spectrum name (as ``spectrum``, values in [0, 1]) that multiplies each
+transmission through the surface, not its reflections (Mitsuba's ``specular_transmittance``:
+twice through a solid, entering and leaving; once through a pane).
 ``roughness`` is the GGX α in [0, 1] (0 = smooth); ``ior`` lies in (1, 3].
 
 A ``textured`` material is a spectral texture (:mod:`spectrinsic.scenes.textures`): per texel a
@@ -75,8 +79,8 @@ _KEYS = {
     "diffuse": ("kind", "spectrum"),
     "plastic": ("kind", "spectrum", "ior", "roughness"),
     "conductor": ("kind", "metal", "roughness"),
-    "dielectric": ("kind", "ior", "roughness"),
-    "thindielectric": ("kind", "ior"),
+    "dielectric": ("kind", "ior", "roughness", "transmittance"),
+    "thindielectric": ("kind", "ior", "transmittance"),
 }
 
 
@@ -109,6 +113,10 @@ def material_problem(m: Material) -> str | None:
         )
     if m.kind == "thindielectric" and m.roughness != 0.0:
         return f"roughness {m.roughness!r}: a thindielectric is smooth (Mitsuba has no rough one)"
+    if not isinstance(m.transmittance, str):
+        return f"transmittance {m.transmittance!r}: expected a spectrum name"
+    if m.transmittance and not m.transmissive:
+        return f"transmittance {m.transmittance!r} given for a {m.kind} material (only for glass)"
     if m.kind == "conductor":
         try:
             check_conductor(m.metal)
@@ -187,6 +195,9 @@ def parse_material(name: str, value: Any) -> Material | TexturedMaterial | str:
     for key in ("ior", "roughness"):
         if key in value and not _number(value[key]):
             return f"{key}: expected a number, got {value[key]!r}"
+    tint = value.get("transmittance", "")
+    if "transmittance" in value and (not isinstance(tint, str) or not tint.strip()):
+        return f"transmittance: expected a non-empty spectrum name, got {tint!r}"
     m = Material(
         name=name,
         spectrum=value["spectrum"] if "spectrum" in _KEYS[kind] else METAL_SPECTRUM,
@@ -194,6 +205,7 @@ def parse_material(name: str, value: Any) -> Material | TexturedMaterial | str:
         roughness=float(value.get("roughness", 0.0)),
         ior=float(value.get("ior", 1.5)),
         metal=value.get("metal", ""),
+        transmittance=tint,
     )
     return material_problem(m) or m
 
@@ -211,6 +223,8 @@ def material_entry(m: Material) -> str | dict[str, Any]:
         entry["ior"] = float(m.ior)
     if "roughness" in _KEYS[m.kind]:
         entry["roughness"] = float(m.roughness)
+    if m.transmittance:
+        entry["transmittance"] = m.transmittance
     return entry
 
 

@@ -11,8 +11,8 @@ A glTF material's ``pbrMetallicRoughness`` factors set the gloss as for ``.blend
 ≥ 0.5 makes a metal (``conductor``, Al: the factors name no metal; no spectrum needed), else
 roughness < 0.5 a coated diffuse (``plastic``, η = 1.5); GGX α = roughness². Absent factors
 count as matte (not glTF's default of 1), so files without them import as before. A material
-with ``KHR_materials_transmission`` factor 1 is clear glass (:mod:`~spectrinsic.scenes.gltf_glass`;
-a partial factor is refused in one line).
+with ``KHR_materials_transmission`` factor 1 is glass, tinted by its ``baseColorFactor``
+(:mod:`~spectrinsic.scenes.gltf_glass`; a partial factor is refused in one line).
 
 Colours from the asset (``colours_from_asset=True``, the default; ``--no-colours-from-asset``
 turns it off): a material not in the map takes the colour its file states, a glTF

@@ -8,11 +8,14 @@ metals), the rough ones with ``alpha`` and the ``ggx`` distribution (Mitsuba's d
 ones). A ``specular_reflectance`` other than 1 has no exact counterpart and is refused. A
 ``conductor`` with ``material`` ``none`` (or none given, Mitsuba's default) is the perfect mirror.
 
-Glass (:data:`GLASS`) is read exactly as clear glass: ``dielectric``, ``thindielectric`` and
+Glass (:data:`GLASS`) is read exactly: ``dielectric``, ``thindielectric`` and
 ``roughdielectric`` (``alpha``, ``ggx`` only, as above) with ``int_ior``/``ext_ior`` numbers or
 the names of Mitsuba's own table (``bk7``, ``water``, ``air``..., Mitsuba's defaults ``bk7`` and
-``air``), whose ratio is the material's ``ior``. A ``specular_reflectance`` or
-``specular_transmittance`` other than 1 (tinted glass) is refused (``--approximate``: taken as 1).
+``air``), whose ratio is the material's ``ior``. A ``specular_transmittance`` other than 1 is
+tinted glass: its ``rgb``, ``spectrum`` or ``float`` becomes the material's ``transmittance``
+(as a reflectance above; Mitsuba multiplies only the refracted lobe by it, and so does the band
+path). A textured one (``bitmap``) is refused (``--approximate``: taken as 1), and so is a
+``specular_reflectance`` other than 1 (a tinted reflection).
 
 The wrappers ``mask``, ``bumpmap`` and ``normalmap`` (:data:`WRAPPERS`, in any order with
 ``twosided``) are read exactly: the material is the BSDF they wrap, and the wrappers' opacity
@@ -153,7 +156,7 @@ def material_of(node: XmlNode, what: str, base: Path, say: Say) -> Material | No
         return Material(name or spectrum, spectrum)
     _unit_specular(node, what, say)
     if kind in GLASS:
-        return _glass(node, name, alpha, what, say)
+        return _glass(node, name, alpha, what, base, say)
     if kind.endswith("conductor"):
         metal = node.props.get("material", PERFECT_MIRROR)
         if not isinstance(metal, str) or not metal:
@@ -191,12 +194,35 @@ def _ior(node: XmlNode, key: str, default: str, what: str) -> float:
     return ior
 
 
-def _glass(node: XmlNode, name: str, alpha: float, what: str, say: Say) -> Material:
-    """Clear glass of *node* (module docstring); *alpha* already read for ``roughdielectric``."""
-    _unit_specular(node, what, say, "specular_transmittance")
+def _transmittance(node: XmlNode, what: str, base: Path, say: Say) -> str:
+    """The ``specular_transmittance`` of glass *node* as a spectrum name, ``""`` where it is 1
+    (clear glass; a refused or approximated ``bitmap`` too)."""
+    key = "specular_transmittance"
+    value: Value | None = node.props.get(key)
+    if isinstance(value, XmlNode) and value.plugin == "bitmap":
+        if say is None:
+            raise SceneError(
+                f"{what}: {key} {value.label()} in {node.label()}: a textured tint has no exact "
+                "ground truth; only a uniform rgb, spectrum or float (--approximate would use 1)"
+            )
+        say(f"{what}: {node.label()} textured {key} taken as 1")
+        return ""
+    unit = value is None or (isinstance(value, (int, float)) and value == 1.0)
+    unit = unit or (isinstance(value, np.ndarray) and bool(np.all(value == 1.0)))
+    return "" if unit else reflectance_name(value, f"{what} {key}", base)
+
+
+def _glass(node: XmlNode, name: str, alpha: float, what: str, base: Path, say: Say) -> Material:
+    """Glass of *node*, clear or tinted (module docstring); *alpha* already read for
+    ``roughdielectric``."""
     inside, outside = _GLASS_IORS
     ior = _ior(node, "int_ior", inside, what) / _ior(node, "ext_ior", outside, what)
     kind: MaterialKind = "thindielectric" if node.plugin == "thindielectric" else "dielectric"
     return Material(
-        name or f"{node.plugin} {ior:.4g}", METAL_SPECTRUM, kind=kind, roughness=alpha, ior=ior
+        name or f"{node.plugin} {ior:.4g}",
+        METAL_SPECTRUM,
+        kind=kind,
+        roughness=alpha,
+        ior=ior,
+        transmittance=_transmittance(node, what, base, say),
     )

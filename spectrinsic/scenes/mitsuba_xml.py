@@ -420,8 +420,8 @@ def _spd_records(files: list[SceneFile]) -> list[dict[str, str]]:
 
 
 def xml_notes(scene: Scene) -> list[str]:
-    """One line per fix, approximation and ignored setting a Mitsuba XML read made (from
-    ``scene.metadata``; empty for other scenes), for stderr."""
+    """One line per fix, approximation and ignored setting a Mitsuba XML (or a ``.blend``'s
+    World) read made (from ``scene.metadata``; empty for other scenes), for stderr."""
     meta = scene.metadata
     return [
         f"{meta.get('source', scene.name)}: {what}: {phrase}"

@@ -66,8 +66,9 @@ def _material(value: Any, base: Path) -> Any:
     if not isinstance(value, dict) or _INLINE_KEYS & set(value):
         return resolve_spectrum(value, "reflectance", base)
     out = dict(value)
-    if "spectrum" in out:
-        out["spectrum"] = resolve_spectrum(out["spectrum"], "reflectance", base)
+    for key in ("spectrum", "transmittance"):  # a glass's transmittance is a fraction too
+        if key in out:
+            out[key] = resolve_spectrum(out[key], "reflectance", base)
     if isinstance(out.get("basis"), list):
         out["basis"] = [resolve_spectrum(b, "reflectance", base) for b in out["basis"]]
     return out

@@ -200,9 +200,9 @@ def test_a_thin_pane_shows_the_wall_behind_it_in_specular_at_its_transmittance()
     [
         ('<bsdf type="roughdielectric" id="glass"/>', "distribution beckmann (the default)"),
         (
-            '<bsdf type="dielectric" id="glass"><rgb name="specular_transmittance" '
+            '<bsdf type="dielectric" id="glass"><rgb name="specular_reflectance" '
             'value="0.5, 0.9, 0.5"/></bsdf>',
-            "specular_transmittance [0.5, 0.9, 0.5]",
+            "specular_reflectance [0.5, 0.9, 0.5]",
         ),
         (
             '<bsdf type="thindielectric" id="glass"><string name="int_ior" value="glass"/></bsdf>',
@@ -251,18 +251,19 @@ def test_the_passes_integrator_refuses_glass_in_one_line_before_any_work(glass_b
     assert not out.exists()
 
 
-def test_approximate_takes_a_tint_as_clear_glass_and_says_so(glass_box):
+def test_approximate_takes_a_tinted_reflection_as_clear_glass_and_says_so(glass_box):
+    """A tinted transmission is exact (``test_tinted_glass.py``); a tinted reflection is not."""
     tinted = (
         '<bsdf type="dielectric" id="glass">'
-        '<rgb name="specular_transmittance" value="0.5, 0.9, 0.5"/></bsdf>'
+        '<rgb name="specular_reflectance" value="0.5, 0.9, 0.5"/></bsdf>'
     )
     path = glass_box.with_name("tinted.xml")
     path.write_text(XML.replace(SMOOTH_GLASS, tinted))
     scene = load_mitsuba_xml(path, approximate=True)
     (glass,) = [m for m in scene.materials if m.name == "glass"]
-    assert glass.kind == "dielectric"
+    assert glass.kind == "dielectric" and not glass.tinted
     (said,) = scene.metadata["approximated"]
-    assert "specular_transmittance [0.5, 0.9, 0.5] taken as 1" in said
+    assert "specular_reflectance [0.5, 0.9, 0.5] taken as 1" in said
 
 
 def test_a_thin_pane_stays_the_first_hit_in_a_scene_with_masks(glass_box):

@@ -1,18 +1,21 @@
 """Build a .blend with Principled BSDF materials for tests/scenes/test_blender_gloss.py
 (run in a subprocess: bpy state is global).
 
-Usage: python make_blend_gloss.py -- OUT.blend
+Usage: python make_blend_gloss.py -- OUT.blend [R,G,B | textured]
 
 Three quads side by side: "Copper" (Metallic 1, Roughness 0.3, custom property metal = "Cu"),
 "munsell:5R 4/14" (Metallic 0, Roughness 0.2, IOR 1.45), "flat:0.5" (Roughness 0.8) and
-"Glass" (Transmission 1, Roughness 0, IOR 1.52); a camera above and a sun.
+"Glass" (Transmission 1, Roughness 0, IOR 1.52; its Base Color white, or R,G,B, or fed by an
+Image Texture node with ``textured``); a camera above and a sun.
 """
 
 import sys
+from pathlib import Path
 
 import bpy
 
-out = sys.argv[-1]
+args = sys.argv[sys.argv.index("--") + 1 :]
+out, tint = args[0], (args[1] if len(args) > 1 else "1,1,1")
 bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
 
@@ -33,7 +36,16 @@ glass = principled("Glass", 0.0, 0.0, 1.52)
 node = next(n for n in glass.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
 key = "Transmission Weight" if "Transmission Weight" in node.inputs else "Transmission"
 node.inputs[key].default_value = 1.0
-node.inputs["Base Color"].default_value = (1.0, 1.0, 1.0, 1.0)  # Blender's 0.8 would tint it
+if tint == "textured":
+    image = glass.node_tree.nodes.new("ShaderNodeTexImage")
+    png = str(Path(out).with_name("tint.png"))  # beside the .blend, where the reader looks
+    made = bpy.data.images.new("tint", 4, 4)
+    made.filepath_raw, made.file_format = png, "PNG"
+    made.save()
+    image.image = bpy.data.images.load(png)
+    glass.node_tree.links.new(image.outputs["Color"], node.inputs["Base Color"])
+else:  # white: Blender's 0.8 would tint it
+    node.inputs["Base Color"].default_value = (*map(float, tint.split(",")), 1.0)
 mats = [
     copper,
     principled("munsell:5R 4/14", 0.0, 0.2, 1.45),
@@ -46,6 +58,8 @@ for i, mat in enumerate(mats):
     me.from_pydata(
         [(x - 1, -1, 0), (x + 1, -1, 0), (x + 1, 1, 0), (x - 1, 1, 0)], [], [(0, 1, 2, 3)]
     )
+    if tint == "textured":  # the image's coordinates
+        me.uv_layers.new(name="UVMap")
     me.update()
     obj = bpy.data.objects.new(f"Quad{i}", me)
     obj.data.materials.append(mat)

@@ -138,6 +138,7 @@ def _meta(
     height, width = gt.layers["image"].data.shape[:2]
     files_used = spectrum_files(
         [m.spectrum for m in scene.materials]
+        + [m.transmittance for m in scene.materials if m.transmittance]  # tinted glass
         + [li.spectrum for li in scene.lights]
         + [*gt.cameras],
         scene_folder,

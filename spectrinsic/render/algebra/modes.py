@@ -165,11 +165,16 @@ class ChannelValues:
         ``(M, N, K)`` float64 band factors of each material's non-diffuse lobe at N cosines
         (:func:`spectrinsic.spectra.conductors.fresnel_table` for a conductor, 1 otherwise),
         when the scene has glossy materials; ``None`` otherwise.
+    transmittance
+        ``(M, K)`` float64 band values ``∫T_m S_k / ∫S_k`` of each glass's transmittance, as
+        :attr:`materials` of its reflectance (1 for clear glass and every other material),
+        when the scene has tinted glass; ``None`` otherwise.
     """
 
     materials: np.ndarray
     lights: np.ndarray
     specular: np.ndarray | None = None
+    transmittance: np.ndarray | None = None
 
 
 def light_spectra(
@@ -227,7 +232,25 @@ def channel_values(
         specular=_specular(scene, curves, wavelengths)
         if any(m.glossy for m in scene.materials)
         else None,
+        transmittance=_transmittance(scene, curves, wavelengths, data_dir)
+        if any(m.tinted for m in scene.materials)
+        else None,
     )
+
+
+def _transmittance(
+    scene: Scene, curves: np.ndarray, wavelengths: Wavelengths, data_dir: str | None
+) -> np.ndarray:
+    """``(M, K)`` band values of every material's transmittance (1 where it has none)."""
+    spectra = np.stack(
+        [
+            get_spectrum(m.transmittance, data_dir=data_dir).on(wavelengths)
+            if m.tinted
+            else np.ones(np.size(wavelengths))
+            for m in scene.materials
+        ]
+    )
+    return diagonal_values(spectra, curves, wavelengths)
 
 
 def _specular(scene: Scene, curves: np.ndarray, wavelengths: Wavelengths) -> np.ndarray:
