@@ -115,15 +115,16 @@ def mitsuba_xyz(path: Path, spp: int) -> list[np.ndarray]:
     ]
 
 
-def assert_blocks_agree(ours: np.ndarray, theirs: np.ndarray) -> None:
+def assert_blocks_agree(ours: np.ndarray, theirs: np.ndarray, *, max_t: float = np.inf) -> None:
     """Per block and channel of ``(SEEDS, 4, 4, 3)`` block means, the two renderers agree within
     t standard errors of the difference, from the spread of the seeds (t: Student's quantile,
     SEEDS − 1 degrees of freedom, for a family-wise false alarm of FALSE_ALARM over the
-    comparisons), and each standard error is below 10 % of the block mean (the test can see)."""
+    comparisons, at most *max_t*), and each standard error is below 10 % of the block mean (the
+    test can see)."""
     from scipy.stats import t as student
 
     stderr = np.hypot(ours.std(axis=0, ddof=1), theirs.std(axis=0, ddof=1)) / np.sqrt(SEEDS)
     diff = ours.mean(axis=0) - theirs.mean(axis=0)
-    bound = student.ppf(1 - FALSE_ALARM / (2 * diff.size), df=SEEDS - 1)
+    bound = min(student.ppf(1 - FALSE_ALARM / (2 * diff.size), df=SEEDS - 1), max_t)
     assert np.all(np.abs(diff) <= bound * stderr), np.abs(diff / stderr).max()
     assert np.all(stderr < 0.1 * theirs.mean(axis=0)), (stderr / theirs.mean(axis=0)).max()
