@@ -30,7 +30,7 @@ from ..render import (
     render_scene,
 )
 from ..render.base.plugins import MAX_PATH_DEPTH
-from ..render.budget import check_render_size
+from ..render.budget import RenderLoad, check_render_size
 from ..render.settings import DEFAULT_INTEGRATOR
 from ..scenes.mitsuba_xml import render_hints_line
 from ..scenes.model import Scene
@@ -128,7 +128,7 @@ def run(args: argparse.Namespace) -> int:
         scene.camera.height,
         settings,
         what=given or f"scene {args.scene!r}",
-        n_lights=len(scene.lights),
+        load=RenderLoad.of_scene(scene),
         data_dir=data_dir,
     )
     with staged_output(Path(args.out)) as stage:  # a failed run leaves --out as it was

@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SceneError
-from .gltf_colours import gltf_document
+from .gltf_colours import GLTF_SUFFIXES, gltf_document, named_materials
 
 __all__ = ["TRANSMISSION", "gltf_glass"]
 
@@ -95,13 +95,12 @@ def gltf_glass(path: str | Path) -> dict[str, dict[str, Any]]:
     """``{material name: gloss fields}`` of the named glass materials of the ``.gltf``/``.glb``
     file at *path* (module docstring); ``{}`` for other files."""
     path = Path(path)
-    if path.suffix.lower() not in (".gltf", ".glb"):
+    if path.suffix.lower() not in GLTF_SUFFIXES:
         return {}
     doc, _ = gltf_document(path)
     out = {}
-    for material in doc.get("materials") or []:
-        if isinstance(material, dict) and isinstance(material.get("name"), str):
-            glass = _glass(material["name"], material, str(path))
-            if glass is not None:
-                out[material["name"]] = glass
+    for name, material in named_materials(doc):
+        glass = _glass(name, material, str(path))
+        if glass is not None:
+            out[name] = glass
     return out

@@ -41,7 +41,7 @@ import numpy as np
 
 from ..errors import SceneError
 from .budget import MAX_FACES, MAX_VERTICES
-from .gltf_colours import gltf_colours
+from .gltf_colours import GLTF_SUFFIXES, gltf_colours
 from .gltf_glass import gltf_glass
 from .gltf_maps import gltf_maps, warn_mirrored_uv
 from .image_textures import AssetColour, ImageTexture, corner_spectra
@@ -184,7 +184,7 @@ def _frame(vertices: np.ndarray, width: int, height: int) -> tuple[Camera, Light
 
 
 def _asset_colours(path: Path) -> dict[str, AssetColour]:
-    return gltf_colours(path) if path.suffix.lower() in (".gltf", ".glb") else mtl_colours(path)
+    return gltf_colours(path) if path.suffix.lower() in GLTF_SUFFIXES else mtl_colours(path)
 
 
 def _mesh_maps(maps: MeshMaps | None, uv: np.ndarray | None, where: str) -> MeshMaps | None:

@@ -19,18 +19,8 @@ from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import get_sensors
 
-from .test_glass import (
-    _ICO_F,
-    _ICO_V,
-    FALSE_ALARM,
-    SEEDS,
-    SMOOTH_GLASS,
-    XML,
-    _blocks,
-    _mitsuba,
-    _thin_fresnel,
-)
-from .test_glass import _ours as _ours_xyz
+from ._reference import SEEDS, assert_blocks_agree, blocks, icosahedron_obj, mitsuba_xyz, ours_xyz
+from .test_glass import SMOOTH_GLASS, XML, _thin_fresnel
 
 #: A green bottle glass: written-out samples, so both renderers read the same spectrum.
 TINT = "360:0.25, 450:0.3, 520:0.85, 560:0.8, 620:0.35, 830:0.3"
@@ -42,9 +32,7 @@ TINTED_GEM = (
 
 @pytest.fixture
 def tinted_box(tmp_path):
-    obj = "".join(f"v {x:.9f} {y:.9f} {z:.9f}\n" for x, y, z in _ICO_V)
-    obj += "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in _ICO_F)
-    (tmp_path / "gem.obj").write_text(obj)
+    (tmp_path / "gem.obj").write_text(icosahedron_obj())
     path = tmp_path / "box.xml"
     path.write_text(XML.replace(SMOOTH_GLASS, TINTED_GEM))
     return path
@@ -60,19 +48,13 @@ def test_a_tinted_gem_matches_mitsubas_own_spectral_path_render(tinted_box):
     Measured (16 seeds, 8 spp ours, 32 spp Mitsuba): |z| ≤ 2.2, block ratios 0.94–1.11,
     standard errors up to 7 % of the darkest block means. Without the tint in the band path
     the blocks differ by up to 3 × (the test fails)."""
-    from scipy.stats import t as student
-
     scene = load_mitsuba_xml(tinted_box)
     (glass,) = [m for m in scene.materials if m.name == "glass"]
     assert glass.tinted and glass.transmittance.startswith("inline:reflectance:")
-    runs = [_ours_xyz(scene, 8, seed) for seed in range(SEEDS)]
-    ours = np.stack([_blocks(image) for image, _ in runs])
-    theirs = np.stack([_blocks(image) for image in _mitsuba(tinted_box, 32)])
-    stderr = np.hypot(ours.std(axis=0, ddof=1), theirs.std(axis=0, ddof=1)) / np.sqrt(SEEDS)
-    diff = ours.mean(axis=0) - theirs.mean(axis=0)
-    bound = student.ppf(1 - FALSE_ALARM / (2 * diff.size), df=SEEDS - 1)
-    assert np.all(np.abs(diff) <= min(bound, 3.5) * stderr), np.abs(diff / stderr).max()
-    assert np.all(stderr < 0.1 * theirs.mean(axis=0)), (stderr / theirs.mean(axis=0)).max()
+    runs = [ours_xyz(scene, 8, seed) for seed in range(SEEDS)]
+    ours = np.stack([blocks(image) for image, _ in runs])
+    theirs = np.stack([blocks(image) for image in mitsuba_xyz(tinted_box, 32)])
+    assert_blocks_agree(ours, theirs, max_t=3.5)
 
     layers = {
         k: v.data.astype(np.float64)
