@@ -311,17 +311,17 @@ def test_the_passes_integrator_refuses_glass_in_one_line_before_any_work(glass_b
     assert not out.exists()
 
 
-def test_approximate_takes_a_tinted_reflection_as_clear_glass_and_says_so(glass_box):
-    """A tinted transmission is exact (``test_tinted_glass.py``); a tinted reflection is not."""
+def test_approximate_takes_a_tinted_mirror_as_untinted_and_says_so(glass_box):
+    """Tinted glass is exact (``test_tinted_glass.py``); a tinted conductor is not."""
     tinted = (
-        '<bsdf type="dielectric" id="glass">'
+        '<bsdf type="conductor" id="glass">'
         '<rgb name="specular_reflectance" value="0.5, 0.9, 0.5"/></bsdf>'
     )
     path = glass_box.with_name("tinted.xml")
     path.write_text(XML.replace(SMOOTH_GLASS, tinted))
     scene = load_mitsuba_xml(path, approximate=True)
     (glass,) = [m for m in scene.materials if m.name == "glass"]
-    assert glass.kind == "dielectric" and not glass.tinted
+    assert glass.kind == "conductor" and glass.metal == "none"
     (said,) = scene.metadata["approximated"]
     assert "specular_reflectance [0.5, 0.9, 0.5] taken as 1" in said
 

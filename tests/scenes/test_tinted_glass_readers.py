@@ -145,13 +145,45 @@ def test_xml_a_textured_tint_is_refused_in_one_line_or_taken_as_clear(tmp_path, 
     assert "textured specular_transmittance taken as 1" in said
 
 
-def test_xml_a_tinted_reflection_is_still_refused(tmp_path):
-    glass = (
-        '<bsdf type="dielectric" id="glass">'
+@pytest.mark.parametrize(
+    ("tint", "expected"),
+    [
+        ('<rgb name="specular_reflectance" value="0.5, 0.9, 0.5"/>', "rgb:0.5,0.9,0.5"),
+        ('<float name="specular_reflectance" value="0.6"/>', "flat:0.6"),
+        (
+            '<spectrum name="specular_reflectance" value="400:0.2, 700:0.9"/>',
+            "inline:reflectance:400.0=0.2,700.0=0.9",
+        ),
+        ('<float name="specular_reflectance" value="1"/>', ""),
+    ],
+)
+def test_xml_specular_reflectance_is_the_glass_reflection_tint(tmp_path, tint, expected):
+    """On every glass plugin, as ``specular_transmittance``; the other tint stays clear."""
+    ggx = '<string name="distribution" value="ggx"/><float name="alpha" value="0.2"/>'
+    for plugin in ("dielectric", "thindielectric", "roughdielectric"):
+        rough = ggx if plugin == "roughdielectric" else ""
+        glass = f'<bsdf type="{plugin}" id="glass">{rough}{tint}</bsdf>'
+        (gem,) = [m for m in load_mitsuba_xml(_xml(tmp_path, glass)).materials if m.transmissive]
+        assert (gem.specular_reflectance, gem.transmittance) == (expected, "")
+        assert gem.tinted == bool(expected)
+
+
+def test_xml_a_textured_reflection_tint_or_a_tinted_conductor_is_refused(tmp_path, capsys):
+    """A ``bitmap`` reflection tint on glass, and any ``specular_reflectance`` on a conductor
+    (the band path's mirror and metal rows have no reflection tint), are refused in one line
+    (rc 2 from the command line)."""
+    from PIL import Image
+
+    Image.fromarray(np.full((4, 4, 3), 128, np.uint8)).save(tmp_path / "tint.png")
+    path = _xml(tmp_path, _BITMAP_TINT.replace("specular_transmittance", "specular_reflectance"))
+    err = _refused(capsys, path, tmp_path / "out")
+    assert "specular_reflectance" in err and "textured tint" in err
+    mirror = (
+        '<bsdf type="conductor" id="glass"><string name="material" value="none"/>'
         '<rgb name="specular_reflectance" value="0.5, 0.9, 0.5"/></bsdf>'
     )
-    with pytest.raises(SceneError, match="specular_reflectance"):
-        load_mitsuba_xml(_xml(tmp_path, glass))
+    err = _refused(capsys, _xml(tmp_path, mirror), tmp_path / "out")
+    assert "specular_reflectance [0.5, 0.9, 0.5]" in err and "only 1" in err
 
 
 # -- glTF ------------------------------------------------------------------------------------
@@ -277,8 +309,8 @@ def test_blender_principled_base_color_tints_each_crossing_by_its_square_root():
             "fed by a node",
         ),
         (
-            _Mat("Green", _Node("BSDF_GLASS", Color=(0.2, 0.9, 0.2, 1), Roughness=0.0, IOR=1.5)),
-            "tints its reflection too",
+            _Mat("Green", _Node("BSDF_GLASS", ("Color",), Color=(1, 1, 1, 1), Roughness=0.0, IOR=1.5)),
+            "Color fed by a node",
         ),
         (
             _Mat("Old", _principled(Transmission=1.0, Base_Color=(0.2, 0.9, 0.2, 1))),
@@ -286,7 +318,7 @@ def test_blender_principled_base_color_tints_each_crossing_by_its_square_root():
         ),
     ],
 )
-def test_blender_a_textured_tint_or_a_tinted_glass_bsdf_is_refused_in_one_line(mat, expected):
+def test_blender_a_textured_tint_is_refused_in_one_line(mat, expected):
     with pytest.raises(SceneError) as info:
         principled_gloss(mat)
     message = str(info.value)

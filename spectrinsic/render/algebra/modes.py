@@ -169,12 +169,15 @@ class ChannelValues:
         ``(M, K)`` float64 band values ``∫T_m S_k / ∫S_k`` of each glass's transmittance, as
         :attr:`materials` of its reflectance (1 for clear glass and every other material),
         when the scene has tinted glass; ``None`` otherwise.
+    specular_reflectance
+        ``(M, K)`` band values of each glass's reflection tint, as :attr:`transmittance`.
     """
 
     materials: np.ndarray
     lights: np.ndarray
     specular: np.ndarray | None = None
     transmittance: np.ndarray | None = None
+    specular_reflectance: np.ndarray | None = None
 
 
 def light_spectra(
@@ -222,6 +225,7 @@ def channel_values(
     curves = sensors.on(wavelengths)
     rho = _reflectances(scene, wavelengths, data_dir)
     emission = light_spectra(scene, wavelengths, data_dir=data_dir)
+    tinted = any(m.tinted for m in scene.materials)
     return ChannelValues(
         materials=diagonal_values(rho, curves, wavelengths)
         if len(rho)
@@ -232,23 +236,21 @@ def channel_values(
         specular=_specular(scene, curves, wavelengths)
         if any(m.glossy for m in scene.materials)
         else None,
-        transmittance=_transmittance(scene, curves, wavelengths, data_dir)
-        if any(m.tinted for m in scene.materials)
+        transmittance=_tint(scene, "transmittance", curves, wavelengths, data_dir)
+        if tinted
+        else None,
+        specular_reflectance=_tint(scene, "specular_reflectance", curves, wavelengths, data_dir)
+        if tinted
         else None,
     )
 
 
-def _transmittance(
-    scene: Scene, curves: np.ndarray, wavelengths: Wavelengths, data_dir: str | None
+def _tint(
+    scene: Scene, key: str, curves: np.ndarray, wavelengths: Wavelengths, data_dir: str | None
 ) -> np.ndarray:
-    """``(M, K)`` band values of every material's transmittance (1 where it has none)."""
+    """``(M, K)`` band values of every material's glass tint *key* (1 where it has none)."""
     spectra = np.stack(
-        [
-            get_spectrum(m.transmittance, data_dir=data_dir).on(wavelengths)
-            if m.tinted
-            else np.ones(np.size(wavelengths))
-            for m in scene.materials
-        ]
+        [get_spectrum(m.tint(key), data_dir=data_dir).on(wavelengths) for m in scene.materials]
     )
     return diagonal_values(spectra, curves, wavelengths)
 
