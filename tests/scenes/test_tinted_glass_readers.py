@@ -309,7 +309,9 @@ def test_blender_principled_base_color_tints_each_crossing_by_its_square_root():
             "fed by a node",
         ),
         (
-            _Mat("Green", _Node("BSDF_GLASS", ("Color",), Color=(1, 1, 1, 1), Roughness=0.0, IOR=1.5)),
+            _Mat(
+                "Green", _Node("BSDF_GLASS", ("Color",), Color=(1, 1, 1, 1), Roughness=0.0, IOR=1.5)
+            ),
             "Color fed by a node",
         ),
         (
