@@ -1,7 +1,8 @@
-"""Tinted glass in every reader: YAML ``transmittance``, Mitsuba XML ``specular_transmittance``,
-glTF ``KHR_materials_transmission`` with a ``baseColorFactor``, Blender's Principled Base Color
-under Transmission 1; a textured tint (and what has no exact counterpart) refused in one line,
-rc 2 on the command line before any work."""
+"""Tinted glass in every reader: YAML ``transmittance`` and ``specular_reflectance``, Mitsuba
+XML ``specular_transmittance`` and ``specular_reflectance``, glTF ``KHR_materials_transmission``
+with a ``baseColorFactor``, Blender's Principled Base Color under Transmission 1 and Glass BSDF
+Color; a textured tint (and what has no exact counterpart) refused in one line, rc 2 on the
+command line before any work."""
 
 from __future__ import annotations
 
@@ -387,3 +388,60 @@ def test_a_blend_file_reads_a_principled_tint_and_refuses_a_textured_one(tmp_pat
         else:
             (glass,) = [m for m in load_blend(out).materials if m.transmissive]
             assert glass.transmittance == "rgb:0.5,0.75,0.25"
+
+
+def test_blender_glass_bsdf_color_tints_reflection_and_transmission_alike():
+    """Cycles' Glass BSDF sets the Fresnel's reflection and transmission tints both to its
+    Color, once per interaction (no square root, unlike the Principled)."""
+    node = _Node("BSDF_GLASS", Color=(0.25, 0.5, 0.75, 1), Roughness=0.0, IOR=1.5)
+    assert principled_gloss(_Mat("Green", node)) == {
+        "kind": "dielectric", "ior": 1.5, "roughness": 0.0,
+        "transmittance": "rgb:0.25,0.5,0.75", "specular_reflectance": "rgb:0.25,0.5,0.75",
+    }  # fmt: skip
+
+
+def test_a_blend_file_reads_a_glass_bsdf_color_as_both_tints_and_refuses_a_textured_one(
+    tmp_path, capsys
+):
+    """Through bpy: a Glass BSDF of Color (0.25, 0.5625, 0.0625) is glass whose transmittance
+    and reflection tint are both that colour; an Image Texture feeding its Color is refused in
+    one line, rc 2 before any work."""
+    pytest.importorskip("bpy", reason="the optional 'blender' extra (bpy) is not installed")
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from spectrinsic.scenes.blender import load_blend
+
+    make = Path(__file__).with_name("make_blend_gloss.py")
+    for tint in ("0.25,0.5625,0.0625", "textured"):
+        out = tmp_path / f"glass-{tint[:4]}.blend"
+        proc = subprocess.run(
+            [sys.executable, "-P", str(make), "--", str(out), f"glass-bsdf:{tint}"],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+        assert proc.returncode == 0 and out.is_file(), proc.stderr[-2000:]
+        if tint == "textured":
+            err = _refused(capsys, out, tmp_path / "out")
+            assert "'Glass'" in err and "Color fed by a node" in err
+        else:
+            (glass,) = [m for m in load_blend(out).materials if m.transmissive]
+            expected = "rgb:0.25,0.5625,0.0625"
+            assert (glass.transmittance, glass.specular_reflectance) == (expected, expected)
+            assert (glass.kind, glass.ior) == ("dielectric", pytest.approx(1.52))
+
+
+def test_yaml_glass_takes_a_reflection_tint_and_writes_it_back():
+    gem = {"kind": "dielectric", "transmittance": "flat:0.5", "specular_reflectance": "rgb:1,0,0"}
+    parsed = parse_material("gem", gem)
+    assert isinstance(parsed, Material) and parsed.tinted
+    assert parsed.specular_reflectance == "rgb:1,0,0"
+    assert material_entry(parsed) == gem | {"ior": 1.5, "roughness": 0.0}
+    assert parse_material("gem", material_entry(parsed)) == parsed
+    only = parse_material("pane", {"kind": "thindielectric", "specular_reflectance": "flat:0.2"})
+    assert isinstance(only, Material) and only.tinted and only.transmittance == ""
+    assert "specular_reflectance" in parse_material(
+        "foil", {"kind": "conductor", "metal": "none", "specular_reflectance": "flat:0.5"}
+    )  # a mirror has no reflection tint (refused: unknown key)
