@@ -228,6 +228,11 @@ def test_gltf_a_base_colour_factor_tints_the_glass(tmp_path):
     solid = _TRANSMISSION | {"KHR_materials_volume": {"thicknessFactor": 0.1}}
     (gem,) = load_mesh_scene(_gltf(tmp_path, solid, pbr), materials={}, width=8, height=8).materials
     assert (gem.kind, gem.transmittance) == ("dielectric", "rgb:0.2,0.9,0.25")
+    plain = {"KHR_materials_specular": {"specularFactor": 1, "specularColorFactor": [1, 1, 1]}}
+    (gem,) = load_mesh_scene(
+        _gltf(tmp_path, solid | plain, pbr), materials={}, width=8, height=8
+    ).materials  # KHR_materials_specular at its defaults changes nothing
+    assert (gem.transmittance, gem.specular_reflectance) == ("rgb:0.2,0.9,0.25", "")
 
 
 @pytest.mark.parametrize(
@@ -248,6 +253,11 @@ def test_gltf_a_base_colour_factor_tints_the_glass(tmp_path):
             _TRANSMISSION,
             {"baseColorFactor": [1.5, 0.5, 0.5, 1.0]},
             "expected 3 or 4 numbers in [0, 1]",
+        ),
+        (
+            _TRANSMISSION | {"KHR_materials_specular": {"specularColorFactor": [1, 0.5, 0.5]}},
+            {"roughnessFactor": 0.0},
+            "no exact reflection tint",
         ),
     ],
 )
