@@ -11,7 +11,7 @@ A material is a spectrum name (Lambertian, as before) or a mapping::
       vase: {kind: dielectric, ior: 1.5, roughness: 0}  # clear glass, solid
       pane: {kind: thindielectric, ior: 1.5}            # clear glass, a thin sheet
       bottle: {kind: dielectric, transmittance: "rgb:0.2,0.6,0.3"}  # tinted glass
-      gem: {kind: dielectric, transmittance: "rgb:0.9,0.3,0.3", specular_reflectance: "rgb:0.9,0.3,0.3"}
+      gem: {kind: dielectric, specular_reflectance: "rgb:0.9,0.3,0.3"}  # tinted reflections
 
 ``plastic`` is a diffuse base under a dielectric coat of index ``ior`` (Mitsuba ``plastic``,
 or ``roughplastic`` when ``roughness`` > 0); ``conductor`` is a metal with Mitsuba's measured

@@ -114,15 +114,13 @@ def _tables(
     )
 
 
-def _tint_table(
-    scene: Scene, value_sets: Sequence[ChannelValues], key: str
-) -> np.ndarray | None:
-    """``(M + 1, K)`` band values of every material's glass tint *key* (the value sets' side
+def _tint_table(scene: Scene, sets: Sequence[ChannelValues], key: str) -> np.ndarray | None:
+    """``(M + 1, K)`` band values of every material's glass tint *key* (the value *sets*' side
     by side over bands; the last row, black, ones), or ``None`` without tinted glass."""
     if not any(m.tinted for m in scene.materials):
         return None
-    tables = [getattr(v, key) for v in value_sets if getattr(v, key) is not None]
-    if len(tables) != len(value_sets):
+    tables = [getattr(v, key) for v in sets if getattr(v, key) is not None]
+    if len(tables) != len(sets):
         raise RenderError(
             f"scene {scene.name!r} has tinted glass but its channel values carry no {key}"
         )
