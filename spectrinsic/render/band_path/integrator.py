@@ -4,22 +4,14 @@ Today's diagonal modes render ⌈K/3⌉ RGB passes that trace identical paths (c
 numbers) and differ only in the channel values of materials and lights (Eq. 5.2). A Lambertian
 vertex multiplies the throughput by its material's band albedo ρ_k and a light adds its band
 value E_k; neither changes the path. So one traversal can carry all K bands at once:
-:class:`BandPath` (built by :func:`band_path_class`) is Mitsuba's ``path`` integrator
-(``src/integrators/path.cpp``: emitter hits and next-event estimation with the same power-
-heuristic MIS, the same sampler calls in the same order) written in Python on Dr.Jit, whose
-throughput is a list of K band products gathered from a per-material table, and whose
-contributions go to one accumulator per (light, band). Its loop is the one body of
-:class:`~spectrinsic.render.band_path.kernel.BandKernel`; ``gloss`` and ``metals`` switch on its
-glossy (G1) factors with the specular part and the white-at-metal loop when it is traced
-("metal" there: any first hit without a diffuse lobe, metal, mirror or glass).
-
-The scene is loaded with white Lambertian surfaces (area-light shapes black) and unit white
-emitters, so Mitsuba's own BSDF and emitter sampling give the band-independent factors
-(cosine, pdfs, visibility, spot falloff); the integrator multiplies each by
-``ρ[material(shape), k]`` along the path. Its output is the **light transport** of each light
-for unit emission, ``T_{l,k}`` per pixel, ``(H, W, L·K)``; the K-channel image is
-``Σ_l E_{l,k} T_{l,k}``, equal to the diagonal passes' image to float rounding (same seed, spp
-and paths), and each light's share is exact: the per-light images sum to the total.
+:class:`BandPath` (built by :func:`band_path_class`) runs the one loop of
+:class:`~spectrinsic.render.band_path.kernel.BandKernel` (Mitsuba's ``path`` on K band
+throughputs, its ``gloss`` and ``metals`` features switched on when traced; that module says
+how) on the scene loaded with white Lambertian surfaces (area-light shapes black) and unit
+white emitters. Its output is the **light transport** of each light for unit emission,
+``T_{l,k}`` per pixel, ``(H, W, L·K)``; the K-channel image is ``Σ_l E_{l,k} T_{l,k}``, equal
+to the diagonal passes' image to float rounding (same seed, spp and paths), and each light's
+share is exact: the per-light images sum to the total.
 
 Material and emitter indices come from Mitsuba's registry ids of ``si.shape`` and
 ``ds.emitter`` (``dr.reinterpret_array``), mapped through lookup tables built after loading.
@@ -218,14 +210,8 @@ def _empty_tables(mi: Any, it: Any) -> None:
     it.albedo = mi.Float(np.zeros(it.n_bands, np.float32))
     it.shape_lut = mi.UInt32(np.zeros(1, np.uint32))
     it.emitter_lut = mi.UInt32(np.zeros(1, np.uint32))
-    _set_envmaps(it, None)
-
-
-def _set_envmaps(it: Any, tables: BandTables | None) -> None:
-    """Integrator *it*'s light channels and extra environment maps from *tables* (none: every
-    light its own emitter's component 0, no extra map)."""
-    it.light_channels = () if tables is None else tables.channels()
-    it.extra_maps = () if tables is None else tuple(tables.extra_maps)
+    it.light_channels = tuple((j, 0, 0) for j in range(it.n_lights))
+    it.extra_maps = ()
 
 
 def _init_maps(mi: Any, it: Any, props: Any) -> None:
@@ -234,12 +220,6 @@ def _init_maps(mi: Any, it: Any, props: Any) -> None:
     it.map_lut = mi.UInt32(np.zeros(1, np.uint32))
     #: (kind, texture, bump scale) of each bump- or normal-mapped shape (surface_maps)
     it.surface_maps = []
-
-
-def _init_features(mi: Any, it: Any, props: Any) -> None:
-    """The glossy (:func:`_init_gloss`) and mask and map (:func:`_init_maps`) properties."""
-    _init_gloss(mi, it, props)
-    _init_maps(mi, it, props)
 
 
 def _set_maps(mi: Any, dr: Any, it: Any, scene: Any, tables: BandTables) -> None:
@@ -288,7 +268,8 @@ def _make_class(mi: Any, dr: Any) -> type:
             self.n_surfaces = int(props.get("n_surfaces", 0))
             self.n_texcols = int(props.get("n_texcols", 0))
             _empty_tables(mi, self)
-            _init_features(mi, self, props)
+            _init_gloss(mi, self, props)
+            _init_maps(mi, self, props)
 
         def set_tables(self, scene: Any, tables: BandTables) -> None:
             """Point the lookups at *tables* for the loaded *scene* (no recompilation)."""
@@ -299,7 +280,7 @@ def _make_class(mi: Any, dr: Any) -> type:
             lookups = texture_lookups(mi, dr, scene, tables.textures, tables.shape_textures)
             self.slot_lut, self.tex_widths, self.tex_heights, self.tex_offsets = lookups[:4]
             self.texel_albedo, self.texel_weights = lookups[4:]
-            _set_envmaps(self, tables)
+            self.light_channels, self.extra_maps = tables.channels(), tuple(tables.extra_maps)
             _set_maps(mi, dr, self, scene, tables)
             _set_transmittance(mi, self, tables)
 

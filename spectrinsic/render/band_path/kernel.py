@@ -4,8 +4,9 @@
 emitter hits and next-event estimation with the power-heuristic :func:`mis_weight`, the same
 sampler calls in the same order) whose throughput is a list of K band products and whose
 contributions go to one accumulator per (light, band). The scene is loaded white, so Mitsuba's
-own BSDF and emitter sampling give the band-independent factors; the kernel multiplies each by a
-band factor ``c_k`` of the vertex (:mod:`spectrinsic.render.band_path.integrator` builds the integrator).
+own BSDF and emitter sampling give the band-independent factors (cosine, pdfs, visibility, spot
+falloff); the kernel multiplies each by a band factor ``c_k`` of the vertex
+(:mod:`spectrinsic.render.band_path.integrator` builds the integrator).
 One body, three loops, told apart by Python flags read while Dr.Jit traces the kernel (as
 Mitsuba's ``prb.py`` switches its features), so each traced kernel holds only its own steps:
 
@@ -196,10 +197,7 @@ class BandKernel:
         """ρ_k of the material of the shape hit (the black row elsewhere), or of the nearest
         texel on a textured shape."""
         mi, dr, k = self.mi, self.dr, self.it.n_bands
-        valid = si.is_valid()
-        row = dr.gather(
-            mi.UInt32, self.it.shape_lut, dr.reinterpret_array(mi.UInt32, si.shape), valid
-        )
+        valid, row = si.is_valid(), self.row(si)
         rho = [dr.gather(mi.Float, self.it.albedo, row * k + b, valid) for b in range(k)]
         if not self.it.n_texcols:
             return rho
@@ -222,13 +220,12 @@ class BandKernel:
         """``acc[j·K + k] += bands[k]·weights[m_j][c_j]`` on the lanes whose emitter is light
         j's owner ``o_j``. *weights* are RGB values (``Color3f``): the emitter's own, then one
         per extra environment map (:meth:`extra_maps_at`); ``(o_j, c_j, m_j)`` =
-        ``it.light_channels[j]`` (Python ints, read when traced; empty: ``(j, 0, 0)`` for
-        every light). Only an environment map's channel lights take another component or
+        ``it.light_channels[j]`` (Python ints, read when traced; ``(j, 0, 0)`` for a light of
+        its own). Only an environment map's channel lights take another component or
         source: the emitters are loaded white, so today's components are equal and component
         0 of the emitter's own value is exactly the scalar of before."""
         k, out = self.it.n_bands, list(acc)
-        triples = self.it.light_channels or [(j, 0, 0) for j in range(self.it.n_lights)]
-        for j, (owner, channel, source) in enumerate(triples):
+        for j, (owner, channel, source) in enumerate(self.it.light_channels):
             w = self.dr.select(mask & (light == owner), weights[source][channel], 0.0)
             for b in range(k):
                 out[j * k + b] = self.dr.fma(bands[b], w, out[j * k + b])
@@ -313,8 +310,8 @@ class BandKernel:
             towards.wi = -ds.d
             nee += self.extra_maps_at(towards, bsdf_val[0] * mis_em / ds.pdf, active_em)
         nee = tuple(s.beta * w for w in nee)
+        light = self.light_of(ds.emitter, active_em)
         if not self.gloss:
-            light = self.light_of(ds.emitter, active_em)
             return _Vertex(light, nee, active_em, bsdf_sample, bsdf_weight[0])
         em_lobes = self.lobes(si, bsdf, wo_em, mi.Bool(False), active_em)
         delta = mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
@@ -322,7 +319,6 @@ class BandKernel:
         if self.it.tinted:  # the sampled lobe says it exactly, also in a bump map's frame
             through = mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Transmission)
             bs_lobes = (*bs_lobes[:2], dr.select(through, 1.0, 0.0))
-        light = self.light_of(ds.emitter, active_em)
         return _Vertex(light, nee, active_em, bsdf_sample, bsdf_weight[0], em_lobes, bs_lobes)
 
     def specular_bands(self, row: UInt, mu: Float, valid: Bool) -> list[Float]:

@@ -146,10 +146,6 @@ def _mitsuba_mesh(mi: Any, part: SurfaceGeometry, bsdf: Mapping) -> Any:
     return mesh
 
 
-def _lambertian(reflectance: Mapping) -> dict[str, Any]:
-    return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": dict(reflectance)}}
-
-
 def material_bsdf(
     material: Material,
     reflectance: Mapping,
@@ -171,7 +167,7 @@ def material_bsdf(
     Lambertian.
     """
     if material.kind == "diffuse":
-        return _lambertian(reflectance)
+        return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": dict(reflectance)}}
     rough = material.roughness > 0.0
     if material.transmissive:  # a thindielectric is always smooth (materials.py)
         glass = {"type": material.kind, "int_ior": float(material.ior), "ext_ior": 1.0}
@@ -258,63 +254,59 @@ def envmap_entry(mi: Any, light: Light, emission: Mapping) -> dict[str, Any]:
 
 
 def _light(mi: Any, light: Light, emission: Mapping | None, what: str) -> dict[str, Any] | None:
-    if light.kind == "envmap":
-        return None if emission is None else envmap_entry(mi, light, emission)
-    if light.kind == "point":
-        return (
-            None
-            if emission is None
-            else {
-                "type": "point",
-                "position": list(map(float, light.position)),
-                "intensity": dict(emission),
-            }
-        )
-    if light.kind == "spot":
-        return (
-            None
-            if emission is None
-            else {
-                "type": "spot",
-                "to_world": _look_at(mi, light.position, light.direction, what),
-                "cutoff_angle": float(light.cutoff_deg),
-                "intensity": dict(emission),
-            }
-        )
-    if light.kind == "directional":
-        return (
-            None
-            if emission is None
-            else {
-                "type": "directional",
-                "direction": list(map(float, light.direction)),
-                "irradiance": dict(emission),
-            }
-        )
-    if light.kind == "sky":
-        return None if emission is None else {"type": "constant", "radiance": dict(emission)}
+    """The Mitsuba entry of *light* emitting *emission*; ``None`` leaves it out (the shape of
+    an area or sphere light stays, black)."""
     if light.kind in _SHAPE_LIGHTS:
-        w, h = (float(s) for s in light.size)
-        shape: dict[str, Any] = (
-            {
-                "type": "rectangle",
-                "to_world": _look_at(mi, light.position, light.direction, what)
-                @ mi.ScalarTransform4f().scale([w / 2, h / 2, 1.0]),
-            }
-            if light.kind == "area"
-            else {
-                "type": "sphere",
-                "center": list(map(float, light.position)),
-                "radius": float(light.radius),
-            }
-        )
-        # an instance, not a dict: load_dict merges identical dicts into one shared BSDF,
-        # and every surface needs its own for the per-surface coverage passes
-        shape["bsdf"] = mi.load_dict(black_bsdf())
-        if emission is not None:
-            shape["emitter"] = {"type": "area", "radiance": dict(emission)}
-        return shape
-    raise SceneError(f"{what}: {unknown_light_kind(light.kind)}")
+        return _shape_light(mi, light, emission, what)
+    if light.kind not in _EMISSION_PARAM:
+        raise SceneError(f"{what}: {unknown_light_kind(light.kind)}")
+    if emission is None:
+        return None
+    if light.kind == "envmap":
+        return envmap_entry(mi, light, emission)
+    if light.kind == "point":
+        return {
+            "type": "point",
+            "position": list(map(float, light.position)),
+            "intensity": dict(emission),
+        }
+    if light.kind == "spot":
+        return {
+            "type": "spot",
+            "to_world": _look_at(mi, light.position, light.direction, what),
+            "cutoff_angle": float(light.cutoff_deg),
+            "intensity": dict(emission),
+        }
+    if light.kind == "directional":
+        return {
+            "type": "directional",
+            "direction": list(map(float, light.direction)),
+            "irradiance": dict(emission),
+        }
+    return {"type": "constant", "radiance": dict(emission)}  # sky
+
+
+def _shape_light(mi: Any, light: Light, emission: Mapping | None, what: str) -> dict[str, Any]:
+    w, h = (float(s) for s in light.size)
+    shape: dict[str, Any] = (
+        {
+            "type": "rectangle",
+            "to_world": _look_at(mi, light.position, light.direction, what)
+            @ mi.ScalarTransform4f().scale([w / 2, h / 2, 1.0]),
+        }
+        if light.kind == "area"
+        else {
+            "type": "sphere",
+            "center": list(map(float, light.position)),
+            "radius": float(light.radius),
+        }
+    )
+    # an instance, not a dict: load_dict merges identical dicts into one shared BSDF,
+    # and every surface needs its own for the per-surface coverage passes
+    shape["bsdf"] = mi.load_dict(black_bsdf())
+    if emission is not None:
+        shape["emitter"] = {"type": "area", "radiance": dict(emission)}
+    return shape
 
 
 def _camera(mi: Any, scene: Scene, film: Mapping, sample_count: int) -> dict[str, Any]:
