@@ -354,8 +354,8 @@ def band_path(
     columns (:class:`TextureTables`) if not 0, the glossy (G1) factors and specular part with
     *gloss*, and the white-surface radiance at metal first hits with *metals* (implies *gloss*;
     :mod:`~spectrinsic.render.band_path.kernel`), null events through opacity masks with
-    *masks*, and the band transmittance of tinted glass (:attr:`BandTables.transmittance`) with
-    *tinted*."""
+    *masks*, and the band transmittance and reflection tint of tinted glass
+    (:attr:`BandTables.transmittance`, :attr:`BandTables.specular_reflectance`) with *tinted*."""
     band_path_class(mi.variant())
     return mi.load_dict(
         {

@@ -339,7 +339,8 @@ class BandKernel:
         self, rho: list[Float], row: UInt, lobes: tuple[Float, ...], valid: Bool
     ) -> tuple[list[Float], list[Float]]:
         """(G1) ``c_k`` and its non-diffuse part ``s_k (1 − a)`` for ``lobes = (a, μ)``, or
-        ``(a, μ, through)`` with tinted glass (``s_k`` times ``T_k`` where *through* is 1)."""
+        ``(a, μ, through)`` with tinted glass (``s_k`` times ``T_k`` where *through* is 1, else
+        ``R_k``)."""
         a, mu = lobes[:2]
         bands = self.specular_bands(row, mu, valid)
         if self.it.tinted:
