@@ -118,8 +118,9 @@ def render_spectral(
             {
                 param: regular_spectrum(get_spectrum(m.tint(key), data_dir=data_dir).on(wl), wl)
                 for key, param in GLASS_TINTS.items()
+                if m.transmissive or getattr(m, key)  # a conductor has only a reflection tint
             }
-            if m.tinted
+            if m.tinted or m.specular_reflectance
             else None
             for m in scene.materials
         ]

@@ -12,6 +12,7 @@ A material is a spectrum name (Lambertian, as before) or a mapping::
       pane: {kind: thindielectric, ior: 1.5}            # clear glass, a thin sheet
       bottle: {kind: dielectric, transmittance: "rgb:0.2,0.6,0.3"}  # tinted glass
       gem: {kind: dielectric, specular_reflectance: "rgb:0.9,0.3,0.3"}  # tinted reflections
+      foil: {kind: conductor, metal: none, specular_reflectance: "rgb:0.9,0.6,0.2"}  # coloured mirror
 
 ``plastic`` is a diffuse base under a dielectric coat of index ``ior`` (Mitsuba ``plastic``,
 or ``roughplastic`` when ``roughness`` > 0); ``conductor`` is a metal with Mitsuba's measured
@@ -24,7 +25,8 @@ no diffuse lobe either and a constant ``ior`` (no dispersion). Glass is clear un
 transmission through the surface, not its reflections (Mitsuba's ``specular_transmittance``:
 twice through a solid, entering and leaving; once through a pane), and a
 ``specular_reflectance`` likewise multiplies each reflection off it (Mitsuba's parameter of
-that name; a Blender Glass BSDF's Color is both).
+that name; a Blender Glass BSDF's Color is both). A ``conductor`` takes a
+``specular_reflectance`` too (its Fresnel times the tint; ``metal: none`` a coloured mirror).
 ``roughness`` is the GGX α in [0, 1] (0 = smooth); ``ior`` lies in (1, 3].
 
 A ``textured`` material is a spectral texture (:mod:`spectrinsic.scenes.textures`): per texel a
@@ -81,7 +83,7 @@ _TEXTURED_KEYS = ("kind", "basis", "pattern", "size", "seed", "weights")
 _KEYS = {
     "diffuse": ("kind", "spectrum"),
     "plastic": ("kind", "spectrum", "ior", "roughness"),
-    "conductor": ("kind", "metal", "roughness"),
+    "conductor": ("kind", "metal", "roughness", "specular_reflectance"),
     "dielectric": ("kind", "ior", "roughness", *GLASS_TINTS),
     "thindielectric": ("kind", "ior", *GLASS_TINTS),
 }
@@ -120,8 +122,10 @@ def material_problem(m: Material) -> str | None:
         tint = getattr(m, key)
         if not isinstance(tint, str):
             return f"{key} {tint!r}: expected a spectrum name"
-        if tint and not m.transmissive:
-            return f"{key} {tint!r} given for a {m.kind} material (only for glass)"
+        allowed = m.transmissive or (m.kind == "conductor" and key == "specular_reflectance")
+        if tint and not allowed:
+            where = "glass and conductors" if key == "specular_reflectance" else "glass"
+            return f"{key} {tint!r} given for a {m.kind} material (only for {where})"
     if m.kind == "conductor":
         try:
             check_conductor(m.metal)

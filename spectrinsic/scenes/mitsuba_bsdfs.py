@@ -5,8 +5,9 @@ Read exactly: ``diffuse`` (``reflectance``), ``plastic`` and ``roughplastic``
 1.000277), ``conductor`` and ``roughconductor`` (``material``, one of Mitsuba's measured
 metals), the rough ones with ``alpha`` and the ``ggx`` distribution (Mitsuba's default,
 ``beckmann``, is refused: the renderer's microfacets are GGX), bare or in a ``twosided`` with one BSDF (or two equal
-ones). A ``specular_reflectance`` other than 1 on these has no exact counterpart and is
-refused (on glass it is read, below). A
+ones). A conductor's ``specular_reflectance`` (``rgb``, ``spectrum``, ``float``) is read as
+its reflection tint, exactly (the band path multiplies its band Fresnel by it); a plastic's
+other than 1 has no exact counterpart and is refused. A
 ``conductor`` with ``material`` ``none`` (or none given, Mitsuba's default) is the perfect mirror.
 
 Glass (:data:`GLASS`) is read exactly: ``dielectric``, ``thindielectric`` and
@@ -158,7 +159,6 @@ def material_of(node: XmlNode, what: str, base: Path, say: Say) -> Material | No
         return Material(name or spectrum, spectrum)
     if kind in GLASS:
         return _glass(node, name, alpha, what, base, say)
-    _unit_specular(node, what, say)
     if kind.endswith("conductor"):
         metal = node.props.get("material", PERFECT_MIRROR)
         if not isinstance(metal, str) or not metal:
@@ -171,7 +171,9 @@ def material_of(node: XmlNode, what: str, base: Path, say: Say) -> Material | No
             kind="conductor",
             roughness=alpha,
             metal=metal,
+            specular_reflectance=_tint(node, "specular_reflectance", what, base, say),
         )
+    _unit_specular(node, what, say)
     spectrum = _colour(node, "diffuse_reflectance", what, base, say)
     ior = _number(node, "int_ior", 1.49, what) / _number(node, "ext_ior", 1.000277, what)
     return Material(

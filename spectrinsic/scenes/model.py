@@ -149,10 +149,11 @@ class Material:
         refraction of a ``dielectric``, the straight pass of a ``thindielectric``), not its
         reflections, as Mitsuba's ``specular_transmittance``; only for glass kinds.
     specular_reflectance
-        Registry name of a glass's reflection tint R_t(λ) in [0, 1] (as *transmittance*), or
-        ``""`` (1): it multiplies every reflection off the surface (the Fresnel-weighted
-        reflected lobe), not its transmissions, as Mitsuba's ``specular_reflectance``;
-        only for glass kinds (a Blender Glass BSDF's Color is both tints).
+        Registry name of a glass's or conductor's reflection tint R_t(λ) in [0, 1] (as
+        *transmittance*), or ``""`` (1): it multiplies every reflection off the surface (the
+        Fresnel-weighted reflected lobe), not its transmissions, as Mitsuba's
+        ``specular_reflectance``; only for glass and conductor kinds (a Blender Glass BSDF's
+        Color is both of a glass's tints; a tinted ``metal: none`` is a coloured mirror).
     """
 
     name: str
@@ -185,10 +186,9 @@ class Material:
         return self.transmissive and bool(self.transmittance or self.specular_reflectance)
 
     def tint(self, key: str) -> str:
-        """The spectrum name of tint *key* (of :data:`GLASS_TINTS`): ``"flat:1"`` where
-        untinted and for every material but glass."""
-        name = str(getattr(self, key)) if self.transmissive else ""
-        return name or "flat:1"
+        """The spectrum name of tint *key* (of :data:`GLASS_TINTS`), ``"flat:1"`` where
+        untinted (:func:`material_problem` allows tints on glass and conductors only)."""
+        return str(getattr(self, key)) or "flat:1"
 
 
 def _named_class(mesh: Mesh) -> bool:

@@ -268,8 +268,8 @@ def test_a_thin_pane_shows_the_wall_behind_it_in_specular_at_its_transmittance()
             '<bsdf type="thindielectric" id="glass"><string name="int_ior" value="glass"/></bsdf>',
             "int_ior 'glass'",
         ),
-        (  # a dimmed mirror gem: Mitsuba's specular_reflectance scales F; refused as a tint
-            '<bsdf type="conductor" id="glass"><string name="material" value="none"/>'
+        (  # a plastic's specular_reflectance scales its coat's reflection: refused as a tint
+            '<bsdf type="plastic" id="glass">'
             '<float name="specular_reflectance" value="0.5"/></bsdf>',
             "specular_reflectance 0.5",
         ),
@@ -311,17 +311,18 @@ def test_the_passes_integrator_refuses_glass_in_one_line_before_any_work(glass_b
     assert not out.exists()
 
 
-def test_approximate_takes_a_tinted_mirror_as_untinted_and_says_so(glass_box):
-    """Tinted glass is exact (``test_tinted_glass.py``); a tinted conductor is not."""
+def test_approximate_takes_a_tinted_plastic_coat_as_untinted_and_says_so(glass_box):
+    """Tinted glass and conductors are exact (``test_tinted_glass.py``); a tinted plastic
+    coat is not."""
     tinted = (
-        '<bsdf type="conductor" id="glass">'
+        '<bsdf type="plastic" id="glass">'
         '<rgb name="specular_reflectance" value="0.5, 0.9, 0.5"/></bsdf>'
     )
     path = glass_box.with_name("tinted.xml")
     path.write_text(XML.replace(SMOOTH_GLASS, tinted))
     scene = load_mitsuba_xml(path, approximate=True)
     (glass,) = [m for m in scene.materials if m.name == "glass"]
-    assert glass.kind == "conductor" and glass.metal == "none"
+    assert glass.kind == "plastic"
     (said,) = scene.metadata["approximated"]
     assert "specular_reflectance [0.5, 0.9, 0.5] taken as 1" in said
 

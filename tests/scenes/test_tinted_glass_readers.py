@@ -169,22 +169,31 @@ def test_xml_specular_reflectance_is_the_glass_reflection_tint(tmp_path, tint, e
         assert gem.tinted == bool(expected)
 
 
-def test_xml_a_textured_reflection_tint_or_a_tinted_conductor_is_refused(tmp_path, capsys):
-    """A ``bitmap`` reflection tint on glass, and any ``specular_reflectance`` on a conductor
-    (the band path's mirror and metal rows have no reflection tint), are refused in one line
-    (rc 2 from the command line)."""
+def test_xml_a_textured_reflection_tint_or_a_tinted_plastic_is_refused(tmp_path, capsys):
+    """A ``bitmap`` reflection tint on glass, and any ``specular_reflectance`` on a plastic
+    (it scales the coat's reflection, which the band path does not tint), are refused in one
+    line (rc 2 from the command line); a conductor's is read."""
     from PIL import Image
 
     Image.fromarray(np.full((4, 4, 3), 128, np.uint8)).save(tmp_path / "tint.png")
     path = _xml(tmp_path, _BITMAP_TINT.replace("specular_transmittance", "specular_reflectance"))
     err = _refused(capsys, path, tmp_path / "out")
     assert "specular_reflectance" in err and "textured tint" in err
-    mirror = (
-        '<bsdf type="conductor" id="glass"><string name="material" value="none"/>'
+    coat = (
+        '<bsdf type="plastic" id="glass">'
         '<rgb name="specular_reflectance" value="0.5, 0.9, 0.5"/></bsdf>'
     )
-    err = _refused(capsys, _xml(tmp_path, mirror), tmp_path / "out")
+    err = _refused(capsys, _xml(tmp_path, coat), tmp_path / "out")
     assert "specular_reflectance [0.5, 0.9, 0.5]" in err and "only 1" in err
+    mirror = coat.replace('"plastic"', '"conductor"').replace(
+        "<rgb", '<string name="material" value="none"/><rgb'
+    )
+    (foil,) = [m for m in load_mitsuba_xml(_xml(tmp_path, mirror)).materials if m.metal]
+    assert (foil.kind, foil.metal, foil.specular_reflectance) == (
+        "conductor",
+        "none",
+        "rgb:0.5,0.9,0.5",
+    )
 
 
 # -- glTF ------------------------------------------------------------------------------------
@@ -452,6 +461,10 @@ def test_yaml_glass_takes_a_reflection_tint_and_writes_it_back():
     assert parse_material("gem", material_entry(parsed)) == parsed
     only = parse_material("pane", {"kind": "thindielectric", "specular_reflectance": "flat:0.2"})
     assert isinstance(only, Material) and only.tinted and only.transmittance == ""
-    assert "specular_reflectance" in parse_material(
-        "foil", {"kind": "conductor", "metal": "none", "specular_reflectance": "flat:0.5"}
-    )  # a mirror has no reflection tint (refused: unknown key)
+    foil = {"kind": "conductor", "metal": "none", "specular_reflectance": "flat:0.5"}
+    parsed = parse_material("foil", foil)  # a coloured mirror
+    assert isinstance(parsed, Material) and not parsed.tinted  # tinted: glass only
+    assert material_entry(parsed) == foil | {"roughness": 0.0}
+    assert "unknown key 'specular_reflectance'" in parse_material(
+        "coat", {"kind": "plastic", "spectrum": "flat:0.5", "specular_reflectance": "flat:0.5"}
+    )

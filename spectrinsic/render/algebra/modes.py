@@ -36,7 +36,7 @@ import numpy as np
 
 from ...arrays import Wavelengths
 from ...errors import RenderError, SpectralDataError, validate_choice
-from ...scenes.model import Scene
+from ...scenes.model import Material, Scene
 from ...spectra import (
     COLORIMETRIC_WAVELENGTHS,
     SensorSet,
@@ -233,7 +233,7 @@ def channel_values(
         lights=responses(emission, curves, wavelengths)
         if len(emission)
         else np.zeros((0, sensors.n)),
-        specular=_specular(scene, curves, wavelengths)
+        specular=_specular(scene, curves, wavelengths, data_dir)
         if any(m.glossy for m in scene.materials)
         else None,
         transmittance=_tint(scene, "transmittance", curves, wavelengths, data_dir)
@@ -255,14 +255,29 @@ def _tint(
     return diagonal_values(spectra, curves, wavelengths)
 
 
-def _specular(scene: Scene, curves: np.ndarray, wavelengths: Wavelengths) -> np.ndarray:
+def _specular(
+    scene: Scene, curves: np.ndarray, wavelengths: Wavelengths, data_dir: str | None
+) -> np.ndarray:
+    """``(M, N, K)`` band factors of each material's non-diffuse lobe: a conductor's Fresnel
+    times its reflection tint (if any), 1 otherwise (glass tints: :func:`_tint`)."""
     ones = np.ones((FRESNEL_NODES, curves.shape[0]))
     return np.stack(
         [
-            fresnel_table(m.metal, curves, wavelengths) if m.kind == "conductor" else ones
+            fresnel_table(m.metal, curves, wavelengths, _conductor_tint(m, wavelengths, data_dir))
+            if m.kind == "conductor"
+            else ones
             for m in scene.materials
         ]
     )
+
+
+def _conductor_tint(
+    m: Material, wavelengths: Wavelengths, data_dir: str | None
+) -> np.ndarray | None:
+    """Conductor *m*'s reflection tint on *wavelengths*, or ``None`` where it has none."""
+    if not m.specular_reflectance:
+        return None
+    return np.asarray(get_spectrum(m.specular_reflectance, data_dir=data_dir).on(wavelengths))
 
 
 def integration_matrix(

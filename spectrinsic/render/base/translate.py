@@ -187,7 +187,7 @@ def material_bsdf(
         bsdf = {
             "type": "roughconductor" if rough else "conductor",
             "material": "none" if white_metal else material.metal,
-        }
+        } | {key: dict(value) for key, value in (tints or {}).items()}
     if rough:
         bsdf |= {"distribution": "ggx", "alpha": float(material.roughness)}
     return {"type": "twosided", "bsdf": bsdf}
