@@ -24,7 +24,8 @@ from ..pipeline.source_plan import (
 from ..render.base.variants import import_mitsuba
 from ..scenes.generators import GlossDistribution
 from ..scenes.generators.world_defaults import GLOSSY_FRACTION, METALLIC_FRACTION, TEXTURE_FRACTION
-from ..scenes.mitsuba_xml import render_hints_line, xml_notes
+from ..scenes.mitsuba_xml import render_hints_line
+from ..scenes.reading_notes import reading_notes
 from ..scenes.semantic import SemanticRules, read_semantic_map
 from ..scenes.sources import FileSource, takes_asset_colours
 from ..scenes.spectrum_refs import resolve_spectrum
@@ -409,7 +410,7 @@ def parse_resolution(text: str) -> tuple[int, int]:
 def check_scene_files(config: Any, data_dir: str | None, *, quiet: bool = False) -> None:
     """``--scenes``: every file reads as a valid scene with this material map and default
     spectrum, before the folder is stamped with the config (a bad file is an input error, not
-    a failed sample); what a Mitsuba XML read fixed or approximated, and the spp and depth that
+    a failed sample); what a file's read fixed or approximated, and the spp and depth that
     apply to it (the preset's), are said on stderr unless *quiet*."""
 
     spec = json.loads(config.source or "{}")
@@ -439,7 +440,7 @@ def check_scene_files(config: Any, data_dir: str | None, *, quiet: bool = False)
         ).build(data_dir)
         check_scene_integrator(config, scene, entry["path"])  # every sample would fail
         if not quiet:
-            for note in xml_notes(scene):
+            for note in reading_notes(scene):
                 print(f"spectrinsic dataset: {note}", file=sys.stderr)
             given = f"the dataset's settings (preset {config.preset!r} and options)"
             line = render_hints_line(scene, config.render.spp, config.render.max_depth, given)

@@ -29,7 +29,7 @@ subsurface, emission, textures) is ignored; other materials are Lambertian.
 With ``colours_from_asset=True`` (the default; ``--no-colours-from-asset`` turns it off), a
 material that the mapping, its
 custom property and its name leave without a spectrum takes the Principled node's Base Color
-(scene-linear Rec. 709, as Blender stores it; alpha ignored) as the reflectance ``rgb:R,G,B``
+(linear Rec. 709, from the file's working space; alpha ignored) as the reflectance ``rgb:R,G,B``
 (:mod:`spectrinsic.spectra.user_spectra`, Mallett & Yuksel 2019); a colour outside [0, 1] is
 refused when validated, not clipped, and a Base Color fed by a node (an image texture) is not
 read, so that material still needs a spectrum, unless the node is an Image Texture on a UV
@@ -243,10 +243,11 @@ class _MaterialTable:
             name, spectrum = "default", self.default_spectrum
         else:
             name = mat.name
-            spectrum = self.mapping.get(name) or _prop(mat) or self._colour(mat) or name
-        try:
+        try:  # glass without exact ground truth, colours in other primaries: name the file
+            if mat is not None:
+                spectrum = self.mapping.get(name) or _prop(mat) or self._colour(mat) or name
             gloss = principled_gloss(mat) if mat is not None else {}
-        except SceneError as exc:  # glass without exact ground truth: name the file
+        except SceneError as exc:
             raise SceneError(f"{self.source}: {exc}") from None
         if name not in self.table and gloss.get("kind") in NON_DIFFUSE_KINDS:
             material = Material(name=name, spectrum=METAL_SPECTRUM, **gloss)

@@ -10,11 +10,11 @@ solid (a thin pane is modelled with two faces, as in Blender).
 
 Tints, as Cycles applies them (Blender 4): the Principled BSDF tints each transmission (not its
 reflection) by √(Base Color), so that light entering and leaving a solid is tinted by Base
-Color; its ``transmittance`` is ``rgb:`` of those square roots (scene-linear Rec. 709,
-Mallett–Yuksel upsampled, as every Blender colour). Blender 3.x's Principled BSDF (input
-``Transmission``) tinted otherwise: a tint there is refused. The Glass BSDF's Color tints
-reflection and transmission alike, once per interaction (no square root): its ``transmittance``
-and ``specular_reflectance`` are both ``rgb:`` of the Color (Cycles'
+Color; its ``transmittance`` is ``rgb:`` of those square roots (linear Rec. 709 from the file's
+working space, Mallett–Yuksel upsampled, as every Blender colour). Blender 3.x's Principled
+BSDF (input ``Transmission``) tinted otherwise: a tint there is refused. The Glass BSDF's Color
+tints reflection and transmission alike, once per interaction (no square root): its
+``transmittance`` and ``specular_reflectance`` are both ``rgb:`` of the Color (Cycles'
 ``intern/cycles/kernel/svm/closure.h``, ``CLOSURE_BSDF_MICROFACET_GGX_GLASS_ID``: the
 Fresnel's ``reflection_tint`` and ``transmission_tint`` are both the node's colour; Blender 3.x
 weights its reflection and refraction closures by the colour too).
@@ -32,6 +32,7 @@ from typing import Any
 
 from ..errors import SceneError
 from .blender_colours import principled_node
+from .blender_working_space import rec709_colour
 from .materials import IOR_RANGE
 
 __all__ = ["METAL_PROPERTY", "DEFAULT_METAL", "principled_gloss", "material_glass"]
@@ -50,17 +51,20 @@ def _nodes(mat: Any) -> list[Any]:
 
 
 def _colour(mat: Any, node: Any, colour: str) -> list[float]:
-    """The unlinked RGB of *node*'s input *colour*, in [0, 1]; a linked one (a textured tint)
-    or one out of range is refused."""
+    """The unlinked RGB of *node*'s input *colour* in linear Rec. 709 (from the file's working
+    space), in [0, 1]; a linked one (a textured tint) or one out of range is refused."""
     socket = node.inputs[colour]
-    rgb = [float(c) for c in list(socket.default_value)[:3]]
     if socket.is_linked:
         raise SceneError(
             f"material {mat.name!r}: glass with its {colour} fed by a node; a textured tint "
             "has no exact ground truth (set a uniform colour)"
         )
+    rgb = list(rec709_colour(socket.default_value, f"material {mat.name!r}: glass {colour}"))
     if not all(0.0 <= c <= 1.0 for c in rgb):
-        raise SceneError(f"material {mat.name!r}: glass {colour} {rgb}; expected values in [0, 1]")
+        raise SceneError(
+            f"material {mat.name!r}: glass {colour} {rgb} (linear Rec. 709); expected values "
+            "in [0, 1]"
+        )
     return rgb
 
 

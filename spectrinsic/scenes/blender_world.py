@@ -4,19 +4,21 @@ Environment Texture as an environment map (``envmap``).
 Cycles lights a scene from its World's shader, which :func:`world_lights` reads (nothing of
 the file runs) from the Surface of the World's active output:
 
-- a *Background* node of unlinked Color ``(R, G, B)`` (scene-linear Rec. 709, as Blender
-  stores it) and Strength ``s`` is a constant radiance ``s · (R, G, B)`` per channel in
-  W·m⁻²·sr⁻¹ (Strength 1 of white is a radiance of 1): one ``sky`` light (Mitsuba
-  ``constant``) whose radiance spectrum is ``s · (R b_R + G b_G + B b_B)(λ) · D65(λ)``, D65 at
-  unit luminance and ``b`` the Mallett & Yuksel basis: what an environment-map texel of that
-  colour radiates (:mod:`~spectrinsic.scenes.envmaps`). With ``m`` the largest of ``s · RGB``
-  its spectrum is ``rgblight:`` of ``s · RGB / m`` and its power ``m · rgb_light_power(s · RGB
-  / m)`` (:func:`~spectrinsic.spectra.user_spectra.rgb_light_power`);
+- a *Background* node of unlinked Color ``(R, G, B)`` (linear Rec. 709, converted from the
+  file's working space, :mod:`~spectrinsic.scenes.blender_working_space`) and Strength ``s``
+  is a constant radiance ``s · (R, G, B)`` per channel in W·m⁻²·sr⁻¹ (Strength 1 of white is
+  a radiance of 1): one ``sky`` light (Mitsuba ``constant``) whose radiance spectrum is
+  ``s · (R b_R + G b_G + B b_B)(λ) · D65(λ)``, D65 at unit luminance and ``b`` the Mallett &
+  Yuksel basis: what an environment-map texel of that colour radiates
+  (:mod:`~spectrinsic.scenes.envmaps`). With ``m`` the largest of ``s · RGB`` its spectrum is
+  ``rgblight:`` of ``s · RGB / m`` and its power ``m · rgb_light_power(s · RGB / m)``
+  (:func:`~spectrinsic.spectra.user_spectra.rgb_light_power`);
 - a Background whose Color an *Environment Texture* node's Color feeds is an environment map of
   scale ``s``: the node's image (equirectangular, linear, an OpenEXR or Radiance HDR file
-  inside the ``.blend``'s folder; a packed image is refused: unpack it beside the file) looked
-  up at the direction itself (the Vector unlinked, or a Texture Coordinate's Generated) or
-  turned by a *Mapping* node about Z alone (:func:`blender_map_rotation`).
+  inside the ``.blend``'s folder, ``Non-Color`` only in a Linear Rec.709 file; a packed image
+  is refused: unpack it beside the file) looked up at the direction itself (the Vector
+  unlinked, or a Texture Coordinate's Generated) or turned by a *Mapping* node about Z alone
+  (:func:`blender_map_rotation`).
 
 A World of Strength 0 or a black colour gives no light, and no message. Anything else (a Sky
 Texture, a mix, a Light Path, a volume, rays that do not see the World, a Mapping that does
@@ -45,15 +47,15 @@ import numpy as np
 
 from ..errors import SceneError
 from ..spectra.user_spectra import rgb_light_power
+from .blender_colours import LINEAR_SPACES
+from .blender_working_space import check_raw_values, rec709_colour
 from .budget import SceneBudget
 from .envmaps import check_map_file, envmap_lights
 from .mitsuba_files import file_sha256
 from .model import Light
 
 __all__ = [
-    "WORKING_SPACE",
     "BLENDER_MAP_FRAME",
-    "LINEAR_SPACES",
     "WorldLights",
     "blender_map_rotation",
     "world_lights",
@@ -66,10 +68,6 @@ BLENDER_MAP_FRAME = (
     1.0, 0.0, 0.0,
     0.0, 1.0, 0.0,
 )  # fmt: skip
-#: The scene-linear space whose colours are read (Blender 5's default working space).
-WORKING_SPACE = "Linear Rec.709"
-#: Image colour spaces read as linear Rec. 709 radiance.
-LINEAR_SPACES = ("Linear Rec.709", "Linear", "Non-Color")
 #: Mapping node types that turn the direction looked up by +angle (the others: ``TEXTURE``,
 #: the inverse).
 _FORWARD = ("POINT", "VECTOR", "NORMAL")
@@ -102,10 +100,13 @@ def blender_map_rotation(angle_z: float, *, texture: bool = False) -> tuple[floa
 
 
 class _Reading:
-    """One World read: the refusals' prefix, the approximation switch and its phrases."""
+    """One World read: the refusals' prefix (the file and the World), the approximation
+    switch and its phrases (the World alone: the notes name the file,
+    :func:`~spectrinsic.scenes.reading_notes.reading_notes`)."""
 
-    def __init__(self, where: str, approximate: bool) -> None:
-        self.where = where
+    def __init__(self, blend: Path, world: str, approximate: bool) -> None:
+        self.world = f"world {world!r}"
+        self.where = f"{blend}: {self.world}"
         self.approximate = approximate
         self.approximated: list[str] = []
 
@@ -115,7 +116,7 @@ class _Reading:
             raise SceneError(
                 f"{self.where}: {problem}; no exact ground truth (--approximate: {instead})"
             )
-        self.approximated.append(f"{self.where}: {problem}: {instead}")
+        self.approximated.append(f"{self.world}: {problem}: {instead}")
 
 
 def _label(node: Any) -> str:
@@ -166,8 +167,9 @@ def _background(world: Any, r: _Reading) -> Any:
 
 
 def _colour_sky(name: str, rgb: Any, strength: float, where: str) -> Light | None:
-    """The ``sky`` of constant radiance *strength* · *rgb* (module docstring); None if black."""
-    radiance = float(strength) * np.asarray(list(rgb)[:3], dtype=np.float64)
+    """The ``sky`` of constant radiance *strength* · *rgb* (module docstring; *rgb* in the
+    file's working space, read in linear Rec. 709); None if black."""
+    radiance = float(strength) * np.asarray(rec709_colour(rgb, where), dtype=np.float64)
     if not np.isfinite(radiance).all() or (radiance < 0).any():
         raise SceneError(
             f"{where}: background colour {tuple(radiance.tolist())} (colour x strength); "
@@ -199,6 +201,8 @@ def _image_file(node: Any, blend: Path, where: str) -> Path:
             f"{where}: image {image.name!r} in colour space {space!r}; expected a linear "
             f"radiance map ({', '.join(LINEAR_SPACES)})"
         )
+    if space == "Non-Color":
+        check_raw_values(f"{where}: image {image.name!r}")
     name = str(image.filepath)  # "//" starts a path relative to the .blend (Blender's rule)
     root = blend.parent.resolve()
     path = (root / name[2:] if name.startswith("//") else Path(name)).resolve()
@@ -274,15 +278,7 @@ def _environment(
 
 
 def _check_lit(world: Any, r: _Reading) -> None:
-    """Refuse a World that some rays do not see (the renderer's World is seen by all), or
-    whose file's colours are not Rec. 709 (Blender 5's per-file working space)."""
-    import bpy
-
-    space = getattr(getattr(bpy.data, "colorspace", None), "working_space", WORKING_SPACE)
-    if space != WORKING_SPACE:
-        raise SceneError(
-            f"{r.where}: the file's working colour space is {space!r}; expected {WORKING_SPACE!r}"
-        )
+    """Refuse a World that some rays do not see (the renderer's World is seen by all)."""
     flags = getattr(world, "cycles_visibility", None)
     hidden = [ray for ray in _RAYS if flags is not None and not getattr(flags, ray, True)]
     if hidden:
@@ -303,10 +299,12 @@ def world_lights(
     """
     if world is None:
         return WorldLights()
-    r = _Reading(f"{blend}: world {world.name!r}", approximate)
+    r = _Reading(blend, world.name, approximate)
     if world.node_tree is None:  # a World without nodes: Cycles shows its colour
         sky = _colour_sky(world.name, world.color, 1.0, r.where)
-        return WorldLights(() if sky is None else (sky,))
+        if sky is not None:
+            _check_lit(world, r)
+        return WorldLights(() if sky is None else (sky,), tuple(r.approximated))
     background = _background(world, r)
     if background is None:
         return WorldLights((), tuple(r.approximated))

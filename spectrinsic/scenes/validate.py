@@ -231,8 +231,10 @@ def _check_power(power: object, source: str, field: str) -> None:
 
 
 def _check_lights(scene: Scene, source: str) -> None:
-    if not scene.lights:
-        raise field_error(source, "lights", "a scene needs at least one light")
+    if not scene.lights:  # say what --approximate left out (say, a .blend's World)
+        changed = "; ".join(scene.metadata.get("approximated") or ())
+        why = f" (--approximate: {changed})" if changed else ""
+        raise field_error(source, "lights", f"a scene needs at least one light{why}")
     for i, light in enumerate(scene.lights):
         where = f"lights[{i}]"
         if light.kind not in LIGHT_KINDS:

@@ -16,8 +16,7 @@ FOLDER, ``outside.exr``. Every file holds the same scene: a unit cube at the ori
 - ``tilted``: that Mapping also turned 10 deg about X; ``sky``: a Sky Texture feeds the Color
   (the Background's own colour (0.1, 0.2, 0.3), Strength 2);
 - ``mix``: a Mix Shader of two Backgrounds is the Surface; ``packed``: ``hdri`` with the image
-  packed; ``escape``: an image ``//../outside.exr``; ``wide``: grey (0.5, 0.5, 0.5) in a file
-  whose working colour space is Linear Rec.2020 (made last: the setting is the file's).
+  packed; ``escape``: an image ``//../outside.exr`` (working spaces: make_colour_blends.py).
 """
 
 import math
@@ -112,11 +111,6 @@ def escape():
     tex.image.filepath = "//../outside.exr"
 
 
-def wide():
-    background("Wide", (0.5, 0.5, 0.5), 1.0)
-    bpy.ops.wm.set_working_color_space(working_space="Linear Rec.2020", convert_colors=False)
-
-
 WORLDS = {
     "colour": lambda: background("World", (0.8, 0.4, 0.2), 2.5),
     "zero": lambda: sky("Zero", 0.0),
@@ -128,7 +122,6 @@ WORLDS = {
     "mix": mix,
     "packed": packed,
     "escape": escape,
-    "wide": wide,
 }
 
 for stem, build in WORLDS.items():

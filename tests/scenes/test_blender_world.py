@@ -243,7 +243,7 @@ def test_a_sky_texture_is_refused_by_the_command_line_in_one_line(worlds, tmp_pa
 def test_approximate_takes_the_background_colour_and_says_so(worlds):
     """``--approximate``: the Sky Texture is left out and the Background's own colour
     (0.1, 0.2, 0.3) at Strength 2 taken, in one phrase; a Mix Shader World is dropped."""
-    from spectrinsic.scenes.mitsuba_xml import xml_notes
+    from spectrinsic.scenes.reading_notes import reading_notes
 
     scene = load(worlds / "sky.blend", approximate=True)
     (sky,) = scene.lights
@@ -251,7 +251,7 @@ def test_approximate_takes_the_background_colour_and_says_so(worlds):
     np.testing.assert_allclose(rgb, [1 / 3, 2 / 3, 1], atol=1e-6)  # Blender's float32
     (phrase,) = scene.metadata["approximated"]
     assert "Sky Texture" in phrase and "own colour" in phrase
-    assert len(xml_notes(scene)) == 1
+    assert len(reading_notes(scene)) == 1
     mixed = load(worlds / "mix.blend", approximate=True, validate=False)
     assert mixed.lights == () and "Mix Shader" in mixed.metadata["approximated"][0]
 
@@ -282,7 +282,6 @@ def test_approximate_applies_to_blend_files_on_the_command_line(worlds, tmp_path
         ("mix", "Mix Shader"),
         ("packed", "packed in the .blend"),
         ("escape", "inside the .blend's folder"),
-        ("wide", "working colour space is 'Linear Rec.2020'"),
     ],
 )
 def test_other_worlds_are_refused_in_one_line(worlds, stem, says):
