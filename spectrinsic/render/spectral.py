@@ -10,7 +10,7 @@ import numpy as np
 
 from ..errors import RenderError, SceneError
 from ..scenes.envmaps import envmap_groups, verified_map
-from ..scenes.model import Scene
+from ..scenes.model import GLASS_TINTS, Scene
 from ..spectra import COLORIMETRIC_WAVELENGTHS, SensorSet, get_spectrum
 from .algebra.modes import light_spectra
 from .base import translate as tr
@@ -114,9 +114,13 @@ def render_spectral(
             regular_spectrum(get_spectrum(m.spectrum, data_dir=data_dir).on(wl), wl)
             for m in scene.materials
         ]
-        tints = [  # tinted glass: Mitsuba's specular_transmittance, the same spectrum
-            regular_spectrum(get_spectrum(m.transmittance, data_dir=data_dir).on(wl), wl)
-            if m.tinted
+        tints = [  # tinted glass: Mitsuba's specular_transmittance/_reflectance, the same spectra
+            {
+                param: regular_spectrum(get_spectrum(m.tint(key), data_dir=data_dir).on(wl), wl)
+                for key, param in GLASS_TINTS.items()
+                if m.transmissive or getattr(m, key)  # a conductor has only a reflection tint
+            }
+            if m.tinted or m.specular_reflectance
             else None
             for m in scene.materials
         ]

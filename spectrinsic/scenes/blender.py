@@ -22,7 +22,8 @@ else is needed). A Principled BSDF node sets the gloss (:func:`principled_gloss`
 ≥ 0.5 makes a metal (``conductor``, η/k of the custom property ``"metal"``, default ``Al``; no
 spectrum needed), else Roughness < 0.5 a coated diffuse (``plastic``, the node's IOR); GGX α is
 Roughness² (Blender's convention); Transmission 1 or a Glass BSDF is glass, the Principled's
-tinted by its Base Color (:mod:`~spectrinsic.scenes.blender_gloss`). Everything else of the node (coat, sheen,
+tinted by its Base Color, the Glass BSDF's reflection and transmission by its Color
+(:mod:`~spectrinsic.scenes.blender_gloss`). Everything else of the node (coat, sheen,
 subsurface, emission, textures) is ignored; other materials are Lambertian.
 
 With ``colours_from_asset=True`` (the default; ``--no-colours-from-asset`` turns it off), a

@@ -11,14 +11,17 @@ solid (a thin pane is modelled with two faces, as in Blender).
 Tints, as Cycles applies them (Blender 4): the Principled BSDF tints each transmission (not its
 reflection) by √(Base Color), so that light entering and leaving a solid is tinted by Base
 Color; its ``transmittance`` is ``rgb:`` of those square roots (linear Rec. 709 from the file's
-working space, Mallett–Yuksel upsampled, as every Blender colour). Blender 3.x's Principled BSDF (input
-``Transmission``) tinted otherwise: a tint there is refused. The Glass BSDF's Color tints reflection
-and transmission alike, and a tinted reflection has no exact ground truth: a Glass BSDF Color
-other than white is refused in one line that says to use a Principled BSDF instead.
+working space, Mallett–Yuksel upsampled, as every Blender colour). Blender 3.x's Principled
+BSDF (input ``Transmission``) tinted otherwise: a tint there is refused. The Glass BSDF's Color
+tints reflection and transmission alike, once per interaction (no square root): its
+``transmittance`` and ``specular_reflectance`` are both ``rgb:`` of the Color (Cycles'
+``intern/cycles/kernel/svm/closure.h``, ``CLOSURE_BSDF_MICROFACET_GGX_GLASS_ID``: the
+Fresnel's ``reflection_tint`` and ``transmission_tint`` are both the node's colour; Blender 3.x
+weights its reflection and refraction closures by the colour too).
 
 Refused in one line naming the material, since they have no exact ground truth: a transmission
 strictly between 0 and 1 (a mix of glass and the diffuse base), a textured tint (a Base Color
-or Glass Color fed by a node), a tinted Glass BSDF (above), and a rough Glass BSDF whose
+or Glass Color fed by a node), and a rough Glass BSDF whose
 distribution is not GGX. Pure Python over duck-typed ``bpy`` objects, so it needs no ``bpy``
 to test.
 """
@@ -79,15 +82,14 @@ def _principled_tint(mat: Any, node: Any, key: str) -> dict[str, str]:
     return {"transmittance": "rgb:" + ",".join(f"{c**0.5:.9g}" for c in rgb)}
 
 
-def _clear(mat: Any, node: Any) -> None:
-    """Refuse a tinted Glass BSDF (module docstring)."""
+def _glass_tint(mat: Any, node: Any) -> dict[str, str]:
+    """``transmittance`` and ``specular_reflectance`` both ``rgb:`` of a Glass BSDF's Color
+    (module docstring), ``{}`` if white."""
     rgb = _colour(mat, node, "Color")
-    if rgb != [1.0, 1.0, 1.0]:
-        raise SceneError(
-            f"material {mat.name!r}: Glass BSDF Color {rgb} tints its reflection too, which has "
-            "no exact ground truth; use a Principled BSDF of Transmission 1 (its Base Color "
-            "tints the transmission only)"
-        )
+    if rgb == [1.0, 1.0, 1.0]:
+        return {}
+    name = "rgb:" + ",".join(f"{c:.9g}" for c in rgb)
+    return {"transmittance": name, "specular_reflectance": name}
 
 
 def _fields(node: Any) -> dict[str, Any]:
@@ -119,8 +121,7 @@ def material_glass(mat: Any) -> dict[str, Any] | None:
     glass = next((n for n in nodes if n.type == "BSDF_GLASS"), None)
     if glass is None:
         return None
-    _clear(mat, glass)
-    fields = _fields(glass)
+    fields = _fields(glass) | _glass_tint(mat, glass)
     distribution = str(getattr(glass, "distribution", "GGX"))
     if fields["roughness"] > 0.0 and distribution != "GGX":
         raise SceneError(

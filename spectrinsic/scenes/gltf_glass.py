@@ -15,8 +15,11 @@ What has no exact ground truth is refused in one line naming the material: a fac
 between 0 and 1 (a mix of glass and the diffuse base), a ``transmissionTexture``, a textured
 tint (``baseColorTexture``), or a volume attenuation (``attenuationColor`` /
 ``attenuationDistance``: absorption along the path inside, Beer–Lambert, which the renderer
-does not trace). A factor of 0 (or no extension) leaves the material to the
-metallic-roughness reading.
+does not trace), and a ``KHR_materials_specular`` other than its defaults on glass: its
+``specularColorFactor`` scales the Schlick F0 but not F90 (the grazing reflection stays white)
+and changes the transmission with it, so it is no multiplicative reflection tint
+(Mitsuba's ``specular_reflectance``). A factor of 0 (or no extension) leaves the material to
+the metallic-roughness reading.
 """
 
 from __future__ import annotations
@@ -31,6 +34,8 @@ __all__ = ["TRANSMISSION", "gltf_glass"]
 
 #: The glTF extension read.
 TRANSMISSION = "KHR_materials_transmission"
+#: The glTF extension refused on glass unless at its defaults (module docstring).
+SPECULAR = "KHR_materials_specular"
 
 
 def _number(value: Any, default: float) -> float:
@@ -55,6 +60,7 @@ def _glass(name: str, material: dict[str, Any], where: str) -> dict[str, Any] | 
         raise SceneError(
             f"{what} transmissionFactor {factor:g}; only 1 (glass) or 0 has exact ground truth"
         )
+    _plain_specular(ext.get(SPECULAR), what)
     pbr = material.get("pbrMetallicRoughness") or {}
     tint = _tint(pbr, what)
     volume = ext.get("KHR_materials_volume") or {}
@@ -74,6 +80,24 @@ def _glass(name: str, material: dict[str, Any], where: str) -> dict[str, Any] | 
             "a thin pane is smooth only (add a volume thickness for rough solid glass)"
         )
     return {"kind": "thindielectric", "ior": ior} | tinted
+
+
+def _plain_specular(specular: Any, what: str) -> None:
+    """Refuse a ``KHR_materials_specular`` *specular* that is not at its defaults (factor 1,
+    white colour, no textures; module docstring)."""
+    if specular is None:
+        return
+    textured = isinstance(specular, dict) and bool(
+        {"specularTexture", "specularColorTexture"} & set(specular)
+    )
+    plain = isinstance(specular, dict) and not textured
+    plain = plain and specular.get("specularFactor", 1) == 1
+    plain = plain and specular.get("specularColorFactor", [1, 1, 1]) == [1, 1, 1]
+    if not plain:
+        raise SceneError(
+            f"{what} with {SPECULAR} {specular!r}; its Schlick F0 scale is no exact reflection "
+            "tint (only the defaults, factor 1 and white, are read)"
+        )
 
 
 def _tint(pbr: dict[str, Any], what: str) -> str:

@@ -11,6 +11,8 @@ A material is a spectrum name (Lambertian, as before) or a mapping::
       vase: {kind: dielectric, ior: 1.5, roughness: 0}  # clear glass, solid
       pane: {kind: thindielectric, ior: 1.5}            # clear glass, a thin sheet
       bottle: {kind: dielectric, transmittance: "rgb:0.2,0.6,0.3"}  # tinted glass
+      gem: {kind: dielectric, specular_reflectance: "rgb:0.9,0.3,0.3"}  # tinted reflections
+      foil: {kind: conductor, metal: none, specular_reflectance: "rgb:0.9,0.6,0.2"}  # coloured mirror
 
 ``plastic`` is a diffuse base under a dielectric coat of index ``ior`` (Mitsuba ``plastic``,
 or ``roughplastic`` when ``roughness`` > 0); ``conductor`` is a metal with Mitsuba's measured
@@ -21,7 +23,10 @@ relative to the outside (Mitsuba ``dielectric``, or ``roughdielectric`` with GGX
 no diffuse lobe either and a constant ``ior`` (no dispersion). Glass is clear unless given a
 ``transmittance``: a spectrum name (as ``spectrum``, values in [0, 1]) that multiplies each
 transmission through the surface, not its reflections (Mitsuba's ``specular_transmittance``:
-twice through a solid, entering and leaving; once through a pane).
+twice through a solid, entering and leaving; once through a pane), and a
+``specular_reflectance`` likewise multiplies each reflection off it (Mitsuba's parameter of
+that name; a Blender Glass BSDF's Color is both). A ``conductor`` takes a
+``specular_reflectance`` too (its Fresnel times the tint; ``metal: none`` a coloured mirror).
 ``roughness`` is the GGX α in [0, 1] (0 = smooth); ``ior`` lies in (1, 3].
 
 A ``textured`` material is a spectral texture (:mod:`spectrinsic.scenes.textures`): per texel a
@@ -46,7 +51,7 @@ import numpy as np
 
 from ..errors import SpectralDataError, did_you_mean
 from ..spectra.conductors import check_conductor
-from .model import MATERIAL_KINDS, Material
+from .model import GLASS_TINTS, MATERIAL_KINDS, Material
 from .textures import (
     BASIS_MAX,
     PATTERNS,
@@ -78,9 +83,9 @@ _TEXTURED_KEYS = ("kind", "basis", "pattern", "size", "seed", "weights")
 _KEYS = {
     "diffuse": ("kind", "spectrum"),
     "plastic": ("kind", "spectrum", "ior", "roughness"),
-    "conductor": ("kind", "metal", "roughness"),
-    "dielectric": ("kind", "ior", "roughness", "transmittance"),
-    "thindielectric": ("kind", "ior", "transmittance"),
+    "conductor": ("kind", "metal", "roughness", "specular_reflectance"),
+    "dielectric": ("kind", "ior", "roughness", *GLASS_TINTS),
+    "thindielectric": ("kind", "ior", *GLASS_TINTS),
 }
 
 
@@ -113,10 +118,14 @@ def material_problem(m: Material) -> str | None:
         )
     if m.kind == "thindielectric" and m.roughness != 0.0:
         return f"roughness {m.roughness!r}: a thindielectric is smooth (Mitsuba has no rough one)"
-    if not isinstance(m.transmittance, str):
-        return f"transmittance {m.transmittance!r}: expected a spectrum name"
-    if m.transmittance and not m.transmissive:
-        return f"transmittance {m.transmittance!r} given for a {m.kind} material (only for glass)"
+    for key in GLASS_TINTS:
+        tint = getattr(m, key)
+        if not isinstance(tint, str):
+            return f"{key} {tint!r}: expected a spectrum name"
+        allowed = m.transmissive or (m.kind == "conductor" and key == "specular_reflectance")
+        if tint and not allowed:
+            where = "glass and conductors" if key == "specular_reflectance" else "glass"
+            return f"{key} {tint!r} given for a {m.kind} material (only for {where})"
     if m.kind == "conductor":
         try:
             check_conductor(m.metal)
@@ -195,9 +204,10 @@ def parse_material(name: str, value: Any) -> Material | TexturedMaterial | str:
     for key in ("ior", "roughness"):
         if key in value and not _number(value[key]):
             return f"{key}: expected a number, got {value[key]!r}"
-    tint = value.get("transmittance", "")
-    if "transmittance" in value and (not isinstance(tint, str) or not tint.strip()):
-        return f"transmittance: expected a non-empty spectrum name, got {tint!r}"
+    for key in GLASS_TINTS:
+        tint = value.get(key, "")
+        if key in value and (not isinstance(tint, str) or not tint.strip()):
+            return f"{key}: expected a non-empty spectrum name, got {tint!r}"
     m = Material(
         name=name,
         spectrum=value["spectrum"] if "spectrum" in _KEYS[kind] else METAL_SPECTRUM,
@@ -205,7 +215,8 @@ def parse_material(name: str, value: Any) -> Material | TexturedMaterial | str:
         roughness=float(value.get("roughness", 0.0)),
         ior=float(value.get("ior", 1.5)),
         metal=value.get("metal", ""),
-        transmittance=tint,
+        transmittance=value.get("transmittance", ""),
+        specular_reflectance=value.get("specular_reflectance", ""),
     )
     return material_problem(m) or m
 
@@ -223,8 +234,7 @@ def material_entry(m: Material) -> str | dict[str, Any]:
         entry["ior"] = float(m.ior)
     if "roughness" in _KEYS[m.kind]:
         entry["roughness"] = float(m.roughness)
-    if m.transmittance:
-        entry["transmittance"] = m.transmittance
+    entry |= {key: getattr(m, key) for key in GLASS_TINTS if getattr(m, key)}
     return entry
 
 

@@ -108,7 +108,13 @@ NON_DIFFUSE_KINDS: tuple[MaterialKind, ...] = ("conductor", "dielectric", "thind
 TRANSMISSIVE_KINDS: tuple[MaterialKind, ...] = ("dielectric", "thindielectric")
 #: The optional fields of :class:`Material`; at their defaults they are left out of
 #: :func:`scene_to_dict`, so a matte scene's record and hash are those of before they existed.
-GLOSS_FIELDS = ("kind", "roughness", "ior", "metal", "transmittance")
+GLOSS_FIELDS = ("kind", "roughness", "ior", "metal", "transmittance", "specular_reflectance")
+#: A glass's tint fields (spectrum names, ``""`` untinted) and the Mitsuba parameter each is:
+#: the transmitted and the reflected lobe's factor.
+GLASS_TINTS = {
+    "transmittance": "specular_transmittance",
+    "specular_reflectance": "specular_reflectance",
+}
 _OPTIONAL = {"omit_default": True}
 
 
@@ -142,6 +148,12 @@ class Material:
         for clear glass (T = 1). It multiplies every transmission through the surface (each
         refraction of a ``dielectric``, the straight pass of a ``thindielectric``), not its
         reflections, as Mitsuba's ``specular_transmittance``; only for glass kinds.
+    specular_reflectance
+        Registry name of a glass's or conductor's reflection tint R_t(λ) in [0, 1] (as
+        *transmittance*), or ``""`` (1): it multiplies every reflection off the surface (the
+        Fresnel-weighted reflected lobe), not its transmissions, as Mitsuba's
+        ``specular_reflectance``; only for glass and conductor kinds (a Blender Glass BSDF's
+        Color is both of a glass's tints; a tinted ``metal: none`` is a coloured mirror).
     """
 
     name: str
@@ -151,6 +163,7 @@ class Material:
     ior: float = field(default=1.5, metadata=_OPTIONAL)
     metal: str = field(default="", metadata=_OPTIONAL)
     transmittance: str = field(default="", metadata=_OPTIONAL)
+    specular_reflectance: str = field(default="", metadata=_OPTIONAL)
 
     @property
     def glossy(self) -> bool:
@@ -169,8 +182,13 @@ class Material:
 
     @property
     def tinted(self) -> bool:
-        """Whether the material is glass with a transmittance spectrum (not clear)."""
-        return self.transmissive and bool(self.transmittance)
+        """Whether the material is glass with a transmittance or reflection tint (not clear)."""
+        return self.transmissive and bool(self.transmittance or self.specular_reflectance)
+
+    def tint(self, key: str) -> str:
+        """The spectrum name of tint *key* (of :data:`GLASS_TINTS`), ``"flat:1"`` where
+        untinted (:func:`material_problem` allows tints on glass and conductors only)."""
+        return str(getattr(self, key)) or "flat:1"
 
 
 def _named_class(mesh: Mesh) -> bool:

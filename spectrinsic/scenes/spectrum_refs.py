@@ -23,6 +23,7 @@ from typing import Any
 from ..errors import SceneError, SpectrinsicError
 from ..spectra.io import CSV_MAX_BYTES
 from ..spectra.user_spectra import inline_name, split_csv_key
+from .model import GLASS_TINTS
 
 __all__ = ["resolve_spectrum_refs", "resolve_spectrum", "confined_csv"]
 
@@ -66,7 +67,7 @@ def _material(value: Any, base: Path) -> Any:
     if not isinstance(value, dict) or _INLINE_KEYS & set(value):
         return resolve_spectrum(value, "reflectance", base)
     out = dict(value)
-    for key in ("spectrum", "transmittance"):  # a glass's transmittance is a fraction too
+    for key in ("spectrum", *GLASS_TINTS):  # a glass's tints are fractions too
         if key in out:
             out[key] = resolve_spectrum(out[key], "reflectance", base)
     if isinstance(out.get("basis"), list):

@@ -24,7 +24,7 @@ from ..errors import SpectrinsicError, with_article
 from ..spectra import get_spectrum
 from .envmaps import check_envmaps
 from .materials import material_problem
-from .model import LIGHT_FIELDS, LIGHT_KINDS, Scene, unknown_light_kind
+from .model import GLASS_TINTS, LIGHT_FIELDS, LIGHT_KINDS, Scene, unknown_light_kind
 from .placement import check_placement as _check_placement  # the keyword below has its name
 from .problems import Problems, field_error
 from .semantic import SEMANTIC_CLASSES
@@ -371,12 +371,12 @@ def validate_scene(
                 data_dir,
                 cache,
             )
-            if mat.transmittance:  # a fraction in [0, 1] as a reflectance is
+            for key in (k for k in GLASS_TINTS if getattr(mat, k)):  # fractions in [0, 1]
                 problems.get(
                     _check_spectrum,
                     source,
-                    f"materials[{i}] ({mat.name!r}).transmittance",
-                    mat.transmittance,
+                    f"materials[{i}] ({mat.name!r}).{key}",
+                    getattr(mat, key),
                     "reflectance",
                     data_dir,
                     cache,

@@ -199,17 +199,17 @@ def test_a_thin_pane_shows_the_wall_behind_it_in_specular_at_its_transmittance()
     ("bsdf", "expected"),
     [
         ('<bsdf type="roughdielectric" id="glass"/>', "distribution beckmann (the default)"),
-        (
-            '<bsdf type="dielectric" id="glass"><rgb name="specular_reflectance" '
-            'value="0.5, 0.9, 0.5"/></bsdf>',
-            "specular_reflectance [0.5, 0.9, 0.5]",
+        (  # a reflection tint is read (test_tinted_glass.py), but only as a fraction
+            '<bsdf type="dielectric" id="glass"><float name="specular_reflectance" '
+            'value="1.5"/></bsdf>',
+            "specular_reflectance",
         ),
         (
             '<bsdf type="thindielectric" id="glass"><string name="int_ior" value="glass"/></bsdf>',
             "int_ior 'glass'",
         ),
-        (  # a dimmed mirror gem: Mitsuba's specular_reflectance scales F; refused as a tint
-            '<bsdf type="conductor" id="glass"><string name="material" value="none"/>'
+        (  # a plastic's specular_reflectance scales its coat's reflection: refused as a tint
+            '<bsdf type="plastic" id="glass">'
             '<float name="specular_reflectance" value="0.5"/></bsdf>',
             "specular_reflectance 0.5",
         ),
@@ -251,17 +251,18 @@ def test_the_passes_integrator_refuses_glass_in_one_line_before_any_work(glass_b
     assert not out.exists()
 
 
-def test_approximate_takes_a_tinted_reflection_as_clear_glass_and_says_so(glass_box):
-    """A tinted transmission is exact (``test_tinted_glass.py``); a tinted reflection is not."""
+def test_approximate_takes_a_tinted_plastic_coat_as_untinted_and_says_so(glass_box):
+    """Tinted glass and conductors are exact (``test_tinted_glass.py``); a tinted plastic
+    coat is not."""
     tinted = (
-        '<bsdf type="dielectric" id="glass">'
+        '<bsdf type="plastic" id="glass">'
         '<rgb name="specular_reflectance" value="0.5, 0.9, 0.5"/></bsdf>'
     )
     path = glass_box.with_name("tinted.xml")
     path.write_text(XML.replace(SMOOTH_GLASS, tinted))
     scene = load_mitsuba_xml(path, approximate=True)
     (glass,) = [m for m in scene.materials if m.name == "glass"]
-    assert glass.kind == "dielectric" and not glass.tinted
+    assert glass.kind == "plastic"
     (said,) = scene.metadata["approximated"]
     assert "specular_reflectance [0.5, 0.9, 0.5] taken as 1" in said
 

@@ -83,8 +83,8 @@ def test_principled_transmission_1_and_a_glass_node_are_clear_glass():
     [
         (_Mat("Mix", _principled(Transmission_Weight=0.5)), "Transmission Weight 0.5"),
         (
-            _Mat("Green", _Node("BSDF_GLASS", Color=(0.2, 0.9, 0.2, 1), Roughness=0.0, IOR=1.5)),
-            "Glass BSDF Color",
+            _Mat("Red", _Node("BSDF_GLASS", Color=(1.2, 0.9, 0.2, 1), Roughness=0.0, IOR=1.5)),
+            "glass Color",
         ),
     ],
 )

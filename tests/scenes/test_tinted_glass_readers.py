@@ -1,7 +1,8 @@
-"""Tinted glass in every reader: YAML ``transmittance``, Mitsuba XML ``specular_transmittance``,
-glTF ``KHR_materials_transmission`` with a ``baseColorFactor``, Blender's Principled Base Color
-under Transmission 1; a textured tint (and what has no exact counterpart) refused in one line,
-rc 2 on the command line before any work."""
+"""Tinted glass in every reader: YAML ``transmittance`` and ``specular_reflectance``, Mitsuba
+XML ``specular_transmittance`` and ``specular_reflectance``, glTF ``KHR_materials_transmission``
+with a ``baseColorFactor``, Blender's Principled Base Color under Transmission 1 and Glass BSDF
+Color; a textured tint (and what has no exact counterpart) refused in one line, rc 2 on the
+command line before any work."""
 
 from __future__ import annotations
 
@@ -145,13 +146,54 @@ def test_xml_a_textured_tint_is_refused_in_one_line_or_taken_as_clear(tmp_path, 
     assert "textured specular_transmittance taken as 1" in said
 
 
-def test_xml_a_tinted_reflection_is_still_refused(tmp_path):
-    glass = (
-        '<bsdf type="dielectric" id="glass">'
+@pytest.mark.parametrize(
+    ("tint", "expected"),
+    [
+        ('<rgb name="specular_reflectance" value="0.5, 0.9, 0.5"/>', "rgb:0.5,0.9,0.5"),
+        ('<float name="specular_reflectance" value="0.6"/>', "flat:0.6"),
+        (
+            '<spectrum name="specular_reflectance" value="400:0.2, 700:0.9"/>',
+            "inline:reflectance:400.0=0.2,700.0=0.9",
+        ),
+        ('<float name="specular_reflectance" value="1"/>', ""),
+    ],
+)
+def test_xml_specular_reflectance_is_the_glass_reflection_tint(tmp_path, tint, expected):
+    """On every glass plugin, as ``specular_transmittance``; the other tint stays clear."""
+    ggx = '<string name="distribution" value="ggx"/><float name="alpha" value="0.2"/>'
+    for plugin in ("dielectric", "thindielectric", "roughdielectric"):
+        rough = ggx if plugin == "roughdielectric" else ""
+        glass = f'<bsdf type="{plugin}" id="glass">{rough}{tint}</bsdf>'
+        (gem,) = [m for m in load_mitsuba_xml(_xml(tmp_path, glass)).materials if m.transmissive]
+        assert (gem.specular_reflectance, gem.transmittance) == (expected, "")
+        assert gem.tinted == bool(expected)
+
+
+def test_xml_a_textured_reflection_tint_or_a_tinted_plastic_is_refused(tmp_path, capsys):
+    """A ``bitmap`` reflection tint on glass, and any ``specular_reflectance`` on a plastic
+    (it scales the coat's reflection, which the band path does not tint), are refused in one
+    line (rc 2 from the command line); a conductor's is read."""
+    from PIL import Image
+
+    Image.fromarray(np.full((4, 4, 3), 128, np.uint8)).save(tmp_path / "tint.png")
+    path = _xml(tmp_path, _BITMAP_TINT.replace("specular_transmittance", "specular_reflectance"))
+    err = _refused(capsys, path, tmp_path / "out")
+    assert "specular_reflectance" in err and "textured tint" in err
+    coat = (
+        '<bsdf type="plastic" id="glass">'
         '<rgb name="specular_reflectance" value="0.5, 0.9, 0.5"/></bsdf>'
     )
-    with pytest.raises(SceneError, match="specular_reflectance"):
-        load_mitsuba_xml(_xml(tmp_path, glass))
+    err = _refused(capsys, _xml(tmp_path, coat), tmp_path / "out")
+    assert "specular_reflectance [0.5, 0.9, 0.5]" in err and "only 1" in err
+    mirror = coat.replace('"plastic"', '"conductor"').replace(
+        "<rgb", '<string name="material" value="none"/><rgb'
+    )
+    (foil,) = [m for m in load_mitsuba_xml(_xml(tmp_path, mirror)).materials if m.metal]
+    assert (foil.kind, foil.metal, foil.specular_reflectance) == (
+        "conductor",
+        "none",
+        "rgb:0.5,0.9,0.5",
+    )
 
 
 # -- glTF ------------------------------------------------------------------------------------
@@ -195,6 +237,11 @@ def test_gltf_a_base_colour_factor_tints_the_glass(tmp_path):
     solid = _TRANSMISSION | {"KHR_materials_volume": {"thicknessFactor": 0.1}}
     (gem,) = load_mesh_scene(_gltf(tmp_path, solid, pbr), materials={}, width=8, height=8).materials
     assert (gem.kind, gem.transmittance) == ("dielectric", "rgb:0.2,0.9,0.25")
+    plain = {"KHR_materials_specular": {"specularFactor": 1, "specularColorFactor": [1, 1, 1]}}
+    (gem,) = load_mesh_scene(
+        _gltf(tmp_path, solid | plain, pbr), materials={}, width=8, height=8
+    ).materials  # KHR_materials_specular at its defaults changes nothing
+    assert (gem.transmittance, gem.specular_reflectance) == ("rgb:0.2,0.9,0.25", "")
 
 
 @pytest.mark.parametrize(
@@ -215,6 +262,11 @@ def test_gltf_a_base_colour_factor_tints_the_glass(tmp_path):
             _TRANSMISSION,
             {"baseColorFactor": [1.5, 0.5, 0.5, 1.0]},
             "expected 3 or 4 numbers in [0, 1]",
+        ),
+        (
+            _TRANSMISSION | {"KHR_materials_specular": {"specularColorFactor": [1, 0.5, 0.5]}},
+            {"roughnessFactor": 0.0},
+            "no exact reflection tint",
         ),
     ],
 )
@@ -277,8 +329,10 @@ def test_blender_principled_base_color_tints_each_crossing_by_its_square_root():
             "fed by a node",
         ),
         (
-            _Mat("Green", _Node("BSDF_GLASS", Color=(0.2, 0.9, 0.2, 1), Roughness=0.0, IOR=1.5)),
-            "tints its reflection too",
+            _Mat(
+                "Green", _Node("BSDF_GLASS", ("Color",), Color=(1, 1, 1, 1), Roughness=0.0, IOR=1.5)
+            ),
+            "Color fed by a node",
         ),
         (
             _Mat("Old", _principled(Transmission=1.0, Base_Color=(0.2, 0.9, 0.2, 1))),
@@ -286,7 +340,7 @@ def test_blender_principled_base_color_tints_each_crossing_by_its_square_root():
         ),
     ],
 )
-def test_blender_a_textured_tint_or_a_tinted_glass_bsdf_is_refused_in_one_line(mat, expected):
+def test_blender_a_textured_tint_is_refused_in_one_line(mat, expected):
     with pytest.raises(SceneError) as info:
         principled_gloss(mat)
     message = str(info.value)
@@ -353,3 +407,64 @@ def test_a_blend_file_reads_a_principled_tint_and_refuses_a_textured_one(tmp_pat
         else:
             (glass,) = [m for m in load_blend(out).materials if m.transmissive]
             assert glass.transmittance == "rgb:0.5,0.75,0.25"
+
+
+def test_blender_glass_bsdf_color_tints_reflection_and_transmission_alike():
+    """Cycles' Glass BSDF sets the Fresnel's reflection and transmission tints both to its
+    Color, once per interaction (no square root, unlike the Principled)."""
+    node = _Node("BSDF_GLASS", Color=(0.25, 0.5, 0.75, 1), Roughness=0.0, IOR=1.5)
+    assert principled_gloss(_Mat("Green", node)) == {
+        "kind": "dielectric", "ior": 1.5, "roughness": 0.0,
+        "transmittance": "rgb:0.25,0.5,0.75", "specular_reflectance": "rgb:0.25,0.5,0.75",
+    }  # fmt: skip
+
+
+def test_a_blend_file_reads_a_glass_bsdf_color_as_both_tints_and_refuses_a_textured_one(
+    tmp_path, capsys
+):
+    """Through bpy: a Glass BSDF of Color (0.25, 0.5625, 0.0625) is glass whose transmittance
+    and reflection tint are both that colour; an Image Texture feeding its Color is refused in
+    one line, rc 2 before any work."""
+    pytest.importorskip("bpy", reason="the optional 'blender' extra (bpy) is not installed")
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from spectrinsic.scenes.blender import load_blend
+
+    make = Path(__file__).with_name("make_blend_gloss.py")
+    for tint in ("0.25,0.5625,0.0625", "textured"):
+        out = tmp_path / f"glass-{tint[:4]}.blend"
+        proc = subprocess.run(
+            [sys.executable, "-P", str(make), "--", str(out), f"glass-bsdf:{tint}"],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+        assert proc.returncode == 0 and out.is_file(), proc.stderr[-2000:]
+        if tint == "textured":
+            err = _refused(capsys, out, tmp_path / "out")
+            assert "'Glass'" in err and "Color fed by a node" in err
+        else:
+            (glass,) = [m for m in load_blend(out).materials if m.transmissive]
+            expected = "rgb:0.25,0.5625,0.0625"
+            assert (glass.transmittance, glass.specular_reflectance) == (expected, expected)
+            assert (glass.kind, glass.ior) == ("dielectric", pytest.approx(1.52))
+
+
+def test_yaml_glass_takes_a_reflection_tint_and_writes_it_back():
+    gem = {"kind": "dielectric", "transmittance": "flat:0.5", "specular_reflectance": "rgb:1,0,0"}
+    parsed = parse_material("gem", gem)
+    assert isinstance(parsed, Material) and parsed.tinted
+    assert parsed.specular_reflectance == "rgb:1,0,0"
+    assert material_entry(parsed) == gem | {"ior": 1.5, "roughness": 0.0}
+    assert parse_material("gem", material_entry(parsed)) == parsed
+    only = parse_material("pane", {"kind": "thindielectric", "specular_reflectance": "flat:0.2"})
+    assert isinstance(only, Material) and only.tinted and only.transmittance == ""
+    foil = {"kind": "conductor", "metal": "none", "specular_reflectance": "flat:0.5"}
+    parsed = parse_material("foil", foil)  # a coloured mirror
+    assert isinstance(parsed, Material) and not parsed.tinted  # tinted: glass only
+    assert material_entry(parsed) == foil | {"roughness": 0.0}
+    assert "unknown key 'specular_reflectance'" in parse_material(
+        "coat", {"kind": "plastic", "spectrum": "flat:0.5", "specular_reflectance": "flat:0.5"}
+    )

@@ -35,6 +35,7 @@ from ...file_writes import write_text_file
 from ...provenance import software_versions
 from ...scenes.envmaps import portable_map_files
 from ...scenes.model import (
+    GLASS_TINTS,
     LIGHT_FIELDS,
     LIGHT_PLACEMENT,
     Scene,
@@ -138,7 +139,7 @@ def _meta(
     height, width = gt.layers["image"].data.shape[:2]
     files_used = spectrum_files(
         [m.spectrum for m in scene.materials]
-        + [m.transmittance for m in scene.materials if m.transmittance]  # tinted glass
+        + [getattr(m, k) for m in scene.materials for k in GLASS_TINTS if getattr(m, k)]
         + [li.spectrum for li in scene.lights]
         + [*gt.cameras],
         scene_folder,

@@ -87,6 +87,8 @@ class BandTables:
     transmittance
         ``(R, K)`` band transmittances per row (tinted glass; 1 on every other row, the black
         one too), or ``None`` where no glass is tinted.
+    specular_reflectance
+        ``(R, K)`` band reflection tints per row, as :attr:`transmittance`.
     """
 
     albedo: np.ndarray
@@ -101,6 +103,7 @@ class BandTables:
     map_scales: dict[str, float] = field(default_factory=dict)
     masks: bool = False
     transmittance: np.ndarray | None = None
+    specular_reflectance: np.ndarray | None = None
 
     def channels(self) -> tuple[tuple[int, int, int], ...]:
         """:attr:`light_channels`, or ``(j, 0, 0)`` per light where empty."""
@@ -192,6 +195,7 @@ def _init_gloss(mi: Any, it: Any, props: Any) -> None:
     if it.gloss:
         it.specular = mi.Float(np.ones(it.n_nodes * it.n_bands, np.float32))
         it.transmittance = mi.Float(np.ones(it.n_bands, np.float32))
+        it.reflection_tint = mi.Float(np.ones(it.n_bands, np.float32))
         it.non_diffuse_rows = mi.UInt32(np.zeros(1, np.uint32))
         # two-sided as every material of the scene; Mitsuba's diffuse defaults to 0.5
         it.white_bsdf = mi.load_dict(
@@ -226,14 +230,17 @@ def _set_maps(mi: Any, dr: Any, it: Any, scene: Any, tables: BandTables) -> None
 
 
 def _set_transmittance(mi: Any, it: Any, tables: BandTables) -> None:
-    """Integrator *it*'s ``(R, K)`` band transmittances per albedo-table row from *tables*
-    (tinted glass; kept as they are where *tables* have none)."""
-    table = tables.transmittance
-    if table is None:
-        return
-    if np.ndim(table) != 2 or np.shape(table)[1] != it.n_bands:
-        raise RenderError(f"transmittance table {np.shape(table)} does not fit {it.n_bands} bands")
-    it.transmittance = mi.Float(np.asarray(table, np.float32).ravel())
+    """Integrator *it*'s ``(R, K)`` band transmittances and reflection tints per albedo-table
+    row from *tables* (tinted glass; kept as they are where *tables* have none)."""
+    for table, name in (
+        (tables.transmittance, "transmittance"),
+        (tables.specular_reflectance, "reflection_tint"),
+    ):
+        if table is None:
+            continue
+        if np.ndim(table) != 2 or np.shape(table)[1] != it.n_bands:
+            raise RenderError(f"{name} table {np.shape(table)} does not fit {it.n_bands} bands")
+        setattr(it, name, mi.Float(np.asarray(table, np.float32).ravel()))
 
 
 def _check_specular(it: Any, table: np.ndarray) -> None:
@@ -347,8 +354,8 @@ def band_path(
     columns (:class:`TextureTables`) if not 0, the glossy (G1) factors and specular part with
     *gloss*, and the white-surface radiance at metal first hits with *metals* (implies *gloss*;
     :mod:`~spectrinsic.render.band_path.kernel`), null events through opacity masks with
-    *masks*, and the band transmittance of tinted glass (:attr:`BandTables.transmittance`) with
-    *tinted*."""
+    *masks*, and the band transmittance and reflection tint of tinted glass
+    (:attr:`BandTables.transmittance`, :attr:`BandTables.specular_reflectance`) with *tinted*."""
     band_path_class(mi.variant())
     return mi.load_dict(
         {

@@ -42,9 +42,11 @@ Mitsuba's ``prb.py`` switches its features), so each traced kernel holds only it
   (``si.wi`` inside) and ``spawn_ray`` offsets the refracted ray, as in ``path.cpp``.
 * **tinted glass** (``it.tinted``, with gloss): a transmission through glass of
   transmittance T(λ) multiplies band k by ``T_k`` (a per-row table, 1 on every other row),
-  a reflection by 1, as Mitsuba's ``specular_transmittance`` weights only the refracted lobe
-  (``dielectric``, ``roughdielectric``, ``thindielectric``; the lobe choice is Fresnel's
-  alone). So ``s_k`` becomes ``T_k s_k`` on a transmission: a BSDF sample whose sampled type
+  a reflection by its reflection tint ``R_k`` (likewise), as Mitsuba's
+  ``specular_transmittance`` weights only the refracted lobe and ``specular_reflectance``
+  only the reflected one (``dielectric``, ``roughdielectric``, ``thindielectric``; the lobe
+  choice is Fresnel's alone). So ``s_k`` becomes ``T_k s_k`` on a transmission, ``R_k s_k``
+  on a reflection: a BSDF sample whose sampled type
   is ``BSDFFlags.Transmission`` (a ``thindielectric``'s is ``Null``, which that flag holds), an
   emitter sample (rough glass only) where ``cos θ_i cos θ_o`` is not positive, the test of
   ``roughdielectric``'s ``eval``. A mask on tinted glass is refused (its hole's null event
@@ -337,7 +339,8 @@ class BandKernel:
         self, rho: list[Float], row: UInt, lobes: tuple[Float, ...], valid: Bool
     ) -> tuple[list[Float], list[Float]]:
         """(G1) ``c_k`` and its non-diffuse part ``s_k (1 − a)`` for ``lobes = (a, μ)``, or
-        ``(a, μ, through)`` with tinted glass (``s_k`` times ``T_k`` where *through* is 1)."""
+        ``(a, μ, through)`` with tinted glass (``s_k`` times ``T_k`` where *through* is 1, else
+        ``R_k``)."""
         a, mu = lobes[:2]
         bands = self.specular_bands(row, mu, valid)
         if self.it.tinted:
@@ -346,10 +349,12 @@ class BandKernel:
         return [self.dr.fma(r, a, s) for r, s in zip(rho, spec, strict=True)], spec
 
     def tint(self, row: UInt, band: int, through: Float, valid: Bool) -> Float:
-        """``T_k`` of table row *row* where *through* is 1 (a transmission), else 1."""
+        """``T_k`` of table row *row* where *through* is 1 (a transmission), else ``R_k``."""
         mi, dr = self.mi, self.dr
-        t = dr.gather(mi.Float, self.it.transmittance, row * self.it.n_bands + band, valid)
-        return dr.select(through > 0.0, t, 1.0)
+        at = row * self.it.n_bands + band
+        t = dr.gather(mi.Float, self.it.transmittance, at, valid)
+        r = dr.gather(mi.Float, self.it.reflection_tint, at, valid)
+        return dr.select(through > 0.0, t, r)
 
     # -- first-hit maps --------------------------------------------------------------------
 

@@ -104,19 +104,20 @@ def _tables(
         light_channels=light_channels(scene, emitters),
         map_scales=map_scales(scene, surfaces),
         masks=any(m.maps is not None and m.maps.masked for m in scene.meshes),
-        transmittance=_transmittance_table(scene, value_sets),
+        transmittance=_tint_table(scene, value_sets, "transmittance"),
+        specular_reflectance=_tint_table(scene, value_sets, "specular_reflectance"),
     )
 
 
-def _transmittance_table(scene: Scene, value_sets: Sequence[ChannelValues]) -> np.ndarray | None:
-    """``(M + 1, K)`` band transmittances of every material (the value sets' side by side
-    over bands; the last row, black, ones), or ``None`` without tinted glass."""
+def _tint_table(scene: Scene, sets: Sequence[ChannelValues], key: str) -> np.ndarray | None:
+    """``(M + 1, K)`` band values of every material's glass tint *key* (the value *sets*' side
+    by side over bands; the last row, black, ones), or ``None`` without tinted glass."""
     if not any(m.tinted for m in scene.materials):
         return None
-    tables = [v.transmittance for v in value_sets if v.transmittance is not None]
-    if len(tables) != len(value_sets):
+    tables = [getattr(v, key) for v in sets if getattr(v, key) is not None]
+    if len(tables) != len(sets):
         raise RenderError(
-            f"scene {scene.name!r} has tinted glass but its channel values carry no transmittances"
+            f"scene {scene.name!r} has tinted glass but its channel values carry no {key}"
         )
     table = np.concatenate(tables, axis=1)
     return np.vstack([table, np.ones((1, table.shape[1]))])

@@ -151,7 +151,7 @@ def material_bsdf(
     reflectance: Mapping,
     *,
     white_metal: bool = False,
-    transmittance: Mapping | None = None,
+    tints: Mapping[str, Mapping] | None = None,
 ) -> dict[str, Any]:
     """The two-sided Mitsuba BSDF of *material* with diffuse *reflectance*.
 
@@ -161,9 +161,10 @@ def material_bsdf(
     ``conductor``/``roughconductor`` with its measured η/k of ``material.metal``, or with
     *white_metal* a perfect mirror (``material: none``, F = 1) whose Fresnel factor the band
     integrator applies per band. Glass: Mitsuba's ``(rough)dielectric``/``thindielectric`` of
-    index ``ior`` over air's 1, not in a ``twosided``, with *transmittance* (a spectrum dict)
-    as its ``specular_transmittance`` where given (tinted glass; the band path loads it clear
-    and applies the tint per band). Else Lambertian.
+    index ``ior`` over air's 1, not in a ``twosided``, with *tints* (``{Mitsuba parameter:
+    spectrum dict}``, ``specular_transmittance`` and ``specular_reflectance``) where given
+    (tinted glass; the band path loads it clear and applies the tints per band). Else
+    Lambertian.
     """
     if material.kind == "diffuse":
         return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": dict(reflectance)}}
@@ -171,7 +172,7 @@ def material_bsdf(
     if material.transmissive:  # a thindielectric is always smooth (materials.py)
         glass = {"type": material.kind, "int_ior": float(material.ior), "ext_ior": 1.0}
         ggx = {"type": "roughdielectric", "distribution": "ggx", "alpha": material.roughness}
-        tint = {} if transmittance is None else {"specular_transmittance": dict(transmittance)}
+        tint = {key: dict(value) for key, value in (tints or {}).items()}
         return glass | (ggx if rough else {}) | tint
     bsdf: dict[str, Any]
     if material.kind == "plastic":
@@ -186,7 +187,7 @@ def material_bsdf(
         bsdf = {
             "type": "roughconductor" if rough else "conductor",
             "material": "none" if white_metal else material.metal,
-        }
+        } | {key: dict(value) for key, value in (tints or {}).items()}
     if rough:
         bsdf |= {"distribution": "ggx", "alpha": float(material.roughness)}
     return {"type": "twosided", "bsdf": bsdf}
@@ -197,7 +198,7 @@ def _surface_bsdf(
     part: SurfaceGeometry,
     materials: Sequence[Mapping],
     white_metal: bool,
-    transmittances: Sequence[Mapping | None],
+    transmittances: Sequence[Mapping[str, Mapping] | None],
 ) -> dict[str, Any]:
     """The BSDF of one surface: its material's, or on a textured mesh the texel-weighted mix of
     its basis materials (a mix of equal reflectances, such as the band path's white load, is
@@ -209,7 +210,7 @@ def _surface_bsdf(
         scene.materials[part.material],
         materials[part.material],
         white_metal=white_metal,
-        transmittance=transmittances[part.material] if transmittances else None,
+        tints=transmittances[part.material] if transmittances else None,
     )
     if texture is not None:
         basis = [materials[b] for b in texture.basis]
@@ -334,7 +335,7 @@ def scene_to_mitsuba(
     sample_count: int,
     geometry: Sequence[SurfaceGeometry] | None = None,
     white_metal: bool = False,
-    transmittances: Sequence[Mapping | None] = (),
+    transmittances: Sequence[Mapping[str, Mapping] | None] = (),
 ) -> dict[str, Any]:
     """Translate *scene* into a dict for ``mitsuba.load_dict``.
 
@@ -359,9 +360,9 @@ def scene_to_mitsuba(
     white_metal
         Metals as perfect mirrors (:func:`material_bsdf`), for the band integrator.
     transmittances
-        One Mitsuba spectrum dict (or ``None``) per ``scene.materials`` entry: a tinted glass's
-        ``specular_transmittance``; empty (the default): every glass clear, as the band
-        integrator loads it.
+        One ``{Mitsuba parameter: spectrum dict}`` (or ``None``) per ``scene.materials``
+        entry: a tinted glass's ``specular_transmittance`` and ``specular_reflectance``; empty
+        (the default): every glass clear, as the band integrator loads it.
     """
     mi = import_mitsuba()
     if transmittances and len(transmittances) != len(scene.materials):
