@@ -127,9 +127,7 @@ def _meta(
     scene_record: Mapping[str, Any],
     scene_folder: Path | None,
 ) -> dict[str, Any]:
-    render_meta = {
-        k: v for k, v in result.meta.items() if k not in _VOLATILE_META
-    }
+    render_meta = {k: v for k, v in result.meta.items() if k not in _VOLATILE_META}
     lights = []
     for record in gt.lights:
         unused = set(LIGHT_PLACEMENT) - set(LIGHT_FIELDS[record.kind])
