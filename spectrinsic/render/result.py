@@ -56,8 +56,9 @@ class RenderResult:
     meta
         Variants, spp, seed, max_depth, sensors and XYZ matrices per mode, wavelength grid,
         timings (seconds per pass), Mitsuba version; with batches also ``batches``,
-        ``batch_spp`` and ``batch_seeds``. ``spp`` is the total over the batches, but
-        ``spectral_spp`` one batch's (a file key of ``meta.json``, kept for byte identity).
+        ``batch_spp`` and ``batch_seeds``. ``spp`` and ``spectral_spp`` (the spectral pass's)
+        are totals over the batches, ``batch_spp`` and ``spectral_batch_spp`` one batch's
+        (:mod:`spectrinsic.gt_export.sample.render_spp` reads samples written before).
     batch_raw
         Per independent batch (:func:`spectrinsic.render.render_batches`), mode -> ``(H, W, K)``
         float32 raw channels of that batch alone; ``raw`` is their mean. Empty for a single

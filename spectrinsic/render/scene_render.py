@@ -226,7 +226,7 @@ def render_meta(
         "integrator": plan.integrator,
     }
     if any(m.kind == "spectral" for m in objs):
-        meta["spectral_spp"] = settings.spectral_batch_spp
+        meta["spectral_spp"] = settings.spectral_batch_spp  # one batch's, as "spp" above
     return meta
 
 
