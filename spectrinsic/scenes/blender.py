@@ -27,13 +27,12 @@ tinted by its Base Color, the Glass BSDF's reflection and transmission by its Co
 subsurface, emission, textures) is ignored; other materials are Lambertian.
 
 With ``colours_from_asset=True`` (the default; ``--no-colours-from-asset`` turns it off), a
-material that the mapping, its
-custom property and its name leave without a spectrum takes the Principled node's Base Color
-(linear Rec. 709, from the file's working space; alpha ignored) as the reflectance ``rgb:R,G,B``
-(:mod:`spectrinsic.spectra.user_spectra`, Mallett & Yuksel 2019); a colour outside [0, 1] is
-refused when validated, not clipped, and a Base Color fed by a node (an image texture) is not
-read, so that material still needs a spectrum, unless the node is an Image Texture on a UV
-map: that image becomes an exact spectral texture (:mod:`spectrinsic.scenes.blender_colours`;
+material that the mapping, its custom property and its name leave without a spectrum takes the
+Principled node's Base Color (linear Rec. 709, from the file's working space; alpha ignored) as
+the reflectance ``rgb:R,G,B`` (:mod:`spectrinsic.spectra.user_spectra`, Mallett & Yuksel 2019);
+a colour outside [0, 1] is refused when validated, not clipped, and a Base Color fed by a node
+is not read, so that material still needs a spectrum, unless the node is an Image Texture on a
+UV map: that image becomes an exact spectral texture (:mod:`spectrinsic.scenes.blender_colours`;
 the object must hold that material alone). Without the option such a material is an error.
 
 Opening a file replaces the data of the running ``bpy`` session (Blender has one global state).
