@@ -54,7 +54,10 @@ _STANDARD_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
 #: 6: raw channels go to XYZ by einsum in chunks rather than BLAS (spectrinsic/render/algebra/modes.py), and an
 #: image's XYZ is the float64 sum of its lights' XYZ (spectrinsic/render/algebra/light_transport.py): XYZ images
 #: move by at most one float32 rounding, and no longer depend on the BLAS kernel.
-PIXELS_VERSION = 6
+#: 7: a render whose samples per pixel are not a power of two is the sample-weighted mean of
+#: power-of-two parts, each with its own seed (spectrinsic/render/base/sample_split.py): the bits
+#: no longer follow Dr.Jit's thread schedule; such renders draw other samples than before.
+PIXELS_VERSION = 7
 #: What of the installed software changes pixels, hence enters the config hash, and how much
 #: of its version: the renderer exactly (its sampling changes between patch releases);
 #: colour-science's data tables (CMFs, illuminants, cameras) by minor release; numpy by major

@@ -19,6 +19,7 @@ from ...interrupts import raise_if_requested
 from ...scenes.model import Scene
 from ..settings import PassRequest
 from .plugins import rgb_spectrum
+from .sample_split import split_render
 
 __all__ = [
     "DIRECT_DEPTH",
@@ -85,12 +86,13 @@ def timed_render(
     mi: Any, loaded: Any, request: PassRequest, integrator: Any = None
 ) -> tuple[np.ndarray, float]:
     """One ``mi.render`` of *request*'s samples and seed as float32 and its seconds, reported
-    to its progress; a Ctrl-C stops the build within it."""
+    to its progress, its samples split so that its bits do not follow the thread schedule
+    (:func:`~.sample_split.split_render`); a Ctrl-C stops the build within it."""
     raise_if_requested()
     start = time.perf_counter()
     try:
         spp, seed = int(request.batch_spp), int(request.seed)
-        image = np.array(mi.render(loaded, spp=spp, seed=seed, integrator=integrator), np.float32)
+        image = split_render(mi, loaded, spp=spp, seed=seed, integrator=integrator)
     except RuntimeError as exc:
         raise_if_requested()  # Dr.Jit re-raises a Ctrl-C inside the render as RuntimeError
         raise RenderError(f"Mitsuba render failed: {exc}") from exc

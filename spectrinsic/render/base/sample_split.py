@@ -1,0 +1,111 @@
+"""One render call's samples split so that its film's bits do not follow the thread schedule.
+
+Mitsuba's JIT variants render every sample of one call as one wavefront laid out pixel by pixel
+(the spp samples of a pixel in consecutive lanes; ``SamplingIntegrator::render`` in
+``src/render/integrator.cpp``) and add each sample into its pixel of the film with an atomic
+scatter-add (``ImageBlock::put``). Dr.Jit's LLVM backend runs a wavefront as work units on its
+thread pool (``LLVMThreadState::launch`` in drjit-core): units of :data:`WORK_UNIT` lanes when
+the wavefront has more than ``2 · WORK_UNIT`` lanes per thread, else one share per thread.
+Where a pixel's lanes straddle two units, two threads add into that pixel, and the order of
+those float additions, so the pixel's last bits, follows the thread schedule: two builds of
+one sample with one seed differed run to run (docs/reproducibility.md).
+
+So :func:`split_render` renders a sample count as powers of two of at most :data:`WORK_UNIT`
+(:func:`sample_splits`: 160 = 128 + 32), each part with its own seed (:func:`part_seeds`). A
+large part's units then hold whole pixels: one thread adds every sample of a pixel, in lane
+order. A part too small for units of :data:`WORK_UNIT` lanes (:func:`single_thread`) runs on one
+Dr.Jit thread, which adds in the same lane order. The film is then the same bits run to run and
+for any number of threads. The parts' images are averaged with weights ``spp_i / spp`` in
+float64, in part order: the same estimate (the mean of spp independent samples per pixel), and
+a power-of-two count renders exactly as one call did.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+
+from ...rng import seed_from_key
+
+__all__ = ["WORK_UNIT", "sample_splits", "part_seeds", "single_thread", "split_render"]
+
+#: Lanes per work unit of Dr.Jit's LLVM backend on large launches (``jitc_llvm_block_size``,
+#: 16384 by default); no part of a split has more samples per pixel.
+WORK_UNIT = 2**14
+
+
+def sample_splits(spp: int) -> tuple[int, ...]:
+    """*spp* as powers of two of at most :data:`WORK_UNIT`, largest first.
+
+    >>> sample_splits(160), sample_splits(64), sample_splits(5)
+    ((128, 32), (64,), (4, 1))
+    >>> sample_splits(2**15 + 3)
+    (16384, 16384, 2, 1)
+    """
+    if isinstance(spp, bool) or not isinstance(spp, int) or spp < 1:
+        raise ValueError(f"samples per pixel {spp!r}: expected a positive integer")
+    full, rest = divmod(spp, WORK_UNIT)
+    bits = [1 << b for b in range(rest.bit_length() - 1, -1, -1) if rest >> b & 1]
+    return (WORK_UNIT,) * full + tuple(bits)
+
+
+def part_seeds(seed: int, parts: int) -> tuple[int, ...]:
+    """Sampler seeds of the *parts* of one render: *seed* first (so a render of one part is
+    the unsplit render), then seeds derived from it by key
+    (:func:`~spectrinsic.rng.seed_from_key`), as independent as the batches' seeds.
+
+    >>> part_seeds(7, 2)[0], len(set(part_seeds(7, 3)))
+    (7, 3)
+    """
+    return (int(seed),) + tuple(seed_from_key(int(seed), f"samples-{i}") for i in range(1, parts))
+
+
+def single_thread(lanes: int, threads: int) -> bool:
+    """Whether a wavefront of *lanes* lanes is too small for Dr.Jit's units of
+    :data:`WORK_UNIT` lanes on *threads* threads (it is then cut into one share per thread,
+    whose borders may fall inside a pixel).
+
+    >>> single_thread(32 * 32 * 32, 2), single_thread(32 * 32 * 128, 2)
+    (True, False)
+    """
+    return threads > 1 and lanes <= 2 * WORK_UNIT * threads
+
+
+@contextlib.contextmanager
+def _threads(dr: Any, count: int | None) -> Iterator[None]:
+    """Dr.Jit's thread pool at *count* threads inside the block (``None``: as it is)."""
+    before = dr.thread_count()
+    if count is None or count == before:
+        yield
+        return
+    dr.set_thread_count(count)
+    try:
+        yield
+    finally:
+        dr.set_thread_count(before)
+
+
+def split_render(
+    mi: Any, loaded: Any, *, spp: int, seed: int, integrator: Any = None
+) -> np.ndarray:
+    """``mi.render`` of *spp* samples per pixel, as float32, in the parts of
+    :func:`sample_splits` on an LLVM variant (module docstring); one plain call on the other
+    variants (scalar: one thread per image block; CUDA: not covered)."""
+    if not mi.variant().startswith("llvm"):
+        image = mi.render(loaded, spp=spp, seed=seed, integrator=integrator)
+        return np.array(image, dtype=np.float32)
+    import drjit as dr
+
+    width, height = loaded.sensors()[0].film().crop_size()
+    parts = sample_splits(spp)
+    weighted = []
+    for count, part_seed in zip(parts, part_seeds(seed, len(parts)), strict=True):
+        small = single_thread(int(width) * int(height) * count, dr.thread_count())
+        with _threads(dr, 1 if small else None):
+            image = mi.render(loaded, spp=count, seed=part_seed, integrator=integrator)
+            weighted.append(np.array(image, dtype=np.float64) * count)
+    return (functools.reduce(np.add, weighted) / spp).astype(np.float32)
