@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
 from spectrinsic.decompose.decomposition import Decomposition
 from spectrinsic.decompose.methods.names_shades import NamesAndShades
 from spectrinsic.decompose.methods.shading_texture import return_fine_detail, texture_share
