@@ -347,7 +347,9 @@ class NamesAndShades:
         """Decompose a linear ``(H, W, 3)`` image into reflectance and shading.
 
         The five steps of the module docstring (:meth:`labelling` then :meth:`reflectance`);
-        ``info`` records each step's time in seconds and the collapse guard's check.
+        ``info`` records each step's time in seconds, the collapse guard's check and what the
+        fine-detail step moved (``info["texture"]``); that step acts last, on whatever the
+        collapse guard returns.
         """
         result = self.reflectance(self.labelling(image, mask))
         img, m = prepare_input(image, mask)
