@@ -1,4 +1,4 @@
-"""Names-and-shades on the MIT development half under stress variants, before and after issue 48.
+"""Names-and-shades on the MIT development half under stress variants, before and after a change.
 
 Usage: python -P scripts/mit_stress.py MIT_DIR OUT.json [--variants=V,W] [OBJECT ...]
        python -P scripts/mit_stress.py --table OUT.md PART.json ...
@@ -6,10 +6,9 @@ Usage: python -P scripts/mit_stress.py MIT_DIR OUT.json [--variants=V,W] [OBJECT
 Every object of MIT_DIR (``$SPECTRINSIC_DATA/mit_intrinsic_dev``; all by default) under every
 variant of :data:`spectrinsic.decompose.evaluation.mit_variants.VARIANTS` (all by default) is
 decomposed by three methods and scored with the thesis' protocol (MIT LMSE,
-:mod:`spectrinsic.decompose.evaluation.mit`): ``before`` (names-and-shades without the sharp
-achromatic edge rule, the collapse guard and round 6's blurred-step reads, i.e. main before
-issue 48), ``after`` (the
-defaults) and ``image-as-reflectance``. OUT.json keeps every score and the guard's action;
+:mod:`spectrinsic.decompose.evaluation.mit`): ``before`` (names-and-shades without round 7's
+return of the fine detail to the reflectance, i.e. main at bbf89c8; rounds 5-6 compared main
+before issue 48 here), ``after`` (the defaults) and ``image-as-reflectance``. OUT.json keeps every score and the guard's action;
 ``--table`` merges parts (runs on disjoint objects can share the cores) into a markdown table
 per variant with each object's ratio to image-as-reflectance and the worst case.
 """
@@ -29,7 +28,7 @@ from spectrinsic.decompose.methods.names_shades import NamesAndShades
 from spectrinsic.errors import DatasetError
 
 METHODS = {
-    "before": NamesAndShades(sharp_edges="none", collapse_guard=False, blurred_steps=False),
+    "before": NamesAndShades(fine_detail=False),
     "after": NamesAndShades(),
     "image-as-reflectance": ImageAsReflectance(),
 }

@@ -2,8 +2,8 @@
 
 Usage: python -P scripts/teabag1_diagnosis.py MIT_DIR OUT.png [OBJECT] [--before]
 
-One row per setting (the defaults, and ``NamesAndShades(blurred_steps=False)``, the method
-before round 6, with ``--before``): the photograph, the true reflectance and shading, the estimates, and two error
+One row per setting (the defaults, and, with ``--before``, the method before round 6,
+``NamesAndShades(blurred_steps=False, fine_detail=False)``): the photograph, the true reflectance and shading, the estimates, and two error
 maps, ``log(R_est / R_true)`` per pixel (after one global scale, the median; red: too light,
 blue: too dark) and the local shading error (each 20-pixel window's squared error after its
 own least-squares scale, the MIT LMSE's term, spread over the window). Prints each row's MIT
@@ -95,7 +95,7 @@ def main(folder: Path, out: Path, name: str, before: bool) -> None:
     print(f"{name}: image-as-reflectance LMSE {iar:.4f}")
     settings = {"defaults": NamesAndShades()}
     if before:
-        settings["before round 6"] = NamesAndShades(blurred_steps=False)
+        settings["before round 6"] = NamesAndShades(blurred_steps=False, fine_detail=False)
     ys, xs = np.nonzero(m)
     crop = (slice(ys.min(), ys.max() + 1), slice(xs.min(), xs.max() + 1))
     fig, axes = plt.subplots(len(settings), 7, figsize=(17, 2.9 * len(settings)), squeeze=False)

@@ -20,7 +20,9 @@ from spectrinsic.decompose.methods.sharp_edges import achromatic_contrast, sharp
 pytestmark = pytest.mark.filterwarnings("ignore::FutureWarning")  # gco's numpy aliases
 
 #: Names-and-shades before issue 48 (main at e7c9e6f).
-BEFORE = NamesAndShades(sharp_edges="none", collapse_guard=False, blurred_steps=False)
+BEFORE = NamesAndShades(
+    sharp_edges="none", collapse_guard=False, blurred_steps=False, fine_detail=False
+)
 PRINT, PAPER = 0.05, 0.8
 N = 48
 

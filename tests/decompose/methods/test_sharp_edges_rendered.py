@@ -23,7 +23,9 @@ from spectrinsic.scenes.validate import validate_scene
 
 pytestmark = pytest.mark.filterwarnings("ignore::FutureWarning")  # gco's numpy aliases
 
-BEFORE = NamesAndShades(sharp_edges="none", collapse_guard=False, blurred_steps=False)
+BEFORE = NamesAndShades(
+    sharp_edges="none", collapse_guard=False, blurred_steps=False, fine_detail=False
+)
 WHITE, BLACK = 0.8, 0.05
 
 
