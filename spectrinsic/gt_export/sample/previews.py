@@ -20,7 +20,7 @@ from ..layers.gloss import SPECULAR
 from . import PREVIEW_DIR
 from .working_view import srgb_layer, view_kind
 
-__all__ = ["Preview", "PreviewMaker", "preview_maker", "preview_path", "shown_layers"]
+__all__ = ["Preview", "preview_maker", "preview_path", "shown_layers"]
 
 
 #: A preview and how its pixels encode the layer: ``{"kind": "srgb", "scale": k}`` (PNG =
@@ -28,9 +28,6 @@ __all__ = ["Preview", "PreviewMaker", "preview_maker", "preview_path", "shown_la
 #: ``{"kind": "colormap", "cmap", "vmin", "vmax"}`` (false colour of a scalar) or
 #: ``{"kind": "categorical"}`` (ids, normals, mask).
 Preview = tuple[np.ndarray, dict[str, Any]]
-#: A preview maker: ``maker(layer, layers) -> (rgb8, encoding)``, *layers* the sample's layers
-#: as previews show them (:func:`shown_layers`); a pure function of its arguments.
-PreviewMaker = Callable[[Layer, Mapping[str, Layer]], Preview]
 
 #: Layers that share one exposure per sample, so brightness differences between them are real:
 #: every image mode and camera image uses ``image``'s, every shading ``shading``'s.
@@ -141,7 +138,7 @@ def _raw_preview(layer: Layer, layers: Mapping[str, Layer]) -> Preview:
 
 
 #: (layer-name prefix, preview maker); the first matching prefix wins; no match, no preview.
-_PREVIEWS: tuple[tuple[str, PreviewMaker], ...] = (
+_PREVIEWS: tuple[tuple[str, Callable[[Layer, Mapping[str, Layer]], Preview]], ...] = (
     ("image", _colour_preview),
     ("shading_grey", _grey_preview),
     ("shading", _colour_preview),
@@ -166,7 +163,7 @@ _PREVIEWS: tuple[tuple[str, PreviewMaker], ...] = (
 )
 
 
-def preview_maker(layer: Layer) -> PreviewMaker | None:
+def preview_maker(layer: Layer) -> Callable[[Layer, Mapping[str, Layer]], Preview] | None:
     """The maker of *layer*'s preview (first matching prefix of :data:`_PREVIEWS`), or ``None``
     (also for band layers, ``*_bands``: their sRGB views are the RGB layers' previews)."""
     if layer.data.ndim == 3 and layer.data.shape[-1] not in (1, 3):

@@ -26,7 +26,7 @@ import re
 import shutil
 import tempfile
 import uuid
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -49,7 +49,6 @@ from ..formats import png
 from ..formats.exr import write_exr
 from ..layers import (
     GroundTruth,
-    Layer,
     LayerSettings,
     compute_ground_truth,
     identities,
@@ -71,7 +70,7 @@ from . import (
     plain_data,
 )
 from .integrity import replaceable_sample, sample_problem
-from .previews import PreviewMaker, preview_maker, preview_path, shown_layers
+from .previews import preview_maker, preview_path, shown_layers
 from .sensor import SensorOutput, sensor_output, write_sensor_files
 from .stored_layers import compression_of, stored_layers
 from .transport_cube import CubeFactors, cube_factors, with_cube
@@ -205,34 +204,23 @@ def _write_layers(
     return list(stored.arrays), stored.record()
 
 
-def _preview_task(
-    maker: PreviewMaker, layer: Layer, shown: Mapping[str, Layer], encodings: dict[str, Any]
-) -> Callable[[Path], None]:
-    """Draw *layer*'s preview, record its encoding in *encodings* and write the PNG (in a write
-    thread: the makers are numpy and Pillow's zlib, and each reads only finished layers)."""
-
-    def draw_and_write(path: Path) -> None:
-        rgb8, encodings[layer.name] = maker(layer, shown)
-        png.write_png(path, rgb8)
-
-    return draw_and_write
-
-
 def _write_previews(
     folder: Path, writes: FileWrites, gt: GroundTruth
-) -> tuple[dict[str, str], dict[str, Any]]:
-    """One PNG per layer that has a preview maker, drawn and written by *writes*; return
-    ``{layer: path}`` and ``{layer: encoding}``, complete once *writes* has joined."""
+) -> dict[str, tuple[str, dict[str, Any]]]:
+    """One PNG per layer that has a preview maker, handed to *writes* as soon as it is drawn;
+    return ``{layer: (path, encoding)}``."""
     (folder / PREVIEW_DIR).mkdir()
-    paths: dict[str, str] = {}
-    encodings: dict[str, Any] = {}
+    previews: dict[str, tuple[str, dict[str, Any]]] = {}
     shown = shown_layers(gt.layers, gt.working_space)  # previews are sRGB
     for layer in shown.values():
         maker = preview_maker(layer)
-        if maker is not None:
-            paths[layer.name] = preview_path(layer)
-            writes.submit(paths[layer.name], _preview_task(maker, layer, shown, encodings))
-    return paths, encodings
+        if maker is None:
+            continue
+        rel = preview_path(layer)
+        rgb8, encoding = maker(layer, shown)
+        writes.submit(rel, functools.partial(png.write_png, rgb8=rgb8))
+        previews[layer.name] = (rel, encoding)
+    return previews
 
 
 def _write_meta(folder: Path, meta: dict[str, Any], hashes: Mapping[str, str]) -> None:
@@ -260,15 +248,15 @@ def _fill_folder(
     sensor: SensorOutput | None = None,
     scene_folder: Path | None = None,
     **meta_kw: Any,
-) -> tuple[dict[str, Any], dict[str, str]]:
+) -> dict[str, Any]:
     """Write (or hand to *writes*) every file of the sample but ``meta.json``; return
-    ``meta.json``'s content without its hashes and seal, and the hashes *writes* computed."""
+    ``meta.json``'s content without its hashes and seal."""
     coverage = (getattr(result, "aovs", None) or {}).get("coverage")
     files, storage = _write_layers(writes, gt, meta_kw["sample_id"], coverage, cube)
     if sensor is not None:  # the camera chain's raw DNG and processed PNG (gt_export.sensor)
         files += write_sensor_files(folder, sensor)
-    preview_paths, encodings = _write_previews(folder, writes, gt)
-    files += list(preview_paths.values())
+    previews = _write_previews(folder, writes, gt)
+    files += [rel for rel, _ in previews.values()]
     # scene_to_dict, the record the scene hash is taken of (a procedural texture's recipe, not
     # its texel weights); scene_from_dict reads it back
     # its csv: names relative to the scene's folder, as every record of the sample holds them
@@ -283,8 +271,6 @@ def _fill_folder(
         )
         record["cameras"] = list(gt.cameras)  # full sensor-set names, to relight the camera layers
         files.append(TRANSPORT_NAME)
-    hashes = writes.hashes()  # every file handed over written, every preview drawn
-    previews = {k: (rel, encodings[k]) for k, rel in preview_paths.items()}
     meta = _meta(
         scene,
         result,
@@ -301,7 +287,7 @@ def _fill_folder(
     if sensor is not None:
         meta["sensor"] = sensor.meta
         meta["identities"].append(sensor.identity)
-    return portable_names(meta, scene_folder), hashes  # csv: names of materials, lights, sensors
+    return portable_names(meta, scene_folder)  # csv: names of materials, lights and sensors
 
 
 def export_sample(
@@ -376,7 +362,7 @@ def export_sample(
     try:
         tmp.chmod(0o755)
         with FileWrites(tmp) as writes:  # EXR and PNG files encoded while the rest is computed
-            meta, hashes = _fill_folder(
+            meta = _fill_folder(
                 tmp,
                 writes,
                 scene,
@@ -390,6 +376,7 @@ def export_sample(
                 sensor=sensor,
                 scene_folder=None if settings.scene_folder is None else Path(settings.scene_folder),
             )
+            hashes = writes.hashes()
         _write_meta(tmp, meta, hashes)
         _move_into_place(tmp, final, config_hash(config))
     except WriteError as exc:  # named as the file will be (a full disk): not the temporary
