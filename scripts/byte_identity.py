@@ -12,7 +12,11 @@ spectral studies. It writes ``{relative path: sha256}`` of every output file to 
 ``scene.json`` is left out (its texel weights follow the scene hash since issue 35), and
 JSON files (``meta.json``, ``manifest.json``, the studies') are hashed as canonical JSON without
 version strings, the git commit and ``config_hash``, and without the hashes of ``scene.json`` and ``meta.json`` they list (so a
-version bump alone does not count as a change). Compare two runs with
+version bump alone does not count as a change). Build times change from run to run and are left
+out: a dataset's ``build-time.json`` is hashed without its fields ``finished``, ``wall_seconds``,
+``sample_seconds``, ``mitsuba_seconds`` and ``cpus`` (each run's ``samples_built`` is kept), and
+``DATASET.md`` without its one line that starts with ``Build time:`` (time, CPUs, dates); the
+card's size figures stay in, as they follow the sample files' bytes. Compare two runs with
 ``python scripts/byte_identity.py --compare A.json B.json``; re-hash a folder kept with
 ``--keep DIR`` by ``--hash DIR OUT.json``.
 """
@@ -84,6 +88,11 @@ _DROPPED = {
     "git_sha",
     "created",
 }
+#: Keys removed before hashing a dataset's ``build-time.json`` (its run-dependent fields,
+#: ``build_time.RUN_TIME_FIELDS``; the count of samples each run built is kept).
+_BUILD_TIME_FIELDS = {"finished", "wall_seconds", "sample_seconds", "mitsuba_seconds", "cpus"}
+#: The dataset card's one line of build time, machine and date (``build_time.BUILD_TIME_LINE``).
+_CARD_TIME_LINE = "Build time:"
 _FAST = ["--preset", "preview", "--resolution", "24x24", "--spp", "4", "--spectral-spp", "2"]
 
 
@@ -101,6 +110,14 @@ def _strip(value: object) -> object:
 
 
 def _digest(path: Path) -> str:
+    if path.name == "build-time.json":
+        runs = json.loads(path.read_text())["runs"]
+        kept = [{k: v for k, v in run.items() if k not in _BUILD_TIME_FIELDS} for run in runs]
+        return hashlib.sha256(json.dumps(kept, sort_keys=True).encode()).hexdigest()
+    if path.name == "DATASET.md":
+        lines = path.read_text(encoding="utf-8").splitlines(keepends=True)
+        kept_text = "".join(x for x in lines if not x.startswith(_CARD_TIME_LINE))
+        return hashlib.sha256(kept_text.encode()).hexdigest()
     if path.suffix == ".json":
         data = _strip(json.loads(path.read_text()))
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()

@@ -16,16 +16,11 @@ from ..pipeline.dataset import SampleFailure, build_dataset
 from ..pipeline.executors import check_scheduler, choose_executor
 from ..pipeline.presets import PRESETS, DatasetConfig, get_preset, preset_names
 from ..pipeline.source_plan import check_integrator_plan
-from ..render.budget import check_render_size
+from ..render.budget import PLANNED_LOAD, RenderLoad, check_render_size
 from ..render.settings import INTEGRATORS, UINT32_MAX
 from .dataset_layers import add_extra_layer_options, layer_changes
-from .dataset_source import (
-    add_source_options,
-    check_scene_files,
-    parse_resolution,
-    source_from_args,
-    source_notes,
-)
+from .dataset_scene_files import check_scene_files, source_notes
+from .dataset_source import add_source_options, parse_resolution, source_from_args
 from .dataset_variant import add_variant_option, check_variant
 
 __all__ = [
@@ -281,19 +276,24 @@ def preflight(
             f"to {UINT32_MAX} and at most {UINT32_MAX} samples per pixel"
         )
     check_build_folder(Path(out), config.config_hash(), rebuild=rebuild)
-    check_scene_files(config, data_dir, quiet=quiet)
+    scenes = check_scene_files(config, data_dir, quiet=quiet)
     check_integrator_plan(config)  # integrator x materials: every sample would fail
     if scheduler:
         check_scheduler(scheduler)
-    # two lights: the library's two-colour conditions, rendered once per light
-    check_render_size(
-        config.width,
-        config.height,
-        config.render,
-        what=f"--resolution {config.width}x{config.height}",
-        processes=workers or 1,
-        n_lights=2,
-    )
+    sizes = [
+        (f"scene {s.name!r} at", s.camera.width, s.camera.height, RenderLoad.of_scene(s))
+        for s in scenes
+    ] or [("--resolution", config.width, config.height, PLANNED_LOAD)]
+    for what, width, height, load in sizes:
+        check_render_size(
+            width,
+            height,
+            config.render,
+            what=f"{what} {width}x{height}",
+            processes=workers or 1,
+            load=load,
+            data_dir=data_dir,
+        )
 
 
 def run(args: argparse.Namespace) -> int:

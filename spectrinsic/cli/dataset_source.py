@@ -1,45 +1,34 @@
 """The scene-source options of ``spectrinsic dataset`` and their parsing: library, generator
 or scene files (``--generator``, ``--scenes`` and their settings), ``--material-map``,
-``--resolution``, and the check of scene files before a build; shared with
-``render --ground-truth``."""
+and ``--resolution``; shared with ``render --ground-truth`` (the check of scene files before
+a build: :mod:`.dataset_scene_files`)."""
 
 from __future__ import annotations
 
 import argparse
-import json
 import math
-import sys
 from pathlib import Path
 from typing import Any
 
 from ..errors import DatasetError, SceneError, SpectrinsicError
-from ..pipeline.presets import DatasetConfig
 from ..pipeline.source_plan import (
-    check_scene_integrator,
-    file_sample,
     files_source,
     generator_source,
-    semantic_rules,
 )
-from ..render.base.variants import import_mitsuba
 from ..scenes.generators import GlossDistribution
 from ..scenes.generators.world_defaults import GLOSSY_FRACTION, METALLIC_FRACTION, TEXTURE_FRACTION
-from ..scenes.mitsuba_xml import render_hints_line, xml_notes
 from ..scenes.semantic import SemanticRules, read_semantic_map
-from ..scenes.sources import FileSource, takes_asset_colours
+from ..scenes.sources import takes_asset_colours
 from ..scenes.spectrum_refs import resolve_spectrum
 from ..scenes.yaml_limits import load_yaml_file
-from ..spectra import get_spectrum
 
 __all__ = [
     "add_source_options",
-    "check_scene_files",
     "material_map",
     "semantic_map",
     "add_semantic_map_option",
     "parse_resolution",
     "source_from_args",
-    "source_notes",
 ]
 
 
@@ -190,7 +179,8 @@ def _add_scene_file_options(src: Any) -> None:
         "--approximate",
         action="store_true",
         help="Mitsuba XML scenes: approximate what has no exact ground truth (glass, masks, "
-        "bump maps, bitmaps, environment maps...) instead of refusing it, one line saying what",
+        "bump maps, bitmaps, environment maps...; a .blend World's Sky Texture...) instead of "
+        "refusing it, one line saying what",
     )
     src.add_argument(
         "--new-sample",
@@ -372,29 +362,6 @@ def source_from_args(args: argparse.Namespace) -> str | None:
     return None
 
 
-def source_notes(config: DatasetConfig) -> list[str]:
-    """What applies to each scene file of *config* (``--scenes``, ``render --ground-truth``):
-    its size (the file's camera or --resolution) and its sample (a saved one, reproduced, or a
-    new one); empty for the library and generators."""
-    spec = json.loads(config.source or "{}")
-    notes = []
-    for entry in spec.get("scenes", ()):
-        size = spec.get("resolution")
-        where = (
-            f"{size[0]}x{size[1]} (--resolution)"
-            if size
-            else "the file's camera size (--resolution to change it)"
-        )
-        sid, seed = file_sample(entry["path"], new_sample=bool(spec.get("new_sample")))
-        sample = (
-            f"reproduces its saved sample {sid} with seed {seed} (--new-sample for a new one)"
-            if seed is not None
-            else f"sample {sid}"
-        )
-        notes.append(f"{Path(entry['path']).name}: {where}; {sample}")
-    return notes
-
-
 def parse_resolution(text: str) -> tuple[int, int]:
     """``WIDTHxHEIGHT`` as two positive integers."""
     w, sep, h = text.lower().partition("x")
@@ -403,44 +370,3 @@ def parse_resolution(text: str) -> tuple[int, int]:
             f"--resolution {text!r}; expected WIDTHxHEIGHT of positive integers, e.g. 256x256"
         )
     return int(w), int(h)
-
-
-def check_scene_files(config: Any, data_dir: str | None, *, quiet: bool = False) -> None:
-    """``--scenes``: every file reads as a valid scene with this material map and default
-    spectrum, before the folder is stamped with the config (a bad file is an input error, not
-    a failed sample); what a Mitsuba XML read fixed or approximated, and the spp and depth that
-    apply to it (the preset's), are said on stderr unless *quiet*."""
-
-    spec = json.loads(config.source or "{}")
-    if "scenes" not in spec:
-        return
-    materials = spec.get("materials") or {}
-    named = [("--default-spectrum", spec.get("default_spectrum"))]
-    named += [(f"--material-map entry {k!r}", v) for k, v in sorted(materials.items())]
-    for option, name in named:
-        try:
-            if name is not None:
-                get_spectrum(name, data_dir=data_dir)
-        except SpectrinsicError as exc:
-            raise DatasetError(f"{option} {name!r}: {exc}") from exc
-    width, height = spec.get("resolution") or (None, None)
-    import_mitsuba()  # set up before a Mitsuba XML read imports it (the libLLVM Dr.Jit loads)
-    for entry in spec["scenes"]:
-        scene = FileSource(
-            entry["path"],
-            width,
-            height,
-            tuple(sorted(materials.items())),
-            spec.get("default_spectrum"),
-            colours_from_asset=bool(spec.get("colours_from_asset", False)),
-            approximate=bool(spec.get("approximate")),
-            semantic=semantic_rules(spec),
-        ).build(data_dir)
-        check_scene_integrator(config, scene, entry["path"])  # every sample would fail
-        if not quiet:
-            for note in xml_notes(scene):
-                print(f"spectrinsic dataset: {note}", file=sys.stderr)
-            given = f"the dataset's settings (preset {config.preset!r} and options)"
-            line = render_hints_line(scene, config.render.spp, config.render.max_depth, given)
-            if line is not None:
-                print(f"spectrinsic dataset: {line}", file=sys.stderr)

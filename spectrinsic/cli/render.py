@@ -30,10 +30,11 @@ from ..render import (
     render_scene,
 )
 from ..render.base.plugins import MAX_PATH_DEPTH
-from ..render.budget import check_render_size
+from ..render.budget import RenderLoad, check_render_size
 from ..render.settings import DEFAULT_INTEGRATOR
-from ..scenes.mitsuba_xml import render_hints_line, xml_notes
+from ..scenes.mitsuba_xml import render_hints_line
 from ..scenes.model import Scene
+from ..scenes.reading_notes import reading_notes
 from ..scenes.sources import is_scene_file
 from .dataset_layers import given_layer_options
 from .dataset_source import material_map
@@ -127,7 +128,7 @@ def run(args: argparse.Namespace) -> int:
         scene.camera.height,
         settings,
         what=given or f"scene {args.scene!r}",
-        n_lights=len(scene.lights),
+        load=RenderLoad.of_scene(scene),
         data_dir=data_dir,
     )
     with staged_output(Path(args.out)) as stage:  # a failed run leaves --out as it was
@@ -161,7 +162,7 @@ def _file_settings(
     """*settings* with a Mitsuba XML file's ``sample_count`` and ``max_depth`` where the
     command line gave no ``--spp`` / ``--max-depth``; says what it read and which applies."""
     if not getattr(args, "quiet", False):
-        for note in xml_notes(scene):
+        for note in reading_notes(scene):
             print(f"spectrinsic render: {note}", file=sys.stderr)
         line = render_hints_line(scene, args.spp, args.max_depth)
         if line is not None:

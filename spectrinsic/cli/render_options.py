@@ -201,8 +201,8 @@ def _add_material_options(p: Any) -> None:
         "--approximate",
         action="store_true",
         help="Mitsuba XML: approximate what has no exact ground truth (glass, bitmaps other "
-        "than a diffuse reflectance, environment maps...) instead of refusing it, one line "
-        "saying what",
+        "than a diffuse reflectance, environment maps...; a .blend World's Sky Texture...) "
+        "instead of refusing it, one line saying what",
     )
 
 
@@ -237,8 +237,10 @@ def check_source_options(args: argparse.Namespace) -> None:
     }
     library_only = ("--condition", "--view")
     file_only = ("--material-map", "--default-spectrum", "--semantic-map")
-    if args.approximate and Path(args.scene).suffix.lower() != ".xml":
-        raise RenderError(f"--approximate applies to Mitsuba XML scenes; {args.scene!r} is not one")
+    if args.approximate and Path(args.scene).suffix.lower() not in (".xml", ".blend"):
+        raise RenderError(
+            f"--approximate applies to Mitsuba XML scenes and .blend worlds; {args.scene!r} is neither"
+        )
     for option in library_only if file else file_only:
         if given[option]:
             kind = "a scene file" if file else "a library scene"

@@ -33,6 +33,7 @@ from ..gt_export import (
     write_dataset_card,
     write_manifest,
 )
+from ..gt_export.dataset.build_time import BuildRun, record_build_run
 from ..gt_export.folders.build_folder import (
     check_build_folder,
     remove_owned_temporaries,
@@ -54,7 +55,7 @@ from .executors import Executor, SerialExecutor
 from .presets import DatasetConfig
 from .sample_plan import plan_samples
 from .source_plan import save_generated
-from .tasks import SampleFailure, SampleOutcome, SampleTask
+from .tasks import SampleFailure, SampleOutcome, SampleTask, mitsuba_seconds, run_record
 
 __all__ = [
     "SampleTask",
@@ -161,7 +162,7 @@ def build_sample(task: SampleTask) -> SampleOutcome:
         path=str(path),
         seconds=seconds,
         render_seconds=render_seconds,
-        mitsuba_seconds=_mitsuba_seconds(result.meta, render_seconds),
+        mitsuba_seconds=mitsuba_seconds(result.meta, render_seconds),
         peak_rss_mb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
     )
 
@@ -187,20 +188,6 @@ def _task_scene(task: SampleTask) -> Any:
     scene = task.source.build(task.data_dir, probe=probe)
     save_generated(task.out_dir, task.sample_id, scene, task.seed)
     return scene
-
-
-def _mitsuba_seconds(meta: dict[str, Any], fallback: float) -> float:
-    """Seconds spent in Mitsuba's ``render`` calls, summed over the renderer's reported passes
-    (``meta["timings"][pass_group]["seconds"]``); *fallback* when none are reported."""
-    timings = meta.get("timings") if isinstance(meta, dict) else None
-    if not isinstance(timings, dict):
-        return fallback
-    seconds = [
-        float(t["seconds"])
-        for t in timings.values()
-        if isinstance(t, dict) and isinstance(t.get("seconds"), int | float)
-    ]
-    return sum(seconds) if seconds else fallback
 
 
 def build_dataset(
@@ -317,7 +304,9 @@ def _build_locked(
     built, failed = _run(executor, task_fn, todo, progress)
     files: dict[str, str] = {}
     if finalize:
-        files = finalize_dataset(out, config, data_dir=data_dir)
+        files = finalize_dataset(
+            out, config, data_dir=data_dir, run=run_record(built, start, config.relight)
+        )
     return DatasetReport(
         out_dir=out,
         config=config,
@@ -425,12 +414,15 @@ def finalize_dataset(
     config: DatasetConfig,
     *,
     data_dir: str | os.PathLike[str] | None = None,
+    run: BuildRun | None = None,
 ) -> dict[str, str]:
     """Write ``manifest.json``, ``DATASET.md`` and the gallery; return their paths by kind.
 
     First removes spectrinsic's temporaries, whichever worker left them (all have finished).
-    A folder without any complete sample gets nothing (``{}``): no empty manifest.
+    A folder without any complete sample gets nothing (``{}``): no empty manifest. *run* (this
+    run's times so far) goes into ``build-time.json``, which the card states.
     """
+    start = time.perf_counter()
     out = Path(out_dir)
     for path in remove_owned_temporaries(out):
         log.info("removed %s, left by a worker that died", path.name)
@@ -438,6 +430,8 @@ def finalize_dataset(
         return {}
     cfg = config.to_dict()
     manifest = write_manifest(out, cfg, data_dir=data_dir, split_fractions=config.split_fractions)
+    if run is not None:  # the manifest's hashing is part of this run's wall time
+        record_build_run(out, config.config_hash(), run.finished_after(time.perf_counter() - start))
     card = write_dataset_card(out, cfg)
     gallery = build_gallery(out)
     return {"manifest": str(manifest), "card": str(card), "gallery": str(gallery)}

@@ -211,9 +211,10 @@ def files_source(
     }
     spec["colours_from_asset"] = bool(colours_from_asset)
     if approximate:
-        if not any(scene_file_kind(e["path"]) == "mitsuba" for e in entries):
+        if not any(scene_file_kind(e["path"]) in ("mitsuba", "blend") for e in entries):
             raise DatasetError(
-                "--approximate applies to Mitsuba XML scenes; no --scenes file is one"
+                "--approximate applies to Mitsuba XML scenes and .blend worlds; no --scenes file "
+                "is either"
             )
         spec["approximate"] = True
     if semantic is not None:  # --semantic-map's rules themselves (in the JSON only when given)

@@ -1,4 +1,5 @@
-"""The records of one sample's work: the task a worker gets, and what it gives back.
+"""The records of one sample's work: the task a worker gets, and what it gives back; the
+times they add up to (Mitsuba's part of a sample, a build run's record).
 
 Plain picklable records (no live objects), below both the planner of the library layout
 (:mod:`spectrinsic.pipeline.dataset`) and that of generated scenes and scene files
@@ -7,16 +8,19 @@ Plain picklable records (no live objects), below both the planner of the library
 
 from __future__ import annotations
 
+import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
+from ..gt_export.dataset.build_time import BuildRun, usable_cpus, utc_now
 from ..rng import seed_from_key
 from ..scenes.sample_id import SampleId
 from ..scenes.sources import FileSource
 from .presets import DatasetConfig
 
-__all__ = ["SampleTask", "SampleOutcome", "SampleFailure"]
+__all__ = ["SampleTask", "SampleOutcome", "SampleFailure", "mitsuba_seconds", "run_record"]
 
 
 @dataclass(frozen=True)
@@ -122,3 +126,31 @@ class SampleFailure:
 
     sample_id: str
     error: str
+
+
+def mitsuba_seconds(meta: dict[str, Any], fallback: float) -> float:
+    """Seconds spent in Mitsuba's ``render`` calls, summed over the renderer's reported passes
+    (``meta["timings"][pass_group]["seconds"]``); *fallback* when none are reported."""
+    timings = meta.get("timings") if isinstance(meta, dict) else None
+    if not isinstance(timings, dict):
+        return fallback
+    seconds = [
+        float(t["seconds"])
+        for t in timings.values()
+        if isinstance(t, dict) and isinstance(t.get("seconds"), int | float)
+    ]
+    return sum(seconds) if seconds else fallback
+
+
+def run_record(built: Sequence[SampleOutcome], start: float, relight: int) -> BuildRun:
+    """A build run's record so far (``build-time.json``): the wall time since *start*
+    (``time.perf_counter()``), the *built* samples' summed task time and Mitsuba's part of it,
+    and the sample folders written (each built sample with its *relight* relit variants)."""
+    return BuildRun(
+        finished=utc_now(),
+        wall_seconds=time.perf_counter() - start,
+        samples_built=len(built) * (1 + relight),
+        sample_seconds=sum(o.seconds for o in built),
+        mitsuba_seconds=sum(o.mitsuba_seconds for o in built),
+        cpus=usable_cpus(),
+    )

@@ -32,18 +32,8 @@ def render_batches(
     progress: PassProgress | None = None,
     data_dir: str | None = None,
 ) -> RenderResult:
-    """:func:`render_scene` as ``settings.batches`` independent batches, merged.
-
-    Inside a batch every mode and the AOVs share seed and paths (common random numbers); the
-    batches differ only in their seed (:func:`batch_seeds`), so the spread between them is a
-    direct estimate of the Monte Carlo error of their mean (the noise budget of the ground
-    truth).
-
-    Adaptive sampling: with ``settings.noise_target``, batches are added one at a time while
-    the median relative standard error of the image (:func:`image_noise`) is above it, up to
-    ``settings.max_batches`` (default ``4 * batches``). ``meta["noise_target"]`` records the
-    target and the median reached.
-    """
+    """:func:`render_scene` as ``settings.batches`` independent batches (module docstring),
+    merged; with ``settings.noise_target``, adaptively (:func:`run_batches`)."""
 
     def one(s: int) -> RenderResult:
         return render_scene(scene, settings, seed=s, progress=progress, data_dir=data_dir)

@@ -1,26 +1,38 @@
 """Memory a render needs, estimated before it starts, against the memory this machine has.
 
 A render holds, per pixel and per colour mode, the raw K channels and their XYZ, once more per
-light when each light is rendered alone, plus the AOVs (coverage, ids, depth, normals), as
+light when each light's share is kept, plus the AOVs (coverage, ids, depth, normals), as
 float32. :func:`estimate_render_bytes` counts those values, times :data:`OVERHEAD_FACTOR` for
-the copies made on the way (film, numpy copies, EXR encoding), plus :data:`BASE_BYTES` for the
-process itself (Python, Mitsuba, the compiled kernels). It is calibrated to be an upper bound
+the copies made on the way (numpy copies, EXR encoding), plus :data:`BASE_BYTES` for the
+process itself (Python, Mitsuba, the compiled kernels), plus the band-path traversal's film:
+one channel per light and band of every diagonal mode for each part it accumulates (transport,
+specular, white at metals) and one per surface for the first-hit coverage
+(:func:`traversal_channels`), :data:`FILM_COPIES` times, and the float64 material and object
+coverage the AOVs are assembled from. That film is what grows with the lights and surfaces of a
+scene (800 channels for a 4-light interior of 300 meshes, docs/artist-interior-speed.md), so
+the scene's counts (:class:`RenderLoad`) are part of the estimate. The samples per pixel are
+not: Mitsuba's symbolic loops keep no per-sample state (the peak at 350 x 200 was the same at
+spp 8 and 32). The per-light terms are checked against measured peaks of multi-light,
+environment-map scenes in docs/artist-interior-speed.md ("The size check's estimate"). It was
+first calibrated to be an upper bound
 of the measured peak resident memory (``ru_maxrss``) of ``spectrinsic render obj-apple`` with
 the four default modes (73 values per pixel with the AOVs), spp 16, on the 2-core CI machine:
 
 =========  ===========================  ==========
 size       measured                     estimate
 =========  ===========================  ==========
-8 x 8      277 MiB (passes)             1.0 GiB
-64 x 64    1215 MiB (single, full suite) 1.6 GiB
-192 x 192  1215 MiB (single, full suite) 1.6 GiB
-256 x 256  305 / 348 MiB (passes/single) 1.6 GiB
-512 x 512  488 / 608 MiB (passes/single) 1.9 GiB
-2048^2     5.0 GB (passes)              8.9 GB
+8 x 8      277 MiB (passes)             2.0 GiB
+64 x 64    1215 MiB (single, full suite) 2.0 GiB
+192 x 192  1215 MiB (single, full suite) 2.0 GiB
+256 x 256  305 / 348 MiB (passes/single) 2.2 GiB
+512 x 512  488 / 608 MiB (passes/single) 2.6 GiB
+2048^2     5.0 GB (passes)              13.1 GB
 =========  ===========================  ==========
 
-(the 2048^2 figure from issue 17, where the former count, 684 B/pixel without the process,
-estimated 1.7 GiB). The 1215 MiB rows are the largest of four measurements made inside
+(estimates of this module as it is now, obj-apple's counts, the four modes: the film term adds
+51 channels; the 2048^2 figure from issue 17, where the former count, 684 B/pixel without the
+process, estimated 1.7 GiB; it was rendered with the passes, which have no traversal film, so
+that row over-estimates the passes by 2.6 x). The 1215 MiB rows are the largest of four measurements made inside
 full ``make test`` runs on a loaded machine (1148-1215 MiB, modes spectral, rgb3, rgb6, spp 2;
 the same render alone peaks at 240 MiB warm and 259 MiB with an empty kernel cache; the
 cause, other work in the test process's environment, is not isolated); they set
@@ -35,17 +47,25 @@ table.
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import RenderError
+from ..scenes.model import Scene
+from ..spectra import get_sensors
 from .algebra.modes import get_mode, n_passes
+from .base.translate import surfaces
 from .settings import RenderSettings
 
 __all__ = [
+    "RenderLoad",
+    "PLANNED_LOAD",
+    "traversal_channels",
     "BYTES_PER_VALUE",
     "OVERHEAD_FACTOR",
     "BASE_BYTES",
     "AOV_VALUES",
+    "FILM_COPIES",
     "MAX_SIDE",
     "estimate_render_bytes",
     "available_memory_bytes",
@@ -67,6 +87,105 @@ BASE_BYTES = 2048 * 2**20
 AOV_VALUES = 16
 #: Longest image side accepted at all (OpenEXR and Mitsuba films use 32-bit sizes).
 MAX_SIDE = 65_536
+#: Copies of every channel of the band-path traversal's image alive at once: Mitsuba's image
+#: block and the developed tensor ``mi.render`` returns (Dr.Jit memory, which its allocation
+#: cache keeps resident after the call), the float32 numpy copy
+#: (:func:`~spectrinsic.render.base.one_pass.timed_render`) and the traversal's cuts of it per
+#: mode (``np.ascontiguousarray``). Measured inside the render call alone: 3.9 to 4.4 copies
+#: (docs/artist-interior-speed.md).
+FILM_COPIES = 4
+
+
+@dataclass(frozen=True)
+class RenderLoad:
+    """What of a scene sizes its render's memory besides the image size and the modes.
+
+    Attributes
+    ----------
+    n_lights
+        Lights L (each light's share is a set of accumulators of the band path).
+    n_surfaces
+        BSDF-carrying shapes S (:func:`~spectrinsic.render.base.translate.surfaces`): one
+        first-hit coverage channel each.
+    n_texcols
+        Texture columns T (basis materials of the textured meshes,
+        :func:`~spectrinsic.render.base.textures.texture_tables`): one channel each.
+    n_materials
+        Materials M (a float64 coverage map each while the AOVs are assembled).
+    n_objects
+        Distinct object ids O (a float64 coverage map each, likewise).
+    glossy
+        Whether a material has a non-diffuse lobe (the specular accumulators).
+    metals
+        Whether a material has no diffuse lobe (metal, mirror, glass: the white-at-metal ones).
+    """
+
+    n_lights: int = 1
+    n_surfaces: int = 0
+    n_texcols: int = 0
+    n_materials: int = 0
+    n_objects: int = 0
+    glossy: bool = False
+    metals: bool = False
+
+    @classmethod
+    def of_scene(cls, scene: Scene) -> RenderLoad:
+        """The counts of *scene*."""
+        textured = [m.texture for m in scene.meshes if m.texture is not None]
+        return cls(
+            n_lights=len(scene.lights),
+            n_surfaces=len(surfaces(scene)),
+            n_texcols=len({b for t in textured for b in t.basis}),  # texture_tables' columns
+            n_materials=len(scene.materials),
+            n_objects=len({m.object_id for m in scene.meshes}),
+            glossy=any(m.glossy for m in scene.materials),
+            metals=any(m.non_diffuse for m in scene.materials),
+        )
+
+
+#: Counts the render-size check sizes a library or generated dataset by, whose scenes do not
+#: exist before the build (a ``--scenes`` one is sized by each file's own): the largest of the
+#: library (2 lights, 25 surfaces, 23 materials, 14 objects, glossy and metal variants;
+#: tests/render/test_planned_load.py checks every scene) and of 24 generated scenes (4 lights,
+#: 103 surfaces, 98 materials, 19 objects, no texture), rounded up. A planning figure for
+#: generated scenes (their counts are drawn), not a bound proven for every draw.
+PLANNED_LOAD = RenderLoad(
+    n_lights=4,
+    n_surfaces=112,
+    n_texcols=8,
+    n_materials=104,
+    n_objects=24,
+    glossy=True,
+    metals=True,
+)
+
+
+def traversal_channels(
+    settings: RenderSettings, load: RenderLoad, *, data_dir: str | None = None
+) -> tuple[int, int]:
+    """Channels per pixel of the image the band-path traversal's ``mi.render`` returns
+    (:mod:`~spectrinsic.render.band_path`): the first traversal's and, with
+    ``settings.direct``, the direct-light one's (else 0).
+
+    The image holds R, G, B (Mitsuba's ``hdrfilm``; its image block one more, the weight), then
+    the AOVs of :func:`~spectrinsic.render.band_path.integrator.aov_channels`: one accumulator
+    per light and band of every diagonal mode (K = Σ bands), L·K each for the transport, the
+    specular part (glossy scenes) and the white-at-metal part (first traversal, scenes with
+    metals), and with ``settings.aovs`` the first-hit maps: S coverages, T texture columns,
+    the ray distance and the normal."""
+    k = sum(
+        get_sensors(mode.sensors, data_dir=data_dir).n
+        for mode in (get_mode(name) for name in settings.modes)
+        if mode.kind == "diagonal"
+    )
+    if k == 0 and not settings.aovs:
+        return 0, 0
+    k = k or 3  # the first-hit maps alone come from an rgb3 traversal (render_jobs)
+    lk = load.n_lights * k
+    maps = load.n_surfaces + load.n_texcols + 4 if settings.aovs else 0
+    first = 3 + lk * (1 + load.glossy + load.metals) + maps
+    direct = 3 + lk * (1 + load.glossy) if settings.direct and k else 0
+    return first, direct
 
 
 def estimate_render_bytes(
@@ -74,19 +193,24 @@ def estimate_render_bytes(
     height: int,
     settings: RenderSettings,
     *,
-    n_lights: int = 1,
+    load: RenderLoad = RenderLoad(),
     data_dir: str | None = None,
 ) -> int:
     """Upper bound of the peak memory in bytes of rendering ``settings.modes`` at
-    ``width x height`` in one process (see the module's table)."""
+    ``width x height`` in one process (see the module's table): the result's values and the
+    band-path traversal's film (:func:`traversal_channels`) per pixel, and the process."""
     values = 0
     for name in settings.modes:
         raw = 3 * n_passes(get_mode(name), data_dir=data_dir)
         values += raw + 3  # raw channels + XYZ
-    per_light = settings.per_light and n_lights > 1
-    copies = 1 + (n_lights if per_light else 0) + (1 if settings.direct else 0)
-    per_pixel = (values * copies + AOV_VALUES) * BYTES_PER_VALUE * OVERHEAD_FACTOR
-    return BASE_BYTES + width * height * per_pixel
+    # each light's share is held even for one light (scene_render: one share per main job)
+    copies = 1 + (load.n_lights if settings.per_light else 0) + (1 if settings.direct else 0)
+    result = (values * copies + AOV_VALUES) * BYTES_PER_VALUE * OVERHEAD_FACTOR
+    first, direct = traversal_channels(settings, load, data_dir=data_dir)
+    film = (first + direct) * FILM_COPIES * BYTES_PER_VALUE
+    # the AOVs' per-material and per-object coverage maps (float64) are assembled from the film
+    maps = (load.n_materials + load.n_objects) * 8 if settings.aovs else 0
+    return BASE_BYTES + width * height * (result + film + maps)
 
 
 def available_memory_bytes() -> int | None:
@@ -110,7 +234,7 @@ def check_render_size(
     *,
     what: str,
     processes: int = 1,
-    n_lights: int = 1,
+    load: RenderLoad = RenderLoad(),
     data_dir: str | None = None,
 ) -> int:
     """Refuse a size that is not positive, too large, or cannot fit in memory; return the estimate.
@@ -121,8 +245,8 @@ def check_render_size(
         How the user gave the size, for the message (``"--width 100000 --height 128"``).
     processes
         Renders running at once (worker processes), each needing the estimate.
-    n_lights
-        Lights of the scene (each rendered alone with ``settings.per_light``).
+    load
+        The scene's counts (:class:`RenderLoad`): lights, surfaces, materials.
 
     Raises
     ------
@@ -136,9 +260,7 @@ def check_render_size(
             raise RenderError(
                 f"{what}: image {side} {value} exceeds the largest supported, {MAX_SIDE}"
             )
-    need = processes * estimate_render_bytes(
-        width, height, settings, n_lights=n_lights, data_dir=data_dir
-    )
+    need = processes * estimate_render_bytes(width, height, settings, load=load, data_dir=data_dir)
     have = available_memory_bytes()
     if have is not None and need > have:
         raise RenderError(

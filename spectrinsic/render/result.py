@@ -14,10 +14,12 @@ from ..errors import RenderError
 __all__ = ["METAL_WHITE", "PARTS", "SPECULAR", "RenderResult"]
 
 #: Glossy scenes' part of the transport: the light whose first camera-ray vertex went through a
-#: non-diffuse lobe (it becomes the ``specular`` layer).
+#: non-diffuse lobe (coat reflection, metal, glass), with everything those lobes reflect; 0 in
+#: matte scenes (it becomes the ``specular`` layer).
 SPECULAR = "specular"
-#: Metals' white-surface radiance at their first hits (not part of the transport; it enters
-#: the shading of metal pixels).
+#: Metals' white-surface radiance at their first hits times their coverage, ``c_metal · E_k / π``
+#: (not part of the transport; it keeps the shading of metal pixels defined where the diffuse
+#: albedo is 0; :mod:`spectrinsic.render.band_path.kernel`).
 METAL_WHITE = "metal_white"
 #: The parts a band-path traversal splits off beside its transport, in the order of its AOV
 #: channels (:func:`~spectrinsic.render.band_path.integrator.aov_channels`), and the one letter
@@ -54,7 +56,9 @@ class RenderResult:
     meta
         Variants, spp, seed, max_depth, sensors and XYZ matrices per mode, wavelength grid,
         timings (seconds per pass), Mitsuba version; with batches also ``batches``,
-        ``batch_spp`` and ``batch_seeds``.
+        ``batch_spp`` and ``batch_seeds``. ``spp`` and ``spectral_spp`` (the spectral pass's)
+        are totals over the batches, ``batch_spp`` and ``spectral_batch_spp`` one batch's
+        (:mod:`spectrinsic.gt_export.sample.render_spp` reads samples written before).
     batch_raw
         Per independent batch (:func:`spectrinsic.render.render_batches`), mode -> ``(H, W, K)``
         float32 raw channels of that batch alone; ``raw`` is their mean. Empty for a single
@@ -66,14 +70,9 @@ class RenderResult:
         ``raw[mode][..., k] = Σ_l E_{l,k} transport[mode][l, ..., k]``, with E the lights'
         channel values (:func:`spectrinsic.render.algebra.modes.channel_values`). Empty otherwise.
     parts
-        Single traversal: part name (:data:`spectrinsic.render.result.PARTS`) -> mode ->
-        ``(H, W, K)`` float32 raw channels of that part, summed over the lights as ``raw`` is;
-        only the parts the scene has. ``"specular"`` (glossy materials): the light the camera
-        rays' first hits return through their non-diffuse lobes (coat reflection, metal), with
-        everything those lobes reflect (:mod:`spectrinsic.render.band_path.kernel`), a part of
-        ``raw[mode]``. ``"metal_white"`` (metals): the radiance a white Lambertian surface would
-        reflect at the first hits on metals, times their coverage (not part of ``raw``), so the
-        shading stays defined where the diffuse albedo is 0.
+        Single traversal: part name (:data:`PARTS`: ``"specular"``, a part of ``raw``;
+        ``"metal_white"``, not) -> mode -> ``(H, W, K)`` float32 raw channels of that part,
+        summed over the lights as ``raw`` is; only the parts the scene has.
     part_transport
         The per-light parts behind ``parts`` as ``transport`` is behind ``raw`` (part name ->
         mode -> ``(L, H, W, K)`` float32 for unit emission); empty without them.

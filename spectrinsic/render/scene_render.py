@@ -15,23 +15,17 @@ from ..spectra import COLORIMETRIC_WAVELENGTHS, get_sensors
 from .algebra.modes import RenderMode, channel_values, get_mode, n_passes, raw_to_xyz, to_xyz_matrix
 from .band_path.traversal import SingleTraversal, render_jobs, resolve_integrator
 from .base.geometry import prepare_geometry
-from .base.one_pass import PassOutput, PassProgress
+from .base.one_pass import PassOutput, PassProgress, timing
 from .base.translate import surfaces
 from .base.variants import choose_variant, import_mitsuba, variant_scope
 from .passes import render_diagonal
 from .passes.aovs import render_aovs
 from .result import PARTS, RenderResult
-from .settings import DEFAULT_MODES, PassRequest, RenderSettings
+from .settings import PassRequest, RenderSettings
 from .spectral import render_spectral
 
-__all__ = [
-    "DEFAULT_MODES",
-    "render_scene",
-    "count_passes",
-]
+__all__ = ["render_scene", "count_passes"]
 
-# long module: one driver (plan, run, assemble every mode of one scene) and the meta record it
-# writes of the render (issue 46 moved render_meta here, out of the numpy-only result record)
 logger = logging.getLogger(__name__)
 
 
@@ -103,16 +97,12 @@ class _Run:
     #: One dict mode -> pass output per job, filled by the parts.
     outputs: list[dict[str, PassOutput]]
 
-    @property
-    def settings(self) -> RenderSettings:
-        return self.plan.settings
-
 
 def _rgb_part(
     run: _Run, rgb_variant: str
 ) -> tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
     """The diagonal modes of every job (one traversal, or the passes) and the AOVs."""
-    scene, plan, settings, single = run.scene, run.plan, run.settings, SingleTraversal({}, ())
+    scene, plan, single = run.scene, run.plan, SingleTraversal({}, ())
     request = replace(run.request, variant=rgb_variant)
     aov_maps: dict[str, np.ndarray] = {}
     if plan.traversal:
@@ -122,7 +112,7 @@ def _rgb_part(
             request,
             wanted=plan.wanted,
             data_dir=run.data_dir,
-            aovs=settings.aovs,
+            aovs=plan.settings.aovs,
         )
         aov_maps = single.aovs
         for out, part in zip(run.outputs, parts, strict=True):
@@ -151,7 +141,7 @@ def _rgb_part(
             if diagonal
             else ()
         )
-    if not settings.aovs:
+    if not plan.settings.aovs:
         return aov_maps, (), single
     aov_maps, aov_seconds = render_aovs(scene, request)
     return aov_maps, aov_seconds, single
@@ -159,8 +149,8 @@ def _rgb_part(
 
 def _spectral_part(run: _Run, spectral_variant: str) -> None:
     """The spectral passes of every job (``settings.spectral_batch_spp`` samples each)."""
-    spp = run.settings.spectral_batch_spp
-    request = replace(run.request, batch_spp=spp, variant=spectral_variant)
+    batch_spp = run.plan.settings.spectral_batch_spp  # one batch's, as every request holds
+    request = replace(run.request, batch_spp=batch_spp, variant=spectral_variant)
     for out, job in zip(run.outputs, run.plan.jobs, strict=True):
         for m in (m for m in job.modes if m.kind == "spectral"):
             out[m.name] = render_spectral(
@@ -173,15 +163,8 @@ def _spectral_part(run: _Run, spectral_variant: str) -> None:
             )
 
 
-def _run_jobs(
-    scene: Scene,
-    plan: _Plan,
-    *,
-    seed: int,
-    progress: PassProgress | None,
-    data_dir: str | None,
-) -> tuple[list[dict[str, PassOutput]], dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
-    """Every pass of *plan*'s jobs, grouped by Mitsuba variant, plus the AOVs.
+def _run_jobs(run: _Run) -> tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
+    """Every pass of the run's jobs into ``run.outputs``, grouped by Mitsuba variant, and the AOVs.
 
     Each switch between the RGB and the spectral variant reloads Mitsuba's Python modules
     (0.25 s on the 2-core machine, measured: 8 switches were 2.0 s of a 14.5 s default sample),
@@ -192,8 +175,7 @@ def _run_jobs(
     With ``plan.traversal`` the diagonal modes of every job, and a textured scene's AOVs even
     without them, come from one band-path traversal (:func:`~spectrinsic.render.band_path.traversal.render_jobs`).
     """
-    request = PassRequest.of(plan.settings, seed, progress, prepare_geometry(scene))
-    run = _Run(scene, plan, request, data_dir, [{} for _ in plan.jobs])
+    plan = run.plan
     found: tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]
     found = ({}, (), SingleTraversal({}, ()))
     variant, parts = plan.settings.variant, []
@@ -207,28 +189,23 @@ def _run_jobs(
                 found = _rgb_part(run, chosen)
             else:
                 _spectral_part(run, chosen)
-    return run.outputs, *found
+    return found
 
 
 def render_meta(
-    scene: Scene,
-    plan: _Plan,
-    variants: dict[str, str],
-    timings: dict[str, list[float]],
-    *,
-    seed: int,
-    data_dir: str | None,
+    run: _Run, variants: dict[str, str], timings: dict[str, list[float]]
 ) -> dict[str, Any]:
-    """The ``meta`` record of one batch's render (*plan*'s settings, modes and matrices):
+    """The ``meta`` record of one batch's render (the run's settings, modes, matrices, seed):
     versions, variants, samples, modes, their sensors and XYZ matrices, the spectral grid,
     which modes have direct light and per-light images, the integrator, and timings (s)."""
+    plan, data_dir = run.plan, run.data_dir
     objs, settings = plan.objs, plan.settings
     names = [m.name for m in objs]
     meta = {
         "mitsuba": import_mitsuba().__version__,
         "variants": variants,
         "spp": int(settings.batch_spp),  # one batch's: merge_batches makes it the total
-        "seed": int(seed),
+        "seed": int(run.request.seed),
         "max_depth": int(settings.max_depth),
         "modes": names,
         "sensors": {m.name: get_sensors(m.sensors, data_dir=data_dir).name for m in objs},
@@ -241,10 +218,7 @@ def render_meta(
         },
         "per_light": bool(settings.per_light),
         "direct_modes": sorted(plan.wanted),
-        "timings": {
-            k: {"passes": len(v), "seconds": float(sum(v)), "per_pass": [float(x) for x in v]}
-            for k, v in timings.items()
-        },
+        "timings": {k: timing(v) for k, v in timings.items()},
         "units": "XYZ = integral of radiance times CIE 1931 CMF over nm; raw = integral of radiance times S_k",
         "per_light_modes": (
             [m.name for m in plan.share] if plan.split else (names if settings.per_light else [])
@@ -252,7 +226,7 @@ def render_meta(
         "integrator": plan.integrator,
     }
     if any(m.kind == "spectral" for m in objs):
-        meta["spectral_spp"] = settings.spectral_batch_spp
+        meta["spectral_spp"] = settings.spectral_batch_spp  # one batch's, as "spp" above
     return meta
 
 
@@ -277,24 +251,21 @@ def render_scene(
     Parameters
     ----------
     settings
-        Modes, samples, path depth, variant, per-light, direct and AOV choices
-        (:class:`~spectrinsic.render.settings.RenderSettings`), and the integrator of the
-        diagonal modes: ``"passes"``, ⌈K/3⌉ RGB passes per mode and one scene per light;
-        ``"single"`` (default), one traversal for every diagonal mode, band and light
-        (:mod:`spectrinsic.render.band_path.traversal`): the same images to float rounding, per-light
-        images that are exact shares of the full render, and ``RenderResult.transport``.
+        Modes, samples, path depth, variant, per-light, direct and AOV choices and the
+        integrator (:class:`~spectrinsic.render.settings.RenderSettings`); ``"single"`` also
+        fills ``RenderResult.transport``.
     seed
         Sampler seed, shared by every pass.
     progress
         Called with 1 after each Mitsuba pass; :func:`count_passes` gives the total.
     """
     plan = _plan(scene, settings, data_dir)
-    outputs, aov_maps, aov_seconds, single = _run_jobs(
-        scene, plan, seed=seed, progress=progress, data_dir=data_dir
-    )
+    request = PassRequest.of(settings, seed, progress, prepare_geometry(scene))
+    run = _Run(scene, plan, request, data_dir, [{} for _ in plan.jobs])
+    aov_maps, aov_seconds, single = _run_jobs(run)
     timings: dict[str, list[float]] = {m.name: [] for m in plan.objs + plan.share}
     variants: dict[str, str] = {}
-    for out in outputs:
+    for out in run.outputs:
         for name, o in out.items():
             timings[name].extend(o.seconds)
             variants[name] = o.variant
@@ -302,9 +273,9 @@ def render_scene(
         timings["aovs"] = list(aov_seconds)
     if single.seconds:
         timings["single"] = list(single.seconds)
-    meta = render_meta(scene, plan, variants, timings, seed=seed, data_dir=data_dir)
+    meta = render_meta(run, variants, timings)
     logger.debug("rendered %s: %s", scene.name, {k: sum(v) for k, v in timings.items()})
-    return _assemble(scene, plan, outputs, aov_maps, single, meta, data_dir=data_dir)
+    return _assemble(run, aov_maps, single, meta)
 
 
 @dataclass(frozen=True)
@@ -372,16 +343,10 @@ def _plan(scene: Scene, settings: RenderSettings, data_dir: str | None) -> _Plan
 
 
 def _assemble(
-    scene: Scene,
-    plan: _Plan,
-    outputs: Sequence[dict[str, PassOutput]],
-    aov_maps: dict[str, np.ndarray],
-    single: SingleTraversal,
-    meta: dict[str, Any],
-    *,
-    data_dir: str | None,
+    run: _Run, aov_maps: dict[str, np.ndarray], single: SingleTraversal, meta: dict[str, Any]
 ) -> RenderResult:
     """The XYZ images of the jobs' raw outputs: totals, per-light shares and direct light."""
+    scene, plan, outputs = run.scene, run.plan, run.outputs
     main_out, share_out = outputs[: plan.n_main], outputs[plan.n_main :]
     names = [m.name for m in plan.objs]
     matrices, groups = plan.matrices, [job.group for job in plan.jobs[: plan.n_main]]
@@ -391,7 +356,7 @@ def _assemble(
     }
     per_light_images: tuple[dict[str, np.ndarray], ...] = ()
     if plan.split:
-        share_xyz = {m.name: to_xyz_matrix(m, scene, data_dir=data_dir) for m in plan.share}
+        share_xyz = {m.name: to_xyz_matrix(m, scene, data_dir=run.data_dir) for m in plan.share}
         per_light_images = tuple(
             {n: raw_to_xyz(g[n].image, share_xyz[n]) for n in share_xyz} for g in share_out
         )

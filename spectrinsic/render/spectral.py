@@ -10,7 +10,7 @@ import numpy as np
 
 from ..errors import RenderError, SceneError
 from ..scenes.envmaps import envmap_groups, verified_map
-from ..scenes.model import Scene
+from ..scenes.model import GLASS_TINTS, Scene
 from ..spectra import COLORIMETRIC_WAVELENGTHS, SensorSet, get_spectrum
 from .algebra.modes import light_spectra
 from .base import translate as tr
@@ -32,16 +32,13 @@ def _render_pass(
     mi: Any, loaded: Any, request: PassRequest, direct: bool
 ) -> tuple[np.ndarray, np.ndarray | None, list[float]]:
     """One loaded scene rendered (and direct light only with *direct*): images and seconds."""
-    spp, seed = request.batch_spp, request.seed
-    image, dt = timed_render(mi, loaded, spp=spp, seed=seed)
+    image, dt = timed_render(mi, loaded, request)
     seconds = [dt]
-    request.tick()
     direct_image = None
     if direct:
         integrator = mi.load_dict(path_integrator(DIRECT_DEPTH))
-        direct_image, dt = timed_render(mi, loaded, spp=spp, seed=seed, integrator=integrator)
+        direct_image, dt = timed_render(mi, loaded, request, integrator)
         seconds.append(dt)
-        request.tick()
     return image, direct_image, seconds
 
 
@@ -99,10 +96,8 @@ def render_spectral(
     Materials and lights are their registry spectra on the 1 nm CIE grid (360–830 nm), lights
     scaled by their power; channel k is ``∫ L(λ) S_k(λ) dλ`` (nm), the exact counterpart of a
     diagonal render's channel k. Works with any sensor set (CIE 1931, a camera's curves);
-    negative lobes (``"srgb"``) are not supported by ``specfilm`` and are clipped. *request*
-    (:class:`~spectrinsic.render.settings.PassRequest`) gives samples, seed, depth, variant,
-    progress and prepared geometry. An environment map takes one more pass per channel
-    (:func:`_light_passes`).
+    negative lobes (``"srgb"``) are not supported by ``specfilm`` and are clipped. An
+    environment map takes one more pass per channel (:func:`_light_passes`).
     """
     check_scene_lights(scene)
     active = active_light_set(scene, active_lights)
@@ -117,6 +112,16 @@ def render_spectral(
     with variant_scope(chosen) as mi:
         materials = [
             regular_spectrum(get_spectrum(m.spectrum, data_dir=data_dir).on(wl), wl)
+            for m in scene.materials
+        ]
+        tints = [  # tinted glass: Mitsuba's specular_transmittance/_reflectance, the same spectra
+            {
+                param: regular_spectrum(get_spectrum(m.tint(key), data_dir=data_dir).on(wl), wl)
+                for key, param in GLASS_TINTS.items()
+                if m.transmissive or getattr(m, key)  # a conductor has only a reflection tint
+            }
+            if m.tinted or m.specular_reflectance
+            else None
             for m in scene.materials
         ]
         passes = []
@@ -138,6 +143,7 @@ def render_spectral(
                 integrator=path_integrator(request.max_depth),
                 sample_count=request.batch_spp,
                 geometry=request.geometry,
+                transmittances=tints,
             )
             passes.append(_render_pass(mi, mi.load_dict(mitsuba_dict), request, direct))
     image = np.sum([p[0] for p in passes], axis=0)

@@ -45,7 +45,7 @@ from .algebra.light_transport import LightTransport, diagonal_mode_names, relit_
 from .algebra.modes import ChannelValues, channel_values, get_mode
 from .band_path.traversal import resolve_integrator
 from .base.geometry import prepare_geometry
-from .base.one_pass import PassProgress
+from .base.one_pass import PassProgress, timing
 from .base.variants import choose_variant, variant_scope
 from .batches import run_batches
 from .passes import render_diagonal
@@ -239,19 +239,15 @@ def _batch(
     :func:`render_transport_batches`), else one set of passes per light."""
     if settings.integrator == "single":
         return _traversal_batch(scene, settings, seed, progress=progress, data_dir=data_dir)
-    modes, variant = settings.modes, settings.variant
+    modes = settings.modes
     names = diagonal_mode_names(modes)
     others = tuple(m for m in dict.fromkeys(modes) if m not in names)
     t, seconds = render_transport(scene, settings, seed=seed, progress=progress, data_dir=data_dir)
-    rgb = choose_variant("rgb", variant)
-    timing = {
-        m: {"passes": len(s), "seconds": float(sum(s)), "per_pass": list(s)}
-        for m, s in seconds.items()
-    }
+    timings = {m: timing(s) for m, s in seconds.items()}
     base = {
         "max_depth": int(settings.max_depth),
-        "timings": timing,
-        "variants": dict.fromkeys(names, rgb),
+        "timings": timings,
+        "variants": dict.fromkeys(names, choose_variant("rgb", settings.variant)),
     }
     batch = _one_batch(names, settings, seed, t)
     diagonal = relit_result(batch, scene, meta=base, data_dir=data_dir)
@@ -274,11 +270,7 @@ def _batch(
         aovs = other.aovs
     else:
         aovs, aov_seconds = render_aovs(scene, PassRequest.of(settings, seed, progress))
-        timing["aovs"] = {
-            "passes": len(aov_seconds),
-            "seconds": float(sum(aov_seconds)),
-            "per_pass": list(aov_seconds),
-        }
+        timings["aovs"] = timing(aov_seconds)
     return batch, _join(diagonal, other, aovs, list(dict.fromkeys(modes)))
 
 
@@ -322,15 +314,13 @@ def render_transport_batches(
         for m in (*names, "single")
         if m in done[0][1].meta["timings"]
     }
-    transport = LightTransport(
-        modes=names,
-        sensors={m: get_mode(m).sensors for m in names},
+    first = done[0][0]  # every batch's record holds the same modes, samples and depth
+    transport = replace(
+        first,
         batches=tuple(t.batches[0] for t, _ in done),
-        seeds=tuple(int(s) for s in seeds[: len(done)]),
-        batch_spp=int(settings.batch_spp),
-        max_depth=int(settings.max_depth),
+        seeds=tuple(int(s) for s in seeds),
         seconds=seconds,
-        parts={p: tuple(t.parts[p][0] for t, _ in done) for p in done[0][0].parts},
+        parts={p: tuple(t.parts[p][0] for t, _ in done) for p in first.parts},
     )
     merged.meta["transport"] = {"modes": list(names), "batches": len(done)}
     logger.debug(

@@ -11,7 +11,9 @@ converts, in world space:
 - point, spot, area and sun lights. Blender's light colour is ignored: each light's spectrum is
   its custom property ``"spectrum"`` (on the object or the light data), else *light_spectrum*.
   Powers are converted from Blender's watts: point and spot radiant intensity ``P / 4π``, area
-  radiance ``P / (π A)`` (one-sided Lambertian), sun irradiance = strength.
+  radiance ``P / (π A)`` (one-sided Lambertian), sun irradiance = strength;
+- the World: a background colour as a ``sky``, an Environment Texture as an environment map
+  (:mod:`~spectrinsic.scenes.blender_world`; *approximate*: what it cannot read exactly).
 
 Each material becomes a material named after the Blender material, with its reflectance
 spectrum chosen by, in order: the *materials* mapping passed in, the material's custom property
@@ -19,18 +21,18 @@ spectrum chosen by, in order: the *materials* mapping passed in, the material's 
 else is needed). A Principled BSDF node sets the gloss (:func:`principled_gloss`): Metallic
 ≥ 0.5 makes a metal (``conductor``, η/k of the custom property ``"metal"``, default ``Al``; no
 spectrum needed), else Roughness < 0.5 a coated diffuse (``plastic``, the node's IOR); GGX α is
-Roughness² (Blender's convention); Transmission 1 or a Glass BSDF is clear glass
+Roughness² (Blender's convention); Transmission 1 or a Glass BSDF is glass, the Principled's
+tinted by its Base Color, the Glass BSDF's reflection and transmission by its Color
 (:mod:`~spectrinsic.scenes.blender_gloss`). Everything else of the node (coat, sheen,
 subsurface, emission, textures) is ignored; other materials are Lambertian.
 
 With ``colours_from_asset=True`` (the default; ``--no-colours-from-asset`` turns it off), a
-material that the mapping, its
-custom property and its name leave without a spectrum takes the Principled node's Base Color
-(scene-linear Rec. 709, as Blender stores it; alpha ignored) as the reflectance ``rgb:R,G,B``
-(:mod:`spectrinsic.spectra.user_spectra`, Mallett & Yuksel 2019); a colour outside [0, 1] is
-refused when validated, not clipped, and a Base Color fed by a node (an image texture) is not
-read, so that material still needs a spectrum, unless the node is an Image Texture on a UV
-map: that image becomes an exact spectral texture (:mod:`spectrinsic.scenes.blender_colours`;
+material that the mapping, its custom property and its name leave without a spectrum takes the
+Principled node's Base Color (linear Rec. 709, from the file's working space; alpha ignored) as
+the reflectance ``rgb:R,G,B`` (:mod:`spectrinsic.spectra.user_spectra`, Mallett & Yuksel 2019);
+a colour outside [0, 1] is refused when validated, not clipped, and a Base Color fed by a node
+is not read, so that material still needs a spectrum, unless the node is an Image Texture on a
+UV map: that image becomes an exact spectral texture (:mod:`spectrinsic.scenes.blender_colours`;
 the object must hold that material alone). Without the option such a material is an error.
 
 Opening a file replaces the data of the running ``bpy`` session (Blender has one global state).
@@ -51,6 +53,7 @@ from ..errors import MissingDependencyError, SceneError, SpectrinsicError, with_
 from ..spectra import get_spectrum
 from .blender_colours import base_colour, corner_uvs, object_texture
 from .blender_gloss import METAL_PROPERTY, principled_gloss
+from .blender_world import world_lights
 from .budget import SceneBudget
 from .image_textures import corner_spectra
 from .materials import METAL_SPECTRUM, material_problem
@@ -239,10 +242,11 @@ class _MaterialTable:
             name, spectrum = "default", self.default_spectrum
         else:
             name = mat.name
-            spectrum = self.mapping.get(name) or _prop(mat) or self._colour(mat) or name
-        try:
+        try:  # glass without exact ground truth, colours in other primaries: name the file
+            if mat is not None:
+                spectrum = self.mapping.get(name) or _prop(mat) or self._colour(mat) or name
             gloss = principled_gloss(mat) if mat is not None else {}
-        except SceneError as exc:  # glass without exact ground truth: name the file
+        except SceneError as exc:
             raise SceneError(f"{self.source}: {exc}") from None
         if name not in self.table and gloss.get("kind") in NON_DIFFUSE_KINDS:
             material = Material(name=name, spectrum=METAL_SPECTRUM, **gloss)
@@ -372,6 +376,7 @@ def load_blend(
     data_dir: str | None = None,
     validate: bool = True,
     colours_from_asset: bool = True,
+    approximate: bool = False,
 ) -> Scene:
     """Read a ``.blend`` file into a :class:`~spectrinsic.scenes.model.Scene`.
 
@@ -395,6 +400,9 @@ def load_blend(
     colours_from_asset
         Give materials without a spectrum their Principled Base Color as an ``rgb:``
         reflectance (module docstring, the default); False: they are an error.
+    approximate
+        Leave out, or approximate, a World without exact ground truth instead of refusing it,
+        each phrase in ``scene.metadata["approximated"]``.
 
     Raises
     ------
@@ -415,6 +423,7 @@ def load_blend(
     meshes: list[Mesh] = []
     lights: list[Light] = []
     budget = SceneBudget(source)
+    world = world_lights(bpy_scene.world, path, budget, approximate=approximate)  # before meshes
     for obj in sorted(bpy_scene.objects, key=lambda o: o.name):
         if obj.hide_render or not obj.visible_get():
             continue
@@ -424,13 +433,17 @@ def load_blend(
             mesh = _mesh(obj, depsgraph, table, object_id=len(meshes), budget=budget)
             if mesh is not None:
                 meshes.append(mesh)
+    metadata: dict[str, Any] = {"source": "blender", "file": path.name}
+    metadata["blender"] = bpy.app.version_string
+    if approximate:  # only then, so the records of other reads stay as they were
+        metadata |= {"approximate": True, "approximated": list(world.approximated)}
     scene = Scene(
         name=path.stem,
         meshes=tuple(meshes),
         materials=tuple(table.table.values()),
-        lights=tuple(lights),
+        lights=(*lights, *world.lights),
         camera=camera,
-        metadata={"source": "blender", "file": path.name, "blender": bpy.app.version_string},
+        metadata=metadata,
     )
     if validate:
         validate_scene(scene, source=source, data_dir=data_dir)

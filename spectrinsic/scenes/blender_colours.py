@@ -1,19 +1,24 @@
 """Blender base colours: a Principled BSDF's Base Color as an ``rgb:`` colour or, fed by an
 image-texture node, an exact spectral texture (issue 41).
 
-:func:`base_colour` reads an unlinked Base Color (scene-linear Rec. 709, as Blender stores
-it) as ``rgb:R,G,B``. An *Image Texture* node linked straight into a Principled BSDF's Base Color is read as an
+:func:`base_colour` reads an unlinked Base Color as ``rgb:R,G,B`` in linear Rec. 709 (converted
+from the file's working colour space, :mod:`~spectrinsic.scenes.blender_working_space`). An
+*Image Texture* node linked straight into a Principled BSDF's Base Color is read as an
 :class:`~spectrinsic.scenes.image_textures.ImageTexture` (the upsampling, limits and decoding of
-that module): the image's colour space says its encoding (``sRGB`` is decoded; ``Non-Color``,
-``Linear Rec.709``, ``Linear`` are read as linear; others are refused), the node's extension
-its wrap (``REPEAT`` → ``repeat``, ``EXTEND`` → ``clamp``, ``MIRROR`` → ``mirror``; ``CLIP``
-is refused) and its interpolation the filter the asset asks for (``Closest`` → ``nearest``,
-``Linear`` → ``bilinear``, ``Cubic``/``Smart`` → ``cubic``; the band path reads the nearest
-texel and says so). The node's coordinates must be a UV map: its Vector input unlinked (the
-mesh's active render UV map), or linked from a *UV Map* node or a *Texture Coordinate* node's
-UV output; its projection must be ``FLAT``. The image is the file's packed copy or a file
-inside the ``.blend``'s folder. Anything else feeding the Base Color (a mix, a procedural
-texture) is not read: the material then needs a spectrum, as before.
+that module): the image's colour space says its encoding (``sRGB`` is decoded; ``Linear
+Rec.709``, ``Linear`` (Blender 3's name) and ``Non-Color`` are read as linear,
+:data:`LINEAR_SPACES`, ``Non-Color`` only in a Linear Rec.709 file; others, ``Linear CIE-XYZ
+D65`` among them, are refused; an image's colour does not depend on the working space), the
+node's extension its wrap (``REPEAT`` → ``repeat``, ``EXTEND`` → ``clamp``, ``MIRROR`` →
+``mirror``; ``CLIP`` is refused) and its interpolation the filter the asset asks for
+(``Closest`` → ``nearest``, ``Linear`` → ``bilinear``, ``Cubic``/``Smart`` → ``cubic``; the
+band path reads the nearest texel and says so). The node's coordinates must be a UV map: its
+Vector input unlinked (the mesh's active render UV map), or linked from a *UV Map* node or a
+*Texture Coordinate* node's UV output; its projection must be ``FLAT``. The image is the
+file's packed copy or a file inside the ``.blend``'s folder. The node's Color output must feed
+the Base Color (its Alpha is refused), through a link and a node that are not muted. Anything
+else feeding the Base Color (a mix, a procedural texture) is not read: the material then needs
+a spectrum, as before.
 """
 
 from __future__ import annotations
@@ -25,10 +30,22 @@ from typing import Any
 import numpy as np
 
 from ..errors import SceneError
+from .blender_working_space import check_raw_values, rec709_colour
 from .image_textures import Filter, ImageTexture, Wrap, image_texture_from_bytes
 from .image_textures import image_texture_from_file as _from_file
 
-__all__ = ["principled_node", "base_colour", "base_colour_image", "corner_uvs", "object_texture"]
+__all__ = [
+    "LINEAR_SPACES",
+    "principled_node",
+    "base_colour",
+    "base_colour_image",
+    "corner_uvs",
+    "object_texture",
+]
+
+#: Image colour spaces read as linear Rec. 709 (``Non-Color``: the working space's values,
+#: :func:`~spectrinsic.scenes.blender_working_space.check_raw_values`).
+LINEAR_SPACES = ("Linear Rec.709", "Linear", "Non-Color")
 
 _WRAP: dict[str, Wrap] = {"REPEAT": "repeat", "EXTEND": "clamp", "MIRROR": "mirror"}
 _FILTER: dict[str, Filter] = {
@@ -37,7 +54,6 @@ _FILTER: dict[str, Filter] = {
     "Cubic": "cubic",
     "Smart": "cubic",
 }
-_LINEAR = ("Non-Color", "Linear Rec.709", "Linear", "Linear CIE-XYZ D65")
 
 
 def principled_node(mat: Any) -> Any:
@@ -54,8 +70,8 @@ def base_colour(mat: Any) -> str | None:
     node = principled_node(mat)
     if node is None or node.inputs["Base Color"].is_linked:
         return None
-    rgba = node.inputs["Base Color"].default_value
-    return "rgb:" + ",".join(f"{float(c):.9g}" for c in list(rgba)[:3])
+    rgb = rec709_colour(node.inputs["Base Color"].default_value, f"material {mat.name!r}")
+    return "rgb:" + ",".join(f"{c:.9g}" for c in rgb)
 
 
 def _uv_map(node: Any, where: str) -> str:
@@ -80,10 +96,13 @@ def _image(node: Any, blend: Path, where: str) -> ImageTexture:
     if image is None or image.source != "FILE":
         raise SceneError(f"{where}: image texture node holds no image file")
     space = str(image.colorspace_settings.name)
-    if space != "sRGB" and space not in _LINEAR:
+    if space != "sRGB" and space not in LINEAR_SPACES:
         raise SceneError(
-            f"{where}: image {image.name!r} in colour space {space!r}; expected sRGB or linear"
+            f"{where}: image {image.name!r} in colour space {space!r}; expected sRGB or "
+            f"{', '.join(LINEAR_SPACES)}"
         )
+    if space == "Non-Color":
+        check_raw_values(f"{where}: image {image.name!r}")
     wrap, filt = _WRAP.get(str(node.extension)), _FILTER.get(str(node.interpolation), "bilinear")
     if wrap is None or node.projection != "FLAT":
         raise SceneError(
@@ -108,9 +127,20 @@ def base_colour_image(principled: Any, blend: Path, where: str) -> tuple[ImageTe
     image node feeds it (module docstring); *blend* is the ``.blend`` file."""
     if principled is None or not principled.inputs["Base Color"].is_linked:
         return None
-    node = principled.inputs["Base Color"].links[0].from_node
+    link = principled.inputs["Base Color"].links[0]
+    node = link.from_node
     if node.type != "TEX_IMAGE":
         return None
+    if link.is_muted or node.mute:
+        raise SceneError(
+            f"{where}: the Image Texture node {node.name!r} or its link to the Base Color is "
+            "muted; unmute or remove it"
+        )
+    if link.from_socket.name != "Color":
+        raise SceneError(
+            f"{where}: the Image Texture node {node.name!r} feeds the Base Color from its "
+            f"{link.from_socket.name} output; expected its Color output"
+        )
     return _image(node, blend, where), _uv_map(node, where)
 
 

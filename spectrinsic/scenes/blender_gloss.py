@@ -3,15 +3,27 @@
 or a Glass BSDF node (:func:`material_glass`).
 
 A Principled BSDF whose ``Transmission Weight`` (Blender 4; ``Transmission`` in 3.x) is 1 and
-``Metallic`` below 0.5, or a material whose only shader is a Glass BSDF (``BSDF_GLASS``), is clear
+``Metallic`` below 0.5, or a material whose only shader is a Glass BSDF (``BSDF_GLASS``), is
 glass: :class:`~spectrinsic.scenes.model.Material` kind ``dielectric`` of the node's IOR (within
 the scene format's range) and GGX α = Roughness² (Blender's convention). Blender's glass is a
 solid (a thin pane is modelled with two faces, as in Blender).
 
+Tints, as Cycles applies them (Blender 4): the Principled BSDF tints each transmission (not its
+reflection) by √(Base Color), so that light entering and leaving a solid is tinted by Base
+Color; its ``transmittance`` is ``rgb:`` of those square roots (linear Rec. 709 from the file's
+working space, Mallett–Yuksel upsampled, as every Blender colour). Blender 3.x's Principled
+BSDF (input ``Transmission``) tinted otherwise: a tint there is refused. The Glass BSDF's Color
+tints reflection and transmission alike, once per interaction (no square root): its
+``transmittance`` and ``specular_reflectance`` are both ``rgb:`` of the Color (Cycles'
+``intern/cycles/kernel/svm/closure.h``, ``CLOSURE_BSDF_MICROFACET_GGX_GLASS_ID``: the
+Fresnel's ``reflection_tint`` and ``transmission_tint`` are both the node's colour; Blender 3.x
+weights its reflection and refraction closures by the colour too).
+
 Refused in one line naming the material, since they have no exact ground truth: a transmission
-strictly between 0 and 1 (a mix of glass and the diffuse base), a tint (a Base Color or Glass
-Color other than white, or fed by a node), and a rough Glass BSDF whose distribution is not GGX.
-Pure Python over duck-typed ``bpy`` objects, so it needs no ``bpy`` to test.
+strictly between 0 and 1 (a mix of glass and the diffuse base), a textured tint (a Base Color
+or Glass Color fed by a node), and a rough Glass BSDF whose
+distribution is not GGX. Pure Python over duck-typed ``bpy`` objects, so it needs no ``bpy``
+to test.
 """
 
 from __future__ import annotations
@@ -20,6 +32,7 @@ from typing import Any
 
 from ..errors import SceneError
 from .blender_colours import principled_node
+from .blender_working_space import rec709_colour
 from .materials import IOR_RANGE
 
 __all__ = ["METAL_PROPERTY", "DEFAULT_METAL", "principled_gloss", "material_glass"]
@@ -37,15 +50,46 @@ def _nodes(mat: Any) -> list[Any]:
     return [] if tree is None else list(tree.nodes)
 
 
-def _clear(mat: Any, node: Any, colour: str) -> None:
-    """Refuse a tinted glass (module docstring)."""
+def _colour(mat: Any, node: Any, colour: str) -> list[float]:
+    """The unlinked RGB of *node*'s input *colour* in linear Rec. 709 (from the file's working
+    space), in [0, 1]; a linked one (a textured tint) or one out of range is refused."""
     socket = node.inputs[colour]
-    rgb = [float(c) for c in list(socket.default_value)[:3]]
-    if socket.is_linked or rgb != [1.0, 1.0, 1.0]:
+    if socket.is_linked:
         raise SceneError(
-            f"material {mat.name!r}: glass with {colour} {rgb}; only clear (white, unlinked) "
-            "glass has exact ground truth"
+            f"material {mat.name!r}: glass with its {colour} fed by a node; a textured tint "
+            "has no exact ground truth (set a uniform colour)"
         )
+    rgb = list(rec709_colour(socket.default_value, f"material {mat.name!r}: glass {colour}"))
+    if not all(0.0 <= c <= 1.0 for c in rgb):
+        raise SceneError(
+            f"material {mat.name!r}: glass {colour} {rgb} (linear Rec. 709); expected values "
+            "in [0, 1]"
+        )
+    return rgb
+
+
+def _principled_tint(mat: Any, node: Any, key: str) -> dict[str, str]:
+    """``{"transmittance": "rgb:..."}`` of √(Base Color) (module docstring), ``{}`` if white;
+    a tint under Blender 3.x's input *key* ``Transmission`` is refused."""
+    rgb = _colour(mat, node, "Base Color")
+    if rgb == [1.0, 1.0, 1.0]:
+        return {}
+    if key != _TRANSMISSION[0]:
+        raise SceneError(
+            f"material {mat.name!r}: glass with Base Color {rgb} under Blender 3.x's "
+            f"{key!r}; tints are read as Blender 4's Principled BSDF applies them only"
+        )
+    return {"transmittance": "rgb:" + ",".join(f"{c**0.5:.9g}" for c in rgb)}
+
+
+def _glass_tint(mat: Any, node: Any) -> dict[str, str]:
+    """``transmittance`` and ``specular_reflectance`` both ``rgb:`` of a Glass BSDF's Color
+    (module docstring), ``{}`` if white."""
+    rgb = _colour(mat, node, "Color")
+    if rgb == [1.0, 1.0, 1.0]:
+        return {}
+    name = "rgb:" + ",".join(f"{c:.9g}" for c in rgb)
+    return {"transmittance": name, "specular_reflectance": name}
 
 
 def _fields(node: Any) -> dict[str, Any]:
@@ -62,20 +106,22 @@ def material_glass(mat: Any) -> dict[str, Any] | None:
     if principled is not None:
         key = next((k for k in _TRANSMISSION if k in principled.inputs), None)
         weight = 0.0 if key is None else float(principled.inputs[key].default_value)
-        if weight == 0.0 or float(principled.inputs["Metallic"].default_value) >= 0.5:
+        if (
+            key is None
+            or weight == 0.0
+            or float(principled.inputs["Metallic"].default_value) >= 0.5
+        ):
             return None
         if weight != 1.0:
             raise SceneError(
-                f"material {mat.name!r}: Principled {key} {weight:g}; only 1 (clear glass) or 0 "
+                f"material {mat.name!r}: Principled {key} {weight:g}; only 1 (glass) or 0 "
                 "has exact ground truth"
             )
-        _clear(mat, principled, "Base Color")
-        return _fields(principled)
+        return _fields(principled) | _principled_tint(mat, principled, key)
     glass = next((n for n in nodes if n.type == "BSDF_GLASS"), None)
     if glass is None:
         return None
-    _clear(mat, glass, "Color")
-    fields = _fields(glass)
+    fields = _fields(glass) | _glass_tint(mat, glass)
     distribution = str(getattr(glass, "distribution", "GGX"))
     if fields["roughness"] > 0.0 and distribution != "GGX":
         raise SceneError(

@@ -21,13 +21,24 @@ import base64
 import json
 import struct
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 from ..errors import SceneError, SpectrinsicWarning
 from .image_textures import AssetColour, Filter, ImageTexture, Wrap, image_texture_from_bytes
 
-__all__ = ["gltf_colours", "gltf_document", "gltf_image", "gltf_image_bytes"]
+__all__ = [
+    "GLTF_SUFFIXES",
+    "gltf_colours",
+    "gltf_document",
+    "gltf_image",
+    "gltf_image_bytes",
+    "named_materials",
+]
+
+#: File suffixes read as glTF (lower case): JSON and binary.
+GLTF_SUFFIXES = (".gltf", ".glb")
 
 #: glTF sampler codes (spec 5.26): wrapS/wrapT and magFilter.
 _WRAP = {10497: "repeat", 33071: "clamp", 33648: "mirror"}
@@ -47,6 +58,15 @@ def gltf_document(path: Path) -> tuple[dict[str, Any], bytes]:
         return json.loads(data), b""
     except (ValueError, struct.error) as exc:
         raise SceneError(f"{path}: cannot read its glTF JSON ({exc})") from None
+
+
+def named_materials(document: dict[str, Any]) -> Iterator[tuple[str, dict[str, Any]]]:
+    """``(name, material)`` of every material of a glTF *document* that is a JSON object with
+    a string ``name`` (what the readers of colours, maps and glass key their results by);
+    others are skipped."""
+    for material in document.get("materials") or []:
+        if isinstance(material, dict) and isinstance(material.get("name"), str):
+            yield material["name"], material
 
 
 def _uri_bytes(path: Path, uri: str) -> bytes:
@@ -129,13 +149,11 @@ def gltf_colours(path: str | Path) -> dict[str, AssetColour]:
     file at *path* with a ``baseColorFactor`` or a ``baseColorTexture`` (module docstring);
     ``{}`` for other files."""
     path = Path(path)
-    if path.suffix.lower() not in (".gltf", ".glb"):
+    if path.suffix.lower() not in GLTF_SUFFIXES:
         return {}
     doc, binary = gltf_document(path)
     out = {}
-    for material in doc.get("materials") or []:
-        if not isinstance(material, dict) or not isinstance(material.get("name"), str):
-            continue
+    for name, material in named_materials(doc):
         pbr = material.get("pbrMetallicRoughness") or {}
         factor = pbr.get("baseColorFactor")
         stated = isinstance(factor, list) and len(factor) == 4
@@ -146,8 +164,8 @@ def gltf_colours(path: str | Path) -> dict[str, AssetColour]:
                 image = gltf_image(
                     path, doc, binary, pbr["baseColorTexture"], factor if stated else [1, 1, 1]
                 )
-            out[material["name"]] = AssetColour(image=image)
+            out[name] = AssetColour(image=image)
         elif isinstance(factor, list) and len(factor) == 4:
             rgb = "rgb:" + ",".join(f"{float(c):.9g}" for c in factor[:3])
-            out[material["name"]] = AssetColour(spectrum=rgb)
+            out[name] = AssetColour(spectrum=rgb)
     return out

@@ -26,7 +26,13 @@ from typing import Any
 import numpy as np
 
 from ..errors import SceneError, SpectrinsicWarning
-from .gltf_colours import gltf_document, gltf_image, gltf_image_bytes
+from .gltf_colours import (
+    GLTF_SUFFIXES,
+    gltf_document,
+    gltf_image,
+    gltf_image_bytes,
+    named_materials,
+)
 from .image_textures import ImageTexture
 from .surface_maps import MeshMaps, alpha_values, opacity_image
 
@@ -81,20 +87,18 @@ def gltf_maps(path: str | Path) -> dict[str, MeshMaps]:
     material of the ``.gltf``/``.glb`` file at *path* with a mask or a normal texture (module
     docstring); ``{}`` for other files."""
     path = Path(path)
-    if path.suffix.lower() not in (".gltf", ".glb"):
+    if path.suffix.lower() not in GLTF_SUFFIXES:
         return {}
     doc, binary = gltf_document(path)
     out = {}
-    for material in doc.get("materials") or []:
-        if not isinstance(material, dict) or not isinstance(material.get("name"), str):
-            continue
+    for name, material in named_materials(doc):
         maps = _opacity(path, doc, binary, material)
         normal = _normal(path, doc, binary, material)
         if normal is not None:
             maps = maps or MeshMaps(np.zeros((0, 3, 2)))
             maps = replace(maps, normal_image=normal[0], normal_scale=normal[1])
         if maps is not None:
-            out[material["name"]] = maps
+            out[name] = maps
     return out
 
 

@@ -10,6 +10,9 @@ A material is a spectrum name (Lambertian, as before) or a mapping::
       mirror: {kind: conductor, metal: none}            # perfect mirror, F = 1
       vase: {kind: dielectric, ior: 1.5, roughness: 0}  # clear glass, solid
       pane: {kind: thindielectric, ior: 1.5}            # clear glass, a thin sheet
+      bottle: {kind: dielectric, transmittance: "rgb:0.2,0.6,0.3"}  # tinted glass
+      gem: {kind: dielectric, specular_reflectance: "rgb:0.9,0.3,0.3"}  # tinted reflections
+      foil: {kind: conductor, metal: none, specular_reflectance: "rgb:0.9,0.6,0.2"}  # coloured mirror
 
 ``plastic`` is a diffuse base under a dielectric coat of index ``ior`` (Mitsuba ``plastic``,
 or ``roughplastic`` when ``roughness`` > 0); ``conductor`` is a metal with Mitsuba's measured
@@ -17,7 +20,13 @@ or ``roughplastic`` when ``roughness`` > 0); ``conductor`` is a metal with Mitsu
 no diffuse lobe (spectrum ``flat:0``). ``dielectric`` is a clear glass solid of index ``ior``
 relative to the outside (Mitsuba ``dielectric``, or ``roughdielectric`` with GGX when
 ``roughness`` > 0); ``thindielectric`` a smooth thin pane (Mitsuba ``thindielectric``); glass has
-no diffuse lobe either and is untinted (no absorption, a constant ``ior``: no dispersion).
+no diffuse lobe either and a constant ``ior`` (no dispersion). Glass is clear unless given a
+``transmittance``: a spectrum name (as ``spectrum``, values in [0, 1]) that multiplies each
+transmission through the surface, not its reflections (Mitsuba's ``specular_transmittance``:
+twice through a solid, entering and leaving; once through a pane), and a
+``specular_reflectance`` likewise multiplies each reflection off it (Mitsuba's parameter of
+that name; a Blender Glass BSDF's Color is both). A ``conductor`` takes a
+``specular_reflectance`` too (its Fresnel times the tint; ``metal: none`` a coloured mirror).
 ``roughness`` is the GGX α in [0, 1] (0 = smooth); ``ior`` lies in (1, 3].
 
 A ``textured`` material is a spectral texture (:mod:`spectrinsic.scenes.textures`): per texel a
@@ -42,7 +51,7 @@ import numpy as np
 
 from ..errors import SpectralDataError, did_you_mean
 from ..spectra.conductors import check_conductor
-from .model import MATERIAL_KINDS, Material
+from .model import GLASS_TINTS, MATERIAL_KINDS, Material
 from .textures import (
     BASIS_MAX,
     PATTERNS,
@@ -74,9 +83,9 @@ _TEXTURED_KEYS = ("kind", "basis", "pattern", "size", "seed", "weights")
 _KEYS = {
     "diffuse": ("kind", "spectrum"),
     "plastic": ("kind", "spectrum", "ior", "roughness"),
-    "conductor": ("kind", "metal", "roughness"),
-    "dielectric": ("kind", "ior", "roughness"),
-    "thindielectric": ("kind", "ior"),
+    "conductor": ("kind", "metal", "roughness", "specular_reflectance"),
+    "dielectric": ("kind", "ior", "roughness", *GLASS_TINTS),
+    "thindielectric": ("kind", "ior", *GLASS_TINTS),
 }
 
 
@@ -109,6 +118,14 @@ def material_problem(m: Material) -> str | None:
         )
     if m.kind == "thindielectric" and m.roughness != 0.0:
         return f"roughness {m.roughness!r}: a thindielectric is smooth (Mitsuba has no rough one)"
+    for key in GLASS_TINTS:
+        tint = getattr(m, key)
+        if not isinstance(tint, str):
+            return f"{key} {tint!r}: expected a spectrum name"
+        allowed = m.transmissive or (m.kind == "conductor" and key == "specular_reflectance")
+        if tint and not allowed:
+            where = "glass and conductors" if key == "specular_reflectance" else "glass"
+            return f"{key} {tint!r} given for a {m.kind} material (only for {where})"
     if m.kind == "conductor":
         try:
             check_conductor(m.metal)
@@ -187,6 +204,10 @@ def parse_material(name: str, value: Any) -> Material | TexturedMaterial | str:
     for key in ("ior", "roughness"):
         if key in value and not _number(value[key]):
             return f"{key}: expected a number, got {value[key]!r}"
+    for key in GLASS_TINTS:
+        tint = value.get(key, "")
+        if key in value and (not isinstance(tint, str) or not tint.strip()):
+            return f"{key}: expected a non-empty spectrum name, got {tint!r}"
     m = Material(
         name=name,
         spectrum=value["spectrum"] if "spectrum" in _KEYS[kind] else METAL_SPECTRUM,
@@ -194,6 +215,8 @@ def parse_material(name: str, value: Any) -> Material | TexturedMaterial | str:
         roughness=float(value.get("roughness", 0.0)),
         ior=float(value.get("ior", 1.5)),
         metal=value.get("metal", ""),
+        transmittance=value.get("transmittance", ""),
+        specular_reflectance=value.get("specular_reflectance", ""),
     )
     return material_problem(m) or m
 
@@ -211,6 +234,7 @@ def material_entry(m: Material) -> str | dict[str, Any]:
         entry["ior"] = float(m.ior)
     if "roughness" in _KEYS[m.kind]:
         entry["roughness"] = float(m.roughness)
+    entry |= {key: getattr(m, key) for key in GLASS_TINTS if getattr(m, key)}
     return entry
 
 

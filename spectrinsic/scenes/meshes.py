@@ -11,8 +11,8 @@ A glTF material's ``pbrMetallicRoughness`` factors set the gloss as for ``.blend
 ≥ 0.5 makes a metal (``conductor``, Al: the factors name no metal; no spectrum needed), else
 roughness < 0.5 a coated diffuse (``plastic``, η = 1.5); GGX α = roughness². Absent factors
 count as matte (not glTF's default of 1), so files without them import as before. A material
-with ``KHR_materials_transmission`` factor 1 is clear glass (:mod:`~spectrinsic.scenes.gltf_glass`;
-a partial factor is refused in one line).
+with ``KHR_materials_transmission`` factor 1 is glass, tinted by its ``baseColorFactor``
+(:mod:`~spectrinsic.scenes.gltf_glass`; a partial factor is refused in one line).
 
 Colours from the asset (``colours_from_asset=True``, the default; ``--no-colours-from-asset``
 turns it off): a material not in the map takes the colour its file states, a glTF
@@ -41,7 +41,7 @@ import numpy as np
 
 from ..errors import SceneError
 from .budget import MAX_FACES, MAX_VERTICES
-from .gltf_colours import gltf_colours
+from .gltf_colours import GLTF_SUFFIXES, gltf_colours
 from .gltf_glass import gltf_glass
 from .gltf_maps import gltf_maps, warn_mirrored_uv
 from .image_textures import AssetColour, ImageTexture, corner_spectra
@@ -184,7 +184,7 @@ def _frame(vertices: np.ndarray, width: int, height: int) -> tuple[Camera, Light
 
 
 def _asset_colours(path: Path) -> dict[str, AssetColour]:
-    return gltf_colours(path) if path.suffix.lower() in (".gltf", ".glb") else mtl_colours(path)
+    return gltf_colours(path) if path.suffix.lower() in GLTF_SUFFIXES else mtl_colours(path)
 
 
 def _mesh_maps(maps: MeshMaps | None, uv: np.ndarray | None, where: str) -> MeshMaps | None:

@@ -5,14 +5,20 @@ Read exactly: ``diffuse`` (``reflectance``), ``plastic`` and ``roughplastic``
 1.000277), ``conductor`` and ``roughconductor`` (``material``, one of Mitsuba's measured
 metals), the rough ones with ``alpha`` and the ``ggx`` distribution (Mitsuba's default,
 ``beckmann``, is refused: the renderer's microfacets are GGX), bare or in a ``twosided`` with one BSDF (or two equal
-ones). A ``specular_reflectance`` other than 1 has no exact counterpart and is refused. A
+ones). A conductor's ``specular_reflectance`` (``rgb``, ``spectrum``, ``float``) is read as
+its reflection tint, exactly (the band path multiplies its band Fresnel by it); a plastic's
+other than 1 has no exact counterpart and is refused. A
 ``conductor`` with ``material`` ``none`` (or none given, Mitsuba's default) is the perfect mirror.
 
-Glass (:data:`GLASS`) is read exactly as clear glass: ``dielectric``, ``thindielectric`` and
+Glass (:data:`GLASS`) is read exactly: ``dielectric``, ``thindielectric`` and
 ``roughdielectric`` (``alpha``, ``ggx`` only, as above) with ``int_ior``/``ext_ior`` numbers or
 the names of Mitsuba's own table (``bk7``, ``water``, ``air``..., Mitsuba's defaults ``bk7`` and
-``air``), whose ratio is the material's ``ior``. A ``specular_reflectance`` or
-``specular_transmittance`` other than 1 (tinted glass) is refused (``--approximate``: taken as 1).
+``air``), whose ratio is the material's ``ior``. A ``specular_transmittance`` other than 1 is
+tinted glass: its ``rgb``, ``spectrum`` or ``float`` becomes the material's ``transmittance``
+(as a reflectance above; Mitsuba multiplies only the refracted lobe by it, and so does the band
+path), and a ``specular_reflectance`` other than 1 its ``specular_reflectance`` (Mitsuba and
+the band path multiply only the reflected lobe by it). A textured tint (``bitmap``) is refused
+(``--approximate``: taken as 1).
 
 The wrappers ``mask``, ``bumpmap`` and ``normalmap`` (:data:`WRAPPERS`, in any order with
 ``twosided``) are read exactly: the material is the BSDF they wrap, and the wrappers' opacity
@@ -37,7 +43,7 @@ from ..spectra.conductors import PERFECT_MIRROR
 from .materials import METAL_SPECTRUM
 from .mitsuba_spectra import reflectance_name
 from .mitsuba_tree import Value, XmlNode, named_ior
-from .model import Material, MaterialKind
+from .model import GLASS_TINTS, Material, MaterialKind
 
 __all__ = ["GLASS", "WRAPPERS", "DEFAULT_MATERIAL", "inner_bsdf", "material_of"]
 
@@ -151,9 +157,8 @@ def material_of(node: XmlNode, what: str, base: Path, say: Say) -> Material | No
     if kind == "diffuse":
         spectrum = _colour(node, "reflectance", what, base, say)
         return Material(name or spectrum, spectrum)
-    _unit_specular(node, what, say)
     if kind in GLASS:
-        return _glass(node, name, alpha, what, say)
+        return _glass(node, name, alpha, what, base, say)
     if kind.endswith("conductor"):
         metal = node.props.get("material", PERFECT_MIRROR)
         if not isinstance(metal, str) or not metal:
@@ -166,7 +171,9 @@ def material_of(node: XmlNode, what: str, base: Path, say: Say) -> Material | No
             kind="conductor",
             roughness=alpha,
             metal=metal,
+            specular_reflectance=_tint(node, "specular_reflectance", what, base, say),
         )
+    _unit_specular(node, what, say)
     spectrum = _colour(node, "diffuse_reflectance", what, base, say)
     ior = _number(node, "int_ior", 1.49, what) / _number(node, "ext_ior", 1.000277, what)
     return Material(
@@ -191,12 +198,36 @@ def _ior(node: XmlNode, key: str, default: str, what: str) -> float:
     return ior
 
 
-def _glass(node: XmlNode, name: str, alpha: float, what: str, say: Say) -> Material:
-    """Clear glass of *node* (module docstring); *alpha* already read for ``roughdielectric``."""
-    _unit_specular(node, what, say, "specular_transmittance")
+def _tint(node: XmlNode, key: str, what: str, base: Path, say: Say) -> str:
+    """The tint *key* (``specular_transmittance``, ``specular_reflectance``) of glass *node* as
+    a spectrum name, ``""`` where it is 1 (clear glass; a refused or approximated ``bitmap``
+    too)."""
+    value: Value | None = node.props.get(key)
+    if isinstance(value, XmlNode) and value.plugin == "bitmap":
+        if say is None:
+            raise SceneError(
+                f"{what}: {key} {value.label()} in {node.label()}: a textured tint has no exact "
+                "ground truth; only a uniform rgb, spectrum or float (--approximate would use 1)"
+            )
+        say(f"{what}: {node.label()} textured {key} taken as 1")
+        return ""
+    unit = value is None or (isinstance(value, (int, float)) and value == 1.0)
+    unit = unit or (isinstance(value, np.ndarray) and bool(np.all(value == 1.0)))
+    return "" if unit else reflectance_name(value, f"{what} {key}", base)
+
+
+def _glass(node: XmlNode, name: str, alpha: float, what: str, base: Path, say: Say) -> Material:
+    """Glass of *node*, clear or tinted (module docstring); *alpha* already read for
+    ``roughdielectric``."""
     inside, outside = _GLASS_IORS
     ior = _ior(node, "int_ior", inside, what) / _ior(node, "ext_ior", outside, what)
     kind: MaterialKind = "thindielectric" if node.plugin == "thindielectric" else "dielectric"
     return Material(
-        name or f"{node.plugin} {ior:.4g}", METAL_SPECTRUM, kind=kind, roughness=alpha, ior=ior
+        name or f"{node.plugin} {ior:.4g}",
+        METAL_SPECTRUM,
+        kind=kind,
+        roughness=alpha,
+        ior=ior,
+        transmittance=_tint(node, GLASS_TINTS["transmittance"], what, base, say),
+        specular_reflectance=_tint(node, GLASS_TINTS["specular_reflectance"], what, base, say),
     )

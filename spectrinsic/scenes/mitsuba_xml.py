@@ -22,7 +22,8 @@ The file goes through three steps, each in its own module:
 What has no exact ground truth is refused in one line naming the element and the file; with
 ``approximate=True`` (``--approximate``) it is approximated instead, each approximation one
 phrase in ``scene.metadata["approximated"]``. Fixes of old files are in ``["fixed"]`` and
-settings that do not reach the render in ``["ignored"]``; the command line prints all three.
+settings that do not reach the render in ``["ignored"]``; the command line prints all three
+(:func:`~spectrinsic.scenes.reading_notes.reading_notes`).
 """
 
 from __future__ import annotations
@@ -52,7 +53,7 @@ from .surface_maps import MeshMaps
 from .textures import make_image_texture
 from .validate import validate_scene
 
-__all__ = ["MAX_XML_BYTES", "ENVIRONMENT", "load_mitsuba_xml", "xml_notes", "render_hints_line"]
+__all__ = ["MAX_XML_BYTES", "ENVIRONMENT", "load_mitsuba_xml", "render_hints_line"]
 
 #: Emitters that light the scene from infinity (one per scene in Mitsuba).
 ENVIRONMENT = ("constant", "envmap", "sunsky", "sky", "sun")
@@ -417,17 +418,6 @@ def _spd_records(files: list[SceneFile]) -> list[dict[str, str]]:
     for f in sorted(files, key=lambda f: f.path):
         out.append({"spectrum": f"spd:{f.path}", "file": f.path, "sha256": f.sha256})
     return out
-
-
-def xml_notes(scene: Scene) -> list[str]:
-    """One line per fix, approximation and ignored setting a Mitsuba XML read made (from
-    ``scene.metadata``; empty for other scenes), for stderr."""
-    meta = scene.metadata
-    return [
-        f"{meta.get('source', scene.name)}: {what}: {phrase}"
-        for what in ("fixed", "approximated", "ignored")
-        for phrase in meta.get(what, ())
-    ]
 
 
 def render_hints_line(

@@ -104,17 +104,23 @@ MATERIAL_KINDS: tuple[MaterialKind, ...] = (
 )
 #: Kinds without a diffuse lobe (reflectance 0; shading the white-Lambertian ``W = E/π``).
 NON_DIFFUSE_KINDS: tuple[MaterialKind, ...] = ("conductor", "dielectric", "thindielectric")
-#: Kinds that transmit light (clear glass).
+#: Kinds that transmit light (glass, clear or tinted).
 TRANSMISSIVE_KINDS: tuple[MaterialKind, ...] = ("dielectric", "thindielectric")
 #: The optional fields of :class:`Material`; at their defaults they are left out of
 #: :func:`scene_to_dict`, so a matte scene's record and hash are those of before they existed.
-GLOSS_FIELDS = ("kind", "roughness", "ior", "metal")
+GLOSS_FIELDS = ("kind", "roughness", "ior", "metal", "transmittance", "specular_reflectance")
+#: A glass's tint fields (spectrum names, ``""`` untinted) and the Mitsuba parameter each is:
+#: the transmitted and the reflected lobe's factor.
+GLASS_TINTS = {
+    "transmittance": "specular_transmittance",
+    "specular_reflectance": "specular_reflectance",
+}
 _OPTIONAL = {"omit_default": True}
 
 
 @dataclass(frozen=True)
 class Material:
-    """A material: Lambertian (default), coated diffuse, metal or clear glass.
+    """A material: Lambertian (default), coated diffuse, metal or glass (clear or tinted).
 
     Attributes
     ----------
@@ -136,6 +142,18 @@ class Material:
         Name of a conductor whose measured η/k Mitsuba ships (``Au``, ``Cu``, ``Al``, ``Ag``...),
         or ``none`` for a perfect mirror (F = 1, Mitsuba's ``material: none``), for
         ``conductor``.
+    transmittance
+        Registry name of a glass's transmittance spectrum T(λ), a fraction in [0, 1] (a
+        reflectance-kind name: ``rgb:``, ``munsell:``, ``csv:``, ``inline:``...), or ``""``
+        for clear glass (T = 1). It multiplies every transmission through the surface (each
+        refraction of a ``dielectric``, the straight pass of a ``thindielectric``), not its
+        reflections, as Mitsuba's ``specular_transmittance``; only for glass kinds.
+    specular_reflectance
+        Registry name of a glass's or conductor's reflection tint R_t(λ) in [0, 1] (as
+        *transmittance*), or ``""`` (1): it multiplies every reflection off the surface (the
+        Fresnel-weighted reflected lobe), not its transmissions, as Mitsuba's
+        ``specular_reflectance``; only for glass and conductor kinds (a Blender Glass BSDF's
+        Color is both of a glass's tints; a tinted ``metal: none`` is a coloured mirror).
     """
 
     name: str
@@ -144,6 +162,8 @@ class Material:
     roughness: float = field(default=0.0, metadata=_OPTIONAL)
     ior: float = field(default=1.5, metadata=_OPTIONAL)
     metal: str = field(default="", metadata=_OPTIONAL)
+    transmittance: str = field(default="", metadata=_OPTIONAL)
+    specular_reflectance: str = field(default="", metadata=_OPTIONAL)
 
     @property
     def glossy(self) -> bool:
@@ -159,6 +179,16 @@ class Material:
     def transmissive(self) -> bool:
         """Whether the material is glass (transmits light)."""
         return self.kind in TRANSMISSIVE_KINDS
+
+    @property
+    def tinted(self) -> bool:
+        """Whether the material is glass with a transmittance or reflection tint (not clear)."""
+        return self.transmissive and bool(self.transmittance or self.specular_reflectance)
+
+    def tint(self, key: str) -> str:
+        """The spectrum name of tint *key* (of :data:`GLASS_TINTS`), ``"flat:1"`` where
+        untinted (:func:`material_problem` allows tints on glass and conductors only)."""
+        return str(getattr(self, key)) or "flat:1"
 
 
 def _named_class(mesh: Mesh) -> bool:

@@ -18,6 +18,7 @@ Every file named (MTL and image) must lie inside the OBJ's folder; an MTL file i
 from __future__ import annotations
 
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -25,13 +26,15 @@ import numpy as np
 from ..errors import SceneError, SpectrinsicWarning
 from .image_textures import AssetColour, Wrap, image_texture_from_file
 
-__all__ = ["MTL_BYTES_MAX", "mtl_colours", "mtl_files"]
+__all__ = ["MTL_BYTES_MAX", "mtl_colours", "mtl_files", "mtl_statements", "file_inside"]
 
 #: Largest MTL file read (bytes).
 MTL_BYTES_MAX = 4 << 20
 
 
-def _inside(base: Path, name: str, what: str) -> Path:
+def file_inside(base: Path, name: str, what: str) -> Path:
+    """The file *name* (relative to the resolved folder *base*), refused unless it is a file
+    inside *base* (no path escapes); *what* names the statement for the message."""
     full = (base / name).resolve()
     if not full.is_relative_to(base) or not full.is_file():
         raise SceneError(f"{what}: {name!r} is not a file inside {base}")
@@ -46,7 +49,7 @@ def mtl_files(obj: Path) -> list[Path]:
         for line in fh:
             if line.lstrip().startswith(b"mtllib"):
                 name = line.split(None, 1)[1].decode("utf-8", "replace").strip()
-                out.append(_inside(base, name, str(obj)))
+                out.append(file_inside(base, name, str(obj)))
     return out
 
 
@@ -78,16 +81,22 @@ def _colour(words: list[str], where: str) -> tuple[float, float, float]:
     return tuple(float(c) for c in np.clip(rgb, 0.0, 1.0))  # type: ignore[return-value]
 
 
-def _parse(mtl: Path) -> dict[str, tuple[tuple[float, float, float] | None, str, Wrap]]:
-    """``{material: (Kd or None, map_Kd file or "", wrap)}`` of one MTL file."""
+def mtl_statements(mtl: Path) -> Iterator[tuple[int, list[str]]]:
+    """``(line number, words)`` of every statement of the MTL file *mtl* (comments and blank
+    lines left out), refused above :data:`MTL_BYTES_MAX` before it is read."""
     if mtl.stat().st_size > MTL_BYTES_MAX:
         raise SceneError(f"{mtl}: {mtl.stat().st_size:,} bytes; expected at most {MTL_BYTES_MAX:,}")
-    out: dict[str, tuple[tuple[float, float, float] | None, str, Wrap]] = {}
-    name = ""
     for number, line in enumerate(mtl.read_text("utf-8", "replace").splitlines(), 1):
         words = line.split("#", 1)[0].split()
-        if not words:
-            continue
+        if words:
+            yield number, words
+
+
+def _parse(mtl: Path) -> dict[str, tuple[tuple[float, float, float] | None, str, Wrap]]:
+    """``{material: (Kd or None, map_Kd file or "", wrap)}`` of one MTL file."""
+    out: dict[str, tuple[tuple[float, float, float] | None, str, Wrap]] = {}
+    name = ""
+    for number, words in mtl_statements(mtl):
         where = f"{mtl.name} line {number}"
         if words[0] == "newmtl" and len(words) > 1:
             name = " ".join(words[1:])
@@ -110,7 +119,7 @@ def mtl_colours(path: str | Path) -> dict[str, AssetColour]:
     for mtl in mtl_files(path):
         for name, (kd, image, wrap) in _parse(mtl).items():
             if image:
-                full = _inside(base, image, f"{mtl.name} (material {name!r})")
+                full = file_inside(base, image, f"{mtl.name} (material {name!r})")
                 out[name] = AssetColour(
                     image=image_texture_from_file(
                         full, root=base, srgb=True, wrap=wrap, factor=kd or (1.0, 1.0, 1.0)

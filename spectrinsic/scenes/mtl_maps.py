@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import SceneError, SpectrinsicWarning
 from .image_textures import Wrap
-from .mtl_colours import MTL_BYTES_MAX, mtl_files
+from .mtl_colours import file_inside, mtl_files, mtl_statements
 from .surface_maps import MeshMaps, alpha_values, opacity_image
 
 __all__ = ["mtl_maps"]
@@ -45,13 +45,10 @@ def _image(words: list[str], where: str) -> tuple[str, Wrap]:
 
 def _parse(mtl: Path) -> dict[str, tuple[float, str, Wrap]]:
     """``{material: (d, map_d file or "", wrap)}`` of one MTL file's materials with either."""
-    if mtl.stat().st_size > MTL_BYTES_MAX:
-        raise SceneError(f"{mtl}: {mtl.stat().st_size:,} bytes; expected at most {MTL_BYTES_MAX:,}")
     out: dict[str, tuple[float, str, Wrap]] = {}
     name, bumps = "", []
-    for number, line in enumerate(mtl.read_text("utf-8", "replace").splitlines(), 1):
-        words = line.split("#", 1)[0].split()
-        if not words or not name and words[0] != "newmtl":
+    for number, words in mtl_statements(mtl):
+        if not name and words[0] != "newmtl":
             continue
         where = f"{mtl.name} line {number} (material {name!r})"
         d, image, wrap = out.get(name, (1.0, "", "repeat"))
@@ -88,9 +85,7 @@ def mtl_maps(path: str | Path) -> dict[str, MeshMaps]:
             where = f"{mtl.name} (material {name!r})"
             image = None
             if file:
-                full = (base / file).resolve()
-                if not full.is_relative_to(base) or not full.is_file():
-                    raise SceneError(f"{where}: map_d {file!r} is not a file inside {base}")
+                full = file_inside(base, file, f"{where}: map_d")
                 values = alpha_values(full.read_bytes(), where, luminance_without_alpha=True)
                 source = full.relative_to(base).as_posix() + "#opacity"
                 image = (

@@ -188,9 +188,9 @@ def load_scene_file(
         states (glTF base colour and texture, MTL ``Kd``/``map_Kd``, Principled Base Color;
         the default); False (``--no-colours-from-asset``): they are an error.
     approximate
-        Approximate what a Mitsuba XML file holds without exact ground truth instead of
-        refusing it (``--approximate``); other kinds of file have nothing to approximate (the
-        command line refuses the option where no scene file is XML).
+        Approximate what a Mitsuba XML file or a ``.blend``'s World holds without exact ground
+        truth instead of refusing it (``--approximate``); other kinds of file have nothing to
+        approximate (the command line refuses the option where no scene file is either).
     semantic
         The user's semantic rules (``--semantic-map``), tried before the default map's
         (:func:`labelled`); None: the default map alone.
@@ -265,6 +265,7 @@ def _read_scene_file(
             default_spectrum=default_spectrum,
             data_dir=data_dir,
             colours_from_asset=colours_from_asset,
+            approximate=approximate,
         )
     if kind == "mitsuba":
         scene = load_mitsuba_xml(path, data_dir=data_dir, approximate=approximate)
@@ -292,7 +293,8 @@ class FileSource:
     colours_from_asset
         The colours and textures the file states, for materials without a spectrum.
     approximate
-        Approximate what a Mitsuba XML file holds without exact ground truth.
+        Approximate what a Mitsuba XML file or a ``.blend``'s World holds without exact
+        ground truth.
     semantic
         The user's semantic rules (``--semantic-map``), before the default map's.
     """

@@ -23,6 +23,7 @@ from typing import Any
 from ..errors import SceneError, SpectrinsicError
 from ..spectra.io import CSV_MAX_BYTES
 from ..spectra.user_spectra import inline_name, split_csv_key
+from .model import GLASS_TINTS
 
 __all__ = ["resolve_spectrum_refs", "resolve_spectrum", "confined_csv"]
 
@@ -66,8 +67,9 @@ def _material(value: Any, base: Path) -> Any:
     if not isinstance(value, dict) or _INLINE_KEYS & set(value):
         return resolve_spectrum(value, "reflectance", base)
     out = dict(value)
-    if "spectrum" in out:
-        out["spectrum"] = resolve_spectrum(out["spectrum"], "reflectance", base)
+    for key in ("spectrum", *GLASS_TINTS):  # a glass's tints are fractions too
+        if key in out:
+            out[key] = resolve_spectrum(out[key], "reflectance", base)
     if isinstance(out.get("basis"), list):
         out["basis"] = [resolve_spectrum(b, "reflectance", base) for b in out["basis"]]
     return out

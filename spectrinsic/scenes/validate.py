@@ -4,7 +4,8 @@
 
 - structure: array shapes and dtypes, finite vertices (no NaN), face and material indices in
   range, unique mesh names, positive image size, a field of view in (0, 180) degrees;
-- spectra: every material names a known *reflectance* and every light a known *illuminant*
+- spectra: every material names a known *reflectance* (and a tinted glass's transmittance is
+  one too, a fraction in [0, 1]) and every light a known *illuminant*
   (:func:`spectrinsic.spectra.get_spectrum`, whose did-you-mean suggestions are kept);
 - physics: light power > 0; and, unless asked not to, the placement of the camera and the
   lights (:func:`spectrinsic.scenes.placement.check_placement`: nothing inside a closed mesh,
@@ -23,7 +24,7 @@ from ..errors import SpectrinsicError, with_article
 from ..spectra import get_spectrum
 from .envmaps import check_envmaps
 from .materials import material_problem
-from .model import LIGHT_FIELDS, LIGHT_KINDS, Scene, unknown_light_kind
+from .model import GLASS_TINTS, LIGHT_FIELDS, LIGHT_KINDS, Scene, unknown_light_kind
 from .placement import check_placement as _check_placement  # the keyword below has its name
 from .problems import Problems, field_error
 from .semantic import SEMANTIC_CLASSES
@@ -195,8 +196,22 @@ def _check_textures(scene: Scene, source: str) -> None:
         if problem is not None:
             raise field_error(source, f"meshes[{i}] ({m.name!r}).texture", problem)
         problem = None if m.maps is None else maps_problem(m.maps, len(m.faces))
+        if problem is None and m.maps is not None and m.maps.masked:
+            problem = _masked_tint(scene, m.face_materials)
         if problem is not None:
             raise field_error(source, f"meshes[{i}] ({m.name!r}).maps", problem)
+
+
+def _masked_tint(scene: Scene, face_materials: np.ndarray) -> str | None:
+    """Why a masked mesh of *face_materials* is refused: tinted glass among them (the band
+    path cannot tell a mask's hole from a transmission through glass, and would tint it)."""
+    n = len(scene.materials)
+    tinted = [
+        scene.materials[j].name
+        for j in np.unique(face_materials)
+        if 0 <= j < n and scene.materials[j].tinted
+    ]
+    return f"an opacity mask on tinted glass {tinted[0]!r} is not supported" if tinted else None
 
 
 def _check_power(power: object, source: str, field: str) -> None:
@@ -216,8 +231,10 @@ def _check_power(power: object, source: str, field: str) -> None:
 
 
 def _check_lights(scene: Scene, source: str) -> None:
-    if not scene.lights:
-        raise field_error(source, "lights", "a scene needs at least one light")
+    if not scene.lights:  # say what --approximate left out (say, a .blend's World)
+        changed = "; ".join(scene.metadata.get("approximated") or ())
+        why = f" (--approximate: {changed})" if changed else ""
+        raise field_error(source, "lights", f"a scene needs at least one light{why}")
     for i, light in enumerate(scene.lights):
         where = f"lights[{i}]"
         if light.kind not in LIGHT_KINDS:
@@ -354,6 +371,16 @@ def validate_scene(
                 data_dir,
                 cache,
             )
+            for key in (k for k in GLASS_TINTS if getattr(mat, k)):  # fractions in [0, 1]
+                problems.get(
+                    _check_spectrum,
+                    source,
+                    f"materials[{i}] ({mat.name!r}).{key}",
+                    getattr(mat, key),
+                    "reflectance",
+                    data_dir,
+                    cache,
+                )
         for i, light in enumerate(scene.lights):
             problems.get(
                 _check_spectrum,

@@ -93,16 +93,22 @@ def fresnel_conductor(mu: np.ndarray, eta: np.ndarray, k: np.ndarray) -> np.ndar
     return 0.5 * (r_s + r_p)
 
 
-def fresnel_table(name: str, curves: SensorCurves, wavelengths: Wavelengths) -> np.ndarray:
+def fresnel_table(
+    name: str, curves: SensorCurves, wavelengths: Wavelengths, tint: np.ndarray | None = None
+) -> np.ndarray:
     """``(FRESNEL_NODES, K)`` band Fresnel values ``F_k(μ_j)`` of conductor *name* for the
-    sensor *curves* ``(K, W)`` on *wavelengths* (module docstring)."""
+    sensor *curves* ``(K, W)`` on *wavelengths* (module docstring); with *tint* ``(W,)``, a
+    reflection tint R_t(λ) (Mitsuba's ``specular_reflectance``), those of ``F R_t``."""
     if np.ndim(curves) != 2:
         raise SpectralDataError(
             f"fresnel_table({name!r}): expected (K, W) sensor curves, got {np.shape(curves)}"
         )
-    if name == PERFECT_MIRROR:
+    if name == PERFECT_MIRROR and tint is None:
         return np.ones((FRESNEL_NODES, np.shape(curves)[0]))
-    eta, k = conductor_ior(name, wavelengths)
     mu = np.linspace(0.0, 1.0, FRESNEL_NODES)
-    spectra = fresnel_conductor(mu[:, None], eta[None, :], k[None, :])
-    return diagonal_values(spectra, curves, wavelengths)
+    if name == PERFECT_MIRROR:
+        spectra = np.ones((FRESNEL_NODES, np.size(wavelengths)))
+    else:
+        eta, k = conductor_ior(name, wavelengths)
+        spectra = fresnel_conductor(mu[:, None], eta[None, :], k[None, :])
+    return diagonal_values(spectra * (1.0 if tint is None else tint), curves, wavelengths)

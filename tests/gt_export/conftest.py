@@ -9,29 +9,16 @@ gt_export code under test.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 import pytest
 
+from spectrinsic.render.result import RenderResult
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 
 H, W = 12, 16
 MATERIALS = ("munsell:5R 4/14", "munsell:5PB 4/10", "colorchecker:dark skin", "flat:0.8")
-
-
-@dataclass(frozen=True)
-class FakeResult:
-    """Mirrors the fields of :class:`spectrinsic.render.result.RenderResult`."""
-
-    images: dict[str, np.ndarray]
-    raw: dict[str, np.ndarray] = field(default_factory=dict)
-    per_light: tuple[dict[str, np.ndarray], ...] = ()
-    direct: dict[str, np.ndarray] = field(default_factory=dict)
-    aovs: dict[str, np.ndarray] = field(default_factory=dict)
-    meta: dict[str, Any] = field(default_factory=dict)
-    batch_raw: tuple[dict[str, np.ndarray], ...] = ()
 
 
 def coverage_map() -> np.ndarray:
@@ -86,8 +73,9 @@ def make_result(
     geometry: np.ndarray | None = None,
     *,
     modes: tuple[str, ...] = ("bands31", "spectral"),
-) -> FakeResult:
-    """A consistent synthetic render of *scene*.
+) -> RenderResult:
+    """A consistent synthetic render of *scene* (the real record: gt_export reads its typed
+    fields, so a renamed field fails here too).
 
     Parameters
     ----------
@@ -144,17 +132,17 @@ def make_result(
         "sensors": {"bands31": "bands:31@400-700"},
         "timings": {"total": 0.123},
     }
-    return FakeResult(images=images, raw=raw, per_light=per_light, aovs=aovs, meta=meta)
+    return RenderResult(images=images, raw=raw, per_light=per_light, aovs=aovs, meta=meta)
 
 
 @pytest.fixture
-def one_light_sample() -> tuple[Scene, FakeResult]:
+def one_light_sample() -> tuple[Scene, RenderResult]:
     scene = make_scene(("planck:2800K",))
     return scene, make_result(scene)
 
 
 @pytest.fixture
-def two_light_sample() -> tuple[Scene, FakeResult]:
+def two_light_sample() -> tuple[Scene, RenderResult]:
     scene = make_scene(("planck:2800K", "cie:FL11"))
     return scene, make_result(scene, modes=("bands31", "spectral", "rgb3"))
 
@@ -176,7 +164,7 @@ def synth() -> Any:
         H=H,
         W=W,
         MATERIALS=MATERIALS,
-        FakeResult=FakeResult,
+        RenderResult=RenderResult,
     )
 
 

@@ -10,7 +10,6 @@ without the pane.
 
 from __future__ import annotations
 
-import colour
 import numpy as np
 import pytest
 
@@ -21,32 +20,14 @@ from spectrinsic.render import RenderSettings, render_scene
 from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 
-#: Independent seeds per renderer, whose spread gives each block's standard error.
-SEEDS = 16
-RES = 32
-#: Family-wise false-alarm rate of the 48 block-channel comparisons.
-FALSE_ALARM = 1e-3
-#: Mitsuba's spectral film divides XYZ by ∫ȳ dλ (``MI_CIE_Y_NORMALIZATION``, 1 nm, 360–830 nm);
-#: spectrinsic's raw channels are ``∫ L x̄ dλ`` unnormalised.
-_CMFS = (
-    colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
-    .copy()
-    .align(colour.SpectralShape(360, 830, 1))
+from ._reference import (
+    SEEDS,
+    assert_blocks_agree,
+    blocks,
+    icosahedron_obj,
+    mitsuba_xyz,
+    ours_xyz,
 )
-Y_NORMALISATION = float(_CMFS.values[:, 1].sum())
-
-#: A flat-shaded icosahedron of circumradius 1: the same triangles in both renderers (an
-#: analytic ``sphere`` is triangulated by spectrinsic, and refraction would see the facets).
-_T = (1 + 5**0.5) / 2
-_ICO_V = np.array(
-    [[-1, _T, 0], [1, _T, 0], [-1, -_T, 0], [1, -_T, 0], [0, -1, _T], [0, 1, _T],
-     [0, -1, -_T], [0, 1, -_T], [_T, 0, -1], [_T, 0, 1], [-_T, 0, -1], [-_T, 0, 1]]
-) / np.hypot(1, _T)  # fmt: skip
-_ICO_F = [
-    [0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4],
-    [11, 10, 2], [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9],
-    [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1],
-]  # fmt: skip
 
 XML = """<scene version="3.0.0">
   <integrator type="path"><integer name="max_depth" value="6"/></integrator>
@@ -101,44 +82,9 @@ XML = """<scene version="3.0.0">
 
 @pytest.fixture
 def glass_box(tmp_path):
-    obj = "".join(f"v {x:.9f} {y:.9f} {z:.9f}\n" for x, y, z in _ICO_V)
-    obj += "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in _ICO_F)
-    (tmp_path / "gem.obj").write_text(obj)
+    (tmp_path / "gem.obj").write_text(icosahedron_obj())
     (tmp_path / "box.xml").write_text(XML)
     return tmp_path / "box.xml"
-
-
-def _blocks(image: np.ndarray) -> np.ndarray:
-    """``(4, 4, 3)`` means of the 8 × 8 blocks of a 32 × 32 image."""
-    return image.reshape(RES // 8, 8, RES // 8, 8, 3).mean(axis=(1, 3))
-
-
-def _ours(scene: Scene, spp: int, seed: int) -> tuple[np.ndarray, object]:
-    result = render_scene(scene, RenderSettings(spp, modes=("bands31",), max_depth=6), seed=seed)
-    to_xyz = np.asarray(result.meta["to_xyz"]["bands31"], float)
-    return np.einsum("hwk,ck->hwc", result.raw["bands31"], to_xyz), result
-
-
-def _mitsuba(path, spp: int) -> list[np.ndarray]:
-    """Mitsuba's own spectral ``path`` render of the file at *path* (its film set to CIE XYZ
-    with a box filter, as spectrinsic's pixels), one image per seed."""
-    from spectrinsic.mitsuba_import import import_mitsuba
-    from spectrinsic.render.base.variants import choose_variant
-
-    mi = import_mitsuba()
-    mi.set_variant(choose_variant("spectral"))
-    xyz = path.with_name("xyz.xml")
-    xyz.write_text(
-        path.read_text().replace(
-            '<film type="hdrfilm">',
-            '<film type="hdrfilm"><string name="pixel_format" value="xyz"/><rfilter type="box"/>',
-        )
-    )
-    loaded = mi.load_file(str(xyz))
-    return [
-        np.asarray(mi.render(loaded, spp=spp, seed=s), float)[..., :3] * Y_NORMALISATION
-        for s in range(SEEDS)
-    ]
 
 
 #: The smooth glass of :data:`XML` and a rough one in its place.
@@ -160,20 +106,14 @@ def test_a_glass_gem_and_a_mirror_match_mitsubas_own_spectral_path_render(glass_
     Measured (16 seeds, 128 spp ours, 512 spp Mitsuba): block ratios 0.98–1.02, |z| ≤ 2.9,
     standard errors 0.3–1.3 % of the block means; rough (α 0.2) and thin glass alike (64/256
     spp: |z| ≤ 3.0, ratios 0.97–1.02)."""
-    from scipy.stats import t as student
-
     glass_box.write_text(XML.replace(SMOOTH_GLASS, glass))
     scene = load_mitsuba_xml(glass_box)
     kinds = {m.name: m.kind for m in scene.materials}
     assert kinds["glass"] == "dielectric" and kinds["mirror"] == "conductor"
-    runs = [_ours(scene, 16, seed) for seed in range(SEEDS)]
-    ours = np.stack([_blocks(image) for image, _ in runs])
-    theirs = np.stack([_blocks(image) for image in _mitsuba(glass_box, 64)])
-    stderr = np.hypot(ours.std(axis=0, ddof=1), theirs.std(axis=0, ddof=1)) / np.sqrt(SEEDS)
-    diff = ours.mean(axis=0) - theirs.mean(axis=0)
-    bound = student.ppf(1 - FALSE_ALARM / (2 * diff.size), df=SEEDS - 1)
-    assert np.all(np.abs(diff) <= bound * stderr), np.abs(diff / stderr).max()
-    assert np.all(stderr < 0.1 * theirs.mean(axis=0)), (stderr / theirs.mean(axis=0)).max()
+    runs = [ours_xyz(scene, 16, seed) for seed in range(SEEDS)]
+    ours = np.stack([blocks(image) for image, _ in runs])
+    theirs = np.stack([blocks(image) for image in mitsuba_xyz(glass_box, 64)])
+    assert_blocks_agree(ours, theirs)
 
     gt = compute_ground_truth(scene, runs[0][1])
     layers = {k: v.data.astype(np.float64) for k, v in gt.layers.items()}
@@ -259,17 +199,17 @@ def test_a_thin_pane_shows_the_wall_behind_it_in_specular_at_its_transmittance()
     ("bsdf", "expected"),
     [
         ('<bsdf type="roughdielectric" id="glass"/>', "distribution beckmann (the default)"),
-        (
-            '<bsdf type="dielectric" id="glass"><rgb name="specular_transmittance" '
-            'value="0.5, 0.9, 0.5"/></bsdf>',
-            "specular_transmittance [0.5, 0.9, 0.5]",
+        (  # a reflection tint is read (test_tinted_glass.py), but only as a fraction
+            '<bsdf type="dielectric" id="glass"><float name="specular_reflectance" '
+            'value="1.5"/></bsdf>',
+            "specular_reflectance",
         ),
         (
             '<bsdf type="thindielectric" id="glass"><string name="int_ior" value="glass"/></bsdf>',
             "int_ior 'glass'",
         ),
-        (  # a dimmed mirror gem: Mitsuba's specular_reflectance scales F; refused as a tint
-            '<bsdf type="conductor" id="glass"><string name="material" value="none"/>'
+        (  # a plastic's specular_reflectance scales its coat's reflection: refused as a tint
+            '<bsdf type="plastic" id="glass">'
             '<float name="specular_reflectance" value="0.5"/></bsdf>',
             "specular_reflectance 0.5",
         ),
@@ -311,18 +251,20 @@ def test_the_passes_integrator_refuses_glass_in_one_line_before_any_work(glass_b
     assert not out.exists()
 
 
-def test_approximate_takes_a_tint_as_clear_glass_and_says_so(glass_box):
+def test_approximate_takes_a_tinted_plastic_coat_as_untinted_and_says_so(glass_box):
+    """Tinted glass and conductors are exact (``test_tinted_glass.py``); a tinted plastic
+    coat is not."""
     tinted = (
-        '<bsdf type="dielectric" id="glass">'
-        '<rgb name="specular_transmittance" value="0.5, 0.9, 0.5"/></bsdf>'
+        '<bsdf type="plastic" id="glass">'
+        '<rgb name="specular_reflectance" value="0.5, 0.9, 0.5"/></bsdf>'
     )
     path = glass_box.with_name("tinted.xml")
     path.write_text(XML.replace(SMOOTH_GLASS, tinted))
     scene = load_mitsuba_xml(path, approximate=True)
     (glass,) = [m for m in scene.materials if m.name == "glass"]
-    assert glass.kind == "dielectric"
+    assert glass.kind == "plastic"
     (said,) = scene.metadata["approximated"]
-    assert "specular_transmittance [0.5, 0.9, 0.5] taken as 1" in said
+    assert "specular_reflectance [0.5, 0.9, 0.5] taken as 1" in said
 
 
 def test_a_thin_pane_stays_the_first_hit_in_a_scene_with_masks(glass_box):

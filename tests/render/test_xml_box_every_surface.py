@@ -10,7 +10,7 @@ basis (``b_R + b_G + b_B = 1`` within 4e-8), and a grey map v is ``v · D65`` in
 (docs/envmap_design.md, fact 3); a coloured texel or map is upsampled non-linearly by Mitsuba
 and linearly by spectrinsic, so only grey makes the comparison exact by construction.
 
-The ball is a flat-shaded icosahedron (tests/render/test_glass.py): Mitsuba's analytic
+The ball is a flat-shaded icosahedron (tests/render/_reference.py): Mitsuba's analytic
 ``sphere`` is triangulated by spectrinsic, and refraction would see the facets; an icosphere's
 facets meet below the 30° crease and would be smoothed; its OBJ carries spherical ``vt``
 for the crossed box's bump map. The bitmaps ask for ``nearest``
@@ -42,29 +42,21 @@ from spectrinsic.render.algebra.light_transport import relit_result
 from spectrinsic.render.transport_render import render_transport_batches
 from spectrinsic.scenes.envmaps import envmap_groups
 from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml
-from spectrinsic.scenes.model import Scene
 
-#: Independent seeds per renderer, whose spread gives each block's standard error.
-SEEDS = 16
-RES = 32
-#: Family-wise false-alarm rate of the 48 block-channel comparisons.
-FALSE_ALARM = 1e-3
+from ._reference import (
+    RES,
+    SEEDS,
+    assert_blocks_agree,
+    blocks,
+    icosahedron_obj,
+    mitsuba_xyz,
+    ours_xyz,
+)
+
 #: The leaf: a square of half-side LEAF_HALF at y = LEAF_Y, centred at (LEAF_X, LEAF_Z); its
 #: mask a 3 × 3 checker, corners and centre opaque (the same under any flip of the image).
 LEAF_HALF, LEAF_X, LEAF_Y, LEAF_Z = 0.45, -0.45, -0.5, 1.5
 CAMERA_Y, FOV = -3.5, 40.0
-
-#: A flat-shaded icosahedron of circumradius 1.
-_T = (1 + 5**0.5) / 2
-_ICO_V = np.array(
-    [[-1, _T, 0], [1, _T, 0], [-1, -_T, 0], [1, -_T, 0], [0, -1, _T], [0, 1, _T],
-     [0, -1, -_T], [0, 1, -_T], [_T, 0, -1], [_T, 0, 1], [-_T, 0, -1], [-_T, 0, 1]]
-) / np.hypot(1, _T)  # fmt: skip
-_ICO_F = [
-    [0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4],
-    [11, 10, 2], [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9],
-    [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1],
-]  # fmt: skip
 
 XML = f"""<scene version="3.0.0">
   <integrator type="path"><integer name="max_depth" value="6"/></integrator>
@@ -152,12 +144,7 @@ def _png(path: Path, grey: np.ndarray) -> None:
 def box(tmp_path_factory) -> Path:
     """The box's folder: the XML and its files (mesh, three grey PNGs, a grey EXR map)."""
     folder = tmp_path_factory.mktemp("box")
-    u = np.arctan2(_ICO_V[:, 1], _ICO_V[:, 0]) / (2 * np.pi) + 0.5  # for :data:`CROSSED`'s bump
-    v = np.arccos(np.clip(_ICO_V[:, 2], -1.0, 1.0)) / np.pi
-    obj = "".join(f"v {x:.9f} {y:.9f} {z:.9f}\n" for x, y, z in _ICO_V)
-    obj += "".join(f"vt {a:.9f} {b:.9f}\n" for a, b in zip(u, v, strict=True))
-    obj += "".join(f"f {a + 1}/{a + 1} {b + 1}/{b + 1} {c + 1}/{c + 1}\n" for a, b, c in _ICO_F)
-    (folder / "ball.obj").write_text(obj)
+    (folder / "ball.obj").write_text(icosahedron_obj(uv=True))  # uv: CROSSED's bump map
     parity = np.add.outer(np.arange(4), np.arange(4)) % 2
     _png(folder / "checker.png", np.where(parity, 60, 220))
     ripple = (np.sin(np.linspace(0.0, 4 * np.pi, 16)) * 0.5 + 0.5) * 255
@@ -173,54 +160,12 @@ def box(tmp_path_factory) -> Path:
     return folder / "box.xml"
 
 
-def _blocks(image: np.ndarray) -> np.ndarray:
-    """``(4, 4, 3)`` means of the 8 × 8 blocks of a 32 × 32 image."""
-    return image.reshape(RES // 8, 8, RES // 8, 8, 3).mean(axis=(1, 3))
-
-
-def _ours(scene: Scene, spp: int, seed: int, per_light: bool = False):
-    settings = RenderSettings(spp, modes=("bands31",), max_depth=6, per_light=per_light)
-    result = render_scene(scene, settings, seed=seed)
-    to_xyz = np.asarray(result.meta["to_xyz"]["bands31"], float)
-    return np.einsum("hwk,ck->hwc", result.raw["bands31"], to_xyz), result
-
-
-def _y_normalisation() -> float:
-    """∫ȳ dλ on Mitsuba's 1 nm grid 360–830 nm: its spectral XYZ film divides by it
-    (``MI_CIE_Y_NORMALIZATION``); spectrinsic's raw channels are ``∫ L x̄ dλ`` unnormalised."""
-    import colour
-
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
-    return float(cmfs.copy().align(colour.SpectralShape(360, 830, 1)).values[:, 1].sum())
-
-
-def _mitsuba(path: Path, spp: int) -> list[np.ndarray]:
-    """Mitsuba's own spectral ``path`` render of the file at *path* (film CIE XYZ, box
-    filter, as spectrinsic's pixels), one image per seed, in spectrinsic's units."""
-    from spectrinsic.render.base.variants import choose_variant
-
-    mi = import_mitsuba()
-    mi.set_variant(choose_variant("spectral"))
-    xyz = path.with_name("xyz.xml")
-    xyz.write_text(
-        path.read_text().replace(
-            '<film type="hdrfilm">',
-            '<film type="hdrfilm"><string name="pixel_format" value="xyz"/><rfilter type="box"/>',
-        )
-    )
-    loaded = mi.load_file(str(xyz))
-    scale = _y_normalisation()
-    return [
-        np.asarray(mi.render(loaded, spp=spp, seed=s), float)[..., :3] * scale for s in range(SEEDS)
-    ]
-
-
 @pytest.fixture(scope="module")
 def truth(box):
     """The box read and one band-path render (16 spp) with each light alone too (what the
     ground truth needs)."""
     scene = load_mitsuba_xml(box)
-    return scene, _ours(scene, 16, 0, per_light=True)[1]
+    return scene, ours_xyz(scene, 16, 0, per_light=True)[1]
 
 
 #: Replacements that cross the features over (``crossed``): the glass ball bump-mapped, the
@@ -266,8 +211,6 @@ def test_the_box_agrees_with_mitsubas_own_spectral_path_render_per_block(box, cr
     the map's scale × 1.1 gives 28, the leaf unmasked 167, a flat 0.45 floor for the checker
     17; a ball of index 1.4 for bk7's 1.50 only 5.9 (the ball covers few blocks). Crossed:
     max |z| 2.63, ratios 0.976–1.052, standard errors 0.7–2.5 %."""
-    from scipy.stats import t as student
-
     if crossed:
         text = XML
         for old, new in CROSSED.items():
@@ -282,13 +225,9 @@ def test_the_box_agrees_with_mitsubas_own_spectral_path_render_per_block(box, cr
     assert maps["leaf"].masked and maps["left"].perturbed and len(envmap_groups(scene)) == 1
     if crossed:
         assert maps["ball"].perturbed and maps["looking-glass"].masked
-    ours = np.stack([_blocks(_ours(scene, 16, seed)[0]) for seed in range(SEEDS)])
-    theirs = np.stack([_blocks(image) for image in _mitsuba(box, 64)])
-    stderr = np.hypot(ours.std(axis=0, ddof=1), theirs.std(axis=0, ddof=1)) / np.sqrt(SEEDS)
-    diff = ours.mean(axis=0) - theirs.mean(axis=0)
-    bound = student.ppf(1 - FALSE_ALARM / (2 * diff.size), df=SEEDS - 1)
-    assert np.all(np.abs(diff) <= bound * stderr), np.abs(diff / stderr).max()
-    assert np.all(stderr < 0.1 * theirs.mean(axis=0)), (stderr / theirs.mean(axis=0)).max()
+    ours = np.stack([blocks(ours_xyz(scene, 16, seed)[0]) for seed in range(SEEDS)])
+    theirs = np.stack([blocks(image) for image in mitsuba_xyz(box, 64)])
+    assert_blocks_agree(ours, theirs)
 
 
 def test_the_ground_truth_holds_on_glass_mirror_and_every_pixel(truth):
@@ -327,7 +266,7 @@ def test_through_the_leafs_holes_the_first_hit_is_what_lies_behind(truth):
     scene, result = truth
     (leaf,) = [m for m in scene.meshes if m.name == "leaf"]
     bare = dataclasses.replace(scene, meshes=tuple(m for m in scene.meshes if m is not leaf))
-    _, without = _ours(bare, 16, 0, per_light=True)
+    _, without = ours_xyz(bare, 16, 0, per_light=True)
     hole, opaque = _leaf_texels()
     assert hole.sum() > 20 and opaque.sum() > 20, (hole.sum(), opaque.sum())
     ids = compute_ground_truth(scene, result).layers["object_id"].data.reshape(RES, RES)

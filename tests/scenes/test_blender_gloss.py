@@ -82,7 +82,10 @@ def test_principled_transmission_1_and_a_glass_node_are_clear_glass():
     ("mat", "expected"),
     [
         (_Mat("Mix", _principled(Transmission_Weight=0.5)), "Transmission Weight 0.5"),
-        (_Mat("Green", _principled(Transmission=1.0, Base_Color=(0.2, 0.9, 0.2, 1))), "Base Color"),
+        (
+            _Mat("Red", _Node("BSDF_GLASS", Color=(1.2, 0.9, 0.2, 1), Roughness=0.0, IOR=1.5)),
+            "glass Color",
+        ),
     ],
 )
 def test_partial_or_tinted_blender_glass_is_refused_in_one_line(mat, expected):

@@ -108,9 +108,12 @@ def test_gltf_transmission_1_is_clear_glass_thin_without_a_volume(tmp_path):
             "transmissionFactor 0.5",
         ),
         (
-            {"KHR_materials_transmission": {"transmissionFactor": 1.0}},
-            {"baseColorFactor": [0.2, 0.9, 0.2, 1.0], "roughnessFactor": 0.0},
-            "tinted base colour",
+            {
+                "KHR_materials_transmission": {"transmissionFactor": 1.0},
+                "KHR_materials_volume": {"attenuationColor": [0.2, 0.9, 0.2]},
+            },
+            None,
+            "volume attenuation",
         ),
         (
             {"KHR_materials_transmission": {"transmissionFactor": 1.0}},

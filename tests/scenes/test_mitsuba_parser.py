@@ -14,7 +14,8 @@ from spectrinsic.cli import main
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes.meshes import MAX_FACES
 from spectrinsic.scenes.mitsuba_spectra import planck_radiance
-from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml, render_hints_line, xml_notes
+from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml, render_hints_line
+from spectrinsic.scenes.reading_notes import reading_notes
 from spectrinsic.spectra.user_spectra import inline_name
 
 FLOOR = '<shape type="rectangle" id="floor"><transform name="to_world"><scale value="3"/></transform>{bsdf}</shape>'
@@ -169,7 +170,7 @@ def test_a_mitsuba_05_file_loads_and_says_what_it_fixed(tmp_path, capsys):
     assert scene.camera.fov_deg == pytest.approx(
         np.degrees(2 * np.arctan(np.tan(np.radians(22.5)) * 8 / 6))
     )
-    notes = xml_notes(scene)
+    notes = reading_notes(scene)
     assert all("\n" not in n for n in notes) and len(notes) == len(scene.metadata["fixed"])
     assert (
         render_hints_line(scene, None, 5)

@@ -1,8 +1,10 @@
 """``DATASET.md``: the dataset card (what each layer is, its units, how to load it).
 
 Filled from ``spectrinsic/gt_export/templates/DATASET.md`` with the samples' validated ``meta.json``
-records. Everything taken from the data (scene and layer names, units) is HTML-escaped, so a
-scene called ``<script>...`` shows as text in a Markdown viewer instead of running.
+records, and its "Size and build time" section with the set's own bytes (measured from the
+folder, :mod:`.disk_use`) and its build's time (:mod:`.build_time`). Everything taken
+from the data (scene and layer names, units) is HTML-escaped, so a scene called
+``<script>...`` shows as text in a Markdown viewer instead of running.
 """
 
 from __future__ import annotations
@@ -23,9 +25,12 @@ from ..layers.spectral_intrinsics import gamut_key, residual_summary
 from ..sample import CARD_NAME, META_NAME, config_hash, plain_data, sample_dirs
 from ..sample.meta import LayerRecord, SampleMeta, read_meta
 from ..sample.working_view import space_of
+from .build_time import read_build_record
 from .card_residual import write_residual_figure
+from .card_sizes import size_section
 from .card_text import colour_conventions, percent
 from .colour_spread import shown, spread_summary
+from .disk_use import disk_use
 from .diversity import DIVERSITY_NAME, spread_record, write_diversity
 from .manifest import noise_summary, read_manifest, splits_by_scene, variants_of
 
@@ -163,6 +168,8 @@ def write_dataset_card(
         raise DatasetError(f"dataset folder {str(root)!r} has no complete samples to describe")
     metas = [read_meta(s) for s in samples]
     scenes = sorted({m.scene for m in metas})
+    chash = config_hash(config) if config is not None else metas[0].config_hash
+    variants = variants_of(metas)
     text = string.Template(read_template("DATASET.md")).substitute(
         **colour_conventions([space_of(m.raw) for m in metas]),
         noise_table=_noise_table(noise_summary(metas)),
@@ -171,12 +178,15 @@ def write_dataset_card(
         n_scenes=len(scenes),
         scenes=", ".join(_text(s) for s in scenes),
         layer_table=_layer_table(metas),
-        config_hash=config_hash(config) if config is not None else metas[0].config_hash,
+        config_hash=chash,
         config=json.dumps(
             plain_data(config or {}), indent=2, sort_keys=True, allow_nan=False
         ),  # a code block
         versions=json.dumps(software_versions(), indent=2, sort_keys=True, allow_nan=False),
-        variants=", ".join(_text(v) for v in variants_of(metas)),
+        variants=", ".join(_text(v) for v in variants),
+        size_section=size_section(
+            disk_use(samples), read_build_record(root, chash), [_text(v) for v in variants]
+        ),
     ) + _diversity_section(root, samples, metas)
     path = root / CARD_NAME
     write_text_file(path, text)

@@ -3,7 +3,7 @@
 Written when a build finishes (and rewritten by every resumed build): the hash of every file of
 every sample (paths relative to the dataset folder), train/val/test splits made by scene, and
 the median noise figures. Nothing time-dependent is recorded, so the same build gives the same
-manifest.
+manifest (the build's time is in ``build-time.json``, :mod:`.build_time`).
 """
 
 from __future__ import annotations

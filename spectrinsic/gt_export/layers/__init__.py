@@ -1,8 +1,8 @@
 """Ground-truth layers computed from a render result and the scene's spectra (pure functions).
 
 Nothing here reads or writes files or touches a renderer: inputs are a :class:`Scene` (which
-names every spectrum) and a :class:`RenderRecord` (a :class:`spectrinsic.render.RenderResult`
-or anything with its fields). :func:`compute_ground_truth` composes one function per family of
+names every spectrum) and a :class:`spectrinsic.render.result.RenderResult` (read by its
+typed fields: a renamed field fails in mypy, not by a silently missing layer). :func:`compute_ground_truth` composes one function per family of
 layers: images and errors, geometry, reflectance, irradiance shading (with noise and
 denoising), lights, cameras and the chapter-4 matrices.
 
@@ -33,7 +33,6 @@ from .records import (
     GroundTruth,
     Layer,
     LightRecord,
-    RenderRecord,
     reference_mode,
 )
 from .settings import DEFAULT_CAMERAS, LayerSettings
@@ -42,7 +41,6 @@ from .spectral import camera_curves, canonical_responses, cube_to_sensors, photo
 __all__ = [
     "DEFAULT_CAMERAS",
     "LayerSettings",
-    "RenderRecord",
     "Layer",
     "LightRecord",
     "GroundTruth",

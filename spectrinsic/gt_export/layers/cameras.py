@@ -66,7 +66,7 @@ def camera_layers(
             nonnegative=True,
         ),
     ]
-    spec = (getattr(s.result, "specular", None) or {}).get("bands31")
+    spec = s.result.specular.get("bands31")
     specular = None if spec is None else np.asarray(spec, float) @ weights.T
     if specular is not None:
         out.append(

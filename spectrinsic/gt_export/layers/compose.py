@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError
+from ...render.result import RenderResult
 from ...scenes.material_labels import material_label
 from ...scenes.model import Scene
 from ...spectra import get_sensors, get_spectrum, white_normalised_responses
@@ -35,7 +36,6 @@ from .records import (
     RGB,
     GroundTruth,
     Layer,
-    RenderRecord,
     SampleInputs,
     aov,
     camera_key,
@@ -58,7 +58,7 @@ from .spectral_intrinsics import (
 __all__ = ["compute_ground_truth", "identities"]
 
 
-def _sample(scene: Scene, result: Any, data_dir: Any, space: WorkingSpace) -> SampleInputs:
+def _sample(scene: Scene, result: RenderResult, data_dir: Any, space: WorkingSpace) -> SampleInputs:
     wl = grid()
     rho = (
         np.stack([get_spectrum(m.spectrum, data_dir=data_dir).on(wl) for m in scene.materials])
@@ -97,7 +97,7 @@ def _reflectance(s: SampleInputs, coverage: np.ndarray) -> tuple[Layer, Any]:
 
 def compute_ground_truth(
     scene: Scene,
-    result: RenderRecord,
+    result: RenderResult,
     settings: LayerSettings | None = None,
     *,
     denoise_quality: str = "fast",
@@ -111,7 +111,7 @@ def compute_ground_truth(
     scene
         The scene that was rendered (names every material and light spectrum).
     result
-        The render (:class:`RenderRecord`).
+        The render (:class:`~spectrinsic.render.result.RenderResult`).
     settings
         The layers asked for (:class:`~spectrinsic.gt_export.layers.settings.LayerSettings`,
         default ``LayerSettings()``):
@@ -151,7 +151,7 @@ def compute_ground_truth(
             if denoiser is None
             else denoiser(w_raw, guides)
         )
-        batches = tuple(b[s.ref] for b in getattr(result, "batch_raw", ()) or () if s.ref in b)
+        batches = tuple(b[s.ref] for b in result.batch_raw if s.ref in b)
         w = irr.unlit_masked(w, w_raw, batches)
     specular = specular_rgb(s, w_raw.to_xyz)
     layers += intrinsic_layers(s, w_raw, w, image, reflectance, denoised=denoise, specular=specular)

@@ -54,7 +54,7 @@ SPECULAR_BANDS = f"{SPECULAR}_bands"
 
 def specular_raw(s: SampleInputs) -> np.ndarray | None:
     """``(H, W, K)`` float64 raw specular channels of the reference mode, or ``None`` (matte)."""
-    spec = getattr(s.result, "specular", None) or {}
+    spec = s.result.specular
     return np.asarray(spec[s.ref], np.float64) if s.ref in spec else None
 
 

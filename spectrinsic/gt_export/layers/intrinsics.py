@@ -59,7 +59,7 @@ def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
     :mod:`~spectrinsic.gt_export.layers.irradiance`, with the band albedos the renderer used."""
     mode = get_mode(s.ref)
     albedos = band_albedos(s)
-    matrices = (s.result.meta or {}).get("to_xyz", {})
+    matrices = s.result.meta.get("to_xyz", {})
     to_xyz = (
         np.asarray(matrices[s.ref], float)
         if s.ref in matrices
@@ -67,7 +67,7 @@ def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
     )
     raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
     metals = np.array([m.non_diffuse for m in s.scene.materials], bool)
-    metal_white = (getattr(s.result, "metal_white", None) or {}).get(s.ref)
+    metal_white = s.result.metal_white.get(s.ref)
     # W of the first hits' diffuse lobes only: the specular part is its own layer; at metals
     # the renderer's white-surface estimate
     return irr.white_radiance(
@@ -242,7 +242,7 @@ def intrinsic_layers(
 
 def noise_of(s: SampleInputs, w: irr.WhiteRadiance) -> tuple[list[Layer], dict[str, Any]]:
     """Relative standard error maps of ``image`` and ``shading`` from the independent batches."""
-    batches = [b[s.ref] for b in getattr(s.result, "batch_raw", ()) or () if s.ref in b]
+    batches = [b[s.ref] for b in s.result.batch_raw if s.ref in b]
     if len(batches) < 2:
         return [], {}
     white = rgb_white(s)

@@ -54,7 +54,7 @@ def light_records(
 def _per_light_luminance(s: SampleInputs) -> np.ndarray:
     """``(L, H, W)`` luminance of each light's own render (the reference mode if rendered per
     light, else the per-light share mode)."""
-    per_light = tuple(getattr(s.result, "per_light", None) or ())
+    per_light = s.result.per_light
     lights = s.scene.lights
     if per_light:
         if len(per_light) != len(lights):

@@ -7,11 +7,12 @@ from __future__ import annotations
 import logging
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 
 from ...errors import DatasetError
+from ...render.result import RenderResult
 from ...scenes.model import Scene
 from ...spectra import COLORIMETRIC_WAVELENGTHS
 from ...spectra.user_spectra import portable_sensor_csv
@@ -25,7 +26,6 @@ __all__ = [
     "REFLECTANCE_FLOOR",
     "ERROR_FLOOR",
     "TRAINING_FAMILY",
-    "RenderRecord",
     "Layer",
     "LightRecord",
     "GroundTruth",
@@ -64,26 +64,6 @@ ERROR_FLOOR = 1e-3
 
 #: Training reflectances of the photometric matrices (thesis section 4.4 uses Munsell chips).
 TRAINING_FAMILY = "munsell"
-
-
-class RenderRecord(Protocol):
-    """What ground truth reads of a render (the fields of :class:`spectrinsic.render.RenderResult`).
-
-    ``images`` mode -> ``(H, W, 3)`` XYZ; ``raw`` mode -> ``(H, W, K)`` raw channels;
-    ``per_light`` one dict mode -> XYZ per light; ``aovs`` coverage, ids, depth, normals, mask;
-    ``meta`` sensors and ``to_xyz`` per mode; ``batch_raw`` per independent batch, mode -> raw.
-    """
-
-    @property
-    def images(self) -> Mapping[str, np.ndarray]: ...
-    @property
-    def raw(self) -> Mapping[str, np.ndarray]: ...
-    @property
-    def per_light(self) -> Sequence[Mapping[str, np.ndarray]]: ...
-    @property
-    def aovs(self) -> Mapping[str, np.ndarray]: ...
-    @property
-    def meta(self) -> Mapping[str, Any]: ...
 
 
 @dataclass(frozen=True)
@@ -177,17 +157,17 @@ def grid() -> np.ndarray:
     return COLORIMETRIC_WAVELENGTHS
 
 
-def aov(result: Any, name: str) -> np.ndarray | None:
-    aovs = getattr(result, "aovs", None) or {}
-    value = aovs.get(name) if isinstance(aovs, Mapping) else getattr(aovs, name, None)
+def aov(result: RenderResult, name: str) -> np.ndarray | None:
+    """The AOV *name* of *result* (``None`` where it was not rendered)."""
+    value = result.aovs.get(name)
     return None if value is None else np.asarray(value)
 
 
-def reference_mode(result: Any) -> str:
+def reference_mode(result: RenderResult) -> str:
     """The render mode whose image is the reference ``image`` (first of :data:`REFERENCE_MODES`;
     for a glossy scene, first of those whose specular part was rendered)."""
     # with glossy materials, the first mode whose specular part was rendered (a diagonal one)
-    split = getattr(result, "specular", None) or {}
+    split = result.specular
     for mode in REFERENCE_MODES:
         if mode in result.images and (not split or mode in split):
             return mode
@@ -196,8 +176,8 @@ def reference_mode(result: Any) -> str:
     raise DatasetError("render result has no images; expected at least one render mode")
 
 
-def cube_sensor_name(result: Any) -> str:
-    sensors = (getattr(result, "meta", None) or {}).get("sensors")
+def cube_sensor_name(result: RenderResult) -> str:
+    sensors = result.meta.get("sensors")
     if isinstance(sensors, Mapping) and isinstance(sensors.get("bands31"), str):
         return sensors["bands31"]
     log.info("render meta names no sensors for 'bands31'; assuming %s", DEFAULT_CUBE_SENSORS)
@@ -245,7 +225,7 @@ class SampleInputs:
     """What every family of layers reads: the scene, the render and the spectra on the 1 nm grid."""
 
     scene: Scene
-    result: Any
+    result: RenderResult
     ref: str
     wl: np.ndarray
     material_rho: np.ndarray

@@ -45,6 +45,7 @@ from ..layers.records import reference_mode
 from ..sample import META_NAME, SCENE_NAME, file_sha256
 from ..sample.integrity import replaceable_sample
 from ..sample.meta import read_meta
+from ..sample.render_spp import current_render_record
 from ..sample.sensor import model_from_meta
 from ..sample.transport_exr import read_transport
 from ..sample.working_view import space_of
@@ -192,7 +193,9 @@ def relit_scene(
 def _render_meta(
     meta: Mapping[str, Any], transport: LightTransport, relit: Mapping[str, Any]
 ) -> dict[str, Any]:
-    base = {k: v for k, v in (meta.get("render") or {}).items() if k not in _DROPPED_META}
+    # a sample written before issue 46 held one batch's spectral_spp: relit, it holds the total
+    record = current_render_record(meta.get("render") or {})
+    base = {k: v for k, v in record.items() if k not in _DROPPED_META}
     variants = base.get("variants") or {}
     base["variants"] = {m: v for m, v in variants.items() if m in transport.modes}
     base["relit"] = dict(relit)

@@ -85,13 +85,12 @@ def cube_factors(
     return CubeFactors(means, light_band_means(scene, sensors, data_dir=data_dir))
 
 
-def with_cube(result: Any, factors: CubeFactors | None) -> Any:
+def with_cube(result: RenderResult, factors: CubeFactors | None) -> RenderResult:
     """*result* (a :class:`~spectrinsic.render.result.RenderResult`) with its raw cube replaced
     by the one its stored transport defines (unchanged without *factors* or a cube)."""
-    raw = getattr(result, "raw", None) or {}
-    if factors is None or CUBE_MODE not in raw or not isinstance(result, RenderResult):
+    if factors is None or CUBE_MODE not in result.raw:
         return result
-    return dataclasses.replace(result, raw={**raw, CUBE_MODE: factors.cube()})
+    return dataclasses.replace(result, raw={**result.raw, CUBE_MODE: factors.cube()})
 
 
 def read_cube_factors(

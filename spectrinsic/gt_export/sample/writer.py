@@ -34,8 +34,10 @@ from typing import TYPE_CHECKING, Any
 from ...errors import DatasetError, WriteError
 from ...file_writes import write_text_file
 from ...provenance import software_versions
+from ...render.result import RenderResult
 from ...scenes.envmaps import portable_map_files
 from ...scenes.model import (
+    GLASS_TINTS,
     LIGHT_FIELDS,
     LIGHT_PLACEMENT,
     Scene,
@@ -117,7 +119,7 @@ def _layer_records(
 
 def _meta(
     scene: Scene,
-    result: Any,
+    result: RenderResult,
     gt: GroundTruth,
     *,
     sample_id: str,
@@ -128,9 +130,7 @@ def _meta(
     scene_record: Mapping[str, Any],
     scene_folder: Path | None,
 ) -> dict[str, Any]:
-    render_meta = {
-        k: v for k, v in (getattr(result, "meta", None) or {}).items() if k not in _VOLATILE_META
-    }
+    render_meta = {k: v for k, v in result.meta.items() if k not in _VOLATILE_META}
     lights = []
     for record in gt.lights:
         unused = set(LIGHT_PLACEMENT) - set(LIGHT_FIELDS[record.kind])
@@ -140,6 +140,7 @@ def _meta(
     height, width = gt.layers["image"].data.shape[:2]
     files_used = spectrum_files(
         [m.spectrum for m in scene.materials]
+        + [getattr(m, k) for m in scene.materials for k in GLASS_TINTS if getattr(m, k)]
         + [li.spectrum for li in scene.lights]
         + [*gt.cameras],
         scene_folder,
@@ -240,7 +241,7 @@ def _fill_folder(
     folder: Path,
     writes: FileWrites,
     scene: Scene,
-    result: Any,
+    result: RenderResult,
     gt: GroundTruth,
     *,
     transport: LightTransport | None = None,
@@ -251,7 +252,7 @@ def _fill_folder(
 ) -> dict[str, Any]:
     """Write (or hand to *writes*) every file of the sample but ``meta.json``; return
     ``meta.json``'s content without its hashes and seal."""
-    coverage = (getattr(result, "aovs", None) or {}).get("coverage")
+    coverage = result.aovs.get("coverage")
     files, storage = _write_layers(writes, gt, meta_kw["sample_id"], coverage, cube)
     if sensor is not None:  # the camera chain's raw DNG and processed PNG (gt_export.sensor)
         files += write_sensor_files(folder, sensor)
@@ -293,7 +294,7 @@ def _fill_folder(
 def export_sample(
     out_dir: str | os.PathLike[str],
     scene: Scene,
-    result: Any,
+    result: RenderResult,
     settings: LayerSettings | None = None,
     *,
     sample_id: str,
@@ -310,9 +311,8 @@ def export_sample(
     scene
         The rendered scene.
     result
-        A :class:`~spectrinsic.render.result.RenderResult`, or any record with its fields
-        (``images``, ``raw``, ``per_light``, ``direct``, ``aovs``, ``meta``, ``batch_raw``);
-        never a live renderer.
+        A :class:`~spectrinsic.render.result.RenderResult` (arrays and metadata, never a live
+        renderer).
     settings
         The layers to write (:class:`~spectrinsic.gt_export.layers.settings.LayerSettings`,
         default ``LayerSettings()``): cameras (default
@@ -344,7 +344,7 @@ def export_sample(
     if not sample_id or "/" in sample_id or sample_id.startswith("."):
         raise DatasetError(f"sample id {sample_id!r}: expected a plain folder name")
     settings = settings or LayerSettings()
-    settings = settings.with_cube("bands31" in (getattr(result, "raw", None) or {}))
+    settings = settings.with_cube("bands31" in result.raw)
     # with the transport stored, the cube is its stored means' sum (transport_cube), which
     # the readers rebuild bit for bit: every layer is computed from that cube
     cube = cube_factors(transport, scene, data_dir=settings.data_dir)

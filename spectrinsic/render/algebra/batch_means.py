@@ -149,6 +149,10 @@ def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
             for k in first.meta["timings"]
         },
     )
+    if "spectral_spp" in first.meta:
+        # as spp: every count a total, every per-batch count *batch_spp (meta.json, issue 46)
+        spectral = int(first.meta["spectral_spp"])
+        meta.update(spectral_spp=spectral * len(results), spectral_batch_spp=spectral)
     return RenderResult(
         images={m: batch_mean([r.images[m] for r in results]) for m in modes},
         raw={m: batch_mean([r.raw[m] for r in results]) for m in first.raw},

@@ -15,7 +15,7 @@ from ...errors import RenderError
 from ...scenes.model import Scene
 from ...spectra import COLORIMETRIC_WAVELENGTHS, diagonal_values, get_sensors
 from ...threads import thread_map
-from ..result import METAL_WHITE, SPECULAR, RenderResult
+from ..result import RenderResult
 from .batch_means import batch_mean
 from .modes import get_mode, light_spectra, lights_to_xyz_matrix, raw_to_xyz
 from .shares import compose, light_shares, sum_lights
@@ -53,11 +53,9 @@ class LightTransport:
         Seconds of each Mitsuba pass, per mode, and under ``"single"`` those of the traversals
         carrying every mode at once (empty when read from a file).
     parts
-        Part name (:data:`spectrinsic.render.result.PARTS`) -> one dict per batch as
-        :attr:`batches`, for the same unit spectrum: glossy scenes' ``"specular"`` part of ``T``
-        (first camera-ray vertex through a non-diffuse lobe) and metals' ``"metal_white"``
-        white-surface radiance at metal first hits (not part of ``T``)
-        (:mod:`~spectrinsic.render.band_path.kernel`); only the parts held.
+        Part name (:data:`~spectrinsic.render.result.PARTS`: ``"specular"``, a part of ``T``;
+        ``"metal_white"``, not) -> one dict per batch as :attr:`batches`, for the same unit
+        spectrum; only the parts held.
     """
 
     modes: tuple[str, ...]
@@ -83,16 +81,6 @@ class LightTransport:
                 f"transport: every batch must hold modes {list(self.modes)} with "
                 f"one (lights, height, width); got shapes {sorted(shapes)}"
             )
-
-    @property
-    def specular(self) -> tuple[dict[str, np.ndarray], ...]:
-        """``parts["specular"]`` (empty for a matte scene)."""
-        return self.parts.get(SPECULAR, ())
-
-    @property
-    def metal_white(self) -> tuple[dict[str, np.ndarray], ...]:
-        """``parts["metal_white"]`` (empty without metals)."""
-        return self.parts.get(METAL_WHITE, ())
 
     @property
     def n_lights(self) -> int:

@@ -36,7 +36,7 @@ import numpy as np
 
 from ...arrays import Wavelengths
 from ...errors import RenderError, SpectralDataError, validate_choice
-from ...scenes.model import Scene
+from ...scenes.model import Material, Scene
 from ...spectra import (
     COLORIMETRIC_WAVELENGTHS,
     SensorSet,
@@ -165,11 +165,19 @@ class ChannelValues:
         ``(M, N, K)`` float64 band factors of each material's non-diffuse lobe at N cosines
         (:func:`spectrinsic.spectra.conductors.fresnel_table` for a conductor, 1 otherwise),
         when the scene has glossy materials; ``None`` otherwise.
+    transmittance
+        ``(M, K)`` float64 band values ``∫T_m S_k / ∫S_k`` of each glass's transmittance, as
+        :attr:`materials` of its reflectance (1 for clear glass and every other material),
+        when the scene has tinted glass; ``None`` otherwise.
+    specular_reflectance
+        ``(M, K)`` band values of each glass's reflection tint, as :attr:`transmittance`.
     """
 
     materials: np.ndarray
     lights: np.ndarray
     specular: np.ndarray | None = None
+    transmittance: np.ndarray | None = None
+    specular_reflectance: np.ndarray | None = None
 
 
 def light_spectra(
@@ -217,6 +225,7 @@ def channel_values(
     curves = sensors.on(wavelengths)
     rho = _reflectances(scene, wavelengths, data_dir)
     emission = light_spectra(scene, wavelengths, data_dir=data_dir)
+    tinted = any(m.tinted for m in scene.materials)
     return ChannelValues(
         materials=diagonal_values(rho, curves, wavelengths)
         if len(rho)
@@ -224,20 +233,51 @@ def channel_values(
         lights=responses(emission, curves, wavelengths)
         if len(emission)
         else np.zeros((0, sensors.n)),
-        specular=_specular(scene, curves, wavelengths)
+        specular=_specular(scene, curves, wavelengths, data_dir)
         if any(m.glossy for m in scene.materials)
+        else None,
+        transmittance=_tint(scene, "transmittance", curves, wavelengths, data_dir)
+        if tinted
+        else None,
+        specular_reflectance=_tint(scene, "specular_reflectance", curves, wavelengths, data_dir)
+        if tinted
         else None,
     )
 
 
-def _specular(scene: Scene, curves: np.ndarray, wavelengths: Wavelengths) -> np.ndarray:
+def _tint(
+    scene: Scene, key: str, curves: np.ndarray, wavelengths: Wavelengths, data_dir: str | None
+) -> np.ndarray:
+    """``(M, K)`` band values of every material's glass tint *key* (1 where it has none)."""
+    spectra = np.stack(
+        [get_spectrum(m.tint(key), data_dir=data_dir).on(wavelengths) for m in scene.materials]
+    )
+    return diagonal_values(spectra, curves, wavelengths)
+
+
+def _specular(
+    scene: Scene, curves: np.ndarray, wavelengths: Wavelengths, data_dir: str | None
+) -> np.ndarray:
+    """``(M, N, K)`` band factors of each material's non-diffuse lobe: a conductor's Fresnel
+    times its reflection tint (if any), 1 otherwise (glass tints: :func:`_tint`)."""
     ones = np.ones((FRESNEL_NODES, curves.shape[0]))
     return np.stack(
         [
-            fresnel_table(m.metal, curves, wavelengths) if m.kind == "conductor" else ones
+            fresnel_table(m.metal, curves, wavelengths, _conductor_tint(m, wavelengths, data_dir))
+            if m.kind == "conductor"
+            else ones
             for m in scene.materials
         ]
     )
+
+
+def _conductor_tint(
+    m: Material, wavelengths: Wavelengths, data_dir: str | None
+) -> np.ndarray | None:
+    """Conductor *m*'s reflection tint on *wavelengths*, or ``None`` where it has none."""
+    if not m.specular_reflectance:
+        return None
+    return np.asarray(get_spectrum(m.specular_reflectance, data_dir=data_dir).on(wavelengths))
 
 
 def integration_matrix(

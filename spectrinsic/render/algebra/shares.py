@@ -69,11 +69,9 @@ class TransportOutput:
     emission
         ``(L, K)`` float64 the lights' channel values ``E_{l,k}`` (:class:`ChannelValues`).
     parts
-        Part name (:data:`~spectrinsic.render.result.PARTS`) -> ``(L, H, W, K)`` float32, the parts the traversal rendered:
-        ``"specular"``, the part of :attr:`transport` whose first camera-ray vertex went through
-        a non-diffuse lobe (glossy scenes; 0 in matte ones); ``"metal_white"``, the radiance a
-        white Lambertian surface would reflect at the pixel's metal first hits, times their
-        coverage (``c_metal · E_k / π``; scenes with metals; not part of the image).
+        Part name (:data:`~spectrinsic.render.result.PARTS`: ``"specular"``, a part of
+        :attr:`transport`; ``"metal_white"``, not) -> ``(L, H, W, K)`` float32, the parts the
+        traversal rendered.
     """
 
     transport: np.ndarray

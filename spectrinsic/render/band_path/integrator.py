@@ -4,22 +4,14 @@ Today's diagonal modes render ⌈K/3⌉ RGB passes that trace identical paths (c
 numbers) and differ only in the channel values of materials and lights (Eq. 5.2). A Lambertian
 vertex multiplies the throughput by its material's band albedo ρ_k and a light adds its band
 value E_k; neither changes the path. So one traversal can carry all K bands at once:
-:class:`BandPath` (built by :func:`band_path_class`) is Mitsuba's ``path`` integrator
-(``src/integrators/path.cpp``: emitter hits and next-event estimation with the same power-
-heuristic MIS, the same sampler calls in the same order) written in Python on Dr.Jit, whose
-throughput is a list of K band products gathered from a per-material table, and whose
-contributions go to one accumulator per (light, band). Its loop is the one body of
-:class:`~spectrinsic.render.band_path.kernel.BandKernel`; ``gloss`` and ``metals`` switch on its
-glossy (G1) factors with the specular part and the white-at-metal loop when it is traced
-("metal" there: any first hit without a diffuse lobe, metal, mirror or glass).
-
-The scene is loaded with white Lambertian surfaces (area-light shapes black) and unit white
-emitters, so Mitsuba's own BSDF and emitter sampling give the band-independent factors
-(cosine, pdfs, visibility, spot falloff); the integrator multiplies each by
-``ρ[material(shape), k]`` along the path. Its output is the **light transport** of each light
-for unit emission, ``T_{l,k}`` per pixel, ``(H, W, L·K)``; the K-channel image is
-``Σ_l E_{l,k} T_{l,k}``, equal to the diagonal passes' image to float rounding (same seed, spp
-and paths), and each light's share is exact: the per-light images sum to the total.
+:class:`BandPath` (built by :func:`band_path_class`) runs the one loop of
+:class:`~spectrinsic.render.band_path.kernel.BandKernel` (Mitsuba's ``path`` on K band
+throughputs, its ``gloss`` and ``metals`` features switched on when traced; that module says
+how) on the scene loaded with white Lambertian surfaces (area-light shapes black) and unit
+white emitters. Its output is the **light transport** of each light for unit emission,
+``T_{l,k}`` per pixel, ``(H, W, L·K)``; the K-channel image is ``Σ_l E_{l,k} T_{l,k}``, equal
+to the diagonal passes' image to float rounding (same seed, spp and paths), and each light's
+share is exact: the per-light images sum to the total.
 
 Material and emitter indices come from Mitsuba's registry ids of ``si.shape`` and
 ``ds.emitter`` (``dr.reinterpret_array``), mapped through lookup tables built after loading.
@@ -92,6 +84,11 @@ class BandTables:
         normal the first-hit maps hold (:mod:`~spectrinsic.render.base.surface_maps`).
     masks
         Whether a shape has an opacity mask (null events: :mod:`~spectrinsic.render.band_path.kernel`).
+    transmittance
+        ``(R, K)`` band transmittances per row (tinted glass; 1 on every other row, the black
+        one too), or ``None`` where no glass is tinted.
+    specular_reflectance
+        ``(R, K)`` band reflection tints per row, as :attr:`transmittance`.
     """
 
     albedo: np.ndarray
@@ -105,6 +102,8 @@ class BandTables:
     extra_maps: tuple[object, ...] = ()
     map_scales: dict[str, float] = field(default_factory=dict)
     masks: bool = False
+    transmittance: np.ndarray | None = None
+    specular_reflectance: np.ndarray | None = None
 
     def channels(self) -> tuple[tuple[int, int, int], ...]:
         """:attr:`light_channels`, or ``(j, 0, 0)`` per light where empty."""
@@ -187,13 +186,16 @@ def _check_fit(it: Any, tables: BandTables) -> None:
 
 
 def _init_gloss(mi: Any, it: Any, props: Any) -> None:
-    """The glossy properties of integrator *it*: flags, μ nodes, a specular table of ones, no
-    non-diffuse rows, and the white BSDF the white-at-metal loop swaps in."""
+    """The glossy properties of integrator *it*: flags, μ nodes, specular and transmittance
+    tables of ones, no non-diffuse rows, and the white BSDF the white-at-metal loop swaps in."""
     it.metals = bool(props.get("metals", False))
     it.gloss = bool(props.get("gloss", False)) or it.metals
+    it.tinted = bool(props.get("tinted", False)) and it.gloss
     it.n_nodes = int(props.get("n_nodes", FRESNEL_NODES))
     if it.gloss:
         it.specular = mi.Float(np.ones(it.n_nodes * it.n_bands, np.float32))
+        it.transmittance = mi.Float(np.ones(it.n_bands, np.float32))
+        it.reflection_tint = mi.Float(np.ones(it.n_bands, np.float32))
         it.non_diffuse_rows = mi.UInt32(np.zeros(1, np.uint32))
         # two-sided as every material of the scene; Mitsuba's diffuse defaults to 0.5
         it.white_bsdf = mi.load_dict(
@@ -208,14 +210,8 @@ def _empty_tables(mi: Any, it: Any) -> None:
     it.albedo = mi.Float(np.zeros(it.n_bands, np.float32))
     it.shape_lut = mi.UInt32(np.zeros(1, np.uint32))
     it.emitter_lut = mi.UInt32(np.zeros(1, np.uint32))
-    _set_envmaps(it, None)
-
-
-def _set_envmaps(it: Any, tables: BandTables | None) -> None:
-    """Integrator *it*'s light channels and extra environment maps from *tables* (none: every
-    light its own emitter's component 0, no extra map)."""
-    it.light_channels = () if tables is None else tables.channels()
-    it.extra_maps = () if tables is None else tuple(tables.extra_maps)
+    it.light_channels = tuple((j, 0, 0) for j in range(it.n_lights))
+    it.extra_maps = ()
 
 
 def _init_maps(mi: Any, it: Any, props: Any) -> None:
@@ -226,17 +222,25 @@ def _init_maps(mi: Any, it: Any, props: Any) -> None:
     it.surface_maps = []
 
 
-def _init_features(mi: Any, it: Any, props: Any) -> None:
-    """The glossy (:func:`_init_gloss`) and mask and map (:func:`_init_maps`) properties."""
-    _init_gloss(mi, it, props)
-    _init_maps(mi, it, props)
-
-
 def _set_maps(mi: Any, dr: Any, it: Any, scene: Any, tables: BandTables) -> None:
     """Point integrator *it* at the bump and normal maps of the loaded *scene*'s shapes
     named in *tables* (their texture objects, shape id -> map index)."""
     lut, it.surface_maps = map_textures(mi, scene, tables.map_scales)
     it.map_lut = mi.UInt32(shape_id_table(mi, dr, scene, lut, len(lut)))
+
+
+def _set_transmittance(mi: Any, it: Any, tables: BandTables) -> None:
+    """Integrator *it*'s ``(R, K)`` band transmittances and reflection tints per albedo-table
+    row from *tables* (tinted glass; kept as they are where *tables* have none)."""
+    for table, name in (
+        (tables.transmittance, "transmittance"),
+        (tables.specular_reflectance, "reflection_tint"),
+    ):
+        if table is None:
+            continue
+        if np.ndim(table) != 2 or np.shape(table)[1] != it.n_bands:
+            raise RenderError(f"{name} table {np.shape(table)} does not fit {it.n_bands} bands")
+        setattr(it, name, mi.Float(np.asarray(table, np.float32).ravel()))
 
 
 def _check_specular(it: Any, table: np.ndarray) -> None:
@@ -264,7 +268,8 @@ def _make_class(mi: Any, dr: Any) -> type:
             self.n_surfaces = int(props.get("n_surfaces", 0))
             self.n_texcols = int(props.get("n_texcols", 0))
             _empty_tables(mi, self)
-            _init_features(mi, self, props)
+            _init_gloss(mi, self, props)
+            _init_maps(mi, self, props)
 
         def set_tables(self, scene: Any, tables: BandTables) -> None:
             """Point the lookups at *tables* for the loaded *scene* (no recompilation)."""
@@ -275,8 +280,9 @@ def _make_class(mi: Any, dr: Any) -> type:
             lookups = texture_lookups(mi, dr, scene, tables.textures, tables.shape_textures)
             self.slot_lut, self.tex_widths, self.tex_heights, self.tex_offsets = lookups[:4]
             self.texel_albedo, self.texel_weights = lookups[4:]
-            _set_envmaps(self, tables)
+            self.light_channels, self.extra_maps = tables.channels(), tuple(tables.extra_maps)
             _set_maps(mi, dr, self, scene, tables)
+            _set_transmittance(mi, self, tables)
 
         def set_non_diffuse(self, rows: np.ndarray) -> None:
             """``(R,)`` per row: 0, ``MIRROR_ROW`` or ``GLASS_ROW`` (kernel: ``non_diffuse_rows``)."""
@@ -317,8 +323,8 @@ def band_path_class(variant: str) -> type:
     since ``mi.SamplingIntegrator`` is the variant's), registered as :data:`INTEGRATOR_NAME`.
 
     Properties: ``max_depth``, ``rr_depth`` (as ``path``), ``n_bands`` (K), ``n_lights`` (L),
-    ``n_surfaces``, ``n_texcols``, ``gloss``, ``metals``, ``masks``, ``n_nodes`` (μ nodes of the band
-    Fresnel tables). Its AOVs are :func:`aov_channels`; its RGB output is zero.
+    ``n_surfaces``, ``n_texcols``, ``gloss``, ``metals``, ``masks``, ``tinted``, ``n_nodes``
+    (μ nodes of the band Fresnel tables). Its AOVs are :func:`aov_channels`; its RGB output is zero.
     """
     mi = import_mitsuba()
     if mi.variant() != variant:
@@ -341,13 +347,15 @@ def band_path(
     gloss: bool = False,
     metals: bool = False,
     masks: bool = False,
+    tinted: bool = False,
 ) -> Any:
     """A :class:`BandPath` instance for the active variant (rr off: ``rr_depth`` > ``max_depth``),
     with first-hit maps of *n_surfaces* surfaces if not 0, textures of *n_texcols* coverage
     columns (:class:`TextureTables`) if not 0, the glossy (G1) factors and specular part with
     *gloss*, and the white-surface radiance at metal first hits with *metals* (implies *gloss*;
-    :mod:`~spectrinsic.render.band_path.kernel`), and null events through opacity masks with
-    *masks*."""
+    :mod:`~spectrinsic.render.band_path.kernel`), null events through opacity masks with
+    *masks*, and the band transmittance and reflection tint of tinted glass
+    (:attr:`BandTables.transmittance`, :attr:`BandTables.specular_reflectance`) with *tinted*."""
     band_path_class(mi.variant())
     return mi.load_dict(
         {
@@ -361,5 +369,6 @@ def band_path(
             "gloss": bool(gloss),
             "metals": bool(metals),
             "masks": bool(masks),
+            "tinted": bool(tinted),
         }
     )

@@ -4,8 +4,9 @@
 emitter hits and next-event estimation with the power-heuristic :func:`mis_weight`, the same
 sampler calls in the same order) whose throughput is a list of K band products and whose
 contributions go to one accumulator per (light, band). The scene is loaded white, so Mitsuba's
-own BSDF and emitter sampling give the band-independent factors; the kernel multiplies each by a
-band factor ``c_k`` of the vertex (:mod:`spectrinsic.render.band_path.integrator` builds the integrator).
+own BSDF and emitter sampling give the band-independent factors (cosine, pdfs, visibility, spot
+falloff); the kernel multiplies each by a band factor ``c_k`` of the vertex
+(:mod:`spectrinsic.render.band_path.integrator` builds the integrator).
 One body, three loops, told apart by Python flags read while Dr.Jit traces the kernel (as
 Mitsuba's ``prb.py`` switches its features), so each traced kernel holds only its own steps:
 
@@ -39,6 +40,17 @@ Mitsuba's ``prb.py`` switches its features), so each traced kernel holds only it
   ``s_k = 1`` on both lobes (a row of ones; μ, meaningless when refracted, is unused). ``a = 0``:
   all the camera sees in and through glass is ``S``. Mitsuba's BSDF handles both sides
   (``si.wi`` inside) and ``spawn_ray`` offsets the refracted ray, as in ``path.cpp``.
+* **tinted glass** (``it.tinted``, with gloss): a transmission through glass of
+  transmittance T(λ) multiplies band k by ``T_k`` (a per-row table, 1 on every other row),
+  a reflection by its reflection tint ``R_k`` (likewise), as Mitsuba's
+  ``specular_transmittance`` weights only the refracted lobe and ``specular_reflectance``
+  only the reflected one (``dielectric``, ``roughdielectric``, ``thindielectric``; the lobe
+  choice is Fresnel's alone). So ``s_k`` becomes ``T_k s_k`` on a transmission, ``R_k s_k``
+  on a reflection: a BSDF sample whose sampled type
+  is ``BSDFFlags.Transmission`` (a ``thindielectric``'s is ``Null``, which that flag holds), an
+  emitter sample (rough glass only) where ``cos θ_i cos θ_o`` is not positive, the test of
+  ``roughdielectric``'s ``eval``. A mask on tinted glass is refused (its hole's null event
+  would be tinted; :mod:`~spectrinsic.scenes.validate`).
 * **first-hit maps** (``n_surfaces`` > 0, not in the white loop): the camera ray's surface, ray
   distance, shading normal (and texel) are kept in the loop state. Under a bump or normal map
   the normal is the perturbed one Mitsuba's wrapper shades with
@@ -185,10 +197,7 @@ class BandKernel:
         """ρ_k of the material of the shape hit (the black row elsewhere), or of the nearest
         texel on a textured shape."""
         mi, dr, k = self.mi, self.dr, self.it.n_bands
-        valid = si.is_valid()
-        row = dr.gather(
-            mi.UInt32, self.it.shape_lut, dr.reinterpret_array(mi.UInt32, si.shape), valid
-        )
+        valid, row = si.is_valid(), self.row(si)
         rho = [dr.gather(mi.Float, self.it.albedo, row * k + b, valid) for b in range(k)]
         if not self.it.n_texcols:
             return rho
@@ -211,13 +220,12 @@ class BandKernel:
         """``acc[j·K + k] += bands[k]·weights[m_j][c_j]`` on the lanes whose emitter is light
         j's owner ``o_j``. *weights* are RGB values (``Color3f``): the emitter's own, then one
         per extra environment map (:meth:`extra_maps_at`); ``(o_j, c_j, m_j)`` =
-        ``it.light_channels[j]`` (Python ints, read when traced; empty: ``(j, 0, 0)`` for
-        every light). Only an environment map's channel lights take another component or
+        ``it.light_channels[j]`` (Python ints, read when traced; ``(j, 0, 0)`` for a light of
+        its own). Only an environment map's channel lights take another component or
         source: the emitters are loaded white, so today's components are equal and component
         0 of the emitter's own value is exactly the scalar of before."""
         k, out = self.it.n_bands, list(acc)
-        triples = self.it.light_channels or [(j, 0, 0) for j in range(self.it.n_lights)]
-        for j, (owner, channel, source) in enumerate(triples):
+        for j, (owner, channel, source) in enumerate(self.it.light_channels):
             w = self.dr.select(mask & (light == owner), weights[source][channel], 0.0)
             for b in range(k):
                 out[j * k + b] = self.dr.fma(bands[b], w, out[j * k + b])
@@ -258,9 +266,10 @@ class BandKernel:
         wo: mi.Vector3f,
         delta: Bool,
         active: Bool,
-    ) -> tuple[Float, Float]:
+    ) -> tuple[Float, ...]:
         """``a = f_d / f`` at local direction *wo* (0 where *delta*; exactly 1 for a BSDF
-        without non-diffuse lobes) and ``μ = |wi · h|``."""
+        without non-diffuse lobes) and ``μ = |wi · h|``; with tinted glass also 1 where *wo*
+        is a transmission (``cos θ_i cos θ_o`` not positive), else 0."""
         mi, dr = self.mi, self.dr
         diffuse = bsdf.eval(
             mi.BSDFContext(mi.TransportMode.Radiance, mi.BSDFFlags.Diffuse), si, wo, active
@@ -273,7 +282,10 @@ class BandKernel:
         h = si.wi + wo
         norm = dr.norm(h)
         mu = dr.select(norm > 0.0, dr.abs(dr.dot(si.wi, h)) / norm, 1.0)
-        return a, dr.clip(mu, 0.0, 1.0)
+        if not self.it.tinted:
+            return a, dr.clip(mu, 0.0, 1.0)
+        through = dr.select(si.wi.z * wo.z > 0.0, 0.0, 1.0)
+        return a, dr.clip(mu, 0.0, 1.0), through
 
     def vertex(
         self, s: PathState, si: mi.SurfaceInteraction3f, bsdf: mi.BSDFPtr, active_next: Bool
@@ -298,13 +310,15 @@ class BandKernel:
             towards.wi = -ds.d
             nee += self.extra_maps_at(towards, bsdf_val[0] * mis_em / ds.pdf, active_em)
         nee = tuple(s.beta * w for w in nee)
+        light = self.light_of(ds.emitter, active_em)
         if not self.gloss:
-            light = self.light_of(ds.emitter, active_em)
             return _Vertex(light, nee, active_em, bsdf_sample, bsdf_weight[0])
         em_lobes = self.lobes(si, bsdf, wo_em, mi.Bool(False), active_em)
         delta = mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Delta)
         bs_lobes = self.lobes(si, bsdf, bsdf_sample.wo, delta, active_next)
-        light = self.light_of(ds.emitter, active_em)
+        if self.it.tinted:  # the sampled lobe says it exactly, also in a bump map's frame
+            through = mi.has_flag(bsdf_sample.sampled_type, mi.BSDFFlags.Transmission)
+            bs_lobes = (*bs_lobes[:2], dr.select(through, 1.0, 0.0))
         return _Vertex(light, nee, active_em, bsdf_sample, bsdf_weight[0], em_lobes, bs_lobes)
 
     def specular_bands(self, row: UInt, mu: Float, valid: Bool) -> list[Float]:
@@ -324,10 +338,23 @@ class BandKernel:
     def factors(
         self, rho: list[Float], row: UInt, lobes: tuple[Float, ...], valid: Bool
     ) -> tuple[list[Float], list[Float]]:
-        """(G1) ``c_k`` and its non-diffuse part ``s_k (1 − a)`` for ``lobes = (a, μ)``."""
-        a, mu = lobes
-        spec = [s * (1.0 - a) for s in self.specular_bands(row, mu, valid)]
+        """(G1) ``c_k`` and its non-diffuse part ``s_k (1 − a)`` for ``lobes = (a, μ)``, or
+        ``(a, μ, through)`` with tinted glass (``s_k`` times ``T_k`` where *through* is 1, else
+        ``R_k``)."""
+        a, mu = lobes[:2]
+        bands = self.specular_bands(row, mu, valid)
+        if self.it.tinted:
+            bands = [s * self.tint(row, b, lobes[2], valid) for b, s in enumerate(bands)]
+        spec = [s * (1.0 - a) for s in bands]
         return [self.dr.fma(r, a, s) for r, s in zip(rho, spec, strict=True)], spec
+
+    def tint(self, row: UInt, band: int, through: Float, valid: Bool) -> Float:
+        """``T_k`` of table row *row* where *through* is 1 (a transmission), else ``R_k``."""
+        mi, dr = self.mi, self.dr
+        at = row * self.it.n_bands + band
+        t = dr.gather(mi.Float, self.it.transmittance, at, valid)
+        r = dr.gather(mi.Float, self.it.reflection_tint, at, valid)
+        return dr.select(through > 0.0, t, r)
 
     # -- first-hit maps --------------------------------------------------------------------
 

@@ -45,28 +45,23 @@ __all__ = [
     "render_traversal",
     "render_jobs",
     "light_of_emitters",
-    "single_traversal_runs",
     "resolve_integrator",
 ]
 
 
-def single_traversal_runs(variant: str | None) -> bool:
-    """Whether the band-path traversal runs with *variant*'s RGB variant: a JIT one (LLVM or
-    CUDA), where Dr.Jit traces it into one kernel. On a scalar variant a Python integrator
-    would run once per sample, so :func:`spectrinsic.render.render_scene` uses the passes."""
-    return not choose_variant("rgb", variant).startswith("scalar")
-
-
 def resolve_integrator(name: str | None, variant: str | None = None) -> str:
     """*name* checked against :data:`~spectrinsic.render.settings.INTEGRATORS` (``None``:
-    :data:`~spectrinsic.render.settings.DEFAULT_INTEGRATOR`);
-    ``"passes"`` where the traversal does not run (:func:`single_traversal_runs`)."""
+    :data:`~spectrinsic.render.settings.DEFAULT_INTEGRATOR`); ``"passes"`` where the traversal
+    does not run: on a scalar RGB variant of *variant* a Python integrator would run once per
+    sample (a JIT one, LLVM or CUDA, traces it into one kernel)."""
     chosen = (
         DEFAULT_INTEGRATOR
         if name is None
         else validate_choice(name, INTEGRATORS, "integrator", error=RenderError)
     )
-    return chosen if chosen == "passes" or single_traversal_runs(variant) else "passes"
+    if chosen == "passes" or not choose_variant("rgb", variant).startswith("scalar"):
+        return chosen
+    return "passes"
 
 
 def light_of_emitters(mi: Any, loaded: Any) -> dict[int, int]:
@@ -109,7 +104,23 @@ def _tables(
         light_channels=light_channels(scene, emitters),
         map_scales=map_scales(scene, surfaces),
         masks=any(m.maps is not None and m.maps.masked for m in scene.meshes),
+        transmittance=_tint_table(scene, value_sets, "transmittance"),
+        specular_reflectance=_tint_table(scene, value_sets, "specular_reflectance"),
     )
+
+
+def _tint_table(scene: Scene, sets: Sequence[ChannelValues], key: str) -> np.ndarray | None:
+    """``(M + 1, K)`` band values of every material's glass tint *key* (the value *sets*' side
+    by side over bands; the last row, black, ones), or ``None`` without tinted glass."""
+    if not any(m.tinted for m in scene.materials):
+        return None
+    tables = [getattr(v, key) for v in sets if getattr(v, key) is not None]
+    if len(tables) != len(sets):
+        raise RenderError(
+            f"scene {scene.name!r} has tinted glass but its channel values carry no {key}"
+        )
+    table = np.concatenate(tables, axis=1)
+    return np.vstack([table, np.ones((1, table.shape[1]))])
 
 
 def light_channels(scene: Scene, emitters: dict[int, int]) -> tuple[tuple[int, int, int], ...]:
@@ -155,8 +166,7 @@ def _render(
     mi: Any, loaded: Any, integrator: Any, request: PassRequest, n: int
 ) -> tuple[np.ndarray, float]:
     """The traversal's last *n* AOV channels (the band transport) and the render's seconds."""
-    spp, seed = request.batch_spp, request.seed
-    image, seconds = timed_render(mi, loaded, spp=spp, seed=seed, integrator=integrator)
+    image, seconds = timed_render(mi, loaded, request, integrator)
     if image.shape[-1] < n:
         raise RenderError(
             f"band-path render returned {image.shape[-1]} channels; expected at least {n}"
@@ -221,6 +231,7 @@ def _trace(
         gloss=dims.glossy,
         metals=metals,
         masks=tables.masks,
+        tinted=tables.transmittance is not None,
     )
     integrator.set_tables(loaded, tables if n_surfaces else replace(tables, shape_surfaces={}))
     if spec_table is not None:
@@ -294,8 +305,7 @@ def render_traversal(
         Channel values (:func:`spectrinsic.render.algebra.modes.channel_values`) of each diagonal mode;
         their bands are traced together.
     request
-        Samples, seed, path depth, variant, progress and prepared geometry
-        (:class:`~spectrinsic.render.settings.PassRequest`).
+        The batch's :class:`~spectrinsic.render.settings.PassRequest`.
     direct
         Also trace direct light only (path depth 2), for the energy ratio r of Eq. 5.8.
     aovs
@@ -354,7 +364,6 @@ def render_traversal(
             traced.append(
                 _trace(mi, loaded, tables, dims, spec_table, request, depth=depth, first=first)
             )
-            request.tick()
     outputs = _outputs(value_sets, widths, traced, direct)
     hits = traced[0].first
     aov_maps = _first_hit_maps(scene, tables, hits) if aovs and hits is not None else {}

@@ -17,16 +17,17 @@ import numpy as np
 from ...errors import RenderError, SceneError
 from ...interrupts import raise_if_requested
 from ...scenes.model import Scene
+from ..settings import PassRequest
 from .plugins import rgb_spectrum
 
 __all__ = [
     "DIRECT_DEPTH",
     "PassProgress",
     "PassOutput",
-    "AOV_NAMES",
     "check_scene_lights",
     "active_light_set",
     "timed_render",
+    "timing",
     "placeholder_light",
     "scene_parameters",
     "set_rgb",
@@ -36,8 +37,6 @@ __all__ = [
 DIRECT_DEPTH = 2
 #: Called with 1 after each Mitsuba pass (e.g. ``tqdm.update``).
 PassProgress = Callable[[int], Any]
-#: Keys of the dict :func:`~spectrinsic.render.passes.aovs.render_aovs` returns.
-AOV_NAMES = ("coverage", "material_id", "object_id", "depth", "normals", "mask")
 
 
 @dataclass(frozen=True, eq=False)
@@ -83,20 +82,28 @@ def active_light_set(scene: Scene, active_lights: Sequence[int] | None) -> set[i
 
 
 def timed_render(
-    mi: Any, loaded: Any, *, spp: int, seed: int, integrator: Any = None
+    mi: Any, loaded: Any, request: PassRequest, integrator: Any = None
 ) -> tuple[np.ndarray, float]:
-    """One ``mi.render`` as float32 and its seconds; a Ctrl-C stops the build within it."""
+    """One ``mi.render`` of *request*'s samples and seed as float32 and its seconds, reported
+    to its progress; a Ctrl-C stops the build within it."""
     raise_if_requested()
     start = time.perf_counter()
     try:
-        image = np.array(
-            mi.render(loaded, spp=int(spp), seed=int(seed), integrator=integrator), dtype=np.float32
-        )
+        spp, seed = int(request.batch_spp), int(request.seed)
+        image = np.array(mi.render(loaded, spp=spp, seed=seed, integrator=integrator), np.float32)
     except RuntimeError as exc:
         raise_if_requested()  # Dr.Jit re-raises a Ctrl-C inside the render as RuntimeError
         raise RenderError(f"Mitsuba render failed: {exc}") from exc
     raise_if_requested()  # Mitsuba's own SIGINT handler may have cut the pass short
-    return image, time.perf_counter() - start
+    seconds = time.perf_counter() - start
+    request.tick()
+    return image, seconds
+
+
+def timing(seconds: Sequence[float]) -> dict[str, Any]:
+    """The ``meta["timings"]`` record of some Mitsuba passes: their number, total and each (s)."""
+    total = float(sum(seconds))
+    return {"passes": len(seconds), "seconds": total, "per_pass": [float(x) for x in seconds]}
 
 
 def placeholder_light(index: int) -> dict[str, Any]:

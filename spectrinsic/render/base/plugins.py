@@ -29,6 +29,7 @@ __all__ = [
     "rgb_spectrum",
     "regular_spectrum",
     "black_bsdf",
+    "raw_bitmap",
     "hdr_film",
     "spectral_film",
     "path_integrator",
@@ -71,6 +72,20 @@ def black_bsdf() -> dict[str, Any]:
     return {
         "type": "twosided",
         "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.0, 0.0, 0.0]}},
+    }
+
+
+def raw_bitmap(mi: Any, values: np.ndarray, filter_type: str, wrap_mode: str) -> dict[str, Any]:
+    """A ``bitmap`` texture of ``(h, w, c)`` *values* as they are (``raw``: no colour
+    conversion), row 0 at v = 0 as Mitsuba looks up spectrinsic's texture coordinates."""
+    return {
+        "type": "bitmap",
+        # a Bitmap, not a TensorXf: nanobind tries a (3, …) tensor as a colour first and
+        # prints each failed conversion on stderr (same texel values, measured)
+        "bitmap": mi.Bitmap(np.ascontiguousarray(values, np.float32)),
+        "raw": True,
+        "filter_type": filter_type,
+        "wrap_mode": wrap_mode,
     }
 
 

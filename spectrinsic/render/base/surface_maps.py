@@ -30,6 +30,7 @@ from ...errors import RenderError
 from ...scenes.image_textures import ImageTexture
 from ...scenes.model import Scene
 from ...scenes.surface_maps import MeshMaps, luminance
+from .plugins import raw_bitmap
 
 __all__ = [
     "MapKind",
@@ -45,17 +46,9 @@ MapKind = str
 
 
 def _bitmap(mi: Any, image: ImageTexture, values: np.ndarray) -> dict[str, Any]:
-    """A raw ``bitmap`` of ``(h, w, c)`` *values* (row 0 at v = 0, as Mitsuba looks up our
-    texture coordinates) with *image*'s wrap mode and filter."""
-    return {
-        "type": "bitmap",
-        # a Bitmap, not a TensorXf: nanobind tries a (3, …) tensor as a colour first and
-        # prints each failed conversion on stderr (same texel values, measured)
-        "bitmap": mi.Bitmap(np.ascontiguousarray(values, np.float32)),
-        "raw": True,
-        "filter_type": "nearest" if image.filter == "nearest" else "bilinear",
-        "wrap_mode": image.wrap,
-    }
+    """:func:`raw_bitmap` of *values* with *image*'s wrap mode and filter (module docstring)."""
+    filter_type = "nearest" if image.filter == "nearest" else "bilinear"
+    return raw_bitmap(mi, values, filter_type, image.wrap)
 
 
 def wrap_bsdf(mi: Any, maps: MeshMaps, bsdf: dict[str, Any]) -> dict[str, Any]:

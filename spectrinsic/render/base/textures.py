@@ -26,6 +26,7 @@ import numpy as np
 from ...errors import RenderError
 from ...scenes.model import Scene
 from ...scenes.textures import Texture
+from .plugins import raw_bitmap
 
 __all__ = [
     "TextureTables",
@@ -103,18 +104,6 @@ def shape_slots(tables: TextureTables | None, surfaces: Sequence[Any]) -> dict[s
     return {s.key: tables.mesh_slots[s.mesh] for s in surfaces if s.mesh in tables.mesh_slots}
 
 
-def _weight_bitmap(mi: Any, values: np.ndarray) -> dict[str, Any]:
-    return {
-        "type": "bitmap",
-        # a Bitmap, not a TensorXf: nanobind tries a (3, …) tensor as a colour first and
-        # prints each failed conversion on stderr (same texel values, measured)
-        "bitmap": mi.Bitmap(np.ascontiguousarray(values[..., None], np.float32)),
-        "raw": True,
-        "filter_type": "nearest",
-        "wrap_mode": "clamp",
-    }
-
-
 def textured_bsdf(mi: Any, texture: Texture, reflectances: Sequence[Mapping]) -> dict[str, Any]:
     """Two-sided nested ``blendbsdf`` of Lambertian basis BSDFs with *reflectances* (one
     Mitsuba spectrum dict per basis material), weighted per texel (module docstring)."""
@@ -127,7 +116,7 @@ def textured_bsdf(mi: Any, texture: Texture, reflectances: Sequence[Mapping]) ->
         )
         bsdf = {
             "type": "blendbsdf",
-            "weight": _weight_bitmap(mi, t),
+            "weight": raw_bitmap(mi, t[..., None], "nearest", "clamp"),
             "bsdf_0": {"type": "diffuse", "reflectance": dict(reflectances[b])},
             "bsdf_1": bsdf,
         }

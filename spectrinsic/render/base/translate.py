@@ -146,12 +146,12 @@ def _mitsuba_mesh(mi: Any, part: SurfaceGeometry, bsdf: Mapping) -> Any:
     return mesh
 
 
-def _lambertian(reflectance: Mapping) -> dict[str, Any]:
-    return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": dict(reflectance)}}
-
-
 def material_bsdf(
-    material: Material, reflectance: Mapping, *, white_metal: bool = False
+    material: Material,
+    reflectance: Mapping,
+    *,
+    white_metal: bool = False,
+    tints: Mapping[str, Mapping] | None = None,
 ) -> dict[str, Any]:
     """The two-sided Mitsuba BSDF of *material* with diffuse *reflectance*.
 
@@ -161,15 +161,19 @@ def material_bsdf(
     ``conductor``/``roughconductor`` with its measured η/k of ``material.metal``, or with
     *white_metal* a perfect mirror (``material: none``, F = 1) whose Fresnel factor the band
     integrator applies per band. Glass: Mitsuba's ``(rough)dielectric``/``thindielectric`` of
-    index ``ior`` over air's 1, band-independent, not in a ``twosided``. Else Lambertian.
+    index ``ior`` over air's 1, not in a ``twosided``, with *tints* (``{Mitsuba parameter:
+    spectrum dict}``, ``specular_transmittance`` and ``specular_reflectance``) where given
+    (tinted glass; the band path loads it clear and applies the tints per band). Else
+    Lambertian.
     """
     if material.kind == "diffuse":
-        return _lambertian(reflectance)
+        return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": dict(reflectance)}}
     rough = material.roughness > 0.0
     if material.transmissive:  # a thindielectric is always smooth (materials.py)
         glass = {"type": material.kind, "int_ior": float(material.ior), "ext_ior": 1.0}
         ggx = {"type": "roughdielectric", "distribution": "ggx", "alpha": material.roughness}
-        return glass | (ggx if rough else {})
+        tint = {key: dict(value) for key, value in (tints or {}).items()}
+        return glass | (ggx if rough else {}) | tint
     bsdf: dict[str, Any]
     if material.kind == "plastic":
         bsdf = {
@@ -183,14 +187,18 @@ def material_bsdf(
         bsdf = {
             "type": "roughconductor" if rough else "conductor",
             "material": "none" if white_metal else material.metal,
-        }
+        } | {key: dict(value) for key, value in (tints or {}).items()}
     if rough:
         bsdf |= {"distribution": "ggx", "alpha": float(material.roughness)}
     return {"type": "twosided", "bsdf": bsdf}
 
 
 def _surface_bsdf(
-    scene: Scene, part: SurfaceGeometry, materials: Sequence[Mapping], white_metal: bool
+    scene: Scene,
+    part: SurfaceGeometry,
+    materials: Sequence[Mapping],
+    white_metal: bool,
+    transmittances: Sequence[Mapping[str, Mapping] | None],
 ) -> dict[str, Any]:
     """The BSDF of one surface: its material's, or on a textured mesh the texel-weighted mix of
     its basis materials (a mix of equal reflectances, such as the band path's white load, is
@@ -199,7 +207,10 @@ def _surface_bsdf(
     mesh = scene.meshes[part.mesh] if part.mesh >= 0 else None
     texture = None if mesh is None else mesh.texture
     bsdf = material_bsdf(
-        scene.materials[part.material], materials[part.material], white_metal=white_metal
+        scene.materials[part.material],
+        materials[part.material],
+        white_metal=white_metal,
+        tints=transmittances[part.material] if transmittances else None,
     )
     if texture is not None:
         basis = [materials[b] for b in texture.basis]
@@ -243,63 +254,59 @@ def envmap_entry(mi: Any, light: Light, emission: Mapping) -> dict[str, Any]:
 
 
 def _light(mi: Any, light: Light, emission: Mapping | None, what: str) -> dict[str, Any] | None:
-    if light.kind == "envmap":
-        return None if emission is None else envmap_entry(mi, light, emission)
-    if light.kind == "point":
-        return (
-            None
-            if emission is None
-            else {
-                "type": "point",
-                "position": list(map(float, light.position)),
-                "intensity": dict(emission),
-            }
-        )
-    if light.kind == "spot":
-        return (
-            None
-            if emission is None
-            else {
-                "type": "spot",
-                "to_world": _look_at(mi, light.position, light.direction, what),
-                "cutoff_angle": float(light.cutoff_deg),
-                "intensity": dict(emission),
-            }
-        )
-    if light.kind == "directional":
-        return (
-            None
-            if emission is None
-            else {
-                "type": "directional",
-                "direction": list(map(float, light.direction)),
-                "irradiance": dict(emission),
-            }
-        )
-    if light.kind == "sky":
-        return None if emission is None else {"type": "constant", "radiance": dict(emission)}
+    """The Mitsuba entry of *light* emitting *emission*; ``None`` leaves it out (the shape of
+    an area or sphere light stays, black)."""
     if light.kind in _SHAPE_LIGHTS:
-        w, h = (float(s) for s in light.size)
-        shape: dict[str, Any] = (
-            {
-                "type": "rectangle",
-                "to_world": _look_at(mi, light.position, light.direction, what)
-                @ mi.ScalarTransform4f().scale([w / 2, h / 2, 1.0]),
-            }
-            if light.kind == "area"
-            else {
-                "type": "sphere",
-                "center": list(map(float, light.position)),
-                "radius": float(light.radius),
-            }
-        )
-        # an instance, not a dict: load_dict merges identical dicts into one shared BSDF,
-        # and every surface needs its own for the per-surface coverage passes
-        shape["bsdf"] = mi.load_dict(black_bsdf())
-        if emission is not None:
-            shape["emitter"] = {"type": "area", "radiance": dict(emission)}
-        return shape
-    raise SceneError(f"{what}: {unknown_light_kind(light.kind)}")
+        return _shape_light(mi, light, emission, what)
+    if light.kind not in _EMISSION_PARAM:
+        raise SceneError(f"{what}: {unknown_light_kind(light.kind)}")
+    if emission is None:
+        return None
+    if light.kind == "envmap":
+        return envmap_entry(mi, light, emission)
+    if light.kind == "point":
+        return {
+            "type": "point",
+            "position": list(map(float, light.position)),
+            "intensity": dict(emission),
+        }
+    if light.kind == "spot":
+        return {
+            "type": "spot",
+            "to_world": _look_at(mi, light.position, light.direction, what),
+            "cutoff_angle": float(light.cutoff_deg),
+            "intensity": dict(emission),
+        }
+    if light.kind == "directional":
+        return {
+            "type": "directional",
+            "direction": list(map(float, light.direction)),
+            "irradiance": dict(emission),
+        }
+    return {"type": "constant", "radiance": dict(emission)}  # sky
+
+
+def _shape_light(mi: Any, light: Light, emission: Mapping | None, what: str) -> dict[str, Any]:
+    w, h = (float(s) for s in light.size)
+    shape: dict[str, Any] = (
+        {
+            "type": "rectangle",
+            "to_world": _look_at(mi, light.position, light.direction, what)
+            @ mi.ScalarTransform4f().scale([w / 2, h / 2, 1.0]),
+        }
+        if light.kind == "area"
+        else {
+            "type": "sphere",
+            "center": list(map(float, light.position)),
+            "radius": float(light.radius),
+        }
+    )
+    # an instance, not a dict: load_dict merges identical dicts into one shared BSDF,
+    # and every surface needs its own for the per-surface coverage passes
+    shape["bsdf"] = mi.load_dict(black_bsdf())
+    if emission is not None:
+        shape["emitter"] = {"type": "area", "radiance": dict(emission)}
+    return shape
 
 
 def _camera(mi: Any, scene: Scene, film: Mapping, sample_count: int) -> dict[str, Any]:
@@ -328,6 +335,7 @@ def scene_to_mitsuba(
     sample_count: int,
     geometry: Sequence[SurfaceGeometry] | None = None,
     white_metal: bool = False,
+    transmittances: Sequence[Mapping[str, Mapping] | None] = (),
 ) -> dict[str, Any]:
     """Translate *scene* into a dict for ``mitsuba.load_dict``.
 
@@ -351,8 +359,17 @@ def scene_to_mitsuba(
         :func:`prepare_geometry` of *scene*, if already computed.
     white_metal
         Metals as perfect mirrors (:func:`material_bsdf`), for the band integrator.
+    transmittances
+        One ``{Mitsuba parameter: spectrum dict}`` (or ``None``) per ``scene.materials``
+        entry: a tinted glass's ``specular_transmittance`` and ``specular_reflectance``; empty
+        (the default): every glass clear, as the band integrator loads it.
     """
     mi = import_mitsuba()
+    if transmittances and len(transmittances) != len(scene.materials):
+        raise SceneError(
+            f"scene {scene.name!r}: got {len(transmittances)} transmittances for "
+            f"{len(scene.materials)} materials"
+        )
     if len(materials) != len(scene.materials) or len(lights) != len(scene.lights):
         raise SceneError(
             f"scene {scene.name!r}: got {len(materials)} material and {len(lights)} light colours for "
@@ -364,7 +381,8 @@ def scene_to_mitsuba(
         "sensor": _camera(mi, scene, film, sample_count),
     }
     for part in prepare_geometry(scene) if geometry is None else geometry:
-        out[part.key] = _mitsuba_mesh(mi, part, _surface_bsdf(scene, part, materials, white_metal))
+        bsdf = _surface_bsdf(scene, part, materials, white_metal, transmittances)
+        out[part.key] = _mitsuba_mesh(mi, part, bsdf)
     loaded_map = False  # Mitsuba takes one environment emitter: the first map given one
     for j, (light, emission) in enumerate(zip(scene.lights, lights, strict=True)):
         if light.kind == "envmap" and emission is not None:

@@ -1,18 +1,8 @@
-"""Choosing a Mitsuba variant (the set-up of Mitsuba's import lives in
-:mod:`spectrinsic.mitsuba_import`, re-exported here).
-
-Dr.Jit's LLVM backend JIT-compiles through a system ``libLLVM``. The LLVM 14 and 15 libraries
-that Debian ships crash it (``Cannot select: fminimum``); LLVM 16 or newer works. Dr.Jit loads
-the library named by the environment variable ``DRJIT_LIBLLVM_PATH`` when ``drjit`` is first
-imported, and has no other way to be told.
-
-The set-up step is :func:`import_mitsuba`, the one place that imports Mitsuba (and so Dr.Jit).
-On its first call it picks the library (:func:`configure_llvm`: the user's
-``DRJIT_LIBLLVM_PATH`` if set, else the newest ``libLLVM`` >= 16 found), sets the variable for
-the duration of ``import drjit`` only, and restores the environment as it was. So the process
-environment is never changed for good, and child processes (which call :func:`import_mitsuba`
-themselves) inherit the user's. When no suitable library exists the LLVM variants are not used:
-renders fall back to the (about twice slower) scalar variants with one
+"""Choosing a Mitsuba variant. Mitsuba is imported through
+:func:`spectrinsic.mitsuba_import.import_mitsuba`, which points Dr.Jit's LLVM backend at a
+``libLLVM`` >= 16 for the duration of ``import drjit`` only (the libraries Debian ships, 14 and
+15, crash it; that module says why and how). When no suitable library exists the LLVM
+variants are not used: renders fall back to the (about twice slower) scalar variants with one
 :class:`~spectrinsic.errors.SpectrinsicWarning`.
 
 Variants are chosen per pass (cuda > llvm > scalar; ``*_spectral`` for the spectral reference,
@@ -33,21 +23,14 @@ from ...errors import RenderError, SpectrinsicWarning, validate_choice
 from ...mitsuba_import import (
     LLVM_ENV,
     LLVM_MIN_VERSION,
-    configure_llvm,
-    find_libllvm,
     import_mitsuba,
     llvm_version_from_name,
     loaded_libllvm,
 )
 
 __all__ = [
-    "LLVM_ENV",
-    "LLVM_MIN_VERSION",
     "BACKENDS",
     "VariantKind",
-    "llvm_version_from_name",
-    "find_libllvm",
-    "configure_llvm",
     "import_mitsuba",
     "set_thread_count",
     "usable_backends",

@@ -60,8 +60,7 @@ def render_diagonal(
     value_sets
         Channel values (:func:`spectrinsic.render.algebra.modes.channel_values`) of each render.
     request
-        Samples, seed, path depth, variant, progress and prepared geometry
-        (:class:`~spectrinsic.render.settings.PassRequest`).
+        The batch's :class:`~spectrinsic.render.settings.PassRequest`.
     direct
         Per value set (or for all): also render direct light only (``max_depth`` 2), for the
         energy ratio r of Eq. 5.8.
@@ -131,14 +130,6 @@ class _DiagonalPasses:
     direct_integrator: Any
     request: PassRequest
 
-    def _render(self, integrator: Any = None) -> tuple[np.ndarray, float]:
-        r = self.request
-        image, dt = timed_render(
-            self.mi, self.loaded, spp=r.batch_spp, seed=r.seed, integrator=integrator
-        )
-        self.request.tick()
-        return image, dt
-
     def render(
         self,
         scene: Scene,
@@ -161,11 +152,11 @@ class _DiagonalPasses:
             for j in active:
                 set_rgb(self.mi, self.params, tr.emission_key(scene, j, spectral=False), lights[j])
             self.params.update()
-            image, dt = self._render()
+            image, dt = timed_render(self.mi, self.loaded, self.request)
             full.append(image)
             seconds.append(dt)
             if want_direct:
-                image, dt = self._render(self.direct_integrator)
+                image, dt = timed_render(self.mi, self.loaded, self.request, self.direct_integrator)
                 direct_parts.append(image)
                 seconds.append(dt)
         return PassOutput(

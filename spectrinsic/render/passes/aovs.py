@@ -80,9 +80,8 @@ def render_aovs(
                     onehot[i % 3] = 1.0
                 set_rgb(mi, params, tr.reflectance_key(s, spectral=False), onehot)
             params.update()
-            image, dt = timed_render(mi, loaded, spp=request.batch_spp, seed=request.seed)
+            image, dt = timed_render(mi, loaded, request)
             seconds.append(dt)
-            request.tick()
             if image.shape[-1] != 7:
                 raise RenderError(
                     f"AOV pass returned {image.shape[-1]} channels; expected 7 (depth, normal, albedo)"

@@ -270,7 +270,7 @@ def test_missing_inputs_raise_clear_errors(synth):
 
     scene = synth.make_scene(("planck:2800K", "cie:FL11"))
     result = synth.make_result(scene, modes=("spectral",))
-    no_split = synth.FakeResult(images=result.images, aovs=result.aovs)
+    no_split = synth.RenderResult(images=result.images, raw={}, aovs=result.aovs)
     with pytest.raises(DatasetError, match="per_light=True"):
         compute_ground_truth(scene, no_split, LayerSettings(cameras=()))
     with pytest.raises(DatasetError, match="bands31"):

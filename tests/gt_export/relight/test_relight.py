@@ -8,7 +8,9 @@ usual path. A relit sample must equal it to float rounding in every layer.
 from __future__ import annotations
 
 import json
+import shutil
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,7 +20,8 @@ from spectrinsic.gt_export import check_sample, export_sample, load_sample
 from spectrinsic.gt_export.layers import LayerSettings
 from spectrinsic.gt_export.relight import relight, relit_scene
 from spectrinsic.gt_export.relight.augment import RandomRelight, relit_layers
-from spectrinsic.gt_export.sample import write_pool
+from spectrinsic.gt_export.sample import META_NAME, SEAL_KEY, canonical_json, meta_seal, write_pool
+from spectrinsic.gt_export.sample.render_spp import render_spp
 from spectrinsic.gt_export.sample.transport_exr import TRANSPORT_NAME
 from spectrinsic.render import RenderSettings, count_passes, render_batches
 from spectrinsic.render.transport_render import render_transport_batches
@@ -225,15 +228,9 @@ def test_the_write_threads_write_a_relit_sample_byte_for_byte_as_the_serial_writ
     threaded = relight(sample, NEW_LIGHTS, tmp_path / "threads" / "relit__v0__two")
     monkeypatch.setattr(write_pool, "WRITE_THREADS", 0)
     serial = relight(sample, NEW_LIGHTS, tmp_path / "serial" / "relit__v0__two")
-
-    def files(folder):
-        return {
-            str(p.relative_to(folder)): p.read_bytes() for p in folder.rglob("*") if p.is_file()
-        }
-
-    written = files(threaded)
+    written = _files(threaded)
     assert len(written) > 20 and "meta.json" in written
-    assert written == files(serial)
+    assert written == _files(serial)
 
 
 def test_random_relight_is_seeded_per_item_and_epoch(built):
@@ -261,6 +258,56 @@ def test_transport_file_is_recorded_with_its_size(built):
         and record["batches"] == 2
         and record["modes"] == ["rgb3", "rgb6", "bands31"]
     )
+
+
+def test_the_render_record_states_totals_beside_per_batch_counts(built):
+    """Issue 46: spp and spectral_spp are totals over the batches (the settings' totals), and
+    batch_spp and spectral_batch_spp one batch's."""
+    render = json.loads((built[2] / META_NAME).read_text())["render"]
+    assert render["spp"] == render["batch_spp"] * render["batches"] == SETTINGS.spp
+    total = SETTINGS.spectral_spp or SETTINGS.spp  # no spectral_spp: the spectral pass's is spp
+    assert render["spectral_spp"] == render["spectral_batch_spp"] * render["batches"] == total
+    assert render["batches"] == SETTINGS.batches == 2
+
+
+def _written_before_issue_46(sample: Path, parent: Path) -> Path:
+    """A copy of *sample* whose meta.json is in the form written before issue 46 (one batch's
+    spectral_spp, no spectral_batch_spp), sealed again as that version sealed it."""
+    old = parent / sample.name
+    shutil.copytree(sample, old)
+    meta = json.loads((old / META_NAME).read_text())
+    meta["render"]["spectral_spp"] = meta["render"].pop("spectral_batch_spp")
+    meta[SEAL_KEY] = meta_seal(meta)
+    (old / META_NAME).write_text(canonical_json(meta))
+    return old
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    return {
+        p.relative_to(folder).as_posix(): p.read_bytes() for p in folder.rglob("*") if p.is_file()
+    }
+
+
+def _meta_less_source_hash(data: bytes) -> dict:
+    """A relit meta.json without what names its source's bytes (its hash, and the seal)."""
+    meta = json.loads(data)
+    del meta["render"]["relit"]["from_meta_sha256"], meta[SEAL_KEY]
+    return meta
+
+
+def test_a_sample_written_before_issue_46_relights_as_a_new_one(built, tmp_path):
+    _, _, sample = built
+    old = _written_before_issue_46(sample, tmp_path / "old")
+    assert render_spp(json.loads((old / META_NAME).read_text())["render"]) == render_spp(
+        json.loads((sample / META_NAME).read_text())["render"]
+    )
+    relit_new = _files(relight(sample, NEW_LIGHTS, tmp_path / "a" / "relit__v0__form"))
+    relit_old = _files(relight(old, NEW_LIGHTS, tmp_path / "b" / "relit__v0__form"))
+    assert relit_old.keys() == relit_new.keys()
+    assert [k for k in relit_new if k != META_NAME and relit_old[k] != relit_new[k]] == []
+    new_meta = _meta_less_source_hash(relit_new[META_NAME])
+    assert _meta_less_source_hash(relit_old[META_NAME]) == new_meta
+    assert new_meta["render"]["spectral_spp"] == 2 * new_meta["render"]["spectral_batch_spp"]
 
 
 def test_relight_refuses_bad_requests_before_writing(built, tmp_path):

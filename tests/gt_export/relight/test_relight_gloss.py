@@ -17,6 +17,7 @@ from spectrinsic.gt_export import check_sample, export_sample, load_sample
 from spectrinsic.gt_export.layers import LayerSettings
 from spectrinsic.gt_export.relight import relight, relit_scene
 from spectrinsic.render import RenderSettings, render_batches
+from spectrinsic.render.result import METAL_WHITE, SPECULAR
 from spectrinsic.render.transport_render import render_transport_batches
 from spectrinsic.scenes.model import Material
 
@@ -73,12 +74,13 @@ def _arrays(sample: dict) -> dict[str, np.ndarray]:
 
 def test_the_glossy_transport_holds_the_specular_and_metal_parts_per_light(glossy):
     _, scene, _, transport = glossy
-    assert len(transport.specular) == len(transport.metal_white) == 2
-    for part in (transport.specular, transport.metal_white):
+    specular, metal_white = transport.parts[SPECULAR], transport.parts[METAL_WHITE]
+    assert len(specular) == len(metal_white) == 2
+    for part in (specular, metal_white):
         assert part[0]["bands31"].shape == transport.batches[0]["bands31"].shape
         assert part[0]["bands31"].max() > 0
     # the specular part is a part of the transport; the white-at-metal radiance is not
-    s, t = transport.specular[0]["bands31"], transport.batches[0]["bands31"]
+    s, t = specular[0]["bands31"], transport.batches[0]["bands31"]
     assert np.all(s <= t * (1 + 1e-5) + 1e-7)
 
 

@@ -9,6 +9,7 @@ import sys
 import numpy as np
 import pytest
 
+from spectrinsic import mitsuba_import
 from spectrinsic.errors import RenderError, SpectrinsicError, SpectrinsicWarning
 from spectrinsic.render import RenderSettings
 from spectrinsic.render.base import variants
@@ -27,7 +28,7 @@ from spectrinsic.render.base import variants
     ],
 )
 def test_llvm_version_from_name(name, version):
-    assert variants.llvm_version_from_name(name) == version
+    assert mitsuba_import.llvm_version_from_name(name) == version
 
 
 def test_find_libllvm_prefers_newest_suitable(tmp_path):
@@ -39,18 +40,18 @@ def test_find_libllvm_prefers_newest_suitable(tmp_path):
         "libLLVM-20.a",
     ):
         (tmp_path / name).write_bytes(b"")
-    assert variants.find_libllvm([str(tmp_path)]).name == "libLLVM.so.19.1"
+    assert mitsuba_import.find_libllvm([str(tmp_path)]).name == "libLLVM.so.19.1"
 
 
 def test_find_libllvm_rejects_old_versions(tmp_path):
     for name in ("libLLVM-14.so.1", "libLLVM-15.so"):
         (tmp_path / name).write_bytes(b"")
-    assert variants.find_libllvm([str(tmp_path)]) is None
+    assert mitsuba_import.find_libllvm([str(tmp_path)]) is None
 
 
 def test_configure_llvm_keeps_user_setting(monkeypatch):
-    monkeypatch.setenv(variants.LLVM_ENV, "/somewhere/libLLVM-18.so")
-    assert variants.configure_llvm() == "/somewhere/libLLVM-18.so"
+    monkeypatch.setenv(mitsuba_import.LLVM_ENV, "/somewhere/libLLVM-18.so")
+    assert mitsuba_import.configure_llvm() == "/somewhere/libLLVM-18.so"
 
 
 def test_importing_render_does_not_import_mitsuba():
@@ -93,9 +94,9 @@ def test_available_variants_lists_usable_variants():
     assert report["rgb"] == usable[0] and report["spectral"] == usable[1]
     assert set(usable) <= set(report["compiled"])
     if "llvm" in report["backends"]:
-        assert variants.llvm_version_from_name(report["libllvm"]) in (
+        assert mitsuba_import.llvm_version_from_name(report["libllvm"]) in (
             None,
-            *range(variants.LLVM_MIN_VERSION, 100),
+            *range(mitsuba_import.LLVM_MIN_VERSION, 100),
         )
 
 
@@ -129,7 +130,7 @@ def test_scalar_variant_renders_the_same_deterministic_plane(make_plane):
 
 def _fresh(code: str, **env: str) -> list[str]:
     """stdout lines of *code* run in a new interpreter (a process whose Mitsuba is not set up)."""
-    environ = {k: v for k, v in os.environ.items() if k != variants.LLVM_ENV} | env
+    environ = {k: v for k, v in os.environ.items() if k != mitsuba_import.LLVM_ENV} | env
     out = subprocess.run(
         [sys.executable, "-P", "-c", code], capture_output=True, text=True, check=True, env=environ
     )
@@ -141,17 +142,18 @@ def test_set_up_leaves_the_environment_as_it_was():
     """Dr.Jit gets the chosen libLLVM while it is imported; the environment is not changed."""
     code = (
         "import os, sys\n"
+        "from spectrinsic import mitsuba_import\n"
         "from spectrinsic.render.base import variants\n"
         "variants.import_mitsuba()\n"
-        "print(repr(os.environ.get(variants.LLVM_ENV)))\n"
+        "print(repr(os.environ.get(mitsuba_import.LLVM_ENV)))\n"
         "print(repr(variants.llvm_library()))\n"
-        "print(repr(variants.configure_llvm()))\n"
+        "print(repr(mitsuba_import.configure_llvm()))\n"
         "print(sorted({l.split()[-1] for l in open('/proc/self/maps') if 'libLLVM' in l}))\n"
     )
     env_after, used, chosen, mapped = _fresh(code)
     assert env_after == "None"
     if chosen == "None":
-        pytest.skip(f"no libLLVM >= {variants.LLVM_MIN_VERSION} on this machine")
+        pytest.skip(f"no libLLVM >= {mitsuba_import.LLVM_MIN_VERSION} on this machine")
     assert used == chosen
     # the library Dr.Jit actually loaded is the chosen one, not another libLLVM on the system
     assert mapped == repr([os.path.realpath(eval(chosen))])
@@ -160,11 +162,12 @@ def test_set_up_leaves_the_environment_as_it_was():
 def test_set_up_keeps_the_users_libllvm_setting():
     code = (
         "import os\n"
+        "from spectrinsic import mitsuba_import\n"
         "from spectrinsic.render.base import variants\n"
         "variants.import_mitsuba()\n"
-        "print(os.environ[variants.LLVM_ENV])\n"
+        "print(os.environ[mitsuba_import.LLVM_ENV])\n"
     )
-    assert _fresh(code, **{variants.LLVM_ENV: "/nowhere/libLLVM-18.so"}) == [
+    assert _fresh(code, **{mitsuba_import.LLVM_ENV: "/nowhere/libLLVM-18.so"}) == [
         "/nowhere/libLLVM-18.so"
     ]
 

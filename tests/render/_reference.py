@@ -1,0 +1,130 @@
+"""Mitsuba's own spectral ``path`` render as the independent reference of the XML box tests
+(tests/render/test_glass.py, tests/render/test_xml_box_every_surface.py): the glass mesh both
+renderers trace, the band path's and Mitsuba's CIE XYZ images, and their comparison per
+8 × 8 block against the spread of independent seeds.
+
+A helper module, not a conftest: its functions take arguments (scene, file, spp, seed), and
+tests/test_test_layout.py checks only ``test_*.py`` files.
+"""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+import numpy as np
+
+from spectrinsic.render import RenderSettings, render_scene
+from spectrinsic.render.result import RenderResult
+from spectrinsic.scenes.model import Scene
+
+__all__ = [
+    "SEEDS",
+    "RES",
+    "FALSE_ALARM",
+    "ICO_V",
+    "ICO_F",
+    "icosahedron_obj",
+    "blocks",
+    "y_normalisation",
+    "ours_xyz",
+    "mitsuba_xyz",
+    "assert_blocks_agree",
+]
+
+#: Independent seeds per renderer, whose spread gives each block's standard error.
+SEEDS = 16
+#: Image side of the boxes (pixels): 4 × 4 blocks of 8 × 8.
+RES = 32
+#: Family-wise false-alarm rate of the 48 block-channel comparisons.
+FALSE_ALARM = 1e-3
+
+#: A flat-shaded icosahedron of circumradius 1: the same triangles in both renderers (an
+#: analytic ``sphere`` is triangulated by spectrinsic, and refraction would see the facets).
+_T = (1 + 5**0.5) / 2
+ICO_V = np.array(
+    [[-1, _T, 0], [1, _T, 0], [-1, -_T, 0], [1, -_T, 0], [0, -1, _T], [0, 1, _T],
+     [0, -1, -_T], [0, 1, -_T], [_T, 0, -1], [_T, 0, 1], [-_T, 0, -1], [-_T, 0, 1]]
+) / np.hypot(1, _T)  # fmt: skip
+ICO_F = [
+    [0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4],
+    [11, 10, 2], [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9],
+    [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1],
+]  # fmt: skip
+
+
+def icosahedron_obj(*, uv: bool = False) -> str:
+    """The icosahedron as OBJ text; with *uv*, spherical texture coordinates per vertex
+    (u the azimuth, v the polar angle, each in [0, 1]) for a bump map on it."""
+    obj = "".join(f"v {x:.9f} {y:.9f} {z:.9f}\n" for x, y, z in ICO_V)
+    if not uv:
+        return obj + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in ICO_F)
+    u = np.arctan2(ICO_V[:, 1], ICO_V[:, 0]) / (2 * np.pi) + 0.5
+    v = np.arccos(np.clip(ICO_V[:, 2], -1.0, 1.0)) / np.pi
+    obj += "".join(f"vt {a:.9f} {b:.9f}\n" for a, b in zip(u, v, strict=True))
+    return obj + "".join(
+        f"f {a + 1}/{a + 1} {b + 1}/{b + 1} {c + 1}/{c + 1}\n" for a, b, c in ICO_F
+    )
+
+
+def blocks(image: np.ndarray) -> np.ndarray:
+    """``(4, 4, 3)`` means of the 8 × 8 blocks of a 32 × 32 image."""
+    return image.reshape(RES // 8, 8, RES // 8, 8, 3).mean(axis=(1, 3))
+
+
+@functools.cache
+def y_normalisation() -> float:
+    """∫ȳ dλ on Mitsuba's 1 nm grid 360–830 nm: its spectral XYZ film divides by it
+    (``MI_CIE_Y_NORMALIZATION``); spectrinsic's raw channels are ``∫ L x̄ dλ`` unnormalised."""
+    import colour
+
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+    return float(cmfs.copy().align(colour.SpectralShape(360, 830, 1)).values[:, 1].sum())
+
+
+def ours_xyz(
+    scene: Scene, spp: int, seed: int, *, per_light: bool = False
+) -> tuple[np.ndarray, RenderResult]:
+    """The band path's CIE XYZ image of *scene* (its ``bands31`` raw channels through the
+    render's own ``to_xyz``, depth 6 as the XML's ``path``) and the render's result."""
+    settings = RenderSettings(spp, modes=("bands31",), max_depth=6, per_light=per_light)
+    result = render_scene(scene, settings, seed=seed)
+    to_xyz = np.asarray(result.meta["to_xyz"]["bands31"], float)
+    return np.einsum("hwk,ck->hwc", result.raw["bands31"], to_xyz), result
+
+
+def mitsuba_xyz(path: Path, spp: int) -> list[np.ndarray]:
+    """Mitsuba's own spectral ``path`` render of the file at *path* (film CIE XYZ, box
+    filter, as spectrinsic's pixels), one image per seed, in spectrinsic's units."""
+    from spectrinsic.mitsuba_import import import_mitsuba
+    from spectrinsic.render.base.variants import choose_variant
+
+    mi = import_mitsuba()
+    mi.set_variant(choose_variant("spectral"))
+    xyz = path.with_name("xyz.xml")
+    xyz.write_text(
+        path.read_text().replace(
+            '<film type="hdrfilm">',
+            '<film type="hdrfilm"><string name="pixel_format" value="xyz"/><rfilter type="box"/>',
+        )
+    )
+    loaded = mi.load_file(str(xyz))
+    scale = y_normalisation()
+    return [
+        np.asarray(mi.render(loaded, spp=spp, seed=s), float)[..., :3] * scale for s in range(SEEDS)
+    ]
+
+
+def assert_blocks_agree(ours: np.ndarray, theirs: np.ndarray, *, max_t: float = np.inf) -> None:
+    """Per block and channel of ``(SEEDS, 4, 4, 3)`` block means, the two renderers agree within
+    t standard errors of the difference, from the spread of the seeds (t: Student's quantile,
+    SEEDS − 1 degrees of freedom, for a family-wise false alarm of FALSE_ALARM over the
+    comparisons, at most *max_t*), and each standard error is below 10 % of the block mean (the
+    test can see)."""
+    from scipy.stats import t as student
+
+    stderr = np.hypot(ours.std(axis=0, ddof=1), theirs.std(axis=0, ddof=1)) / np.sqrt(SEEDS)
+    diff = ours.mean(axis=0) - theirs.mean(axis=0)
+    bound = min(student.ppf(1 - FALSE_ALARM / (2 * diff.size), df=SEEDS - 1), max_t)
+    assert np.all(np.abs(diff) <= bound * stderr), np.abs(diff / stderr).max()
+    assert np.all(stderr < 0.1 * theirs.mean(axis=0)), (stderr / theirs.mean(axis=0)).max()
