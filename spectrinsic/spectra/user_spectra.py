@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import SpectralDataError, SpectrumNotFoundError
+from ..number_lists import copy_numbers, numbers_only
 from .csv_spectra import read_csv_column
 from .illuminants import cie_illuminant, normalise_illuminant
 from .records import Spectrum, SpectrumKind
@@ -372,12 +373,15 @@ def sensor_files_record(names: Any) -> dict[str, list[dict[str, str]]]:
 
 def portable_names(data: Any, base: str | Path | None = None) -> Any:
     """A copy of the plain data *data* (dicts, lists, strings) with every ``csv:`` name made
-    portable (:func:`portable_csv`), wherever it stands (materials, lights, records)."""
+    portable (:func:`portable_csv`), wherever it stands (materials, lights, records); lists of
+    plain numbers (a mesh's) copied whole (:mod:`~spectrinsic.number_lists`)."""
     if isinstance(data, str):
         return portable_csv(data, base) if data[:4].lower() == "csv:" else data
     if isinstance(data, dict):
         return {k: portable_names(v, base) for k, v in data.items()}
     if isinstance(data, (list, tuple)):
+        if numbers_only(data):
+            return copy_numbers(data)
         return [portable_names(v, base) for v in data]
     return data
 

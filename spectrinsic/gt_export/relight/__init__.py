@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError, SceneError, SpectrinsicError
+from ...number_lists import numbers_only
 from ...render.algebra.light_transport import LightTransport, relit_result
 from ...render.result import RenderResult
 from ...scenes.model import Scene, scene_from_dict
@@ -110,9 +111,11 @@ def _scene_record(sample: Path) -> Any:
 
 
 def _csv_names(data: Any) -> set[str]:
-    """Every ``csv:`` name in the plain data *data*."""
+    """Every ``csv:`` name in the plain data *data* (none in a list of plain numbers)."""
     if isinstance(data, str):
         return {data} if data[:4].lower() == "csv:" else set()
+    if isinstance(data, list) and numbers_only(data):
+        return set()
     values = data.values() if isinstance(data, dict) else data if isinstance(data, list) else ()
     return set().union(*(_csv_names(v) for v in values if isinstance(v, (str, dict, list))))
 
@@ -125,8 +128,12 @@ def read_sample_scene(
     :func:`~spectrinsic.scenes.model.scene_to_dict`), its ``csv:`` names (relative to the scene
     file's folder) resolved inside *scene_dir* (:func:`~.checks.readable_names`)."""
     sample = Path(sample_dir)
-    folder = None if scene_dir is None else Path(scene_dir)
-    data = readable_names(_scene_record(sample), sample, folder)
+    return _scene_of(_scene_record(sample), sample, None if scene_dir is None else Path(scene_dir))
+
+
+def _scene_of(record: Any, sample: Path, folder: Path | None) -> Scene:
+    """The :class:`Scene` of *sample*'s parsed ``scene.json`` *record* (:func:`read_sample_scene`)."""
+    data = readable_names(record, sample, folder)
     try:
         return scene_from_dict(data)
     except SceneError as exc:
@@ -258,10 +265,11 @@ def relit_render(
         raise DatasetError(f"--power {stray[0]!r}: the sample has lights 0..{n_lights - 1}")
     check_relight_inputs(sample, meta)  # every file read matches meta.json; the EXR's header
     folder = None if scene_dir is None else Path(scene_dir)
-    used = _csv_names(_scene_record(sample))  # as recorded: relative to the scene's folder
+    record = _scene_record(sample)  # parsed once (110,000 values of mesh data in a room)
+    used = _csv_names(record)  # as recorded: relative to the scene's folder
     used |= {c for c in settings_of(meta).cameras or () if c[:4].lower() == "csv:"}  # sensors
     check_spectrum_files(sample, meta, used, folder)  # CSVs read again: as at build time
-    source = read_sample_scene(sample, folder)
+    source = _scene_of(record, sample, folder)
     transport, coverage = read_transport(sample, meta["transport"])
     scene = relit_scene(source, lights, powers, source=str(meta["sample_id"]))
     relit = {

@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import DatasetError, SpectrinsicError
+from ...number_lists import copy_numbers, numbers_only
 from ...render.result import RenderResult
 from ...scenes.spectrum_refs import confined_csv
 from ...spectra import get_sensors
@@ -170,12 +171,15 @@ def _readable_csv(sample: Path, name: str, scene_dir: Path | None) -> str:
 
 def readable_names(data: Any, sample: Path, scene_dir: Path | None) -> Any:
     """A copy of the scene record *data* (``scene.json``) with every ``csv:`` name made
-    readable (:func:`_readable_csv`), so the registry reads the files the sample names."""
+    readable (:func:`_readable_csv`), so the registry reads the files the sample names; lists of
+    plain numbers (a mesh's) copied whole (:mod:`~spectrinsic.number_lists`)."""
     if isinstance(data, str):
         return _readable_csv(sample, data, scene_dir) if data[:4].lower() == "csv:" else data
     if isinstance(data, dict):
         return {k: readable_names(v, sample, scene_dir) for k, v in data.items()}
     if isinstance(data, list):
+        if numbers_only(data):
+            return copy_numbers(data)
         return [readable_names(v, sample, scene_dir) for v in data]
     return data
 

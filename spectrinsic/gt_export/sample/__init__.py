@@ -29,6 +29,7 @@ import numpy as np
 
 from ...errors import DatasetError
 from ...file_writes import TMP_PREFIX  # one home: every sweep of temporaries knows it
+from ...number_lists import copy_numbers, finite_numbers, numbers_only
 from ...scenes.model import record_fields
 
 __all__ = [
@@ -79,13 +80,6 @@ META_DIGITS = 12
 # Canonical JSON
 
 
-def _plain_scalar(value: Any) -> bool:
-    """Whether *value* is its own plain data: a ``str``, ``int``, ``bool``, ``None`` or finite
-    ``float`` (``inf - inf`` and ``nan - nan`` are not 0)."""
-    kind = type(value)
-    return kind in (str, int, bool) or value is None or (kind is float and value - value == 0)
-
-
 def plain_data(value: Any, digits: int | None = None) -> Any:
     """Plain JSON data of *value* (dataclasses, mappings, arrays, numpy scalars); floats rounded
     to *digits* significant digits if given; non-finite floats as their ``str`` (``"nan"``).
@@ -107,8 +101,8 @@ def plain_data(value: Any, digits: int | None = None) -> Any:
     if isinstance(value, np.generic):
         return plain_data(value.item(), digits)
     if isinstance(value, (list, tuple)):
-        if digits is None and all(map(_plain_scalar, value)):
-            return list(value)  # a mesh's numbers: already plain, without a call per value
+        if digits is None and numbers_only(value) and finite_numbers(value):
+            return copy_numbers(value)  # a mesh's numbers: already plain, without a call per value
         return [plain_data(v, digits) for v in value]
     if isinstance(value, float):
         if not np.isfinite(value):

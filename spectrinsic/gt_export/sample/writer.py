@@ -19,6 +19,7 @@ take them from there too, never from this module.
 
 from __future__ import annotations
 
+import functools
 import logging
 import os
 import re
@@ -76,6 +77,7 @@ from .sensor import SensorOutput, sensor_output, write_sensor_files
 from .stored_layers import compression_of, stored_layers
 from .transport_cube import CubeFactors, cube_factors, with_cube
 from .transport_exr import TRANSPORT_NAME, write_transport
+from .write_pool import FileWrites
 
 if TYPE_CHECKING:
     from ...render.algebra.light_transport import LightTransport
@@ -182,28 +184,32 @@ def _meta(
 
 
 def _write_layers(
-    folder: Path, gt: GroundTruth, sample_id: str, coverage: Any, cube: CubeFactors | None
+    writes: FileWrites, gt: GroundTruth, sample_id: str, coverage: Any, cube: CubeFactors | None
 ) -> tuple[list[str], dict[str, Any]]:
     """One EXR file per layer group, layers that their stored factors rebuild bit for bit
-    stored as those (:mod:`~spectrinsic.gt_export.sample.layer_storage`); return the file
-    names and ``meta.json["storage"]``."""
+    stored as those (:mod:`~spectrinsic.gt_export.sample.layer_storage`), handed to *writes*;
+    return the file names and ``meta.json["storage"]``."""
     stored = stored_layers(gt, coverage, identities(gt), cube)
-    files = []
     for name, arrays in stored.arrays.items():
-        write_exr(
-            folder / name,
-            arrays,
-            channel_names=stored.channels[name],
-            attributes={"spectrinsic.sample": sample_id} | stored.attributes.get(name, {}),
-            half=[k for k in stored.half if k in arrays],
-            compression=compression_of(name),
+        writes.submit(
+            name,
+            functools.partial(
+                write_exr,
+                layers=arrays,
+                channel_names=stored.channels[name],
+                attributes={"spectrinsic.sample": sample_id} | stored.attributes.get(name, {}),
+                half=[k for k in stored.half if k in arrays],
+                compression=compression_of(name),
+            ),
         )
-        files.append(name)
-    return files, stored.record()
+    return list(stored.arrays), stored.record()
 
 
-def _write_previews(folder: Path, gt: GroundTruth) -> dict[str, tuple[str, dict[str, Any]]]:
-    """One PNG per layer that has a preview maker; return ``{layer: (path, encoding)}``."""
+def _write_previews(
+    folder: Path, writes: FileWrites, gt: GroundTruth
+) -> dict[str, tuple[str, dict[str, Any]]]:
+    """One PNG per layer that has a preview maker, handed to *writes* as soon as it is drawn;
+    return ``{layer: (path, encoding)}``."""
     (folder / PREVIEW_DIR).mkdir()
     previews: dict[str, tuple[str, dict[str, Any]]] = {}
     shown = shown_layers(gt.layers, gt.working_space)  # previews are sRGB
@@ -213,13 +219,27 @@ def _write_previews(folder: Path, gt: GroundTruth) -> dict[str, tuple[str, dict[
             continue
         rel = preview_path(layer)
         rgb8, encoding = maker(layer, shown)
-        png.write_png(folder / rel, rgb8)
+        writes.submit(rel, functools.partial(png.write_png, rgb8=rgb8))
         previews[layer.name] = (rel, encoding)
     return previews
 
 
+def _write_meta(folder: Path, meta: dict[str, Any], hashes: Mapping[str, str]) -> None:
+    """Write ``meta.json``: *meta* with the SHA-256 of every file it lists (*hashes*, as the
+    file writes computed them, or read here) and its seal."""
+    # meta.json last: its presence (with the right config hash) marks the folder complete; it
+    # records the SHA-256 of every other file, so a resumed build can tell an intact sample,
+    # and its own seal, so it can tell an intact meta.json
+    files = meta["files"]
+    meta[HASHES_KEY] = {rel: hashes.get(rel) or file_sha256(folder / rel) for rel in files}
+    meta = plain_data(meta, META_DIGITS)
+    meta[SEAL_KEY] = meta_seal(meta)
+    _dump_json(folder / META_NAME, meta)
+
+
 def _fill_folder(
     folder: Path,
+    writes: FileWrites,
     scene: Scene,
     result: RenderResult,
     gt: GroundTruth,
@@ -229,12 +249,14 @@ def _fill_folder(
     sensor: SensorOutput | None = None,
     scene_folder: Path | None = None,
     **meta_kw: Any,
-) -> None:
+) -> dict[str, Any]:
+    """Write (or hand to *writes*) every file of the sample but ``meta.json``; return
+    ``meta.json``'s content without its hashes and seal."""
     coverage = result.aovs.get("coverage")
-    files, storage = _write_layers(folder, gt, meta_kw["sample_id"], coverage, cube)
+    files, storage = _write_layers(writes, gt, meta_kw["sample_id"], coverage, cube)
     if sensor is not None:  # the camera chain's raw DNG and processed PNG (gt_export.sensor)
         files += write_sensor_files(folder, sensor)
-    previews = _write_previews(folder, gt)
+    previews = _write_previews(folder, writes, gt)
     files += [rel for rel, _ in previews.values()]
     # scene_to_dict, the record the scene hash is taken of (a procedural texture's recipe, not
     # its texel weights); scene_from_dict reads it back
@@ -243,9 +265,6 @@ def _fill_folder(
     scene_record = portable_map_files(scene_record, scene_folder)  # environment maps' files
     _dump_json(folder / SCENE_NAME, scene_record, compact=True)
     files.append(SCENE_NAME)
-    # meta.json last: its presence (with the right config hash) marks the folder complete; it
-    # records the SHA-256 of every other file, so a resumed build can tell an intact sample,
-    # and its own seal, so it can tell an intact meta.json
     record = None
     if transport is not None:  # the per-light transport, for exact relighting
         record = write_transport(
@@ -269,11 +288,7 @@ def _fill_folder(
     if sensor is not None:
         meta["sensor"] = sensor.meta
         meta["identities"].append(sensor.identity)
-    meta = portable_names(meta, scene_folder)  # csv: names of materials, lights and sensors
-    meta[HASHES_KEY] = {rel: file_sha256(folder / rel) for rel in sorted(files)}
-    meta = plain_data(meta, META_DIGITS)
-    meta[SEAL_KEY] = meta_seal(meta)
-    _dump_json(folder / META_NAME, meta)
+    return portable_names(meta, scene_folder)  # csv: names of materials, lights and sensors
 
 
 def export_sample(
@@ -346,19 +361,23 @@ def export_sample(
     tmp = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{sample_id}-", dir=out_dir))
     try:
         tmp.chmod(0o755)
-        _fill_folder(
-            tmp,
-            scene,
-            result,
-            gt,
-            sample_id=sample_id,
-            config=config,
-            seed=seed,
-            transport=transport,
-            cube=cube,
-            sensor=sensor,
-            scene_folder=None if settings.scene_folder is None else Path(settings.scene_folder),
-        )
+        with FileWrites(tmp) as writes:  # EXR and PNG files encoded while the rest is computed
+            meta = _fill_folder(
+                tmp,
+                writes,
+                scene,
+                result,
+                gt,
+                sample_id=sample_id,
+                config=config,
+                seed=seed,
+                transport=transport,
+                cube=cube,
+                sensor=sensor,
+                scene_folder=None if settings.scene_folder is None else Path(settings.scene_folder),
+            )
+            hashes = writes.hashes()
+        _write_meta(tmp, meta, hashes)
         _move_into_place(tmp, final, config_hash(config))
     except WriteError as exc:  # named as the file will be (a full disk): not the temporary
         shutil.rmtree(tmp, ignore_errors=True)

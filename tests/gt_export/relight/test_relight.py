@@ -20,7 +20,7 @@ from spectrinsic.gt_export import check_sample, export_sample, load_sample
 from spectrinsic.gt_export.layers import LayerSettings
 from spectrinsic.gt_export.relight import relight, relit_scene
 from spectrinsic.gt_export.relight.augment import RandomRelight, relit_layers
-from spectrinsic.gt_export.sample import META_NAME, SEAL_KEY, canonical_json, meta_seal
+from spectrinsic.gt_export.sample import META_NAME, SEAL_KEY, canonical_json, meta_seal, write_pool
 from spectrinsic.gt_export.sample.render_spp import render_spp
 from spectrinsic.gt_export.sample.transport_exr import TRANSPORT_NAME
 from spectrinsic.render import RenderSettings, count_passes, render_batches
@@ -217,6 +217,20 @@ def test_in_memory_relighting_equals_the_written_relit_sample(built):
             )
         else:
             np.testing.assert_array_equal(memory[key], value, err_msg=key)
+
+
+def test_the_write_threads_write_a_relit_sample_byte_for_byte_as_the_serial_writer(
+    built, tmp_path, monkeypatch
+):
+    """Issue 45: every file of a relit folder (``meta.json`` included: it holds no time) is
+    the serial writer's, although the EXR files and previews were encoded by threads."""
+    _, _, sample = built
+    threaded = relight(sample, NEW_LIGHTS, tmp_path / "threads" / "relit__v0__two")
+    monkeypatch.setattr(write_pool, "WRITE_THREADS", 0)
+    serial = relight(sample, NEW_LIGHTS, tmp_path / "serial" / "relit__v0__two")
+    written = _files(threaded)
+    assert len(written) > 20 and "meta.json" in written
+    assert written == _files(serial)
 
 
 def test_random_relight_is_seeded_per_item_and_epoch(built):

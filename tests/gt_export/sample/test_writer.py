@@ -124,7 +124,9 @@ def test_a_write_failing_midway_leaves_nothing_complete_looking(
     monkeypatch.setattr(png, "write_png", failing)
     with pytest.raises(OSError, match="simulated"):
         export_sample(tmp_path, scene, result, sample_id="s", config=config, seed=1)
-    assert calls["n"] == 3  # it really failed midway, after EXR files and two previews
+    # it really failed midway, after EXR files and two previews (later previews may have been
+    # under way in the write threads, gt_export.sample.write_pool)
+    assert calls["n"] >= 3
     assert not (tmp_path / "s").exists()
     assert list(tmp_path.iterdir()) == []  # the temporary folder is gone too
     assert sample_dirs(tmp_path) == []
