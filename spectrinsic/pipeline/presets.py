@@ -51,12 +51,10 @@ _STANDARD_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
 #: shares, guided by normals and a depth grey marked clean (spectrinsic/gt_export/layers/denoise.py).
 #: 5: each light's share is one float32 product (spectrinsic/render/algebra/shares.py): images and
 #: layers move by at most one float32 rounding.
-#: 6: raw channels go to XYZ by einsum in chunks rather than BLAS (spectrinsic/render/algebra/modes.py), and an
-#: image's XYZ is the float64 sum of its lights' XYZ (spectrinsic/render/algebra/light_transport.py): XYZ images
-#: move by at most one float32 rounding, and no longer depend on the BLAS kernel.
-#: 7: a render whose samples per pixel are not a power of two is the sample-weighted mean of
-#: power-of-two parts, each with its own seed (spectrinsic/render/base/sample_split.py): the bits
-#: no longer follow Dr.Jit's thread schedule; such renders draw other samples than before.
+#: 6: raw channels go to XYZ by chunked einsum, not BLAS (render/algebra/modes.py), an image's XYZ
+#: is the float64 sum of its lights' (light_transport.py): one float32 rounding, BLAS-free.
+#: 7: a non-power-of-two spp renders as power-of-two parts with their own seeds, averaged
+#: (render/base/sample_split.py): bits independent of Dr.Jit's threads, other samples drawn.
 PIXELS_VERSION = 7
 #: What of the installed software changes pixels, hence enters the config hash, and how much
 #: of its version: the renderer exactly (its sampling changes between patch releases);
