@@ -7,16 +7,14 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
-from typing import Any
 
 from ..errors import DatasetError, SpectrinsicError
 from ..pipeline.presets import DatasetConfig
-from ..pipeline.source_plan import check_scene_integrator, file_sample, semantic_rules
+from ..pipeline.source_plan import check_scene_integrator, file_sample, spec_file_source
 from ..render.base.variants import import_mitsuba
 from ..scenes.mitsuba_xml import render_hints_line
 from ..scenes.model import Scene
 from ..scenes.reading_notes import reading_notes
-from ..scenes.sources import FileSource
 from ..spectra import get_spectrum
 
 __all__ = ["check_scene_files", "source_notes"]
@@ -45,7 +43,9 @@ def source_notes(config: DatasetConfig) -> list[str]:
     return notes
 
 
-def check_scene_files(config: Any, data_dir: str | None, *, quiet: bool = False) -> list[Scene]:
+def check_scene_files(
+    config: DatasetConfig, data_dir: str | None, *, quiet: bool = False
+) -> list[Scene]:
     """``--scenes``: every file reads as a valid scene with this material map and default
     spectrum, before the folder is stamped with the config (a bad file is an input error, not
     a failed sample); what a file's read fixed or approximated, and the spp and depth that
@@ -62,20 +62,10 @@ def check_scene_files(config: Any, data_dir: str | None, *, quiet: bool = False)
                 get_spectrum(name, data_dir=data_dir)
         except SpectrinsicError as exc:
             raise DatasetError(f"{option} {name!r}: {exc}") from exc
-    width, height = spec.get("resolution") or (None, None)
     import_mitsuba()  # set up before a Mitsuba XML read imports it (the libLLVM Dr.Jit loads)
     scenes = []
     for entry in spec["scenes"]:
-        scene = FileSource(
-            entry["path"],
-            width,
-            height,
-            tuple(sorted(materials.items())),
-            spec.get("default_spectrum"),
-            colours_from_asset=bool(spec.get("colours_from_asset", False)),
-            approximate=bool(spec.get("approximate")),
-            semantic=semantic_rules(spec),
-        ).build(data_dir)
+        scene = spec_file_source(spec, entry["path"]).build(data_dir)
         check_scene_integrator(config, scene, entry["path"])  # every sample would fail
         if not quiet:
             for note in reading_notes(scene):

@@ -60,6 +60,7 @@ __all__ = [
     "saved_sample",
     "file_sample",
     "semantic_rules",
+    "spec_file_source",
 ]
 
 #: Folder of a dataset holding the generated scenes' YAML files.
@@ -356,6 +357,22 @@ def semantic_rules(spec: Mapping[str, Any]) -> SemanticRules:
     return SemanticRules() if record is None else rules_from_record(record, "--semantic-map")
 
 
+def spec_file_source(spec: Mapping[str, Any], path: str) -> FileSource:
+    """The :class:`FileSource` of scene file *path* under a files source's *spec*: its
+    ``resolution`` (else the file's camera), material map, default spectrum and reading flags."""
+    width, height = spec.get("resolution") or (None, None)
+    return FileSource(
+        path,
+        width,
+        height,
+        tuple(sorted((spec.get("materials") or {}).items())),
+        spec.get("default_spectrum"),
+        colours_from_asset=bool(spec.get("colours_from_asset", False)),
+        approximate=bool(spec.get("approximate")),
+        semantic=semantic_rules(spec),
+    )
+
+
 def _file_tasks(
     spec: Mapping[str, Any],
     out: str,
@@ -366,20 +383,9 @@ def _file_tasks(
 ) -> list[SampleTask]:
     """One task per scene file: the file's camera size unless the spec's ``resolution``; a
     saved generated scene keeps its sample id and seed unless ``new_sample``."""
-    materials = tuple(sorted(spec.get("materials", {}).items()))
-    width, height = spec.get("resolution") or (None, None)
     tasks = []
     for entry in spec["scenes"]:
-        src = FileSource(
-            entry["path"],
-            width,
-            height,
-            materials,
-            spec.get("default_spectrum"),
-            colours_from_asset=bool(spec.get("colours_from_asset", False)),
-            approximate=bool(spec.get("approximate")),
-            semantic=semantic_rules(spec),
-        )
+        src = spec_file_source(spec, entry["path"])
         sid, seed = file_sample(entry["path"], new_sample=bool(spec.get("new_sample")))
         task = SampleTask.planned(
             sid, config, out, data_dir=data_dir, render_threads=render_threads, source=src
