@@ -24,6 +24,7 @@ CORE_BASE = {
     "threads",
     "file_writes",
     "mitsuba_import",
+    "number_lists",
 }
 ORDER = ["spectra", "scenes", "render", "gt_export", "learn", "decompose"]
 #: The top layer, left to right: a study may run the pipeline, a benchmark a study, the CLI all.
