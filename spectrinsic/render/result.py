@@ -99,11 +99,6 @@ class RenderResult:
         """``parts["metal_white"]``: mode -> ``(H, W, K)`` raw white-at-metal radiance."""
         return self.parts.get(METAL_WHITE, {})
 
-    @property
-    def shape(self) -> tuple[int, int]:
-        """``(H, W)`` of the images."""
-        first = next(iter(self.images.values()))
-        return int(first.shape[0]), int(first.shape[1])
 
     def energy_ratio(self, mode: str) -> float:
         """r = Σ_x ‖p¹(x)‖ / Σ_x ‖p^∞(x)‖ (Eq. 5.8) on *mode*'s XYZ, from the direct-only render."""

@@ -87,11 +87,6 @@ class LightTransport:
         """Number of lights L."""
         return int(next(iter(self.batches[0].values())).shape[0])
 
-    @property
-    def shape(self) -> tuple[int, int]:
-        """``(H, W)`` of the images."""
-        first = next(iter(self.batches[0].values()))
-        return int(first.shape[1]), int(first.shape[2])
 
 
 def diagonal_mode_names(modes: Iterable[str]) -> tuple[str, ...]:
