@@ -17,7 +17,7 @@ from ...spectra import COLORIMETRIC_WAVELENGTHS, diagonal_values, get_sensors
 from ...threads import thread_map
 from ..result import RenderResult
 from .batch_means import batch_mean
-from .modes import get_mode, light_spectra, lights_to_xyz_matrix, raw_to_xyz
+from .modes import get_mode, light_spectra, raw_to_xyz, to_xyz_matrix
 from .shares import compose, light_shares, sum_lights
 
 __all__ = [
@@ -88,7 +88,6 @@ class LightTransport:
         return int(next(iter(self.batches[0].values())).shape[0])
 
 
-
 def diagonal_mode_names(modes: Iterable[str]) -> tuple[str, ...]:
     """The diagonal (relightable) modes among *modes*, in order, validated."""
     return tuple(m for m in dict.fromkeys(modes) if get_mode(m).kind == "diagonal")
@@ -131,7 +130,9 @@ def mode_lighting(
     return {
         m: ModeLighting(
             _band_means(emitted, get_mode(m).sensors, data_dir),
-            np.asarray(lights_to_xyz_matrix(get_mode(m), emitted, data_dir=data_dir), np.float64),
+            np.asarray(
+                to_xyz_matrix(get_mode(m), scene, data_dir=data_dir, emitted=emitted), float
+            ),
         )
         for m in modes
     }

@@ -61,7 +61,6 @@ __all__ = [
     "integration_matrix",
     "regression_matrix",
     "to_xyz_matrix",
-    "lights_to_xyz_matrix",
     "raw_to_xyz",
     "pad_to_passes",
 ]
@@ -352,27 +351,13 @@ def to_xyz_matrix(
     scene: Scene,
     *,
     data_dir: str | None = None,
-    wavelengths: Wavelengths = COLORIMETRIC_WAVELENGTHS,
+    emitted: np.ndarray | None = None,
 ) -> np.ndarray:
-    """``(3, K)`` matrix taking *mode*'s raw channels to CIE 1931 XYZ: ``xyz = raw @ T.T``."""
-    emitted = (
-        light_spectra(scene, wavelengths, data_dir=data_dir)
-        if mode.to_xyz == "regression"
-        else np.zeros((0, np.size(wavelengths)))
-    )
-    return lights_to_xyz_matrix(mode, emitted, data_dir=data_dir, wavelengths=wavelengths)
+    """``(3, K)`` matrix taking *mode*'s raw channels to CIE 1931 XYZ: ``xyz = raw @ T.T``.
 
-
-def lights_to_xyz_matrix(
-    mode: RenderMode,
-    emitted: np.ndarray,
-    *,
-    data_dir: str | None = None,
-    wavelengths: Wavelengths = COLORIMETRIC_WAVELENGTHS,
-) -> np.ndarray:
-    """:func:`to_xyz_matrix` for lights whose ``(L, W)`` spectra on *wavelengths* are already
-    known (:func:`light_spectra`; only a regression mode uses them), so a caller that needs
-    them anyway computes them once."""
+    A regression mode fits it under the lights' ``(L, W)`` *emitted* spectra on the CIE grid
+    (:func:`light_spectra` of *scene* where not given: a caller that needs them anyway passes
+    them, computed once)."""
     sensors = get_sensors(mode.sensors, data_dir=data_dir)
     xyz = get_sensors(XYZ_SENSORS)
     if mode.to_xyz == "identity":
@@ -382,8 +367,10 @@ def lights_to_xyz_matrix(
             )
         return np.eye(3)
     if mode.to_xyz == "integration":
-        return integration_matrix(sensors, xyz, wavelengths)
-    return regression_matrix(sensors, xyz, emitted, wavelengths)
+        return integration_matrix(sensors, xyz)
+    if emitted is None:
+        emitted = light_spectra(scene, data_dir=data_dir)
+    return regression_matrix(sensors, xyz, emitted)
 
 
 #: Pixels converted at a time by :func:`raw_to_xyz`: one chunk's float64 copy stays in cache.

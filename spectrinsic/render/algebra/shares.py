@@ -79,16 +79,13 @@ class TransportOutput:
     emission: np.ndarray
     parts: dict[str, np.ndarray] = field(default_factory=dict)
 
-    def per_light(self, *, direct: bool = False) -> np.ndarray:
-        """``(L, H, W, K)`` float32 each light's image: ``E_{l,k} · transport``."""
+    def image(self, lights: Sequence[int] | None = None, *, direct: bool = False) -> np.ndarray:
+        """``(H, W, K)`` float32 image of the *lights* (default all): the sum of their shares
+        ``E_{l,k} · transport`` (:func:`compose`)."""
         t = self.direct if direct else self.transport
         if t is None:
             raise RenderError("no direct-only transport was rendered")
-        return light_shares(t, self.emission)
-
-    def image(self, lights: Sequence[int] | None = None, *, direct: bool = False) -> np.ndarray:
-        """``(H, W, K)`` float32 image of the *lights* (default all): the sum of their shares."""
-        return sum_lights(self.per_light(direct=direct), lights)
+        return compose(t, self.emission, lights)
 
     def part_image(self, part: str, lights: Sequence[int] | None = None) -> np.ndarray | None:
         """``(H, W, K)`` float32 image of *part* (:data:`~spectrinsic.render.result.PARTS`) for the *lights* (default all),
