@@ -103,7 +103,7 @@ def light_band_means(scene: Scene, sensors: str, *, data_dir: str | None = None)
     >>> float(light_band_means(s, "bands:31@400-700").round(12).max())
     2.0
     """
-    emitted = light_spectra(scene, COLORIMETRIC_WAVELENGTHS, data_dir=data_dir)
+    emitted = light_spectra(scene, data_dir=data_dir)
     return _band_means(emitted, sensors, data_dir)
 
 
@@ -126,27 +126,14 @@ def mode_lighting(
 ) -> dict[str, ModeLighting]:
     """:class:`ModeLighting` of each of *modes* under *scene*'s lights, computed once for all
     the batches of a sample (the lights' spectra resampled once for all modes)."""
-    emitted = light_spectra(scene, COLORIMETRIC_WAVELENGTHS, data_dir=data_dir)
+    emitted = light_spectra(scene, data_dir=data_dir)
     return {
         m: ModeLighting(
             _band_means(emitted, get_mode(m).sensors, data_dir),
-            np.asarray(
-                to_xyz_matrix(get_mode(m), scene, data_dir=data_dir, emitted=emitted), float
-            ),
+            to_xyz_matrix(get_mode(m), scene, data_dir=data_dir, emitted=emitted),
         )
         for m in modes
     }
-
-
-@dataclass(frozen=True, eq=False)
-class _Composed:
-    """The arrays of a render composed from transport (:func:`_compose`)."""
-
-    raw: dict[str, np.ndarray]
-    images: dict[str, np.ndarray]
-    per_light: tuple[dict[str, np.ndarray], ...]
-    batch_raw: tuple[dict[str, np.ndarray], ...]
-    parts: dict[str, dict[str, np.ndarray]]
 
 
 @dataclass(frozen=True, eq=False)
@@ -167,40 +154,6 @@ def _batch_images(transport: np.ndarray, lighting: ModeLighting) -> _BatchImages
     return _BatchImages(
         sum_lights(shares), each.sum(axis=0).astype(np.float32), each.astype(np.float32)
     )
-
-
-def _compose(
-    transport: LightTransport, scene: Scene, lighting: Mapping[str, ModeLighting]
-) -> _Composed:
-    """Eq. 1 for every batch and mode, merged over the batches as
-    :func:`~spectrinsic.render.merge_batches` merges rendered ones (bit for bit); the batches
-    and modes are independent, so they run side by side (:func:`~spectrinsic.threads.thread_map`)."""
-    if transport.n_lights != len(scene.lights):
-        raise RenderError(
-            f"transport has {transport.n_lights} lights; the scene has {len(scene.lights)}"
-        )
-    n = len(transport.batches)
-    tasks = [(m, b) for m in transport.modes for b in range(n)]
-    composed = thread_map(
-        lambda t: _batch_images(transport.batches[t[1]][t[0]], lighting[t[0]]), tasks
-    )
-    done = dict(zip(tasks, composed))
-    batch_raw = tuple({m: done[m, b].raw for m in transport.modes} for b in range(n))
-    raw: dict[str, np.ndarray] = {}
-    images: dict[str, np.ndarray] = {}
-    parts: dict[str, dict[str, np.ndarray]] = {p: {} for p, held in transport.parts.items() if held}
-    per_light: list[dict[str, np.ndarray]] = [{} for _ in scene.lights]
-    for mode in transport.modes:
-        mine = [done[mode, b] for b in range(n)]
-        raw[mode] = batch_mean([c.raw for c in mine])
-        images[mode] = batch_mean([c.xyz for c in mine])
-        mean_shares = batch_mean([c.shares_xyz for c in mine])
-        for j in range(len(scene.lights)):
-            per_light[j][mode] = mean_shares[j]
-        e = lighting[mode].means
-        for p, out in parts.items():
-            out[mode] = batch_mean([compose(b[mode], e) for b in transport.parts[p]])
-    return _Composed(raw, images, tuple(per_light), batch_raw, parts)
 
 
 def _meta(
@@ -234,24 +187,49 @@ def relit_result(
     meta: Mapping[str, Any] | None = None,
     data_dir: str | None = None,
 ) -> RenderResult:
-    """The render of every batch of *transport* under *scene*'s light spectra and powers,
-    merged as :func:`~spectrinsic.render.merge_batches` merges rendered batches (each batch's
-    raw channels kept), from Eq. 1.
+    """The render of every batch of *transport* under *scene*'s light spectra and powers
+    (Eq. 1), merged as :func:`~spectrinsic.render.merge_batches` merges rendered batches, bit
+    for bit (each batch's raw channels kept).
 
     Per mode and batch: each light's raw channels ``T_l ∘ ē_l`` (float32, as Mitsuba returns a
     pass), their float64 sum as ``raw`` (as :func:`~spectrinsic.render.render_scene` sums
-    lights), and the XYZ of both through the mode's matrix for this scene's lights; the
-    specular and white-at-metal parts likewise, where held. *meta* (a render's metadata) is
-    kept, with the modes, sensors, XYZ matrices, seeds and spp set. The lights' band means
-    and XYZ matrices are computed once for all batches (:func:`mode_lighting`).
+    lights), and the XYZ of both through the mode's matrix for this scene's lights; the parts
+    likewise, where held. *meta* (a render's metadata) is kept, with the modes, sensors, XYZ
+    matrices, seeds and spp set. The batches and modes are independent, so they run side by
+    side (:func:`~spectrinsic.threads.thread_map`).
     """
+    if transport.n_lights != len(scene.lights):
+        raise RenderError(
+            f"transport has {transport.n_lights} lights; the scene has {len(scene.lights)}"
+        )
     lighting = mode_lighting(scene, transport.modes, data_dir=data_dir)
-    c = _compose(transport, scene, lighting)
+    n = len(transport.batches)
+    tasks = [(m, b) for m in transport.modes for b in range(n)]
+    composed = thread_map(
+        lambda t: _batch_images(transport.batches[t[1]][t[0]], lighting[t[0]]), tasks
+    )
+    done = dict(zip(tasks, composed))
+    raw: dict[str, np.ndarray] = {}
+    images: dict[str, np.ndarray] = {}
+    parts: dict[str, dict[str, np.ndarray]] = {p: {} for p, held in transport.parts.items() if held}
+    per_light: list[dict[str, np.ndarray]] = [{} for _ in scene.lights]
+    for mode in transport.modes:
+        mine = [done[mode, b] for b in range(n)]
+        raw[mode] = batch_mean([c.raw for c in mine])
+        images[mode] = batch_mean([c.xyz for c in mine])
+        mean_shares = batch_mean([c.shares_xyz for c in mine])
+        for j in range(len(scene.lights)):
+            per_light[j][mode] = mean_shares[j]
+        e = lighting[mode].means
+        for p, out in parts.items():
+            out[mode] = batch_mean([compose(b[mode], e) for b in transport.parts[p]])
     return RenderResult(
-        images=c.images,
-        raw=c.raw,
-        per_light=c.per_light,
+        images=images,
+        raw=raw,
+        per_light=tuple(per_light),
         meta=_meta(transport, lighting, meta),
-        batch_raw=c.batch_raw if len(transport.batches) > 1 else (),
-        parts=c.parts,
+        batch_raw=tuple({m: done[m, b].raw for m in transport.modes} for b in range(n))
+        if n > 1
+        else (),
+        parts=parts,
     )
