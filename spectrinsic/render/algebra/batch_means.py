@@ -120,9 +120,8 @@ def _merge_aovs(parts: Sequence[dict[str, np.ndarray]]) -> dict[str, np.ndarray]
     return merged
 
 
-def _mean_part(results: Sequence[RenderResult], field: str, part: str) -> dict[str, np.ndarray]:
-    """Mode -> :func:`batch_mean` of one *part* of the results' ``parts`` or ``part_transport``."""
-    held = [getattr(r, field)[part] for r in results]
+def _mean_modes(held: Sequence[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
+    """Mode -> :func:`batch_mean` of one dict per batch (the modes of the first)."""
     return {m: batch_mean([h[m] for h in held]) for m in held[0]}
 
 
@@ -133,7 +132,6 @@ def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
     if len(results) == 1:
         return results[0]
     first = results[0]
-    modes = list(first.images)
     meta = dict(first.meta)
     meta.update(
         spp=int(first.meta["spp"]) * len(results),
@@ -154,17 +152,18 @@ def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
         spectral = int(first.meta["spectral_spp"])
         meta.update(spectral_spp=spectral * len(results), spectral_batch_spp=spectral)
     return RenderResult(
-        images={m: batch_mean([r.images[m] for r in results]) for m in modes},
-        raw={m: batch_mean([r.raw[m] for r in results]) for m in first.raw},
+        images=_mean_modes([r.images for r in results]),
+        raw=_mean_modes([r.raw for r in results]),
         per_light=tuple(
-            {m: batch_mean([r.per_light[i][m] for r in results]) for m in pl}
-            for i, pl in enumerate(first.per_light)
+            _mean_modes([r.per_light[i] for r in results]) for i in range(len(first.per_light))
         ),
-        direct={m: batch_mean([r.direct[m] for r in results]) for m in first.direct},
+        direct=_mean_modes([r.direct for r in results]),
         aovs=_merge_aovs([r.aovs for r in results]),
-        transport={m: batch_mean([r.transport[m] for r in results]) for m in first.transport},
-        parts={p: _mean_part(results, "parts", p) for p in first.parts},
-        part_transport={p: _mean_part(results, "part_transport", p) for p in first.part_transport},
+        transport=_mean_modes([r.transport for r in results]),
+        parts={p: _mean_modes([r.parts[p] for r in results]) for p in first.parts},
+        part_transport={
+            p: _mean_modes([r.part_transport[p] for r in results]) for p in first.part_transport
+        },
         meta=meta,
         batch_raw=tuple(dict(r.raw) for r in results),
     )
