@@ -59,20 +59,16 @@ def run_batches(
     cap = max(batches, settings.max_batches if settings.max_batches is not None else 4 * batches)
     seeds = batch_seeds(seed, cap if noise_target is not None else batches)
     done = [one(s) for s in seeds[:batches]]
-    reached = image_noise([result_of(d) for d in done]) if noise_target is not None else None
-    while (
-        reached is not None
-        and noise_target is not None
-        and reached > noise_target
-        and len(done) < cap
-    ):
+    if noise_target is None:
+        return done, merge_batches([result_of(d) for d in done]), seeds
+    reached = image_noise([result_of(d) for d in done])
+    while reached is not None and reached > noise_target and len(done) < cap:
         done.append(one(seeds[len(done)]))
         reached = image_noise([result_of(d) for d in done])
     merged = merge_batches([result_of(d) for d in done])
-    if noise_target is not None:
-        merged.meta["noise_target"] = {
-            "target": float(noise_target),
-            "reached": reached,
-            "max_batches": cap,
-        }
+    merged.meta["noise_target"] = {
+        "target": float(noise_target),
+        "reached": reached,
+        "max_batches": cap,
+    }
     return done, merged, seeds[: len(done)]
