@@ -1,10 +1,6 @@
 """Independent batches of one scene's render, run: the one batch loop (:func:`run_batches`).
-
 Inside a batch every mode shares seed and paths (:func:`~spectrinsic.render.scene_render.render_scene`);
-the batches differ only in their seed, so the spread between them is a direct estimate of the
-Monte Carlo error of their mean (the noise budget of the ground truth, and the adaptive
-sampling of ``RenderSettings.noise_target``).
-"""
+the batches' seeds, mean and spread are :mod:`~spectrinsic.render.algebra.batch_means`'."""
 
 from __future__ import annotations
 

@@ -53,9 +53,8 @@ class LightTransport:
         Seconds of each Mitsuba pass, per mode, and under ``"single"`` those of the traversals
         carrying every mode at once (empty when read from a file).
     parts
-        Part name (:data:`~spectrinsic.render.result.PARTS`: ``"specular"``, a part of ``T``;
-        ``"metal_white"``, not) -> one dict per batch as :attr:`batches`, for the same unit
-        spectrum; only the parts held.
+        :data:`~spectrinsic.render.result.PARTS` name -> one dict per batch as :attr:`batches`,
+        for the same unit spectrum; only the parts held.
     """
 
     modes: tuple[str, ...]

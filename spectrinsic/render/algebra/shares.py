@@ -1,8 +1,9 @@
 """What one band-path traversal gives per value set: :class:`TransportOutput`.
 
-Every array is for **unit emission** in every band of every light; the images follow by
-multiplying with the lights' channel values ``E_{l,k}`` (Eq. 5.2), so each light's share is
-exact and the shares sum to the total.
+Every array is for **unit emission** in every band of every light: ``transport[l, ..., k]`` is
+light l's ``∫ radiance S_k`` per unit ``E_{l,k}``, and an image is ``Σ_l E_{l,k} ·
+transport[l, ..., k]`` with the lights' channel values ``E_{l,k}`` (Eq. 5.2, :func:`compose`),
+so each light's share is exact and the shares sum to the total.
 """
 
 from __future__ import annotations
@@ -61,17 +62,14 @@ class TransportOutput:
     Attributes
     ----------
     transport
-        ``(L, H, W, K)`` float32: light l's contribution to channel k for unit emission in
-        every band (``∫ radiance S_k`` per unit ``E_{l,k}``); the diagonal image is
-        ``Σ_l E_{l,k} · transport[l, ..., k]``.
+        ``(L, H, W, K)`` float32 per-light transport (module docstring).
     direct
         The same for direct light only (path depth 2), or ``None`` when not asked for.
     emission
         ``(L, K)`` float64 the lights' channel values ``E_{l,k}`` (:class:`ChannelValues`).
     parts
-        Part name (:data:`~spectrinsic.render.result.PARTS`: ``"specular"``, a part of
-        :attr:`transport`; ``"metal_white"``, not) -> ``(L, H, W, K)`` float32, the parts the
-        traversal rendered.
+        :data:`~spectrinsic.render.result.PARTS` name -> ``(L, H, W, K)`` float32, the parts
+        the traversal rendered.
     """
 
     transport: np.ndarray
