@@ -18,6 +18,7 @@ from ...rng import seed_from_key
 from ..result import RenderResult
 
 __all__ = [
+    "batch_counts",
     "batch_mean",
     "batch_seeds",
     "relative_standard_error",
@@ -32,6 +33,17 @@ def batch_seeds(seed: int, batches: int) -> list[int]:
     if isinstance(batches, bool) or not isinstance(batches, int) or batches < 1:
         raise SceneError(f"batches {batches!r}: expected a positive integer")
     return [int(seed)] + [seed_from_key(int(seed), f"batch-{b}") for b in range(1, batches)]
+
+
+def batch_counts(seeds: Sequence[int], batch_spp: int) -> dict[str, int | list[int]]:
+    """The count keys of a render's ``meta`` for batches of *batch_spp* samples per pixel with
+    *seeds*: ``seed`` (the first), ``spp`` (the total) and, with several batches, ``batches``,
+    ``batch_spp`` (one batch's) and ``batch_seeds``; one home for merged and relit renders."""
+    n = len(seeds)
+    counts: dict[str, int | list[int]] = {"seed": int(seeds[0]), "spp": batch_spp * n}
+    if n > 1:
+        counts.update(batches=n, batch_spp=batch_spp, batch_seeds=list(seeds))
+    return counts
 
 
 def relative_standard_error(batches: Sequence[np.ndarray], valid: np.ndarray) -> np.ndarray:
@@ -134,10 +146,7 @@ def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
     first = results[0]
     meta = dict(first.meta)
     meta.update(
-        spp=int(first.meta["spp"]) * len(results),
-        batches=len(results),
-        batch_spp=int(first.meta["spp"]),
-        batch_seeds=[int(r.meta["seed"]) for r in results],
+        batch_counts([int(r.meta["seed"]) for r in results], int(first.meta["spp"])),
         timings={
             k: {
                 "passes": sum(r.meta["timings"][k]["passes"] for r in results),

@@ -16,7 +16,7 @@ from ...scenes.model import Scene
 from ...spectra import COLORIMETRIC_WAVELENGTHS, diagonal_values, get_sensors
 from ...threads import thread_map
 from ..result import RenderResult
-from .batch_means import batch_mean
+from .batch_means import batch_counts, batch_mean
 from .modes import get_mode, light_spectra, raw_to_xyz, to_xyz_matrix
 from .shares import compose, light_shares, sum_lights
 
@@ -160,13 +160,12 @@ def _meta(
     lighting: Mapping[str, ModeLighting],
     meta: Mapping[str, Any] | None,
 ) -> dict[str, Any]:
-    """*meta* (a render's metadata) with the modes, sensors, XYZ matrices, seed and spp set,
-    and the batches as :func:`~spectrinsic.render.merge_batches` sets them."""
-    n, modes = len(transport.batches), list(transport.modes)
+    """*meta* (a render's metadata) with the modes, sensors, XYZ matrices and the batches'
+    counts (:func:`~.batch_means.batch_counts`) set."""
+    modes = list(transport.modes)
     out: dict[str, Any] = dict(meta or {})
     out.update(
-        seed=int(transport.seeds[0]),
-        spp=int(transport.batch_spp) * n,
+        batch_counts(transport.seeds, int(transport.batch_spp)),
         modes=modes,
         per_light=True,
         per_light_modes=modes,
@@ -174,8 +173,6 @@ def _meta(
         to_xyz={m: np.asarray(lighting[m].to_xyz).tolist() for m in modes},
     )
     out.setdefault("timings", {})
-    if n > 1:
-        out.update(batches=n, batch_spp=int(transport.batch_spp), batch_seeds=list(transport.seeds))
     return out
 
 
