@@ -91,11 +91,6 @@ class RenderResult:
         """``parts["specular"]``: mode -> ``(H, W, K)`` raw specular part (empty: matte scene)."""
         return self.parts.get(SPECULAR, {})
 
-    @property
-    def metal_white(self) -> dict[str, np.ndarray]:
-        """``parts["metal_white"]``: mode -> ``(H, W, K)`` raw white-at-metal radiance."""
-        return self.parts.get(METAL_WHITE, {})
-
     def energy_ratio(self, mode: str) -> float:
         """r = Σ_x ‖p¹(x)‖ / Σ_x ‖p^∞(x)‖ (Eq. 5.8) on *mode*'s XYZ, from the direct-only render."""
         if mode not in self.direct:
