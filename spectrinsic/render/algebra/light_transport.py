@@ -22,10 +22,8 @@ from .shares import compose, light_shares, sum_lights
 
 __all__ = [
     "LightTransport",
-    "ModeLighting",
     "diagonal_mode_names",
     "light_band_means",
-    "mode_lighting",
     "relit_result",
 ]
 
@@ -112,7 +110,7 @@ def _band_means(emitted: np.ndarray, sensors: str, data_dir: str | None) -> np.n
 
 
 @dataclass(frozen=True, eq=False)
-class ModeLighting:
+class _ModeLighting:
     """What a mode's raw channels need from the scene's lights: their band means ``ē_lk``
     (``(L, K)``, :func:`light_band_means`) and the mode's raw -> XYZ matrix (``(3, K)``)."""
 
@@ -120,14 +118,14 @@ class ModeLighting:
     to_xyz: np.ndarray
 
 
-def mode_lighting(
+def _mode_lighting(
     scene: Scene, modes: Iterable[str], *, data_dir: str | None = None
-) -> dict[str, ModeLighting]:
-    """:class:`ModeLighting` of each of *modes* under *scene*'s lights, computed once for all
+) -> dict[str, _ModeLighting]:
+    """:class:`_ModeLighting` of each of *modes* under *scene*'s lights, computed once for all
     the batches of a sample (the lights' spectra resampled once for all modes)."""
     emitted = light_spectra(scene, data_dir=data_dir)
     return {
-        m: ModeLighting(
+        m: _ModeLighting(
             _band_means(emitted, get_mode(m).sensors, data_dir),
             to_xyz_matrix(get_mode(m), scene, data_dir=data_dir, emitted=emitted),
         )
@@ -144,7 +142,7 @@ class _BatchImages:
     shares_xyz: np.ndarray
 
 
-def _batch_images(transport: np.ndarray, lighting: ModeLighting) -> _BatchImages:
+def _batch_images(transport: np.ndarray, lighting: _ModeLighting) -> _BatchImages:
     """Eq. 1 for one batch of one mode: ``(L, H, W, K)`` *transport* under *lighting*. The
     image's XYZ is the float64 sum of the lights' XYZ (the matrix is linear), which spares
     converting the summed raw channels a second time."""
@@ -157,7 +155,7 @@ def _batch_images(transport: np.ndarray, lighting: ModeLighting) -> _BatchImages
 
 def _meta(
     transport: LightTransport,
-    lighting: Mapping[str, ModeLighting],
+    lighting: Mapping[str, _ModeLighting],
     meta: Mapping[str, Any] | None,
 ) -> dict[str, Any]:
     """*meta* (a render's metadata) with the modes, sensors, XYZ matrices and the batches'
@@ -198,7 +196,7 @@ def relit_result(
         raise RenderError(
             f"transport has {transport.n_lights} lights; the scene has {len(scene.lights)}"
         )
-    lighting = mode_lighting(scene, transport.modes, data_dir=data_dir)
+    lighting = _mode_lighting(scene, transport.modes, data_dir=data_dir)
     n = len(transport.batches)
     tasks = [(m, b) for m in transport.modes for b in range(n)]
     composed = thread_map(
