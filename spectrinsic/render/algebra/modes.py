@@ -298,9 +298,9 @@ def regression_matrix(
     """``(C, K)`` least-squares projection from K-sensor to C target responses (thesis 5.2.3).
 
     Fitted on the radiances ``ρ_i(λ) L_j(λ)`` of the 1269 matte Munsell chips ρ_i (the thesis'
-    colour set) under each of the scene's lights L_j, stacked: the
-    regression knows the scene's illuminants, as the thesis' own regression could, but not its
-    interreflections (products of several reflectances), whose error it is meant to show.
+    colour set) under each of the scene's lights L_j, stacked: the regression knows the scene's
+    illuminants, as the thesis' own regression could, but not its interreflections (products of
+    several reflectances), whose error it is meant to show.
 
     Parameters
     ----------
