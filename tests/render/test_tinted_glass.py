@@ -21,8 +21,8 @@ from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import get_sensors
 
-from ._reference import SEEDS, assert_blocks_agree, blocks, icosahedron_obj, mitsuba_xyz, ours_xyz
-from .test_glass import SMOOTH_GLASS, XML, _thin_fresnel
+from ._reference import SMOOTH_GLASS, assert_matches_mitsuba, icosahedron_obj
+from .test_glass import XML, _thin_fresnel
 
 #: A green bottle glass: written-out samples, so both renderers read the same spectrum.
 TINT = "360:0.25, 450:0.3, 520:0.85, 560:0.8, 620:0.35, 830:0.3"
@@ -66,14 +66,11 @@ def test_a_tinted_gem_matches_mitsubas_own_spectral_path_render(tinted_box):
     assert glass.tinted and glass.transmittance.startswith("inline:reflectance:")
     both = "specular_reflectance" in tinted_box.read_text()
     assert glass.specular_reflectance.startswith("inline:reflectance:") == both
-    runs = [ours_xyz(scene, 8, seed) for seed in range(SEEDS)]
-    ours = np.stack([blocks(image) for image, _ in runs])
-    theirs = np.stack([blocks(image) for image in mitsuba_xyz(tinted_box, 32)])
-    assert_blocks_agree(ours, theirs, max_t=3.5)
+    results = assert_matches_mitsuba(scene, tinted_box, 8, 32, max_t=3.5)
 
     layers = {
         k: v.data.astype(np.float64)
-        for k, v in compute_ground_truth(scene, runs[0][1]).layers.items()
+        for k, v in compute_ground_truth(scene, results[0]).layers.items()
     }
     gem = layers["transmissive"] == 1.0
     assert gem.sum() > 40
