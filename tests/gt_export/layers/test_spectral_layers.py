@@ -21,11 +21,11 @@ from spectrinsic.gt_export.dataset.loader import filter_residual_share, working_
 from spectrinsic.gt_export.layers import LayerSettings, compute_ground_truth, identities
 from spectrinsic.gt_export.relight import relight, relit_scene
 from spectrinsic.render import RenderSettings, render_batches, render_scene
-from spectrinsic.render.transport_render import render_transport_batches
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as WL
 from spectrinsic.spectra import get_sensors, get_spectrum, responses
 from tests.conftest import quad
+from tests.gt_export._builders import render_transport_sample
 
 #: Issue 30: the per-band identity and the band reflectance, within 1e-5.
 TOL = 1e-5
@@ -138,17 +138,10 @@ def room_sample(tmp_path_factory, make_room):
     out = tmp_path_factory.mktemp("spectral")
     scene = make_room(size=12)
     settings = RenderSettings(spp=4, modes=("rgb3", "bands31"), batches=2, max_depth=4)
-    transport, result = render_transport_batches(scene, settings, seed=5)
-    sample = export_sample(
-        out,
-        scene,
-        result,
-        LayerSettings(denoise=True, spectral_layers=True),
-        sample_id="room__v0__two",
-        config={"test": "spectral"},
-        seed=5,
-        transport=transport,
-    )
+    sample, _, _ = render_transport_sample(
+        out, scene, settings, seed=5, sample_id="room__v0__two", config={"test": "spectral"},
+        layers=LayerSettings(denoise=True, spectral_layers=True),
+    )  # fmt: skip
     return out, scene, sample, settings
 
 

@@ -26,6 +26,7 @@ from spectrinsic.gt_export.sample.render_spp import render_spp
 from spectrinsic.gt_export.sample.transport_exr import TRANSPORT_NAME
 from spectrinsic.render import RenderSettings, count_passes, render_batches
 from spectrinsic.render.transport_render import render_transport_batches
+from tests.gt_export._builders import render_transport_sample
 
 #: Issue 20: a relit layer and the direct render's agree to float rounding, 1e-5 of the
 #: layer's largest magnitude (float32 storage, and ē multiplied after the path sum, not inside).
@@ -48,16 +49,9 @@ def built(tmp_path_factory, make_room):
     """A two-light room sample stored with its transport (2 batches, denoised, two cameras)."""
     out = tmp_path_factory.mktemp("relight")
     scene = make_room(size=16)
-    transport, result = render_transport_batches(scene, SETTINGS, seed=SEED)
-    sample = export_sample(
-        out,
-        scene,
-        result,
-        LayerSettings(denoise=True),
-        sample_id="room__v0__two",
-        config=CONFIG,
-        seed=SEED,
-        transport=transport,
+    layers = LayerSettings(denoise=True)
+    sample, _, _ = render_transport_sample(
+        out, scene, SETTINGS, seed=SEED, sample_id="room__v0__two", config=CONFIG, layers=layers
     )
     return out, scene, sample
 
@@ -164,18 +158,11 @@ def test_relit_sample_equals_a_direct_render_with_the_passes(tmp_path, make_room
     relights as exactly, against a direct render with the same passes."""
     scene = make_room(size=12)
     settings = SETTINGS.with_options(integrator="passes", spp=2)
-    transport, result = render_transport_batches(scene, settings, seed=SEED)
+    sample, transport, result = render_transport_sample(
+        tmp_path, scene, settings, seed=SEED, sample_id="room__v0__passes", config=CONFIG,
+        layers=LayerSettings(denoise=True),
+    )  # fmt: skip
     assert "single" not in transport.seconds and result.meta.get("integrator") != "single"
-    sample = export_sample(
-        tmp_path,
-        scene,
-        result,
-        LayerSettings(denoise=True),
-        sample_id="room__v0__passes",
-        config=CONFIG,
-        seed=SEED,
-        transport=transport,
-    )
     _relit_and_direct(tmp_path, scene, sample, settings, "passes")
 
 
