@@ -10,7 +10,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import shutil
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +26,7 @@ from spectrinsic.gt_export.sample.transport_exr import TRANSPORT_NAME
 from spectrinsic.render import RenderSettings, count_passes, render_batches
 from spectrinsic.render.transport_render import render_transport_batches
 from tests.gt_export._builders import render_transport_sample
+from tests.gt_export.folders._holder import held_lock
 
 #: Issue 20: a relit layer and the direct render's agree to float rounding, 1e-5 of the
 #: layer's largest magnitude (float32 storage, and ē multiplied after the path sum, not inside).
@@ -413,56 +413,24 @@ def test_cheap_augmentation_leaves_out_denoising_and_cameras_only(built):
 def test_cli_follows_the_out_rule_and_the_lock_of_every_writing_verb(built, tmp_path, capsys):
     """--out inside a dataset is refused, and so is one whose folder another run holds: one
     line, status 2, before any relighting, and nothing written."""
-    import subprocess
-
     from spectrinsic.cli import main
 
     _, _, sample = built
+
+    def refused(out: Path) -> tuple[int, str]:
+        rc = main(["-q", "relight", str(sample), "--light", "0=cie:D65", "--out", str(out)])
+        return rc, capsys.readouterr().err.strip()
+
     dataset = tmp_path / "ds"
     dataset.mkdir()
     (dataset / "manifest.json").write_text(json.dumps({"format_version": 1, "config_hash": "h"}))
-    rc = main(
-        [
-            "-q",
-            "relight",
-            str(sample),
-            "--light",
-            "0=cie:D65",
-            "--out",
-            str(dataset / "relit__v0__x"),
-        ]
-    )
-    err = capsys.readouterr().err.strip()
+    rc, err = refused(dataset / "relit__v0__x")
     assert rc == 2 and len(err.splitlines()) == 1 and "inside the dataset folder" in err, err
     assert sorted(p.name for p in dataset.iterdir()) == ["manifest.json"]
 
     held = tmp_path / "held"
-    code = (
-        "import sys; from pathlib import Path; from spectrinsic.gt_export.folders.outfolder import folder_lock\n"
-        f"with folder_lock(Path({str(held)!r})):\n"
-        "    print('held', flush=True); sys.stdin.read()\n"
-    )
-    proc = subprocess.Popen(
-        [sys.executable, "-P", "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
-    )
-    try:
-        assert proc.stdout is not None and proc.stdout.readline().strip() == "held"
-        rc = main(
-            [
-                "-q",
-                "relight",
-                str(sample),
-                "--light",
-                "0=cie:D65",
-                "--out",
-                str(held / "relit__v0__x"),
-            ]
-        )
-        err = capsys.readouterr().err.strip()
-    finally:
-        assert proc.stdin is not None
-        proc.stdin.close()
-        assert proc.wait(timeout=60) == 0
+    with held_lock(held) as proc:
+        rc, err = refused(held / "relit__v0__x")
     assert rc == 2 and len(err.splitlines()) == 1, err
     assert "in use by another spectrinsic run" in err and f"pid {proc.pid}" in err
     assert not held.exists()  # the holder removed its folder; the refused run wrote nothing
