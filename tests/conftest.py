@@ -111,6 +111,32 @@ lights:
   - {kind: point, spectrum: "cie:D65", power: 4, position: [0, 0, 2]}
 camera: {origin: [0, -3, 2], target: [0, 0, 0], width: 16, height: 16}
 """
+#: The command-line options of the tiny dataset builds: the preview preset at 16 x 16 pixels,
+#: 2 samples per pixel.
+TINY_BUILD = ["--preset", "preview", "--resolution", "16x16", "--spp", "2"]
+
+
+def one_line_error(capsys: pytest.CaptureFixture[str], *needles: str) -> str:
+    """The error a command just printed: one line on stderr, no traceback, holding every one of
+    *needles* (the house rule for bad input)."""
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "Traceback" not in err, err
+    for needle in needles:
+        assert needle in err, err
+    return err
+
+
+#: The text of a user's own file, which no command may replace or delete.
+USER_TEXT = "the user's own file\n"
+
+
+@pytest.fixture
+def outside(tmp_path: Path) -> Path:
+    """A user's file (:data:`USER_TEXT`) outside any output folder."""
+    path = tmp_path / "elsewhere" / "precious.txt"
+    path.parent.mkdir()
+    path.write_text(USER_TEXT)
+    return path
 
 
 def quad(

@@ -16,9 +16,9 @@ import pytest
 
 from spectrinsic.cli import main
 from spectrinsic.render import RenderSettings
+from tests.conftest import TINY_BUILD
 from tests.gt_export._builders import render_transport_sample
 
-TINY = ["--preset", "preview", "--resolution", "16x16", "--spp", "2"]
 SCENE = """\
 name: quad
 materials: {sfu: "sfu:munsell/17"}
@@ -63,7 +63,15 @@ def test_relight_uses_the_global_data_dir(data_dir, environment, tmp_path, make_
 
 def test_dataset_generator_samples_use_the_global_data_dir(data_dir, environment, tmp_path, capsys):
     out = tmp_path / "ds"
-    argv = ["-q", "--data-dir", str(data_dir), "dataset", *TINY, "--generator", "objects-on-ground"]
+    argv = [
+        "-q",
+        "--data-dir",
+        str(data_dir),
+        "dataset",
+        *TINY_BUILD,
+        "--generator",
+        "objects-on-ground",
+    ]
     rc = main([*argv, "--count", "1", "--sfu", "--out", str(out)])
     _ok(rc, capsys)
     assert len([p for p in out.rglob("meta.json")]) == 1
@@ -75,7 +83,7 @@ def test_dataset_scene_file_with_sfu_spectra_uses_the_global_data_dir(
     scene = tmp_path / "scene.yaml"
     scene.write_text(SCENE)
     out = tmp_path / "ds"
-    rc = main(["-q", "--data-dir", str(data_dir), "dataset", *TINY, "--scenes", str(scene),
+    rc = main(["-q", "--data-dir", str(data_dir), "dataset", *TINY_BUILD, "--scenes", str(scene),
                "--out", str(out)])  # fmt: skip
     _ok(rc, capsys)
     assert len([p for p in out.rglob("meta.json")]) == 1

@@ -20,6 +20,7 @@ from spectrinsic.gt_export.folders.outfolder import (
     folder_lock,
     output_folder,
 )
+from tests.conftest import TINY_BUILD
 from tests.gt_export.folders._holder import held_lock
 
 #: Longest wait for the helper process to take the lock, seconds.
@@ -101,17 +102,7 @@ def test_every_writing_verb_refuses_a_held_folder_in_one_line_before_any_work(
     out = tmp_path / "out"
     with held_lock(out) as proc:
         argv = {
-            "dataset": [
-                "dataset",
-                "--preset",
-                "preview",
-                "--resolution",
-                "16x16",
-                "--spp",
-                "2",
-                "--only",
-                "obj-apple__v0__white",
-            ],
+            "dataset": ["dataset", *TINY_BUILD, "--only", "obj-apple__v0__white"],
             "export": ["export", str(_dataset(tmp_path))],
             "render": ["render", "obj-apple", "--width", "16", "--height", "16"],
             "study": ["study", "reconstruction-error"],
