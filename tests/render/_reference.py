@@ -33,7 +33,9 @@ __all__ = [
     "ICO_F",
     "icosahedron_obj",
     "blocks",
+    "cie_1931",
     "y_normalisation",
+    "bands_xyz",
     "ours_xyz",
     "mitsuba_xyz",
     "assert_blocks_agree",
@@ -133,14 +135,28 @@ def blocks(image: np.ndarray) -> np.ndarray:
     return image.reshape(RES // 8, 8, RES // 8, 8, 3).mean(axis=(1, 3))
 
 
+def cie_1931() -> tuple[np.ndarray, np.ndarray]:
+    """colour-science's CIE 1931 2° functions on Mitsuba's 1 nm grid 360–830 nm: the
+    wavelengths (nm) and ``(471, 3)`` x̄, ȳ, z̄."""
+    import colour
+
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy()
+    cmfs = cmfs.align(colour.SpectralShape(360, 830, 1))
+    return np.asarray(cmfs.wavelengths), np.asarray(cmfs.values)
+
+
 @functools.cache
 def y_normalisation() -> float:
     """∫ȳ dλ on Mitsuba's 1 nm grid 360–830 nm: its spectral XYZ film divides by it
     (``MI_CIE_Y_NORMALIZATION``); spectrinsic's raw channels are ``∫ L x̄ dλ`` unnormalised."""
-    import colour
+    return float(cie_1931()[1][:, 1].sum())
 
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
-    return float(cmfs.copy().align(colour.SpectralShape(360, 830, 1)).values[:, 1].sum())
+
+def bands_xyz(result: RenderResult) -> np.ndarray:
+    """``(H, W, 3)`` CIE XYZ of a render's ``bands31`` raw channels, through the render's own
+    ``to_xyz`` matrix."""
+    to_xyz = np.asarray(result.meta["to_xyz"]["bands31"], float)
+    return np.einsum("hwk,ck->hwc", result.raw["bands31"], to_xyz)
 
 
 def ours_xyz(
@@ -150,8 +166,7 @@ def ours_xyz(
     render's own ``to_xyz``, depth 6 as the XML's ``path``) and the render's result."""
     settings = RenderSettings(spp, modes=("bands31",), max_depth=6, per_light=per_light)
     result = render_scene(scene, settings, seed=seed)
-    to_xyz = np.asarray(result.meta["to_xyz"]["bands31"], float)
-    return np.einsum("hwk,ck->hwc", result.raw["bands31"], to_xyz), result
+    return bands_xyz(result), result
 
 
 def mitsuba_xyz(path: Path, spp: int) -> list[np.ndarray]:
