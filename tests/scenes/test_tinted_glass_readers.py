@@ -22,7 +22,7 @@ from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml
 from spectrinsic.scenes.model import Material
 from spectrinsic.scenes.scene_reader import load_scene
 
-from ._builders import build_blend
+from ._builders import build_blend, gltf_with_material
 from .test_io import BASE, write
 
 
@@ -211,18 +211,9 @@ def _gltf(tmp_path, extensions: dict, pbr: dict, textured: bool = False):
     uv = np.random.default_rng(0).random((len(box.vertices), 2)) if textured else None
     material = PBRMaterial(name="glass", baseColorTexture=image)
     box.visual = trimesh.visual.TextureVisuals(uv=uv, material=material)
-    scene = trimesh.Scene()
-    scene.add_geometry(box, "pane")
-    files = scene.export(file_type="gltf")
-    doc = json.loads(files.pop("model.gltf"))
-    for name, data in files.items():
-        (tmp_path / name).write_bytes(data)
-    (entry,) = doc["materials"]
-    entry["extensions"] = extensions
-    entry["pbrMetallicRoughness"] = entry.get("pbrMetallicRoughness", {}) | pbr
-    assert textured == ("baseColorTexture" in entry["pbrMetallicRoughness"])
-    path = tmp_path / "glass.gltf"
-    path.write_text(json.dumps(doc))
+    path = gltf_with_material(tmp_path, box, extensions, pbr)
+    written = json.loads(path.read_text())["materials"][0]["pbrMetallicRoughness"]
+    assert textured == ("baseColorTexture" in written)
     return path
 
 
