@@ -111,6 +111,32 @@ lights:
   - {kind: point, spectrum: "cie:D65", power: 4, position: [0, 0, 2]}
 camera: {origin: [0, -3, 2], target: [0, 0, 0], width: 16, height: 16}
 """
+#: The command-line options of the tiny dataset builds: the preview preset at 16 x 16 pixels,
+#: 2 samples per pixel.
+TINY_BUILD = ["--preset", "preview", "--resolution", "16x16", "--spp", "2"]
+
+
+def one_line_error(capsys: pytest.CaptureFixture[str], *needles: str) -> str:
+    """The error a command just printed: one line on stderr, no traceback, holding every one of
+    *needles* (the house rule for bad input)."""
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "Traceback" not in err, err
+    for needle in needles:
+        assert needle in err, err
+    return err
+
+
+#: The text of a user's own file, which no command may replace or delete.
+USER_TEXT = "the user's own file\n"
+
+
+@pytest.fixture
+def outside(tmp_path: Path) -> Path:
+    """A user's file (:data:`USER_TEXT`) outside any output folder."""
+    path = tmp_path / "elsewhere" / "precious.txt"
+    path.parent.mkdir()
+    path.write_text(USER_TEXT)
+    return path
 
 
 def quad(
@@ -148,13 +174,23 @@ def plane_scene(
     )
 
 
-def corner_scene(first: Material, wall: str = "munsell:5R 5/12", *, size: int = 16) -> Scene:
+def corner_scene(
+    first: Material,
+    wall: str = "munsell:5R 5/12",
+    *,
+    size: int = 16,
+    light: str = "cie:D65",
+    power: float = 5.0,
+    wall_half: float = 3.0,
+) -> Scene:
     """A wall of material *first* (plane x = 0, facing +x) beside a coloured *wall* (plane
-    y = 1, facing -y). A distant D65 light along +y lights the coloured wall head-on and
-    grazes the first one (cos θ = 0), which so receives only light bounced off the coloured
-    wall. The camera sees the first wall alone."""
+    y = 1, facing -y, x ∈ [0, 2 *wall_half*], |z| ≤ *wall_half*). A distant light (*light* at
+    *power*) along +y lights the coloured wall head-on and grazes the first one (cos θ = 0),
+    which so receives only light bounced off the coloured wall. The camera sees the first wall
+    alone."""
     first_v, first_f = quad((0, -3, -3), (0, 0, 6), (0, 4, 0))  # seen from its back: two-sided
-    wall_v, wall_f = quad((0, 1, -3), (6, 0, 0), (0, 0, 6))
+    h = wall_half
+    wall_v, wall_f = quad((0, 1, -h), (2 * h, 0, 0), (0, 0, 2 * h))
     return Scene(
         name="corner",
         meshes=(
@@ -162,7 +198,7 @@ def corner_scene(first: Material, wall: str = "munsell:5R 5/12", *, size: int = 
             Mesh("wall", wall_v, wall_f, np.ones(2, np.int64), object_id=1),
         ),
         materials=(first, Material("wall", wall)),
-        lights=(Light("directional", "cie:D65", 5.0, direction=(0.0, 1.0, 0.0)),),
+        lights=(Light("directional", light, power, direction=(0.0, 1.0, 0.0)),),
         camera=Camera(
             origin=(1.0, -0.5, 0.0),
             target=(0.0, 0.2, 0.0),

@@ -19,6 +19,7 @@ import pytest
 
 from spectrinsic.errors import WriteError
 from spectrinsic.file_writes import replacing, write_bytes_file, write_text_file
+from tests.conftest import USER_TEXT
 
 PACKAGE = Path(__file__).resolve().parents[1] / "spectrinsic"
 #: A call that writes a file's content: text, bytes, figures, PIL images, OpenEXR, opened files.
@@ -28,7 +29,6 @@ _WRITE_CALL = re.compile(
     r"|\.(?P<opened2>\w+)\.open\(['\"][wax]"
     r"|OpenEXR\.File\([^)]*\)\.write\((?P<exr>[^)]*)\)"
 )
-USER_TEXT = "the user's own file\n"
 
 
 def _write_calls() -> list[tuple[str, int, str]]:
@@ -72,15 +72,6 @@ def test_every_write_call_in_the_package_writes_a_temporary_renamed_over_its_nam
         lines = (PACKAGE / module).read_text(encoding="utf-8").splitlines()[:number]
         above = "\n".join(lines[-25:])
         assert re.search(r"replacing\([^)]*\) as tmp", above), f"{module}:{number}"
-
-
-@pytest.fixture
-def outside(tmp_path: Path) -> Path:
-    """A user's file outside the output folder."""
-    path = tmp_path / "elsewhere" / "precious.txt"
-    path.parent.mkdir()
-    path.write_text(USER_TEXT)
-    return path
 
 
 def _png(path: Path) -> None:

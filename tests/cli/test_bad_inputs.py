@@ -20,21 +20,12 @@ from spectrinsic.cli import main
 from spectrinsic.errors import DatasetError
 from spectrinsic.gt_export.folders.build_folder import MARKER_NAME, write_marker
 from spectrinsic.pipeline.presets import get_preset
-from tests.conftest import QUAD_YAML
+from tests.conftest import QUAD_YAML, TINY_BUILD
 
-#: The dataset options of the tiny builds (as in tests/pipeline/test_pipeline.py).
-TINY = [
-    "--preset",
-    "preview",
-    "--resolution",
-    "16x16",
-    "--spp",
-    "2",
-    "--only",
-    "obj-apple__v0__white",
-]
-TINY_HASH = get_preset("preview").with_options(width=16, height=16, spp=2).config_hash()
 APPLE = "obj-apple__v0__white"
+#: The tiny build of one library sample.
+TINY = [*TINY_BUILD, "--only", APPLE]
+TINY_HASH = get_preset("preview").with_options(width=16, height=16, spp=2).config_hash()
 
 
 #: A scene whose second mesh has only a zero-area face (three collinear vertices).

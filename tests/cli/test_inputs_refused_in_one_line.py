@@ -14,19 +14,10 @@ import pytest
 from spectrinsic.cli import main
 from spectrinsic.gt_export.folders.build_folder import write_marker
 from spectrinsic.pipeline.presets import get_preset
-from tests.conftest import QUAD_YAML
+from tests.conftest import QUAD_YAML, TINY_BUILD, one_line_error
 
-TINY = ["--preset", "preview", "--resolution", "16x16", "--spp", "2"]
 APPLE = "obj-apple__v0__white"
-GENERATED = ["--generator", "objects-on-ground", "--count", "1", *TINY]
-
-
-def _one_line(capsys, *needles: str) -> str:
-    err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0 and "Traceback" not in err, err
-    for needle in needles:
-        assert needle in err, err
-    return err
+GENERATED = ["--generator", "objects-on-ground", "--count", "1", *TINY_BUILD]
 
 
 def _scene(tmp_path: Path, text: str = QUAD_YAML) -> str:
@@ -44,7 +35,7 @@ def _scene(tmp_path: Path, text: str = QUAD_YAML) -> str:
 def test_a_range_with_an_infinite_end_is_refused(tmp_path, capsys, option, value):
     out = tmp_path / "ds"
     assert main(["dataset", *GENERATED, option, value, "--out", str(out)]) == 2
-    _one_line(capsys, option, "finite")
+    one_line_error(capsys, option, "finite")
     assert not out.exists()
 
 
@@ -61,28 +52,28 @@ def test_the_json_spectrinsic_writes_is_strict():
 # -- cause 8: tracebacks instead of one line --------------------------------------------------
 
 
-def test_a_yaml_file_with_a_control_character_is_one_line(tmp_path, capsys):
+def test_a_yaml_file_with_a_control_character_isone_line_error(tmp_path, capsys):
     scene = _scene(tmp_path, QUAD_YAML.replace("name: quad", "name: qu\x01ad"))
     assert main(["render", scene, "--out", str(tmp_path / "o")]) == 2
-    _one_line(capsys, "scene.yaml", "invalid YAML", "#x0001")
+    one_line_error(capsys, "scene.yaml", "invalid YAML", "#x0001")
 
 
-def test_a_face_index_beyond_32_bits_is_one_line(tmp_path, capsys):
+def test_a_face_index_beyond_32_bits_isone_line_error(tmp_path, capsys):
     scene = _scene(tmp_path, QUAD_YAML.replace("[0, 2, 3]", f"[0, 2, {2**70}]"))
     assert main(["render", scene, "--out", str(tmp_path / "o")]) == 2
-    _one_line(capsys, "meshes[0].faces[1][2]", "32-bit")
+    one_line_error(capsys, "meshes[0].faces[1][2]", "32-bit")
 
 
-def test_a_vertex_too_large_for_a_float_is_one_line(tmp_path, capsys):
+def test_a_vertex_too_large_for_a_float_isone_line_error(tmp_path, capsys):
     scene = _scene(tmp_path, QUAD_YAML.replace("[-2, -2, 0]", f"[-2, -2, {10**400}]", 1))
     assert main(["render", scene, "--out", str(tmp_path / "o")]) == 2
-    _one_line(capsys, "meshes[0].vertices", "too large")
+    one_line_error(capsys, "meshes[0].vertices", "too large")
 
 
-def test_a_path_depth_beyond_mitsubas_integers_is_one_line(tmp_path, capsys):
+def test_a_path_depth_beyond_mitsubas_integers_isone_line_error(tmp_path, capsys):
     out = tmp_path / "o"
     assert main(["render", _scene(tmp_path), "--out", str(out), "--max-depth", "2147483648"]) == 2
-    _one_line(capsys, "--max-depth 2147483648", "expected 1 to")
+    one_line_error(capsys, "--max-depth 2147483648", "expected 1 to")
     assert not out.exists()
 
 
@@ -101,12 +92,12 @@ def test_check_of_a_deeply_nested_meta_json_is_one_line_per_problem(tmp_path, ca
     assert "not valid JSON" in out.err + out.out
 
 
-def test_a_dataset_rerun_over_a_deeply_nested_meta_json_is_one_line(tmp_path, capsys):
+def test_a_dataset_rerun_over_a_deeply_nested_meta_json_isone_line_error(tmp_path, capsys):
     root = tmp_path / "ds"
     write_marker(root, get_preset("preview").with_options(width=16, height=16, spp=2).config_hash())
     _nested_meta(root)
-    assert main(["dataset", "--out", str(root), *TINY, "--only", APPLE]) == 2
-    _one_line(capsys, APPLE)
+    assert main(["dataset", "--out", str(root), *TINY_BUILD, "--only", APPLE]) == 2
+    one_line_error(capsys, APPLE)
 
 
 # -- cause 7: options and keys that do not apply ------------------------------------------
@@ -125,7 +116,7 @@ def test_a_light_key_of_another_kind_is_refused(tmp_path, capsys, light, key):
         '{kind: point, spectrum: "cie:D65", power: 4, position: [0, 0, 2]}', light
     )
     assert main(["render", _scene(tmp_path, text), "--out", str(tmp_path / "o")]) == 2
-    _one_line(capsys, f"lights[0].{key}", "light has no")
+    one_line_error(capsys, f"lights[0].{key}", "light has no")
 
 
 def test_save_scene_writes_only_the_keys_a_light_kind_uses(tmp_path):
@@ -150,14 +141,14 @@ def test_save_scene_writes_only_the_keys_a_light_kind_uses(tmp_path):
 def test_library_options_on_a_scene_file_are_refused(tmp_path, capsys, extra, option):
     out = tmp_path / "o"
     assert main(["render", _scene(tmp_path), "--out", str(out), *extra]) == 2
-    _one_line(capsys, option, "library scenes", "scene.yaml")
+    one_line_error(capsys, option, "library scenes", "scene.yaml")
     assert not out.exists()
 
 
 def test_file_options_on_a_library_scene_are_refused(tmp_path, capsys):
     out = tmp_path / "o"
     assert main(["render", "obj-apple", "--out", str(out), "--default-spectrum", "flat:0.5"]) == 2
-    _one_line(capsys, "--default-spectrum", "obj-apple")
+    one_line_error(capsys, "--default-spectrum", "obj-apple")
     assert not out.exists()
 
 
@@ -168,8 +159,8 @@ def test_file_options_on_a_library_scene_are_refused(tmp_path, capsys):
 )
 def test_generator_options_on_a_library_dataset_are_refused(tmp_path, capsys, extra):
     out = tmp_path / "ds"
-    assert main(["dataset", *TINY, "--only", APPLE, *extra, "--out", str(out)]) == 2
-    _one_line(capsys, extra[0], "applies to --generator")
+    assert main(["dataset", *TINY_BUILD, "--only", APPLE, *extra, "--out", str(out)]) == 2
+    one_line_error(capsys, extra[0], "applies to --generator")
     assert not out.exists()
 
 
@@ -177,7 +168,7 @@ def test_a_scene_file_option_on_a_generated_dataset_is_refused(tmp_path, capsys)
     out = tmp_path / "ds"
     args = ["dataset", *GENERATED, "--default-spectrum", "flat:0.5", "--out", str(out)]
     assert main(args) == 2
-    _one_line(capsys, "--default-spectrum", "applies to --scenes")
+    one_line_error(capsys, "--default-spectrum", "applies to --scenes")
     assert not out.exists()
 
 
@@ -199,7 +190,7 @@ def test_an_empty_layer_list_is_refused(tmp_path, capsys):
     (root / "manifest.json").write_text("{}")
     out = tmp_path / "shards"
     assert main(["export", str(root), "--out", str(out), "--layers", ""]) == 2
-    _one_line(capsys, "--layers ''")
+    one_line_error(capsys, "--layers ''")
     assert not out.exists()
 
 
@@ -208,15 +199,15 @@ def test_an_empty_layer_list_is_refused(tmp_path, capsys):
 
 def test_a_billion_relit_variants_are_refused_before_work(tmp_path, capsys):
     out = tmp_path / "ds"
-    args = ["dataset", "--scenes", _scene(tmp_path), *TINY, "--store-transport"]
+    args = ["dataset", "--scenes", _scene(tmp_path), *TINY_BUILD, "--store-transport"]
     assert main([*args, "--relight", "1000000000", "--out", str(out)]) == 2
-    _one_line(capsys, "--relight 1000000000", "at most 1000")
+    one_line_error(capsys, "--relight 1000000000", "at most 1000")
     assert not out.exists()
 
 
 def test_gloss_with_the_passes_integrator_is_refused_before_the_first_sample(tmp_path, capsys):
     out = tmp_path / "ds"
     args = ["dataset", "--generator", "rooms", "--glossy", "0.5", "--integrator", "passes"]
-    assert main([*args, "--count", "1", *TINY, "--out", str(out)]) == 2
-    _one_line(capsys, "--glossy/--metallic", "passes")
+    assert main([*args, "--count", "1", *TINY_BUILD, "--out", str(out)]) == 2
+    one_line_error(capsys, "--glossy/--metallic", "passes")
     assert not out.exists()

@@ -17,9 +17,8 @@ import pytest
 
 from spectrinsic.cli import main
 from spectrinsic.gt_export.folders.outfolder import output_folder
-from tests.conftest import QUAD_YAML
+from tests.conftest import QUAD_YAML, TINY_BUILD
 
-TINY = ["--preset", "preview", "--resolution", "16x16", "--spp", "2"]
 MINE = "the user's own words\n"
 
 
@@ -67,7 +66,7 @@ def dataset(tmp_path_factory) -> Path:
 
 
 def _dataset_argv(out: Path) -> list[str]:
-    return ["-q", "dataset", *TINY, "--scenes", str(out.parent / "s.yaml"), "--out", str(out)]
+    return ["-q", "dataset", *TINY_BUILD, "--scenes", str(out.parent / "s.yaml"), "--out", str(out)]
 
 
 @pytest.mark.parametrize("name", ["DATASET.md", "index.html", "gallery.js", "gallery-pixels"])

@@ -15,11 +15,10 @@ import os
 import pytest
 
 from spectrinsic.cli import main
-from spectrinsic.gt_export import export_sample
 from spectrinsic.render import RenderSettings
-from spectrinsic.render.transport_render import render_transport_batches
+from tests.conftest import TINY_BUILD
+from tests.gt_export._builders import render_transport_sample
 
-TINY = ["--preset", "preview", "--resolution", "16x16", "--spp", "2"]
 SCENE = """\
 name: quad
 materials: {sfu: "sfu:munsell/17"}
@@ -52,11 +51,9 @@ def _ok(rc: int, capsys) -> None:
 def test_relight_uses_the_global_data_dir(data_dir, environment, tmp_path, make_room, capsys):
     scene = make_room(size=8)
     settings = RenderSettings(spp=2, modes=("rgb3",), batches=2, max_depth=3)
-    transport, result = render_transport_batches(scene, settings, seed=3)
-    sample = export_sample(
-        tmp_path / "src", scene, result, sample_id="room__v0__two", config={"t": 36}, seed=3,
-        transport=transport,
-    )  # fmt: skip
+    sample, _, _ = render_transport_sample(
+        tmp_path / "src", scene, settings, seed=3, sample_id="room__v0__two", config={"t": 36}
+    )
     out = tmp_path / "relit"
     argv = ["-q", "--data-dir", str(data_dir), "relight", str(sample)]
     rc = main([*argv, "--light", "0=sfu-illum:mws_000", "--out", str(out)])
@@ -66,7 +63,15 @@ def test_relight_uses_the_global_data_dir(data_dir, environment, tmp_path, make_
 
 def test_dataset_generator_samples_use_the_global_data_dir(data_dir, environment, tmp_path, capsys):
     out = tmp_path / "ds"
-    argv = ["-q", "--data-dir", str(data_dir), "dataset", *TINY, "--generator", "objects-on-ground"]
+    argv = [
+        "-q",
+        "--data-dir",
+        str(data_dir),
+        "dataset",
+        *TINY_BUILD,
+        "--generator",
+        "objects-on-ground",
+    ]
     rc = main([*argv, "--count", "1", "--sfu", "--out", str(out)])
     _ok(rc, capsys)
     assert len([p for p in out.rglob("meta.json")]) == 1
@@ -78,7 +83,7 @@ def test_dataset_scene_file_with_sfu_spectra_uses_the_global_data_dir(
     scene = tmp_path / "scene.yaml"
     scene.write_text(SCENE)
     out = tmp_path / "ds"
-    rc = main(["-q", "--data-dir", str(data_dir), "dataset", *TINY, "--scenes", str(scene),
+    rc = main(["-q", "--data-dir", str(data_dir), "dataset", *TINY_BUILD, "--scenes", str(scene),
                "--out", str(out)])  # fmt: skip
     _ok(rc, capsys)
     assert len([p for p in out.rglob("meta.json")]) == 1

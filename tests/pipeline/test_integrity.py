@@ -30,22 +30,12 @@ from spectrinsic.gt_export.dataset.build_time import (
 from spectrinsic.gt_export.sample import TMP_PREFIX
 from spectrinsic.pipeline.dataset import build_dataset
 from spectrinsic.pipeline.presets import get_preset
+from tests.conftest import TINY_BUILD
 
 IDS = ("obj-apple__v0__white", "obj-box__v0__white")
 ONLY = ",".join(IDS)
 CONFIG = get_preset("preview").with_options(width=16, height=16, spp=2)
-CLI = [
-    "-q",
-    "dataset",
-    "--preset",
-    "preview",
-    "--resolution",
-    "16x16",
-    "--spp",
-    "2",
-    "--only",
-    ONLY,
-]
+CLI = ["-q", "dataset", *TINY_BUILD, "--only", ONLY]
 #: How long a subprocess build may take to reach the state a test interrupts.
 WAIT_S = 180.0
 

@@ -1,7 +1,8 @@
 """Mitsuba's own spectral ``path`` render as the independent reference of the XML box tests
-(tests/render/test_glass.py, tests/render/test_xml_box_every_surface.py): the glass mesh both
-renderers trace, the band path's and Mitsuba's CIE XYZ images, and their comparison per
-8 × 8 block against the spread of independent seeds.
+(tests/render/test_glass.py, test_tinted_glass.py, test_xml_box_every_surface.py): the box
+they share (:func:`box_xml`), the glass mesh both renderers trace, the band path's and
+Mitsuba's CIE XYZ images, and their comparison per 8 × 8 block against the spread of
+independent seeds (:func:`assert_matches_mitsuba`).
 
 A helper module, not a conftest: its functions take arguments (scene, file, spp, seed), and
 tests/test_test_layout.py checks only ``test_*.py`` files.
@@ -17,16 +18,24 @@ import numpy as np
 from spectrinsic.render import RenderSettings, render_scene
 from spectrinsic.render.result import RenderResult
 from spectrinsic.scenes.model import Scene
+from tests.scenes._cornell import box_walls
 
 __all__ = [
     "SEEDS",
     "RES",
     "FALSE_ALARM",
+    "CAMERA_Y",
+    "FOV",
+    "SMOOTH_GLASS",
+    "box_xml",
+    "assert_matches_mitsuba",
     "ICO_V",
     "ICO_F",
     "icosahedron_obj",
     "blocks",
+    "cie_1931",
     "y_normalisation",
+    "bands_xyz",
     "ours_xyz",
     "mitsuba_xyz",
     "assert_blocks_agree",
@@ -38,6 +47,60 @@ SEEDS = 16
 RES = 32
 #: Family-wise false-alarm rate of the 48 block-channel comparisons.
 FALSE_ALARM = 1e-3
+#: The box's camera: at (0, CAMERA_Y, 1) looking along +y, vertical field of view FOV degrees.
+CAMERA_Y, FOV = -3.5, 40
+#: The box's smooth BK7 glass (``id="glass"``: a test swaps it for another by replacing it).
+SMOOTH_GLASS = '<bsdf type="dielectric" id="glass"><string name="int_ior" value="bk7"/></bsdf>'
+
+_BOX = """<scene version="3.0.0">
+  <integrator type="path"><integer name="max_depth" value="6"/></integrator>
+  <bsdf type="diffuse" id="white"><spectrum name="reflectance" value="0.7"/></bsdf>
+{bsdfs}
+  {glass}
+  <bsdf type="conductor" id="mirror"><string name="material" value="none"/></bsdf>
+{emitters}{walls}
+{inside}
+  <shape type="rectangle" id="lamp">
+    <bsdf type="diffuse"><spectrum name="reflectance" value="0"/></bsdf>
+    <transform name="to_world">
+      <scale value="0.3"/><rotate x="1" angle="180"/><translate value="0 0 1.99"/>
+    </transform>
+    <emitter type="area">
+      <spectrum name="radiance" value="360:4, 450:5, 550:6, 650:7, 830:8"/></emitter>
+  </shape>
+  <sensor type="perspective">
+    <float name="fov" value="{fov:g}"/>
+    <transform name="to_world"><lookat origin="0, {camera_y:g}, 1" target="0, 0, 1" up="0, 0, 1"/></transform>
+    <sampler type="independent"><integer name="sample_count" value="16"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="{res}"/><integer name="height" value="{res}"/>
+    </film>
+  </sensor>
+</scene>
+"""
+
+
+def box_xml(
+    *, bsdfs: str, floor: str, left: str, mirror: tuple[str, str], inside: str, emitters: str = ""
+) -> str:
+    """The Mitsuba XML box the tests share: a 2 × 2 × 2 room (floor z = 0, back wall y = 1,
+    open towards the camera), white ceiling and back, a ``green`` right wall, a mirror
+    ``looking-glass`` (*mirror*: its scale and centre) before the back wall, a ceiling lamp,
+    the :data:`SMOOTH_GLASS` ``glass``, the camera of :data:`CAMERA_Y` and :data:`FOV`,
+    RES × RES pixels. *bsdfs* (XML lines) declare ``green`` and the ids *floor* and *left*
+    name besides ``white``; *inside*, the shapes in the room; *emitters*, lines of them."""
+    scale, centre = mirror
+    looking_glass = f"""  <shape type="rectangle" id="looking-glass"><ref id="mirror"/>
+    <transform name="to_world">
+      <scale value="{scale}"/><rotate x="1" angle="90"/><translate value="{centre}"/>
+    </transform>
+  </shape>
+"""
+    walls = box_walls(floor=floor, left=left, before_back=looking_glass)
+    return _BOX.format(
+        bsdfs=bsdfs, glass=SMOOTH_GLASS, emitters=emitters, walls=walls, inside=inside,
+        fov=FOV, camera_y=CAMERA_Y, res=RES,
+    )  # fmt: skip
+
 
 #: A flat-shaded icosahedron of circumradius 1: the same triangles in both renderers (an
 #: analytic ``sphere`` is triangulated by spectrinsic, and refraction would see the facets).
@@ -72,14 +135,28 @@ def blocks(image: np.ndarray) -> np.ndarray:
     return image.reshape(RES // 8, 8, RES // 8, 8, 3).mean(axis=(1, 3))
 
 
+def cie_1931() -> tuple[np.ndarray, np.ndarray]:
+    """colour-science's CIE 1931 2° functions on Mitsuba's 1 nm grid 360–830 nm: the
+    wavelengths (nm) and ``(471, 3)`` x̄, ȳ, z̄."""
+    import colour
+
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy()
+    cmfs = cmfs.align(colour.SpectralShape(360, 830, 1))
+    return np.asarray(cmfs.wavelengths), np.asarray(cmfs.values)
+
+
 @functools.cache
 def y_normalisation() -> float:
     """∫ȳ dλ on Mitsuba's 1 nm grid 360–830 nm: its spectral XYZ film divides by it
     (``MI_CIE_Y_NORMALIZATION``); spectrinsic's raw channels are ``∫ L x̄ dλ`` unnormalised."""
-    import colour
+    return float(cie_1931()[1][:, 1].sum())
 
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
-    return float(cmfs.copy().align(colour.SpectralShape(360, 830, 1)).values[:, 1].sum())
+
+def bands_xyz(result: RenderResult) -> np.ndarray:
+    """``(H, W, 3)`` CIE XYZ of a render's ``bands31`` raw channels, through the render's own
+    ``to_xyz`` matrix."""
+    to_xyz = np.asarray(result.meta["to_xyz"]["bands31"], float)
+    return np.einsum("hwk,ck->hwc", result.raw["bands31"], to_xyz)
 
 
 def ours_xyz(
@@ -89,8 +166,7 @@ def ours_xyz(
     render's own ``to_xyz``, depth 6 as the XML's ``path``) and the render's result."""
     settings = RenderSettings(spp, modes=("bands31",), max_depth=6, per_light=per_light)
     result = render_scene(scene, settings, seed=seed)
-    to_xyz = np.asarray(result.meta["to_xyz"]["bands31"], float)
-    return np.einsum("hwk,ck->hwc", result.raw["bands31"], to_xyz), result
+    return bands_xyz(result), result
 
 
 def mitsuba_xyz(path: Path, spp: int) -> list[np.ndarray]:
@@ -128,3 +204,16 @@ def assert_blocks_agree(ours: np.ndarray, theirs: np.ndarray, *, max_t: float = 
     bound = min(student.ppf(1 - FALSE_ALARM / (2 * diff.size), df=SEEDS - 1), max_t)
     assert np.all(np.abs(diff) <= bound * stderr), np.abs(diff / stderr).max()
     assert np.all(stderr < 0.1 * theirs.mean(axis=0)), (stderr / theirs.mean(axis=0)).max()
+
+
+def assert_matches_mitsuba(
+    scene: Scene, path: Path, spp: int, mitsuba_spp: int, *, max_t: float = np.inf
+) -> list[RenderResult]:
+    """The band path's renders of *scene* (seeds 0 to SEEDS − 1, *spp* each), once their
+    blocks agree with Mitsuba's own renders of the file at *path* (*mitsuba_spp* each) as
+    :func:`assert_blocks_agree` asks."""
+    runs = [ours_xyz(scene, spp, seed) for seed in range(SEEDS)]
+    ours = np.stack([blocks(image) for image, _ in runs])
+    theirs = np.stack([blocks(image) for image in mitsuba_xyz(path, mitsuba_spp)])
+    assert_blocks_agree(ours, theirs, max_t=max_t)
+    return [result for _, result in runs]

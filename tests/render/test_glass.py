@@ -20,64 +20,24 @@ from spectrinsic.render import RenderSettings, render_scene
 from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 
-from ._reference import (
-    SEEDS,
-    assert_blocks_agree,
-    blocks,
-    icosahedron_obj,
-    mitsuba_xyz,
-    ours_xyz,
-)
+from ._reference import SMOOTH_GLASS, assert_matches_mitsuba, box_xml, icosahedron_obj
 
-XML = """<scene version="3.0.0">
-  <integrator type="path"><integer name="max_depth" value="6"/></integrator>
-  <bsdf type="diffuse" id="white"><spectrum name="reflectance" value="0.7"/></bsdf>
-  <bsdf type="diffuse" id="red">
+#: The shared box (:func:`box_xml`) with a red left wall, a 1.2-wide mirror centred on the back
+#: wall and a BK7 glass gem (the icosahedron) on the floor.
+XML = box_xml(
+    bsdfs="""  <bsdf type="diffuse" id="red">
     <spectrum name="reflectance" value="360:0.05, 560:0.05, 600:0.6, 830:0.6"/></bsdf>
   <bsdf type="diffuse" id="green">
-    <spectrum name="reflectance" value="360:0.1, 480:0.1, 530:0.5, 580:0.1, 830:0.1"/></bsdf>
-  <bsdf type="dielectric" id="glass"><string name="int_ior" value="bk7"/></bsdf>
-  <bsdf type="conductor" id="mirror"><string name="material" value="none"/></bsdf>
-  <shape type="rectangle" id="floor"><ref id="white"/></shape>
-  <shape type="rectangle" id="ceiling"><ref id="white"/>
-    <transform name="to_world"><rotate x="1" angle="180"/><translate value="0 0 2"/></transform>
-  </shape>
-  <shape type="rectangle" id="looking-glass"><ref id="mirror"/>
-    <transform name="to_world">
-      <scale value="0.6"/><rotate x="1" angle="90"/><translate value="0 0.99 1"/>
-    </transform>
-  </shape>
-  <shape type="rectangle" id="back"><ref id="white"/>
-    <transform name="to_world"><rotate x="1" angle="90"/><translate value="0 1 1"/></transform>
-  </shape>
-  <shape type="rectangle" id="left"><ref id="red"/>
-    <transform name="to_world"><rotate y="1" angle="90"/><translate value="-1 0 1"/></transform>
-  </shape>
-  <shape type="rectangle" id="right"><ref id="green"/>
-    <transform name="to_world"><rotate y="1" angle="-90"/><translate value="1 0 1"/></transform>
-  </shape>
-  <shape type="obj" id="gem">
+    <spectrum name="reflectance" value="360:0.1, 480:0.1, 530:0.5, 580:0.1, 830:0.1"/></bsdf>""",
+    floor="white",
+    left="red",
+    mirror=("0.6", "0 0.99 1"),
+    inside="""  <shape type="obj" id="gem">
     <string name="filename" value="gem.obj"/><boolean name="face_normals" value="true"/>
     <ref id="glass"/>
     <transform name="to_world"><scale value="0.45"/><translate value="0 -0.2 0.6"/></transform>
-  </shape>
-  <shape type="rectangle" id="lamp">
-    <bsdf type="diffuse"><spectrum name="reflectance" value="0"/></bsdf>
-    <transform name="to_world">
-      <scale value="0.3"/><rotate x="1" angle="180"/><translate value="0 0 1.99"/>
-    </transform>
-    <emitter type="area">
-      <spectrum name="radiance" value="360:4, 450:5, 550:6, 650:7, 830:8"/></emitter>
-  </shape>
-  <sensor type="perspective">
-    <float name="fov" value="40"/>
-    <transform name="to_world"><lookat origin="0, -3.5, 1" target="0, 0, 1" up="0, 0, 1"/></transform>
-    <sampler type="independent"><integer name="sample_count" value="16"/></sampler>
-    <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="32"/>
-    </film>
-  </sensor>
-</scene>
-"""
+  </shape>""",
+)
 
 
 @pytest.fixture
@@ -87,8 +47,7 @@ def glass_box(tmp_path):
     return tmp_path / "box.xml"
 
 
-#: The smooth glass of :data:`XML` and a rough one in its place.
-SMOOTH_GLASS = '<bsdf type="dielectric" id="glass"><string name="int_ior" value="bk7"/></bsdf>'
+#: A rough glass in the place of :data:`SMOOTH_GLASS`.
 ROUGH_GLASS = (
     '<bsdf type="roughdielectric" id="glass"><float name="alpha" value="0.2"/>'
     '<string name="distribution" value="ggx"/></bsdf>'
@@ -110,12 +69,9 @@ def test_a_glass_gem_and_a_mirror_match_mitsubas_own_spectral_path_render(glass_
     scene = load_mitsuba_xml(glass_box)
     kinds = {m.name: m.kind for m in scene.materials}
     assert kinds["glass"] == "dielectric" and kinds["mirror"] == "conductor"
-    runs = [ours_xyz(scene, 16, seed) for seed in range(SEEDS)]
-    ours = np.stack([blocks(image) for image, _ in runs])
-    theirs = np.stack([blocks(image) for image in mitsuba_xyz(glass_box, 64)])
-    assert_blocks_agree(ours, theirs)
+    results = assert_matches_mitsuba(scene, glass_box, 16, 64)
 
-    gt = compute_ground_truth(scene, runs[0][1])
+    gt = compute_ground_truth(scene, results[0])
     layers = {k: v.data.astype(np.float64) for k, v in gt.layers.items()}
     glass = layers["transmissive"] == 1.0
     mirror = layers["metallic"] == 1.0

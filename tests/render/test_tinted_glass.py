@@ -11,7 +11,6 @@ colour-science computed here, and the same scene without the pane.
 
 from __future__ import annotations
 
-import colour
 import numpy as np
 import pytest
 
@@ -21,8 +20,8 @@ from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.spectra import get_sensors
 
-from ._reference import SEEDS, assert_blocks_agree, blocks, icosahedron_obj, mitsuba_xyz, ours_xyz
-from .test_glass import SMOOTH_GLASS, XML, _thin_fresnel
+from ._reference import SMOOTH_GLASS, assert_matches_mitsuba, bands_xyz, cie_1931, icosahedron_obj
+from .test_glass import XML, _thin_fresnel
 
 #: A green bottle glass: written-out samples, so both renderers read the same spectrum.
 TINT = "360:0.25, 450:0.3, 520:0.85, 560:0.8, 620:0.35, 830:0.3"
@@ -66,14 +65,11 @@ def test_a_tinted_gem_matches_mitsubas_own_spectral_path_render(tinted_box):
     assert glass.tinted and glass.transmittance.startswith("inline:reflectance:")
     both = "specular_reflectance" in tinted_box.read_text()
     assert glass.specular_reflectance.startswith("inline:reflectance:") == both
-    runs = [ours_xyz(scene, 8, seed) for seed in range(SEEDS)]
-    ours = np.stack([blocks(image) for image, _ in runs])
-    theirs = np.stack([blocks(image) for image in mitsuba_xyz(tinted_box, 32)])
-    assert_blocks_agree(ours, theirs, max_t=3.5)
+    results = assert_matches_mitsuba(scene, tinted_box, 8, 32, max_t=3.5)
 
     layers = {
         k: v.data.astype(np.float64)
-        for k, v in compute_ground_truth(scene, runs[0][1]).layers.items()
+        for k, v in compute_ground_truth(scene, results[0]).layers.items()
     }
     gem = layers["transmissive"] == 1.0
     assert gem.sum() > 40
@@ -148,8 +144,7 @@ def test_a_thin_tinted_pane_transmits_its_tint_times_the_thin_film_transmittance
     for pane in (False, True):
         scene = _screen_scene(pane)
         result = render_scene(scene, settings, seed=3)
-        to_xyz = np.asarray(result.meta["to_xyz"]["bands31"], float)
-        bands = np.einsum("hwk,ck->hwc", result.raw["bands31"], to_xyz)
+        bands = bands_xyz(result)
         seen[pane] = {
             "bands31": bands.mean(axis=(0, 1)),
             "spectral": result.raw["spectral"].mean(axis=(0, 1)),
@@ -158,9 +153,7 @@ def test_a_thin_tinted_pane_transmits_its_tint_times_the_thin_film_transmittance
     r = ((1.5 - 1) / (1.5 + 1)) ** 2
     film = (1 - r) / (1 + r)
     assert film == pytest.approx((1 - r) ** 2 / (1 - r**2))
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy()
-    cmfs = cmfs.align(colour.SpectralShape(360, 830, 1))
-    wl, cmf = cmfs.wavelengths, cmfs.values
+    wl, cmf = cie_1931()
     xyz = film * (cmf * _ramp(wl)[:, None]).sum(axis=0) / cmf.sum(axis=0)
     for mode in ("bands31", "spectral"):
         np.testing.assert_allclose(seen[True][mode] / seen[False][mode], xyz, rtol=0.012)
@@ -179,8 +172,7 @@ def test_a_tinted_pane_reflects_untinted():
     seen = {}
     for mirror in (False, True):
         result = render_scene(_screen_scene(mirror, mirror=mirror), settings, seed=4)
-        to_xyz = np.asarray(result.meta["to_xyz"]["bands31"], float)
-        seen[mirror] = np.einsum("hwk,ck->hwc", result.raw["bands31"], to_xyz).mean(axis=(0, 1))
+        seen[mirror] = bands_xyz(result).mean(axis=(0, 1))
     expected = _thin_fresnel(np.cos(np.radians(45)), 1.5)
     assert 0.09 < expected < 0.1
     np.testing.assert_allclose(seen[True] / seen[False], expected, rtol=0.08)
@@ -194,8 +186,7 @@ def test_a_rough_tinted_interface_matches_the_spectral_pass():
     emitter samples the band path is 5 to 17 % too bright."""
     settings = RenderSettings(64, modes=("bands31", "spectral"), max_depth=3)
     result = render_scene(_screen_scene(True, roughness=0.3), settings, seed=6)
-    to_xyz = np.asarray(result.meta["to_xyz"]["bands31"], float)
-    bands = np.einsum("hwk,ck->hwc", result.raw["bands31"], to_xyz).mean(axis=(0, 1))
+    bands = bands_xyz(result).mean(axis=(0, 1))
     np.testing.assert_allclose(bands, result.raw["spectral"].mean(axis=(0, 1)), rtol=0.02)
 
 
@@ -213,15 +204,12 @@ def test_a_pane_with_a_reflection_tint_reflects_it_times_the_thin_film_reflectan
     for mirror in (False, True):
         scene = _screen_scene(mirror, mirror=mirror, reflection=True)
         result = render_scene(scene, settings, seed=5)
-        to_xyz = np.asarray(result.meta["to_xyz"]["bands31"], float)
-        bands = np.einsum("hwk,ck->hwc", result.raw["bands31"], to_xyz)
+        bands = bands_xyz(result)
         seen[mirror] = {
             "bands31": bands.mean(axis=(0, 1)),
             "spectral": result.raw["spectral"].mean(axis=(0, 1)),
         }
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy()
-    cmfs = cmfs.align(colour.SpectralShape(360, 830, 1))
-    wl, cmf = cmfs.wavelengths, cmfs.values
+    wl, cmf = cie_1931()
     tinted = (cmf * _ramp(wl)[:, None]).sum(axis=0) / cmf.sum(axis=0)
     expected = _thin_fresnel(np.cos(np.radians(45)), 1.5) * tinted
     assert np.ptp(tinted) > 0.15  # an untinted or a 0.3-transmittance reflection is far off
@@ -236,8 +224,7 @@ def _xyz_ratio(scene_of, settings: RenderSettings, seed: int) -> dict[str, np.nd
     seen = {}
     for on in (False, True):
         result = render_scene(scene_of(on), settings, seed=seed)
-        to_xyz = np.asarray(result.meta["to_xyz"]["bands31"], float)
-        bands = np.einsum("hwk,ck->hwc", result.raw["bands31"], to_xyz)
+        bands = bands_xyz(result)
         seen[on] = {"bands31": bands.mean(axis=(0, 1)), "spectral": result.raw["spectral"]}
     return {
         mode: seen[True][mode] / seen[False][mode]
@@ -257,9 +244,7 @@ def test_a_tinted_mirror_reflects_its_tint_and_a_tinted_rough_copper_matches_the
     integral, the copper within 0.7 %; without the conductor's tint in the band Fresnel table
     both are 59 % to 207 % off."""
     settings = RenderSettings(32, modes=("bands31", "spectral"), max_depth=3)
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy()
-    cmfs = cmfs.align(colour.SpectralShape(360, 830, 1))
-    wl, cmf = cmfs.wavelengths, cmfs.values
+    wl, cmf = cie_1931()
     tinted = (cmf * _ramp(wl)[:, None]).sum(axis=0) / cmf.sum(axis=0)
     mirror = _xyz_ratio(lambda on: _screen_scene(on, mirror=on, metal="none"), settings, 8)
     for mode in ("bands31", "spectral"):

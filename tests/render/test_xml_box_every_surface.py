@@ -44,24 +44,23 @@ from spectrinsic.scenes.envmaps import envmap_groups
 from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml
 
 from ._reference import (
+    CAMERA_Y,
+    FOV,
     RES,
-    SEEDS,
-    assert_blocks_agree,
-    blocks,
+    assert_matches_mitsuba,
+    box_xml,
     icosahedron_obj,
-    mitsuba_xyz,
     ours_xyz,
 )
 
 #: The leaf: a square of half-side LEAF_HALF at y = LEAF_Y, centred at (LEAF_X, LEAF_Z); its
 #: mask a 3 × 3 checker, corners and centre opaque (the same under any flip of the image).
 LEAF_HALF, LEAF_X, LEAF_Y, LEAF_Z = 0.45, -0.45, -0.5, 1.5
-CAMERA_Y, FOV = -3.5, 40.0
 
-XML = f"""<scene version="3.0.0">
-  <integrator type="path"><integer name="max_depth" value="6"/></integrator>
-  <bsdf type="diffuse" id="white"><spectrum name="reflectance" value="0.7"/></bsdf>
-  <bsdf type="diffuse" id="checker">
+#: The shared box (:func:`box_xml`) with the checker floor, the bump-mapped left wall, the
+#: leaf, the glass ball, a 1-wide mirror off centre and the envmap.
+XML = box_xml(
+    bsdfs="""  <bsdf type="diffuse" id="checker">
     <texture type="bitmap" name="reflectance"><string name="filename" value="checker.png"/>
       <string name="filter_type" value="nearest"/></texture>
   </bsdf>
@@ -80,32 +79,16 @@ XML = f"""<scene version="3.0.0">
     <bsdf type="twosided"><bsdf type="diffuse">
       <spectrum name="reflectance" value="360:0.05, 500:0.1, 550:0.4, 600:0.1, 830:0.05"/>
     </bsdf></bsdf>
-  </bsdf>
-  <bsdf type="dielectric" id="glass"><string name="int_ior" value="bk7"/></bsdf>
-  <bsdf type="conductor" id="mirror"><string name="material" value="none"/></bsdf>
-  <emitter type="envmap"><string name="filename" value="sky.exr"/>
+  </bsdf>""",
+    floor="checker",
+    left="bumpy",
+    mirror=("0.5", "0.3 0.99 1"),
+    emitters="""  <emitter type="envmap"><string name="filename" value="sky.exr"/>
     <float name="scale" value="1.5"/>
     <transform name="to_world"><rotate x="1" angle="90"/></transform>
   </emitter>
-  <shape type="rectangle" id="floor"><ref id="checker"/></shape>
-  <shape type="rectangle" id="ceiling"><ref id="white"/>
-    <transform name="to_world"><rotate x="1" angle="180"/><translate value="0 0 2"/></transform>
-  </shape>
-  <shape type="rectangle" id="looking-glass"><ref id="mirror"/>
-    <transform name="to_world">
-      <scale value="0.5"/><rotate x="1" angle="90"/><translate value="0.3 0.99 1"/>
-    </transform>
-  </shape>
-  <shape type="rectangle" id="back"><ref id="white"/>
-    <transform name="to_world"><rotate x="1" angle="90"/><translate value="0 1 1"/></transform>
-  </shape>
-  <shape type="rectangle" id="left"><ref id="bumpy"/>
-    <transform name="to_world"><rotate y="1" angle="90"/><translate value="-1 0 1"/></transform>
-  </shape>
-  <shape type="rectangle" id="right"><ref id="green"/>
-    <transform name="to_world"><rotate y="1" angle="-90"/><translate value="1 0 1"/></transform>
-  </shape>
-  <shape type="rectangle" id="leaf"><ref id="leafy"/>
+""",
+    inside=f"""  <shape type="rectangle" id="leaf"><ref id="leafy"/>
     <transform name="to_world"><scale value="{LEAF_HALF}"/><rotate x="1" angle="90"/>
       <translate value="{LEAF_X} {LEAF_Y} {LEAF_Z}"/></transform>
   </shape>
@@ -113,25 +96,8 @@ XML = f"""<scene version="3.0.0">
     <string name="filename" value="ball.obj"/><boolean name="face_normals" value="true"/>
     <ref id="glass"/>
     <transform name="to_world"><scale value="0.4"/><translate value="0.25 -0.2 0.4"/></transform>
-  </shape>
-  <shape type="rectangle" id="lamp">
-    <bsdf type="diffuse"><spectrum name="reflectance" value="0"/></bsdf>
-    <transform name="to_world">
-      <scale value="0.3"/><rotate x="1" angle="180"/><translate value="0 0 1.99"/>
-    </transform>
-    <emitter type="area">
-      <spectrum name="radiance" value="360:4, 450:5, 550:6, 650:7, 830:8"/></emitter>
-  </shape>
-  <sensor type="perspective">
-    <float name="fov" value="{FOV}"/>
-    <transform name="to_world">
-      <lookat origin="0, {CAMERA_Y}, 1" target="0, 0, 1" up="0, 0, 1"/></transform>
-    <sampler type="independent"><integer name="sample_count" value="16"/></sampler>
-    <film type="hdrfilm"><integer name="width" value="{RES}"/><integer name="height" value="{RES}"/>
-    </film>
-  </sensor>
-</scene>
-"""
+  </shape>""",
+)
 
 
 def _png(path: Path, grey: np.ndarray) -> None:
@@ -225,9 +191,7 @@ def test_the_box_agrees_with_mitsubas_own_spectral_path_render_per_block(box, cr
     assert maps["leaf"].masked and maps["left"].perturbed and len(envmap_groups(scene)) == 1
     if crossed:
         assert maps["ball"].perturbed and maps["looking-glass"].masked
-    ours = np.stack([blocks(ours_xyz(scene, 16, seed)[0]) for seed in range(SEEDS)])
-    theirs = np.stack([blocks(image) for image in mitsuba_xyz(box, 64)])
-    assert_blocks_agree(ours, theirs)
+    assert_matches_mitsuba(scene, box, 16, 64)
 
 
 def test_the_ground_truth_holds_on_glass_mirror_and_every_pixel(truth):

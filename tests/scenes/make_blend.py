@@ -11,13 +11,16 @@ block that writes MARKER_PATH if Blender ever runs the file's Python.
 
 import math
 import sys
+from pathlib import Path
 
 import bpy
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # run by path under -P: _bpy_parts
+from _bpy_parts import camera, empty_scene, unit_cube  # noqa: E402
+
 out, marker = sys.argv[-4], sys.argv[-3]
 with_camera, unknown_material = sys.argv[-2] == "1", sys.argv[-1] == "1"
-bpy.ops.wm.read_factory_settings(use_empty=True)
-scene = bpy.context.scene
+scene = empty_scene()
 
 
 def material(name, spectrum=None):
@@ -28,25 +31,18 @@ def material(name, spectrum=None):
 
 
 # a unit cube (8 vertices, 6 quads) placed by a transform: world = T(1,2,0.5) Rz(90) S(2,1,1)
-verts = [(x, y, z) for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)]
-quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
-me = bpy.data.meshes.new("cube")
-me.from_pydata(verts, [], quads)
-me.update()
-cube = bpy.data.objects.new("Cube", me)
-cube.data.materials.append(material("munsell:5R 4/14"))
+cube = unit_cube(scene, material("munsell:5R 4/14"))
 paint = material("Paint")
 # a Principled Base Color, read only with colours_from_asset=True (the node exists by default)
 next(n for n in paint.node_tree.nodes if n.type == "BSDF_PRINCIPLED").inputs[
     "Base Color"
 ].default_value = (0.2, 0.3, 0.6, 1.0)
 cube.data.materials.append(paint)
-for i, poly in enumerate(me.polygons):
+for i, poly in enumerate(cube.data.polygons):
     poly.material_index = 0 if i < 4 else 1
 cube.location = (1.0, 2.0, 0.5)
 cube.rotation_euler = (0.0, 0.0, math.pi / 2)
 cube.scale = (2.0, 1.0, 1.0)
-scene.collection.objects.link(cube)
 
 ground_me = bpy.data.meshes.new("ground")
 ground_me.from_pydata(
@@ -76,18 +72,12 @@ light("Panel", "AREA", 50.0, (0, 3, 3), shape="RECTANGLE", size=0.5, size_y=0.25
 light("Sun", "SUN", 3.0, (0, 0, 10), (math.radians(30), 0, 0))
 
 if with_camera:
-    cam_data = bpy.data.cameras.new("Cam")
-    cam_data.lens, cam_data.sensor_width, cam_data.sensor_fit = 35.0, 36.0, "HORIZONTAL"
-    cam = bpy.data.objects.new("Cam", cam_data)
-    cam.location = (1.0, -6.0, 0.5)
+    cam = camera(scene, (1.0, -6.0, 0.5), (64, 48))
+    cam.data.lens, cam.data.sensor_width, cam.data.sensor_fit = 35.0, 36.0, "HORIZONTAL"
     cam.rotation_euler = (math.pi / 2, 0.0, 0.0)  # looks along +y with +z up
-    scene.collection.objects.link(cam)
-    scene.camera = cam
-scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = (
-    64,
-    48,
-    100,
-)
+else:
+    scene.render.resolution_x, scene.render.resolution_y = 64, 48
+    scene.render.resolution_percentage = 100
 
 # a registered text block: Blender runs it on load when auto-execution is allowed
 text = bpy.data.texts.new("autorun.py")

@@ -16,10 +16,12 @@ from pathlib import Path
 
 import bpy
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # run by path under -P: _bpy_parts
+from _bpy_parts import camera, empty_scene, linked, sun  # noqa: E402
+
 args = sys.argv[sys.argv.index("--") + 1 :]
 out, tint = args[0], (args[1] if len(args) > 1 else "1,1,1")
-bpy.ops.wm.read_factory_settings(use_empty=True)
-scene = bpy.context.scene
+scene = empty_scene()
 
 
 def principled(name, metallic, roughness, ior=1.5):
@@ -72,16 +74,9 @@ for i, mat in enumerate(mats):
     if tint == "textured":  # the image's coordinates
         me.uv_layers.new(name="UVMap")
     me.update()
-    obj = bpy.data.objects.new(f"Quad{i}", me)
-    obj.data.materials.append(mat)
-    scene.collection.objects.link(obj)
+    me.materials.append(mat)
+    linked(scene, f"Quad{i}", me)
 
-cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-cam.location = (0.0, 0.0, 8.0)
-scene.collection.objects.link(cam)
-scene.camera = cam
-scene.render.resolution_x, scene.render.resolution_y = 32, 16
-sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
-sun.data.energy = 2.0
-scene.collection.objects.link(sun)
+camera(scene, (0.0, 0.0, 8.0), (32, 16), name="Camera")
+sun(scene).data.energy = 2.0
 bpy.ops.wm.save_as_mainfile(filepath=out)

@@ -31,32 +31,18 @@ from pathlib import Path
 
 import bpy
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # run by path under -P: _bpy_parts
+from _bpy_parts import camera, empty_scene, sun, uv_plane  # noqa: E402
+
 folder = Path(sys.argv[-1])
 
 
 def plane(material):
     """A fresh file of the plane of *material*, a camera and a sun; returns the material."""
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
-    me = bpy.data.meshes.new("plane")
-    me.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)])
-    uv = me.uv_layers.new(name="UVMap")
-    for loop in me.loops:
-        x, y, _ = me.vertices[loop.vertex_index].co
-        uv.data[loop.index].uv = ((x + 1) / 2, (y + 1) / 2)
-    me.update()
-    obj = bpy.data.objects.new("Plane", me)
-    mat = bpy.data.materials.new(material)
-    mat.use_nodes = True
-    obj.data.materials.append(mat)
-    scene.collection.objects.link(obj)
-    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
-    cam.location = (0, 0, 4)
-    scene.collection.objects.link(cam)
-    scene.camera = cam
-    scene.render.resolution_x = scene.render.resolution_y = 16
-    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
-    scene.collection.objects.link(sun)
+    scene = empty_scene()
+    mat = uv_plane(scene, material)
+    camera(scene, (0, 0, 4), (16, 16))
+    sun(scene)
     return mat
 
 

@@ -26,26 +26,14 @@ from pathlib import Path
 import bpy
 from mathutils import Vector
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # run by path under -P: _bpy_parts
+from _bpy_parts import camera, empty_scene, unit_cube  # noqa: E402
+
 folder = Path(sys.argv[-1])
-bpy.ops.wm.read_factory_settings(use_empty=True)
-scene = bpy.context.scene
-
-verts = [(x, y, z) for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)]
-quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
-me = bpy.data.meshes.new("cube")
-me.from_pydata(verts, [], quads)
-me.update()
-cube = bpy.data.objects.new("Cube", me)
-cube.data.materials.append(bpy.data.materials.new("flat:0.8"))
-scene.collection.objects.link(cube)
-
-cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
-cam.location = (3.0, 2.5, 2.2)
+scene = empty_scene()
+unit_cube(scene, bpy.data.materials.new("flat:0.8"))
+cam = camera(scene, (3.0, 2.5, 2.2), (24, 24))
 cam.rotation_euler = (Vector((0, 0, 0)) - cam.location).to_track_quat("-Z", "Y").to_euler()
-scene.collection.objects.link(cam)
-scene.camera = cam
-scene.render.resolution_x = scene.render.resolution_y = 24
-scene.render.resolution_percentage = 100
 bpy.ops.wm.save_as_mainfile(filepath=str(folder / "base.blend"))  # "//" is FOLDER from here on
 
 

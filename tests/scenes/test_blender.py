@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import subprocess
 import sys
 from pathlib import Path
 
@@ -12,7 +11,8 @@ import pytest
 
 from spectrinsic.errors import MissingDependencyError, SceneError
 
-MAKE_BLEND = Path(__file__).with_name("make_blend.py")
+from ._builders import build_blend
+
 #: Blender stores vertex coordinates and matrices in float32.
 FLOAT32 = 1e-6
 
@@ -20,21 +20,15 @@ FLOAT32 = 1e-6
 def make_blend(
     folder: Path, *, camera: bool = True, unknown_material: bool = False
 ) -> tuple[Path, Path]:
+    """``test.blend`` of ``make_blend.py`` in *folder*, and the file its text block would write
+    if Blender ran it."""
     out, marker = folder / "test.blend", folder / "autorun-ran.txt"
-    args = [str(out), str(marker), "1" if camera else "0", "1" if unknown_material else "0"]
-    proc = subprocess.run(
-        [sys.executable, "-P", str(MAKE_BLEND), "--", *args],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert proc.returncode == 0 and out.is_file(), proc.stderr[-2000:]
-    return out, marker
+    options = str(marker), "1" if camera else "0", "1" if unknown_material else "0"
+    return build_blend("make_blend.py", out, *options), marker
 
 
 @pytest.fixture(scope="module")
 def blend_file(tmp_path_factory):
-    pytest.importorskip("bpy", reason="the optional 'blender' extra (bpy) is not installed")
     return make_blend(tmp_path_factory.mktemp("blend"))
 
 
@@ -118,7 +112,6 @@ def test_file_scripts_never_run(blend_file, imported):
 
 @pytest.mark.blender
 def test_blend_without_camera(tmp_path):
-    pytest.importorskip("bpy", reason="the optional 'blender' extra (bpy) is not installed")
     from spectrinsic.scenes.blender import load_blend
 
     path, _ = make_blend(tmp_path, camera=False)
@@ -128,7 +121,6 @@ def test_blend_without_camera(tmp_path):
 
 @pytest.mark.blender
 def test_blend_with_unknown_spectrum(tmp_path):
-    pytest.importorskip("bpy", reason="the optional 'blender' extra (bpy) is not installed")
     from spectrinsic.scenes.blender import load_blend
 
     path, _ = make_blend(tmp_path, unknown_material=True)

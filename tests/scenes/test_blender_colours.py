@@ -5,32 +5,23 @@ named when a scene is left without light. The files are built with bpy in one su
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 from PIL import Image
 
-MAKE = Path(__file__).with_name("make_colour_blends.py")
+from ._builders import build_blend
+
 #: The texture's texels (bottom row first once read: Blender's v = 0).
 PIXELS = np.array([[[255, 128, 0], [64, 32, 16]], [[0, 0, 255], [200, 100, 50]]], np.uint8)
 
 
 @pytest.fixture(scope="module")
 def blends(tmp_path_factory) -> Path:
-    pytest.importorskip("bpy", reason="the optional 'blender' extra (bpy) is not installed")
     folder = tmp_path_factory.mktemp("colours")
     Image.fromarray(PIXELS).save(folder / "texel.png")
-    proc = subprocess.run(
-        [sys.executable, "-P", str(MAKE), "--", str(folder)],
-        capture_output=True,
-        text=True,
-        timeout=180,
-    )
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    return folder
+    return build_blend("make_colour_blends.py", folder)
 
 
 def load(path: Path, **options):

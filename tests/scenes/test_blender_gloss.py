@@ -2,27 +2,15 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
-from pathlib import Path
-
 import pytest
 
-MAKE = Path(__file__).with_name("make_blend_gloss.py")
+from ._builders import build_blend
 
 
 def test_principled_metallic_roughness_and_ior(tmp_path):
-    pytest.importorskip("bpy", reason="the optional 'blender' extra (bpy) is not installed")
     from spectrinsic.scenes.blender import load_blend
 
-    out = tmp_path / "gloss.blend"
-    proc = subprocess.run(
-        [sys.executable, "-P", str(MAKE), "--", str(out)],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert proc.returncode == 0 and out.is_file(), proc.stderr[-2000:]
+    out = build_blend("make_blend_gloss.py", tmp_path / "gloss.blend")
     mats = {m.name: m for m in load_blend(out).materials}
     copper, coat, matte = mats["Copper"], mats["munsell:5R 4/14"], mats["flat:0.5"]
     assert (copper.kind, copper.metal, copper.spectrum) == ("conductor", "Cu", "flat:0")

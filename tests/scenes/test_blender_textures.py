@@ -3,8 +3,6 @@ built with bpy in a subprocess, its image written here with PIL."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +11,8 @@ from PIL import Image
 
 from spectrinsic.scenes.image_textures import corner_spectra
 
-MAKE = Path(__file__).with_name("make_textured_blend.py")
+from ._builders import build_blend
+
 #: Blender stores UVs in float32.
 FLOAT32 = 1e-6
 PIXELS = np.array([[[230, 40, 25], [20, 90, 200]], [[20, 90, 200], [200, 200, 30]]], np.uint8)
@@ -21,19 +20,13 @@ PIXELS = np.array([[[230, 40, 25], [20, 90, 200]], [[20, 90, 200], [200, 200, 30
 
 def _blend(folder: Path, pack: bool) -> Path:
     Image.fromarray(PIXELS).save(folder / "checker.png")
-    out = folder / "plane.blend"
-    args = [str(out), str(folder / "checker.png"), "1" if pack else "0"]
-    proc = subprocess.run(
-        [sys.executable, "-P", str(MAKE), "--", *args], capture_output=True, text=True, timeout=120
-    )
-    assert proc.returncode == 0 and out.is_file(), proc.stderr[-2000:]
-    return out
+    png = str(folder / "checker.png")
+    return build_blend("make_textured_blend.py", folder / "plane.blend", png, "1" if pack else "0")
 
 
 @pytest.mark.blender
 @pytest.mark.parametrize("pack", [False, True], ids=["file", "packed"])
 def test_an_image_texture_node_becomes_an_exact_texture_on_the_uv_map(tmp_path, pack):
-    pytest.importorskip("bpy", reason="the optional 'blender' extra (bpy) is not installed")
     import colour
 
     from spectrinsic.scenes.blender import load_blend

@@ -13,8 +13,6 @@ from __future__ import annotations
 
 import hashlib
 import math
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +21,8 @@ import pytest
 from spectrinsic.errors import SceneError
 from spectrinsic.mitsuba_import import import_mitsuba
 
-MAKE = Path(__file__).with_name("make_world_blend.py")
+from ._builders import build_blend
+
 #: The maps' size (rows, columns).
 ROWS, COLS = 32, 64
 #: A map of value 1.5 + direction against Mitsuba's bilinear lookup at its own rows (i / (H − 1),
@@ -66,21 +65,13 @@ def write_map(path: Path, image: np.ndarray) -> None:
 
 @pytest.fixture(scope="module")
 def worlds(tmp_path_factory) -> Path:
-    pytest.importorskip("bpy", reason="the optional 'blender' extra (bpy) is not installed")
     root = tmp_path_factory.mktemp("world")
     folder = root / "scene"
     (folder / "maps").mkdir(parents=True)
     write_map(folder / "maps" / "patch.exr", patch_map())
     write_map(folder / "maps" / "smooth.exr", 1.5 + texel_directions(ROWS, COLS))
     write_map(root / "outside.exr", patch_map())
-    proc = subprocess.run(
-        [sys.executable, "-P", str(MAKE), "--", str(folder)],
-        capture_output=True,
-        text=True,
-        timeout=180,
-    )
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    return folder
+    return build_blend("make_world_blend.py", folder)
 
 
 def load(path: Path, **options):

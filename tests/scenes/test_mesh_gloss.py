@@ -8,6 +8,8 @@ from trimesh.visual.material import PBRMaterial
 
 from spectrinsic.scenes.meshes import load_mesh_scene
 
+from ._builders import gltf_with_material
+
 
 def _box(name: str, offset: float, material: PBRMaterial | None) -> trimesh.Trimesh:
     box = trimesh.creation.box((1.0, 1.0, 1.0))
@@ -66,20 +68,8 @@ def test_an_obj_usemtl_without_a_library_keeps_its_names(tmp_path):
 
 def _gltf_with(tmp_path, extensions: dict, pbr: dict | None = None):
     """A .gltf of one box whose material 'glass' carries *extensions* (and *pbr* factors)."""
-    import json
-
-    scene = trimesh.Scene()
-    scene.add_geometry(_box("pane", 0.0, PBRMaterial(name="glass", roughnessFactor=0.0)), "pane")
-    files = scene.export(file_type="gltf")
-    doc = json.loads(files.pop("model.gltf"))
-    for name, data in files.items():
-        (tmp_path / name).write_bytes(data)
-    (material,) = doc["materials"]
-    material["extensions"] = extensions
-    material["pbrMetallicRoughness"] = pbr or {"roughnessFactor": 0.0}
-    path = tmp_path / "glass.gltf"
-    path.write_text(json.dumps(doc))
-    return path
+    box = _box("pane", 0.0, PBRMaterial(name="glass", roughnessFactor=0.0))
+    return gltf_with_material(tmp_path, box, extensions, pbr or {})
 
 
 def test_gltf_transmission_1_is_clear_glass_thin_without_a_volume(tmp_path):

@@ -1,5 +1,6 @@
-"""Mitsuba 3 XML scenes (issue 32): a Cornell box written as XML against the same box written
-as YAML by hand, full ground truth, and one-line refusals."""
+"""Mitsuba 3 XML scenes (issue 32): a Cornell box written as XML (its walls those of
+``_cornell.py``) against the same box written as YAML by hand, full ground truth, and one-line
+refusals."""
 
 from __future__ import annotations
 
@@ -14,6 +15,8 @@ from spectrinsic.cli import main
 from spectrinsic.errors import SceneError
 from spectrinsic.scenes import load_scene
 from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml
+
+from ._cornell import box_walls
 
 GREEN = {"wavelengths": [400, 500, 550, 600, 700], "values": [0.1, 0.4, 0.5, 0.2, 0.1]}
 LAMP = {"wavelengths": [400, 450, 500, 550, 600, 650, 700], "values": [4, 5, 6, 6, 7, 7, 8]}
@@ -30,19 +33,7 @@ XML = f"""<scene version="3.0.0">
   <bsdf type="diffuse" id="red"><rgb name="reflectance" value="0.6, 0.05, 0.05"/></bsdf>
   <bsdf type="twosided" id="green"><bsdf type="diffuse">
     <spectrum name="reflectance" value="{_spectrum(GREEN)}"/></bsdf></bsdf>
-  <shape type="rectangle" id="floor"><ref id="white"/></shape>
-  <shape type="rectangle" id="ceiling"><ref id="white"/>
-    <transform name="to_world"><rotate x="1" angle="180"/><translate value="0 0 2"/></transform>
-  </shape>
-  <shape type="rectangle" id="back"><ref id="white"/>
-    <transform name="to_world"><rotate x="1" angle="90"/><translate x="0" y="1" z="1"/></transform>
-  </shape>
-  <shape type="rectangle" id="left"><ref id="red"/>
-    <transform name="to_world"><rotate y="1" angle="90"/><translate value="-1 0 1"/></transform>
-  </shape>
-  <shape type="rectangle" id="right"><ref id="green"/>
-    <transform name="to_world"><rotate y="1" angle="-90"/><translate value="1 0 1"/></transform>
-  </shape>
+{box_walls()}
   <shape type="obj" id="box"><string name="filename" value="box.obj"/><ref id="white"/>
     <transform name="to_world"><translate value="0.3 0.2 0"/></transform>
   </shape>

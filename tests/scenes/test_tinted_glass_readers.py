@@ -22,6 +22,7 @@ from spectrinsic.scenes.mitsuba_xml import load_mitsuba_xml
 from spectrinsic.scenes.model import Material
 from spectrinsic.scenes.scene_reader import load_scene
 
+from ._builders import build_blend, gltf_with_material
 from .test_io import BASE, write
 
 
@@ -210,18 +211,9 @@ def _gltf(tmp_path, extensions: dict, pbr: dict, textured: bool = False):
     uv = np.random.default_rng(0).random((len(box.vertices), 2)) if textured else None
     material = PBRMaterial(name="glass", baseColorTexture=image)
     box.visual = trimesh.visual.TextureVisuals(uv=uv, material=material)
-    scene = trimesh.Scene()
-    scene.add_geometry(box, "pane")
-    files = scene.export(file_type="gltf")
-    doc = json.loads(files.pop("model.gltf"))
-    for name, data in files.items():
-        (tmp_path / name).write_bytes(data)
-    (entry,) = doc["materials"]
-    entry["extensions"] = extensions
-    entry["pbrMetallicRoughness"] = entry.get("pbrMetallicRoughness", {}) | pbr
-    assert textured == ("baseColorTexture" in entry["pbrMetallicRoughness"])
-    path = tmp_path / "glass.gltf"
-    path.write_text(json.dumps(doc))
+    path = gltf_with_material(tmp_path, box, extensions, pbr)
+    written = json.loads(path.read_text())["materials"][0]["pbrMetallicRoughness"]
+    assert textured == ("baseColorTexture" in written)
     return path
 
 
@@ -384,23 +376,10 @@ def test_a_blend_file_reads_a_principled_tint_and_refuses_a_textured_one(tmp_pat
     """Through bpy: Base Color (0.25, 0.5625, 0.0625) under Transmission 1 is the
     transmittance ``rgb:0.5,0.75,0.25`` (its square roots, exact in float32); an Image Texture
     feeding the Base Color is refused in one line, rc 2 before any work."""
-    pytest.importorskip("bpy", reason="the optional 'blender' extra (bpy) is not installed")
-    import subprocess
-    import sys
-    from pathlib import Path
-
     from spectrinsic.scenes.blender import load_blend
 
-    make = Path(__file__).with_name("make_blend_gloss.py")
     for tint in ("0.25,0.5625,0.0625", "textured"):
-        out = tmp_path / f"{tint[:4]}.blend"
-        proc = subprocess.run(
-            [sys.executable, "-P", str(make), "--", str(out), tint],
-            capture_output=True,
-            text=True,
-            timeout=120,
-        )
-        assert proc.returncode == 0 and out.is_file(), proc.stderr[-2000:]
+        out = build_blend("make_blend_gloss.py", tmp_path / f"{tint[:4]}.blend", tint)
         if tint == "textured":
             err = _refused(capsys, out, tmp_path / "out")
             assert "'Glass'" in err and "fed by a node" in err
@@ -425,23 +404,11 @@ def test_a_blend_file_reads_a_glass_bsdf_color_as_both_tints_and_refuses_a_textu
     """Through bpy: a Glass BSDF of Color (0.25, 0.5625, 0.0625) is glass whose transmittance
     and reflection tint are both that colour; an Image Texture feeding its Color is refused in
     one line, rc 2 before any work."""
-    pytest.importorskip("bpy", reason="the optional 'blender' extra (bpy) is not installed")
-    import subprocess
-    import sys
-    from pathlib import Path
-
     from spectrinsic.scenes.blender import load_blend
 
-    make = Path(__file__).with_name("make_blend_gloss.py")
     for tint in ("0.25,0.5625,0.0625", "textured"):
         out = tmp_path / f"glass-{tint[:4]}.blend"
-        proc = subprocess.run(
-            [sys.executable, "-P", str(make), "--", str(out), f"glass-bsdf:{tint}"],
-            capture_output=True,
-            text=True,
-            timeout=120,
-        )
-        assert proc.returncode == 0 and out.is_file(), proc.stderr[-2000:]
+        build_blend("make_blend_gloss.py", out, f"glass-bsdf:{tint}")
         if tint == "textured":
             err = _refused(capsys, out, tmp_path / "out")
             assert "'Glass'" in err and "Color fed by a node" in err

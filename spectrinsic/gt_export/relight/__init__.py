@@ -15,8 +15,10 @@ camera layers, noise maps and the chapter-4 matrices, all for the new lights.
 * Noise: the transport keeps the independent batches apart, so the relit sample's noise maps
   and ``meta.json["noise"]`` are measured from the spread of its own relit batches.
 * Not relit: the spectral Monte Carlo image (it samples wavelengths; no band transport
-  describes it) and direct-only renders; a relit sample has neither, and its
-  ``meta.json["render"]["relit"]`` names the source sample and the new lights.
+  describes it) and direct-only renders; a relit sample has neither, so its
+  ``meta.json["render"]`` holds no ``spectral_spp``/``spectral_batch_spp`` (its ``spp`` and
+  ``batches`` are the transport's), and its ``relit`` record names the source sample (and
+  the hash of its ``meta.json``, where the source's counts stand) and the new lights.
 """
 
 from __future__ import annotations
@@ -45,7 +47,6 @@ from ..layers.records import reference_mode
 from ..sample import META_NAME, SCENE_NAME, file_sha256
 from ..sample.integrity import replaceable_sample
 from ..sample.meta import read_meta
-from ..sample.render_spp import current_render_record
 from ..sample.sensor import model_from_meta
 from ..sample.transport_exr import read_transport
 from ..sample.working_view import space_of
@@ -71,8 +72,16 @@ log = logging.getLogger(__name__)
 
 #: AOV layers read back from ``geometry.exr`` (coverage comes from ``transport.exr``).
 _AOV_LAYERS = ("depth", "normals", "material_id", "object_id", "mask")
-#: Render metadata of the source that no longer describes a relit render.
-_DROPPED_META = ("direct_modes", "noise_target", "transport")
+#: Render metadata of the source that no longer describes a relit render: the spectral pass's
+#: counts among them, as a relit sample holds no spectral image (its images are composed from
+#: the transport, whose ``spp`` and ``batches`` the record keeps).
+_DROPPED_META = (
+    "direct_modes",
+    "noise_target",
+    "transport",
+    "spectral_spp",
+    "spectral_batch_spp",
+)
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -193,8 +202,7 @@ def relit_scene(
 def _render_meta(
     meta: Mapping[str, Any], transport: LightTransport, relit: Mapping[str, Any]
 ) -> dict[str, Any]:
-    # a sample written before issue 46 held one batch's spectral_spp: relit, it holds the total
-    record = current_render_record(meta.get("render") or {})
+    record = meta.get("render") or {}
     base = {k: v for k, v in record.items() if k not in _DROPPED_META}
     variants = base.get("variants") or {}
     base["variants"] = {m: v for m, v in variants.items() if m in transport.modes}

@@ -16,7 +16,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["RenderSpp", "render_spp", "current_render_record"]
+__all__ = ["RenderSpp", "render_spp"]
 
 
 @dataclass(frozen=True)
@@ -33,7 +33,8 @@ class RenderSpp:
         One batch's count (``spp / batches``).
     spectral_spp
         Total over the batches of the spectral reference pass, ``None`` where it was not
-        rendered (a relit sample keeps its source's, though it holds no spectral image).
+        rendered (a relit sample's: its images are composed from the transport, and its
+        record keeps no spectral count).
     spectral_batch_spp
         One batch's count of the spectral pass.
     """
@@ -61,15 +62,3 @@ def render_spp(record: Mapping[str, Any]) -> RenderSpp:
         spectral, spectral_batch = spectral * batches, spectral
     batch_spp = _int(record, "batch_spp") or (None if spp is None else spp // batches)
     return RenderSpp(spp, batches, batch_spp, spectral, spectral_batch)
-
-
-def current_render_record(record: Mapping[str, Any]) -> dict[str, Any]:
-    """*record* in the form written now: an old-form ``spectral_spp`` made the total, with
-    ``spectral_batch_spp`` beside it where there are batches (as
-    :func:`~spectrinsic.render.merge_batches` writes them); a current record unchanged."""
-    out = dict(record)
-    counts = render_spp(record)
-    if "spectral_spp" in out and counts.batches > 1:
-        out["spectral_spp"] = counts.spectral_spp
-        out["spectral_batch_spp"] = counts.spectral_batch_spp
-    return out

@@ -10,17 +10,7 @@ from pathlib import Path
 import pytest
 
 from spectrinsic.errors import WriteError
-
-USER_TEXT = "the user's own file\n"
-
-
-@pytest.fixture
-def outside(tmp_path: Path) -> Path:
-    """A user's file outside the dataset folder."""
-    path = tmp_path / "elsewhere" / "precious.txt"
-    path.parent.mkdir()
-    path.write_text(USER_TEXT)
-    return path
+from tests.conftest import USER_TEXT
 
 
 def test_a_rerun_of_the_gallery_and_card_leaves_hard_linked_files_alone(

@@ -20,6 +20,7 @@ from spectrinsic.gt_export.folders.outfolder import LOCK_NAME
 pytest.importorskip("webdataset", reason="the shards extra (webdataset) is in the dev extra")
 
 from spectrinsic.gt_export.dataset.shards import write_shards  # noqa: E402
+from tests.conftest import one_line_error
 
 HOLD = """
 import fcntl, os, sys, time
@@ -30,21 +31,13 @@ time.sleep(60)
 """
 
 
-def _one_line(capsys, *needles: str) -> str:
-    err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0 and "Traceback" not in err, err
-    for needle in needles:
-        assert needle in err, err
-    return err
-
-
 def test_a_listed_sample_that_is_missing_is_refused_before_out_exists(
     built, tmp_path_factory, capsys
 ):
     shutil.rmtree(built / "a-one")
     out = tmp_path_factory.mktemp("export") / "shards"
     assert main(["-q", "export", str(built), "--out", str(out)]) == 2
-    _one_line(capsys, "a-one", "missing", "manifest.json")
+    one_line_error(capsys, "a-one", "missing", "manifest.json")
     assert not out.exists()
     with pytest.raises(DatasetError, match="a-one"):
         write_shards(built, out)
@@ -58,7 +51,7 @@ def test_a_dataset_held_by_a_build_is_refused(built, tmp_path_factory, capsys):
         assert holder.stdout is not None and holder.stdout.readline().strip() == "held"
         out = tmp_path_factory.mktemp("export") / "shards"
         assert main(["-q", "export", str(built), "--out", str(out)]) == 2
-        _one_line(capsys, "in use by another spectrinsic run")
+        one_line_error(capsys, "in use by another spectrinsic run")
         assert not out.exists()
         with pytest.raises(FolderLockedError):
             write_shards(built, out)

@@ -5,9 +5,6 @@ from __future__ import annotations
 
 import json
 import os
-import subprocess
-import sys
-import time
 from pathlib import Path
 
 import pytest
@@ -23,9 +20,10 @@ from spectrinsic.gt_export.folders.outfolder import (
     folder_lock,
     output_folder,
 )
+from tests.conftest import TINY_BUILD
+from tests.gt_export.folders._holder import held_lock
 
 #: Longest wait for the helper process to take the lock, seconds.
-HOLDER_START_S = 60.0
 
 
 def _marker(out: Path) -> dict:
@@ -86,38 +84,13 @@ def test_a_refused_run_under_the_lock_leaves_no_folder(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
-def _hold_lock(folder: Path) -> subprocess.Popen:
-    """A second process holding *folder*'s lock until its stdin closes."""
-    code = (
-        "import sys; from pathlib import Path; from spectrinsic.gt_export.folders.outfolder import folder_lock\n"
-        f"with folder_lock(Path({str(folder)!r})):\n"
-        "    print('held', flush=True); sys.stdin.read()\n"
-    )
-    proc = subprocess.Popen(
-        [sys.executable, "-P", "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
-    )
-    deadline = time.monotonic() + HOLDER_START_S
-    assert proc.stdout is not None and proc.stdout.readline().strip() == "held"
-    assert time.monotonic() < deadline
-    return proc
-
-
-def _release(proc: subprocess.Popen) -> None:
-    assert proc.stdin is not None
-    proc.stdin.close()
-    assert proc.wait(timeout=HOLDER_START_S) == 0
-
-
 def test_a_second_process_is_refused_with_the_holders_pid_host_and_start(tmp_path):
     folder = tmp_path / "ds"
-    proc = _hold_lock(folder)
-    try:
+    with held_lock(folder) as proc:
         with pytest.raises(FolderLockedError) as info, folder_lock(folder):
             pass
         message = str(info.value)
         assert f"pid {proc.pid} on " in message and "started 20" in message and "UTC" in message
-    finally:
-        _release(proc)
     with folder_lock(folder):  # released when the holder ended
         pass
 
@@ -127,28 +100,15 @@ def test_every_writing_verb_refuses_a_held_folder_in_one_line_before_any_work(
     tmp_path, capsys, verb
 ):
     out = tmp_path / "out"
-    proc = _hold_lock(out)
-    try:
+    with held_lock(out) as proc:
         argv = {
-            "dataset": [
-                "dataset",
-                "--preset",
-                "preview",
-                "--resolution",
-                "16x16",
-                "--spp",
-                "2",
-                "--only",
-                "obj-apple__v0__white",
-            ],
+            "dataset": ["dataset", *TINY_BUILD, "--only", "obj-apple__v0__white"],
             "export": ["export", str(_dataset(tmp_path))],
             "render": ["render", "obj-apple", "--width", "16", "--height", "16"],
             "study": ["study", "reconstruction-error"],
         }[verb]
         rc = main(["-q", *argv, "--out", str(out)])
         err = capsys.readouterr().err.strip()
-    finally:
-        _release(proc)
     assert rc == 2 and len(err.splitlines()) == 1, err
     assert "in use by another spectrinsic run" in err and f"pid {proc.pid}" in err
     assert (

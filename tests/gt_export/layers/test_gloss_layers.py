@@ -12,6 +12,7 @@ from spectrinsic.gt_export import check_dataset, export_sample, write_manifest
 from spectrinsic.gt_export.layers import LayerSettings, compute_ground_truth, identities
 from spectrinsic.render import RenderSettings, render_batches
 from spectrinsic.scenes.model import Material
+from tests.gt_export.layers._checks import assert_finite_and_light_nonnegative
 
 #: float32 round-off of the stored layers (as test_ground_truth_physics).
 FLOAT32_RTOL = 1e-5
@@ -54,16 +55,7 @@ def test_d_identity_with_the_specular_term_raw_denoised_and_per_camera(glossy_ro
             rtol=FLOAT32_RTOL,
             atol=FLOAT32_RTOL * np.abs(image).max(),
         )
-    for name, layer in gt.layers.items():
-        assert np.isfinite(layer.data).all(), name
-        if name.split("/")[0] in (
-            "shading",
-            "shading_raw",
-            "shading_camera",
-            "shading_grey",
-            "illuminant",
-        ):
-            assert (layer.data >= 0).all(), name
+    assert_finite_and_light_nonnegative(gt)
 
 
 def test_material_maps_and_metal_pixels(glossy_room):

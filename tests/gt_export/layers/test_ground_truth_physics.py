@@ -16,6 +16,7 @@ from spectrinsic.scenes.model import Material, Scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as WL
 from spectrinsic.spectra import get_sensors, get_spectrum, responses, xyz_to_linear_srgb
 from spectrinsic.spectra.working_space import DEFAULT_WORKING_SPACE, working_space
+from tests.gt_export.layers._checks import assert_finite_and_light_nonnegative
 
 #: Band integration (31 box bands of 10 nm) against 1 nm integration of smooth spectra.
 BAND_RTOL = 5e-3
@@ -122,17 +123,7 @@ def test_d_e_identity_and_shading_sign_in_a_room_with_interreflections(make_room
         np.testing.assert_allclose(
             refl * shading + res, image, rtol=FLOAT32_RTOL, atol=FLOAT32_RTOL * np.abs(image).max()
         )
-    for name, layer in gt.layers.items():
-        assert np.isfinite(layer.data).all(), name
-        if name.split("/")[0] in (
-            "shading",
-            "shading_raw",
-            "shading_camera",
-            "shading_grey",
-            "illuminant",
-            "light_share",
-        ):
-            assert (layer.data >= 0).all(), name
+    assert_finite_and_light_nonnegative(gt)
     share = gt.layers["light_share"].data
     lit = gt.layers["shading_grey"].data > 0
     np.testing.assert_allclose(share[lit].sum(axis=-1), 1.0, atol=1e-5)

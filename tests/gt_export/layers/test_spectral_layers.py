@@ -21,11 +21,11 @@ from spectrinsic.gt_export.dataset.loader import filter_residual_share, working_
 from spectrinsic.gt_export.layers import LayerSettings, compute_ground_truth, identities
 from spectrinsic.gt_export.relight import relight, relit_scene
 from spectrinsic.render import RenderSettings, render_batches, render_scene
-from spectrinsic.render.transport_render import render_transport_batches
-from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
+from spectrinsic.scenes.model import Material
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS as WL
 from spectrinsic.spectra import get_sensors, get_spectrum, responses
-from tests.conftest import quad
+from tests.conftest import corner_scene
+from tests.gt_export._builders import render_transport_sample
 
 #: Issue 30: the per-band identity and the band reflectance, within 1e-5.
 TOL = 1e-5
@@ -73,38 +73,15 @@ def test_a_plane_under_a_narrow_led_has_the_exact_band_identity_and_reflectance(
     assert spectral == [dict(zip(("image", "reflectance", "shading", "residual"), SPECTRAL))]
 
 
-def _facing_planes(first: str, second: str, light: str, power: float, size: int) -> Scene:
-    """A plane *first* (x = 0, facing +x) beside a far larger plane *second* (y = 1, facing
-    −y, x ∈ [0, 2000], |z| ≤ 2000), which each see the other. A distant light along +y lights
-    *second* head-on and grazes *first* (cos θ = 0). The camera sees *first* alone."""
-    a_v, a_f = quad((0, -3, -3), (0, 0, 6), (0, 4, 0))
-    b_v, b_f = quad((0, 1, -2000), (2000, 0, 0), (0, 0, 4000))
-    return Scene(
-        name="facing",
-        meshes=(
-            Mesh("first", a_v, a_f, np.zeros(2, np.int64), object_id=0),
-            Mesh("second", b_v, b_f, np.ones(2, np.int64), object_id=1),
-        ),
-        materials=(Material("first", first), Material("second", second)),
-        lights=(Light("directional", light, power, direction=(0.0, 1.0, 0.0)),),
-        camera=Camera(
-            origin=(1.0, -0.5, 0.0),
-            target=(0.0, 0.2, 0.0),
-            up=(0, 0, 1),
-            fov_deg=20,
-            width=size,
-            height=size,
-        ),
-    )
-
-
 def test_b_band_shading_of_one_bounce_between_coloured_planes_is_the_closed_form():
     """Seen from a point of the first plane, the half-plane covers every direction with
     d_x > 0 and d_y > 0: half the cosine-weighted hemisphere, form factor F = 1/2 (the finite
     plane misses < 1e-3 of it). With depth 3 the first plane receives only that bounce:
     ``E_k = ρ_second,k · P ∫ L B_k dλ · F`` per band and ``W_k = E_k / π``."""
     light, power = "cie:FL11", 3.0
-    scene = _facing_planes("munsell:5PB 4/10", "munsell:5R 5/12", light, power, size=16)
+    # the corner's coloured wall far larger (|z| ≤ 2000): the form factor is 1/2 to < 1e-3
+    first = Material("first", "munsell:5PB 4/10")
+    scene = corner_scene(first, "munsell:5R 5/12", light=light, power=power, wall_half=2000)
     settings = RenderSettings(spp=64, max_depth=3, modes=("bands31",))
     gt = compute_ground_truth(
         scene, render_scene(scene, settings, seed=7), LayerSettings(spectral_layers=True)
@@ -138,17 +115,10 @@ def room_sample(tmp_path_factory, make_room):
     out = tmp_path_factory.mktemp("spectral")
     scene = make_room(size=12)
     settings = RenderSettings(spp=4, modes=("rgb3", "bands31"), batches=2, max_depth=4)
-    transport, result = render_transport_batches(scene, settings, seed=5)
-    sample = export_sample(
-        out,
-        scene,
-        result,
-        LayerSettings(denoise=True, spectral_layers=True),
-        sample_id="room__v0__two",
-        config={"test": "spectral"},
-        seed=5,
-        transport=transport,
-    )
+    sample, _, _ = render_transport_sample(
+        out, scene, settings, seed=5, sample_id="room__v0__two", config={"test": "spectral"},
+        layers=LayerSettings(denoise=True, spectral_layers=True),
+    )  # fmt: skip
     return out, scene, sample, settings
 
 

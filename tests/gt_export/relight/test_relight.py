@@ -7,9 +7,9 @@ usual path. A relit sample must equal it to float rounding in every layer.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import shutil
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +25,8 @@ from spectrinsic.gt_export.sample.render_spp import render_spp
 from spectrinsic.gt_export.sample.transport_exr import TRANSPORT_NAME
 from spectrinsic.render import RenderSettings, count_passes, render_batches
 from spectrinsic.render.transport_render import render_transport_batches
+from tests.gt_export._builders import render_transport_sample
+from tests.gt_export.folders._holder import held_lock
 
 #: Issue 20: a relit layer and the direct render's agree to float rounding, 1e-5 of the
 #: layer's largest magnitude (float32 storage, and ē multiplied after the path sum, not inside).
@@ -47,16 +49,9 @@ def built(tmp_path_factory, make_room):
     """A two-light room sample stored with its transport (2 batches, denoised, two cameras)."""
     out = tmp_path_factory.mktemp("relight")
     scene = make_room(size=16)
-    transport, result = render_transport_batches(scene, SETTINGS, seed=SEED)
-    sample = export_sample(
-        out,
-        scene,
-        result,
-        LayerSettings(denoise=True),
-        sample_id="room__v0__two",
-        config=CONFIG,
-        seed=SEED,
-        transport=transport,
+    layers = LayerSettings(denoise=True)
+    sample, _, _ = render_transport_sample(
+        out, scene, SETTINGS, seed=SEED, sample_id="room__v0__two", config=CONFIG, layers=layers
     )
     return out, scene, sample
 
@@ -163,18 +158,11 @@ def test_relit_sample_equals_a_direct_render_with_the_passes(tmp_path, make_room
     relights as exactly, against a direct render with the same passes."""
     scene = make_room(size=12)
     settings = SETTINGS.with_options(integrator="passes", spp=2)
-    transport, result = render_transport_batches(scene, settings, seed=SEED)
+    sample, transport, result = render_transport_sample(
+        tmp_path, scene, settings, seed=SEED, sample_id="room__v0__passes", config=CONFIG,
+        layers=LayerSettings(denoise=True),
+    )  # fmt: skip
     assert "single" not in transport.seconds and result.meta.get("integrator") != "single"
-    sample = export_sample(
-        tmp_path,
-        scene,
-        result,
-        LayerSettings(denoise=True),
-        sample_id="room__v0__passes",
-        config=CONFIG,
-        seed=SEED,
-        transport=transport,
-    )
     _relit_and_direct(tmp_path, scene, sample, settings, "passes")
 
 
@@ -307,7 +295,14 @@ def test_a_sample_written_before_issue_46_relights_as_a_new_one(built, tmp_path)
     assert [k for k in relit_new if k != META_NAME and relit_old[k] != relit_new[k]] == []
     new_meta = _meta_less_source_hash(relit_new[META_NAME])
     assert _meta_less_source_hash(relit_old[META_NAME]) == new_meta
-    assert new_meta["render"]["spectral_spp"] == 2 * new_meta["render"]["spectral_batch_spp"]
+    # no spectral pass is relit: the record counts the transport's batches and no spectral pass
+    source_meta = json.loads((sample / META_NAME).read_text())
+    assert "image_spectral" in source_meta["layers"] and "image_spectral" not in new_meta["layers"]
+    source = render_spp(source_meta["render"])
+    assert source.spectral_spp == SETTINGS.spp
+    assert render_spp(new_meta["render"]) == dataclasses.replace(
+        source, spectral_spp=None, spectral_batch_spp=None
+    )
 
 
 def test_relight_refuses_bad_requests_before_writing(built, tmp_path):
@@ -418,56 +413,24 @@ def test_cheap_augmentation_leaves_out_denoising_and_cameras_only(built):
 def test_cli_follows_the_out_rule_and_the_lock_of_every_writing_verb(built, tmp_path, capsys):
     """--out inside a dataset is refused, and so is one whose folder another run holds: one
     line, status 2, before any relighting, and nothing written."""
-    import subprocess
-
     from spectrinsic.cli import main
 
     _, _, sample = built
+
+    def refused(out: Path) -> tuple[int, str]:
+        rc = main(["-q", "relight", str(sample), "--light", "0=cie:D65", "--out", str(out)])
+        return rc, capsys.readouterr().err.strip()
+
     dataset = tmp_path / "ds"
     dataset.mkdir()
     (dataset / "manifest.json").write_text(json.dumps({"format_version": 1, "config_hash": "h"}))
-    rc = main(
-        [
-            "-q",
-            "relight",
-            str(sample),
-            "--light",
-            "0=cie:D65",
-            "--out",
-            str(dataset / "relit__v0__x"),
-        ]
-    )
-    err = capsys.readouterr().err.strip()
+    rc, err = refused(dataset / "relit__v0__x")
     assert rc == 2 and len(err.splitlines()) == 1 and "inside the dataset folder" in err, err
     assert sorted(p.name for p in dataset.iterdir()) == ["manifest.json"]
 
     held = tmp_path / "held"
-    code = (
-        "import sys; from pathlib import Path; from spectrinsic.gt_export.folders.outfolder import folder_lock\n"
-        f"with folder_lock(Path({str(held)!r})):\n"
-        "    print('held', flush=True); sys.stdin.read()\n"
-    )
-    proc = subprocess.Popen(
-        [sys.executable, "-P", "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
-    )
-    try:
-        assert proc.stdout is not None and proc.stdout.readline().strip() == "held"
-        rc = main(
-            [
-                "-q",
-                "relight",
-                str(sample),
-                "--light",
-                "0=cie:D65",
-                "--out",
-                str(held / "relit__v0__x"),
-            ]
-        )
-        err = capsys.readouterr().err.strip()
-    finally:
-        assert proc.stdin is not None
-        proc.stdin.close()
-        assert proc.wait(timeout=60) == 0
+    with held_lock(held) as proc:
+        rc, err = refused(held / "relit__v0__x")
     assert rc == 2 and len(err.splitlines()) == 1, err
     assert "in use by another spectrinsic run" in err and f"pid {proc.pid}" in err
     assert not held.exists()  # the holder removed its folder; the refused run wrote nothing

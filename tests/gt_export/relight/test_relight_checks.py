@@ -17,11 +17,10 @@ import pytest
 
 from spectrinsic.cli import main
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export import export_sample
 from spectrinsic.gt_export.sample.meta import read_meta
 from spectrinsic.gt_export.sample.transport_exr import TRANSPORT_NAME
 from spectrinsic.render import RenderSettings
-from spectrinsic.render.transport_render import render_transport_batches
+from tests.gt_export._builders import render_transport_sample
 
 SETTINGS = RenderSettings(spp=2, modes=("rgb3",), batches=2, max_depth=3)
 
@@ -31,11 +30,10 @@ def source(tmp_path_factory, make_room) -> Path:
     """A two-light room sample (8x8) stored with its transport."""
     out = tmp_path_factory.mktemp("relight-checks")
     scene = make_room(size=8)
-    transport, result = render_transport_batches(scene, SETTINGS, seed=3)
-    return export_sample(
-        out, scene, result, sample_id="room__v0__two", config={"t": 36}, seed=3,
-        transport=transport,
-    )  # fmt: skip
+    sample, _, _ = render_transport_sample(
+        out, scene, SETTINGS, seed=3, sample_id="room__v0__two", config={"t": 36}
+    )
+    return sample
 
 
 @pytest.fixture

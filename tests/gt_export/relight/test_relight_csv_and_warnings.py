@@ -19,11 +19,10 @@ import pytest
 
 import spectrinsic
 from spectrinsic.cli import main
-from spectrinsic.gt_export import export_sample
 from spectrinsic.gt_export.layers import LayerSettings
 from spectrinsic.gt_export.sample.meta import read_meta
 from spectrinsic.render import RenderSettings
-from spectrinsic.render.transport_render import render_transport_batches
+from tests.gt_export._builders import render_transport_sample
 
 SETTINGS = RenderSettings(spp=1, modes=("rgb3",), batches=1, max_depth=2)
 CSV = "wavelength [nm],paint [%]\n380,40\n550,60\n780,20\n"
@@ -38,10 +37,9 @@ def source(tmp_path_factory, make_room) -> tuple[Path, Path]:
     room = make_room(size=8)
     first = dataclasses.replace(room.materials[0], spectrum=f"csv:{csv}#paint [%]")
     scene = dataclasses.replace(room, materials=(first, *room.materials[1:]))
-    transport, result = render_transport_batches(scene, SETTINGS, seed=3)
-    sample = export_sample(
-        out / "ds", scene, result, LayerSettings().for_scene_folder(out),
-        sample_id="s", config={"t": 44}, seed=3, transport=transport,
+    sample, _, _ = render_transport_sample(
+        out / "ds", scene, SETTINGS, seed=3, sample_id="s", config={"t": 44},
+        layers=LayerSettings().for_scene_folder(out),
     )  # fmt: skip
     return sample, csv
 

@@ -18,8 +18,8 @@ from spectrinsic.gt_export.layers import LayerSettings
 from spectrinsic.gt_export.relight import relight, relit_scene
 from spectrinsic.render import RenderSettings, render_batches
 from spectrinsic.render.result import METAL_WHITE, SPECULAR
-from spectrinsic.render.transport_render import render_transport_batches
 from spectrinsic.scenes.model import Material
+from tests.gt_export._builders import render_transport_sample
 
 #: A relit layer and the direct render's agree to float rounding (as tests/gt_export/relight/test_relight.py).
 RELIGHT_RTOL = 1e-5
@@ -54,16 +54,9 @@ def glossy(tmp_path_factory, make_room):
     mats[6] = Material("cube", "munsell:5P 5/10", kind="plastic", ior=1.5, roughness=0.15)
     scene = replace(scene, materials=tuple(mats))
     out = tmp_path_factory.mktemp("relight-gloss")
-    transport, result = render_transport_batches(scene, SETTINGS, seed=SEED)
-    sample = export_sample(
-        out,
-        scene,
-        result,
-        LayerSettings(denoise=True),
-        sample_id="gloss__v0__two",
-        config=CONFIG,
-        seed=SEED,
-        transport=transport,
+    layers = LayerSettings(denoise=True)
+    sample, transport, _ = render_transport_sample(
+        out, scene, SETTINGS, seed=SEED, sample_id="gloss__v0__two", config=CONFIG, layers=layers
     )
     return out, scene, sample, transport
 

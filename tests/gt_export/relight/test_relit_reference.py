@@ -16,35 +16,27 @@ import pytest
 from spectrinsic.cli import main
 from spectrinsic.errors import DatasetError
 from spectrinsic.pipeline.presets import DatasetConfig
-from tests.conftest import QUAD_YAML
+from tests.conftest import QUAD_YAML, TINY_BUILD, one_line_error
 
 TINY = {"width": 8, "height": 8, "spp": 2, "max_depth": 3}
-PREVIEW = ["--preset", "preview", "--resolution", "16x16", "--spp", "2"]
-
-
-def _one_line(capsys, *needles: str) -> None:
-    err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0 and "Traceback" not in err, err
-    for needle in needles:
-        assert needle in err, err
 
 
 def test_relighting_a_preview_sample_is_refused_not_switched_to_rgb3(tmp_path, capsys):
     (tmp_path / "s.yaml").write_text(QUAD_YAML)
     ds = tmp_path / "ds"
-    argv = ["-q", "dataset", *PREVIEW, "--scenes", str(tmp_path / "s.yaml"), "--store-transport"]
+    argv = ["-q", "dataset", *TINY_BUILD, "--scenes", str(tmp_path / "s.yaml"), "--store-transport"]
     assert main([*argv, "--out", str(ds)]) == 0, capsys.readouterr().err
     (sample,) = [p.parent for p in ds.glob("*/meta.json")]
     assert json.loads((sample / "meta.json").read_text())["reference_mode"] == "spectral"
     out = tmp_path / "relit"
     rc = main(["-q", "relight", str(sample), "--light", "0=cie:D65", "--out", str(out)])
     assert rc == 2
-    _one_line(capsys, "'spectral'", "cannot relight")
+    one_line_error(capsys, "'spectral'", "cannot relight")
     assert not out.exists()
     # and a build that would make such variants is refused before its first sample
     rc = main([*argv, "--relight", "1", "--out", str(tmp_path / "ds2")])
     assert rc == 2
-    _one_line(capsys, "--relight 1", "'spectral'")
+    one_line_error(capsys, "--relight 1", "'spectral'")
     assert not (tmp_path / "ds2").exists()
 
 

@@ -13,7 +13,6 @@ import numpy as np
 import pytest
 
 from spectrinsic.errors import DatasetError
-from spectrinsic.gt_export import export_sample
 from spectrinsic.gt_export.formats.exr import read_exr, read_exr_attributes, write_exr
 from spectrinsic.gt_export.sample.meta import read_meta
 from spectrinsic.gt_export.sample.transport_exr import (
@@ -25,8 +24,8 @@ from spectrinsic.gt_export.sample.transport_exr import (
 )
 from spectrinsic.render import RenderSettings
 from spectrinsic.render.algebra.batch_means import batch_mean
-from spectrinsic.render.transport_render import render_transport_batches
 from spectrinsic.spectra import get_sensors
+from tests.gt_export._builders import render_transport_sample
 
 pytestmark = pytest.mark.render
 
@@ -39,15 +38,8 @@ def matte(tmp_path_factory, make_room):
     """A matte two-light room's transport, in memory and written as a sample."""
     out = tmp_path_factory.mktemp("compact")
     scene = make_room(size=12)
-    transport, result = render_transport_batches(scene, SETTINGS, seed=SEED)
-    sample = export_sample(
-        out,
-        scene,
-        result,
-        sample_id="room__v0__compact",
-        config={"test": "compact"},
-        seed=SEED,
-        transport=transport,
+    sample, transport, _ = render_transport_sample(
+        out, scene, SETTINGS, seed=SEED, sample_id="room__v0__compact", config={"test": "compact"}
     )
     return transport, sample
 

@@ -19,12 +19,12 @@ from spectrinsic.gt_export import check_sample, export_sample, load_sample
 from spectrinsic.gt_export.formats.exr import read_exr, read_exr_attributes, write_exr
 from spectrinsic.gt_export.layers import LayerSettings, compute_ground_truth, identities
 from spectrinsic.gt_export.layers.settings import DEFAULT_CAMERAS
-from spectrinsic.gt_export.sample import HASHES_KEY, SEAL_KEY, file_sha256, meta_seal
 from spectrinsic.gt_export.sample.layer_storage import COVERAGE_LAYER
 from spectrinsic.gt_export.sample.stored_layers import stored_layers
 from spectrinsic.render import RenderSettings, render_batches
 from spectrinsic.scenes.model import Camera, Light, Material, Mesh, Scene
 from spectrinsic.scenes.textures import basis_name, make_texture
+from tests.gt_export._builders import renew_seal
 
 #: The layers every sample here gets: the default cameras, denoised, per band.
 SETTINGS = LayerSettings(cameras=DEFAULT_CAMERAS, denoise=True, spectral_layers=True)
@@ -153,7 +153,7 @@ def test_check_passes_on_the_compact_form_and_finds_a_tampered_table(written, tm
     assert any("spectral.exr" in p and "SHA-256" in p for p in problems), problems
     with pytest.raises(DatasetError, match="SHA-256"):
         load_sample(copy, layers=["reflectance_bands"])
-    _renew_seal(copy)  # the file's hash renewed too: the rebuilt layer's own hash still differs
+    renew_seal(copy)  # the file's hash renewed too: the rebuilt layer's own hash still differs
     problems = check_sample(copy)
     assert any("'reflectance_bands' rebuilt" in p and "SHA-256" in p for p in problems), problems
 
@@ -174,7 +174,7 @@ def _as_old_form(sample, gt, dest):
         )
     del meta["storage"]
     (dest / "meta.json").write_text(json.dumps(meta))
-    _renew_seal(dest)
+    renew_seal(dest)
     return dest
 
 
@@ -207,15 +207,6 @@ def test_a_layer_its_factors_do_not_rebuild_exactly_is_stored_in_full(written):
     assert stored.forms["reflectance_bands"] == "coverage_table"  # the others unchanged
 
 
-def _renew_seal(folder) -> None:
-    """Hashes and seal of *folder*'s ``meta.json`` renewed over its files as they are now."""
-    meta = json.loads((folder / "meta.json").read_text())
-    meta[HASHES_KEY] = {rel: file_sha256(folder / rel) for rel in meta[HASHES_KEY]}
-    meta.pop(SEAL_KEY)
-    meta[SEAL_KEY] = meta_seal(meta)
-    (folder / "meta.json").write_text(json.dumps(meta))
-
-
 def test_check_finds_a_wrong_factor_by_the_rebuilt_layers_sha256(room, tmp_path):
     """``shading_bands`` 0.1 % too bright, file hashes and seal renewed (a writer bug, not
     damage): the rebuilt ``image_bands`` and residual absorb it, so the identity holds, but
@@ -233,7 +224,7 @@ def test_check_finds_a_wrong_factor_by_the_rebuilt_layers_sha256(room, tmp_path)
         channel_names=json.loads(header["spectrinsic.channels"]),
         attributes={key: header[key]},
     )
-    _renew_seal(copy)
+    renew_seal(copy)
     problems = check_sample(copy)
     assert "layer 'image_bands' rebuilt from its stored factors does not match its SHA-256" in (
         "\n".join(problems)
@@ -249,13 +240,13 @@ def test_an_unknown_form_or_wrong_terms_are_refused_in_one_line(room, tmp_path):
     meta = json.loads((copy / "meta.json").read_text())
     meta["storage"]["layers"]["residual_bands"] = "zip-magic"
     (copy / "meta.json").write_text(json.dumps(meta))
-    _renew_seal(copy)
+    renew_seal(copy)
     with pytest.raises(DatasetError, match=r"storage\.layers\.residual_bands: 'zip-magic'"):
         load_sample(copy)
     assert any("zip-magic" in p for p in check_sample(copy))
     meta["storage"]["layers"]["residual_bands"] = "identity_residual"
     meta["storage"]["terms"]["residual_bands"] = ["image_bands"]  # a residual of one term
     (copy / "meta.json").write_text(json.dumps(meta))
-    _renew_seal(copy)
+    renew_seal(copy)
     with pytest.raises(DatasetError, match=r"storage\.terms: .* as many as its form takes"):
         load_sample(copy, layers=["residual_bands"])

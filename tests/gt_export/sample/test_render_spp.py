@@ -4,7 +4,7 @@ before issue 46 (``spectral_spp`` one batch's) and after (``spectral_spp`` the t
 
 from __future__ import annotations
 
-from spectrinsic.gt_export.sample.render_spp import RenderSpp, current_render_record, render_spp
+from spectrinsic.gt_export.sample.render_spp import RenderSpp, render_spp
 
 #: The preview preset with ``--spp 4 --spectral-spp 2``, as written now (2 batches).
 NEW = {"spp": 4, "batches": 2, "batch_spp": 2, "spectral_spp": 2, "spectral_batch_spp": 1}
@@ -18,16 +18,9 @@ def test_both_forms_give_the_same_totals():
     assert render_spp(OLD) == expected
 
 
-def test_an_old_record_is_rewritten_in_the_current_form_and_a_new_one_is_kept():
-    assert current_render_record(OLD) == NEW
-    assert current_render_record(NEW) == NEW
-    assert OLD == {"spp": 4, "batches": 2, "batch_spp": 2, "spectral_spp": 1}  # not edited
-
-
 def test_one_batch_reads_the_same_in_both_forms():
     one = {"spp": 8, "spectral_spp": 4}
     assert render_spp(one) == RenderSpp(8, 1, 8, 4, 4)
-    assert current_render_record(one) == one
 
 
 def test_a_relit_record_without_a_spectral_pass_has_no_spectral_count():

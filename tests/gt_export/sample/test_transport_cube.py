@@ -19,13 +19,13 @@ from spectrinsic.gt_export import check_sample, export_sample, load_sample
 from spectrinsic.gt_export.formats.exr import read_exr, read_exr_attributes, write_exr
 from spectrinsic.gt_export.layers import LayerSettings
 from spectrinsic.gt_export.relight import relight, relit_scene
-from spectrinsic.gt_export.sample import HASHES_KEY, SEAL_KEY, file_sha256, meta_seal
 from spectrinsic.gt_export.sample.meta import read_meta
 from spectrinsic.gt_export.sample.transport_cube import CUBE_MODE, MEANS_ATTRIBUTE
 from spectrinsic.gt_export.sample.transport_exr import TRANSPORT_NAME, transport_layer
 from spectrinsic.render import RenderSettings
 from spectrinsic.render.algebra.light_transport import light_band_means
 from spectrinsic.render.transport_render import render_transport_batches
+from tests.gt_export._builders import renew_seal
 
 pytestmark = pytest.mark.render
 
@@ -90,15 +90,6 @@ def test_the_cube_is_not_stored_and_is_the_stored_transports_sum_bit_for_bit(wri
     assert 0 < gap < 1e-6, gap
 
 
-def _renew_seal(folder) -> None:
-    """Hashes and seal of *folder*'s ``meta.json`` renewed over its files as they are now."""
-    meta = json.loads((folder / "meta.json").read_text())
-    meta[HASHES_KEY] = {rel: file_sha256(folder / rel) for rel in meta[HASHES_KEY]}
-    meta.pop(SEAL_KEY)
-    meta[SEAL_KEY] = meta_seal(meta)
-    (folder / "meta.json").write_text(json.dumps(meta))
-
-
 def test_check_passes_and_finds_a_tampered_transport(written, tmp_path):
     _, _, _, denoised, _ = written
     assert check_sample(denoised) == []  # the identities hold on the rebuilt cube
@@ -113,7 +104,7 @@ def test_check_passes_and_finds_a_tampered_transport(written, tmp_path):
     order = json.loads(str(header["spectrinsic.channels"]))
     write_exr(path, arrays, channel_names=order, attributes={"spectrinsic.sample": copy.name})
     assert any(TRANSPORT_NAME in p and "SHA-256" in p for p in check_sample(copy))
-    _renew_seal(copy)  # the file's hash renewed too: the rebuilt cube's own hash differs
+    renew_seal(copy)  # the file's hash renewed too: the rebuilt cube's own hash differs
     problems = check_sample(copy)
     assert any("'image_bands_raw'" in p and "SHA-256" in p for p in problems), problems
 
