@@ -166,65 +166,6 @@ def _join(
     )
 
 
-def _traversal_batch(
-    scene: Scene,
-    settings: RenderSettings,
-    seed: int,
-    *,
-    progress: PassProgress | None,
-    data_dir: str | None,
-) -> tuple[LightTransport, RenderResult]:
-    """:func:`_batch` from one single traversal (:mod:`spectrinsic.render.band_path.traversal`), which
-    already splits every band by light: its transport ``T'_lk`` (per unit channel emission
-    ``E_lk``) times the flat unit spectrum's channel values ``∫S_k dλ`` is Eq. 1's ``T_lk``,
-    so no per-light pass is rendered. The same call renders the other modes and the AOVs from
-    the same pixel samples, as a direct render with ``integrator="single"`` does, so a relit
-    sample equals that render to float rounding."""
-    names = diagonal_mode_names(settings.modes)
-    direct = (
-        tuple(m for m in settings.modes if m not in names)
-        if settings.direct is True
-        else tuple(m for m in settings.direct or () if m not in names)
-    )
-    render = render_scene(
-        scene,
-        settings.with_options(per_light=False, share_mode=None, direct=direct, aovs=True),
-        seed=seed,
-        progress=progress,
-        data_dir=data_dir,
-    )
-    flat = {
-        m: _unit_values(scene, get_mode(m).sensors, data_dir).lights[:, None, None, :]
-        for m in names
-    }
-
-    def unit(part: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-        # per unit channel emission E_lk -> per flat unit spectrum (Eq. 1's T_lk)
-        return {m: (part[m].astype(np.float64) * flat[m]).astype(np.float32) for m in part}
-
-    parts = {p: unit(held) for p, held in render.part_transport.items()}
-    batch = _one_batch(names, settings, seed, unit(render.transport), parts)
-    base = {
-        "max_depth": int(settings.max_depth),
-        "variants": {m: render.meta["variants"][m] for m in names},
-        "timings": {m: render.meta["timings"][m] for m in names},
-    }
-    diagonal = relit_result(batch, scene, meta=base, data_dir=data_dir)
-    others = [m for m in dict.fromkeys(settings.modes) if m not in names]
-    other = (
-        replace(
-            render,
-            images={m: render.images[m] for m in others},
-            raw={m: render.raw[m] for m in others},
-            transport={},
-            part_transport={},
-        )
-        if others
-        else None
-    )
-    return batch, _join(diagonal, other, render.aovs, list(dict.fromkeys(settings.modes)))
-
-
 def _batch(
     scene: Scene,
     settings: RenderSettings,
@@ -233,45 +174,76 @@ def _batch(
     progress: PassProgress | None,
     data_dir: str | None,
 ) -> tuple[LightTransport, RenderResult]:
-    """Transport of one batch and the sample's render of that batch (other modes rendered
-    directly with every light on, the AOVs from the same pixel samples): from the single
-    traversal where it runs (*settings*' integrator, resolved by
-    :func:`render_transport_batches`), else one set of passes per light."""
-    if settings.integrator == "single":
-        return _traversal_batch(scene, settings, seed, progress=progress, data_dir=data_dir)
-    modes = settings.modes
-    names = diagonal_mode_names(modes)
-    others = tuple(m for m in dict.fromkeys(modes) if m not in names)
-    t, seconds = render_transport(scene, settings, seed=seed, progress=progress, data_dir=data_dir)
-    timings = {m: timing(s) for m, s in seconds.items()}
-    base = {
-        "max_depth": int(settings.max_depth),
-        "timings": timings,
-        "variants": dict.fromkeys(names, choose_variant("rgb", settings.variant)),
-    }
-    batch = _one_batch(names, settings, seed, t)
-    diagonal = relit_result(batch, scene, meta=base, data_dir=data_dir)
-    other = None
-    if others:
-        direct = (
-            settings.direct
-            if isinstance(settings.direct, bool)
-            else tuple(m for m in settings.direct if m in others)
-        )
-        other = render_scene(
+    """Transport of one batch and the sample's render of that batch (the diagonal modes
+    composed from it, the other modes rendered directly with every light on, the AOVs from the
+    same pixel samples): where *settings*' integrator (resolved by
+    :func:`render_transport_batches`) is ``"single"``, from one traversal, whose per-light split
+    ``T'_lk`` (per unit channel emission) times ``∫S_k dλ`` is Eq. 1's ``T_lk``; else from one
+    set of passes per light (:func:`render_transport`)."""
+    order = list(dict.fromkeys(settings.modes))
+    names = diagonal_mode_names(order)
+    others = [m for m in order if m not in names]
+    direct = (
+        tuple(others)
+        if settings.direct is True
+        else tuple(m for m in settings.direct or () if m not in names)
+    )
+
+    def rendered(modes: Sequence[str]) -> RenderResult:
+        return render_scene(
             scene,
             settings.with_options(
-                modes=others, per_light=False, share_mode=None, direct=direct, aovs=True
+                modes=tuple(modes), per_light=False, share_mode=None, direct=direct, aovs=True
             ),
             seed=seed,
             progress=progress,
             data_dir=data_dir,
         )
-        aovs = other.aovs
+
+    if settings.integrator == "single":
+        render = rendered(settings.modes)
+        flat = {
+            m: _unit_values(scene, get_mode(m).sensors, data_dir).lights[:, None, None, :]
+            for m in names
+        }
+
+        def unit(part: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+            # per unit channel emission E_lk -> per flat unit spectrum (Eq. 1's T_lk)
+            return {m: (part[m].astype(np.float64) * flat[m]).astype(np.float32) for m in part}
+
+        parts = {p: unit(held) for p, held in render.part_transport.items()}
+        batch = _one_batch(names, settings, seed, unit(render.transport), parts)
+        timings = {m: render.meta["timings"][m] for m in names}
+        variants = {m: render.meta["variants"][m] for m in names}
+        aovs = render.aovs
+        other = (
+            replace(
+                render,
+                images={m: render.images[m] for m in others},
+                raw={m: render.raw[m] for m in others},
+                transport={},
+                part_transport={},
+            )
+            if others
+            else None
+        )
     else:
-        aovs, aov_seconds = render_aovs(scene, PassRequest.of(settings, seed, progress))
-        timings["aovs"] = timing(aov_seconds)
-    return batch, _join(diagonal, other, aovs, list(dict.fromkeys(modes)))
+        t, seconds = render_transport(
+            scene, settings, seed=seed, progress=progress, data_dir=data_dir
+        )
+        batch = _one_batch(names, settings, seed, t)
+        timings = {m: timing(s) for m, s in seconds.items()}
+        variants = dict.fromkeys(names, choose_variant("rgb", settings.variant))
+        other = rendered(others) if others else None
+        if other is None:
+            aovs, aov_seconds = render_aovs(scene, PassRequest.of(settings, seed, progress))
+            timings["aovs"] = timing(aov_seconds)
+        else:
+            aovs = other.aovs
+    meta = {"max_depth": int(settings.max_depth), "variants": variants, "timings": timings}
+    return batch, _join(
+        relit_result(batch, scene, meta=meta, data_dir=data_dir), other, aovs, order
+    )
 
 
 def render_transport_batches(
