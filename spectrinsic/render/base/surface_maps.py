@@ -91,24 +91,16 @@ def refuse_maps(scene: Scene, what: str) -> None:
         )
 
 
-class _Children:
-    """Collects an object's named children through Mitsuba's ``traverse``."""
-
-    def __init__(self, mi: Any) -> None:
-        outer = self
-
-        class Callback(mi.TraversalCallback):  # type: ignore[misc, name-defined]
-            def put(self, name: str, value: Any, *rest: Any) -> None:
-                outer.found[name] = value
-
-        self.found: dict[str, Any] = {}
-        self.callback = Callback()
-
-
 def _children(mi: Any, obj: Any) -> dict[str, Any]:
-    collect = _Children(mi)
-    obj.traverse(collect.callback)
-    return collect.found
+    """An object's named children, collected through Mitsuba's ``traverse``."""
+    found: dict[str, Any] = {}
+
+    class Callback(mi.TraversalCallback):  # type: ignore[misc, name-defined]
+        def put(self, name: str, value: Any, *rest: Any) -> None:
+            found[name] = value
+
+    obj.traverse(Callback())
+    return found
 
 
 def _map_texture(mi: Any, bsdf: Any) -> tuple[MapKind, Any]:
