@@ -26,6 +26,7 @@ __all__ = [
     "PassProgress",
     "PassOutput",
     "check_scene_lights",
+    "refuse_surface_detail",
     "active_light_set",
     "timed_render",
     "timing",
@@ -67,6 +68,23 @@ def check_scene_lights(scene: Scene) -> None:
     :class:`~spectrinsic.render.settings.PassRequest`)."""
     if not scene.lights:
         raise SceneError(f"scene {scene.name!r} has no lights: nothing to render")
+
+
+def refuse_surface_detail(scene: Scene, what: str) -> None:
+    """Raise a one-line :class:`RenderError` if *scene* has spectral textures, or opacity masks
+    or bump or normal maps, which *what* (passes of Mitsuba's own BSDFs and AOVs) cannot
+    render exactly; the band-path traversal renders them."""
+    textured = [m.name for m in scene.meshes if m.texture is not None]
+    mapped = [m.name for m in scene.meshes if m.maps is not None]
+    for detail, names in (
+        ("spectral textures", textured),
+        ("opacity masks or bump or normal maps", mapped),
+    ):
+        if names:
+            raise RenderError(
+                f"scene {scene.name!r}: {what} cannot render {detail} (mesh {names[0]!r}); "
+                "use the single band-path traversal (integrator 'single')"
+            )
 
 
 def active_light_set(scene: Scene, active_lights: Sequence[int] | None) -> set[int]:

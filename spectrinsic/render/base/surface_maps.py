@@ -35,7 +35,6 @@ from .plugins import raw_bitmap
 __all__ = [
     "MapKind",
     "wrap_bsdf",
-    "refuse_maps",
     "map_scales",
     "map_textures",
     "perturbed_normal",
@@ -78,17 +77,6 @@ def wrap_bsdf(mi: Any, maps: MeshMaps, bsdf: dict[str, Any]) -> dict[str, Any]:
     elif maps.opacity < 1.0:
         out = {"type": "mask", "opacity": float(maps.opacity), "bsdf": out}
     return out
-
-
-def refuse_maps(scene: Scene, what: str) -> None:
-    """Raise a one-line :class:`RenderError` if *scene* has masks or bump or normal maps, whose
-    ground truth *what* cannot make."""
-    names = [m.name for m in scene.meshes if m.maps is not None]
-    if names:
-        raise RenderError(
-            f"scene {scene.name!r}: {what} cannot render opacity masks or bump or normal maps "
-            f"(mesh {names[0]!r}); use the single band-path traversal (integrator 'single')"
-        )
 
 
 def _children(mi: Any, obj: Any) -> dict[str, Any]:

@@ -25,13 +25,12 @@ from ..base.one_pass import (
     active_light_set,
     check_scene_lights,
     placeholder_light,
+    refuse_surface_detail,
     scene_parameters,
     set_rgb,
     timed_render,
 )
 from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
-from ..base.surface_maps import refuse_maps
-from ..base.textures import refuse_textures
 from ..base.variants import choose_variant, variant_scope
 from ..settings import PassRequest
 
@@ -66,8 +65,7 @@ def render_diagonal(
             "channels into lights; render it with the single traversal (--integrator single, "
             "an llvm or cuda variant)"
         )
-    refuse_textures(scene, "the diagonal passes")
-    refuse_maps(scene, "the diagonal passes")
+    refuse_surface_detail(scene, "the diagonal passes")
     active = sorted(active_light_set(scene, active_lights))
     flags = (
         [bool(direct)] * len(value_sets) if isinstance(direct, bool) else [bool(d) for d in direct]

@@ -11,13 +11,12 @@ from ..base import translate as tr
 from ..base.aov_maps import assemble_aovs
 from ..base.one_pass import (
     placeholder_light,
+    refuse_surface_detail,
     scene_parameters,
     set_rgb,
     timed_render,
 )
 from ..base.plugins import aov_integrator, hdr_film, rgb_spectrum
-from ..base.surface_maps import refuse_maps
-from ..base.textures import refuse_textures
 from ..base.variants import choose_variant, variant_scope
 from ..settings import PassRequest
 
@@ -49,8 +48,7 @@ def render_aovs(
     seconds
         Seconds per pass.
     """
-    refuse_textures(scene, "the coverage passes")
-    refuse_maps(scene, "the coverage passes")
+    refuse_surface_detail(scene, "the coverage passes")
     surfaces = tr.surfaces(scene)
     n_pass = max(1, -(-len(surfaces) // 3))
     chosen = choose_variant("rgb", request.variant)
