@@ -18,7 +18,6 @@ from .base.one_pass import (
     DIRECT_DEPTH,
     PassOutput,
     active_light_set,
-    check_scene_lights,
     timed_render,
 )
 from .base.plugins import path_integrator, regular_spectrum, spectral_film
@@ -99,7 +98,6 @@ def render_spectral(
     negative lobes (``"srgb"``) are not supported by ``specfilm`` and are clipped. An
     environment map takes one more pass per channel (:func:`_light_passes`).
     """
-    check_scene_lights(scene)
     active = active_light_set(scene, active_lights)
     wl = COLORIMETRIC_WAVELENGTHS
     if np.any(sensors.curves < 0):

@@ -62,12 +62,9 @@ logger = logging.getLogger(__name__)
 def _unit_values(scene: Scene, sensors: str, data_dir: str | None) -> ChannelValues:
     """Material values of the scene and, for every light, the flat unit spectrum at power 1
     (``∫S_k dλ``, what :func:`channel_values` gives a light of spectrum 1)."""
-    wl = COLORIMETRIC_WAVELENGTHS
-    curves = get_sensors(sensors, data_dir=data_dir).on(wl)
-    flat = responses(np.ones(wl.size), curves, wl)
-    materials = channel_values(
-        scene, get_sensors(sensors, data_dir=data_dir), data_dir=data_dir
-    ).materials
+    wl, sensor_set = COLORIMETRIC_WAVELENGTHS, get_sensors(sensors, data_dir=data_dir)
+    flat = responses(np.ones(wl.size), sensor_set.on(wl), wl)
+    materials = channel_values(scene, sensor_set, data_dir=data_dir).materials
     return ChannelValues(materials=materials, lights=np.tile(flat, (len(scene.lights), 1)))
 
 

@@ -88,6 +88,8 @@ def refuse_surface_detail(scene: Scene, what: str) -> None:
 
 
 def active_light_set(scene: Scene, active_lights: Sequence[int] | None) -> set[int]:
+    """The lights a pass renders (*active_lights*, default all), checked (and that there are any)."""
+    check_scene_lights(scene)
     active = (
         set(range(len(scene.lights))) if active_lights is None else {int(i) for i in active_lights}
     )

@@ -23,7 +23,6 @@ from ..base.one_pass import (
     DIRECT_DEPTH,
     PassOutput,
     active_light_set,
-    check_scene_lights,
     placeholder_light,
     refuse_surface_detail,
     scene_parameters,
@@ -58,7 +57,6 @@ def render_diagonal(
     active_lights
         Indices of the lights to render (default all); others are left out (per-light renders).
     """
-    check_scene_lights(scene)
     if any(light.kind == "envmap" for light in scene.lights):
         raise SceneError(
             f"scene {scene.name!r} has an environment map: the passes cannot split its RGB "
