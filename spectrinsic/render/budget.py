@@ -236,8 +236,6 @@ def check_render_size(
         How the user gave the size, for the message (``"--width 100000 --height 128"``).
     processes
         Renders running at once (worker processes), each needing the estimate.
-    load
-        The scene's counts (:class:`RenderLoad`): lights, surfaces, materials.
 
     Raises
     ------

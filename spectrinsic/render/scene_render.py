@@ -162,8 +162,6 @@ def _run_jobs(run: _Run) -> tuple[dict[str, np.ndarray], tuple[float, ...], Sing
     scope and every spectral pass in another; the variant already active goes first and stays
     active afterwards (``restore=False``), so consecutive batches switch once each, not four
     times. Passes do not depend on each other's order: each sets its own values, seed and spp.
-    With ``plan.traversal`` the diagonal modes of every job, and a textured scene's AOVs even
-    without them, come from one band-path traversal (:func:`~spectrinsic.render.band_path.traversal.render_jobs`).
     """
     plan = run.plan
     found: tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]

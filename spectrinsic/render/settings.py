@@ -87,10 +87,9 @@ class RenderSettings:
     max_batches
         Cap of the adaptive batches (``None``: ``4 * batches``).
     integrator
-        How the diagonal modes are rendered, one of :data:`INTEGRATORS`; ``"single"`` falls
-        back to ``"passes"`` on a scalar variant
-        (:func:`spectrinsic.render.band_path.traversal.resolve_integrator`). Not hashed by a dataset
-        config: both give the same pixels to float rounding.
+        One of :data:`INTEGRATORS`, resolved per variant by
+        :func:`spectrinsic.render.band_path.traversal.resolve_integrator`. Not hashed by a
+        dataset config: both give the same pixels to float rounding.
     spectral_spp
         Samples per pixel of the spectral Monte Carlo pass over all batches (``None``: *spp*).
         The reference image, the ground truth and the per-light transport come from the
@@ -193,11 +192,8 @@ class PassRequest:
     seed
         The sampler seed (the batch's); every pass of a batch uses it, so passes trace the
         same paths (common random numbers).
-    max_depth
-        Longest path (Mitsuba convention: 2 = direct light only).
-    variant
-        Backend or variant name (:func:`spectrinsic.render.base.variants.choose_variant`);
-        ``None``: the best usable.
+    max_depth, variant
+        As :class:`RenderSettings`'.
     progress
         Called with 1 after each Mitsuba pass (e.g. ``tqdm.update``), or ``None``.
     geometry

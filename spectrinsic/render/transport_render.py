@@ -76,13 +76,9 @@ def render_transport(
     progress: PassProgress | None = None,
     data_dir: str | None = None,
 ) -> tuple[dict[str, np.ndarray], dict[str, tuple[float, ...]]]:
-    """One batch of transport: mode -> ``(L, H, W, K)`` float32 ``T_lk`` and the pass seconds.
-
-    Each light is rendered alone (its own scene load) with the flat unit spectrum at power 1
-    and the scene's material values, seed *seed*, ``settings.batch_spp`` samples, depth
-    ``settings.max_depth`` and Russian roulette off, so its paths are those of a per-light
-    render with the same settings; only the diagonal ones of ``settings.modes`` are rendered.
-    """
+    """One batch of transport by the passes, each light alone with the flat unit spectrum at
+    power 1 (module docstring), for the diagonal ones of ``settings.modes``: mode ->
+    ``(L, H, W, K)`` float32 ``T_lk``, and the pass seconds."""
     modes = settings.modes
     names = diagonal_mode_names(modes)
     if not names:
@@ -253,13 +249,11 @@ def render_transport_batches(
 ) -> tuple[LightTransport, RenderResult]:
     """The sample's transport and its render, as :func:`~spectrinsic.render.render_batches`.
 
-    The diagonal modes of every batch are composed from the transport with the scene's own
-    spectra (:func:`~spectrinsic.render.algebra.light_transport.relit_result`), so relighting the sample with those spectra gives it
-    back exactly; the other modes (the spectral reference) are rendered directly with every
-    light on, with a direct-only render when ``settings.direct``. Batches, seeds and adaptive
-    sampling (``settings.noise_target``, ``settings.max_batches``) follow
-    :func:`~spectrinsic.render.render_batches`; ``per_light`` and ``share_mode`` do not apply
-    (the transport is per light already).
+    Each batch is :func:`_batch`'s, its diagonal modes composed with the scene's own spectra
+    (:func:`~spectrinsic.render.algebra.light_transport.relit_result`), so relighting the
+    sample with those spectra gives it back exactly. Batches, seeds and adaptive sampling
+    follow :func:`~spectrinsic.render.render_batches`; ``per_light`` and ``share_mode`` do not
+    apply (the transport is per light already).
     """
     modes = settings.modes
     if settings.direct and not [m for m in modes if m not in diagonal_mode_names(modes)]:

@@ -84,11 +84,8 @@ class SurfaceGeometry:
 
 
 def prepare_geometry(scene: Scene) -> tuple[SurfaceGeometry, ...]:
-    """Split every mesh by material and compute its smoothed corner normals (pure numpy).
-
-    :func:`scene_to_mitsuba` does this itself when not given the result; callers translating
-    one scene several times (several variants, light subsets) compute it once.
-    """
+    """Split every mesh by material and compute its smoothed corner normals (module docstring);
+    :func:`scene_to_mitsuba` does this itself when not given the result."""
     out = []
     for index, mesh in enumerate(scene.meshes):
         faces = np.asarray(mesh.faces, np.int64)

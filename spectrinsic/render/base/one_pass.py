@@ -1,9 +1,5 @@
 """One Mitsuba pass, shared by every pass and the band-path traversal: its record
-(:class:`PassOutput`), its timed render call, and the checks every pass makes first.
-
-Every pass of one image uses the same sampler seed, sample count and path depth with Russian
-roulette off, so passes trace identical paths (common random numbers).
-"""
+(:class:`PassOutput`), its timed render call, and the checks every pass makes first."""
 
 from __future__ import annotations
 

@@ -1,9 +1,7 @@
-"""Choosing a Mitsuba variant. Mitsuba is imported through
-:func:`spectrinsic.mitsuba_import.import_mitsuba`, which points Dr.Jit's LLVM backend at a
-``libLLVM`` >= 16 for the duration of ``import drjit`` only (the libraries Debian ships, 14 and
-15, crash it; that module says why and how). When no suitable library exists the LLVM
-variants are not used: renders fall back to the (about twice slower) scalar variants with one
-:class:`~spectrinsic.errors.SpectrinsicWarning`.
+"""Choosing a Mitsuba variant (Mitsuba is imported through
+:func:`spectrinsic.mitsuba_import.import_mitsuba`, which says why and how it picks a
+``libLLVM``). Without a suitable ``libLLVM`` the LLVM variants are not used: renders fall back to
+the (about twice slower) scalar variants with one :class:`~spectrinsic.errors.SpectrinsicWarning`.
 
 Variants are chosen per pass (cuda > llvm > scalar; ``*_spectral`` for the spectral reference,
 ``*_rgb`` for diagonal passes and AOVs) and activated only inside :func:`variant_scope`; nothing
