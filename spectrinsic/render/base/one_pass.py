@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -14,8 +14,9 @@ from ...errors import RenderError, SceneError
 from ...interrupts import raise_if_requested
 from ...scenes.model import Scene
 from ..settings import PassRequest
-from .plugins import rgb_spectrum
+from .plugins import hdr_film, rgb_spectrum
 from .sample_split import split_render
+from .translate import scene_to_mitsuba
 
 __all__ = [
     "DIRECT_DEPTH",
@@ -26,8 +27,7 @@ __all__ = [
     "active_light_set",
     "timed_render",
     "timing",
-    "placeholder_light",
-    "scene_parameters",
+    "load_rgb_scene",
     "set_rgb",
 ]
 
@@ -124,19 +124,37 @@ def timing(seconds: Sequence[float]) -> dict[str, Any]:
     return {"passes": len(seconds), "seconds": total, "per_pass": [float(x) for x in seconds]}
 
 
-def placeholder_light(index: int) -> dict[str, Any]:
-    """Distinct emission per light at load time (identical dicts could be merged into one
-    shared object); every pass sets the real values before rendering."""
-    return rgb_spectrum([1.0 + index, 1.0, 1.0])
-
-
-def scene_parameters(mi: Any, loaded: Any, keys: Sequence[str]) -> Any:
-    """``mi.traverse`` of a loaded scene, checked to expose every parameter a pass updates."""
+def load_rgb_scene(
+    mi: Any,
+    scene: Scene,
+    request: PassRequest,
+    integrator: Mapping[str, Any],
+    active: Collection[int],
+    keys: Sequence[str],
+) -> tuple[Any, Any]:
+    """*scene* loaded in the active RGB variant for passes that set their own values (black
+    materials; the *active* lights with placeholders, the others left out), an ``hdrfilm``,
+    *integrator* and *request*'s samples and geometry; and its ``mi.traverse`` parameters,
+    checked to hold the *keys* the passes update."""
+    mitsuba_dict = scene_to_mitsuba(
+        scene,
+        materials=[rgb_spectrum([0.0, 0.0, 0.0])] * len(scene.materials),
+        # distinct emission per light (identical dicts could be merged into one shared object)
+        lights=[
+            rgb_spectrum([1.0 + j, 1.0, 1.0]) if j in active else None
+            for j in range(len(scene.lights))
+        ],
+        film=hdr_film(scene.camera.width, scene.camera.height),
+        integrator=integrator,
+        sample_count=request.batch_spp,
+        geometry=request.geometry,
+    )
+    loaded = mi.load_dict(mitsuba_dict)
     params = mi.traverse(loaded)
     missing = [k for k in keys if k not in params]
     if missing:
         raise RenderError(f"Mitsuba scene lacks the parameters {missing[:3]} the passes update")
-    return params
+    return loaded, params
 
 
 def set_rgb(mi: Any, params: Any, key: str, values: np.ndarray) -> None:

@@ -23,13 +23,12 @@ from ..base.one_pass import (
     DIRECT_DEPTH,
     PassOutput,
     active_light_set,
-    placeholder_light,
+    load_rgb_scene,
     refuse_surface_detail,
-    scene_parameters,
     set_rgb,
     timed_render,
 )
-from ..base.plugins import hdr_film, path_integrator, rgb_spectrum
+from ..base.plugins import path_integrator
 from ..base.variants import choose_variant, variant_scope
 from ..settings import PassRequest
 
@@ -79,20 +78,8 @@ def render_diagonal(
     chosen = choose_variant("rgb", request.variant)
     outputs = []
     with variant_scope(chosen) as mi:
-        mitsuba_dict = tr.scene_to_mitsuba(
-            scene,
-            # placeholders: every pass sets its own values before rendering
-            materials=[rgb_spectrum([0.0, 0.0, 0.0])] * len(scene.materials),
-            lights=[
-                placeholder_light(j) if j in active else None for j in range(len(scene.lights))
-            ],
-            film=hdr_film(scene.camera.width, scene.camera.height),
-            integrator=path_integrator(request.max_depth),
-            sample_count=request.batch_spp,
-            geometry=request.geometry,
-        )
-        loaded = mi.load_dict(mitsuba_dict)
-        params = scene_parameters(mi, loaded, keys)
+        integrator = path_integrator(request.max_depth)
+        loaded, params = load_rgb_scene(mi, scene, request, integrator, active, keys)
         direct_integrator = mi.load_dict(path_integrator(DIRECT_DEPTH)) if any(flags) else None
         for values, want_direct in zip(value_sets, flags, strict=True):
             runs: list[tuple[Any, list[np.ndarray]]] = [(None, [])] + (

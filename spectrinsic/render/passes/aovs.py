@@ -10,13 +10,12 @@ from ...scenes.model import Scene
 from ..base import translate as tr
 from ..base.aov_maps import assemble_aovs
 from ..base.one_pass import (
-    placeholder_light,
+    load_rgb_scene,
     refuse_surface_detail,
-    scene_parameters,
     set_rgb,
     timed_render,
 )
-from ..base.plugins import aov_integrator, hdr_film, rgb_spectrum
+from ..base.plugins import aov_integrator
 from ..base.variants import choose_variant, variant_scope
 from ..settings import PassRequest
 
@@ -56,20 +55,9 @@ def render_aovs(
     cover = np.zeros((h, w, len(surfaces)), np.float64)
     seconds = []
     with variant_scope(chosen) as mi:
-        zero = rgb_spectrum([0.0, 0.0, 0.0])
-        mitsuba_dict = tr.scene_to_mitsuba(
-            scene,
-            materials=[zero] * len(scene.materials),
-            lights=[placeholder_light(j) for j in range(len(scene.lights))],
-            film=hdr_film(w, h),
-            integrator=aov_integrator(),
-            sample_count=request.batch_spp,
-            geometry=request.geometry,
-        )
-        loaded = mi.load_dict(mitsuba_dict)
-        params = scene_parameters(
-            mi, loaded, [tr.reflectance_key(s, spectral=False) for s in surfaces]
-        )
+        keys = [tr.reflectance_key(s, spectral=False) for s in surfaces]
+        every = range(len(scene.lights))
+        loaded, params = load_rgb_scene(mi, scene, request, aov_integrator(), every, keys)
         depth_sum = normal_sum = None
         for p in range(n_pass):
             for i, s in enumerate(surfaces):
