@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from ..errors import RenderError
 
@@ -44,10 +44,15 @@ DEFAULT_INTEGRATOR = "single"
 UINT32_MAX = 2**32 - 1
 
 
+def _refuse(name: str, value: Any, expected: str) -> NoReturn:
+    """The one form of a refused render setting."""
+    raise RenderError(f"render setting {name}={value!r}; expected {expected}")
+
+
 def _positive(name: str, value: Any) -> None:
     """The one "at least 1" check of a count (samples, depth, batches)."""
     if not isinstance(value, int) or isinstance(value, bool) or value < 1:
-        raise RenderError(f"render setting {name}={value!r}; expected a positive integer")
+        _refuse(name, value, "a positive integer")
 
 
 @dataclass(frozen=True)
@@ -135,25 +140,13 @@ class RenderSettings:
                     f"expected {name} divisible by batches (each batch renders {name} / "
                     "batches samples)"
                 )
-        if self.noise_target is not None and not (
-            isinstance(self.noise_target, int | float) and 0 < self.noise_target < 1
-        ):
-            raise RenderError(
-                f"render setting noise_target={self.noise_target!r}; expected a "
-                "fraction in (0, 1), e.g. 0.02"
-            )
-        if self.max_batches is not None and (
-            not isinstance(self.max_batches, int) or self.max_batches < self.batches
-        ):
-            raise RenderError(
-                f"render setting max_batches={self.max_batches!r}; expected an "
-                f"integer >= batches ({self.batches})"
-            )
+        target, most = self.noise_target, self.max_batches
+        if target is not None and not (isinstance(target, int | float) and 0 < target < 1):
+            _refuse("noise_target", target, "a fraction in (0, 1), e.g. 0.02")
+        if most is not None and (not isinstance(most, int) or most < self.batches):
+            _refuse("max_batches", most, f"an integer >= batches ({self.batches})")
         if self.integrator not in INTEGRATORS:
-            raise RenderError(
-                f"render setting integrator={self.integrator!r}; expected one of "
-                f"{', '.join(INTEGRATORS)}"
-            )
+            _refuse("integrator", self.integrator, f"one of {', '.join(INTEGRATORS)}")
 
     @property
     def batch_spp(self) -> int:
