@@ -137,20 +137,13 @@ def _join(
     if other is None:
         return replace(diagonal, aovs=dict(aovs))
     meta = dict(other.meta)
-    for key in ("sensors", "to_xyz"):
-        meta[key] = {**other.meta.get(key, {}), **diagonal.meta[key]}
-    meta["timings"] = {**other.meta.get("timings", {}), **diagonal.meta["timings"]}
-    meta.update(
-        modes=list(order),
-        per_light=True,
-        per_light_modes=diagonal.meta["per_light_modes"],
-        variants={**other.meta.get("variants", {}), **diagonal.meta.get("variants", {})},
-    )
+    for key in ("sensors", "to_xyz", "timings", "variants"):
+        meta[key] = {**other.meta.get(key, {}), **diagonal.meta.get(key, {})}
+    meta.update(modes=list(order), per_light=True, per_light_modes=diagonal.meta["per_light_modes"])
+    images, raw = {**other.images, **diagonal.images}, {**other.raw, **diagonal.raw}
     return RenderResult(
-        images={m: {**other.images, **diagonal.images}[m] for m in order},
-        raw={
-            m: {**other.raw, **diagonal.raw}[m] for m in order if m in {**other.raw, **diagonal.raw}
-        },
+        images={m: images[m] for m in order},
+        raw={m: raw[m] for m in order if m in raw},
         per_light=diagonal.per_light,
         direct=dict(other.direct),
         aovs=dict(aovs),
