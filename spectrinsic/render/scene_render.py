@@ -92,49 +92,26 @@ def _rgb_part(
     run: _Run, rgb_variant: str
 ) -> tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
     """The diagonal modes of every job (one traversal, or the passes) and the AOVs."""
-    scene, plan, single = run.scene, run.plan, SingleTraversal({}, ())
+    scene, plan, data_dir = run.scene, run.plan, run.data_dir
     request = replace(run.request, variant=rgb_variant)
-    aov_maps: dict[str, np.ndarray] = {}
     if plan.traversal:
+        jobs = [(j.modes, j.group, j.with_direct) for j in plan.jobs]
         parts, single = render_jobs(
-            scene,
-            [(j.modes, j.group, j.with_direct) for j in plan.jobs],
-            request,
-            wanted=plan.wanted,
-            data_dir=run.data_dir,
-            aovs=plan.settings.aovs,
+            scene, jobs, request, wanted=plan.wanted, data_dir=data_dir, aovs=plan.settings.aovs
         )
-        aov_maps = single.aovs
         for out, part in zip(run.outputs, parts, strict=True):
             out.update(part)
-        return aov_maps, (), single
+        return single.aovs, (), single
     for out, job in zip(run.outputs, plan.jobs, strict=True):
         diagonal = [m for m in job.modes if m.kind == "diagonal"]
-        values = [
-            channel_values(
-                scene, get_sensors(m.sensors, data_dir=run.data_dir), data_dir=run.data_dir
-            )
-            for m in diagonal
-        ]
-        out.update(
-            zip(
-                (m.name for m in diagonal),
-                render_diagonal(
-                    scene,
-                    values,
-                    request,
-                    direct=[job.with_direct and m.name in plan.wanted for m in diagonal],
-                    active_lights=job.group,
-                ),
-                strict=True,
-            )
-            if diagonal
-            else ()
-        )
-    if not plan.settings.aovs:
-        return aov_maps, (), single
-    aov_maps, aov_seconds = render_aovs(scene, request)
-    return aov_maps, aov_seconds, single
+        if diagonal:  # the passes refuse what they cannot render, even with no value set
+            sensors = [get_sensors(m.sensors, data_dir=data_dir) for m in diagonal]
+            values = [channel_values(scene, s, data_dir=data_dir) for s in sensors]
+            direct = [job.with_direct and m.name in plan.wanted for m in diagonal]
+            images = render_diagonal(scene, values, request, direct=direct, active_lights=job.group)
+            out.update(zip((m.name for m in diagonal), images, strict=True))
+    aov_maps, aov_seconds = render_aovs(scene, request) if plan.settings.aovs else ({}, ())
+    return aov_maps, aov_seconds, SingleTraversal({}, ())
 
 
 def _spectral_part(run: _Run, spectral_variant: str) -> None:
@@ -346,7 +323,9 @@ def _assemble(
         per_light=per_light_images,
         direct={
             n: raw_to_xyz(
-                np.sum([g[n].direct for g in main_out], axis=0, dtype=np.float64), matrices[n]
+                # every main job renders the direct light of the wanted modes: no None here
+                np.sum([g[n].direct for g in main_out], axis=0, dtype=np.float64),  # type: ignore[arg-type]
+                matrices[n],
             )
             for n in names
             if n in plan.wanted
