@@ -31,9 +31,8 @@ def render_aovs(
     the ``albedo`` AOV, averaged by a box filter, is the fraction of the pixel's samples hitting
     it; with the seed and sample count of the colour passes these are the very samples those
     passes averaged, so ``Σ_m coverage_m ρ_m`` is the ground-truth reflectance of each pixel.
-    Mitsuba's own albedo of the real materials is not used (it assumes RGB wavelengths).
-    *request* (:class:`~spectrinsic.render.settings.PassRequest`) gives samples, seed, variant,
-    progress and prepared geometry (the path depth is the ``aov`` integrator's first hit).
+    Mitsuba's own albedo of the real materials is not used (it assumes RGB wavelengths). The
+    path depth of *request* does not apply: the ``aov`` integrator reads the first hit.
 
     Returns
     -------
@@ -60,11 +59,8 @@ def render_aovs(
         loaded, params = load_rgb_scene(mi, scene, request, aov_integrator(), every, keys)
         depth_sum = normal_sum = None
         for p in range(n_pass):
-            for i, s in enumerate(surfaces):
-                onehot = np.zeros(3)
-                if i // 3 == p:
-                    onehot[i % 3] = 1.0
-                set_rgb(mi, params, tr.reflectance_key(s, spectral=False), onehot)
+            for i, key in enumerate(keys):  # one-hot: surface i is channel i % 3 of pass i // 3
+                set_rgb(mi, params, key, np.eye(3)[i % 3] * (i // 3 == p))
             params.update()
             image, dt = timed_render(mi, loaded, request)
             seconds.append(dt)
@@ -73,10 +69,7 @@ def render_aovs(
                     f"AOV pass returned {image.shape[-1]} channels; expected 7 (depth, normal, albedo)"
                 )
             if p == 0:
-                depth_sum, normal_sum = (
-                    image[..., 0].astype(np.float64),
-                    image[..., 1:4].astype(np.float64),
-                )
+                depth_sum, normal_sum = image[..., 0].astype(float), image[..., 1:4].astype(float)
             block = surfaces[3 * p : 3 * p + 3]
             cover[..., 3 * p : 3 * p + len(block)] = image[..., 4 : 4 + len(block)]
     return assemble_aovs(scene, surfaces, cover, depth_sum, normal_sum), tuple(seconds)
