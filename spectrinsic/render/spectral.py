@@ -128,13 +128,11 @@ def render_spectral(
                 scene,
                 materials=materials,
                 lights=[
-                    (
-                        {"bitmap": bitmap}
-                        if j in on and bitmap is not None
-                        else regular_spectrum(emission[j], wl)
-                        if j in on
-                        else None
-                    )
+                    None
+                    if j not in on
+                    else regular_spectrum(emission[j], wl)
+                    if bitmap is None
+                    else {"bitmap": bitmap}
                     for j in range(len(scene.lights))
                 ],
                 film=spectral_film(scene.camera.width, scene.camera.height, curves * factor, wl),
