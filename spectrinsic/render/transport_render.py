@@ -152,6 +152,22 @@ def _join(
     )
 
 
+def _flat_unit(
+    scene: Scene, render: RenderResult, names: Sequence[str], data_dir: str | None
+) -> tuple[dict[str, np.ndarray], dict[str, dict[str, np.ndarray]]]:
+    """A traversal's transport and parts, per unit channel emission ``E_lk``, per flat unit
+    spectrum instead (times ``∫S_k dλ``): Eq. 1's ``T_lk``."""
+    flat = {
+        m: _unit_values(scene, get_mode(m).sensors, data_dir).lights[:, None, None, :]
+        for m in names
+    }
+
+    def unit(part: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        return {m: (part[m].astype(np.float64) * flat[m]).astype(np.float32) for m in part}
+
+    return unit(render.transport), {p: unit(held) for p, held in render.part_transport.items()}
+
+
 def _batch(
     scene: Scene,
     settings: RenderSettings,
@@ -188,17 +204,8 @@ def _batch(
 
     if settings.integrator == "single":
         render = rendered(settings.modes)
-        flat = {
-            m: _unit_values(scene, get_mode(m).sensors, data_dir).lights[:, None, None, :]
-            for m in names
-        }
-
-        def unit(part: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-            # per unit channel emission E_lk -> per flat unit spectrum (Eq. 1's T_lk)
-            return {m: (part[m].astype(np.float64) * flat[m]).astype(np.float32) for m in part}
-
-        parts = {p: unit(held) for p, held in render.part_transport.items()}
-        batch = _one_batch(names, settings, seed, unit(render.transport), parts)
+        t, parts = _flat_unit(scene, render, names, data_dir)
+        batch = _one_batch(names, settings, seed, t, parts)
         timings = {m: render.meta["timings"][m] for m in names}
         variants = {m: render.meta["variants"][m] for m in names}
         aovs = render.aovs
