@@ -1,10 +1,6 @@
 """Independent batches of one scene's render, run: the one batch loop (:func:`run_batches`).
-
 Inside a batch every mode shares seed and paths (:func:`~spectrinsic.render.scene_render.render_scene`);
-the batches differ only in their seed, so the spread between them is a direct estimate of the
-Monte Carlo error of their mean (the noise budget of the ground truth, and the adaptive
-sampling of ``RenderSettings.noise_target``).
-"""
+the batches' seeds, mean and spread are :mod:`~spectrinsic.render.algebra.batch_means`'."""
 
 from __future__ import annotations
 
@@ -59,20 +55,16 @@ def run_batches(
     cap = max(batches, settings.max_batches if settings.max_batches is not None else 4 * batches)
     seeds = batch_seeds(seed, cap if noise_target is not None else batches)
     done = [one(s) for s in seeds[:batches]]
-    reached = image_noise([result_of(d) for d in done]) if noise_target is not None else None
-    while (
-        reached is not None
-        and noise_target is not None
-        and reached > noise_target
-        and len(done) < cap
-    ):
+    if noise_target is None:
+        return done, merge_batches([result_of(d) for d in done]), seeds
+    reached = image_noise([result_of(d) for d in done])
+    while reached is not None and reached > noise_target and len(done) < cap:
         done.append(one(seeds[len(done)]))
         reached = image_noise([result_of(d) for d in done])
     merged = merge_batches([result_of(d) for d in done])
-    if noise_target is not None:
-        merged.meta["noise_target"] = {
-            "target": float(noise_target),
-            "reached": reached,
-            "max_batches": cap,
-        }
+    merged.meta["noise_target"] = {
+        "target": float(noise_target),
+        "reached": reached,
+        "max_batches": cap,
+    }
     return done, merged, seeds[: len(done)]

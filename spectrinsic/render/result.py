@@ -62,17 +62,14 @@ class RenderResult:
     batch_raw
         Per independent batch (:func:`spectrinsic.render.render_batches`), mode -> ``(H, W, K)``
         float32 raw channels of that batch alone; ``raw`` is their mean. Empty for a single
-        batch. Inside a batch every mode shares its paths; batches have independent seeds, so
-        their spread measures the Monte Carlo noise.
+        batch.
     transport
         With the single-traversal integrator, mode -> ``(L, H, W, K)`` float32 per-light band
-        transport for unit emission (:class:`spectrinsic.render.algebra.shares.TransportOutput`):
-        ``raw[mode][..., k] = Σ_l E_{l,k} transport[mode][l, ..., k]``, with E the lights'
-        channel values (:func:`spectrinsic.render.algebra.modes.channel_values`). Empty otherwise.
+        transport for unit emission, composed to ``raw`` by Eq. 5.2
+        (:mod:`spectrinsic.render.algebra.shares`). Empty otherwise.
     parts
-        Single traversal: part name (:data:`PARTS`: ``"specular"``, a part of ``raw``;
-        ``"metal_white"``, not) -> mode -> ``(H, W, K)`` float32 raw channels of that part,
-        summed over the lights as ``raw`` is; only the parts the scene has.
+        Single traversal: :data:`PARTS` name -> mode -> ``(H, W, K)`` float32 raw channels of
+        that part, summed over the lights as ``raw`` is; only the parts the scene has.
     part_transport
         The per-light parts behind ``parts`` as ``transport`` is behind ``raw`` (part name ->
         mode -> ``(L, H, W, K)`` float32 for unit emission); empty without them.
@@ -93,17 +90,6 @@ class RenderResult:
     def specular(self) -> dict[str, np.ndarray]:
         """``parts["specular"]``: mode -> ``(H, W, K)`` raw specular part (empty: matte scene)."""
         return self.parts.get(SPECULAR, {})
-
-    @property
-    def metal_white(self) -> dict[str, np.ndarray]:
-        """``parts["metal_white"]``: mode -> ``(H, W, K)`` raw white-at-metal radiance."""
-        return self.parts.get(METAL_WHITE, {})
-
-    @property
-    def shape(self) -> tuple[int, int]:
-        """``(H, W)`` of the images."""
-        first = next(iter(self.images.values()))
-        return int(first.shape[0]), int(first.shape[1])
 
     def energy_ratio(self, mode: str) -> float:
         """r = Σ_x ‖p¹(x)‖ / Σ_x ‖p^∞(x)‖ (Eq. 5.8) on *mode*'s XYZ, from the direct-only render."""

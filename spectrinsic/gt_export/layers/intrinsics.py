@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from ...render.algebra.modes import channel_values, get_mode, to_xyz_matrix
+from ...render.result import METAL_WHITE
 from ...spectra import get_sensors
 from . import irradiance as irr
 from .gloss import diffuse_raw
@@ -67,7 +68,7 @@ def white_radiance(s: SampleInputs, coverage: np.ndarray) -> irr.WhiteRadiance:
     )
     raw = s.result.raw[s.ref] if s.ref in s.result.raw else s.result.images[s.ref]
     metals = np.array([m.non_diffuse for m in s.scene.materials], bool)
-    metal_white = s.result.metal_white.get(s.ref)
+    metal_white = s.result.parts.get(METAL_WHITE, {}).get(s.ref)
     # W of the first hits' diffuse lobes only: the specular part is its own layer; at metals
     # the renderer's white-surface estimate
     return irr.white_radiance(

@@ -18,6 +18,7 @@ from ...rng import seed_from_key
 from ..result import RenderResult
 
 __all__ = [
+    "batch_counts",
     "batch_mean",
     "batch_seeds",
     "relative_standard_error",
@@ -32,6 +33,17 @@ def batch_seeds(seed: int, batches: int) -> list[int]:
     if isinstance(batches, bool) or not isinstance(batches, int) or batches < 1:
         raise SceneError(f"batches {batches!r}: expected a positive integer")
     return [int(seed)] + [seed_from_key(int(seed), f"batch-{b}") for b in range(1, batches)]
+
+
+def batch_counts(seeds: Sequence[int], batch_spp: int) -> dict[str, int | list[int]]:
+    """The count keys of a render's ``meta`` for batches of *batch_spp* samples per pixel with
+    *seeds*: ``seed`` (the first), ``spp`` (the total) and, with several batches, ``batches``,
+    ``batch_spp`` (one batch's) and ``batch_seeds``; one home for merged and relit renders."""
+    n = len(seeds)
+    counts: dict[str, int | list[int]] = {"seed": int(seeds[0]), "spp": batch_spp * n}
+    if n > 1:
+        counts.update(batches=n, batch_spp=batch_spp, batch_seeds=list(seeds))
+    return counts
 
 
 def relative_standard_error(batches: Sequence[np.ndarray], valid: np.ndarray) -> np.ndarray:
@@ -120,9 +132,8 @@ def _merge_aovs(parts: Sequence[dict[str, np.ndarray]]) -> dict[str, np.ndarray]
     return merged
 
 
-def _mean_part(results: Sequence[RenderResult], field: str, part: str) -> dict[str, np.ndarray]:
-    """Mode -> :func:`batch_mean` of one *part* of the results' ``parts`` or ``part_transport``."""
-    held = [getattr(r, field)[part] for r in results]
+def _mean_modes(held: Sequence[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
+    """Mode -> :func:`batch_mean` of one dict per batch (the modes of the first)."""
     return {m: batch_mean([h[m] for h in held]) for m in held[0]}
 
 
@@ -133,13 +144,9 @@ def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
     if len(results) == 1:
         return results[0]
     first = results[0]
-    modes = list(first.images)
     meta = dict(first.meta)
     meta.update(
-        spp=int(first.meta["spp"]) * len(results),
-        batches=len(results),
-        batch_spp=int(first.meta["spp"]),
-        batch_seeds=[int(r.meta["seed"]) for r in results],
+        batch_counts([int(r.meta["seed"]) for r in results], int(first.meta["spp"])),
         timings={
             k: {
                 "passes": sum(r.meta["timings"][k]["passes"] for r in results),
@@ -154,17 +161,18 @@ def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
         spectral = int(first.meta["spectral_spp"])
         meta.update(spectral_spp=spectral * len(results), spectral_batch_spp=spectral)
     return RenderResult(
-        images={m: batch_mean([r.images[m] for r in results]) for m in modes},
-        raw={m: batch_mean([r.raw[m] for r in results]) for m in first.raw},
+        images=_mean_modes([r.images for r in results]),
+        raw=_mean_modes([r.raw for r in results]),
         per_light=tuple(
-            {m: batch_mean([r.per_light[i][m] for r in results]) for m in pl}
-            for i, pl in enumerate(first.per_light)
+            _mean_modes([r.per_light[i] for r in results]) for i in range(len(first.per_light))
         ),
-        direct={m: batch_mean([r.direct[m] for r in results]) for m in first.direct},
+        direct=_mean_modes([r.direct for r in results]),
         aovs=_merge_aovs([r.aovs for r in results]),
-        transport={m: batch_mean([r.transport[m] for r in results]) for m in first.transport},
-        parts={p: _mean_part(results, "parts", p) for p in first.parts},
-        part_transport={p: _mean_part(results, "part_transport", p) for p in first.part_transport},
+        transport=_mean_modes([r.transport for r in results]),
+        parts={p: _mean_modes([r.parts[p] for r in results]) for p in first.parts},
+        part_transport={
+            p: _mean_modes([r.part_transport[p] for r in results]) for p in first.part_transport
+        },
         meta=meta,
         batch_raw=tuple(dict(r.raw) for r in results),
     )

@@ -16,16 +16,14 @@ from ...scenes.model import Scene
 from ...spectra import COLORIMETRIC_WAVELENGTHS, diagonal_values, get_sensors
 from ...threads import thread_map
 from ..result import RenderResult
-from .batch_means import batch_mean
-from .modes import get_mode, light_spectra, lights_to_xyz_matrix, raw_to_xyz
+from .batch_means import batch_counts, batch_mean
+from .modes import get_mode, light_spectra, raw_to_xyz, to_xyz_matrix
 from .shares import compose, light_shares, sum_lights
 
 __all__ = [
     "LightTransport",
-    "ModeLighting",
     "diagonal_mode_names",
     "light_band_means",
-    "mode_lighting",
     "relit_result",
 ]
 
@@ -53,9 +51,8 @@ class LightTransport:
         Seconds of each Mitsuba pass, per mode, and under ``"single"`` those of the traversals
         carrying every mode at once (empty when read from a file).
     parts
-        Part name (:data:`~spectrinsic.render.result.PARTS`: ``"specular"``, a part of ``T``;
-        ``"metal_white"``, not) -> one dict per batch as :attr:`batches`, for the same unit
-        spectrum; only the parts held.
+        :data:`~spectrinsic.render.result.PARTS` name -> one dict per batch as :attr:`batches`,
+        for the same unit spectrum; only the parts held.
     """
 
     modes: tuple[str, ...]
@@ -87,12 +84,6 @@ class LightTransport:
         """Number of lights L."""
         return int(next(iter(self.batches[0].values())).shape[0])
 
-    @property
-    def shape(self) -> tuple[int, int]:
-        """``(H, W)`` of the images."""
-        first = next(iter(self.batches[0].values()))
-        return int(first.shape[1]), int(first.shape[2])
-
 
 def diagonal_mode_names(modes: Iterable[str]) -> tuple[str, ...]:
     """The diagonal (relightable) modes among *modes*, in order, validated."""
@@ -109,7 +100,7 @@ def light_band_means(scene: Scene, sensors: str, *, data_dir: str | None = None)
     >>> float(light_band_means(s, "bands:31@400-700").round(12).max())
     2.0
     """
-    emitted = light_spectra(scene, COLORIMETRIC_WAVELENGTHS, data_dir=data_dir)
+    emitted = light_spectra(scene, data_dir=data_dir)
     return _band_means(emitted, sensors, data_dir)
 
 
@@ -119,7 +110,7 @@ def _band_means(emitted: np.ndarray, sensors: str, data_dir: str | None) -> np.n
 
 
 @dataclass(frozen=True, eq=False)
-class ModeLighting:
+class _ModeLighting:
     """What a mode's raw channels need from the scene's lights: their band means ``ē_lk``
     (``(L, K)``, :func:`light_band_means`) and the mode's raw -> XYZ matrix (``(3, K)``)."""
 
@@ -127,30 +118,19 @@ class ModeLighting:
     to_xyz: np.ndarray
 
 
-def mode_lighting(
+def _mode_lighting(
     scene: Scene, modes: Iterable[str], *, data_dir: str | None = None
-) -> dict[str, ModeLighting]:
-    """:class:`ModeLighting` of each of *modes* under *scene*'s lights, computed once for all
+) -> dict[str, _ModeLighting]:
+    """:class:`_ModeLighting` of each of *modes* under *scene*'s lights, computed once for all
     the batches of a sample (the lights' spectra resampled once for all modes)."""
-    emitted = light_spectra(scene, COLORIMETRIC_WAVELENGTHS, data_dir=data_dir)
+    emitted = light_spectra(scene, data_dir=data_dir)
     return {
-        m: ModeLighting(
+        m: _ModeLighting(
             _band_means(emitted, get_mode(m).sensors, data_dir),
-            np.asarray(lights_to_xyz_matrix(get_mode(m), emitted, data_dir=data_dir), np.float64),
+            to_xyz_matrix(get_mode(m), scene, data_dir=data_dir, emitted=emitted),
         )
         for m in modes
     }
-
-
-@dataclass(frozen=True, eq=False)
-class _Composed:
-    """The arrays of a render composed from transport (:func:`_compose`)."""
-
-    raw: dict[str, np.ndarray]
-    images: dict[str, np.ndarray]
-    per_light: tuple[dict[str, np.ndarray], ...]
-    batch_raw: tuple[dict[str, np.ndarray], ...]
-    parts: dict[str, dict[str, np.ndarray]]
 
 
 @dataclass(frozen=True, eq=False)
@@ -162,7 +142,7 @@ class _BatchImages:
     shares_xyz: np.ndarray
 
 
-def _batch_images(transport: np.ndarray, lighting: ModeLighting) -> _BatchImages:
+def _batch_images(transport: np.ndarray, lighting: _ModeLighting) -> _BatchImages:
     """Eq. 1 for one batch of one mode: ``(L, H, W, K)`` *transport* under *lighting*. The
     image's XYZ is the float64 sum of the lights' XYZ (the matrix is linear), which spares
     converting the summed raw channels a second time."""
@@ -173,23 +153,56 @@ def _batch_images(transport: np.ndarray, lighting: ModeLighting) -> _BatchImages
     )
 
 
-def _compose(
-    transport: LightTransport, scene: Scene, lighting: Mapping[str, ModeLighting]
-) -> _Composed:
-    """Eq. 1 for every batch and mode, merged over the batches as
-    :func:`~spectrinsic.render.merge_batches` merges rendered ones (bit for bit); the batches
-    and modes are independent, so they run side by side (:func:`~spectrinsic.threads.thread_map`)."""
+def _meta(
+    transport: LightTransport,
+    lighting: Mapping[str, _ModeLighting],
+    meta: Mapping[str, Any] | None,
+) -> dict[str, Any]:
+    """*meta* (a render's metadata) with the modes, sensors, XYZ matrices and the batches'
+    counts (:func:`~.batch_means.batch_counts`) set."""
+    modes = list(transport.modes)
+    out: dict[str, Any] = dict(meta or {})
+    out.update(
+        batch_counts(transport.seeds, int(transport.batch_spp)),
+        modes=modes,
+        per_light=True,
+        per_light_modes=modes,
+        sensors={m: get_mode(m).sensors for m in modes},
+        to_xyz={m: np.asarray(lighting[m].to_xyz).tolist() for m in modes},
+    )
+    out.setdefault("timings", {})
+    return out
+
+
+def relit_result(
+    transport: LightTransport,
+    scene: Scene,
+    *,
+    meta: Mapping[str, Any] | None = None,
+    data_dir: str | None = None,
+) -> RenderResult:
+    """The render of every batch of *transport* under *scene*'s light spectra and powers
+    (Eq. 1), merged as :func:`~spectrinsic.render.merge_batches` merges rendered batches, bit
+    for bit (each batch's raw channels kept).
+
+    Per mode and batch: each light's raw channels ``T_l ∘ ē_l`` (float32, as Mitsuba returns a
+    pass), their float64 sum as ``raw`` (as :func:`~spectrinsic.render.render_scene` sums
+    lights), and the XYZ of both through the mode's matrix for this scene's lights; the parts
+    likewise, where held. *meta* (a render's metadata) is kept, with the modes, sensors, XYZ
+    matrices, seeds and spp set. The batches and modes are independent, so they run side by
+    side (:func:`~spectrinsic.threads.thread_map`).
+    """
     if transport.n_lights != len(scene.lights):
         raise RenderError(
             f"transport has {transport.n_lights} lights; the scene has {len(scene.lights)}"
         )
+    lighting = _mode_lighting(scene, transport.modes, data_dir=data_dir)
     n = len(transport.batches)
     tasks = [(m, b) for m in transport.modes for b in range(n)]
     composed = thread_map(
         lambda t: _batch_images(transport.batches[t[1]][t[0]], lighting[t[0]]), tasks
     )
     done = dict(zip(tasks, composed))
-    batch_raw = tuple({m: done[m, b].raw for m in transport.modes} for b in range(n))
     raw: dict[str, np.ndarray] = {}
     images: dict[str, np.ndarray] = {}
     parts: dict[str, dict[str, np.ndarray]] = {p: {} for p, held in transport.parts.items() if held}
@@ -204,58 +217,13 @@ def _compose(
         e = lighting[mode].means
         for p, out in parts.items():
             out[mode] = batch_mean([compose(b[mode], e) for b in transport.parts[p]])
-    return _Composed(raw, images, tuple(per_light), batch_raw, parts)
-
-
-def _meta(
-    transport: LightTransport,
-    lighting: Mapping[str, ModeLighting],
-    meta: Mapping[str, Any] | None,
-) -> dict[str, Any]:
-    """*meta* (a render's metadata) with the modes, sensors, XYZ matrices, seed and spp set,
-    and the batches as :func:`~spectrinsic.render.merge_batches` sets them."""
-    n, modes = len(transport.batches), list(transport.modes)
-    out: dict[str, Any] = dict(meta or {})
-    out.update(
-        seed=int(transport.seeds[0]),
-        spp=int(transport.batch_spp) * n,
-        modes=modes,
-        per_light=True,
-        per_light_modes=modes,
-        sensors={m: get_mode(m).sensors for m in modes},
-        to_xyz={m: np.asarray(lighting[m].to_xyz).tolist() for m in modes},
-    )
-    out.setdefault("timings", {})
-    if n > 1:
-        out.update(batches=n, batch_spp=int(transport.batch_spp), batch_seeds=list(transport.seeds))
-    return out
-
-
-def relit_result(
-    transport: LightTransport,
-    scene: Scene,
-    *,
-    meta: Mapping[str, Any] | None = None,
-    data_dir: str | None = None,
-) -> RenderResult:
-    """The render of every batch of *transport* under *scene*'s light spectra and powers,
-    merged as :func:`~spectrinsic.render.merge_batches` merges rendered batches (each batch's
-    raw channels kept), from Eq. 1.
-
-    Per mode and batch: each light's raw channels ``T_l ∘ ē_l`` (float32, as Mitsuba returns a
-    pass), their float64 sum as ``raw`` (as :func:`~spectrinsic.render.render_scene` sums
-    lights), and the XYZ of both through the mode's matrix for this scene's lights; the
-    specular and white-at-metal parts likewise, where held. *meta* (a render's metadata) is
-    kept, with the modes, sensors, XYZ matrices, seeds and spp set. The lights' band means
-    and XYZ matrices are computed once for all batches (:func:`mode_lighting`).
-    """
-    lighting = mode_lighting(scene, transport.modes, data_dir=data_dir)
-    c = _compose(transport, scene, lighting)
     return RenderResult(
-        images=c.images,
-        raw=c.raw,
-        per_light=c.per_light,
+        images=images,
+        raw=raw,
+        per_light=tuple(per_light),
         meta=_meta(transport, lighting, meta),
-        batch_raw=c.batch_raw if len(transport.batches) > 1 else (),
-        parts=c.parts,
+        batch_raw=tuple({m: done[m, b].raw for m in transport.modes} for b in range(n))
+        if n > 1
+        else (),
+        parts=parts,
     )

@@ -61,7 +61,6 @@ __all__ = [
     "integration_matrix",
     "regression_matrix",
     "to_xyz_matrix",
-    "lights_to_xyz_matrix",
     "raw_to_xyz",
     "pad_to_passes",
 ]
@@ -187,83 +186,64 @@ def light_spectra(
     data_dir: str | None = None,
 ) -> np.ndarray:
     """``(L, W)`` emitted spectra of the scene's lights: ``power · L(λ)`` on *wavelengths*."""
-    return (
-        np.stack(
-            [
-                li.power * get_spectrum(li.spectrum, data_dir=data_dir).on(wavelengths)
-                for li in scene.lights
-            ]
-        )
-        if scene.lights
-        else np.zeros((0, np.size(wavelengths)))
+    return _stack(
+        [
+            li.power * get_spectrum(li.spectrum, data_dir=data_dir).on(wavelengths)
+            for li in scene.lights
+        ],
+        wavelengths,
     )
 
 
-def _reflectances(scene: Scene, wavelengths: Wavelengths, data_dir: str | None) -> np.ndarray:
-    return (
-        np.stack(
-            [get_spectrum(m.spectrum, data_dir=data_dir).on(wavelengths) for m in scene.materials]
-        )
-        if scene.materials
-        else np.zeros((0, np.size(wavelengths)))
-    )
+def _stack(rows: list[np.ndarray], wavelengths: Wavelengths) -> np.ndarray:
+    """``(N, W)`` spectra from *rows*, ``(0, W)`` for none."""
+    return np.stack(rows) if rows else np.zeros((0, np.size(wavelengths)))
 
 
 def channel_values(
-    scene: Scene,
-    sensors: SensorSet,
-    *,
-    wavelengths: Wavelengths = COLORIMETRIC_WAVELENGTHS,
-    data_dir: str | None = None,
+    scene: Scene, sensors: SensorSet, *, data_dir: str | None = None
 ) -> ChannelValues:
     """Material and light channel values of a diagonal render of *scene* with *sensors*.
 
     Materials get ``∫ρ S_k dλ / ∫S_k dλ`` (Eq. 5.4 normalised), lights ``power ∫L S_k dλ``
-    (Eq. 5.5), integrated on *wavelengths* (nm). Their product is the diagonal estimate
+    (Eq. 5.5), integrated on the CIE grid (nm). Their product is the diagonal estimate
     ``p̂_k`` of Eq. 5.2.
     """
-    curves = sensors.on(wavelengths)
-    rho = _reflectances(scene, wavelengths, data_dir)
-    emission = light_spectra(scene, wavelengths, data_dir=data_dir)
-    tinted = any(m.tinted for m in scene.materials)
+    wl = COLORIMETRIC_WAVELENGTHS
+    curves = sensors.on(wl)
+    rho = _stack([get_spectrum(m.spectrum, data_dir=data_dir).on(wl) for m in scene.materials], wl)
     return ChannelValues(
-        materials=diagonal_values(rho, curves, wavelengths)
-        if len(rho)
-        else np.zeros((0, sensors.n)),
-        lights=responses(emission, curves, wavelengths)
-        if len(emission)
-        else np.zeros((0, sensors.n)),
-        specular=_specular(scene, curves, wavelengths, data_dir)
-        if any(m.glossy for m in scene.materials)
-        else None,
-        transmittance=_tint(scene, "transmittance", curves, wavelengths, data_dir)
-        if tinted
-        else None,
-        specular_reflectance=_tint(scene, "specular_reflectance", curves, wavelengths, data_dir)
-        if tinted
-        else None,
+        materials=diagonal_values(rho, curves, wl),
+        lights=responses(light_spectra(scene, data_dir=data_dir), curves, wl),
+        specular=_specular(scene, curves, data_dir),
+        transmittance=_tint(scene, "transmittance", curves, data_dir),
+        specular_reflectance=_tint(scene, "specular_reflectance", curves, data_dir),
     )
 
 
-def _tint(
-    scene: Scene, key: str, curves: np.ndarray, wavelengths: Wavelengths, data_dir: str | None
-) -> np.ndarray:
-    """``(M, K)`` band values of every material's glass tint *key* (1 where it has none)."""
+def _tint(scene: Scene, key: str, curves: np.ndarray, data_dir: str | None) -> np.ndarray | None:
+    """``(M, K)`` band values of every material's glass tint *key* (1 where it has none);
+    ``None`` where no material is tinted."""
+    if not any(m.tinted for m in scene.materials):
+        return None
+    wl = COLORIMETRIC_WAVELENGTHS
     spectra = np.stack(
-        [get_spectrum(m.tint(key), data_dir=data_dir).on(wavelengths) for m in scene.materials]
+        [get_spectrum(m.tint(key), data_dir=data_dir).on(wl) for m in scene.materials]
     )
-    return diagonal_values(spectra, curves, wavelengths)
+    return diagonal_values(spectra, curves, wl)
 
 
-def _specular(
-    scene: Scene, curves: np.ndarray, wavelengths: Wavelengths, data_dir: str | None
-) -> np.ndarray:
+def _specular(scene: Scene, curves: np.ndarray, data_dir: str | None) -> np.ndarray | None:
     """``(M, N, K)`` band factors of each material's non-diffuse lobe: a conductor's Fresnel
-    times its reflection tint (if any), 1 otherwise (glass tints: :func:`_tint`)."""
+    times its reflection tint (if any), 1 otherwise (glass tints: :func:`_tint`); ``None``
+    where no material is glossy."""
+    if not any(m.glossy for m in scene.materials):
+        return None
+    wl = COLORIMETRIC_WAVELENGTHS
     ones = np.ones((FRESNEL_NODES, curves.shape[0]))
     return np.stack(
         [
-            fresnel_table(m.metal, curves, wavelengths, _conductor_tint(m, wavelengths, data_dir))
+            fresnel_table(m.metal, curves, wl, _conductor_tint(m, data_dir))
             if m.kind == "conductor"
             else ones
             for m in scene.materials
@@ -271,13 +251,11 @@ def _specular(
     )
 
 
-def _conductor_tint(
-    m: Material, wavelengths: Wavelengths, data_dir: str | None
-) -> np.ndarray | None:
-    """Conductor *m*'s reflection tint on *wavelengths*, or ``None`` where it has none."""
+def _conductor_tint(m: Material, data_dir: str | None) -> np.ndarray | None:
+    """Conductor *m*'s reflection tint on the CIE grid, or ``None`` where it has none."""
     if not m.specular_reflectance:
         return None
-    return np.asarray(get_spectrum(m.specular_reflectance, data_dir=data_dir).on(wavelengths))
+    return get_spectrum(m.specular_reflectance, data_dir=data_dir).on(COLORIMETRIC_WAVELENGTHS)
 
 
 def integration_matrix(
@@ -316,15 +294,13 @@ def regression_matrix(
     target: SensorSet,
     lights: np.ndarray,
     wavelengths: Wavelengths = COLORIMETRIC_WAVELENGTHS,
-    *,
-    reflectances: np.ndarray | None = None,
 ) -> np.ndarray:
     """``(C, K)`` least-squares projection from K-sensor to C target responses (thesis 5.2.3).
 
-    Fitted on the radiances ``ρ_i(λ) L_j(λ)`` of training reflectances ρ_i (default: the 1269
-    Munsell chips, the thesis' colour set) under each of the scene's lights L_j, stacked: the
-    regression knows the scene's illuminants, as the thesis' own regression could, but not its
-    interreflections (products of several reflectances), whose error it is meant to show.
+    Fitted on the radiances ``ρ_i(λ) L_j(λ)`` of the 1269 matte Munsell chips ρ_i (the thesis'
+    colour set) under each of the scene's lights L_j, stacked: the regression knows the scene's
+    illuminants, as the thesis' own regression could, but not its interreflections (products of
+    several reflectances), whose error it is meant to show.
 
     Parameters
     ----------
@@ -332,11 +308,7 @@ def regression_matrix(
         ``(J, W)`` spectra of the lights on *wavelengths*; each is normalised to unit maximum so
         every light weighs alike in the fit.
     """
-    rho = (  # the matte Munsell chips (1269, read-only, cached per grid)
-        family_values("munsell", wavelengths)
-        if reflectances is None
-        else np.asarray(reflectances, float)
-    )
+    rho = family_values("munsell", wavelengths)  # read-only, cached per grid
     lights = np.atleast_2d(np.asarray(lights, float))
     if lights.shape[0] == 0:
         lights = np.ones((1, np.size(wavelengths)))
@@ -352,27 +324,13 @@ def to_xyz_matrix(
     scene: Scene,
     *,
     data_dir: str | None = None,
-    wavelengths: Wavelengths = COLORIMETRIC_WAVELENGTHS,
+    emitted: np.ndarray | None = None,
 ) -> np.ndarray:
-    """``(3, K)`` matrix taking *mode*'s raw channels to CIE 1931 XYZ: ``xyz = raw @ T.T``."""
-    emitted = (
-        light_spectra(scene, wavelengths, data_dir=data_dir)
-        if mode.to_xyz == "regression"
-        else np.zeros((0, np.size(wavelengths)))
-    )
-    return lights_to_xyz_matrix(mode, emitted, data_dir=data_dir, wavelengths=wavelengths)
+    """``(3, K)`` matrix taking *mode*'s raw channels to CIE 1931 XYZ: ``xyz = raw @ T.T``.
 
-
-def lights_to_xyz_matrix(
-    mode: RenderMode,
-    emitted: np.ndarray,
-    *,
-    data_dir: str | None = None,
-    wavelengths: Wavelengths = COLORIMETRIC_WAVELENGTHS,
-) -> np.ndarray:
-    """:func:`to_xyz_matrix` for lights whose ``(L, W)`` spectra on *wavelengths* are already
-    known (:func:`light_spectra`; only a regression mode uses them), so a caller that needs
-    them anyway computes them once."""
+    A regression mode fits it under the lights' ``(L, W)`` *emitted* spectra on the CIE grid
+    (:func:`light_spectra` of *scene* where not given: a caller that needs them anyway passes
+    them, computed once)."""
     sensors = get_sensors(mode.sensors, data_dir=data_dir)
     xyz = get_sensors(XYZ_SENSORS)
     if mode.to_xyz == "identity":
@@ -382,8 +340,10 @@ def lights_to_xyz_matrix(
             )
         return np.eye(3)
     if mode.to_xyz == "integration":
-        return integration_matrix(sensors, xyz, wavelengths)
-    return regression_matrix(sensors, xyz, emitted, wavelengths)
+        return integration_matrix(sensors, xyz)
+    if emitted is None:
+        emitted = light_spectra(scene, data_dir=data_dir)
+    return regression_matrix(sensors, xyz, emitted)
 
 
 #: Pixels converted at a time by :func:`raw_to_xyz`: one chunk's float64 copy stays in cache.

@@ -1,8 +1,9 @@
 """What one band-path traversal gives per value set: :class:`TransportOutput`.
 
-Every array is for **unit emission** in every band of every light; the images follow by
-multiplying with the lights' channel values ``E_{l,k}`` (Eq. 5.2), so each light's share is
-exact and the shares sum to the total.
+Every array is for **unit emission** in every band of every light: ``transport[l, ..., k]`` is
+light l's ``∫ radiance S_k`` per unit ``E_{l,k}``, and an image is ``Σ_l E_{l,k} ·
+transport[l, ..., k]`` with the lights' channel values ``E_{l,k}`` (Eq. 5.2, :func:`compose`),
+so each light's share is exact and the shares sum to the total.
 """
 
 from __future__ import annotations
@@ -61,17 +62,14 @@ class TransportOutput:
     Attributes
     ----------
     transport
-        ``(L, H, W, K)`` float32: light l's contribution to channel k for unit emission in
-        every band (``∫ radiance S_k`` per unit ``E_{l,k}``); the diagonal image is
-        ``Σ_l E_{l,k} · transport[l, ..., k]``.
+        ``(L, H, W, K)`` float32 per-light transport (module docstring).
     direct
         The same for direct light only (path depth 2), or ``None`` when not asked for.
     emission
         ``(L, K)`` float64 the lights' channel values ``E_{l,k}`` (:class:`ChannelValues`).
     parts
-        Part name (:data:`~spectrinsic.render.result.PARTS`: ``"specular"``, a part of
-        :attr:`transport`; ``"metal_white"``, not) -> ``(L, H, W, K)`` float32, the parts the
-        traversal rendered.
+        :data:`~spectrinsic.render.result.PARTS` name -> ``(L, H, W, K)`` float32, the parts
+        the traversal rendered.
     """
 
     transport: np.ndarray
@@ -79,16 +77,13 @@ class TransportOutput:
     emission: np.ndarray
     parts: dict[str, np.ndarray] = field(default_factory=dict)
 
-    def per_light(self, *, direct: bool = False) -> np.ndarray:
-        """``(L, H, W, K)`` float32 each light's image: ``E_{l,k} · transport``."""
+    def image(self, lights: Sequence[int] | None = None, *, direct: bool = False) -> np.ndarray:
+        """``(H, W, K)`` float32 image of the *lights* (default all): the sum of their shares
+        ``E_{l,k} · transport`` (:func:`compose`)."""
         t = self.direct if direct else self.transport
         if t is None:
             raise RenderError("no direct-only transport was rendered")
-        return light_shares(t, self.emission)
-
-    def image(self, lights: Sequence[int] | None = None, *, direct: bool = False) -> np.ndarray:
-        """``(H, W, K)`` float32 image of the *lights* (default all): the sum of their shares."""
-        return sum_lights(self.per_light(direct=direct), lights)
+        return compose(t, self.emission, lights)
 
     def part_image(self, part: str, lights: Sequence[int] | None = None) -> np.ndarray | None:
         """``(H, W, K)`` float32 image of *part* (:data:`~spectrinsic.render.result.PARTS`) for the *lights* (default all),
