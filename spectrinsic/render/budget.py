@@ -1,22 +1,20 @@
 """Memory a render needs, estimated before it starts, against the memory this machine has.
 
-A render holds, per pixel and per colour mode, the raw K channels and their XYZ, once more per
-light when each light's share is kept, plus the AOVs (coverage, ids, depth, normals), as
-float32. :func:`estimate_render_bytes` counts those values, times :data:`OVERHEAD_FACTOR` for
-the copies made on the way (numpy copies, EXR encoding), plus :data:`BASE_BYTES` for the
-process itself (Python, Mitsuba, the compiled kernels), plus the band-path traversal's film:
-one channel per light and band of every diagonal mode for each part it accumulates (transport,
-specular, white at metals) and one per surface for the first-hit coverage
-(:func:`traversal_channels`), :data:`FILM_COPIES` times, and the float64 material and object
-coverage the AOVs are assembled from. That film is what grows with the lights and surfaces of a
-scene (800 channels for a 4-light interior of 300 meshes, docs/artist-interior-speed.md), so
-the scene's counts (:class:`RenderLoad`) are part of the estimate. The samples per pixel are
-not: Mitsuba's symbolic loops keep no per-sample state (the peak at 350 x 200 was the same at
-spp 8 and 32). The per-light terms are checked against measured peaks of multi-light,
-environment-map scenes in docs/artist-interior-speed.md ("The size check's estimate"). It was
-first calibrated to be an upper bound
-of the measured peak resident memory (``ru_maxrss``) of ``spectrinsic render obj-apple`` with
-the four default modes (73 values per pixel with the AOVs), spp 16, on the 2-core CI machine:
+:func:`estimate_render_bytes` counts per pixel the float32 values a render holds (per mode the
+raw K channels and their XYZ, once more per light when each light's share is kept, plus the
+AOVs) times :data:`OVERHEAD_FACTOR` (the copies made on the way to the files); the band-path
+traversal's film (:func:`traversal_channels`: one channel per light and band of every diagonal
+mode for each part it accumulates, one per surface for the first-hit coverage) times
+:data:`FILM_COPIES`; the float64 material and object coverage the AOVs are assembled from; and
+:data:`BASE_BYTES` for the process (Python, Mitsuba, the compiled kernels). The film grows with
+the lights and surfaces of a scene (800 channels for a 4-light interior of 300 meshes), so the
+scene's counts (:class:`RenderLoad`) are part of the estimate; the samples per pixel are not:
+Mitsuba's symbolic loops keep no per-sample state (256 x 256 peaked at 304 MiB at spp 64, and
+350 x 200 the same at spp 8 and 32). The per-light terms are checked against measured peaks of
+multi-light, environment-map scenes in docs/artist-interior-speed.md ("The size check's
+estimate"). The estimate is an upper bound of the measured peak resident memory
+(``ru_maxrss``) of ``spectrinsic render obj-apple`` with the four default modes (73 values per
+pixel with the AOVs), spp 16, on the 2-core CI machine:
 
 =========  ===========================  ==========
 size       measured                     estimate
@@ -29,19 +27,14 @@ size       measured                     estimate
 2048^2     5.0 GB (passes)              13.1 GB
 =========  ===========================  ==========
 
-(estimates of this module as it is now, obj-apple's counts, the four modes: the film term adds
-51 channels; the 2048^2 figure from issue 17, where the former count, 684 B/pixel without the
-process, estimated 1.7 GiB; it was rendered with the passes, which have no traversal film, so
-that row over-estimates the passes by 2.6 x). The 1215 MiB rows are the largest of four measurements made inside
-full ``make test`` runs on a loaded machine (1148-1215 MiB, modes spectral, rgb3, rgb6, spp 2;
-the same render alone peaks at 240 MiB warm and 259 MiB with an empty kernel cache; the
-cause, other work in the test process's environment, is not isolated); they set
-:data:`BASE_BYTES`. Earlier: the single traversal (``RenderSettings.integrator="single"``) compiles one
-large kernel: a cold LLVM compile (a mode set not yet in Dr.Jit's kernel cache) peaks at about
-850 MiB whatever the size, which sets :data:`BASE_BYTES`. The samples per pixel do not matter:
-256 x 256 at spp 64 peaked at 304 MiB, as Mitsuba's symbolic loops keep no per-sample state. So
-a size refused here could not have worked, and a size let through fits with the margin of the
-table.
+(obj-apple's counts: the film term adds 51 channels. The 2048^2 row is issue 17's, rendered
+with the passes, which have no traversal film, so the estimate is 2.6 x over it. The 1215 MiB
+rows, the largest of four measurements inside full ``make test`` runs on a loaded machine,
+1148-1215 MiB, modes spectral, rgb3, rgb6, spp 2, set :data:`BASE_BYTES`: the same render
+alone peaks at 240 MiB warm and 259 MiB with an empty kernel cache, and a cold LLVM compile of
+the single traversal at about 850 MiB; the cause, other work in the test process's
+environment, is not isolated.) So a size refused here could not have worked, and a size let
+through fits with the margin of the table.
 """
 
 from __future__ import annotations
@@ -78,10 +71,8 @@ BYTES_PER_VALUE = 4
 #: arrays, the EXR encoder's buffers (fitted: 1120 B/pixel measured at 2048^2 for 73 values is
 #: 3.8 copies; 6 keeps the estimate above every measurement of the module's table).
 OVERHEAD_FACTOR = 6
-#: Resident memory of a render process before its first pixel, a cold compile of the single
-#: traversal's kernel included (up to 1215 MiB measured at 64 x 64 and 192 x 192 inside full
-#: test runs; 277 MiB at 8 x 8 with the passes), and PyTorch where the torch extra is
-#: installed (pyoidn imports it: 1549 MiB at 64 x 64 then); the margin covers other builds.
+#: Resident memory of a render process before its first pixel (the module's table), and
+#: PyTorch where the torch extra is installed (pyoidn imports it: 1549 MiB at 64 x 64 then).
 BASE_BYTES = 2048 * 2**20
 #: AOV values per pixel: coverage of up to 9 materials, 2 ids, depth, 3 normals, the mask.
 AOV_VALUES = 16
@@ -245,8 +236,6 @@ def check_render_size(
         How the user gave the size, for the message (``"--width 100000 --height 128"``).
     processes
         Renders running at once (worker processes), each needing the estimate.
-    load
-        The scene's counts (:class:`RenderLoad`): lights, surfaces, materials.
 
     Raises
     ------

@@ -36,12 +36,10 @@ def _modes(modes: Iterable[str]) -> list[RenderMode]:
     return [get_mode(m) for m in names]
 
 
-def _direct_modes(direct: bool | Iterable[str], modes: Sequence[RenderMode]) -> set[str]:
-    if direct is True:
-        return {m.name for m in modes}
-    if direct is False or direct is None:
-        return set()
-    wanted = {get_mode(m).name for m in direct}  # type: ignore[union-attr]
+def _direct_modes(direct: bool | tuple[str, ...], modes: Sequence[RenderMode]) -> set[str]:
+    if isinstance(direct, bool):
+        return {m.name for m in modes} if direct else set()
+    wanted = {get_mode(m).name for m in direct}
     missing = wanted - {m.name for m in modes}
     if missing:
         raise SceneError(
@@ -65,14 +63,6 @@ def count_passes(scene: Scene, settings: RenderSettings, *, data_dir: str | None
     aovs = settings.aovs and not plan.traversal
     aov_passes = max(1, -(-len(surfaces(scene)) // 3)) if aovs else 0
     return diagonal + plan.n_main * colour + len(scene.lights) * shares + aov_passes
-
-
-def _sum_direct(parts: Sequence[np.ndarray | None]) -> np.ndarray:
-    """Sum of the direct-only renders of every light group (each was asked for)."""
-    present = [p for p in parts if p is not None]
-    if len(present) != len(parts):
-        raise RenderError("a direct-only render is missing for a light group")
-    return np.sum(present, axis=0, dtype=np.float64)
 
 
 @dataclass(frozen=True)
@@ -102,49 +92,26 @@ def _rgb_part(
     run: _Run, rgb_variant: str
 ) -> tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]:
     """The diagonal modes of every job (one traversal, or the passes) and the AOVs."""
-    scene, plan, single = run.scene, run.plan, SingleTraversal({}, ())
+    scene, plan, data_dir = run.scene, run.plan, run.data_dir
     request = replace(run.request, variant=rgb_variant)
-    aov_maps: dict[str, np.ndarray] = {}
     if plan.traversal:
+        jobs = [(j.modes, j.group, j.with_direct) for j in plan.jobs]
         parts, single = render_jobs(
-            scene,
-            [(j.modes, j.group, j.with_direct) for j in plan.jobs],
-            request,
-            wanted=plan.wanted,
-            data_dir=run.data_dir,
-            aovs=plan.settings.aovs,
+            scene, jobs, request, wanted=plan.wanted, data_dir=data_dir, aovs=plan.settings.aovs
         )
-        aov_maps = single.aovs
         for out, part in zip(run.outputs, parts, strict=True):
             out.update(part)
-        return aov_maps, (), single
+        return single.aovs, (), single
     for out, job in zip(run.outputs, plan.jobs, strict=True):
         diagonal = [m for m in job.modes if m.kind == "diagonal"]
-        values = [
-            channel_values(
-                scene, get_sensors(m.sensors, data_dir=run.data_dir), data_dir=run.data_dir
-            )
-            for m in diagonal
-        ]
-        out.update(
-            zip(
-                (m.name for m in diagonal),
-                render_diagonal(
-                    scene,
-                    values,
-                    request,
-                    direct=[job.with_direct and m.name in plan.wanted for m in diagonal],
-                    active_lights=job.group,
-                ),
-                strict=True,
-            )
-            if diagonal
-            else ()
-        )
-    if not plan.settings.aovs:
-        return aov_maps, (), single
-    aov_maps, aov_seconds = render_aovs(scene, request)
-    return aov_maps, aov_seconds, single
+        if diagonal:  # the passes refuse what they cannot render, even with no value set
+            sensors = [get_sensors(m.sensors, data_dir=data_dir) for m in diagonal]
+            values = [channel_values(scene, s, data_dir=data_dir) for s in sensors]
+            direct = [job.with_direct and m.name in plan.wanted for m in diagonal]
+            images = render_diagonal(scene, values, request, direct=direct, active_lights=job.group)
+            out.update(zip((m.name for m in diagonal), images, strict=True))
+    aov_maps, aov_seconds = render_aovs(scene, request) if plan.settings.aovs else ({}, ())
+    return aov_maps, aov_seconds, SingleTraversal({}, ())
 
 
 def _spectral_part(run: _Run, spectral_variant: str) -> None:
@@ -172,8 +139,6 @@ def _run_jobs(run: _Run) -> tuple[dict[str, np.ndarray], tuple[float, ...], Sing
     scope and every spectral pass in another; the variant already active goes first and stays
     active afterwards (``restore=False``), so consecutive batches switch once each, not four
     times. Passes do not depend on each other's order: each sets its own values, seed and spp.
-    With ``plan.traversal`` the diagonal modes of every job, and a textured scene's AOVs even
-    without them, come from one band-path traversal (:func:`~spectrinsic.render.band_path.traversal.render_jobs`).
     """
     plan = run.plan
     found: tuple[dict[str, np.ndarray], tuple[float, ...], SingleTraversal]
@@ -240,24 +205,14 @@ def render_scene(
 ) -> RenderResult:
     """Render *scene* in each of ``settings.modes`` and convert every mode to CIE 1931 XYZ.
 
-    One batch: every pass renders ``settings.batch_spp`` samples with sampler seed *seed*
-    (a spectral pass ``settings.spectral_batch_spp``, in ``meta["spectral_spp"]``). All
-    diagonal modes share one loaded scene and the same paths (same seed and sample count,
-    Russian roulette off): ``rgb3``, ``rgb6`` and ``bands31`` differ only by spectral error.
-    With ``settings.per_light`` and no ``share_mode`` every mode is rendered light by light and
-    ``images`` is exactly the sum of the per-light images (and ``direct`` of per-light direct
-    images), costing no extra.
-
-    Parameters
-    ----------
-    settings
-        Modes, samples, path depth, variant, per-light, direct and AOV choices and the
-        integrator (:class:`~spectrinsic.render.settings.RenderSettings`); ``"single"`` also
-        fills ``RenderResult.transport``.
-    seed
-        Sampler seed, shared by every pass.
-    progress
-        Called with 1 after each Mitsuba pass; :func:`count_passes` gives the total.
+    One batch: every pass renders ``settings.batch_spp`` samples (a spectral pass
+    ``settings.spectral_batch_spp``) with sampler seed *seed*; *progress* is called with 1
+    after each Mitsuba pass (:func:`count_passes` gives the total). All diagonal modes share
+    one loaded scene and the same paths (Russian roulette off), so ``rgb3``, ``rgb6`` and
+    ``bands31`` differ only by spectral error. With ``settings.per_light`` and no
+    ``share_mode`` every mode is rendered light by light and ``images`` is exactly the sum of
+    the per-light images (and ``direct`` of per-light direct images), costing no extra; the
+    ``"single"`` integrator also fills ``RenderResult.transport``.
     """
     plan = _plan(scene, settings, data_dir)
     request = PassRequest.of(settings, seed, progress, prepare_geometry(scene))
@@ -301,11 +256,8 @@ class _Plan:
     #: integrator is ``"single"`` and there are diagonal modes, or a textured scene's AOVs
     #: (which the coverage passes cannot give) without them.
     traversal: bool
-
-    @property
-    def diagonal(self) -> bool:
-        """Whether any job renders a diagonal mode."""
-        return any(m.kind == "diagonal" for job in self.jobs for m in job.modes)
+    #: Whether any job renders a diagonal mode.
+    diagonal: bool
 
 
 def _plan(scene: Scene, settings: RenderSettings, data_dir: str | None) -> _Plan:
@@ -339,6 +291,7 @@ def _plan(scene: Scene, settings: RenderSettings, data_dir: str | None) -> _Plan
         jobs=jobs,
         n_main=len(main),
         traversal=integrator == "single" and (diagonal or (settings.aovs and scene.textured)),
+        diagonal=diagonal,
     )
 
 
@@ -369,7 +322,11 @@ def _assemble(
         raw=raw,
         per_light=per_light_images,
         direct={
-            n: raw_to_xyz(_sum_direct([g[n].direct for g in main_out]), matrices[n])
+            n: raw_to_xyz(
+                # every main job renders the direct light of the wanted modes: no None here
+                np.sum([g[n].direct for g in main_out], axis=0, dtype=np.float64),  # type: ignore[arg-type]
+                matrices[n],
+            )
             for n in names
             if n in plan.wanted
         },

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from ..errors import RenderError
 
@@ -44,10 +44,15 @@ DEFAULT_INTEGRATOR = "single"
 UINT32_MAX = 2**32 - 1
 
 
+def _refuse(name: str, value: Any, expected: str) -> NoReturn:
+    """The one form of a refused render setting."""
+    raise RenderError(f"render setting {name}={value!r}; expected {expected}")
+
+
 def _positive(name: str, value: Any) -> None:
     """The one "at least 1" check of a count (samples, depth, batches)."""
     if not isinstance(value, int) or isinstance(value, bool) or value < 1:
-        raise RenderError(f"render setting {name}={value!r}; expected a positive integer")
+        _refuse(name, value, "a positive integer")
 
 
 @dataclass(frozen=True)
@@ -87,10 +92,9 @@ class RenderSettings:
     max_batches
         Cap of the adaptive batches (``None``: ``4 * batches``).
     integrator
-        How the diagonal modes are rendered, one of :data:`INTEGRATORS`; ``"single"`` falls
-        back to ``"passes"`` on a scalar variant
-        (:func:`spectrinsic.render.band_path.traversal.resolve_integrator`). Not hashed by a dataset
-        config: both give the same pixels to float rounding.
+        One of :data:`INTEGRATORS`, resolved per variant by
+        :func:`spectrinsic.render.band_path.traversal.resolve_integrator`. Not hashed by a
+        dataset config: both give the same pixels to float rounding.
     spectral_spp
         Samples per pixel of the spectral Monte Carlo pass over all batches (``None``: *spp*).
         The reference image, the ground truth and the per-light transport come from the
@@ -136,25 +140,13 @@ class RenderSettings:
                     f"expected {name} divisible by batches (each batch renders {name} / "
                     "batches samples)"
                 )
-        if self.noise_target is not None and not (
-            isinstance(self.noise_target, int | float) and 0 < self.noise_target < 1
-        ):
-            raise RenderError(
-                f"render setting noise_target={self.noise_target!r}; expected a "
-                "fraction in (0, 1), e.g. 0.02"
-            )
-        if self.max_batches is not None and (
-            not isinstance(self.max_batches, int) or self.max_batches < self.batches
-        ):
-            raise RenderError(
-                f"render setting max_batches={self.max_batches!r}; expected an "
-                f"integer >= batches ({self.batches})"
-            )
+        target, most = self.noise_target, self.max_batches
+        if target is not None and not (isinstance(target, int | float) and 0 < target < 1):
+            _refuse("noise_target", target, "a fraction in (0, 1), e.g. 0.02")
+        if most is not None and (not isinstance(most, int) or most < self.batches):
+            _refuse("max_batches", most, f"an integer >= batches ({self.batches})")
         if self.integrator not in INTEGRATORS:
-            raise RenderError(
-                f"render setting integrator={self.integrator!r}; expected one of "
-                f"{', '.join(INTEGRATORS)}"
-            )
+            _refuse("integrator", self.integrator, f"one of {', '.join(INTEGRATORS)}")
 
     @property
     def batch_spp(self) -> int:
@@ -193,11 +185,8 @@ class PassRequest:
     seed
         The sampler seed (the batch's); every pass of a batch uses it, so passes trace the
         same paths (common random numbers).
-    max_depth
-        Longest path (Mitsuba convention: 2 = direct light only).
-    variant
-        Backend or variant name (:func:`spectrinsic.render.base.variants.choose_variant`);
-        ``None``: the best usable.
+    max_depth, variant
+        As :class:`RenderSettings`'.
     progress
         Called with 1 after each Mitsuba pass (e.g. ``tqdm.update``), or ``None``.
     geometry

@@ -18,7 +18,6 @@ from .base.one_pass import (
     DIRECT_DEPTH,
     PassOutput,
     active_light_set,
-    check_scene_lights,
     timed_render,
 )
 from .base.plugins import path_integrator, regular_spectrum, spectral_film
@@ -99,7 +98,6 @@ def render_spectral(
     negative lobes (``"srgb"``) are not supported by ``specfilm`` and are clipped. An
     environment map takes one more pass per channel (:func:`_light_passes`).
     """
-    check_scene_lights(scene)
     active = active_light_set(scene, active_lights)
     wl = COLORIMETRIC_WAVELENGTHS
     if np.any(sensors.curves < 0):
@@ -130,13 +128,11 @@ def render_spectral(
                 scene,
                 materials=materials,
                 lights=[
-                    (
-                        {"bitmap": bitmap}
-                        if j in on and bitmap is not None
-                        else regular_spectrum(emission[j], wl)
-                        if j in on
-                        else None
-                    )
+                    None
+                    if j not in on
+                    else regular_spectrum(emission[j], wl)
+                    if bitmap is None
+                    else {"bitmap": bitmap}
                     for j in range(len(scene.lights))
                 ],
                 film=spectral_film(scene.camera.width, scene.camera.height, curves * factor, wl),

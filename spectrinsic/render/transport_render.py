@@ -62,12 +62,9 @@ logger = logging.getLogger(__name__)
 def _unit_values(scene: Scene, sensors: str, data_dir: str | None) -> ChannelValues:
     """Material values of the scene and, for every light, the flat unit spectrum at power 1
     (``∫S_k dλ``, what :func:`channel_values` gives a light of spectrum 1)."""
-    wl = COLORIMETRIC_WAVELENGTHS
-    curves = get_sensors(sensors, data_dir=data_dir).on(wl)
-    flat = responses(np.ones(wl.size), curves, wl)
-    materials = channel_values(
-        scene, get_sensors(sensors, data_dir=data_dir), data_dir=data_dir
-    ).materials
+    wl, sensor_set = COLORIMETRIC_WAVELENGTHS, get_sensors(sensors, data_dir=data_dir)
+    flat = responses(np.ones(wl.size), sensor_set.on(wl), wl)
+    materials = channel_values(scene, sensor_set, data_dir=data_dir).materials
     return ChannelValues(materials=materials, lights=np.tile(flat, (len(scene.lights), 1)))
 
 
@@ -79,13 +76,9 @@ def render_transport(
     progress: PassProgress | None = None,
     data_dir: str | None = None,
 ) -> tuple[dict[str, np.ndarray], dict[str, tuple[float, ...]]]:
-    """One batch of transport: mode -> ``(L, H, W, K)`` float32 ``T_lk`` and the pass seconds.
-
-    Each light is rendered alone (its own scene load) with the flat unit spectrum at power 1
-    and the scene's material values, seed *seed*, ``settings.batch_spp`` samples, depth
-    ``settings.max_depth`` and Russian roulette off, so its paths are those of a per-light
-    render with the same settings; only the diagonal ones of ``settings.modes`` are rendered.
-    """
+    """One batch of transport by the passes, each light alone with the flat unit spectrum at
+    power 1 (module docstring), for the diagonal ones of ``settings.modes``: mode ->
+    ``(L, H, W, K)`` float32 ``T_lk``, and the pass seconds."""
     modes = settings.modes
     names = diagonal_mode_names(modes)
     if not names:
@@ -144,20 +137,13 @@ def _join(
     if other is None:
         return replace(diagonal, aovs=dict(aovs))
     meta = dict(other.meta)
-    for key in ("sensors", "to_xyz"):
-        meta[key] = {**other.meta.get(key, {}), **diagonal.meta[key]}
-    meta["timings"] = {**other.meta.get("timings", {}), **diagonal.meta["timings"]}
-    meta.update(
-        modes=list(order),
-        per_light=True,
-        per_light_modes=diagonal.meta["per_light_modes"],
-        variants={**other.meta.get("variants", {}), **diagonal.meta.get("variants", {})},
-    )
+    for key in ("sensors", "to_xyz", "timings", "variants"):
+        meta[key] = {**other.meta.get(key, {}), **diagonal.meta.get(key, {})}
+    meta.update(modes=list(order), per_light=True, per_light_modes=diagonal.meta["per_light_modes"])
+    images, raw = {**other.images, **diagonal.images}, {**other.raw, **diagonal.raw}
     return RenderResult(
-        images={m: {**other.images, **diagonal.images}[m] for m in order},
-        raw={
-            m: {**other.raw, **diagonal.raw}[m] for m in order if m in {**other.raw, **diagonal.raw}
-        },
+        images={m: images[m] for m in order},
+        raw={m: raw[m] for m in order if m in raw},
         per_light=diagonal.per_light,
         direct=dict(other.direct),
         aovs=dict(aovs),
@@ -166,63 +152,20 @@ def _join(
     )
 
 
-def _traversal_batch(
-    scene: Scene,
-    settings: RenderSettings,
-    seed: int,
-    *,
-    progress: PassProgress | None,
-    data_dir: str | None,
-) -> tuple[LightTransport, RenderResult]:
-    """:func:`_batch` from one single traversal (:mod:`spectrinsic.render.band_path.traversal`), which
-    already splits every band by light: its transport ``T'_lk`` (per unit channel emission
-    ``E_lk``) times the flat unit spectrum's channel values ``∫S_k dλ`` is Eq. 1's ``T_lk``,
-    so no per-light pass is rendered. The same call renders the other modes and the AOVs from
-    the same pixel samples, as a direct render with ``integrator="single"`` does, so a relit
-    sample equals that render to float rounding."""
-    names = diagonal_mode_names(settings.modes)
-    direct = (
-        tuple(m for m in settings.modes if m not in names)
-        if settings.direct is True
-        else tuple(m for m in settings.direct or () if m not in names)
-    )
-    render = render_scene(
-        scene,
-        settings.with_options(per_light=False, share_mode=None, direct=direct, aovs=True),
-        seed=seed,
-        progress=progress,
-        data_dir=data_dir,
-    )
+def _flat_unit(
+    scene: Scene, render: RenderResult, names: Sequence[str], data_dir: str | None
+) -> tuple[dict[str, np.ndarray], dict[str, dict[str, np.ndarray]]]:
+    """A traversal's transport and parts, per unit channel emission ``E_lk``, per flat unit
+    spectrum instead (times ``∫S_k dλ``): Eq. 1's ``T_lk``."""
     flat = {
         m: _unit_values(scene, get_mode(m).sensors, data_dir).lights[:, None, None, :]
         for m in names
     }
 
     def unit(part: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-        # per unit channel emission E_lk -> per flat unit spectrum (Eq. 1's T_lk)
         return {m: (part[m].astype(np.float64) * flat[m]).astype(np.float32) for m in part}
 
-    parts = {p: unit(held) for p, held in render.part_transport.items()}
-    batch = _one_batch(names, settings, seed, unit(render.transport), parts)
-    base = {
-        "max_depth": int(settings.max_depth),
-        "variants": {m: render.meta["variants"][m] for m in names},
-        "timings": {m: render.meta["timings"][m] for m in names},
-    }
-    diagonal = relit_result(batch, scene, meta=base, data_dir=data_dir)
-    others = [m for m in dict.fromkeys(settings.modes) if m not in names]
-    other = (
-        replace(
-            render,
-            images={m: render.images[m] for m in others},
-            raw={m: render.raw[m] for m in others},
-            transport={},
-            part_transport={},
-        )
-        if others
-        else None
-    )
-    return batch, _join(diagonal, other, render.aovs, list(dict.fromkeys(settings.modes)))
+    return unit(render.transport), {p: unit(held) for p, held in render.part_transport.items()}
 
 
 def _batch(
@@ -233,45 +176,67 @@ def _batch(
     progress: PassProgress | None,
     data_dir: str | None,
 ) -> tuple[LightTransport, RenderResult]:
-    """Transport of one batch and the sample's render of that batch (other modes rendered
-    directly with every light on, the AOVs from the same pixel samples): from the single
-    traversal where it runs (*settings*' integrator, resolved by
-    :func:`render_transport_batches`), else one set of passes per light."""
-    if settings.integrator == "single":
-        return _traversal_batch(scene, settings, seed, progress=progress, data_dir=data_dir)
-    modes = settings.modes
-    names = diagonal_mode_names(modes)
-    others = tuple(m for m in dict.fromkeys(modes) if m not in names)
-    t, seconds = render_transport(scene, settings, seed=seed, progress=progress, data_dir=data_dir)
-    timings = {m: timing(s) for m, s in seconds.items()}
-    base = {
-        "max_depth": int(settings.max_depth),
-        "timings": timings,
-        "variants": dict.fromkeys(names, choose_variant("rgb", settings.variant)),
-    }
-    batch = _one_batch(names, settings, seed, t)
-    diagonal = relit_result(batch, scene, meta=base, data_dir=data_dir)
-    other = None
-    if others:
-        direct = (
-            settings.direct
-            if isinstance(settings.direct, bool)
-            else tuple(m for m in settings.direct if m in others)
-        )
-        other = render_scene(
+    """Transport of one batch and the sample's render of that batch (the diagonal modes
+    composed from it, the other modes rendered directly with every light on, the AOVs from the
+    same pixel samples): where *settings*' integrator (resolved by
+    :func:`render_transport_batches`) is ``"single"``, from one traversal, whose per-light split
+    ``T'_lk`` (per unit channel emission) times ``∫S_k dλ`` is Eq. 1's ``T_lk``; else from one
+    set of passes per light (:func:`render_transport`)."""
+    order = list(dict.fromkeys(settings.modes))
+    names = diagonal_mode_names(order)
+    others = [m for m in order if m not in names]
+    direct = (
+        tuple(others)
+        if settings.direct is True
+        else tuple(m for m in settings.direct or () if m not in names)
+    )
+
+    def rendered(modes: Sequence[str]) -> RenderResult:
+        return render_scene(
             scene,
             settings.with_options(
-                modes=others, per_light=False, share_mode=None, direct=direct, aovs=True
+                modes=tuple(modes), per_light=False, share_mode=None, direct=direct, aovs=True
             ),
             seed=seed,
             progress=progress,
             data_dir=data_dir,
         )
-        aovs = other.aovs
+
+    if settings.integrator == "single":
+        render = rendered(settings.modes)
+        t, parts = _flat_unit(scene, render, names, data_dir)
+        batch = _one_batch(names, settings, seed, t, parts)
+        timings = {m: render.meta["timings"][m] for m in names}
+        variants = {m: render.meta["variants"][m] for m in names}
+        aovs = render.aovs
+        other = (
+            replace(
+                render,
+                images={m: render.images[m] for m in others},
+                raw={m: render.raw[m] for m in others},
+                transport={},
+                part_transport={},
+            )
+            if others
+            else None
+        )
     else:
-        aovs, aov_seconds = render_aovs(scene, PassRequest.of(settings, seed, progress))
-        timings["aovs"] = timing(aov_seconds)
-    return batch, _join(diagonal, other, aovs, list(dict.fromkeys(modes)))
+        t, seconds = render_transport(
+            scene, settings, seed=seed, progress=progress, data_dir=data_dir
+        )
+        batch = _one_batch(names, settings, seed, t)
+        timings = {m: timing(s) for m, s in seconds.items()}
+        variants = dict.fromkeys(names, choose_variant("rgb", settings.variant))
+        other = rendered(others) if others else None
+        if other is None:
+            aovs, aov_seconds = render_aovs(scene, PassRequest.of(settings, seed, progress))
+            timings["aovs"] = timing(aov_seconds)
+        else:
+            aovs = other.aovs
+    meta = {"max_depth": int(settings.max_depth), "variants": variants, "timings": timings}
+    return batch, _join(
+        relit_result(batch, scene, meta=meta, data_dir=data_dir), other, aovs, order
+    )
 
 
 def render_transport_batches(
@@ -284,13 +249,11 @@ def render_transport_batches(
 ) -> tuple[LightTransport, RenderResult]:
     """The sample's transport and its render, as :func:`~spectrinsic.render.render_batches`.
 
-    The diagonal modes of every batch are composed from the transport with the scene's own
-    spectra (:func:`~spectrinsic.render.algebra.light_transport.relit_result`), so relighting the sample with those spectra gives it
-    back exactly; the other modes (the spectral reference) are rendered directly with every
-    light on, with a direct-only render when ``settings.direct``. Batches, seeds and adaptive
-    sampling (``settings.noise_target``, ``settings.max_batches``) follow
-    :func:`~spectrinsic.render.render_batches`; ``per_light`` and ``share_mode`` do not apply
-    (the transport is per light already).
+    Each batch is :func:`_batch`'s, its diagonal modes composed with the scene's own spectra
+    (:func:`~spectrinsic.render.algebra.light_transport.relit_result`), so relighting the
+    sample with those spectra gives it back exactly. Batches, seeds and adaptive sampling
+    follow :func:`~spectrinsic.render.render_batches`; ``per_light`` and ``share_mode`` do not
+    apply (the transport is per light already).
     """
     modes = settings.modes
     if settings.direct and not [m for m in modes if m not in diagonal_mode_names(modes)]:

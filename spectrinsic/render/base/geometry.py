@@ -83,19 +83,14 @@ class SurfaceGeometry:
     uv: np.ndarray | None = None
 
 
-def prepare_geometry(
-    scene: Scene, crease_deg: float = CREASE_ANGLE_DEG
-) -> tuple[SurfaceGeometry, ...]:
-    """Split every mesh by material and compute its smoothed corner normals (pure numpy).
-
-    :func:`scene_to_mitsuba` does this itself when not given the result; callers translating
-    one scene several times (several variants, light subsets) compute it once.
-    """
+def prepare_geometry(scene: Scene) -> tuple[SurfaceGeometry, ...]:
+    """Split every mesh by material and compute its smoothed corner normals (module docstring);
+    :func:`scene_to_mitsuba` does this itself when not given the result."""
     out = []
     for index, mesh in enumerate(scene.meshes):
         faces = np.asarray(mesh.faces, np.int64)
         corners = np.asarray(mesh.vertices, float)[faces]
-        normals = smooth_corner_normals(mesh.vertices, faces, crease_deg)
+        normals = smooth_corner_normals(mesh.vertices, faces)
         face_materials = np.asarray(mesh.face_materials, np.int64)
         texture = mesh.texture
         uv = (

@@ -1,14 +1,10 @@
 """One Mitsuba pass, shared by every pass and the band-path traversal: its record
-(:class:`PassOutput`), its timed render call, and the checks every pass makes first.
-
-Every pass of one image uses the same sampler seed, sample count and path depth with Russian
-roulette off, so passes trace identical paths (common random numbers).
-"""
+(:class:`PassOutput`), its timed render call, and the checks every pass makes first."""
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -18,19 +14,20 @@ from ...errors import RenderError, SceneError
 from ...interrupts import raise_if_requested
 from ...scenes.model import Scene
 from ..settings import PassRequest
-from .plugins import rgb_spectrum
+from .plugins import hdr_film, rgb_spectrum
 from .sample_split import split_render
+from .translate import scene_to_mitsuba
 
 __all__ = [
     "DIRECT_DEPTH",
     "PassProgress",
     "PassOutput",
     "check_scene_lights",
+    "refuse_surface_detail",
     "active_light_set",
     "timed_render",
     "timing",
-    "placeholder_light",
-    "scene_parameters",
+    "load_rgb_scene",
     "set_rgb",
 ]
 
@@ -69,7 +66,26 @@ def check_scene_lights(scene: Scene) -> None:
         raise SceneError(f"scene {scene.name!r} has no lights: nothing to render")
 
 
+def refuse_surface_detail(scene: Scene, what: str) -> None:
+    """Raise a one-line :class:`RenderError` if *scene* has spectral textures, or opacity masks
+    or bump or normal maps, which *what* (passes of Mitsuba's own BSDFs and AOVs) cannot
+    render exactly; the band-path traversal renders them."""
+    textured = [m.name for m in scene.meshes if m.texture is not None]
+    mapped = [m.name for m in scene.meshes if m.maps is not None]
+    for detail, names in (
+        ("spectral textures", textured),
+        ("opacity masks or bump or normal maps", mapped),
+    ):
+        if names:
+            raise RenderError(
+                f"scene {scene.name!r}: {what} cannot render {detail} (mesh {names[0]!r}); "
+                "use the single band-path traversal (integrator 'single')"
+            )
+
+
 def active_light_set(scene: Scene, active_lights: Sequence[int] | None) -> set[int]:
+    """The lights a pass renders (*active_lights*, default all), checked (and that there are any)."""
+    check_scene_lights(scene)
     active = (
         set(range(len(scene.lights))) if active_lights is None else {int(i) for i in active_lights}
     )
@@ -108,19 +124,37 @@ def timing(seconds: Sequence[float]) -> dict[str, Any]:
     return {"passes": len(seconds), "seconds": total, "per_pass": [float(x) for x in seconds]}
 
 
-def placeholder_light(index: int) -> dict[str, Any]:
-    """Distinct emission per light at load time (identical dicts could be merged into one
-    shared object); every pass sets the real values before rendering."""
-    return rgb_spectrum([1.0 + index, 1.0, 1.0])
-
-
-def scene_parameters(mi: Any, loaded: Any, keys: Sequence[str]) -> Any:
-    """``mi.traverse`` of a loaded scene, checked to expose every parameter a pass updates."""
+def load_rgb_scene(
+    mi: Any,
+    scene: Scene,
+    request: PassRequest,
+    integrator: Mapping[str, Any],
+    active: Collection[int],
+    keys: Sequence[str],
+) -> tuple[Any, Any]:
+    """*scene* loaded in the active RGB variant for passes that set their own values (black
+    materials; the *active* lights with placeholders, the others left out), an ``hdrfilm``,
+    *integrator* and *request*'s samples and geometry; and its ``mi.traverse`` parameters,
+    checked to hold the *keys* the passes update."""
+    mitsuba_dict = scene_to_mitsuba(
+        scene,
+        materials=[rgb_spectrum([0.0, 0.0, 0.0])] * len(scene.materials),
+        # distinct emission per light (identical dicts could be merged into one shared object)
+        lights=[
+            rgb_spectrum([1.0 + j, 1.0, 1.0]) if j in active else None
+            for j in range(len(scene.lights))
+        ],
+        film=hdr_film(scene.camera.width, scene.camera.height),
+        integrator=integrator,
+        sample_count=request.batch_spp,
+        geometry=request.geometry,
+    )
+    loaded = mi.load_dict(mitsuba_dict)
     params = mi.traverse(loaded)
     missing = [k for k in keys if k not in params]
     if missing:
         raise RenderError(f"Mitsuba scene lacks the parameters {missing[:3]} the passes update")
-    return params
+    return loaded, params
 
 
 def set_rgb(mi: Any, params: Any, key: str, values: np.ndarray) -> None:

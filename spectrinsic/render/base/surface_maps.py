@@ -35,7 +35,6 @@ from .plugins import raw_bitmap
 __all__ = [
     "MapKind",
     "wrap_bsdf",
-    "refuse_maps",
     "map_scales",
     "map_textures",
     "perturbed_normal",
@@ -80,35 +79,16 @@ def wrap_bsdf(mi: Any, maps: MeshMaps, bsdf: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def refuse_maps(scene: Scene, what: str) -> None:
-    """Raise a one-line :class:`RenderError` if *scene* has masks or bump or normal maps, whose
-    ground truth *what* cannot make."""
-    names = [m.name for m in scene.meshes if m.maps is not None]
-    if names:
-        raise RenderError(
-            f"scene {scene.name!r}: {what} cannot render opacity masks or bump or normal maps "
-            f"(mesh {names[0]!r}); use the single band-path traversal (integrator 'single')"
-        )
-
-
-class _Children:
-    """Collects an object's named children through Mitsuba's ``traverse``."""
-
-    def __init__(self, mi: Any) -> None:
-        outer = self
-
-        class Callback(mi.TraversalCallback):  # type: ignore[misc, name-defined]
-            def put(self, name: str, value: Any, *rest: Any) -> None:
-                outer.found[name] = value
-
-        self.found: dict[str, Any] = {}
-        self.callback = Callback()
-
-
 def _children(mi: Any, obj: Any) -> dict[str, Any]:
-    collect = _Children(mi)
-    obj.traverse(collect.callback)
-    return collect.found
+    """An object's named children, collected through Mitsuba's ``traverse``."""
+    found: dict[str, Any] = {}
+
+    class Callback(mi.TraversalCallback):  # type: ignore[misc, name-defined]
+        def put(self, name: str, value: Any, *rest: Any) -> None:
+            found[name] = value
+
+    obj.traverse(Callback())
+    return found
 
 
 def _map_texture(mi: Any, bsdf: Any) -> tuple[MapKind, Any]:

@@ -23,7 +23,6 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import RenderError
 from ...scenes.model import Scene
 from ...scenes.textures import Texture
 from .plugins import raw_bitmap
@@ -33,7 +32,6 @@ __all__ = [
     "texture_tables",
     "shape_slots",
     "textured_bsdf",
-    "refuse_textures",
     "texel_of",
     "shape_id_table",
     "texture_lookups",
@@ -121,17 +119,6 @@ def textured_bsdf(mi: Any, texture: Texture, reflectances: Sequence[Mapping]) ->
             "bsdf_1": bsdf,
         }
     return {"type": "twosided", "bsdf": bsdf}
-
-
-def refuse_textures(scene: Scene, what: str) -> None:
-    """Raise a one-line :class:`RenderError` if *scene* has textured meshes, which *what*
-    cannot render exactly."""
-    names = [m.name for m in scene.meshes if m.texture is not None]
-    if names:
-        raise RenderError(
-            f"scene {scene.name!r}: {what} cannot render spectral textures (mesh {names[0]!r}); "
-            "use the single band-path traversal (integrator 'single')"
-        )
 
 
 def texel_of(mi: Any, dr: Any, it: Any, si: Any) -> tuple[Any, Any]:

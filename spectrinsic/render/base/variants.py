@@ -1,9 +1,7 @@
-"""Choosing a Mitsuba variant. Mitsuba is imported through
-:func:`spectrinsic.mitsuba_import.import_mitsuba`, which points Dr.Jit's LLVM backend at a
-``libLLVM`` >= 16 for the duration of ``import drjit`` only (the libraries Debian ships, 14 and
-15, crash it; that module says why and how). When no suitable library exists the LLVM
-variants are not used: renders fall back to the (about twice slower) scalar variants with one
-:class:`~spectrinsic.errors.SpectrinsicWarning`.
+"""Choosing a Mitsuba variant (Mitsuba is imported through
+:func:`spectrinsic.mitsuba_import.import_mitsuba`, which says why and how it picks a
+``libLLVM``). Without a suitable ``libLLVM`` the LLVM variants are not used: renders fall back to
+the (about twice slower) scalar variants with one :class:`~spectrinsic.errors.SpectrinsicWarning`.
 
 Variants are chosen per pass (cuda > llvm > scalar; ``*_spectral`` for the spectral reference,
 ``*_rgb`` for diagonal passes and AOVs) and activated only inside :func:`variant_scope`; nothing
@@ -70,10 +68,8 @@ def _llvm_suitable() -> bool:
     path = loaded_libllvm()
     if not path:
         return False  # Dr.Jit would pick whatever libLLVM it finds: possibly 14/15, which crash
-    version = llvm_version_from_name(path)
-    return (
-        version is None or version >= LLVM_MIN_VERSION
-    )  # an unversioned path set by the user is trusted
+    version = llvm_version_from_name(path)  # an unversioned path set by the user is trusted
+    return version is None or version >= LLVM_MIN_VERSION
 
 
 def usable_backends() -> tuple[str, ...]:
@@ -88,12 +84,6 @@ def usable_backends() -> tuple[str, ...]:
         found.append("llvm")
     found.append("scalar")
     return tuple(found)
-
-
-def _backend_of(requested: str) -> str:
-    """``"llvm"`` for ``"llvm"``, ``"llvm_ad_rgb"`` or ``"llvm_ad_spectral"``; likewise cuda/scalar."""
-    head = requested.split("_", 1)[0]
-    return validate_choice(head, BACKENDS, "Mitsuba backend", error=RenderError)
 
 
 def choose_variant(kind: VariantKind, requested: str | None = None) -> str:
@@ -117,7 +107,10 @@ def choose_variant(kind: VariantKind, requested: str | None = None) -> str:
     mi = import_mitsuba()
     usable = usable_backends()
     if requested is not None:
-        backend = _backend_of(requested)
+        # "llvm" of "llvm", "llvm_ad_rgb" or "llvm_ad_spectral"; likewise cuda and scalar
+        backend = validate_choice(
+            requested.split("_", 1)[0], BACKENDS, "Mitsuba backend", error=RenderError
+        )
         if backend not in usable:
             raise RenderError(
                 f"Mitsuba backend {backend!r} (from {requested!r}) is not usable here; usable: "

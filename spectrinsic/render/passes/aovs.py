@@ -10,14 +10,12 @@ from ...scenes.model import Scene
 from ..base import translate as tr
 from ..base.aov_maps import assemble_aovs
 from ..base.one_pass import (
-    placeholder_light,
-    scene_parameters,
+    load_rgb_scene,
+    refuse_surface_detail,
     set_rgb,
     timed_render,
 )
-from ..base.plugins import aov_integrator, hdr_film, rgb_spectrum
-from ..base.surface_maps import refuse_maps
-from ..base.textures import refuse_textures
+from ..base.plugins import aov_integrator
 from ..base.variants import choose_variant, variant_scope
 from ..settings import PassRequest
 
@@ -33,9 +31,8 @@ def render_aovs(
     the ``albedo`` AOV, averaged by a box filter, is the fraction of the pixel's samples hitting
     it; with the seed and sample count of the colour passes these are the very samples those
     passes averaged, so ``Σ_m coverage_m ρ_m`` is the ground-truth reflectance of each pixel.
-    Mitsuba's own albedo of the real materials is not used (it assumes RGB wavelengths).
-    *request* (:class:`~spectrinsic.render.settings.PassRequest`) gives samples, seed, variant,
-    progress and prepared geometry (the path depth is the ``aov`` integrator's first hit).
+    Mitsuba's own albedo of the real materials is not used (it assumes RGB wavelengths). The
+    path depth of *request* does not apply: the ``aov`` integrator reads the first hit.
 
     Returns
     -------
@@ -49,8 +46,7 @@ def render_aovs(
     seconds
         Seconds per pass.
     """
-    refuse_textures(scene, "the coverage passes")
-    refuse_maps(scene, "the coverage passes")
+    refuse_surface_detail(scene, "the coverage passes")
     surfaces = tr.surfaces(scene)
     n_pass = max(1, -(-len(surfaces) // 3))
     chosen = choose_variant("rgb", request.variant)
@@ -58,27 +54,13 @@ def render_aovs(
     cover = np.zeros((h, w, len(surfaces)), np.float64)
     seconds = []
     with variant_scope(chosen) as mi:
-        zero = rgb_spectrum([0.0, 0.0, 0.0])
-        mitsuba_dict = tr.scene_to_mitsuba(
-            scene,
-            materials=[zero] * len(scene.materials),
-            lights=[placeholder_light(j) for j in range(len(scene.lights))],
-            film=hdr_film(w, h),
-            integrator=aov_integrator(),
-            sample_count=request.batch_spp,
-            geometry=request.geometry,
-        )
-        loaded = mi.load_dict(mitsuba_dict)
-        params = scene_parameters(
-            mi, loaded, [tr.reflectance_key(s, spectral=False) for s in surfaces]
-        )
+        keys = [tr.reflectance_key(s, spectral=False) for s in surfaces]
+        every = range(len(scene.lights))
+        loaded, params = load_rgb_scene(mi, scene, request, aov_integrator(), every, keys)
         depth_sum = normal_sum = None
         for p in range(n_pass):
-            for i, s in enumerate(surfaces):
-                onehot = np.zeros(3)
-                if i // 3 == p:
-                    onehot[i % 3] = 1.0
-                set_rgb(mi, params, tr.reflectance_key(s, spectral=False), onehot)
+            for i, key in enumerate(keys):  # one-hot: surface i is channel i % 3 of pass i // 3
+                set_rgb(mi, params, key, np.eye(3)[i % 3] * (i // 3 == p))
             params.update()
             image, dt = timed_render(mi, loaded, request)
             seconds.append(dt)
@@ -87,10 +69,7 @@ def render_aovs(
                     f"AOV pass returned {image.shape[-1]} channels; expected 7 (depth, normal, albedo)"
                 )
             if p == 0:
-                depth_sum, normal_sum = (
-                    image[..., 0].astype(np.float64),
-                    image[..., 1:4].astype(np.float64),
-                )
+                depth_sum, normal_sum = image[..., 0].astype(float), image[..., 1:4].astype(float)
             block = surfaces[3 * p : 3 * p + 3]
             cover[..., 3 * p : 3 * p + len(block)] = image[..., 4 : 4 + len(block)]
     return assemble_aovs(scene, surfaces, cover, depth_sum, normal_sum), tuple(seconds)
