@@ -1,0 +1,317 @@
+"""Every code reference in the docs resolves (a newcomer reads the docs first).
+
+The docs scanned: ``README.md``, ``docs/*.md`` and every ``.md`` file in the package (its
+``FORMAT.md`` files, the dataset card template, the data sources). Only spans in backticks
+outside fenced code blocks are read, and only those that are clearly a reference to this
+repository:
+
+* **a path** (``render/spectral.py``, ``spectrinsic/scenes/``, ``scripts/x.py``,
+  ``tests/...py``): a span of path characters with a ``/`` whose first folder is a folder of the
+  repository (so ``eval/REPORT.md`` in a dataset or ``intern/cycles/...`` in Blender are not
+  read). It resolves when it names a file or folder relative to the repository root, to
+  ``spectrinsic/``, to the doc's own folder, or as the tail of a path in the repository
+  (``algebra/modes.py`` in a section about ``render/``). A bare file name ``x.py`` resolves
+  when a module of that name exists; a file of another project is named by its project's path
+  (``mitsuba/.../prb.py``), whose first folder is not one of ours;
+* **a path with a name** (``render/spectral._light_passes``,
+  ``gt_export/sample/render_spp.render_spp``): the module resolves as a path, and the name is
+  defined in it (below);
+* **a dotted module name** (``spectrinsic.scenes.validate_scene``): the longest prefix that is
+  a module or package of the repository, then the rest as names in it;
+* **module.name** (``mitsuba_bsdfs._tint``): the first word is the name of a module of the
+  package (``np.cross`` and ``mi.Ray3f`` are not read);
+* **Class.member** (``RenderResult.parts``): the first word is CapWords, with a member; the
+  class must be defined somewhere in the package and hold that member.
+
+A name is defined in a module when the module (``ast``, nothing imported) binds it at top
+level: ``def``, ``class``, an assignment or an import (a package's ``__init__`` re-exports),
+or - one level down - when a class of the module holds it (a method, a field, a class
+attribute). ``Class.member`` also accepts a member an instance attribute set in a method
+(``self.x = ...``). Trailing calls and subscripts (``.build()``, ``[j]``) are dropped.
+Placeholders (``<name>``, ``*``, ``{a,b}``, ``...``) are not read.
+
+Historical names are allowed where the doc says so: a reference in the same sentence as a word
+such as *removed*, *renamed*, *was*, *gone*, *replaced*, *formerly*, *no longer* or *before*
+names past code on purpose, and so does every reference under a heading that contains
+*History* or *Changes*. Nothing else is allowlisted.
+
+``make X`` must be a target of the Makefile.
+"""
+
+from __future__ import annotations
+
+import ast
+import functools
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "spectrinsic"
+#: Folders of the repository that are not its source (build outputs, local data, tools' caches).
+SKIPPED_FOLDERS = frozenset({"data", "results", "build", "dist"})
+IDENT = r"[A-Za-z_][A-Za-z0-9_]*"
+#: A path: path characters with at least one ``/``, optionally a trailing ``/``.
+PATH = re.compile(r"[A-Za-z0-9_.\-]+(?:/[A-Za-z0-9_.\-]+)+/?|[A-Za-z0-9_.\-]+/")
+#: A path to a module (no ``.py``) followed by one or two names.
+PATH_NAME = re.compile(rf"((?:{IDENT}/)+{IDENT})((?:\.{IDENT}){{1,2}})")
+#: A bare file name of a module.
+PY_FILE = re.compile(rf"{IDENT}\.py")
+#: ``a.b`` or ``a.b.c``... of identifiers.
+DOTTED = re.compile(rf"{IDENT}(?:\.{IDENT})+")
+#: What a reference may end with and still be the same reference: a call or a subscript.
+TRAILER = re.compile(r"(?:\([^()]*\)|\[[^\[\]]*\])+$")
+#: Words that mark a sentence naming past code on purpose.
+HISTORICAL = re.compile(
+    r"\b(removed|renamed|gone|replaced|formerly|no longer|deleted|retired|dropped|superseded|"
+    r"folded into|used to)\b",
+    re.IGNORECASE,
+)
+HISTORY_HEADING = re.compile(r"^#+ .*\b(history|changes)\b", re.IGNORECASE)
+MAKE = re.compile(r"make ([a-z][a-z0-9_-]*)")
+SPAN = re.compile(r"`([^`\n]+)`")
+FENCE = re.compile(r"^\s*(```|~~~)")
+
+
+def doc_files() -> list[Path]:
+    """The documents whose references are checked."""
+    docs = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    return docs + sorted(PACKAGE.rglob("*.md"))
+
+
+@dataclass(frozen=True)
+class Reference:
+    """One backticked span of a document: where it is and whether its sentence is historical."""
+
+    doc: Path
+    line: int
+    text: str
+    historical: bool
+
+    def __str__(self) -> str:
+        return f"{self.doc.relative_to(ROOT)}:{self.line}: `{self.text}`"
+
+
+def _sentence_around(line: str, start: int, end: int) -> str:
+    """The sentence (or table cell) of ``line`` holding the span ``start:end``."""
+    cut = re.compile(r"(?<=[.;:!?])\s+(?=[A-Z(`*])|\|")
+    left = [m.end() for m in cut.finditer(line, 0, start)]
+    right = cut.search(line, end)
+    return line[left[-1] if left else 0 : right.start() if right else len(line)]
+
+
+def _is_table(line: str) -> bool:
+    return line.lstrip().startswith("|")
+
+
+def references(doc: Path) -> list[Reference]:
+    """Every backticked span of ``doc`` outside fenced code blocks."""
+    found: list[Reference] = []
+    fenced = history = past_table = False
+    lead = ""  # the last line of text before a table: it introduces the table
+    for number, line in enumerate(doc.read_text(encoding="utf-8").splitlines(), 1):
+        if FENCE.match(line):
+            fenced = not fenced
+            continue
+        if fenced:
+            continue
+        if line.startswith("#"):
+            history = bool(HISTORY_HEADING.match(line))
+        if _is_table(line):
+            past_table = past_table or bool(HISTORICAL.search(lead))
+        elif line.strip():
+            lead, past_table = line, False
+        for span in SPAN.finditer(line):
+            past = history or past_table
+            past = past or bool(HISTORICAL.search(_sentence_around(line, *span.span())))
+            found.append(Reference(doc, number, span.group(1).strip(), past))
+    return found
+
+
+@functools.cache
+def repo_paths() -> tuple[frozenset[str], frozenset[str]]:
+    """Every file and folder of the repository (relative, posix) and every folder name."""
+    paths: set[str] = set()
+    names: set[str] = set()
+
+    def walk(folder: Path) -> None:
+        for entry in folder.iterdir():
+            if entry.name.startswith(".") or entry.name == "__pycache__":
+                continue
+            if folder == ROOT and entry.name in SKIPPED_FOLDERS:
+                continue
+            if entry.name.endswith(".egg-info"):
+                continue
+            paths.add(entry.relative_to(ROOT).as_posix())
+            if entry.is_dir():
+                names.add(entry.name)
+                walk(entry)
+
+    walk(ROOT)
+    return frozenset(paths), frozenset(names)
+
+
+@functools.cache
+def path_tails() -> dict[str, tuple[str, ...]]:
+    """Every tail of every repository path (``modes.py``, ``algebra/modes.py``, ...) -> paths."""
+    tails: dict[str, list[str]] = {}
+    for path in repo_paths()[0]:
+        parts = path.split("/")
+        for cut in range(len(parts)):
+            tails.setdefault("/".join(parts[cut:]), []).append(path)
+    return {tail: tuple(sorted(found)) for tail, found in tails.items()}
+
+
+def resolve_path(path: str, doc: Path) -> tuple[str, ...]:
+    """The repository paths ``path`` names: relative to the root, to ``spectrinsic/`` or to the
+    doc's folder, else as the tail of a path."""
+    path = path.rstrip("/")
+    paths = repo_paths()[0]
+    bases = ("", "spectrinsic/", doc.parent.relative_to(ROOT).as_posix() + "/")
+    exact = tuple((base + path).lstrip("/") for base in bases if (base + path).lstrip("/") in paths)
+    return exact or path_tails().get(path, ())
+
+
+def is_repo_path(text: str) -> bool:
+    """Whether ``text`` is clearly a path into this repository (its first folder is ours)."""
+    if not PATH.fullmatch(text) or ".." in text.split("/"):
+        return False
+    return text.split("/")[0] in repo_paths()[1]
+
+
+@functools.cache
+def module_tree(path: str) -> ast.Module:
+    return ast.parse((ROOT / path).read_text(encoding="utf-8"), filename=path)
+
+
+def _bound(body: list[ast.stmt]) -> dict[str, ast.stmt]:
+    """The names a block binds at its own level, with the statement that binds each."""
+    bound: dict[str, ast.stmt] = {}
+    for node in body:
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+            bound[node.name] = node
+        elif isinstance(node, ast.Assign | ast.AnnAssign | ast.AugAssign):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            for target in targets:
+                for name in ast.walk(target):
+                    if isinstance(name, ast.Name):
+                        bound[name.id] = node
+        elif isinstance(node, ast.Import | ast.ImportFrom):
+            for alias in node.names:
+                bound[(alias.asname or alias.name).split(".")[0]] = node
+        elif isinstance(node, ast.If | ast.Try):
+            nested = node.body + node.orelse + getattr(node, "finalbody", [])
+            bound.update(_bound(nested))
+    return bound
+
+
+def class_members(node: ast.ClassDef) -> set[str]:
+    """What a class holds: its own names and the ``self.x`` attributes its methods set."""
+    members = set(_bound(node.body))
+    for child in ast.walk(node):
+        if isinstance(child, ast.Attribute) and isinstance(child.ctx, ast.Store):
+            if isinstance(child.value, ast.Name) and child.value.id == "self":
+                members.add(child.attr)
+    return members
+
+
+def defines(module: str, names: list[str]) -> bool:
+    """Whether the module file ``module`` defines ``names`` (a name, or a class and its member)."""
+    bound = _bound(module_tree(module).body)
+    first = bound.get(names[0])
+    if len(names) == 1:
+        if first is not None:
+            return True
+        classes = [n for n in bound.values() if isinstance(n, ast.ClassDef)]
+        return any(names[0] in class_members(c) for c in classes)
+    return isinstance(first, ast.ClassDef) and names[1] in class_members(first)
+
+
+def modules_at(path: str, doc: Path) -> tuple[str, ...]:
+    """The module files of the repository that ``path`` (no ``.py``) names."""
+    return resolve_path(path + ".py", doc) + resolve_path(path + "/__init__.py", doc)
+
+
+@functools.cache
+def package_classes() -> dict[str, tuple[ast.ClassDef, ...]]:
+    """Every class of the package, by name."""
+    classes: dict[str, list[ast.ClassDef]] = {}
+    for path in sorted(repo_paths()[0]):
+        if path.startswith("spectrinsic/") and path.endswith(".py"):
+            for node in ast.walk(module_tree(path)):
+                if isinstance(node, ast.ClassDef):
+                    classes.setdefault(node.name, []).append(node)
+    return {name: tuple(found) for name, found in classes.items()}
+
+
+def check(reference: Reference) -> str | None:
+    """Why ``reference`` does not resolve, or None when it resolves or is not a reference."""
+    text = TRAILER.sub("", reference.text)
+    if any(mark in text for mark in "<>*{}…") or "..." in text:
+        return None
+    if make := MAKE.fullmatch(text):
+        return None if make.group(1) in make_targets() else "no such make target"
+    if is_repo_path(text) and resolve_path(text, reference.doc):
+        return None
+    named = PATH_NAME.fullmatch(text)
+    if named and text.rsplit(".", 1)[1] not in FILE_EXTENSIONS | {"py"}:
+        module, names = named.group(1), named.group(2)[1:].split(".")
+        if is_repo_path(module + "/"):
+            return _check_names(modules_at(module, reference.doc), module, names)
+    if is_repo_path(text):
+        return "no such file or folder"
+    if PY_FILE.fullmatch(text):
+        return None if path_tails().get(text) else "no module of that name"
+    if DOTTED.fullmatch(text) and text.rsplit(".", 1)[1] not in FILE_EXTENSIONS:
+        return _check_dotted(text.split("."), reference.doc)
+    return None
+
+
+def _check_names(modules: tuple[str, ...], module: str, names: list[str]) -> str | None:
+    if not modules:
+        return f"no module {module}"
+    if any(defines(found, names[:2]) for found in modules):
+        return None
+    return f"{'.'.join(names)} is not defined in {module}"
+
+
+def _check_dotted(words: list[str], doc: Path) -> str | None:
+    """A dotted name: the longest prefix that is a module of ours, then names in it; else a
+    ``Class.member`` of the package; else not ours (``np.cross``)."""
+    top = 1 if words[0] == "spectrinsic" else 0
+    for cut in range(len(words), top, -1):
+        path = "/".join(words[:cut])
+        modules = modules_at(path, doc)
+        if modules and all(m.startswith(("spectrinsic/", "scripts/")) for m in modules):
+            return None if cut == len(words) else _check_names(modules, path, words[cut:])
+    if top or not (words[0][0].isupper() and not words[0].isupper()):
+        return None  # a namespace (an entry-point group, a file attribute) or another project's
+    classes = package_classes().get(words[0], ())
+    if not classes:
+        return f"no class {words[0]} in the package"
+    if any(words[1] in class_members(c) for c in classes):
+        return None
+    return f"no class {words[0]} holds {words[1]}"
+
+
+#: Last words that make a dotted span a file name (``manifest.json``), not a module's name.
+FILE_EXTENSIONS = frozenset(
+    "json exr png csv md txt npz npy yaml yml xml obj ply mtl spd dng hdr blend gltf glb pt "
+    "html js cff toml cpp h stl off jpg pdf ocio".split()
+)
+
+
+@functools.cache
+def make_targets() -> frozenset[str]:
+    text = (ROOT / "Makefile").read_text(encoding="utf-8")
+    return frozenset(re.findall(r"^([a-z][a-z0-9_-]*):", text, re.MULTILINE))
+
+
+def test_every_code_reference_in_the_docs_resolves() -> None:
+    stale = []
+    for doc in doc_files():
+        for reference in references(doc):
+            why = check(reference)
+            if why is not None and not reference.historical:
+                stale.append(f"{reference}: {why}")
+    assert not stale, "stale references in the docs:\n" + "\n".join(stale)
