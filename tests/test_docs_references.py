@@ -81,7 +81,8 @@ def doc_files() -> list[Path]:
 
 @dataclass(frozen=True)
 class Reference:
-    """One backticked span of a document: where it is and whether its sentence is historical."""
+    """One backticked span of a document: where it is (the first line of its paragraph) and
+    whether its sentence is historical."""
 
     doc: Path
     line: int
@@ -94,7 +95,7 @@ class Reference:
 
 def _sentence_around(line: str, start: int, end: int) -> str:
     """The sentence (or table cell) of ``line`` holding the span ``start:end``."""
-    cut = re.compile(r"(?<=[.;:!?])\s+(?=[A-Z(`*])|\|")
+    cut = re.compile(r"(?<=[.!?])\s+(?=[A-Z(`*])|\|")
     left = [m.end() for m in cut.finditer(line, 0, start)]
     right = cut.search(line, end)
     return line[left[-1] if left else 0 : right.start() if right else len(line)]
@@ -104,26 +105,43 @@ def _is_table(line: str) -> bool:
     return line.lstrip().startswith("|")
 
 
-def references(doc: Path) -> list[Reference]:
-    """Every backticked span of ``doc`` outside fenced code blocks."""
-    found: list[Reference] = []
-    fenced = history = past_table = False
-    lead = ""  # the last line of text before a table: it introduces the table
+def _starts_block(line: str) -> bool:
+    """Whether ``line`` starts a new block: a heading, a table row, a list item."""
+    return line.startswith("#") or _is_table(line) or bool(re.match(r"\s*([-*+]|\d+\.)\s", line))
+
+
+def blocks(doc: Path) -> list[tuple[int, str]]:
+    """The paragraphs, list items, headings and table rows of ``doc`` outside fenced code, each
+    with its first line number and its lines joined by spaces (a sentence may wrap)."""
+    found: list[tuple[int, list[str]]] = []
+    fenced = False
     for number, line in enumerate(doc.read_text(encoding="utf-8").splitlines(), 1):
         if FENCE.match(line):
             fenced = not fenced
-            continue
-        if fenced:
-            continue
-        if line.startswith("#"):
-            history = bool(HISTORY_HEADING.match(line))
-        if _is_table(line):
+        elif fenced or not line.strip():
+            found.append((number, []))
+        elif _starts_block(line) or not found or not found[-1][1] or _is_table(found[-1][1][-1]):
+            found.append((number, [line]))
+        else:
+            found[-1][1].append(line.strip())
+    return [(number, " ".join(lines)) for number, lines in found if lines]
+
+
+def references(doc: Path) -> list[Reference]:
+    """Every backticked span of ``doc`` outside fenced code blocks."""
+    found: list[Reference] = []
+    history = past_table = False
+    lead = ""  # the last block of text before a table: it introduces the table
+    for number, block in blocks(doc):
+        if block.startswith("#"):
+            history = bool(HISTORY_HEADING.match(block))
+        if _is_table(block):
             past_table = past_table or bool(HISTORICAL.search(lead))
-        elif line.strip():
-            lead, past_table = line, False
-        for span in SPAN.finditer(line):
+        else:
+            lead, past_table = block, False
+        for span in SPAN.finditer(block):
             past = history or past_table
-            past = past or bool(HISTORICAL.search(_sentence_around(line, *span.span())))
+            past = past or bool(HISTORICAL.search(_sentence_around(block, *span.span())))
             found.append(Reference(doc, number, span.group(1).strip(), past))
     return found
 
@@ -284,7 +302,8 @@ def _check_dotted(words: list[str], doc: Path) -> str | None:
         modules = modules_at(path, doc)
         if modules and all(m.startswith(("spectrinsic/", "scripts/")) for m in modules):
             return None if cut == len(words) else _check_names(modules, path, words[cut:])
-    if top or not (words[0][0].isupper() and not words[0].isupper()):
+    cap = words[0].lstrip("_")
+    if top or not cap or not (cap[0].isupper() and not cap.isupper()):
         return None  # a namespace (an entry-point group, a file attribute) or another project's
     classes = package_classes().get(words[0], ())
     if not classes:
@@ -315,3 +334,49 @@ def test_every_code_reference_in_the_docs_resolves() -> None:
             if why is not None and not reference.historical:
                 stale.append(f"{reference}: {why}")
     assert not stale, "stale references in the docs:\n" + "\n".join(stale)
+
+
+def _checked(text: str) -> str | None:
+    return check(Reference(ROOT / "docs" / "example.md", 1, text, historical=False))
+
+
+def test_the_checker_reports_what_does_not_exist_and_passes_what_does() -> None:
+    resolving = [
+        "spectrinsic/render/spectral.py",
+        "render/base/translate.material_bsdf",
+        "gt_export/sample/render_spp.render_spp",
+        "algebra/modes.py",
+        "spectrinsic.scenes.validate_scene",
+        "RenderResult.parts",
+        "make lint",
+    ]
+    stale = [
+        "render/base/translate._glass_bsdf",  # docs/ARCHITECTURE.md once named it
+        "spectrinsic/render/spectrum.py",
+        "spectrinsic.scenes.validate_scenes",
+        "RenderResult.shape",
+        "_DiagonalPasses._render",
+        "make lints",
+    ]
+    not_ours = ["np.cross", "mi.Ray3f", "eval/REPORT.md", "manifest.json", "<stem>_meshes/"]
+    assert [t for t in resolving if _checked(t) is not None] == []
+    assert [t for t in stale if _checked(t) is None] == []
+    assert [t for t in not_ours if _checked(t) is not None] == []
+
+
+def test_a_sentence_or_table_saying_removed_names_past_code_on_purpose(tmp_path: Path) -> None:
+    doc = tmp_path / "history.md"
+    doc.write_text(
+        "The passes record `_DiagonalPasses` was\nremoved in issue 46. It reads `RenderResult.parts`.\n\n"
+        "Removed (one commit per kind):\n\n| what |\n|---|\n| `RenderResult.shape` |\n\n"
+        "Kept:\n\n| what |\n|---|\n| `RenderResult.raw` |\n\n## History\n\n`LightTransport.shape`\n",
+        encoding="utf-8",
+    )
+    found = {r.text: r.historical for r in references(doc)}
+    assert found == {
+        "_DiagonalPasses": True,
+        "RenderResult.parts": False,
+        "RenderResult.shape": True,
+        "RenderResult.raw": False,
+        "LightTransport.shape": True,
+    }
