@@ -69,6 +69,10 @@ HISTORICAL = re.compile(
 )
 HISTORY_HEADING = re.compile(r"^#+ .*\b(history|changes)\b", re.IGNORECASE)
 MAKE = re.compile(r"make ([a-z][a-z0-9_-]*)")
+#: A command line that runs a module or a script of ours.
+COMMAND = re.compile(r"python[0-9.]* ")
+#: A pytest node id: a test file and a test in it.
+TEST_ID = re.compile(rf"([A-Za-z0-9_./-]+\.py)::((?:{IDENT}::)?{IDENT})")
 SPAN = re.compile(r"`([^`\n]+)`")
 FENCE = re.compile(r"^\s*(```|~~~)")
 
@@ -81,8 +85,7 @@ def doc_files() -> list[Path]:
 
 @dataclass(frozen=True)
 class Reference:
-    """One backticked span of a document: where it is (the first line of its paragraph) and
-    whether its sentence is historical."""
+    """One backticked span of a document: where it is and whether its sentence is historical."""
 
     doc: Path
     line: int
@@ -110,21 +113,39 @@ def _starts_block(line: str) -> bool:
     return line.startswith("#") or _is_table(line) or bool(re.match(r"\s*([-*+]|\d+\.)\s", line))
 
 
-def blocks(doc: Path) -> list[tuple[int, str]]:
-    """The paragraphs, list items, headings and table rows of ``doc`` outside fenced code, each
-    with its first line number and its lines joined by spaces (a sentence may wrap)."""
-    found: list[tuple[int, list[str]]] = []
+@dataclass(frozen=True)
+class Block:
+    """A paragraph, list item, heading or table row, its lines joined by spaces (a sentence may
+    wrap), with the line number and offset in ``text`` where each of its lines starts."""
+
+    text: str
+    lines: tuple[tuple[int, int], ...]
+
+    def line_at(self, offset: int) -> int:
+        return max(number for number, start in self.lines if start <= offset)
+
+
+def blocks(doc: Path) -> list[Block]:
+    """The blocks of ``doc`` outside fenced code."""
+    found: list[list[tuple[int, str]]] = [[]]
     fenced = False
     for number, line in enumerate(doc.read_text(encoding="utf-8").splitlines(), 1):
         if FENCE.match(line):
             fenced = not fenced
         elif fenced or not line.strip():
-            found.append((number, []))
-        elif _starts_block(line) or not found or not found[-1][1] or _is_table(found[-1][1][-1]):
-            found.append((number, [line]))
+            found.append([])
+        elif _starts_block(line) or not found[-1] or _is_table(found[-1][-1][1]):
+            found.append([(number, line)])
         else:
-            found[-1][1].append(line.strip())
-    return [(number, " ".join(lines)) for number, lines in found if lines]
+            found[-1].append((number, line.strip()))
+    joined = []
+    for lines in filter(None, found):
+        starts = [0]
+        for _, line in lines[:-1]:
+            starts.append(starts[-1] + len(line) + 1)
+        text = " ".join(line for _, line in lines)
+        joined.append(Block(text, tuple((n, s) for (n, _), s in zip(lines, starts, strict=True))))
+    return joined
 
 
 def references(doc: Path) -> list[Reference]:
@@ -132,17 +153,18 @@ def references(doc: Path) -> list[Reference]:
     found: list[Reference] = []
     history = past_table = False
     lead = ""  # the last block of text before a table: it introduces the table
-    for number, block in blocks(doc):
-        if block.startswith("#"):
-            history = bool(HISTORY_HEADING.match(block))
-        if _is_table(block):
+    for block in blocks(doc):
+        if block.text.startswith("#"):
+            history = bool(HISTORY_HEADING.match(block.text))
+        if _is_table(block.text):
             past_table = past_table or bool(HISTORICAL.search(lead))
         else:
-            lead, past_table = block, False
-        for span in SPAN.finditer(block):
+            lead, past_table = block.text, False
+        for span in SPAN.finditer(block.text):
             past = history or past_table
-            past = past or bool(HISTORICAL.search(_sentence_around(block, *span.span())))
-            found.append(Reference(doc, number, span.group(1).strip(), past))
+            past = past or bool(HISTORICAL.search(_sentence_around(block.text, *span.span())))
+            line = block.line_at(span.start())
+            found.append(Reference(doc, line, span.group(1).strip(), past))
     return found
 
 
@@ -262,34 +284,48 @@ def package_classes() -> dict[str, tuple[ast.ClassDef, ...]]:
     return {name: tuple(found) for name, found in classes.items()}
 
 
+#: What :func:`check` says of a reference that resolves (None: the span is not a reference).
+RESOLVES = ""
+
+
 def check(reference: Reference) -> str | None:
-    """Why ``reference`` does not resolve, or None when it resolves or is not a reference."""
+    """Why ``reference`` does not resolve; :data:`RESOLVES` when it does; None when the span is
+    not a reference to this repository."""
     text = TRAILER.sub("", reference.text)
     if any(mark in text for mark in "<>*{}…") or "..." in text:
         return None
     if make := MAKE.fullmatch(text):
-        return None if make.group(1) in make_targets() else "no such make target"
-    if is_repo_path(text) and resolve_path(text, reference.doc):
-        return None
+        return RESOLVES if make.group(1) in make_targets() else "no such make target"
+    if COMMAND.match(text):
+        return _check_command(text.split(), reference.doc)
+    if test := TEST_ID.fullmatch(text):
+        return _check_test(test.group(1), test.group(2), reference.doc)
+    return _check_name(text, reference.doc)
+
+
+def _check_name(text: str, doc: Path) -> str | None:
+    """A path, a path with names, a module file name or a dotted name (see the module docstring)."""
+    if is_repo_path(text) and resolve_path(text, doc):
+        return RESOLVES
     named = PATH_NAME.fullmatch(text)
     if named and text.rsplit(".", 1)[1] not in FILE_EXTENSIONS | {"py"}:
         module, names = named.group(1), named.group(2)[1:].split(".")
         if is_repo_path(module + "/"):
-            return _check_names(modules_at(module, reference.doc), module, names)
+            return _check_names(modules_at(module, doc), module, names)
     if is_repo_path(text):
         return "no such file or folder"
     if PY_FILE.fullmatch(text):
-        return None if path_tails().get(text) else "no module of that name"
+        return RESOLVES if path_tails().get(text) else "no module of that name"
     if DOTTED.fullmatch(text) and text.rsplit(".", 1)[1] not in FILE_EXTENSIONS:
-        return _check_dotted(text.split("."), reference.doc)
+        return _check_dotted(text.split("."), doc)
     return None
 
 
-def _check_names(modules: tuple[str, ...], module: str, names: list[str]) -> str | None:
+def _check_names(modules: tuple[str, ...], module: str, names: list[str]) -> str:
     if not modules:
         return f"no module {module}"
     if any(defines(found, names[:2]) for found in modules):
-        return None
+        return RESOLVES
     return f"{'.'.join(names)} is not defined in {module}"
 
 
@@ -301,7 +337,7 @@ def _check_dotted(words: list[str], doc: Path) -> str | None:
         path = "/".join(words[:cut])
         modules = modules_at(path, doc)
         if modules and all(m.startswith(("spectrinsic/", "scripts/")) for m in modules):
-            return None if cut == len(words) else _check_names(modules, path, words[cut:])
+            return RESOLVES if cut == len(words) else _check_names(modules, path, words[cut:])
     cap = words[0].lstrip("_")
     if top or not cap or not (cap[0].isupper() and not cap.isupper()):
         return None  # a namespace (an entry-point group, a file attribute) or another project's
@@ -309,8 +345,30 @@ def _check_dotted(words: list[str], doc: Path) -> str | None:
     if not classes:
         return f"no class {words[0]} in the package"
     if any(words[1] in class_members(c) for c in classes):
-        return None
+        return RESOLVES
     return f"no class {words[0]} holds {words[1]}"
+
+
+def _check_test(path: str, name: str, doc: Path) -> str:
+    """``tests/x.py::test_y`` (or ``::Class::test_y``): the file exists and defines the test."""
+    files = resolve_path(path, doc) if is_repo_path(path) else ()
+    if not files:
+        return "no such file or folder"
+    return _check_names(files, path, name.split("::"))
+
+
+def _check_command(words: list[str], doc: Path) -> str | None:
+    """``python [-P] -m module ...`` or ``python [-P] scripts/x.py ...``: the module or the
+    script exists (what follows is its arguments)."""
+    script = next((w for w in words[1:] if not w.startswith("-")), "")
+    if "-m" in words:
+        script = words[words.index("-m") + 1] if words.index("-m") + 1 < len(words) else ""
+        if not script.startswith("spectrinsic"):
+            return None
+        return _check_name(script, doc) or (
+            RESOLVES if modules_at(script.replace(".", "/"), doc) else "no such module"
+        )
+    return _check_name(script, doc) if script.endswith(".py") else None
 
 
 #: Last words that make a dotted span a file name (``manifest.json``), not a module's name.
@@ -331,7 +389,7 @@ def test_every_code_reference_in_the_docs_resolves() -> None:
     for doc in doc_files():
         for reference in references(doc):
             why = check(reference)
-            if why is not None and not reference.historical:
+            if why and not reference.historical:
                 stale.append(f"{reference}: {why}")
     assert not stale, "stale references in the docs:\n" + "\n".join(stale)
 
@@ -349,6 +407,9 @@ def test_the_checker_reports_what_does_not_exist_and_passes_what_does() -> None:
         "spectrinsic.scenes.validate_scene",
         "RenderResult.parts",
         "make lint",
+        "tests/test_style.py::test_no_function_body_is_over_sixty_lines",
+        "python -P -m spectrinsic.bench --only residual",
+        "python -P scripts/mit_stress.py --table",
     ]
     stale = [
         "render/base/translate._glass_bsdf",  # docs/ARCHITECTURE.md once named it
@@ -357,10 +418,14 @@ def test_the_checker_reports_what_does_not_exist_and_passes_what_does() -> None:
         "RenderResult.shape",
         "_DiagonalPasses._render",
         "make lints",
+        "tests/test_style.py::test_a_test_that_does_not_exist",
+        "tests/test_stile.py::test_long_functions_are_found",
+        "python -P -m spectrinsic.benches --only residual",
+        "python -P scripts/mit_stresses.py",
     ]
     not_ours = ["np.cross", "mi.Ray3f", "eval/REPORT.md", "manifest.json", "<stem>_meshes/"]
-    assert [t for t in resolving if _checked(t) is not None] == []
-    assert [t for t in stale if _checked(t) is None] == []
+    assert [t for t in resolving if _checked(t) != RESOLVES] == []
+    assert [t for t in stale if not _checked(t)] == []
     assert [t for t in not_ours if _checked(t) is not None] == []
 
 
