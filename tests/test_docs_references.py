@@ -19,9 +19,12 @@ repository:
 * **a dotted module name** (``spectrinsic.scenes.validate_scene``): the longest prefix that is
   a module or package of the repository, then the rest as names in it;
 * **module.name** (``mitsuba_bsdfs._tint``): the first word is the name of a module of the
-  package (``np.cross`` and ``mi.Ray3f`` are not read);
-* **Class.member** (``RenderResult.parts``): the first word is CapWords, with a member; the
-  class must be defined somewhere in the package and hold that member.
+  package (``np.cross`` and ``mi.Ray3f`` are not read); a module's file in backticks followed
+  by a name in backticks (``algebra/shares.py` `compose``) is read as ``algebra/shares.compose``;
+* **Class.member** (``RenderResult.parts``, ``_Run.plan``): the first word is CapWords (after
+  leading underscores), with a member; the class must be defined somewhere in the package and
+  hold that member. ``spectrinsic.x`` where no prefix is a module is a namespace (an
+  entry-point group, an EXR header attribute), not read.
 
 A name is defined in a module when the module (``ast``, nothing imported) binds it at top
 level: ``def``, ``class``, an assignment or an import (a package's ``__init__`` re-exports),
@@ -31,11 +34,16 @@ attribute). ``Class.member`` also accepts a member an instance attribute set in 
 Placeholders (``<name>``, ``*``, ``{a,b}``, ``...``) are not read.
 
 Historical names are allowed where the doc says so: a reference in the same sentence as a word
-such as *removed*, *renamed*, *was*, *gone*, *replaced*, *formerly*, *no longer* or *before*
-names past code on purpose, and so does every reference under a heading that contains
-*History* or *Changes*. Nothing else is allowlisted.
+such as *removed*, *renamed*, *gone*, *replaced*, *folded into*, *formerly* or *no longer*
+(:data:`HISTORICAL`) names past code on purpose (a sentence may wrap over lines), so does every row of a table
+whose introducing paragraph says so (``Removed (one commit per kind):``), and every reference
+under a heading that contains *History* or *Changes*. Nothing else is allowlisted.
 
-``make X`` must be a target of the Makefile.
+Also read: ``make X`` (a target of the Makefile); a pytest node id ``tests/x.py::test_y`` (the
+file defines the test); ``python [-P] -m spectrinsic.x ...`` and ``python [-P] scripts/x.py ...``
+(the module or script exists); and every ``spectrinsic VERB ... --flag`` command line, in
+backticks or on a line of a fenced block, whose verb and flags the argument parser must know
+(it is built, as ``spectrinsic --help`` builds it; nothing is run).
 """
 
 from __future__ import annotations
@@ -74,6 +82,8 @@ COMMAND = re.compile(r"python[0-9.]* ")
 #: A pytest node id: a test file and a test in it.
 TEST_ID = re.compile(rf"([A-Za-z0-9_./-]+\.py)::((?:{IDENT}::)?{IDENT})")
 SPAN = re.compile(r"`([^`\n]+)`")
+#: A module's file followed by one of its names: ``algebra/shares.py` `compose``.
+FILE_THEN_NAME = re.compile(rf"`((?:[\w.-]+/)*{IDENT})\.py` `({IDENT})(?:\([^`]*\))?`")
 FENCE = re.compile(r"^\s*(```|~~~)")
 
 
@@ -165,6 +175,11 @@ def references(doc: Path) -> list[Reference]:
             past = past or bool(HISTORICAL.search(_sentence_around(block.text, *span.span())))
             line = block.line_at(span.start())
             found.append(Reference(doc, line, span.group(1).strip(), past))
+        for pair in FILE_THEN_NAME.finditer(block.text):
+            past = history or past_table
+            past = past or bool(HISTORICAL.search(_sentence_around(block.text, *pair.span())))
+            name = f"{pair.group(1)}.{pair.group(2)}"
+            found.append(Reference(doc, block.line_at(pair.start()), name, past))
     return found
 
 
@@ -445,3 +460,95 @@ def test_a_sentence_or_table_saying_removed_names_past_code_on_purpose(tmp_path:
         "RenderResult.raw": False,
         "LightTransport.shape": True,
     }
+
+
+#: A command line of ``spectrinsic``: in backticks, or a line of a fenced block (``\`` joins).
+SPECTRINSIC_COMMAND = re.compile(r"(?:\$ )?spectrinsic (-|[a-z]+\b)")
+FLAG = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]*")
+
+
+def command_lines(doc: Path) -> list[tuple[int, str]]:
+    """The ``spectrinsic ...`` command lines of ``doc`` (line number, text; comments cut), from
+    backticks outside historical sentences and from fenced blocks."""
+    found = [
+        (r.line, r.text)
+        for r in references(doc)
+        if not r.historical and SPECTRINSIC_COMMAND.match(r.text)
+    ]
+    fenced, held = False, ""
+    for number, line in enumerate(doc.read_text(encoding="utf-8").splitlines(), 1):
+        if FENCE.match(line):
+            fenced, held = not fenced, ""
+            continue
+        text = held + line.split(" #")[0].strip()
+        held = text[:-1] + " " if fenced and text.endswith("\\") else ""
+        if fenced and not held and SPECTRINSIC_COMMAND.match(text):
+            found.append((number, text))
+    return found
+
+
+@dataclass(frozen=True)
+class Cli:
+    """What the parser takes: each verb's option strings (``""``: the options before the verb)
+    and the options before the verb that take a value (``--data-dir DIR``)."""
+
+    flags: dict[str, frozenset[str]]
+    valued: frozenset[str]
+
+
+def parsed_cli() -> Cli:
+    import argparse
+
+    from spectrinsic.cli import build_parser
+
+    parser = build_parser()
+    flags = {"": frozenset(parser._option_string_actions)}
+    valued = frozenset(
+        option
+        for action in parser._actions
+        if action.nargs is None and action.option_strings
+        for option in action.option_strings
+    )
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for verb, sub in action.choices.items():
+                flags[verb] = frozenset(sub._option_string_actions)
+    return Cli(flags, valued)
+
+
+def command_problems(text: str, cli: Cli) -> list[str]:
+    """What the parser would refuse in the command line ``text``: its verb, its flags."""
+    if any(mark in text for mark in "{}<>"):
+        return []  # a placeholder for several verbs or values
+    words, verb = iter(text.removeprefix("$ ").split()[1:]), ""
+    for word in words:
+        if not word.startswith("-"):
+            verb = word
+            break
+        if word in cli.valued:
+            next(words, None)
+    if verb in ("...", "…"):
+        return []  # any verb
+    if verb not in cli.flags:
+        return [f"no verb {verb}"]
+    known = cli.flags[verb]
+    return [f"{verb or 'spectrinsic'} has no {f}" for f in FLAG.findall(text) if f not in known]
+
+
+def test_every_command_line_in_the_docs_names_a_verb_and_flags_that_exist() -> None:
+    cli = parsed_cli()
+    good = [
+        "spectrinsic check --noise DIR",
+        "spectrinsic --debug render x.xml --out o",
+        "spectrinsic --data-dir render dataset --out o",  # a data folder called render
+        "spectrinsic --version",
+    ]
+    bad = ["spectrinsic check --noisy DIR", "spectrinsic rendre x.xml", "spectrinsic --nope"]
+    assert [t for t in good if command_problems(t, cli)] == []
+    assert [t for t in bad if not command_problems(t, cli)] == []
+    wrong = []
+    for doc in doc_files():
+        for number, text in command_lines(doc):
+            where = f"{doc.relative_to(ROOT)}:{number}: `{text}`"
+            wrong += [f"{where}: {why}" for why in command_problems(text, cli)]
+    assert not wrong, "command lines in the docs that the parser refuses:\n" + "\n".join(wrong)
