@@ -11,7 +11,7 @@ to the method). Each candidate replaces round 7's step on that cached result; pr
 every object's MIT LMSE and its ratio to image-as-reflectance (IaR), the mean and the worst.
 The last column, ``oracle-scales``, is a diagnostic, not a method: every region of the cached
 reflectance (4-connected pixels of one value) takes its best scale against the *true*
-reflectance, then round 7's step acts. Second form (``--upstream``): the defaults against two
+reflectance, then round 7's step acts. Second form (``--upstream``): the defaults against three
 changes before the step, each run in full (both are described in docs/names-shades-mit.md,
 round 8). Each candidate's reason was written in its docstring before it was measured; none
 has a constant of its own.
@@ -47,6 +47,8 @@ from spectrinsic.decompose.methods.sharp_edges import SHARPNESS, achromatic_cont
 from spectrinsic.errors import DatasetError
 
 Step = Callable[[Decomposition, np.ndarray, np.ndarray, MitObject], Decomposition]
+DEFAULT_COHERENCE = coherence.global_coherence
+DEFAULT_MINIMUM = coherence.bounded_minimum
 #: The median's half-width: round 7's 2 px (a 5 x 5 window removes structures <= 2 px wide).
 RADIUS = int(DETAIL_SIGMA)
 
@@ -252,6 +254,65 @@ def scale_free_coherence(a) -> np.ndarray:
     return lam
 
 
+def thin_regions(regions: np.ndarray) -> np.ndarray:
+    """``(R + 1,)`` bool: the region has no pixel whose four neighbours are all in it (it is
+    made only of boundary pixels, which the blur mixes at a reflectance edge)."""
+    same = regions > 0
+    same[[0, -1], :] = False
+    same[:, [0, -1]] = False
+    eq_h, eq_v = regions[:, 1:] == regions[:, :-1], regions[1:] == regions[:-1]
+    same[:, 1:] &= eq_h
+    same[:, :-1] &= eq_h
+    same[1:] &= eq_v
+    same[:-1] &= eq_v
+    thin = np.ones(int(regions.max()) + 1, bool)
+    thin[regions[same]] = False
+    thin[0] = False
+    return thin
+
+
+def thin_regions_second(
+    regions: np.ndarray,
+    region_intensity: np.ndarray,
+    image_intensity: np.ndarray,
+    blurred: np.ndarray | None = None,
+    blur_reach: int = 2,
+) -> np.ndarray:
+    """Sec. 3.4 in two stages: Eq. 3.9 on the pairs of regions that have an interior (as now,
+    ``lambda >= 1``), then the thin regions' scales (:func:`thin_regions`: their colour and
+    boundary reads are mixtures, which compress the ratios chained through them) minimise the
+    same ``W`` with the others fixed (``Q_tt lambda_t = -Q_tf lambda_f``); a thin region that
+    touches no other keeps the one-stage solution, rescaled to the first stage's."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import spsolve
+
+    thin = thin_regions(regions)
+    one_stage = DEFAULT_MINIMUM
+
+    def two_stages(a) -> np.ndarray:
+        a = sp.csr_matrix(a)
+        full = one_stage(a)
+        touches = np.asarray(a[:, np.flatnonzero(thin)].getnnz(axis=1)).ravel() > 0
+        lam = one_stage(a[~touches]) if (~touches).any() else np.ones(a.shape[1])
+        q = (a.T @ a).tocsr()
+        used = q.diagonal() > 0.0
+        t, f = np.flatnonzero(thin & used), np.flatnonzero(~thin & used)
+        if t.size and f.size:
+            rhs = -np.asarray(q[t][:, f] @ lam[f]).ravel()
+            with np.errstate(all="ignore"):
+                sol = np.atleast_1d(spsolve(sp.csc_matrix(q[t][:, t]), rhs))
+            bad = ~np.isfinite(sol) | (sol <= 0.0)
+            sol[bad] = full[t][bad] * float(np.median(lam[f] / full[f]))
+            lam[t] = sol
+        return lam
+
+    coherence.bounded_minimum = two_stages
+    try:
+        return DEFAULT_COHERENCE(regions, region_intensity, image_intensity, blurred, blur_reach)
+    finally:
+        coherence.bounded_minimum = one_stage
+
+
 def _iar(varied: MitObject) -> float:
     return mit_measures(varied, ImageAsReflectance()(varied.image, varied.mask))["lmse"]
 
@@ -306,11 +367,12 @@ def candidates(folder: Path, cache: Path, variants: list[str], objects: list[str
 
 def upstream(folder: Path, variants: list[str], objects: list[str] | None) -> None:
     """The second form (module docstring)."""
-    default_edges, default_minimum = names_shades.sharp_contrast_edges, coherence.bounded_minimum
+    default_edges = names_shades.sharp_contrast_edges
     changes = {
-        "defaults": (default_edges, default_minimum),
-        "contrast-over-2-px": (contrast_over_two_pixels, default_minimum),
-        "scale-free-coherence": (default_edges, scale_free_coherence),
+        "defaults": (default_edges, DEFAULT_MINIMUM, DEFAULT_COHERENCE),
+        "contrast-over-2-px": (contrast_over_two_pixels, DEFAULT_MINIMUM, DEFAULT_COHERENCE),
+        "scale-free-coherence": (default_edges, scale_free_coherence, DEFAULT_COHERENCE),
+        "thin-regions-second": (default_edges, DEFAULT_MINIMUM, thin_regions_second),
     }
     rows: dict[tuple[str, str, str], float] = {}
     names_seen: list[str] = []
@@ -321,14 +383,16 @@ def upstream(folder: Path, variants: list[str], objects: list[str] | None) -> No
             for variant in variants:
                 varied = apply_variant(variant, obj)
                 rows[(variant, obj.name, "IaR")] = _iar(varied)
-                for name, (edges, minimum) in changes.items():
+                for name, (edges, minimum, solve) in changes.items():
                     names_shades.sharp_contrast_edges = collapse.sharp_contrast_edges = edges
                     coherence.bounded_minimum = minimum
+                    names_shades.global_coherence = solve
                     res = names_shades.NamesAndShades()(varied.image, varied.mask)
                     rows[(variant, obj.name, name)] = mit_measures(varied, res)["lmse"]
     finally:
         names_shades.sharp_contrast_edges = collapse.sharp_contrast_edges = default_edges
-        coherence.bounded_minimum = default_minimum
+        coherence.bounded_minimum = DEFAULT_MINIMUM
+        names_shades.global_coherence = DEFAULT_COHERENCE
     _print(rows, variants, list(changes), names_seen)
 
 
