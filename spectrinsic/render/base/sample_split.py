@@ -23,7 +23,6 @@ a power-of-two count renders exactly as one call did.
 from __future__ import annotations
 
 import contextlib
-import functools
 from collections.abc import Iterator
 from typing import Any
 
@@ -89,6 +88,26 @@ def _threads(dr: Any, count: int | None) -> Iterator[None]:
         dr.set_thread_count(before)
 
 
+def _render_part(
+    mi: Any, dr: Any, loaded: Any, count: int, seed: int, integrator: Any, dtype: type
+) -> np.ndarray:
+    """One part's film as a *dtype* copy, at a peak of two films (not four): the film's
+    storage is given back once its developed tensor is evaluated, the tensor once copied
+    (with every band-path channel, each is the size of the image; Dr.Jit's allocation cache
+    would keep them resident)."""
+    width, height = loaded.sensors()[0].film().crop_size()
+    small = single_thread(int(width) * int(height) * count, dr.thread_count())
+    with _threads(dr, 1 if small else None):
+        image = mi.render(loaded, spp=count, seed=seed, integrator=integrator)
+        dr.eval(image)  # in this thread count
+    loaded.sensors()[0].film().prepare([])  # its storage swapped for one without AOVs
+    dr.flush_malloc_cache()
+    part = np.array(image, dtype=dtype)
+    del image
+    dr.flush_malloc_cache()
+    return part
+
+
 def split_render(
     mi: Any, loaded: Any, *, spp: int, seed: int, integrator: Any = None
 ) -> np.ndarray:
@@ -100,12 +119,15 @@ def split_render(
         return np.array(image, dtype=np.float32)
     import drjit as dr
 
-    width, height = loaded.sensors()[0].film().crop_size()
     parts = sample_splits(spp)
-    weighted = []
-    for count, part_seed in zip(parts, part_seeds(seed, len(parts)), strict=True):
-        small = single_thread(int(width) * int(height) * count, dr.thread_count())
-        with _threads(dr, 1 if small else None):
-            image = mi.render(loaded, spp=count, seed=part_seed, integrator=integrator)
-            weighted.append(np.array(image, dtype=np.float64) * count)
-    return (functools.reduce(np.add, weighted) / spp).astype(np.float32)
+    seeds = part_seeds(seed, len(parts))
+    if len(parts) == 1:  # x * spp / spp in float64 is x: the float32 film as it is
+        return _render_part(mi, dr, loaded, spp, seeds[0], integrator, np.float32)
+    total = _render_part(mi, dr, loaded, parts[0], seeds[0], integrator, np.float64)
+    total *= parts[0]
+    for count, part_seed in zip(parts[1:], seeds[1:], strict=True):
+        part = _render_part(mi, dr, loaded, count, part_seed, integrator, np.float64)
+        part *= count
+        total += part  # in part order, as the sum of the weighted copies was
+    total /= spp
+    return total.astype(np.float32)
