@@ -181,7 +181,8 @@ class _Dims:
 
     h: int
     w: int
-    n_bands: int
+    #: Bands of each value set, traced side by side.
+    widths: tuple[int, ...]
     n_lights: int
     glossy: bool
     #: Per albedo-table row (materials, then the black row): 0 with a diffuse lobe, else
@@ -192,15 +193,29 @@ class _Dims:
     def metals(self) -> bool:
         return any(self.non_diffuse_rows)
 
+    @property
+    def n_bands(self) -> int:
+        return sum(self.widths)
+
+    def per_set(self, channels: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Light-major film *channels* ``(H, W, L·K)`` cut into each value set's contiguous
+        ``(L, H, W, K_m)``: copies, so the film can be dropped at once."""
+        per_light = channels.reshape(self.h, self.w, self.n_lights, self.n_bands)
+        edges = np.cumsum([0, *self.widths])
+        return tuple(
+            np.ascontiguousarray(per_light[..., a:b].transpose(2, 0, 1, 3))
+            for a, b in zip(edges[:-1], edges[1:], strict=True)
+        )
+
 
 @dataclass(frozen=True, eq=False)
 class _Traced:
-    """One traversal: transport ``(L, H, W, K)``, the parts of :data:`~spectrinsic.render.result.PARTS`
-    it rendered (same shape; the first traversal only), the first-hit maps (first traversal
-    with surfaces) and its seconds."""
+    """One traversal: each value set's transport ``(L, H, W, K_m)``, the parts of
+    :data:`~spectrinsic.render.result.PARTS` it rendered (the same per value set; the first
+    traversal only), the first-hit channels (first traversal with surfaces) and its seconds."""
 
-    transport: np.ndarray
-    parts: dict[str, np.ndarray]
+    transport: tuple[np.ndarray, ...]
+    parts: dict[str, tuple[np.ndarray, ...]]
     first: np.ndarray | None
     seconds: float
 
@@ -244,19 +259,16 @@ def _trace(
     n_first = len(first_hit_channels(n_surfaces, n_texcols))
     image, dt = _render(mi, loaded, integrator, request, n_t + n_spec + n_white + n_first)
 
-    def per_light(channels: np.ndarray) -> np.ndarray:
-        return channels.reshape(dims.h, dims.w, dims.n_lights, dims.n_bands).transpose(2, 0, 1, 3)
-
     end = n_t + n_spec + n_white
     parts = {}
     if dims.glossy and first:
-        parts[SPECULAR] = per_light(image[..., n_t : n_t + n_spec])
+        parts[SPECULAR] = dims.per_set(image[..., n_t : n_t + n_spec])
     if metals:
-        parts[METAL_WHITE] = per_light(image[..., n_t + n_spec : end])
+        parts[METAL_WHITE] = dims.per_set(image[..., n_t + n_spec : end])
     return _Traced(
-        transport=per_light(image[..., :n_t]),
+        transport=dims.per_set(image[..., :n_t]),
         parts=parts,
-        first=image[..., end:] if n_surfaces else None,
+        first=np.ascontiguousarray(image[..., end:]) if n_surfaces else None,
         seconds=dt,
     )
 
@@ -270,21 +282,17 @@ def _first_hit_maps(scene: Scene, tables: BandTables, hits: np.ndarray) -> dict[
 
 
 def _outputs(
-    value_sets: Sequence[ChannelValues],
-    widths: Sequence[int],
-    traced: Sequence[_Traced],
-    direct: bool,
+    value_sets: Sequence[ChannelValues], traced: Sequence[_Traced], direct: bool
 ) -> list[TransportOutput]:
-    """The traversals' bands cut back into one :class:`TransportOutput` per value set."""
-    edges = np.cumsum([0, *widths])
+    """One :class:`TransportOutput` per value set from the traversals' cuts."""
     return [
         TransportOutput(
-            transport=np.ascontiguousarray(traced[0].transport[..., a:b]),
-            direct=np.ascontiguousarray(traced[1].transport[..., a:b]) if direct else None,
+            transport=traced[0].transport[i],
+            direct=traced[1].transport[i] if direct else None,
             emission=np.asarray(v.lights, float),
-            parts={n: np.ascontiguousarray(p[..., a:b]) for n, p in traced[0].parts.items()},
+            parts={n: p[i] for n, p in traced[0].parts.items()},
         )
-        for v, a, b in zip(value_sets, edges[:-1], edges[1:], strict=True)
+        for i, v in enumerate(value_sets)
     ]
 
 
@@ -330,7 +338,7 @@ def render_traversal(
     if not value_sets:
         raise SceneError("render_traversal: expected at least one set of channel values")
     widths = [np.asarray(v.materials).shape[1] for v in value_sets]
-    n_bands, n_lights = sum(widths), len(scene.lights)
+    n_lights = len(scene.lights)
     chosen = choose_variant("rgb", request.variant)
     h, w = (
         (scene.camera.height, scene.camera.width) if crop is None else (int(crop[3]), int(crop[2]))
@@ -356,7 +364,7 @@ def render_traversal(
             GLASS_ROW if m.transmissive else MIRROR_ROW if m.non_diffuse else 0
             for m in scene.materials
         ) + (0,)
-        dims = _Dims(h, w, n_bands, n_lights, glossy, non_diffuse_rows)
+        dims = _Dims(h, w, tuple(widths), n_lights, glossy, non_diffuse_rows)
         spec_table = _specular_table(scene, value_sets) if glossy else None
         traced: list[_Traced] = []
         for depth in [request.max_depth] + ([DIRECT_DEPTH] if direct else []):
@@ -364,7 +372,7 @@ def render_traversal(
             traced.append(
                 _trace(mi, loaded, tables, dims, spec_table, request, depth=depth, first=first)
             )
-    outputs = _outputs(value_sets, widths, traced, direct)
+    outputs = _outputs(value_sets, traced, direct)
     hits = traced[0].first
     aov_maps = _first_hit_maps(scene, tables, hits) if aovs and hits is not None else {}
     seconds = [t.seconds for t in traced]
