@@ -162,18 +162,6 @@ def _specular_table(scene: Scene, value_sets: Sequence[ChannelValues]) -> np.nda
     return np.concatenate([table, np.ones((1, *table.shape[1:]))], axis=0)
 
 
-def _render(
-    mi: Any, loaded: Any, integrator: Any, request: PassRequest, n: int
-) -> tuple[np.ndarray, float]:
-    """The traversal's last *n* AOV channels (the band transport) and the render's seconds."""
-    image, seconds = timed_render(mi, loaded, request, integrator)
-    if image.shape[-1] < n:
-        raise RenderError(
-            f"band-path render returned {image.shape[-1]} channels; expected at least {n}"
-        )
-    return image[..., image.shape[-1] - n :], seconds
-
-
 @dataclass(frozen=True)
 class _Dims:
     """Image height and width, bands K, lights L, and whether the scene has glossy materials
@@ -256,8 +244,11 @@ def _trace(
     n_t = dims.n_bands * dims.n_lights
     n_spec = n_t if dims.glossy else 0
     n_white = n_t if metals else 0
-    n_first = len(first_hit_channels(n_surfaces, n_texcols))
-    image, dt = _render(mi, loaded, integrator, request, n_t + n_spec + n_white + n_first)
+    n = n_t + n_spec + n_white + len(first_hit_channels(n_surfaces, n_texcols))
+    film, dt = timed_render(mi, loaded, request, integrator)
+    if film.shape[-1] < n:
+        raise RenderError(f"band-path render returned {film.shape[-1]} channels; expected {n}+")
+    image = film[..., film.shape[-1] - n :]  # the AOVs: after Mitsuba's own R, G, B
 
     end = n_t + n_spec + n_white
     parts = {}
