@@ -102,7 +102,7 @@ def _render_part(
         dr.eval(image)  # in this thread count
     loaded.sensors()[0].film().prepare([])  # its storage swapped for one without AOVs
     dr.flush_malloc_cache()
-    part = np.array(image, dtype=dtype)
+    part: np.ndarray = np.array(image, dtype=dtype)
     del image
     dr.flush_malloc_cache()
     return part
