@@ -264,14 +264,6 @@ def _trace(
     )
 
 
-def _first_hit_maps(scene: Scene, tables: BandTables, hits: np.ndarray) -> dict[str, np.ndarray]:
-    """:func:`~spectrinsic.render.base.aov_maps.assemble_aovs` of the traversal's first-hit channels
-    (coverage, texture columns, ray distance, normal)."""
-    columns = None if tables.textures is None else tables.textures.columns
-    surfaces = tr.surfaces(scene)
-    return assemble_aovs(scene, surfaces, hits[..., :-4], hits[..., -4], hits[..., -3:], columns)
-
-
 def _outputs(
     value_sets: Sequence[ChannelValues], traced: Sequence[_Traced], direct: bool
 ) -> list[TransportOutput]:
@@ -364,8 +356,11 @@ def render_traversal(
                 _trace(mi, loaded, tables, dims, spec_table, request, depth=depth, first=first)
             )
     outputs = _outputs(value_sets, traced, direct)
-    hits = traced[0].first
-    aov_maps = _first_hit_maps(scene, tables, hits) if aovs and hits is not None else {}
+    hits, aov_maps = traced[0].first, {}
+    if aovs and hits is not None:  # coverage (and texture columns), ray distance, normal
+        columns = None if tables.textures is None else tables.textures.columns
+        cover, distance, normal = hits[..., :-4], hits[..., -4], hits[..., -3:]
+        aov_maps = assemble_aovs(scene, tr.surfaces(scene), cover, distance, normal, columns)
     seconds = [t.seconds for t in traced]
     return outputs, aov_maps, tuple(seconds), chosen
 
