@@ -231,6 +231,22 @@ def _set_transmittance(mi: Any, it: Any, tables: BandTables) -> None:
         setattr(it, name, mi.Float(np.asarray(table, np.float32).ravel()))
 
 
+def _set_maps(mi: Any, dr: Any, it: Any, scene: Any, tables: BandTables) -> None:
+    """Point integrator *it* at the bump and normal maps of the loaded *scene*'s shapes
+    named in *tables* (their texture objects, shape id -> map index)."""
+    lut, it.surface_maps = map_textures(mi, scene, tables.map_scales)
+    it.map_lut = mi.UInt32(shape_id_table(mi, dr, scene, lut, len(lut)))
+
+
+def _check_specular(it: Any, table: np.ndarray) -> None:
+    """Raise unless *table* is ``(R, n_nodes, K)`` for integrator *it*."""
+    shape = np.shape(table)
+    if len(shape) != 3 or shape[1:] != (it.n_nodes, it.n_bands):
+        raise RenderError(
+            f"specular table {shape} does not fit {it.n_nodes} nodes x {it.n_bands} bands"
+        )
+
+
 def _make_class(mi: Any, dr: Any) -> type:
     """The :class:`BandPath` class of the active variant (module docstring)."""
 
@@ -260,8 +276,7 @@ def _make_class(mi: Any, dr: Any) -> type:
             self.slot_lut, self.tex_widths, self.tex_heights, self.tex_offsets = lookups[:4]
             self.texel_albedo, self.texel_weights = lookups[4:]
             self.light_channels, self.extra_maps = tables.channels(), tuple(tables.extra_maps)
-            lut, self.surface_maps = map_textures(mi, scene, tables.map_scales)
-            self.map_lut = mi.UInt32(shape_id_table(mi, dr, scene, lut, len(lut)))
+            _set_maps(mi, dr, self, scene, tables)
             _set_transmittance(mi, self, tables)
 
         def set_non_diffuse(self, rows: np.ndarray) -> None:
@@ -270,11 +285,7 @@ def _make_class(mi: Any, dr: Any) -> type:
 
         def set_specular(self, table: np.ndarray) -> None:
             """``(R, n_nodes, K)`` band factors ``s_k(μ_j)`` per albedo-table row."""
-            shape = np.shape(table)
-            if len(shape) != 3 or shape[1:] != (self.n_nodes, self.n_bands):
-                raise RenderError(
-                    f"specular table {shape} does not fit {self.n_nodes} nodes x {self.n_bands} bands"
-                )
+            _check_specular(self, table)
             self.specular = mi.Float(np.asarray(table, np.float32).ravel())
 
         def aov_names(self) -> list[str]:
