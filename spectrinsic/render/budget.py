@@ -78,13 +78,13 @@ BASE_BYTES = 2048 * 2**20
 AOV_VALUES = 16
 #: Longest image side accepted at all (OpenEXR and Mitsuba films use 32-bit sizes).
 MAX_SIDE = 65_536
-#: Copies of every channel of the band-path traversal's image alive at once: Mitsuba's image
-#: block and the developed tensor ``mi.render`` returns (Dr.Jit memory, which its allocation
-#: cache keeps resident after the call), the float32 numpy copy
-#: (:func:`~spectrinsic.render.base.one_pass.timed_render`) and the traversal's cuts of it per
-#: mode (``np.ascontiguousarray``). Measured inside the render call alone: 3.9 to 4.4 copies
-#: (docs/artist-interior-speed.md).
-FILM_COPIES = 4
+#: Copies of every channel of the band-path traversal's image alive at once: a render peaks at
+#: two (the film's storage and its developed tensor, then the tensor and its numpy copy:
+#: :func:`~spectrinsic.render.base.sample_split.split_render` gives each back at once) beside
+#: the previous batch's cuts of it per mode, and merging the batches holds both batches' cuts
+#: and their mean: three. Was 4 (3.9 to 4.4 measured inside the render call, before the copies
+#: were released); measured peaks against it: docs/artist-interior-speed.md.
+FILM_COPIES = 3
 
 
 @dataclass(frozen=True)

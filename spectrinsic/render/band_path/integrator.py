@@ -205,28 +205,16 @@ def _init_gloss(mi: Any, it: Any, props: Any) -> None:
 
 def _empty_tables(mi: Any, it: Any) -> None:
     """Integrator *it*'s lookups before :meth:`set_tables`: one zero entry each, every light
-    its own emitter's component 0 and no extra map."""
+    its own emitter's component 0, no extra map and no bump or normal map."""
     it.surface_lut = mi.UInt32(np.zeros(1, np.uint32))
     it.albedo = mi.Float(np.zeros(it.n_bands, np.float32))
     it.shape_lut = mi.UInt32(np.zeros(1, np.uint32))
     it.emitter_lut = mi.UInt32(np.zeros(1, np.uint32))
     it.light_channels = tuple((j, 0, 0) for j in range(it.n_lights))
     it.extra_maps = ()
-
-
-def _init_maps(mi: Any, it: Any, props: Any) -> None:
-    """The mask flag of integrator *it* and no bump or normal maps yet."""
-    it.masks = bool(props.get("masks", False))
     it.map_lut = mi.UInt32(np.zeros(1, np.uint32))
     #: (kind, texture, bump scale) of each bump- or normal-mapped shape (surface_maps)
     it.surface_maps = []
-
-
-def _set_maps(mi: Any, dr: Any, it: Any, scene: Any, tables: BandTables) -> None:
-    """Point integrator *it* at the bump and normal maps of the loaded *scene*'s shapes
-    named in *tables* (their texture objects, shape id -> map index)."""
-    lut, it.surface_maps = map_textures(mi, scene, tables.map_scales)
-    it.map_lut = mi.UInt32(shape_id_table(mi, dr, scene, lut, len(lut)))
 
 
 def _set_transmittance(mi: Any, it: Any, tables: BandTables) -> None:
@@ -241,6 +229,13 @@ def _set_transmittance(mi: Any, it: Any, tables: BandTables) -> None:
         if np.ndim(table) != 2 or np.shape(table)[1] != it.n_bands:
             raise RenderError(f"{name} table {np.shape(table)} does not fit {it.n_bands} bands")
         setattr(it, name, mi.Float(np.asarray(table, np.float32).ravel()))
+
+
+def _set_maps(mi: Any, dr: Any, it: Any, scene: Any, tables: BandTables) -> None:
+    """Point integrator *it* at the bump and normal maps of the loaded *scene*'s shapes
+    named in *tables* (their texture objects, shape id -> map index)."""
+    lut, it.surface_maps = map_textures(mi, scene, tables.map_scales)
+    it.map_lut = mi.UInt32(shape_id_table(mi, dr, scene, lut, len(lut)))
 
 
 def _check_specular(it: Any, table: np.ndarray) -> None:
@@ -267,9 +262,9 @@ def _make_class(mi: Any, dr: Any) -> type:
             self.n_lights = int(props.get("n_lights", 1))
             self.n_surfaces = int(props.get("n_surfaces", 0))
             self.n_texcols = int(props.get("n_texcols", 0))
+            self.masks = bool(props.get("masks", False))
             _empty_tables(mi, self)
             _init_gloss(mi, self, props)
-            _init_maps(mi, self, props)
 
         def set_tables(self, scene: Any, tables: BandTables) -> None:
             """Point the lookups at *tables* for the loaded *scene* (no recompilation)."""

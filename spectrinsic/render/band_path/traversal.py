@@ -162,18 +162,6 @@ def _specular_table(scene: Scene, value_sets: Sequence[ChannelValues]) -> np.nda
     return np.concatenate([table, np.ones((1, *table.shape[1:]))], axis=0)
 
 
-def _render(
-    mi: Any, loaded: Any, integrator: Any, request: PassRequest, n: int
-) -> tuple[np.ndarray, float]:
-    """The traversal's last *n* AOV channels (the band transport) and the render's seconds."""
-    image, seconds = timed_render(mi, loaded, request, integrator)
-    if image.shape[-1] < n:
-        raise RenderError(
-            f"band-path render returned {image.shape[-1]} channels; expected at least {n}"
-        )
-    return image[..., image.shape[-1] - n :], seconds
-
-
 @dataclass(frozen=True)
 class _Dims:
     """Image height and width, bands K, lights L, and whether the scene has glossy materials
@@ -181,7 +169,8 @@ class _Dims:
 
     h: int
     w: int
-    n_bands: int
+    #: Bands of each value set, traced side by side.
+    widths: tuple[int, ...]
     n_lights: int
     glossy: bool
     #: Per albedo-table row (materials, then the black row): 0 with a diffuse lobe, else
@@ -192,15 +181,29 @@ class _Dims:
     def metals(self) -> bool:
         return any(self.non_diffuse_rows)
 
+    @property
+    def n_bands(self) -> int:
+        return sum(self.widths)
+
+    def per_set(self, channels: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Light-major film *channels* ``(H, W, L·K)`` cut into each value set's contiguous
+        ``(L, H, W, K_m)``: copies, so the film can be dropped at once."""
+        per_light = channels.reshape(self.h, self.w, self.n_lights, self.n_bands)
+        edges = np.cumsum([0, *self.widths])
+        return tuple(
+            np.ascontiguousarray(per_light[..., a:b].transpose(2, 0, 1, 3))
+            for a, b in zip(edges[:-1], edges[1:], strict=True)
+        )
+
 
 @dataclass(frozen=True, eq=False)
 class _Traced:
-    """One traversal: transport ``(L, H, W, K)``, the parts of :data:`~spectrinsic.render.result.PARTS`
-    it rendered (same shape; the first traversal only), the first-hit maps (first traversal
-    with surfaces) and its seconds."""
+    """One traversal: each value set's transport ``(L, H, W, K_m)``, the parts of
+    :data:`~spectrinsic.render.result.PARTS` it rendered (the same per value set; the first
+    traversal only), the first-hit channels (first traversal with surfaces) and its seconds."""
 
-    transport: np.ndarray
-    parts: dict[str, np.ndarray]
+    transport: tuple[np.ndarray, ...]
+    parts: dict[str, tuple[np.ndarray, ...]]
     first: np.ndarray | None
     seconds: float
 
@@ -241,50 +244,38 @@ def _trace(
     n_t = dims.n_bands * dims.n_lights
     n_spec = n_t if dims.glossy else 0
     n_white = n_t if metals else 0
-    n_first = len(first_hit_channels(n_surfaces, n_texcols))
-    image, dt = _render(mi, loaded, integrator, request, n_t + n_spec + n_white + n_first)
-
-    def per_light(channels: np.ndarray) -> np.ndarray:
-        return channels.reshape(dims.h, dims.w, dims.n_lights, dims.n_bands).transpose(2, 0, 1, 3)
+    n = n_t + n_spec + n_white + len(first_hit_channels(n_surfaces, n_texcols))
+    film, dt = timed_render(mi, loaded, request, integrator)
+    if film.shape[-1] < n:
+        raise RenderError(f"band-path render returned {film.shape[-1]} channels; expected {n}+")
+    image = film[..., film.shape[-1] - n :]  # the AOVs: after Mitsuba's own R, G, B
 
     end = n_t + n_spec + n_white
     parts = {}
     if dims.glossy and first:
-        parts[SPECULAR] = per_light(image[..., n_t : n_t + n_spec])
+        parts[SPECULAR] = dims.per_set(image[..., n_t : n_t + n_spec])
     if metals:
-        parts[METAL_WHITE] = per_light(image[..., n_t + n_spec : end])
+        parts[METAL_WHITE] = dims.per_set(image[..., n_t + n_spec : end])
     return _Traced(
-        transport=per_light(image[..., :n_t]),
+        transport=dims.per_set(image[..., :n_t]),
         parts=parts,
-        first=image[..., end:] if n_surfaces else None,
+        first=np.ascontiguousarray(image[..., end:]) if n_surfaces else None,
         seconds=dt,
     )
 
 
-def _first_hit_maps(scene: Scene, tables: BandTables, hits: np.ndarray) -> dict[str, np.ndarray]:
-    """:func:`~spectrinsic.render.base.aov_maps.assemble_aovs` of the traversal's first-hit channels
-    (coverage, texture columns, ray distance, normal)."""
-    columns = None if tables.textures is None else tables.textures.columns
-    surfaces = tr.surfaces(scene)
-    return assemble_aovs(scene, surfaces, hits[..., :-4], hits[..., -4], hits[..., -3:], columns)
-
-
 def _outputs(
-    value_sets: Sequence[ChannelValues],
-    widths: Sequence[int],
-    traced: Sequence[_Traced],
-    direct: bool,
+    value_sets: Sequence[ChannelValues], traced: Sequence[_Traced], direct: bool
 ) -> list[TransportOutput]:
-    """The traversals' bands cut back into one :class:`TransportOutput` per value set."""
-    edges = np.cumsum([0, *widths])
+    """One :class:`TransportOutput` per value set from the traversals' cuts."""
     return [
         TransportOutput(
-            transport=np.ascontiguousarray(traced[0].transport[..., a:b]),
-            direct=np.ascontiguousarray(traced[1].transport[..., a:b]) if direct else None,
+            transport=traced[0].transport[i],
+            direct=traced[1].transport[i] if direct else None,
             emission=np.asarray(v.lights, float),
-            parts={n: np.ascontiguousarray(p[..., a:b]) for n, p in traced[0].parts.items()},
+            parts={n: p[i] for n, p in traced[0].parts.items()},
         )
-        for v, a, b in zip(value_sets, edges[:-1], edges[1:], strict=True)
+        for i, v in enumerate(value_sets)
     ]
 
 
@@ -330,7 +321,7 @@ def render_traversal(
     if not value_sets:
         raise SceneError("render_traversal: expected at least one set of channel values")
     widths = [np.asarray(v.materials).shape[1] for v in value_sets]
-    n_bands, n_lights = sum(widths), len(scene.lights)
+    n_lights = len(scene.lights)
     chosen = choose_variant("rgb", request.variant)
     h, w = (
         (scene.camera.height, scene.camera.width) if crop is None else (int(crop[3]), int(crop[2]))
@@ -356,7 +347,7 @@ def render_traversal(
             GLASS_ROW if m.transmissive else MIRROR_ROW if m.non_diffuse else 0
             for m in scene.materials
         ) + (0,)
-        dims = _Dims(h, w, n_bands, n_lights, glossy, non_diffuse_rows)
+        dims = _Dims(h, w, tuple(widths), n_lights, glossy, non_diffuse_rows)
         spec_table = _specular_table(scene, value_sets) if glossy else None
         traced: list[_Traced] = []
         for depth in [request.max_depth] + ([DIRECT_DEPTH] if direct else []):
@@ -364,9 +355,12 @@ def render_traversal(
             traced.append(
                 _trace(mi, loaded, tables, dims, spec_table, request, depth=depth, first=first)
             )
-    outputs = _outputs(value_sets, widths, traced, direct)
-    hits = traced[0].first
-    aov_maps = _first_hit_maps(scene, tables, hits) if aovs and hits is not None else {}
+    outputs = _outputs(value_sets, traced, direct)
+    hits, aov_maps = traced[0].first, {}
+    if aovs and hits is not None:  # coverage (and texture columns), ray distance, normal
+        columns = None if tables.textures is None else tables.textures.columns
+        cover, distance, normal = hits[..., :-4], hits[..., -4], hits[..., -3:]
+        aov_maps = assemble_aovs(scene, tr.surfaces(scene), cover, distance, normal, columns)
     seconds = [t.seconds for t in traced]
     return outputs, aov_maps, tuple(seconds), chosen
 

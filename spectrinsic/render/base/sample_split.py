@@ -23,7 +23,6 @@ a power-of-two count renders exactly as one call did.
 from __future__ import annotations
 
 import contextlib
-import functools
 from collections.abc import Iterator
 from typing import Any
 
@@ -89,6 +88,41 @@ def _threads(dr: Any, count: int | None) -> Iterator[None]:
         dr.set_thread_count(before)
 
 
+def _render_part(
+    mi: Any, dr: Any, loaded: Any, count: int, seed: int, integrator: Any
+) -> np.ndarray:
+    """One part's film as a float32 copy, at a peak of two films (not four): the film's
+    storage is given back once its developed tensor is evaluated, the tensor once copied
+    (with every band-path channel, each is the size of the image; Dr.Jit's allocation cache
+    would keep them resident)."""
+    width, height = loaded.sensors()[0].film().crop_size()
+    small = single_thread(int(width) * int(height) * count, dr.thread_count())
+    with _threads(dr, 1 if small else None):
+        image = mi.render(loaded, spp=count, seed=seed, integrator=integrator)
+        dr.eval(image)  # in this thread count
+    loaded.sensors()[0].film().prepare([])  # its storage swapped for one without AOVs
+    dr.flush_malloc_cache()
+    part: np.ndarray = np.array(image, dtype=np.float32)
+    del image
+    dr.flush_malloc_cache()
+    return part
+
+
+def _weighted_mean(parts: list[np.ndarray], counts: tuple[int, ...]) -> np.ndarray:
+    """``Σ_i counts_i · parts_i / Σ counts`` in float64, in part order, as float32, written
+    over the first part a block of rows at a time (no float64 copy of the whole film)."""
+    out, spp = parts[0], sum(counts)
+    step = max(1, 2**22 // max(1, out[0].size))
+    for start in range(0, out.shape[0], step):
+        rows = slice(start, start + step)
+        total = np.multiply(parts[0][rows], counts[0], dtype=np.float64)
+        for part, count in zip(parts[1:], counts[1:], strict=True):
+            total += np.multiply(part[rows], count, dtype=np.float64)
+        total /= spp
+        out[rows] = total
+    return out
+
+
 def split_render(
     mi: Any, loaded: Any, *, spp: int, seed: int, integrator: Any = None
 ) -> np.ndarray:
@@ -100,12 +134,11 @@ def split_render(
         return np.array(image, dtype=np.float32)
     import drjit as dr
 
-    width, height = loaded.sensors()[0].film().crop_size()
-    parts = sample_splits(spp)
-    weighted = []
-    for count, part_seed in zip(parts, part_seeds(seed, len(parts)), strict=True):
-        small = single_thread(int(width) * int(height) * count, dr.thread_count())
-        with _threads(dr, 1 if small else None):
-            image = mi.render(loaded, spp=count, seed=part_seed, integrator=integrator)
-            weighted.append(np.array(image, dtype=np.float64) * count)
-    return (functools.reduce(np.add, weighted) / spp).astype(np.float32)
+    counts = sample_splits(spp)
+    seeds = part_seeds(seed, len(counts))
+    parts = [
+        _render_part(mi, dr, loaded, count, part_seed, integrator)
+        for count, part_seed in zip(counts, seeds, strict=True)
+    ]
+    # one part: x * spp / spp in float64 is x, the float32 film as it is
+    return parts[0] if len(parts) == 1 else _weighted_mean(parts, counts)

@@ -10,6 +10,10 @@ share per thread) runs on one thread.
 
 from __future__ import annotations
 
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -93,3 +97,54 @@ def test_a_split_render_is_the_sample_weighted_mean_of_its_parts(llvm):
     seeds = part_seeds(5, 2)
     mean = (128 * plain(128, seeds[0]) + 32 * plain(32, seeds[1])) / 160
     np.testing.assert_array_equal(split_render(mi, scene, spp=160, seed=5), mean.astype(np.float32))
+
+
+#: A fresh process renders a Cornell box through Mitsuba's ``aov`` integrator with
+#: :data:`_AOVS` depth channels (a film as wide as a band-path traversal's) in one part (1 spp)
+#: and in two (3 spp), and prints the film copy's bytes and each render's peak above its start
+#: (``VmHWM``, reset through ``/proc/self/clear_refs``; a first round compiles the kernels).
+_AOVS = 250
+_PEAK = f"""
+from pathlib import Path
+from spectrinsic.render.base.sample_split import split_render
+from spectrinsic.render.base.variants import choose_variant, variant_scope
+
+def hwm():
+    status = Path("/proc/self/status").read_text().splitlines()
+    return next(int(s.split()[1]) * 1024 for s in status if s.startswith("VmHWM:"))
+
+with variant_scope(choose_variant("rgb", "llvm")) as mi:
+    scene = mi.cornell_box()
+    scene["sensor"]["film"].update(width=256, height=256, rfilter={{"type": "box"}})
+    aovs = ",".join(f"d{{i}}:depth" for i in range({_AOVS}))
+    loaded = mi.load_dict({{**scene, "integrator": {{"type": "aov", "aovs": aovs}}}})
+    for spp in (1, 3):
+        split_render(mi, loaded, spp=spp, seed=0)
+    peaks = []
+    for spp in (1, 3):
+        Path("/proc/self/clear_refs").write_text("5")
+        start = hwm()
+        image = split_render(mi, loaded, spp=spp, seed=0)
+        peaks.append(hwm() - start)
+        channels, film = image.shape[-1], image.nbytes
+        del image
+    print(channels, film, *peaks)
+"""
+
+
+@pytest.mark.render
+def test_a_wide_film_is_copied_at_two_films_peak(llvm):
+    """The film's storage is given back once its tensor is evaluated and the tensor once
+    copied (and Dr.Jit's allocation cache flushed), with no float64 copy of the film: one part
+    peaks at about two films above its start, two parts at about three (the first part's copy
+    beside the second's two), not five to seven (docs/artist-interior-speed.md)."""
+    if not Path("/proc/self/clear_refs").exists():
+        pytest.skip("needs Linux's /proc/self/clear_refs to reset the peak resident memory")
+    done = subprocess.run(
+        [sys.executable, "-P", "-c", _PEAK], capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    channels, film, one, two = (int(x) for x in done.stdout.split()[-4:])
+    assert channels >= _AOVS
+    mib = f"film {film / 2**20:.0f} MiB, peaks {one / 2**20:.0f} and {two / 2**20:.0f} MiB"
+    assert one < 3 * film and two < 4 * film, mib
