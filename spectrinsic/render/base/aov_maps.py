@@ -24,6 +24,40 @@ def _majority(coverage: np.ndarray) -> np.ndarray:
     return np.where(winner == coverage.shape[-1], -1, winner).astype(np.int32)
 
 
+#: float64 coverage held at once per row block: the per-object maps of a scene with hundreds of
+#: objects are otherwise gigabytes (docs/artist-interior-speed.md); every map is per pixel, so
+#: a block's bits are those of the whole image's.
+_BLOCK_BYTES = 32 * 2**20
+
+
+def _row_blocks(h: int, w: int, channels: int) -> list[slice]:
+    """Row slices of about :data:`_BLOCK_BYTES` of float64 for *channels* maps of width *w*."""
+    step = max(1, _BLOCK_BYTES // max(1, 8 * w * channels))
+    return [slice(r, min(h, r + step)) for r in range(0, h, step)]
+
+
+def _block_coverage(
+    scene: Scene,
+    surfaces: Sequence[tr.Surface],
+    cover: np.ndarray,
+    columns: np.ndarray,
+    object_ids: list[int],
+) -> tuple[np.ndarray, np.ndarray]:
+    """float64 coverage per material and per object (*object_ids* order) of rows of *cover*."""
+    h, w = cover.shape[:2]
+    material_cov = np.zeros((h, w, len(scene.materials)))
+    object_cov = np.zeros((h, w, len(object_ids)))
+    slot = {o: k for k, o in enumerate(object_ids)}
+    for i, s in enumerate(surfaces):
+        if s.material >= 0:
+            if scene.meshes[s.mesh].texture is None:
+                material_cov[..., s.material] += cover[..., i]
+            object_cov[..., slot[scene.meshes[s.mesh].object_id]] += cover[..., i]
+    for g, m in enumerate(columns):
+        material_cov[..., int(m)] += cover[..., len(surfaces) + g]
+    return material_cov, object_cov
+
+
 def assemble_aovs(
     scene: Scene,
     surfaces: Sequence[tr.Surface],
@@ -42,20 +76,18 @@ def assemble_aovs(
     own coverage in the material coverage."""
     columns = np.zeros(0, np.int64) if texture_columns is None else np.asarray(texture_columns)
     h, w = cover.shape[:2]
-    n_mat = len(scene.materials)
-    material_cov = np.zeros((h, w, n_mat))
     object_ids = sorted({m.object_id for m in scene.meshes})
-    object_cov = np.zeros((h, w, len(object_ids)))
-    for i, s in enumerate(surfaces):
-        if s.material >= 0:
-            if scene.meshes[s.mesh].texture is None:
-                material_cov[..., s.material] += cover[..., i]
-            object_cov[..., object_ids.index(scene.meshes[s.mesh].object_id)] += cover[..., i]
-    for g, m in enumerate(columns):
-        material_cov[..., int(m)] += cover[..., len(surfaces) + g]
+    coverage = np.empty((h, w, len(scene.materials)), np.float32)
+    material_id = np.empty((h, w), np.int32)
+    winner = np.empty((h, w), np.int32)
+    for rows in _row_blocks(h, w, len(scene.materials) + len(object_ids) + 1):
+        material_cov, object_cov = _block_coverage(
+            scene, surfaces, cover[rows], columns, object_ids
+        )
+        material_id[rows] = _majority(material_cov)
+        winner[rows] = _majority(object_cov)
+        coverage[rows] = np.clip(material_cov, 0.0, 1.0)
     hit = cover[..., : len(surfaces)].sum(axis=-1)
-    material_id = _majority(material_cov)
-    winner = _majority(object_cov)
     object_id = np.where(winner >= 0, np.asarray(object_ids + [-1], np.int64)[winner], -1).astype(
         np.int32
     )
@@ -68,7 +100,7 @@ def assemble_aovs(
     length = np.linalg.norm(normals, axis=-1, keepdims=True)
     normals = np.divide(normals, length, out=np.zeros_like(normals), where=length > 1e-6)
     return {
-        "coverage": np.clip(material_cov, 0.0, 1.0).astype(np.float32),
+        "coverage": coverage,
         "material_id": material_id,
         "object_id": object_id,
         "depth": depth.astype(np.float32),
