@@ -4,12 +4,13 @@ arithmetic on the batches' arrays (no render here: :mod:`~spectrinsic.render.bat
 The batches differ only in their seed (:func:`batch_seeds`), so the spread between them is a
 direct estimate of the Monte Carlo error of their mean (:func:`relative_standard_error`,
 :func:`image_noise`); :func:`batch_mean` and :func:`merge_batches` give the mean in float32,
-summed in float64 in batch order.
+summed in float64 in batch order; :func:`merge_owned_batches` gives the same bits, written over
+the first batch's arrays where it can (a caller that drops the batches holds no third copy).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -24,6 +25,7 @@ __all__ = [
     "relative_standard_error",
     "image_noise",
     "merge_batches",
+    "merge_owned_batches",
 ]
 
 
@@ -137,8 +139,81 @@ def _mean_modes(held: Sequence[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
     return {m: batch_mean([h[m] for h in held]) for m in held[0]}
 
 
+#: float32 elements per block of :func:`_half_into` (16 MiB of temporaries).
+_HALF_BLOCK = 2**22
+
+
+def _half_into(a: np.ndarray, b: np.ndarray) -> None:
+    """``a[:] =`` :func:`batch_mean` ``([a, b])`` of C-contiguous float32 arrays, block by
+    block: :func:`_half_sum` where its half is finite, else the float64 mean, which are the
+    same bits wherever both are finite (:func:`_half_sum`), so per block is as for the whole."""
+    flat_a, flat_b = a.reshape(-1), b.reshape(-1)
+    for start in range(0, flat_a.size, _HALF_BLOCK):
+        block = slice(start, start + _HALF_BLOCK)
+        half = _half_sum(flat_a[block], flat_b[block])
+        if half is None:
+            half = batch_mean([flat_a[block], flat_b[block]])
+        flat_a[block] = half
+
+
+def _arrays(result: RenderResult) -> list[np.ndarray]:
+    """Every array of *result*'s per-mode dicts and AOVs."""
+    dicts = [result.images, result.raw, result.direct, result.transport, result.aovs]
+    dicts += [*result.per_light, *result.parts.values(), *result.part_transport.values()]
+    return [a for d in dicts for a in d.values()]
+
+
+class _InPlaceMeans:
+    """Means of two batches written over the first batch's arrays where that array shares
+    memory with no other array of the first batch (so nothing else reads it after, and the
+    raw channels that :attr:`RenderResult.batch_raw` keeps are untouched); others get a new one."""
+
+    def __init__(self, first: RenderResult) -> None:
+        arrays = _arrays(first)
+        self._exclusive = {
+            id(a)
+            for i, a in enumerate(arrays)
+            if not any(np.may_share_memory(a, o) for j, o in enumerate(arrays) if j != i)
+        }
+
+    def _owned(self, a: np.ndarray, b: np.ndarray) -> bool:
+        fits = a.dtype == b.dtype == np.float32 and a.shape == b.shape
+        fits = fits and a.flags.c_contiguous and a.flags.writeable and b.flags.c_contiguous
+        return fits and id(a) in self._exclusive and not np.may_share_memory(a, b)
+
+    def __call__(self, held: Sequence[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
+        out = {}
+        for m in held[0]:
+            a, b = held[0][m], held[1][m]
+            if self._owned(a, b):
+                _half_into(a, b)
+                out[m] = a
+            else:
+                out[m] = batch_mean([a, b])
+        return out
+
+
 def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
     """The mean of independent batch renders of one scene, keeping each batch's raw channels."""
+    return _merge(results, _mean_modes)
+
+
+def merge_owned_batches(results: Sequence[RenderResult]) -> RenderResult:
+    """:func:`merge_batches`, bit for bit, for a caller that drops *results* after: with two
+    batches, every float32 mean except the raw channels' is written over the first batch's
+    array (the mean of a large render holds no third copy of its transport); the first batch
+    is left holding means."""
+    if len(results) != 2:
+        return merge_batches(results)
+    return _merge(results, _InPlaceMeans(results[0]))
+
+
+def _merge(
+    results: Sequence[RenderResult],
+    mean_modes: Callable[[Sequence[dict[str, np.ndarray]]], dict[str, np.ndarray]],
+) -> RenderResult:
+    """:func:`merge_batches` with *mean_modes* for the per-mode float32 means but the raw
+    channels' (which every batch keeps)."""
     if not results:
         raise RenderError("no batches to merge")
     if len(results) == 1:
@@ -161,17 +236,17 @@ def merge_batches(results: Sequence[RenderResult]) -> RenderResult:
         spectral = int(first.meta["spectral_spp"])
         meta.update(spectral_spp=spectral * len(results), spectral_batch_spp=spectral)
     return RenderResult(
-        images=_mean_modes([r.images for r in results]),
+        images=mean_modes([r.images for r in results]),
         raw=_mean_modes([r.raw for r in results]),
         per_light=tuple(
-            _mean_modes([r.per_light[i] for r in results]) for i in range(len(first.per_light))
+            mean_modes([r.per_light[i] for r in results]) for i in range(len(first.per_light))
         ),
-        direct=_mean_modes([r.direct for r in results]),
+        direct=mean_modes([r.direct for r in results]),
         aovs=_merge_aovs([r.aovs for r in results]),
-        transport=_mean_modes([r.transport for r in results]),
-        parts={p: _mean_modes([r.parts[p] for r in results]) for p in first.parts},
+        transport=mean_modes([r.transport for r in results]),
+        parts={p: mean_modes([r.parts[p] for r in results]) for p in first.parts},
         part_transport={
-            p: _mean_modes([r.part_transport[p] for r in results]) for p in first.part_transport
+            p: mean_modes([r.part_transport[p] for r in results]) for p in first.part_transport
         },
         meta=meta,
         batch_raw=tuple(dict(r.raw) for r in results),

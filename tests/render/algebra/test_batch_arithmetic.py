@@ -134,3 +134,36 @@ def test_a_relit_image_is_the_sum_of_its_lights_and_the_xyz_of_its_raw_channels(
     scale = np.abs(image).max()
     assert np.abs(image - summed).max() <= 4e-7 * scale
     assert np.abs(image - from_raw).max() <= 4e-7 * scale
+
+
+def test_an_owned_merge_is_merge_batches_bit_for_bit_and_reuses_the_first_batch(monkeypatch):
+    """merge_owned_batches writes the mean over the first batch's transport (no third copy of
+    a large render's transport), with merge_batches' bits: across blocks, in a block whose
+    float32 sum overflows, and where an array is shared (images that are the raw channels,
+    which batch_raw keeps, are not written over)."""
+    import spectrinsic.render.algebra.batch_means as bm
+    from spectrinsic.render.result import RenderResult
+
+    monkeypatch.setattr(bm, "_HALF_BLOCK", 50)  # several blocks in a 6x7x3 transport
+
+    def batch(seed: int) -> RenderResult:
+        rng = np.random.default_rng(seed)
+        transport = rng.lognormal(0.0, 3.0, (6, 7, 3)).astype(np.float32)
+        transport[0, 0, 0] = np.float32(3e38)  # its block's float32 sum overflows
+        image = rng.random((6, 7, 3)).astype(np.float32)
+        timing = {"passes": 1, "seconds": 0.5, "per_pass": [0.5]}
+        meta = {"spp": 3, "seed": seed, "timings": {"rgb3": timing}}
+        return RenderResult(
+            images={"rgb3": image}, raw={"rgb3": image}, transport={"rgb3": transport}, meta=meta
+        )
+
+    expected = bm.merge_batches([batch(1), batch(2)])
+    first = batch(1)
+    kept = first.raw["rgb3"].copy()
+    merged = bm.merge_owned_batches([first, batch(2)])
+    assert merged.transport["rgb3"] is first.transport["rgb3"]
+    assert np.isfinite(merged.transport["rgb3"]).all()
+    for field in ("transport", "images", "raw"):
+        got, want = getattr(merged, field)["rgb3"], getattr(expected, field)["rgb3"]
+        assert got.dtype == want.dtype and got.tobytes() == want.tobytes(), field
+    assert merged.batch_raw[0]["rgb3"].tobytes() == kept.tobytes()
