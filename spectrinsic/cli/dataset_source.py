@@ -18,7 +18,7 @@ from ..pipeline.source_plan import (
 from ..scenes.generators import GlossDistribution
 from ..scenes.generators.world_defaults import GLOSSY_FRACTION, METALLIC_FRACTION, TEXTURE_FRACTION
 from ..scenes.semantic import SemanticRules, read_semantic_map
-from ..scenes.sources import takes_asset_colours
+from ..scenes.sources import takes_asset_colours, takes_material_map
 from ..scenes.spectrum_refs import resolve_spectrum
 from ..scenes.yaml_limits import load_yaml_file
 
@@ -348,6 +348,15 @@ def source_from_args(args: argparse.Namespace) -> str | None:
                 "--colours-from-asset applies to glTF/GLB, OBJ/MTL and .blend files; none of the "
                 "--scenes is one"
             )
+        for option, value in (
+            ("--material-map", args.material_map),
+            ("--default-spectrum", args.default_spectrum),
+        ):
+            if value is not None and not any(takes_material_map(s) for s in args.scenes):
+                raise DatasetError(
+                    f"{option} applies to .blend and mesh files; none of the --scenes is one "
+                    "(YAML and Mitsuba XML scenes state their materials' spectra)"
+                )
         size = None if args.resolution is None else parse_resolution(args.resolution)
         return files_source(
             args.scenes,
