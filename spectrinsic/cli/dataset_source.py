@@ -178,9 +178,10 @@ def _add_scene_file_options(src: Any) -> None:
     src.add_argument(
         "--approximate",
         action="store_true",
-        help="Mitsuba XML scenes: approximate what has no exact ground truth (glass, masks, "
-        "bump maps, bitmaps, environment maps...; a .blend World's Sky Texture...) instead of "
-        "refusing it, one line saying what",
+        help="Mitsuba XML scenes: approximate what has no exact ground truth (a textured "
+        "glass tint or plastic specular, a Beckmann roughness, a sunsky, an emitter it "
+        "cannot read...; a .blend World's Sky Texture...) instead of refusing it, one "
+        "line saying what",
     )
     src.add_argument(
         "--new-sample",

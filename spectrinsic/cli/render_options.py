@@ -200,9 +200,10 @@ def _add_material_options(p: Any) -> None:
     p.add_argument(
         "--approximate",
         action="store_true",
-        help="Mitsuba XML: approximate what has no exact ground truth (glass, bitmaps other "
-        "than a diffuse reflectance, environment maps...; a .blend World's Sky Texture...) "
-        "instead of refusing it, one line saying what",
+        help="Mitsuba XML: approximate what has no exact ground truth (a textured glass tint"
+        " or plastic specular, a Beckmann roughness, a sunsky, an emitter it cannot "
+        "read...; a .blend World's Sky Texture...) instead of refusing it, one line "
+        "saying what",
     )
 
 
