@@ -44,6 +44,7 @@ def _alpha(data: bytes) -> object:
         (b"hello, not a png", "not a format PIL knows"),
         (png_declaring(4, 4), "cannot read it as an image"),  # header only: no pixel data
     ],
+    ids=["bomb", "too-large", "not-an-image", "no-pixels"],
 )
 def test_a_bomb_or_a_non_image_is_one_line(read, data, needle):
     with pytest.raises(SceneError, match="t.png") as info:
