@@ -18,7 +18,7 @@ from ..pipeline.source_plan import (
 from ..scenes.generators import GlossDistribution
 from ..scenes.generators.world_defaults import GLOSSY_FRACTION, METALLIC_FRACTION, TEXTURE_FRACTION
 from ..scenes.semantic import SemanticRules, read_semantic_map
-from ..scenes.sources import takes_asset_colours
+from ..scenes.sources import takes_asset_colours, takes_material_map
 from ..scenes.spectrum_refs import resolve_spectrum
 from ..scenes.yaml_limits import load_yaml_file
 
@@ -178,9 +178,10 @@ def _add_scene_file_options(src: Any) -> None:
     src.add_argument(
         "--approximate",
         action="store_true",
-        help="Mitsuba XML scenes: approximate what has no exact ground truth (glass, masks, "
-        "bump maps, bitmaps, environment maps...; a .blend World's Sky Texture...) instead of "
-        "refusing it, one line saying what",
+        help="Mitsuba XML scenes: approximate what has no exact ground truth (a textured "
+        "glass tint or plastic specular, a Beckmann roughness, a sunsky, an emitter it "
+        "cannot read...; a .blend World's Sky Texture...) instead of refusing it, one "
+        "line saying what",
     )
     src.add_argument(
         "--new-sample",
@@ -348,6 +349,15 @@ def source_from_args(args: argparse.Namespace) -> str | None:
                 "--colours-from-asset applies to glTF/GLB, OBJ/MTL and .blend files; none of the "
                 "--scenes is one"
             )
+        for option, value in (
+            ("--material-map", args.material_map),
+            ("--default-spectrum", args.default_spectrum),
+        ):
+            if value is not None and not any(takes_material_map(s) for s in args.scenes):
+                raise DatasetError(
+                    f"{option} applies to .blend and mesh files; none of the --scenes is one "
+                    "(YAML and Mitsuba XML scenes state their materials' spectra)"
+                )
         size = None if args.resolution is None else parse_resolution(args.resolution)
         return files_source(
             args.scenes,

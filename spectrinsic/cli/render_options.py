@@ -17,7 +17,7 @@ from ..render.algebra.modes import RENDER_MODES
 from ..render.base.plugins import MAX_PATH_DEPTH
 from ..render.settings import DEFAULT_INTEGRATOR, INTEGRATORS, UINT32_MAX
 from ..render.settings import DEFAULT_MODES as RENDER_DEFAULT_MODES
-from ..scenes.sources import FILE_SIZE, is_scene_file, takes_asset_colours
+from ..scenes.sources import FILE_SIZE, is_scene_file, takes_asset_colours, takes_material_map
 from .dataset_layers import add_layer_options
 from .dataset_source import add_semantic_map_option, parse_resolution
 
@@ -200,9 +200,10 @@ def _add_material_options(p: Any) -> None:
     p.add_argument(
         "--approximate",
         action="store_true",
-        help="Mitsuba XML: approximate what has no exact ground truth (glass, bitmaps other "
-        "than a diffuse reflectance, environment maps...; a .blend World's Sky Texture...) "
-        "instead of refusing it, one line saying what",
+        help="Mitsuba XML: approximate what has no exact ground truth (a textured glass tint"
+        " or plastic specular, a Beckmann roughness, a sunsky, an emitter it cannot "
+        "read...; a .blend World's Sky Texture...) instead of refusing it, one line "
+        "saying what",
     )
 
 
@@ -246,6 +247,12 @@ def check_source_options(args: argparse.Namespace) -> None:
             kind = "a scene file" if file else "a library scene"
             applies = "library scenes" if file else "scene files"
             raise RenderError(f"{option} applies to {applies}; {args.scene!r} is {kind}")
+    for option in ("--material-map", "--default-spectrum"):
+        if file and given[option] and not takes_material_map(args.scene):
+            raise RenderError(
+                f"{option} applies to .blend and mesh files; {args.scene!r} states its "
+                "materials' spectra itself"
+            )
     if args.colours_from_asset is True and not (file and takes_asset_colours(args.scene)):
         raise RenderError(
             f"--colours-from-asset applies to glTF/GLB, OBJ/MTL and .blend files; {args.scene!r} states "

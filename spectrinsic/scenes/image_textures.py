@@ -29,18 +29,22 @@ Untrusted input: an image of more than :data:`IMAGE_TEXELS_MAX` texels (after re
 from __future__ import annotations
 
 import base64
+import contextlib
 import hashlib
 import io
 import warnings
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
 from ..errors import SceneError, SpectrinsicWarning
 from ..spectra.colorimetry import decode_srgb
+
+if TYPE_CHECKING:
+    from PIL.Image import Image as PILImage
 
 __all__ = [
     "CORNERS",
@@ -53,6 +57,7 @@ __all__ = [
     "corner_weights",
     "decode_texels",
     "image_texture_from_file",
+    "opened_image",
     "image_texture_from_bytes",
     "image_from_record",
 ]
@@ -193,8 +198,11 @@ def decode_texels(
     return np.clip(values, 0.0, 1.0)
 
 
-def _read_pixels(data: bytes, what: str) -> np.ndarray:
-    """``(h, w, 3)`` values in [0, 1] of the 8-bit image file *data* (top row first)."""
+@contextlib.contextmanager
+def opened_image(data: bytes, what: str) -> Iterator[PILImage]:
+    """The image file *data* opened by PIL, of at most :data:`IMAGE_TEXELS_MAX` texels; an
+    unreadable file or a larger declared size (a decompression bomb: PIL's own limit raises
+    ``DecompressionBombError`` before this check) is refused in one line naming *what*."""
     from PIL import Image
 
     try:
@@ -205,14 +213,27 @@ def _read_pixels(data: bytes, what: str) -> np.ndarray:
                     f"{what}: image of {w}x{h} texels; expected at most "
                     f"{IMAGE_TEXELS_MAX:,} texels (downsize it)"
                 )
-            if img.mode not in _MODES:
-                raise SceneError(
-                    f"{what}: image mode {img.mode!r}; expected 8-bit {', '.join(_MODES)}"
-                )
-            alpha = img.mode in ("LA", "RGBA") and np.asarray(img.getchannel("A")).min() < 255
-            pixels = np.asarray(img.convert("RGB"), np.float64) / 255.0
-    except (OSError, Image.UnidentifiedImageError) as exc:
+            yield img
+    except Image.DecompressionBombError:
+        raise SceneError(
+            f"{what}: image of more than {2 * (Image.MAX_IMAGE_PIXELS or 0):,} texels; expected "
+            f"at most {IMAGE_TEXELS_MAX:,} texels (downsize it)"
+        ) from None
+    except Image.UnidentifiedImageError:  # its message holds the BytesIO's repr
+        raise SceneError(
+            f"{what}: cannot read it as an image (not a format PIL knows: PNG, JPEG, ...)"
+        ) from None
+    except OSError as exc:
         raise SceneError(f"{what}: cannot read it as an image ({exc})") from None
+
+
+def _read_pixels(data: bytes, what: str) -> np.ndarray:
+    """``(h, w, 3)`` values in [0, 1] of the 8-bit image file *data* (top row first)."""
+    with opened_image(data, what) as img:
+        if img.mode not in _MODES:
+            raise SceneError(f"{what}: image mode {img.mode!r}; expected 8-bit {', '.join(_MODES)}")
+        alpha = img.mode in ("LA", "RGBA") and np.asarray(img.getchannel("A")).min() < 255
+        pixels = np.asarray(img.convert("RGB"), np.float64) / 255.0  # OSError: opened_image's
     if alpha:
         warnings.warn(
             f"{what}: alpha below 1 is not read (surfaces are opaque)",

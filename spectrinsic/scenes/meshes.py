@@ -41,6 +41,7 @@ import numpy as np
 
 from ..errors import SceneError
 from .budget import MAX_FACES, MAX_VERTICES
+from .gltf_buffers import check_gltf_buffers
 from .gltf_colours import GLTF_SUFFIXES, gltf_colours
 from .gltf_glass import gltf_glass
 from .gltf_maps import gltf_maps, warn_mirrored_uv
@@ -135,6 +136,8 @@ def _geometries(path: Path) -> list[_Geometry]:
     ``uv`` ``(F, 3, 2)`` are the face corners' texture coordinates (v up), ``None`` without."""
 
     check_mesh_size(path)
+    if path.suffix.lower() in GLTF_SUFFIXES:  # trimesh reads a short buffer without complaint
+        check_gltf_buffers(path)
     try:
         loaded: Any = _load_mesh_file(path)
     except Exception as exc:  # noqa: BLE001 - trimesh raises many types for corrupt files

@@ -25,6 +25,7 @@ from __future__ import annotations
 import hashlib
 import math
 import os
+import re
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -85,7 +86,13 @@ def _plugin(mi: Any, node: XmlNode, where: str, **override: float) -> Any:
             props[key] = value
         else:
             raise SceneError(f"{where}: {key} {value!r} in {node.label()}; expected a number")
-    return mi.load_dict(props | override)
+    try:
+        return mi.load_dict(props | override)
+    except RuntimeError as exc:  # Mitsuba's own range checks (turbidity 1-10, albedo 0-1, ...)
+        detail = re.sub(r"\[[\w./]+:\d+\]\s*", "", str(exc)).rsplit('"sunsky": ', 1)[-1]
+        raise SceneError(
+            f"{where}: {node.label()}: {' '.join(detail.split())} (Mitsuba's sunsky refuses it)"
+        ) from None
 
 
 def _eval(mi: Any, emitter: Any, directions: np.ndarray) -> np.ndarray:

@@ -31,6 +31,7 @@ __all__ = [
     "FileSource",
     "scene_file_kind",
     "takes_asset_colours",
+    "takes_material_map",
     "is_scene_file",
     "load_scene_file",
     "labelled",
@@ -157,6 +158,13 @@ def takes_asset_colours(path: str | Path) -> bool:
     colour); YAML, XML, PLY, STL and OFF files state none, so the option would do nothing there."""
     suffix = Path(path).suffix.lower()
     return suffix in (".glb", ".gltf", ".obj") or scene_file_kind(path) == "blend"
+
+
+def takes_material_map(path: str | Path) -> bool:
+    """Whether ``--material-map`` and ``--default-spectrum`` apply to the scene file at *path*:
+    a mesh or ``.blend`` file, whose materials are names only; a YAML or Mitsuba XML scene
+    states every material's spectrum itself, so the options would do nothing there."""
+    return scene_file_kind(path) in ("mesh", "blend")
 
 
 def load_scene_file(

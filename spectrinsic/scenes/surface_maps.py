@@ -32,14 +32,13 @@ from typing import Any
 import numpy as np
 from PIL import Image
 
-from ..errors import SceneError
 from .image_textures import (
-    IMAGE_TEXELS_MAX,
     Filter,
     ImageTexture,
     Wrap,
     image_from_record,
     image_texture_from_bytes,
+    opened_image,
 )
 
 __all__ = [
@@ -157,20 +156,12 @@ def alpha_values(data: bytes, what: str, *, luminance_without_alpha: bool) -> np
     """``(h, w)`` 8-bit alpha of the image file *data* (row 0 the image's top); an image
     without alpha gives 255 everywhere, or with *luminance_without_alpha* its 8-bit grey
     (PIL's ``L``). One line names *what* for an unreadable or too large image."""
-    try:
-        with Image.open(io.BytesIO(data)) as img:
-            if img.size[0] * img.size[1] > IMAGE_TEXELS_MAX:
-                raise SceneError(
-                    f"{what}: image of {img.size[0]}x{img.size[1]} texels; expected at most "
-                    f"{IMAGE_TEXELS_MAX:,}"
-                )
-            if img.mode in ("LA", "RGBA") or (img.mode == "P" and "transparency" in img.info):
-                return np.asarray(img.convert("RGBA").getchannel("A"), np.uint8)
-            if luminance_without_alpha:
-                return np.asarray(img.convert("L"), np.uint8)
-            return np.full(img.size[::-1], 255, np.uint8)
-    except (OSError, Image.UnidentifiedImageError) as exc:
-        raise SceneError(f"{what}: cannot read it as an image ({exc})") from None
+    with opened_image(data, what) as img:
+        if img.mode in ("LA", "RGBA") or (img.mode == "P" and "transparency" in img.info):
+            return np.asarray(img.convert("RGBA").getchannel("A"), np.uint8)
+        if luminance_without_alpha:
+            return np.asarray(img.convert("L"), np.uint8)
+        return np.full(img.size[::-1], 255, np.uint8)
 
 
 def opacity_image(values: np.ndarray, source: str, wrap: Wrap, filter: Filter) -> ImageTexture:  # noqa: A002

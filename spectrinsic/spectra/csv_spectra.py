@@ -158,6 +158,11 @@ def _increasing(path: Path, wl: list[float], rows: list[int], column: str) -> No
             )
     if len(wl) < 2:
         raise SpectralDataError(f"{path}: {column!r}: expected at least 2 wavelength rows")
+    if wl[0] <= 0:  # increasing, so every later one is positive
+        raise SpectralDataError(
+            f"{path}: row {rows[0]}, column {column!r}: wavelength {wl[0]:g} nm; expected "
+            "positive wavelengths in nm"
+        )
 
 
 def _wide(path: Path, rows: list[list[str]], want: str) -> Column:

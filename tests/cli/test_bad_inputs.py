@@ -613,7 +613,7 @@ CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
             "--preset",
             "preview",
             "--scenes",
-            _scene(t),
+            _scene(t, TRIANGLE_OBJ, "tri.obj"),  # the option applies to mesh files
             "--default-spectrum",
             "munsell:nope",
             "--out",
@@ -628,7 +628,7 @@ CASES: list[tuple[str, Callable[[Path], list[str]], str]] = [
             "--preset",
             "preview",
             "--scenes",
-            _scene(t),
+            _scene(t, TRIANGLE_OBJ, "tri.obj"),  # the option applies to mesh files
             "--material-map",
             _scene(t, "grey: nope:1\n", "map.yaml"),
             "--out",

@@ -113,3 +113,18 @@ def test_an_empty_value_inside_a_pair_is_refused_naming_its_row(tmp_path):
     path = _instrument_file(tmp_path / "hole.csv", lines + ["", "", ""])
     with pytest.raises(SpectralDataError, match="row 6, column 'Refl. %': empty cell"):
         get_spectrum(f"csv:{path}#1")
+
+
+@pytest.mark.parametrize("layout", ["wide", "pairs", "long"])
+def test_a_wavelength_at_or_below_zero_is_refused(tmp_path, layout):
+    """Task r5-probe: rows of -5, 400, 700 nm were read as a spectrum (increasing, so every
+    check passed); a wavelength is positive, and the first row is the one to name."""
+    wl = [-5, 400, 700]
+    lines = {
+        "wide": ["nm,lamp [1]"] + [f"{w},0.5" for w in wl],
+        "pairs": ["nm,lamp [1],nm,other [1]"] + [f"{w},0.5,{w + 10},0.5" for w in wl],
+        "long": ["sample,wavelength [nm],value [1]"] + [f"lamp,{w},0.5" for w in wl],
+    }[layout]
+    path = _instrument_file(tmp_path / "negative.csv", lines)
+    with pytest.raises(SpectralDataError, match="row 2, .*wavelength -5 nm; expected positive"):
+        get_spectrum(f"csv:{path}#1" if layout != "long" else f"csv:{path}#lamp")
