@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SceneError
-from .gltf_colours import gltf_document
+from .gltf_colours import gltf_document, gltf_uri_file
 
 __all__ = ["MAX_BUFFER_BYTES", "check_gltf_buffers"]
 
@@ -71,11 +71,7 @@ def _buffer_size(path: Path, index: int, buffer: dict[str, Any], binary: bytes) 
     elif uri.startswith("data:"):
         held = _data_uri_length(path, index, uri)
     else:
-        base = path.parent.resolve()
-        full = (base / uri).resolve()
-        if not full.is_relative_to(base) or not full.is_file():
-            raise SceneError(f"{path}: buffer {uri!r} is not a file inside {base}")
-        held = full.stat().st_size
+        held = gltf_uri_file(path, uri, "buffer").stat().st_size
     if held < declared:
         raise SceneError(
             f"{path}: buffers[{index}] holds {held:,} bytes but declares byteLength "

@@ -32,6 +32,7 @@ __all__ = [
     "GLTF_SUFFIXES",
     "gltf_colours",
     "gltf_document",
+    "gltf_uri_file",
     "gltf_image",
     "gltf_image_bytes",
     "named_materials",
@@ -69,15 +70,21 @@ def named_materials(document: dict[str, Any]) -> Iterator[tuple[str, dict[str, A
             yield material["name"], material
 
 
+def gltf_uri_file(path: Path, uri: str, what: str) -> Path:
+    """The file a glTF's relative *uri* (of an image or buffer, *what*) names, which must lie
+    inside *path*'s folder (no ``../`` or absolute escapes, links resolved first)."""
+    base = path.parent.resolve()
+    full = (base / uri).resolve()
+    if not full.is_relative_to(base) or not full.is_file():
+        raise SceneError(f"{path}: {what} {uri!r} is not a file inside {base}")
+    return full
+
+
 def _uri_bytes(path: Path, uri: str) -> bytes:
     """The bytes a glTF *uri* names: a ``data:`` URI or a file inside *path*'s folder."""
     if uri.startswith("data:"):
         return base64.b64decode(uri.split(",", 1)[-1])
-    base = path.parent.resolve()
-    full = (base / uri).resolve()
-    if not full.is_relative_to(base) or not full.is_file():
-        raise SceneError(f"{path}: image or buffer {uri!r} is not a file inside {base}")
-    return full.read_bytes()
+    return gltf_uri_file(path, uri, "image or buffer").read_bytes()
 
 
 def _image_bytes(path: Path, doc: dict[str, Any], binary: bytes, index: int) -> bytes:
