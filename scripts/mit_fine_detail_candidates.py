@@ -276,7 +276,6 @@ def thin_regions_second(
     region_intensity: np.ndarray,
     image_intensity: np.ndarray,
     blurred: np.ndarray | None = None,
-    blur_reach: int = 2,
 ) -> np.ndarray:
     """Sec. 3.4 in two stages: Eq. 3.9 on the pairs of regions that have an interior (as now,
     ``lambda >= 1``), then the thin regions' scales (:func:`thin_regions`: their colour and
@@ -308,7 +307,7 @@ def thin_regions_second(
 
     coherence.bounded_minimum = two_stages
     try:
-        return DEFAULT_COHERENCE(regions, region_intensity, image_intensity, blurred, blur_reach)
+        return DEFAULT_COHERENCE(regions, region_intensity, image_intensity, blurred)
     finally:
         coherence.bounded_minimum = one_stage
 

@@ -6,9 +6,9 @@ Usage: python -P scripts/mit_stress.py MIT_DIR OUT.json [--variants=V,W] [OBJECT
 Every object of MIT_DIR (``$SPECTRINSIC_DATA/mit_intrinsic_dev``; all by default) under every
 variant of :data:`spectrinsic.decompose.evaluation.mit_variants.VARIANTS` (all by default) is
 decomposed by three methods and scored with the thesis' protocol (MIT LMSE,
-:mod:`spectrinsic.decompose.evaluation.mit`): ``before`` (names-and-shades without round 7's
-return of the fine detail to the reflectance, i.e. main at bbf89c8; rounds 5-6 compared main
-before issue 48 here), ``after`` (the defaults) and ``image-as-reflectance``. OUT.json keeps every score and the guard's action;
+:mod:`spectrinsic.decompose.evaluation.mit`): ``before`` (the defaults without round 7's
+return of the fine detail to the reflectance; round 7 compared main at bbf89c8 here, rounds
+5-6 main before issue 48), ``after`` (the defaults) and ``image-as-reflectance``. OUT.json keeps every score and the guard's action;
 ``--table`` merges parts (runs on disjoint objects can share the cores) into a markdown table
 per variant with each object's ratio to image-as-reflectance and the worst case.
 """

@@ -48,7 +48,6 @@ def global_coherence(
     region_intensity: np.ndarray,
     image_intensity: np.ndarray,
     blurred: np.ndarray | None = None,
-    blur_reach: int = 2,
 ) -> np.ndarray:
     """Per-region reflectance scales of thesis sec. 3.4 (Eqs. 3.8-3.10).
 
@@ -58,17 +57,12 @@ def global_coherence(
     side, and ``m_ij`` the mean of the two products (scale normalisation).
 
     Across the edges marked *blurred* (sharp, high-contrast steps,
-    :func:`spectrinsic.decompose.methods.sharp_edges.sharp_contrast_edges`) the two boundary
-    pixels are read up to ``blur_reach`` pixels further into their regions, straight away
-    from each other, while the pixels passed look like a lens' blur (:func:`_past_blur`): the
-    point spread mixes both reflectances into the pixels on a step, which pulls the ratio
-    measured there towards 1, while each region's ``L_i`` is dominated by its unmixed inside
-    (a print at ratio 16 seen through a 15 % spread reads 4.2 on its boundary). Eq. 3.8's
-    premise, the same shading on both sides, still holds over those few pixels. Elsewhere, and
-    where the changes look like shading, the boundary pixels are read: reading inside a smooth
-    shading gradient would add the gradient over the reach to every ratio of a chain of bands
-    (tried on the MIT development half: every object but teabag1 got worse; docs/
-    names-shades-mit.md, round 6).
+    :func:`spectrinsic.decompose.methods.sharp_edges.sharp_contrast_edges`) each side's
+    boundary intensity is extrapolated from the two pixels behind it (:func:`_side_reads`):
+    the optics' point spread (and any averaging of pixels, as in a downscaled image) mixes
+    both reflectances into the pixels on a step, which pulls the ratio measured there towards
+    1, while reading further inside would add the shading's gradient over those pixels to the
+    ratio (round 6, docs/names-shades-mit.md). Elsewhere the boundary pixels are read.
 
     Parameters
     ----------
@@ -77,13 +71,10 @@ def global_coherence(
     region_intensity
         ``(R + 1,)`` intensity ``L_i`` of each region's reflectance colour (entry 0 unused).
     image_intensity
-        ``(H, W)`` intensity of the input image.
+        ``(H, W)`` linear intensity of the input image.
     blurred
         ``(E,)`` bool per 4-neighbour edge of the mask ``regions > 0`` in :func:`grid_edges`
         order, or None (every boundary read where it is, as before issue 48's round 6).
-    blur_reach
-        Pixels stepped into each region across a *blurred* edge (2: the blur width of
-        :mod:`spectrinsic.decompose.methods.sharp_edges`).
 
     Returns
     -------
@@ -101,21 +92,16 @@ def global_coherence(
         return np.ones(n)
     pa, pb, ra, rb = flat[cross, 0], flat[cross, 1], ra[cross], rb[cross]
     # (own region, other region, pixel): each boundary pixel once per neighbouring region;
-    # its intensity is the mean over its edges to that region of the pixel read inside.
+    # its intensity is the mean over its edges to that region of what is read for it.
     own = np.concatenate([ra, rb])
     other = np.concatenate([rb, ra])
     pixel = np.concatenate([pa, pb])
-    read_a, read_b = pa, pb
-    if blurred is not None:
-        read_a, read_b = _past_blur(regions, flat_intensity, pa, pb, blurred[cross], blur_reach)
-    read = np.concatenate([read_a, read_b])
+    marks = None if blurred is None else blurred[cross]
+    read = np.concatenate(_side_reads(regions, flat_intensity, pa, pb, marks))
     key, key_of_edge = np.unique(np.stack([own, other, pixel], axis=1), axis=0, return_inverse=True)
     key_of_edge = key_of_edge.ravel()
     edges_per_key = np.bincount(key_of_edge, minlength=key.shape[0])
-    key_int = (
-        np.bincount(key_of_edge, weights=flat_intensity[read], minlength=key.shape[0])
-        / edges_per_key
-    )
+    key_int = np.bincount(key_of_edge, weights=read, minlength=key.shape[0]) / edges_per_key
     pair_id = key[:, 0] * n + key[:, 1]
     uniq, inverse, counts = np.unique(pair_id, return_inverse=True, return_counts=True)
     inverse = inverse.ravel()
@@ -147,46 +133,56 @@ def global_coherence(
     return lam / lam[1:].min()
 
 
-def _past_blur(
+def _side_reads(
     regions: np.ndarray,
     intensity: np.ndarray,
     pa: np.ndarray,
     pb: np.ndarray,
-    blurred: np.ndarray,
-    reach: int,
+    blurred: np.ndarray | None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Flat indices at which to read the two sides of the boundary edges ``(pa, pb)``: up to
-    *reach* pixels straight inside each region across a *blurred* edge, both sides together,
-    for as long as the next pair of pixels looks like the lens' blur and not like shading.
+    """Eq. 3.8's intensity on each side of the boundary edges ``(pa, pb)`` (flat indices).
 
-    A symmetric point spread moves light from the bright side of a step to the dark side, so
-    one step further inside, the *linear* intensity moves away from the other side by about
-    the same amount on both sides; a shading gradient scales both sides alike, so their
-    linear changes differ by the step's contrast (at least 3.7 at a sharp, high-contrast
-    edge). A pair is taken as blur when both changes lead away from the other side and the
-    smaller is at least half the larger (half: the geometric middle of 1 and 1/3.7). Both
-    reads stay in their own region and the image.
+    The boundary pixels' own intensities, except across a *blurred* edge where both sides
+    have two more pixels of their own region straight behind the boundary pixel: there each
+    side is extrapolated linearly in log intensity from those two pixels, ``2 log I_1 -
+    log I_2``, back to the boundary pixel's position. Those pixels lie outside the 1-2 px over
+    which a sharp step is mixed (the blur width of
+    :mod:`spectrinsic.decompose.methods.sharp_edges`), and the extrapolation cancels a
+    shading gradient to first order (exactly for a light falling by a constant factor per
+    pixel), so Eq. 3.8's premise, the same shading at the boundary on both sides, is kept.
     """
+    read_a, read_b = intensity[pa], intensity[pb]
+    if blurred is None:
+        return read_a, read_b
+    first_a, second_a, behind_a = _two_behind(regions, pa, pa - pb)
+    first_b, second_b, behind_b = _two_behind(regions, pb, pb - pa)
+    positive = intensity > 0.0  # a log needs light on both pixels behind each side
+    use = blurred & behind_a & behind_b & positive[first_a] & positive[second_a]
+    use &= positive[first_b] & positive[second_b]
+    log_i = np.log(np.where(positive, intensity, 1.0))
+    extrapolated_a = np.exp(2.0 * log_i[first_a] - log_i[second_a])
+    extrapolated_b = np.exp(2.0 * log_i[first_b] - log_i[second_b])
+    return np.where(use, extrapolated_a, read_a), np.where(use, extrapolated_b, read_b)
+
+
+def _two_behind(
+    regions: np.ndarray, start: np.ndarray, away: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Flat indices of the pixels one and two steps of *away* (``+-1`` or ``+-W``) from each
+    *start* pixel, and whether both lie in the image and in the start pixel's own region."""
     h, w = regions.shape
     flat_regions = regions.ravel()
-    step = pb - pa
-    horizontal = np.abs(step) == 1
-    sign = np.sign(intensity[pa] - intensity[pb])  # +1 where a is the bright side
-    here_a, here_b = pa.copy(), pb.copy()
-    going = blurred.copy()
-    for _ in range(reach):
-        next_a, next_b = here_a - step, here_b + step
-        for here, there, own in ((here_a, next_a, pa), (here_b, next_b, pb)):
-            in_image = np.where(horizontal, there // w == here // w, (there >= 0) & (there < h * w))
-            going &= in_image & (flat_regions[np.clip(there, 0, h * w - 1)] == flat_regions[own])
-        next_a, next_b = np.clip(next_a, 0, h * w - 1), np.clip(next_b, 0, h * w - 1)
-        away_a = sign * (intensity[next_a] - intensity[here_a])
-        away_b = -sign * (intensity[next_b] - intensity[here_b])
-        going &= (away_a > 0) & (away_b > 0)
-        going &= 2.0 * np.minimum(away_a, away_b) >= np.maximum(away_a, away_b)
-        here_a = np.where(going, next_a, here_a)
-        here_b = np.where(going, next_b, here_b)
-    return here_a, here_b
+    inside = np.ones(start.shape, bool)
+    behind = []
+    for k in (1, 2):
+        there = start + k * away
+        in_image = np.where(
+            np.abs(away) == 1, there // w == start // w, (there >= 0) & (there < h * w)
+        )
+        there = np.clip(there, 0, h * w - 1)
+        inside &= in_image & (flat_regions[there] == flat_regions[start])
+        behind.append(there)
+    return behind[0], behind[1], inside
 
 
 def bounded_minimum(a) -> np.ndarray:

@@ -90,11 +90,34 @@ def test_coherence_reads_a_blurred_step_past_its_mixed_pixels():
 
 
 def test_a_shading_gradient_at_a_sharp_step_is_not_taken_for_blur():
-    # the same step, unblurred, under a light falling 10 % per pixel: stepping inside would
-    # add the gradient to the ratio; the boundary pixels (one pixel of gradient) are read
+    # the same step, unblurred, under a light falling 10 % per pixel: reading inside would
+    # add the gradient to the ratio; the extrapolated reads give the boundary pixels' values
     x = np.arange(16)
     row = np.where(x < 8, 0.8, 0.05) * 0.9**x
     assert _two_regions(row, 8, blurred=True) == pytest.approx(
         _two_regions(row, 8, blurred=False), rel=1e-9
     )
     assert _two_regions(row, 8, blurred=False) == pytest.approx(16 / 0.9, rel=1e-6)
+
+
+def test_a_blurred_step_under_a_shading_gradient_reads_as_the_unblurred_boundary():
+    # the blurred print of the first test under the falling light of the second (teabag1 at
+    # half size: mixed pixels and a gradient together); the extrapolation from the two pixels
+    # behind each boundary pixel gives what Eq. 3.8 reads on the unblurred image, 16 / 0.9
+    # (round 6's reads past the blur went 2 px inside and read 21.9, the gradient over 4 px)
+    x = np.arange(16)
+    row = _lens(np.where(x < 8, 0.8, 0.05) * 0.9**x)
+    assert _two_regions(row, 8, blurred=False) == pytest.approx(4.44, abs=0.01)  # mixed
+    assert _two_regions(row, 8, blurred=True) == pytest.approx(16 / 0.9, rel=1e-6)
+
+
+def test_a_side_without_two_pixels_behind_it_is_read_on_its_boundary():
+    # a one-pixel-wide middle region cannot be extrapolated: both its edges read the
+    # boundary pixels, so the marks change nothing on an unblurred image
+    image = np.array([[0.8, 0.8, 0.8, 0.05, 0.8, 0.8, 0.8]] * 3)
+    regions = np.array([[1, 1, 1, 2, 3, 3, 3]] * 3)
+    means = np.array([0.0, 0.8, 0.05, 0.8])
+    marks = np.ones(grid_edges(regions > 0)[1].shape[0], bool)
+    lam = global_coherence(regions, means, image, marks)
+    assert lam[1] * means[1] / (lam[2] * means[2]) == pytest.approx(16.0, rel=1e-9)
+    assert lam[3] == pytest.approx(lam[1], rel=1e-9)
