@@ -1,9 +1,13 @@
 """Where names-and-shades loses on one MIT object: the figure and numbers of issue 48, round 6.
 
-Usage: python -P scripts/teabag1_diagnosis.py MIT_DIR OUT.png [OBJECT] [--before]
+Usage: python -P scripts/teabag1_diagnosis.py MIT_DIR OUT.png [OBJECT] [--before] [--no-reads]
+       [--variant=NAME]
 
-One row per setting (the defaults, and, with ``--before``, the method before round 6,
-``NamesAndShades(blurred_steps=False, fine_detail=False)``): the photograph, the true reflectance and shading, the estimates, and two error
+One row per setting (the defaults; with ``--before``, the method before round 6,
+``NamesAndShades(blurred_steps=False, fine_detail=False)``; with ``--no-reads``, the defaults
+without sec. 3.4's reads across sharp steps, ``blurred_steps=False``, rounds 6 and 9), on the
+object under a stress variant of :mod:`spectrinsic.decompose.evaluation.mit_variants`
+(``--variant``, default ``original``): the photograph, the true reflectance and shading, the estimates, and two error
 maps, ``log(R_est / R_true)`` per pixel (after one global scale, the median; red: too light,
 blue: too dark) and the local shading error (each 20-pixel window's squared error after its
 own least-squares scale, the MIT LMSE's term, spread over the window). Prints each row's MIT
@@ -24,6 +28,7 @@ import numpy as np
 
 from spectrinsic.decompose.decomposition import finish
 from spectrinsic.decompose.evaluation.mit import MitObject, load_mit_object, mit_measures
+from spectrinsic.decompose.evaluation.mit_variants import VARIANTS, apply_variant
 from spectrinsic.decompose.methods.baselines import ImageAsReflectance
 from spectrinsic.decompose.methods.names_shades import NamesAndShades
 
@@ -83,18 +88,20 @@ def _breakdown(obj: MitObject, refl: np.ndarray, regions: np.ndarray) -> list[st
     return lines
 
 
-def main(folder: Path, out: Path, name: str, before: bool) -> None:
+def main(folder: Path, out: Path, name: str, rows: tuple[str, ...], variant: str) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    obj = load_mit_object(folder / f"{name}.npz")
+    obj = apply_variant(variant, load_mit_object(folder / f"{name}.npz"))
     m = obj.mask
     iar = mit_measures(obj, ImageAsReflectance()(obj.image, m))["lmse"]
-    print(f"{name}: image-as-reflectance LMSE {iar:.4f}")
+    print(f"{name} ({variant}): image-as-reflectance LMSE {iar:.4f}")
     settings = {"defaults": NamesAndShades()}
-    if before:
+    if "--no-reads" in rows:
+        settings["no reads across steps"] = NamesAndShades(blurred_steps=False)
+    if "--before" in rows:
         settings["before round 6"] = NamesAndShades(blurred_steps=False, fine_detail=False)
     ys, xs = np.nonzero(m)
     crop = (slice(ys.min(), ys.max() + 1), slice(xs.min(), xs.max() + 1))
@@ -144,8 +151,10 @@ def main(folder: Path, out: Path, name: str, before: bool) -> None:
 
 if __name__ == "__main__":
     warnings.filterwarnings("ignore", category=FutureWarning)  # gco's numpy aliases
-    args = [a for a in sys.argv[1:] if a != "--before"]
-    if len(args) not in (2, 3):
+    flags = tuple(a for a in sys.argv[1:] if a in ("--before", "--no-reads"))
+    chosen = [a.split("=", 1)[1] for a in sys.argv[1:] if a.startswith("--variant=")]
+    args = [a for a in sys.argv[1:] if a not in flags and not a.startswith("--variant=")]
+    if len(args) not in (2, 3) or len(chosen) > 1 or (chosen and chosen[0] not in VARIANTS):
         sys.exit(__doc__)
     name = args[2] if len(args) == 3 else "teabag1"
-    main(Path(args[0]), Path(args[1]), name, "--before" in sys.argv[1:])
+    main(Path(args[0]), Path(args[1]), name, flags, chosen[0] if chosen else "original")
