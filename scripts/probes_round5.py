@@ -238,8 +238,18 @@ def xml_cases() -> list[Case]:
                     '<shape type="sphere"><float name="radius" value="-1"/><bsdf type="diffuse"/></shape>'
                 )
             },
-            expect="s.xml",
-            either=True,
+            expect="sphere radius -1; expected > 0",
+        ),
+        Case(
+            "xml/sphere-light-negative-radius",
+            render("s.xml"),
+            {
+                "s.xml": xml(
+                    RECT + '<shape type="sphere"><float name="radius" value="-0.2"/>'
+                    '<emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>'
+                )
+            },
+            expect="sphere radius -0.2; expected > 0",
         ),
         Case(
             "xml/reflectance-nan",
@@ -717,10 +727,26 @@ def xml_cases() -> list[Case]:
             "xml/obj-nan-vertex",
             render("s.xml"),
             {
-                "s.xml": xml('<shape type="obj"><string name="filename" value="m.obj"/></shape>'),
-                "m.obj": "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+                "s.xml": xml(
+                    '<shape type="obj"><string name="filename" value="sub/m.obj"/></shape>'
+                ),
+                "sub/m.obj": "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
             },
-            expect="NaN",
+            expect="mesh file 'sub/m.obj': 1 vertices are NaN",
+        ),
+        Case(
+            "xml/obj-nan-vertex-textured",
+            render("s.xml"),
+            {
+                "s.xml": xml(
+                    '<shape type="obj"><string name="filename" value="sub/m.obj"/>'
+                    '<bsdf type="diffuse"><texture type="bitmap" name="reflectance">'
+                    '<string name="filename" value="t.png"/></texture></bsdf></shape>'
+                ),
+                "sub/m.obj": "v nan 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n",
+                "t.png": png_bytes(2, 2),
+            },
+            expect="mesh file 'sub/m.obj'",
         ),
         Case(
             "xml/obj-index-out-of-range",
@@ -1400,7 +1426,12 @@ def list_cases() -> list[Case]:
             either=True,
             expect="quad",
         ),
-        Case("scenes/directory", (*ds, "d", *tail), {"d/x.txt": "x"}, expect="d"),
+        Case(
+            "scenes/directory",
+            (*ds, "d", *tail),
+            {"d/x.txt": "x"},
+            expect="--scenes 'd' is a folder; expected scene files",
+        ),
         Case(
             "scenes/list-file-itself",
             (*ds, "list.txt", *tail),

@@ -43,7 +43,7 @@ from ..scenes.model import Scene
 from ..scenes.sample_id import SampleId
 from ..scenes.scene_writer import save_scene
 from ..scenes.semantic import SemanticRules, rules_from_record
-from ..scenes.sources import FileSource, GeneratedSource, scene_file_kind
+from ..scenes.sources import FileSource, GeneratedSource, file_type, scene_file_kind
 from ..scenes.yaml_limits import load_yaml_file
 from ..spectra import list_spectra
 from .presets import DatasetConfig
@@ -195,6 +195,11 @@ def files_source(
     entries = []
     for p in paths:
         path = Path(p).resolve()
+        if path.exists() and not path.is_file():  # a folder: name what the option takes
+            raise DatasetError(
+                f"--scenes {str(p)!r} is {file_type(path)}; expected scene files (.yaml, .xml, "
+                f".blend, .obj/.ply/.glb...), e.g. {os.path.join(str(p), '*.yaml')}"
+            )
         if not path.is_file():
             raise DatasetError(f"--scenes {str(p)!r}: no such file")
         scene_file_kind(path)

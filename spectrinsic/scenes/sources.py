@@ -30,6 +30,7 @@ __all__ = [
     "GeneratedSource",
     "FileSource",
     "scene_file_kind",
+    "file_type",
     "takes_asset_colours",
     "takes_material_map",
     "is_scene_file",
@@ -93,7 +94,7 @@ def _compressed_blend(head: bytes, path: Path) -> bool:
     return False
 
 
-def _file_type(path: Path) -> str:
+def file_type(path: Path) -> str:
     """What *path* is, in words, for a refusal (``stat`` follows links, as ``open`` would)."""
     mode = path.stat().st_mode
     for test, what in (
@@ -117,7 +118,7 @@ def scene_file_kind(path: str | Path) -> str:
     p = Path(path)
     if p.exists() and not p.is_file():
         raise SceneError(
-            f"scene file {str(p)!r} is {_file_type(p)}, not a regular file; expected a scene file"
+            f"scene file {str(p)!r} is {file_type(p)}, not a regular file; expected a scene file"
         )
     suffix = p.suffix.lower()
     if suffix in (".yaml", ".yml"):
