@@ -14,6 +14,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import DataDirectoryError
+from .path_kinds import folder_problem
 
 __all__ = ["DATA_ENV", "DATA_SUBDIRS", "resolve_data_dir", "require_data_file", "one_data_dir"]
 
@@ -49,8 +50,8 @@ def resolve_data_dir(data_dir: str | os.PathLike[str] | None = None) -> Path | N
             return None
         data_dir, source = env, DATA_ENV
     path = Path(data_dir).expanduser()
-    if not path.is_dir():
-        raise DataDirectoryError(f"data directory {str(path)!r} (from {source}) does not exist")
+    if (problem := folder_problem(path)) is not None:
+        raise DataDirectoryError(f"data directory {str(path)!r} (from {source}) {problem}")
     return path.resolve()
 
 

@@ -26,6 +26,7 @@ from typing import Any
 
 from ..errors import DatasetError, SceneError, SpectrinsicError, validate_choice
 from ..gt_export.sample import file_sha256
+from ..path_kinds import file_type
 from ..render.algebra.light_transport import diagonal_mode_names
 from ..render.band_path.traversal import resolve_integrator
 from ..scenes.generators import (
@@ -43,7 +44,7 @@ from ..scenes.model import Scene
 from ..scenes.sample_id import SampleId
 from ..scenes.scene_writer import save_scene
 from ..scenes.semantic import SemanticRules, rules_from_record
-from ..scenes.sources import FileSource, GeneratedSource, file_type, scene_file_kind
+from ..scenes.sources import FileSource, GeneratedSource, scene_file_kind
 from ..scenes.yaml_limits import load_yaml_file
 from ..spectra import list_spectra
 from .presets import DatasetConfig

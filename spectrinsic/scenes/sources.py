@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import dataclasses
 import gzip
-import stat
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import SceneError
+from ..path_kinds import file_type
 from .blender import load_blend
 from .generators import GeneratorOptions, generate
 from .generators.view_rule import FrameProbe
@@ -30,7 +30,6 @@ __all__ = [
     "GeneratedSource",
     "FileSource",
     "scene_file_kind",
-    "file_type",
     "takes_asset_colours",
     "takes_material_map",
     "is_scene_file",
@@ -92,21 +91,6 @@ def _compressed_blend(head: bytes, path: Path) -> bool:
         except (OSError, zstandard.ZstdError):
             return False
     return False
-
-
-def file_type(path: Path) -> str:
-    """What *path* is, in words, for a refusal (``stat`` follows links, as ``open`` would)."""
-    mode = path.stat().st_mode
-    for test, what in (
-        (stat.S_ISDIR, "a folder"),
-        (stat.S_ISFIFO, "a FIFO (named pipe)"),
-        (stat.S_ISSOCK, "a socket"),
-        (stat.S_ISCHR, "a character device"),
-        (stat.S_ISBLK, "a block device"),
-    ):
-        if test(mode):
-            return what
-    return "a special file"
 
 
 def scene_file_kind(path: str | Path) -> str:

@@ -1,0 +1,68 @@
+"""A new researcher's first mistakes (task r5-probe2): a mistyped verb, option or choice gets
+the closest name; a folder argument given a file, or a folder that holds no dataset, is told
+what it is. Each is one line on stderr, status 2."""
+
+from __future__ import annotations
+
+import pytest
+
+from spectrinsic.cli import main
+
+
+def _one_line(capsys, argv: list[str]) -> str:
+    try:
+        status = main(argv)
+    except SystemExit as exc:  # argparse's own refusals exit from the parser
+        status = exc.code
+    assert status == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("spectrinsic: error: ")
+    return err
+
+
+@pytest.mark.parametrize(
+    "argv, hint",
+    [
+        (["rendr", "x.yaml"], "(did you mean 'render'?)"),
+        (["study", "photometrc"], "(did you mean 'photometric'?)"),
+        (["dataset", "--preset", "previw"], "(did you mean 'preview'?)"),
+        (
+            ["dataset", "--sceens", "a.yaml"],
+            "dataset: unrecognized arguments: --sceens a.yaml "
+            "(did you mean '--scenes'?) (see spectrinsic dataset --help)",
+        ),  # fmt: skip
+        (["render", "a.yaml", "--out", "o", "--ground-truht"], "(did you mean '--ground-truth'?)"),
+    ],
+)
+def test_a_mistyped_name_gets_the_closest_one(capsys, argv, hint):
+    assert hint in _one_line(capsys, argv)
+
+
+def test_an_unlike_name_gets_no_guess(capsys):
+    err = _one_line(capsys, ["info", "--bogus"])
+    assert "info: unrecognized arguments: --bogus" in err and "did you mean" not in err
+
+
+@pytest.mark.parametrize(
+    "argv, said",
+    [
+        (["check", "{f}"], "check '{f}' is a file, not a folder; expected a dataset folder"),
+        (["--data-dir", "{f}", "info"], "data directory '{f}' (from --data-dir) is a file, not"),
+        (["evaluate", "--dataset", "{f}", "--out", "{d}/ev"], "--dataset '{f}' is a file, not"),
+        (["check", "{d}/gone"], "check '{d}/gone' does not exist; expected a dataset folder"),
+    ],
+)
+def test_a_file_where_a_folder_is_expected_is_called_a_file(tmp_path, capsys, argv, said):
+    f = tmp_path / "notes.txt"
+    f.write_text("x")
+    argv = [a.format(f=f, d=tmp_path) for a in argv]
+    assert said.format(f=f, d=tmp_path) in _one_line(capsys, argv)
+    assert not (tmp_path / "ev").exists()
+
+
+@pytest.mark.torch
+def test_train_on_a_folder_without_a_manifest_says_so(tmp_path, capsys):
+    """It said "manifest.json has no splits; rebuild the dataset"."""
+    pytest.importorskip("torch", reason="train needs the torch extra (make test-torch)")
+    err = _one_line(capsys, ["train", str(tmp_path), "--out", str(tmp_path / "tr")])
+    assert "no manifest.json; expected a built dataset folder" in err
