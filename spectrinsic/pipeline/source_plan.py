@@ -195,6 +195,8 @@ def files_source(
     ``--semantic-map`` rules, before the default map's."""
     entries = []
     for p in paths:
+        if not str(p):  # Path("") is the working folder
+            raise DatasetError("--scenes '': an empty path; expected scene files")
         path = Path(p).resolve()
         if path.exists() and not path.is_file():  # a folder: name what the option takes
             raise DatasetError(

@@ -130,9 +130,15 @@ def is_scene_file(argument: str | Path) -> bool:
     """Whether a scene argument names a file (a scene-file suffix, or an existing path) rather
     than a library scene.
 
+    An empty argument names nothing (``Path("")`` is the working folder, which exists).
+
     >>> is_scene_file("chair.OBJ"), is_scene_file("room.yaml"), is_scene_file("room-living")
     (True, True, False)
+    >>> is_scene_file("")
+    False
     """
+    if not str(argument):
+        return False
     p = Path(argument)
     return p.suffix.lower() in (".yaml", ".yml", ".xml", ".blend", *MESH_SUFFIXES) or p.exists()
 

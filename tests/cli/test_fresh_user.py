@@ -66,3 +66,30 @@ def test_train_on_a_folder_without_a_manifest_says_so(tmp_path, capsys):
     pytest.importorskip("torch", reason="train needs the torch extra (make test-torch)")
     err = _one_line(capsys, ["train", str(tmp_path), "--out", str(tmp_path / "tr")])
     assert "no manifest.json; expected a built dataset folder" in err
+
+
+@pytest.mark.parametrize(
+    "argv, said",
+    [
+        (["bogus", "--ground-truth"], "unknown library scene 'bogus'; expected one of"),
+        (["room-corner", "--view", "7", "--ground-truth"], "view 7 of library scene"),
+        (["room-corner", "--condition", "blue", "--ground-truth"], "illumination condition 'blue'"),
+        (["", "--ground-truth"], "unknown library scene ''"),  # not "'.' is a folder"
+    ],
+)
+def test_a_library_sample_that_does_not_exist_is_named_as_such(tmp_path, capsys, argv, said):
+    """Under --ground-truth it said "--only 'bogus__v0__white' matches no sample", an option
+    the user never gave."""
+    out = tmp_path / "o"
+    err = _one_line(capsys, ["render", *argv, "--out", str(out), "--preset", "preview", "-q"])
+    assert said in err and "--only" not in err and not out.exists()
+
+
+def test_an_empty_scenes_entry_is_not_the_working_folder(tmp_path, capsys):
+    err = _one_line(capsys, ["dataset", "--scenes", "", "--out", str(tmp_path / "o"), "-q"])
+    assert "--scenes '': an empty path; expected scene files" in err
+
+
+def test_an_empty_scene_is_no_scene_file(tmp_path, capsys):
+    err = _one_line(capsys, ["render", "", "--out", str(tmp_path / "o"), "-q"])
+    assert "unknown library scene ''" in err and "is a folder" not in err
