@@ -1647,6 +1647,138 @@ def option_cases() -> list[Case]:
     ]
 
 
+def user_cases() -> list[Case]:
+    """A new researcher's first day (task r5-probe2): mistyped verbs, options and choices, a
+    file where a folder is expected, an --out that is a file, a scenes folder or a dataset."""
+    q = {"quad.yaml": QUAD_YAML}
+    f = {"f.txt": "notes\n"}
+    ds = {"ds/.spectrinsic-dataset": json.dumps({"spectrinsic_dataset": 1})}
+    r = ("render", "quad.yaml")
+    gt = ("--ground-truth", "--out", "out", "--preset", "preview", "-q")
+    ts = ("dataset", "--out", "out", "--preset", "preview", "-q")
+    return [
+        Case("user/no-verb", (), expect="COMMAND"),
+        Case("user/mistyped-verb", ("rendr", "quad.yaml"), q, expect="did you mean 'render'"),
+        Case(
+            "user/mistyped-option",
+            (*render("quad.yaml"), "--resolutoin", "16x16"),
+            q,
+            expect="did you mean '--resolution'",
+        ),
+        Case(
+            "user/mistyped-flag",
+            (*render("quad.yaml"), "--ground-truht"),
+            q,
+            expect="did you mean '--ground-truth'",
+        ),
+        Case("user/mistyped-preset", (*ts, "--preset", "previw"), expect="'preview'"),
+        Case("user/mistyped-study", ("study", "photometrc"), expect="'photometric'"),
+        Case("user/mistyped-list", ("list", "scnes"), expect="did you mean 'scenes'"),
+        Case("user/mistyped-mode", (*render("quad.yaml"), "--modes", "rgb4"), q, expect="rgb4"),
+        Case("user/out-is-a-file", (*r, "--out", "f.txt", *TINY), q | f, expect="is a file"),
+        Case(
+            "user/out-below-a-file",
+            (*r, "--out", "f.txt/o", *TINY),
+            q | f,
+            expect="lies below the file",
+        ),
+        Case(
+            "user/out-is-the-scenes-folder",
+            ("render", "sc/quad.yaml", "--out", "sc", *TINY),
+            {"sc/quad.yaml": QUAD_YAML},
+            expect="is not empty",
+        ),
+        Case(
+            "user/out-not-writable",
+            (*r, "--out", "/proc/spectrinsic-probe", *TINY),
+            q,
+            expect="not writable",
+        ),
+        Case(
+            "user/out-is-a-dataset",
+            (*r, "--out", "ds", *TINY),
+            q | ds,
+            expect="'ds' is a spectrinsic dataset, not",
+        ),
+        Case(
+            "user/scene-is-a-folder",
+            ("render", "sc", "--out", "out", *TINY),
+            {"sc/quad.yaml": QUAD_YAML},
+            expect="is a folder",
+        ),  # fmt: skip
+        Case("user/scene-empty", ("render", "", "--out", "out", *TINY), expect="scene ''"),
+        Case("user/scenes-entry-empty", (*ts, "--scenes", ""), expect="an empty path"),
+        Case("user/scenes-no-files", (*ts, "--scenes"), expect="--scenes"),
+        Case(
+            "user/library-typo-ground-truth",
+            ("render", "room-cornr", *gt),
+            expect="did you mean 'room-corner'",
+        ),
+        Case(
+            "user/library-view-ground-truth",
+            ("render", "room-corner", "--view", "7", *gt),
+            expect="view 7",
+        ),  # fmt: skip
+        Case(
+            "user/resolution-one-number",
+            (*r, "--out", "out", "--resolution", "16"),
+            q,
+            expect="--resolution",
+        ),  # fmt: skip
+        Case(
+            "user/resolution-and-width",
+            (*render("quad.yaml"), "--width", "32"),
+            q,
+            expect="give one",
+        ),  # fmt: skip
+        Case("user/spp-fraction", (*r, "--out", "out", "--spp", "1.5"), q, expect="--spp"),
+        Case("user/seed-negative", (*render("quad.yaml"), "--seed", "-1"), q, expect="--seed"),
+        Case("user/workers-zero", (*ts, "--workers", "0"), expect="--workers"),
+        Case(
+            "user/split-two-shares",
+            (*ts, "--split-fractions", "0.5,0.5"),
+            expect="--split-fractions",
+        ),  # fmt: skip
+        Case("user/check-a-file", ("check", "f.txt"), f, expect="is a file, not a folder"),
+        Case("user/check-missing", ("check", "gone"), expect="'gone' does not exist"),
+        Case(
+            "user/data-dir-a-file",
+            ("--data-dir", "f.txt", "info"),
+            f,
+            expect="is a file, not a folder",
+        ),  # fmt: skip
+        Case(
+            "user/evaluate-dataset-a-file",
+            ("evaluate", "--dataset", "f.txt", "--out", "out"),
+            f,
+            expect="is a file, not a folder",
+        ),  # fmt: skip
+        Case(
+            "user/evaluate-dataset-missing",
+            ("evaluate", "--dataset", "gone", "--out", "out"),
+            expect="does not exist",
+        ),  # fmt: skip
+        Case(
+            "user/export-not-a-dataset",
+            ("export", "d", "--out", "out"),
+            {"d/x.txt": "x"},
+            expect="no manifest.json",
+        ),  # fmt: skip
+        Case(
+            "user/train-not-a-dataset",
+            ("train", "d", "--out", "out"),
+            {"d/x.txt": "x"},
+            expect="no manifest.json",
+        ),  # fmt: skip
+        Case(
+            "user/relight-no-light",
+            ("relight", "d", "--out", "out"),
+            {"d/x.txt": "x"},
+            expect="--light",
+        ),  # fmt: skip
+    ]
+
+
 def all_cases() -> list[Case]:
     return [
         *xml_cases(),
@@ -1656,6 +1788,7 @@ def all_cases() -> list[Case]:
         *relight_cases(),
         *list_cases(),
         *option_cases(),
+        *user_cases(),
     ]
 
 

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import difflib
 import importlib
 import logging
 import re
@@ -19,7 +18,7 @@ from collections.abc import Iterator, Sequence
 from typing import Any, NoReturn, TextIO
 
 from ..data_dir import one_data_dir
-from ..errors import SpectrinsicError
+from ..errors import SpectrinsicError, did_you_mean
 from ..interrupts import exit_status, interrupts_reach_python
 from ..provenance import software_versions
 
@@ -59,17 +58,11 @@ class _Parser(argparse.ArgumentParser):
         )
 
 
-def _close(word: str, known: Sequence[str]) -> str:
-    """`` (did you mean 'x'?)`` for the known names closest to a mistyped *word*, else ``""``."""
-    near = difflib.get_close_matches(word, known, n=2, cutoff=0.75)
-    return f" (did you mean {' or '.join(repr(n) for n in near)}?)" if near else ""
-
-
 def _choice_hint(message: str) -> str:
     """A suggestion for argparse's ``invalid choice: 'rendr' (choose from 'info', ...)``: a
     mistyped verb, study or preset (Python 3.11's argparse suggests nothing)."""
     found = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)
-    return _close(found[1], re.findall(r"'([^']*)'", found[2])) if found else ""
+    return did_you_mean(found[1], re.findall(r"'([^']*)'", found[2])) if found else ""
 
 
 def _unrecognized(parser: _Parser, verb: str | None, extras: list[str]) -> NoReturn:
@@ -77,7 +70,9 @@ def _unrecognized(parser: _Parser, verb: str | None, extras: list[str]) -> NoRet
     its ``--help``) and with the verb's closest option for each mistyped one."""
     by = parser.verbs.get(verb or "", parser)
     options = sorted(set(re.findall(r"--[a-z][\w-]*", by.format_usage())))
-    hints = "".join(_close(e.split("=", 1)[0], options) for e in extras if e.startswith("--"))
+    hints = "".join(
+        did_you_mean(e.split("=", 1)[0], options, n=2) for e in extras if e.startswith("--")
+    )
     by.error(f"unrecognized arguments: {' '.join(extras)}{hints}")
 
 
