@@ -1705,7 +1705,7 @@ def user_cases() -> list[Case]:
             ("render", "sc", "--out", "out", *TINY),
             {"sc/quad.yaml": QUAD_YAML},
             expect="is a folder",
-        ),  # fmt: skip
+        ),
         Case("user/scene-empty", ("render", "", "--out", "out", *TINY), expect="scene ''"),
         Case("user/scenes-entry-empty", (*ts, "--scenes", ""), expect="an empty path"),
         Case("user/scenes-no-files", (*ts, "--scenes"), expect="--scenes"),
@@ -1718,19 +1718,19 @@ def user_cases() -> list[Case]:
             "user/library-view-ground-truth",
             ("render", "room-corner", "--view", "7", *gt),
             expect="view 7",
-        ),  # fmt: skip
+        ),
         Case(
             "user/resolution-one-number",
             (*r, "--out", "out", "--resolution", "16"),
             q,
             expect="--resolution",
-        ),  # fmt: skip
+        ),
         Case(
             "user/resolution-and-width",
             (*render("quad.yaml"), "--width", "32"),
             q,
             expect="give one",
-        ),  # fmt: skip
+        ),
         Case("user/spp-fraction", (*r, "--out", "out", "--spp", "1.5"), q, expect="--spp"),
         Case("user/seed-negative", (*render("quad.yaml"), "--seed", "-1"), q, expect="--seed"),
         Case("user/workers-zero", (*ts, "--workers", "0"), expect="--workers"),
@@ -1738,7 +1738,7 @@ def user_cases() -> list[Case]:
             "user/split-two-shares",
             (*ts, "--split-fractions", "0.5,0.5"),
             expect="--split-fractions",
-        ),  # fmt: skip
+        ),
         Case("user/check-a-file", ("check", "f.txt"), f, expect="is a file, not a folder"),
         Case("user/check-missing", ("check", "gone"), expect="'gone' does not exist"),
         Case(
@@ -1746,36 +1746,55 @@ def user_cases() -> list[Case]:
             ("--data-dir", "f.txt", "info"),
             f,
             expect="is a file, not a folder",
-        ),  # fmt: skip
+        ),
         Case(
             "user/evaluate-dataset-a-file",
             ("evaluate", "--dataset", "f.txt", "--out", "out"),
             f,
             expect="is a file, not a folder",
-        ),  # fmt: skip
+        ),
         Case(
             "user/evaluate-dataset-missing",
             ("evaluate", "--dataset", "gone", "--out", "out"),
             expect="does not exist",
-        ),  # fmt: skip
+        ),
         Case(
             "user/export-not-a-dataset",
             ("export", "d", "--out", "out"),
             {"d/x.txt": "x"},
             expect="no manifest.json",
-        ),  # fmt: skip
+        ),
         Case(
             "user/train-not-a-dataset",
             ("train", "d", "--out", "out"),
             {"d/x.txt": "x"},
             expect="no manifest.json",
-        ),  # fmt: skip
+        ),
         Case(
             "user/relight-no-light",
             ("relight", "d", "--out", "out"),
             {"d/x.txt": "x"},
             expect="--light",
-        ),  # fmt: skip
+        ),
+        Case(
+            "user/modes-twice",
+            (*r, "--out", "out", "--modes", "rgb3,rgb3"),
+            q,
+            expect="rgb3 given twice",
+        ),
+        Case(
+            "user/modes-capitals",
+            (*r, "--out", "out", "--modes", "RGB3"),
+            q,
+            expect="did you mean 'rgb3'",
+        ),
+        Case("user/data-dir-empty", ("--data-dir", "", "info"), expect="an empty path"),
+        Case(
+            "user/mit-a-file",
+            ("evaluate", "--mit", "f.txt", "--out", "out"),
+            f,
+            expect="'f.txt' is a file, not a folder",
+        ),
     ]
 
 

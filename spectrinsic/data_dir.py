@@ -49,6 +49,8 @@ def resolve_data_dir(data_dir: str | os.PathLike[str] | None = None) -> Path | N
         if not env:
             return None
         data_dir, source = env, DATA_ENV
+    if not str(data_dir).strip():  # Path("") is the working folder
+        raise DataDirectoryError(f"data directory {str(data_dir)!r} (from {source}): an empty path")
     path = Path(data_dir).expanduser()
     if (problem := folder_problem(path)) is not None:
         raise DataDirectoryError(f"data directory {str(path)!r} (from {source}) {problem}")

@@ -92,3 +92,23 @@ def test_an_empty_scenes_entry_is_not_the_working_folder(tmp_path, capsys):
 def test_an_empty_scene_is_no_scene_file(tmp_path, capsys):
     err = _one_line(capsys, ["render", "", "--out", str(tmp_path / "o"), "-q"])
     assert "unknown library scene ''" in err and "is a folder" not in err
+
+
+@pytest.mark.parametrize(
+    "argv, said",
+    [
+        (["--modes", "rgb3,rgb3"], "--modes 'rgb3,rgb3': rgb3 given twice"),
+        (["--modes", "RGB3"], "(did you mean 'rgb3'"),
+    ],
+)
+def test_modes_given_twice_or_in_capitals(tmp_path, capsys, argv, said):
+    (tmp_path / "s.yaml").write_text("name: s\n")  # refused before the scene is read
+    err = _one_line(
+        capsys, ["render", str(tmp_path / "s.yaml"), "--out", str(tmp_path / "o"), *argv]
+    )
+    assert said in err and not (tmp_path / "o").exists()
+
+
+def test_an_empty_data_dir_is_not_the_working_folder(capsys):
+    err = _one_line(capsys, ["--data-dir", "", "info"])
+    assert "data directory '' (from --data-dir): an empty path" in err
