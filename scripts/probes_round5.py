@@ -238,8 +238,18 @@ def xml_cases() -> list[Case]:
                     '<shape type="sphere"><float name="radius" value="-1"/><bsdf type="diffuse"/></shape>'
                 )
             },
-            expect="s.xml",
-            either=True,
+            expect="sphere radius -1; expected > 0",
+        ),
+        Case(
+            "xml/sphere-light-negative-radius",
+            render("s.xml"),
+            {
+                "s.xml": xml(
+                    RECT + '<shape type="sphere"><float name="radius" value="-0.2"/>'
+                    '<emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>'
+                )
+            },
+            expect="sphere radius -0.2; expected > 0",
         ),
         Case(
             "xml/reflectance-nan",
@@ -717,10 +727,26 @@ def xml_cases() -> list[Case]:
             "xml/obj-nan-vertex",
             render("s.xml"),
             {
-                "s.xml": xml('<shape type="obj"><string name="filename" value="m.obj"/></shape>'),
-                "m.obj": "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+                "s.xml": xml(
+                    '<shape type="obj"><string name="filename" value="sub/m.obj"/></shape>'
+                ),
+                "sub/m.obj": "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
             },
-            expect="NaN",
+            expect="mesh file 'sub/m.obj': 1 vertices are NaN",
+        ),
+        Case(
+            "xml/obj-nan-vertex-textured",
+            render("s.xml"),
+            {
+                "s.xml": xml(
+                    '<shape type="obj"><string name="filename" value="sub/m.obj"/>'
+                    '<bsdf type="diffuse"><texture type="bitmap" name="reflectance">'
+                    '<string name="filename" value="t.png"/></texture></bsdf></shape>'
+                ),
+                "sub/m.obj": "v nan 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n",
+                "t.png": png_bytes(2, 2),
+            },
+            expect="mesh file 'sub/m.obj'",
         ),
         Case(
             "xml/obj-index-out-of-range",
@@ -1400,7 +1426,12 @@ def list_cases() -> list[Case]:
             either=True,
             expect="quad",
         ),
-        Case("scenes/directory", (*ds, "d", *tail), {"d/x.txt": "x"}, expect="d"),
+        Case(
+            "scenes/directory",
+            (*ds, "d", *tail),
+            {"d/x.txt": "x"},
+            expect="--scenes 'd' is a folder; expected scene files",
+        ),
         Case(
             "scenes/list-file-itself",
             (*ds, "list.txt", *tail),
@@ -1616,6 +1647,157 @@ def option_cases() -> list[Case]:
     ]
 
 
+def user_cases() -> list[Case]:
+    """A new researcher's first day (task r5-probe2): mistyped verbs, options and choices, a
+    file where a folder is expected, an --out that is a file, a scenes folder or a dataset."""
+    q = {"quad.yaml": QUAD_YAML}
+    f = {"f.txt": "notes\n"}
+    ds = {"ds/.spectrinsic-dataset": json.dumps({"spectrinsic_dataset": 1})}
+    r = ("render", "quad.yaml")
+    gt = ("--ground-truth", "--out", "out", "--preset", "preview", "-q")
+    ts = ("dataset", "--out", "out", "--preset", "preview", "-q")
+    return [
+        Case("user/no-verb", (), expect="COMMAND"),
+        Case("user/mistyped-verb", ("rendr", "quad.yaml"), q, expect="did you mean 'render'"),
+        Case(
+            "user/mistyped-option",
+            (*render("quad.yaml"), "--resolutoin", "16x16"),
+            q,
+            expect="did you mean '--resolution'",
+        ),
+        Case(
+            "user/mistyped-flag",
+            (*render("quad.yaml"), "--ground-truht"),
+            q,
+            expect="did you mean '--ground-truth'",
+        ),
+        Case("user/mistyped-preset", (*ts, "--preset", "previw"), expect="'preview'"),
+        Case("user/mistyped-study", ("study", "photometrc"), expect="'photometric'"),
+        Case("user/mistyped-list", ("list", "scnes"), expect="did you mean 'scenes'"),
+        Case("user/mistyped-mode", (*render("quad.yaml"), "--modes", "rgb4"), q, expect="rgb4"),
+        Case("user/out-is-a-file", (*r, "--out", "f.txt", *TINY), q | f, expect="is a file"),
+        Case(
+            "user/out-below-a-file",
+            (*r, "--out", "f.txt/o", *TINY),
+            q | f,
+            expect="lies below the file",
+        ),
+        Case(
+            "user/out-is-the-scenes-folder",
+            ("render", "sc/quad.yaml", "--out", "sc", *TINY),
+            {"sc/quad.yaml": QUAD_YAML},
+            expect="is not empty",
+        ),
+        Case(
+            "user/out-not-writable",
+            (*r, "--out", "/proc/spectrinsic-probe", *TINY),
+            q,
+            expect="not writable",
+        ),
+        Case(
+            "user/out-is-a-dataset",
+            (*r, "--out", "ds", *TINY),
+            q | ds,
+            expect="'ds' is a spectrinsic dataset, not",
+        ),
+        Case(
+            "user/scene-is-a-folder",
+            ("render", "sc", "--out", "out", *TINY),
+            {"sc/quad.yaml": QUAD_YAML},
+            expect="is a folder",
+        ),
+        Case("user/scene-empty", ("render", "", "--out", "out", *TINY), expect="scene ''"),
+        Case("user/scenes-entry-empty", (*ts, "--scenes", ""), expect="an empty path"),
+        Case("user/scenes-no-files", (*ts, "--scenes"), expect="--scenes"),
+        Case(
+            "user/library-typo-ground-truth",
+            ("render", "room-cornr", *gt),
+            expect="did you mean 'room-corner'",
+        ),
+        Case(
+            "user/library-view-ground-truth",
+            ("render", "room-corner", "--view", "7", *gt),
+            expect="view 7",
+        ),
+        Case(
+            "user/resolution-one-number",
+            (*r, "--out", "out", "--resolution", "16"),
+            q,
+            expect="--resolution",
+        ),
+        Case(
+            "user/resolution-and-width",
+            (*render("quad.yaml"), "--width", "32"),
+            q,
+            expect="give one",
+        ),
+        Case("user/spp-fraction", (*r, "--out", "out", "--spp", "1.5"), q, expect="--spp"),
+        Case("user/seed-negative", (*render("quad.yaml"), "--seed", "-1"), q, expect="--seed"),
+        Case("user/workers-zero", (*ts, "--workers", "0"), expect="--workers"),
+        Case(
+            "user/split-two-shares",
+            (*ts, "--split-fractions", "0.5,0.5"),
+            expect="--split-fractions",
+        ),
+        Case("user/check-a-file", ("check", "f.txt"), f, expect="is a file, not a folder"),
+        Case("user/check-missing", ("check", "gone"), expect="'gone' does not exist"),
+        Case(
+            "user/data-dir-a-file",
+            ("--data-dir", "f.txt", "info"),
+            f,
+            expect="is a file, not a folder",
+        ),
+        Case(
+            "user/evaluate-dataset-a-file",
+            ("evaluate", "--dataset", "f.txt", "--out", "out"),
+            f,
+            expect="is a file, not a folder",
+        ),
+        Case(
+            "user/evaluate-dataset-missing",
+            ("evaluate", "--dataset", "gone", "--out", "out"),
+            expect="does not exist",
+        ),
+        Case(
+            "user/export-not-a-dataset",
+            ("export", "d", "--out", "out"),
+            {"d/x.txt": "x"},
+            expect="no manifest.json",
+        ),
+        Case(
+            "user/train-not-a-dataset",
+            ("train", "d", "--out", "out"),
+            {"d/x.txt": "x"},
+            expect="no manifest.json",
+        ),
+        Case(
+            "user/relight-no-light",
+            ("relight", "d", "--out", "out"),
+            {"d/x.txt": "x"},
+            expect="--light",
+        ),
+        Case(
+            "user/modes-twice",
+            (*r, "--out", "out", "--modes", "rgb3,rgb3"),
+            q,
+            expect="rgb3 given twice",
+        ),
+        Case(
+            "user/modes-capitals",
+            (*r, "--out", "out", "--modes", "RGB3"),
+            q,
+            expect="did you mean 'rgb3'",
+        ),
+        Case("user/data-dir-empty", ("--data-dir", "", "info"), expect="an empty path"),
+        Case(
+            "user/mit-a-file",
+            ("evaluate", "--mit", "f.txt", "--out", "out"),
+            f,
+            expect="'f.txt' is a file, not a folder",
+        ),
+    ]
+
+
 def all_cases() -> list[Case]:
     return [
         *xml_cases(),
@@ -1625,6 +1807,7 @@ def all_cases() -> list[Case]:
         *relight_cases(),
         *list_cases(),
         *option_cases(),
+        *user_cases(),
     ]
 
 

@@ -14,6 +14,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import DataDirectoryError
+from .path_kinds import folder_problem
 
 __all__ = ["DATA_ENV", "DATA_SUBDIRS", "resolve_data_dir", "require_data_file", "one_data_dir"]
 
@@ -48,9 +49,11 @@ def resolve_data_dir(data_dir: str | os.PathLike[str] | None = None) -> Path | N
         if not env:
             return None
         data_dir, source = env, DATA_ENV
+    if not str(data_dir).strip():  # Path("") is the working folder
+        raise DataDirectoryError(f"data directory {str(data_dir)!r} (from {source}): an empty path")
     path = Path(data_dir).expanduser()
-    if not path.is_dir():
-        raise DataDirectoryError(f"data directory {str(path)!r} (from {source}) does not exist")
+    if (problem := folder_problem(path)) is not None:
+        raise DataDirectoryError(f"data directory {str(path)!r} (from {source}) {problem}")
     return path.resolve()
 
 

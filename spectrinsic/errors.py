@@ -106,8 +106,12 @@ class SpectrinsicWarning(UserWarning):
 
 
 def did_you_mean(value: str, choices: Iterable[str], n: int = 3) -> str:
-    """Return ``" (did you mean 'a', 'b'?)"`` for close matches of *value*, or ``""``."""
-    close = difflib.get_close_matches(value, list(choices), n=n, cutoff=0.6)
+    """Return ``" (did you mean 'a', 'b'?)"`` for close matches of *value*, or ``""``; letter
+    case aside (``RGB3`` is close to ``rgb3``)."""
+    by_lower = {c.lower(): c for c in choices}
+    close = [
+        by_lower[c] for c in difflib.get_close_matches(value.lower(), by_lower, n=n, cutoff=0.6)
+    ]
     if not close:
         return ""
     return " (did you mean " + ", ".join(repr(c) for c in close) + "?)"

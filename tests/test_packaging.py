@@ -23,6 +23,7 @@ CORE_BASE = {
     "interrupts",
     "threads",
     "file_writes",
+    "path_kinds",
     "mitsuba_import",
     "number_lists",
 }

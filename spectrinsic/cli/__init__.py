@@ -10,6 +10,7 @@ import argparse
 import contextlib
 import importlib
 import logging
+import re
 import sys
 import traceback
 import warnings
@@ -17,7 +18,7 @@ from collections.abc import Iterator, Sequence
 from typing import Any, NoReturn, TextIO
 
 from ..data_dir import one_data_dir
-from ..errors import SpectrinsicError
+from ..errors import SpectrinsicError, did_you_mean
 from ..interrupts import exit_status, interrupts_reach_python
 from ..provenance import software_versions
 
@@ -43,18 +44,39 @@ _COMMANDS: tuple[str, ...] = (
 class _Parser(argparse.ArgumentParser):
     """An argument parser whose errors are one line (``spectrinsic: error: ...``, status 2),
     like every other bad input; ``--help`` still prints the usage. Sub-command parsers are of
-    this class too (``add_subparsers`` makes them with the parent's class)."""
+    this class too (``add_subparsers`` makes them with the parent's class). :attr:`verbs`:
+    the top-level parser's sub-command parsers by name."""
+
+    verbs: dict[str, argparse.ArgumentParser]
 
     def error(self, message: str) -> NoReturn:
         where = self.prog.removeprefix("spectrinsic").strip()
-        text = " ".join(message.split())
+        text = " ".join(message.split()) + _choice_hint(message)
         self.exit(
             2,
             f"spectrinsic: error: {where + ': ' if where else ''}{text} (see {self.prog} --help)\n",
         )
 
 
-def build_parser() -> argparse.ArgumentParser:
+def _choice_hint(message: str) -> str:
+    """A suggestion for argparse's ``invalid choice: 'rendr' (choose from 'info', ...)``: a
+    mistyped verb, study or preset (Python 3.11's argparse suggests nothing)."""
+    found = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)
+    return did_you_mean(found[1], re.findall(r"'([^']*)'", found[2])) if found else ""
+
+
+def _unrecognized(parser: _Parser, verb: str | None, extras: list[str]) -> NoReturn:
+    """Refuse arguments no parser took, by the verb's parser (so the line names the verb and
+    its ``--help``) and with the verb's closest option for each mistyped one."""
+    by = parser.verbs.get(verb or "", parser)
+    options = sorted(set(re.findall(r"--[a-z][\w-]*", by.format_usage())))
+    hints = "".join(
+        did_you_mean(e.split("=", 1)[0], options, n=2) for e in extras if e.startswith("--")
+    )
+    by.error(f"unrecognized arguments: {' '.join(extras)}{hints}")
+
+
+def build_parser() -> _Parser:
     parser = _Parser(
         prog="spectrinsic",
         description="Spectral rendering of synthetic intrinsic-image datasets.",
@@ -64,6 +86,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in _COMMANDS:
         importlib.import_module(name).register(sub)
+    parser.verbs = dict(sub.choices)
     for command in sub.choices.values():  # the global options work after the verb too
         _add_global_options(command.add_argument_group("global options"), after_verb=True)
     return parser
@@ -123,7 +146,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _main(argv: Sequence[str] | None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args, extras = parser.parse_known_args(argv)
+    if extras:
+        _unrecognized(parser, getattr(args, "command", None), extras)
     logging.basicConfig(
         level=logging.WARNING - 10 * min(args.verbose, 2),
         format="%(levelname)s %(name)s: %(message)s",

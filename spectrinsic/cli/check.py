@@ -20,6 +20,7 @@ from ..gt_export.dataset.check import (
     sample_share_problem,
 )
 from ..gt_export.sample import META_NAME
+from ..path_kinds import folder_problem
 from .problems import problem_lines
 
 __all__ = ["register", "run"]
@@ -88,9 +89,9 @@ def run(args: argparse.Namespace) -> int:
     if args.max_per_sample < 0:
         raise DatasetError(f"--max-per-sample {args.max_per_sample}; expected a whole number >= 0")
     root = Path(args.dir)
-    if not root.is_dir():
+    if (problem := folder_problem(root)) is not None:
         raise DatasetError(
-            f"check {str(root)!r}: no such folder; expected a dataset folder or a sample folder"
+            f"check {str(root)!r} {problem}; expected a dataset folder or a sample folder"
         )
     if (root / META_NAME).is_file():  # one sample folder, e.g. what `relight --out` writes
         problems = [f"{root.name}: {p}" for p in check_sample(root)]

@@ -24,6 +24,7 @@ from ..gt_export.dataset.loader import load_sample
 from ..gt_export.folders.outfolder import check_output_folder
 from ..gt_export.folders.staged_output import staged_output
 from ..gt_export.sample import sample_dirs
+from ..path_kinds import folder_problem
 
 __all__ = ["register", "run", "DEFAULT_DATASET", "DEFAULT_OUT"]
 
@@ -157,6 +158,8 @@ def _methods(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def _folders(dataset: Path, patterns: str | None) -> list[Path]:
+    if dataset.exists() and (problem := folder_problem(dataset)) is not None:
+        raise DatasetError(f"--dataset {str(dataset)!r} {problem}; expected a dataset folder")
     if not dataset.is_dir():
         raise DatasetError(
             f"dataset folder {str(dataset)!r} does not exist; build it first with "

@@ -11,6 +11,7 @@ from typing import Any
 from ..errors import RenderError
 from ..pipeline.presets import get_preset
 from ..pipeline.source_plan import files_source
+from ..scenes import library
 from ..scenes.sample_id import SampleId
 from ..scenes.sources import is_scene_file
 from . import dataset as cli_dataset
@@ -60,6 +61,7 @@ def ground_truth(args: argparse.Namespace) -> int:
             semantic=semantic_map(args.semantic_map),
         )
     else:
+        library.check_sample(args.scene, args.view, args.condition)
         only = str(SampleId(args.scene, args.view, args.condition))
     preset = "default" if args.preset is None else args.preset
     config = get_preset(preset, seed=args.seed).with_options(**changes)

@@ -284,4 +284,7 @@ def parse_modes(args: argparse.Namespace) -> list[str]:
         )
     for mode in modes:
         get_mode(mode)
+    twice = sorted({m for m in modes if modes.count(m) > 1})
+    if twice:  # each mode is one set of files: a repeat would be dropped without a word
+        raise SceneError(f"--modes {args.modes!r}: {twice[0]} given twice; expected each mode once")
     return modes

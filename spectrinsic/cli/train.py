@@ -20,6 +20,7 @@ from ..learn import card
 from ..learn.data import TrainLayers, training_folders
 from ..learn.torch_import import require_torch
 from ..learn.train import CHECKPOINT, TrainOptions, train
+from ..path_kinds import folder_problem
 
 __all__ = ["register", "run", "TRAINING_MARKER"]
 
@@ -113,8 +114,8 @@ def _check_out(out: Path, resume: bool) -> None:
 
 def run(args: argparse.Namespace) -> int:
     options = _options(args)
-    if not args.dataset.is_dir():
-        raise DatasetError(f"dataset folder {str(args.dataset)!r} does not exist")
+    if (problem := folder_problem(args.dataset)) is not None:
+        raise DatasetError(f"dataset folder {str(args.dataset)!r} {problem}")
     torch = require_torch("spectrinsic train")  # before any folder is made
     if options.device == "cuda" and not torch.cuda.is_available():
         raise DatasetError("--device cuda: this torch sees no CUDA device; use --device cpu")

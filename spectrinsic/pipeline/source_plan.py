@@ -26,6 +26,7 @@ from typing import Any
 
 from ..errors import DatasetError, SceneError, SpectrinsicError, validate_choice
 from ..gt_export.sample import file_sha256
+from ..path_kinds import file_type
 from ..render.algebra.light_transport import diagonal_mode_names
 from ..render.band_path.traversal import resolve_integrator
 from ..scenes.generators import (
@@ -194,7 +195,14 @@ def files_source(
     ``--semantic-map`` rules, before the default map's."""
     entries = []
     for p in paths:
+        if not str(p):  # Path("") is the working folder
+            raise DatasetError("--scenes '': an empty path; expected scene files")
         path = Path(p).resolve()
+        if path.exists() and not path.is_file():  # a folder: name what the option takes
+            raise DatasetError(
+                f"--scenes {str(p)!r} is {file_type(path)}; expected scene files (.yaml, .xml, "
+                f".blend, .obj/.ply/.glb...), e.g. {os.path.join(str(p), '*.yaml')}"
+            )
         if not path.is_file():
             raise DatasetError(f"--scenes {str(p)!r}: no such file")
         scene_file_kind(path)

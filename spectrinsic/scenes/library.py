@@ -57,6 +57,7 @@ __all__ = [
     "n_views",
     "build",
     "condition_illuminants",
+    "check_sample",
     "default_samples",
     "glossy_samples",
 ]
@@ -168,6 +169,14 @@ def _check_view(name: str, view: int) -> None:
         raise SceneError(
             f"view {view!r} of library scene {name!r}: expected 0..{n_views(name) - 1}"
         )
+
+
+def check_sample(name: str, view: int, condition: str) -> None:
+    """Raise :class:`SceneError` unless scene *name*, *view* and *condition* name a library
+    sample (``render --ground-truth`` checks before it plans its one-sample build, which would
+    otherwise find no sample of that id)."""
+    _check_view(name, view)
+    validate_choice(condition, CONDITIONS, "illumination condition", error=SceneError)
 
 
 def _light(

@@ -40,6 +40,7 @@ __all__ = [
     "check_budget",
     "triangles",
     "textured_triangles",
+    "sphere_radius",
 ]
 
 #: Shapes made of triangles here, and shapes read from a file.
@@ -166,6 +167,12 @@ def check_budget(placed: list[Placed], base: Path) -> None:
         budget.charge(p.where, faces=f, vertices=v)
 
 
+def _named(p: Placed) -> str:
+    """*p* and its mesh file as the scene states it (relative to the scene's folder), for a
+    refusal of the file's content."""
+    return f"{p.where}: mesh file {p.node.props.get('filename')!r}"
+
+
 def _mesh_file(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray]:
     import trimesh
 
@@ -174,14 +181,14 @@ def _mesh_file(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray]:
         try:
             return mesh_file(p.node.plugin, str(path), p.node.integer("shape_index", 0))
         except SceneError as exc:
-            raise SceneError(f"{p.where}: {exc}") from None
+            raise SceneError(f"{_named(p)}: {exc}") from None
     # no check_mesh_size: check_budget counted this file's header, within the same limits
     try:
         if p.node.plugin == "obj":
             return _obj(path, trimesh.exchange.obj.load_obj)
         mesh: Any = trimesh.load(str(path), force="mesh", process=False)
     except Exception as exc:  # noqa: BLE001 - trimesh raises many types for corrupt files
-        raise SceneError(f"{p.where}: cannot read {path.name!r} ({type(exc).__name__})") from None
+        raise SceneError(f"{_named(p)}: cannot read it ({type(exc).__name__})") from None
     return np.asarray(mesh.vertices, float), np.asarray(mesh.faces, np.int64)
 
 
@@ -202,14 +209,41 @@ def _obj(path: Path, load_obj: Any) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(vertices), np.concatenate(faces)
 
 
+def sphere_radius(p: Placed) -> float:
+    """A ``sphere``'s ``radius`` (default 1), refused in one line unless > 0: Mitsuba turns a
+    sphere of negative radius inside out (its normals point inward, a one-sided BSDF is black
+    from outside), while our tessellation would render it lit and write inward normals."""
+    radius = p.node.number("radius", 1.0)
+    if not radius > 0:
+        raise SceneError(
+            f"{p.where}: sphere radius {radius:g}; expected > 0 (a negative radius turns "
+            "Mitsuba's sphere inside out)"
+        )
+    return radius
+
+
+def _finite(p: Placed, v: np.ndarray) -> np.ndarray:
+    """A mesh file's vertices *v*, refused in one line naming the file (as the scene states
+    it, relative to the scene's folder) if any is NaN or infinite: the scene's own check
+    after the transform would name only the shape's id."""
+    bad = np.flatnonzero(~np.isfinite(v).all(axis=1))
+    if bad.size:
+        raise SceneError(
+            f"{_named(p)}: {bad.size} vertices are NaN or infinite (first: vertex "
+            f"{int(bad[0])}); expected finite coordinates"
+        )
+    return v
+
+
 def _local(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray]:
     props = p.node.props
     plugin = p.node.plugin
     if plugin in FILE_SHAPES:
-        return _mesh_file(p, base)
+        v, f = _mesh_file(p, base)
+        return _finite(p, v), f
     if plugin == "sphere":
         centre = np.asarray(props.get("center", np.zeros(3)), float)
-        return parts.sphere(centre, p.node.number("radius", 1.0))
+        return parts.sphere(centre, sphere_radius(p))
     if plugin == "cylinder":
         p0 = np.asarray(props.get("p0", np.zeros(3)), float)
         p1 = np.asarray(props.get("p1", np.array([0.0, 0.0, 1.0])), float)
@@ -255,7 +289,8 @@ def textured_triangles(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray, n
         try:
             v, f, uv = mesh_file_uv(plugin, str(path), p.node.integer("shape_index", 0))
         except SceneError as exc:
-            raise SceneError(f"{p.where}: {exc}") from None
+            raise SceneError(f"{_named(p)}: {exc}") from None
+        _finite(p, v)
     else:
         uv = np.zeros((0, 0))
     if uv.shape[1:] != (2,):

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 from typing import Any, Union
 
 import numpy as np
@@ -289,9 +288,7 @@ def _load_mesh(plugin: str, path: str, index: int) -> Any:
         return mi.traverse(mi.load_dict(spec))
     except RuntimeError as exc:
         message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise SceneError(
-            f"cannot read {Path(path).name!r} ({message.split('] ', 1)[-1]})"
-        ) from None
+        raise SceneError(f"cannot read it ({message.rsplit('] ', 1)[-1]})") from None
 
 
 def mesh_file(plugin: str, path: str, index: int = 0) -> tuple[np.ndarray, np.ndarray]:

@@ -110,7 +110,7 @@ def _area_light(p: shapes.Placed, node: XmlNode, r: _Reading) -> Light | None:
         scales = np.linalg.norm(m[:3, :3], axis=0)
         if not np.allclose(scales, scales[0], rtol=1e-9):
             raise SceneError(f"{p.where}: an area sphere scaled unevenly is not a sphere")
-        radius = p.node.number("radius", 1.0) * float(scales[0])
+        radius = shapes.sphere_radius(p) * float(scales[0])
         return Light("sphere", spectrum, power, position=_vec(centre), radius=radius, name=p.name)
     if p.node.plugin != "rectangle":
         r.refuse_or_drop(node, p.where, "the emitter (the shape stays, unlit)")

@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import dataclasses
 import gzip
-import stat
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import SceneError
+from ..path_kinds import file_type
 from .blender import load_blend
 from .generators import GeneratorOptions, generate
 from .generators.view_rule import FrameProbe
@@ -93,21 +93,6 @@ def _compressed_blend(head: bytes, path: Path) -> bool:
     return False
 
 
-def _file_type(path: Path) -> str:
-    """What *path* is, in words, for a refusal (``stat`` follows links, as ``open`` would)."""
-    mode = path.stat().st_mode
-    for test, what in (
-        (stat.S_ISDIR, "a folder"),
-        (stat.S_ISFIFO, "a FIFO (named pipe)"),
-        (stat.S_ISSOCK, "a socket"),
-        (stat.S_ISCHR, "a character device"),
-        (stat.S_ISBLK, "a block device"),
-    ):
-        if test(mode):
-            return what
-    return "a special file"
-
-
 def scene_file_kind(path: str | Path) -> str:
     """``"yaml"``, ``"mitsuba"`` (``.xml``), ``"blend"`` or ``"mesh"`` for a scene file, by suffix; a ``.blend`` also by
     its magic bytes, plain or compressed (gzip, zstd), under any name. One-line error for
@@ -117,7 +102,7 @@ def scene_file_kind(path: str | Path) -> str:
     p = Path(path)
     if p.exists() and not p.is_file():
         raise SceneError(
-            f"scene file {str(p)!r} is {_file_type(p)}, not a regular file; expected a scene file"
+            f"scene file {str(p)!r} is {file_type(p)}, not a regular file; expected a scene file"
         )
     suffix = p.suffix.lower()
     if suffix in (".yaml", ".yml"):
@@ -145,9 +130,15 @@ def is_scene_file(argument: str | Path) -> bool:
     """Whether a scene argument names a file (a scene-file suffix, or an existing path) rather
     than a library scene.
 
+    An empty argument names nothing (``Path("")`` is the working folder, which exists).
+
     >>> is_scene_file("chair.OBJ"), is_scene_file("room.yaml"), is_scene_file("room-living")
     (True, True, False)
+    >>> is_scene_file("")
+    False
     """
+    if not str(argument):
+        return False
     p = Path(argument)
     return p.suffix.lower() in (".yaml", ".yml", ".xml", ".blend", *MESH_SUFFIXES) or p.exists()
 

@@ -72,4 +72,4 @@ def test_global_flags_keep_their_defaults_when_not_given():
 def test_a_flag_after_the_verb_reaches_the_run(tmp_path, capsys):
     assert main(["check", str(tmp_path / "missing"), "-q"]) == 2
     err = capsys.readouterr().err
-    assert "unrecognized" not in err and "no such folder" in err
+    assert "unrecognized" not in err and "does not exist" in err

@@ -203,3 +203,15 @@ def test_render_ground_truth_is_the_dataset_path(tmp_path):
     )
     assert rc == 0 and check_dataset(out) == []
     assert LAYERS <= _layers(out, "obj-cup__v0__file")
+
+
+def test_a_folder_given_to_scenes_is_named_a_folder_with_what_the_option_takes(tmp_path):
+    """Not "no such file": the folder exists, and ``--scenes`` takes scene files."""
+    (tmp_path / "d").mkdir()
+    with pytest.raises(SpectrinsicError) as info:
+        files_source([tmp_path / "d"])
+    message = str(info.value)
+    assert "is a folder; expected scene files" in message and "no such file" not in message
+    assert message.endswith(str(tmp_path / "d" / "*.yaml"))
+    with pytest.raises(SpectrinsicError, match="no such file"):
+        files_source([tmp_path / "gone.yaml"])

@@ -38,6 +38,7 @@ import numpy as np
 
 from ...errors import DatasetError
 from ...file_writes import write_text_file
+from ...path_kinds import folder_problem
 from ...results import write_csv
 from ..decomposition import Decomposition
 from ..metrics.scale import almse, correlation, lmse, si_mse
@@ -164,9 +165,9 @@ def mit_folder_objects(folder: Path, patterns: Iterable[str] | None = None) -> l
     that match nothing.
     """
     folder = Path(folder)
-    if not folder.is_dir():
+    if (problem := folder_problem(folder)) is not None:
         raise DatasetError(
-            f"MIT folder {str(folder)!r} does not exist (expected a folder of "
+            f"MIT folder {str(folder)!r} {problem} (expected a folder of "
             f"<object>.npz files, e.g. $SPECTRINSIC_DATA/mit_intrinsic_dev)"
         )
     files = sorted(p for p in folder.glob("*.npz") if p.is_file())

@@ -44,6 +44,7 @@ import numpy as np
 from ...errors import DatasetError, validate_choice
 from ...gt_export.formats.exr import exr_size, read_exr, write_exr
 from ...gt_export.formats.png import PNG16_MAX, png_size, read_png16, write_png16
+from ...path_kinds import folder_problem
 from ...spectra.colorimetry import decode_srgb, encode_srgb
 from ..decomposition import Decomposition, finish
 
@@ -161,8 +162,8 @@ class Predictions:
 
     def __post_init__(self) -> None:
         validate_choice(self.encoding, PNG_ENCODINGS, "PNG encoding", error=DatasetError)
-        if not Path(self.root).is_dir():
-            raise DatasetError(f"predictions folder {str(self.root)!r} does not exist")
+        if (problem := folder_problem(self.root)) is not None:
+            raise DatasetError(f"predictions folder {str(self.root)!r} {problem}")
 
     def folder(self, sample_id: str, scenario: str) -> Path:
         """Where the files of one sample and scenario (``"srgb"``: the sample folder) lie."""

@@ -192,7 +192,9 @@ def read_splits(
         record = read_manifest(dataset_dir)
     except SampleMetaError as exc:
         raise DatasetError(f"{exc}; rebuild the dataset") from exc
-    if record is None or "splits" not in record.raw:
+    if record is None:
+        raise DatasetError(f"{dataset_dir}: no {MANIFEST_NAME}; expected a built dataset folder")
+    if "splits" not in record.raw:
         raise DatasetError(f"{dataset_dir}: {MANIFEST_NAME} has no splits; rebuild the dataset")
     if split is not None and split not in record.splits:
         raise DatasetError(f"split {split!r}; expected one of {sorted(record.splits)}")

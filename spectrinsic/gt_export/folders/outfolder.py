@@ -156,6 +156,11 @@ def check_out_folder(
     if not root.is_dir() or not _entries(root):
         _require_writable(root, option)
         return True
+    if not own(root) and _is_dataset(root):  # spectrinsic wrote it, but as another kind
+        raise DatasetError(
+            f"{option} {str(root)!r} is a spectrinsic dataset, not {what}; choose a new or "
+            "empty folder (this verb never writes into a dataset)"
+        )
     if not own(root):
         raise DatasetError(
             f"{option} {str(root)!r} is not empty and is not {what}, so it "

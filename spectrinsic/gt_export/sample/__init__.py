@@ -30,6 +30,7 @@ import numpy as np
 from ...errors import DatasetError
 from ...file_writes import TMP_PREFIX  # one home: every sweep of temporaries knows it
 from ...number_lists import copy_numbers, finite_numbers, numbers_only
+from ...path_kinds import folder_problem
 from ...scenes.model import record_fields
 
 __all__ = [
@@ -217,8 +218,8 @@ def confined_path(folder: Path, rel: object) -> Path | None:
 def sample_dirs(dataset_dir: str | os.PathLike[str]) -> list[Path]:
     """Sample folders of a dataset (visible sub-folders holding ``meta.json``), sorted by name."""
     root = Path(dataset_dir)
-    if not root.is_dir():
-        raise DatasetError(f"dataset folder {str(root)!r} does not exist")
+    if (problem := folder_problem(root)) is not None:
+        raise DatasetError(f"dataset folder {str(root)!r} {problem}")
     return sorted(
         p
         for p in root.iterdir()

@@ -175,10 +175,12 @@ def test_cli_scores_methods_and_predictions_on_an_mit_folder(mit_folder, tmp_pat
     "make, expected",
     [
         (lambda t: ["--mit", str(t / "absent")], "does not exist"),
+        (lambda t: ["--mit", str(t / "notes.txt")], "notes.txt' is a file, not a folder"),
         (lambda t: ["--mit", str(t)], "holds no <object>.npz"),
     ],
 )
 def test_bad_mit_folder_is_one_line_rc2(tmp_path, capsys, make, expected):
+    (tmp_path / "notes.txt").write_text("x")
     rc = main(["-q", "evaluate", *make(tmp_path), "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err.strip()
     assert rc == 2 and len(err.splitlines()) == 1 and expected in err

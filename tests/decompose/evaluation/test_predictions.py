@@ -116,6 +116,9 @@ def test_missing_and_bad_predictions_are_one_line_errors(tmp_path):
     image = input_image(sample)[1]
     with pytest.raises(DatasetError, match="does not exist"):
         Predictions(tmp_path / "nowhere")
+    (tmp_path / "notes.txt").write_text("x")
+    with pytest.raises(DatasetError, match="'[^']*notes.txt' is a file, not a folder"):
+        Predictions(tmp_path / "notes.txt")
     with pytest.raises(DatasetError, match="no reflectance or shading"):
         Predictions(tmp_path).load("obj-a__v0__white", "srgb", image, np.ones((48, 48), bool))
     assert (

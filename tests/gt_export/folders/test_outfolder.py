@@ -16,6 +16,7 @@ from spectrinsic.gt_export.folders.build_folder import check_build_folder, write
 from spectrinsic.gt_export.folders.outfolder import (
     LOCK_NAME,
     OUTPUT_MARKER,
+    check_out_folder,
     check_output_folder,
     folder_lock,
     output_folder,
@@ -142,3 +143,18 @@ def test_a_write_probe_left_by_a_killed_run_does_not_block_the_next(tmp_path):
     with pytest.raises(DatasetError, match="not empty"):
         check_build_folder(other, "h" * 64, rebuild=False)
     assert (other / ".spectrinsic-tmp-probe-4242" / "mine.txt").read_text() == "mine"
+
+
+def test_a_dataset_given_as_another_verbs_out_is_called_a_dataset(tmp_path):
+    """``evaluate --out data/dataset`` said the dataset "holds files spectrinsic did not write"
+    (task r5-probe2): it is spectrinsic's, but not the kind of folder that verb writes."""
+    (tmp_path / ".spectrinsic-dataset").write_text(json.dumps({"spectrinsic_dataset": 1}))
+    (tmp_path / "a-sample").mkdir()
+    with pytest.raises(
+        DatasetError, match="is a spectrinsic dataset, not a train folder; "
+    ) as info:
+        check_out_folder(tmp_path, own=lambda _: False, what="a train folder")
+    assert "did not write" not in str(info.value)
+    (tmp_path / ".spectrinsic-dataset").unlink()  # a user's folder: as before
+    with pytest.raises(DatasetError, match="holds files spectrinsic did not write"):
+        check_out_folder(tmp_path, own=lambda _: False, what="a train folder")
