@@ -18,6 +18,13 @@ Dr.Jit thread, which adds in the same lane order. The film is then the same bits
 for any number of threads. The parts' images are averaged with weights ``spp_i / spp`` in
 float64, in part order: the same estimate (the mean of spp independent samples per pixel), and
 a power-of-two count renders exactly as one call did.
+
+Memory: a part is copied out of Dr.Jit's film and the film given back before the next part
+renders. The last part of several is not developed by Mitsuba: its film's storage (``R, G, B``,
+the weight, the AOVs) is divided by the weight in numpy a block of rows at a time and summed
+into the mean (:func:`_develop_rows`, ``HDRFilm::develop``'s float32 division), where the first
+part's storage gave Mitsuba's developed film bit for bit (:func:`_develops_raw`; an RGB
+``hdrfilm``, as every film of the band path and the RGB passes): two films at the peak, not three.
 """
 
 from __future__ import annotations
