@@ -80,7 +80,8 @@ AOV_VALUES = 16
 MAX_SIDE = 65_536
 #: Copies of every channel of the band-path traversal's image alive at once: a render peaks at
 #: two (the film's storage and its developed tensor, then the tensor and its numpy copy:
-#: :func:`~spectrinsic.render.base.sample_split.split_render` gives each back at once) beside
+#: :func:`~spectrinsic.render.base.sample_split.split_render` gives each back at once; in two
+#: parts, the first part's copy and the second's storage, merged a block of rows at a time) beside
 #: the previous batch's cuts of it per mode, and merging the batches holds both batches' cuts
 #: and their mean: three. Was 4 (3.9 to 4.4 measured inside the render call, before the copies
 #: were released); measured peaks against it: docs/artist-interior-speed.md.
