@@ -55,7 +55,9 @@ _STANDARD_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
 #: is the float64 sum of its lights' (light_transport.py): one float32 rounding, BLAS-free.
 #: 7: a non-power-of-two spp renders as power-of-two parts with their own seeds, averaged
 #: (render/base/sample_split.py): bits independent of Dr.Jit's threads, other samples drawn.
-PIXELS_VERSION = 7
+#: 8: an environment map's spectral reference is one pass (render/base/summed_envmap.py), not one
+#: per map channel: the same expectation, other samples drawn (scenes with a map only).
+PIXELS_VERSION = 8
 #: What of the installed software changes pixels, hence enters the config hash, and how much
 #: of its version: the renderer exactly (its sampling changes between patch releases);
 #: colour-science's data tables (CMFs, illuminants, cameras) by minor release; numpy by major
