@@ -33,6 +33,10 @@ from .plugins import regular_spectrum
 
 __all__ = ["MapLight", "summed_envmap", "attach_summed_envmap"]
 
+#: The largest float32 below 1: a rescaled sample stays in [0, 1) (a Python float, so it also
+#: serves the scalar variants, where ``mi.Float`` is ``float``).
+_BELOW_ONE = float(np.nextafter(np.float32(1.0), np.float32(0.0)))
+
 
 @dataclass(frozen=True)
 class MapLight:
@@ -135,7 +139,7 @@ def _sample(parts: _Parts, it: Any, sample: Any, active: Any) -> tuple[Any, Any]
     for i, (p, sampler) in enumerate(parts.samplers):
         last = i == len(parts.samplers) - 1
         chosen = (sample.x >= start) & (mi.Bool(True) if last else sample.x < start + p)
-        x = dr.clip((sample.x - start) / p, 0.0, dr.one_minus_epsilon(mi.Float))
+        x = dr.clip((sample.x - start) / p, 0.0, _BELOW_ONE)
         ds_i, _ = sampler.sample_direction(it, mi.Point2f(x, sample.y), active & chosen)
         ds = ds_i if ds is None else dr.select(chosen, ds_i, ds)
         start += p
@@ -169,7 +173,9 @@ def _emitter_class(mi: Any) -> Any:
 
         def sample_direction(self, it: Any, sample: Any, active: Any = True) -> Any:
             ds, weight = _sample(self.parts, it, sample, active)
-            ds.emitter = mi.EmitterPtr(self)
+            # as Mitsuba's envmap does: the sample names its emitter (a pointer array in JIT
+            # variants, the object in scalar ones)
+            ds.emitter = mi.EmitterPtr(self) if self.parts.dr.is_jit_v(mi.Float) else self
             return ds, weight
 
         def attach(self, scene: Any) -> None:

@@ -178,3 +178,21 @@ def test_its_pdf_integrates_to_one_and_matches_its_sample_weights(two_maps):
         assert np.allclose(np.asarray(drawn.pdf), pdf, rtol=1e-5)
         assert np.allclose(np.asarray(weight[0]) * pdf, radiance, rtol=1e-4, atol=0)
         assert np.all(pdf > 0)
+
+
+def test_the_scalar_variant_renders_the_same_light(two_maps):
+    """Without a usable libLLVM the pass falls back to ``scalar_spectral``, where Mitsuba calls
+    the emitter per sample (``mi.Float`` is ``float``, ``ds.emitter`` the object): its pixel
+    mean must agree with the LLVM variant's within 4 standard errors (8², 16 spp each)."""
+    small = dataclasses.replace(
+        two_maps, camera=dataclasses.replace(two_maps.camera, width=8, height=8)
+    )
+    px = {
+        v: render_spectral(small, get_sensors("cie1931"), PassRequest(16, seed=2, variant=v))
+        .image.reshape(-1, 3)
+        .astype(np.float64)
+        for v in ("scalar_spectral", choose_variant("spectral", None))
+    }
+    (a, b) = px.values()
+    err = np.hypot(a.std(0, ddof=1), b.std(0, ddof=1)) / np.sqrt(len(a))
+    assert np.all(np.isfinite(a)) and np.all(np.abs(a.mean(0) - b.mean(0)) <= 4 * err)
