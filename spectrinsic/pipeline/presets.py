@@ -54,8 +54,7 @@ _STANDARD_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
 #: is the float64 sum of its lights' (light_transport.py): one float32 rounding, BLAS-free.
 #: 7: a non-power-of-two spp renders as power-of-two parts with their own seeds, averaged
 #: (render/base/sample_split.py): bits independent of Dr.Jit's threads, other samples drawn.
-#: 8: a scene's environment maps are one emitter of the spectral pass, not a pass per channel
-#: (render/base/summed_envmap.py): the same expectation, other samples (scenes with a map).
+#: 8: environment maps in one spectral pass (render/base/summed_envmap.py): other samples.
 PIXELS_VERSION = 8
 #: What of the installed software changes pixels, hence enters the config hash, and how much
 #: of its version: the renderer exactly (its sampling changes between patch releases);
