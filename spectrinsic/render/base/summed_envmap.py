@@ -15,10 +15,11 @@ bilinear lookup, seam and rotation as the per-channel passes it replaces. ``E_j`
 ``regular`` spectrum on the 1 nm grid (linearly interpolated).
 
 Directions are sampled from a mixture over the maps: map i with probability ``p_i``, then
-Mitsuba's ``envmap`` of the grey map ``Σ_c w_c |m_c|`` (``w_c`` > 0, by the channel's weight
-given), whose pdf is positive wherever any channel radiates; the pdf is ``Σ_i p_i pdf_i(ω)``,
-the sample weight ``L / pdf``. The estimate is unbiased for any weights, so its expectation is
-the per-channel passes' (only the variance depends on the weights).
+Mitsuba's ``envmap`` of the grey map ``Σ_c w_c |m_c|`` (``w_c`` ≥ 0 the channel's weight given,
+0 only for a channel the film cannot see), whose pdf is positive wherever a seen channel
+radiates; the pdf is ``Σ_i p_i pdf_i(ω)``, the sample weight ``L / pdf``. The estimate is
+unbiased for any such weights, so its expectation is the per-channel passes' (only the
+variance depends on the weights).
 """
 
 from __future__ import annotations
@@ -42,8 +43,9 @@ _BELOW_ONE = float(np.nextafter(np.float32(1.0), np.float32(0.0)))
 class MapLight:
     """One environment map as the summed emitter takes it: *data* ``(H, W, 3)`` linear RGB
     (float32, the file's), *to_world* its 4 × 4 rotation, and per channel c either ``None``
-    (the channel is dark) or its emitted spectrum on the wavelengths given (W/(m² sr nm)),
-    with *weights* (c,) > 0 its channel's share of the sampling map."""
+    (the channel is off) or its emitted spectrum on the wavelengths given (W/(m² sr nm)), at
+    least one not ``None``; *weights* ≥ 0 each channel's share of the sampling map (0 only
+    where the film sees nothing of the channel's spectrum)."""
 
     data: np.ndarray
     to_world: np.ndarray
