@@ -13,7 +13,7 @@ repository:
   (``algebra/modes.py`` in a section about ``render/``). A bare file name ``x.py`` resolves
   when a module of that name exists; a file of another project is named by its project's path
   (``mitsuba/.../prb.py``), whose first folder is not one of ours;
-* **a path with a name** (``render/spectral._light_passes``,
+* **a path with a name** (``render/spectral._map_lights``,
   ``gt_export/sample/render_spp.render_spp``): the module resolves as a path, and the name is
   defined in it (below);
 * **a dotted module name** (``spectrinsic.scenes.validate_scene``): the longest prefix that is

@@ -49,13 +49,13 @@ _STANDARD_MODES: tuple[str, ...] = ("spectral", "rgb3", "rgb6", "bands31")
 #: render (spectrinsic/render/band_path/traversal.py), not one render per light.
 #: 4: the white-surface radiance is denoised as three broad bands (OIDN high) times per-band
 #: shares, guided by normals and a depth grey marked clean (spectrinsic/gt_export/layers/denoise.py).
-#: 5: each light's share is one float32 product (spectrinsic/render/algebra/shares.py): images and
-#: layers move by at most one float32 rounding.
+#: 5: each light's share is one float32 product (render/algebra/shares.py): at most one rounding.
 #: 6: raw channels go to XYZ by chunked einsum, not BLAS (render/algebra/modes.py), an image's XYZ
 #: is the float64 sum of its lights' (light_transport.py): one float32 rounding, BLAS-free.
 #: 7: a non-power-of-two spp renders as power-of-two parts with their own seeds, averaged
 #: (render/base/sample_split.py): bits independent of Dr.Jit's threads, other samples drawn.
-PIXELS_VERSION = 7
+#: 8: environment maps in one spectral pass (render/base/summed_envmap.py): other samples.
+PIXELS_VERSION = 8
 #: What of the installed software changes pixels, hence enters the config hash, and how much
 #: of its version: the renderer exactly (its sampling changes between patch releases);
 #: colour-science's data tables (CMFs, illuminants, cameras) by minor release; numpy by major

@@ -21,10 +21,14 @@ from .base.one_pass import (
     timed_render,
 )
 from .base.plugins import path_integrator, regular_spectrum, spectral_film
+from .base.summed_envmap import MapLight, attach_summed_envmap, summed_envmap
 from .base.variants import choose_variant, variant_scope
 from .settings import PassRequest
 
-__all__ = ["render_spectral"]
+__all__ = ["SUMMED_ENVMAP_KEY", "render_spectral"]
+
+#: Key of the environment maps' one emitter in the pass's Mitsuba scene dictionary.
+SUMMED_ENVMAP_KEY = "environment_maps"
 
 
 def _render_pass(
@@ -41,43 +45,24 @@ def _render_pass(
     return image, direct_image, seconds
 
 
-def _mitsuba_d65(mi: Any, wl: np.ndarray) -> np.ndarray:
-    """Mitsuba's own D65 (the ``d65`` texture a spectral ``envmap`` multiplies by) at *wl*."""
-    import drjit as dr
-
-    si = dr.zeros(mi.SurfaceInteraction3f)
-    si.wavelengths = mi.Spectrum(*[mi.Float(np.asarray(wl, float))] * 4)
-    return np.asarray(mi.load_dict({"type": "d65"}).eval(si)[0], float)
-
-
-def _light_passes(
-    mi: Any, scene: Scene, active: set[int], emission: np.ndarray, wl: np.ndarray
-) -> list[tuple[set[int], Any, np.ndarray]]:
-    """The passes of one spectral render, each ``(lights on, grey bitmap or None, film factor
-    (W,))``: one pass of every active light but an environment map's, then one per active
-    channel light of the map.
-
-    A spectral ``envmap`` evaluates its RGB data through a non-linear spectral upsampling,
-    but a grey map of value v exactly as ``v · D65_mi(λ)`` (``docs/envmap_design.md`` fact 3).
-    Channel light j (channel c) radiates ``m_c(ω) · E_j(λ)``; its pass loads the grey map of
-    channel c and a film of curves ``S_k(λ) · E_j(λ) / D65_mi(λ)``, so its channel k is
-    exactly ``∫ m_c E_j S_k dλ``. The passes sum (the render is linear in the lights)."""
-    maps = envmap_groups(scene)
-    env = {j for m in maps for j in m.lights}
-    ones = np.ones(len(wl))
-    others = active - env
-    out: list[tuple[set[int], Any, np.ndarray]] = (
-        [(others, None, ones)] if others or not (active & env) else []
-    )
-    if not active & env:
-        return out
-    d65 = _mitsuba_d65(mi, wl)
-    for group in maps:
-        data = np.asarray(mi.Bitmap(verified_map(scene.lights[group.lights[0]])), np.float32)
-        for c, j in enumerate(group.lights):
-            if j in active:
-                grey = np.repeat(data[..., c : c + 1], 3, axis=-1)
-                out.append(({j}, mi.Bitmap(np.ascontiguousarray(grey)), emission[j] / d65))
+def _map_lights(
+    mi: Any, scene: Scene, active: set[int], emission: np.ndarray, curves: np.ndarray
+) -> list[MapLight]:
+    """The environment maps with an active channel light, as the summed emitter takes them:
+    each active channel's emitted spectrum, sampled by its weight ``∫ E_j Σ_k S_k dλ`` (only
+    the variance depends on it; equal weights if every one is 0)."""
+    out = []
+    for group in envmap_groups(scene):
+        lit = [j if j in active else None for j in group.lights]
+        if all(j is None for j in lit):
+            continue
+        w = np.array([0.0 if j is None else float(emission[j] @ curves.sum(0)) for j in lit])
+        w = w if np.all(np.isfinite(w)) and w.sum() > 0 else np.ones(3)
+        light = scene.lights[group.lights[0]]
+        data = np.asarray(mi.Bitmap(verified_map(light)), np.float32)
+        spectra = tuple(None if j is None else emission[j] for j in lit)
+        weights = tuple(float(x) for x in w)
+        out.append(MapLight(data, tr.envmap_to_world(light), spectra, weights))  # type: ignore[arg-type]
     return out
 
 
@@ -96,7 +81,8 @@ def render_spectral(
     scaled by their power; channel k is ``∫ L(λ) S_k(λ) dλ`` (nm), the exact counterpart of a
     diagonal render's channel k. Works with any sensor set (CIE 1931, a camera's curves);
     negative lobes (``"srgb"``) are not supported by ``specfilm`` and are clipped. An
-    environment map takes one more pass per channel (:func:`_light_passes`).
+    environment map's channel lights are one emitter of the same pass (:func:`_map_lights`,
+    :mod:`~spectrinsic.render.base.summed_envmap`).
     """
     active = active_light_set(scene, active_lights)
     wl = COLORIMETRIC_WAVELENGTHS
@@ -122,29 +108,28 @@ def render_spectral(
             else None
             for m in scene.materials
         ]
-        passes = []
-        for on, bitmap, factor in _light_passes(mi, scene, active, emission, wl):
-            mitsuba_dict = tr.scene_to_mitsuba(
-                scene,
-                materials=materials,
-                lights=[
-                    None
-                    if j not in on
-                    else regular_spectrum(emission[j], wl)
-                    if bitmap is None
-                    else {"bitmap": bitmap}
-                    for j in range(len(scene.lights))
-                ],
-                film=spectral_film(scene.camera.width, scene.camera.height, curves * factor, wl),
-                integrator=path_integrator(request.max_depth),
-                sample_count=request.batch_spp,
-                geometry=request.geometry,
-                transmittances=tints,
-            )
-            passes.append(_render_pass(mi, mi.load_dict(mitsuba_dict), request, direct))
-    image = np.sum([p[0] for p in passes], axis=0)
-    direct_image = np.sum([p[1] for p in passes if p[1] is not None], axis=0) if direct else None
-    seconds = [sum(p[2][i] for p in passes) for i in range(len(passes[0][2]))]
+        maps = _map_lights(mi, scene, active, emission, curves)
+        env = {j for group in envmap_groups(scene) for j in group.lights}
+        mitsuba_dict = tr.scene_to_mitsuba(
+            scene,
+            materials=materials,
+            lights=[
+                regular_spectrum(emission[j], wl) if j in active - env else None
+                for j in range(len(scene.lights))
+            ],
+            film=spectral_film(scene.camera.width, scene.camera.height, curves, wl),
+            integrator=path_integrator(request.max_depth),
+            sample_count=request.batch_spp,
+            geometry=request.geometry,
+            transmittances=tints,
+        )
+        emitter = summed_envmap(mi, maps, wl) if maps else None
+        if emitter is not None:
+            mitsuba_dict[SUMMED_ENVMAP_KEY] = emitter
+        loaded = mi.load_dict(mitsuba_dict)
+        if emitter is not None:
+            attach_summed_envmap(emitter, loaded)
+        image, direct_image, seconds = _render_pass(mi, loaded, request, direct)
     k = sensors.n
     if image.shape[-1] < k:
         raise RenderError(f"specfilm returned {image.shape[-1]} channels for {k} sensors")

@@ -145,7 +145,7 @@ def extra_maps(mi: Any, scene: Scene) -> tuple[object, ...]:
     """Standalone Mitsuba ``envmap`` emitters of the scene's environment maps after the first
     (Mitsuba loads one per scene; the band path evaluates these itself)."""
     return tuple(
-        mi.load_dict(tr.envmap_entry(mi, scene.lights[g.lights[0]], {}))
+        mi.load_dict(tr.envmap_entry(mi, scene.lights[g.lights[0]]))
         for g in envmap_groups(scene)[1:]
     )
 

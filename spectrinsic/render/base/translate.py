@@ -47,6 +47,7 @@ __all__ = [
     "material_bsdf",
     "emission_key",
     "envmap_entry",
+    "envmap_to_world",
     "scene_to_mitsuba",
 ]
 
@@ -233,24 +234,23 @@ def _look_at(mi: Any, origin: Sequence[float], direction: Sequence[float], what:
     )
 
 
-def envmap_entry(mi: Any, light: Light, emission: Mapping) -> dict[str, Any]:
+def envmap_to_world(light: Light) -> np.ndarray:
+    """The 4 × 4 ``to_world`` of environment-map light *light*: its rotation."""
+    matrix = np.eye(4)
+    matrix[:3, :3] = np.asarray(light.rotation, float).reshape(3, 3)
+    return matrix
+
+
+def envmap_entry(mi: Any, light: Light) -> dict[str, Any]:
     """The Mitsuba ``envmap`` of environment-map light *light*: its file's RGB data at unit
     scale (exact in RGB variants, ``docs/envmap_design.md`` fact 2; the channel lights' powers
-    are applied outside Mitsuba), or the ``mi.Bitmap`` *emission* holds under ``"bitmap"``
-    instead (the spectral pass's grey map of one channel), rotated by the map's ``to_world``."""
-    rot = np.asarray(light.rotation, float).reshape(3, 3)
-    matrix = np.eye(4)
-    matrix[:3, :3] = rot
-    entry: dict[str, Any] = {
+    are applied outside Mitsuba), rotated by the map's ``to_world``."""
+    return {
         "type": "envmap",
         "scale": 1.0,
-        "to_world": mi.ScalarTransform4f(matrix.tolist()),
+        "to_world": mi.ScalarTransform4f(envmap_to_world(light).tolist()),
+        "filename": verified_map(light),
     }
-    if "bitmap" in emission:
-        entry["bitmap"] = emission["bitmap"]
-    else:
-        entry["filename"] = verified_map(light)
-    return entry
 
 
 def _light(mi: Any, light: Light, emission: Mapping | None, what: str) -> dict[str, Any] | None:
@@ -263,7 +263,7 @@ def _light(mi: Any, light: Light, emission: Mapping | None, what: str) -> dict[s
     if emission is None:
         return None
     if light.kind == "envmap":
-        return envmap_entry(mi, light, emission)
+        return envmap_entry(mi, light)
     if light.kind == "point":
         return {
             "type": "point",
