@@ -5,8 +5,9 @@ environment whose code is checked (its ``spectrinsic`` command beside it). Needs
 (``SPECTRINSIC_DATA``, default ``/work/shared/data``).
 
 It builds, in a temporary folder: a matte library sample (single traversal), the same sample
-with ``--integrator passes``, a glossy (plastics and metals) and a textured generated room, a gold-room scene file
-(metals, plastic, a textured material), a sample with ``--store-transport`` plus a sample
+at 12 and 6 spp (both renders split into parts), the same with ``--integrator passes``, a glossy (plastics and metals) and a textured generated room, a gold-room scene file
+(metals, plastic, a textured material), a floor under a coloured environment map and a
+sphere light (an XML scene) at 12 and 6 spp, a sample with ``--store-transport`` plus a sample
 relit from it by ``spectrinsic relight``, an ``evaluate`` run on the matte dataset, and the two
 spectral studies. It writes ``{relative path: sha256}`` of every output file to OUT.json:
 ``scene.json`` is left out (its texel weights follow the scene hash since issue 35), and
@@ -94,6 +95,50 @@ _BUILD_TIME_FIELDS = {"finished", "wall_seconds", "sample_seconds", "mitsuba_sec
 #: The dataset card's one line of build time, machine and date (``build_time.BUILD_TIME_LINE``).
 _CARD_TIME_LINE = "Build time:"
 _FAST = ["--preset", "preview", "--resolution", "24x24", "--spp", "4", "--spectral-spp", "2"]
+#: Counts that split both renders into parts (12 = 8 + 4, 6 = 4 + 2;
+#: ``render/base/sample_split.py``): the route of the default preset's 320 and 64 spp.
+_SPLIT = ["--preset", "preview", "--resolution", "24x24", "--spp", "12", "--spectral-spp", "6"]
+#: A floor under a coloured environment map (its spectral reference is one summed pass,
+#: ``render/base/summed_envmap.py``) beside a sphere light.
+SKY_ROOM = """<scene version="3.0.0">
+  <emitter type="envmap">
+    <string name="filename" value="sky.exr"/>
+    <float name="scale" value="2"/>
+    <transform name="to_world"><rotate x="1" angle="90"/></transform>
+  </emitter>
+  <shape type="rectangle">
+    <transform name="to_world"><scale value="5"/></transform>
+    <bsdf type="diffuse"><rgb name="reflectance" value="0.8, 0.6, 0.3"/></bsdf>
+  </shape>
+  <shape type="sphere">
+    <point name="center" x="0.5" y="0" z="0.6"/><float name="radius" value="0.2"/>
+    <emitter type="area"><rgb name="radiance" value="3, 3, 2"/></emitter>
+  </shape>
+  <sensor type="perspective">
+    <float name="fov" value="40"/>
+    <transform name="to_world"><lookat origin="0,-3,2" target="0,0,0" up="0,0,1"/></transform>
+    <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="24"/></film>
+  </sensor>
+</scene>
+"""
+
+
+def _write_sky(folder: Path) -> Path:
+    """SKY_ROOM and its 16 x 8 map (a blue zenith over a warm horizon, by rows) in *folder*."""
+    import numpy as np
+
+    from spectrinsic.mitsuba_import import import_mitsuba
+
+    mi = import_mitsuba()
+    if mi.variant() is None:
+        mi.set_variant("scalar_rgb")
+    rows = np.linspace(0.0, 1.0, 8, dtype=np.float32)[:, None, None]
+    sky = (1 - rows) * np.array([0.3, 0.5, 1.0], np.float32) + rows * np.array([1.0, 0.7, 0.4])
+    mi.Bitmap(np.ascontiguousarray(np.repeat(sky, 16, axis=1), np.float32)).write(
+        str(folder / "sky.exr")
+    )
+    (folder / "sky-room.xml").write_text(SKY_ROOM)
+    return folder / "sky-room.xml"
 
 
 def _strip(value: object) -> object:
@@ -137,6 +182,7 @@ def build(root: Path) -> None:
     exe = Path(sys.executable).with_name("spectrinsic")
     only = ["--only", "obj-apple__v0__two-colour-a"]
     _run(exe, "dataset", "--out", str(root / "matte"), *_FAST, *only)
+    _run(exe, "dataset", "--out", str(root / "split"), *_SPLIT, *only)
     _run(exe, "dataset", "--out", str(root / "passes"), *_FAST, *only, "--integrator", "passes")
     gen = ["--generator", "rooms", "--count", "1", "--views", "1"]
     gloss = ["--glossy", "0.5", "--metallic", "0.3"]
@@ -147,6 +193,8 @@ def build(root: Path) -> None:
     scene_file.parent.mkdir(exist_ok=True)
     scene_file.write_text(GOLD_ROOM)
     _run(exe, "dataset", "--out", str(root / "gold"), *_FAST, "--scenes", str(scene_file))
+    sky_file = _write_sky(scene_file.parent)
+    _run(exe, "dataset", "--out", str(root / "sky"), *_SPLIT, "--scenes", str(sky_file))
     store = root / "store"
     _run(
         exe,
