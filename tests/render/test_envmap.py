@@ -8,14 +8,11 @@ above the test plane (``tests/conftest.py``'s ``plane_scene``: z up, seen from a
 from __future__ import annotations
 
 import dataclasses
-import hashlib
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from spectrinsic.errors import RenderError, SceneError
-from spectrinsic.mitsuba_import import import_mitsuba
 from spectrinsic.render import RenderSettings, render_scene
 from spectrinsic.render.algebra.light_transport import relit_result
 from spectrinsic.render.transport_render import render_transport_batches
@@ -23,17 +20,9 @@ from spectrinsic.scenes.envmaps import envmap_groups, envmap_lights
 from spectrinsic.scenes.model import Light
 from spectrinsic.scenes.validate import validate_scene
 
-UP_IS_Z = (1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0)
+from ._maps import UP_IS_Z, write_map
+
 N_SIGMA = 4.0
-
-
-def write_map(path: Path, image: np.ndarray) -> tuple[str, str]:
-    """*image* ``(H, W, 3)`` written as an OpenEXR map; its path and SHA-256."""
-    mi = import_mitsuba()
-    if mi.variant() is None:
-        mi.set_variant("scalar_rgb")
-    mi.Bitmap(np.ascontiguousarray(image, np.float32)).write(str(path))
-    return str(path), hashlib.sha256(path.read_bytes()).hexdigest()
 
 
 def lit_by_map(plane, path: str, sha: str, scale: float = 1.0):

@@ -9,13 +9,10 @@ Mitsuba directly; its sampling must be a normalised pdf consistent with its samp
 from __future__ import annotations
 
 import dataclasses
-import hashlib
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from spectrinsic.mitsuba_import import import_mitsuba
 from spectrinsic.render.algebra.modes import light_spectra
 from spectrinsic.render.base import translate as tr
 from spectrinsic.render.base.plugins import path_integrator, regular_spectrum, spectral_film
@@ -26,23 +23,14 @@ from spectrinsic.render.spectral import render_spectral
 from spectrinsic.scenes.envmaps import envmap_groups, envmap_lights, verified_map
 from spectrinsic.scenes.validate import validate_scene
 from spectrinsic.spectra import COLORIMETRIC_WAVELENGTHS, get_sensors, get_spectrum
+from tests.render._maps import UP_IS_Z, write_map
 
-UP_IS_Z = (1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0)
 _C, _S = np.cos(np.radians(40)), np.sin(np.radians(40))
 #: A turn of 40° about the scene's z axis after UP_IS_Z, so the two maps are not aligned.
 TURNED = tuple(
     (np.array([[_C, -_S, 0], [_S, _C, 0], [0, 0, 1]]) @ np.reshape(UP_IS_Z, (3, 3))).ravel()
 )
 SPP = 64
-
-
-def write_map(path: Path, image: np.ndarray) -> tuple[str, str]:
-    """*image* ``(H, W, 3)`` written as an OpenEXR map; its path and SHA-256."""
-    mi = import_mitsuba()
-    if mi.variant() is None:
-        mi.set_variant("scalar_rgb")
-    mi.Bitmap(np.ascontiguousarray(image, np.float32)).write(str(path))
-    return str(path), hashlib.sha256(path.read_bytes()).hexdigest()
 
 
 @pytest.fixture(scope="module")
