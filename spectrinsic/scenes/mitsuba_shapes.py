@@ -5,7 +5,8 @@ spectrinsic), ``serialized`` (``shape_index``; Mitsuba's own loader of that one 
 ``disk``, ``sphere`` (``center``, ``radius``) and ``cylinder`` (``p0``, ``p1``, ``radius``;
 tessellated, :mod:`~spectrinsic.scenes.mitsuba_parts`), each with its ``to_world`` and
 ``flip_normals``; ``shapegroup`` and ``instance`` (each instance is a copy of its group's
-shapes under the instance's transform).
+shapes under the instance's transform). Each shape's triangles are wound so that their normals
+face the side Mitsuba's face, under mirroring transforms too (:func:`reversed_winding`).
 
 :func:`occurrences` lists every shape as it appears (an instance's shapes once per instance), and
 :func:`check_budget` counts their faces and vertices from file headers and the built-in
@@ -41,11 +42,17 @@ __all__ = [
     "triangles",
     "textured_triangles",
     "sphere_radius",
+    "KEEP_SIDE",
+    "mirrors",
+    "reversed_winding",
 ]
 
 #: Shapes made of triangles here, and shapes read from a file.
 BUILT_IN = ("rectangle", "cube", "disk", "sphere", "cylinder")
 FILE_SHAPES = ("obj", "ply", "serialized")
+#: Shapes whose normals Mitsuba maps by the inverse transpose of their own ``to_world``: a
+#: mirroring one leaves them on the same side (:func:`reversed_winding`).
+KEEP_SIDE = ("rectangle", "cube", "disk", "cylinder")
 _GEOMETRY = {"to_world", "flip_normals", "id"}
 _PARAMS = {
     "obj": {"filename", "face_normals"},
@@ -257,7 +264,7 @@ def _local(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray]:
 def triangles(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray]:
     """World-space vertices ``(V, 3)`` and faces ``(F, 3)`` of *p*."""
     v, f = _local(p, base)
-    if props_true(p.node, "flip_normals"):
+    if reversed_winding(p):
         f = f[:, ::-1]
     local = _matrix(p.node)
     if not (np.isfinite(local).all() and np.isfinite(p.matrix).all()):  # before the product
@@ -299,9 +306,28 @@ def textured_triangles(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray, n
             "expected a rectangle or a mesh file with them"
         )
     corners = np.stack([uv[:, 0], 1.0 - uv[:, 1]], axis=1)[f]
-    if props_true(p.node, "flip_normals"):
+    if reversed_winding(p):
         f, corners = f[:, ::-1], corners[:, ::-1]
     return parts.apply(p.matrix @ _matrix(p.node), v), f, corners
+
+
+def mirrors(m: np.ndarray) -> bool:
+    """Whether the 4 × 4 transform *m* mirrors space (its linear part's determinant < 0)."""
+    return bool(np.linalg.det(np.asarray(m, float)[:3, :3]) < 0)
+
+
+def reversed_winding(p: Placed) -> bool:
+    """Whether *p*'s triangles are wound the other way round, so that their normals (the
+    right-hand rule on the transformed corners) point to Mitsuba's side of the surface.
+
+    Mitsuba 3.9.1 (measured with its ``aov`` integrator's ``sh_normal``): ``flip_normals``
+    turns every shape's normals over; an instance's mirroring ``to_world`` never does (it maps
+    normals by its inverse transpose), nor does a shape's own mirroring ``to_world`` on the
+    shapes of :data:`KEEP_SIDE`; a ``sphere``'s and a mesh file's own mirroring ``to_world``
+    does (their normals follow the mirrored surface), as a mirrored winding does here.
+    """
+    own = mirrors(_matrix(p.node)) and p.node.plugin in KEEP_SIDE
+    return props_true(p.node, "flip_normals") ^ mirrors(p.matrix) ^ own
 
 
 def props_true(node: XmlNode, key: str) -> bool:
