@@ -114,6 +114,8 @@ def test_a_mesh_file_with_a_nan_vertex_is_named_by_its_file(tmp_path, textured):
 # to_world (a mirroring one keeps their side), a sphere's and a face-normal mesh file's follow
 # the mirrored surface, an instance's mirroring keeps every side, and flip_normals turns it.
 QUAD_OBJ = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\n"
+QUAD_V, QUAD_F = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]]), [[0, 1, 2], [0, 2, 3]]
+FACE_NORMALS = '<boolean name="face_normals" value="true"/>'
 CYLINDER = '<point name="p0" x="0" y="0" z="-1"/><point name="p1" x="0" y="0" z="1"/>'
 SHAPES = {
     "rectangle": ("rectangle", ""),
@@ -122,7 +124,54 @@ SHAPES = {
     "sphere": ("sphere", '<float name="radius" value="0.8"/>'),
     "cylinder": ("cylinder", CYLINDER + '<float name="radius" value="0.5"/>'),
     "obj": ("obj", '<string name="filename" value="quad.obj"/>'),
+    "obj-vn": ("obj", '<string name="filename" value="quad_vn.obj"/>'),
+    "obj-vn-face": ("obj", '<string name="filename" value="quad_vn.obj"/>' + FACE_NORMALS),
+    "ply": ("ply", '<string name="filename" value="quad.ply"/>'),
+    "ply-nx": ("ply", '<string name="filename" value="quad_nx.ply"/>'),
+    "serialized": ("serialized", '<string name="filename" value="quad.serialized"/>'),
+    "serialized-n": ("serialized", '<string name="filename" value="quad_n.serialized"/>'),
+    # flagged 0x0010 (face normals) too: Mitsuba still shades with the stored ones
+    "serialized-n16": ("serialized", '<string name="filename" value="quad_n16.serialized"/>'),
 }
+
+
+def _mesh_files(folder) -> None:
+    """The quad of :data:`QUAD_OBJ` in every file format, with and without stored normals
+    (+z): what Mitsuba then shades with under a mirroring to_world (:data:`SHAPES`)."""
+    (folder / "quad.obj").write_text(QUAD_OBJ)
+    (folder / "quad_vn.obj").write_text(
+        QUAD_OBJ.replace("f 1 2 3\nf 1 3 4", "vn 0 0 1\nf 1//1 2//1 3//1\nf 1//1 3//1 4//1")
+    )
+    for name, normals in (("quad", False), ("quad_nx", True)):
+        extra = "property float nx\nproperty float ny\nproperty float nz\n" if normals else ""
+        rows = "".join(
+            " ".join(map(str, [*v, *([0, 0, 1] if normals else [])])) + "\n" for v in QUAD_V
+        )
+        (folder / f"{name}.ply").write_text(
+            "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+            f"property float z\n{extra}element face 2\nproperty list uchar int vertex_indices\n"
+            f"end_header\n{rows}3 0 1 2\n3 0 2 3\n"
+        )
+        (folder / f"{name.replace('_nx', '_n')}.serialized").write_bytes(_serialized(normals))
+    (folder / "quad_n16.serialized").write_bytes(_serialized(True, 0x0010))
+
+
+def _serialized(normals: bool, more_flags: int = 0) -> bytes:
+    """The quad as a Mitsuba ``.serialized`` file (format 4, single precision; flag 0x0001 and
+    +z vertex normals with *normals*; *more_flags* besides), as
+    tests/scenes/test_mitsuba_parser.py writes one."""
+    import struct
+    import zlib
+
+    flags = 0x1000 | (0x0001 if normals else 0) | more_flags
+    body = struct.pack("<I", flags) + b"quad\0" + struct.pack("<QQ", 4, 2)
+    body += QUAD_V.astype("<f4").tobytes()
+    body += np.tile([0, 0, 1], (4, 1)).astype("<f4").tobytes() if normals else b""
+    body += np.asarray(QUAD_F, "<u4").tobytes()
+    out = struct.pack("<HH", 0x041C, 4) + zlib.compress(body)
+    return out + struct.pack("<Q", 0) + struct.pack("<I", 1)
+
+
 MIRRORS = {"none": "", "x": '<scale x="-1"/>', "z": '<scale z="-1"/>'}
 #: The camera's ray (above, looking down -z): off the axes, so it meets one triangle.
 ORIGIN, DOWN = np.array([0.05, 0.03, 3.0]), np.array([0.0, 0.0, -1.0])
@@ -176,18 +225,18 @@ def test_our_triangles_face_the_side_mitsubas_shape_faces(tmp_path, mitsuba, nam
     """Under ``flip_normals`` and a mirroring ``to_world``, our triangle under the camera's
     ray turns the way Mitsuba's shading normal does (within its tessellation: same sign of z,
     close direction); before task r5-flip a mirrored winding turned every shape."""
-    (tmp_path / "quad.obj").write_text(QUAD_OBJ)
+    _mesh_files(tmp_path)
     path = _write(tmp_path, _shape(*SHAPES[name], MIRRORS[mirror], flip))
     theirs, ours = _mitsubas_normal(mitsuba, path), _our_normal(path)
     assert abs(theirs[2]) > 0.9  # the ray meets the shape face on (test can see a flip)
     assert ours @ theirs > 0.95
 
 
-@pytest.mark.parametrize("name", ["rectangle", "sphere", "obj"])
+@pytest.mark.parametrize("name", ["rectangle", "sphere", "obj", "ply-nx"])
 def test_an_instances_mirroring_keeps_the_side(tmp_path, mitsuba, name):
     """An instance's mirroring ``to_world`` never turns its shapes (Mitsuba maps the normals
     by its inverse transpose), not even a sphere's or a mesh file's."""
-    (tmp_path / "quad.obj").write_text(QUAD_OBJ)
+    _mesh_files(tmp_path)
     path = _write(tmp_path, _instanced(_shape(*SHAPES[name], "", False), MIRRORS["x"]))
     theirs, ours = _mitsubas_normal(mitsuba, path), _our_normal(path)
     assert theirs[2] > 0.9 and ours @ theirs > 0.95
