@@ -5,7 +5,8 @@ spectrinsic), ``serialized`` (``shape_index``; Mitsuba's own loader of that one 
 ``disk``, ``sphere`` (``center``, ``radius``) and ``cylinder`` (``p0``, ``p1``, ``radius``;
 tessellated, :mod:`~spectrinsic.scenes.mitsuba_parts`), each with its ``to_world`` and
 ``flip_normals``; ``shapegroup`` and ``instance`` (each instance is a copy of its group's
-shapes under the instance's transform).
+shapes under the instance's transform). Each shape's triangles are wound so that their normals
+face the side Mitsuba's face, under mirroring transforms too (:func:`reversed_winding`).
 
 :func:`occurrences` lists every shape as it appears (an instance's shapes once per instance), and
 :func:`check_budget` counts their faces and vertices from file headers and the built-in
@@ -17,6 +18,7 @@ references counted each time (issue 44).
 
 from __future__ import annotations
 
+import re
 import struct
 import zlib
 from dataclasses import dataclass
@@ -41,12 +43,20 @@ __all__ = [
     "triangles",
     "textured_triangles",
     "sphere_radius",
+    "KEEP_SIDE",
+    "mirrors",
+    "reversed_winding",
+    "stored_normals",
 ]
 
 #: Shapes made of triangles here, and shapes read from a file.
 BUILT_IN = ("rectangle", "cube", "disk", "sphere", "cylinder")
 FILE_SHAPES = ("obj", "ply", "serialized")
+#: Shapes whose normals Mitsuba maps by the inverse transpose of their own ``to_world``: a
+#: mirroring one leaves them on the same side (:func:`reversed_winding`).
+KEEP_SIDE = ("rectangle", "cube", "disk", "cylinder")
 _GEOMETRY = {"to_world", "flip_normals", "id"}
+_OBJ_NORMAL = re.compile(rb"^[ \t]*vn[ \t]", re.M)
 _PARAMS = {
     "obj": {"filename", "face_normals"},
     "ply": {"filename", "face_normals"},
@@ -118,8 +128,13 @@ def _file(p: Placed, base: Path) -> Path:
 
 
 def _serialized_counts(path: Path, index: int, where: str) -> tuple[int, int]:
-    """Vertices and triangles of mesh *index* of a Mitsuba ``.serialized`` file, from the
-    head of its zlib stream (the file's offset table at its end locates mesh *index*)."""
+    """Vertices and triangles of mesh *index* of a Mitsuba ``.serialized`` file."""
+    return _serialized_head(path, index, where)[1:]
+
+
+def _serialized_head(path: Path, index: int, where: str) -> tuple[int, int, int]:
+    """Flags, vertices and triangles of mesh *index* of a Mitsuba ``.serialized`` file, from
+    the head of its zlib stream (the file's offset table at its end locates mesh *index*)."""
     with path.open("rb") as fh:
         head = fh.read(4)
         offset = 0
@@ -140,7 +155,7 @@ def _serialized_counts(path: Path, index: int, where: str) -> tuple[int, int]:
     if version == 4:
         at = data.index(b"\0", 4) + 1
     n_v, n_f = struct.unpack_from("<QQ", data, at)
-    return int(n_v), int(n_f)
+    return struct.unpack_from("<I", data)[0], int(n_v), int(n_f)
 
 
 def _counts(p: Placed, base: Path) -> tuple[int, int]:
@@ -257,7 +272,7 @@ def _local(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray]:
 def triangles(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray]:
     """World-space vertices ``(V, 3)`` and faces ``(F, 3)`` of *p*."""
     v, f = _local(p, base)
-    if props_true(p.node, "flip_normals"):
+    if reversed_winding(p, base):
         f = f[:, ::-1]
     local = _matrix(p.node)
     if not (np.isfinite(local).all() and np.isfinite(p.matrix).all()):  # before the product
@@ -299,9 +314,55 @@ def textured_triangles(p: Placed, base: Path) -> tuple[np.ndarray, np.ndarray, n
             "expected a rectangle or a mesh file with them"
         )
     corners = np.stack([uv[:, 0], 1.0 - uv[:, 1]], axis=1)[f]
-    if props_true(p.node, "flip_normals"):
+    if reversed_winding(p, base):
         f, corners = f[:, ::-1], corners[:, ::-1]
     return parts.apply(p.matrix @ _matrix(p.node), v), f, corners
+
+
+def mirrors(m: np.ndarray) -> bool:
+    """Whether the 4 × 4 transform *m* mirrors space (its linear part's determinant < 0)."""
+    return bool(np.linalg.det(np.asarray(m, float)[:3, :3]) < 0)
+
+
+def stored_normals(p: Placed, base: Path) -> bool:
+    """Whether Mitsuba shades mesh file *p* with the vertex normals the file stores (unless
+    ``face_normals``; else it computes them from the transformed triangles): an OBJ with
+    ``vn`` lines, a PLY whose vertices have ``nx``, a ``serialized`` mesh flagged ``0x0001``."""
+    if p.node.plugin not in FILE_SHAPES or props_true(p.node, "face_normals"):
+        return False
+    path = _file(p, base)
+    if p.node.plugin == "serialized":
+        flags = _serialized_head(path, p.node.integer("shape_index", 0), p.where)[0]
+        return bool(flags & 0x0001)  # Mitsuba 3.9.1 shades with them whatever 0x0010 says
+    with path.open("rb") as fh:
+        if p.node.plugin == "ply":
+            head = fh.read(65536).split(b"end_header", 1)[0]
+            return any(line.split()[::2] == [b"property", b"nx"] for line in head.splitlines())
+        carry = b""
+        while block := fh.read(2**20):  # streamed: the vn lines of an OBJ come early
+            lines = carry + block
+            cut = lines.rfind(b"\n") + 1
+            if _OBJ_NORMAL.search(lines, 0, cut):
+                return True
+            carry = lines[cut:]
+        return _OBJ_NORMAL.search(carry) is not None
+
+
+def reversed_winding(p: Placed, base: Path) -> bool:
+    """Whether *p*'s triangles are wound the other way round, so that their normals (the
+    right-hand rule on the transformed corners) point to Mitsuba's side of the surface.
+
+    Mitsuba 3.9.1 (measured with its ``aov`` integrator's ``sh_normal``): ``flip_normals``
+    turns every shape's normals over; an instance's mirroring ``to_world`` never does (it maps
+    normals by its inverse transpose), nor does a shape's own mirroring ``to_world`` on the
+    shapes of :data:`KEEP_SIDE` and on mesh files with :func:`stored_normals`; a ``sphere``'s
+    and another mesh file's own mirroring ``to_world`` does (their normals follow the mirrored
+    surface), as a mirrored winding does here.
+    """
+    own = mirrors(_matrix(p.node)) and (
+        p.node.plugin in KEEP_SIDE or (p.node.plugin in FILE_SHAPES and stored_normals(p, base))
+    )
+    return props_true(p.node, "flip_normals") ^ mirrors(p.matrix) ^ own
 
 
 def props_true(node: XmlNode, key: str) -> bool:

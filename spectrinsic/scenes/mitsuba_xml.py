@@ -116,7 +116,12 @@ def _area_light(p: shapes.Placed, node: XmlNode, r: _Reading) -> Light | None:
         r.refuse_or_drop(node, p.where, "the emitter (the shape stays, unlit)")
         return None
     u, v = m[:3, 0], m[:3, 1]
-    normal = -np.cross(u, v) if shapes.props_true(p.node, "flip_normals") else np.cross(u, v)
+    # Mitsuba's normal: the inverse transpose of m applied to +z, i.e. u × v / det(m)
+    normal = (
+        -np.cross(u, v)
+        if shapes.props_true(p.node, "flip_normals") ^ shapes.mirrors(m)
+        else np.cross(u, v)
+    )
     if not np.linalg.norm(normal) > 0:  # a rectangle scaled to a line or a point (or NaN)
         raise SceneError(
             f"{p.where}: an area emitter on a rectangle of zero area (its to_world scales it "
