@@ -21,14 +21,14 @@ from .base.one_pass import (
     timed_render,
 )
 from .base.plugins import path_integrator, regular_spectrum, spectral_film
-from .base.summed_envmap import MapLight, attach_summed_envmap, summed_envmap
+from .base.summed_envmap import MapLight, summed_envmap
 from .base.variants import choose_variant, variant_scope
 from .settings import PassRequest
 
-__all__ = ["SUMMED_ENVMAP_KEY", "render_spectral"]
+__all__ = ["render_spectral"]
 
 #: Key of the environment maps' one emitter in the pass's Mitsuba scene dictionary.
-SUMMED_ENVMAP_KEY = "environment_maps"
+_SUMMED_ENVMAP_KEY = "environment_maps"
 
 
 def _render_pass(
@@ -125,10 +125,10 @@ def render_spectral(
         )
         emitter = summed_envmap(mi, maps, wl) if maps else None
         if emitter is not None:
-            mitsuba_dict[SUMMED_ENVMAP_KEY] = emitter
+            mitsuba_dict[_SUMMED_ENVMAP_KEY] = emitter
         loaded = mi.load_dict(mitsuba_dict)
         if emitter is not None:
-            attach_summed_envmap(emitter, loaded)
+            emitter.attach(loaded)  # Mitsuba calls set_scene on built-in emitters only
         image, direct_image, seconds = _render_pass(mi, loaded, request, direct)
     k = sensors.n
     if image.shape[-1] < k:

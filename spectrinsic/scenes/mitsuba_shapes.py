@@ -127,11 +127,6 @@ def _file(p: Placed, base: Path) -> Path:
     return path
 
 
-def _serialized_counts(path: Path, index: int, where: str) -> tuple[int, int]:
-    """Vertices and triangles of mesh *index* of a Mitsuba ``.serialized`` file."""
-    return _serialized_head(path, index, where)[1:]
-
-
 def _serialized_head(path: Path, index: int, where: str) -> tuple[int, int, int]:
     """Flags, vertices and triangles of mesh *index* of a Mitsuba ``.serialized`` file, from
     the head of its zlib stream (the file's offset table at its end locates mesh *index*)."""
@@ -167,7 +162,7 @@ def _counts(p: Placed, base: Path) -> tuple[int, int]:
     path = _file(p, base)
     if plugin == "serialized":
         index = p.node.integer("shape_index", 0)
-        return _serialized_counts(path, index, p.where)
+        return _serialized_head(path, index, p.where)[1:]
     return mesh_counts(path)
 
 

@@ -82,13 +82,15 @@ def single_thread(lanes: int, threads: int) -> bool:
 
 
 @contextlib.contextmanager
-def _threads(dr: Any, count: int | None) -> Iterator[None]:
-    """Dr.Jit's thread pool at *count* threads inside the block (``None``: as it is)."""
+def _threads(dr: Any, film: Any, spp: int) -> Iterator[None]:
+    """Dr.Jit's thread pool inside the block: one thread where a wavefront of *film*'s pixels
+    times *spp* is too small for its work units (:func:`single_thread`), else as it is."""
     before = dr.thread_count()
-    if count is None or count == before:
+    width, height = film.crop_size()
+    if before == 1 or not single_thread(int(width) * int(height) * spp, before):
         yield
         return
-    dr.set_thread_count(count)
+    dr.set_thread_count(1)
     try:
         yield
     finally:
@@ -140,9 +142,7 @@ def _render_part(
     would keep them resident); and, with *check*, whether the storage develops to it
     (:func:`_develops_raw`, before the storage is given back)."""
     film = loaded.sensors()[0].film()
-    width, height = film.crop_size()
-    small = single_thread(int(width) * int(height) * count, dr.thread_count())
-    with _threads(dr, 1 if small else None):
+    with _threads(dr, film, count):
         image = mi.render(loaded, spp=count, seed=seed, integrator=integrator)
         dr.eval(image)  # in this thread count
     raw_ok = check and _develops_raw(film, image)
@@ -168,10 +168,8 @@ def _merge_last_part(
     (the held parts beside the storage and the developed tensor)."""
     sensor = loaded.sensors()[0]
     film = sensor.film()
-    width, height = film.crop_size()
     count = counts[-1]
-    small = single_thread(int(width) * int(height) * count, dr.thread_count())
-    with _threads(dr, 1 if small else None), dr.suspend_grad():
+    with _threads(dr, film, count), dr.suspend_grad():
         chosen = loaded.integrator() if integrator is None else integrator
         chosen.render(loaded, sensor, seed=seed, spp=count, develop=False, evaluate=True)
     sensor.sampler().seed(0, 1)  # as mi.render leaves it: its per-lane state given back

@@ -32,7 +32,7 @@ import numpy as np
 
 from .plugins import regular_spectrum
 
-__all__ = ["MapLight", "summed_envmap", "attach_summed_envmap"]
+__all__ = ["MapLight", "summed_envmap"]
 
 #: The largest float32 below 1: a rescaled sample stays in [0, 1) (a Python float, so it also
 #: serves the scalar variants, where ``mi.Float`` is ``float``).
@@ -204,7 +204,7 @@ def _emitter_class(mi: Any) -> Any:
 
 def summed_envmap(mi: Any, maps: Sequence[MapLight], wavelengths: np.ndarray) -> Any:
     """The emitter of *maps*' lit channels (module docstring), for the active spectral variant;
-    after loading the scene that holds it, call :func:`attach_summed_envmap`."""
+    after loading the scene that holds it, call its ``attach(scene)``."""
     channels = [
         (
             _envmap(mi, _grey(mi, m.data[..., c]), m.to_world),
@@ -223,8 +223,3 @@ def summed_envmap(mi: Any, maps: Sequence[MapLight], wavelengths: np.ndarray) ->
     )
     parts = _Parts(mi, dr, mi.load_dict({"type": "d65"}), tuple(channels), samplers)
     return _emitter_class(mi)(parts)
-
-
-def attach_summed_envmap(emitter: Any, loaded_scene: Any) -> None:
-    """Point *emitter*'s inner envmaps at *loaded_scene*, the Mitsuba scene holding it."""
-    emitter.attach(loaded_scene)
